@@ -1,0 +1,49 @@
+/* rc_config.h - compile-time limits and contract checks of the rcal core.
+ *
+ * The core (lib/) is C99 with no heap, no stdio and no global state. Every
+ * buffer is caller-owned and sized by the limits below, which a firmware build
+ * may override with -D. Contract violations (a NULL where the API forbids it)
+ * go to RC_ASSERT, which a firmware build may redirect; runtime failures are
+ * returned as rc_status codes (rc_status.h).
+ */
+#ifndef RC_CONFIG_H
+#define RC_CONFIG_H
+
+/* Joints of the serial arm and DH parameters per joint (a, d, alpha, theta). */
+#define RC_NJ 6
+#define RC_DH_PER_JOINT 4
+#define RC_N_DH (RC_NJ * RC_DH_PER_JOINT) /* 24 */
+#define RC_N_ENC 3                        /* encoder outlet e (x, y, z) */
+#define RC_N_BASE (RC_N_DH + RC_N_ENC)    /* 27: geometry + encoder */
+
+/* Maximum number of model parameters: 27 base plus model extensions
+ * (rc_model.h effects: length offset, joint compliance, periodic joint
+ * errors, drift, per-group offsets). */
+#ifndef RC_MAX_PARAMS
+#define RC_MAX_PARAMS 96
+#endif
+#if RC_MAX_PARAMS < RC_N_BASE
+#error "RC_MAX_PARAMS must be at least 27 (24 DH parameters + encoder position)"
+#endif
+#if RC_MAX_PARAMS > 1024
+#error "RC_MAX_PARAMS above 1024 makes the solver workspace unreasonably large"
+#endif
+
+/* Maximum number of model extensions (effects) in one model. */
+#ifndef RC_MAX_EFFECTS
+#define RC_MAX_EFFECTS 8
+#endif
+#if RC_MAX_EFFECTS < 1 || RC_MAX_EFFECTS > 64
+#error "RC_MAX_EFFECTS must be within 1..64"
+#endif
+
+/* Contract checks. Default: the C library's assert (compiled out by NDEBUG).
+ * Firmware may define RC_ASSERT to its own fault handler. */
+#ifndef RC_ASSERT
+#include <assert.h>
+#define RC_ASSERT(cond) assert(cond)
+#endif
+
+#define RC_STATIC_ASSERT(cond, name) typedef char rc_static_assert_##name[(cond) ? 1 : -1]
+
+#endif /* RC_CONFIG_H */

@@ -1,0 +1,22 @@
+/* rc_linalg.h - small dense linear algebra for the core (prefix rcu_).
+ *
+ * Symmetric matrices are stored full, row-major, with leading dimension n.
+ * No heap: callers pass every buffer. Sizes are bounded by RC_MAX_PARAMS.
+ */
+#ifndef RC_LINALG_H
+#define RC_LINALG_H
+
+#include "rc_status.h"
+
+/* In-place Cholesky factorisation A = L L^T (lower triangle of A receives L)
+ * and solution of A x = b into b. A: (n x n). b: (n). RC_ERR_NUMERIC when A is
+ * not positive definite. */
+rc_status rcu_chol_solve(double *A, double *b, unsigned n);
+
+/* Eigen-decomposition of a symmetric matrix by cyclic Jacobi rotations.
+ * A: (n x n), destroyed. V: (n x n), column k the eigenvector of eval[k].
+ * eval: (n), sorted descending. RC_ERR_NOCONV after max_sweeps sweeps
+ * (0 means 60). */
+rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned max_sweeps);
+
+#endif /* RC_LINALG_H */

@@ -1,0 +1,413 @@
+/* rc_model.c - kinematics and the cable-length measurement model. */
+#include "rc_model.h"
+
+#include <math.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+RC_STATIC_ASSERT(RC_MAX_PARAMS <= 65535, params_fit_uint16);
+
+/* Frames of the chain: o[k] origin and R[k] rotation of frame k (frame 0 is
+ * the base, frame k the one after joint k's transform). */
+typedef struct {
+    double o[RC_NJ + 1][3];
+    double R[RC_NJ + 1][9];
+} chain;
+
+static void chain_compute(chain *c, const double dh[][4], const double theta_rad[], unsigned nj)
+{
+    static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    memcpy(c->R[0], eye, sizeof eye);
+    c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
+    for (unsigned i = 0; i < nj; ++i) {
+        const double a = dh[i][0], d = dh[i][1], al = dh[i][2];
+        const double ct = cos(theta_rad[i]), st = sin(theta_rad[i]);
+        const double ca = cos(al), sa = sin(al);
+        const double L[9] = {ct, -st * ca, st * sa, st, ct * ca, -ct * sa, 0.0, sa, ca};
+        const double t[3] = {a * ct, a * st, d};
+        const double *P = c->R[i];
+        double *N = c->R[i + 1];
+        for (int r = 0; r < 3; ++r) {
+            for (int k = 0; k < 3; ++k)
+                N[3 * r + k] = P[3 * r] * L[k] + P[3 * r + 1] * L[3 + k] + P[3 * r + 2] * L[6 + k];
+            c->o[i + 1][r] = c->o[i][r] + P[3 * r] * t[0] + P[3 * r + 1] * t[1] + P[3 * r + 2] * t[2];
+        }
+    }
+}
+
+static void cross3(double out[3], const double a[3], const double b[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+rc_status rc_model_init(rc_model *m, const double dh[RC_NJ][4], const double enc_mm[3])
+{
+    RC_ASSERT(m != NULL && dh != NULL && enc_mm != NULL);
+    memset(m, 0, sizeof *m);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        for (unsigned k = 0; k < 4; ++k) {
+            if (!isfinite(dh[i][k]))
+                return RC_ERR_RANGE;
+            m->x[4 * i + k] = dh[i][k];
+        }
+        m->q_min_rad[i] = -M_PI;
+        m->q_max_rad[i] = M_PI;
+    }
+    for (unsigned k = 0; k < 3; ++k) {
+        if (!isfinite(enc_mm[k]))
+            return RC_ERR_RANGE;
+        m->x[RC_P_ENC + k] = enc_mm[k];
+    }
+    m->n_params = RC_N_BASE;
+    return RC_OK;
+}
+
+rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, unsigned count)
+{
+    RC_ASSERT(m != NULL);
+    unsigned n;
+    switch (kind) {
+    case RC_EFF_LENGTH_OFFSET: n = 1; joint = 0; break;
+    case RC_EFF_LENGTH_SCALE: n = 1; joint = 0; break;
+    case RC_EFF_TIME_DRIFT: n = 2; joint = 0; break;
+    case RC_EFF_GROUP_OFFSET: n = count; joint = 0; break;
+    case RC_EFF_JOINT_PERIODIC: n = 4; break;
+    case RC_EFF_JOINT_COMPLIANCE:
+        n = 1;
+        if (joint != 1 && joint != 2)
+            return RC_ERR_ARG; /* gravity lever defined for joints 2 and 3 */
+        break;
+    case RC_EFF_NONE:
+    default: return RC_ERR_ARG;
+    }
+    if (joint >= RC_NJ || n == 0)
+        return RC_ERR_ARG;
+    if (m->n_effects >= RC_MAX_EFFECTS || (unsigned)m->n_params + n > RC_MAX_PARAMS)
+        return RC_ERR_CAPACITY;
+    rc_effect *e = &m->effects[m->n_effects++];
+    memset(e, 0, sizeof *e);
+    e->kind = (uint8_t)kind;
+    e->joint = (uint8_t)joint;
+    e->first = m->n_params;
+    e->count = (uint16_t)n;
+    for (unsigned i = 0; i < 4; ++i)
+        for (unsigned k = 0; k < 4; ++k)
+            e->ref_dh[i][k] = m->x[4 * i + k];
+    for (unsigned k = 0; k < n; ++k)
+        m->x[m->n_params + k] = 0.0;
+    m->n_params = (uint16_t)(m->n_params + n);
+    return RC_OK;
+}
+
+const char *rc_effect_name(rc_effect_kind kind)
+{
+    switch (kind) {
+    case RC_EFF_LENGTH_OFFSET: return "length_offset";
+    case RC_EFF_JOINT_COMPLIANCE: return "joint_compliance";
+    case RC_EFF_JOINT_PERIODIC: return "joint_periodic";
+    case RC_EFF_TIME_DRIFT: return "time_drift";
+    case RC_EFF_GROUP_OFFSET: return "group_offset";
+    case RC_EFF_LENGTH_SCALE: return "length_scale";
+    case RC_EFF_NONE: break;
+    }
+    return "none";
+}
+
+/* Small bounded formatter: copies s into buf at *pos. */
+static void put_str(char *buf, size_t len, size_t *pos, const char *s)
+{
+    while (*s != '\0' && *pos + 1 < len)
+        buf[(*pos)++] = *s++;
+    buf[*pos < len ? *pos : len - 1] = '\0';
+}
+
+static void put_uint(char *buf, size_t len, size_t *pos, unsigned v)
+{
+    char tmp[12];
+    int n = 0;
+    do {
+        tmp[n++] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v != 0 && n < 11);
+    while (n > 0 && *pos + 1 < len)
+        buf[(*pos)++] = tmp[--n];
+    buf[*pos < len ? *pos : len - 1] = '\0';
+}
+
+const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned k)
+{
+    static const char *const dh_names[4] = {"a", "d", "alpha", "theta"};
+    static const char *const enc_names[3] = {"ex", "ey", "ez"};
+    static const char *const per_names[4] = {".s1", ".c1", ".s2", ".c2"};
+    size_t pos = 0;
+    RC_ASSERT(buf != NULL && buf_len > 0 && m != NULL);
+    buf[0] = '\0';
+    if (k < RC_N_DH) {
+        put_str(buf, buf_len, &pos, dh_names[k % 4]);
+        put_uint(buf, buf_len, &pos, k / 4 + 1);
+        return buf;
+    }
+    if (k < RC_N_BASE) {
+        put_str(buf, buf_len, &pos, enc_names[k - RC_N_DH]);
+        return buf;
+    }
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *e = &m->effects[i];
+        if (k < e->first || k >= (unsigned)e->first + e->count)
+            continue;
+        unsigned j = k - e->first;
+        put_str(buf, buf_len, &pos, rc_effect_name((rc_effect_kind)e->kind));
+        switch ((rc_effect_kind)e->kind) {
+        case RC_EFF_JOINT_COMPLIANCE:
+            put_str(buf, buf_len, &pos, ".j");
+            put_uint(buf, buf_len, &pos, e->joint + 1u);
+            break;
+        case RC_EFF_JOINT_PERIODIC:
+            put_str(buf, buf_len, &pos, ".j");
+            put_uint(buf, buf_len, &pos, e->joint + 1u);
+            put_str(buf, buf_len, &pos, per_names[j & 3u]);
+            break;
+        case RC_EFF_TIME_DRIFT:
+            put_str(buf, buf_len, &pos, j == 0 ? ".d1" : ".d2");
+            break;
+        case RC_EFF_GROUP_OFFSET:
+            put_str(buf, buf_len, &pos, ".g");
+            put_uint(buf, buf_len, &pos, j);
+            break;
+        default: break;
+        }
+        return buf;
+    }
+    put_str(buf, buf_len, &pos, "p");
+    put_uint(buf, buf_len, &pos, k);
+    return buf;
+}
+
+int rc_param_unit(const rc_model *m, unsigned k)
+{
+    if (k < RC_N_DH)
+        return (k % 4 == 0 || k % 4 == 1) ? 0 : 1;
+    if (k < RC_N_BASE)
+        return 0;
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *e = &m->effects[i];
+        if (k >= e->first && k < (unsigned)e->first + e->count) {
+            switch ((rc_effect_kind)e->kind) {
+            case RC_EFF_LENGTH_OFFSET:
+            case RC_EFF_TIME_DRIFT:
+            case RC_EFF_GROUP_OFFSET: return 0;
+            case RC_EFF_JOINT_PERIODIC: return 1;
+            default: return 2;
+            }
+        }
+    }
+    return 2;
+}
+
+double rc_gravity_lever_m(const double ref_dh[4][4], unsigned joint, const double q_rad[RC_NJ])
+{
+    chain c;
+    double th[4], v[3], w[3];
+    static const double down[3] = {0.0, 0.0, -1.0};
+    RC_ASSERT(joint < 4);
+    for (unsigned i = 0; i < 4; ++i)
+        th[i] = q_rad[i] + ref_dh[i][3];
+    chain_compute(&c, ref_dh, th, 4);
+    const double z[3] = {c.R[joint][2], c.R[joint][5], c.R[joint][8]};
+    for (int r = 0; r < 3; ++r)
+        v[r] = c.o[4][r] - c.o[joint][r];
+    cross3(w, v, down);
+    return dot3(z, w) * 1e-3;
+}
+
+void rc_model_theta(double theta_rad[RC_NJ], const rc_model *m, const double q_rad[RC_NJ])
+{
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        theta_rad[i] = q_rad[i] + m->x[RC_P_THETA(i)];
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *e = &m->effects[i];
+        const double *p = &m->x[e->first];
+        const double q = q_rad[e->joint];
+        if (e->kind == RC_EFF_JOINT_COMPLIANCE)
+            theta_rad[e->joint] += p[0] * rc_gravity_lever_m(e->ref_dh, e->joint, q_rad);
+        else if (e->kind == RC_EFF_JOINT_PERIODIC)
+            theta_rad[e->joint] += p[0] * sin(q) + p[1] * cos(q) + p[2] * sin(2.0 * q) + p[3] * cos(2.0 * q);
+    }
+}
+
+/* dtheta/dq (6 x 6, row = theta index, column = q index) including effects. */
+static void theta_dq(double D[36], const rc_model *m, const double q_rad[RC_NJ])
+{
+    memset(D, 0, 36 * sizeof D[0]);
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        D[7 * i] = 1.0;
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *e = &m->effects[i];
+        const double *p = &m->x[e->first];
+        const unsigned j = e->joint;
+        const double q = q_rad[j];
+        if (e->kind == RC_EFF_JOINT_PERIODIC) {
+            D[7 * j] += p[0] * cos(q) - p[1] * sin(q) + 2.0 * p[2] * cos(2.0 * q) - 2.0 * p[3] * sin(2.0 * q);
+        } else if (e->kind == RC_EFF_JOINT_COMPLIANCE && p[0] != 0.0) {
+            /* The lever depends on q2..q4 smoothly; a central difference is
+             * exact enough for Newton steps (it scales the Jacobian only). */
+            double qq[RC_NJ];
+            const double h = 1e-6;
+            memcpy(qq, q_rad, sizeof qq);
+            for (unsigned k = 0; k < 4; ++k) {
+                const double q0 = qq[k];
+                qq[k] = q0 + h;
+                const double fp = rc_gravity_lever_m(e->ref_dh, j, qq);
+                qq[k] = q0 - h;
+                const double fm = rc_gravity_lever_m(e->ref_dh, j, qq);
+                qq[k] = q0;
+                D[6 * j + k] += p[0] * (fp - fm) / (2.0 * h);
+            }
+        }
+    }
+}
+
+static void model_chain(chain *c, const rc_model *m, const double q_rad[RC_NJ])
+{
+    double dh[RC_NJ][4], th[RC_NJ];
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        for (unsigned k = 0; k < 4; ++k)
+            dh[i][k] = m->x[4 * i + k];
+    rc_model_theta(th, m, q_rad);
+    chain_compute(c, (const double(*)[4])dh, th, RC_NJ);
+}
+
+void rc_fk(double pos_mm[3], double rot[9], const rc_model *m, const double q_rad[RC_NJ])
+{
+    chain c;
+    RC_ASSERT(pos_mm != NULL && m != NULL && q_rad != NULL);
+    model_chain(&c, m, q_rad);
+    memcpy(pos_mm, c.o[RC_NJ], 3 * sizeof pos_mm[0]);
+    if (rot != NULL)
+        memcpy(rot, c.R[RC_NJ], 9 * sizeof rot[0]);
+}
+
+void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *m,
+               const double q_rad[RC_NJ])
+{
+    chain c;
+    double Jt[36], D[36];
+    RC_ASSERT(pos_mm != NULL && jac != NULL && m != NULL && q_rad != NULL);
+    model_chain(&c, m, q_rad);
+    const double *p = c.o[RC_NJ];
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const double z[3] = {c.R[i][2], c.R[i][5], c.R[i][8]};
+        double v[3], w[3];
+        for (int r = 0; r < 3; ++r)
+            v[r] = p[r] - c.o[i][r];
+        cross3(w, z, v);
+        for (unsigned r = 0; r < 3; ++r) {
+            Jt[6 * r + i] = w[r];
+            Jt[6 * (r + 3) + i] = z[r];
+        }
+    }
+    theta_dq(D, m, q_rad);
+    for (int r = 0; r < 6; ++r)
+        for (int k = 0; k < 6; ++k) {
+            double s = 0.0;
+            for (int i = 0; i < 6; ++i)
+                s += Jt[6 * r + i] * D[6 * i + k];
+            jac[6 * r + k] = s;
+        }
+    memcpy(pos_mm, p, 3 * sizeof pos_mm[0]);
+    if (rot != NULL)
+        memcpy(rot, c.R[RC_NJ], 9 * sizeof rot[0]);
+}
+
+rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sample *s)
+{
+    chain c;
+    double u[3], dl_dtheta[RC_NJ];
+    RC_ASSERT(len_mm != NULL && m != NULL && s != NULL);
+    model_chain(&c, m, s->q_rad);
+    const double *p = c.o[RC_NJ];
+    const double *e = &m->x[RC_P_ENC];
+    for (int r = 0; r < 3; ++r)
+        u[r] = p[r] - e[r];
+    const double dist = sqrt(dot3(u, u));
+    if (!(dist > 1e-9) || !isfinite(dist))
+        return RC_ERR_NUMERIC;
+    for (int r = 0; r < 3; ++r)
+        u[r] /= dist;
+
+    /* Length-side effects: l = (1 + scale) * dist + additive terms. */
+    double scale = 1.0, add = 0.0;
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *ef = &m->effects[i];
+        const double *x = &m->x[ef->first];
+        switch ((rc_effect_kind)ef->kind) {
+        case RC_EFF_LENGTH_OFFSET: add += x[0]; break;
+        case RC_EFF_LENGTH_SCALE: scale += x[0]; break;
+        case RC_EFF_TIME_DRIFT: add += x[0] * s->t + x[1] * s->t * s->t; break;
+        case RC_EFF_GROUP_OFFSET:
+            if (s->group < ef->count)
+                add += x[s->group];
+            break;
+        default: break;
+        }
+    }
+    *len_mm = scale * dist + add;
+    if (jac == NULL)
+        return RC_OK;
+
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const double z[3] = {c.R[i][2], c.R[i][5], c.R[i][8]};
+        const double x1[3] = {c.R[i + 1][0], c.R[i + 1][3], c.R[i + 1][6]};
+        double v[3], w[3];
+        for (int r = 0; r < 3; ++r)
+            v[r] = p[r] - c.o[i][r];
+        cross3(w, z, v);
+        dl_dtheta[i] = scale * dot3(u, w);
+        for (int r = 0; r < 3; ++r)
+            v[r] = p[r] - c.o[i + 1][r];
+        cross3(w, x1, v);
+        jac[RC_P_A(i)] = scale * dot3(u, x1);
+        jac[RC_P_D(i)] = scale * dot3(u, z);
+        jac[RC_P_ALPHA(i)] = scale * dot3(u, w);
+        jac[RC_P_THETA(i)] = dl_dtheta[i];
+    }
+    for (int r = 0; r < 3; ++r)
+        jac[RC_P_ENC + r] = -scale * u[r];
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *ef = &m->effects[i];
+        double *J = &jac[ef->first];
+        const double q = s->q_rad[ef->joint];
+        switch ((rc_effect_kind)ef->kind) {
+        case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
+        case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
+        case RC_EFF_TIME_DRIFT:
+            J[0] = s->t;
+            J[1] = s->t * s->t;
+            break;
+        case RC_EFF_GROUP_OFFSET:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = (k == s->group) ? 1.0 : 0.0;
+            break;
+        case RC_EFF_JOINT_COMPLIANCE:
+            J[0] = dl_dtheta[ef->joint] * rc_gravity_lever_m(ef->ref_dh, ef->joint, s->q_rad);
+            break;
+        case RC_EFF_JOINT_PERIODIC: {
+            const double g = dl_dtheta[ef->joint];
+            J[0] = g * sin(q);
+            J[1] = g * cos(q);
+            J[2] = g * sin(2.0 * q);
+            J[3] = g * cos(2.0 * q);
+            break;
+        }
+        case RC_EFF_NONE: break;
+        }
+    }
+    return RC_OK;
+}

@@ -1,0 +1,124 @@
+/* rc_model.h - robot model, forward kinematics and the cable-length measurement.
+ *
+ * What: a six-joint serial arm in standard Denavit-Hartenberg form,
+ *   T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i),  theta_i = q_i + theta_off_i,
+ * a cable-encoder outlet e in the base frame, and optional model extensions
+ * ("effects") for what pure geometry misses. The predicted cable length is
+ *   l(q) = |p(q) - e| + (length-side effects),
+ * p(q) being the translation of T_1...T_6 (the flange point).
+ *
+ * Parameter vector x (n_params), one storage order everywhere:
+ *   x[4*i + 0] a_i      (mm)     joint i = 0..5
+ *   x[4*i + 1] d_i      (mm)
+ *   x[4*i + 2] alpha_i  (rad)
+ *   x[4*i + 3] theta_i  (rad)    offset added to the joint reading q_i
+ *   x[24..26]  e        (mm)     encoder outlet in the base frame
+ *   x[27..]    effect parameters, in the order the effects were added.
+ * Matrices are row-major; 3x3 rotations as double[9].
+ *
+ * Depends on: libm only. Memory: all structs are caller-owned, fixed size.
+ * Thread safety: functions are reentrant; a model may be shared read-only.
+ * Errors: rc_status codes; contract violations to RC_ASSERT.
+ */
+#ifndef RC_MODEL_H
+#define RC_MODEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rc_config.h"
+#include "rc_status.h"
+
+#define RC_P_A(i) (4 * (i) + 0)
+#define RC_P_D(i) (4 * (i) + 1)
+#define RC_P_ALPHA(i) (4 * (i) + 2)
+#define RC_P_THETA(i) (4 * (i) + 3)
+#define RC_P_ENC RC_N_DH
+
+/* Model extensions. Joint-side effects change the joint angle seen by the
+ * geometry; length-side effects add to the predicted cable length. */
+typedef enum rc_effect_kind {
+    RC_EFF_NONE = 0,
+    RC_EFF_LENGTH_OFFSET = 1,   /* l += b;                         1 param, mm */
+    RC_EFF_JOINT_COMPLIANCE = 2, /* theta_j += k * tau_j(q);       1 param, rad per m of lever */
+    RC_EFF_JOINT_PERIODIC = 3,  /* theta_j += s1 sin q + c1 cos q + s2 sin 2q + c2 cos 2q; 4 params, rad */
+    RC_EFF_TIME_DRIFT = 4,      /* l += d1 t + d2 t^2, t in [0,1] acquisition order; 2 params, mm */
+    RC_EFF_GROUP_OFFSET = 5,    /* l += g_k for samples of group k; count params, mm */
+    RC_EFF_LENGTH_SCALE = 6     /* l *= (1 + s) (encoder scale);   1 param, unitless */
+} rc_effect_kind;
+
+typedef struct rc_effect {
+    uint8_t kind;     /* rc_effect_kind */
+    uint8_t joint;    /* 0..5 for joint-side effects, else 0 */
+    uint16_t first;   /* index of its first parameter in x */
+    uint16_t count;   /* number of parameters */
+    /* Frozen reference geometry (DH rows of joints 1..4: a, d, alpha, theta)
+     * for the gravity lever of RC_EFF_JOINT_COMPLIANCE, copied when the effect
+     * is added so that the lever depends on q only. */
+    double ref_dh[4][4];
+} rc_effect;
+
+typedef struct rc_model {
+    uint16_t n_params;                 /* 27 + sum of effect counts */
+    uint16_t n_effects;
+    rc_effect effects[RC_MAX_EFFECTS];
+    double x[RC_MAX_PARAMS];           /* (n_params) see the storage order above */
+    double q_min_rad[RC_NJ];           /* joint limits */
+    double q_max_rad[RC_NJ];
+} rc_model;
+
+/* One measurement: joint readings, cable length and its context. */
+typedef struct rc_sample {
+    double q_rad[RC_NJ]; /* (6) joint readings */
+    double len_mm;       /* measured cable length */
+    double t;            /* acquisition order scaled to [0, 1] */
+    uint16_t group;      /* set-up group (consecutive samples sharing a set-up) */
+} rc_sample;
+
+/* Initialise a model from a DH table and an encoder position.
+ * dh: (6 x 4) rows a_mm, d_mm, alpha_rad, theta_off_rad; enc_mm: (3).
+ * Joint limits default to +-pi. */
+rc_status rc_model_init(rc_model *m, const double dh[RC_NJ][4], const double enc_mm[3]);
+
+/* Append an effect with zero-valued parameters. count is used only by
+ * RC_EFF_GROUP_OFFSET (number of groups); joint only by joint-side effects.
+ * RC_ERR_CAPACITY when RC_MAX_PARAMS or RC_MAX_EFFECTS would be exceeded. */
+rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, unsigned count);
+
+/* Short machine name of an effect kind ("length_offset", ...); never NULL. */
+const char *rc_effect_name(rc_effect_kind kind);
+
+/* Name of parameter k of model m into buf (e.g. "a2", "theta3", "ex",
+ * "joint_periodic.j3.s1"); returns buf. */
+const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned k);
+
+/* Unit class of parameter k: 0 = mm, 1 = rad, 2 = other (rad/m, unitless). */
+int rc_param_unit(const rc_model *m, unsigned k);
+
+/* The effective joint angles theta_i = q_i + theta_off_i + joint-side effects.
+ * theta_rad: (6). */
+void rc_model_theta(double theta_rad[RC_NJ], const rc_model *m, const double q_rad[RC_NJ]);
+
+/* Gravity lever of joint j (1 or 2, i.e. joints 2 and 3) in metres: the
+ * moment arm about the joint axis of a point mass at the wrist centre, from
+ * the frozen geometry ref_dh (4 x 4). Used by RC_EFF_JOINT_COMPLIANCE. */
+double rc_gravity_lever_m(const double ref_dh[4][4], unsigned joint, const double q_rad[RC_NJ]);
+
+/* Forward kinematics. pos_mm: (3) flange point; rot: (3 x 3) flange
+ * orientation or NULL. */
+void rc_fk(double pos_mm[3], double rot[9], const rc_model *m, const double q_rad[RC_NJ]);
+
+/* Forward kinematics with the geometric joint Jacobian.
+ * jac: (6 x 6) row-major, rows 0..2 d(pos_mm)/d(q_rad), rows 3..5 angular
+ * velocity per joint rate (rad/rad). Joint-side effects are included in the
+ * chain rule. rot may be NULL. */
+void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *m,
+               const double q_rad[RC_NJ]);
+
+/* Predicted cable length of one sample and, when jac is not NULL, its
+ * analytic derivative with respect to every model parameter.
+ * jac: (m->n_params). Returns RC_ERR_NUMERIC when the flange point
+ * coincides with the encoder outlet (length derivative undefined). */
+rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sample *s);
+
+#endif /* RC_MODEL_H */

@@ -1,0 +1,384 @@
+/* rc_solve.c - LM, LTLM and the paper's variants over streamed normal equations. */
+#include "rc_solve.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "rc_linalg.h"
+#include "rc_rand.h"
+
+const char *rc_method_name(rc_method method)
+{
+    switch (method) {
+    case RC_METHOD_LM: return "lm";
+    case RC_METHOD_LTLM: return "ltlm";
+    case RC_METHOD_LM_PAPER: return "lm-paper";
+    case RC_METHOD_LTLM_PAPER: return "ltlm-paper";
+    }
+    return "unknown";
+}
+
+const char *rc_exit_str(rc_exit e)
+{
+    switch (e) {
+    case RC_EXIT_NONE: return "none";
+    case RC_EXIT_SMALL_STEP: return "step below tolerance";
+    case RC_EXIT_SMALL_COST: return "cost decrease below tolerance";
+    case RC_EXIT_SMALL_GRAD: return "gradient below tolerance";
+    case RC_EXIT_MAX_ITER: return "iteration limit";
+    case RC_EXIT_NO_DESCENT: return "no further descent (damping limit)";
+    case RC_EXIT_NONFINITE: return "diverged to non-finite values";
+    }
+    return "unknown";
+}
+
+rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples, size_t n)
+{
+    double sum = 0.0;
+    RC_ASSERT(cost_mm2 != NULL && m != NULL && (samples != NULL || n == 0));
+    for (size_t i = 0; i < n; ++i) {
+        double l;
+        rc_status st = rc_meas(&l, NULL, m, &samples[i]);
+        if (st != RC_OK)
+            return st;
+        const double r = l - samples[i].len_mm;
+        sum += r * r;
+    }
+    *cost_mm2 = sum;
+    return isfinite(sum) ? RC_OK : RC_ERR_NUMERIC;
+}
+
+rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
+                       const uint16_t *idx, unsigned nf, const rc_sample *samples, size_t n)
+{
+    double sum = 0.0;
+    memset(A, 0, (size_t)nf * nf * sizeof A[0]);
+    memset(g, 0, nf * sizeof g[0]);
+    for (size_t s = 0; s < n; ++s) {
+        double l;
+        rc_status st = rc_meas(&l, jrow, m, &samples[s]);
+        if (st != RC_OK)
+            return st;
+        const double r = l - samples[s].len_mm;
+        sum += r * r;
+        for (unsigned i = 0; i < nf; ++i) {
+            const double ji = jrow[idx[i]];
+            if (ji == 0.0)
+                continue;
+            g[i] += ji * r;
+            double *Ai = &A[(size_t)i * nf];
+            for (unsigned k = i; k < nf; ++k)
+                Ai[k] += ji * jrow[idx[k]];
+        }
+    }
+    for (unsigned i = 0; i < nf; ++i)
+        for (unsigned k = 0; k < i; ++k)
+            A[(size_t)i * nf + k] = A[(size_t)k * nf + i];
+    *cost_mm2 = sum;
+    return isfinite(sum) ? RC_OK : RC_ERR_NUMERIC;
+}
+
+rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, size_t n)
+{
+    double mean = 0.0, m2 = 0.0, sq = 0.0, abs_sum = 0.0, mx = 0.0;
+    RC_ASSERT(out != NULL && m != NULL);
+    memset(out, 0, sizeof *out);
+    if (n == 0)
+        return RC_ERR_ARG;
+    for (size_t i = 0; i < n; ++i) {
+        double l;
+        rc_status st = rc_meas(&l, NULL, m, &samples[i]);
+        if (st != RC_OK)
+            return st;
+        const double e = l - samples[i].len_mm;
+        const double d = e - mean;
+        mean += d / (double)(i + 1);
+        m2 += d * (e - mean);
+        sq += e * e;
+        abs_sum += fabs(e);
+        if (fabs(e) > mx)
+            mx = fabs(e);
+    }
+    out->n = n;
+    out->rmse_mm = sqrt(sq / (double)n);
+    out->mean_abs_mm = abs_sum / (double)n;
+    out->sd_mm = n > 1 ? sqrt(m2 / (double)(n - 1)) : 0.0;
+    out->mean_mm = mean;
+    out->max_mm = mx;
+    return isfinite(out->rmse_mm) ? RC_OK : RC_ERR_NUMERIC;
+}
+
+/* trial = base + D^-1 * dx on the free parameters. */
+static void apply_step(rc_model *trial, const rc_model *base, const rc_solve_work *w, unsigned nf,
+                       const double *dx)
+{
+    *trial = *base;
+    for (unsigned i = 0; i < nf; ++i)
+        trial->x[w->idx[i]] += dx[i] / w->D[i];
+}
+
+static double rms_of(double cost, size_t n) { return sqrt(cost / (double)n); }
+
+/* LTLM, after the LM candidate cand (cost *cand_cost) was formed from the
+ * step dx (scaled): map M chaotic sequences into the interval
+ * cand +- span*|dx_i| per free parameter and keep the best point.
+ * Returns 1 when a chaotic candidate beat the LM candidate. */
+static int ltlm_candidates(rc_model *cand, double *cand_cost, rc_solve_work *w, unsigned nf,
+                           const rc_solve_config *cfg, const rc_sample *samples, size_t n,
+                           unsigned *evals)
+{
+    const unsigned M = cfg->n_candidates ? cfg->n_candidates : 20u;
+    const double r = cfg->chaos_r > 0.0 ? cfg->chaos_r : 0.5;
+    const double span = cfg->ltlm_span > 0.0 ? cfg->ltlm_span : 1.0;
+    int won = 0;
+    w->best = *cand;
+    for (unsigned k = 0; k < M; ++k) {
+        w->trial = *cand;
+        for (unsigned i = 0; i < nf; ++i) {
+            w->chaos[i] = rc_lt_map(w->chaos[i], r);
+            /* guard against the map's fixed points and cycles collapsing */
+            if (w->chaos[i] < 1e-9 || w->chaos[i] > 1.0 - 1e-9)
+                w->chaos[i] = 0.5 * (w->chaos[i] + 0.123456789);
+            const double half = span * fabs(w->dx[i]) / w->D[i];
+            w->trial.x[w->idx[i]] = cand->x[w->idx[i]] + (2.0 * w->chaos[i] - 1.0) * half;
+        }
+        double c;
+        ++*evals;
+        if (rc_cost(&c, &w->trial, samples, n) == RC_OK && c < *cand_cost) {
+            *cand_cost = c;
+            w->best = w->trial;
+            won = 1;
+        }
+    }
+    if (won)
+        *cand = w->best;
+    return won;
+}
+
+static void chaos_init(rc_solve_work *w, unsigned nf, uint64_t seed)
+{
+    rc_rng g;
+    rc_rng_seed(&g, seed ^ 0x4C544C4Dull);
+    for (unsigned i = 0; i < nf; ++i)
+        w->chaos[i] = 0.05 + 0.9 * rc_rng_u01(&g);
+}
+
+static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w,
+                             const rc_solve_config *cfg, unsigned nf, const rc_sample *samples,
+                             size_t n)
+{
+    const double mu = cfg->mu0 > 0.0 ? cfg->mu0 : 5.0;
+    const unsigned max_iter = cfg->max_iter ? cfg->max_iter : 50u;
+    const int ltlm = cfg->method == RC_METHOD_LTLM_PAPER;
+    double cost = 0.0;
+    for (unsigned i = 0; i < nf; ++i)
+        w->D[i] = 1.0; /* raw units, as Eq. 10 is written */
+    if (ltlm)
+        chaos_init(w, nf, cfg->seed);
+    res->exit = RC_EXIT_MAX_ITER;
+    for (unsigned it = 0; it < max_iter; ++it) {
+        rc_status st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+        ++res->cost_evals;
+        if (st != RC_OK) {
+            res->exit = RC_EXIT_NONFINITE;
+            return RC_OK;
+        }
+        if (it == 0)
+            res->rms_start_mm = rms_of(cost, n);
+        for (unsigned i = 0; i < nf; ++i) {
+            w->A[(size_t)i * nf + i] += mu;
+            w->dx[i] = -w->g[i];
+        }
+        if (rcu_chol_solve(w->A, w->dx, nf) != RC_OK) {
+            res->exit = RC_EXIT_NONFINITE;
+            break;
+        }
+        apply_step(&w->trial, m, w, nf, w->dx);
+        if (ltlm) {
+            double c;
+            ++res->cost_evals;
+            if (rc_cost(&c, &w->trial, samples, n) == RC_OK &&
+                ltlm_candidates(&w->trial, &c, w, nf, cfg, samples, n, &res->cost_evals))
+                ++res->ltlm_wins;
+        }
+        *m = w->trial; /* no acceptance test: Eq. 10 as written */
+        res->iterations = it + 1;
+        double c2;
+        if (rc_cost(&c2, m, samples, n) != RC_OK) {
+            res->exit = RC_EXIT_NONFINITE;
+            return RC_OK;
+        }
+        ++res->cost_evals;
+        res->rms_final_mm = rms_of(c2, n);
+        if (cfg->on_iter)
+            cfg->on_iter(cfg->cb_ctx, it + 1, res->rms_final_mm, m);
+        double step = 0.0;
+        for (unsigned i = 0; i < nf; ++i)
+            step += w->dx[i] * w->dx[i];
+        if (sqrt(step) < (cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9)) {
+            res->exit = RC_EXIT_SMALL_STEP;
+            break;
+        }
+    }
+    return RC_OK;
+}
+
+rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
+                   const rc_sample *samples, size_t n)
+{
+    static const rc_solve_config defaults;
+    rc_solve_result local;
+    RC_ASSERT(m != NULL && w != NULL);
+    if (cfg == NULL)
+        cfg = &defaults;
+    if (res == NULL)
+        res = &local;
+    memset(res, 0, sizeof *res);
+    if (samples == NULL || n == 0)
+        return RC_ERR_ARG;
+    if (m->n_params > RC_MAX_PARAMS || m->n_params < RC_N_BASE)
+        return RC_ERR_ARG;
+
+    unsigned nf = 0;
+    for (unsigned k = 0; k < m->n_params; ++k)
+        if (cfg->fixed == NULL || cfg->fixed[k] == 0)
+            w->idx[nf++] = (uint16_t)k;
+    res->n_free = nf;
+    if (nf == 0)
+        return RC_ERR_RANK;
+
+    if (cfg->method == RC_METHOD_LM_PAPER || cfg->method == RC_METHOD_LTLM_PAPER)
+        return solve_paper(m, res, w, cfg, nf, samples, n);
+    if (cfg->method != RC_METHOD_LM && cfg->method != RC_METHOD_LTLM)
+        return RC_ERR_ARG;
+
+    const unsigned max_iter = cfg->max_iter ? cfg->max_iter : 100u;
+    const double tau = cfg->mu0 > 0.0 ? cfg->mu0 : 1e-3;
+    const double tol_step = cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9;
+    const double tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-10;
+    const double rcond = cfg->rcond > 0.0 ? cfg->rcond : 1e-9;
+    const int ltlm = cfg->method == RC_METHOD_LTLM;
+    double cost, mu = 0.0, nu = 2.0;
+
+    rc_status st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+    ++res->cost_evals;
+    if (st != RC_OK)
+        return st;
+    res->rms_start_mm = res->rms_final_mm = rms_of(cost, n);
+    /* Fixed scaling from the starting Jacobian: D_i = column norm. A column
+     * that is zero (a parameter the data cannot move at all) keeps D = 1 and
+     * falls in the null space below. */
+    double dmax = 0.0;
+    for (unsigned i = 0; i < nf; ++i) {
+        const double a = w->A[(size_t)i * nf + i];
+        if (a > dmax)
+            dmax = a;
+    }
+    for (unsigned i = 0; i < nf; ++i) {
+        const double a = w->A[(size_t)i * nf + i];
+        w->D[i] = a > 1e-24 * dmax && a > 0.0 ? sqrt(a) : 1.0;
+    }
+    if (ltlm)
+        chaos_init(w, nf, cfg->seed);
+
+    res->exit = RC_EXIT_MAX_ITER;
+    for (unsigned it = 0; it < max_iter; ++it) {
+        if (it > 0) {
+            st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+            ++res->cost_evals;
+            if (st != RC_OK)
+                return st;
+        }
+        /* scale: A_s = D^-1 A D^-1, g_s = D^-1 g */
+        for (unsigned i = 0; i < nf; ++i) {
+            w->g[i] /= w->D[i];
+            for (unsigned k = 0; k < nf; ++k)
+                w->A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
+        }
+        st = rcu_eig_sym(w->ev, w->V, w->A, nf, 0);
+        if (st == RC_ERR_NUMERIC)
+            return st;
+        const double lmax = w->ev[0];
+        if (!(lmax > 0.0))
+            return RC_ERR_RANK;
+        unsigned rank = 0;
+        double gnorm = 0.0;
+        for (unsigned k = 0; k < nf; ++k) {
+            if (w->ev[k] <= rcond * lmax)
+                break;
+            ++rank;
+            double c = 0.0;
+            for (unsigned i = 0; i < nf; ++i)
+                c += w->V[(size_t)i * nf + k] * w->g[i];
+            w->c[k] = c;
+            gnorm += c * c;
+        }
+        res->rank = rank;
+        res->cond = sqrt(lmax / w->ev[rank - 1]);
+        if (sqrt(gnorm) <= 1e-14 * (cost + 1e-300) || gnorm == 0.0) {
+            res->exit = RC_EXIT_SMALL_GRAD;
+            break;
+        }
+        if (it == 0)
+            mu = tau * lmax;
+
+        int accepted = 0, done = 0;
+        for (unsigned tries = 0; tries < 60 && !accepted; ++tries) {
+            double pred = 0.0, xs = 0.0, ds = 0.0;
+            for (unsigned i = 0; i < nf; ++i)
+                w->dx[i] = 0.0;
+            for (unsigned k = 0; k < rank; ++k) {
+                const double lam = w->ev[k], coef = -w->c[k] / (lam + mu);
+                pred += -2.0 * coef * w->c[k] - lam * coef * coef;
+                for (unsigned i = 0; i < nf; ++i)
+                    w->dx[i] += coef * w->V[(size_t)i * nf + k];
+            }
+            for (unsigned i = 0; i < nf; ++i) {
+                ds += w->dx[i] * w->dx[i];
+                xs += (m->x[w->idx[i]] * w->D[i]) * (m->x[w->idx[i]] * w->D[i]);
+            }
+            apply_step(&w->trial, m, w, nf, w->dx);
+            double cnew;
+            ++res->cost_evals;
+            st = rc_cost(&cnew, &w->trial, samples, n);
+            if (st == RC_OK && ltlm &&
+                ltlm_candidates(&w->trial, &cnew, w, nf, cfg, samples, n, &res->cost_evals))
+                ++res->ltlm_wins;
+            const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
+            if (rho > 0.0) {
+                accepted = 1;
+                const double rel = (cost - cnew) / (cost + 1e-300);
+                *m = w->trial;
+                const double t = 2.0 * rho - 1.0;
+                double f = 1.0 - t * t * t;
+                mu *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
+                nu = 2.0;
+                cost = cnew;
+                if (sqrt(ds) <= tol_step * (sqrt(xs) + tol_step) || rel < tol_cost) {
+                    res->exit = sqrt(ds) <= tol_step * (sqrt(xs) + tol_step) ? RC_EXIT_SMALL_STEP
+                                                                            : RC_EXIT_SMALL_COST;
+                    done = 1;
+                }
+            } else {
+                if (sqrt(ds) <= tol_step * (sqrt(xs) + tol_step)) {
+                    res->exit = RC_EXIT_SMALL_STEP;
+                    done = 1;
+                    break;
+                }
+                mu *= nu;
+                nu *= 2.0;
+            }
+        }
+        res->iterations = it + 1;
+        res->rms_final_mm = rms_of(cost, n);
+        if (cfg->on_iter)
+            cfg->on_iter(cfg->cb_ctx, it + 1, res->rms_final_mm, m);
+        if (!accepted && !done) {
+            res->exit = RC_EXIT_NO_DESCENT;
+            break;
+        }
+        if (done)
+            break;
+    }
+    return RC_OK;
+}

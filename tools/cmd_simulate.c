@@ -1,0 +1,12 @@
+/* cmd_simulate.c - placeholder until issue 2 lands: says so and fails. */
+#include <stdio.h>
+
+#include "rcal_cmds.h"
+
+int rcal_cmd_simulate(int argc, char **argv)
+{
+    (void)argc;
+    (void)argv;
+    fprintf(stderr, "rcal simulate: not implemented yet (issue 2)\n");
+    return 2;
+}

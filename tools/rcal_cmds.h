@@ -1,0 +1,22 @@
+/* rcal_cmds.h - the subcommands of the rcal command-line tool.
+ *
+ * Each subcommand lives in its own file tools/cmd_<name>.c and gets argv
+ * starting at its own name (argv[0] == "calibrate"). Return value is the
+ * process exit status: 0 success, 1 failure of the work, 2 usage error.
+ */
+#ifndef RCAL_CMDS_H
+#define RCAL_CMDS_H
+
+int rcal_cmd_calibrate(int argc, char **argv);  /* issue 2 */
+int rcal_cmd_simulate(int argc, char **argv);   /* issue 2 */
+int rcal_cmd_fkcheck(int argc, char **argv);    /* issue 2 */
+int rcal_cmd_bench(int argc, char **argv);      /* benchmarks (all issues) */
+int rcal_cmd_compare(int argc, char **argv);    /* issue 3 */
+int rcal_cmd_chaos(int argc, char **argv);      /* issue 3 */
+int rcal_cmd_acquire(int argc, char **argv);    /* issue 4 */
+int rcal_cmd_poses(int argc, char **argv);      /* issue 4 */
+int rcal_cmd_compensate(int argc, char **argv); /* issue 5 */
+int rcal_cmd_grind(int argc, char **argv);      /* issue 5 */
+int rcal_cmd_diagnose(int argc, char **argv);   /* issue 6 */
+
+#endif
