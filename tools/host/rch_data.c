@@ -1,0 +1,336 @@
+#include "rch_data.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "rc_rand.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_N = 12 };
+static const char *const col_names[C_N] = {"q1", "q2", "q3", "q4", "q5", "q6", "L", "x", "y", "z", "t", "group"};
+
+typedef struct {
+    const char *p; /* field start */
+    size_t len;
+    unsigned col;  /* 1-based column of the first character */
+} field;
+
+/* Split one line (without its terminator) into fields; returns the count. */
+static size_t split_line(field *f, size_t max, const char *line, size_t len)
+{
+    size_t n = 0, start = 0;
+    for (size_t i = 0; i <= len; ++i) {
+        if (i == len || line[i] == ',') {
+            if (n < max) {
+                size_t a = start, b = i;
+                while (a < b && (line[a] == ' ' || line[a] == '\t'))
+                    ++a;
+                while (b > a && (line[b - 1] == ' ' || line[b - 1] == '\t' || line[b - 1] == '\r'))
+                    --b;
+                f[n].p = line + a;
+                f[n].len = b - a;
+                f[n].col = (unsigned)(a + 1);
+            }
+            ++n;
+            start = i + 1;
+        }
+    }
+    return n;
+}
+
+static int parse_number(double *v, const field *f)
+{
+    char buf[64];
+    char *end;
+    if (f->len == 0 || f->len >= sizeof buf)
+        return -1;
+    memcpy(buf, f->p, f->len);
+    buf[f->len] = '\0';
+    errno = 0;
+    *v = strtod(buf, &end);
+    if (end != buf + f->len || errno == ERANGE)
+        return -1;
+    return 0;
+}
+
+int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                   rch_diag *d)
+{
+    int col_of[C_N];
+    field fields[256];
+    size_t cap = 0, line_no = 0, pos = 0;
+    int have_header = 0;
+    memset(out, 0, sizeof *out);
+    for (int k = 0; k < C_N; ++k)
+        col_of[k] = -1;
+
+    while (pos < len) {
+        size_t e = pos;
+        while (e < len && text[e] != '\n')
+            ++e;
+        const char *line = text + pos;
+        size_t ll = e - pos;
+        pos = e + 1;
+        ++line_no;
+        if (ll > 0 && line[ll - 1] == '\r')
+            --ll;
+        size_t blank = 0;
+        while (blank < ll && isspace((unsigned char)line[blank]))
+            ++blank;
+        if (blank == ll || line[blank] == '#')
+            continue;
+        for (size_t i = 0; i < ll; ++i) {
+            if (line[i] == '\0') {
+                rch_diag_set(d, name, (unsigned)line_no, (unsigned)i + 1, "NUL byte in text");
+                goto fail;
+            }
+        }
+        const size_t nf = split_line(fields, 256, line, ll);
+        if (nf > 256) {
+            rch_diag_set(d, name, (unsigned)line_no, 1, "too many columns (%zu, at most 256)", nf);
+            goto fail;
+        }
+        if (!have_header) {
+            for (size_t i = 0; i < nf; ++i) {
+                for (int k = 0; k < C_N; ++k) {
+                    if (fields[i].len == strlen(col_names[k]) &&
+                        strncasecmp(fields[i].p, col_names[k], fields[i].len) == 0) {
+                        if (col_of[k] >= 0) {
+                            rch_diag_set(d, name, (unsigned)line_no, fields[i].col,
+                                         "column '%s' appears twice in the header", col_names[k]);
+                            goto fail;
+                        }
+                        col_of[k] = (int)i;
+                    }
+                }
+            }
+            for (int k = 0; k <= C_L; ++k) {
+                if (col_of[k] < 0 && !(k == C_L && (flags & RCH_DATA_NO_LEN))) {
+                    rch_diag_set(d, name, (unsigned)line_no, 1,
+                                 "header has no '%s' column (need q1..q6 in degrees%s)", col_names[k],
+                                 (flags & RCH_DATA_NO_LEN) ? "" : " and L in mm");
+                    goto fail;
+                }
+            }
+            if ((col_of[C_X] >= 0) != (col_of[C_Y] >= 0) || (col_of[C_X] >= 0) != (col_of[C_Z] >= 0))
+                col_of[C_X] = col_of[C_Y] = col_of[C_Z] = -1; /* use x,y,z only as a triple */
+            have_header = 1;
+            continue;
+        }
+        if (out->n == cap) {
+            size_t nc = cap ? 2 * cap : 256;
+            rc_sample *s = realloc(out->s, nc * sizeof *s);
+            unsigned *ln = s ? realloc(out->line, nc * sizeof *ln) : NULL;
+            if (s)
+                out->s = s;
+            if (ln)
+                out->line = ln;
+            if (!s || !ln) {
+                rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
+                goto fail;
+            }
+            if (col_of[C_X] >= 0) {
+                double(*xyz)[3] = realloc(out->xyz, nc * sizeof *xyz);
+                if (!xyz) {
+                    rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
+                    goto fail;
+                }
+                out->xyz = xyz;
+            }
+            cap = nc;
+        }
+        rc_sample *s = &out->s[out->n];
+        memset(s, 0, sizeof *s);
+        double v[C_N] = {0};
+        for (int k = 0; k < C_N; ++k) {
+            if (col_of[k] < 0)
+                continue;
+            const size_t c = (size_t)col_of[k];
+            if (c >= nf) {
+                rch_diag_set(d, name, (unsigned)line_no, (unsigned)ll + 1,
+                             "missing field '%s' (column %zu; the line has %zu fields)", col_names[k],
+                             c + 1, nf);
+                goto fail;
+            }
+            if (parse_number(&v[k], &fields[c]) != 0) {
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': '%.*s' is not a number",
+                             col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p);
+                goto fail;
+            }
+            if (!isfinite(v[k])) {
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': %s is not finite",
+                             col_names[k], isnan(v[k]) ? "NaN" : "infinity");
+                goto fail;
+            }
+            if (k < C_L && fabs(v[k]) > 720.0) {
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
+                             "field '%s': %g degrees is outside -720..720", col_names[k], v[k]);
+                goto fail;
+            }
+            if (k == C_L && !(v[k] > 0.0 && v[k] <= 20000.0)) {
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
+                             "field 'L': %g mm is not a cable length (0 < L <= 20000)", v[k]);
+                goto fail;
+            }
+            if ((k == C_X || k == C_Y || k == C_Z) && fabs(v[k]) > 1e5) {
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': %g mm is absurd",
+                             col_names[k], v[k]);
+                goto fail;
+            }
+            if (k == C_G && (v[k] < 0.0 || v[k] > 65535.0 || v[k] != floor(v[k]))) {
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
+                             "field 'group': %g is not an integer in 0..65535", v[k]);
+                goto fail;
+            }
+        }
+        for (int j = 0; j < RC_NJ; ++j)
+            s->q_rad[j] = v[C_Q1 + j] * (M_PI / 180.0);
+        s->len_mm = v[C_L];
+        s->t = v[C_T];
+        s->group = (uint16_t)v[C_G];
+        if (out->xyz) {
+            out->xyz[out->n][0] = v[C_X];
+            out->xyz[out->n][1] = v[C_Y];
+            out->xyz[out->n][2] = v[C_Z];
+        }
+        out->line[out->n] = (unsigned)line_no;
+        ++out->n;
+    }
+    if (!have_header) {
+        rch_diag_set(d, name, 0, 0, "empty file: no header line");
+        goto fail;
+    }
+    if (out->n == 0) {
+        rch_diag_set(d, name, (unsigned)line_no, 0, "no data rows after the header");
+        goto fail;
+    }
+    out->has_t = col_of[C_T] >= 0;
+    out->has_group = col_of[C_G] >= 0;
+    /* acquisition order scaled to [0, 1]: the t column if present, else the row order */
+    double tmin = 0.0, tmax = 0.0;
+    for (size_t i = 0; i < out->n; ++i) {
+        if (!out->has_t)
+            out->s[i].t = (double)i;
+        if (i == 0 || out->s[i].t < tmin)
+            tmin = out->s[i].t;
+        if (i == 0 || out->s[i].t > tmax)
+            tmax = out->s[i].t;
+    }
+    for (size_t i = 0; i < out->n; ++i)
+        out->s[i].t = tmax > tmin ? (out->s[i].t - tmin) / (tmax - tmin) : 0.0;
+    return 0;
+fail:
+    rch_data_free(out);
+    return -1;
+}
+
+int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d)
+{
+    memset(out, 0, sizeof *out);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        rch_diag_set(d, path, 0, 0, "cannot open: %s", strerror(errno));
+        return -1;
+    }
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    while (buf) {
+        size_t got = fread(buf + len, 1, cap - len, f);
+        len += got;
+        if (len < cap)
+            break;
+        if (cap >= (size_t)1 << 30) {
+            free(buf);
+            fclose(f);
+            rch_diag_set(d, path, 0, 0, "file larger than 1 GiB");
+            return -1;
+        }
+        char *nb = realloc(buf, cap * 2);
+        if (!nb) {
+            free(buf);
+            buf = NULL;
+            break;
+        }
+        buf = nb;
+        cap *= 2;
+    }
+    int err = ferror(f);
+    fclose(f);
+    if (!buf || err) {
+        free(buf);
+        rch_diag_set(d, path, 0, 0, err ? "read error" : "out of memory");
+        return -1;
+    }
+    int rc = rch_data_parse(out, buf, len, path, flags, d);
+    free(buf);
+    return rc;
+}
+
+void rch_data_free(rch_data *data)
+{
+    free(data->s);
+    free(data->xyz);
+    free(data->line);
+    memset(data, 0, sizeof *data);
+}
+
+rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k)
+{
+    rc_sample *o = malloc((k ? k : 1) * sizeof *o);
+    if (!o)
+        return NULL;
+    for (size_t i = 0; i < k; ++i)
+        o[i] = s[idx[i]];
+    return o;
+}
+
+unsigned rch_data_group_by_wrist(rc_sample *s, size_t n)
+{
+    unsigned g = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (i > 0 && (s[i].q_rad[3] != s[i - 1].q_rad[3] || s[i].q_rad[4] != s[i - 1].q_rad[4] ||
+                      s[i].q_rad[5] != s[i - 1].q_rad[5]))
+            ++g;
+        s[i].group = (uint16_t)(g > 65535 ? 65535 : g);
+    }
+    return n ? g + 1 : 0;
+}
+
+int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nominal)
+{
+    if (fprintf(f, "%sq1,q2,q3,q4,q5,q6,L\n", nominal ? "x,y,z," : "") < 0)
+        return -1;
+    for (size_t i = 0; i < n; ++i) {
+        if (nominal) {
+            double p[3];
+            rc_fk(p, NULL, nominal, s[i].q_rad);
+            fprintf(f, "%.4f,%.4f,%.4f,", p[0], p[1], p[2]);
+        }
+        for (int j = 0; j < RC_NJ; ++j)
+            fprintf(f, "%.4f,", s[i].q_rad[j] * (180.0 / M_PI));
+        if (fprintf(f, "%.4f\n", s[i].len_mm) < 0)
+            return -1;
+    }
+    return fflush(f) == 0 ? 0 : -1;
+}
+
+void rch_split(size_t *idx, size_t n, unsigned long long seed)
+{
+    rc_rng g;
+    rc_rng_seed(&g, seed);
+    for (size_t i = 0; i < n; ++i)
+        idx[i] = i;
+    for (size_t i = n; i > 1; --i) { /* Fisher-Yates */
+        size_t j = (size_t)rc_rng_below(&g, (uint32_t)i);
+        size_t t = idx[i - 1];
+        idx[i - 1] = idx[j];
+        idx[j] = t;
+    }
+}

@@ -1,0 +1,58 @@
+/* rch_data.h - reading and writing measurement files (CSV).
+ *
+ * Format: comma-separated, first line a header; columns are found by name
+ * (case-insensitive): q1..q6 joint angles in degrees, L cable length in mm.
+ * Optional: x, y, z (the controller's nominal flange position, mm), t
+ * (acquisition time or order, any unit; scaled to [0, 1]), group (set-up
+ * group, integer >= 0). Every other column is ignored. Blank lines and lines
+ * starting with '#' are skipped.
+ * A bad field is refused with file, line and column: missing fields, text
+ * that is not a number, NaN, infinity, and absurd values (|q| > 720 deg,
+ * L <= 0 or L > 20000 mm). Nothing is silently used.
+ * Memory: the loader allocates; rch_data_free releases.
+ */
+#ifndef RCH_DATA_H
+#define RCH_DATA_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "rc_model.h"
+#include "rch_diag.h"
+
+enum {
+    RCH_DATA_NO_LEN = 1u /* pose plan: L is not required (len_mm = 0) */
+};
+
+typedef struct rch_data {
+    rc_sample *s;       /* (n) samples, q in rad */
+    size_t n;
+    double (*xyz)[3];   /* (n x 3) x, y, z columns, or NULL when absent */
+    unsigned *line;     /* (n) source line of each sample */
+    int has_t;          /* a t column was present */
+    int has_group;      /* a group column was present */
+} rch_data;
+
+/* Load a file; on failure returns non-zero with d filled in. */
+int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d);
+/* The same from memory (name is used in the diagnostics). */
+int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                   rch_diag *d);
+void rch_data_free(rch_data *data);
+
+/* Copy of the samples selected by idx (k). Returns NULL on allocation failure. */
+rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k);
+
+/* Assign set-up groups: consecutive samples whose wrist joints (q4, q5, q6)
+ * stay the same share a group. Returns the number of groups. */
+unsigned rch_data_group_by_wrist(rc_sample *s, size_t n);
+
+/* Write samples as CSV: x,y,z (nominal FK at q when nominal is not NULL),
+ * q1..q6 (deg, %.4f), L (mm, %.4f). Returns 0 or -1 (errno set). */
+int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nominal);
+
+/* Random train/test split: a permutation of 0..n-1 from seed; the first
+ * n_test indices go to test. idx: (n) output. */
+void rch_split(size_t *idx, size_t n, unsigned long long seed);
+
+#endif

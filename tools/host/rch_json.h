@@ -1,0 +1,30 @@
+/* rch_json.h - a small strict JSON reader (RFC 8259) for model files.
+ * Builds a tree on the heap; every node remembers its line and column so that
+ * callers can report "file:line:col: what is wrong". Depth is limited to 64,
+ * strings and keys to 4096 bytes; duplicate keys are refused. */
+#ifndef RCH_JSON_H
+#define RCH_JSON_H
+
+#include <stddef.h>
+
+#include "rch_diag.h"
+
+typedef enum { RCH_JNULL, RCH_JBOOL, RCH_JNUM, RCH_JSTR, RCH_JARR, RCH_JOBJ } rch_jtype;
+
+typedef struct rch_json {
+    rch_jtype type;
+    double num;               /* RCH_JNUM, and 0/1 for RCH_JBOOL */
+    char *str;                /* RCH_JSTR (NUL-terminated, no embedded NUL) */
+    struct rch_json **items;  /* (n) array elements or object values */
+    char **keys;              /* (n) object keys */
+    size_t n;
+    unsigned line, col;
+} rch_json;
+
+rch_json *rch_json_parse(const char *text, size_t len, const char *name, rch_diag *d);
+rch_json *rch_json_load(const char *path, rch_diag *d);
+void rch_json_free(rch_json *j);
+/* Member of an object, or NULL. */
+const rch_json *rch_json_get(const rch_json *obj, const char *key);
+
+#endif

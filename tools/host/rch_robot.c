@@ -1,0 +1,294 @@
+#include "rch_robot.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "rch_json.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+static int want_num(double *v, const rch_json *j, const char *what, const char *file, rch_diag *d,
+                    const rch_json *parent)
+{
+    if (!j) {
+        rch_diag_set(d, file, parent->line, parent->col, "missing %s", what);
+        return -1;
+    }
+    if (j->type != RCH_JNUM) {
+        rch_diag_set(d, file, j->line, j->col, "%s must be a number", what);
+        return -1;
+    }
+    *v = j->num;
+    return 0;
+}
+
+static int read_dh(double dh[RC_NJ][4], const rch_json *arr, const char *file, rch_diag *d,
+                   const rch_json *parent)
+{
+    static const char *const keys[4] = {"a_mm", "d_mm", "alpha_deg", "theta_deg"};
+    if (!arr || arr->type != RCH_JARR || arr->n != RC_NJ) {
+        const rch_json *at = arr ? arr : parent;
+        rch_diag_set(d, file, at->line, at->col, "\"dh\" must be an array of 6 joint rows");
+        return -1;
+    }
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const rch_json *row = arr->items[i];
+        if (row->type != RCH_JOBJ) {
+            rch_diag_set(d, file, row->line, row->col, "dh row %u must be an object", i + 1);
+            return -1;
+        }
+        for (unsigned k = 0; k < 4; ++k) {
+            char what[64];
+            snprintf(what, sizeof what, "dh[%u].%s", i + 1, keys[k]);
+            if (want_num(&dh[i][k], rch_json_get(row, keys[k]), what, file, d, row) != 0)
+                return -1;
+            const double lim = k < 2 ? 1e5 : 720.0;
+            if (fabs(dh[i][k]) > lim) {
+                const rch_json *at = rch_json_get(row, keys[k]);
+                rch_diag_set(d, file, at->line, at->col, "%s = %g is absurd (|value| > %g)", what, dh[i][k], lim);
+                return -1;
+            }
+            if (k >= 2)
+                dh[i][k] *= DEG;
+        }
+    }
+    return 0;
+}
+
+static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_diag *d)
+{
+    static const char *const names[] = {"length_offset", "joint_compliance", "joint_periodic",
+                                        "time_drift",    "group_offset",     "length_scale"};
+    static const rc_effect_kind kinds[] = {RC_EFF_LENGTH_OFFSET, RC_EFF_JOINT_COMPLIANCE, RC_EFF_JOINT_PERIODIC,
+                                           RC_EFF_TIME_DRIFT,    RC_EFF_GROUP_OFFSET,     RC_EFF_LENGTH_SCALE};
+    if (arr->type != RCH_JARR) {
+        rch_diag_set(d, file, arr->line, arr->col, "\"effects\" must be an array");
+        return -1;
+    }
+    for (size_t i = 0; i < arr->n; ++i) {
+        const rch_json *e = arr->items[i];
+        const rch_json *kind = rch_json_get(e, "kind"), *joint = rch_json_get(e, "joint"),
+                       *params = rch_json_get(e, "params"), *ref = rch_json_get(e, "ref_dh");
+        if (e->type != RCH_JOBJ || !kind || kind->type != RCH_JSTR) {
+            rch_diag_set(d, file, e->line, e->col, "effect %zu needs a \"kind\" string", i + 1);
+            return -1;
+        }
+        int k = -1;
+        for (int t = 0; t < 6; ++t)
+            if (strcmp(kind->str, names[t]) == 0)
+                k = t;
+        if (k < 0) {
+            rch_diag_set(d, file, kind->line, kind->col, "unknown effect kind \"%s\"", kind->str);
+            return -1;
+        }
+        unsigned j = 0;
+        if (joint) {
+            if (joint->type != RCH_JNUM || joint->num < 1 || joint->num > 6 || joint->num != floor(joint->num)) {
+                rch_diag_set(d, file, joint->line, joint->col, "effect joint must be 1..6");
+                return -1;
+            }
+            j = (unsigned)joint->num - 1;
+        }
+        if (!params || params->type != RCH_JARR || params->n == 0 || params->n > RC_MAX_PARAMS) {
+            rch_diag_set(d, file, e->line, e->col, "effect %zu needs a non-empty \"params\" array", i + 1);
+            return -1;
+        }
+        rc_status st = rc_model_add_effect(m, kinds[k], j, (unsigned)params->n);
+        if (st != RC_OK) {
+            rch_diag_set(d, file, e->line, e->col, "effect %zu (%s): %s", i + 1, kind->str, rc_strerror(st));
+            return -1;
+        }
+        rc_effect *ef = &m->effects[m->n_effects - 1];
+        if (ef->count != params->n) {
+            rch_diag_set(d, file, params->line, params->col, "effect %s takes %u parameters, not %zu", kind->str,
+                         (unsigned)ef->count, params->n);
+            return -1;
+        }
+        for (size_t p = 0; p < params->n; ++p)
+            if (want_num(&m->x[ef->first + p], params->items[p], "effect parameter", file, d, params) != 0)
+                return -1;
+        if (ref) {
+            if (ref->type != RCH_JARR || ref->n != 4) {
+                rch_diag_set(d, file, ref->line, ref->col, "\"ref_dh\" must be 4 rows [a, d, alpha, theta]");
+                return -1;
+            }
+            for (unsigned r = 0; r < 4; ++r) {
+                const rch_json *row = ref->items[r];
+                if (row->type != RCH_JARR || row->n != 4) {
+                    rch_diag_set(d, file, row->line, row->col, "ref_dh row must have 4 numbers");
+                    return -1;
+                }
+                for (unsigned c = 0; c < 4; ++c) {
+                    if (want_num(&ef->ref_dh[r][c], row->items[c], "ref_dh value", file, d, row) != 0)
+                        return -1;
+                    if (c >= 2)
+                        ef->ref_dh[r][c] *= DEG;
+                }
+            }
+        }
+    }
+    return 0;
+}
+
+int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d)
+{
+    double dh[RC_NJ][4], enc[3] = {0, 0, 0};
+    memset(out, 0, sizeof *out);
+    rch_json *root = rch_json_parse(text, len, name, d);
+    if (!root)
+        return -1;
+    int rc = -1;
+    if (root->type != RCH_JOBJ) {
+        rch_diag_set(d, name, root->line, root->col, "a model file must be a JSON object");
+        goto done;
+    }
+    const rch_json *fmt = rch_json_get(root, "format");
+    if (fmt && (fmt->type != RCH_JSTR || strcmp(fmt->str, "rcal-model/1") != 0)) {
+        rch_diag_set(d, name, fmt->line, fmt->col, "unsupported format (expected \"rcal-model/1\")");
+        goto done;
+    }
+    const rch_json *nm = rch_json_get(root, "name");
+    snprintf(out->name, sizeof out->name, "%s", nm && nm->type == RCH_JSTR ? nm->str : "robot");
+    if (read_dh(dh, rch_json_get(root, "dh"), name, d, root) != 0)
+        goto done;
+    const rch_json *e = rch_json_get(root, "encoder_mm");
+    if (e) {
+        if (e->type != RCH_JARR || e->n != 3) {
+            rch_diag_set(d, name, e->line, e->col, "\"encoder_mm\" must be [x, y, z]");
+            goto done;
+        }
+        for (unsigned k = 0; k < 3; ++k) {
+            if (want_num(&enc[k], e->items[k], "encoder_mm value", name, d, e) != 0)
+                goto done;
+            if (fabs(enc[k]) > 1e5) {
+                rch_diag_set(d, name, e->items[k]->line, e->items[k]->col, "encoder_mm value is absurd");
+                goto done;
+            }
+        }
+        out->has_encoder = 1;
+    }
+    if (rc_model_init(&out->model, (const double(*)[4])dh, enc) != RC_OK) {
+        rch_diag_set(d, name, root->line, root->col, "invalid DH table");
+        goto done;
+    }
+    const rch_json *lim = rch_json_get(root, "joint_limits_deg");
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        out->model.q_min_rad[i] = -M_PI;
+        out->model.q_max_rad[i] = M_PI;
+    }
+    if (lim) {
+        if (lim->type != RCH_JARR || lim->n != RC_NJ) {
+            rch_diag_set(d, name, lim->line, lim->col, "\"joint_limits_deg\" must be 6 [min, max] pairs");
+            goto done;
+        }
+        for (unsigned i = 0; i < RC_NJ; ++i) {
+            const rch_json *pr = lim->items[i];
+            double lo, hi;
+            if (pr->type != RCH_JARR || pr->n != 2 ||
+                want_num(&lo, pr->items[0], "joint limit", name, d, pr) != 0 ||
+                want_num(&hi, pr->items[1], "joint limit", name, d, pr) != 0 || !(lo < hi) || fabs(lo) > 720 ||
+                fabs(hi) > 720) {
+                rch_diag_set(d, name, pr->line, pr->col, "joint %u limits must be [min, max] degrees, min < max",
+                             i + 1);
+                goto done;
+            }
+            out->model.q_min_rad[i] = lo * DEG;
+            out->model.q_max_rad[i] = hi * DEG;
+        }
+    }
+    out->nominal = out->model;
+    const rch_json *nom = rch_json_get(root, "nominal");
+    if (nom) {
+        double ndh[RC_NJ][4];
+        if (nom->type != RCH_JOBJ || read_dh(ndh, rch_json_get(nom, "dh"), name, d, nom) != 0) {
+            if (nom->type != RCH_JOBJ)
+                rch_diag_set(d, name, nom->line, nom->col, "\"nominal\" must be an object with \"dh\"");
+            goto done;
+        }
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            for (unsigned k = 0; k < 4; ++k)
+                out->nominal.x[4 * i + k] = ndh[i][k];
+        out->has_nominal = 1;
+    }
+    const rch_json *eff = rch_json_get(root, "effects");
+    if (eff && read_effects(&out->model, eff, name, d) != 0)
+        goto done;
+    rc = 0;
+done:
+    rch_json_free(root);
+    return rc;
+}
+
+int rch_robot_load(rch_robot *out, const char *path, rch_diag *d)
+{
+    FILE *f = fopen(path, "rb");
+    char buf[1 << 16];
+    if (!f) {
+        rch_diag_set(d, path, 0, 0, "cannot open model file");
+        return -1;
+    }
+    size_t len = fread(buf, 1, sizeof buf, f);
+    int big = len == sizeof buf;
+    fclose(f);
+    if (big) {
+        rch_diag_set(d, path, 0, 0, "model file larger than 64 KiB");
+        return -1;
+    }
+    return rch_robot_parse(out, buf, len, path, d);
+}
+
+static void write_dh(FILE *f, const rc_model *m, const char *indent)
+{
+    fprintf(f, "[\n");
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        fprintf(f, "%s  {\"a_mm\": %.9g, \"d_mm\": %.9g, \"alpha_deg\": %.9g, \"theta_deg\": %.9g}%s\n", indent,
+                m->x[RC_P_A(i)], m->x[RC_P_D(i)], m->x[RC_P_ALPHA(i)] / DEG, m->x[RC_P_THETA(i)] / DEG,
+                i + 1 < RC_NJ ? "," : "");
+    fprintf(f, "%s]", indent);
+}
+
+int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model *nominal,
+                    const char *calibration_json)
+{
+    fprintf(f, "{\n  \"format\": \"rcal-model/1\",\n  \"name\": \"");
+    for (const char *p = name ? name : "robot"; *p; ++p) {
+        if (*p == '"' || *p == '\\')
+            fputc('\\', f);
+        if ((unsigned char)*p >= 0x20)
+            fputc(*p, f);
+    }
+    fprintf(f, "\",\n  \"dh\": ");
+    write_dh(f, m, "  ");
+    fprintf(f, ",\n  \"joint_limits_deg\": [");
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        fprintf(f, "[%.9g, %.9g]%s", m->q_min_rad[i] / DEG, m->q_max_rad[i] / DEG, i + 1 < RC_NJ ? ", " : "");
+    fprintf(f, "],\n  \"encoder_mm\": [%.9g, %.9g, %.9g]", m->x[RC_P_ENC], m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2]);
+    if (m->n_effects) {
+        fprintf(f, ",\n  \"effects\": [\n");
+        for (unsigned i = 0; i < m->n_effects; ++i) {
+            const rc_effect *e = &m->effects[i];
+            fprintf(f, "    {\"kind\": \"%s\", \"joint\": %u, \"params\": [", rc_effect_name((rc_effect_kind)e->kind),
+                    e->joint + 1u);
+            for (unsigned k = 0; k < e->count; ++k)
+                fprintf(f, "%.12g%s", m->x[e->first + k], k + 1 < e->count ? ", " : "");
+            fprintf(f, "], \"ref_dh\": [");
+            for (unsigned r = 0; r < 4; ++r)
+                fprintf(f, "[%.9g, %.9g, %.9g, %.9g]%s", e->ref_dh[r][0], e->ref_dh[r][1], e->ref_dh[r][2] / DEG,
+                        e->ref_dh[r][3] / DEG, r < 3 ? ", " : "");
+            fprintf(f, "]}%s\n", i + 1 < m->n_effects ? "," : "");
+        }
+        fprintf(f, "  ]");
+    }
+    if (nominal) {
+        fprintf(f, ",\n  \"nominal\": {\"dh\": ");
+        write_dh(f, nominal, "  ");
+        fprintf(f, "}");
+    }
+    if (calibration_json)
+        fprintf(f, ",\n  \"calibration\": %s", calibration_json);
+    fprintf(f, "\n}\n");
+    return fflush(f) == 0 && !ferror(f) ? 0 : -1;
+}

@@ -1,0 +1,42 @@
+/* rch_robot.h - robot-model and calibrated-model files (JSON).
+ *
+ * Format "rcal-model/1" (lengths in mm, angles in degrees):
+ * {
+ *   "format": "rcal-model/1",
+ *   "name": "ABB IRB120",
+ *   "dh": [ {"a_mm": 0, "d_mm": 290, "alpha_deg": -90, "theta_deg": 0}, ... 6 rows ],
+ *   "joint_limits_deg": [[-165, 165], ... 6 pairs],          (optional, default +-180)
+ *   "encoder_mm": [x, y, z],                                  (optional in a robot file)
+ *   "effects": [ {"kind": "joint_periodic", "joint": 3,       (optional model extensions;
+ *                 "params": [...], "ref_dh": [[a, d, alpha, theta] x 4]} ],  joint 1-based,
+ *                                                              params in SI: mm, rad, rad/m)
+ *   "nominal": { "dh": [...] },   (calibrated model: the nominal table it corrects)
+ *   "calibration": { ... }        (calibrated model: informational, not read back)
+ * }
+ * theta_deg is the joint offset: theta_i = q_i + theta_deg_i.
+ */
+#ifndef RCH_ROBOT_H
+#define RCH_ROBOT_H
+
+#include <stdio.h>
+
+#include "rc_model.h"
+#include "rch_diag.h"
+
+typedef struct rch_robot {
+    char name[128];
+    rc_model model;     /* the model in the file (calibrated or nominal) */
+    rc_model nominal;   /* "nominal" member if present, else == model without effects */
+    int has_encoder;    /* encoder_mm was given */
+    int has_nominal;    /* the file is a calibrated model with a nominal table */
+} rch_robot;
+
+int rch_robot_load(rch_robot *out, const char *path, rch_diag *d);
+int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d);
+
+/* Write a model file. nominal may be NULL; calibration_json is inserted
+ * verbatim as the "calibration" member when not NULL (must be a JSON object). */
+int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model *nominal,
+                    const char *calibration_json);
+
+#endif

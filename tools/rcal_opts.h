@@ -1,0 +1,18 @@
+/* rcal_opts.h - tiny option helpers shared by the rcal subcommands. */
+#ifndef RCAL_OPTS_H
+#define RCAL_OPTS_H
+
+#ifndef RCAL_DEFAULT_ROBOT
+#define RCAL_DEFAULT_ROBOT "data/irb120.json"
+#endif
+
+/* If argv[*i] is NAME, consume its value into *out (advancing *i) and return
+ * 1; exits with a usage error when the value is missing or malformed. */
+int rcal_opt_str(int argc, char **argv, int *i, const char *name, const char **out);
+int rcal_opt_double(int argc, char **argv, int *i, const char *name, double *out);
+int rcal_opt_uint(int argc, char **argv, int *i, const char *name, unsigned long *out);
+/* Print "rcal CMD: unknown option X" and return 2. */
+int rcal_opt_unknown(const char *cmd, const char *arg);
+int rcal_opt_missing(const char *cmd, const char *opt);
+
+#endif
