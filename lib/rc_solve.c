@@ -133,20 +133,21 @@ static int ltlm_candidates(rc_model *cand, double *cand_cost, rc_solve_work *w, 
     int won = 0;
     w->best = *cand;
     for (unsigned k = 0; k < M; ++k) {
-        w->trial = *cand;
+        rc_model *t = &w->cand;
+        *t = w->best;
         for (unsigned i = 0; i < nf; ++i) {
             w->chaos[i] = rc_lt_map(w->chaos[i], r);
             /* guard against the map's fixed points and cycles collapsing */
             if (w->chaos[i] < 1e-9 || w->chaos[i] > 1.0 - 1e-9)
                 w->chaos[i] = 0.5 * (w->chaos[i] + 0.123456789);
             const double half = span * fabs(w->dx[i]) / w->D[i];
-            w->trial.x[w->idx[i]] = cand->x[w->idx[i]] + (2.0 * w->chaos[i] - 1.0) * half;
+            t->x[w->idx[i]] = cand->x[w->idx[i]] + (2.0 * w->chaos[i] - 1.0) * half;
         }
         double c;
         ++*evals;
-        if (rc_cost(&c, &w->trial, samples, n) == RC_OK && c < *cand_cost) {
+        if (rc_cost(&c, t, samples, n) == RC_OK && c < *cand_cost) {
             *cand_cost = c;
-            w->best = w->trial;
+            w->best = *t;
             won = 1;
         }
     }
@@ -381,4 +382,45 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             break;
     }
     return RC_OK;
+}
+
+rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n)
+{
+    double A[16] = {0}, b[4] = {0}, c[3] = {0, 0, 0};
+    RC_ASSERT(enc_mm != NULL && m != NULL);
+    if (n < 4)
+        return RC_ERR_RANK;
+    /* centre the points for conditioning: unknowns e' = e - c, k = |e'|^2 */
+    for (size_t i = 0; i < n; ++i) {
+        double p[3];
+        rc_fk(p, NULL, m, samples[i].q_rad);
+        for (int r = 0; r < 3; ++r)
+            c[r] += p[r] / (double)n;
+    }
+    double trace = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        double p[3];
+        rc_fk(p, NULL, m, samples[i].q_rad);
+        for (int r = 0; r < 3; ++r)
+            p[r] -= c[r];
+        /* -2 p.e' + k = L^2 - |p|^2 */
+        const double row[4] = {-2.0 * p[0], -2.0 * p[1], -2.0 * p[2], 1.0};
+        const double rhs = samples[i].len_mm * samples[i].len_mm - (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        for (unsigned a = 0; a < 4; ++a) {
+            b[a] += row[a] * rhs;
+            for (unsigned k = 0; k < 4; ++k)
+                A[4 * a + k] += row[a] * row[k];
+        }
+    }
+    for (unsigned a = 0; a < 3; ++a)
+        trace += A[5 * a];
+    /* a pose set without spread in some direction cannot place e */
+    for (unsigned a = 0; a < 3; ++a)
+        if (!(A[5 * a] > 1e-10 * trace))
+            return RC_ERR_RANK;
+    if (rcu_chol_solve(A, b, 4) != RC_OK)
+        return RC_ERR_RANK;
+    for (int r = 0; r < 3; ++r)
+        enc_mm[r] = b[r] + c[r];
+    return (isfinite(enc_mm[0]) && isfinite(enc_mm[1]) && isfinite(enc_mm[2])) ? RC_OK : RC_ERR_NUMERIC;
 }

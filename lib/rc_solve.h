@@ -95,6 +95,7 @@ typedef struct rc_solve_work {
     uint16_t idx[RC_MAX_PARAMS];              /* (nf) free parameter indices */
     rc_model trial;
     rc_model best;
+    rc_model cand;                            /* LTLM chaotic candidate */
 } rc_solve_work;
 
 const char *rc_method_name(rc_method method);
@@ -127,4 +128,11 @@ typedef struct rc_metrics {
 
 rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, size_t n);
 
+
+
+/* Initial guess of the encoder outlet e from the model's flange points and
+ * the measured lengths, by the linearisation |p|^2 - 2 p.e + |e|^2 = L^2
+ * (linear least squares in e and |e|^2, 4 x 4 normal equations).
+ * enc_mm: (3) output. RC_ERR_RANK when the points are (nearly) coplanar. */
+rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n);
 #endif /* RC_SOLVE_H */
