@@ -1,0 +1,157 @@
+/* rcd_display.c - display reader: port + protocol + format lock. */
+#include <string.h>
+#include <time.h>
+
+#include "rcd_display.h"
+
+static long long now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+static int is_polled(const rcd_display *d)
+{
+    return d->cfg.protocol != RCD_PROTO_ASCII;
+}
+
+rc_status rcd_display_init(rcd_display *d, rcd_port *port, const rcd_proto_config *cfg)
+{
+    if (!d || !port || !port->ops)
+        return RC_ERR_ARG;
+    memset(d, 0, sizeof *d);
+    d->port = port;
+    if (cfg)
+        d->cfg = *cfg;
+    if ((unsigned)d->cfg.protocol > RCD_PROTO_MODBUS || d->cfg.mb_decimals > 9 ||
+        (unsigned)d->cfg.mb_order > RCD_WO_DCBA || (unsigned)d->cfg.mb_format > RCD_MB_FLOAT32)
+        return RC_ERR_ARG;
+    d->need_poll = 1;
+    d->lock_decimals = -2;
+    d->cand_decimals = -2;
+    return RC_OK;
+}
+
+void rcd_display_reset(rcd_display *d)
+{
+    d->len = 0;
+    d->need_poll = 1;
+}
+
+static void drop(rcd_display *d, size_t n)
+{
+    if (n >= d->len) {
+        d->len = 0;
+        return;
+    }
+    memmove(d->buf, d->buf + n, d->len - n);
+    d->len -= n;
+}
+
+/* Shape check; RC_OK when the reading may be returned. */
+static rc_status check_shape(rcd_display *d, const rcd_reading *r)
+{
+    if (d->cfg.protocol == RCD_PROTO_MODBUS)
+        return RC_OK;
+    if (d->lock_decimals != -2) {
+        if (r->decimals == d->lock_decimals && r->unit == d->lock_unit)
+            return RC_OK;
+        d->stats.shape_rejects++;
+        return RC_ERR_FORMAT;
+    }
+    if (r->decimals == d->cand_decimals && r->unit == d->cand_unit) {
+        d->cand_count++;
+    } else {
+        d->cand_decimals = r->decimals;
+        d->cand_unit = r->unit;
+        d->cand_count = 1;
+    }
+    if (d->cand_count >= RCD_DISPLAY_LOCK_COUNT) {
+        d->lock_decimals = d->cand_decimals;
+        d->lock_unit = d->cand_unit;
+        return RC_OK;
+    }
+    return RC_ERR_INCOMPLETE; /* still learning the format: keep reading */
+}
+
+rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms)
+{
+    long long deadline;
+    if (!d || !d->port)
+        return RC_ERR_ARG;
+    deadline = now_ms() + timeout_ms;
+    for (;;) {
+        rc_status st;
+        size_t n = 0;
+        long long left;
+        if (is_polled(d) && d->need_poll) {
+            uint8_t req[32];
+            size_t rl = 0, wn = 0;
+            d->len = 0;
+            st = rcd_port_flush(d->port);
+            if (st != RC_OK)
+                return st;
+            st = rcd_build_request(req, &rl, sizeof req, &d->cfg);
+            if (st != RC_OK)
+                return st;
+            left = deadline - now_ms();
+            st = rcd_port_write(d->port, &wn, req, rl, left > 0 ? (unsigned)left : 1u);
+            if (st == RC_ERR_TIMEOUT)
+                d->stats.timeouts++;
+            if (st != RC_OK)
+                return st;
+            d->stats.polls++;
+            d->need_poll = 0;
+        }
+        while (d->len > 0) {
+            rcd_reading r;
+            size_t c = 0;
+            st = rcd_parse(&r, &c, &d->cfg, d->buf, d->len);
+            drop(d, c);
+            if (st == RC_ERR_INCOMPLETE)
+                break;
+            d->need_poll = 1;
+            if (st == RC_OK) {
+                st = check_shape(d, &r);
+                if (st == RC_ERR_INCOMPLETE)
+                    break; /* warm-up frame: poll again / keep listening */
+                if (st == RC_OK) {
+                    d->stats.readings++;
+                    if (out)
+                        *out = r;
+                }
+                return st;
+            }
+            if (st == RC_ERR_DEVICE) {
+                d->stats.device_errors++;
+                if (out)
+                    *out = r;
+                return st;
+            }
+            d->stats.bad_frames++;
+            return st;
+        }
+        if (d->len == sizeof d->buf)
+            drop(d, sizeof d->buf / 2); /* cannot happen with the parsers' limits */
+        if (is_polled(d) && d->need_poll)
+            continue;
+        left = deadline - now_ms();
+        if (left <= 0) {
+            d->stats.timeouts++;
+            d->need_poll = 1;
+            return RC_ERR_TIMEOUT;
+        }
+        st = rcd_port_read(d->port, &n, d->buf + d->len, sizeof d->buf - d->len, (unsigned)left);
+        if (st == RC_OK) {
+            d->len += n;
+            d->stats.bytes += n;
+        } else if (st == RC_ERR_TIMEOUT) {
+            d->stats.timeouts++; /* the port waited for what was left */
+            d->need_poll = 1;
+            return st;
+        } else {
+            return st;
+        }
+    }
+}
