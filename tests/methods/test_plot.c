@@ -1,0 +1,172 @@
+/* test_plot.c - rch_plot writes well-formed SVG with escaped text, legend,
+ * ticks, log axis and bars, and survives degenerate input. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "rch_plot.h"
+
+static char *render(const rch_plot *p)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    assert_non_null(f);
+    assert_int_equal(rch_plot_write_svg_stream(p, f), 0);
+    fclose(f);
+    return buf;
+}
+
+static size_t count(const char *hay, const char *needle)
+{
+    size_t n = 0;
+    const char *s = hay;
+    while ((s = strstr(s, needle)) != NULL) {
+        n++;
+        s += strlen(needle);
+    }
+    return n;
+}
+
+/* Every '<' opens a tag whose name is known, and tags balance. */
+static void assert_balanced(const char *svg)
+{
+    long depth = 0;
+    const char *s = svg;
+    while ((s = strchr(s, '<')) != NULL) {
+        const char *e = strchr(s, '>');
+        assert_non_null(e);
+        if (s[1] == '?') {
+        } else if (s[1] == '/') {
+            depth--;
+        } else if (e[-1] != '/') {
+            depth++;
+        }
+        assert_true(depth >= 0);
+        s = e + 1;
+    }
+    assert_int_equal(depth, 0);
+}
+
+static void test_lines_legend_escape(void **state)
+{
+    double x[50], y1[50], y2[50];
+    size_t k;
+    rch_plot *p;
+    char *svg;
+    (void)state;
+    for (k = 0; k < 50; k++) {
+        x[k] = (double)k;
+        y1[k] = exp(-0.1 * (double)k);
+        y2[k] = 0.5 * exp(-0.05 * (double)k);
+    }
+    y2[10] = NAN; /* breaks the line, must not print "nan" */
+    p = rch_plot_new("A <b> & \"c\"", "iteration", "RMS (mm)");
+    assert_non_null(p);
+    rch_plot_line(p, "LM & co", x, y1, 50);
+    rch_plot_line(p, "EKF<2>", x, y2, 50);
+    rch_plot_scatter(p, "pts", x, y1, 5);
+    svg = render(p);
+    assert_non_null(strstr(svg, "<svg"));
+    assert_non_null(strstr(svg, "A &lt;b&gt; &amp; &quot;c&quot;"));
+    assert_non_null(strstr(svg, "LM &amp; co"));
+    assert_non_null(strstr(svg, "EKF&lt;2&gt;"));
+    assert_null(strstr(svg, "nan"));
+    assert_null(strstr(svg, "inf"));
+    assert_null(strstr(svg, "<b>"));
+    /* two lines in distinct colours, both in the legend */
+    assert_non_null(strstr(svg, "#0072B2"));
+    assert_non_null(strstr(svg, "#D55E00"));
+    /* the NaN splits the second path into two sub-paths */
+    assert_true(count(svg, "\"M") + count(svg, "M") >= 3);
+    /* ticks: several labelled y and x ticks */
+    assert_true(count(svg, "text-anchor=\"end\">") >= 4);
+    assert_balanced(svg);
+    free(svg);
+    rch_plot_free(p);
+}
+
+static void test_logy_bars_file(void **state)
+{
+    const char *labels[3] = {"BC", "LM", "a&b"};
+    double v[3] = {2.18, 0.36, 0.32}, e[3] = {0.1, 0.02, 0.01};
+    double x[3] = {1, 2, 3}, y[3] = {1e-3, 0.1, 10.0};
+    char path[] = "/tmp/rcal_plot_XXXXXX";
+    int fd;
+    rch_plot *p = rch_plot_new("bars", "method", "mm");
+    rch_plot *q = rch_plot_new("log", "x", "y");
+    char *svg;
+    (void)state;
+    rch_plot_bars(p, labels, v, e, 3);
+    svg = render(p);
+    assert_int_equal(count(svg, "<rect") - 2 /* background, frame */ - 1 /* clip */, 3);
+    assert_non_null(strstr(svg, ">BC<"));
+    assert_non_null(strstr(svg, "a&amp;b"));
+    assert_balanced(svg);
+    free(svg);
+
+    rch_plot_logy(q, 1);
+    rch_plot_line(q, "decay", x, y, 3);
+    svg = render(q);
+    /* decade ticks 0.001 .. 10 */
+    assert_non_null(strstr(svg, ">0.001<"));
+    assert_non_null(strstr(svg, ">10<"));
+    assert_balanced(svg);
+    free(svg);
+
+    fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(rch_plot_write_svg(q, path), 0);
+    {
+        FILE *f = fopen(path, "r");
+        char head[64] = {0};
+        assert_non_null(f);
+        assert_true(fread(head, 1, sizeof head - 1, f) > 10);
+        fclose(f);
+        assert_non_null(strstr(head, "<?xml"));
+    }
+    remove(path);
+    assert_int_equal(rch_plot_write_svg(q, "/nonexistent-dir/x.svg"), -1);
+    rch_plot_free(p);
+    rch_plot_free(q);
+}
+
+static void test_degenerate(void **state)
+{
+    double one = 3.0;
+    rch_plot *p = rch_plot_new(NULL, NULL, NULL);
+    char *svg;
+    (void)state;
+    svg = render(p); /* empty chart */
+    assert_balanced(svg);
+    free(svg);
+    rch_plot_line(p, "", &one, &one, 1); /* one point, constant range, no legend */
+    rch_plot_logy(p, 1);
+    svg = render(p);
+    assert_balanced(svg);
+    assert_null(strstr(svg, "nan"));
+    free(svg);
+    rch_plot_free(p);
+    rch_plot_free(NULL);
+    rch_plot_line(NULL, "x", &one, &one, 1);
+    assert_int_equal(rch_plot_write_svg(NULL, "/tmp/x.svg"), -1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_lines_legend_escape),
+        cmocka_unit_test(test_logy_bars_file),
+        cmocka_unit_test(test_degenerate),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,654 @@
+/* rch_plot.c - a small SVG chart writer; see rch_plot.h. */
+#include "rch_plot.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { PLOT_LINE = 0, PLOT_SCATTER = 1 };
+
+typedef struct plot_series {
+    int kind;
+    char *label;
+    double *x; /* (n) */
+    double *y; /* (n) */
+    size_t n;
+} plot_series;
+
+struct rch_plot {
+    char *title;
+    char *xlabel;
+    char *ylabel;
+    plot_series *series; /* (n_series) */
+    size_t n_series;
+    size_t cap_series;
+    char **bar_labels; /* (n_bars) */
+    double *bar_val;   /* (n_bars) */
+    double *bar_err;   /* (n_bars) or NULL */
+    size_t n_bars;
+    int logy;
+    int failed;
+    unsigned width, height;
+    double xlo, xhi, ylo, yhi; /* forced ranges when lo < hi */
+};
+
+/* Okabe-Ito palette (colour-blind safe), then a few more distinct colours. */
+static const char *const plot_colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
+                                           "#E69F00", "#56B4E9", "#000000", "#F0E442",
+                                           "#7F3C8D", "#8C564B", "#17BECF", "#BCBD22"};
+#define PLOT_NCOL (sizeof plot_colours / sizeof plot_colours[0])
+
+static char *plot_strdup(const char *s)
+{
+    size_t n;
+    char *r;
+    if (!s)
+        s = "";
+    n = strlen(s);
+    r = malloc(n + 1);
+    if (r)
+        memcpy(r, s, n + 1);
+    return r;
+}
+
+static double *plot_dupd(const double *v, size_t n)
+{
+    double *r;
+    if (n == 0)
+        return malloc(sizeof(double)); /* non-NULL marker */
+    r = malloc(n * sizeof(double));
+    if (r && v)
+        memcpy(r, v, n * sizeof(double));
+    return r;
+}
+
+rch_plot *rch_plot_new(const char *title, const char *xlabel, const char *ylabel)
+{
+    rch_plot *p = calloc(1, sizeof *p);
+    if (!p)
+        return NULL;
+    p->title = plot_strdup(title);
+    p->xlabel = plot_strdup(xlabel);
+    p->ylabel = plot_strdup(ylabel);
+    p->width = 800;
+    p->height = 500;
+    if (!p->title || !p->xlabel || !p->ylabel) {
+        rch_plot_free(p);
+        return NULL;
+    }
+    return p;
+}
+
+static void plot_add(rch_plot *p, int kind, const char *label, const double *x, const double *y,
+                     size_t n)
+{
+    plot_series *s;
+    if (!p)
+        return;
+    if ((n > 0 && (!x || !y))) {
+        p->failed = 1;
+        return;
+    }
+    if (p->n_series == p->cap_series) {
+        size_t cap = p->cap_series ? 2 * p->cap_series : 8;
+        plot_series *ns = realloc(p->series, cap * sizeof *ns);
+        if (!ns) {
+            p->failed = 1;
+            return;
+        }
+        p->series = ns;
+        p->cap_series = cap;
+    }
+    s = &p->series[p->n_series];
+    s->kind = kind;
+    s->label = plot_strdup(label);
+    s->x = plot_dupd(x, n);
+    s->y = plot_dupd(y, n);
+    s->n = n;
+    if (!s->label || !s->x || !s->y) {
+        free(s->label);
+        free(s->x);
+        free(s->y);
+        p->failed = 1;
+        return;
+    }
+    p->n_series++;
+}
+
+void rch_plot_line(rch_plot *p, const char *label, const double *x, const double *y, size_t n)
+{
+    plot_add(p, PLOT_LINE, label, x, y, n);
+}
+
+void rch_plot_scatter(rch_plot *p, const char *label, const double *x, const double *y, size_t n)
+{
+    plot_add(p, PLOT_SCATTER, label, x, y, n);
+}
+
+static void plot_free_bars(rch_plot *p)
+{
+    size_t i;
+    if (p->bar_labels)
+        for (i = 0; i < p->n_bars; i++)
+            free(p->bar_labels[i]);
+    free(p->bar_labels);
+    free(p->bar_val);
+    free(p->bar_err);
+    p->bar_labels = NULL;
+    p->bar_val = NULL;
+    p->bar_err = NULL;
+    p->n_bars = 0;
+}
+
+void rch_plot_bars(rch_plot *p, const char *const *labels, const double *values,
+                   const double *errs, size_t n)
+{
+    size_t i;
+    if (!p)
+        return;
+    plot_free_bars(p);
+    if (n == 0)
+        return;
+    if (!values) {
+        p->failed = 1;
+        return;
+    }
+    p->bar_labels = calloc(n, sizeof(char *));
+    p->bar_val = plot_dupd(values, n);
+    p->bar_err = errs ? plot_dupd(errs, n) : NULL;
+    if (!p->bar_labels || !p->bar_val || (errs && !p->bar_err)) {
+        free(p->bar_labels);
+        free(p->bar_val);
+        free(p->bar_err);
+        p->bar_labels = NULL;
+        p->bar_val = NULL;
+        p->bar_err = NULL;
+        p->failed = 1;
+        return;
+    }
+    p->n_bars = n;
+    for (i = 0; i < n; i++) {
+        p->bar_labels[i] = plot_strdup(labels ? labels[i] : "");
+        if (!p->bar_labels[i])
+            p->failed = 1;
+    }
+}
+
+void rch_plot_logy(rch_plot *p, int on)
+{
+    if (p)
+        p->logy = on != 0;
+}
+
+void rch_plot_size(rch_plot *p, unsigned width_px, unsigned height_px)
+{
+    if (!p)
+        return;
+    p->width = width_px < 200 ? 200 : width_px;
+    p->height = height_px < 150 ? 150 : height_px;
+}
+
+void rch_plot_xrange(rch_plot *p, double lo, double hi)
+{
+    if (p) {
+        p->xlo = lo;
+        p->xhi = hi;
+    }
+}
+
+void rch_plot_yrange(rch_plot *p, double lo, double hi)
+{
+    if (p) {
+        p->ylo = lo;
+        p->yhi = hi;
+    }
+}
+
+void rch_plot_free(rch_plot *p)
+{
+    size_t i;
+    if (!p)
+        return;
+    for (i = 0; i < p->n_series; i++) {
+        free(p->series[i].label);
+        free(p->series[i].x);
+        free(p->series[i].y);
+    }
+    free(p->series);
+    plot_free_bars(p);
+    free(p->title);
+    free(p->xlabel);
+    free(p->ylabel);
+    free(p);
+}
+
+/* ---- writing ---------------------------------------------------------- */
+
+static void plot_esc(FILE *f, const char *s)
+{
+    for (; s && *s; s++) {
+        switch (*s) {
+        case '&': fputs("&amp;", f); break;
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '"': fputs("&quot;", f); break;
+        case '\'': fputs("&apos;", f); break;
+        default:
+            /* control characters are not allowed in XML 1.0 text */
+            if ((unsigned char)*s < 0x20 && *s != '\t' && *s != '\n')
+                fputc(' ', f);
+            else
+                fputc(*s, f);
+        }
+    }
+}
+
+/* 1-2-5 step for about `want` intervals over span. */
+static double plot_nice_step(double span, int want)
+{
+    double raw = span / (double)want, mag, f;
+    if (!(raw > 0.0) || !isfinite(raw))
+        return 1.0;
+    mag = pow(10.0, floor(log10(raw)));
+    f = raw / mag;
+    if (f < 1.5)
+        return mag;
+    if (f < 3.5)
+        return 2.0 * mag;
+    if (f < 7.5)
+        return 5.0 * mag;
+    return 10.0 * mag;
+}
+
+typedef struct plot_axis {
+    double lo, hi; /* data range (in transformed units for log) */
+    int log;
+} plot_axis;
+
+static double plot_tr(const plot_axis *a, double v)
+{
+    return a->log ? log10(v) : v;
+}
+
+static int plot_ok(const plot_axis *ay, double y)
+{
+    return isfinite(y) && (!ay->log || y > 0.0);
+}
+
+/* Compute ranges from data; returns 0 when there is nothing to draw. */
+static void plot_ranges(const rch_plot *p, plot_axis *ax, plot_axis *ay)
+{
+    double xlo = HUGE_VAL, xhi = -HUGE_VAL, ylo = HUGE_VAL, yhi = -HUGE_VAL;
+    size_t i, k;
+    ax->log = 0;
+    ay->log = p->logy;
+    for (i = 0; i < p->n_series; i++) {
+        const plot_series *s = &p->series[i];
+        for (k = 0; k < s->n; k++) {
+            if (!isfinite(s->x[k]) || !plot_ok(ay, s->y[k]))
+                continue;
+            if (s->x[k] < xlo) xlo = s->x[k];
+            if (s->x[k] > xhi) xhi = s->x[k];
+            if (s->y[k] < ylo) ylo = s->y[k];
+            if (s->y[k] > yhi) yhi = s->y[k];
+        }
+    }
+    if (p->n_bars > 0) {
+        if (-0.5 < xlo) xlo = -0.5;
+        if ((double)p->n_bars - 0.5 > xhi) xhi = (double)p->n_bars - 0.5;
+        for (k = 0; k < p->n_bars; k++) {
+            double v = p->bar_val[k], e = p->bar_err ? fabs(p->bar_err[k]) : 0.0;
+            if (!isfinite(e))
+                e = 0.0;
+            if (!plot_ok(ay, v))
+                continue;
+            if (v + e > yhi) yhi = v + e;
+            if (v < ylo) ylo = v;
+            if (!ay->log && 0.0 < ylo) ylo = 0.0; /* bars start at zero */
+        }
+    }
+    if (p->xlo < p->xhi) {
+        xlo = p->xlo;
+        xhi = p->xhi;
+    }
+    if (p->ylo < p->yhi && (!ay->log || p->ylo > 0.0)) {
+        ylo = p->ylo;
+        yhi = p->yhi;
+    }
+    if (!(xlo <= xhi)) {
+        xlo = 0.0;
+        xhi = 1.0;
+    }
+    if (!(ylo <= yhi)) {
+        ylo = ay->log ? 1.0 : 0.0;
+        yhi = ay->log ? 10.0 : 1.0;
+    }
+    if (ay->log) {
+        ylo = log10(ylo);
+        yhi = log10(yhi);
+    }
+    if (xhi - xlo <= 0.0) {
+        double d = fabs(xlo) > 0.0 ? 0.1 * fabs(xlo) : 1.0;
+        xlo -= d;
+        xhi += d;
+    }
+    if (yhi - ylo <= 0.0) {
+        double d = ay->log ? 0.5 : (fabs(ylo) > 0.0 ? 0.1 * fabs(ylo) : 1.0);
+        ylo -= d;
+        yhi += d;
+    }
+    ax->lo = xlo;
+    ax->hi = xhi;
+    ay->lo = ylo;
+    ay->hi = yhi;
+}
+
+static void plot_marker(FILE *f, int shape, double x, double y, const char *col)
+{
+    switch (shape % 4) {
+    case 0:
+        fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"3\" fill=\"%s\"/>\n", x, y, col);
+        break;
+    case 1:
+        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"6\" height=\"6\" fill=\"%s\"/>\n", x - 3,
+                y - 3, col);
+        break;
+    case 2:
+        fprintf(f, "<path d=\"M%.2f %.2fL%.2f %.2fL%.2f %.2fZ\" fill=\"%s\"/>\n", x, y - 4, x + 4,
+                y + 3, x - 4, y + 3, col);
+        break;
+    default:
+        fprintf(f, "<path d=\"M%.2f %.2fL%.2f %.2fL%.2f %.2fL%.2f %.2fZ\" fill=\"%s\"/>\n", x,
+                y - 4, x + 4, y, x, y + 4, x - 4, y, col);
+    }
+}
+
+static void plot_fmt(char *buf, size_t len, double v, double step)
+{
+    if (fabs(v) < 1e-12 * (step > 0 ? step : 1.0))
+        v = 0.0;
+    snprintf(buf, len, "%g", v);
+}
+
+int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
+{
+    plot_axis ax, ay;
+    double W, H, L = 75.0, R = 20.0, T = 45.0, B = 60.0, pw, ph, legw = 0.0;
+    double xs, ys;
+    size_t i, k, nleg = 0, maxlab = 0;
+    int rot_labels = 0;
+    if (!p || !f || p->failed) {
+        errno = EINVAL;
+        return -1;
+    }
+    W = (double)p->width;
+    H = (double)p->height;
+    plot_ranges(p, &ax, &ay);
+
+    /* legend: one entry per series (and one for the bars when labelled) */
+    for (i = 0; i < p->n_series; i++) {
+        size_t l = strlen(p->series[i].label);
+        if (l > 0) {
+            nleg++;
+            if (l > maxlab)
+                maxlab = l;
+        }
+    }
+    if (nleg > 0) {
+        legw = 34.0 + 6.5 * (double)(maxlab > 40 ? 40 : maxlab);
+        R += legw + 10.0;
+    }
+    if (p->n_bars > 0) {
+        size_t ml = 0;
+        for (k = 0; k < p->n_bars; k++)
+            if (strlen(p->bar_labels[k]) > ml)
+                ml = strlen(p->bar_labels[k]);
+        if ((double)ml * 7.0 > (W - L - R) / (double)p->n_bars) {
+            rot_labels = 1;
+            B += 5.0 * (double)(ml > 20 ? 20 : ml);
+        }
+    }
+    if (H - T - B < 60.0)
+        B = H - T - 60.0;
+    pw = W - L - R;
+    ph = H - T - B;
+    if (pw < 50.0)
+        pw = 50.0;
+    xs = pw / (ax.hi - ax.lo);
+    ys = ph / (ay.hi - ay.lo);
+#define PX(v) (L + ((v) - ax.lo) * xs)
+#define PY(v) (T + ph - ((v) - ay.lo) * ys)
+
+    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    fprintf(f,
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%u\" height=\"%u\" "
+            "viewBox=\"0 0 %u %u\" font-family=\"Helvetica, Arial, sans-serif\" "
+            "font-size=\"12\">\n",
+            p->width, p->height, p->width, p->height);
+    fprintf(f, "<rect x=\"0\" y=\"0\" width=\"%u\" height=\"%u\" fill=\"white\"/>\n", p->width,
+            p->height);
+    fprintf(f, "<text x=\"%.1f\" y=\"24\" text-anchor=\"middle\" font-size=\"16\" "
+               "font-weight=\"bold\">",
+            L + pw / 2.0);
+    plot_esc(f, p->title);
+    fprintf(f, "</text>\n");
+
+    /* y ticks and grid */
+    {
+        double y0, step;
+        int guard = 0;
+        char buf[64];
+        if (ay.log) {
+            double span = ay.hi - ay.lo;
+            int d0 = (int)floor(ay.lo), d1 = (int)ceil(ay.hi), d;
+            static const double sub[3] = {1.0, 2.0, 5.0};
+            int nsub = span < 2.5 ? 3 : 1;
+            int every = span > 12 ? (int)ceil(span / 8.0) : 1;
+            for (d = d0; d <= d1 && guard < 400; d++, guard++) {
+                int s;
+                if ((d - d0) % every != 0)
+                    continue;
+                for (s = 0; s < nsub; s++) {
+                    double v = pow(10.0, (double)d) * sub[s], tv = log10(v), py;
+                    if (tv < ay.lo - 1e-9 || tv > ay.hi + 1e-9)
+                        continue;
+                    py = PY(tv);
+                    fprintf(f,
+                            "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
+                            "stroke=\"#e0e0e0\"/>\n",
+                            L, py, L + pw, py);
+                    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
+                               "stroke=\"black\"/>\n",
+                            L - 5, py, L, py);
+                    snprintf(buf, sizeof buf, "%g", v);
+                    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n",
+                            L - 8, py + 4, buf);
+                }
+            }
+        } else {
+            step = plot_nice_step(ay.hi - ay.lo, 6);
+            for (y0 = ceil(ay.lo / step - 1e-9) * step; y0 <= ay.hi + 1e-9 * step && guard < 100;
+                 y0 += step, guard++) {
+                double py = PY(y0);
+                fprintf(f,
+                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
+                        "stroke=\"#e0e0e0\"/>\n",
+                        L, py, L + pw, py);
+                fprintf(f,
+                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
+                        L - 5, py, L, py);
+                plot_fmt(buf, sizeof buf, y0, step);
+                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8,
+                        py + 4, buf);
+            }
+        }
+    }
+    /* x ticks (numeric unless this is a pure bar chart) */
+    if (p->n_bars == 0) {
+        double step = plot_nice_step(ax.hi - ax.lo, 8), x0;
+        int guard = 0;
+        char buf[64];
+        for (x0 = ceil(ax.lo / step - 1e-9) * step; x0 <= ax.hi + 1e-9 * step && guard < 100;
+             x0 += step, guard++) {
+            double px = PX(x0);
+            fprintf(f,
+                    "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e0e0e0\"/>\n",
+                    px, T, px, T + ph);
+            fprintf(f,
+                    "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
+                    px, T + ph, px, T + ph + 5);
+            plot_fmt(buf, sizeof buf, x0, step);
+            fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">%s</text>\n", px,
+                    T + ph + 18, buf);
+        }
+    }
+
+    /* bars */
+    if (p->n_bars > 0) {
+        double bw = 0.6 * xs;
+        double base = ay.log ? ay.lo : (ay.lo > 0.0 ? ay.lo : (ay.hi < 0.0 ? ay.hi : 0.0));
+        for (k = 0; k < p->n_bars; k++) {
+            double v = p->bar_val[k], cx = PX((double)k), top, bot;
+            const char *col = plot_colours[k % PLOT_NCOL];
+            if (plot_ok(&ay, v)) {
+                double tv = plot_tr(&ay, v);
+                if (tv > ay.hi) tv = ay.hi;
+                if (tv < ay.lo) tv = ay.lo;
+                top = PY(tv > base ? tv : base);
+                bot = PY(tv > base ? base : tv);
+                fprintf(f,
+                        "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"%s\" "
+                        "fill-opacity=\"0.85\"><title>",
+                        cx - bw / 2.0, top, bw, bot - top, col);
+                plot_esc(f, p->bar_labels[k]);
+                fprintf(f, ": %g</title></rect>\n", v);
+                if (p->bar_err && isfinite(p->bar_err[k]) && p->bar_err[k] != 0.0) {
+                    double e = fabs(p->bar_err[k]), hi = v + e, lo = v - e, yh, yl;
+                    yh = plot_tr(&ay, hi);
+                    yl = (ay.log && lo <= 0.0) ? ay.lo : plot_tr(&ay, lo);
+                    if (yh > ay.hi) yh = ay.hi;
+                    if (yl < ay.lo) yl = ay.lo;
+                    fprintf(f,
+                            "<path d=\"M%.2f %.2fV%.2fM%.2f %.2fH%.2fM%.2f %.2fH%.2f\" "
+                            "stroke=\"black\" stroke-width=\"1.2\" fill=\"none\"/>\n",
+                            cx, PY(yl), PY(yh), cx - bw / 6.0, PY(yl), cx + bw / 6.0,
+                            cx - bw / 6.0, PY(yh), cx + bw / 6.0);
+                }
+                {
+                    char buf[64];
+                    snprintf(buf, sizeof buf, "%.3g", v);
+                    fprintf(f,
+                            "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\" "
+                            "font-size=\"10\">%s</text>\n",
+                            cx + (p->bar_err ? bw / 4.0 : 0.0), top - 3.0, buf);
+                }
+            }
+            if (rot_labels) {
+                fprintf(f,
+                        "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\" "
+                        "transform=\"rotate(-45 %.2f %.2f)\">",
+                        cx, T + ph + 14, cx, T + ph + 14);
+            } else {
+                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", cx,
+                        T + ph + 18);
+            }
+            plot_esc(f, p->bar_labels[k]);
+            fprintf(f, "</text>\n");
+        }
+    }
+
+    /* series, clipped to the plot area */
+    fprintf(f,
+            "<defs><clipPath id=\"plotarea\"><rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" "
+            "height=\"%.2f\"/></clipPath></defs>\n<g clip-path=\"url(#plotarea)\">\n",
+            L, T, pw, ph);
+    for (i = 0; i < p->n_series; i++) {
+        const plot_series *s = &p->series[i];
+        const char *col = plot_colours[i % PLOT_NCOL];
+        if (s->kind == PLOT_LINE) {
+            int pen = 0;
+            fprintf(f, "<path fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\" d=\"", col);
+            for (k = 0; k < s->n; k++) {
+                if (!isfinite(s->x[k]) || !plot_ok(&ay, s->y[k])) {
+                    pen = 0;
+                    continue;
+                }
+                fprintf(f, "%s%.2f %.2f", pen ? "L" : "M", PX(s->x[k]),
+                        PY(plot_tr(&ay, s->y[k])));
+                pen = 1;
+            }
+            fprintf(f, "\"/>\n");
+            if (s->n == 1 && isfinite(s->x[0]) && plot_ok(&ay, s->y[0]))
+                plot_marker(f, 0, PX(s->x[0]), PY(plot_tr(&ay, s->y[0])), col);
+        } else {
+            for (k = 0; k < s->n; k++)
+                if (isfinite(s->x[k]) && plot_ok(&ay, s->y[k]))
+                    plot_marker(f, (int)i, PX(s->x[k]), PY(plot_tr(&ay, s->y[k])), col);
+        }
+    }
+    fprintf(f, "</g>\n");
+
+    /* frame and axis labels */
+    fprintf(f,
+            "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"none\" "
+            "stroke=\"black\"/>\n",
+            L, T, pw, ph);
+    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", L + pw / 2.0, H - 12.0);
+    plot_esc(f, p->xlabel);
+    fprintf(f, "</text>\n");
+    fprintf(f,
+            "<text x=\"16\" y=\"%.2f\" text-anchor=\"middle\" transform=\"rotate(-90 16 %.2f)\">",
+            T + ph / 2.0, T + ph / 2.0);
+    plot_esc(f, p->ylabel);
+    fprintf(f, "</text>\n");
+
+    /* legend */
+    if (nleg > 0) {
+        double lx = L + pw + 10.0, ly = T;
+        fprintf(f,
+                "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"white\" "
+                "stroke=\"#999999\"/>\n",
+                lx, ly, legw, 8.0 + 18.0 * (double)nleg);
+        for (i = 0; i < p->n_series; i++) {
+            const plot_series *s = &p->series[i];
+            const char *col = plot_colours[i % PLOT_NCOL];
+            double yy;
+            if (s->label[0] == '\0')
+                continue;
+            yy = ly + 16.0;
+            if (s->kind == PLOT_LINE)
+                fprintf(f,
+                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" "
+                        "stroke-width=\"2.5\"/>\n",
+                        lx + 6, yy - 4, lx + 26, yy - 4, col);
+            else
+                plot_marker(f, (int)i, lx + 16, yy - 4, col);
+            fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">", lx + 30, yy);
+            plot_esc(f, s->label);
+            fprintf(f, "</text>\n");
+            ly += 18.0;
+        }
+    }
+    fprintf(f, "</svg>\n");
+#undef PX
+#undef PY
+    return ferror(f) ? -1 : 0;
+}
+
+int rch_plot_write_svg(const rch_plot *p, const char *path)
+{
+    FILE *f;
+    int rc;
+    if (!p || !path) {
+        errno = EINVAL;
+        return -1;
+    }
+    f = fopen(path, "w");
+    if (!f)
+        return -1;
+    rc = rch_plot_write_svg_stream(p, f);
+    if (fclose(f) != 0)
+        rc = -1;
+    return rc;
+}

@@ -1,0 +1,64 @@
+/* rch_plot.h - a small SVG chart writer (lines, scatter, bars).
+ *
+ * What: one chart per rch_plot object: a title, axis labels, any number of
+ * line and scatter series over a common numeric x axis, or one bar series
+ * over categories (with optional error bars). Axes carry "nice" ticks
+ * (1-2-5 steps; decades on a log y axis), a grid, and a legend naming every
+ * series; series get distinct colours (a colour-blind-safe palette) and
+ * distinct markers for scatter. All text is XML-escaped. Output is a single
+ * self-contained SVG file that any browser opens.
+ *
+ * Bars and numeric series in one chart: bars take the categories 0..n-1 as
+ * x positions; line/scatter series added to a bar chart are drawn on the same
+ * axis (x = category index), e.g. for a reference line.
+ *
+ * Non-finite points (NaN, inf) are skipped and break a line; on a log y axis
+ * points with y <= 0 are skipped too.
+ *
+ * Depends on: the C library (stdio, stdlib, string, math). Memory: the chart
+ * copies every string and array it is given (callers may free theirs at once);
+ * rch_plot_free releases it. Thread safety: one object per thread.
+ * Errors: rch_plot_new returns NULL on allocation failure; an allocation
+ * failure in an add function is remembered and makes rch_plot_write_svg
+ * return -1. rch_plot_write_svg returns 0, or -1 with errno set when the file
+ * could not be written. Every function accepts p == NULL and does nothing.
+ */
+#ifndef RCH_PLOT_H
+#define RCH_PLOT_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+typedef struct rch_plot rch_plot;
+
+/* New empty chart; any string may be NULL (treated as ""). */
+rch_plot *rch_plot_new(const char *title, const char *xlabel, const char *ylabel);
+
+/* A polyline through (x[k], y[k]), k = 0..n-1; x, y: (n). */
+void rch_plot_line(rch_plot *p, const char *label, const double *x, const double *y, size_t n);
+
+/* Markers at (x[k], y[k]); x, y: (n). */
+void rch_plot_scatter(rch_plot *p, const char *label, const double *x, const double *y, size_t n);
+
+/* One bar per category: labels (n) under the bars, values (n) bar heights,
+ * errs (n) half-lengths of error bars or NULL. Replaces earlier bars. */
+void rch_plot_bars(rch_plot *p, const char *const *labels, const double *values,
+                   const double *errs, size_t n);
+
+/* Logarithmic y axis (on != 0). Default linear. */
+void rch_plot_logy(rch_plot *p, int on);
+
+/* Size in pixels (default 800 x 500). Values below 200 x 150 are raised. */
+void rch_plot_size(rch_plot *p, unsigned width_px, unsigned height_px);
+
+/* Force axis ranges (lo < hi; otherwise automatic, which is the default). */
+void rch_plot_xrange(rch_plot *p, double lo, double hi);
+void rch_plot_yrange(rch_plot *p, double lo, double hi);
+
+/* Write the chart to a file path, or to an open stream. 0 or -1. */
+int rch_plot_write_svg(const rch_plot *p, const char *path);
+int rch_plot_write_svg_stream(const rch_plot *p, FILE *f);
+
+void rch_plot_free(rch_plot *p);
+
+#endif
