@@ -338,6 +338,12 @@ static void plot_ranges(const rch_plot *p, plot_axis *ax, plot_axis *ay)
         ylo -= d;
         yhi += d;
     }
+    if (!(p->ylo < p->yhi)) { /* headroom: 4 % (bars keep their zero base) */
+        double pad = 0.04 * (yhi - ylo);
+        if (!(p->n_bars > 0 && !ay->log && ylo == 0.0))
+            ylo -= pad;
+        yhi += pad;
+    }
     ax->lo = xlo;
     ax->hi = xhi;
     ay->lo = ylo;
@@ -396,7 +402,7 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
         }
     }
     if (nleg > 0) {
-        legw = 34.0 + 6.5 * (double)(maxlab > 40 ? 40 : maxlab);
+        legw = 40.0 + 7.2 * (double)(maxlab > 40 ? 40 : maxlab);
         R += legw + 10.0;
     }
     if (p->n_bars > 0) {
@@ -442,8 +448,10 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
         if (ay.log) {
             double span = ay.hi - ay.lo;
             int d0 = (int)floor(ay.lo), d1 = (int)ceil(ay.hi), d;
-            static const double sub[3] = {1.0, 2.0, 5.0};
-            int nsub = span < 2.5 ? 3 : 1;
+            static const double sub3[3] = {1.0, 2.0, 5.0};
+            static const double sub9[9] = {1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0};
+            const double *sub = span < 1.2 ? sub9 : sub3;
+            int nsub = span < 1.2 ? 9 : (span < 2.5 ? 3 : 1);
             int every = span > 12 ? (int)ceil(span / 8.0) : 1;
             for (d = d0; d <= d1 && guard < 400; d++, guard++) {
                 int s;
