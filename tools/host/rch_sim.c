@@ -103,3 +103,33 @@ int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const
     }
     return 0;
 }
+
+void rch_sim_flange_diff(double *rms_mm, double *max_mm, const rc_model *a, const rc_model *b,
+                         const rc_sample *poses, size_t n, int align)
+{
+    double sxy = 0.0, sxx = 0.0, dz = 0.0, phi = 0.0, sum2 = 0.0, mx = 0.0;
+    if (align) {
+        for (size_t i = 0; i < n; ++i) {
+            double pa[3], pb[3];
+            rc_fk(pa, NULL, a, poses[i].q_rad);
+            rc_fk(pb, NULL, b, poses[i].q_rad);
+            sxy += pa[0] * pb[1] - pa[1] * pb[0];
+            sxx += pa[0] * pb[0] + pa[1] * pb[1];
+            dz += (pb[2] - pa[2]) / (double)n;
+        }
+        phi = atan2(sxy, sxx);
+    }
+    const double c = cos(phi), s = sin(phi);
+    for (size_t i = 0; i < n; ++i) {
+        double pa[3], pb[3];
+        rc_fk(pa, NULL, a, poses[i].q_rad);
+        rc_fk(pb, NULL, b, poses[i].q_rad);
+        const double x = c * pa[0] - s * pa[1], y = s * pa[0] + c * pa[1], z = pa[2] + dz;
+        const double d = sqrt((x - pb[0]) * (x - pb[0]) + (y - pb[1]) * (y - pb[1]) + (z - pb[2]) * (z - pb[2]));
+        sum2 += d * d;
+        if (d > mx)
+            mx = d;
+    }
+    *rms_mm = n ? sqrt(sum2 / (double)n) : 0.0;
+    *max_mm = mx;
+}

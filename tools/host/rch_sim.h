@@ -46,4 +46,11 @@ void rch_sim_truth(rc_model *truth, const rc_model *nominal, const double enc_mm
 int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const rc_model *truth,
                     const rch_sim_config *c, rc_rng *g);
 
+/* Flange-position agreement of two models over poses (n): RMS and max of
+ * |p_a(q) - p_b(q)| in mm. With align != 0, first removes what cable lengths
+ * cannot see: a rotation about the base z axis and a shift along it (the
+ * base heading and height), fitted in closed form. */
+void rch_sim_flange_diff(double *rms_mm, double *max_mm, const rc_model *a, const rc_model *b,
+                         const rc_sample *poses, size_t n, int align);
+
 #endif
