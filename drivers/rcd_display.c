@@ -114,8 +114,11 @@ rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms
             d->need_poll = 1;
             if (st == RC_OK) {
                 st = check_shape(d, &r);
-                if (st == RC_ERR_INCOMPLETE)
-                    break; /* warm-up frame: poll again / keep listening */
+                if (st == RC_ERR_INCOMPLETE) {
+                    if (is_polled(d))
+                        break; /* warm-up frame: poll again */
+                    continue;  /* warm-up frame: keep parsing */
+                }
                 if (st == RC_OK) {
                     d->stats.readings++;
                     if (out)

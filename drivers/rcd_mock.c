@@ -42,6 +42,12 @@ static rc_status mk_read(void *ctx, size_t *n_read, uint8_t *buf, size_t cap, un
     if (m->timeout_every && m->n_reads % m->timeout_every == 0)
         return RC_ERR_TIMEOUT;
     left = m->rx_len - m->rx_pos;
+    if (m->n_segments) {
+        size_t lim = m->released < m->rx_len ? m->released : m->rx_len;
+        left = lim > m->rx_pos ? lim - m->rx_pos : 0;
+        if (left == 0 && m->rx_pos < m->rx_len)
+            return RC_ERR_TIMEOUT; /* the device waits for a request */
+    }
     if (left == 0)
         return m->closed_at_end ? RC_ERR_CLOSED : RC_ERR_TIMEOUT;
     n = cap < left ? cap : left;
@@ -76,6 +82,8 @@ static rc_status mk_write(void *ctx, size_t *n_written, const uint8_t *buf, size
             m->tx[m->tx_len++] = buf[i];
     m->tx_total += n;
     *n_written = n;
+    if (m->n_segments && m->seg_next < m->n_segments)
+        m->released += m->segments[m->seg_next++];
     return n == len ? RC_OK : fail_st(m);
 }
 

@@ -131,8 +131,9 @@ rc_status rcd_posix_attach(rcd_port *p, rcd_posix_ctx *ctx, int fd, int owned);
  *    further read / write returns fail_status (default RC_ERR_IO);
  *  - max_chunk: a read returns at most this many bytes (short reads);
  *  - timeout_every: every k-th read returns RC_ERR_TIMEOUT with no byte;
- *  - at the end of the script a read returns RC_ERR_TIMEOUT, or
- *    RC_ERR_CLOSED when closed_at_end is set.
+ *  - at the end of the script (or of the released segments) a read returns
+ *    RC_ERR_TIMEOUT, or RC_ERR_CLOSED when closed_at_end is set.
+ * flush only counts (scripted bytes are the device's future output).
  * No time passes: a timeout is reported at once. */
 #define RCD_MOCK_NEVER ((size_t)-1)
 
@@ -150,6 +151,13 @@ typedef struct rcd_mock_ctx {
     unsigned timeout_every; /* 0: never */
     int closed_at_end;
     int fail_open;          /* open returns fail_status */
+    /* polled device: when n_segments > 0, the script is cut into segments
+     * (segments: (n_segments) byte counts) and each write releases the next
+     * one: a reply only after a request. */
+    const size_t *segments;
+    size_t n_segments;
+    size_t released;        /* bytes released so far (state) */
+    size_t seg_next;        /* next segment to release (state) */
     /* state, read by tests */
     size_t rx_pos;
     size_t tx_len;     /* bytes captured (<= tx_cap) */
