@@ -1,0 +1,214 @@
+/* Kinematics and measurement model: analytic Jacobians against finite
+ * differences, FK against the real file's nominal x, y, z. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rc_model.h"
+#include "rc_rand.h"
+#include "rch_data.h"
+#include "rch_robot.h"
+
+static rc_model nominal(void)
+{
+    rch_robot r;
+    rch_diag d;
+    assert_int_equal(rch_robot_load(&r, RCAL_SOURCE_DIR "/data/irb120.json", &d), 0);
+    r.model.x[RC_P_ENC] = 250.0;
+    r.model.x[RC_P_ENC + 1] = -460.0;
+    r.model.x[RC_P_ENC + 2] = 10.0;
+    return r.model;
+}
+
+static void random_pose(rc_sample *s, rc_rng *g)
+{
+    memset(s, 0, sizeof *s);
+    for (int j = 0; j < RC_NJ; ++j)
+        s->q_rad[j] = (2.0 * rc_rng_u01(g) - 1.0) * 2.5;
+    s->t = rc_rng_u01(g);
+    s->group = (uint16_t)rc_rng_below(g, 3);
+}
+
+/* d l / d x_k: central differences against rc_meas's analytic gradient, for
+ * the base model and a model with every effect kind. */
+static void check_param_jacobian(rc_model *m, rc_rng *g)
+{
+    for (int trial = 0; trial < 50; ++trial) {
+        rc_sample s;
+        random_pose(&s, g);
+        double l, jac[RC_MAX_PARAMS];
+        assert_int_equal(rc_meas(&l, jac, m, &s), RC_OK);
+        for (unsigned k = 0; k < m->n_params; ++k) {
+            const double h = rc_param_unit(m, k) == 0 ? 1e-4 : 1e-7;
+            rc_model mp = *m, mm = *m;
+            mp.x[k] += h;
+            mm.x[k] -= h;
+            double lp, lm;
+            assert_int_equal(rc_meas(&lp, NULL, &mp, &s), RC_OK);
+            assert_int_equal(rc_meas(&lm, NULL, &mm, &s), RC_OK);
+            const double fd = (lp - lm) / (2.0 * h);
+            if (fabs(fd - jac[k]) > 1e-5 * (1.0 + fabs(fd))) {
+                char name[64];
+                print_error("param %s: analytic %.9g, finite difference %.9g\n", rc_param_name(name, 64, m, k),
+                            jac[k], fd);
+                fail();
+            }
+        }
+    }
+}
+
+static void test_param_jacobian_base(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 1);
+    rc_model m = nominal();
+    for (unsigned k = 0; k < RC_N_BASE; ++k) /* away from the special nominal values */
+        m.x[k] += 0.01 * rc_rng_normal(&g);
+    check_param_jacobian(&m, &g);
+}
+
+static void test_param_jacobian_effects(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 2);
+    rc_model m = nominal();
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_OFFSET, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 1, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 2, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 3, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TIME_DRIFT, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_GROUP_OFFSET, 0, 3), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_SCALE, 0, 0), RC_OK);
+    assert_int_equal(m.n_params, RC_N_BASE + 1 + 1 + 1 + 4 + 2 + 3 + 1);
+    for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
+        m.x[k] = 1e-3 * rc_rng_normal(&g);
+    check_param_jacobian(&m, &g);
+}
+
+static void test_effect_capacity(void **state)
+{
+    (void)state;
+    rc_model m = nominal();
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 0, 0), RC_ERR_ARG);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_GROUP_OFFSET, 0, RC_MAX_PARAMS), RC_ERR_CAPACITY);
+    assert_int_equal(m.n_params, RC_N_BASE);
+}
+
+/* d p / d q and the angular rows against finite differences, with a periodic
+ * joint error so the chain rule through effects is exercised. */
+static void test_joint_jacobian(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 3);
+    rc_model m = nominal();
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 2, 0), RC_OK);
+    for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
+        m.x[k] = 2e-3;
+    for (int trial = 0; trial < 50; ++trial) {
+        rc_sample s;
+        random_pose(&s, &g);
+        double p[3], R[9], J[36];
+        rc_fk_jac(p, R, J, &m, s.q_rad);
+        for (unsigned j = 0; j < RC_NJ; ++j) {
+            const double h = 1e-7;
+            double qp[RC_NJ], qm[RC_NJ], pp[3], pm[3], Rp[9], Rm[9];
+            memcpy(qp, s.q_rad, sizeof qp);
+            memcpy(qm, s.q_rad, sizeof qm);
+            qp[j] += h;
+            qm[j] -= h;
+            rc_fk(pp, Rp, &m, qp);
+            rc_fk(pm, Rm, &m, qm);
+            for (int r = 0; r < 3; ++r)
+                assert_true(fabs((pp[r] - pm[r]) / (2 * h) - J[6 * r + j]) < 1e-5);
+            /* angular velocity: skew part of dR R^T */
+            double W[9];
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < 3; ++b) {
+                    double sum = 0.0;
+                    for (int k = 0; k < 3; ++k)
+                        sum += (Rp[3 * a + k] - Rm[3 * a + k]) / (2 * h) * R[3 * b + k];
+                    W[3 * a + b] = sum;
+                }
+            assert_true(fabs(W[7] - J[6 * 3 + j]) < 1e-6);
+            assert_true(fabs(W[2] - J[6 * 4 + j]) < 1e-6);
+            assert_true(fabs(W[3] - J[6 * 5 + j]) < 1e-6);
+        }
+    }
+}
+
+static void test_fk_zero_pose(void **state)
+{
+    (void)state;
+    rc_model m = nominal();
+    double q[RC_NJ] = {0}, p[3];
+    rc_fk(p, NULL, &m, q);
+    /* IRB120 at zero: flange at x = 302 + 72, z = 290 + 270 + 70 */
+    assert_true(fabs(p[0] - 374.0) < 1e-9);
+    assert_true(fabs(p[1]) < 1e-9);
+    assert_true(fabs(p[2] - 630.0) < 1e-9);
+}
+
+static void test_fk_real_file(void **state)
+{
+    (void)state;
+    FILE *f = fopen(RCAL_SHARED_DATA, "r");
+    if (!f) {
+        print_message("SKIP: %s is absent; FK check against the real file not run\n", RCAL_SHARED_DATA);
+        skip();
+    }
+    fclose(f);
+    rch_data d;
+    rch_diag dg;
+    assert_int_equal(rch_data_load(&d, RCAL_SHARED_DATA, 0, &dg), 0);
+    assert_non_null(d.xyz);
+    rc_model m = nominal();
+    size_t within_1mm = 0, far = 0;
+    for (size_t i = 0; i < d.n; ++i) {
+        double p[3];
+        rc_fk(p, NULL, &m, d.s[i].q_rad);
+        const double dist = sqrt(pow(p[0] - d.xyz[i][0], 2) + pow(p[1] - d.xyz[i][1], 2) + pow(p[2] - d.xyz[i][2], 2));
+        if (dist < 1.0)
+            ++within_1mm;
+        else if (dist > 50.0)
+            ++far;
+    }
+    /* all rows but the faulty ones agree within the 0.1 deg angle rounding */
+    assert_int_equal(d.n, 1042);
+    assert_true(within_1mm >= 1039);
+    assert_int_equal(far, 1); /* line 952: z = 504.5 in the file, FK says 405.35 */
+    rch_data_free(&d);
+}
+
+static void test_lt_map(void **state)
+{
+    (void)state;
+    double n = 0.37;
+    for (int i = 0; i < 10000; ++i) {
+        n = rc_lt_map(n, 0.5);
+        assert_true(n >= 0.0 && n < 1.0);
+    }
+    /* Eq. 11 by hand: N = 0.2 < 0.5: 0.5*0.2*0.8 + 3.5*0.1 = 0.43 */
+    assert_true(fabs(rc_lt_map(0.2, 0.5) - 0.43) < 1e-12);
+    /* N = 0.8: 0.5*0.8*0.2 + 3.5*0.1 = 0.43 */
+    assert_true(fabs(rc_lt_map(0.8, 0.5) - 0.43) < 1e-12);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_param_jacobian_base), cmocka_unit_test(test_param_jacobian_effects),
+        cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
+        cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_fk_real_file),
+        cmocka_unit_test(test_lt_map),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
