@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Install what is missing (Debian packages only). Root or sudo required.
+set -euo pipefail
+PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev libcmocka-dev
+      gcc-arm-none-eabi libnewlib-arm-none-eabi clang libclang-rt-14-dev cppcheck clang-tidy valgrind)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "installing: ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
+fi

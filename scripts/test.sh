@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The whole test suite: install what is missing, then
+#  1. build + ctest (Release),
+#  2. build + ctest with AddressSanitizer and UndefinedBehaviorSanitizer,
+#  3. extra checks that exist: cross-build of the core for Cortex-M7,
+#     static analysis, fuzzing (bounded time), valgrind.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+JOBS=$(nproc)
+status=0
+
+echo "== build and test (Release)"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$JOBS" 2>&1 | grep -E 'warning|error' || true
+cmake --build build -j"$JOBS" >/dev/null
+ctest --test-dir build --output-on-failure -j"$JOBS" || status=1
+
+echo "== build and test with ASan + UBSan"
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DRCAL_SANITIZE=ON >/dev/null
+cmake --build build-asan -j"$JOBS" >/dev/null
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build-asan --output-on-failure -j"$JOBS" || status=1
+
+for extra in firmware_host/cross_build.sh scripts/static_analysis.sh fuzz/run.sh scripts/valgrind_tests.sh; do
+  if [ -x "$extra" ]; then
+    echo "== $extra"
+    "$extra" || status=1
+  fi
+done
+
+if [ $status -eq 0 ]; then echo "ALL CHECKS PASSED"; else echo "SOME CHECKS FAILED"; fi
+exit $status
