@@ -1,0 +1,427 @@
+/* test_comp.c - compensation of joint targets (rc_comp): accuracy on a
+ * simulated truth (given and identified from cable lengths), singular poses,
+ * joint limits, non-convergence, bad input, the stream, inverse kinematics. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rc_comp.h"
+#include "rc_rand.h"
+#include "rc_solve.h"
+
+#define DEG (3.14159265358979323846 / 180.0)
+
+static const double irb120_dh[RC_NJ][4] = {
+    {0, 290, -90 * DEG, 0}, {270, 0, 0, -90 * DEG}, {70, 0, -90 * DEG, 0},
+    {0, 302, 90 * DEG, 0},  {0, 0, -90 * DEG, 0},   {0, 72, 0, 0},
+};
+static const double irb120_lim_deg[RC_NJ][2] = {{-165, 165}, {-110, 110}, {-110, 70},
+                                                {-160, 160}, {-120, 120}, {-400, 400}};
+static const double enc_mm[3] = {600, -300, 50};
+
+static void make_nominal(rc_model *m)
+{
+    assert_int_equal(rc_model_init(m, irb120_dh, enc_mm), RC_OK);
+    for (int i = 0; i < RC_NJ; ++i) {
+        m->q_min_rad[i] = irb120_lim_deg[i][0] * DEG;
+        m->q_max_rad[i] = irb120_lim_deg[i][1] * DEG;
+    }
+}
+
+/* truth = nominal + N(0, len) on a, d and N(0, ang) on alpha, theta. */
+static void make_truth(rc_model *t, const rc_model *nom, double len_mm, double ang_deg, uint64_t seed)
+{
+    rc_rng g;
+    rc_rng_seed(&g, seed);
+    *t = *nom;
+    for (int k = 0; k < RC_N_DH; ++k)
+        t->x[k] += (k % 4 < 2 ? len_mm : ang_deg * DEG) * rc_rng_normal(&g);
+}
+
+/* A random pose inside the limits, kept away from the three singularities
+ * as a robot program is: the wrist (q5 = 0), the stretched elbow (q3 = -77
+ * deg, the workspace boundary) and the wrist centre over axis 1 (closer than
+ * 100 mm). */
+static void random_pose(double q[RC_NJ], rc_rng *g)
+{
+    static const double lo[RC_NJ] = {-120, -60, -62, -120, -100, -180};
+    static const double hi[RC_NJ] = {120, 80, 50, 120, 100, 180};
+    rc_model nom;
+    assert_int_equal(rc_model_init(&nom, irb120_dh, enc_mm), RC_OK);
+    for (;;) {
+        double p[3], R[9];
+        for (int i = 0; i < RC_NJ; ++i)
+            q[i] = (lo[i] + (hi[i] - lo[i]) * rc_rng_u01(g)) * DEG;
+        if (fabs(q[4]) < 10 * DEG)
+            q[4] = (q[4] < 0 ? -10 : 10) * DEG;
+        rc_fk(p, R, &nom, q);
+        const double wx = p[0] - 72.0 * R[2], wy = p[1] - 72.0 * R[5];
+        if (wx * wx + wy * wy > 100.0 * 100.0)
+            return;
+    }
+}
+
+static double dist3(const double a[3], const double b[3])
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+static double rot_angle(const double A[9], const double B[9])
+{
+    double tr = 0.0;
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k)
+            tr += A[3 * r + k] * B[3 * r + k];
+    double c = 0.5 * (tr - 1.0);
+    c = c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c);
+    return acos(c);
+}
+
+static void assert_finite_q(const double q[RC_NJ])
+{
+    for (int i = 0; i < RC_NJ; ++i)
+        assert_true(isfinite(q[i]));
+}
+
+static void assert_in_limits(const rc_model *m, const double q[RC_NJ])
+{
+    for (int i = 0; i < RC_NJ; ++i) {
+        assert_true(q[i] >= m->q_min_rad[i]);
+        assert_true(q[i] <= m->q_max_rad[i]);
+    }
+}
+
+/* With the true model as the calibrated one, the true robot lands on the
+ * nominal targets to far better than 0.05 mm, where uncompensated it is off
+ * by millimetres. Orientation is matched too. */
+static void test_truth_model_compensates(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    rc_rng g;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 0.5, 0.1, 11);
+    rc_rng_seed(&g, 5);
+    double sum_unc = 0.0, max_comp = 0.0, max_rot = 0.0;
+    unsigned iters = 0;
+    const int n = 300;
+    for (int k = 0; k < n; ++k) {
+        double q[RC_NJ], qc[RC_NJ], pn[3], Rn[9], pt[3], Rt[9], pu[3];
+        rc_comp_result res;
+        random_pose(q, &g);
+        rc_fk(pn, Rn, &nom, q);
+        rc_fk(pu, NULL, &truth, q);
+        sum_unc += dist3(pu, pn);
+        assert_int_equal(rc_comp_joint(qc, &res, &truth, &nom, q, NULL, NULL), RC_OK);
+        assert_int_equal(res.exit, RC_COMP_CONVERGED);
+        assert_in_limits(&truth, qc);
+        rc_fk(pt, Rt, &truth, qc);
+        max_comp = fmax(max_comp, dist3(pt, pn));
+        max_rot = fmax(max_rot, rot_angle(Rt, Rn));
+        assert_true(res.pos_err_mm <= 1e-5);
+        iters += res.iterations;
+    }
+    assert_true(sum_unc / n > 1.0);   /* off by millimetres */
+    assert_true(max_comp < 1e-4);     /* well inside 0.05 mm */
+    assert_true(max_rot < 1e-6);
+    assert_true(iters <= 4u * (unsigned)n); /* Newton: a few iterations each */
+}
+
+/* End to end: identify the model from simulated cable lengths with rc_solve
+ * (encoder outlet known), then compensate with the identified model. */
+static void test_identified_model_compensates(void **state)
+{
+    (void)state;
+    static rc_solve_work w;
+    static rc_sample s[240];
+    static uint8_t fixed[RC_MAX_PARAMS];
+    rc_model nom, truth, cal;
+    rc_rng g;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 0.5, 0.1, 23);
+    rc_rng_seed(&g, 7);
+    for (size_t i = 0; i < sizeof s / sizeof s[0]; ++i) {
+        random_pose(s[i].q_rad, &g);
+        s[i].t = 0.0;
+        s[i].group = 0;
+        assert_int_equal(rc_meas(&s[i].len_mm, NULL, &truth, &s[i]), RC_OK);
+    }
+    cal = nom;
+    memset(fixed, 0, sizeof fixed);
+    fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 1; /* outlet known */
+    rc_solve_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.fixed = fixed;
+    rc_solve_result sr;
+    assert_int_equal(rc_solve(&cal, &sr, &w, &cfg, s, sizeof s / sizeof s[0]), RC_OK);
+    assert_true(sr.rms_final_mm < 1e-3);
+
+    rc_rng_seed(&g, 99);
+    double sum_unc = 0.0, max_comp = 0.0;
+    const int n = 200;
+    for (int k = 0; k < n; ++k) {
+        double q[RC_NJ], qc[RC_NJ], pn[3], pt[3], pu[3];
+        random_pose(q, &g);
+        rc_fk(pn, NULL, &nom, q);
+        rc_fk(pu, NULL, &truth, q);
+        sum_unc += dist3(pu, pn);
+        assert_int_equal(rc_comp_joint(qc, NULL, &cal, &nom, q, NULL, NULL), RC_OK);
+        rc_fk(pt, NULL, &truth, qc); /* where the true robot goes */
+        max_comp = fmax(max_comp, dist3(pt, pn));
+    }
+    assert_true(sum_unc / n > 1.0);
+    assert_true(max_comp < 0.05);
+}
+
+/* Wrist singularity (q5 = 0 and nearly 0), arm stretched, wrist centre on
+ * axis 1: no NaN, joints within their box, position matched or flagged. */
+static void test_singular_poses(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 0.5, 0.1, 31);
+    /* q3 where a3 and d4 line up with a2: elbow stretched */
+    const double q3_str = -90 * DEG + atan2(70.0, 302.0);
+    const double poses[][RC_NJ] = {
+        {0.3, 0.2, -0.4, 0.5, 0.0, -0.2},
+        {0.3, 0.2, -0.4, 0.5, 1e-7, -0.2},
+        {0.3, 0.2, -0.4, 0.0, 0.0, 0.0},
+        {0.0, 0.1, q3_str, 0.2, 0.5, 0.1},
+        {0.0, 0.0, q3_str, 0.0, 0.0, 0.0},
+        {0.1, -0.3, 1.0, 0.0, 0.6, 0.0}, /* wrist centre near axis 1 */
+    };
+    for (size_t k = 0; k < sizeof poses / sizeof poses[0]; ++k) {
+        for (unsigned flags = 0; flags < 2; ++flags) {
+            double qc[RC_NJ], pn[3], pt[3];
+            rc_comp_result res;
+            rc_comp_config cfg;
+            memset(&cfg, 0, sizeof cfg);
+            cfg.flags = flags;
+            rc_status st = rc_comp_joint(qc, &res, &truth, &nom, poses[k], NULL, &cfg);
+            assert_finite_q(qc);
+            assert_in_limits(&truth, qc);
+            for (int i = 0; i < RC_NJ; ++i)
+                assert_true(fabs(qc[i] - poses[k][i]) <= 0.1 + 1e-12);
+            assert_true(isfinite(res.pos_err_mm) && isfinite(res.rot_err_rad));
+            rc_fk(pn, NULL, &nom, poses[k]);
+            rc_fk(pt, NULL, &truth, qc);
+            if (st == RC_OK) {
+                assert_true(dist3(pt, pn) < 1e-4);
+                assert_true(res.exit == RC_COMP_CONVERGED || res.exit == RC_COMP_POSITION_ONLY);
+            } else {
+                assert_int_equal(st, RC_ERR_NOCONV);
+                assert_true(res.exit == RC_COMP_MAX_ITER || res.exit == RC_COMP_NO_DESCENT);
+            }
+            /* the position is matched at every one of these poses */
+            assert_true(dist3(pt, pn) < 0.05);
+        }
+    }
+}
+
+/* A target on the joint-2 limit whose correction points outside: joint 2
+ * stays on its limit, the bound is reported; with position only the other
+ * joints take over and the position is matched. */
+static void test_joint_limit(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    make_nominal(&nom);
+    truth = nom;
+    truth.x[RC_P_THETA(1)] -= 0.01; /* joint 2 reads 0.01 rad more than it is */
+    const double q[RC_NJ] = {0.2, 110 * DEG, -0.5, 0.3, 0.8, 0.1};
+    double qc[RC_NJ], pn[3], pt[3];
+    rc_comp_result res;
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+
+    rc_status st = rc_comp_joint(qc, &res, &truth, &nom, q, NULL, &cfg);
+    assert_finite_q(qc);
+    assert_in_limits(&truth, qc);
+    assert_true(res.bound_mask & 2u);
+    assert_true(qc[1] == truth.q_max_rad[1]);
+    assert_true(st == RC_OK ? res.exit == RC_COMP_POSITION_ONLY : st == RC_ERR_NOCONV);
+
+    cfg.flags = RC_COMP_FLAG_POSITION_ONLY;
+    assert_int_equal(rc_comp_joint(qc, &res, &truth, &nom, q, NULL, &cfg), RC_OK);
+    assert_int_equal(res.exit, RC_COMP_CONVERGED);
+    assert_in_limits(&truth, qc);
+    rc_fk(pn, NULL, &nom, q);
+    rc_fk(pt, NULL, &truth, qc);
+    assert_true(dist3(pt, pn) < 1e-4);
+}
+
+/* Not converging: one iteration only, and a target the model cannot reach
+ * within max_dev. The call returns RC_ERR_NOCONV, the best point (closer than
+ * the start), finite and within the box. */
+static void test_nonconvergence(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 2.0, 0.5, 41);
+    const double q[RC_NJ] = {0.4, 0.3, -0.3, 0.6, 0.9, -0.4};
+    double qc[RC_NJ], pn[3], pu[3], pt[3];
+    rc_comp_result res;
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.max_iter = 1;
+    rc_fk(pn, NULL, &nom, q);
+    rc_fk(pu, NULL, &truth, q);
+    assert_int_equal(rc_comp_joint(qc, &res, &truth, &nom, q, NULL, &cfg), RC_ERR_NOCONV);
+    assert_int_equal(res.exit, RC_COMP_MAX_ITER);
+    assert_finite_q(qc);
+    rc_fk(pt, NULL, &truth, qc);
+    assert_true(dist3(pt, pn) < dist3(pu, pn));
+    assert_true(fabs(dist3(pt, pn) - res.pos_err_mm) < 1e-9);
+
+    /* 100 mm of link error cannot be undone within 0.01 rad */
+    rc_model bad = truth;
+    bad.x[RC_P_A(1)] += 100.0;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.max_dev_rad = 0.01;
+    cfg.max_iter = 30;
+    assert_int_equal(rc_comp_joint(qc, &res, &bad, &nom, q, NULL, &cfg), RC_ERR_NOCONV);
+    assert_finite_q(qc);
+    for (int i = 0; i < RC_NJ; ++i)
+        assert_true(fabs(qc[i] - q[i]) <= 0.01 + 1e-12);
+    assert_true(res.bound_mask != 0u);
+    rc_fk(pu, NULL, &bad, q);
+    rc_fk(pt, NULL, &bad, qc);
+    assert_true(dist3(pt, pn) < dist3(pu, pn));
+}
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 0.5, 0.1, 3);
+    double qc[RC_NJ];
+    rc_comp_result res;
+    double q[RC_NJ] = {0.1, 0.2, NAN, 0.1, 0.5, 0.0};
+    assert_int_equal(rc_comp_joint(qc, &res, &truth, &nom, q, NULL, NULL), RC_ERR_RANGE);
+    assert_int_equal(res.exit, RC_COMP_BAD_INPUT);
+    for (int i = 0; i < RC_NJ; ++i)
+        assert_true(qc[i] == 0.0);
+    q[2] = 3.0; /* outside joint 3's limits */
+    assert_int_equal(rc_comp_joint(qc, &res, &truth, &nom, q, NULL, NULL), RC_ERR_RANGE);
+    assert_memory_equal(qc, q, sizeof q);
+    q[2] = 0.0;
+    q[0] = INFINITY;
+    assert_int_equal(rc_comp_joint(qc, &res, &truth, &nom, q, NULL, NULL), RC_ERR_RANGE);
+
+    /* a calibrated model with NaN in it: RC_ERR_NUMERIC, q unchanged */
+    rc_model broken = truth;
+    broken.x[RC_P_A(2)] = NAN;
+    q[0] = 0.1;
+    assert_int_equal(rc_comp_joint(qc, &res, &broken, &nom, q, NULL, NULL), RC_ERR_NUMERIC);
+    assert_int_equal(res.exit, RC_COMP_NONFINITE);
+    assert_memory_equal(qc, q, sizeof q);
+
+    /* inverse use: non-finite target */
+    const double p_nan[3] = {NAN, 0, 500};
+    assert_int_equal(rc_comp_pose(qc, &res, &truth, p_nan, NULL, q, NULL), RC_ERR_RANGE);
+    assert_finite_q(qc);
+}
+
+/* A smooth stream converges in about one iteration per target; a forced
+ * failure gives q + the last good correction and the flag. */
+static void test_stream(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    rc_comp_stream s;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 0.5, 0.1, 17);
+    assert_int_equal(rc_comp_stream_init(&s, &truth, &nom, NULL), RC_OK);
+    unsigned iters = 0;
+    double last_dq[RC_NJ] = {0};
+    const int n = 1000;
+    for (int k = 0; k < n; ++k) {
+        const double t = (double)k / 1000.0; /* one second at 1 kHz */
+        double q[RC_NJ], qc[RC_NJ], pn[3], pt[3];
+        rc_comp_result res;
+        for (int i = 0; i < RC_NJ; ++i)
+            q[i] = 0.5 * sin(2.0 * 3.14159265 * 0.5 * t + i) * (i == 4 ? 0.5 : 1.0) + (i == 4 ? 0.8 : 0.0);
+        assert_int_equal(rc_comp_stream_step(&s, qc, &res, q), RC_OK);
+        iters += res.iterations;
+        rc_fk(pn, NULL, &nom, q);
+        rc_fk(pt, NULL, &truth, qc);
+        assert_true(dist3(pt, pn) < 1e-4);
+        for (int i = 0; i < RC_NJ; ++i)
+            last_dq[i] = qc[i] - q[i];
+    }
+    assert_true(s.n_ok == (unsigned long)n && s.n_fail == 0);
+    assert_true(iters <= 2u * (unsigned)n);
+
+    /* force a failure: one iteration, impossible tolerance */
+    s.cfg.max_iter = 1;
+    s.cfg.tol_mm = 1e-30;
+    const double q[RC_NJ] = {0.3, 0.1, -0.2, 0.4, 0.9, 0.2};
+    double qc[RC_NJ];
+    rc_comp_result res;
+    assert_int_equal(rc_comp_stream_step(&s, qc, &res, q), RC_ERR_NOCONV);
+    for (int i = 0; i < RC_NJ; ++i)
+        assert_true(fabs(qc[i] - (q[i] + last_dq[i])) < 1e-15);
+    assert_int_equal(s.fail_run, 1);
+    assert_int_equal(s.n_fail, 1);
+}
+
+/* Inverse use: pose -> joints on the nominal model from a distant seed
+ * (full pose and position only), and the corrected target on the truth. */
+static void test_pose_ik(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    rc_rng g;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 0.5, 0.1, 19);
+    rc_rng_seed(&g, 77);
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.max_iter = 100;
+    for (int k = 0; k < 50; ++k) {
+        double q[RC_NJ], seed[RC_NJ], qi[RC_NJ], p[3], R[9], p2[3], R2[9];
+        rc_comp_result res;
+        random_pose(q, &g);
+        for (int i = 0; i < RC_NJ; ++i)
+            seed[i] = q[i] + 0.2 * (rc_rng_u01(&g) - 0.5);
+        rc_fk(p, R, &nom, q);
+        assert_int_equal(rc_comp_pose(qi, &res, &nom, p, R, seed, &cfg), RC_OK);
+        assert_int_equal(res.exit, RC_COMP_CONVERGED);
+        rc_fk(p2, R2, &nom, qi);
+        assert_true(dist3(p, p2) < 1e-4);
+        assert_true(rot_angle(R, R2) < 1e-6);
+        /* corrected target: the truth reaches the same pose */
+        assert_int_equal(rc_comp_pose(qi, &res, &truth, p, R, q, &cfg), RC_OK);
+        rc_fk(p2, R2, &truth, qi);
+        assert_true(dist3(p, p2) < 1e-4);
+        assert_true(rot_angle(R, R2) < 1e-6);
+        /* position only */
+        assert_int_equal(rc_comp_pose(qi, &res, &truth, p, NULL, seed, &cfg), RC_OK);
+        rc_fk(p2, NULL, &truth, qi);
+        assert_true(dist3(p, p2) < 1e-4);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_truth_model_compensates),
+        cmocka_unit_test(test_identified_model_compensates),
+        cmocka_unit_test(test_singular_poses),
+        cmocka_unit_test(test_joint_limit),
+        cmocka_unit_test(test_nonconvergence),
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_stream),
+        cmocka_unit_test(test_pose_ik),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
