@@ -1,0 +1,50 @@
+/* fuzz_data_common.h - one fuzz body for the CSV reader (rch_data_parse),
+ * used with flags 0 (measurement files) and RCH_DATA_NO_LEN (pose plans). */
+#ifndef FUZZ_DATA_COMMON_H
+#define FUZZ_DATA_COMMON_H
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "fuzz_check.h"
+#include "rch_data.h"
+
+static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
+{
+    rch_data d;
+    rch_diag diag;
+    const double q_max = 720.0 * 3.14159265358979323846 / 180.0 * (1.0 + 1e-12);
+    memset(&diag, 0, sizeof diag);
+    /* The parser gets exactly size bytes (no NUL after them): ASan catches any
+     * read past the end. */
+    int rc = rch_data_parse(&d, (const char *)data, size, "fuzz.csv", flags, &diag);
+    if (rc != 0) {
+        /* refused: a message, nothing left allocated */
+        FZ_CHECK(diag.msg[0] != '\0');
+        FZ_CHECK(d.s == NULL && d.xyz == NULL && d.line == NULL && d.n == 0);
+        return;
+    }
+    FZ_CHECK(d.n >= 1 && d.s != NULL && d.line != NULL);
+    for (size_t i = 0; i < d.n; ++i) {
+        const rc_sample *s = &d.s[i];
+        for (int j = 0; j < RC_NJ; ++j)
+            FZ_CHECK(isfinite(s->q_rad[j]) && fabs(s->q_rad[j]) <= q_max);
+        if (flags & RCH_DATA_NO_LEN)
+            FZ_CHECK(s->len_mm == 0.0 || (s->len_mm > 0.0 && s->len_mm <= 20000.0));
+        else
+            FZ_CHECK(s->len_mm > 0.0 && s->len_mm <= 20000.0);
+        /* documented: t scaled to [0, 1] */
+        FZ_CHECK(isfinite(s->t) && s->t >= 0.0 && s->t <= 1.0);
+        FZ_CHECK(d.line[i] >= 2);
+        if (i > 0)
+            FZ_CHECK(d.line[i] > d.line[i - 1]);
+        if (d.xyz)
+            for (int k = 0; k < 3; ++k)
+                FZ_CHECK(isfinite(d.xyz[i][k]));
+    }
+    rch_data_free(&d);
+    FZ_CHECK(d.s == NULL && d.n == 0);
+}
+
+#endif
