@@ -184,6 +184,10 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
                              col_names[k], v[k]);
                 goto fail;
             }
+            if (k == C_T && fabs(v[k]) > 1e300) { /* t_max - t_min must stay finite when scaling */
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field 't': %g is absurd", v[k]);
+                goto fail;
+            }
             if (k == C_G && (v[k] < 0.0 || v[k] > 65535.0 || v[k] != floor(v[k]))) {
                 rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
                              "field 'group': %g is not an integer in 0..65535", v[k]);
