@@ -59,7 +59,7 @@ typedef struct rc_solve_config {
     double mu0;              /* robust: initial damping relative to the largest
                                 scaled eigenvalue, 0: 1e-3; paper: absolute mu, 0: 5 */
     double tol_step;         /* 0: 1e-9 (relative, scaled) */
-    double tol_cost;         /* 0: 1e-10 (relative decrease) */
+    double tol_cost;         /* 0: 1e-6 (relative decrease of the cost in one iteration) */
     double rcond;            /* 0: 1e-9: eigenvalue cut-off relative to the largest */
     unsigned n_candidates;   /* LTLM M, 0: 20 */
     double chaos_r;          /* LTLM map parameter r, 0: 0.5 */
