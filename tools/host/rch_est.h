@@ -1,0 +1,100 @@
+/* rch_est.h - the seven identification methods of the LTLM paper's
+ * comparison (its Table 5) behind one call, with timing and convergence
+ * curves, for rcal compare and tests.
+ *
+ * M1 LM and M7 LTLM are rc_solve's robust methods (all free parameters, the
+ * solver's own eigen-truncation of unidentifiable directions); M2 EKF, M3 PF,
+ * M4 SCA, M5 QIBAS and M6 SSLM are rc_est's (identifiable subset, bounds
+ * around the start; see rc_est.h for every hyperparameter). Every method
+ * starts from the model it is given (rch_calib_start's BC model in compare).
+ *
+ * Depends on: rc_solve, rc_est (core), libc. Memory: rch_est_ws holds both
+ * solver workspaces (about 1 MB) on the heap; curves grow on the heap.
+ * Thread safety: one workspace per thread. Errors: rc_status from the
+ * solvers; RC_ERR_CAPACITY when an allocation fails.
+ */
+#ifndef RCH_EST_H
+#define RCH_EST_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rc_est.h"
+#include "rc_solve.h"
+
+typedef enum rch_est_id {
+    RCH_EST_LM = 0,
+    RCH_EST_EKF = 1,
+    RCH_EST_PF = 2,
+    RCH_EST_SCA = 3,
+    RCH_EST_QIBAS = 4,
+    RCH_EST_SSLM = 5,
+    RCH_EST_LTLM = 6,
+    RCH_EST_COUNT = 7
+} rch_est_id;
+
+/* "LM", "EKF", "PF", "SCA", "QIBAS", "SSLM", "LTLM" (the paper's names). */
+const char *rch_est_name(rch_est_id id);
+/* Case-insensitive name (or "m1".."m7") to id; -1 when unknown. */
+int rch_est_parse(const char *name);
+
+/* Training RMS per iteration; rms_mm[0] is the start. */
+typedef struct rch_curve {
+    double *rms_mm; /* (n) */
+    size_t n, cap;
+    int failed;     /* an allocation failed: the curve is truncated */
+} rch_curve;
+void rch_curve_free(rch_curve *c);
+
+typedef struct rch_est_ws {
+    rc_solve_work solve;
+    rc_est_work est;
+} rch_est_ws;
+rch_est_ws *rch_est_ws_new(void);
+void rch_est_ws_free(rch_est_ws *ws);
+
+/* Options beyond the per-method defaults (all-zero: defaults). */
+typedef struct rch_est_opts {
+    unsigned max_iter;     /* 0: the method's default */
+    unsigned pop;          /* PF/SCA population; 0: default */
+    double bound_len_mm;   /* see rc_est_config; 0: default */
+    double bound_ang_rad;
+    double bound_enc_mm;
+} rch_est_opts;
+
+typedef struct rch_est_out {
+    double time_ms;        /* wall time of the identification alone (CLOCK_MONOTONIC) */
+    unsigned iterations;
+    unsigned cost_evals;   /* passes over the training samples */
+    double rms_start_mm;   /* training RMS */
+    double rms_final_mm;
+    unsigned n_moved;      /* parameters the method moved (LM/LTLM: rank found) */
+} rch_est_out;
+
+/* Identify m (in: start, out: result) with method id from train (n).
+ * curve may be NULL. opts may be NULL. */
+rc_status rch_est_run(rc_model *m, rch_est_out *out, rch_curve *curve, rch_est_ws *ws,
+                      rch_est_id id, uint64_t seed, const rch_est_opts *opts,
+                      const rc_sample *train, size_t n);
+
+#endif
+
+/* ---- the chaos study (paper Figs. 2-3, Eq. 12) ---------------------------- */
+
+/* Uniformity of the logistic-tent map rc_lt_map at r: iterate `points` times
+ * from n0 (n0 itself not counted), count the iterates in `bins` equal bins
+ * of [0, 1), and return the standard deviation of the bin counts,
+ * sqrt(sum_k (c_k - points/bins)^2 / bins) (the paper's Eq. 12 as we read it:
+ * the population sd; 0 = perfectly uniform). counts: (bins) receives the
+ * histogram, or NULL. */
+double rch_chaos_sd(unsigned *counts, double r, double n0, unsigned points, unsigned bins);
+
+/* The same averaged over n_starts initial values drawn uniformly in
+ * (0.01, 0.99) from seed (fixed seed: reproducible); se (may be NULL)
+ * receives the standard error of that mean. */
+double rch_chaos_sd_avg(double *se, double r, unsigned points, unsigned bins, unsigned n_starts,
+                        uint64_t seed);
+
+/* The expected sd of the bin counts of `points` independent uniform draws:
+ * sqrt(points / bins * (1 - 1 / bins)), the yardstick for "uniform". */
+double rch_chaos_sd_iid(unsigned points, unsigned bins);
