@@ -117,6 +117,7 @@ void rcd_serialport_init(rcd_port *p, rcd_serialport_ctx *ctx);
 typedef struct rcd_posix_ctx {
     int fd;         /* -1 when closed */
     int owned;      /* close(2) the fd on rcd_port_close */
+    int is_tty;     /* read() == 0 means "no data yet" on a raw tty, EOF elsewhere */
     char err[256];
 } rcd_posix_ctx;
 

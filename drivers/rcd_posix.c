@@ -104,7 +104,8 @@ static rc_status px_open(void *ctx, const char *path, const rcd_serial_config *c
         return e == ENOENT || e == ENXIO ? RC_ERR_CLOSED : RC_ERR_IO;
     }
     c->owned = 1;
-    if (isatty(c->fd)) {
+    c->is_tty = isatty(c->fd);
+    if (c->is_tty) {
         st = configure(c, cfg);
         if (st != RC_OK) {
             close(c->fd);
@@ -145,11 +146,11 @@ static rc_status px_read(void *ctx, size_t *n_read, uint8_t *buf, size_t cap, un
             *n_read = (size_t)n;
             return RC_OK;
         }
-        if (n == 0) {
+        if (n == 0 && !c->is_tty) {
             snprintf(c->err, sizeof c->err, "read: end of file (peer closed)");
             return RC_ERR_CLOSED;
         }
-        if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
+        if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
             return set_errno(c, "read", errno);
         left = deadline - now_ms();
         if (left <= 0)
@@ -270,5 +271,6 @@ rc_status rcd_posix_attach(rcd_port *p, rcd_posix_ctx *ctx, int fd, int owned)
         return set_errno(ctx, "fcntl", errno);
     ctx->fd = fd;
     ctx->owned = owned;
+    ctx->is_tty = isatty(fd);
     return RC_OK;
 }

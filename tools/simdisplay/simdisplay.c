@@ -1,0 +1,604 @@
+/* simdisplay.c - a simulated cable-encoder display on a pseudo-terminal.
+ *
+ * Opens a pty, puts its slave side in raw mode, prints the slave's path as
+ * the FIRST LINE of stdout (and points --link at it), then speaks one display
+ * protocol like a real device until killed, --exit-after-frames or
+ * --max-seconds:
+ *   ascii       streams "+0509.190\r\n" lines at --rate-hz
+ *   ascii-poll  answers each poll command (default "R\r") with one line
+ *   stx         answers each poll command with STX payload ETX BCC
+ *   modbus      answers fn 0x03 requests for --mb-reg (2 registers); other
+ *               registers get exception 2 (illegal data address)
+ *
+ * Value source (mm):
+ *   --value MM                constant
+ *   --script FILE             one value per line, the next one for each frame
+ *                             (the last one is held)
+ *   --truth MODEL.json --poses POSES.csv [--follow FILE]
+ *                             the true cable length of a simulated robot
+ *                             (rc_meas of the truth model) at the pose the
+ *                             acquisition is at. How the display learns the
+ *                             pose: `rcal acquire --announce FILE` writes the
+ *                             index of the pose it asks the robot to visit to
+ *                             FILE (atomically, "INDEX q1 .. q6"), standing for
+ *                             the robot program; the display re-reads FILE
+ *                             before each frame. After a change the shown
+ *                             length moves from the old to the new value over
+ *                             --settle-ms with a decaying 0.5 mm vibration, as
+ *                             the arm travels and settles.
+ * Realism and faults:
+ *   --noise-mm S        Gaussian noise on each reading (default 0)
+ *   --decimals D        digits after the point (ascii/stx, default 3)
+ *   --style zero|unit   "+0509.190" or "+ 509.190, MM" (ascii, default zero)
+ *   --unit mm|cm|m|in   unit shown in the unit style (default mm)
+ *   --baud B            pace output at B baud, 10 bits per byte (0: no pacing)
+ *   --drop P, --corrupt P    per-byte probability of dropping / replacing it
+ *   --garbage P         per-frame probability of 1..12 random bytes before it
+ *   --silence-every N --silence-ms T   after every N frames, say nothing for T ms
+ *   --disconnect-after N  after N frames send half a frame and close the pty;
+ *                       with --reconnect-ms R open a new pty R ms later (its
+ *                       path printed as a new stdout line, --link re-pointed),
+ *                       else exit
+ *   --seed S            random faults and noise are reproducible
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rc_rand.h"
+#include "rcd_proto.h"
+#include "rch_data.h"
+#include "rch_robot.h"
+
+typedef enum { SRC_CONST, SRC_SCRIPT, SRC_ROBOT } src_kind;
+
+typedef struct sim {
+    rcd_proto_config pc;
+    unsigned decimals;
+    rcd_ascii_style style;
+    rcd_unit unit;
+    double rate_hz, noise_mm, p_drop, p_corrupt, p_garbage;
+    unsigned long baud, silence_every, silence_ms, disconnect_after, exit_after, settle_ms;
+    long reconnect_ms;
+    double max_seconds;
+    const char *link, *follow;
+    src_kind src;
+    double const_mm;
+    double *script;
+    size_t n_script, script_pos;
+    double *pose_len; /* (n_poses) true lengths */
+    size_t n_poses;
+    long cur_pose;
+    double from_mm;
+    long long change_ms;
+    int master, keeper;
+    char path[128];
+    rc_rng rng;
+    unsigned long frames;
+    double line_free_s;
+    long long silent_until_ms;
+    unsigned long last_silence_frame;
+    int disconnected;
+} sim;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static long long now_ms(void)
+{
+    return (long long)(now_s() * 1000.0);
+}
+
+static void sleep_s(double s)
+{
+    struct timespec ts;
+    if (s <= 0)
+        return;
+    ts.tv_sec = (time_t)s;
+    ts.tv_nsec = (long)((s - (double)ts.tv_sec) * 1e9);
+    nanosleep(&ts, NULL);
+}
+
+static int open_pty(sim *s)
+{
+    struct termios tio;
+    const char *name;
+    s->master = posix_openpt(O_RDWR | O_NOCTTY);
+    if (s->master < 0 || grantpt(s->master) != 0 || unlockpt(s->master) != 0 ||
+        !(name = ptsname(s->master))) {
+        fprintf(stderr, "simdisplay: cannot open a pseudo-terminal: %s\n", strerror(errno));
+        return -1;
+    }
+    snprintf(s->path, sizeof s->path, "%s", name);
+    /* Keep a slave fd open: the master then never sees EIO while no client
+     * is connected, and the raw mode set here stays until a client changes it. */
+    s->keeper = open(s->path, O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (s->keeper < 0 || tcgetattr(s->keeper, &tio) != 0) {
+        fprintf(stderr, "simdisplay: cannot open %s: %s\n", s->path, strerror(errno));
+        return -1;
+    }
+    cfmakeraw(&tio);
+    tcsetattr(s->keeper, TCSANOW, &tio);
+    fcntl(s->master, F_SETFL, fcntl(s->master, F_GETFL) | O_NONBLOCK);
+    if (s->link) {
+        char tmp[600];
+        snprintf(tmp, sizeof tmp, "%s.tmp%ld", s->link, (long)getpid());
+        unlink(tmp);
+        if (symlink(s->path, tmp) != 0 || rename(tmp, s->link) != 0) {
+            fprintf(stderr, "simdisplay: cannot link %s: %s\n", s->link, strerror(errno));
+            return -1;
+        }
+    }
+    printf("%s\n", s->path);
+    fflush(stdout);
+    return 0;
+}
+
+static void close_pty(sim *s)
+{
+    if (s->master >= 0)
+        close(s->master);
+    if (s->keeper >= 0)
+        close(s->keeper);
+    s->master = s->keeper = -1;
+}
+
+/* Paced write; drops what the pty cannot take (nobody reading). */
+static void send_bytes(sim *s, const uint8_t *b, size_t n)
+{
+    size_t off = 0;
+    if (s->baud) {
+        double t = now_s();
+        if (s->line_free_s > t)
+            sleep_s(s->line_free_s - t);
+        t = now_s();
+        s->line_free_s = (s->line_free_s > t ? s->line_free_s : t) + (double)n * 10.0 / (double)s->baud;
+    }
+    while (off < n) {
+        ssize_t w = write(s->master, b + off, n - off);
+        if (w > 0) {
+            off += (size_t)w;
+            continue;
+        }
+        if (w < 0 && errno == EINTR)
+            continue;
+        break; /* EAGAIN: buffer full, the frame is lost like on a real line */
+    }
+}
+
+static long read_follow(const sim *s)
+{
+    FILE *f;
+    long idx = -1;
+    if (!s->follow || !(f = fopen(s->follow, "r")))
+        return -1;
+    if (fscanf(f, "%ld", &idx) != 1)
+        idx = -1;
+    fclose(f);
+    return idx;
+}
+
+static double true_value(sim *s)
+{
+    switch (s->src) {
+    case SRC_CONST:
+        return s->const_mm;
+    case SRC_SCRIPT: {
+        size_t i = s->script_pos < s->n_script ? s->script_pos : s->n_script - 1;
+        s->script_pos++;
+        return s->script[i];
+    }
+    case SRC_ROBOT:
+    default: {
+        long idx = read_follow(s);
+        long long t = now_ms();
+        double target, frac;
+        if (idx >= 0 && (size_t)idx < s->n_poses && idx != s->cur_pose) {
+            /* start of a move: from what is shown now */
+            double shown = s->pose_len[s->cur_pose];
+            if (t - s->change_ms < (long long)s->settle_ms && s->settle_ms) {
+                frac = (double)(t - s->change_ms) / (double)s->settle_ms;
+                shown = s->from_mm + (shown - s->from_mm) * frac;
+            }
+            s->from_mm = shown;
+            s->cur_pose = idx;
+            s->change_ms = t;
+        }
+        target = s->pose_len[s->cur_pose];
+        if (!s->settle_ms || t - s->change_ms >= (long long)s->settle_ms)
+            return target;
+        frac = (double)(t - s->change_ms) / (double)s->settle_ms;
+        return s->from_mm + (target - s->from_mm) * frac +
+               0.5 * (1.0 - frac) * sin(6.283185307179586 * (double)(t - s->change_ms) / 40.0);
+    }
+    }
+}
+
+/* Build, damage and send one frame (or half of one, then disconnect). */
+static void emit(sim *s)
+{
+    uint8_t f[RCD_MAX_FRAME], out[RCD_MAX_FRAME * 2 + 16];
+    size_t n = 0, k = 0;
+    rc_status st;
+    double v = true_value(s);
+    if (s->noise_mm > 0)
+        v += s->noise_mm * rc_rng_normal(&s->rng);
+    switch (s->pc.protocol) {
+    case RCD_PROTO_ASCII:
+    case RCD_PROTO_ASCII_POLL:
+        st = rcd_encode_ascii(f, &n, sizeof f, v, s->style, s->unit, s->decimals);
+        break;
+    case RCD_PROTO_STX:
+        st = rcd_encode_stx(f, &n, sizeof f, v, s->decimals);
+        break;
+    default:
+        st = rcd_encode_modbus(f, &n, sizeof f, v, &s->pc);
+        break;
+    }
+    if (st != RC_OK) {
+        fprintf(stderr, "simdisplay: cannot encode %.4f mm: %s\n", v, rc_strerror(st));
+        return;
+    }
+    s->frames++;
+    if (s->disconnect_after && s->frames == s->disconnect_after + 1) {
+        send_bytes(s, f, n / 2);
+        sleep_s(0.05);
+        close_pty(s);
+        s->disconnected = 1;
+        return;
+    }
+    if (s->p_garbage > 0 && rc_rng_u01(&s->rng) < s->p_garbage) {
+        unsigned g = 1 + rc_rng_below(&s->rng, 12);
+        while (g--)
+            out[k++] = (uint8_t)rc_rng_below(&s->rng, 256);
+    }
+    for (size_t i = 0; i < n; ++i) {
+        if (s->p_drop > 0 && rc_rng_u01(&s->rng) < s->p_drop)
+            continue;
+        if (s->p_corrupt > 0 && rc_rng_u01(&s->rng) < s->p_corrupt)
+            out[k++] = (uint8_t)(f[i] ^ (1u + rc_rng_below(&s->rng, 255)));
+        else
+            out[k++] = f[i];
+    }
+    send_bytes(s, out, k);
+}
+
+static int is_silent(sim *s)
+{
+    long long t = now_ms();
+    if (t < s->silent_until_ms)
+        return 1;
+    if (s->silence_every && s->frames && s->frames % s->silence_every == 0 &&
+        s->last_silence_frame != s->frames) {
+        s->last_silence_frame = s->frames;
+        s->silent_until_ms = t + (long long)s->silence_ms;
+        return 1;
+    }
+    return 0;
+}
+
+static int load_script(sim *s, const char *path)
+{
+    FILE *f = fopen(path, "r");
+    char line[256];
+    size_t cap = 0;
+    if (!f) {
+        fprintf(stderr, "simdisplay: %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    while (fgets(line, sizeof line, f)) {
+        char *end;
+        double v = strtod(line, &end);
+        if (end == line || line[0] == '#')
+            continue;
+        if (s->n_script == cap) {
+            cap = cap ? 2 * cap : 64;
+            s->script = realloc(s->script, cap * sizeof *s->script);
+            if (!s->script) {
+                fclose(f);
+                return -1;
+            }
+        }
+        s->script[s->n_script++] = v;
+    }
+    fclose(f);
+    if (!s->n_script) {
+        fprintf(stderr, "simdisplay: %s holds no value\n", path);
+        return -1;
+    }
+    return 0;
+}
+
+static int load_robot(sim *s, const char *truth_path, const char *poses_path)
+{
+    rch_robot *r = calloc(1, sizeof *r);
+    rch_data d;
+    rch_diag dg;
+    char buf[900];
+    if (!r)
+        return -1;
+    if (rch_robot_load(r, truth_path, &dg) != 0) {
+        fprintf(stderr, "simdisplay: %s\n", rch_diag_str(&dg, buf, sizeof buf));
+        free(r);
+        return -1;
+    }
+    if (!r->has_encoder)
+        fprintf(stderr, "simdisplay: warning: %s has no encoder_mm; using its default\n", truth_path);
+    if (rch_data_load(&d, poses_path, RCH_DATA_NO_LEN, &dg) != 0) {
+        fprintf(stderr, "simdisplay: %s\n", rch_diag_str(&dg, buf, sizeof buf));
+        free(r);
+        return -1;
+    }
+    s->n_poses = d.n;
+    s->pose_len = calloc(d.n ? d.n : 1, sizeof *s->pose_len);
+    for (size_t i = 0; i < d.n; ++i) {
+        rc_sample smp = d.s[i];
+        double l;
+        smp.t = d.n > 1 ? (double)i / (double)(d.n - 1) : 0.0;
+        if (rc_meas(&l, NULL, &r->model, &smp) != RC_OK) {
+            fprintf(stderr, "simdisplay: pose %zu: no length (flange at the encoder)\n", i);
+            rch_data_free(&d);
+            free(r);
+            return -1;
+        }
+        s->pose_len[i] = l;
+    }
+    rch_data_free(&d);
+    free(r);
+    return s->n_poses ? 0 : -1;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: rcal_simdisplay --protocol ascii|ascii-poll|stx|modbus\n"
+               "         (--value MM | --script FILE | --truth MODEL.json --poses POSES.csv [--follow FILE])\n"
+               "         [--noise-mm S] [--decimals D] [--style zero|unit] [--unit mm|cm|m|in]\n"
+               "         [--rate-hz R] [--baud B] [--poll-cmd TEXT] [--mb-addr A] [--mb-reg R]\n"
+               "         [--mb-format int32|float] [--mb-order abcd|cdab|badc|dcba] [--mb-decimals D]\n"
+               "         [--drop P] [--corrupt P] [--garbage P] [--silence-every N --silence-ms T]\n"
+               "         [--disconnect-after N [--reconnect-ms R]] [--settle-ms T] [--reply-delay-ms T]\n"
+               "         [--link PATH] [--seed S] [--exit-after-frames N] [--max-seconds T]\n"
+               "  Prints the pty path as the first line of stdout. See the comment of simdisplay.c.\n");
+}
+
+int main(int argc, char **argv)
+{
+    sim s;
+    const char *script = NULL, *truth = NULL, *poses = NULL;
+    unsigned long reply_delay_ms = 0, seed = 1;
+    uint8_t rq[512];
+    size_t rq_len = 0;
+    double t_start, next_frame;
+    int have_value = 0;
+    memset(&s, 0, sizeof s);
+    s.decimals = 3;
+    s.rate_hz = 20;
+    s.reconnect_ms = -1;
+    s.max_seconds = 600;
+    s.master = s.keeper = -1;
+    s.pc.protocol = RCD_PROTO_ASCII;
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+#define OPT(name) (strcmp(a, name) == 0 && v && (++i, 1))
+        if (OPT("--protocol")) {
+            if (rcd_protocol_from_name(&s.pc.protocol, v) != RC_OK) {
+                fprintf(stderr, "simdisplay: unknown protocol '%s'\n", v);
+                return 2;
+            }
+        } else if (OPT("--value")) {
+            s.const_mm = atof(v);
+            have_value = 1;
+        } else if (OPT("--script")) {
+            script = v;
+        } else if (OPT("--truth")) {
+            truth = v;
+        } else if (OPT("--poses")) {
+            poses = v;
+        } else if (OPT("--follow")) {
+            s.follow = v;
+        } else if (OPT("--noise-mm")) {
+            s.noise_mm = atof(v);
+        } else if (OPT("--decimals")) {
+            s.decimals = (unsigned)atoi(v);
+        } else if (OPT("--style")) {
+            s.style = strcmp(v, "unit") == 0 ? RCD_STYLE_SPACE_UNIT : RCD_STYLE_ZERO_PAD;
+        } else if (OPT("--unit")) {
+            if (rcd_unit_from_name(&s.unit, v) != RC_OK)
+                return 2;
+        } else if (OPT("--rate-hz")) {
+            s.rate_hz = atof(v);
+        } else if (OPT("--baud")) {
+            s.baud = strtoul(v, NULL, 10);
+        } else if (OPT("--poll-cmd")) {
+            /* C escapes \r and \n are understood */
+            size_t k = 0;
+            for (const char *p = v; *p && k + 1 < sizeof s.pc.poll_cmd; ++p) {
+                if (p[0] == '\\' && (p[1] == 'r' || p[1] == 'n')) {
+                    s.pc.poll_cmd[k++] = p[1] == 'r' ? '\r' : '\n';
+                    ++p;
+                } else {
+                    s.pc.poll_cmd[k++] = *p;
+                }
+            }
+        } else if (OPT("--mb-addr")) {
+            s.pc.mb_addr = (uint8_t)atoi(v);
+        } else if (OPT("--mb-reg")) {
+            s.pc.mb_reg = (uint16_t)strtoul(v, NULL, 0);
+        } else if (OPT("--mb-format")) {
+            s.pc.mb_format = strcmp(v, "float") == 0 ? RCD_MB_FLOAT32 : RCD_MB_INT32;
+        } else if (OPT("--mb-order")) {
+            if (rcd_word_order_from_name(&s.pc.mb_order, v) != RC_OK)
+                return 2;
+        } else if (OPT("--mb-decimals")) {
+            s.pc.mb_decimals = (uint8_t)atoi(v);
+        } else if (OPT("--drop")) {
+            s.p_drop = atof(v);
+        } else if (OPT("--corrupt")) {
+            s.p_corrupt = atof(v);
+        } else if (OPT("--garbage")) {
+            s.p_garbage = atof(v);
+        } else if (OPT("--silence-every")) {
+            s.silence_every = strtoul(v, NULL, 10);
+        } else if (OPT("--silence-ms")) {
+            s.silence_ms = strtoul(v, NULL, 10);
+        } else if (OPT("--disconnect-after")) {
+            s.disconnect_after = strtoul(v, NULL, 10);
+        } else if (OPT("--reconnect-ms")) {
+            s.reconnect_ms = atol(v);
+        } else if (OPT("--settle-ms")) {
+            s.settle_ms = strtoul(v, NULL, 10);
+        } else if (OPT("--reply-delay-ms")) {
+            reply_delay_ms = strtoul(v, NULL, 10);
+        } else if (OPT("--link")) {
+            s.link = v;
+        } else if (OPT("--seed")) {
+            seed = strtoul(v, NULL, 10);
+        } else if (OPT("--exit-after-frames")) {
+            s.exit_after = strtoul(v, NULL, 10);
+        } else if (OPT("--max-seconds")) {
+            s.max_seconds = atof(v);
+        } else if (strcmp(a, "--help") == 0) {
+            usage(stdout);
+            return 0;
+        } else {
+            fprintf(stderr, "simdisplay: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return 2;
+        }
+#undef OPT
+    }
+    rc_rng_seed(&s.rng, seed);
+    if (script) {
+        s.src = SRC_SCRIPT;
+        if (load_script(&s, script) != 0)
+            return 1;
+    } else if (truth || poses) {
+        if (!truth || !poses) {
+            fprintf(stderr, "simdisplay: --truth and --poses go together\n");
+            return 2;
+        }
+        s.src = SRC_ROBOT;
+        if (load_robot(&s, truth, poses) != 0)
+            return 1;
+    } else if (have_value) {
+        s.src = SRC_CONST;
+    } else {
+        usage(stderr);
+        return 2;
+    }
+    if (s.decimals > 6) {
+        fprintf(stderr, "simdisplay: --decimals must be 0..6\n");
+        return 2;
+    }
+    if (open_pty(&s) != 0)
+        return 1;
+    t_start = now_s();
+    next_frame = t_start;
+    for (;;) {
+        struct pollfd pfd;
+        int timeout_ms = 20;
+        double t = now_s();
+        if (t - t_start > s.max_seconds || (s.exit_after && s.frames >= s.exit_after))
+            break;
+        if (s.disconnected) {
+            if (s.reconnect_ms < 0)
+                break;
+            sleep_s((double)s.reconnect_ms / 1000.0);
+            s.disconnected = 0;
+            s.disconnect_after = 0;
+            rq_len = 0;
+            if (open_pty(&s) != 0)
+                return 1;
+            continue;
+        }
+        if (s.pc.protocol == RCD_PROTO_ASCII) {
+            if (t < next_frame) {
+                double w = next_frame - t;
+                timeout_ms = (int)(w * 1000.0);
+            } else {
+                timeout_ms = 0;
+            }
+        }
+        pfd.fd = s.master;
+        pfd.events = POLLIN;
+        pfd.revents = 0;
+        if (poll(&pfd, 1, timeout_ms) > 0 && (pfd.revents & POLLIN)) {
+            ssize_t r = read(s.master, rq + rq_len, sizeof rq - rq_len);
+            if (r > 0)
+                rq_len += (size_t)r;
+        }
+        if (is_silent(&s)) {
+            rq_len = 0; /* a silent display ignores requests */
+            continue;
+        }
+        if (s.pc.protocol == RCD_PROTO_ASCII) {
+            if (now_s() >= next_frame) {
+                emit(&s);
+                next_frame += s.rate_hz > 0 ? 1.0 / s.rate_hz : 0.0;
+                if (next_frame < now_s() - 1.0)
+                    next_frame = now_s(); /* do not burst after a stall */
+            }
+        } else if (s.pc.protocol == RCD_PROTO_MODBUS) {
+            for (;;) {
+                uint16_t reg = 0, cnt = 0;
+                size_t c = 0;
+                rc_status st = rcd_parse_modbus_request(&reg, &cnt, &c, s.pc.mb_addr ? s.pc.mb_addr : 1, rq, rq_len);
+                memmove(rq, rq + c, rq_len - c);
+                rq_len -= c;
+                if (st == RC_ERR_INCOMPLETE)
+                    break;
+                if (st != RC_OK)
+                    continue;
+                sleep_s((double)reply_delay_ms / 1000.0);
+                if (reg != s.pc.mb_reg || cnt != 2) {
+                    uint8_t e[8];
+                    size_t n;
+                    rcd_encode_modbus_exception(e, &n, sizeof e, s.pc.mb_addr ? s.pc.mb_addr : 1, 2);
+                    send_bytes(&s, e, n);
+                } else {
+                    emit(&s);
+                }
+                if (s.disconnected)
+                    break;
+            }
+        } else {
+            const char *cmd = s.pc.poll_cmd[0] ? s.pc.poll_cmd : "R\r";
+            size_t cl = strlen(cmd);
+            for (;;) {
+                size_t p = 0;
+                while (p + cl <= rq_len && memcmp(rq + p, cmd, cl) != 0)
+                    ++p;
+                if (p + cl > rq_len) {
+                    if (rq_len >= cl) { /* keep a possible partial command */
+                        memmove(rq, rq + rq_len - (cl - 1), cl - 1);
+                        rq_len = cl - 1;
+                    }
+                    break;
+                }
+                memmove(rq, rq + p + cl, rq_len - p - cl);
+                rq_len -= p + cl;
+                sleep_s((double)reply_delay_ms / 1000.0);
+                emit(&s);
+                if (s.disconnected)
+                    break;
+            }
+        }
+        if (rq_len == sizeof rq)
+            rq_len = 0;
+    }
+    close_pty(&s);
+    free(s.script);
+    free(s.pose_len);
+    return 0;
+}
