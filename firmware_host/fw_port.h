@@ -1,0 +1,14 @@
+/* fw_port.h - what a firmware build of the rcal core redirects.
+ *
+ * Force-included (-include fw_port.h) when the core is compiled for the
+ * microcontroller: contract violations go to the firmware's fault handler
+ * instead of the C library's assert (which would pull in fprintf). The
+ * handler is defined by the firmware (fw_example.c here).
+ */
+#ifndef FW_PORT_H
+#define FW_PORT_H
+
+void fw_fault(const char *file, int line);
+#define RC_ASSERT(cond) ((cond) ? (void)0 : fw_fault(__FILE__, __LINE__))
+
+#endif

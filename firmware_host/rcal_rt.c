@@ -1,0 +1,530 @@
+/* rcal_rt.c - rcal-rt: the compensation in a host real-time loop, its
+ * benchmark, and the generator of the firmware's compiled-in model tables.
+ *
+ *   rcal-rt [--model MODEL.json] [--rate-hz 1000] [--seconds 10] [--in TARGETS.csv] [--fifo] [--cpu N]
+ *   rcal-rt --bench [--targets N] [--repeat R] [--model MODEL.json]
+ *   rcal-rt --emit-c MODEL.json [--position-only] > fw_model_data.h
+ *
+ * Loop: wakes at absolute times t_k = t_0 + k * period (clock_nanosleep with
+ * TIMER_ABSTIME on CLOCK_MONOTONIC), compensates the k-th target of the
+ * stream, and records: the compute latency (the rc_comp_stream_step call),
+ * the wake-up lateness (actual wake minus t_k) and the completion time
+ * (done minus t_k). A deadline miss is a cycle whose result is ready after
+ * t_k + period (the next cycle's start); cycles so late that their slot has
+ * passed are counted as missed too and not run twice.
+ * Without --model the compiled-in firmware tables (fw_model_data.h) are used.
+ */
+#include <errno.h>
+#include <math.h>
+#include <sched.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include "fw_model_data.h"
+#include "rc_comp.h"
+#include "rch_diag.h"
+#include "rch_robot.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: rcal-rt [--model MODEL.json] [--nominal ROBOT.json] [--rate-hz HZ] [--seconds S]\n"
+            "               [--in TARGETS.csv] [--position-only] [--fifo] [--cpu N] [--json]\n"
+            "       rcal-rt --bench [--targets N] [--repeat R] [--cold] [--model MODEL.json] [--position-only]\n"
+            "       rcal-rt --emit-c MODEL.json [--position-only]\n"
+            "  loop:    compensates one target per period (default 1000 Hz for 10 s) with\n"
+            "           clock_nanosleep(TIMER_ABSTIME) and reports compute latency, wake-up\n"
+            "           lateness and completion time (median, p99, p99.99, max) and deadline misses\n"
+            "  --in     targets (q1..q6 degrees per line, optional header), cycled; default: a\n"
+            "           smooth synthetic joint-space path through the workspace\n"
+            "  --fifo   run as SCHED_FIFO priority 80 with memory locked (needs the privilege)\n"
+            "  --bench  compensates N targets back to back (default 200000), R times (default 5),\n"
+            "           reports latency per target and targets/s for each run and their medians;\n"
+            "           --cold solves every target from scratch (no warm start from the last correction)\n"
+            "  --emit-c writes the C tables of a model for fw_example.c (fw_model_data.h)\n"
+            "Without --model, the compiled-in firmware model tables are used.\n");
+}
+
+static double now_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Nearest-rank percentile of sorted v (n > 0), p in [0, 100]. */
+static double pct(const double *v, size_t n, double p)
+{
+    size_t k = (size_t)ceil(p / 100.0 * (double)n);
+    if (k < 1)
+        k = 1;
+    if (k > n)
+        k = n;
+    return v[k - 1];
+}
+
+typedef struct {
+    double med, p99, p9999, max, mean;
+} stats;
+
+static stats stats_of(double *v, size_t n)
+{
+    stats s = {0, 0, 0, 0, 0};
+    if (n == 0)
+        return s;
+    qsort(v, n, sizeof v[0], cmp_double);
+    double sum = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        sum += v[i];
+    s.med = pct(v, n, 50.0);
+    s.p99 = pct(v, n, 99.0);
+    s.p9999 = pct(v, n, 99.99);
+    s.max = v[n - 1];
+    s.mean = sum / (double)n;
+    return s;
+}
+
+/* Targets: a file's rows (degrees -> rad) or the synthetic path. */
+typedef struct {
+    double (*q)[RC_NJ];
+    size_t n;
+} targets;
+
+/* Smooth path through the workspace, away from the singularities: each
+ * joint a sine of its own frequency. k at rate_hz. */
+static void synth_target(double q[RC_NJ], size_t k, double rate_hz)
+{
+    static const double c[RC_NJ] = {0.0, 0.35, -0.35, 0.0, 0.9, 0.0};
+    static const double a[RC_NJ] = {1.2, 0.35, 0.35, 1.0, 0.5, 1.5};
+    static const double f[RC_NJ] = {0.05, 0.07, 0.11, 0.13, 0.17, 0.19};
+    const double t = (double)k / rate_hz;
+    for (int i = 0; i < RC_NJ; ++i)
+        q[i] = c[i] + a[i] * sin(2.0 * M_PI * f[i] * t + i);
+}
+
+static int load_targets(targets *t, const char *path, const rc_model *m)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "rcal-rt: %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    char line[1024];
+    unsigned lineno = 0;
+    size_t cap = 0;
+    t->q = NULL;
+    t->n = 0;
+    while (fgets(line, sizeof line, f)) {
+        ++lineno;
+        double v[RC_NJ];
+        char *p = line;
+        while (*p == ' ' || *p == '\t')
+            ++p;
+        if (*p == '#' || *p == '\n' || *p == '\r' || *p == '\0')
+            continue;
+        int ok = 1;
+        for (int i = 0; i < RC_NJ && ok; ++i) {
+            char *end;
+            errno = 0;
+            v[i] = strtod(p, &end);
+            if (end == p || errno != 0 || !isfinite(v[i])) {
+                ok = 0;
+                break;
+            }
+            p = end;
+            while (*p == ' ' || *p == '\t')
+                ++p;
+            if (i < RC_NJ - 1) {
+                if (*p != ',') {
+                    ok = 0;
+                    break;
+                }
+                ++p;
+            }
+        }
+        if (!ok) {
+            if (t->n == 0 && lineno == 1)
+                continue; /* a header */
+            fprintf(stderr, "rcal-rt: %s:%u:%ld: expected q1..q6 in degrees\n", path, lineno, (long)(p - line) + 1);
+            fclose(f);
+            free(t->q);
+            return -1;
+        }
+        for (int i = 0; i < RC_NJ; ++i) {
+            v[i] *= DEG;
+            if (v[i] < m->q_min_rad[i] || v[i] > m->q_max_rad[i]) {
+                fprintf(stderr, "rcal-rt: %s:%u: q%d outside the joint limits\n", path, lineno, i + 1);
+                fclose(f);
+                free(t->q);
+                return -1;
+            }
+        }
+        if (t->n == cap) {
+            cap = cap ? 2 * cap : 1024;
+            void *nq = realloc(t->q, cap * sizeof t->q[0]);
+            if (!nq) {
+                fclose(f);
+                free(t->q);
+                return -1;
+            }
+            t->q = nq;
+        }
+        memcpy(t->q[t->n++], v, sizeof v);
+    }
+    fclose(f);
+    if (t->n == 0) {
+        fprintf(stderr, "rcal-rt: %s has no targets\n", path);
+        return -1;
+    }
+    return 0;
+}
+
+static void get_target(double q[RC_NJ], const targets *t, size_t k, double rate_hz)
+{
+    if (t->n > 0)
+        memcpy(q, t->q[k % t->n], sizeof t->q[0]);
+    else
+        synth_target(q, k, rate_hz);
+}
+
+static void print_stats(const char *label, const stats *s, int json)
+{
+    if (json)
+        printf("\"%s\": {\"median_us\": %.3f, \"p99_us\": %.3f, \"p99_99_us\": %.3f, \"max_us\": %.3f, "
+               "\"mean_us\": %.3f}",
+               label, s->med, s->p99, s->p9999, s->max, s->mean);
+    else
+        printf("  %-22s median %8.3f  p99 %8.3f  p99.99 %8.3f  max %9.3f  mean %8.3f  (us)\n", label, s->med,
+               s->p99, s->p9999, s->max, s->mean);
+}
+
+static int run_bench(const rc_model *cal, const rc_model *nom, const rc_comp_config *cfg, const targets *t,
+                     size_t n, unsigned repeat, int cold, int json)
+{
+    double *lat = malloc(n * sizeof *lat);
+    double *meds = malloc(repeat * sizeof *meds), *p4s = malloc(repeat * sizeof *p4s),
+           *tps = malloc(repeat * sizeof *tps);
+    if (!lat || !meds || !p4s || !tps) {
+        fprintf(stderr, "rcal-rt: out of memory\n");
+        return 1;
+    }
+    unsigned long fails = 0, iters = 0;
+    if (!json)
+        printf("rcal-rt bench: %zu targets per run, %u runs, one core, %s\n", n, repeat,
+               cold ? "cold: every target solved from its own q (no warm start)"
+                    : "stream: seeded with the last correction, targets 1 ms apart");
+    double (*tq)[RC_NJ] = malloc(n * sizeof *tq);
+    if (!tq) {
+        fprintf(stderr, "rcal-rt: out of memory\n");
+        return 1;
+    }
+    for (size_t k = 0; k < n; ++k)
+        get_target(tq[k], t, k, 1000.0);
+    for (unsigned r = 0; r < repeat; ++r) {
+        rc_comp_stream s;
+        double qc[RC_NJ], sink = 0.0;
+        /* throughput: back to back, no per-call timing */
+        rc_comp_stream_init(&s, cal, nom, cfg);
+        const double t0 = now_ns();
+        for (size_t k = 0; k < n; ++k) {
+            if (cold)
+                s.have_dq = 0;
+            if (rc_comp_stream_step(&s, qc, NULL, tq[k]) != RC_OK)
+                ++fails;
+            sink += qc[0];
+        }
+        const double total_s = (now_ns() - t0) / 1e9;
+        /* latency: each call timed */
+        rc_comp_stream_init(&s, cal, nom, cfg);
+        for (size_t k = 0; k < n; ++k) {
+            rc_comp_result res;
+            if (cold)
+                s.have_dq = 0;
+            const double a = now_ns();
+            rc_comp_stream_step(&s, qc, &res, tq[k]);
+            lat[k] = (now_ns() - a) / 1e3;
+            iters += res.iterations;
+            sink += qc[1];
+        }
+        stats st = stats_of(lat, n);
+        meds[r] = st.med;
+        p4s[r] = st.p9999;
+        tps[r] = (double)n / total_s;
+        if (!json)
+            printf("  run %u: median %.3f us, p99 %.3f us, p99.99 %.3f us, max %.3f us; %.0f targets/s%s\n", r + 1,
+                   st.med, st.p99, st.p9999, st.max, tps[r], isfinite(sink) ? "" : " (non-finite output!)");
+    }
+    free(tq);
+    qsort(meds, repeat, sizeof *meds, cmp_double);
+    qsort(p4s, repeat, sizeof *p4s, cmp_double);
+    qsort(tps, repeat, sizeof *tps, cmp_double);
+    const double mi = (double)iters / ((double)n * repeat);
+    if (json)
+        printf("{\"targets\": %zu, \"runs\": %u, \"median_us\": %.3f, \"p99_99_us\": %.3f, \"targets_per_s\": %.0f, "
+               "\"iterations_per_target\": %.3f, \"not_converged\": %lu}\n",
+               n, repeat, pct(meds, repeat, 50), pct(p4s, repeat, 50), pct(tps, repeat, 50), mi, fails);
+    else
+        printf("median over runs: latency median %.3f us, p99.99 %.3f us, %.0f targets/s; %.3f iterations/target, "
+               "%lu not converged\n",
+               pct(meds, repeat, 50), pct(p4s, repeat, 50), pct(tps, repeat, 50), mi, fails);
+    free(lat);
+    free(meds);
+    free(p4s);
+    free(tps);
+    return fails ? 1 : 0;
+}
+
+static int run_loop(const rc_model *cal, const rc_model *nom, const rc_comp_config *cfg, const targets *t,
+                    double rate_hz, double seconds, int json)
+{
+    const size_t n = (size_t)(rate_hz * seconds + 0.5);
+    const long period_ns = (long)(1e9 / rate_hz + 0.5);
+    double *lat = malloc(n * sizeof *lat), *wake = malloc(n * sizeof *wake), *done = malloc(n * sizeof *done);
+    if (!lat || !wake || !done || n == 0) {
+        fprintf(stderr, "rcal-rt: out of memory or empty run\n");
+        return 1;
+    }
+    rc_comp_stream s;
+    rc_comp_stream_init(&s, cal, nom, cfg);
+    /* warm up caches and the stream's correction */
+    double q[RC_NJ], qc[RC_NJ];
+    get_target(q, t, 0, rate_hz);
+    rc_comp_stream_step(&s, qc, NULL, q);
+
+    struct timespec next;
+    clock_gettime(CLOCK_MONOTONIC, &next);
+    next.tv_nsec += 2 * period_ns;
+    size_t ran = 0, misses = 0, skipped = 0;
+    unsigned long fails = 0;
+    for (size_t k = 0; k < n; ++k) {
+        while (next.tv_nsec >= 1000000000L) {
+            next.tv_nsec -= 1000000000L;
+            next.tv_sec++;
+        }
+        int e;
+        while ((e = clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL)) == EINTR) {
+        }
+        const double tk = (double)next.tv_sec * 1e9 + (double)next.tv_nsec;
+        const double w = now_ns();
+        get_target(q, t, k, rate_hz);
+        const double a = now_ns();
+        if (rc_comp_stream_step(&s, qc, NULL, q) != RC_OK)
+            ++fails;
+        const double b = now_ns();
+        lat[ran] = (b - a) / 1e3;
+        wake[ran] = (w - tk) / 1e3;
+        done[ran] = (b - tk) / 1e3;
+        if (b - tk > (double)period_ns)
+            ++misses;
+        ++ran;
+        next.tv_nsec += period_ns;
+        /* a cycle whose slot already passed is not run late: count and skip it */
+        for (;;) {
+            const double tn = (double)next.tv_sec * 1e9 + (double)next.tv_nsec;
+            if (now_ns() <= tn + (double)period_ns || k + 1 >= n)
+                break;
+            next.tv_nsec += period_ns;
+            while (next.tv_nsec >= 1000000000L) {
+                next.tv_nsec -= 1000000000L;
+                next.tv_sec++;
+            }
+            ++skipped;
+            ++misses;
+            ++k;
+        }
+    }
+    stats sl = stats_of(lat, ran), sw = stats_of(wake, ran), sd = stats_of(done, ran);
+    if (json) {
+        printf("{\"rate_hz\": %.1f, \"cycles\": %zu, \"deadline_misses\": %zu, \"skipped\": %zu, \"not_converged\": %lu, ",
+               rate_hz, n, misses, skipped, fails);
+        print_stats("compute", &sl, 1);
+        printf(", ");
+        print_stats("wake_lateness", &sw, 1);
+        printf(", ");
+        print_stats("completion", &sd, 1);
+        printf("}\n");
+    } else {
+        printf("rcal-rt: %.0f Hz (period %.1f us), %zu cycles, %.1f s\n", rate_hz, (double)period_ns / 1e3, n,
+               seconds);
+        print_stats("compensation", &sl, 0);
+        print_stats("wake-up lateness", &sw, 0);
+        print_stats("completion (t - t_k)", &sd, 0);
+        printf("  deadline misses: %zu (of which %zu cycles skipped), not converged: %lu\n", misses, skipped, fails);
+    }
+    free(lat);
+    free(wake);
+    free(done);
+    return misses ? 1 : 0;
+}
+
+/* C tables of a model for the firmware (designated initialisers). */
+static void emit_model(FILE *f, const char *name, const rc_model *m)
+{
+    fprintf(f, "static const rc_model %s = {\n    .n_params = %u,\n    .n_effects = %u,\n", name, m->n_params,
+            m->n_effects);
+    if (m->n_effects > 0) {
+        fprintf(f, "    .effects = {\n");
+        for (unsigned i = 0; i < m->n_effects; ++i) {
+            const rc_effect *e = &m->effects[i];
+            fprintf(f, "        {.kind = %u, .joint = %u, .first = %u, .count = %u, .ref_dh = {", e->kind, e->joint,
+                    e->first, e->count);
+            for (int r = 0; r < 4; ++r)
+                fprintf(f, "{%.17g, %.17g, %.17g, %.17g}%s", e->ref_dh[r][0], e->ref_dh[r][1], e->ref_dh[r][2],
+                        e->ref_dh[r][3], r < 3 ? ", " : "");
+            fprintf(f, "}},\n");
+        }
+        fprintf(f, "    },\n");
+    }
+    fprintf(f, "    .x = {");
+    for (unsigned k = 0; k < m->n_params; ++k)
+        fprintf(f, "%s%.17g", k % 4 == 0 ? "\n        " : " ", m->x[k]), (void)(k + 1 < m->n_params && fprintf(f, ","));
+    fprintf(f, "},\n    .q_min_rad = {");
+    for (int i = 0; i < RC_NJ; ++i)
+        fprintf(f, "%.17g%s", m->q_min_rad[i], i < RC_NJ - 1 ? ", " : "");
+    fprintf(f, "},\n    .q_max_rad = {");
+    for (int i = 0; i < RC_NJ; ++i)
+        fprintf(f, "%.17g%s", m->q_max_rad[i], i < RC_NJ - 1 ? ", " : "");
+    fprintf(f, "},\n};\n");
+}
+
+static int emit_c(const char *path, const char *nominal_path, int position_only)
+{
+    static rch_robot robot, nominal;
+    rch_diag d;
+    char msg[1024];
+    if (rch_robot_load(&robot, path, &d) != 0 || (nominal_path && rch_robot_load(&nominal, nominal_path, &d) != 0)) {
+        fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    const rc_model *nom = nominal_path ? &nominal.model : &robot.nominal;
+    const unsigned need = robot.model.n_params > nom->n_params ? robot.model.n_params : nom->n_params;
+    printf("/* fw_model_data.h - generated by `rcal-rt --emit-c %s%s`: do not edit.\n"
+           " * Model \"%s\": the calibrated model (fw_model_cal) and the nominal table the\n"
+           " * robot program's targets were computed with (fw_model_nom), as const data\n"
+           " * (flash on a microcontroller). */\n"
+           "#ifndef FW_MODEL_DATA_H\n#define FW_MODEL_DATA_H\n\n#include \"rc_comp.h\"\n\n"
+           "RC_STATIC_ASSERT(RC_MAX_PARAMS >= %u, fw_model_fits_rc_max_params);\n"
+           "RC_STATIC_ASSERT(RC_MAX_EFFECTS >= %u, fw_model_fits_rc_max_effects);\n\n"
+           "/* rc_comp_config.flags the model is meant to be used with */\n#define FW_MODEL_COMP_FLAGS %s\n\n",
+           path, position_only ? " --position-only" : "", robot.name, need,
+           robot.model.n_effects > 0 ? robot.model.n_effects : 1u, position_only ? "RC_COMP_FLAG_POSITION_ONLY" : "0u");
+    emit_model(stdout, "fw_model_cal", &robot.model);
+    printf("\n");
+    emit_model(stdout, "fw_model_nom", nom);
+    printf("\n#endif /* FW_MODEL_DATA_H */\n");
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *model_path = NULL, *nominal_path = NULL, *in_path = NULL, *emit = NULL;
+    double rate_hz = 1000.0, seconds = 10.0;
+    unsigned long n_bench = 200000, repeat = 5;
+    int bench = 0, cold = 0, fifo = 0, json = 0, position_only = 0, cpu = -1;
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        const int has = i + 1 < argc;
+        if (strcmp(a, "--model") == 0 && has)
+            model_path = argv[++i];
+        else if (strcmp(a, "--nominal") == 0 && has)
+            nominal_path = argv[++i];
+        else if (strcmp(a, "--in") == 0 && has)
+            in_path = argv[++i];
+        else if (strcmp(a, "--emit-c") == 0 && has)
+            emit = argv[++i];
+        else if (strcmp(a, "--rate-hz") == 0 && has)
+            rate_hz = atof(argv[++i]);
+        else if (strcmp(a, "--seconds") == 0 && has)
+            seconds = atof(argv[++i]);
+        else if (strcmp(a, "--targets") == 0 && has)
+            n_bench = strtoul(argv[++i], NULL, 10);
+        else if (strcmp(a, "--repeat") == 0 && has)
+            repeat = strtoul(argv[++i], NULL, 10);
+        else if (strcmp(a, "--cpu") == 0 && has)
+            cpu = atoi(argv[++i]);
+        else if (strcmp(a, "--bench") == 0)
+            bench = 1;
+        else if (strcmp(a, "--cold") == 0)
+            cold = 1;
+        else if (strcmp(a, "--fifo") == 0)
+            fifo = 1;
+        else if (strcmp(a, "--json") == 0)
+            json = 1;
+        else if (strcmp(a, "--position-only") == 0)
+            position_only = 1;
+        else if (strcmp(a, "--help") == 0) {
+            usage(stdout);
+            return 0;
+        } else {
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (emit)
+        return emit_c(emit, nominal_path, position_only);
+    if (!(rate_hz >= 1.0 && rate_hz <= 100000.0) || !(seconds > 0.0 && seconds <= 3600.0) || n_bench == 0 ||
+        repeat == 0 || repeat > 1000) {
+        fprintf(stderr, "rcal-rt: --rate-hz must be 1..100000, --seconds 0..3600, --targets and --repeat positive\n");
+        return 2;
+    }
+
+    static rch_robot robot, nominal;
+    const rc_model *cal = &fw_model_cal, *nom = &fw_model_nom;
+    unsigned flags = FW_MODEL_COMP_FLAGS;
+    if (model_path) {
+        rch_diag d;
+        char msg[1024];
+        if (rch_robot_load(&robot, model_path, &d) != 0 ||
+            (nominal_path && rch_robot_load(&nominal, nominal_path, &d) != 0)) {
+            fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
+            return 1;
+        }
+        cal = &robot.model;
+        nom = nominal_path ? &nominal.model : &robot.nominal;
+        flags = 0;
+    }
+    if (position_only)
+        flags |= RC_COMP_FLAG_POSITION_ONLY;
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.flags = flags;
+
+    targets t = {NULL, 0};
+    if (in_path && load_targets(&t, in_path, cal) != 0)
+        return 1;
+
+    if (cpu >= 0) {
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(cpu, &set);
+        if (sched_setaffinity(0, sizeof set, &set) != 0)
+            fprintf(stderr, "rcal-rt: note: cannot pin to CPU %d: %s\n", cpu, strerror(errno));
+    }
+    if (fifo) {
+        struct sched_param sp;
+        memset(&sp, 0, sizeof sp);
+        sp.sched_priority = 80;
+        if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+            fprintf(stderr, "rcal-rt: note: SCHED_FIFO refused (%s); running as a normal process\n", strerror(errno));
+        if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+            fprintf(stderr, "rcal-rt: note: mlockall refused (%s)\n", strerror(errno));
+    }
+    int rc = bench ? run_bench(cal, nom, &cfg, &t, n_bench, (unsigned)repeat, cold, json)
+                   : run_loop(cal, nom, &cfg, &t, rate_hz, seconds, json);
+    free(t.q);
+    return rc;
+}
