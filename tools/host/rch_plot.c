@@ -436,7 +436,7 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
             p->height);
     fprintf(f, "<text x=\"%.1f\" y=\"24\" text-anchor=\"middle\" font-size=\"16\" "
                "font-weight=\"bold\">",
-            L + pw / 2.0);
+            W / 2.0);
     plot_esc(f, p->title);
     fprintf(f, "</text>\n");
 
