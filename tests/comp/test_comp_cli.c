@@ -1,0 +1,225 @@
+/* test_comp_cli.c - rcal compensate round trips: a target list with a header
+ * and extra columns, plain lines on stdin, a RAPID module, and bad lines
+ * reported with file:line:col. Runs the built rcal binary. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "rc_rand.h"
+#include "rch_robot.h"
+
+#define DEG (3.14159265358979323846 / 180.0)
+#define RCAL RCAL_BINARY_DIR "/tools/rcal"
+
+static char dir[64];
+static char model_path[128];
+static rch_robot robot;
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static char *read_file(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+static int run(const char *cmd)
+{
+    int st = system(cmd);
+    assert_true(st != -1);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static double fk_gap(const double q_deg[6], const double qc_deg[6])
+{
+    double q[6], qc[6], pn[3], pc[3];
+    for (int i = 0; i < 6; ++i) {
+        q[i] = q_deg[i] * DEG;
+        qc[i] = qc_deg[i] * DEG;
+    }
+    rc_fk(pn, NULL, &robot.nominal, q);
+    rc_fk(pc, NULL, &robot.model, qc);
+    return sqrt((pn[0] - pc[0]) * (pn[0] - pc[0]) + (pn[1] - pc[1]) * (pn[1] - pc[1]) +
+                (pn[2] - pc[2]) * (pn[2] - pc[2]));
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    strcpy(dir, "/tmp/rcal_comp_cli_XXXXXX");
+    assert_non_null(mkdtemp(dir));
+    snprintf(model_path, sizeof model_path, "%s/model.json", dir);
+    rch_robot nom;
+    rch_diag d;
+    assert_int_equal(rch_robot_load(&nom, RCAL_SOURCE_DIR "/data/irb120.json", &d), 0);
+    /* "calibrated" model: nominal + known errors */
+    rc_model cal = nom.model;
+    rc_rng g;
+    rc_rng_seed(&g, 8);
+    for (int k = 0; k < RC_N_DH; ++k)
+        cal.x[k] += (k % 4 < 2 ? 0.5 : 0.1 * DEG) * rc_rng_normal(&g);
+    cal.x[RC_P_ALPHA(5)] = nom.model.x[RC_P_ALPHA(5)];
+    FILE *f = fopen(model_path, "w");
+    assert_non_null(f);
+    assert_int_equal(rch_robot_write(f, "test calibrated", &cal, &nom.model, NULL), 0);
+    fclose(f);
+    assert_int_equal(rch_robot_load(&robot, model_path, &d), 0);
+    assert_true(robot.has_nominal);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[160];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void test_target_list_with_header(void **state)
+{
+    (void)state;
+    char in[128], out[128], cmd[512];
+    snprintf(in, sizeof in, "%s/prog.csv", dir);
+    snprintf(out, sizeof out, "%s/prog_comp.csv", dir);
+    const double tq[3][6] = {{10, 20, -30, 40, 50, 60}, {-35, 5, 10, -20, 70, 100}, {60, -10, -40, 90, -45, -30}};
+    write_file(in, "name,q1,q2,q3,q4,q5,q6,speed\n"
+                   "p10,10,20,-30,40,50,60,v100\n"
+                   "# a comment\n"
+                   "\n"
+                   "p20, -35, 5, 10, -20, 70, 100 ,v200\n"
+                   "p30,60,-10,-40,90,-45,-30,v50\n");
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s'", RCAL, model_path, in, out);
+    assert_int_equal(run(cmd), 0);
+    char *txt = read_file(out);
+    char *save = NULL, *line = strtok_r(txt, "\n", &save);
+    assert_string_equal(line, "name,q1,q2,q3,q4,q5,q6,speed");
+    const char *names[3] = {"p10", "p20", "p30"}, *speeds[3] = {"v100", "v200", "v50"};
+    int k = 0;
+    while ((line = strtok_r(NULL, "\n", &save)) != NULL) {
+        if (line[0] == '#')
+            continue;
+        char name[16], speed[16];
+        double q[6];
+        assert_int_equal(sscanf(line, "%15[^,],%lf,%lf,%lf,%lf,%lf,%lf,%15s", name, &q[0], &q[1], &q[2], &q[3],
+                                &q[4], &q[5], speed),
+                         8);
+        assert_true(k < 3);
+        assert_string_equal(name, names[k]);
+        assert_string_equal(speed, speeds[k]);
+        assert_true(fk_gap(tq[k], q) < 1e-3);
+        double corr = 0.0;
+        for (int i = 0; i < 6; ++i)
+            corr = fmax(corr, fabs(q[i] - tq[k][i]));
+        assert_true(corr > 1e-3); /* it did correct */
+        ++k;
+    }
+    assert_int_equal(k, 3);
+}
+
+static void test_stdin_plain(void **state)
+{
+    (void)state;
+    char out[128], cmd[512];
+    snprintf(out, sizeof out, "%s/plain.csv", dir);
+    snprintf(cmd, sizeof cmd, "printf '10,20,-30,40,50,60\\n0,0,0,0,30,0\\n' | '%s' compensate --model '%s' > '%s'",
+             RCAL, model_path, out);
+    assert_int_equal(run(cmd), 0);
+    double q[2][6];
+    const double tq[2][6] = {{10, 20, -30, 40, 50, 60}, {0, 0, 0, 0, 30, 0}};
+    FILE *f = fopen(out, "r");
+    assert_non_null(f);
+    for (int k = 0; k < 2; ++k)
+        assert_int_equal(fscanf(f, "%lf,%lf,%lf,%lf,%lf,%lf", &q[k][0], &q[k][1], &q[k][2], &q[k][3], &q[k][4],
+                                &q[k][5]),
+                         6);
+    fclose(f);
+    for (int k = 0; k < 2; ++k)
+        assert_true(fk_gap(tq[k], q[k]) < 1e-3);
+}
+
+static void test_rapid_module(void **state)
+{
+    (void)state;
+    char in[128], out[128], cmd[512];
+    snprintf(in, sizeof in, "%s/m.mod", dir);
+    snprintf(out, sizeof out, "%s/m_comp.mod", dir);
+    write_file(in, "MODULE Grind\n"
+                   "  CONST jointtarget jt10:=[[10,20,-30,40,50,60],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                   "  PROC main()\n    MoveAbsJ jt10, v100, fine, tool0;\n  ENDPROC\nENDMODULE\n");
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s'", RCAL, model_path, in, out);
+    assert_int_equal(run(cmd), 0);
+    const char *txt = read_file(out);
+    assert_non_null(strstr(txt, "MODULE Grind\n"));
+    assert_non_null(strstr(txt, "    MoveAbsJ jt10, v100, fine, tool0;\n"));
+    const char *jt = strstr(txt, "jt10:=[[");
+    assert_non_null(jt);
+    double q[6];
+    assert_int_equal(sscanf(jt, "jt10:=[[%lf,%lf,%lf,%lf,%lf,%lf]", &q[0], &q[1], &q[2], &q[3], &q[4], &q[5]), 6);
+    assert_non_null(strstr(jt, "],[9E9,9E9,9E9,9E9,9E9,9E9]];"));
+    const double tq[6] = {10, 20, -30, 40, 50, 60};
+    assert_true(fk_gap(tq, q) < 0.01); /* RAPID keeps 4 decimals */
+}
+
+static void test_bad_lines(void **state)
+{
+    (void)state;
+    char in[128], err[128], cmd[512];
+    snprintf(in, sizeof in, "%s/bad.csv", dir);
+    snprintf(err, sizeof err, "%s/err.txt", dir);
+    static const struct {
+        const char *text;
+        const char *where;
+    } cases[] = {
+        {"10,20,-30,40,50,60\n1,2,x,4,5,6\n", ":2:5:"},        /* not a number */
+        {"10,20,-30,40,50,60\n1,2,3,4,5\n", ":2:10:"},          /* missing field */
+        {"10,20,-30,40,50,60,7\n", ":1:20:"},                    /* extra field */
+        {"10,20,100,40,50,60\n", ":1:7:"},                       /* q3 beyond its limit (70 deg) */
+        {"q1,q2,q3,q4,q5\n", ":1:1:"},                           /* header without q6 */
+        {"10,20,-30,40,50,nan\n", ":1:17:"},                     /* NaN */
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        write_file(in, cases[k].text);
+        snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' > /dev/null 2> '%s'", RCAL, model_path, in,
+                 err);
+        assert_int_equal(run(cmd), 1);
+        char want[192];
+        snprintf(want, sizeof want, "%s%s", in, cases[k].where);
+        const char *msg = read_file(err);
+        if (strstr(msg, want) == NULL)
+            fail_msg("case %zu: expected '%s' in: %s", k, want, msg);
+    }
+    /* usage errors */
+    snprintf(cmd, sizeof cmd, "'%s' compensate --in x > /dev/null 2>&1", RCAL);
+    assert_int_equal(run(cmd), 2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_target_list_with_header),
+        cmocka_unit_test(test_stdin_plain),
+        cmocka_unit_test(test_rapid_module),
+        cmocka_unit_test(test_bad_lines),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
