@@ -1,0 +1,1362 @@
+/* rch_diagnose.c - the `rcal diagnose` workflow; see rch_diagnose.h. */
+#include "rch_diagnose.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "rc_linalg.h"
+#include "rc_rand.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+/* ------------------------------------------------------------------ stats */
+
+/* Continued fraction of the incomplete beta function (modified Lentz). */
+static double betacf(double a, double b, double x)
+{
+    const double tiny = 1e-300, eps = 1e-15;
+    double qab = a + b, qap = a + 1.0, qam = a - 1.0;
+    double c = 1.0, dd = 1.0 - qab * x / qap;
+    if (fabs(dd) < tiny)
+        dd = tiny;
+    dd = 1.0 / dd;
+    double h = dd;
+    for (int m = 1; m <= 500; ++m) {
+        const double m2 = 2.0 * m;
+        double aa = m * (b - m) * x / ((qam + m2) * (a + m2));
+        dd = 1.0 + aa * dd;
+        if (fabs(dd) < tiny)
+            dd = tiny;
+        c = 1.0 + aa / c;
+        if (fabs(c) < tiny)
+            c = tiny;
+        dd = 1.0 / dd;
+        h *= dd * c;
+        aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
+        dd = 1.0 + aa * dd;
+        if (fabs(dd) < tiny)
+            dd = tiny;
+        c = 1.0 + aa / c;
+        if (fabs(c) < tiny)
+            c = tiny;
+        dd = 1.0 / dd;
+        const double del = dd * c;
+        h *= del;
+        if (fabs(del - 1.0) < eps)
+            break;
+    }
+    return h;
+}
+
+/* Regularized incomplete beta I_x(a, b). */
+static double incbeta(double a, double b, double x)
+{
+    if (x <= 0.0)
+        return 0.0;
+    if (x >= 1.0)
+        return 1.0;
+    const double lbt = lgamma(a + b) - lgamma(a) - lgamma(b) + a * log(x) + b * log(1.0 - x);
+    if (x < (a + 1.0) / (a + b + 2.0))
+        return exp(lbt) * betacf(a, b, x) / a;
+    return 1.0 - exp(lbt) * betacf(b, a, 1.0 - x) / b;
+}
+
+double rch_diagnose_f_sf(double f, double d1, double d2)
+{
+    if (!(f > 0.0) || !(d1 > 0.0) || !(d2 > 0.0))
+        return 1.0;
+    if (!isfinite(f))
+        return 0.0;
+    return incbeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
+double rch_diagnose_detect_step(const double *values, size_t n)
+{
+    static const double steps[] = {1.0,  0.5,   0.2,   0.1,    0.05,  0.02, 0.01,
+                                   0.005, 0.004, 0.002, 0.001, 0.0005, 0.0001};
+    if (n == 0)
+        return 0.0;
+    for (size_t k = 0; k < sizeof steps / sizeof steps[0]; ++k) {
+        int ok = 1;
+        for (size_t i = 0; i < n && ok; ++i) {
+            const double u = values[i] / steps[k];
+            ok = fabs(u - floor(u + 0.5)) < 1e-6;
+        }
+        if (ok)
+            return steps[k];
+    }
+    return 0.0;
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static double rms(const double *r, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        s += r[i] * r[i];
+    return n ? sqrt(s / (double)n) : 0.0;
+}
+
+/* ------------------------------------------------------- structure tests */
+
+#define MAXREG 6
+
+/* F test of r (n) against regressors X (n x p, row-major), intercept
+ * included. Nearly collinear regressors are dropped (dof counts the rest). */
+static void test_regress(rch_diagnose_test *t, const char *name, const double *r, const double *X,
+                         unsigned p, size_t n, double alpha_each)
+{
+    double xm[MAXREG] = {0}, rm = 0.0, A[MAXREG * MAXREG] = {0}, b[MAXREG] = {0}, rss0 = 0.0;
+    memset(t, 0, sizeof *t);
+    snprintf(t->name, sizeof t->name, "%s", name);
+    for (size_t i = 0; i < n; ++i) {
+        rm += r[i];
+        for (unsigned k = 0; k < p; ++k)
+            xm[k] += X[i * p + k];
+    }
+    rm /= (double)n;
+    for (unsigned k = 0; k < p; ++k)
+        xm[k] /= (double)n;
+    for (size_t i = 0; i < n; ++i) {
+        const double ri = r[i] - rm;
+        rss0 += ri * ri;
+        for (unsigned k = 0; k < p; ++k) {
+            const double xk = X[i * p + k] - xm[k];
+            b[k] += xk * ri;
+            for (unsigned l = 0; l < p; ++l)
+                A[k * p + l] += xk * (X[i * p + l] - xm[l]);
+        }
+    }
+    /* Cholesky-like elimination with pivot dropping. */
+    unsigned used[MAXREG] = {0}, dof = 0;
+    double amax = 0.0;
+    for (unsigned k = 0; k < p; ++k)
+        if (A[k * p + k] > amax)
+            amax = A[k * p + k];
+    double expl = 0.0;
+    for (unsigned k = 0; k < p; ++k) {
+        const double piv = A[k * p + k];
+        if (!(piv > 1e-10 * amax) || !(piv > 0.0))
+            continue;
+        used[k] = 1;
+        ++dof;
+        expl += b[k] * b[k] / piv;
+        for (unsigned i = k + 1; i < p; ++i) {
+            const double f = A[i * p + k] / piv;
+            b[i] -= f * b[k];
+            for (unsigned l = k + 1; l < p; ++l)
+                A[i * p + l] -= f * A[k * p + l];
+        }
+    }
+    (void)used;
+    const double rss1 = rss0 - expl;
+    t->dof1 = dof;
+    t->dof2 = n > (size_t)dof + 1 ? (unsigned)(n - dof - 1) : 0;
+    if (dof == 0 || t->dof2 == 0 || !(rss0 > 0.0)) {
+        t->p_value = 1.0;
+        return;
+    }
+    t->r2 = expl / rss0;
+    t->f_stat = (expl / dof) / ((rss1 > 0.0 ? rss1 : 1e-300) / t->dof2);
+    t->p_value = rch_diagnose_f_sf(t->f_stat, dof, t->dof2);
+    t->significant = t->p_value < alpha_each;
+}
+
+static void test_bias(rch_diagnose_test *t, const double *r, size_t n, double alpha_each)
+{
+    double m = 0.0, ss = 0.0;
+    memset(t, 0, sizeof *t);
+    snprintf(t->name, sizeof t->name, "bias (mean residual)");
+    for (size_t i = 0; i < n; ++i)
+        m += r[i];
+    m /= (double)n;
+    for (size_t i = 0; i < n; ++i)
+        ss += (r[i] - m) * (r[i] - m);
+    t->dof1 = 1;
+    t->dof2 = n > 1 ? (unsigned)(n - 1) : 0;
+    const double tot = ss + (double)n * m * m;
+    if (t->dof2 == 0 || !(ss > 0.0)) {
+        t->p_value = 1.0;
+        return;
+    }
+    t->r2 = (double)n * m * m / tot;
+    t->f_stat = (double)n * m * m / (ss / t->dof2);
+    t->p_value = rch_diagnose_f_sf(t->f_stat, 1.0, t->dof2);
+    t->significant = t->p_value < alpha_each;
+}
+
+static void test_groups(rch_diagnose_test *t, const double *r, const rc_sample *s, size_t n,
+                        unsigned n_groups, double alpha_each)
+{
+    double *sum = calloc(n_groups, sizeof *sum);
+    size_t *cnt = calloc(n_groups, sizeof *cnt);
+    memset(t, 0, sizeof *t);
+    snprintf(t->name, sizeof t->name, "groups (ANOVA)");
+    t->p_value = 1.0;
+    if (!sum || !cnt) {
+        free(sum);
+        free(cnt);
+        return;
+    }
+    double m = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        sum[s[i].group] += r[i];
+        cnt[s[i].group]++;
+        m += r[i];
+    }
+    m /= (double)n;
+    unsigned g_used = 0;
+    double ssb = 0.0, ssw = 0.0;
+    for (unsigned g = 0; g < n_groups; ++g)
+        if (cnt[g]) {
+            ++g_used;
+            const double gm = sum[g] / (double)cnt[g];
+            ssb += (double)cnt[g] * (gm - m) * (gm - m);
+        }
+    for (size_t i = 0; i < n; ++i) {
+        const double gm = sum[s[i].group] / (double)cnt[s[i].group];
+        ssw += (r[i] - gm) * (r[i] - gm);
+    }
+    free(sum);
+    free(cnt);
+    if (g_used < 2 || n <= g_used || !(ssw > 0.0))
+        return;
+    t->dof1 = g_used - 1;
+    t->dof2 = (unsigned)(n - g_used);
+    t->r2 = ssb / (ssb + ssw);
+    t->f_stat = (ssb / t->dof1) / (ssw / t->dof2);
+    t->p_value = rch_diagnose_f_sf(t->f_stat, t->dof1, t->dof2);
+    t->significant = t->p_value < alpha_each;
+}
+
+/* Explanatory variables per sample, from the geometric model. */
+typedef struct explain {
+    double (*var)[12]; /* (n x 12): lever2, lever3, L, ux, uy, uz, t */
+} explain;
+
+enum { V_LEV2 = 0, V_LEV3, V_LEN, V_UX, V_UY, V_UZ, V_T, V_N };
+
+static unsigned groups_usable(unsigned n_groups, size_t n) { return n_groups >= 2 && (size_t)n_groups * 3 <= n; }
+
+/* All structure tests of residuals r (n). Returns the number of tests. */
+static unsigned structure_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
+                                const double (*var)[V_N], unsigned n_groups, double alpha)
+{
+    const unsigned n_tests = 12 + groups_usable(n_groups, n);
+    const double a_each = alpha / n_tests;
+    double *X = malloc(n * MAXREG * sizeof *X);
+    unsigned k = 0;
+    if (!X)
+        return 0;
+    test_bias(&out[k++], r, n, a_each);
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        char name[40];
+        for (size_t i = 0; i < n; ++i) {
+            const double q = s[i].q_rad[j];
+            X[i * 4 + 0] = sin(q);
+            X[i * 4 + 1] = cos(q);
+            X[i * 4 + 2] = sin(2.0 * q);
+            X[i * 4 + 3] = cos(2.0 * q);
+        }
+        snprintf(name, sizeof name, "q%u harmonics (1st, 2nd)", j + 1);
+        test_regress(&out[k++], name, r, X, 4, n, a_each);
+    }
+    for (size_t i = 0; i < n; ++i)
+        X[i] = var[i][V_LEV2];
+    test_regress(&out[k++], "gravity lever j2", r, X, 1, n, a_each);
+    for (size_t i = 0; i < n; ++i)
+        X[i] = var[i][V_LEV3];
+    test_regress(&out[k++], "gravity lever j3", r, X, 1, n, a_each);
+    for (size_t i = 0; i < n; ++i)
+        X[i] = var[i][V_LEN];
+    test_regress(&out[k++], "cable length", r, X, 1, n, a_each);
+    for (size_t i = 0; i < n; ++i) {
+        X[i * 3 + 0] = var[i][V_UX];
+        X[i * 3 + 1] = var[i][V_UY];
+        X[i * 3 + 2] = var[i][V_UZ];
+    }
+    test_regress(&out[k++], "cable direction", r, X, 3, n, a_each);
+    for (size_t i = 0; i < n; ++i) {
+        X[i * 2 + 0] = var[i][V_T];
+        X[i * 2 + 1] = var[i][V_T] * var[i][V_T];
+    }
+    test_regress(&out[k++], "acquisition order (t, t^2)", r, X, 2, n, a_each);
+    if (groups_usable(n_groups, n))
+        test_groups(&out[k++], r, s, n, n_groups, a_each);
+    free(X);
+    return k;
+}
+
+/* ------------------------------------------------------------- workflow */
+
+typedef struct ctx {
+    const rc_sample *s; /* (n) */
+    size_t n;
+    unsigned k;                            /* folds */
+    unsigned *fold;                        /* (n) fold of each sample */
+    rc_sample *train[RCH_DIAGNOSE_MAX_FOLDS]; /* (n_train[f]) */
+    size_t n_train[RCH_DIAGNOSE_MAX_FOLDS];
+    rc_solve_work *w;
+    unsigned max_iter;
+    int verbose;
+} ctx;
+
+static int fit(rc_model *m, rc_solve_result *res, ctx *c, const uint8_t *fixed, const rc_sample *s,
+               size_t n)
+{
+    rc_solve_config cfg;
+    rc_solve_result tmp;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.method = RC_METHOD_LM;
+    cfg.max_iter = c->max_iter;
+    cfg.fixed = fixed;
+    return rc_solve(m, res ? res : &tmp, c->w, &cfg, s, n) == RC_OK ? 0 : -1;
+}
+
+/* A group with no training sample has no fitted offset (the solver leaves
+ * it at zero, an arbitrary level): predict it like a new set-up, with the
+ * sample-weighted mean offset of the groups that were seen. */
+static void unseen_groups(rc_model *m, const rc_sample *train, size_t n)
+{
+    for (unsigned e = 0; e < m->n_effects; ++e) {
+        const rc_effect *ef = &m->effects[e];
+        if (ef->kind != RC_EFF_GROUP_OFFSET)
+            continue;
+        size_t *cnt = calloc(ef->count, sizeof *cnt);
+        if (!cnt)
+            return;
+        for (size_t i = 0; i < n; ++i)
+            if (train[i].group < ef->count)
+                cnt[train[i].group]++;
+        double sum = 0.0;
+        size_t tot = 0;
+        for (unsigned g = 0; g < ef->count; ++g) {
+            sum += (double)cnt[g] * m->x[ef->first + g];
+            tot += cnt[g];
+        }
+        for (unsigned g = 0; g < ef->count; ++g)
+            if (cnt[g] == 0 && tot > 0)
+                m->x[ef->first + g] = sum / (double)tot;
+        free(cnt);
+    }
+}
+
+/* Set-up groups: consecutive samples whose wrist joints (q4..q6) stay the
+ * same. A wrist reading that flickers by one display step (the angle sits
+ * on a rounding boundary) does not start a new group; such samples are
+ * counted in *flicker. Returns the number of groups. */
+static unsigned group_by_wrist(rc_sample *s, size_t n, double q_step_deg, unsigned *flicker)
+{
+    const double tol = (q_step_deg > 0.0 ? 1.5 * q_step_deg : 1e-9) * DEG;
+    unsigned g = 0;
+    *flicker = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (i > 0) {
+            int same = 1, exact = 1;
+            for (unsigned j = 3; j < RC_NJ; ++j) {
+                const double dq = fabs(s[i].q_rad[j] - s[i - 1].q_rad[j]);
+                same = same && dq <= tol;
+                exact = exact && dq == 0.0;
+            }
+            if (!same)
+                ++g;
+            else if (!exact)
+                ++*flicker;
+        }
+        s[i].group = (uint16_t)(g > 65535 ? 65535 : g);
+    }
+    return n ? g + 1 : 0;
+}
+
+/* Cross-validate: models (k) in: starts, out: fitted on each fold's training
+ * samples; res (n) out: held-out residuals l - L. */
+static int cv_run(rc_model *models, double *res, ctx *c)
+{
+    for (unsigned f = 0; f < c->k; ++f) {
+        if (fit(&models[f], NULL, c, NULL, c->train[f], c->n_train[f]) != 0)
+            return -1;
+        unseen_groups(&models[f], c->train[f], c->n_train[f]);
+    }
+    for (size_t i = 0; i < c->n; ++i) {
+        double l;
+        if (rc_meas(&l, NULL, &models[c->fold[i]], &c->s[i]) != RC_OK)
+            return -1;
+        res[i] = l - c->s[i].len_mm;
+    }
+    return 0;
+}
+
+/* Relative eigenvalue of the scaled normal matrix below which a direction
+ * counts as not identifiable at all (singular value ratio 1e-6). */
+#define RANK_TOL 1e-12
+
+/* Rank of the column-scaled normal matrix of the first np parameters of m
+ * over the samples: eigenvalues above tol_rel * largest. ev: scratch. */
+static unsigned rank_at(const rc_model *m, unsigned np, const rc_sample *s, size_t n, rc_solve_work *w,
+                        double tol_rel, int dump)
+{
+    double cost;
+    for (unsigned i = 0; i < np; ++i)
+        w->idx[i] = (uint16_t)i;
+    if (rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, np, s, n) != RC_OK)
+        return 0;
+    for (unsigned i = 0; i < np; ++i) {
+        const double a = w->A[(size_t)i * np + i];
+        w->D[i] = a > 0.0 ? sqrt(a) : 1.0;
+    }
+    for (unsigned i = 0; i < np; ++i)
+        for (unsigned k = 0; k < np; ++k)
+            w->A[(size_t)i * np + k] /= w->D[i] * w->D[k];
+    if (rcu_eig_sym(w->ev, w->V, w->A, np, 0) == RC_ERR_NUMERIC || !(w->ev[0] > 0.0))
+        return 0;
+    unsigned r = 0;
+    for (unsigned k = 0; k < np; ++k) {
+        if (dump)
+            fprintf(stderr, "  ev[%u] = %.3e\n", k, w->ev[k] / w->ev[0]);
+        if (w->ev[k] > tol_rel * w->ev[0])
+            ++r;
+    }
+    return r;
+}
+
+/* Largest joint-side error that is still physical for a gear or joint
+ * deflection (deg); a fit beyond it is the solver using the effect for
+ * something else (e.g. a huge joint-6 ripple moving an off-axis point). */
+#define PLAUSIBLE_DEG 1.0
+
+/* The largest joint-angle change of the last effect of m over the samples
+ * (deg) when it exceeds PLAUSIBLE_DEG, else 0. */
+static double implausible_deg(const rc_model *m, const double (*var)[V_N], size_t n)
+{
+    const rc_effect *ef = &m->effects[m->n_effects - 1];
+    const double *x = &m->x[ef->first];
+    double worst = 0.0;
+    if (ef->kind == RC_EFF_JOINT_PERIODIC)
+        worst = (fabs(x[0]) + fabs(x[1]) + fabs(x[2]) + fabs(x[3])) / DEG;
+    else if (ef->kind == RC_EFF_JOINT_COMPLIANCE)
+        for (size_t i = 0; i < n; ++i) {
+            const double v = fabs(x[0] * var[i][ef->joint == 1 ? V_LEV2 : V_LEV3]) / DEG;
+            worst = v > worst ? v : worst;
+        }
+    return worst > PLAUSIBLE_DEG ? worst : 0.0;
+}
+
+static int has_effect(const rc_model *m, rc_effect_kind kind, unsigned joint0)
+{
+    for (unsigned i = 0; i < m->n_effects; ++i)
+        if (m->effects[i].kind == (uint8_t)kind && m->effects[i].joint == joint0)
+            return 1;
+    return 0;
+}
+
+typedef struct cdef {
+    rc_effect_kind kind;
+    unsigned joint0;
+} cdef;
+
+static const cdef all_cands[] = {
+    {RC_EFF_LENGTH_OFFSET, 0},    {RC_EFF_LENGTH_SCALE, 0},     {RC_EFF_TIME_DRIFT, 0},
+    {RC_EFF_GROUP_OFFSET, 0},     {RC_EFF_JOINT_COMPLIANCE, 1}, {RC_EFF_JOINT_COMPLIANCE, 2},
+    {RC_EFF_JOINT_PERIODIC, 0},   {RC_EFF_JOINT_PERIODIC, 1},   {RC_EFF_JOINT_PERIODIC, 2},
+    {RC_EFF_JOINT_PERIODIC, 3},   {RC_EFF_JOINT_PERIODIC, 4},   {RC_EFF_JOINT_PERIODIC, 5},
+};
+#define N_ALL_CANDS (sizeof all_cands / sizeof all_cands[0])
+
+static int is_joint_kind(rc_effect_kind k) { return k == RC_EFF_JOINT_COMPLIANCE || k == RC_EFF_JOINT_PERIODIC; }
+
+static void cand_name(char *buf, size_t len, rc_effect_kind kind, unsigned joint0)
+{
+    if (is_joint_kind(kind))
+        snprintf(buf, len, "%s j%u", rc_effect_name(kind), joint0 + 1);
+    else
+        snprintf(buf, len, "%s", rc_effect_name(kind));
+}
+
+/* Why a candidate adds fewer identifiable directions than parameters. */
+static const char *known_reason(rc_effect_kind kind, unsigned joint0, const rc_model *base)
+{
+    if (kind == RC_EFF_LENGTH_SCALE)
+        return "a cable scale error equals a uniformly larger robot (every a, d and the encoder scaled)";
+    if (kind == RC_EFF_JOINT_PERIODIC && joint0 == 5)
+        return "joint 6 turns the flange about its own axis: the cable attachment point does not move";
+    if (kind == RC_EFF_LENGTH_OFFSET && has_effect(base, RC_EFF_GROUP_OFFSET, 0))
+        return "a common offset of all groups is a length offset";
+    if (kind == RC_EFF_GROUP_OFFSET && has_effect(base, RC_EFF_LENGTH_OFFSET, 0))
+        return "the sum of the group offsets is the length offset already in the model";
+    if (kind == RC_EFF_JOINT_PERIODIC)
+        return "part of the periodic terms is confounded with the joint's offset or the geometry";
+    if (kind == RC_EFF_GROUP_OFFSET)
+        return "their common level is a length offset, which the geometry nearly absorbs";
+    return "confounded with the geometry on these poses";
+}
+
+static rc_effect_kind cand_kind_of(const rch_diagnose_step *st, int k) { return st->cand[k].kind; }
+
+static void jack_se(double *value_se, const double *vals, unsigned k)
+{
+    double m = 0.0, v = 0.0;
+    for (unsigned f = 0; f < k; ++f)
+        m += vals[f];
+    m /= k;
+    for (unsigned f = 0; f < k; ++f)
+        v += (vals[f] - m) * (vals[f] - m);
+    *value_se = sqrt(v * (double)(k - 1) / (double)k);
+}
+
+static void group_stats(double *mean, double *sd, double *lo, double *hi, const double *x, unsigned count)
+{
+    double m = 0.0, v = 0.0, a = 1e300, b = -1e300;
+    for (unsigned g = 0; g < count; ++g) {
+        m += x[g];
+        a = x[g] < a ? x[g] : a;
+        b = x[g] > b ? x[g] : b;
+    }
+    m /= count;
+    for (unsigned g = 0; g < count; ++g)
+        v += (x[g] - m) * (x[g] - m);
+    *mean = m;
+    *sd = count > 1 ? sqrt(v / (count - 1)) : 0.0;
+    if (lo)
+        *lo = a;
+    if (hi)
+        *hi = b;
+}
+
+static void add_param(rch_diagnose_result *r, const char *name, double value, double se, const char *unit)
+{
+    if (r->n_params >= RCH_DIAGNOSE_MAX_PARAMS)
+        return;
+    rch_diagnose_param *p = &r->params[r->n_params++];
+    snprintf(p->name, sizeof p->name, "%s", name);
+    p->value = value;
+    p->se = se;
+    snprintf(p->unit, sizeof p->unit, "%s", unit);
+}
+
+/* Effect parameters of the final model in display units, with fold-jackknife
+ * standard errors from the fold models (k). */
+static void report_params(rch_diagnose_result *r, const rc_model *fold_models, unsigned k)
+{
+    const rc_model *m = &r->final;
+    double vals[RCH_DIAGNOSE_MAX_FOLDS], se;
+    char name[48];
+    for (unsigned e = 0; e < m->n_effects; ++e) {
+        const rc_effect *ef = &m->effects[e];
+        const rc_effect_kind kind = (rc_effect_kind)ef->kind;
+        if (kind == RC_EFF_GROUP_OFFSET) {
+            /* summarise: common level (trades with the geometry) and the
+             * spread between set-ups (what the groups really differ by) */
+            double vals2[RCH_DIAGNOSE_MAX_FOLDS], se2, mean, sd, lo, hi;
+            group_stats(&mean, &sd, &lo, &hi, &m->x[ef->first], ef->count);
+            for (unsigned f = 0; f < k; ++f)
+                group_stats(&vals[f], &vals2[f], NULL, NULL, &fold_models[f].x[ef->first], ef->count);
+            jack_se(&se, vals, k);
+            jack_se(&se2, vals2, k);
+            add_param(r, "group_offset spread (sd)", sd, se2, "mm");
+            add_param(r, "group_offset range (max-min)", hi - lo, 0.0, "mm");
+            add_param(r, "group_offset common level", mean, se, "mm");
+            continue;
+        }
+        for (unsigned p = 0; p < ef->count; ++p) {
+            const unsigned idx = ef->first + p;
+            double scale = 1.0;
+            const char *unit = "mm";
+            if (kind == RC_EFF_JOINT_PERIODIC) {
+                scale = 1e3 / DEG;
+                unit = "mdeg";
+            } else if (kind == RC_EFF_JOINT_COMPLIANCE) {
+                scale = 1e3 / DEG;
+                unit = "mdeg/m";
+            } else if (kind == RC_EFF_LENGTH_SCALE) {
+                scale = 1e6;
+                unit = "ppm";
+            }
+            for (unsigned f = 0; f < k; ++f)
+                vals[f] = fold_models[f].x[idx] * scale;
+            jack_se(&se, vals, k);
+            rc_param_name(name, sizeof name, m, idx);
+            add_param(r, name, m->x[idx] * scale, se, unit);
+        }
+    }
+}
+
+/* Notes on what cable lengths cannot identify, checked on this data. */
+static void scale_note(rch_diagnose_result *r)
+{
+    /* encoder scale 1e-3 versus the robot and the encoder position scaled
+     * by 1 + 1e-3: compare the cable lengths they predict. */
+    const double sc = 1e-3;
+    rc_model a = r->geo, b = r->geo;
+    if (rc_model_add_effect(&a, RC_EFF_LENGTH_SCALE, 0, 0) != RC_OK)
+        return;
+    a.x[a.effects[a.n_effects - 1].first] = sc;
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        b.x[RC_P_A(i)] *= 1.0 + sc;
+        b.x[RC_P_D(i)] *= 1.0 + sc;
+    }
+    for (unsigned k = 0; k < 3; ++k)
+        b.x[RC_P_ENC + k] *= 1.0 + sc;
+    double d2 = 0.0, e2 = 0.0;
+    for (size_t i = 0; i < r->n; ++i) {
+        double la, lb, l0;
+        if (rc_meas(&la, NULL, &a, &r->s[i]) != RC_OK || rc_meas(&lb, NULL, &b, &r->s[i]) != RC_OK ||
+            rc_meas(&l0, NULL, &r->geo, &r->s[i]) != RC_OK)
+            return;
+        d2 += (la - lb) * (la - lb);
+        e2 += (la - l0) * (la - l0);
+    }
+    if (r->n_notes >= RCH_DIAGNOSE_MAX_NOTES)
+        return;
+    snprintf(r->notes[r->n_notes++], sizeof r->notes[0],
+             "encoder scale vs robot size: a cable scale error of 1000 ppm changes the lengths by %.3f mm rms, "
+             "but a robot and encoder position 1000 ppm larger predict the same lengths to %.1e mm rms: "
+             "not identifiable from cable lengths. A length reference separates them: a gauge of known "
+             "length (or two points a known distance apart, e.g. by laser tracker or CMM) measured with the cable.",
+             sqrt(e2 / (double)r->n), sqrt(d2 / (double)r->n));
+}
+
+int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t n, const rc_model *nominal,
+                     const rch_diagnose_cfg *cfg_in, rch_diag *d)
+{
+    const double t0 = now_ms();
+    rch_diagnose_cfg cfg = *cfg_in;
+    ctx c;
+    int rc = -1;
+    rc_model *base_folds = NULL, *cand_folds = NULL, *cand_full = NULL;
+    double *r0 = NULL, *cand_res = NULL, *tmp = NULL;
+    double (*var)[V_N] = NULL;
+    unsigned *order = NULL;
+
+    memset(out, 0, sizeof *out);
+    memset(&c, 0, sizeof c);
+    if (cfg.folds == 0)
+        cfg.folds = 5;
+    if (cfg.max_steps == 0)
+        cfg.max_steps = 3;
+    if (cfg.max_steps > RCH_DIAGNOSE_MAX_STEPS)
+        cfg.max_steps = RCH_DIAGNOSE_MAX_STEPS;
+    if (cfg.alpha <= 0.0)
+        cfg.alpha = 0.01;
+    if (cfg.gap_factor <= 0.0)
+        cfg.gap_factor = 1.25;
+    if (cfg.folds < 2 || cfg.folds > RCH_DIAGNOSE_MAX_FOLDS) {
+        rch_diag_set(d, "", 0, 0, "folds must be within 2..%d", RCH_DIAGNOSE_MAX_FOLDS);
+        return -1;
+    }
+    if (n < 10u * cfg.folds || n < 60) {
+        rch_diag_set(d, "", 0, 0, "%zu samples are too few to diagnose (need at least %u)", n,
+                     10u * cfg.folds > 60 ? 10u * cfg.folds : 60u);
+        return -1;
+    }
+    out->n = n;
+    out->folds = cfg.folds;
+    out->s = malloc(n * sizeof *out->s);
+    out->res_before_mm = calloc(n, sizeof(double));
+    out->res_after_mm = calloc(n, sizeof(double));
+    out->floor_mm = calloc(n, sizeof(double));
+    c.w = malloc(sizeof *c.w);
+    c.fold = calloc(n, sizeof *c.fold);
+    r0 = calloc(n, sizeof *r0);
+    tmp = calloc(n * RC_NJ, sizeof *tmp);
+    var = calloc(n, sizeof *var);
+    order = calloc(n, sizeof *order);
+    base_folds = calloc(cfg.folds, sizeof *base_folds);
+    cand_folds = calloc((size_t)N_ALL_CANDS * cfg.folds, sizeof *cand_folds);
+    cand_full = calloc(N_ALL_CANDS, sizeof *cand_full);
+    cand_res = calloc(N_ALL_CANDS * n, sizeof *cand_res);
+    if (!out->s || !out->res_before_mm || !out->res_after_mm || !out->floor_mm || !c.w || !c.fold || !r0 ||
+        !tmp || !var || !order || !base_folds || !cand_folds || !cand_full || !cand_res) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    memcpy(out->s, samples, n * sizeof *samples);
+    if (cfg.groups_given) {
+        unsigned g = 0;
+        for (size_t i = 0; i < n; ++i)
+            g = out->s[i].group > g ? out->s[i].group : g;
+        out->n_groups = g + 1;
+    }
+    c.s = out->s;
+    c.n = n;
+    c.k = cfg.folds;
+    c.max_iter = cfg.max_iter;
+    c.verbose = cfg.verbose;
+
+    /* display steps */
+    for (size_t i = 0; i < n; ++i)
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            tmp[i * RC_NJ + j] = out->s[i].q_rad[j] / DEG;
+    out->q_step_deg = cfg.q_step_deg > 0.0 ? cfg.q_step_deg
+                      : cfg.q_step_deg < 0.0 ? 0.0
+                                             : rch_diagnose_detect_step(tmp, n * RC_NJ);
+    for (size_t i = 0; i < n; ++i)
+        tmp[i] = out->s[i].len_mm;
+    out->len_step_mm = cfg.len_step_mm > 0.0 ? cfg.len_step_mm
+                       : cfg.len_step_mm < 0.0 ? 0.0
+                                               : rch_diagnose_detect_step(tmp, n);
+    out->len_noise_mm = cfg.len_noise_mm > 0.0 ? cfg.len_noise_mm : 0.0;
+    if (!cfg.groups_given)
+        out->n_groups = group_by_wrist(out->s, n, out->q_step_deg, &out->n_flicker);
+
+    /* 1. geometric fit on all samples */
+    {
+        rc_model *g = &out->geo;
+        rc_solve_result res;
+        uint8_t fixed[RC_MAX_PARAMS];
+        *g = *nominal;
+        g->n_effects = 0;
+        g->n_params = RC_N_BASE;
+        if (!cfg.have_encoder) {
+            double e[3];
+            if (rc_encoder_guess(e, g, out->s, n) != RC_OK) {
+                rch_diag_set(d, "", 0, 0, "cannot place the encoder: the poses must spread in all directions");
+                goto done;
+            }
+            memcpy(&g->x[RC_P_ENC], e, sizeof e);
+        }
+        memset(fixed, 1, sizeof fixed);
+        fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 0;
+        if (fit(g, NULL, &c, fixed, out->s, n) != 0 || fit(g, &res, &c, NULL, out->s, n) != 0) {
+            rch_diag_set(d, "", 0, 0, "the geometric fit failed");
+            goto done;
+        }
+        out->train_rmse_geo_mm = res.rms_final_mm;
+        out->geo_rank = res.rank;
+        out->geo_free = res.n_free;
+    }
+
+    /* 2. noise floor and explanatory variables */
+    {
+        const double qs = out->q_step_deg * DEG, ls = out->len_step_mm, ln = out->len_noise_mm;
+        double jac[RC_MAX_PARAMS], vq = 0.0, vl = 0.0;
+        const rc_model *g = &out->geo;
+        double ref[4][4];
+        for (unsigned i = 0; i < 4; ++i)
+            for (unsigned k = 0; k < 4; ++k)
+                ref[i][k] = g->x[4 * i + k];
+        for (size_t i = 0; i < n; ++i) {
+            double l, p[3];
+            if (rc_meas(&l, jac, g, &out->s[i]) != RC_OK) {
+                rch_diag_set(d, "", 0, 0, "sample %zu: the flange meets the encoder outlet", i + 1);
+                goto done;
+            }
+            double sq = 0.0;
+            for (unsigned j = 0; j < RC_NJ; ++j)
+                sq += jac[RC_P_THETA(j)] * jac[RC_P_THETA(j)];
+            const double viq = sq * qs * qs / 12.0, vil = ls * ls / 12.0 + ln * ln;
+            out->floor_mm[i] = sqrt(viq + vil);
+            vq += viq;
+            vl += vil;
+            rc_fk(p, NULL, g, out->s[i].q_rad);
+            double u[3], nu = 0.0;
+            for (unsigned k = 0; k < 3; ++k) {
+                u[k] = p[k] - g->x[RC_P_ENC + k];
+                nu += u[k] * u[k];
+            }
+            nu = sqrt(nu);
+            var[i][V_LEV2] = rc_gravity_lever_m((const double(*)[4])ref, 1, out->s[i].q_rad);
+            var[i][V_LEV3] = rc_gravity_lever_m((const double(*)[4])ref, 2, out->s[i].q_rad);
+            var[i][V_LEN] = out->s[i].len_mm;
+            var[i][V_UX] = u[0] / nu;
+            var[i][V_UY] = u[1] / nu;
+            var[i][V_UZ] = u[2] / nu;
+            var[i][V_T] = out->s[i].t;
+        }
+        out->floor_joints_mm = sqrt(vq / (double)n);
+        out->floor_len_mm = sqrt(vl / (double)n);
+        out->noise_floor_mm = sqrt((vq + vl) / (double)n);
+    }
+
+    /* 3. folds: random within each group, dealt round-robin */
+    {
+        rc_rng rng;
+        rc_rng_seed(&rng, cfg.seed ^ 0x6469616700000000ull);
+        for (size_t i = 0; i < n; ++i)
+            order[i] = (unsigned)i;
+        for (size_t i = n; i > 1; --i) {
+            const size_t j = rc_rng_below(&rng, (uint32_t)i);
+            const unsigned t = order[i - 1];
+            order[i - 1] = order[j];
+            order[j] = t;
+        }
+        /* stable pass per group in shuffled order: counter continues across groups */
+        unsigned *gorder = calloc(out->n_groups, sizeof *gorder);
+        if (!gorder) {
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            goto done;
+        }
+        for (unsigned g = 0; g < out->n_groups; ++g)
+            gorder[g] = g;
+        for (unsigned g = out->n_groups; g > 1; --g) {
+            const unsigned j = rc_rng_below(&rng, g);
+            const unsigned t = gorder[g - 1];
+            gorder[g - 1] = gorder[j];
+            gorder[j] = t;
+        }
+        /* bucket samples by group, in shuffled order */
+        size_t *start = calloc((size_t)out->n_groups + 1, sizeof *start);
+        unsigned *byg = calloc(n, sizeof *byg);
+        if (!start || !byg) {
+            free(gorder);
+            free(start);
+            free(byg);
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            goto done;
+        }
+        for (size_t i = 0; i < n; ++i)
+            start[out->s[i].group + 1]++;
+        for (unsigned g = 0; g < out->n_groups; ++g)
+            start[g + 1] += start[g];
+        {
+            size_t *pos = calloc(out->n_groups, sizeof *pos);
+            if (!pos) {
+                free(gorder);
+                free(start);
+                free(byg);
+                rch_diag_set(d, "", 0, 0, "out of memory");
+                goto done;
+            }
+            for (size_t i = 0; i < n; ++i) {
+                const unsigned s = order[i], g = out->s[s].group;
+                byg[start[g] + pos[g]++] = s;
+            }
+            free(pos);
+        }
+        unsigned counter = 0;
+        for (unsigned gi = 0; gi < out->n_groups; ++gi) {
+            const unsigned g = gorder[gi];
+            for (size_t p = start[g]; p < start[g + 1]; ++p)
+                c.fold[byg[p]] = counter++ % c.k;
+        }
+        free(gorder);
+        free(start);
+        free(byg);
+        for (unsigned f = 0; f < c.k; ++f) {
+            size_t nt = 0;
+            for (size_t i = 0; i < n; ++i)
+                nt += c.fold[i] != f;
+            c.train[f] = malloc(nt * sizeof *c.train[f]);
+            if (!c.train[f]) {
+                rch_diag_set(d, "", 0, 0, "out of memory");
+                goto done;
+            }
+            c.n_train[f] = 0;
+            for (size_t i = 0; i < n; ++i)
+                if (c.fold[i] != f)
+                    c.train[f][c.n_train[f]++] = out->s[i];
+        }
+    }
+
+    /* 4. cross-validated geometry */
+    for (unsigned f = 0; f < c.k; ++f)
+        base_folds[f] = out->geo;
+    if (cv_run(base_folds, r0, &c) != 0) {
+        rch_diag_set(d, "", 0, 0, "a cross-validation fit failed");
+        goto done;
+    }
+    memcpy(out->res_before_mm, r0, n * sizeof *r0);
+    out->rmse_before_mm = rms(r0, n);
+    out->n_tests = structure_tests(out->before, r0, out->s, n, (const double(*)[V_N])var, out->n_groups,
+                                   cfg.alpha);
+    if (cfg.verbose)
+        fprintf(stderr, "diagnose: geometry held-out RMSE %.4f mm, floor %.4f mm\n", out->rmse_before_mm,
+                out->noise_floor_mm);
+
+    /* 5. candidate search, one effect per step */
+    {
+        rc_model base = out->geo;
+        for (unsigned step = 0; step < cfg.max_steps; ++step) {
+            rch_diagnose_step *st = &out->steps[out->n_steps++];
+            unsigned n_tested = 0;
+            memset(st, 0, sizeof *st);
+            st->chosen = -1;
+            st->rmse_base_mm = rms(r0, n);
+            for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci) {
+                const cdef *cd = &all_cands[ci];
+                rch_diagnose_cand *ca = &st->cand[st->n_cand];
+                memset(ca, 0, sizeof *ca);
+                ca->kind = cd->kind;
+                ca->joint = is_joint_kind(cd->kind) ? cd->joint0 + 1 : 0;
+                cand_name(ca->name, sizeof ca->name, cd->kind, cd->joint0);
+                if (has_effect(&base, cd->kind, cd->joint0))
+                    continue; /* already in the model */
+                st->n_cand++;
+                unsigned count = 0;
+                if (cd->kind == RC_EFF_GROUP_OFFSET) {
+                    if (!groups_usable(out->n_groups, n)) {
+                        snprintf(ca->note, sizeof ca->note,
+                                 "not applicable: %u groups for %zu samples (need 2..n/3)", out->n_groups, n);
+                        continue;
+                    }
+                    count = out->n_groups;
+                }
+                if (cd->kind == RC_EFF_TIME_DRIFT) {
+                    double lo = 1e300, hi = -1e300;
+                    for (size_t i = 0; i < n; ++i) {
+                        lo = out->s[i].t < lo ? out->s[i].t : lo;
+                        hi = out->s[i].t > hi ? out->s[i].t : hi;
+                    }
+                    if (!(hi > lo)) {
+                        snprintf(ca->note, sizeof ca->note, "not applicable: no acquisition order");
+                        continue;
+                    }
+                }
+                rc_model *full = &cand_full[ci];
+                *full = base;
+                if (rc_model_add_effect(full, cd->kind, cd->joint0, count) != RC_OK) {
+                    snprintf(ca->note, sizeof ca->note, "not applicable: model capacity (RC_MAX_PARAMS %d)",
+                             RC_MAX_PARAMS);
+                    continue;
+                }
+                ca->n_params = full->n_params - base.n_params;
+                rc_solve_result res;
+                if (fit(full, &res, &c, NULL, out->s, n) != 0) {
+                    snprintf(ca->note, sizeof ca->note, "fit failed");
+                    continue;
+                }
+                {
+                    const unsigned ra = rank_at(full, full->n_params, out->s, n, c.w, RANK_TOL, cfg.verbose > 2);
+                    const unsigned rb = rank_at(full, base.n_params, out->s, n, c.w, RANK_TOL, 0);
+                    ca->n_ident = ra > rb ? ra - rb : 0;
+                }
+                if (ca->n_ident > ca->n_params)
+                    ca->n_ident = ca->n_params;
+                if (ca->n_ident == 0) {
+                    snprintf(ca->note, sizeof ca->note, "not identifiable: %s",
+                             known_reason(cd->kind, cd->joint0, &base));
+                    continue;
+                }
+                if (ca->n_ident < ca->n_params)
+                    snprintf(ca->note, sizeof ca->note, "%u of %u parameters identifiable (%s)", ca->n_ident,
+                             ca->n_params, known_reason(cd->kind, cd->joint0, &base));
+                {
+                    double worst_deg = implausible_deg(full, (const double(*)[V_N])var, n);
+                    if (worst_deg > 0.0) {
+                        ca->implausible = 1;
+                        snprintf(ca->note, sizeof ca->note,
+                                 "implausible: fitted joint error up to %.3g deg (limit %.3g): it stands in for "
+                                 "something else",
+                                 worst_deg, PLAUSIBLE_DEG);
+                    }
+                }
+                rc_model *fm = &cand_folds[(size_t)ci * c.k];
+                double *rc_ = &cand_res[(size_t)ci * n];
+                for (unsigned f = 0; f < c.k; ++f) {
+                    fm[f] = base_folds[f];
+                    if (cd->kind == RC_EFF_JOINT_COMPLIANCE) {
+                        /* same frozen lever geometry as the full model */
+                        rc_model_add_effect(&fm[f], cd->kind, cd->joint0, count);
+                        memcpy(fm[f].effects[fm[f].n_effects - 1].ref_dh,
+                               full->effects[full->n_effects - 1].ref_dh, sizeof full->effects[0].ref_dh);
+                    } else {
+                        rc_model_add_effect(&fm[f], cd->kind, cd->joint0, count);
+                    }
+                }
+                if (cv_run(fm, rc_, &c) != 0) {
+                    snprintf(ca->note, sizeof ca->note, "a cross-validation fit failed");
+                    continue;
+                }
+                double sd = 0.0, sd2 = 0.0;
+                for (size_t i = 0; i < n; ++i) {
+                    const double di = r0[i] * r0[i] - rc_[i] * rc_[i];
+                    sd += di;
+                    sd2 += di * di;
+                }
+                const double mean = sd / (double)n;
+                const double var_d = (sd2 - (double)n * mean * mean) / (double)(n - 1);
+                ca->tested = 1;
+                ca->rmse_cv_mm = rms(rc_, n);
+                ca->gain_mm2 = mean;
+                ca->gain_se_mm2 = sqrt(var_d > 0.0 ? var_d / (double)n : 0.0);
+                ca->z = ca->gain_se_mm2 > 0.0 ? mean / ca->gain_se_mm2 : 0.0;
+                ca->p_value = 0.5 * erfc(ca->z / sqrt(2.0));
+                ++n_tested;
+                if (cfg.verbose) {
+                    fprintf(stderr, "diagnose: step %u %-22s held-out %.4f mm  z %.2f train %.4f\n", step + 1,
+                            ca->name, ca->rmse_cv_mm, ca->z, res.rms_final_mm);
+                    if (cfg.verbose > 1)
+                        for (size_t i = 0; i < n; ++i)
+                            if (fabs(rc_[i]) > 4.0 || fabs(r0[i]) > 4.0)
+                                fprintf(stderr, "   sample %zu group %u fold %u r0 %.3f rc %.3f\n", i + 1,
+                                        out->s[i].group, c.fold[i], r0[i], rc_[i]);
+                }
+            }
+            /* significance and choice */
+            int best = -1;
+            for (unsigned k = 0; k < st->n_cand; ++k) {
+                rch_diagnose_cand *ca = &st->cand[k];
+                if (!ca->tested)
+                    continue;
+                ca->significant = ca->p_value < cfg.alpha / n_tested && ca->gain_mm2 > 0.0 && !ca->implausible;
+                if (ca->significant && (best < 0 || ca->gain_mm2 > st->cand[best].gain_mm2))
+                    best = (int)k;
+            }
+            if (best < 0) {
+                snprintf(st->why, sizeof st->why,
+                         "no candidate improves the held-out error significantly (one-sided p < %.2g each)",
+                         cfg.alpha / (n_tested ? n_tested : 1));
+                break;
+            }
+            /* map candidate slot -> all_cands index */
+            unsigned slot_ci[RCH_DIAGNOSE_MAX_CAND];
+            {
+                unsigned k = 0;
+                for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci)
+                    if (!has_effect(&base, all_cands[ci].kind, all_cands[ci].joint0))
+                        slot_ci[k++] = ci;
+            }
+            int chosen = best;
+            const double *rb = &cand_res[(size_t)slot_ci[best] * n];
+            for (unsigned k = 0; k < st->n_cand; ++k) {
+                const rch_diagnose_cand *ca = &st->cand[k];
+                if ((int)k == best || !ca->significant || ca->n_params >= st->cand[best].n_params)
+                    continue;
+                const double *rk = &cand_res[(size_t)slot_ci[k] * n];
+                double s1 = 0.0, s2 = 0.0;
+                for (size_t i = 0; i < n; ++i) {
+                    const double di = rk[i] * rk[i] - rb[i] * rb[i];
+                    s1 += di;
+                    s2 += di * di;
+                }
+                const double m1 = s1 / (double)n;
+                const double se = sqrt(fmax(s2 - (double)n * m1 * m1, 0.0) / (double)(n - 1) / (double)n);
+                if (m1 <= se &&
+                    (chosen == best || ca->n_params < st->cand[chosen].n_params ||
+                     (ca->n_params == st->cand[chosen].n_params && ca->gain_mm2 > st->cand[chosen].gain_mm2)))
+                    chosen = (int)k;
+            }
+            st->chosen = chosen;
+            {
+                char cn[40], bn[40], why[240];
+                memcpy(cn, st->cand[chosen].name, sizeof cn);
+                memcpy(bn, st->cand[best].name, sizeof bn);
+                if (chosen != best)
+                    snprintf(why, sizeof why,
+                             "%s: significant, and within one standard error of the best (%s) with fewer "
+                             "parameters",
+                             cn, bn);
+                else
+                    snprintf(why, sizeof why, "%s: largest significant held-out gain (z = %.1f)", cn,
+                             st->cand[chosen].z);
+                memcpy(st->why, why, sizeof why);
+            }
+            const unsigned ci = slot_ci[chosen];
+            base = cand_full[ci];
+            memcpy(base_folds, &cand_folds[(size_t)ci * c.k], c.k * sizeof *base_folds);
+            memcpy(r0, &cand_res[(size_t)ci * n], n * sizeof *r0);
+            out->n_chosen++;
+            if (out->n_chosen == 1) {
+                snprintf(out->effect, sizeof out->effect, "%s", rc_effect_name(cand_kind_of(st, chosen)));
+                out->joint = st->cand[chosen].joint;
+            }
+        }
+        out->final = base;
+    }
+
+    /* 6. after */
+    memcpy(out->res_after_mm, r0, n * sizeof *r0);
+    out->rmse_after_mm = rms(r0, n);
+    structure_tests(out->after, r0, out->s, n, (const double(*)[V_N])var, out->n_groups, cfg.alpha);
+    {
+        size_t pos = 0;
+        int unexpl = 0;
+        out->remaining_why[0] = '\0';
+        if (out->rmse_after_mm > cfg.gap_factor * out->noise_floor_mm) {
+            unexpl = 1;
+            pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
+                                    "held-out RMSE %.3f mm is %.2f x the noise floor", out->rmse_after_mm,
+                                    out->rmse_after_mm / out->noise_floor_mm);
+        }
+        for (unsigned k = 0; k < out->n_tests; ++k)
+            if (out->after[k].significant && pos < sizeof out->remaining_why) {
+                pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
+                                        "%sstructure against %s (p = %.1e)", unexpl ? "; " : "",
+                                        out->after[k].name, out->after[k].p_value);
+                unexpl = 1;
+            }
+        snprintf(out->remaining, sizeof out->remaining, "%s", unexpl ? "unexplained" : "none");
+        if (out->n_chosen == 0) {
+            memcpy(out->effect, unexpl ? "unexplained" : "none", unexpl ? 12 : 5);
+            out->joint = 0;
+        }
+    }
+    /* 7. effect parameters and their size, notes */
+    report_params(out, base_folds, c.k);
+    {
+        rc_model z = out->final;
+        for (unsigned e = 0; e < z.n_effects; ++e)
+            for (unsigned p = 0; p < z.effects[e].count; ++p)
+                z.x[z.effects[e].first + p] = 0.0;
+        double s2 = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            double la, lb;
+            if (rc_meas(&la, NULL, &out->final, &out->s[i]) == RC_OK && rc_meas(&lb, NULL, &z, &out->s[i]) == RC_OK)
+                s2 += (la - lb) * (la - lb);
+        }
+        out->effect_rms_mm = sqrt(s2 / (double)n);
+    }
+    scale_note(out);
+    for (unsigned st = 0; st < out->n_steps; ++st)
+        for (unsigned k = 0; k < out->steps[st].n_cand; ++k) {
+            const rch_diagnose_cand *ca = &out->steps[st].cand[k];
+            if (st == 0 && ca->n_params > 0 && ca->n_ident < ca->n_params && ca->kind != RC_EFF_LENGTH_SCALE &&
+                out->n_notes < RCH_DIAGNOSE_MAX_NOTES)
+            {
+                char nm[40], nt[160];
+                memcpy(nm, ca->name, sizeof nm);
+                memcpy(nt, ca->note, sizeof nt);
+                snprintf(out->notes[out->n_notes++], sizeof out->notes[0], "%s: %s", nm, nt);
+            }
+        }
+    if (out->n_notes < RCH_DIAGNOSE_MAX_NOTES)
+        snprintf(out->notes[out->n_notes++], sizeof out->notes[0],
+                 "a cable attachment (tool) offset on the flange is not a separate effect: within the flange "
+                 "plane it is a6 with the joint-6 offset theta6, along the flange axis it is d6");
+    rc = 0;
+done:
+    out->time_ms = now_ms() - t0;
+    for (unsigned f = 0; f < RCH_DIAGNOSE_MAX_FOLDS; ++f)
+        free(c.train[f]);
+    free(c.w);
+    free(c.fold);
+    free(r0);
+    free(tmp);
+    free(var);
+    free(order);
+    free(base_folds);
+    free(cand_folds);
+    free(cand_full);
+    free(cand_res);
+    return rc;
+}
+
+void rch_diagnose_free(rch_diagnose_result *r)
+{
+    if (!r)
+        return;
+    free(r->s);
+    free(r->res_before_mm);
+    free(r->res_after_mm);
+    free(r->floor_mm);
+    r->s = NULL;
+    r->res_before_mm = r->res_after_mm = r->floor_mm = NULL;
+}
+
+/* ---------------------------------------------------------------- output */
+
+static void print_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
+{
+    fprintf(f, "  %-28s %5s %6s %10s %9s %7s\n", "variable", "dof1", "dof2", "F", "p", "R^2");
+    for (unsigned k = 0; k < n; ++k)
+        fprintf(f, "  %-28s %5u %6u %10.2f %9.1e %6.1f%% %s\n", t[k].name, t[k].dof1, t[k].dof2, t[k].f_stat,
+                t[k].p_value, 100.0 * t[k].r2, t[k].significant ? "STRUCTURE" : "");
+}
+
+int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
+{
+    fprintf(f, "rcal diagnose: %zu samples, %u set-up groups, %u-fold cross-validation (random within groups)\n",
+             r->n, r->n_groups, r->folds);
+    fprintf(f, "\nNoise floor: %.4f mm rms  (joint display step %.3g deg through the Jacobian: %.4f mm; "
+               "length step %.3g mm%s: %.4f mm)\n",
+            r->noise_floor_mm, r->q_step_deg, r->floor_joints_mm, r->len_step_mm,
+            r->len_noise_mm > 0.0 ? " + noise" : "", r->floor_len_mm);
+    fprintf(f, "Geometric model (27 parameters, rank %u of %u): training RMSE %.4f mm, held-out RMSE %.4f mm "
+               "= %.2f x floor\n",
+            r->geo_rank, r->geo_free, r->train_rmse_geo_mm, r->rmse_before_mm,
+            r->rmse_before_mm / r->noise_floor_mm);
+    fprintf(f, "\nStructure of the held-out residuals (geometry only; F tests, Bonferroni over %u tests):\n",
+            r->n_tests);
+    print_tests(f, r->before, r->n_tests);
+    for (unsigned s = 0; s < r->n_steps; ++s) {
+        const rch_diagnose_step *st = &r->steps[s];
+        fprintf(f, "\nStep %u: candidates fitted jointly with the geometry (model held-out RMSE %.4f mm)\n", s + 1,
+                st->rmse_base_mm);
+        fprintf(f, "  %-22s %6s %6s %10s %11s %7s %9s  %s\n", "effect", "params", "ident", "held-out",
+                "gain mm^2", "z", "p", "");
+        for (unsigned k = 0; k < st->n_cand; ++k) {
+            const rch_diagnose_cand *ca = &st->cand[k];
+            if (ca->tested)
+                fprintf(f, "  %-22s %6u %6u %10.4f %11.5f %7.2f %9.1e  %s%s%s\n", ca->name, ca->n_params,
+                        ca->n_ident, ca->rmse_cv_mm, ca->gain_mm2, ca->z, ca->p_value,
+                        (int)k == st->chosen ? "<- CHOSEN" : ca->significant ? "significant" : "",
+                        ca->note[0] ? "  " : "", ca->note);
+            else
+                fprintf(f, "  %-22s %6u %6u %10s %11s %7s %9s  %s\n", ca->name, ca->n_params, ca->n_ident, "-", "-",
+                        "-", "-", ca->note);
+        }
+        fprintf(f, "  -> %s\n", st->chosen >= 0 ? st->why : st->why[0] ? st->why : "stop");
+    }
+    fprintf(f, "\nVerdict: %s", r->effect);
+    if (r->joint)
+        fprintf(f, " (joint %u)", r->joint);
+    fprintf(f, "\n");
+    if (r->n_chosen > 0) {
+        fprintf(f, "Effects added, in order:");
+        for (unsigned s = 0; s < r->n_steps; ++s)
+            if (r->steps[s].chosen >= 0)
+                fprintf(f, " %s", r->steps[s].cand[r->steps[s].chosen].name);
+        fprintf(f, "\nFitted (all samples; +- fold-jackknife standard error):\n");
+        for (unsigned k = 0; k < r->n_params; ++k)
+            fprintf(f, "  %-28s %12.5f +- %.5f %s\n", r->params[k].name, r->params[k].value, r->params[k].se,
+                    r->params[k].unit);
+        fprintf(f, "  contribution to the cable length: %.4f mm rms\n", r->effect_rms_mm);
+    }
+    fprintf(f, "\nHeld-out RMSE: before %.4f mm (%.2f x floor) -> after %.4f mm (%.2f x floor); floor %.4f mm\n",
+            r->rmse_before_mm, r->rmse_before_mm / r->noise_floor_mm, r->rmse_after_mm,
+            r->rmse_after_mm / r->noise_floor_mm, r->noise_floor_mm);
+    fprintf(f, "Remaining: %s%s%s\n", r->remaining, r->remaining_why[0] ? ": " : "", r->remaining_why);
+    if (r->n_chosen > 0) {
+        fprintf(f, "\nStructure of the held-out residuals after:\n");
+        print_tests(f, r->after, r->n_tests);
+    }
+    fprintf(f, "\nWhat cable lengths cannot identify:\n");
+    for (unsigned k = 0; k < r->n_notes; ++k)
+        fprintf(f, "  - %s\n", r->notes[k]);
+    fprintf(f, "\nTime: %.0f ms\n", r->time_ms);
+    return ferror(f) ? -1 : 0;
+}
+
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; ++s) {
+        if (*s == '"' || *s == '\\')
+            fprintf(f, "\\%c", *s);
+        else if ((unsigned char)*s < 0x20)
+            fprintf(f, "\\u%04x", (unsigned)(unsigned char)*s);
+        else
+            fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+static void json_num(FILE *f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.6g", v);
+    else
+        fprintf(f, "null");
+}
+
+static void json_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
+{
+    fprintf(f, "[");
+    for (unsigned k = 0; k < n; ++k) {
+        fprintf(f, "%s{\"variable\":", k ? "," : "");
+        json_str(f, t[k].name);
+        fprintf(f, ",\"dof1\":%u,\"dof2\":%u,\"f\":", t[k].dof1, t[k].dof2);
+        json_num(f, t[k].f_stat);
+        fprintf(f, ",\"p\":");
+        json_num(f, t[k].p_value);
+        fprintf(f, ",\"r2\":");
+        json_num(f, t[k].r2);
+        fprintf(f, ",\"significant\":%s}", t[k].significant ? "true" : "false");
+    }
+    fprintf(f, "]");
+}
+
+int rch_diagnose_json(FILE *f, const rch_diagnose_result *r)
+{
+    fprintf(f, "{\"effect\":");
+    json_str(f, r->effect);
+    fprintf(f, ",\"joint\":");
+    if (r->joint)
+        fprintf(f, "%u", r->joint);
+    else
+        fprintf(f, "null");
+    fprintf(f, ",\"rmse_before_mm\":");
+    json_num(f, r->rmse_before_mm);
+    fprintf(f, ",\"rmse_after_mm\":");
+    json_num(f, r->rmse_after_mm);
+    fprintf(f, ",\"noise_floor_mm\":");
+    json_num(f, r->noise_floor_mm);
+    fprintf(f, ",\"noise_floor_joints_mm\":");
+    json_num(f, r->floor_joints_mm);
+    fprintf(f, ",\"noise_floor_length_mm\":");
+    json_num(f, r->floor_len_mm);
+    fprintf(f, ",\"q_step_deg\":");
+    json_num(f, r->q_step_deg);
+    fprintf(f, ",\"len_step_mm\":");
+    json_num(f, r->len_step_mm);
+    fprintf(f, ",\"train_rmse_geometry_mm\":");
+    json_num(f, r->train_rmse_geo_mm);
+    fprintf(f, ",\"n\":%zu,\"groups\":%u,\"folds\":%u,\"remaining\":", r->n, r->n_groups, r->folds);
+    json_str(f, r->remaining);
+    fprintf(f, ",\"remaining_why\":");
+    json_str(f, r->remaining_why);
+    fprintf(f, ",\"sequence\":[");
+    for (unsigned s = 0, first = 1; s < r->n_steps; ++s)
+        if (r->steps[s].chosen >= 0) {
+            fprintf(f, "%s", first ? "" : ",");
+            json_str(f, r->steps[s].cand[r->steps[s].chosen].name);
+            first = 0;
+        }
+    fprintf(f, "],\"candidates\":[");
+    for (unsigned s = 0; s < r->n_steps; ++s)
+        for (unsigned k = 0; k < r->steps[s].n_cand; ++k) {
+            const rch_diagnose_cand *ca = &r->steps[s].cand[k];
+            fprintf(f, "%s{\"step\":%u,\"effect\":", (s || k) ? "," : "", s + 1);
+            json_str(f, rc_effect_name(ca->kind));
+            fprintf(f, ",\"joint\":");
+            if (ca->joint)
+                fprintf(f, "%u", ca->joint);
+            else
+                fprintf(f, "null");
+            fprintf(f, ",\"params\":%u,\"identifiable\":%u,\"tested\":%s", ca->n_params, ca->n_ident,
+                    ca->tested ? "true" : "false");
+            if (ca->tested) {
+                fprintf(f, ",\"rmse_cv_mm\":");
+                json_num(f, ca->rmse_cv_mm);
+                fprintf(f, ",\"gain_mm2\":");
+                json_num(f, ca->gain_mm2);
+                fprintf(f, ",\"gain_se_mm2\":");
+                json_num(f, ca->gain_se_mm2);
+                fprintf(f, ",\"z\":");
+                json_num(f, ca->z);
+                fprintf(f, ",\"p\":");
+                json_num(f, ca->p_value);
+            }
+            fprintf(f, ",\"significant\":%s,\"chosen\":%s,\"note\":", ca->significant ? "true" : "false",
+                    (int)k == r->steps[s].chosen ? "true" : "false");
+            json_str(f, ca->note);
+            fprintf(f, "}");
+        }
+    fprintf(f, "],\"params\":[");
+    for (unsigned k = 0; k < r->n_params; ++k) {
+        fprintf(f, "%s{\"name\":", k ? "," : "");
+        json_str(f, r->params[k].name);
+        fprintf(f, ",\"value\":");
+        json_num(f, r->params[k].value);
+        fprintf(f, ",\"se\":");
+        json_num(f, r->params[k].se);
+        fprintf(f, ",\"unit\":");
+        json_str(f, r->params[k].unit);
+        fprintf(f, "}");
+    }
+    fprintf(f, "],\"effect_rms_mm\":");
+    json_num(f, r->effect_rms_mm);
+    fprintf(f, ",\"structure_before\":");
+    json_tests(f, r->before, r->n_tests);
+    fprintf(f, ",\"structure_after\":");
+    json_tests(f, r->after, r->n_tests);
+    fprintf(f, ",\"not_identifiable\":[");
+    for (unsigned k = 0; k < r->n_notes; ++k) {
+        fprintf(f, "%s", k ? "," : "");
+        json_str(f, r->notes[k]);
+    }
+    fprintf(f, "],\"time_ms\":");
+    json_num(f, r->time_ms);
+    fprintf(f, "}\n");
+    return ferror(f) ? -1 : 0;
+}

@@ -1,0 +1,190 @@
+/* rch_diagnose.h - where model and measurement disagree, and which missing
+ * physical effect explains it (issue 6, `rcal diagnose`).
+ *
+ * What: the diagnosis workflow on cable-length data.
+ *  1. Geometric fit (24 DH + encoder) on all samples, started like
+ *     `rcal calibrate` (encoder guess, encoder alone, then everything).
+ *  2. k-fold cross-validation. Folds are drawn at random WITHIN each set-up
+ *     group (the samples of every group are shuffled and dealt round-robin
+ *     over the folds), so every held-out sample has group-mates in training:
+ *     (groups: consecutive samples with the same wrist joints q4..q6; a wrist
+ *     reading that moves by one display step stays in its group)
+ *     that keeps every candidate testable, a per-group offset included. (A
+ *     leave-group-out scheme could never validate a group offset.)
+ *  3. Noise floor per sample: encoder resolution (step^2/12), an optional
+ *     encoder noise, and the joint readings' display step projected through
+ *     the joint Jacobian: sum_j (dl/dq_j)^2 step^2/12. The floor is
+ *     sqrt(mean of those variances). Steps are detected from the data (the
+ *     coarsest grid that every value sits on) unless given.
+ *  4. Structure tests of the held-out residuals (F tests with an intercept):
+ *     bias, each joint's first and second harmonics, the gravity levers of
+ *     joints 2 and 3, cable length, cable direction, acquisition order, and
+ *     the groups (one-way ANOVA). Bonferroni over the tests.
+ *  5. Candidate effects (rc_model effects), each fitted jointly with the
+ *     geometry in every fold: length_offset, length_scale, time_drift,
+ *     group_offset, joint_compliance j2/j3, joint_periodic j1..j6. A
+ *     candidate that adds no identifiable direction (rank of the scaled
+ *     normal matrix does not grow) is flagged, not tested. Held-out gain:
+ *     paired one-sided z test on the per-sample differences of held-out
+ *     squared errors, Bonferroni over the tested candidates at level alpha.
+ *     Among the significant ones the best gain wins, except that a candidate
+ *     with fewer parameters whose held-out MSE is within one standard error
+ *     of the best is preferred (one-standard-error rule).
+ *  6. The chosen effect joins the model and the search repeats (at most
+ *     max_steps effects). The first chosen effect is the verdict; when none
+ *     is significant the verdict is "none", or "unexplained" when the
+ *     held-out RMSE stays above gap_factor * floor or a structure test
+ *     remains significant.
+ *
+ * Depends on: rcal core (rc_model, rc_solve, rc_rand), rch_data (groups).
+ * Memory: rch_diagnose_run allocates the per-sample arrays of the result;
+ * rch_diagnose_free releases them. Thread safety: reentrant (no globals).
+ * Errors: 0 or -1 with the reason in rch_diag.
+ */
+#ifndef RCH_DIAGNOSE_H
+#define RCH_DIAGNOSE_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "rc_solve.h"
+#include "rch_diag.h"
+
+#define RCH_DIAGNOSE_MAX_CAND 16
+#define RCH_DIAGNOSE_MAX_STEPS 4
+#define RCH_DIAGNOSE_MAX_TESTS 16
+#define RCH_DIAGNOSE_MAX_FOLDS 20
+#define RCH_DIAGNOSE_MAX_NOTES 8
+#define RCH_DIAGNOSE_MAX_PARAMS 16
+
+/* All-zero means defaults. */
+typedef struct rch_diagnose_cfg {
+    unsigned folds;          /* k of the cross-validation; 0: 5 (2..RCH_DIAGNOSE_MAX_FOLDS) */
+    unsigned max_steps;      /* effects added one after the other; 0: 3 */
+    unsigned long long seed; /* fold assignment */
+    double q_step_deg;       /* joint display step; 0: detected; < 0: none */
+    double len_step_mm;      /* length display step; 0: detected; < 0: none */
+    double len_noise_mm;     /* encoder noise sigma beyond its step; 0: none */
+    double alpha;            /* family-wise level of each decision; 0: 0.01 */
+    double gap_factor;       /* held-out RMSE above gap_factor * floor is a gap; 0: 1.25 */
+    int groups_given;        /* 1: keep rc_sample.group; 0: group by fixed wrist (q4..q6) */
+    int have_encoder;        /* 1: start from the encoder in the nominal model */
+    unsigned max_iter;       /* LM iterations per fit; 0: 100 */
+    int verbose;             /* progress to stderr */
+} rch_diagnose_cfg;
+
+/* One structure test of residuals against an explanatory variable. */
+typedef struct rch_diagnose_test {
+    char name[40];        /* "q2 harmonics", "groups (ANOVA)", ... */
+    unsigned dof1, dof2;  /* F(dof1, dof2) */
+    double f_stat;
+    double p_value;
+    double r2;            /* share of residual variance it explains */
+    int significant;      /* p < alpha / n_tests */
+} rch_diagnose_test;
+
+/* One candidate effect in one step. */
+typedef struct rch_diagnose_cand {
+    char name[40];         /* "joint_periodic j3" */
+    rc_effect_kind kind;
+    unsigned joint;        /* 1-based joint, 0 when not a joint effect */
+    unsigned n_params;     /* parameters it adds */
+    unsigned n_ident;      /* of which identifiable from cable lengths (rank gain) */
+    int tested;            /* cross-validated */
+    int implausible;       /* fitted joint error beyond 1 deg: not eligible */
+    double rmse_cv_mm;     /* held-out RMSE with the candidate */
+    double gain_mm2;       /* mean reduction of held-out squared error */
+    double gain_se_mm2;    /* its standard error */
+    double z;              /* gain / se */
+    double p_value;        /* one-sided */
+    int significant;       /* p < alpha / tested candidates */
+    char note[160];
+} rch_diagnose_cand;
+
+typedef struct rch_diagnose_step {
+    double rmse_base_mm;   /* held-out RMSE of the model entering the step */
+    unsigned n_cand;
+    rch_diagnose_cand cand[RCH_DIAGNOSE_MAX_CAND];
+    int chosen;            /* index into cand, -1 when none */
+    char why[240];
+} rch_diagnose_step;
+
+/* A fitted effect parameter in display units, with its fold-jackknife
+ * standard error. */
+typedef struct rch_diagnose_param {
+    char name[48];
+    double value;
+    double se;
+    char unit[12];
+} rch_diagnose_param;
+
+typedef struct rch_diagnose_result {
+    size_t n;
+    unsigned n_groups;
+    unsigned n_flicker;        /* samples whose wrist reading moved by one display step within a group */
+    unsigned folds;
+    double q_step_deg, len_step_mm, len_noise_mm; /* used for the floor */
+    double noise_floor_mm;     /* sqrt(mean per-sample floor variance) */
+    double floor_joints_mm;    /* joint-step part alone */
+    double floor_len_mm;       /* length step + noise part alone */
+    double train_rmse_geo_mm;  /* geometric fit on all samples */
+    double rmse_before_mm;     /* held-out, geometry only */
+    double rmse_after_mm;      /* held-out, with the chosen effects */
+    unsigned geo_rank, geo_free;
+
+    unsigned n_tests;
+    rch_diagnose_test before[RCH_DIAGNOSE_MAX_TESTS]; /* on held-out residuals, geometry */
+    rch_diagnose_test after[RCH_DIAGNOSE_MAX_TESTS];  /* with the chosen effects */
+
+    unsigned n_steps;
+    rch_diagnose_step steps[RCH_DIAGNOSE_MAX_STEPS];
+    unsigned n_chosen;             /* effects added */
+    char effect[32];               /* verdict: effect name, "none", "unexplained" */
+    unsigned joint;                /* 1-based joint of the verdict, 0 when none */
+    char remaining[16];            /* after the chosen effects: "none" or "unexplained" */
+    char remaining_why[240];
+
+    unsigned n_params;
+    rch_diagnose_param params[RCH_DIAGNOSE_MAX_PARAMS];
+    double effect_rms_mm;          /* rms of the chosen effects' contribution to l */
+
+    unsigned n_notes;              /* what cable lengths cannot identify */
+    char notes[RCH_DIAGNOSE_MAX_NOTES][512];
+
+    rc_model geo;                  /* geometric fit on all samples */
+    rc_model final;                /* with the chosen effects, all samples */
+    rc_sample *s;                  /* (n) the samples as used (with groups) */
+    double *res_before_mm;         /* (n) held-out residuals l_model - L, geometry */
+    double *res_after_mm;          /* (n) held-out residuals, final model */
+    double *floor_mm;              /* (n) per-sample floor sigma */
+    double time_ms;
+} rch_diagnose_result;
+
+/* Run the workflow on samples (n) with the nominal robot model (its
+ * effects are ignored). Returns 0, or -1 with d set (too few samples, a fit
+ * failed, out of memory). Free the result with rch_diagnose_free, also after
+ * a failure. */
+int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t n,
+                     const rc_model *nominal, const rch_diagnose_cfg *cfg, rch_diag *d);
+
+void rch_diagnose_free(rch_diagnose_result *r);
+
+/* Human report and one JSON object. 0 or -1 on a write error. */
+int rch_diagnose_print(FILE *f, const rch_diagnose_result *r);
+int rch_diagnose_json(FILE *f, const rch_diagnose_result *r);
+
+/* Residual plots (SVG) into dir: residuals before/after against acquisition
+ * order, per-group mean residuals before/after, the candidate gains, and the
+ * residuals against the variable of the strongest structure test. paths
+ * receives the written files, "\n"-separated. 0 or -1 (d set). */
+int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *paths, size_t paths_len,
+                       rch_diag *d);
+
+/* Statistics helpers (exposed for tests). */
+/* Upper tail P(F > f) of the F(d1, d2) distribution. */
+double rch_diagnose_f_sf(double f, double d1, double d2);
+/* Coarsest display step of a fixed list (1, 0.5, 0.2, 0.1, ... 1e-4) that
+ * every value sits on (within 1e-6 of a step); 0 when none fits. values: (n). */
+double rch_diagnose_detect_step(const double *values, size_t n);
+
+#endif

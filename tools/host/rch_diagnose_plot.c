@@ -1,0 +1,192 @@
+/* rch_diagnose_plot.c - the residual plots of `rcal diagnose` (SVG via rch_plot). */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "rch_diagnose.h"
+#include "rch_plot.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static int save(rch_plot *p, const char *dir, const char *file, char *paths, size_t len, rch_diag *d)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    const int rc = rch_plot_write_svg(p, path);
+    rch_plot_free(p);
+    if (rc != 0) {
+        rch_diag_set(d, path, 0, 0, "cannot write the plot: %s", strerror(errno));
+        return -1;
+    }
+    const size_t used = strlen(paths);
+    if (used < len)
+        snprintf(paths + used, len - used, "  %s\n", path);
+    return 0;
+}
+
+/* Explanatory variable of structure test k for sample i (x of the plot). */
+static double test_x(const rch_diagnose_result *r, unsigned k, size_t i, const char **label)
+{
+    const rc_sample *s = &r->s[i];
+    const char *name = r->before[k].name;
+    if (name[0] == 'q' && name[1] >= '1' && name[1] <= '6') {
+        *label = "joint angle (deg)";
+        return s->q_rad[name[1] - '1'] * 180.0 / M_PI;
+    }
+    if (strncmp(name, "gravity lever j", 15) == 0) {
+        double ref[4][4];
+        for (unsigned a = 0; a < 4; ++a)
+            for (unsigned b = 0; b < 4; ++b)
+                ref[a][b] = r->geo.x[4 * a + b];
+        *label = "gravity lever (m)";
+        return rc_gravity_lever_m((const double(*)[4])ref, name[15] == '2' ? 1u : 2u, s->q_rad);
+    }
+    if (strcmp(name, "cable length") == 0) {
+        *label = "cable length (mm)";
+        return s->len_mm;
+    }
+    if (strcmp(name, "cable direction") == 0) {
+        double p[3], u[3], nu = 0.0;
+        rc_fk(p, NULL, &r->geo, s->q_rad);
+        for (int c = 0; c < 3; ++c) {
+            u[c] = p[c] - r->geo.x[RC_P_ENC + c];
+            nu += u[c] * u[c];
+        }
+        *label = "cable direction, z component";
+        return u[2] / sqrt(nu);
+    }
+    if (strncmp(name, "groups", 6) == 0) {
+        *label = "set-up group";
+        return s->group;
+    }
+    *label = "acquisition order (0..1)";
+    return s->t;
+}
+
+int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *paths, size_t paths_len,
+                       rch_diag *d)
+{
+    const size_t n = r->n;
+    double *x = malloc(n * sizeof *x), *fl = malloc(n * sizeof *fl), *fh = malloc(n * sizeof *fh);
+    int rc = -1;
+    if (paths_len)
+        paths[0] = '\0';
+    if (!x || !fl || !fh) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        rch_diag_set(d, dir, 0, 0, "cannot create the directory: %s", strerror(errno));
+        goto done;
+    }
+    char title[256];
+    /* 1. held-out residuals in acquisition order, before and after */
+    for (size_t i = 0; i < n; ++i) {
+        x[i] = (double)i;
+        fl[i] = -r->noise_floor_mm;
+        fh[i] = r->noise_floor_mm;
+    }
+    snprintf(title, sizeof title, "Held-out residuals: geometry %.3f mm rms, with %s %.3f mm rms (floor %.3f mm)",
+             r->rmse_before_mm, r->n_chosen ? r->effect : "nothing", r->rmse_after_mm, r->noise_floor_mm);
+    rch_plot *p = rch_plot_new(title, "sample (acquisition order)", "residual l_model - L (mm)");
+    rch_plot_scatter(p, "geometry only", x, r->res_before_mm, n);
+    if (r->n_chosen)
+        rch_plot_scatter(p, "with the chosen effects", x, r->res_after_mm, n);
+    rch_plot_line(p, "+ noise floor", x, fh, n);
+    rch_plot_line(p, "- noise floor", x, fl, n);
+    rch_plot_size(p, 1000, 500);
+    if (save(p, dir, "residuals_order.svg", paths, paths_len, d) != 0)
+        goto done;
+
+    /* 2. mean held-out residual per group */
+    if (r->n_groups >= 2 && r->n_groups <= n / 2) {
+        const unsigned G = r->n_groups;
+        double *gb = calloc(G, sizeof *gb), *ga = calloc(G, sizeof *ga), *gx = calloc(G, sizeof *gx);
+        size_t *cnt = calloc(G, sizeof *cnt);
+        if (!gb || !ga || !gx || !cnt) {
+            free(gb);
+            free(ga);
+            free(gx);
+            free(cnt);
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            goto done;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            gb[r->s[i].group] += r->res_before_mm[i];
+            ga[r->s[i].group] += r->res_after_mm[i];
+            cnt[r->s[i].group]++;
+        }
+        for (unsigned g = 0; g < G; ++g) {
+            gx[g] = g + 1;
+            gb[g] = cnt[g] ? gb[g] / (double)cnt[g] : NAN;
+            ga[g] = cnt[g] ? ga[g] / (double)cnt[g] : NAN;
+        }
+        p = rch_plot_new("Mean held-out residual per set-up group", "group (consecutive samples, fixed wrist)",
+                         "mean residual (mm)");
+        rch_plot_scatter(p, "geometry only", gx, gb, G);
+        if (r->n_chosen)
+            rch_plot_scatter(p, "with the chosen effects", gx, ga, G);
+        const int ok = save(p, dir, "group_means.svg", paths, paths_len, d);
+        free(gb);
+        free(ga);
+        free(gx);
+        free(cnt);
+        if (ok != 0)
+            goto done;
+    }
+
+    /* 3. candidates of the first step: held-out RMSE */
+    if (r->n_steps > 0) {
+        const rch_diagnose_step *st = &r->steps[0];
+        const char *labels[RCH_DIAGNOSE_MAX_CAND];
+        double v[RCH_DIAGNOSE_MAX_CAND], cx[RCH_DIAGNOSE_MAX_CAND + 2], cy[RCH_DIAGNOSE_MAX_CAND + 2],
+            fy[RCH_DIAGNOSE_MAX_CAND + 2];
+        size_t m = 0;
+        for (unsigned k = 0; k < st->n_cand; ++k)
+            if (st->cand[k].tested) {
+                labels[m] = st->cand[k].name;
+                v[m++] = st->cand[k].rmse_cv_mm;
+            }
+        for (size_t k = 0; k < m + 2; ++k) {
+            cx[k] = (double)k - 1.0;
+            cy[k] = st->rmse_base_mm;
+            fy[k] = r->noise_floor_mm;
+        }
+        p = rch_plot_new("Held-out RMSE of each candidate (step 1)", "candidate effect", "held-out RMSE (mm)");
+        rch_plot_bars(p, labels, v, NULL, m);
+        rch_plot_line(p, "geometry only", cx, cy, m + 2);
+        rch_plot_line(p, "noise floor", cx, fy, m + 2);
+        rch_plot_size(p, 1100, 500);
+        if (save(p, dir, "candidates.svg", paths, paths_len, d) != 0)
+            goto done;
+    }
+
+    /* 4. residuals against the variable of the strongest structure test */
+    {
+        unsigned best = 0;
+        for (unsigned k = 1; k < r->n_tests; ++k)
+            if (r->before[k].p_value < r->before[best].p_value)
+                best = k;
+        const char *label = "";
+        for (size_t i = 0; i < n; ++i)
+            x[i] = test_x(r, best, i, &label);
+        snprintf(title, sizeof title, "Held-out residuals against %s (strongest structure, p = %.1e)",
+                 r->before[best].name, r->before[best].p_value);
+        p = rch_plot_new(title, label, "residual (mm)");
+        rch_plot_scatter(p, "geometry only", x, r->res_before_mm, n);
+        if (r->n_chosen)
+            rch_plot_scatter(p, "with the chosen effects", x, r->res_after_mm, n);
+        if (save(p, dir, "residuals_structure.svg", paths, paths_len, d) != 0)
+            goto done;
+    }
+    rc = 0;
+done:
+    free(x);
+    free(fl);
+    free(fh);
+    return rc;
+}
