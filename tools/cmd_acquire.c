@@ -60,7 +60,7 @@ typedef struct acq_opts {
     const char *port, *poses, *out, *announce, *backend, *joints;
     rcd_serial_config ser;
     rcd_proto_config proto;
-    unsigned long n, settle_ms, read_timeout_ms, retries, pose_timeout_s, reconnect_s;
+    unsigned long n, settle_ms, read_timeout_ms, retries, pose_timeout_s, reconnect_s, poll_interval_ms;
     double tol_mm, min_mm, max_mm;
     int confirm, quiet;
 } acq_opts;
@@ -74,7 +74,8 @@ static void usage(FILE *f)
             "                    [--mb-addr A] [--mb-reg R] [--mb-format int32|float] [--mb-order abcd|cdab|badc|dcba]\n"
             "                    [--mb-decimals D] [--samples-per-pose N] [--stable-mm TOL] [--settle-ms T]\n"
             "                    [--read-timeout-ms T] [--retries R] [--pose-timeout-s S] [--reconnect-s S]\n"
-            "                    [--min-mm A] [--max-mm B] [--announce FILE] [--confirm] [--joints plan] [--quiet]\n"
+            "                    [--min-mm A] [--max-mm B] [--poll-interval-ms T] [--announce FILE] [--confirm]\n"
+            "                    [--joints plan] [--quiet]\n"
             "  For each pose of POSES.csv (q1..q6 in degrees): show it, write 'INDEX q1..q6' to --announce FILE\n"
             "  (for a robot-side program; the simulated display follows it), wait --settle-ms (default 2000) or,\n"
             "  with --confirm, for Enter; then read until --samples-per-pose N (default 5) consecutive readings\n"
@@ -85,7 +86,9 @@ static void usage(FILE *f)
             "  Retry policy: a reading waits --read-timeout-ms (2000); after --retries R (5) failures in a row\n"
             "  (timeouts, corrupt frames, device errors) the port is closed and reopened; a disconnect is retried\n"
             "  for --reconnect-s (10) seconds; a pose that does not settle within --pose-timeout-s (60) stops\n"
-            "  the run. Readings outside [--min-mm 1, --max-mm 20000] are rejected. Exit 0 done, 1 stopped\n"
+            "  the run. Polled protocols ask at most every --poll-interval-ms (100): set it to the display's\n"
+            "  update period or more, so that N readings are N fresh measurements, not one repeated.\n"
+            "  Readings outside [--min-mm 1, --max-mm 20000] are rejected. Exit 0 done, 1 stopped\n"
             "  (rerun to resume), 2 usage.\n");
 }
 
@@ -116,6 +119,7 @@ static int parse_opts(acq_opts *o, int argc, char **argv)
     o->retries = 5;
     o->pose_timeout_s = 60;
     o->reconnect_s = 10;
+    o->poll_interval_ms = 100;
     o->min_mm = 1.0;
     o->max_mm = 20000.0;
     for (int i = 1; i < argc; ++i) {
@@ -137,6 +141,7 @@ static int parse_opts(acq_opts *o, int argc, char **argv)
             rcal_opt_uint(argc, argv, &i, "--retries", &o->retries) ||
             rcal_opt_uint(argc, argv, &i, "--pose-timeout-s", &o->pose_timeout_s) ||
             rcal_opt_uint(argc, argv, &i, "--reconnect-s", &o->reconnect_s) ||
+            rcal_opt_uint(argc, argv, &i, "--poll-interval-ms", &o->poll_interval_ms) ||
             rcal_opt_double(argc, argv, &i, "--min-mm", &o->min_mm) ||
             rcal_opt_double(argc, argv, &i, "--max-mm", &o->max_mm))
             continue;
@@ -398,10 +403,17 @@ static rc_status measure_pose(double *mean_mm, double *spread_mm, acq_port *p, r
     double win[ACQ_MAX_N];
     size_t nw = 0;
     unsigned long fails = 0, reconnects = 0;
-    long long deadline = mono_ms() + (long long)o->pose_timeout_s * 1000;
+    long long deadline = mono_ms() + (long long)o->pose_timeout_s * 1000, last_poll = 0;
     while (mono_ms() < deadline) {
         rcd_reading r = {0};
-        rc_status st = rcd_display_read(d, &r, (unsigned)o->read_timeout_ms);
+        rc_status st;
+        if (d->cfg.protocol != RCD_PROTO_ASCII && o->poll_interval_ms) {
+            long long wait = last_poll + (long long)o->poll_interval_ms - mono_ms();
+            if (last_poll && wait > 0)
+                sleep_ms((unsigned long)wait);
+            last_poll = mono_ms();
+        }
+        st = rcd_display_read(d, &r, (unsigned)o->read_timeout_ms);
         if (st == RC_OK) {
             double lo, hi;
             size_t k;

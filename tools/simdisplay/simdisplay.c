@@ -4,7 +4,7 @@
  * the FIRST LINE of stdout (and points --link at it), then speaks one display
  * protocol like a real device until killed, --exit-after-frames or
  * --max-seconds:
- *   ascii       streams "+0509.190\r\n" lines at --rate-hz
+ *   ascii       streams "+0509.190\r\n" lines at --rate-hz (default 20)
  *   ascii-poll  answers each poll command (default "R\r") with one line
  *   stx         answers each poll command with STX payload ETX BCC
  *   modbus      answers fn 0x03 requests for --mb-reg (2 registers); other
@@ -27,7 +27,9 @@
  *                             --settle-ms with a decaying 0.5 mm vibration, as
  *                             the arm travels and settles.
  * Realism and faults:
- *   --noise-mm S        Gaussian noise on each reading (default 0)
+ *   --rate-hz R         measuring rate: a new value every 1/R s (streamed, or
+ *                       shown to polls: polls in between get the same value)
+ *   --noise-mm S        Gaussian noise on each new value (default 0)
  *   --decimals D        digits after the point (ascii/stx, default 3)
  *   --style zero|unit   "+0509.190" or "+ 509.190, MM" (ascii, default zero)
  *   --unit mm|cm|m|in   unit shown in the unit style (default mm)
@@ -86,6 +88,8 @@ typedef struct sim {
     long long silent_until_ms;
     unsigned long last_silence_frame;
     int disconnected;
+    double shown_mm, next_refresh_s;
+    int have_shown;
 } sim;
 
 static double now_s(void)
@@ -201,20 +205,8 @@ static double true_value(sim *s)
     }
     case SRC_ROBOT:
     default: {
-        long idx = read_follow(s);
         long long t = now_ms();
         double target, frac;
-        if (idx >= 0 && (size_t)idx < s->n_poses && idx != s->cur_pose) {
-            /* start of a move: from what is shown now */
-            double shown = s->pose_len[s->cur_pose];
-            if (t - s->change_ms < (long long)s->settle_ms && s->settle_ms) {
-                frac = (double)(t - s->change_ms) / (double)s->settle_ms;
-                shown = s->from_mm + (shown - s->from_mm) * frac;
-            }
-            s->from_mm = shown;
-            s->cur_pose = idx;
-            s->change_ms = t;
-        }
         target = s->pose_len[s->cur_pose];
         if (!s->settle_ms || t - s->change_ms >= (long long)s->settle_ms)
             return target;
@@ -225,15 +217,51 @@ static double true_value(sim *s)
     }
 }
 
+/* The robot side: notice a new pose index in the --follow file (called on
+ * every turn of the main loop, at most 20 ms apart). */
+static void follow_pose(sim *s)
+{
+    long idx;
+    long long t;
+    double frac, shown;
+    if (s->src != SRC_ROBOT)
+        return;
+    idx = read_follow(s);
+    if (idx < 0 || (size_t)idx >= s->n_poses || idx == s->cur_pose)
+        return;
+    t = now_ms();
+    shown = s->pose_len[s->cur_pose]; /* start of the move: from what is shown now */
+    if (s->settle_ms && t - s->change_ms < (long long)s->settle_ms) {
+        frac = (double)(t - s->change_ms) / (double)s->settle_ms;
+        shown = s->from_mm + (shown - s->from_mm) * frac;
+    }
+    s->from_mm = shown;
+    s->cur_pose = idx;
+    s->change_ms = t;
+}
+
+/* The value the display shows: refreshed at --rate-hz (its measuring rate);
+ * a poll between two refreshes gets the same value again, like a real one. */
+static double shown_value(sim *s)
+{
+    double t = now_s();
+    if (s->pc.protocol != RCD_PROTO_ASCII && s->rate_hz > 0 && s->have_shown && t < s->next_refresh_s)
+        return s->shown_mm;
+    s->shown_mm = true_value(s);
+    if (s->noise_mm > 0)
+        s->shown_mm += s->noise_mm * rc_rng_normal(&s->rng);
+    s->have_shown = 1;
+    s->next_refresh_s = t + (s->rate_hz > 0 ? 1.0 / s->rate_hz : 0.0);
+    return s->shown_mm;
+}
+
 /* Build, damage and send one frame (or half of one, then disconnect). */
 static void emit(sim *s)
 {
     uint8_t f[RCD_MAX_FRAME], out[RCD_MAX_FRAME * 2 + 16];
     size_t n = 0, k = 0;
     rc_status st;
-    double v = true_value(s);
-    if (s->noise_mm > 0)
-        v += s->noise_mm * rc_rng_normal(&s->rng);
+    double v = shown_value(s);
     switch (s->pc.protocol) {
     case RCD_PROTO_ASCII:
     case RCD_PROTO_ASCII_POLL:
@@ -538,6 +566,7 @@ int main(int argc, char **argv)
             if (r > 0)
                 rq_len += (size_t)r;
         }
+        follow_pose(&s);
         if (is_silent(&s)) {
             rq_len = 0; /* a silent display ignores requests */
             continue;
