@@ -445,7 +445,28 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
         double y0, step;
         int guard = 0;
         char buf[64];
-        if (ay.log) {
+        if (ay.log && ay.hi - ay.lo < 0.7) {
+            /* less than a decade: linear 1-2-5 ticks placed on the log axis */
+            const double vlo = pow(10.0, ay.lo), vhi = pow(10.0, ay.hi);
+            step = plot_nice_step(vhi - vlo, 5);
+            for (y0 = ceil(vlo / step - 1e-9) * step; y0 <= vhi + 1e-9 * step && guard < 100;
+                 y0 += step, guard++) {
+                double py;
+                if (y0 <= 0.0)
+                    continue;
+                py = PY(log10(y0));
+                fprintf(f,
+                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
+                        "stroke=\"#e0e0e0\"/>\n",
+                        L, py, L + pw, py);
+                fprintf(f,
+                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
+                        L - 5, py, L, py);
+                plot_fmt(buf, sizeof buf, y0, step);
+                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8,
+                        py + 4, buf);
+            }
+        } else if (ay.log) {
             double span = ay.hi - ay.lo;
             int d0 = (int)floor(ay.lo), d1 = (int)ceil(ay.hi), d;
             static const double sub3[3] = {1.0, 2.0, 5.0};
