@@ -24,7 +24,7 @@ const char *rc_exit_str(rc_exit e)
     case RC_EXIT_NONE: return "none";
     case RC_EXIT_SMALL_STEP: return "step below tolerance";
     case RC_EXIT_SMALL_COST: return "cost decrease below tolerance";
-    case RC_EXIT_SMALL_GRAD: return "gradient below tolerance";
+    case RC_EXIT_SMALL_GRAD: return "no significant step left";
     case RC_EXIT_MAX_ITER: return "iteration limit";
     case RC_EXIT_NO_DESCENT: return "no further descent (damping limit)";
     case RC_EXIT_NONFINITE: return "diverged to non-finite values";
@@ -258,6 +258,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     const double tol_step = cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9;
     const double tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-6;
     const double rcond = cfg->rcond > 0.0 ? cfg->rcond : 1e-9;
+    const double snr_min = cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 2.0);
     const int ltlm = cfg->method == RC_METHOD_LTLM;
     double cost, mu = 0.0, nu = 2.0;
 
@@ -304,6 +305,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             return RC_ERR_RANK;
         unsigned rank = 0;
         double gnorm = 0.0;
+        const double sigma2 = cost / (double)(n > nf ? n - nf : 1);
         for (unsigned k = 0; k < nf; ++k) {
             if (w->ev[k] <= rcond * lmax)
                 break;
@@ -311,12 +313,17 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             double c = 0.0;
             for (unsigned i = 0; i < nf; ++i)
                 c += w->V[(size_t)i * nf + k] * w->g[i];
+            /* Significance: the Gauss-Newton step along v_k is -c/lambda with
+             * standard error sigma/sqrt(lambda); below snr_min standard errors
+             * the data cannot resolve it from noise, so it is not taken. */
+            if (snr_min > 0.0 && c * c < snr_min * snr_min * sigma2 * w->ev[k])
+                c = 0.0;
             w->c[k] = c;
             gnorm += c * c;
         }
         res->rank = rank;
         res->cond = sqrt(lmax / w->ev[rank - 1]);
-        if (sqrt(gnorm) <= 1e-14 * (cost + 1e-300) || gnorm == 0.0) {
+        if (gnorm == 0.0 || sqrt(gnorm) <= 1e-14 * (cost + 1e-300)) {
             res->exit = RC_EXIT_SMALL_GRAD;
             break;
         }

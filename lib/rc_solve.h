@@ -11,7 +11,10 @@
  *    mm and rad are comparable), step acceptance by gain ratio with Nielsen's
  *    damping update, and the step restricted to the identifiable subspace:
  *    eigen-directions of the scaled J^T J below rcond * largest are left
- *    untouched, so the solver never wanders along what the data cannot see.
+ *    untouched, so the solver never wanders along what the data cannot see;
+ *    and a direction is moved only while its step is significant against the
+ *    residual noise (snr_min), which ends the slow creep along weakly
+ *    identified directions that would only fit noise.
  *  - RC_METHOD_LTLM: the robust LM step, then M logistic-tent chaotic
  *    candidates in an interval around the LM candidate (paper Algorithm I);
  *    the best of LM candidate and chaotic candidates is kept if it lowers the
@@ -43,7 +46,7 @@ typedef enum rc_exit {
     RC_EXIT_NONE = 0,
     RC_EXIT_SMALL_STEP = 1,    /* scaled step below tol_step */
     RC_EXIT_SMALL_COST = 2,    /* relative cost decrease below tol_cost */
-    RC_EXIT_SMALL_GRAD = 3,    /* gradient in the identifiable subspace ~ 0 */
+    RC_EXIT_SMALL_GRAD = 3,    /* no identifiable direction left whose step is significant */
     RC_EXIT_MAX_ITER = 4,      /* iteration limit reached */
     RC_EXIT_NO_DESCENT = 5,    /* damping grew to its limit without a better point */
     RC_EXIT_NONFINITE = 6      /* a cost or step became NaN/inf (paper variants) */
@@ -61,6 +64,9 @@ typedef struct rc_solve_config {
     double tol_step;         /* 0: 1e-9 (relative, scaled) */
     double tol_cost;         /* 0: 1e-6 (relative decrease of the cost in one iteration) */
     double rcond;            /* 0: 1e-9: eigenvalue cut-off relative to the largest */
+    double snr_min;          /* 0: 2: an eigen-direction is stepped along only when its
+                                Gauss-Newton step is at least snr_min standard errors
+                                (sigma from the current residual); negative: off */
     unsigned n_candidates;   /* LTLM M, 0: 20 */
     double chaos_r;          /* LTLM map parameter r, 0: 0.5 */
     double ltlm_span;        /* LTLM interval half-width as a multiple of |step|, 0: 1 */
