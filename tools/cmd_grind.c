@@ -363,11 +363,14 @@ static void svg_panel(FILE *f, const path_pt *p, size_t n, int c, const surface 
         const path_pt *q = &p[idx[m]];
         fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"5\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n",
                 PX(q->p[0]), PY(q->p[1]));
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\" fill=\"#d62728\">%s %.3f</text>\n", PX(q->p[0]) + 7,
-                PY(q->p[1]) - 7, names[m], q->dev[c]);
+        const int right = q->p[0] > s->cx + 1e-9, below = q->p[1] < s->cy - 1e-9;
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\" fill=\"#d62728\" text-anchor=\"%s\" "
+                   "font-weight=\"bold\">%s %.3f</text>\n",
+                PX(q->p[0]) + (right ? -9 : 9), PY(q->p[1]) + (below ? 20 : -9), right ? "end" : "start", names[m],
+                q->dev[c]);
     }
     /* colour bar */
-    const double bx = ox + pw + 18, by = oy, bh = ph;
+    const double bx = ox + pw + 30, by = oy, bh = ph;
     for (int i = 0; i < 50; ++i) {
         char col[8];
         colour(col, (i + 0.5) / 50.0);
@@ -378,12 +381,12 @@ static void svg_panel(FILE *f, const path_pt *p, size_t n, int c, const surface 
     for (int i = 0; i <= 4; ++i)
         fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\">%.3g</text>\n", bx + 18, by + bh - i * bh / 4.0 + 4,
                 vmax * i / 4.0);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\">mm</text>\n", bx, by - 6);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\">mm</text>\n", bx, by - 10);
     /* axes: x and y ticks at the patch edges */
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"middle\">x = %.0f</text>\n",
-            PX(s->cx - 0.5 * s->w), PY(s->cy - 0.5 * s->h) + 22, s->cx - 0.5 * s->w);
+            PX(s->cx - 0.5 * s->w), PY(s->cy - 0.5 * s->h) + 42, s->cx - 0.5 * s->w);
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"middle\">x = %.0f mm</text>\n",
-            PX(s->cx + 0.5 * s->w), PY(s->cy - 0.5 * s->h) + 22, s->cx + 0.5 * s->w);
+            PX(s->cx + 0.5 * s->w), PY(s->cy - 0.5 * s->h) + 42, s->cx + 0.5 * s->w);
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"end\">y = %.0f</text>\n",
             PX(s->cx - 0.5 * s->w) - 10, PY(s->cy - 0.5 * s->h) + 4, s->cy - 0.5 * s->h);
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"end\">y = %.0f</text>\n",
@@ -398,7 +401,7 @@ static int write_path_svg(const char *path, const path_pt *p, size_t n, const su
     FILE *f = fopen(path, "w");
     if (!f)
         return -1;
-    const double pw = 420, ph = fmax(120.0, fmin(420.0, 420.0 * s->h / s->w)), W = 2 * pw + 260, H = ph + 140;
+    const double pw = 420, ph = fmax(120.0, fmin(420.0, 420.0 * s->h / s->w)), W = 2 * pw + 360, H = ph + 150;
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
                "font-family=\"sans-serif\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
@@ -408,8 +411,8 @@ static int write_path_svg(const char *path, const path_pt *p, size_t n, const su
             W / 2);
     fprintf(f, "<text x=\"%.1f\" y=\"40\" font-size=\"12\" text-anchor=\"middle\" fill=\"#555\">%s</text>\n", W / 2,
             subtitle);
-    svg_panel(f, p, n, 0, s, 50, 90, pw, ph, "uncompensated", names, idx);
-    svg_panel(f, p, n, 1, s, 50 + pw + 130, 90, pw, ph, "compensated (calibrated model)", names, idx);
+    svg_panel(f, p, n, 0, s, 90, 95, pw, ph, "uncompensated", names, idx);
+    svg_panel(f, p, n, 1, s, 90 + pw + 180, 95, pw, ph, "compensated (calibrated model)", names, idx);
     fprintf(f, "</svg>\n");
     return fclose(f) == 0 ? 0 : -1;
 }
