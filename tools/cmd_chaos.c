@@ -150,6 +150,15 @@ int rcal_cmd_chaos(int argc, char **argv)
     if (plots) {
         struct stat sb;
         char path[4096];
+        char mk[4096];
+        snprintf(mk, sizeof mk, "%s", plots);
+        for (char *q = mk + 1; *q; ++q) /* mkdir -p for the parents */
+            if (*q == '/') {
+                *q = '\0';
+                if (stat(mk, &sb) != 0)
+                    (void)mkdir(mk, 0777);
+                *q = '/';
+            }
         if (!(stat(plots, &sb) == 0 && S_ISDIR(sb.st_mode)) && mkdir(plots, 0777) != 0) {
             fprintf(stderr, "rcal chaos: cannot create %s: %s\n", plots, strerror(errno));
             goto done;

@@ -92,12 +92,32 @@ static int parse_methods(int *sel, const char *list)
     return 0;
 }
 
+/* mkdir -p */
 static int ensure_dir(const char *dir)
 {
+    char buf[4096];
     struct stat sb;
-    if (stat(dir, &sb) == 0)
-        return S_ISDIR(sb.st_mode) ? 0 : -1;
-    return mkdir(dir, 0777);
+    size_t n = strlen(dir);
+    if (n == 0 || n >= sizeof buf) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    memcpy(buf, dir, n + 1);
+    for (size_t i = 1; i <= n; ++i) {
+        if (buf[i] != '/' && buf[i] != '\0')
+            continue;
+        const char c = buf[i];
+        buf[i] = '\0';
+        if (stat(buf, &sb) != 0) {
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return -1;
+        } else if (!S_ISDIR(sb.st_mode)) {
+            errno = ENOTDIR;
+            return -1;
+        }
+        buf[i] = c;
+    }
+    return 0;
 }
 
 static void path_join(char *out, size_t len, const char *dir, const char *name)
