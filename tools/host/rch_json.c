@@ -156,7 +156,8 @@ static rch_json *jvalue(jp *p, int depth);
 
 static int jappend(jp *p, rch_json *j, rch_json *item, char *key)
 {
-    rch_json **ni = realloc(j->items, (j->n + 1) * sizeof *ni);
+    /* sizeof *ni: one element pointer, as intended */
+    rch_json **ni = realloc(j->items, (j->n + 1) * sizeof *ni); /* NOLINT(bugprone-sizeof-expression) */
     if (!ni) {
         jfail(p, "out of memory");
         return -1;
