@@ -46,7 +46,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: rcal grind --model MODEL.json --truth TRUTH.json [--surface SPEC] [--plots DIR]\n"
-            "                  [--nominal ROBOT.json] [--position-only] [--no-align] [--json]\n"
+            "                  [--nominal ROBOT.json] [--position-only] [--max-dev-deg D] [--no-align] [--json]\n"
             "  --model    calibrated model used for compensation (rcal calibrate --out)\n"
             "  --truth    the simulated true robot (rcal simulate --truth-out, or any model file)\n"
             "  --nominal  nominal model the path is programmed with (default: the model's \"nominal\")\n"
@@ -60,6 +60,8 @@ static void usage(FILE *f)
             "             x and y), step=10 (raster line spacing), ds=5 (point spacing). Default: tilted\n"
             "  --plots    directory for grind_path.svg, grind_deviation.svg, grind_points.csv\n"
             "  --position-only  compensate the flange position only (default: full pose)\n"
+            "  --max-dev-deg    largest joint correction (default 30: an offline experiment, not a\n"
+            "                   controller; rcal compensate's default is 5.73 = 0.1 rad)\n"
             "  --no-align keep the calibrated model's base heading and height as identified\n"
             "  --json     one JSON object on stdout instead of the table\n");
 }
@@ -423,7 +425,10 @@ int rcal_cmd_grind(int argc, char **argv)
 {
     const char *model_path = NULL, *truth_path = NULL, *nominal_path = NULL, *spec = NULL, *plots = NULL;
     int json = 0, position_only = 0, align = 1;
+    double max_dev_deg = 30.0;
     for (int i = 1; i < argc; ++i) {
+        if (rcal_opt_double(argc, argv, &i, "--max-dev-deg", &max_dev_deg))
+            continue;
         if (rcal_opt_str(argc, argv, &i, "--model", &model_path) ||
             rcal_opt_str(argc, argv, &i, "--truth", &truth_path) ||
             rcal_opt_str(argc, argv, &i, "--nominal", &nominal_path) ||
@@ -448,6 +453,10 @@ int rcal_cmd_grind(int argc, char **argv)
     surface s;
     if (surf_parse(&s, spec) != 0)
         return 2;
+    if (!(max_dev_deg > 0.0 && max_dev_deg <= 180.0)) {
+        fprintf(stderr, "rcal grind: --max-dev-deg must be within (0, 180]\n");
+        return 2;
+    }
 
     static rch_robot mrob, trob, nrob;
     rch_diag d;
@@ -481,6 +490,8 @@ int rcal_cmd_grind(int argc, char **argv)
     rc_comp_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.flags = position_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
+    cfg.max_dev_rad = max_dev_deg * DEG;
+    cfg.max_iter = 50;
     rc_comp_stream st_cal, st_true;
     rc_comp_stream_init(&st_cal, &cal, nom, &cfg);
     rc_comp_stream_init(&st_true, truth, nom, &cfg);
