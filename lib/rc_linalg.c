@@ -2,6 +2,7 @@
 #include "rc_linalg.h"
 
 #include <math.h>
+#include <stddef.h>
 
 rc_status rcu_chol_solve(double *A, double *b, unsigned n)
 {
@@ -35,7 +36,7 @@ rc_status rcu_chol_solve(double *A, double *b, unsigned n)
     return RC_OK;
 }
 
-rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned max_sweeps)
+rc_status rcu_eig_sym_jacobi(double *eval, double *V, double *A, unsigned n, unsigned max_sweeps)
 {
     if (max_sweeps == 0)
         max_sweeps = 60;
@@ -103,5 +104,195 @@ rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned m
             }
         }
     }
+    return st;
+}
+
+/* Sort eigenpairs descending, moving eigenvector columns along. */
+static void sort_desc(double *eval, double *V, unsigned n)
+{
+    for (unsigned i = 0; i < n; ++i) {
+        unsigned best = i;
+        for (unsigned j = i + 1; j < n; ++j)
+            if (eval[j] > eval[best])
+                best = j;
+        if (best != i) {
+            const double t = eval[i];
+            eval[i] = eval[best];
+            eval[best] = t;
+            for (unsigned k = 0; k < n; ++k) {
+                const double v = V[k * n + i];
+                V[k * n + i] = V[k * n + best];
+                V[k * n + best] = v;
+            }
+        }
+    }
+}
+
+/* Householder reduction of the symmetric V (n x n) to tridiagonal form:
+ * diagonal d, sub-diagonal e (e[0] = 0); V receives the transformation. */
+static void tridiagonalize(double *V, double *d, double *e, unsigned n)
+{
+#define VV(r, c) V[(size_t)(r) * n + (c)]
+    for (unsigned j = 0; j < n; ++j)
+        d[j] = VV(n - 1, j);
+    for (unsigned i = n - 1; i > 0; --i) {
+        double scale = 0.0, h = 0.0;
+        for (unsigned k = 0; k < i; ++k)
+            scale += fabs(d[k]);
+        if (scale == 0.0) {
+            e[i] = d[i - 1];
+            for (unsigned j = 0; j < i; ++j) {
+                d[j] = VV(i - 1, j);
+                VV(i, j) = 0.0;
+                VV(j, i) = 0.0;
+            }
+        } else {
+            for (unsigned k = 0; k < i; ++k) {
+                d[k] /= scale;
+                h += d[k] * d[k];
+            }
+            double f = d[i - 1], g = sqrt(h);
+            if (f > 0.0)
+                g = -g;
+            e[i] = scale * g;
+            h -= f * g;
+            d[i - 1] = f - g;
+            for (unsigned j = 0; j < i; ++j)
+                e[j] = 0.0;
+            for (unsigned j = 0; j < i; ++j) {
+                f = d[j];
+                VV(j, i) = f;
+                g = e[j] + VV(j, j) * f;
+                for (unsigned k = j + 1; k < i; ++k) {
+                    g += VV(k, j) * d[k];
+                    e[k] += VV(k, j) * f;
+                }
+                e[j] = g;
+            }
+            f = 0.0;
+            for (unsigned j = 0; j < i; ++j) {
+                e[j] /= h;
+                f += e[j] * d[j];
+            }
+            const double hh = f / (h + h);
+            for (unsigned j = 0; j < i; ++j)
+                e[j] -= hh * d[j];
+            for (unsigned j = 0; j < i; ++j) {
+                f = d[j];
+                g = e[j];
+                for (unsigned k = j; k < i; ++k)
+                    VV(k, j) -= f * e[k] + g * d[k];
+                d[j] = VV(i - 1, j);
+                VV(i, j) = 0.0;
+            }
+        }
+        d[i] = h;
+    }
+    for (unsigned i = 0; i + 1 < n; ++i) { /* accumulate the transformations */
+        VV(n - 1, i) = VV(i, i);
+        VV(i, i) = 1.0;
+        const double h = d[i + 1];
+        if (h != 0.0) {
+            for (unsigned k = 0; k <= i; ++k)
+                d[k] = VV(k, i + 1) / h;
+            for (unsigned j = 0; j <= i; ++j) {
+                double g = 0.0;
+                for (unsigned k = 0; k <= i; ++k)
+                    g += VV(k, i + 1) * VV(k, j);
+                for (unsigned k = 0; k <= i; ++k)
+                    VV(k, j) -= g * d[k];
+            }
+        }
+        for (unsigned k = 0; k <= i; ++k)
+            VV(k, i + 1) = 0.0;
+    }
+    for (unsigned j = 0; j < n; ++j) {
+        d[j] = VV(n - 1, j);
+        VV(n - 1, j) = 0.0;
+    }
+    VV(n - 1, n - 1) = 1.0;
+    e[0] = 0.0;
+}
+
+/* Implicit QL iterations on the tridiagonal (d, e), rotating V along. */
+static rc_status tridiagonal_ql(double *V, double *d, double *e, unsigned n, unsigned max_iter)
+{
+    for (unsigned i = 1; i < n; ++i)
+        e[i - 1] = e[i];
+    e[n - 1] = 0.0;
+    double f = 0.0, tst1 = 0.0;
+    const double eps = 0x1.0p-52;
+    for (unsigned l = 0; l < n; ++l) {
+        const double t = fabs(d[l]) + fabs(e[l]);
+        if (t > tst1)
+            tst1 = t;
+        unsigned m = l;
+        while (m < n - 1 && fabs(e[m]) > eps * tst1)
+            ++m;
+        if (m > l) {
+            unsigned iter = 0;
+            do {
+                if (++iter > max_iter)
+                    return RC_ERR_NOCONV;
+                double g = d[l];
+                double p = (d[l + 1] - g) / (2.0 * e[l]);
+                double r = hypot(p, 1.0);
+                if (p < 0.0)
+                    r = -r;
+                d[l] = e[l] / (p + r);
+                d[l + 1] = e[l] * (p + r);
+                const double dl1 = d[l + 1];
+                double h = g - d[l];
+                for (unsigned i = l + 2; i < n; ++i)
+                    d[i] -= h;
+                f += h;
+                p = d[m];
+                double c = 1.0, c2 = 1.0, c3 = 1.0, s = 0.0, s2 = 0.0;
+                const double el1 = e[l + 1];
+                for (unsigned i = m; i-- > l;) {
+                    c3 = c2;
+                    c2 = c;
+                    s2 = s;
+                    g = c * e[i];
+                    h = c * p;
+                    r = hypot(p, e[i]);
+                    e[i + 1] = s * r;
+                    s = e[i] / r;
+                    c = p / r;
+                    p = c * d[i] - s * g;
+                    d[i + 1] = h + s * (c * g + s * d[i]);
+                    for (unsigned k = 0; k < n; ++k) {
+                        h = VV(k, i + 1);
+                        VV(k, i + 1) = s * VV(k, i) + c * h;
+                        VV(k, i) = c * VV(k, i) - s * h;
+                    }
+                }
+                p = -s * s2 * c3 * el1 * e[l] / dl1;
+                e[l] = s * p;
+                d[l] = c * p;
+            } while (fabs(e[l]) > eps * tst1);
+        }
+        d[l] += f;
+        e[l] = 0.0;
+    }
+    return RC_OK;
+#undef VV
+}
+
+rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned max_iter)
+{
+    if (n == 0)
+        return RC_OK;
+    double total = 0.0;
+    for (size_t i = 0; i < (size_t)n * n; ++i) {
+        total += A[i] * A[i];
+        V[i] = A[i];
+    }
+    if (!isfinite(total))
+        return RC_ERR_NUMERIC;
+    double *e = A; /* A is scratch from here on: its first n entries hold e */
+    tridiagonalize(V, eval, e, n);
+    rc_status st = tridiagonal_ql(V, eval, e, n, max_iter ? max_iter : 60u);
+    sort_desc(eval, V, n);
     return st;
 }

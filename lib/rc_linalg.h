@@ -13,10 +13,16 @@
  * not positive definite. */
 rc_status rcu_chol_solve(double *A, double *b, unsigned n);
 
-/* Eigen-decomposition of a symmetric matrix by cyclic Jacobi rotations.
- * A: (n x n), destroyed. V: (n x n), column k the eigenvector of eval[k].
- * eval: (n), sorted descending. RC_ERR_NOCONV after max_sweeps sweeps
- * (0 means 60). */
-rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned max_sweeps);
+/* Eigen-decomposition of a symmetric matrix: Householder reduction to
+ * tridiagonal form, then implicit QL iterations (the EISPACK tred2/tql2
+ * algorithm). A: (n x n), destroyed. V: (n x n), column k the eigenvector of
+ * eval[k]. eval: (n), sorted descending. RC_ERR_NOCONV when one eigenvalue
+ * needs more than max_iter QL iterations (0 means 60). */
+rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned max_iter);
+
+/* The same by cyclic Jacobi rotations (slower, small eigenvalues to high
+ * relative accuracy); kept as the reference the tests compare against.
+ * max_sweeps 0 means 60. */
+rc_status rcu_eig_sym_jacobi(double *eval, double *V, double *A, unsigned n, unsigned max_sweeps);
 
 #endif /* RC_LINALG_H */

@@ -127,7 +127,7 @@ static int ltlm_candidates(rc_model *cand, double *cand_cost, rc_solve_work *w, 
                            const rc_solve_config *cfg, const rc_sample *samples, size_t n,
                            unsigned *evals)
 {
-    const unsigned M = cfg->n_candidates ? cfg->n_candidates : 20u;
+    const unsigned M = cfg->n_candidates ? cfg->n_candidates : 10u;
     const double r = cfg->chaos_r > 0.0 ? cfg->chaos_r : 0.5;
     const double span = cfg->ltlm_span > 0.0 ? cfg->ltlm_span : 1.0;
     int won = 0;
@@ -276,9 +276,31 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         if (a > dmax)
             dmax = a;
     }
+    /* alpha6 turns the flange about x6 after the last translation: it can
+     * never move the cable length, so it is dropped from the free set and
+     * keeps its value exactly. (theta6 also has a zero column while a6 = 0,
+     * but becomes identifiable as soon as a6 moves: it stays free, and the
+     * eigen-truncation below keeps it still while it is null.) */
+    {
+        unsigned keep = 0;
+        for (unsigned i = 0; i < nf; ++i) {
+            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || w->A[(size_t)i * nf + i] > 1e-24 * dmax)
+                w->D[keep++] = (double)i;
+        }
+        if (keep == 0)
+            return RC_ERR_RANK;
+        for (unsigned a = 0; a < keep; ++a) {
+            const unsigned ia = (unsigned)w->D[a];
+            for (unsigned b = 0; b < keep; ++b)
+                w->A[(size_t)a * keep + b] = w->A[(size_t)ia * nf + (unsigned)w->D[b]];
+            w->g[a] = w->g[ia];
+            w->idx[a] = w->idx[ia];
+        }
+        nf = keep;
+    }
     for (unsigned i = 0; i < nf; ++i) {
         const double a = w->A[(size_t)i * nf + i];
-        w->D[i] = a > 1e-24 * dmax && a > 0.0 ? sqrt(a) : 1.0;
+        w->D[i] = a > 1e-24 * dmax ? sqrt(a) : 1.0;
     }
     if (ltlm)
         chaos_init(w, nf, cfg->seed);

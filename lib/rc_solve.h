@@ -67,7 +67,7 @@ typedef struct rc_solve_config {
     double snr_min;          /* 0: 2: an eigen-direction is stepped along only when its
                                 Gauss-Newton step is at least snr_min standard errors
                                 (sigma from the current residual); negative: off */
-    unsigned n_candidates;   /* LTLM M, 0: 20 */
+    unsigned n_candidates;   /* LTLM M, 0: 10 */
     double chaos_r;          /* LTLM map parameter r, 0: 0.5 */
     double ltlm_span;        /* LTLM interval half-width as a multiple of |step|, 0: 1 */
     uint64_t seed;           /* LTLM chaotic seed */
