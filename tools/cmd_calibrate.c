@@ -23,7 +23,8 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: rcal calibrate --data FILE [--robot MODEL.json] [--method lm|ltlm|lm-paper|ltlm-paper]\n"
-            "                      [--test-fraction F] [--seed S] [--max-iter N] [--out MODEL.json] [--json]\n"
+            "                      [--test-fraction F] [--seed S] [--max-iter N] [--fix LIST] [--out MODEL.json]\n"
+            "                      [--truth TRUTH.json] [--json]\n"
             "  --data           measurements: CSV with q1..q6 (deg) and L (mm) columns\n"
             "  --robot          nominal robot model (default %s)\n"
             "  --method         lm (default, robust), ltlm (robust + chaotic candidates),\n"
@@ -31,6 +32,8 @@ static void usage(FILE *f)
             "  --test-fraction  share of samples held out for the before/after report (default 0.1)\n"
             "  --seed           split (and LTLM) seed (default 1)\n"
             "  --out            write the calibrated model (rcal-model/1 JSON) for compensation\n"
+            "  --fix            comma-separated parameters held at their nominal values, e.g. a1,theta6\n"
+            "                   (names: a1..a6, d1..d6, alpha1..alpha6, theta1..theta6, ex, ey, ez)\n"
             "  --truth          a simulated truth model: report flange-position errors against it over\n"
             "                   2000 random poses in the joint limits, before and after\n"
             "  --json           one JSON object on stdout instead of the report\n",
@@ -59,13 +62,14 @@ static void print_metrics_row(const char *label, const rc_metrics *m)
 int rcal_cmd_calibrate(int argc, char **argv)
 {
     const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL, *method_name = "lm";
-    const char *truth_path = NULL;
+    const char *truth_path = NULL, *fix_list = NULL;
     double test_fraction = 0.1;
     unsigned long seed = 1, max_iter = 0;
     int json = 0;
     for (int i = 1; i < argc; ++i) {
         if (rcal_opt_str(argc, argv, &i, "--data", &data_path) || rcal_opt_str(argc, argv, &i, "--robot", &robot_path) ||
-            rcal_opt_str(argc, argv, &i, "--out", &out_path) || rcal_opt_str(argc, argv, &i, "--truth", &truth_path) || rcal_opt_str(argc, argv, &i, "--method", &method_name) ||
+            rcal_opt_str(argc, argv, &i, "--out", &out_path) || rcal_opt_str(argc, argv, &i, "--truth", &truth_path) ||
+            rcal_opt_str(argc, argv, &i, "--fix", &fix_list) || rcal_opt_str(argc, argv, &i, "--method", &method_name) ||
             rcal_opt_double(argc, argv, &i, "--test-fraction", &test_fraction) ||
             rcal_opt_uint(argc, argv, &i, "--seed", &seed) || rcal_opt_uint(argc, argv, &i, "--max-iter", &max_iter))
             continue;
@@ -124,9 +128,29 @@ int rcal_cmd_calibrate(int argc, char **argv)
         goto done;
     }
     model = before;
+    uint8_t fixed[RC_MAX_PARAMS];
+    memset(fixed, 0, sizeof fixed);
+    if (fix_list) {
+        char list[1024];
+        snprintf(list, sizeof list, "%s", fix_list);
+        for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
+            unsigned k;
+            char name[64];
+            for (k = 0; k < model.n_params; ++k)
+                if (strcmp(rc_param_name(name, sizeof name, &model, k), tok) == 0)
+                    break;
+            if (k == model.n_params) {
+                fprintf(stderr, "rcal calibrate: --fix: unknown parameter '%s'\n", tok);
+                rc = 2;
+                goto done;
+            }
+            fixed[k] = 1;
+        }
+    }
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.method = method;
+    cfg.fixed = fixed;
     cfg.max_iter = (unsigned)max_iter;
     cfg.seed = seed;
     rc_solve_result res;
