@@ -101,8 +101,11 @@ static void test_gradient_and_filter_methods(void **state)
     fixture *f = *state;
     /* at the noise level: noise 0.01 mm (+ resolution); 0.02 allows for the
      * subset's dropped weak directions and the finite sample */
-    assert_true(run_method(f, RCH_EST_LM, NULL, NULL) < 0.02);
-    assert_true(run_method(f, RCH_EST_LTLM, NULL, NULL) < 0.02);
+    /* the core's LM/LTLM stop once no eigen-direction's step is significant
+     * (rc_solve since b3932fe): on this fixture 0.0199 mm held-out, train
+     * 0.0103 against 0.0097 at the least-squares minimum; bound 0.03 */
+    assert_true(run_method(f, RCH_EST_LM, NULL, NULL) < 0.03);
+    assert_true(run_method(f, RCH_EST_LTLM, NULL, NULL) < 0.03);
     assert_true(run_method(f, RCH_EST_SSLM, NULL, NULL) < 0.02);
     assert_true(run_method(f, RCH_EST_EKF, NULL, NULL) < 0.02);
 }
@@ -110,8 +113,8 @@ static void test_gradient_and_filter_methods(void **state)
 /* Population methods: a measured shortfall. With the default budgets
  * (PF 100 x 100, SCA 30 x 500, QIBAS 2000 x 3 cost evaluations) in a box of
  * +-2 mm / +-0.2 deg / +-5 mm around the start, they do not reach the noise
- * level on 20 parameters. Measured on this fixture (held-out RMSE from 0.40):
- * PF 0.20 (train 0.044), SCA 0.31 (train 0.13), QIBAS 0.12 mm (train 0.026);
+ * level on 20 parameters. Measured on this fixture (held-out RMSE from 0.42):
+ * PF 0.046 (train 0.019), SCA 0.27 (train 0.15), QIBAS 0.13 mm (train 0.027);
  * the test groups have wrist orientations the training groups lack, which
  * is where the directions a random search leaves unconverged show.
  * Asserted with margin: they lower the training RMS they optimise to below
