@@ -319,7 +319,7 @@ static int fit(rc_model *m, rc_solve_result *res, ctx *c, const uint8_t *fixed, 
     rc_solve_result tmp;
     memset(&cfg, 0, sizeof cfg);
     cfg.method = RC_METHOD_LM;
-    cfg.max_iter = c->max_iter;
+    cfg.max_iter = fixed || s == c->s ? 200u : c->max_iter; /* cold starts converge fully */
     cfg.fixed = fixed;
     return rc_solve(m, res ? res : &tmp, c->w, &cfg, s, n) == RC_OK ? 0 : -1;
 }
@@ -690,7 +690,7 @@ int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t 
     c.s = out->s;
     c.n = n;
     c.k = cfg.folds;
-    c.max_iter = cfg.max_iter;
+    c.max_iter = cfg.max_iter ? cfg.max_iter : 40u;
     c.verbose = cfg.verbose;
 
     /* display steps */

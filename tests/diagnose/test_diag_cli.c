@@ -1,0 +1,2 @@
+/* placeholder until the CLI test lands */
+int main(void) { return 0; }
