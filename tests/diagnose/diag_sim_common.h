@@ -47,7 +47,7 @@ static const diag_case diag_cases[] = {
 
 /* Simulate n samples with the case's effect hidden in the truth. Returns 0
  * or -1. nominal: loaded robot model. */
-static int diag_simulate(rc_sample *s, size_t n, const rc_model *nominal, const diag_case *c,
+static inline int diag_simulate(rc_sample *s, size_t n, const rc_model *nominal, const diag_case *c,
                          unsigned long long seed, double q_step_deg, double size)
 {
     rch_sim_config sc;
@@ -89,7 +89,7 @@ static int diag_simulate(rc_sample *s, size_t n, const rc_model *nominal, const 
     return rch_sim_samples(s, NULL, n, &truth, &sc, &g);
 }
 
-static int diag_load_nominal(rc_model *m)
+static inline int diag_load_nominal(rc_model *m)
 {
     rch_robot robot;
     rch_diag d;
@@ -103,7 +103,7 @@ static int diag_load_nominal(rc_model *m)
 }
 
 /* Verdict matches the case (joint too for joint effects). */
-static int diag_match(const rch_diagnose_result *r, const diag_case *c)
+static inline int diag_match(const rch_diagnose_result *r, const diag_case *c)
 {
     if (strcmp(r->effect, c->name) != 0)
         return 0;
@@ -112,7 +112,7 @@ static int diag_match(const rch_diagnose_result *r, const diag_case *c)
     return 1;
 }
 
-static void diag_case_label(char *buf, size_t len, const diag_case *c)
+static inline void diag_case_label(char *buf, size_t len, const diag_case *c)
 {
     if (c->kind == RC_EFF_JOINT_COMPLIANCE || c->kind == RC_EFF_JOINT_PERIODIC)
         snprintf(buf, len, "%s j%u", c->name, c->joint0 + 1);
