@@ -443,13 +443,25 @@ rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample 
     }
     for (unsigned a = 0; a < 3; ++a)
         trace += A[5 * a];
-    /* a pose set without spread in some direction cannot place e */
+    /* A pose set without spread in some direction (in any orientation, so
+     * the smallest eigenvalue of the centred scatter) cannot place e. */
+    double sc[9], vec[9], ev[3];
     for (unsigned a = 0; a < 3; ++a)
-        if (!(A[5 * a] > 1e-10 * trace))
-            return RC_ERR_RANK;
+        for (unsigned k = 0; k < 3; ++k)
+            sc[3 * a + k] = A[4 * a + k];
+    if (!(trace > 0.0) || rcu_eig_sym(ev, vec, sc, 3, 0) != RC_OK || !(ev[2] > 1e-8 * trace))
+        return RC_ERR_RANK;
     if (rcu_chol_solve(A, b, 4) != RC_OK)
         return RC_ERR_RANK;
+    if (!(isfinite(b[0]) && isfinite(b[1]) && isfinite(b[2]) && isfinite(b[3])))
+        return RC_ERR_NUMERIC;
+    /* The linearisation solves for e' and k = |e'|^2 independently: lengths
+     * that fit no sphere (a wild reading, a wrong column) make them
+     * disagree. */
+    const double ee = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    if (!(fabs(b[3] - ee) <= 0.1 * fabs(b[3]) + 1.0))
+        return RC_ERR_RANGE;
     for (int r = 0; r < 3; ++r)
         enc_mm[r] = b[r] + c[r];
-    return (isfinite(enc_mm[0]) && isfinite(enc_mm[1]) && isfinite(enc_mm[2])) ? RC_OK : RC_ERR_NUMERIC;
+    return RC_OK;
 }

@@ -139,6 +139,8 @@ rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, 
 /* Initial guess of the encoder outlet e from the model's flange points and
  * the measured lengths, by the linearisation |p|^2 - 2 p.e + |e|^2 = L^2
  * (linear least squares in e and |e|^2, 4 x 4 normal equations).
- * enc_mm: (3) output. RC_ERR_RANK when the points are (nearly) coplanar. */
+ * enc_mm: (3) output. RC_ERR_RANK when the points are (nearly) coplanar in
+ * any orientation; RC_ERR_RANGE when the lengths fit no sphere (the solved
+ * e' and |e'|^2 disagree by more than 10 %: a wild reading or wrong column). */
 rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n);
 #endif /* RC_SOLVE_H */

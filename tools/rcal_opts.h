@@ -2,8 +2,14 @@
 #ifndef RCAL_OPTS_H
 #define RCAL_OPTS_H
 
+/* The nominal robot shipped in data/ (absolute path of the source tree, so
+ * that rcal works from any directory). */
 #ifndef RCAL_DEFAULT_ROBOT
+#ifdef RCAL_DATA_DIR
+#define RCAL_DEFAULT_ROBOT RCAL_DATA_DIR "/irb120.json"
+#else
 #define RCAL_DEFAULT_ROBOT "data/irb120.json"
+#endif
 #endif
 
 /* If argv[*i] is NAME, consume its value into *out (advancing *i) and return
