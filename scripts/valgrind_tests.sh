@@ -1,0 +1,146 @@
+#!/usr/bin/env bash
+# scripts/valgrind_tests.sh - the ctest suite under valgrind memcheck (issue 7).
+#
+# Builds a non-sanitized RelWithDebInfo tree, asks ctest for every test's
+# command, environment and working directory (ctest --show-only=json-v1), and
+# runs each test executable under
+#   valgrind --leak-check=full --errors-for-leak-kinds=definite,indirect,possible
+# Child processes the tests start (rcal, rcal_simdisplay, ...) are traced too,
+# except system programs (/bin, /usr/bin). A test fails on its own failure or on
+# any memcheck error or leak in it or its children. Disabled tests are skipped;
+# tests whose command is not an executable of the build tree (scripts) run
+# without valgrind.
+#
+# Environment:
+#   BUILD_DIR          build tree (default <repo>/build-valgrind)
+#   VALGRIND_EXCLUDE   extended regex of test names to skip (default none)
+#   VALGRIND_TIMEOUT   seconds per test (default 900)
+#   VALGRIND_CHILDREN  1: trace child processes (default), 0: only the test
+#   JOBS               tests run at the same time (default 1)
+set -u -o pipefail
+
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BUILD_DIR=${BUILD_DIR:-$ROOT/build-valgrind}
+EXCLUDE=${VALGRIND_EXCLUDE:-}
+TMO=${VALGRIND_TIMEOUT:-900}
+CHILDREN=${VALGRIND_CHILDREN:-1}
+JOBS=${JOBS:-1}
+start=$(date +%s)
+
+command -v valgrind >/dev/null || { echo "valgrind: not installed (apt-get install valgrind)"; exit 1; }
+
+echo "== valgrind: building $BUILD_DIR (no sanitizers)"
+mkdir -p "$BUILD_DIR"
+if ! cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRCAL_SANITIZE=OFF \
+    >"$BUILD_DIR/valgrind-cfg.log" 2>&1; then
+    cat "$BUILD_DIR/valgrind-cfg.log"
+    echo "valgrind: configure FAILED"
+    exit 1
+fi
+if ! cmake --build "$BUILD_DIR" -j"$(nproc 2>/dev/null || echo 2)" >"$BUILD_DIR/valgrind-build.log" 2>&1; then
+    tail -40 "$BUILD_DIR/valgrind-build.log"
+    echo "valgrind: build FAILED"
+    exit 1
+fi
+
+LOGDIR="$BUILD_DIR/valgrind"
+rm -rf "$LOGDIR"
+mkdir -p "$LOGDIR"
+
+# One line per test: name <TAB> workdir <TAB> env (;-joined) <TAB> disabled <TAB> argv (\x1f-joined)
+(cd "$BUILD_DIR" && ctest --show-only=json-v1) | python3 -c '
+import json, sys
+for t in json.load(sys.stdin)["tests"]:
+    props = {p["name"]: p["value"] for p in t.get("properties", [])}
+    env = props.get("ENVIRONMENT", [])
+    print("\t".join([t["name"], props.get("WORKING_DIRECTORY", "."), ";".join(env),
+                     "1" if props.get("DISABLED") else "0", "\x1f".join(t.get("command", []))]))
+' >"$LOGDIR/tests.tsv" || { echo "valgrind: ctest --show-only failed"; exit 1; }
+
+VG=(valgrind --tool=memcheck --leak-check=full --show-leak-kinds=definite,indirect,possible
+    --errors-for-leak-kinds=definite,indirect,possible --error-exitcode=99 --num-callers=30
+    --track-fds=no)
+if [ "$CHILDREN" = 1 ]; then
+    VG+=(--trace-children=yes '--trace-children-skip=/bin/*,/usr/bin/*,/usr/sbin/*,*/sh,*/bash')
+fi
+
+run_test() { # name workdir env disabled argv
+    local name=$1 wd=$2 envs=$3 argv=$4 rc t0 t1 status log
+    local -a cmd envv=()
+    IFS=$'\x1f' read -r -a cmd <<<"$argv"
+    IFS=';' read -r -a envv <<<"$envs"
+    log="$LOGDIR/$name"
+    t0=$(date +%s)
+    if [[ ${cmd[0]} == "$BUILD_DIR"/* ]] && file -L "${cmd[0]}" 2>/dev/null | grep -q ELF; then
+        (cd "$wd" && env "${envv[@]}" timeout "$TMO" "${VG[@]}" --log-file="$log.%p.vg" "${cmd[@]}") \
+            >"$log.out" 2>&1
+        rc=$?
+        under=valgrind
+    else
+        (cd "$wd" && env "${envv[@]}" timeout "$TMO" "${cmd[@]}") >"$log.out" 2>&1
+        rc=$?
+        under=plain
+    fi
+    t1=$(date +%s)
+    # memcheck findings in the test or any traced child
+    local errs=0 leaks=""
+    for f in "$log".*.vg; do
+        [ -e "$f" ] || continue
+        if grep -q 'ERROR SUMMARY: [1-9]' "$f"; then errs=$((errs + 1)); fi
+        leaks+=$(grep -hE '(definitely|indirectly|possibly) lost: [1-9]' "$f" | head -3)
+    done
+    if [ "$rc" = 124 ]; then
+        status="FAIL (timeout ${TMO}s)"
+    elif [ "$errs" -ne 0 ] || [ "$rc" = 99 ]; then
+        status="FAIL (memcheck errors, see $log.*.vg)"
+    elif [ "$rc" -ne 0 ]; then
+        status="FAIL (test exit $rc, see $log.out)"
+    else
+        status=ok
+    fi
+    printf '%-24s %-8s %5ss  %s\n' "$name" "$under" "$((t1 - t0))" "$status" >"$log.result"
+    [ -n "$leaks" ] && echo "$leaks" | sed 's/^/    /' >>"$log.result"
+}
+
+echo "== valgrind: running $(grep -c . "$LOGDIR/tests.tsv") tests, $JOBS at a time"
+running=0
+while IFS=$'\t' read -r name wd envs disabled argv; do
+    if [ "$disabled" = 1 ]; then
+        printf '%-24s %-8s %5s   %s\n' "$name" "-" "-" "skipped (disabled)" >"$LOGDIR/$name.result"
+        continue
+    fi
+    if [ -n "$EXCLUDE" ] && [[ $name =~ $EXCLUDE ]]; then
+        printf '%-24s %-8s %5s   %s\n' "$name" "-" "-" "skipped (VALGRIND_EXCLUDE)" >"$LOGDIR/$name.result"
+        continue
+    fi
+    run_test "$name" "$wd" "$envs" "$argv" </dev/null &
+    running=$((running + 1))
+    if [ "$running" -ge "$JOBS" ]; then
+        wait -n
+        running=$((running - 1))
+    fi
+done <"$LOGDIR/tests.tsv"
+wait
+
+pass=0
+failn=0
+printf '%-24s %-8s %6s  %s\n' test run time result
+while IFS=$'\t' read -r name _; do
+    cat "$LOGDIR/$name.result"
+    if grep -q ' ok$' "$LOGDIR/$name.result"; then
+        pass=$((pass + 1))
+    elif grep -q 'FAIL' "$LOGDIR/$name.result"; then
+        failn=$((failn + 1))
+    fi
+done <"$LOGDIR/tests.tsv"
+for f in "$LOGDIR"/*.result; do
+    if grep -q 'memcheck errors' "$f"; then
+        n=$(basename "$f" .result)
+        for v in "$LOGDIR/$n".*.vg; do
+            grep -q 'ERROR SUMMARY: [1-9]' "$v" && { echo "---- $v"; grep -v '^==[0-9]*== *$' "$v" | head -60; }
+        done
+    fi
+done
+echo "== valgrind: $(($(date +%s) - start)) s"
+echo "valgrind: $pass passed, $failn failed"
+[ "$failn" -eq 0 ]
