@@ -256,9 +256,9 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     const unsigned max_iter = cfg->max_iter ? cfg->max_iter : 100u;
     const double tau = cfg->mu0 > 0.0 ? cfg->mu0 : 1e-3;
     const double tol_step = cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9;
-    const double tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-6;
+    const double tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-4;
     const double rcond = cfg->rcond > 0.0 ? cfg->rcond : 1e-9;
-    const double snr_min = cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 2.0);
+    const double snr_min = cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 1.0);
     const int ltlm = cfg->method == RC_METHOD_LTLM;
     double cost, mu = 0.0, nu = 2.0;
 

@@ -62,9 +62,9 @@ typedef struct rc_solve_config {
     double mu0;              /* robust: initial damping relative to the largest
                                 scaled eigenvalue, 0: 1e-3; paper: absolute mu, 0: 5 */
     double tol_step;         /* 0: 1e-9 (relative, scaled) */
-    double tol_cost;         /* 0: 1e-6 (relative decrease of the cost in one iteration) */
+    double tol_cost;         /* 0: 1e-4 (relative decrease of the cost in one iteration) */
     double rcond;            /* 0: 1e-9: eigenvalue cut-off relative to the largest */
-    double snr_min;          /* 0: 2: an eigen-direction is stepped along only when its
+    double snr_min;          /* 0: 1: an eigen-direction is stepped along only when its
                                 Gauss-Newton step is at least snr_min standard errors
                                 (sigma from the current residual); negative: off */
     unsigned n_candidates;   /* LTLM M, 0: 10 */
