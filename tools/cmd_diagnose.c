@@ -16,7 +16,7 @@ static int usage(FILE *f)
     fprintf(f,
             "usage: rcal diagnose --data FILE [--robot MODEL] [--seed S] [--folds K] [--steps N]\n"
             "                     [--plots DIR] [--json] [--q-step-deg D] [--len-step-mm D]\n"
-            "                     [--len-noise-mm S] [--alpha A] [--verbose]\n"
+            "                     [--len-noise-mm S] [--alpha A] [--max-iter N] [--verbose]\n"
             "Fits the geometric model with K-fold cross-validation (folds random within set-up\n"
             "groups), compares the held-out residuals with the noise floor (length step and the\n"
             "joint display step through the Jacobian), tests the residuals for structure, and\n"
@@ -24,14 +24,16 @@ static int usage(FILE *f)
             "joint_compliance j2/j3, joint_periodic j1..j6) jointly with the geometry. An effect\n"
             "is chosen only on a significant held-out gain; the verdict is the effect, 'none'\n"
             "or 'unexplained'. Up to N effects (default 3) are added one after the other.\n"
-            "Steps are detected from the data unless given (a negative value: no quantization).\n");
+            "Steps are detected from the data unless given (a negative value: no quantization).\n"
+            "--len-noise-mm adds the encoder's stated noise to the floor; --max-iter caps the LM\n"
+            "iterations of each warm-started fold fit (default 100).\n");
     return f == stdout ? 0 : 2;
 }
 
 int rcal_cmd_diagnose(int argc, char **argv)
 {
     const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL;
-    unsigned long seed = 1, folds = 5, steps = 3;
+    unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0;
     int json = 0;
     rch_diagnose_cfg cfg;
     memset(&cfg, 0, sizeof cfg);
@@ -40,6 +42,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
             rcal_opt_str(argc, argv, &i, "--robot", &robot_path) ||
             rcal_opt_str(argc, argv, &i, "--plots", &plots) || rcal_opt_uint(argc, argv, &i, "--seed", &seed) ||
             rcal_opt_uint(argc, argv, &i, "--folds", &folds) || rcal_opt_uint(argc, argv, &i, "--steps", &steps) ||
+            rcal_opt_uint(argc, argv, &i, "--max-iter", &max_iter) ||
             rcal_opt_double(argc, argv, &i, "--q-step-deg", &cfg.q_step_deg) ||
             rcal_opt_double(argc, argv, &i, "--len-step-mm", &cfg.len_step_mm) ||
             rcal_opt_double(argc, argv, &i, "--len-noise-mm", &cfg.len_noise_mm) ||
@@ -68,6 +71,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
     cfg.folds = (unsigned)folds;
     cfg.max_steps = (unsigned)steps;
     cfg.seed = seed;
+    cfg.max_iter = (unsigned)max_iter;
 
     rch_robot robot;
     rch_data data;

@@ -57,7 +57,7 @@ int main(int argc, char **argv)
             cfg.max_steps = 1;
             cfg.seed = 1000u + k;
             cfg.len_noise_mm = 0.01; /* the simulated encoder noise, as its data sheet would state */
-            cfg.max_iter = getenv("DIAG_MAX_ITER") ? (unsigned)atoi(getenv("DIAG_MAX_ITER")) : 0u;
+            cfg.max_iter = getenv("DIAG_MAX_ITER") ? (unsigned)atoi(getenv("DIAG_MAX_ITER")) : 40u;
             if (diag_simulate(s, n, &nominal, c, 7919ull * (k + 1) + ci, q_step, size) != 0 ||
                 rch_diagnose_run(&r, s, n, &nominal, &cfg, &d) != 0) {
                 fprintf(stderr, "case %u seed %u failed\n", ci, k + 1);

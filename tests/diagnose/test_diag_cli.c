@@ -70,7 +70,7 @@ static void test_sim_csv_json(void **state)
     fclose(f);
     assert_non_null(mkdtemp(plots));
     snprintf(args, sizeof args,
-             "--data %s --robot %s/data/irb120.json --folds 3 --steps 2 --len-noise-mm 0.01 --json --plots %s", csv,
+             "--data %s --robot %s/data/irb120.json --folds 3 --steps 2 --max-iter 40 --len-noise-mm 0.01 --json --plots %s", csv,
              RCAL_SOURCE_DIR, plots);
     int status;
     rch_json *j = run_json(args, &status);
@@ -140,7 +140,7 @@ static void test_real_data(void **state)
     }
     fclose(f);
     char args[1024];
-    snprintf(args, sizeof args, "--data %s --robot %s/data/irb120.json --folds 3 --steps 1 --json", RCAL_SHARED_DATA,
+    snprintf(args, sizeof args, "--data %s --robot %s/data/irb120.json --folds 3 --steps 1 --max-iter 40 --json", RCAL_SHARED_DATA,
              RCAL_SOURCE_DIR);
     int status;
     rch_json *j = run_json(args, &status);

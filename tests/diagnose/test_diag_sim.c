@@ -37,6 +37,7 @@ static unsigned run_case(const diag_case *c, unsigned ci, const rc_model *nomina
         memset(&cfg, 0, sizeof cfg);
         cfg.folds = 3;
         cfg.max_steps = 1;
+        cfg.max_iter = 40;
         cfg.seed = 1000u + k;
         cfg.len_noise_mm = 0.01; /* the simulated encoder's stated noise */
         assert_int_equal(diag_simulate(s, N_SAMPLES, nominal, c, 7919ull * (k + 1) + ci, 0.01, 1.0), 0);
@@ -103,6 +104,7 @@ static void test_controls_coarse(void **state)
         memset(&cfg, 0, sizeof cfg);
         cfg.folds = 3;
         cfg.max_steps = 1;
+        cfg.max_iter = 40;
         cfg.seed = 77u + k;
         assert_int_equal(diag_simulate(s, N_SAMPLES, &nominal, &diag_cases[0], 31337ull + k, 0.1, 1.0), 0);
         assert_int_equal(rch_diagnose_run(&r, s, N_SAMPLES, &nominal, &cfg, &d), 0);
@@ -133,6 +135,7 @@ static void test_not_identifiable(void **state)
     memset(&cfg, 0, sizeof cfg);
     cfg.folds = 3;
     cfg.max_steps = 1;
+    cfg.max_iter = 40;
     assert_int_equal(rch_diagnose_run(&r, s, N_SAMPLES, &nominal, &cfg, &d), 0);
     int scale_flagged = 0, note = 0;
     for (unsigned k = 0; k < r.steps[0].n_cand; ++k) {

@@ -690,7 +690,7 @@ int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t 
     c.s = out->s;
     c.n = n;
     c.k = cfg.folds;
-    c.max_iter = cfg.max_iter ? cfg.max_iter : 40u;
+    c.max_iter = cfg.max_iter ? cfg.max_iter : 100u;
     c.verbose = cfg.verbose;
 
     /* display steps */
