@@ -75,7 +75,8 @@ typedef struct rc_comp_config {
 typedef enum rc_comp_exit {
     RC_COMP_CONVERGED = 0,     /* position and (unless position-only) orientation within tolerance */
     RC_COMP_POSITION_ONLY = 1, /* position within tolerance; orientation could not be matched
-                                  (singular pose, joint limit or max_dev): best effort */
+                                  (singular pose, workspace boundary, joint limit or
+                                  max_dev): best effort */
     RC_COMP_MAX_ITER = 2,      /* position tolerance not met within max_iter */
     RC_COMP_NO_DESCENT = 3,    /* damping reached its limit without progress (bound or singularity) */
     RC_COMP_BAD_INPUT = 4,     /* target or seed not finite, or outside the joint limits */
