@@ -6,8 +6,9 @@
  *  - Modbus with faults, interrupted by a disconnect mid-frame and by a
  *    crash mid-write, then resumed: the same file as an uninterrupted run
  *    (the wall-clock column t_unix_ms excluded).
- * The plan and truth come from `rcal simulate`. */
+ * The truth comes from `rcal simulate`, the pose plan from `rcal poses`. */
 #include <errno.h>
+#include <math.h>
 #include <setjmp.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -151,9 +152,13 @@ static int setup(void **state)
     snprintf(g_dir, sizeof g_dir, "%s/drv_e2e_XXXXXX", RCAL_BINARY_DIR);
     if (!mkdtemp(g_dir) || !r)
         return -1;
-    if (run("%s simulate --robot %s/data/irb120.json --out %s/plan.csv --truth-out %s/truth.json "
-            "--samples %d --seed 5 >%s/simulate.log 2>&1",
-            RCAL_EXE, RCAL_SOURCE_DIR, g_dir, g_dir, NPOSES, g_dir) != 0)
+    /* the truth from `rcal simulate`, the plan from `rcal poses` */
+    if (run("%s simulate --robot %s/data/irb120.json --out %s/sim.csv --truth-out %s/truth.json "
+            "--samples 10 --seed 5 >%s/simulate.log 2>&1",
+            RCAL_EXE, RCAL_SOURCE_DIR, g_dir, g_dir, g_dir) != 0)
+        return -1;
+    if (run("%s poses --robot %s/data/irb120.json --count %d --seed 5 --out %s/plan.csv >%s/poses.log 2>&1",
+            RCAL_EXE, RCAL_SOURCE_DIR, NPOSES, g_dir, g_dir) != 0)
         return -1;
     snprintf(path, sizeof path, "%s/truth.json", g_dir);
     if (rch_robot_load(r, path, &dg) != 0)
@@ -187,7 +192,7 @@ static double json_num(const char *js, const char *obj, const char *key)
     if (!p)
         return -1;
     p = strstr(p, key);
-    if (!p || sscanf(p + strlen(key) + 3, "%lf", &v) != 1)
+    if (!p || !(p = strchr(p, ':')) || sscanf(p + 1, "%lf", &v) != 1)
         return -1;
     return v;
 }
@@ -207,8 +212,12 @@ static void test_ascii_acquire_calibrate(void **state)
     assert_int_equal(acquire(&s, "ascii", "ascii.csv", "--stable-mm 0.03"), 0);
     sim_stop(&s);
     check_file("ascii.csv", 0.01);
+    /* --method lm-paper: the default robust LM currently stops at iteration 0
+     * on this 40-pose plan (its noise-significance gate estimates sigma from
+     * the uncalibrated residual with 14 degrees of freedom and rejects every
+     * direction); reported to the solver's owner. */
     assert_int_equal(run("%s calibrate --robot %s/data/irb120.json --data %s/ascii.csv --truth %s/truth.json "
-                         "--test-fraction 0 --json >%s/calib.json 2>>%s/acquire.log",
+                         "--method lm-paper --test-fraction 0 --json >%s/calib.json 2>>%s/acquire.log",
                          RCAL_EXE, RCAL_SOURCE_DIR, g_dir, g_dir, g_dir, g_dir), 0);
     snprintf(path, sizeof path, "%s/calib.json", g_dir);
     f = fopen(path, "r");
@@ -224,7 +233,7 @@ static void test_ascii_acquire_calibrate(void **state)
     after = json_num(js, "\"truth_flange\"", "\"after_rms_mm\"");
     print_message("calibrate on acquired data: fit rms %.4f mm; flange vs truth %.4f -> %.4f mm\n", fit, before, after);
     assert_true(fit >= 0 && fit < 0.01);
-    assert_true(after >= 0 && after < before);
+    assert_true(after >= 0 && after < 0.05 && after < before / 10);
     free(js);
 }
 
@@ -285,9 +294,49 @@ static void test_modbus_resume_identical(void **state)
     sim_stop(&s);
 }
 
+/* `rcal poses`: a plan inside the joint limits that beats a random plan. */
+static void test_poses_plan(void **state)
+{
+    char path[512], line[512];
+    FILE *f;
+    double ratio = 0;
+    int rows = 0;
+    (void)state;
+    snprintf(path, sizeof path, "%s/poses.log", g_dir);
+    f = fopen(path, "r");
+    assert_non_null(f);
+    while (fgets(line, sizeof line, f)) {
+        const char *p = strstr(line, "ratio ");
+        if (p)
+            ratio = atof(p + 6);
+    }
+    fclose(f);
+    print_message("rcal poses: O1 planned / random = %.2f\n", ratio);
+    assert_true(ratio > 1.1);
+    snprintf(path, sizeof path, "%s/plan.csv", g_dir);
+    f = fopen(path, "r");
+    assert_non_null(f);
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_string_equal(line, "pose,q1,q2,q3,q4,q5,q6\n");
+    while (fgets(line, sizeof line, f)) {
+        static const double lim[6] = {165, 110, 110, 160, 120, 400};
+        double q[6];
+        int k;
+        assert_int_equal(sscanf(line, "%d,%lf,%lf,%lf,%lf,%lf,%lf", &k, &q[0], &q[1], &q[2], &q[3], &q[4], &q[5]), 7);
+        for (int j = 0; j < 6; ++j)
+            assert_true(fabs(q[j]) <= lim[j]);
+        assert_true(q[2] <= 70.0); /* joint 3: [-110, 70] */
+        assert_true(g_true_len[rows] > 240 && g_true_len[rows] < 810);
+        ++rows;
+    }
+    fclose(f);
+    assert_int_equal(rows, NPOSES);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_poses_plan),
         cmocka_unit_test(test_ascii_acquire_calibrate),
         cmocka_unit_test(test_stx_faults),
         cmocka_unit_test(test_modbus_resume_identical),
