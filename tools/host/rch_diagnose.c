@@ -1166,7 +1166,10 @@ static void print_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
 int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
 {
     fprintf(f, "rcal diagnose: %zu samples, %u set-up groups, %u-fold cross-validation (random within groups)\n",
-             r->n, r->n_groups, r->folds);
+            r->n, r->n_groups, r->folds);
+    if (r->n_flicker)
+        fprintf(f, "  %u sample(s) kept in their group although a wrist reading moved by one display step\n",
+                r->n_flicker);
     fprintf(f, "\nNoise floor: %.4f mm rms  (joint display step %.3g deg through the Jacobian: %.4f mm; "
                "length step %.3g mm%s: %.4f mm)\n",
             r->noise_floor_mm, r->q_step_deg, r->floor_joints_mm, r->len_step_mm,
@@ -1291,7 +1294,8 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r)
     json_num(f, r->len_step_mm);
     fprintf(f, ",\"train_rmse_geometry_mm\":");
     json_num(f, r->train_rmse_geo_mm);
-    fprintf(f, ",\"n\":%zu,\"groups\":%u,\"folds\":%u,\"remaining\":", r->n, r->n_groups, r->folds);
+    fprintf(f, ",\"n\":%zu,\"groups\":%u,\"wrist_flicker_samples\":%u,\"folds\":%u,\"remaining\":", r->n,
+            r->n_groups, r->n_flicker, r->folds);
     json_str(f, r->remaining);
     fprintf(f, ",\"remaining_why\":");
     json_str(f, r->remaining_why);
