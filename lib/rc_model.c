@@ -106,6 +106,24 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     return RC_OK;
 }
 
+void rc_model_wrap_angles(rc_model *m)
+{
+    RC_ASSERT(m != NULL);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        for (unsigned k = RC_P_ALPHA(i); k <= RC_P_THETA(i); ++k) {
+            double a = m->x[k];
+            if (!isfinite(a))
+                continue;
+            a = fmod(a, 2.0 * M_PI); /* (-2 pi, 2 pi) */
+            if (a > M_PI)
+                a -= 2.0 * M_PI;
+            else if (a <= -M_PI)
+                a += 2.0 * M_PI;
+            m->x[k] = a;
+        }
+    }
+}
+
 const char *rc_effect_name(rc_effect_kind kind)
 {
     switch (kind) {

@@ -85,6 +85,10 @@ rc_status rc_model_init(rc_model *m, const double dh[RC_NJ][4], const double enc
  * RC_ERR_CAPACITY when RC_MAX_PARAMS or RC_MAX_EFFECTS would be exceeded. */
 rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, unsigned count);
 
+/* Wrap every DH angle (alpha_i, theta_i) into (-pi, pi]: the model is
+ * unchanged (angles enter through sin and cos only). */
+void rc_model_wrap_angles(rc_model *m);
+
 /* Short machine name of an effect kind ("length_offset", ...); never NULL. */
 const char *rc_effect_name(rc_effect_kind kind);
 

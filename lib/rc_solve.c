@@ -248,8 +248,11 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     if (nf == 0)
         return RC_ERR_RANK;
 
-    if (cfg->method == RC_METHOD_LM_PAPER || cfg->method == RC_METHOD_LTLM_PAPER)
-        return solve_paper(m, res, w, cfg, nf, samples, n);
+    if (cfg->method == RC_METHOD_LM_PAPER || cfg->method == RC_METHOD_LTLM_PAPER) {
+        const rc_status sp = solve_paper(m, res, w, cfg, nf, samples, n);
+        rc_model_wrap_angles(m);
+        return sp;
+    }
     if (cfg->method != RC_METHOD_LM && cfg->method != RC_METHOD_LTLM)
         return RC_ERR_ARG;
 
@@ -410,6 +413,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         if (done)
             break;
     }
+    rc_model_wrap_angles(m);
     return RC_OK;
 }
 

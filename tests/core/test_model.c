@@ -188,6 +188,31 @@ static void test_fk_real_file(void **state)
     rch_data_free(&d);
 }
 
+static void test_wrap_angles(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 9);
+    rc_model m = nominal(), w;
+    m.x[RC_P_THETA(5)] = 2802.79 * 3.14159265358979323846 / 180.0;
+    m.x[RC_P_ALPHA(2)] = -7.0;
+    m.x[RC_P_THETA(0)] = 3.14159265358979323846;
+    w = m;
+    rc_model_wrap_angles(&w);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        assert_true(w.x[RC_P_ALPHA(i)] > -3.1415926536 && w.x[RC_P_ALPHA(i)] <= 3.1415926536);
+        assert_true(w.x[RC_P_THETA(i)] > -3.1415926536 && w.x[RC_P_THETA(i)] <= 3.1415926536);
+    }
+    for (int trial = 0; trial < 20; ++trial) { /* same lengths */
+        rc_sample s;
+        random_pose(&s, &g);
+        double l1, l2;
+        assert_int_equal(rc_meas(&l1, NULL, &m, &s), RC_OK);
+        assert_int_equal(rc_meas(&l2, NULL, &w, &s), RC_OK);
+        assert_true(fabs(l1 - l2) < 1e-9);
+    }
+}
+
 static void test_lt_map(void **state)
 {
     (void)state;
@@ -208,7 +233,7 @@ int main(void)
         cmocka_unit_test(test_param_jacobian_base), cmocka_unit_test(test_param_jacobian_effects),
         cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
         cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_fk_real_file),
-        cmocka_unit_test(test_lt_map),
+        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
