@@ -76,6 +76,7 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     switch (kind) {
     case RC_EFF_LENGTH_OFFSET: n = 1; joint = 0; break;
     case RC_EFF_LENGTH_SCALE: n = 1; joint = 0; break;
+    case RC_EFF_TOOL_OFFSET: n = 3; joint = 0; break;
     case RC_EFF_TIME_DRIFT: n = 2; joint = 0; break;
     case RC_EFF_GROUP_OFFSET: n = count; joint = 0; break;
     case RC_EFF_JOINT_PERIODIC: n = 4; break;
@@ -133,6 +134,7 @@ const char *rc_effect_name(rc_effect_kind kind)
     case RC_EFF_TIME_DRIFT: return "time_drift";
     case RC_EFF_GROUP_OFFSET: return "group_offset";
     case RC_EFF_LENGTH_SCALE: return "length_scale";
+    case RC_EFF_TOOL_OFFSET: return "tool_offset";
     case RC_EFF_NONE: break;
     }
     return "none";
@@ -199,6 +201,9 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
             put_str(buf, buf_len, &pos, ".g");
             put_uint(buf, buf_len, &pos, j);
             break;
+        case RC_EFF_TOOL_OFFSET:
+            put_str(buf, buf_len, &pos, j == 0 ? ".x" : j == 1 ? ".y" : ".z");
+            break;
         default: break;
         }
         return buf;
@@ -220,7 +225,8 @@ int rc_param_unit(const rc_model *m, unsigned k)
             switch ((rc_effect_kind)e->kind) {
             case RC_EFF_LENGTH_OFFSET:
             case RC_EFF_TIME_DRIFT:
-            case RC_EFF_GROUP_OFFSET: return 0;
+            case RC_EFF_GROUP_OFFSET:
+            case RC_EFF_TOOL_OFFSET: return 0;
             case RC_EFF_JOINT_PERIODIC: return 1;
             default: return 2;
             }
@@ -292,7 +298,18 @@ static void theta_dq(double D[36], const rc_model *m, const double q_rad[RC_NJ])
     }
 }
 
-static void model_chain(chain *c, const rc_model *m, const double q_rad[RC_NJ])
+/* Index of the tool-offset parameters in x, or -1. */
+static int tool_index(const rc_model *m)
+{
+    for (unsigned i = 0; i < m->n_effects; ++i)
+        if (m->effects[i].kind == RC_EFF_TOOL_OFFSET)
+            return (int)m->effects[i].first;
+    return -1;
+}
+
+/* Chain of the model at q; tool (3) receives the measured point: the flange
+ * origin, plus R6 t with a tool offset. */
+static void model_chain(chain *c, double tool[3], const rc_model *m, const double q_rad[RC_NJ])
 {
     double dh[RC_NJ][4], th[RC_NJ];
     for (unsigned i = 0; i < RC_NJ; ++i)
@@ -300,14 +317,24 @@ static void model_chain(chain *c, const rc_model *m, const double q_rad[RC_NJ])
             dh[i][k] = m->x[4 * i + k];
     rc_model_theta(th, m, q_rad);
     chain_compute(c, (const double(*)[4])dh, th, RC_NJ);
+    const int ti = tool_index(m);
+    for (unsigned r = 0; r < 3; ++r) {
+        tool[r] = c->o[RC_NJ][r];
+        if (ti >= 0) {
+            const double *t = &m->x[ti];
+            const double *R = c->R[RC_NJ];
+            tool[r] += R[3 * r] * t[0] + R[3 * r + 1] * t[1] + R[3 * r + 2] * t[2];
+        }
+    }
 }
 
 void rc_fk(double pos_mm[3], double rot[9], const rc_model *m, const double q_rad[RC_NJ])
 {
     chain c;
+    double tool[3];
     RC_ASSERT(pos_mm != NULL && m != NULL && q_rad != NULL);
-    model_chain(&c, m, q_rad);
-    memcpy(pos_mm, c.o[RC_NJ], 3 * sizeof pos_mm[0]);
+    model_chain(&c, tool, m, q_rad);
+    memcpy(pos_mm, tool, 3 * sizeof pos_mm[0]);
     if (rot != NULL)
         memcpy(rot, c.R[RC_NJ], 9 * sizeof rot[0]);
 }
@@ -316,10 +343,9 @@ void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *
                const double q_rad[RC_NJ])
 {
     chain c;
-    double Jt[36], D[36];
+    double Jt[36], D[36], p[3];
     RC_ASSERT(pos_mm != NULL && jac != NULL && m != NULL && q_rad != NULL);
-    model_chain(&c, m, q_rad);
-    const double *p = c.o[RC_NJ];
+    model_chain(&c, p, m, q_rad);
     for (unsigned i = 0; i < RC_NJ; ++i) {
         const double z[3] = {c.R[i][2], c.R[i][5], c.R[i][8]};
         double v[3], w[3];
@@ -347,10 +373,9 @@ void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *
 rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sample *s)
 {
     chain c;
-    double u[3], dl_dtheta[RC_NJ];
+    double u[3], dl_dtheta[RC_NJ], p[3];
     RC_ASSERT(len_mm != NULL && m != NULL && s != NULL);
-    model_chain(&c, m, s->q_rad);
-    const double *p = c.o[RC_NJ];
+    model_chain(&c, p, m, s->q_rad);
     const double *e = &m->x[RC_P_ENC];
     for (int r = 0; r < 3; ++r)
         u[r] = p[r] - e[r];
@@ -422,6 +447,12 @@ rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sampl
             J[1] = g * cos(q);
             J[2] = g * sin(2.0 * q);
             J[3] = g * cos(2.0 * q);
+            break;
+        }
+        case RC_EFF_TOOL_OFFSET: { /* dp/dt = R6 */
+            const double *R = c.R[RC_NJ];
+            for (unsigned k = 0; k < 3; ++k)
+                J[k] = scale * (u[0] * R[k] + u[1] * R[3 + k] + u[2] * R[6 + k]);
             break;
         }
         case RC_EFF_NONE: break;

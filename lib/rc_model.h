@@ -44,7 +44,9 @@ typedef enum rc_effect_kind {
     RC_EFF_JOINT_PERIODIC = 3,  /* theta_j += s1 sin q + c1 cos q + s2 sin 2q + c2 cos 2q; 4 params, rad */
     RC_EFF_TIME_DRIFT = 4,      /* l += d1 t + d2 t^2, t in [0,1] acquisition order; 2 params, mm */
     RC_EFF_GROUP_OFFSET = 5,    /* l += g_k for samples of group k; count params, mm */
-    RC_EFF_LENGTH_SCALE = 6     /* l *= (1 + s) (encoder scale);   1 param, unitless */
+    RC_EFF_LENGTH_SCALE = 6,    /* l *= (1 + s) (encoder scale);   1 param, unitless */
+    RC_EFF_TOOL_OFFSET = 7      /* measured point = flange + R6 (tx, ty, tz): where the cable
+                                   is attached, in the flange frame; 3 params, mm */
 } rc_effect_kind;
 
 typedef struct rc_effect {
@@ -108,7 +110,8 @@ void rc_model_theta(double theta_rad[RC_NJ], const rc_model *m, const double q_r
  * the frozen geometry ref_dh (4 x 4). Used by RC_EFF_JOINT_COMPLIANCE. */
 double rc_gravity_lever_m(const double ref_dh[4][4], unsigned joint, const double q_rad[RC_NJ]);
 
-/* Forward kinematics. pos_mm: (3) flange point; rot: (3 x 3) flange
+/* Forward kinematics. pos_mm: (3) flange point (the tool point when the
+ * model has RC_EFF_TOOL_OFFSET); rot: (3 x 3) flange
  * orientation or NULL. */
 void rc_fk(double pos_mm[3], double rot[9], const rc_model *m, const double q_rad[RC_NJ]);
 

@@ -23,7 +23,8 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: rcal calibrate --data FILE [--robot MODEL.json] [--method lm|ltlm|lm-paper|ltlm-paper]\n"
-            "                      [--test-fraction F] [--seed S] [--max-iter N] [--fix LIST] [--out MODEL.json]\n"
+            "                      [--test-fraction F] [--seed S] [--max-iter N] [--fix LIST] [--tool-offset]\n"
+            "                      [--out MODEL.json]\n"
             "                      [--truth TRUTH.json] [--json]\n"
             "  --data           measurements: CSV with q1..q6 (deg) and L (mm) columns\n"
             "  --robot          nominal robot model (default %s)\n"
@@ -32,6 +33,7 @@ static void usage(FILE *f)
             "  --test-fraction  share of samples held out for the before/after report (default 0.1)\n"
             "  --seed           split (and LTLM) seed (default 1)\n"
             "  --out            write the calibrated model (rcal-model/1 JSON) for compensation\n"
+            "  --tool-offset    also identify where the cable is attached in the flange frame (tx, ty, tz)\n"
             "  --fix            comma-separated parameters held at their nominal values, e.g. a1,theta6\n"
             "                   (names: a1..a6, d1..d6, alpha1..alpha6, theta1..theta6, ex, ey, ez)\n"
             "  --truth          a simulated truth model: report flange-position errors against it over\n"
@@ -65,7 +67,7 @@ int rcal_cmd_calibrate(int argc, char **argv)
     const char *truth_path = NULL, *fix_list = NULL;
     double test_fraction = 0.1;
     unsigned long seed = 1, max_iter = 0;
-    int json = 0;
+    int json = 0, tool_offset = 0;
     for (int i = 1; i < argc; ++i) {
         if (rcal_opt_str(argc, argv, &i, "--data", &data_path) || rcal_opt_str(argc, argv, &i, "--robot", &robot_path) ||
             rcal_opt_str(argc, argv, &i, "--out", &out_path) || rcal_opt_str(argc, argv, &i, "--truth", &truth_path) ||
@@ -75,6 +77,10 @@ int rcal_cmd_calibrate(int argc, char **argv)
             continue;
         if (strcmp(argv[i], "--json") == 0) {
             json = 1;
+            continue;
+        }
+        if (strcmp(argv[i], "--tool-offset") == 0) {
+            tool_offset = 1;
             continue;
         }
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
@@ -101,6 +107,11 @@ int rcal_cmd_calibrate(int argc, char **argv)
     char msg[1024];
     if (rch_robot_load(&robot, robot_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
         fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (tool_offset && rc_model_add_effect(&robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
+        fprintf(stderr, "rcal calibrate: cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)\n");
+        rch_data_free(&data);
         return 1;
     }
     int rc = 1;

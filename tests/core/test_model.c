@@ -87,7 +87,8 @@ static void test_param_jacobian_effects(void **state)
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_TIME_DRIFT, 0, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_GROUP_OFFSET, 0, 3), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_SCALE, 0, 0), RC_OK);
-    assert_int_equal(m.n_params, RC_N_BASE + 1 + 1 + 1 + 4 + 2 + 3 + 1);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
+    assert_int_equal(m.n_params, RC_N_BASE + 1 + 1 + 1 + 4 + 2 + 3 + 1 + 3);
     for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
         m.x[k] = 1e-3 * rc_rng_normal(&g);
     check_param_jacobian(&m, &g);
@@ -113,6 +114,10 @@ static void test_joint_jacobian(void **state)
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 2, 0), RC_OK);
     for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
         m.x[k] = 2e-3;
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
+    m.x[m.n_params - 3] = 12.0;
+    m.x[m.n_params - 2] = -7.0;
+    m.x[m.n_params - 1] = 30.0;
     for (int trial = 0; trial < 50; ++trial) {
         rc_sample s;
         random_pose(&s, &g);

@@ -470,6 +470,7 @@ static const cdef all_cands[] = {
     {RC_EFF_GROUP_OFFSET, 0},     {RC_EFF_JOINT_COMPLIANCE, 1}, {RC_EFF_JOINT_COMPLIANCE, 2},
     {RC_EFF_JOINT_PERIODIC, 0},   {RC_EFF_JOINT_PERIODIC, 1},   {RC_EFF_JOINT_PERIODIC, 2},
     {RC_EFF_JOINT_PERIODIC, 3},   {RC_EFF_JOINT_PERIODIC, 4},   {RC_EFF_JOINT_PERIODIC, 5},
+    {RC_EFF_TOOL_OFFSET, 0},
 };
 #define N_ALL_CANDS (sizeof all_cands / sizeof all_cands[0])
 
@@ -488,6 +489,8 @@ static const char *known_reason(rc_effect_kind kind, unsigned joint0, const rc_m
 {
     if (kind == RC_EFF_LENGTH_SCALE)
         return "a cable scale error equals a uniformly larger robot (every a, d and the encoder scaled)";
+    if (kind == RC_EFF_TOOL_OFFSET)
+        return "a cable attachment offset in the flange frame trades against a6, d6 and theta6";
     if (kind == RC_EFF_JOINT_PERIODIC && joint0 == 5)
         return "joint 6 turns the flange about its own axis: the cable attachment point does not move";
     if (kind == RC_EFF_LENGTH_OFFSET && has_effect(base, RC_EFF_GROUP_OFFSET, 0))
@@ -1119,10 +1122,6 @@ int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t 
                 snprintf(out->notes[out->n_notes++], sizeof out->notes[0], "%s: %s", nm, nt);
             }
         }
-    if (out->n_notes < RCH_DIAGNOSE_MAX_NOTES)
-        snprintf(out->notes[out->n_notes++], sizeof out->notes[0],
-                 "a cable attachment (tool) offset on the flange is not a separate effect: within the flange "
-                 "plane it is a6 with the joint-6 offset theta6, along the flange axis it is d6");
     rc = 0;
 done:
     out->time_ms = now_ms() - t0;

@@ -61,9 +61,10 @@ static int read_dh(double dh[RC_NJ][4], const rch_json *arr, const char *file, r
 static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_diag *d)
 {
     static const char *const names[] = {"length_offset", "joint_compliance", "joint_periodic",
-                                        "time_drift",    "group_offset",     "length_scale"};
+                                        "time_drift",    "group_offset",     "length_scale", "tool_offset"};
     static const rc_effect_kind kinds[] = {RC_EFF_LENGTH_OFFSET, RC_EFF_JOINT_COMPLIANCE, RC_EFF_JOINT_PERIODIC,
-                                           RC_EFF_TIME_DRIFT,    RC_EFF_GROUP_OFFSET,     RC_EFF_LENGTH_SCALE};
+                                           RC_EFF_TIME_DRIFT,    RC_EFF_GROUP_OFFSET,     RC_EFF_LENGTH_SCALE,
+                                           RC_EFF_TOOL_OFFSET};
     if (arr->type != RCH_JARR) {
         rch_diag_set(d, file, arr->line, arr->col, "\"effects\" must be an array");
         return -1;
@@ -77,7 +78,7 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
             return -1;
         }
         int k = -1;
-        for (int t = 0; t < 6; ++t)
+        for (int t = 0; t < (int)(sizeof kinds / sizeof kinds[0]); ++t)
             if (strcmp(kind->str, names[t]) == 0)
                 k = t;
         if (k < 0) {
