@@ -119,7 +119,9 @@ static rc_status sp_open_(void *ctx, const char *path, const rcd_serial_config *
         /* the library leaves port NULL on failure; free defensively */
         if (port)
             sp_free_port(port);
-        return fail(c, "find port", r, 0);
+        /* libserialport says SP_ERR_ARG when it knows no port of that name */
+        return fail(c, r == SP_ERR_ARG ? "find port (no such serial device, or not one libserialport handles)"
+                                       : "find port", r, 0);
     }
     r = sp_open(port, SP_MODE_READ_WRITE);
     if (r != SP_OK) {

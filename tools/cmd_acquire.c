@@ -584,8 +584,10 @@ int rcal_cmd_acquire(int argc, char **argv)
             fprintf(stderr, "rcal acquire: libserialport refuses pseudo-terminals: use --backend posix\n");
         goto out;
     }
-    if (rcd_display_init(&d, &p.port, &o.proto) != RC_OK)
+    if (rcd_display_init(&d, &p.port, &o.proto) != RC_OK) {
+        fprintf(stderr, "rcal acquire: invalid protocol settings\n");
         goto out;
+    }
     for (size_t i = 0; i < plan.n; ++i) {
         double q_deg[RC_NJ], mean = 0, spread = 0;
         if (done[i])
