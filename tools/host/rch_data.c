@@ -295,18 +295,6 @@ rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k)
     return o;
 }
 
-unsigned rch_data_group_by_wrist(rc_sample *s, size_t n)
-{
-    unsigned g = 0;
-    for (size_t i = 0; i < n; ++i) {
-        if (i > 0 && (s[i].q_rad[3] != s[i - 1].q_rad[3] || s[i].q_rad[4] != s[i - 1].q_rad[4] ||
-                      s[i].q_rad[5] != s[i - 1].q_rad[5]))
-            ++g;
-        s[i].group = (uint16_t)(g > 65535 ? 65535 : g);
-    }
-    return n ? g + 1 : 0;
-}
-
 int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nominal)
 {
     if (fprintf(f, "%sq1,q2,q3,q4,q5,q6,L\n", nominal ? "x,y,z," : "") < 0)

@@ -43,10 +43,6 @@ void rch_data_free(rch_data *data);
 /* Copy of the samples selected by idx (k). Returns NULL on allocation failure. */
 rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k);
 
-/* Assign set-up groups: consecutive samples whose wrist joints (q4, q5, q6)
- * stay the same share a group. Returns the number of groups. */
-unsigned rch_data_group_by_wrist(rc_sample *s, size_t n);
-
 /* Write samples as CSV: x,y,z (nominal FK at q when nominal is not NULL),
  * q1..q6 (deg, %.4f), L (mm, %.4f). Returns 0 or -1 (errno set). */
 int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nominal);
