@@ -212,12 +212,9 @@ static void test_ascii_acquire_calibrate(void **state)
     assert_int_equal(acquire(&s, "ascii", "ascii.csv", "--stable-mm 0.03"), 0);
     sim_stop(&s);
     check_file("ascii.csv", 0.01);
-    /* --method lm-paper: the default robust LM currently stops at iteration 0
-     * on this 40-pose plan (its noise-significance gate estimates sigma from
-     * the uncalibrated residual with 14 degrees of freedom and rejects every
-     * direction); reported to the solver's owner. */
+    /* the default method (robust LM) */
     assert_int_equal(run("%s calibrate --robot %s/data/irb120.json --data %s/ascii.csv --truth %s/truth.json "
-                         "--method lm-paper --test-fraction 0 --json >%s/calib.json 2>>%s/acquire.log",
+                         "--test-fraction 0 --json >%s/calib.json 2>>%s/acquire.log",
                          RCAL_EXE, RCAL_SOURCE_DIR, g_dir, g_dir, g_dir, g_dir), 0);
     snprintf(path, sizeof path, "%s/calib.json", g_dir);
     f = fopen(path, "r");
