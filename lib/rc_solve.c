@@ -329,8 +329,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         if (!(lmax > 0.0))
             return RC_ERR_RANK;
         unsigned rank = 0;
-        double gnorm = 0.0;
-        const double sigma2 = cost / (double)(n > nf ? n - nf : 1);
+        double gnorm = 0.0, gn_gain = 0.0;
         for (unsigned k = 0; k < nf; ++k) {
             if (w->ev[k] <= rcond * lmax)
                 break;
@@ -338,13 +337,21 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             double c = 0.0;
             for (unsigned i = 0; i < nf; ++i)
                 c += w->V[(size_t)i * nf + k] * w->g[i];
-            /* Significance: the Gauss-Newton step along v_k is -c/lambda with
-             * standard error sigma/sqrt(lambda); below snr_min standard errors
-             * the data cannot resolve it from noise, so it is not taken. */
-            if (snr_min > 0.0 && c * c < snr_min * snr_min * sigma2 * w->ev[k])
-                c = 0.0;
             w->c[k] = c;
-            gnorm += c * c;
+            gn_gain += c * c / w->ev[k];
+        }
+        /* Significance: the Gauss-Newton step along v_k is -c/lambda with
+         * standard error sigma/sqrt(lambda); below snr_min standard errors the
+         * data cannot resolve it from noise, so it is not taken. sigma^2 is
+         * the residual the full Gauss-Newton step predicts, per degree of
+         * freedom (the current residual would overstate it far from the
+         * solution and stop a small data set at its first iteration). */
+        const double resid = cost - gn_gain > 1e-12 * cost ? cost - gn_gain : 1e-12 * cost;
+        const double sigma2 = n > rank ? resid / (double)(n - rank) : 0.0;
+        for (unsigned k = 0; k < rank; ++k) {
+            if (snr_min > 0.0 && sigma2 > 0.0 && w->c[k] * w->c[k] < snr_min * snr_min * sigma2 * w->ev[k])
+                w->c[k] = 0.0;
+            gnorm += w->c[k] * w->c[k];
         }
         res->rank = rank;
         res->cond = sqrt(lmax / w->ev[rank - 1]);
