@@ -117,7 +117,7 @@ static void all_methods(const char *what, const rc_sample *s, size_t n, outcome 
 
 /* ---- data sets ---------------------------------------------------------- */
 
-enum { NS = 120 };
+enum { NS = 60 };
 static rc_sample S[NS];
 
 static void test_control_good_data(void **state)
