@@ -180,19 +180,36 @@ static double port_rate(rcd_protocol proto, unsigned baud, double seconds)
 int main(int argc, char **argv)
 {
     unsigned baud = 115200;
-    double seconds = 1.0, v[32];
+    double seconds = 1.0, v[32] = {0};
     int runs = 5;
     static const rcd_protocol protos[] = {RCD_PROTO_ASCII, RCD_PROTO_STX, RCD_PROTO_MODBUS};
     for (int i = 1; i + 1 < argc; i += 2) {
-        if (strcmp(argv[i], "--baud") == 0)
-            baud = (unsigned)atoi(argv[i + 1]);
-        else if (strcmp(argv[i], "--seconds") == 0)
-            seconds = atof(argv[i + 1]);
-        else if (strcmp(argv[i], "--runs") == 0)
-            runs = atoi(argv[i + 1]);
+        char *end = NULL;
+        if (strcmp(argv[i], "--baud") == 0) {
+            long b = strtol(argv[i + 1], &end, 10);
+            if (*end != '\0' || b <= 0 || b > 4000000) {
+                fprintf(stderr, "rcal_serial_bench: --baud: '%s' is not a baud rate\n", argv[i + 1]);
+                return 2;
+            }
+            baud = (unsigned)b;
+        } else if (strcmp(argv[i], "--seconds") == 0) {
+            seconds = strtod(argv[i + 1], &end);
+            if (*end != '\0' || !(seconds > 0.0) || seconds > 3600.0) {
+                fprintf(stderr, "rcal_serial_bench: --seconds: '%s' is not a duration in (0, 3600]\n", argv[i + 1]);
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--runs") == 0) {
+            long r = strtol(argv[i + 1], &end, 10);
+            if (*end != '\0' || r < 1 || r > 32) {
+                fprintf(stderr, "rcal_serial_bench: --runs: '%s' is not in 1..32\n", argv[i + 1]);
+                return 2;
+            }
+            runs = (int)r;
+        } else {
+            fprintf(stderr, "rcal_serial_bench: unknown option '%s'\n", argv[i]);
+            return 2;
+        }
     }
-    if (runs < 1 || runs > 32)
-        runs = 5;
     printf("parser alone (median of %d runs over 200000 frames):\n", runs);
     for (int k = 0; k < 3; ++k) {
         for (int r = 0; r < runs; ++r)
