@@ -268,13 +268,46 @@ static void sleep_ms(unsigned long ms)
 /* Scan an existing output: check its header, drop an unfinished last line
  * (a crash mid-write), mark the poses already recorded and check that their
  * joint angles are the plan's. Returns 0, or -1 with a message. */
+/* Saves the bytes [from, end of file) of f to "<path>.dropped" (appended),
+ * so that even the fragment of an interrupted write is never destroyed. */
+static int save_tail(FILE *f, const char *path, long from)
+{
+    char dpath[4096], buf[4096];
+    size_t n;
+    FILE *d;
+    snprintf(dpath, sizeof dpath, "%s.dropped", path);
+    if (fseek(f, from, SEEK_SET) != 0 || !(d = fopen(dpath, "a"))) {
+        fprintf(stderr, "rcal acquire: %s: cannot save the unfinished last line to %s: %s\n", path, dpath,
+                strerror(errno));
+        return -1;
+    }
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        if (fwrite(buf, 1, n, d) != n)
+            break;
+    if (ferror(f) || fclose(d) != 0) {
+        fprintf(stderr, "rcal acquire: %s: cannot save the unfinished last line to %s\n", path, dpath);
+        return -1;
+    }
+    fprintf(stderr, "rcal acquire: the dropped fragment is kept in %s\n", dpath);
+    return 0;
+}
+
+/* Reads an existing acquisition file before resuming. Lines are read with
+ * getline(), so a NUL byte (returned length != strlen) and lines of any
+ * length are seen for what they are. Only the last line of the file may lack
+ * its '\n' (an interrupted write): it is copied to "<out>.dropped" and cut
+ * off. Any damage before the end is refused with its line and column and the
+ * file is left untouched: acquired samples are never deleted. */
 static int scan_existing(const char *path, unsigned char *done, size_t n_poses,
                          double (*plan_deg)[RC_NJ], size_t *n_done)
 {
     FILE *f = fopen(path, "r+");
-    char line[1024];
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t got;
     long good_end = 0;
     unsigned lineno = 0;
+    int rc = 0, partial = 0;
     *n_done = 0;
     if (!f) {
         if (errno == ENOENT)
@@ -282,50 +315,67 @@ static int scan_existing(const char *path, unsigned char *done, size_t n_poses,
         fprintf(stderr, "rcal acquire: %s: %s\n", path, strerror(errno));
         return -1;
     }
-    while (fgets(line, sizeof line, f)) {
-        size_t len = strlen(line);
+    while ((got = getline(&line, &cap, f)) > 0) {
+        size_t len = (size_t)got, clen = strlen(line);
         unsigned long pose;
         double q[RC_NJ], L;
         ++lineno;
-        if (len == 0 || line[len - 1] != '\n') {
+        if (clen != len) {
+            fprintf(stderr, "rcal acquire: %s:%u:%zu: NUL byte: the file is damaged; repair it or choose another "
+                            "--out (nothing was changed)\n", path, lineno, clen + 1);
+            rc = -1;
+            break;
+        }
+        if (line[len - 1] != '\n') {
+            /* getline returns a line without '\n' only at the end of the file */
             fprintf(stderr, "rcal acquire: %s:%u: unfinished last line (interrupted write) dropped\n", path, lineno);
+            partial = 1;
             break;
         }
         if (lineno == 1) {
             if (strncmp(line, ACQ_HEADER, strlen(ACQ_HEADER)) != 0) {
                 fprintf(stderr, "rcal acquire: %s exists but is not an acquisition file (header '%s' expected); "
                                 "choose another --out\n", path, ACQ_HEADER);
-                fclose(f);
-                return -1;
+                rc = -1;
+                break;
             }
         } else if (len > 1) {
             if (sscanf(line, "%lu,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &pose, &q[0], &q[1], &q[2], &q[3], &q[4], &q[5], &L) != 8 ||
                 pose >= n_poses) {
                 fprintf(stderr, "rcal acquire: %s:%u: not a sample of this plan (%zu poses); choose another --out\n",
                         path, lineno, n_poses);
-                fclose(f);
-                return -1;
+                rc = -1;
+                break;
             }
-            for (int j = 0; j < RC_NJ; ++j)
+            for (int j = 0; j < RC_NJ && rc == 0; ++j)
                 if (fabs(q[j] - plan_deg[pose][j]) > 1e-3) {
                     fprintf(stderr, "rcal acquire: %s:%u: pose %lu has q%d = %.4f but the plan says %.4f: "
                                     "the file belongs to another plan\n", path, lineno, pose, j + 1, q[j], plan_deg[pose][j]);
-                    fclose(f);
-                    return -1;
+                    rc = -1;
                 }
+            if (rc != 0)
+                break;
             if (!done[pose])
                 ++*n_done;
             done[pose] = 1;
         }
         good_end = ftell(f);
     }
-    if (ftruncate(fileno(f), good_end) != 0) {
-        fprintf(stderr, "rcal acquire: %s: cannot truncate: %s\n", path, strerror(errno));
-        fclose(f);
-        return -1;
+    free(line);
+    if (rc == 0 && ferror(f)) {
+        fprintf(stderr, "rcal acquire: %s: read error: %s\n", path, strerror(errno));
+        rc = -1;
+    }
+    if (rc == 0 && partial) {
+        if (save_tail(f, path, good_end) != 0) {
+            rc = -1;
+        } else if (ftruncate(fileno(f), good_end) != 0) {
+            fprintf(stderr, "rcal acquire: %s: cannot truncate: %s\n", path, strerror(errno));
+            rc = -1;
+        }
     }
     fclose(f);
-    return 0;
+    return rc;
 }
 
 static int announce(const char *path, size_t pose, const double q_deg[RC_NJ])
