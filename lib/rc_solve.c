@@ -466,13 +466,27 @@ rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample 
         return RC_ERR_RANK;
     if (!(isfinite(b[0]) && isfinite(b[1]) && isfinite(b[2]) && isfinite(b[3])))
         return RC_ERR_NUMERIC;
-    /* The linearisation solves for e' and k = |e'|^2 independently: lengths
-     * that fit no sphere (a wild reading, a wrong column) make them
-     * disagree. */
-    const double ee = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-    if (!(fabs(b[3] - ee) <= 0.1 * fabs(b[3]) + 1.0))
+    /* Lengths that fit no sphere (a wild reading, a wrong column, a
+     * constant column) are refused: the RMS of |p_i - e| - L_i around the
+     * guessed outlet must stay below 15 % of the RMS length (+1 mm). The
+     * points are nominal, so a robot whose geometry is tens of mm off
+     * leaves a residual of that size (42 mm, 6.7 % of the RMS length, for
+     * a truth model 30-40 mm from nominal over the whole workspace); the
+     * guess only starts the fit. */
+    double e[3], res2 = 0.0, len2 = 0.0;
+    for (int r = 0; r < 3; ++r)
+        e[r] = b[r] + c[r];
+    for (size_t i = 0; i < n; ++i) {
+        double p[3];
+        rc_fk(p, NULL, m, samples[i].q_rad);
+        const double dx = p[0] - e[0], dy = p[1] - e[1], dz = p[2] - e[2];
+        const double d = sqrt(dx * dx + dy * dy + dz * dz) - samples[i].len_mm;
+        res2 += d * d;
+        len2 += samples[i].len_mm * samples[i].len_mm;
+    }
+    if (!(sqrt(res2) <= 0.15 * sqrt(len2) + sqrt((double)n)))
         return RC_ERR_RANGE;
     for (int r = 0; r < 3; ++r)
-        enc_mm[r] = b[r] + c[r];
+        enc_mm[r] = e[r];
     return RC_OK;
 }

@@ -140,7 +140,8 @@ rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, 
  * the measured lengths, by the linearisation |p|^2 - 2 p.e + |e|^2 = L^2
  * (linear least squares in e and |e|^2, 4 x 4 normal equations).
  * enc_mm: (3) output. RC_ERR_RANK when the points are (nearly) coplanar in
- * any orientation; RC_ERR_RANGE when the lengths fit no sphere (the solved
- * e' and |e'|^2 disagree by more than 10 %: a wild reading or wrong column). */
+ * any orientation; RC_ERR_RANGE when the lengths fit no sphere around the
+ * guessed e (RMS of |p_i - e| - L_i above 15 % of the RMS length + 1 mm: a
+ * wild reading, a wrong or constant column). */
 rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n);
 #endif /* RC_SOLVE_H */
