@@ -32,6 +32,8 @@
 #define M_PI 3.14159265358979323846
 #endif
 #define DEG (M_PI / 180.0)
+/* --bench --targets limit: 56 bytes per target (its q and its latency) */
+#define RT_MAX_TARGETS 10000000UL
 
 static void usage(FILE *f)
 {
@@ -215,11 +217,21 @@ static void print_stats(const char *label, const stats *s, int json)
 static int run_bench(const rc_model *cal, const rc_model *nom, const rc_comp_config *cfg, const targets *t,
                      size_t n, unsigned repeat, int cold, int json)
 {
+    if (n == 0 || repeat == 0) {
+        fprintf(stderr, "rcal-rt: empty benchmark\n");
+        return 1;
+    }
     double *lat = malloc(n * sizeof *lat);
     double *meds = malloc(repeat * sizeof *meds), *p4s = malloc(repeat * sizeof *p4s),
            *tps = malloc(repeat * sizeof *tps);
-    if (!lat || !meds || !p4s || !tps) {
+    double (*tq)[RC_NJ] = malloc(n * sizeof *tq);
+    if (!lat || !meds || !p4s || !tps || !tq) {
         fprintf(stderr, "rcal-rt: out of memory\n");
+        free(lat);
+        free(meds);
+        free(p4s);
+        free(tps);
+        free(tq);
         return 1;
     }
     unsigned long fails = 0, iters = 0;
@@ -227,11 +239,6 @@ static int run_bench(const rc_model *cal, const rc_model *nom, const rc_comp_con
         printf("rcal-rt bench: %zu targets per run, %u runs, one core, %s\n", n, repeat,
                cold ? "cold: every target solved from its own q (no warm start)"
                     : "stream: seeded with the last correction, targets 1 ms apart");
-    double (*tq)[RC_NJ] = malloc(n * sizeof *tq);
-    if (!tq) {
-        fprintf(stderr, "rcal-rt: out of memory\n");
-        return 1;
-    }
     for (size_t k = 0; k < n; ++k)
         get_target(tq[k], t, k, 1000.0);
     for (unsigned r = 0; r < repeat; ++r) {
@@ -293,9 +300,16 @@ static int run_loop(const rc_model *cal, const rc_model *nom, const rc_comp_conf
 {
     const size_t n = (size_t)(rate_hz * seconds + 0.5);
     const long period_ns = (long)(1e9 / rate_hz + 0.5);
+    if (n == 0) {
+        fprintf(stderr, "rcal-rt: empty run (--rate-hz times --seconds is less than one cycle)\n");
+        return 1;
+    }
     double *lat = malloc(n * sizeof *lat), *wake = malloc(n * sizeof *wake), *done = malloc(n * sizeof *done);
-    if (!lat || !wake || !done || n == 0) {
-        fprintf(stderr, "rcal-rt: out of memory or empty run\n");
+    if (!lat || !wake || !done) {
+        fprintf(stderr, "rcal-rt: out of memory\n");
+        free(lat);
+        free(wake);
+        free(done);
         return 1;
     }
     rc_comp_stream s;
@@ -315,8 +329,7 @@ static int run_loop(const rc_model *cal, const rc_model *nom, const rc_comp_conf
             next.tv_nsec -= 1000000000L;
             next.tv_sec++;
         }
-        int e;
-        while ((e = clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL)) == EINTR) {
+        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL) == EINTR) {
         }
         const double tk = (double)next.tv_sec * 1e9 + (double)next.tv_nsec;
         const double w = now_ns();
@@ -429,12 +442,47 @@ static int emit_c(const char *path, const char *nominal_path, int position_only)
     return 0;
 }
 
+/* Number options: the whole value must be a number (strtod/strtoul with end,
+ * ERANGE and finiteness checks), else a message naming the option and the
+ * value and -1 (main then exits 2, a usage error). Ranges are checked by main. */
+static int opt_double(const char *name, const char *v, double *out)
+{
+    char *end;
+    double x;
+    errno = 0;
+    x = strtod(v, &end);
+    if (end == v || *end != '\0' || errno != 0 || !isfinite(x)) {
+        fprintf(stderr, "rcal-rt: option %s: '%s' is not a number\n", name, v);
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
+static int opt_ulong(const char *name, const char *v, unsigned long *out)
+{
+    char *end;
+    unsigned long x;
+    errno = 0;
+    x = strtoul(v, &end, 10);
+    if (*v < '0' || *v > '9' || *end != '\0' || (errno != 0 && errno != ERANGE)) {
+        fprintf(stderr, "rcal-rt: option %s: '%s' is not a non-negative integer\n", name, v);
+        return -1;
+    }
+    if (errno == ERANGE) {
+        fprintf(stderr, "rcal-rt: option %s: '%s' is too large\n", name, v);
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *model_path = NULL, *nominal_path = NULL, *in_path = NULL, *emit = NULL;
     double rate_hz = 1000.0, seconds = 10.0;
-    unsigned long n_bench = 200000, repeat = 5;
-    int bench = 0, cold = 0, fifo = 0, json = 0, position_only = 0, cpu = -1;
+    unsigned long n_bench = 200000, repeat = 5, cpu = 0;
+    int bench = 0, cold = 0, fifo = 0, json = 0, position_only = 0, pin = 0;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const int has = i + 1 < argc;
@@ -446,17 +494,23 @@ int main(int argc, char **argv)
             in_path = argv[++i];
         else if (strcmp(a, "--emit-c") == 0 && has)
             emit = argv[++i];
-        else if (strcmp(a, "--rate-hz") == 0 && has)
-            rate_hz = atof(argv[++i]);
-        else if (strcmp(a, "--seconds") == 0 && has)
-            seconds = atof(argv[++i]);
-        else if (strcmp(a, "--targets") == 0 && has)
-            n_bench = strtoul(argv[++i], NULL, 10);
-        else if (strcmp(a, "--repeat") == 0 && has)
-            repeat = strtoul(argv[++i], NULL, 10);
-        else if (strcmp(a, "--cpu") == 0 && has)
-            cpu = atoi(argv[++i]);
-        else if (strcmp(a, "--bench") == 0)
+        else if (strcmp(a, "--rate-hz") == 0 && has) {
+            if (opt_double(a, argv[++i], &rate_hz) != 0)
+                return 2;
+        } else if (strcmp(a, "--seconds") == 0 && has) {
+            if (opt_double(a, argv[++i], &seconds) != 0)
+                return 2;
+        } else if (strcmp(a, "--targets") == 0 && has) {
+            if (opt_ulong(a, argv[++i], &n_bench) != 0)
+                return 2;
+        } else if (strcmp(a, "--repeat") == 0 && has) {
+            if (opt_ulong(a, argv[++i], &repeat) != 0)
+                return 2;
+        } else if (strcmp(a, "--cpu") == 0 && has) {
+            if (opt_ulong(a, argv[++i], &cpu) != 0)
+                return 2;
+            pin = 1;
+        } else if (strcmp(a, "--bench") == 0)
             bench = 1;
         else if (strcmp(a, "--cold") == 0)
             cold = 1;
@@ -477,8 +531,17 @@ int main(int argc, char **argv)
     if (emit)
         return emit_c(emit, nominal_path, position_only);
     if (!(rate_hz >= 1.0 && rate_hz <= 100000.0) || !(seconds > 0.0 && seconds <= 3600.0) || n_bench == 0 ||
-        repeat == 0 || repeat > 1000) {
-        fprintf(stderr, "rcal-rt: --rate-hz must be 1..100000, --seconds 0..3600, --targets and --repeat positive\n");
+        n_bench > RT_MAX_TARGETS || repeat == 0 || repeat > 1000) {
+        fprintf(stderr, "rcal-rt: --rate-hz must be 1..100000, --seconds 0..3600 (more than 0), --targets 1..%lu, "
+                        "--repeat 1..1000\n", (unsigned long)RT_MAX_TARGETS);
+        return 2;
+    }
+    if (!bench && rate_hz * seconds < 0.5) {
+        fprintf(stderr, "rcal-rt: --rate-hz times --seconds must be at least one cycle\n");
+        return 2;
+    }
+    if (pin && cpu >= (unsigned long)CPU_SETSIZE) {
+        fprintf(stderr, "rcal-rt: --cpu must be 0..%d\n", CPU_SETSIZE - 1);
         return 2;
     }
 
@@ -507,12 +570,12 @@ int main(int argc, char **argv)
     if (in_path && load_targets(&t, in_path, cal) != 0)
         return 1;
 
-    if (cpu >= 0) {
+    if (pin) {
         cpu_set_t set;
         CPU_ZERO(&set);
-        CPU_SET(cpu, &set);
+        CPU_SET((size_t)cpu, &set);
         if (sched_setaffinity(0, sizeof set, &set) != 0)
-            fprintf(stderr, "rcal-rt: note: cannot pin to CPU %d: %s\n", cpu, strerror(errno));
+            fprintf(stderr, "rcal-rt: note: cannot pin to CPU %lu: %s\n", cpu, strerror(errno));
     }
     if (fifo) {
         struct sched_param sp;

@@ -292,6 +292,43 @@ static int save_tail(FILE *f, const char *path, long from)
     return 0;
 }
 
+/* The leading columns of a sample line of an acquisition file,
+ * "pose,q1,..,q6,L" (further columns are not read): the pose a decimal index,
+ * the others finite numbers, read with strtoul/strtod and their end and
+ * ERANGE checks (the file comes from outside: an out-of-range number is
+ * refused, where sscanf's behaviour would be undefined). 0, or -1 when the
+ * line does not start with such a sample. */
+static int parse_sample(const char *line, unsigned long *pose, double q[RC_NJ], double *L)
+{
+    double v[RC_NJ + 1];
+    const char *p = line;
+    char *end;
+    if (*p < '0' || *p > '9')
+        return -1;
+    errno = 0;
+    *pose = strtoul(p, &end, 10);
+    if (errno != 0 || *end != ',')
+        return -1;
+    p = end + 1;
+    for (int k = 0; k <= RC_NJ; ++k) {
+        errno = 0;
+        v[k] = strtod(p, &end);
+        if (end == p || errno != 0 || !isfinite(v[k]))
+            return -1;
+        p = end;
+        if (k < RC_NJ) {
+            if (*p != ',')
+                return -1;
+            ++p;
+        } else if (*p != ',' && *p != '\n' && *p != '\r' && *p != '\0') {
+            return -1;
+        }
+    }
+    memcpy(q, v, RC_NJ * sizeof v[0]);
+    *L = v[RC_NJ];
+    return 0;
+}
+
 /* Reads an existing acquisition file before resuming. Lines are read with
  * getline(), so a NUL byte (returned length != strlen) and lines of any
  * length are seen for what they are. Only the last line of the file may lack
@@ -340,8 +377,7 @@ static int scan_existing(const char *path, unsigned char *done, size_t n_poses,
                 break;
             }
         } else if (len > 1) {
-            if (sscanf(line, "%lu,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &pose, &q[0], &q[1], &q[2], &q[3], &q[4], &q[5], &L) != 8 ||
-                pose >= n_poses) {
+            if (parse_sample(line, &pose, q, &L) != 0 || pose >= n_poses) {
                 fprintf(stderr, "rcal acquire: %s:%u: not a sample of this plan (%zu poses); choose another --out\n",
                         path, lineno, n_poses);
                 rc = -1;

@@ -54,8 +54,12 @@ int rcal_cmd_bench(int argc, char **argv)
     }
     rc_solve_work *w = malloc(sizeof *w);
     double *t_start = malloc(runs * sizeof *t_start), *t_solve = malloc(runs * sizeof *t_solve);
-    if (!w || !t_start || !t_solve)
-        return 1;
+    int rc = 0;
+    if (!w || !t_start || !t_solve) {
+        fprintf(stderr, "rcal bench: out of memory\n");
+        rc = 1;
+        goto done;
+    }
     static const rc_method methods[] = {RC_METHOD_LM, RC_METHOD_LTLM, RC_METHOD_LM_PAPER, RC_METHOD_LTLM_PAPER};
     double lm_median = 0.0;
     printf("rcal bench: %s, %zu samples, %lu runs per method, one core\n", data_path, data.n, runs);
@@ -68,7 +72,8 @@ int rcal_cmd_bench(int argc, char **argv)
             const double t0 = now_ms();
             if (rch_calib_start(&m, w, &robot, data.s, data.n, &d) != 0) {
                 fprintf(stderr, "rcal bench: %s\n", rch_diag_str(&d, msg, sizeof msg));
-                return 1;
+                rc = 1;
+                goto done;
             }
             const double t1 = now_ms();
             rc_solve_config cfg;
@@ -89,9 +94,10 @@ int rcal_cmd_bench(int argc, char **argv)
                t_start[runs / 2], med, t_solve[0], t_solve[runs - 1], res.iterations, res.rms_final_mm,
                lm_median > 0 ? med / lm_median : 1.0);
     }
+done:
     free(w);
     free(t_start);
     free(t_solve);
     rch_data_free(&data);
-    return 0;
+    return rc;
 }

@@ -107,9 +107,9 @@ static double observability(const rc_model *m, const rc_sample *c, const size_t 
 
 int rcal_cmd_poses(int argc, char **argv)
 {
-    const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL, *enc_str = NULL;
+    const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL;
     unsigned long n = 0, seed = 1, n_cand = 0, passes = 4;
-    double len_min = 250, len_max = 800, margin_deg = 5;
+    double len_min = 250, len_max = 800, margin_deg = 5, enc[3] = {250.0, -460.0, 10.0};
     rch_robot *robot = NULL;
     rch_diag dg;
     char dbuf[900];
@@ -124,7 +124,7 @@ int rcal_cmd_poses(int argc, char **argv)
 
     for (int i = 1; i < argc; ++i) {
         if (rcal_opt_str(argc, argv, &i, "--robot", &robot_path) || rcal_opt_str(argc, argv, &i, "--out", &out_path) ||
-            rcal_opt_str(argc, argv, &i, "--encoder", &enc_str) || rcal_opt_uint(argc, argv, &i, "--count", &n) ||
+            rcal_opt_triple(argc, argv, &i, "--encoder", enc) || rcal_opt_uint(argc, argv, &i, "--count", &n) ||
             rcal_opt_uint(argc, argv, &i, "--seed", &seed) || rcal_opt_uint(argc, argv, &i, "--candidates", &n_cand) ||
             rcal_opt_uint(argc, argv, &i, "--passes", &passes) ||
             rcal_opt_double(argc, argv, &i, "--len-min-mm", &len_min) ||
@@ -158,15 +158,8 @@ int rcal_cmd_poses(int argc, char **argv)
         fprintf(stderr, "rcal poses: %s\n", robot ? rch_diag_str(&dg, dbuf, sizeof dbuf) : "out of memory");
         goto done;
     }
-    if (!robot->has_encoder) {
-        double e[3] = {250.0, -460.0, 10.0};
-        if (enc_str && sscanf(enc_str, "%lf,%lf,%lf", &e[0], &e[1], &e[2]) != 3) {
-            fprintf(stderr, "rcal poses: --encoder wants X,Y,Z in mm, got '%s'\n", enc_str);
-            rc = 2;
-            goto done;
-        }
-        memcpy(&robot->model.x[RC_P_ENC], e, sizeof e);
-    }
+    if (!robot->has_encoder)
+        memcpy(&robot->model.x[RC_P_ENC], enc, sizeof enc);
     P = robot->model.n_params;
     cand = malloc(n_cand * sizeof *cand);
     G = malloc(n_cand * P * sizeof *G);

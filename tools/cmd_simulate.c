@@ -27,15 +27,15 @@ static void usage(FILE *f)
 
 int rcal_cmd_simulate(int argc, char **argv)
 {
-    const char *out_path = NULL, *truth_out = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *truth_path = NULL,
-               *enc_str = NULL;
+    const char *out_path = NULL, *truth_out = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *truth_path = NULL;
     unsigned long n = 500, seed = 1, group = 0;
+    double enc[3] = {250.0, -460.0, 10.0};
     rch_sim_config c;
     memset(&c, 0, sizeof c);
     for (int i = 1; i < argc; ++i) {
         if (rcal_opt_str(argc, argv, &i, "--out", &out_path) || rcal_opt_str(argc, argv, &i, "--truth-out", &truth_out) ||
             rcal_opt_str(argc, argv, &i, "--robot", &robot_path) || rcal_opt_str(argc, argv, &i, "--truth", &truth_path) ||
-            rcal_opt_str(argc, argv, &i, "--encoder", &enc_str) || rcal_opt_uint(argc, argv, &i, "--samples", &n) ||
+            rcal_opt_triple(argc, argv, &i, "--encoder", enc) || rcal_opt_uint(argc, argv, &i, "--samples", &n) ||
             rcal_opt_uint(argc, argv, &i, "--seed", &seed) || rcal_opt_uint(argc, argv, &i, "--group-size", &group) ||
             rcal_opt_double(argc, argv, &i, "--noise-mm", &c.noise_mm) ||
             rcal_opt_double(argc, argv, &i, "--resolution-mm", &c.resolution_mm) ||
@@ -53,11 +53,6 @@ int rcal_cmd_simulate(int argc, char **argv)
         return rcal_opt_missing("simulate", "--out");
     if (n < 1 || n > 10000000) {
         fprintf(stderr, "rcal simulate: --samples must be 1..10000000\n");
-        return 2;
-    }
-    double enc[3] = {250.0, -460.0, 10.0};
-    if (enc_str && sscanf(enc_str, "%lf,%lf,%lf", &enc[0], &enc[1], &enc[2]) != 3) {
-        fprintf(stderr, "rcal simulate: --encoder wants X,Y,Z in mm, got '%s'\n", enc_str);
         return 2;
     }
     c.group_size = (unsigned)group;

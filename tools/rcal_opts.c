@@ -56,6 +56,43 @@ int rcal_opt_uint(int argc, char **argv, int *i, const char *name, unsigned long
     return 1;
 }
 
+int rcal_parse_triple(const char *s, double out[3])
+{
+    double v[3];
+    const char *p = s;
+    for (int k = 0; k < 3; ++k) {
+        char *end;
+        errno = 0;
+        v[k] = strtod(p, &end);
+        if (end == p || errno != 0 || !isfinite(v[k]))
+            return -1;
+        p = end;
+        while (*p == ' ' || *p == '\t')
+            ++p;
+        if (k < 2) {
+            if (*p != ',')
+                return -1;
+            ++p;
+        }
+    }
+    if (*p != '\0')
+        return -1;
+    memcpy(out, v, sizeof v);
+    return 0;
+}
+
+int rcal_opt_triple(int argc, char **argv, int *i, const char *name, double out[3])
+{
+    const char *v = value_of(argc, argv, i, name);
+    if (!v)
+        return 0;
+    if (rcal_parse_triple(v, out) != 0) {
+        fprintf(stderr, "rcal: option %s: '%s' is not X,Y,Z (three finite numbers separated by commas)\n", name, v);
+        exit(2);
+    }
+    return 1;
+}
+
 int rcal_opt_unknown(const char *cmd, const char *arg)
 {
     fprintf(stderr, "rcal %s: unknown option '%s' (see rcal %s --help)\n", cmd, arg, cmd);

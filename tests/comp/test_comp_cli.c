@@ -18,6 +18,7 @@
 
 #define DEG (3.14159265358979323846 / 180.0)
 #define RCAL RCAL_BINARY_DIR "/tools/rcal"
+#define RCAL_RT RCAL_BINARY_DIR "/firmware_host/rcal-rt"
 
 static char dir[64];
 static char model_path[128];
@@ -213,10 +214,38 @@ static void test_bad_lines(void **state)
     assert_int_equal(run(cmd), 2);
 }
 
+/* rcal-rt refuses malformed or out-of-range number options with a message
+ * naming the option (exit 2), before it loads or runs anything. */
+static void test_rt_bad_numbers(void **state)
+{
+    static const char *const bad[] = {
+        "--rate-hz 1000x", "--rate-hz x",  "--seconds 1e999",    "--seconds nan",
+        "--repeat -1",     "--repeat 2.5", "--targets 99999999999999999999999", "--targets 20000000",
+        "--cpu abc",       "--cpu -1",     "--cpu 100000",       "--rate-hz 1 --seconds 0.1",
+    };
+    char cmd[512], err[128];
+    (void)state;
+    if (access(RCAL_RT, X_OK) != 0) {
+        print_message("SKIP: %s not built\n", RCAL_RT);
+        skip();
+    }
+    snprintf(err, sizeof err, "%s/rt.err", dir);
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        snprintf(cmd, sizeof cmd, "'%s' %s > /dev/null 2> '%s'", RCAL_RT, bad[k], err);
+        if (run(cmd) != 2)
+            fail_msg("rcal-rt %s: expected exit 2", bad[k]);
+        char opt[32];
+        snprintf(opt, sizeof opt, "%.*s", (int)strcspn(bad[k], " "), bad[k]);
+        if (!strstr(read_file(err), opt))
+            fail_msg("rcal-rt %s: the message does not name %s: %s", bad[k], opt, read_file(err));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_target_list_with_header),
+        cmocka_unit_test(test_rt_bad_numbers),
         cmocka_unit_test(test_stdin_plain),
         cmocka_unit_test(test_rapid_module),
         cmocka_unit_test(test_bad_lines),

@@ -330,10 +330,40 @@ static void test_poses_plan(void **state)
     assert_int_equal(rows, NPOSES);
 }
 
+/* rcal_simdisplay refuses a malformed or out-of-range number option with a
+ * message naming it (exit 2, before any pty is opened), and a --script file
+ * with a line that is not one finite number (exit 1, file:line). */
+static void test_simdisplay_bad_numbers(void **state)
+{
+    static const char *const bad[][2] = {
+        {"--value", "12x"},     {"--value", "1e999"},       {"--noise-mm", "-1"},  {"--decimals", "7"},
+        {"--decimals", "x"},    {"--rate-hz", "nan"},       {"--baud", "-9600"},   {"--mb-addr", "300"},
+        {"--mb-reg", "0x10000"}, {"--mb-decimals", "3.5"},  {"--drop", "2"},       {"--garbage", ""},
+        {"--reconnect-ms", "-5"}, {"--seed", "99999999999999999999999"},           {"--max-seconds", "inf"},
+    };
+    char path[512];
+    FILE *f;
+    (void)state;
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        if (run("%s --protocol ascii --value 500 %s '%s' >/dev/null 2>%s/sim_opt.err", SIMDISPLAY_EXE, bad[k][0],
+                bad[k][1], g_dir) != 2)
+            fail_msg("simdisplay %s '%s': expected exit 2", bad[k][0], bad[k][1]);
+        assert_int_equal(run("grep -q -e '%s' %s/sim_opt.err", bad[k][0], g_dir), 0);
+    }
+    snprintf(path, sizeof path, "%s/script.txt", g_dir);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("# mm\n500.1\n\n501.2x\n", f);
+    fclose(f);
+    assert_int_equal(run("%s --value 1 --script %s >/dev/null 2>%s/sim_opt.err", SIMDISPLAY_EXE, path, g_dir), 1);
+    assert_int_equal(run("grep -q 'script.txt:4: not a number' %s/sim_opt.err", g_dir), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_poses_plan),
+        cmocka_unit_test(test_simdisplay_bad_numbers),
         cmocka_unit_test(test_ascii_acquire_calibrate),
         cmocka_unit_test(test_stx_faults),
         cmocka_unit_test(test_modbus_resume_identical),

@@ -261,12 +261,42 @@ static void test_chaos(void **state)
     free(out);
 }
 
+/* --encoder X,Y,Z of rcal simulate and rcal poses (rcal_opt_triple): three
+ * finite numbers or exit 2 with a message naming the option; blanks around
+ * the numbers are fine. */
+static void test_encoder_option(void **state)
+{
+    static const char *const bad[] = {"1e999,0,0", "0,-1e999,0", "nan,0,0", "1,2",   "1,2,3,4",
+                                      "1,2,3x",    "1,,3",       "x,y,z",   "1;2;3", ""};
+    char cmd[512], *out = NULL;
+    (void)state;
+    if (!have_rcal())
+        skip();
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        snprintf(cmd, sizeof cmd, "'%s' simulate --encoder '%s' --samples 5 --out '%s/enc.csv' 2>&1", RCAL, bad[k],
+                 g_dir);
+        if (run(cmd, &out) != 2 || !strstr(out, "--encoder"))
+            fail_msg("simulate --encoder '%s': expected exit 2 and a message naming --encoder, got: %s", bad[k], out);
+        free(out);
+        snprintf(cmd, sizeof cmd, "'%s' poses --encoder '%s' --count 5 --out '%s/enc_poses.csv' 2>&1", RCAL, bad[k],
+                 g_dir);
+        if (run(cmd, &out) != 2 || !strstr(out, "--encoder"))
+            fail_msg("poses --encoder '%s': expected exit 2 and a message naming --encoder, got: %s", bad[k], out);
+        free(out);
+    }
+    snprintf(cmd, sizeof cmd, "'%s' simulate --encoder ' 250, -460 ,10 ' --samples 5 --out '%s/enc.csv' 2>&1", RCAL,
+             g_dir);
+    assert_int_equal(run(cmd, &out), 0);
+    free(out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_compare_json_and_plots),
         cmocka_unit_test(test_compare_human_and_errors),
         cmocka_unit_test(test_chaos),
+        cmocka_unit_test(test_encoder_option),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -129,12 +129,42 @@ static void test_unfinished_last_line_saved(void **state)
     assert_true(err_contains("unfinished last line"));
 }
 
+/* numbers out of range or not finite in a sample line (read with
+ * strtoul/strtod, not sscanf, for which they are undefined behaviour): the
+ * line is refused with its line number; nothing cut */
+static void test_out_of_range_numbers_refused(void **state)
+{
+    static const char *const bad[] = {
+        "1,1e999,0.0000,0.0000,0.0000,0.0000,0.0000,501.1000,0.0100,5,1700000000001\n",   /* q1 overflows */
+        "1,10.0000,0.0000,0.0000,0.0000,0.0000,0.0000,-1e400,0.0100,5,1700000000001\n",   /* L overflows */
+        "1,10.0000,0.0000,0.0000,0.0000,0.0000,nan,501.1000,0.0100,5,1700000000001\n",    /* q6 NaN */
+        "1,10.0000,0.0000,0.0000,0.0000,0.0000,0.0000,inf,0.0100,5,1700000000001\n",      /* L infinite */
+        "99999999999999999999999,10.0000,0.0000,0.0000,0.0000,0.0000,0.0000,501.1000\n", /* pose overflows */
+        "-1,10.0000,0.0000,0.0000,0.0000,0.0000,0.0000,501.1000,0.0100,5,1700000000001\n", /* negative pose */
+        "1,10.0000,0.0000,0.0000,0.0000,0.0000,0.0000,501.1x,0.0100,5,1700000000001\n",   /* text after L */
+    };
+    (void)state;
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        char data[1024];
+        int n = snprintf(data, sizeof data, "%s%s%s%s", HDR, S0, bad[k], S2);
+        assert_true(n > 0 && (size_t)n < sizeof data);
+        (void)mkdir(dir_, 0755);
+        write_file("data.csv", data, (size_t)n);
+        assert_int_not_equal(try_resume(), 0);
+        assert_int_equal(file_size("data.csv"), (long long)n);
+        if (!err_contains("data.csv:3: not a sample of this plan"))
+            fail_msg("case %zu (%s) not refused at line 3", k, bad[k]);
+        assert_int_equal(file_size("data.csv.dropped"), -1);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_nul_mid_file_refused),
         cmocka_unit_test(test_long_mid_line_refused),
         cmocka_unit_test(test_unfinished_last_line_saved),
+        cmocka_unit_test(test_out_of_range_numbers_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -45,6 +45,7 @@
  */
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <poll.h>
 #include <stdio.h>
@@ -58,6 +59,9 @@
 #include "rcd_proto.h"
 #include "rch_data.h"
 #include "rch_robot.h"
+
+/* longest delay an option may ask for: one day */
+#define SIM_MAX_MS 86400000UL
 
 typedef enum { SRC_CONST, SRC_SCRIPT, SRC_ROBOT } src_kind;
 
@@ -181,15 +185,27 @@ static void send_bytes(sim *s, const uint8_t *b, size_t n)
     }
 }
 
+/* The pose index at the start of the --follow file ("INDEX q1 .. q6"), or
+ * -1 when there is none yet or it is not a whole non-negative number (a file
+ * being replaced, or garbage: the display keeps its pose). */
 static long read_follow(const sim *s)
 {
     FILE *f;
-    long idx = -1;
+    char buf[64], *end;
+    long idx;
     if (!s->follow || !(f = fopen(s->follow, "r")))
         return -1;
-    if (fscanf(f, "%ld", &idx) != 1)
-        idx = -1;
+    if (!fgets(buf, sizeof buf, f)) {
+        fclose(f);
+        return -1;
+    }
     fclose(f);
+    if (buf[0] < '0' || buf[0] > '9')
+        return -1;
+    errno = 0;
+    idx = strtol(buf, &end, 10);
+    if (errno != 0 || (*end != '\0' && *end != ' ' && *end != '\t' && *end != '\r' && *end != '\n'))
+        return -1;
     return idx;
 }
 
@@ -321,22 +337,39 @@ static int load_script(sim *s, const char *path)
     FILE *f = fopen(path, "r");
     char line[256];
     size_t cap = 0;
+    unsigned lineno = 0;
     if (!f) {
         fprintf(stderr, "simdisplay: %s: %s\n", path, strerror(errno));
         return -1;
     }
     while (fgets(line, sizeof line, f)) {
-        char *end;
-        double v = strtod(line, &end);
-        if (end == line || line[0] == '#')
-            continue;
+        char *p = line, *end;
+        double v;
+        ++lineno;
+        while (*p == ' ' || *p == '\t')
+            ++p;
+        if (*p == '#' || *p == '\n' || *p == '\r' || *p == '\0')
+            continue; /* comment or blank line */
+        errno = 0;
+        v = strtod(p, &end);
+        while (*end == ' ' || *end == '\t' || *end == '\r' || *end == '\n')
+            ++end;
+        if (end == p || *end != '\0' || errno != 0 || !isfinite(v)) {
+            fprintf(stderr, "simdisplay: %s:%u: not a number (one value in mm per line, # for comments)\n", path,
+                    lineno);
+            fclose(f);
+            return -1;
+        }
         if (s->n_script == cap) {
+            double *ns;
             cap = cap ? 2 * cap : 64;
-            s->script = realloc(s->script, cap * sizeof *s->script);
-            if (!s->script) {
+            ns = realloc(s->script, cap * sizeof *s->script);
+            if (!ns) {
+                fprintf(stderr, "simdisplay: out of memory\n");
                 fclose(f);
                 return -1;
             }
+            s->script = ns;
         }
         s->script[s->n_script++] = v;
     }
@@ -370,6 +403,12 @@ static int load_robot(sim *s, const char *truth_path, const char *poses_path)
     }
     s->n_poses = d.n;
     s->pose_len = calloc(d.n ? d.n : 1, sizeof *s->pose_len);
+    if (!s->pose_len) {
+        fprintf(stderr, "simdisplay: out of memory\n");
+        rch_data_free(&d);
+        free(r);
+        return -1;
+    }
     for (size_t i = 0; i < d.n; ++i) {
         rc_sample smp = d.s[i];
         double l;
@@ -400,6 +439,64 @@ static void usage(FILE *f)
                "  Prints the pty path as the first line of stdout. See the comment of simdisplay.c.\n");
 }
 
+/* Number options: the whole value must be a number in [lo, hi] (strtod /
+ * strtoul / strtol with end, ERANGE and finiteness checks), else a message
+ * naming the option and the value and -1 (main then exits 2, a usage error). */
+static int opt_double(const char *name, const char *v, double lo, double hi, double *out)
+{
+    char *end;
+    double x;
+    errno = 0;
+    x = strtod(v, &end);
+    if (end == v || *end != '\0' || errno != 0 || !isfinite(x)) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is not a number\n", name, v);
+        return -1;
+    }
+    if (x < lo || x > hi) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is outside %g..%g\n", name, v, lo, hi);
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
+/* base 10, or 0 to also accept 0x.. (register numbers) */
+static int opt_ulong(const char *name, const char *v, int base, unsigned long hi, unsigned long *out)
+{
+    char *end;
+    unsigned long x;
+    errno = 0;
+    x = strtoul(v, &end, base);
+    if (*v < '0' || *v > '9' || *end != '\0' || (errno != 0 && errno != ERANGE)) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is not a non-negative integer\n", name, v);
+        return -1;
+    }
+    if (errno == ERANGE || x > hi) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is more than %lu\n", name, v, hi);
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
+static int opt_long(const char *name, const char *v, long lo, long hi, long *out)
+{
+    char *end;
+    long x;
+    errno = 0;
+    x = strtol(v, &end, 10);
+    if (end == v || *end != '\0' || (errno != 0 && errno != ERANGE)) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is not an integer\n", name, v);
+        return -1;
+    }
+    if (errno == ERANGE || x < lo || x > hi) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is outside %ld..%ld\n", name, v, lo, hi);
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     sim s;
@@ -408,7 +505,8 @@ int main(int argc, char **argv)
     uint8_t rq[512];
     size_t rq_len = 0;
     double t_start, next_frame;
-    int have_value = 0;
+    int have_value = 0, rc = 0;
+    unsigned long u;
     memset(&s, 0, sizeof s);
     s.decimals = 3;
     s.rate_hz = 20;
@@ -425,7 +523,8 @@ int main(int argc, char **argv)
                 return 2;
             }
         } else if (OPT("--value")) {
-            s.const_mm = atof(v);
+            if (opt_double(a, v, -1e9, 1e9, &s.const_mm) != 0)
+                return 2;
             have_value = 1;
         } else if (OPT("--script")) {
             script = v;
@@ -436,18 +535,23 @@ int main(int argc, char **argv)
         } else if (OPT("--follow")) {
             s.follow = v;
         } else if (OPT("--noise-mm")) {
-            s.noise_mm = atof(v);
+            if (opt_double(a, v, 0.0, 1e9, &s.noise_mm) != 0)
+                return 2;
         } else if (OPT("--decimals")) {
-            s.decimals = (unsigned)atoi(v);
+            if (opt_ulong(a, v, 10, 6, &u) != 0)
+                return 2;
+            s.decimals = (unsigned)u;
         } else if (OPT("--style")) {
             s.style = strcmp(v, "unit") == 0 ? RCD_STYLE_SPACE_UNIT : RCD_STYLE_ZERO_PAD;
         } else if (OPT("--unit")) {
             if (rcd_unit_from_name(&s.unit, v) != RC_OK)
                 return 2;
         } else if (OPT("--rate-hz")) {
-            s.rate_hz = atof(v);
+            if (opt_double(a, v, 0.0, 1e6, &s.rate_hz) != 0)
+                return 2;
         } else if (OPT("--baud")) {
-            s.baud = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, 100000000UL, &s.baud) != 0)
+                return 2;
         } else if (OPT("--poll-cmd")) {
             /* C escapes \r and \n are understood */
             size_t k = 0;
@@ -460,42 +564,60 @@ int main(int argc, char **argv)
                 }
             }
         } else if (OPT("--mb-addr")) {
-            s.pc.mb_addr = (uint8_t)atoi(v);
+            if (opt_ulong(a, v, 10, 247, &u) != 0)
+                return 2;
+            s.pc.mb_addr = (uint8_t)u;
         } else if (OPT("--mb-reg")) {
-            s.pc.mb_reg = (uint16_t)strtoul(v, NULL, 0);
+            if (opt_ulong(a, v, 0, 65535, &u) != 0)
+                return 2;
+            s.pc.mb_reg = (uint16_t)u;
         } else if (OPT("--mb-format")) {
             s.pc.mb_format = strcmp(v, "float") == 0 ? RCD_MB_FLOAT32 : RCD_MB_INT32;
         } else if (OPT("--mb-order")) {
             if (rcd_word_order_from_name(&s.pc.mb_order, v) != RC_OK)
                 return 2;
         } else if (OPT("--mb-decimals")) {
-            s.pc.mb_decimals = (uint8_t)atoi(v);
+            if (opt_ulong(a, v, 10, 9, &u) != 0)
+                return 2;
+            s.pc.mb_decimals = (uint8_t)u;
         } else if (OPT("--drop")) {
-            s.p_drop = atof(v);
+            if (opt_double(a, v, 0.0, 1.0, &s.p_drop) != 0)
+                return 2;
         } else if (OPT("--corrupt")) {
-            s.p_corrupt = atof(v);
+            if (opt_double(a, v, 0.0, 1.0, &s.p_corrupt) != 0)
+                return 2;
         } else if (OPT("--garbage")) {
-            s.p_garbage = atof(v);
+            if (opt_double(a, v, 0.0, 1.0, &s.p_garbage) != 0)
+                return 2;
         } else if (OPT("--silence-every")) {
-            s.silence_every = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, ULONG_MAX, &s.silence_every) != 0)
+                return 2;
         } else if (OPT("--silence-ms")) {
-            s.silence_ms = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, SIM_MAX_MS, &s.silence_ms) != 0)
+                return 2;
         } else if (OPT("--disconnect-after")) {
-            s.disconnect_after = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, ULONG_MAX - 1, &s.disconnect_after) != 0)
+                return 2;
         } else if (OPT("--reconnect-ms")) {
-            s.reconnect_ms = atol(v);
+            if (opt_long(a, v, -1, (long)SIM_MAX_MS, &s.reconnect_ms) != 0)
+                return 2;
         } else if (OPT("--settle-ms")) {
-            s.settle_ms = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, SIM_MAX_MS, &s.settle_ms) != 0)
+                return 2;
         } else if (OPT("--reply-delay-ms")) {
-            reply_delay_ms = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, SIM_MAX_MS, &reply_delay_ms) != 0)
+                return 2;
         } else if (OPT("--link")) {
             s.link = v;
         } else if (OPT("--seed")) {
-            seed = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, ULONG_MAX, &seed) != 0)
+                return 2;
         } else if (OPT("--exit-after-frames")) {
-            s.exit_after = strtoul(v, NULL, 10);
+            if (opt_ulong(a, v, 10, ULONG_MAX, &s.exit_after) != 0)
+                return 2;
         } else if (OPT("--max-seconds")) {
-            s.max_seconds = atof(v);
+            if (opt_double(a, v, 0.0, 1e9, &s.max_seconds) != 0)
+                return 2;
         } else if (strcmp(a, "--help") == 0) {
             usage(stdout);
             return 0;
@@ -509,28 +631,30 @@ int main(int argc, char **argv)
     rc_rng_seed(&s.rng, seed);
     if (script) {
         s.src = SRC_SCRIPT;
-        if (load_script(&s, script) != 0)
-            return 1;
+        if (load_script(&s, script) != 0) {
+            rc = 1;
+            goto out;
+        }
     } else if (truth || poses) {
         if (!truth || !poses) {
             fprintf(stderr, "simdisplay: --truth and --poses go together\n");
             return 2;
         }
         s.src = SRC_ROBOT;
-        if (load_robot(&s, truth, poses) != 0)
-            return 1;
+        if (load_robot(&s, truth, poses) != 0) {
+            rc = 1;
+            goto out;
+        }
     } else if (have_value) {
         s.src = SRC_CONST;
     } else {
         usage(stderr);
         return 2;
     }
-    if (s.decimals > 6) {
-        fprintf(stderr, "simdisplay: --decimals must be 0..6\n");
-        return 2;
+    if (open_pty(&s) != 0) {
+        rc = 1;
+        goto out;
     }
-    if (open_pty(&s) != 0)
-        return 1;
     t_start = now_s();
     next_frame = t_start;
     for (;;) {
@@ -546,8 +670,10 @@ int main(int argc, char **argv)
             s.disconnected = 0;
             s.disconnect_after = 0;
             rq_len = 0;
-            if (open_pty(&s) != 0)
-                return 1;
+            if (open_pty(&s) != 0) {
+                rc = 1;
+                break;
+            }
             continue;
         }
         if (s.pc.protocol == RCD_PROTO_ASCII) {
@@ -626,8 +752,9 @@ int main(int argc, char **argv)
         if (rq_len == sizeof rq)
             rq_len = 0;
     }
+out:
     close_pty(&s);
     free(s.script);
     free(s.pose_len);
-    return 0;
+    return rc;
 }
