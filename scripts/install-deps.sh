@@ -2,7 +2,13 @@
 # Install what is missing (Debian packages only). Root or sudo required.
 set -euo pipefail
 PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev libcmocka-dev
-      gcc-arm-none-eabi libnewlib-arm-none-eabi clang libclang-rt-14-dev cppcheck clang-tidy valgrind)
+      gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi clang libclang-rt-14-dev
+      cppcheck clang-tidy valgrind binutils)
+# --list: print the package list (.ci/run installs it with apt-get itself)
+if [ "${1:-}" = "--list" ]; then
+  echo "${PKGS[@]}"
+  exit 0
+fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
