@@ -36,6 +36,27 @@ rc_status rcu_chol_solve(double *A, double *b, unsigned n)
     return RC_OK;
 }
 
+/* Sort eigenpairs descending, moving eigenvector columns along. */
+static void sort_desc(double *eval, double *V, unsigned n)
+{
+    for (unsigned i = 0; i < n; ++i) {
+        unsigned best = i;
+        for (unsigned j = i + 1; j < n; ++j)
+            if (eval[j] > eval[best])
+                best = j;
+        if (best != i) {
+            const double t = eval[i];
+            eval[i] = eval[best];
+            eval[best] = t;
+            for (unsigned k = 0; k < n; ++k) {
+                const double v = V[k * n + i];
+                V[k * n + i] = V[k * n + best];
+                V[k * n + best] = v;
+            }
+        }
+    }
+}
+
 rc_status rcu_eig_sym_jacobi(double *eval, double *V, double *A, unsigned n, unsigned max_sweeps)
 {
     if (max_sweeps == 0)
@@ -87,46 +108,10 @@ rc_status rcu_eig_sym_jacobi(double *eval, double *V, double *A, unsigned n, uns
     }
     for (unsigned i = 0; i < n; ++i)
         eval[i] = A[i * n + i];
-    /* selection sort, descending, moving eigenvector columns along */
-    for (unsigned i = 0; i < n; ++i) {
-        unsigned best = i;
-        for (unsigned j = i + 1; j < n; ++j)
-            if (eval[j] > eval[best])
-                best = j;
-        if (best != i) {
-            const double t = eval[i];
-            eval[i] = eval[best];
-            eval[best] = t;
-            for (unsigned k = 0; k < n; ++k) {
-                const double v = V[k * n + i];
-                V[k * n + i] = V[k * n + best];
-                V[k * n + best] = v;
-            }
-        }
-    }
+    sort_desc(eval, V, n);
     return st;
 }
 
-/* Sort eigenpairs descending, moving eigenvector columns along. */
-static void sort_desc(double *eval, double *V, unsigned n)
-{
-    for (unsigned i = 0; i < n; ++i) {
-        unsigned best = i;
-        for (unsigned j = i + 1; j < n; ++j)
-            if (eval[j] > eval[best])
-                best = j;
-        if (best != i) {
-            const double t = eval[i];
-            eval[i] = eval[best];
-            eval[best] = t;
-            for (unsigned k = 0; k < n; ++k) {
-                const double v = V[k * n + i];
-                V[k * n + i] = V[k * n + best];
-                V[k * n + best] = v;
-            }
-        }
-    }
-}
 
 /* Householder reduction of the symmetric V (n x n) to tridiagonal form:
  * diagonal d, sub-diagonal e (e[0] = 0); V receives the transformation. */
