@@ -96,7 +96,7 @@ static void one_robot(tally *t, const rch_robot *nom, double noise_mm, size_t n,
     assert_int_equal(rc_solve(&fit, NULL, w, &cfg, s, n), RC_OK);
     rch_uncert u;
     char err[256];
-    assert_int_equal(rch_uncert_compute(&u, &fit, &start, NULL, s, n, 1, err, sizeof err), 0);
+    assert_int_equal(rch_uncert_compute(&u, &fit, NULL, s, n, grouped, err, sizeof err), 0);
     assert_int_equal(u.kind, grouped ? RCH_COV_CLUSTER : RCH_COV_CLASSICAL);
     for (unsigned k = 0; k < 27; ++k) {
         if (u.cls[k] != RCH_PARAM_IDENTIFIABLE || u.null_share[k] > 1e-6 || u.weak_share[k] > 1e-6)

@@ -28,8 +28,7 @@ const char *rch_param_class_name(rch_param_class c)
 void rch_uncert_free(rch_uncert *u)
 {
     free(u->cov);
-    free(u->proj);
-    u->cov = u->proj = NULL;
+    u->cov = NULL;
 }
 
 /* Scaled Jacobian (n x nf, row-major), residuals (n), column norms (nf). */
@@ -169,24 +168,13 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
     return 0;
 }
 
-/* Classes, standard errors, the parameter-space covariance and the
- * projector onto the determined directions. A direction is determined when
- * it is identifiable, or weak but its move from the start (dz, scaled) is
- * significant (at least 2 standard errors). */
-static void classify(rch_uncert *u, const scaled *z, const double *dz)
+/* Classes, standard errors and the parameter-space covariance. */
+static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
 {
     unsigned nf = z->nf, np = u->n_params;
     double emax = z->ev[nf - 1] > 0 ? z->ev[nf - 1] : 1.0;
-    uint8_t keep[RC_MAX_PARAMS];
     for (unsigned d = 0; d < nf; ++d) {
         double sv = sqrt(fmax(z->ev[d], 0.0) / emax);
-        double c = 0.0, var = 0.0;
-        for (unsigned a = 0; a < nf; ++a) {
-            c += z->V[a * nf + d] * dz[a];
-            for (unsigned b = 0; b < nf; ++b)
-                var += z->V[a * nf + d] * z->Cz[a * nf + b] * z->V[b * nf + d];
-        }
-        keep[d] = sv >= RCH_UNCERT_WEAK_SV || (sv >= RCH_UNCERT_NULL_SV && fabs(c) >= 2.0 * sqrt(var));
         for (unsigned a = 0; a < nf; ++a) {
             double w = z->V[a * nf + d] * z->V[a * nf + d];
             unsigned k = z->idx[a];
@@ -201,27 +189,24 @@ static void classify(rch_uncert *u, const scaled *z, const double *dz)
     for (unsigned a = 0; a < nf; ++a) {
         unsigned k = z->idx[a];
         double se = sqrt(fmax(z->Cz[a * nf + a], 0.0)) / z->D[a];
-        if (u->null_share[k] > 0.5) {
+        double tol = rc_param_unit(m, k) == 1 ? RCH_UNCERT_WEAK_RAD : RCH_UNCERT_WEAK_MM;
+        if (u->null_share[k] > RCH_UNCERT_SHARE) {
             u->cls[k] = RCH_PARAM_NOT_IDENTIFIABLE;
             u->se[k] = NAN;
         } else {
-            u->cls[k] = (u->null_share[k] + u->weak_share[k] > 0.5) ? RCH_PARAM_WEAK : RCH_PARAM_IDENTIFIABLE;
+            int weak = u->weak_share[k] > RCH_UNCERT_SHARE || (rc_param_unit(m, k) != 2 && se > tol);
+            u->cls[k] = weak ? RCH_PARAM_WEAK : RCH_PARAM_IDENTIFIABLE;
             u->se[k] = se;
         }
         for (unsigned b = 0; b < nf; ++b) {
             unsigned l = z->idx[b];
             u->cov[(size_t)k * np + l] = z->Cz[a * nf + b] / (z->D[a] * z->D[b]);
-            double p = 0.0;
-            for (unsigned d = 0; d < nf; ++d)
-                if (keep[d])
-                    p += z->V[a * nf + d] * z->V[b * nf + d];
-            u->proj[(size_t)k * np + l] = p / z->D[a] * z->D[b]; /* S^-1 P S */
         }
     }
 }
 
-int rch_uncert_compute(rch_uncert *u, const rc_model *m, const rc_model *start, const uint8_t *fixed,
-                       const rc_sample *s, size_t n, int want_cluster, char *err, size_t errlen)
+int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s, size_t n,
+                       int want_cluster, char *err, size_t errlen)
 {
     memset(u, 0, sizeof *u);
     u->n_params = m->n_params;
@@ -241,9 +226,8 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const rc_model *start, 
     z.V = calloc(nf * nf, sizeof *z.V);
     z.Cz = calloc(nf * nf, sizeof *z.Cz);
     u->cov = calloc(np * np, sizeof *u->cov);
-    u->proj = calloc(np * np, sizeof *u->proj);
     int rc = -1;
-    if (!J || !r || !A || !z.V || !z.Cz || !u->cov || !u->proj) {
+    if (!J || !r || !A || !z.V || !z.Cz || !u->cov) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
@@ -267,14 +251,7 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const rc_model *start, 
         snprintf(err, errlen, "out of memory");
         goto done;
     }
-    /* dz: the fit's move from the start in scaled coordinates (0 without a
-     * start: then only identifiable directions count as determined). */
-    double dz[RC_MAX_PARAMS] = {0};
-    for (unsigned a = 0; start && a < z.nf; ++a) {
-        unsigned k = z.idx[a];
-        dz[a] = z.D[a] * (m->x[k] - (k < start->n_params ? start->x[k] : 0.0));
-    }
-    classify(u, &z, dz);
+    classify(u, &z, m);
     rc = 0;
 done:
     free(J);
@@ -289,20 +266,10 @@ done:
 
 void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_uncert *u)
 {
-    unsigned np = u->n_params;
-    double dx[RC_MAX_PARAMS];
-    rc_model r = *fit;
-    for (unsigned k = 0; k < np; ++k)
-        dx[k] = fit->x[k] - (k < nominal->n_params ? nominal->x[k] : 0.0);
-    for (unsigned k = 0; k < np; ++k) {
-        if (u->cls[k] == RCH_PARAM_FIXED)
-            continue;
-        double v = 0.0;
-        for (unsigned l = 0; l < np; ++l)
-            v += u->proj[(size_t)k * np + l] * dx[l];
-        r.x[k] = (k < nominal->n_params ? nominal->x[k] : 0.0) + v;
-    }
-    *out = r;
+    *out = *fit;
+    for (unsigned k = 0; k < u->n_params && k < RC_P_ENC; ++k)
+        if (u->cls[k] == RCH_PARAM_WEAK || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE)
+            out->x[k] = nominal->x[k];
 }
 
 double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
@@ -363,6 +330,9 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
     for (size_t i = 0; i < n; ++i)
         v[i] = rch_uncert_pos95_mm(u, m, s[i].q_rad);
     med_max(&out->data_median_mm, &out->data_max_mm, v, n);
+    for (size_t i = 0; i < n; ++i)
+        v[i] = rch_uncert_rot95_deg(u, m, s[i].q_rad);
+    med_max(&out->rot_data_median_deg, &out->rot_data_max_deg, v, n);
     out->n_data = n;
     rc_rng g;
     rc_rng_seed(&g, seed);
@@ -376,4 +346,40 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
     out->n_work = n_random;
     free(v);
     return 0;
+}
+
+double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    unsigned np = u->n_params;
+    double Jr[3][RC_MAX_PARAMS];
+    rc_model t = *m;
+    for (unsigned k = 0; k < np; ++k) {
+        Jr[0][k] = Jr[1][k] = Jr[2][k] = 0.0;
+        if (u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE)
+            continue;
+        double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5, p[3], Rp[9], Rm[9];
+        t.x[k] = m->x[k] + h;
+        rc_fk(p, Rp, &t, q_rad);
+        t.x[k] = m->x[k] - h;
+        rc_fk(p, Rm, &t, q_rad);
+        t.x[k] = m->x[k];
+        /* small rotation Rp Rm^T ~ I + [w]x, w = 2 h dw/dx */
+        double D[9];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                D[i * 3 + j] = Rp[i * 3] * Rm[j * 3] + Rp[i * 3 + 1] * Rm[j * 3 + 1] + Rp[i * 3 + 2] * Rm[j * 3 + 2];
+        Jr[0][k] = 0.5 * (D[7] - D[5]) / (2.0 * h);
+        Jr[1][k] = 0.5 * (D[2] - D[6]) / (2.0 * h);
+        Jr[2][k] = 0.5 * (D[3] - D[1]) / (2.0 * h);
+    }
+    double C[9] = {0};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (unsigned k = 0; k < np; ++k)
+                for (unsigned l = 0; Jr[i][k] != 0.0 && l < np; ++l)
+                    C[i * 3 + j] += Jr[i][k] * u->cov[(size_t)k * np + l] * Jr[j][l];
+    double ev[3];
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
+        return NAN;
+    return sqrt(CHI2_3_95 * fmax(ev[2], 0.0)) * 57.29577951308232;
 }

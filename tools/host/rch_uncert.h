@@ -42,6 +42,14 @@ typedef enum { RCH_COV_CLASSICAL = 0, RCH_COV_CLUSTER = 1 } rch_cov_kind;
  * words and limits of the identifiability report. */
 #define RCH_UNCERT_NULL_SV 1e-6
 #define RCH_UNCERT_WEAK_SV 1e-3
+/* A parameter with more than this share of its (scaled) unit vector in
+ * not-identifiable directions is not identifiable on its own (only in
+ * combination); in weak directions, weak. */
+#define RCH_UNCERT_SHARE 0.01
+/* Also weak: a standard error above a typical DH error (0.1 mm, 0.1 deg):
+ * the data do not determine the parameter to the size of what it corrects. */
+#define RCH_UNCERT_WEAK_MM 0.1
+#define RCH_UNCERT_WEAK_RAD 1.7453292519943295e-3
 
 typedef struct rch_uncert {
     unsigned n_params;                /* of the model */
@@ -57,24 +65,20 @@ typedef struct rch_uncert {
     double null_share[RC_MAX_PARAMS]; /* (n_params) share in not-identifiable directions, 0..1 */
     double weak_share[RC_MAX_PARAMS]; /* (n_params) share in weak directions, 0..1 */
     double *cov;                      /* (n_params x n_params) heap, row-major; rows/cols of fixed params 0 */
-    double *proj;                     /* (n_params x n_params) heap: projector onto the identifiable,
-                                         non-weak subspace in parameter units (S^-1 P S) */
 } rch_uncert;
 
-/* Compute the covariance at m over the training samples (n). start (may be
- * NULL) is where the fit began (the nominal model): a weak direction along
- * which the fit moved by at least 2 standard errors counts as determined.
- * fixed (n_params, may be NULL) marks parameters held fixed. want_cluster: 1
- * uses the cluster-robust form when the groups allow it (else classical, and
- * kind says which was used). 0, or -1 (message in err[errlen]). */
-int rch_uncert_compute(rch_uncert *u, const rc_model *m, const rc_model *start, const uint8_t *fixed,
-                       const rc_sample *s, size_t n, int want_cluster, char *err, size_t errlen);
+/* Compute the covariance at m over the training samples (n). fixed
+ * (n_params, may be NULL) marks parameters held fixed. want_cluster: 1 uses
+ * the cluster-robust form when the groups allow it (else classical, and kind
+ * says which was used). 0, or -1 (message in err[errlen]). */
+int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s, size_t n,
+                       int want_cluster, char *err, size_t errlen);
 void rch_uncert_free(rch_uncert *u);
 
-/* The determined part of a calibration: out = nominal + P (fit - nominal),
- * P the projector onto identifiable, non-weak directions; the effects and
- * everything else of fit kept. Parameters of not-identifiable or weak
- * combinations go back to nominal. */
+/* The determined part of a calibration, for compensation: the fit with
+ * every DH parameter the data did not determine (weak or not identifiable)
+ * back at its nominal value. The encoder outlet and effects are kept (they
+ * do not move the robot). */
 void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_uncert *u);
 
 /* 95 % uncertainty of the flange position predicted at q: the longest
@@ -86,8 +90,13 @@ double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double 
 /* Summary over poses: the median and the largest pos95 over the samples'
  * poses (inside the data) and over n_random poses uniform in the joint
  * limits (whole workspace, seed). */
+/* The same for the flange orientation: longest semi-axis of the 95 %
+ * ellipsoid of the small-rotation vector, in degrees. */
+double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ]);
+
 typedef struct rch_uncert_map {
     double data_median_mm, data_max_mm;
+    double rot_data_median_deg, rot_data_max_deg; /* orientation, over the data's poses */
     double work_median_mm, work_max_mm;
     size_t n_data, n_work;
 } rch_uncert_map;
