@@ -20,8 +20,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rc_est.h"
 #include "rc_rand.h"
 #include "rc_solve.h"
+#include "rch_calib.h"
+#include "rch_data.h"
 #include "rch_robot.h"
 
 #define PI 3.14159265358979323846
@@ -491,6 +494,104 @@ static void test_robust_ltlm_null_direction(void **state)
     assert_true(res.rms_final_mm < 1e-3 * res.rms_start_mm);
 }
 
+/* The EKF on the real data: with the adaptive measurement noise the
+ * training RMS falls pass after pass and ends below the start; with R fixed
+ * at the encoder's quantization (the former default, R six orders of
+ * magnitude below the residual) it jumps about. */
+typedef struct passes {
+    double rms[32];
+    unsigned n;
+} passes;
+
+static void on_pass(void *ctx, unsigned it, double rms, const rc_model *m)
+{
+    passes *p = ctx;
+    (void)m;
+    assert_true(it == p->n + 1 && p->n < 32);
+    p->rms[p->n++] = rms;
+}
+
+static void run_ekf_real(passes *p, double *test_rms, rc_est_work *w, const rc_model *start, double alpha,
+                         double noise_mm, const rc_sample *tr, size_t ntr, const rc_sample *te, size_t nte)
+{
+    rc_est_config cfg;
+    rc_est_result res;
+    rc_metrics mt;
+    rc_model m = *start;
+    memset(&cfg, 0, sizeof cfg);
+    memset(p, 0, sizeof *p);
+    cfg.method = RC_EST_EKF;
+    cfg.ekf_alpha = alpha;
+    cfg.noise_mm = noise_mm;
+    cfg.on_iter = on_pass;
+    cfg.cb_ctx = p;
+    assert_int_equal(rc_est_solve(&m, &res, w, &cfg, tr, ntr), RC_OK);
+    assert_int_equal(rc_eval(&mt, &m, te, nte), RC_OK);
+    *test_rms = mt.rmse_mm;
+    assert_true(fabs(p->rms[p->n - 1] - res.rms_final_mm) < 1e-9);
+}
+
+static void test_ekf_real(void **state)
+{
+    FILE *f = fopen(RCAL_SHARED_DATA, "r");
+    rch_robot robot;
+    rch_data d;
+    rch_diag dg;
+    rc_model start;
+    passes fixed_r, adaptive;
+    double t_fixed, t_adapt, t0;
+    char line[512];
+    int k = 0;
+    (void)state;
+    if (!f) {
+        print_message("SKIP: %s is absent; real-data EKF not run\n", RCAL_SHARED_DATA);
+        skip();
+    }
+    fclose(f);
+    rc_est_work *w = calloc(1, sizeof *w);
+    assert_non_null(w);
+    assert_int_equal(rch_robot_load(&robot, RCAL_SOURCE_DIR "/data/irb120.json", &dg), 0);
+    assert_int_equal(rch_data_load(&d, RCAL_SHARED_DATA, 0, &dg), 0);
+    size_t *idx = malloc(d.n * sizeof *idx);
+    assert_non_null(idx);
+    rch_split(idx, d.n, 1);
+    const size_t nte = d.n / 10, ntr = d.n - nte;
+    rc_sample *te = rch_data_pick(d.s, idx, nte), *tr = rch_data_pick(d.s, idx + nte, ntr);
+    assert_non_null(te);
+    assert_non_null(tr);
+    assert_int_equal(rch_calib_start(&start, &W, &robot, tr, ntr, &dg), 0);
+    {
+        rc_metrics m0;
+        assert_int_equal(rc_eval(&m0, &start, te, nte), RC_OK);
+        t0 = m0.rmse_mm;
+    }
+    run_ekf_real(&fixed_r, &t_fixed, w, &start, 1.0, 0.004 / sqrt(12.0), tr, ntr, te, nte);
+    run_ekf_real(&adaptive, &t_adapt, w, &start, 0.0, 0.0, tr, ntr, te, nte);
+    for (unsigned i = 0; i < 2; ++i) {
+        const passes *p = i == 0 ? &fixed_r : &adaptive;
+        k = snprintf(line, sizeof line, "EKF %s, training RMS by pass (mm):", i == 0 ? "R fixed (quantization)" : "adaptive R");
+        for (unsigned j = 0; j < p->n && k > 0 && (size_t)k < sizeof line - 8; ++j)
+            k += snprintf(line + k, sizeof line - (size_t)k, " %.3f", p->rms[j]);
+        print_message("%s; held-out %.3f -> %.3f mm\n", line, t0, i == 0 ? t_fixed : t_adapt);
+    }
+    assert_true(adaptive.n >= 5);
+    for (unsigned j = 1; j < adaptive.n; ++j)
+        assert_true(adaptive.rms[j] <= adaptive.rms[j - 1] * (1.0 + 1e-9));
+    assert_true(adaptive.rms[adaptive.n - 1] < 0.8 * 2.64); /* from 2.64 mm at the start */
+    assert_true(t_adapt < t0);
+    {
+        unsigned rises = 0;
+        for (unsigned j = 1; j < fixed_r.n; ++j)
+            rises += fixed_r.rms[j] > fixed_r.rms[j - 1];
+        assert_true(rises > 0); /* the contrast this test documents */
+    }
+    free(te);
+    free(tr);
+    free(idx);
+    rch_data_free(&d);
+    free(w);
+}
+
 static void test_method_names(void **state)
 {
     static const rc_method all[] = {RC_METHOD_LM,       RC_METHOD_LTLM,         RC_METHOD_LM_PAPER,
@@ -515,6 +616,7 @@ int main(void)
         cmocka_unit_test(test_eq10),
         cmocka_unit_test(test_robust_ltlm),
         cmocka_unit_test(test_robust_ltlm_null_direction),
+        cmocka_unit_test(test_ekf_real),
         cmocka_unit_test(test_method_names),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
