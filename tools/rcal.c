@@ -23,6 +23,7 @@ static const rcal_command commands[] = {
     {"grind", rcal_cmd_grind, "grinding-path experiment: deviation with and without compensation"},
     {"diagnose", rcal_cmd_diagnose, "find the physical effect the model misses"},
     {"bench", rcal_cmd_bench, "benchmarks: calibration time, compensation latency, parser speed"},
+    {"export", rcal_cmd_export, "export a model as a URDF or a DH table in CSV"},
 };
 
 static void usage(FILE *f)
