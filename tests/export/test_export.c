@@ -387,6 +387,14 @@ static void test_names_from_nominal(void **state)
     assert_string_equal(n.flange_joint, "tool");
     assert_string_equal(n.flange_link, "tool0");
     assert_int_equal(n.n_dropped, 2); /* world_joint, sensor */
+    /* the same with a UTF-8 byte-order mark */
+    char *bom = malloc(strlen(good_urdf) + 4);
+    assert_non_null(bom);
+    memcpy(bom, "\xEF\xBB\xBF", 3);
+    strcpy(bom + 3, good_urdf);
+    assert_int_equal(rch_urdf_names_parse(&n, bom, strlen(bom), "bom.urdf", &d), 0);
+    assert_string_equal(n.joint[3], "j4");
+    free(bom);
 }
 
 static void expect_refused(const char *text, const char *needle)

@@ -536,6 +536,8 @@ int rch_urdf_names_parse(rch_urdf_names *n, const char *text, size_t len, const 
         rch_diag_set(d, file, 0, 0, "a NUL byte: not an XML text");
         goto done;
     }
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
+        x->i = 3; /* a UTF-8 byte-order mark */
     if (ux_document(x) == 0)
         rc = chain_names(n, x, file, d);
 done:
