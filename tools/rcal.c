@@ -24,6 +24,7 @@ static const rcal_command commands[] = {
     {"diagnose", rcal_cmd_diagnose, "find the physical effect the model misses"},
     {"evaluate", rcal_cmd_evaluate, "a calibrated model on new data, no refit; ISO 9283 distance figures"},
     {"bench", rcal_cmd_bench, "benchmarks: calibration time, compensation latency, parser speed"},
+    {"export", rcal_cmd_export, "export a model as a URDF or a DH table in CSV"},
 };
 
 static void usage(FILE *f)
