@@ -126,7 +126,7 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
                       const unsigned cols[RC_NJ], rch_diag *d)
 {
     double q[RC_NJ], qc[RC_NJ];
-    const rc_model *m = c->stream.cal;
+    const rc_kin *m = &c->stream.own[0];
     for (unsigned i = 0; i < RC_NJ; ++i) {
         q[i] = in_deg[i] * DEG;
         if (q[i] < m->q_min_rad[i] || q[i] > m->q_max_rad[i]) {
