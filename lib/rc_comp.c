@@ -147,8 +147,17 @@ static int step_solve(rc_real dq[RC_NJ], unsigned *mask, rc_real A[36], rc_real 
                     a += pt->J[6 * r + i] * pt->J[6 * r + k] * wr[r] * wr[r];
                 A[6 * i + k] = A[6 * k + i] = a;
             }
-            A[7 * i] += lam2;
         }
+        /* Damping at least 2^6 epsilons of the largest diagonal entry: the
+         * factorisation must succeed in the working precision (in double
+         * this floor is ~1e-9 (mm/rad)^2, far below lam2_min, so it only
+         * acts in float). */
+        rc_real dmax = RC_REAL_C(0.0);
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            dmax = rc_rfmax(dmax, A[7 * i]);
+        const rc_real lam2_eff = rc_rfmax(lam2, dmax * RC_REAL_EPS * RC_REAL_C(64.0));
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            A[7 * i] += lam2_eff;
         for (unsigned i = 0; i < RC_NJ; ++i) {
             if ((fixed & (1u << i)) == 0u)
                 continue;
@@ -226,6 +235,7 @@ static rc_status comp_solve(rc_real q_out[RC_NJ], rc_comp_result *res, rc_comp_w
                 break;
             cur->cost = cur->pos_err * cur->pos_err;
             no_descent = 0;
+            pushed = 0;
         }
         for (;;) {
             if (cur->pos_err <= pp->tol_mm && (!use_rot || cur->rot_err <= pp->tol_rad))
@@ -234,11 +244,12 @@ static rc_status comp_solve(rc_real q_out[RC_NJ], rc_comp_result *res, rc_comp_w
                 break;
             rc_real dq[RC_NJ] = {0};
             unsigned fmask = 0;
-            if (!step_solve(dq, &fmask, w->A, w->b, cur, lo, hi, pp, use_rot, lam2)) {
+            const int moved = step_solve(dq, &fmask, w->A, w->b, cur, lo, hi, pp, use_rot, lam2);
+            pushed |= fmask;
+            if (!moved) {
                 no_descent = 1;
                 break;
             }
-            pushed = fmask;
             for (unsigned i = 0; i < RC_NJ; ++i)
                 trial->q[i] = clampr(cur->q[i] + dq[i], lo[i], hi[i]);
             ++iters;
@@ -266,8 +277,9 @@ static rc_status comp_solve(rc_real q_out[RC_NJ], rc_comp_result *res, rc_comp_w
         res->exit = (!pp->want_rot || cur->rot_err <= pp->tol_rad) ? RC_COMP_CONVERGED : RC_COMP_POSITION_ONLY;
         return RC_OK;
     }
-    /* Name the cause: a bound that the last step pushed against and the
-     * joint still sits on, else the iteration limit or the damping. */
+    /* Name the cause: a bound that steps of the last phase pushed against
+     * and the joint still sits on (a joint limit first), else the iteration
+     * limit or the damping. */
     pushed &= res->bound_mask;
     if (pushed & res->limit_mask)
         res->exit = RC_COMP_JOINT_LIMIT;
