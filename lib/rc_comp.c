@@ -416,8 +416,12 @@ rc_status rc_comp_stream_step(rc_comp_stream *s, rc_real q_out_rad[RC_NJ], rc_co
     RC_ASSERT(s != NULL && q_out_rad != NULL && q_rad != NULL);
     if (res == NULL)
         res = &tmp;
+#if RC_COMP_STREAM_OWN_MODELS
     const rc_kin *cal = s->cal != NULL ? s->cal : &s->own[0];
     const rc_kin *nom = s->nom != NULL ? s->nom : &s->own[1];
+#else
+    const rc_kin *cal = s->cal, *nom = s->nom;
+#endif
     if (!within_limits(cal, q_rad)) {
         bad_input(q_out_rad, res, q_rad);
         return stream_fail(s, RC_ERR_RANGE);

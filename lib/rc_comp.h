@@ -206,7 +206,16 @@ rc_status rc_comp_joint(rc_real q_out_rad[RC_NJ], rc_comp_result *res, const rc_
  * differences of two readings taken less than a wrap apart, with unsigned
  * 32-bit subtraction (rc_comp_count_since), which is right across the wrap.
  * fail_run saturates at UINT32_MAX instead: a run of failures must never look
- * like a recovery. */
+ * like a recovery.
+ *
+ * RC_COMP_STREAM_OWN_MODELS (default 1) gives the stream room for two
+ * compiled models, used by rc_comp_stream_init; a firmware that only uses
+ * rc_comp_stream_init_kin on tables in flash sets it to 0 and saves
+ * 2 x sizeof(rc_kin) of RAM per stream (rc_comp_stream_init is then not
+ * defined). Library and callers must agree on it. */
+#ifndef RC_COMP_STREAM_OWN_MODELS
+#define RC_COMP_STREAM_OWN_MODELS 1
+#endif
 typedef struct rc_comp_stream {
     const rc_kin *cal;      /* calibrated model (referenced; NULL: own[0]) */
     const rc_kin *nom;      /* nominal model the targets were computed with (NULL: own[1]) */
@@ -218,7 +227,9 @@ typedef struct rc_comp_stream {
     uint32_t n_fail;        /* calls that did not (RC_ERR_NOCONV / RANGE / NUMERIC), modulo 2^32 */
     uint32_t fail_run;      /* consecutive failures up to now, saturating */
     rc_comp_work work;      /* scratch of the step */
+#if RC_COMP_STREAM_OWN_MODELS
     rc_kin own[2];          /* models compiled by rc_comp_stream_init (unused with _init_kin) */
+#endif
 } rc_comp_stream;
 
 /* Calls counted since an earlier reading `then` of the same counter, across
@@ -229,10 +240,12 @@ static inline uint32_t rc_comp_count_since(uint32_t now, uint32_t then) { return
  * flash). cfg may be NULL (defaults). Returns RC_OK. */
 rc_status rc_comp_stream_init_kin(rc_comp_stream *s, const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg);
 
+#if RC_COMP_STREAM_OWN_MODELS
 /* Stream over solver models, compiled into the stream (rc_comp_model.c).
  * cfg may be NULL. Returns RC_OK, or rc_kin_compile's error (then every step
  * returns RC_ERR_NUMERIC with q_out = q). */
 rc_status rc_comp_stream_init(rc_comp_stream *s, const rc_model *cal, const rc_model *nom, const rc_comp_config *cfg);
+#endif
 
 /* q_rad: (6) this cycle's nominal target; q_out_rad: (6) corrected target.
  * res may be NULL. Returns RC_OK, RC_ERR_NOCONV (q + last good dq), or

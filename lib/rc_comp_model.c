@@ -85,6 +85,7 @@ rc_status rc_comp_joint(rc_real q_out_rad[RC_NJ], rc_comp_result *res, const rc_
     return rc_comp_kin_joint(q_out_rad, res, &w, &kc, &kn, q_rad, seed_rad, cfg);
 }
 
+#if RC_COMP_STREAM_OWN_MODELS
 rc_status rc_comp_stream_init(rc_comp_stream *s, const rc_model *cal, const rc_model *nom, const rc_comp_config *cfg)
 {
     RC_ASSERT(s != NULL && cal != NULL && nom != NULL);
@@ -107,3 +108,4 @@ rc_status rc_comp_stream_init(rc_comp_stream *s, const rc_model *cal, const rc_m
     s->model_status = st;
     return st;
 }
+#endif
