@@ -27,6 +27,7 @@
 #include "rc_comp.h"
 #include "rch_diag.h"
 #include "rch_emit.h"
+#include "rch_opt.h"
 #include "rch_robot.h"
 
 #ifndef M_PI
@@ -406,38 +407,25 @@ static int emit_c(const char *path, const char *nominal_path, int position_only)
     return 0;
 }
 
-/* Number options: the whole value must be a number (strtod/strtoul with end,
- * ERANGE and finiteness checks), else a message naming the option and the
- * value and -1 (main then exits 2, a usage error). Ranges are checked by main. */
+/* Number options: the whole value must be a number (the strict readers of
+ * rch_opt.h: no blanks, no hex, finite, no wrap), else a message naming the
+ * option and the value and -1 (main then exits 2, a usage error). Ranges are
+ * checked by main. */
 static int opt_double(const char *name, const char *v, double *out)
 {
-    char *end;
-    double x;
-    errno = 0;
-    x = strtod(v, &end);
-    if (end == v || *end != '\0' || errno != 0 || !isfinite(x)) {
-        fprintf(stderr, "rcal-rt: option %s: '%s' is not a number\n", name, v);
+    if (rch_parse_double(v, out) != 0) {
+        fprintf(stderr, "rcal-rt: option %s: '%s' is not a finite decimal number\n", name, v);
         return -1;
     }
-    *out = x;
     return 0;
 }
 
 static int opt_ulong(const char *name, const char *v, unsigned long *out)
 {
-    char *end;
-    unsigned long x;
-    errno = 0;
-    x = strtoul(v, &end, 10);
-    if (*v < '0' || *v > '9' || *end != '\0' || (errno != 0 && errno != ERANGE)) {
-        fprintf(stderr, "rcal-rt: option %s: '%s' is not a non-negative integer\n", name, v);
+    if (rch_parse_ulong(v, out) != 0) {
+        fprintf(stderr, "rcal-rt: option %s: '%s' is not a non-negative integer that fits\n", name, v);
         return -1;
     }
-    if (errno == ERANGE) {
-        fprintf(stderr, "rcal-rt: option %s: '%s' is too large\n", name, v);
-        return -1;
-    }
-    *out = x;
     return 0;
 }
 

@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "rch_file.h"
+#include "rch_opt.h"
 #include "rch_robot.h"
 
 #ifndef M_PI
@@ -66,20 +67,16 @@ static int split_csv(const char *line, size_t n, size_t start[MAX_FIELDS], size_
     return k;
 }
 
-/* Parse a number occupying exactly text[0..len). */
+/* Parse a number occupying exactly text[0..len) (the strict reader of
+ * rch_opt.h: no blanks, no hex, finite). */
 static int parse_num(double *v, const char *text, size_t len)
 {
     char buf[64];
-    char *end;
     if (len == 0 || len >= sizeof buf)
         return -1;
     memcpy(buf, text, len);
     buf[len] = '\0';
-    errno = 0;
-    *v = strtod(buf, &end);
-    if (*end != '\0' || errno != 0 || !isfinite(*v))
-        return -1;
-    return 0;
+    return rch_parse_double(buf, v);
 }
 
 /* Compensate one target (degrees in, degrees out). 0 ok, 1 not converged
