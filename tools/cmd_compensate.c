@@ -44,15 +44,15 @@ int rcal_cmd_compensate(int argc, char **argv)
     if (ps != RCH_OPT_OK)
         return ps == RCH_OPT_HELP ? 0 : 2;
 
-    rch_comp_job job;
-    memset(&job, 0, sizeof job);
-    job.model_path = model;
-    job.nominal_path = nominal;
-    job.in_path = in;
-    job.out_path = out;
-    job.format = strcmp(format, "csv") == 0 ? RCH_COMP_CSV : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID : RCH_COMP_AUTO;
-    job.position_only = position_only;
-    job.max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0; /* 0: the core's 0.1 rad */
+    const rch_comp_job job = {
+        .model_path = model,
+        .nominal_path = nominal,
+        .in_path = in,
+        .out_path = out,
+        .format = strcmp(format, "csv") == 0 ? RCH_COMP_CSV : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID : RCH_COMP_AUTO,
+        .position_only = position_only,
+        .max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0, /* 0: the core's 0.1 rad */
+    };
     rch_comp_result r;
     rch_diag d;
     char msg[1024];

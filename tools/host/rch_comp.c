@@ -297,15 +297,8 @@ static int do_rapid(comp_ctx *c, const char *line, size_t n, unsigned lineno, rc
 int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
                    const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d)
 {
-    comp_ctx c;
-    memset(&c, 0, sizeof c);
-    c.stream = s;
-    c.cal = cal;
-    c.res = res;
-    c.out = out;
-    c.warn = warn;
-    c.in_name = in_name;
-    c.format = (int)format;
+    comp_ctx c = {.stream = s, .cal = cal, .res = res, .out = out, .warn = warn, .in_name = in_name,
+                  .format = (int)format};
     char *line = NULL;
     size_t cap = 0;
     ssize_t got;
