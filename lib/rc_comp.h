@@ -180,7 +180,11 @@ rc_status rc_comp_kin_joint(rc_real q_out_rad[RC_NJ], rc_comp_result *res, rc_co
 
 /* ---- the same on the solver model (rc_comp_model.c): compile, then solve ---- */
 
-/* As rc_comp_kin_pose on rc_kin_compile(m). A model that does not compile
+/* These two compile their models and keep the tables and the scratch on the
+ * stack (about 6 KB in double): host use. Where stack is scarce, compile
+ * once and call rc_comp_kin_* with a caller-owned rc_comp_work.
+ *
+ * As rc_comp_kin_pose on rc_kin_compile(m). A model that does not compile
  * (not finite) gives RC_ERR_NUMERIC with q_out = seed (RC_ERR_RANGE first
  * when the seed is bad). */
 rc_status rc_comp_pose(rc_real q_out_rad[RC_NJ], rc_comp_result *res, const rc_model *m, const rc_real pos_mm[3],

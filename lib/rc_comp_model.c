@@ -2,7 +2,8 @@
  * into an rc_kin (rc_kin_compile), then run the engine of rc_comp.c. Host
  * code calls these; firmware links generated rc_kin tables and the engine
  * alone. The single-call wrappers keep their compiled tables and scratch on
- * the stack (about 3 KB in double); the stream keeps them in itself. */
+ * the stack (about 6 KB in double: scripts/stack_usage.sh); the stream keeps
+ * them in itself. */
 #include "rc_comp.h"
 
 #include <math.h>
