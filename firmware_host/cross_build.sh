@@ -32,10 +32,12 @@ WARN="-std=c99 -Wall -Wextra -Werror -pedantic -Wconversion -Wdouble-promotion -
 OPT="-Os -ffunction-sections -fdata-sections"
 # Contract checks go to the firmware's fault handler (fw_port.h), not to
 # assert(), which would link fprintf.
-PORT="-include $ROOT/firmware_host/fw_port.h -I$ROOT/lib -I$ROOT/firmware_host"
+PORT="-include $ROOT/firmware_host/fw_port.h -I$ROOT/lib -I$OUT/include -I$ROOT/firmware_host"
 
 rm -rf "$OUT"
 mkdir -p "$OUT/obj"
+# rc_version.h: version and compile-time limits (RC_MAX_PARAMS ...)
+cmake -DRCAL_HEADER_DIR="$OUT/include" -P "$ROOT/cmake/rcal_version_header.cmake"
 echo "cross_build: $("$CC" --version | head -n 1)"
 echo "cross_build: flags $ARCH $WARN $OPT"
 objs=""

@@ -42,7 +42,8 @@ if [[ " $STEPS " == *" warnings "* ]]; then
     echo "== static: core warnings (-Wconversion -Wdouble-promotion -Wshadow ...)"
     WFLAGS=(-std=c99 -Wall -Wextra -Werror -pedantic -Wconversion -Wdouble-promotion -Wshadow
         -Wsign-conversion -Wundef -Wmissing-prototypes -Wstrict-prototypes -Wcast-align
-        -Wpointer-arith -Wwrite-strings -fsyntax-only -I lib)
+        -Wpointer-arith -Wwrite-strings -fsyntax-only -I lib -I "$BUILD_DIR/include")
+    cmake -DRCAL_HEADER_DIR="$BUILD_DIR/include" -P cmake/rcal_version_header.cmake || exit 1
     nw=0
     for cc in gcc clang; do
         if ! command -v $cc >/dev/null; then
