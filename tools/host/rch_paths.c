@@ -58,19 +58,29 @@ int rch_data_path(char *buf, size_t len, const char *file)
         return join(buf, len, env, file);
 
     int have_exe = exe_dir(dir) == 0;
+#if defined(RCH_BUILD_DIR) && defined(RCH_SOURCE_DATA_DIR)
+    int in_build_tree = have_exe && is_under(dir, RCH_BUILD_DIR);
+#else
+    (void)is_under;
+#endif
     char installed[PATH_MAX] = "";
     if (have_exe) {
         char data[PATH_MAX];
-        if (join(data, sizeof data, dir, RCH_BIN_TO_DATA) == 0 && join(installed, sizeof installed, data, file) == 0 &&
+        /* dir is canonical (the kernel's path of the program): each leading
+         * "../" of RCH_BIN_TO_DATA removes its last component. */
+        const char *rel = RCH_BIN_TO_DATA;
+        char *slash;
+        while (strncmp(rel, "../", 3) == 0 && (slash = strrchr(dir, '/')) != NULL && slash != dir) {
+            *slash = '\0';
+            rel += 3;
+        }
+        if (join(data, sizeof data, dir, rel) == 0 && join(installed, sizeof installed, data, file) == 0 &&
             access(installed, R_OK) == 0)
             return join(buf, len, data, file);
     }
 #if defined(RCH_BUILD_DIR) && defined(RCH_SOURCE_DATA_DIR)
-    if (have_exe && is_under(dir, RCH_BUILD_DIR) && join(cand, sizeof cand, RCH_SOURCE_DATA_DIR, file) == 0 &&
-        access(cand, R_OK) == 0)
+    if (in_build_tree && join(cand, sizeof cand, RCH_SOURCE_DATA_DIR, file) == 0 && access(cand, R_OK) == 0)
         return join(buf, len, RCH_SOURCE_DATA_DIR, file);
-#else
-    (void)is_under;
 #endif
     /* Not found: the installed place, or the bare name, for the message. */
     if (installed[0] != '\0' && strlen(installed) < len)
