@@ -4,7 +4,8 @@
 #  1. copy the tree as git sees it (tracked and new files, no build
 #     directories) to a temporary place, configure, build and
 #     `cmake --install` it into a temporary prefix (static libraries);
-#  2. build examples/consumer against the installed tree twice, with
+#  2. every installed header compiles on its own (C99, -pedantic);
+#     build examples/consumer against the installed tree twice, with
 #     find_package(rcal CONFIG) and with a plain cc + pkg-config command line,
 #     run both: they load irb120.json through the installed host library and
 #     must print the same cable length;
@@ -103,6 +104,15 @@ if build_install static; then
         include/rcal/rc_version.h include/rcal/rch_robot.h share/rcal/irb120.json share/doc/rcal/LICENSE; do
         [ -f "$WORK/static/$f" ] || bad "static: $f not installed"
     done
+    # every installed header compiles on its own (C99, -pedantic, -Werror)
+    nh=0
+    for h in "$WORK/static/include/rcal"/*.h; do
+        nh=$((nh + 1))
+        printf '#include "%s"\n' "$(basename "$h")" >"$WORK/header.c"
+        cc -std=c99 -Wall -Wextra -Werror -pedantic -fsyntax-only -I"$WORK/static/include/rcal" "$WORK/header.c" ||
+            bad "static: installed header $(basename "$h") does not compile on its own"
+    done
+    ok "static: $nh installed headers compile on their own"
     static_out=$(consumer_both static --static "") && cat "$WORK/consumer-static.out" &&
         ok "static: the two consumers print the same length"
 else
