@@ -38,7 +38,7 @@ OPT="-Os -ffunction-sections -fdata-sections"
 # Contract checks go to the firmware's fault handler (fw_port.h), not to
 # assert(), which would link fprintf; fw_port.h also leaves the models out of
 # the stream (RC_COMP_STREAM_OWN_MODELS=0: they are tables in flash).
-PORT="-include $ROOT/firmware_host/fw_port.h -I$ROOT/lib -I$ROOT/firmware_host"
+PORT="-include $ROOT/firmware_host/fw_port.h -I$ROOT/lib -I$OUT/include -I$ROOT/firmware_host"
 # The compensation path's objects (what a firmware links for compensation).
 COMP_OBJS="rc_kin.o rc_comp.o fw_example.o"
 FORBIDDEN='^_?(malloc|calloc|realloc|free|_malloc_r|_free_r|_sbrk|_sbrk_r|sbrk|printf|fprintf|sprintf|snprintf|vfprintf|_vfprintf_r|_svfprintf_r|iprintf|fiprintf|puts|fputs|fwrite|_fwrite_r|fopen|__assert_func)$'
@@ -46,6 +46,9 @@ FORBIDDEN='^_?(malloc|calloc|realloc|free|_malloc_r|_free_r|_sbrk|_sbrk_r|sbrk|p
 DOUBLE_SYMS='^(__aeabi_d[a-z0-9]*|__aeabi_f2d|__aeabi_[iu]l?2d|__aeabi_l2d|__aeabi_ul2d|__(add|sub|mul|div|neg|extendsf|truncdf|fix|float|fixuns|floatun|eq|ne|lt|le|gt|ge|unord)[a-z]*df[0-9a-z]*|sin|cos|tan|sqrt|atan2|atan|asin|acos|fabs|fmax|fmin|exp|log|pow|fmod|sincos|hypot|floor|ceil|round)$'
 
 rm -rf "$OUT"
+mkdir -p "$OUT/obj"
+# rc_version.h: version and compile-time limits (RC_MAX_PARAMS ...)
+cmake -DRCAL_HEADER_DIR="$OUT/include" -P "$ROOT/cmake/rcal_version_header.cmake"
 echo "cross_build: $("$CC" --version | head -n 1)"
 rc_all=0
 

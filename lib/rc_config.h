@@ -1,8 +1,8 @@
 /* rc_config.h - compile-time limits and contract checks of the rcal core.
  *
  * The core (lib/) is C99 with no heap, no stdio and no global state. Every
- * buffer is caller-owned and sized by the limits below, which a firmware build
- * may override with -D. Contract violations (a NULL where the API forbids it)
+ * buffer is caller-owned and sized by the limits below (from the generated
+ * rc_version.h). Contract violations (a NULL where the API forbids it)
  * go to RC_ASSERT, which a firmware build may redirect; runtime failures are
  * returned as rc_status codes (rc_status.h).
  */
@@ -16,12 +16,13 @@
 #define RC_N_ENC 3                        /* encoder outlet e (x, y, z) */
 #define RC_N_BASE (RC_N_DH + RC_N_ENC)    /* 27: geometry + encoder */
 
-/* Maximum number of model parameters: 27 base plus model extensions
- * (rc_model.h effects: length offset, joint compliance, periodic joint
- * errors, drift, per-group offsets). */
-#ifndef RC_MAX_PARAMS
-#define RC_MAX_PARAMS 96
-#endif
+/* Version and compile-time limits, generated at configure time and installed
+ * with the headers (cmake/rcal_version_header.cmake): RC_MAX_PARAMS, the
+ * maximum number of model parameters (27 base plus model extensions,
+ * rc_model.h effects), and RC_MAX_EFFECTS, the maximum number of model
+ * extensions. Set them with -DRCAL_MAX_PARAMS=n -DRCAL_MAX_EFFECTS=n when
+ * configuring; a -D of another value to the compiler is refused. */
+#include "rc_version.h"
 #if RC_MAX_PARAMS < RC_N_BASE
 #error "RC_MAX_PARAMS must be at least 27 (24 DH parameters + encoder position)"
 #endif
@@ -29,10 +30,6 @@
 #error "RC_MAX_PARAMS above 1024 makes the solver workspace unreasonably large"
 #endif
 
-/* Maximum number of model extensions (effects) in one model. */
-#ifndef RC_MAX_EFFECTS
-#define RC_MAX_EFFECTS 8
-#endif
 #if RC_MAX_EFFECTS < 1 || RC_MAX_EFFECTS > 64
 #error "RC_MAX_EFFECTS must be within 1..64"
 #endif

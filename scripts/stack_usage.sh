@@ -127,9 +127,10 @@ build() { # label cc flags...
     local dir="$OUT/$label"
     rm -rf "$dir"
     mkdir -p "$dir"
+    cmake -DRCAL_HEADER_DIR="$dir/include" -P "$ROOT/cmake/rcal_version_header.cmake" || return 1
     for f in "$ROOT"/lib/rc_*.c; do
         b=$(basename "$f" .c)
-        if ! (cd "$dir" && "$cc" $WARN "$@" -I"$ROOT/lib" -fstack-usage -fcallgraph-info=su -c "$f" -o "$b.o"); then
+        if ! (cd "$dir" && "$cc" $WARN "$@" -I"$ROOT/lib" -I"$dir/include" -fstack-usage -fcallgraph-info=su -c "$f" -o "$b.o"); then
             echo "stack_usage: $label: compile of $f failed"
             return 1
         fi
