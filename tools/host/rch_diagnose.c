@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "rc_ident.h"
 #include "rc_linalg.h"
 #include "rc_rand.h"
 
@@ -397,37 +398,26 @@ static int cv_run(rc_model *models, double *res, ctx *c)
     return 0;
 }
 
-/* Relative eigenvalue of the scaled normal matrix below which a direction
- * counts as not identifiable at all (singular value ratio 1e-6). */
-#define RANK_TOL 1e-12
-
-/* Rank of the column-scaled normal matrix of the first np parameters of m
- * over the samples: eigenvalues above tol_rel * largest. ev: scratch. */
-static unsigned rank_at(const rc_model *m, unsigned np, const rc_sample *s, size_t n, rc_solve_work *w,
-                        double tol_rel, int dump)
+/* Rank of the first np parameters of m over the samples: the number of
+ * directions rc_ident (the one definition of identifiability) does not call
+ * null. dump: print the relative singular values to stderr. */
+static unsigned rank_at(const rc_model *m, unsigned np, const rc_sample *s, size_t n, rc_solve_work *w, int dump)
 {
     double cost;
     for (unsigned i = 0; i < np; ++i)
         w->idx[i] = (uint16_t)i;
     if (rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, np, s, n) != RC_OK)
         return 0;
-    for (unsigned i = 0; i < np; ++i) {
-        const double a = w->A[(size_t)i * np + i];
-        w->D[i] = a > 0.0 ? sqrt(a) : 1.0;
-    }
-    for (unsigned i = 0; i < np; ++i)
-        for (unsigned k = 0; k < np; ++k)
-            w->A[(size_t)i * np + k] /= w->D[i] * w->D[k];
-    if (rcu_eig_sym(w->ev, w->V, w->A, np, 0) == RC_ERR_NUMERIC || !(w->ev[0] > 0.0))
+    double *work = malloc(rc_ident_work_size(np) * sizeof *work);
+    rc_ident id;
+    const rc_status st = work ? rc_ident_normal(&id, w->V, work, w->A, np, n) : RC_ERR_CAPACITY;
+    free(work);
+    if (st != RC_OK)
         return 0;
-    unsigned r = 0;
-    for (unsigned k = 0; k < np; ++k) {
-        if (dump)
-            fprintf(stderr, "  ev[%u] = %.3e\n", k, w->ev[k] / w->ev[0]);
-        if (w->ev[k] > tol_rel * w->ev[0])
-            ++r;
-    }
-    return r;
+    if (dump)
+        for (unsigned k = 0; k < np; ++k)
+            fprintf(stderr, "  sv_rel[%u] = %.3e\n", k, id.sv_rel[k]);
+    return id.rank;
 }
 
 /* Largest joint-side error that is still physical for a gear or joint
@@ -929,8 +919,8 @@ int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t 
                     continue;
                 }
                 {
-                    const unsigned ra = rank_at(full, full->n_params, out->s, n, c.w, RANK_TOL, cfg.verbose > 2);
-                    const unsigned rb = rank_at(full, base.n_params, out->s, n, c.w, RANK_TOL, 0);
+                    const unsigned ra = rank_at(full, full->n_params, out->s, n, c.w, cfg.verbose > 2);
+                    const unsigned rb = rank_at(full, base.n_params, out->s, n, c.w, 0);
                     ca->n_ident = ra > rb ? ra - rb : 0;
                 }
                 if (ca->n_ident > ca->n_params)

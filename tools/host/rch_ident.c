@@ -1,5 +1,7 @@
 #include "rch_ident.h"
 
+#include "rc_ident.h"
+
 #include <lapacke.h>
 #include <math.h>
 #include <stdio.h>
@@ -15,11 +17,28 @@ static int has(const double *v, const rc_model *m, const char *name, double thr)
     return 0;
 }
 
+/* v_a^2 + v_b^2 of the named parameters */
+static double share(const double *v, const rc_model *m, const char *a, const char *b)
+{
+    char buf[64];
+    double s = 0.0;
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        rc_param_name(buf, sizeof buf, m, k);
+        if (strcmp(buf, a) == 0 || strcmp(buf, b) == 0)
+            s += v[k] * v[k];
+    }
+    return s;
+}
+
 static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
 {
     const double t = 0.15;
     d->why[0] = '\0';
-    if (has(v, m, "alpha6", t) && !has(v, m, "theta6", t) && !has(v, m, "d6", t))
+    if (has(v, m, "alpha6", t) && has(v, m, "theta6", t) && share(v, m, "alpha6", "theta6") > 0.98)
+        snprintf(d->why, sizeof d->why,
+                 "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 "
+                 "is zero (both columns are zero, so any mix of them is null): cable lengths cannot see them");
+    else if (has(v, m, "alpha6", t) && !has(v, m, "theta6", t) && !has(v, m, "d6", t))
         snprintf(d->why, sizeof d->why,
                  "alpha6 turns the flange about its own x axis after the last translation: it never moves the "
                  "flange point, so cable lengths cannot see it");
@@ -57,9 +76,9 @@ int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, siz
         return -1;
     double *J = malloc(n * np * sizeof *J), *sv = malloc(np * sizeof *sv);
     double *vt = malloc((size_t)np * np * sizeof *vt), *norm = calloc(np, sizeof *norm);
-    double *sup = malloc(np * sizeof *sup);
+    double *sup = malloc(np * sizeof *sup), *V = malloc((size_t)np * np * sizeof *V);
     int rc = -1;
-    if (!J || !sv || !vt || !norm || !sup)
+    if (!J || !sv || !vt || !norm || !sup || !V)
         goto done;
     for (size_t i = 0; i < n; ++i) {
         double l;
@@ -68,36 +87,37 @@ int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, siz
         for (unsigned k = 0; k < np; ++k)
             norm[k] += J[i * np + k] * J[i * np + k];
     }
-    for (unsigned k = 0; k < np; ++k) {
-        norm[k] = norm[k] > 0.0 ? sqrt(norm[k]) : 1.0;
+    rc_ident_scale(sup, norm, np, 1); /* the one column-scaling rule */
+    for (unsigned k = 0; k < np; ++k)
         for (size_t i = 0; i < n; ++i)
-            J[i * np + k] /= norm[k];
-    }
+            J[i * np + k] = sup[k] > 0.0 ? J[i * np + k] / sup[k] : 0.0;
     if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'A', (lapack_int)n, (lapack_int)np, J, (lapack_int)np, sv, NULL, 1, vt,
                        (lapack_int)np, sup) != 0)
         goto done;
-    const double smax = sv[0] > 0.0 ? sv[0] : 1.0;
-    double logsum = 0.0;
+    /* the thresholds and figures: rc_ident, the one definition */
     unsigned limit = np < n ? np : (unsigned)n;
-    for (unsigned k = 0; k < np; ++k) {
-        out->sv_rel[k] = k < limit ? sv[k] / smax : 0.0;
-        if (out->sv_rel[k] >= 1e-6) {
-            ++out->rank;
-            logsum += log(sv[k]);
-            out->cond = smax / sv[k];
-            if (out->sv_rel[k] < 1e-3)
-                ++out->n_weak;
-        }
-    }
-    out->observability = out->rank ? exp(logsum / out->rank) / sqrt((double)n) : 0.0;
+    for (unsigned k = limit; k < np; ++k)
+        sv[k] = 0.0;
+    for (unsigned k = 0; k < np; ++k) /* V: direction k in column k */
+        for (unsigned i = 0; i < np; ++i)
+            V[(size_t)i * np + k] = vt[(size_t)k * np + i];
+    rc_ident id;
+    if (rc_ident_classify(&id, sv, V, np, n) != RC_OK)
+        goto done;
+    for (unsigned k = 0; k < np; ++k)
+        out->sv_rel[k] = id.sv_rel[k];
+    out->rank = id.rank;
+    out->n_weak = id.n_weak;
+    out->cond = id.cond;
+    out->observability = id.observability;
     /* describe the null and weak directions, weakest first */
     for (unsigned k = np; k-- > 0 && out->n_dirs < RCH_IDENT_MAX_DIRS;) {
-        if (out->sv_rel[k] >= 1e-3)
+        if (id.dir_class[k] == RC_IDENT_IDENTIFIABLE)
             break;
         rch_ident_dir *d = &out->dirs[out->n_dirs++];
         const double *v = &vt[(size_t)k * np];
         d->sv_rel = out->sv_rel[k];
-        d->weak = out->sv_rel[k] >= 1e-6;
+        d->weak = id.dir_class[k] == RC_IDENT_WEAK;
         size_t pos = 0;
         unsigned order[RC_MAX_PARAMS];
         for (unsigned i = 0; i < np; ++i)
@@ -128,5 +148,6 @@ done:
     free(vt);
     free(norm);
     free(sup);
+    free(V);
     return rc;
 }
