@@ -9,6 +9,8 @@
 #include "rc_ident.h"
 #include "rc_linalg.h"
 #include "rc_rand.h"
+#include "rch_data.h"
+#include "rch_robot.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -1127,6 +1129,22 @@ done:
     free(cand_folds);
     free(cand_full);
     free(cand_res);
+    return rc;
+}
+
+int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const char *robot_path,
+                      const rch_diagnose_cfg *cfg, rch_diag *d)
+{
+    memset(out, 0, sizeof *out);
+    rch_robot robot;
+    rch_data data;
+    if (rch_robot_load(&robot, robot_path, d) != 0 || rch_data_load(&data, data_path, 0, d) != 0)
+        return -1;
+    rch_diagnose_cfg c = *cfg;
+    c.groups_given = data.has_group;
+    c.have_encoder = robot.has_encoder;
+    const int rc = rch_diagnose_run(out, data.s, data.n, &robot.nominal, &c, d);
+    rch_data_free(&data);
     return rc;
 }
 
