@@ -11,6 +11,7 @@
 #include "rc_rand.h"
 #include "rch_calib.h"
 #include "rch_data.h"
+#include "rch_jw.h"
 #include "rch_robot.h"
 #include "rch_stats.h"
 
@@ -1335,137 +1336,109 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
     return ferror(f) ? -1 : 0;
 }
 
-static void json_str(FILE *f, const char *s)
+static void json_num(rch_jw *w, const char *key, double v)
 {
-    fputc('"', f);
-    for (; *s; ++s) {
-        if (*s == '"' || *s == '\\')
-            fprintf(f, "\\%c", *s);
-        else if ((unsigned char)*s < 0x20)
-            fprintf(f, "\\u%04x", (unsigned)(unsigned char)*s);
-        else
-            fputc(*s, f);
-    }
-    fputc('"', f);
+    rch_jw_numf(w, key, v, "%.6g");
 }
 
-static void json_num(FILE *f, double v)
+static void json_joint(rch_jw *w, unsigned joint)
 {
-    if (isfinite(v))
-        fprintf(f, "%.6g", v);
+    if (joint)
+        rch_jw_uint(w, "joint", joint);
     else
-        fprintf(f, "null");
+        rch_jw_null(w, "joint");
 }
 
-static void json_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
+static void json_tests(rch_jw *w, const char *key, const rch_diagnose_test *t, unsigned n)
 {
-    fprintf(f, "[");
+    rch_jw_arr(w, key);
     for (unsigned k = 0; k < n; ++k) {
-        fprintf(f, "%s{\"variable\":", k ? "," : "");
-        json_str(f, t[k].name);
-        fprintf(f, ",\"dof1\":%u,\"dof2\":%u,\"f\":", t[k].dof1, t[k].dof2);
-        json_num(f, t[k].f_stat);
-        fprintf(f, ",\"p\":");
-        json_num(f, t[k].p_value);
-        fprintf(f, ",\"r2\":");
-        json_num(f, t[k].r2);
-        fprintf(f, ",\"significant\":%s}", t[k].significant ? "true" : "false");
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "variable", t[k].name);
+        rch_jw_uint(w, "dof1", t[k].dof1);
+        rch_jw_uint(w, "dof2", t[k].dof2);
+        json_num(w, "f", t[k].f_stat);
+        json_num(w, "p", t[k].p_value);
+        json_num(w, "r2", t[k].r2);
+        rch_jw_bool(w, "significant", t[k].significant);
+        rch_jw_end(w);
     }
-    fprintf(f, "]");
+    rch_jw_end(w);
+}
+
+static void json_cands(rch_jw *w, const rch_diagnose_result *r)
+{
+    rch_jw_arr(w, "candidates");
+    for (unsigned s = 0; s < r->n_steps; ++s)
+        for (unsigned k = 0; k < r->steps[s].n_cand; ++k) {
+            const rch_diagnose_cand *ca = &r->steps[s].cand[k];
+            rch_jw_obj(w, NULL);
+            rch_jw_uint(w, "step", s + 1);
+            rch_jw_str(w, "effect", rc_effect_name(ca->kind));
+            json_joint(w, ca->joint);
+            rch_jw_uint(w, "params", ca->n_params);
+            rch_jw_uint(w, "identifiable", ca->n_ident);
+            rch_jw_bool(w, "tested", ca->tested);
+            if (ca->tested) {
+                json_num(w, "rmse_cv_mm", ca->rmse_cv_mm);
+                json_num(w, "gain_mm2", ca->gain_mm2);
+                json_num(w, "gain_se_mm2", ca->gain_se_mm2);
+                json_num(w, "z", ca->z);
+                json_num(w, "p", ca->p_value);
+            }
+            rch_jw_bool(w, "significant", ca->significant);
+            rch_jw_bool(w, "chosen", (int)k == r->steps[s].chosen);
+            rch_jw_str(w, "note", ca->note);
+            rch_jw_end(w);
+        }
+    rch_jw_end(w);
 }
 
 int rch_diagnose_json(FILE *f, const rch_diagnose_result *r)
 {
-    fprintf(f, "{\"effect\":");
-    json_str(f, r->effect);
-    fprintf(f, ",\"joint\":");
-    if (r->joint)
-        fprintf(f, "%u", r->joint);
-    else
-        fprintf(f, "null");
-    fprintf(f, ",\"rmse_before_mm\":");
-    json_num(f, r->rmse_before_mm);
-    fprintf(f, ",\"rmse_after_mm\":");
-    json_num(f, r->rmse_after_mm);
-    fprintf(f, ",\"noise_floor_mm\":");
-    json_num(f, r->noise_floor_mm);
-    fprintf(f, ",\"noise_floor_joints_mm\":");
-    json_num(f, r->floor_joints_mm);
-    fprintf(f, ",\"noise_floor_length_mm\":");
-    json_num(f, r->floor_len_mm);
-    fprintf(f, ",\"q_step_deg\":");
-    json_num(f, r->q_step_deg);
-    fprintf(f, ",\"len_step_mm\":");
-    json_num(f, r->len_step_mm);
-    fprintf(f, ",\"train_rmse_geometry_mm\":");
-    json_num(f, r->train_rmse_geo_mm);
-    fprintf(f, ",\"n\":%zu,\"groups\":%u,\"wrist_flicker_samples\":%u,\"folds\":%u,\"remaining\":", r->n,
-            r->n_groups, r->n_flicker, r->folds);
-    json_str(f, r->remaining);
-    fprintf(f, ",\"remaining_why\":");
-    json_str(f, r->remaining_why);
-    fprintf(f, ",\"sequence\":[");
-    for (unsigned s = 0, first = 1; s < r->n_steps; ++s)
-        if (r->steps[s].chosen >= 0) {
-            fprintf(f, "%s", first ? "" : ",");
-            json_str(f, r->steps[s].cand[r->steps[s].chosen].name);
-            first = 0;
-        }
-    fprintf(f, "],\"candidates\":[");
+    rch_jw w;
+    rch_jw_init(&w, f, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "effect", r->effect);
+    json_joint(&w, r->joint);
+    json_num(&w, "rmse_before_mm", r->rmse_before_mm);
+    json_num(&w, "rmse_after_mm", r->rmse_after_mm);
+    json_num(&w, "noise_floor_mm", r->noise_floor_mm);
+    json_num(&w, "noise_floor_joints_mm", r->floor_joints_mm);
+    json_num(&w, "noise_floor_length_mm", r->floor_len_mm);
+    json_num(&w, "q_step_deg", r->q_step_deg);
+    json_num(&w, "len_step_mm", r->len_step_mm);
+    json_num(&w, "train_rmse_geometry_mm", r->train_rmse_geo_mm);
+    rch_jw_uint(&w, "n", r->n);
+    rch_jw_uint(&w, "groups", r->n_groups);
+    rch_jw_uint(&w, "wrist_flicker_samples", r->n_flicker);
+    rch_jw_uint(&w, "folds", r->folds);
+    rch_jw_str(&w, "remaining", r->remaining);
+    rch_jw_str(&w, "remaining_why", r->remaining_why);
+    rch_jw_arr(&w, "sequence");
     for (unsigned s = 0; s < r->n_steps; ++s)
-        for (unsigned k = 0; k < r->steps[s].n_cand; ++k) {
-            const rch_diagnose_cand *ca = &r->steps[s].cand[k];
-            fprintf(f, "%s{\"step\":%u,\"effect\":", (s || k) ? "," : "", s + 1);
-            json_str(f, rc_effect_name(ca->kind));
-            fprintf(f, ",\"joint\":");
-            if (ca->joint)
-                fprintf(f, "%u", ca->joint);
-            else
-                fprintf(f, "null");
-            fprintf(f, ",\"params\":%u,\"identifiable\":%u,\"tested\":%s", ca->n_params, ca->n_ident,
-                    ca->tested ? "true" : "false");
-            if (ca->tested) {
-                fprintf(f, ",\"rmse_cv_mm\":");
-                json_num(f, ca->rmse_cv_mm);
-                fprintf(f, ",\"gain_mm2\":");
-                json_num(f, ca->gain_mm2);
-                fprintf(f, ",\"gain_se_mm2\":");
-                json_num(f, ca->gain_se_mm2);
-                fprintf(f, ",\"z\":");
-                json_num(f, ca->z);
-                fprintf(f, ",\"p\":");
-                json_num(f, ca->p_value);
-            }
-            fprintf(f, ",\"significant\":%s,\"chosen\":%s,\"note\":", ca->significant ? "true" : "false",
-                    (int)k == r->steps[s].chosen ? "true" : "false");
-            json_str(f, ca->note);
-            fprintf(f, "}");
-        }
-    fprintf(f, "],\"params\":[");
+        if (r->steps[s].chosen >= 0)
+            rch_jw_str(&w, NULL, r->steps[s].cand[r->steps[s].chosen].name);
+    rch_jw_end(&w);
+    json_cands(&w, r);
+    rch_jw_arr(&w, "params");
     for (unsigned k = 0; k < r->n_params; ++k) {
-        fprintf(f, "%s{\"name\":", k ? "," : "");
-        json_str(f, r->params[k].name);
-        fprintf(f, ",\"value\":");
-        json_num(f, r->params[k].value);
-        fprintf(f, ",\"se\":");
-        json_num(f, r->params[k].se);
-        fprintf(f, ",\"unit\":");
-        json_str(f, r->params[k].unit);
-        fprintf(f, "}");
+        rch_jw_obj(&w, NULL);
+        rch_jw_str(&w, "name", r->params[k].name);
+        json_num(&w, "value", r->params[k].value);
+        json_num(&w, "se", r->params[k].se);
+        rch_jw_str(&w, "unit", r->params[k].unit);
+        rch_jw_end(&w);
     }
-    fprintf(f, "],\"effect_rms_mm\":");
-    json_num(f, r->effect_rms_mm);
-    fprintf(f, ",\"structure_before\":");
-    json_tests(f, r->before, r->n_tests);
-    fprintf(f, ",\"structure_after\":");
-    json_tests(f, r->after, r->n_tests);
-    fprintf(f, ",\"not_identifiable\":[");
-    for (unsigned k = 0; k < r->n_notes; ++k) {
-        fprintf(f, "%s", k ? "," : "");
-        json_str(f, r->notes[k]);
-    }
-    fprintf(f, "],\"time_ms\":");
-    json_num(f, r->time_ms);
-    fprintf(f, "}\n");
-    return ferror(f) ? -1 : 0;
+    rch_jw_end(&w);
+    json_num(&w, "effect_rms_mm", r->effect_rms_mm);
+    json_tests(&w, "structure_before", r->before, r->n_tests);
+    json_tests(&w, "structure_after", r->after, r->n_tests);
+    rch_jw_arr(&w, "not_identifiable");
+    for (unsigned k = 0; k < r->n_notes; ++k)
+        rch_jw_str(&w, NULL, r->notes[k]);
+    rch_jw_end(&w);
+    json_num(&w, "time_ms", r->time_ms);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
 }
