@@ -14,24 +14,13 @@
 /* Write the calibrated model to out_path (never over an input), after the fit. */
 static int write_model(const rch_calib_result *r, const char *out_path, int quiet)
 {
-    const char *inputs[3] = {r->cfg.data_path, r->cfg.robot_path, r->cfg.truth_path};
-    rch_out o;
     rch_diag d;
     char msg[1024];
     if (!r->finite) {
         fprintf(stderr, "rcal calibrate: not writing %s: the model is not finite\n", out_path);
         return 0;
     }
-    if (rch_out_open(&o, out_path, "--out", inputs, 3, &d) != 0) {
-        fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return -1;
-    }
-    if (rch_calib_write_model(o.f, r) != 0) {
-        rch_out_abort(&o);
-        fprintf(stderr, "rcal calibrate: cannot write %s\n", out_path);
-        return -1;
-    }
-    if (rch_out_commit(&o, &d) != 0) {
+    if (rch_calib_save_model(r, out_path, &d) != 0) {
         fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return -1;
     }

@@ -6,34 +6,8 @@
 
 #include "rcal_cmds.h"
 #include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
-#include "rch_data.h"
-#include "rch_file.h"
 #include "rch_opt.h"
 #include "rch_sim.h"
-
-/* One output: refuses an input, written whole or not at all. */
-static int write_out(const char *path, const char *what, const char *const *inputs, size_t n_inputs,
-                     const rch_sim_set *set, int truth)
-{
-    rch_out o;
-    rch_diag d;
-    char msg[1024];
-    if (rch_out_open(&o, path, what, inputs, n_inputs, &d) != 0) {
-        fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return -1;
-    }
-    const int w = truth ? rch_sim_write_truth(o.f, set) : rch_data_write(o.f, set->s, set->n, &set->robot.nominal);
-    if (w != 0) {
-        rch_out_abort(&o);
-        fprintf(stderr, "rcal simulate: cannot write %s\n", path);
-        return -1;
-    }
-    if (rch_out_commit(&o, &d) != 0) {
-        fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return -1;
-    }
-    return 0;
-}
 
 int rcal_cmd_simulate(int argc, char **argv)
 {
@@ -87,13 +61,12 @@ int rcal_cmd_simulate(int argc, char **argv)
         fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
-    const char *inputs[3] = {job.robot_path, job.truth_path, out_path}; /* the truth never over the data */
-    int rc = write_out(out_path, "--out", inputs, 2, &set, 0);
-    if (rc == 0 && truth_out)
-        rc = write_out(truth_out, "--truth-out", inputs, 3, &set, 1);
+    const int rc = rch_sim_save(&set, &job, out_path, truth_out, &d);
     rch_sim_set_free(&set);
-    if (rc != 0)
+    if (rc != 0) {
+        fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
+    }
     printf("rcal simulate: %lu samples written to %s%s%s\n", n, out_path, truth_out ? ", truth to " : "",
            truth_out ? truth_out : "");
     return 0;

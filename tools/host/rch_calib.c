@@ -8,6 +8,7 @@
 
 #include "rch_data.h"
 #include "rch_jw.h"
+#include "rch_save.h"
 #include "rch_sim.h"
 #include "rch_stats.h"
 
@@ -377,6 +378,17 @@ int rch_calib_write_model(FILE *f, const rch_calib_result *r)
         return -1;
     const rch_robot_info info = {calib_info, r};
     return rch_robot_write(f, r->robot.name, &r->model, &r->robot.nominal, &info);
+}
+
+static int write_model_fn(FILE *f, const void *ctx)
+{
+    return rch_calib_write_model(f, ctx);
+}
+
+int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
+{
+    const char *inputs[3] = {r->cfg.data_path, r->cfg.robot_path, r->cfg.truth_path};
+    return rch_save(path, "--out", inputs, 3, write_model_fn, r, d);
 }
 
 /* ------------------------------------------------------------ fkcheck */

@@ -98,6 +98,9 @@ int rch_calib_json(FILE *f, const rch_calib_result *r);
 /* The calibrated model file (rcal-model/1) with a "calibration" member.
  * -1 when the model is not finite or on a write error. */
 int rch_calib_write_model(FILE *f, const rch_calib_result *r);
+/* rch_calib_write_model into path, whole or not at all (rch_save), never over
+ * one of the inputs (--data, --robot, --truth). 0, or -1 with d set. */
+int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d);
 
 /* rcal fkcheck: the nominal FK at each row's joint angles against the row's
  * x, y, z columns. A row further than tol_mm is explained by the display

@@ -4,6 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_data.h"
+#include "rch_file.h"
+#include "rch_save.h"
 #include "rch_stats.h"
 
 #ifndef M_PI
@@ -214,4 +217,28 @@ int rch_sim_write_truth(FILE *f, const rch_sim_set *set)
 {
     const rch_robot_info info = {sim_info, set};
     return rch_robot_write(f, "simulated truth", &set->truth, &set->robot.nominal, &info);
+}
+
+static int write_csv_fn(FILE *f, const void *ctx)
+{
+    const rch_sim_set *set = ctx;
+    return rch_data_write(f, set->s, set->n, &set->robot.nominal);
+}
+
+static int write_truth_fn(FILE *f, const void *ctx)
+{
+    return rch_sim_write_truth(f, ctx);
+}
+
+int rch_sim_save(const rch_sim_set *set, const rch_sim_job *job, const char *out_path, const char *truth_out,
+                 rch_diag *d)
+{
+    const char *inputs[3] = {job->robot_path, job->truth_path, out_path};
+    if (truth_out && (strcmp(truth_out, out_path) == 0 || rch_same_file(truth_out, out_path))) {
+        rch_diag_set(d, "", 0, 0, "--truth-out %s is also --out: refused, nothing written", truth_out);
+        return -1;
+    }
+    if (rch_save(out_path, "--out", inputs, 2, write_csv_fn, set, d) != 0)
+        return -1;
+    return truth_out ? rch_save(truth_out, "--truth-out", inputs, 3, write_truth_fn, set, d) : 0;
 }

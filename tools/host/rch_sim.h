@@ -95,4 +95,10 @@ void rch_sim_set_free(rch_sim_set *set);
  * simulated (seed, noise, resolution, joint step). 0 or -1 (write error). */
 int rch_sim_write_truth(FILE *f, const rch_sim_set *set);
 
+/* The samples as CSV into out_path (rch_data_write) and, when truth_out is not
+ * NULL, the truth into truth_out; each whole or not at all (rch_save), never
+ * over job's inputs (the truth never over the CSV either). 0, or -1 with d. */
+int rch_sim_save(const rch_sim_set *set, const rch_sim_job *job, const char *out_path, const char *truth_out,
+                 rch_diag *d);
+
 #endif
