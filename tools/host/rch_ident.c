@@ -67,18 +67,14 @@ static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
                  "a constant cable offset trades against the encoder position and the link lengths");
 }
 
-int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, size_t n)
+/* SVD of the column-scaled identification Jacobian of m over the samples (n):
+ * sv (np) descending (zero beyond n), vt (np x np) row k = direction k. */
+static int scaled_svd(double *sv, double *vt, const rc_model *m, const rc_sample *s, size_t n)
 {
     const unsigned np = m->n_params;
-    memset(out, 0, sizeof *out);
-    out->n_params = np;
-    if (n == 0 || np == 0)
-        return -1;
-    double *J = malloc(n * np * sizeof *J), *sv = malloc(np * sizeof *sv);
-    double *vt = malloc((size_t)np * np * sizeof *vt), *norm = calloc(np, sizeof *norm);
-    double *sup = malloc(np * sizeof *sup), *V = malloc((size_t)np * np * sizeof *V);
+    double *J = malloc(n * np * sizeof *J), *norm = calloc(np, sizeof *norm), *sup = malloc(np * sizeof *sup);
     int rc = -1;
-    if (!J || !sv || !vt || !norm || !sup || !V)
+    if (!J || !norm || !sup)
         goto done;
     for (size_t i = 0; i < n; ++i) {
         double l;
@@ -94,60 +90,82 @@ int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, siz
     if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'A', (lapack_int)n, (lapack_int)np, J, (lapack_int)np, sv, NULL, 1, vt,
                        (lapack_int)np, sup) != 0)
         goto done;
-    /* the thresholds and figures: rc_ident, the one definition */
-    unsigned limit = np < n ? np : (unsigned)n;
-    for (unsigned k = limit; k < np; ++k)
+    for (unsigned k = np < n ? np : (unsigned)n; k < np; ++k)
         sv[k] = 0.0;
-    for (unsigned k = 0; k < np; ++k) /* V: direction k in column k */
-        for (unsigned i = 0; i < np; ++i)
-            V[(size_t)i * np + k] = vt[(size_t)k * np + i];
-    rc_ident id;
-    if (rc_ident_classify(&id, sv, V, np, n) != RC_OK)
-        goto done;
-    for (unsigned k = 0; k < np; ++k)
-        out->sv_rel[k] = id.sv_rel[k];
-    out->rank = id.rank;
-    out->n_weak = id.n_weak;
-    out->cond = id.cond;
-    out->observability = id.observability;
-    /* describe the null and weak directions, weakest first */
-    for (unsigned k = np; k-- > 0 && out->n_dirs < RCH_IDENT_MAX_DIRS;) {
-        if (id.dir_class[k] == RC_IDENT_IDENTIFIABLE)
-            break;
-        rch_ident_dir *d = &out->dirs[out->n_dirs++];
-        const double *v = &vt[(size_t)k * np];
-        d->sv_rel = out->sv_rel[k];
-        d->weak = id.dir_class[k] == RC_IDENT_WEAK;
-        size_t pos = 0;
-        unsigned order[RC_MAX_PARAMS];
-        for (unsigned i = 0; i < np; ++i)
-            order[i] = i;
-        for (unsigned i = 0; i < np; ++i) /* by |component|, descending */
-            for (unsigned j = i + 1; j < np; ++j)
-                if (fabs(v[order[j]]) > fabs(v[order[i]])) {
-                    unsigned t = order[i];
-                    order[i] = order[j];
-                    order[j] = t;
-                }
-        for (unsigned i = 0; i < np && i < 5; ++i) {
-            char name[48];
-            if (fabs(v[order[i]]) < 0.1)
-                break;
-            int w = snprintf(d->combo + pos, sizeof d->combo - pos, "%s%+.2f %s", i ? " " : "", v[order[i]],
-                             rc_param_name(name, sizeof name, m, order[i]));
-            if (w < 0 || (size_t)w >= sizeof d->combo - pos)
-                break;
-            pos += (size_t)w;
-        }
-        explain(d, v, m);
-    }
     rc = 0;
 done:
     free(J);
-    free(sv);
-    free(vt);
     free(norm);
     free(sup);
+    return rc;
+}
+
+/* "+0.71 d2 -0.71 d3": the (at most five) components of v (np) of at least
+ * 0.1, largest first, then the plain-words reason. */
+static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
+{
+    const unsigned np = m->n_params;
+    size_t pos = 0;
+    unsigned order[RC_MAX_PARAMS];
+    for (unsigned i = 0; i < np; ++i)
+        order[i] = i;
+    for (unsigned i = 0; i < np; ++i) /* by |component|, descending */
+        for (unsigned j = i + 1; j < np; ++j)
+            if (fabs(v[order[j]]) > fabs(v[order[i]])) {
+                unsigned t = order[i];
+                order[i] = order[j];
+                order[j] = t;
+            }
+    for (unsigned i = 0; i < np && i < 5; ++i) {
+        char name[48];
+        if (fabs(v[order[i]]) < 0.1)
+            break;
+        int w = snprintf(d->combo + pos, sizeof d->combo - pos, "%s%+.2f %s", i ? " " : "", v[order[i]],
+                         rc_param_name(name, sizeof name, m, order[i]));
+        if (w < 0 || (size_t)w >= sizeof d->combo - pos)
+            break;
+        pos += (size_t)w;
+    }
+    explain(d, v, m);
+}
+
+int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, size_t n)
+{
+    const unsigned np = m->n_params;
+    memset(out, 0, sizeof *out);
+    out->n_params = np;
+    if (n == 0 || np == 0 || np > RC_MAX_PARAMS)
+        return -1;
+    double *sv = malloc(np * sizeof *sv), *vt = malloc((size_t)np * np * sizeof *vt);
+    double *V = malloc((size_t)np * np * sizeof *V);
+    int rc = -1;
+    if (!sv || !vt || !V || scaled_svd(sv, vt, m, s, n) != 0)
+        goto done;
+    for (unsigned k = 0; k < np; ++k) /* V: direction k in column k */
+        for (unsigned i = 0; i < np; ++i)
+            V[(size_t)i * np + k] = vt[(size_t)k * np + i];
+    /* the thresholds, classes and figures: rc_ident, the one definition */
+    rc_ident *id = &out->core;
+    if (rc_ident_classify(id, sv, V, np, n) != RC_OK)
+        goto done;
+    memcpy(out->sv_rel, id->sv_rel, sizeof out->sv_rel);
+    out->rank = id->rank;
+    out->n_weak = id->n_weak;
+    out->cond = id->cond;
+    out->observability = id->observability;
+    /* describe the null and weak directions, weakest first */
+    for (unsigned k = np; k-- > 0 && out->n_dirs < RCH_IDENT_MAX_DIRS;) {
+        if (id->dir_class[k] == RC_IDENT_IDENTIFIABLE)
+            break;
+        rch_ident_dir *d = &out->dirs[out->n_dirs++];
+        d->sv_rel = out->sv_rel[k];
+        d->weak = id->dir_class[k] == RC_IDENT_WEAK;
+        describe(d, &vt[(size_t)k * np], m);
+    }
+    rc = 0;
+done:
+    free(sv);
+    free(vt);
     free(V);
     return rc;
 }

@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "rc_ident.h"
 #include "rc_model.h"
 
 #define RCH_IDENT_MAX_DIRS 24
@@ -35,6 +36,7 @@ typedef struct rch_ident {
     double observability;         /* O1 = (prod s_i)^(1/r) / sqrt(n), identifiable part */
     unsigned n_dirs;
     rch_ident_dir dirs[RCH_IDENT_MAX_DIRS];
+    rc_ident core;                /* rc_ident's classes per direction and per parameter, log det */
 } rch_ident;
 
 /* Analyse model m at its current parameters over samples (n). Returns 0, or
