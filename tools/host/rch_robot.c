@@ -135,6 +135,77 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
     return 0;
 }
 
+/* "encoder_mm": [x, y, z] when present (has_encoder set). 0 or -1 (d set). */
+static int read_encoder(rch_robot *out, double enc[3], const rch_json *root, const char *name, rch_diag *d)
+{
+    const rch_json *e = rch_json_get(root, "encoder_mm");
+    if (!e)
+        return 0;
+    if (e->type != RCH_JARR || e->n != 3) {
+        rch_diag_set(d, name, e->line, e->col, "\"encoder_mm\" must be [x, y, z]");
+        return -1;
+    }
+    for (unsigned k = 0; k < 3; ++k) {
+        if (want_num(&enc[k], e->items[k], "encoder_mm value", name, d, e) != 0)
+            return -1;
+        if (fabs(enc[k]) > 1e5) {
+            rch_diag_set(d, name, e->items[k]->line, e->items[k]->col, "encoder_mm value is absurd");
+            return -1;
+        }
+    }
+    out->has_encoder = 1;
+    return 0;
+}
+
+/* "joint_limits_deg" into m (default +-180 deg). 0 or -1 (d set). */
+static int read_limits(rc_model *m, const rch_json *root, const char *name, rch_diag *d)
+{
+    const rch_json *lim = rch_json_get(root, "joint_limits_deg");
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        m->q_min_rad[i] = -M_PI;
+        m->q_max_rad[i] = M_PI;
+    }
+    if (!lim)
+        return 0;
+    if (lim->type != RCH_JARR || lim->n != RC_NJ) {
+        rch_diag_set(d, name, lim->line, lim->col, "\"joint_limits_deg\" must be 6 [min, max] pairs");
+        return -1;
+    }
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const rch_json *pr = lim->items[i];
+        double lo, hi;
+        if (pr->type != RCH_JARR || pr->n != 2 || want_num(&lo, pr->items[0], "joint limit", name, d, pr) != 0 ||
+            want_num(&hi, pr->items[1], "joint limit", name, d, pr) != 0 || !(lo < hi) || fabs(lo) > 720 ||
+            fabs(hi) > 720) {
+            rch_diag_set(d, name, pr->line, pr->col, "joint %u limits must be [min, max] degrees, min < max", i + 1);
+            return -1;
+        }
+        m->q_min_rad[i] = lo * DEG;
+        m->q_max_rad[i] = hi * DEG;
+    }
+    return 0;
+}
+
+/* "nominal": {"dh": [...]} of a calibrated model (has_nominal set). */
+static int read_nominal(rch_robot *out, const rch_json *root, const char *name, rch_diag *d)
+{
+    const rch_json *nom = rch_json_get(root, "nominal");
+    double ndh[RC_NJ][4];
+    if (!nom)
+        return 0;
+    if (nom->type != RCH_JOBJ) {
+        rch_diag_set(d, name, nom->line, nom->col, "\"nominal\" must be an object with \"dh\"");
+        return -1;
+    }
+    if (read_dh(ndh, rch_json_get(nom, "dh"), name, d, nom) != 0)
+        return -1;
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        for (unsigned k = 0; k < 4; ++k)
+            out->nominal.x[4 * i + k] = ndh[i][k];
+    out->has_nominal = 1;
+    return 0;
+}
+
 int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d)
 {
     double dh[RC_NJ][4], enc[3] = {0, 0, 0};
@@ -154,67 +225,17 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     }
     const rch_json *nm = rch_json_get(root, "name");
     snprintf(out->name, sizeof out->name, "%s", nm && nm->type == RCH_JSTR ? nm->str : "robot");
-    if (read_dh(dh, rch_json_get(root, "dh"), name, d, root) != 0)
+    if (read_dh(dh, rch_json_get(root, "dh"), name, d, root) != 0 || read_encoder(out, enc, root, name, d) != 0)
         goto done;
-    const rch_json *e = rch_json_get(root, "encoder_mm");
-    if (e) {
-        if (e->type != RCH_JARR || e->n != 3) {
-            rch_diag_set(d, name, e->line, e->col, "\"encoder_mm\" must be [x, y, z]");
-            goto done;
-        }
-        for (unsigned k = 0; k < 3; ++k) {
-            if (want_num(&enc[k], e->items[k], "encoder_mm value", name, d, e) != 0)
-                goto done;
-            if (fabs(enc[k]) > 1e5) {
-                rch_diag_set(d, name, e->items[k]->line, e->items[k]->col, "encoder_mm value is absurd");
-                goto done;
-            }
-        }
-        out->has_encoder = 1;
-    }
     if (rc_model_init(&out->model, (const double(*)[4])dh, enc) != RC_OK) {
         rch_diag_set(d, name, root->line, root->col, "invalid DH table");
         goto done;
     }
-    const rch_json *lim = rch_json_get(root, "joint_limits_deg");
-    for (unsigned i = 0; i < RC_NJ; ++i) {
-        out->model.q_min_rad[i] = -M_PI;
-        out->model.q_max_rad[i] = M_PI;
-    }
-    if (lim) {
-        if (lim->type != RCH_JARR || lim->n != RC_NJ) {
-            rch_diag_set(d, name, lim->line, lim->col, "\"joint_limits_deg\" must be 6 [min, max] pairs");
-            goto done;
-        }
-        for (unsigned i = 0; i < RC_NJ; ++i) {
-            const rch_json *pr = lim->items[i];
-            double lo, hi;
-            if (pr->type != RCH_JARR || pr->n != 2 ||
-                want_num(&lo, pr->items[0], "joint limit", name, d, pr) != 0 ||
-                want_num(&hi, pr->items[1], "joint limit", name, d, pr) != 0 || !(lo < hi) || fabs(lo) > 720 ||
-                fabs(hi) > 720) {
-                rch_diag_set(d, name, pr->line, pr->col, "joint %u limits must be [min, max] degrees, min < max",
-                             i + 1);
-                goto done;
-            }
-            out->model.q_min_rad[i] = lo * DEG;
-            out->model.q_max_rad[i] = hi * DEG;
-        }
-    }
+    if (read_limits(&out->model, root, name, d) != 0)
+        goto done;
     out->nominal = out->model;
-    const rch_json *nom = rch_json_get(root, "nominal");
-    if (nom) {
-        double ndh[RC_NJ][4];
-        if (nom->type != RCH_JOBJ || read_dh(ndh, rch_json_get(nom, "dh"), name, d, nom) != 0) {
-            if (nom->type != RCH_JOBJ)
-                rch_diag_set(d, name, nom->line, nom->col, "\"nominal\" must be an object with \"dh\"");
-            goto done;
-        }
-        for (unsigned i = 0; i < RC_NJ; ++i)
-            for (unsigned k = 0; k < 4; ++k)
-                out->nominal.x[4 * i + k] = ndh[i][k];
-        out->has_nominal = 1;
-    }
+    if (read_nominal(out, root, name, d) != 0)
+        goto done;
     const rch_json *eff = rch_json_get(root, "effects");
     if (eff && read_effects(&out->model, eff, name, d) != 0)
         goto done;
