@@ -9,6 +9,9 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 
+static const char details[] = "A row further than T mm is a fault unless a joint change within the 0.1 deg\n"
+                              "display rounding explains it.";
+
 static int report_json(const rch_fkcheck_result *r)
 {
     rch_jw w;
@@ -53,9 +56,7 @@ int rcal_cmd_fkcheck(int argc, char **argv)
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
     };
     const rch_cmdspec spec = {"fkcheck", "compare the nominal FK at each row's joint angles with its x, y, z",
-                              "A row further than T mm is a fault unless a joint change within the 0.1 deg\n"
-                              "display rounding explains it.",
-                              opts, sizeof opts / sizeof opts[0]};
+                              details, opts, sizeof opts / sizeof opts[0]};
     const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
     if (ps != RCH_OPT_OK)
         return ps == RCH_OPT_HELP ? 0 : 2;

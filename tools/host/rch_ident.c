@@ -8,63 +8,50 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int has(const double *v, const rc_model *m, const char *name, double thr)
+/* Component of v (n_params) on the parameter called name; 0 when none is. */
+static double comp(const double *v, const rc_model *m, const char *name)
 {
     char buf[64];
     for (unsigned k = 0; k < m->n_params; ++k)
-        if (fabs(v[k]) >= thr && strcmp(rc_param_name(buf, sizeof buf, m, k), name) == 0)
-            return 1;
-    return 0;
+        if (strcmp(rc_param_name(buf, sizeof buf, m, k), name) == 0)
+            return v[k];
+    return 0.0;
 }
 
-/* v_a^2 + v_b^2 of the named parameters */
-static double share(const double *v, const rc_model *m, const char *a, const char *b)
+static int has(const double *v, const rc_model *m, const char *name, double thr)
 {
-    char buf[64];
-    double s = 0.0;
-    for (unsigned k = 0; k < m->n_params; ++k) {
-        rc_param_name(buf, sizeof buf, m, k);
-        if (strcmp(buf, a) == 0 || strcmp(buf, b) == 0)
-            s += v[k] * v[k];
-    }
-    return s;
+    return fabs(comp(v, m, name)) >= thr;
 }
 
 static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
 {
     const double t = 0.15;
-    d->why[0] = '\0';
-    if (has(v, m, "alpha6", t) && has(v, m, "theta6", t) && share(v, m, "alpha6", "theta6") > 0.98)
-        snprintf(d->why, sizeof d->why,
-                 "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 "
-                 "is zero (both columns are zero, so any mix of them is null): cable lengths cannot see them");
+    const char *why = "";
+    const double a6 = comp(v, m, "alpha6"), t6 = comp(v, m, "theta6");
+    if (fabs(a6) >= t && fabs(t6) >= t && a6 * a6 + t6 * t6 > 0.98)
+        why = "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 "
+              "is zero (both columns are zero, so any mix of them is null): cable lengths cannot see them";
     else if (has(v, m, "alpha6", t) && !has(v, m, "theta6", t) && !has(v, m, "d6", t))
-        snprintf(d->why, sizeof d->why,
-                 "alpha6 turns the flange about its own x axis after the last translation: it never moves the "
-                 "flange point, so cable lengths cannot see it");
+        why = "alpha6 turns the flange about its own x axis after the last translation: it never moves the "
+              "flange point, so cable lengths cannot see it";
     else if (has(v, m, "theta6", t) && !has(v, m, "a6", 0.5))
-        snprintf(d->why, sizeof d->why,
-                 "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about "
-                 "axis 6 is invisible to a point measurement");
+        why = "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about "
+              "axis 6 is invisible to a point measurement";
     else if (has(v, m, "d1", t) && has(v, m, "ez", t))
-        snprintf(d->why, sizeof d->why,
-                 "moving the robot base up is the same as moving the encoder down: only their difference is "
-                 "measured");
+        why = "moving the robot base up is the same as moving the encoder down: only their difference is "
+              "measured";
     else if (has(v, m, "theta1", t) && (has(v, m, "ex", t) || has(v, m, "ey", t)))
-        snprintf(d->why, sizeof d->why,
-                 "turning the whole robot about its base axis is the same as turning the encoder around it: "
-                 "lengths do not fix the base heading");
+        why = "turning the whole robot about its base axis is the same as turning the encoder around it: "
+              "lengths do not fix the base heading";
     else if (has(v, m, "d2", t) && has(v, m, "d3", t))
-        snprintf(d->why, sizeof d->why,
-                 "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum "
-                 "counts");
+        why = "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum "
+              "counts";
     else if (has(v, m, "length_scale", t))
-        snprintf(d->why, sizeof d->why,
-                 "an encoder scale error looks like a uniformly larger robot: separate them with one reference "
-                 "length (a gauge bar or a laser tracker distance)");
+        why = "an encoder scale error looks like a uniformly larger robot: separate them with one reference "
+              "length (a gauge bar or a laser tracker distance)";
     else if (has(v, m, "length_offset", t))
-        snprintf(d->why, sizeof d->why,
-                 "a constant cable offset trades against the encoder position and the link lengths");
+        why = "a constant cable offset trades against the encoder position and the link lengths";
+    snprintf(d->why, sizeof d->why, "%s", why);
 }
 
 /* SVD of the column-scaled identification Jacobian of m over the samples (n):
