@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "rc_ident.h"
 #include "rch_calib.h"
 #include "rch_data.h"
 #include "rch_json.h"
@@ -89,6 +90,61 @@ static void test_run_demo(void **state)
     free(train);
     free(idx);
     rch_data_free(&data);
+}
+
+/* The two routes to identifiability agree at the demo's solution: the SVD of
+ * the scaled Jacobian (rch_ident, LAPACK) and the eigen-decomposition of the
+ * normal matrix (rc_ident_normal, the core's route for solvers and planning):
+ * same rank, same weak count, same parameter classes, O1 and log det close. */
+static void ident_routes(const char *path)
+{
+    static rch_calib_result r;
+    rch_diag d;
+    rch_calib_cfg cfg = demo_cfg();
+    cfg.data_path = path;
+    assert_int_equal(rch_calib_run(&r, &cfg, &d), 0);
+    rch_data data;
+    assert_int_equal(rch_data_load(&data, path, 0, &d), 0);
+    size_t *idx = malloc(data.n * sizeof *idx);
+    assert_non_null(idx);
+    rch_split(idx, data.n, 1);
+    rc_sample *train = rch_data_pick(data.s, idx + r.n_test, r.n_train);
+    rc_solve_work *w = malloc(sizeof *w);
+    const unsigned np = r.model.n_params;
+    double *V = malloc((size_t)np * np * sizeof *V), *work = malloc(rc_ident_work_size(np) * sizeof *work);
+    assert_true(train && w && V && work);
+    double cost;
+    for (unsigned i = 0; i < np; ++i)
+        w->idx[i] = (uint16_t)i;
+    assert_int_equal(rc_normal_eq(w->A, w->g, &cost, w->jrow, &r.model, w->idx, np, train, r.n_train), RC_OK);
+    rc_ident id;
+    assert_int_equal(rc_ident_normal(&id, V, work, w->A, np, r.n_train), RC_OK);
+    const rc_ident *ref = &r.ident.core;
+    print_message("rank %u (svd %u), weak %u (svd %u), O1 %.6g (svd %.6g)\n", id.rank, ref->rank, id.n_weak,
+                  ref->n_weak, id.observability, ref->observability);
+    assert_int_equal(id.rank, ref->rank);
+    assert_int_equal(id.n_weak, ref->n_weak);
+    assert_int_equal(ref->rank, r.ident.rank);
+    for (unsigned i = 0; i < np; ++i)
+        assert_int_equal(id.param_class[i], ref->param_class[i]);
+    assert_true(fabs(id.observability / ref->observability - 1.0) < 1e-6);
+    assert_true(fabs(id.log_det - ref->log_det) < 1e-6 * fabs(ref->log_det));
+    free(V);
+    free(work);
+    free(w);
+    free(train);
+    free(idx);
+    rch_data_free(&data);
+}
+
+static void test_ident_routes(void **state)
+{
+    (void)state;
+    ident_routes(DEMO);
+    if (access(RCAL_SHARED_DATA, R_OK) == 0)
+        ident_routes(RCAL_SHARED_DATA);
+    else
+        print_message("skipped the real data: %s is absent\n", RCAL_SHARED_DATA);
 }
 
 /* --fix holds the named parameters at nominal; an unknown name is a request
@@ -308,6 +364,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_run_demo),
+        cmocka_unit_test(test_ident_routes),
         cmocka_unit_test(test_fix),
         cmocka_unit_test(test_random_poses),
         cmocka_unit_test(test_stats),
