@@ -37,6 +37,29 @@
 #error "RC_MAX_EFFECTS must be within 1..64"
 #endif
 
+/* ---- Scalar type of the kinematics and compensation path (rc_kin, rc_comp).
+ * rc_real is double by default; -DRC_REAL_FLOAT
+ * makes it float for a single-precision FPU (Cortex-M4F), where a double
+ * costs a soft-float library call. The solvers and estimators (rc_model's
+ * parameter vector, rc_solve, rc_est) stay double: they run on the host.
+ * RC_REAL_C(1.5) writes a literal of the type (1.5 or 1.5f), RC_REAL_EPS its
+ * machine epsilon; tolerances of the compensation are derived from it
+ * (rc_comp.h). */
+#ifdef RC_REAL_FLOAT
+typedef float rc_real;
+#define RC_REAL_IS_FLOAT 1
+#define RC_REAL_C(x) x##f
+#define RC_REAL_EPS 1.1920929e-07f /* FLT_EPSILON */
+#define RC_REAL_NAME "float"
+#else
+typedef double rc_real;
+#define RC_REAL_IS_FLOAT 0
+#define RC_REAL_C(x) x
+#define RC_REAL_EPS 2.220446049250313e-16 /* DBL_EPSILON */
+#define RC_REAL_NAME "double"
+#endif
+/* ---- end of the scalar type block */
+
 /* Contract checks. Default: the C library's assert (compiled out by NDEBUG).
  * Firmware may define RC_ASSERT to its own fault handler. */
 #ifndef RC_ASSERT
