@@ -38,24 +38,32 @@ void rc_ident_scale(double *D, const double *col_sq, unsigned n, size_t stride)
     }
 }
 
-rc_status rc_ident_classify(rc_ident *out, const double *sv, const double *V, unsigned n, size_t n_rows)
+/* s_k from vals: the singular value itself, or sqrt of an eigenvalue
+ * (negative rounding-level eigenvalues count as zero). */
+static double sv_of(const double *vals, int eig, unsigned k)
 {
-    RC_ASSERT(out != NULL && sv != NULL && V != NULL);
+    return eig ? (vals[k] > 0.0 ? sqrt(vals[k]) : 0.0) : vals[k];
+}
+
+static rc_status classify(rc_ident *out, const double *vals, int eig, const double *V, unsigned n, size_t n_rows)
+{
+    RC_ASSERT(out != NULL && vals != NULL && V != NULL);
     memset(out, 0, sizeof *out);
     if (n == 0 || n > RC_MAX_PARAMS)
         return RC_ERR_ARG;
     out->n = n;
     for (unsigned k = 0; k < n; ++k)
-        if (!(sv[k] >= 0.0) || !isfinite(sv[k]))
+        if (!isfinite(vals[k]) || (!eig && !(vals[k] >= 0.0)))
             return RC_ERR_NUMERIC;
-    const double smax = sv[0];
+    const double smax = sv_of(vals, eig, 0);
     double logsum = 0.0;
     for (unsigned k = 0; k < n; ++k) {
-        out->sv_rel[k] = smax > 0.0 ? sv[k] / smax : 0.0;
+        const double sk = sv_of(vals, eig, k);
+        out->sv_rel[k] = smax > 0.0 ? sk / smax : 0.0;
         if (smax > 0.0 && out->sv_rel[k] >= RC_IDENT_NULL_REL) {
             ++out->rank;
-            logsum += log(sv[k]);
-            out->cond = smax / sv[k];
+            logsum += log(sk);
+            out->cond = smax / sk;
             if (out->sv_rel[k] < RC_IDENT_WEAK_REL) {
                 ++out->n_weak;
                 out->dir_class[k] = (uint8_t)RC_IDENT_WEAK;
@@ -86,6 +94,16 @@ rc_status rc_ident_classify(rc_ident *out, const double *sv, const double *V, un
     return RC_OK;
 }
 
+rc_status rc_ident_classify(rc_ident *out, const double *sv, const double *V, unsigned n, size_t n_rows)
+{
+    return classify(out, sv, 0, V, n, n_rows);
+}
+
+rc_status rc_ident_classify_eig(rc_ident *out, const double *ev, const double *V, unsigned n, size_t n_rows)
+{
+    return classify(out, ev, 1, V, n, n_rows);
+}
+
 rc_status rc_ident_normal(rc_ident *out, double *V, double *work, const double *AtA, unsigned n, size_t n_rows)
 {
     RC_ASSERT(out != NULL && V != NULL && work != NULL && AtA != NULL);
@@ -108,7 +126,5 @@ rc_status rc_ident_normal(rc_ident *out, double *V, double *work, const double *
     rc_status st = rcu_eig_sym(D, V, A, n, 0);
     if (st != RC_OK)
         return st;
-    for (unsigned k = 0; k < n; ++k)
-        D[k] = D[k] > 0.0 ? sqrt(D[k]) : 0.0;
-    return rc_ident_classify(out, D, V, n, n_rows);
+    return rc_ident_classify_eig(out, D, V, n, n_rows);
 }

@@ -95,6 +95,12 @@ void rc_ident_scale(double *D, const double *col_sq, unsigned n, size_t stride);
  * or negative singular value. */
 rc_status rc_ident_classify(rc_ident *out, const double *sv, const double *V, unsigned n, size_t n_rows);
 
+/* The same from an eigen-decomposition of the column-scaled normal matrix
+ * (what a solver already has): ev (n) descending, V (n x n) eigenvectors in
+ * columns; s_k = sqrt(ev_k), a negative rounding-level ev_k counts as 0.
+ * RC_ERR_NUMERIC for a non-finite eigenvalue. */
+rc_status rc_ident_classify_eig(rc_ident *out, const double *ev, const double *V, unsigned n, size_t n_rows);
+
 /* Analyse a normal matrix: AtA (n x n) = J^T J of n parameters over n_rows
  * rows, unscaled. Scales it by its diagonal (zero columns as documented
  * above), decomposes it (rcu_eig_sym), and classifies. Outputs: out, V (n x n)

@@ -176,6 +176,19 @@ static void test_classify_thresholds(void **state)
     assert_int_equal(id.param_class[2], RC_IDENT_WEAK);
     assert_int_equal(id.param_class[3], RC_IDENT_NONE);
     assert_true(fabs(id.cond - 1.0 / 0.9999e-3) < 1e-6);
+    /* from eigenvalues (the squares): the same classes and figures */
+    double ev[N];
+    for (unsigned k = 0; k < N; ++k)
+        ev[k] = sv[k] * sv[k];
+    ev[N - 1] = -1e-30; /* rounding below zero: a null direction, not an error */
+    rc_ident ie;
+    assert_int_equal(rc_ident_classify_eig(&ie, ev, V, N, 100), RC_OK);
+    for (unsigned k = 0; k < N; ++k)
+        assert_int_equal(ie.dir_class[k], id.dir_class[k]);
+    assert_int_equal(ie.rank, id.rank);
+    assert_true(fabs(ie.log_det - id.log_det) < 1e-12 && fabs(ie.cond - id.cond) < 1e-6);
+    ev[1] = INFINITY;
+    assert_int_equal(rc_ident_classify_eig(&ie, ev, V, N, 100), RC_ERR_NUMERIC);
     /* errors */
     const double bad[N] = {1.0, NAN, 0.5, 0.1};
     assert_int_equal(rc_ident_classify(&id, bad, V, N, 100), RC_ERR_NUMERIC);
