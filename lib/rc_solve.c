@@ -2,6 +2,8 @@
 #include "rc_solve.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "rc_linalg.h"
@@ -32,13 +34,24 @@ const char *rc_exit_str(rc_exit e)
     return "unknown";
 }
 
-rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples, size_t n)
+/* A pass over the samples evaluates them with rc_meas_prepared: the model's
+ * sines once per pass, the readings' from the tables sin_q, cos_q ((n x 6)
+ * each, rc_qtrig_fill) or, both NULL, per sample. */
+typedef struct {
+    const double *sin_q, *cos_q;
+} qtab;
+
+static const double *tab_row(const double *t, size_t k) { return t != NULL ? t + (size_t)RC_NJ * k : NULL; }
+
+static rc_status cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *samples, qtab t, size_t n)
 {
+    rc_meas_prep p;
     double sum = 0.0;
     RC_ASSERT(cost_mm2 != NULL && m != NULL && (samples != NULL || n == 0));
+    rc_meas_prepare(&p, m);
     for (size_t i = 0; i < n; ++i) {
         double l;
-        rc_status st = rc_meas(&l, NULL, m, &samples[i]);
+        rc_status st = rc_meas_prepared(&l, NULL, m, &p, &samples[i], tab_row(t.sin_q, i), tab_row(t.cos_q, i));
         if (st != RC_OK)
             return st;
         const double r = l - samples[i].len_mm;
@@ -48,27 +61,56 @@ rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples,
     return isfinite(sum) ? RC_OK : RC_ERR_NUMERIC;
 }
 
-rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
-                       const uint16_t *idx, unsigned nf, const rc_sample *samples, size_t n)
+rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples, size_t n)
 {
+    const qtab none = {NULL, NULL};
+    return cost_tab(cost_mm2, m, samples, none, n);
+}
+
+/* Samples per block of the normal-equation update: A += Jb^T Jb with NE_BLOCK
+ * rows at a time reads and writes A once per block instead of once per row.
+ * The rows are added one after the other (left to right), so the sums are
+ * those of the row-by-row update to the last bit. */
+#define NE_BLOCK 4
+
+static rc_status normal_eq_tab(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
+                               const uint16_t *idx, unsigned nf, const rc_sample *samples, qtab t, size_t n)
+{
+    double jb[NE_BLOCK][RC_MAX_PARAMS], rb[NE_BLOCK];
     double sum = 0.0;
+    rc_meas_prep p;
+    RC_ASSERT(A != NULL && g != NULL && cost_mm2 != NULL && jrow != NULL && m != NULL && idx != NULL);
+    RC_ASSERT(nf <= RC_MAX_PARAMS && (samples != NULL || n == 0));
+    rc_meas_prepare(&p, m);
     memset(A, 0, (size_t)nf * nf * sizeof A[0]);
     memset(g, 0, nf * sizeof g[0]);
-    for (size_t s = 0; s < n; ++s) {
-        double l;
-        rc_status st = rc_meas(&l, jrow, m, &samples[s]);
-        if (st != RC_OK)
-            return st;
-        const double r = l - samples[s].len_mm;
-        sum += r * r;
-        for (unsigned i = 0; i < nf; ++i) {
-            const double ji = jrow[idx[i]];
-            if (ji == 0.0)
+    for (size_t s0 = 0; s0 < n; s0 += NE_BLOCK) {
+        const unsigned nb = n - s0 < NE_BLOCK ? (unsigned)(n - s0) : NE_BLOCK;
+        for (unsigned b = 0; b < NE_BLOCK; ++b) {
+            const size_t s = s0 + b;
+            double l;
+            if (b >= nb) { /* last block: zero rows add nothing */
+                rb[b] = 0.0;
+                memset(jb[b], 0, nf * sizeof jb[b][0]);
                 continue;
-            g[i] += ji * r;
+            }
+            rc_status st = rc_meas_prepared(&l, jrow, m, &p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
+            if (st != RC_OK)
+                return st;
+            rb[b] = l - samples[s].len_mm;
+            sum += rb[b] * rb[b];
+            for (unsigned i = 0; i < nf; ++i)
+                jb[b][i] = jrow[idx[i]];
+        }
+        /* upper triangle only, a symmetric rank-NE_BLOCK update */
+        for (unsigned i = 0; i < nf; ++i) {
+            const double a0 = jb[0][i], a1 = jb[1][i], a2 = jb[2][i], a3 = jb[3][i];
+            if (a0 == 0.0 && a1 == 0.0 && a2 == 0.0 && a3 == 0.0)
+                continue;
+            g[i] = g[i] + a0 * rb[0] + a1 * rb[1] + a2 * rb[2] + a3 * rb[3];
             double *Ai = &A[(size_t)i * nf];
             for (unsigned k = i; k < nf; ++k)
-                Ai[k] += ji * jrow[idx[k]];
+                Ai[k] = Ai[k] + a0 * jb[0][k] + a1 * jb[1][k] + a2 * jb[2][k] + a3 * jb[3][k];
         }
     }
     for (unsigned i = 0; i < nf; ++i)
@@ -78,16 +120,25 @@ rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, con
     return isfinite(sum) ? RC_OK : RC_ERR_NUMERIC;
 }
 
+rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
+                       const uint16_t *idx, unsigned nf, const rc_sample *samples, size_t n)
+{
+    const qtab none = {NULL, NULL};
+    return normal_eq_tab(A, g, cost_mm2, jrow, m, idx, nf, samples, none, n);
+}
+
 rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, size_t n)
 {
     double mean = 0.0, m2 = 0.0, sq = 0.0, abs_sum = 0.0, mx = 0.0;
+    rc_meas_prep p;
     RC_ASSERT(out != NULL && m != NULL);
     memset(out, 0, sizeof *out);
     if (n == 0)
         return RC_ERR_ARG;
+    rc_meas_prepare(&p, m);
     for (size_t i = 0; i < n; ++i) {
         double l;
-        rc_status st = rc_meas(&l, NULL, m, &samples[i]);
+        rc_status st = rc_meas_prepared(&l, NULL, m, &p, &samples[i], NULL, NULL);
         if (st != RC_OK)
             return st;
         const double e = l - samples[i].len_mm;
@@ -224,8 +275,10 @@ static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w
     return RC_OK;
 }
 
-rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
-                   const rc_sample *samples, size_t n)
+/* rc_solve on w's small fields and the matrices A, V ((nf x nf) each, n_params^2
+ * entries of room) and the sample tables t. */
+static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, qtab tab,
+                            const rc_solve_config *cfg, const rc_sample *samples, size_t n)
 {
     static const rc_solve_config defaults;
     rc_solve_result local;
@@ -265,7 +318,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     const int ltlm = cfg->method == RC_METHOD_LTLM;
     double cost, mu = 0.0, nu = 2.0;
 
-    rc_status st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+    rc_status st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
     ++res->cost_evals;
     if (st != RC_OK)
         return st;
@@ -275,7 +328,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
      * falls in the null space below. */
     double dmax = 0.0;
     for (unsigned i = 0; i < nf; ++i) {
-        const double a = w->A[(size_t)i * nf + i];
+        const double a = A[(size_t)i * nf + i];
         if (a > dmax)
             dmax = a;
     }
@@ -287,7 +340,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     {
         unsigned keep = 0;
         for (unsigned i = 0; i < nf; ++i) {
-            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || w->A[(size_t)i * nf + i] > 1e-24 * dmax)
+            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || A[(size_t)i * nf + i] > 1e-24 * dmax)
                 w->D[keep++] = (double)i;
         }
         if (keep == 0)
@@ -295,14 +348,14 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         for (unsigned a = 0; a < keep; ++a) {
             const unsigned ia = (unsigned)w->D[a];
             for (unsigned b = 0; b < keep; ++b)
-                w->A[(size_t)a * keep + b] = w->A[(size_t)ia * nf + (unsigned)w->D[b]];
+                A[(size_t)a * keep + b] = A[(size_t)ia * nf + (unsigned)w->D[b]];
             w->g[a] = w->g[ia];
             w->idx[a] = w->idx[ia];
         }
         nf = keep;
     }
     for (unsigned i = 0; i < nf; ++i) {
-        const double a = w->A[(size_t)i * nf + i];
+        const double a = A[(size_t)i * nf + i];
         w->D[i] = a > 1e-24 * dmax ? sqrt(a) : 1.0;
     }
     if (ltlm)
@@ -311,7 +364,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     res->exit = RC_EXIT_MAX_ITER;
     for (unsigned it = 0; it < max_iter; ++it) {
         if (it > 0) {
-            st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+            st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
             ++res->cost_evals;
             if (st != RC_OK)
                 return st;
@@ -320,9 +373,9 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         for (unsigned i = 0; i < nf; ++i) {
             w->g[i] /= w->D[i];
             for (unsigned k = 0; k < nf; ++k)
-                w->A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
+                A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
         }
-        st = rcu_eig_sym(w->ev, w->V, w->A, nf, 0);
+        st = rcu_eig_sym(w->ev, V, A, nf, 0);
         if (st == RC_ERR_NUMERIC)
             return st;
         const double lmax = w->ev[0];
@@ -336,7 +389,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             ++rank;
             double c = 0.0;
             for (unsigned i = 0; i < nf; ++i)
-                c += w->V[(size_t)i * nf + k] * w->g[i];
+                c += V[(size_t)i * nf + k] * w->g[i];
             w->c[k] = c;
             gn_gain += c * c / w->ev[k];
         }
@@ -371,7 +424,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
                 const double lam = w->ev[k], coef = -w->c[k] / (lam + mu);
                 pred += -2.0 * coef * w->c[k] - lam * coef * coef;
                 for (unsigned i = 0; i < nf; ++i)
-                    w->dx[i] += coef * w->V[(size_t)i * nf + k];
+                    w->dx[i] += coef * V[(size_t)i * nf + k];
             }
             for (unsigned i = 0; i < nf; ++i) {
                 ds += w->dx[i] * w->dx[i];
@@ -380,7 +433,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             apply_step(&w->trial, m, w, nf, w->dx);
             double cnew;
             ++res->cost_evals;
-            st = rc_cost(&cnew, &w->trial, samples, n);
+            st = cost_tab(&cnew, &w->trial, samples, tab, n);
             if (st == RC_OK && ltlm &&
                 ltlm_candidates(&w->trial, &cnew, w, nf, cfg, samples, n, &res->cost_evals))
                 ++res->ltlm_wins;
@@ -422,6 +475,70 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     }
     rc_model_wrap_angles(m);
     return RC_OK;
+}
+
+/* solve_core after filling the sample tables sin_q, cos_q ((n x 6) each, or
+ * both NULL: none). */
+static rc_status solve_with(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V,
+                            double *sin_q, double *cos_q, const rc_solve_config *cfg, const rc_sample *samples,
+                            size_t n)
+{
+    qtab tab = {NULL, NULL};
+    if (sin_q != NULL && cos_q != NULL) {
+        rc_qtrig_fill(sin_q, cos_q, samples, n);
+        tab.sin_q = sin_q;
+        tab.cos_q = cos_q;
+    }
+    return solve_core(m, res, w, A, V, tab, cfg, samples, n);
+}
+
+rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
+                   const rc_sample *samples, size_t n)
+{
+    RC_ASSERT(m != NULL && w != NULL);
+    double *sin_q = NULL, *cos_q = NULL;
+    const size_t np2 = (size_t)m->n_params * m->n_params;
+    /* the tables in the tails of A and V when they fit (never when n_params
+     * is out of range: solve_core refuses that) */
+    if (m->n_params <= RC_MAX_PARAMS && samples != NULL && n <= (sizeof w->A / sizeof w->A[0] - np2) / RC_NJ) {
+        sin_q = w->A + np2;
+        cos_q = w->V + np2;
+    }
+    return solve_with(m, res, w, w->A, w->V, sin_q, cos_q, cfg, samples, n);
+}
+
+size_t rc_solve_work_size(unsigned n_params, size_t n_samples)
+{
+    if (n_params < RC_N_BASE || n_params > RC_MAX_PARAMS)
+        return 0;
+    const size_t np2 = (size_t)n_params * n_params;
+    if (n_samples > (SIZE_MAX / sizeof(double) - 2 * np2) / (2 * RC_NJ))
+        return 0;
+    return offsetof(rc_solve_work, A) + (2 * np2 + 2 * RC_NJ * n_samples) * sizeof(double);
+}
+
+rc_status rc_solve_buf(rc_model *m, rc_solve_result *res, void *work, size_t work_bytes,
+                       const rc_solve_config *cfg, const rc_sample *samples, size_t n)
+{
+    RC_ASSERT(m != NULL && work != NULL);
+    const size_t need = rc_solve_work_size(m->n_params, 0);
+    if (need == 0)
+        return RC_ERR_ARG;
+    if ((uintptr_t)work % sizeof(double) != 0)
+        return RC_ERR_ARG;
+    if (work_bytes < need)
+        return RC_ERR_CAPACITY;
+    /* the prefix of rc_solve_work up to A, then A, V and the tables */
+    rc_solve_work *w = (rc_solve_work *)work;
+    double *A = (double *)((unsigned char *)work + offsetof(rc_solve_work, A));
+    double *V = A + (size_t)m->n_params * m->n_params;
+    double *sin_q = NULL, *cos_q = NULL;
+    const size_t full = rc_solve_work_size(m->n_params, n);
+    if (samples != NULL && full != 0 && work_bytes >= full) {
+        sin_q = V + (size_t)m->n_params * m->n_params;
+        cos_q = sin_q + (size_t)RC_NJ * n;
+    }
+    return solve_with(m, res, w, A, V, sin_q, cos_q, cfg, samples, n);
 }
 
 rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n)
