@@ -40,6 +40,33 @@ static void chain_trig(chain *c, const double dh[][4], const double ct[], const 
     }
 }
 
+/* chain_trig for the six joints of a model, with fewer operations (the
+ * solver's passes): R' = R Rz(theta) Rx(alpha) written on the columns x, y, z
+ * of R, o' = o + R (a ct, a st, d):
+ *   x' = x ct + y st,  v = y ct - x st,  y' = v ca + z sa,  z' = z ca - v sa,
+ *   o' = o + a x' + d z.
+ * Equal to chain_trig up to rounding. */
+static void chain_axes(chain *c, const rc_model *m, const double ct[RC_NJ], const double st[RC_NJ],
+                       const double ca[RC_NJ], const double sa[RC_NJ])
+{
+    static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    memcpy(c->R[0], eye, sizeof eye);
+    c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const double a = m->x[RC_P_A(i)], d = m->x[RC_P_D(i)];
+        const double *P = c->R[i];
+        double *N = c->R[i + 1];
+        for (unsigned r = 0; r < 3; ++r) {
+            const double xr = P[3 * r], yr = P[3 * r + 1], zr = P[3 * r + 2];
+            const double nx = xr * ct[i] + yr * st[i], v = yr * ct[i] - xr * st[i];
+            N[3 * r] = nx;
+            N[3 * r + 1] = v * ca[i] + zr * sa[i];
+            N[3 * r + 2] = zr * ca[i] - v * sa[i];
+            c->o[i + 1][r] = c->o[i][r] + a * nx + d * zr;
+        }
+    }
+}
+
 static void chain_compute(chain *c, const double dh[][4], const double theta_rad[], unsigned nj)
 {
     double ct[RC_NJ], st[RC_NJ], ca[RC_NJ], sa[RC_NJ];
@@ -394,8 +421,9 @@ void rc_qtrig_fill(double *sin_q, double *cos_q, const rc_sample *samples, size_
     RC_ASSERT(sin_q != NULL && cos_q != NULL && (samples != NULL || n == 0));
     for (size_t k = 0; k < n; ++k)
         for (unsigned i = 0; i < RC_NJ; ++i) {
-            sin_q[RC_NJ * k + i] = sin(samples[k].q_rad[i]);
-            cos_q[RC_NJ * k + i] = cos(samples[k].q_rad[i]);
+            const double q = samples[k].q_rad[i]; /* one load: sin and cos fuse to sincos */
+            sin_q[RC_NJ * k + i] = sin(q);
+            cos_q[RC_NJ * k + i] = cos(q);
         }
 }
 
@@ -404,10 +432,11 @@ void rc_meas_prepare(rc_meas_prep *p, const rc_model *m)
     RC_ASSERT(p != NULL && m != NULL);
     memset(p, 0, sizeof *p);
     for (unsigned i = 0; i < RC_NJ; ++i) {
-        p->cos_off[i] = cos(m->x[RC_P_THETA(i)]);
-        p->sin_off[i] = sin(m->x[RC_P_THETA(i)]);
-        p->cos_alpha[i] = cos(m->x[RC_P_ALPHA(i)]);
-        p->sin_alpha[i] = sin(m->x[RC_P_ALPHA(i)]);
+        const double th = m->x[RC_P_THETA(i)], al = m->x[RC_P_ALPHA(i)];
+        p->cos_off[i] = cos(th);
+        p->sin_off[i] = sin(th);
+        p->cos_alpha[i] = cos(al);
+        p->sin_alpha[i] = sin(al);
     }
     p->tool = (int16_t)tool_index(m);
     for (unsigned i = 0; i < m->n_effects; ++i) {
@@ -431,12 +460,11 @@ rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sampl
     return meas_chain(len_mm, jac, m, s, &c, p);
 }
 
-rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const rc_meas_prep *pr,
-                           const rc_sample *s, const double *sin_q, const double *cos_q)
+/* Chain of the model at sample s by angle addition; p (3) the measured point. */
+static void chain_prepared(chain *c, double p[3], const rc_model *m, const rc_meas_prep *pr, const rc_sample *s,
+                           const double *sin_q, const double *cos_q)
 {
-    chain c;
-    double own_s[RC_NJ], own_c[RC_NJ], p[3], ct[RC_NJ], st[RC_NJ];
-    RC_ASSERT(len_mm != NULL && m != NULL && pr != NULL && s != NULL);
+    double own_s[RC_NJ], own_c[RC_NJ], ct[RC_NJ], st[RC_NJ];
     if (sin_q == NULL || cos_q == NULL) {
         rc_qtrig_fill(own_s, own_c, s, 1);
         sin_q = own_s;
@@ -455,8 +483,25 @@ rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const
                 st[i] = sin(th[i]);
             }
     }
-    chain_trig(&c, (const double(*)[4])m->x, ct, st, pr->cos_alpha, pr->sin_alpha, RC_NJ);
-    chain_tool(p, &c, m, pr->tool);
+    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha);
+    chain_tool(p, c, m, pr->tool);
+}
+
+void rc_point_prepared(double pos_mm[3], const rc_model *m, const rc_meas_prep *p, const rc_sample *s,
+                       const double *sin_q, const double *cos_q)
+{
+    chain c;
+    RC_ASSERT(pos_mm != NULL && m != NULL && p != NULL && s != NULL);
+    chain_prepared(&c, pos_mm, m, p, s, sin_q, cos_q);
+}
+
+rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const rc_meas_prep *pr,
+                           const rc_sample *s, const double *sin_q, const double *cos_q)
+{
+    chain c;
+    double p[3];
+    RC_ASSERT(len_mm != NULL && m != NULL && pr != NULL && s != NULL);
+    chain_prepared(&c, p, m, pr, s, sin_q, cos_q);
     return meas_chain(len_mm, jac, m, s, &c, p);
 }
 

@@ -155,6 +155,12 @@ typedef struct rc_meas_prep {
 
 void rc_meas_prepare(rc_meas_prep *p, const rc_model *m);
 
+/* The measured point (the flange point, or the tool point with
+ * RC_EFF_TOOL_OFFSET) of sample s as rc_meas_prepared sees it: pos_mm (3).
+ * sin_q, cos_q as there. */
+void rc_point_prepared(double pos_mm[3], const rc_model *m, const rc_meas_prep *p, const rc_sample *s,
+                       const double *sin_q, const double *cos_q);
+
 /* rc_meas with p = rc_meas_prepare(m) and the reading's sines and cosines
  * sin_q, cos_q (6 each, rc_qtrig_fill of s; both NULL: computed here).
  * The result does not depend on whether they are given. */

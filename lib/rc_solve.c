@@ -544,20 +544,22 @@ rc_status rc_solve_buf(rc_model *m, rc_solve_result *res, void *work, size_t wor
 rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n)
 {
     double A[16] = {0}, b[4] = {0}, c[3] = {0, 0, 0};
+    rc_meas_prep mp;
     RC_ASSERT(enc_mm != NULL && m != NULL);
     if (n < 4)
         return RC_ERR_RANK;
+    rc_meas_prepare(&mp, m);
     /* centre the points for conditioning: unknowns e' = e - c, k = |e'|^2 */
     for (size_t i = 0; i < n; ++i) {
         double p[3];
-        rc_fk(p, NULL, m, samples[i].q_rad);
+        rc_point_prepared(p, m, &mp, &samples[i], NULL, NULL);
         for (int r = 0; r < 3; ++r)
             c[r] += p[r] / (double)n;
     }
     double trace = 0.0;
     for (size_t i = 0; i < n; ++i) {
         double p[3];
-        rc_fk(p, NULL, m, samples[i].q_rad);
+        rc_point_prepared(p, m, &mp, &samples[i], NULL, NULL);
         for (int r = 0; r < 3; ++r)
             p[r] -= c[r];
         /* -2 p.e' + k = L^2 - |p|^2 */
@@ -595,7 +597,7 @@ rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample 
         e[r] = b[r] + c[r];
     for (size_t i = 0; i < n; ++i) {
         double p[3];
-        rc_fk(p, NULL, m, samples[i].q_rad);
+        rc_point_prepared(p, m, &mp, &samples[i], NULL, NULL);
         const double dx = p[0] - e[0], dy = p[1] - e[1], dz = p[2] - e[2];
         const double d = sqrt(dx * dx + dy * dy + dz * dz) - samples[i].len_mm;
         res2 += d * d;
