@@ -45,17 +45,38 @@ static void chain_trig(chain *c, const double dh[][4], const double ct[], const 
  * of R, o' = o + R (a ct, a st, d):
  *   x' = x ct + y st,  v = y ct - x st,  y' = v ca + z sa,  z' = z ca - v sa,
  *   o' = o + a x' + d z.
+ * Joint 1 starts from the base (R = I). With full = 0 the last rotation R6 is
+ * left out (a length without Jacobian or tool offset needs o6 only).
  * Equal to chain_trig up to rounding. */
 static void chain_axes(chain *c, const rc_model *m, const double ct[RC_NJ], const double st[RC_NJ],
-                       const double ca[RC_NJ], const double sa[RC_NJ])
+                       const double ca[RC_NJ], const double sa[RC_NJ], int full)
 {
     static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const double a0 = m->x[RC_P_A(0)], d0 = m->x[RC_P_D(0)];
+    double *R1 = c->R[1];
     memcpy(c->R[0], eye, sizeof eye);
     c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
-    for (unsigned i = 0; i < RC_NJ; ++i) {
+    R1[0] = ct[0];
+    R1[1] = -st[0] * ca[0];
+    R1[2] = st[0] * sa[0];
+    R1[3] = st[0];
+    R1[4] = ct[0] * ca[0];
+    R1[5] = -ct[0] * sa[0];
+    R1[6] = 0.0;
+    R1[7] = sa[0];
+    R1[8] = ca[0];
+    c->o[1][0] = a0 * ct[0];
+    c->o[1][1] = a0 * st[0];
+    c->o[1][2] = d0;
+    for (unsigned i = 1; i < RC_NJ; ++i) {
         const double a = m->x[RC_P_A(i)], d = m->x[RC_P_D(i)];
         const double *P = c->R[i];
         double *N = c->R[i + 1];
+        if (i == RC_NJ - 1 && !full) {
+            for (unsigned r = 0; r < 3; ++r)
+                c->o[i + 1][r] = c->o[i][r] + a * (P[3 * r] * ct[i] + P[3 * r + 1] * st[i]) + d * P[3 * r + 2];
+            break;
+        }
         for (unsigned r = 0; r < 3; ++r) {
             const double xr = P[3 * r], yr = P[3 * r + 1], zr = P[3 * r + 2];
             const double nx = xr * ct[i] + yr * st[i], v = yr * ct[i] - xr * st[i];
@@ -460,9 +481,10 @@ rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sampl
     return meas_chain(len_mm, jac, m, s, &c, p);
 }
 
-/* Chain of the model at sample s by angle addition; p (3) the measured point. */
+/* Chain of the model at sample s by angle addition; p (3) the measured point.
+ * full = 0: R[6] is not needed (rc_meas_prepared without jac). */
 static void chain_prepared(chain *c, double p[3], const rc_model *m, const rc_meas_prep *pr, const rc_sample *s,
-                           const double *sin_q, const double *cos_q)
+                           const double *sin_q, const double *cos_q, int full)
 {
     double own_s[RC_NJ], own_c[RC_NJ], ct[RC_NJ], st[RC_NJ];
     if (sin_q == NULL || cos_q == NULL) {
@@ -483,7 +505,7 @@ static void chain_prepared(chain *c, double p[3], const rc_model *m, const rc_me
                 st[i] = sin(th[i]);
             }
     }
-    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha);
+    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || pr->tool >= 0);
     chain_tool(p, c, m, pr->tool);
 }
 
@@ -492,7 +514,7 @@ void rc_point_prepared(double pos_mm[3], const rc_model *m, const rc_meas_prep *
 {
     chain c;
     RC_ASSERT(pos_mm != NULL && m != NULL && p != NULL && s != NULL);
-    chain_prepared(&c, pos_mm, m, p, s, sin_q, cos_q);
+    chain_prepared(&c, pos_mm, m, p, s, sin_q, cos_q, 0);
 }
 
 rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const rc_meas_prep *pr,
@@ -501,7 +523,7 @@ rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const
     chain c;
     double p[3];
     RC_ASSERT(len_mm != NULL && m != NULL && pr != NULL && s != NULL);
-    chain_prepared(&c, p, m, pr, s, sin_q, cos_q);
+    chain_prepared(&c, p, m, pr, s, sin_q, cos_q, jac != NULL);
     return meas_chain(len_mm, jac, m, s, &c, p);
 }
 
