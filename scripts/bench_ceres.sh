@@ -6,8 +6,10 @@
 # Installs libceres-dev when missing (root, apt), builds bench/ceres outside
 # the main build (in BUILD_DIR/ceres-bench), then for data/sim_irb120.csv and
 # ../shared/data/robotcali.csv (when present) times `rcal calibrate
-# --test-fraction 0` and ceres_fit alternately and prints medians, the ratio
-# and both final RMS. Not part of the default build or the test run.
+# --test-fraction 0` and ceres_fit alternately and prints medians, the ratio,
+# both final RMS and where Ceres first reached rcal's final RMS (the stopping
+# rules differ: Ceres runs to its function tolerance or 100 iterations).
+# Not part of the default build or the test run.
 set -eu
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -40,10 +42,12 @@ for DATA in data/sim_irb120.csv ../shared/data/robotcali.csv; do
         i=$((i + 1))
     done
     mr=$(median < "$TMP/r"); mc=$(median < "$TMP/c")
-    rr=$("$RCAL" calibrate --data "$DATA" --test-fraction 0 | sed -n 's/^training RMSE: before \([0-9.]*\) mm, after \([0-9.]*\) mm/\1 -> \2/p')
-    cr=$("$CB/ceres_fit" "$TMP/start.json" "$DATA")
+    "$RCAL" calibrate --data "$DATA" --test-fraction 0 --json > "$TMP/r.json"
+    r0=$(sed -n 's/.*"train_before": {[^}]*"rmse_mm": \([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
+    r1=$(sed -n 's/.*"train_after": {[^}]*"rmse_mm": \([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
+    it=$(sed -n 's/.*"iterations": \([0-9]*\).*/\1/p' "$TMP/r.json")
     echo "$DATA: $RUNS runs each, whole process, alternating"
-    echo "  rcal calibrate --test-fraction 0   median $mr ms   train RMS $rr mm"
-    echo "  ceres_fit (autodiff, LM, dense QR) median $mc ms   $cr"
+    echo "  rcal calibrate --test-fraction 0   median $mr ms   $it iterations, train RMS $r0 -> $r1 mm"
+    echo "  ceres_fit (autodiff, LM, dense QR) median $mc ms   $("$CB/ceres_fit" "$TMP/start.json" "$DATA" --target-rms "$r1")"
     awk -v r="$mr" -v c="$mc" 'BEGIN {printf "  ratio ceres / rcal: %.1fx\n", c / r}'
 done

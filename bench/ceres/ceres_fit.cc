@@ -11,7 +11,10 @@
 // One AutoDiffCostFunction per sample, Levenberg-Marquardt, dense QR, one
 // thread, at most 100 iterations, Ceres' default tolerances.
 //
-// usage: ceres_fit START_MODEL.json DATA.csv   (prints one line)
+// usage: ceres_fit START_MODEL.json DATA.csv [--params] [--target-rms MM]
+// prints one line; --params adds the fitted a_mm d_mm alpha_deg theta_deg per
+// joint and the encoder outlet; --target-rms the first iteration whose
+// training RMS is at or below MM (rcal's final RMS) and Solve's time then.
 #include <ceres/ceres.h>
 
 #include <cmath>
@@ -134,8 +137,19 @@ bool load_data(const char *path, std::vector<double> *q_rad, std::vector<double>
 }  // namespace
 
 int main(int argc, char **argv) {
-    if (argc != 3) {
-        std::fprintf(stderr, "usage: ceres_fit START_MODEL.json DATA.csv\n");
+    bool print_params = false;
+    double target_rms = -1.0;
+    int bad = argc < 3;
+    for (int i = 3; i < argc && !bad; ++i) {
+        if (std::strcmp(argv[i], "--params") == 0)
+            print_params = true;
+        else if (std::strcmp(argv[i], "--target-rms") == 0 && i + 1 < argc)
+            target_rms = std::strtod(argv[++i], nullptr);
+        else
+            bad = 1;
+    }
+    if (bad) {
+        std::fprintf(stderr, "usage: ceres_fit START_MODEL.json DATA.csv [--params] [--target-rms MM]\n");
         return 2;
     }
     double x[kParams];
@@ -166,5 +180,24 @@ int main(int argc, char **argv) {
                 static_cast<int>(sum.iterations.size()) - 1, std::sqrt(2.0 * sum.initial_cost / n),
                 std::sqrt(2.0 * sum.final_cost / n), sum.total_time_in_seconds * 1e3,
                 ceres::TerminationTypeToString(sum.termination_type));
+    if (target_rms > 0.0) {
+        const ceres::IterationSummary *hit = nullptr;
+        for (const auto &it : sum.iterations)
+            if (std::sqrt(2.0 * it.cost / n) <= target_rms) {
+                hit = &it;
+                break;
+            }
+        if (hit)
+            std::printf("  RMS <= %.6f mm first at iteration %d, %.2f ms into Solve\n", target_rms, hit->iteration,
+                        hit->cumulative_time_in_seconds * 1e3);
+        else
+            std::printf("  RMS <= %.6f mm never reached\n", target_rms);
+    }
+    if (print_params) {
+        for (int i = 0; i < 6; ++i)
+            std::printf("  joint %d: a %.4f mm, d %.4f mm, alpha %.5f deg, theta %.5f deg\n", i + 1, x[4 * i],
+                        x[4 * i + 1], x[4 * i + 2] / kDeg, x[4 * i + 3] / kDeg);
+        std::printf("  encoder e = (%.4f, %.4f, %.4f) mm\n", x[24], x[25], x[26]);
+    }
     return sum.IsSolutionUsable() ? 0 : 1;
 }
