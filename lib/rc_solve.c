@@ -56,16 +56,19 @@ const char *rc_exit_str(rc_exit e)
     return "unknown";
 }
 
-/* A pass over the samples evaluates them with rc_meas_prepared: the model's
- * sines once per pass, the readings' from the tables sin_q, cos_q ((n x 6)
- * each, rc_qtrig_fill) or, both NULL, per sample. */
+/* What a pass over the samples may use besides the samples: it evaluates them
+ * with rc_meas_prepared (the model's sines once per pass), the readings'
+ * sines from the tables sin_q, cos_q ((n x 6) each, rc_qtrig_fill; both
+ * NULL: per sample), and rc_normal_eq's row blocks in jblk (NE_BLOCK x nf;
+ * NULL: row by row). */
 typedef struct {
     const double *sin_q, *cos_q;
-} qtab;
+    double *jblk;
+} passbuf;
 
 static const double *tab_row(const double *t, size_t k) { return t != NULL ? t + (size_t)RC_NJ * k : NULL; }
 
-static rc_status cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *samples, qtab t, size_t n)
+static rc_status cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *samples, passbuf t, size_t n)
 {
     rc_meas_prep p;
     double sum = 0.0;
@@ -85,7 +88,7 @@ static rc_status cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *
 
 rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples, size_t n)
 {
-    const qtab none = {NULL, NULL};
+    const passbuf none = {NULL, NULL, NULL};
     return cost_tab(cost_mm2, m, samples, none, n);
 }
 
@@ -95,45 +98,83 @@ rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples,
  * those of the row-by-row update to the last bit. */
 #define NE_BLOCK 4
 
-static rc_status normal_eq_tab(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
-                               const uint16_t *idx, unsigned nf, const rc_sample *samples, qtab t, size_t n)
+/* The rows of samples [s0, s0 + NE_BLOCK) (zero rows past n) into jb
+ * (NE_BLOCK x nf, free parameters only) and their residuals into rb. */
+static rc_status block_rows(double *jb, double rb[NE_BLOCK], double *sum, double *jrow, const rc_model *m,
+                            const rc_meas_prep *p, const uint16_t *idx, unsigned nf, const rc_sample *samples,
+                            passbuf t, size_t s0, size_t n)
 {
-    double jb[NE_BLOCK][RC_MAX_PARAMS], rb[NE_BLOCK];
+    for (unsigned b = 0; b < NE_BLOCK; ++b) {
+        const size_t s = s0 + b;
+        double *row = jb + (size_t)b * nf, l;
+        if (s >= n) { /* past the last sample: a zero row adds nothing */
+            rb[b] = 0.0;
+            memset(row, 0, nf * sizeof row[0]);
+            continue;
+        }
+        rc_status st = rc_meas_prepared(&l, jrow, m, p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
+        if (st != RC_OK)
+            return st;
+        rb[b] = l - samples[s].len_mm;
+        *sum += rb[b] * rb[b];
+        for (unsigned i = 0; i < nf; ++i)
+            row[i] = jrow[idx[i]];
+    }
+    return RC_OK;
+}
+
+/* A (nf x nf, upper triangle) += Jb^T Jb, g += Jb^T rb for the NE_BLOCK rows
+ * j0..j3 (nf each), a symmetric rank-NE_BLOCK update; restrict: A, g and the
+ * rows never overlap, so the inner loop vectorises. */
+static void rank_block_update(double *restrict A, double *restrict g, const double *restrict j0,
+                              const double *restrict j1, const double *restrict j2, const double *restrict j3,
+                              const double rb[NE_BLOCK], unsigned nf)
+{
+    const double r0 = rb[0], r1 = rb[1], r2 = rb[2], r3 = rb[3];
+    for (size_t i = 0; i < nf; ++i) {
+        const double a0 = j0[i], a1 = j1[i], a2 = j2[i], a3 = j3[i];
+        if (a0 == 0.0 && a1 == 0.0 && a2 == 0.0 && a3 == 0.0)
+            continue;
+        g[i] = g[i] + a0 * r0 + a1 * r1 + a2 * r2 + a3 * r3;
+        double *restrict Ai = A + i * nf;
+        for (size_t k = i; k < nf; ++k)
+            Ai[k] = Ai[k] + a0 * j0[k] + a1 * j1[k] + a2 * j2[k] + a3 * j3[k];
+    }
+}
+
+static rc_status normal_eq_tab(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
+                               const uint16_t *idx, unsigned nf, const rc_sample *samples, passbuf t, size_t n)
+{
     double sum = 0.0;
     rc_meas_prep p;
     RC_ASSERT(A != NULL && g != NULL && cost_mm2 != NULL && jrow != NULL && m != NULL && idx != NULL);
-    RC_ASSERT(nf <= RC_MAX_PARAMS && (samples != NULL || n == 0));
+    RC_ASSERT(samples != NULL || n == 0);
     rc_meas_prepare(&p, m);
     memset(A, 0, (size_t)nf * nf * sizeof A[0]);
     memset(g, 0, nf * sizeof g[0]);
-    for (size_t s0 = 0; s0 < n; s0 += NE_BLOCK) {
-        const unsigned nb = n - s0 < NE_BLOCK ? (unsigned)(n - s0) : NE_BLOCK;
-        for (unsigned b = 0; b < NE_BLOCK; ++b) {
-            const size_t s = s0 + b;
-            double l;
-            if (b >= nb) { /* last block: zero rows add nothing */
-                rb[b] = 0.0;
-                memset(jb[b], 0, nf * sizeof jb[b][0]);
-                continue;
-            }
-            rc_status st = rc_meas_prepared(&l, jrow, m, &p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
-            if (st != RC_OK)
-                return st;
-            rb[b] = l - samples[s].len_mm;
-            sum += rb[b] * rb[b];
-            for (unsigned i = 0; i < nf; ++i)
-                jb[b][i] = jrow[idx[i]];
-        }
-        /* upper triangle only, a symmetric rank-NE_BLOCK update */
+    for (size_t s = 0; s < n && t.jblk == NULL; ++s) { /* row by row */
+        double l;
+        rc_status st = rc_meas_prepared(&l, jrow, m, &p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
+        if (st != RC_OK)
+            return st;
+        const double r = l - samples[s].len_mm;
+        sum += r * r;
         for (unsigned i = 0; i < nf; ++i) {
-            const double a0 = jb[0][i], a1 = jb[1][i], a2 = jb[2][i], a3 = jb[3][i];
-            if (a0 == 0.0 && a1 == 0.0 && a2 == 0.0 && a3 == 0.0)
+            const double ji = jrow[idx[i]];
+            if (ji == 0.0)
                 continue;
-            g[i] = g[i] + a0 * rb[0] + a1 * rb[1] + a2 * rb[2] + a3 * rb[3];
+            g[i] += ji * r;
             double *Ai = &A[(size_t)i * nf];
             for (unsigned k = i; k < nf; ++k)
-                Ai[k] = Ai[k] + a0 * jb[0][k] + a1 * jb[1][k] + a2 * jb[2][k] + a3 * jb[3][k];
+                Ai[k] += ji * jrow[idx[k]];
         }
+    }
+    for (size_t s0 = 0; s0 < n && t.jblk != NULL; s0 += NE_BLOCK) {
+        double rb[NE_BLOCK];
+        rc_status st = block_rows(t.jblk, rb, &sum, jrow, m, &p, idx, nf, samples, t, s0, n);
+        if (st != RC_OK)
+            return st;
+        rank_block_update(A, g, t.jblk, t.jblk + nf, t.jblk + 2 * nf, t.jblk + 3 * nf, rb, nf);
     }
     for (unsigned i = 0; i < nf; ++i)
         for (unsigned k = 0; k < i; ++k)
@@ -145,7 +186,7 @@ static rc_status normal_eq_tab(double *A, double *g, double *cost_mm2, double *j
 rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
                        const uint16_t *idx, unsigned nf, const rc_sample *samples, size_t n)
 {
-    const qtab none = {NULL, NULL};
+    const passbuf none = {NULL, NULL, NULL};
     return normal_eq_tab(A, g, cost_mm2, jrow, m, idx, nf, samples, none, n);
 }
 
@@ -438,7 +479,7 @@ static double lm_subspace_step(double *dx, const rc_solve_work *w, const double 
 
 /* rc_solve on w's small fields and the matrices A, V ((nf x nf) each, n_params^2
  * entries of room) and the sample tables t. */
-static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, qtab tab,
+static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, passbuf tab,
                             const rc_solve_config *cfg, const rc_sample *samples, size_t n)
 {
     static const rc_solve_config defaults;
@@ -629,12 +670,12 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
 }
 
 /* solve_core after filling the sample tables sin_q, cos_q ((n x 6) each, or
- * both NULL: none). */
+ * both NULL: none); jblk (NE_BLOCK x n_params) or NULL. */
 static rc_status solve_with(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V,
-                            double *sin_q, double *cos_q, const rc_solve_config *cfg, const rc_sample *samples,
-                            size_t n)
+                            double *sin_q, double *cos_q, double *jblk, const rc_solve_config *cfg,
+                            const rc_sample *samples, size_t n)
 {
-    qtab tab = {NULL, NULL};
+    passbuf tab = {NULL, NULL, jblk};
     if (sin_q != NULL && cos_q != NULL) {
         rc_qtrig_fill(sin_q, cos_q, samples, n);
         tab.sin_q = sin_q;
@@ -647,25 +688,35 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
                    const rc_sample *samples, size_t n)
 {
     RC_ASSERT(m != NULL && w != NULL);
-    double *sin_q = NULL, *cos_q = NULL;
-    const size_t np2 = (size_t)m->n_params * m->n_params;
-    /* the tables in the tails of A and V when they fit (never when n_params
-     * is out of range: solve_core refuses that) */
-    if (m->n_params <= RC_MAX_PARAMS && samples != NULL && n <= (sizeof w->A / sizeof w->A[0] - np2) / RC_NJ) {
-        sin_q = w->A + np2;
-        cos_q = w->V + np2;
+    double *sin_q = NULL, *cos_q = NULL, *jblk = NULL;
+    /* In the unused tails of A and V (beyond n_params^2 entries), when they
+     * fit: the row blocks and sin_q in A's, cos_q in V's. (n_params out of
+     * range: solve_core refuses it.) */
+    if (m->n_params <= RC_MAX_PARAMS) {
+        const size_t cap = sizeof w->A / sizeof w->A[0], np = m->n_params;
+        size_t room = cap - np * np;
+        double *tail = w->A + np * np;
+        if (room >= NE_BLOCK * np) {
+            jblk = tail;
+            tail += NE_BLOCK * np;
+            room -= NE_BLOCK * np;
+        }
+        if (samples != NULL && n <= room / RC_NJ) {
+            sin_q = tail;
+            cos_q = w->V + np * np;
+        }
     }
-    return solve_with(m, res, w, w->A, w->V, sin_q, cos_q, cfg, samples, n);
+    return solve_with(m, res, w, w->A, w->V, sin_q, cos_q, jblk, cfg, samples, n);
 }
 
 size_t rc_solve_work_size(unsigned n_params, size_t n_samples)
 {
     if (n_params < RC_N_BASE || n_params > RC_MAX_PARAMS)
         return 0;
-    const size_t np2 = (size_t)n_params * n_params;
-    if (n_samples > (SIZE_MAX / sizeof(double) - 2 * np2) / (2 * RC_NJ))
+    const size_t np = n_params, fixed = 2 * np * np + NE_BLOCK * np;
+    if (n_samples > (SIZE_MAX / sizeof(double) - fixed - offsetof(rc_solve_work, A)) / (2 * RC_NJ))
         return 0;
-    return offsetof(rc_solve_work, A) + (2 * np2 + 2 * RC_NJ * n_samples) * sizeof(double);
+    return offsetof(rc_solve_work, A) + (fixed + 2 * RC_NJ * n_samples) * sizeof(double);
 }
 
 rc_status rc_solve_buf(rc_model *m, rc_solve_result *res, void *work, size_t work_bytes,
@@ -679,17 +730,19 @@ rc_status rc_solve_buf(rc_model *m, rc_solve_result *res, void *work, size_t wor
         return RC_ERR_ARG;
     if (work_bytes < need)
         return RC_ERR_CAPACITY;
-    /* the prefix of rc_solve_work up to A, then A, V and the tables */
+    /* the prefix of rc_solve_work up to A, then A, V, the row blocks and the
+     * tables */
+    const size_t np = m->n_params;
     rc_solve_work *w = (rc_solve_work *)work;
     double *A = (double *)((unsigned char *)work + offsetof(rc_solve_work, A));
-    double *V = A + (size_t)m->n_params * m->n_params;
+    double *V = A + np * np, *jblk = V + np * np;
     double *sin_q = NULL, *cos_q = NULL;
     const size_t full = rc_solve_work_size(m->n_params, n);
     if (samples != NULL && full != 0 && work_bytes >= full) {
-        sin_q = V + (size_t)m->n_params * m->n_params;
+        sin_q = jblk + NE_BLOCK * np;
         cos_q = sin_q + (size_t)RC_NJ * n;
     }
-    return solve_with(m, res, w, A, V, sin_q, cos_q, cfg, samples, n);
+    return solve_with(m, res, w, A, V, sin_q, cos_q, jblk, cfg, samples, n);
 }
 
 rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n)

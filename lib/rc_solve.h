@@ -134,10 +134,11 @@ typedef struct rc_solve_result {
 /* Workspace of rc_solve. The two matrices come last so that a workspace
  * sized by the parameter count (rc_solve_work_size, rc_solve_buf) is this
  * struct's prefix followed by the matrices at their real size. rc_solve
- * keeps the samples' joint sines and cosines (rc_qtrig_fill) in the unused
- * tails of A and V (beyond n_params^2 entries) when they fit there (up to
- * 1,414 samples for 27 parameters); A and V hold nf x nf matrices (leading
- * dimension nf) as before. */
+ * keeps its normal-equation row blocks (4 x n_params) and the samples' joint
+ * sines and cosines (rc_qtrig_fill) in the unused tails of A and V (beyond
+ * n_params^2 entries) when they fit there (the tables up to 1,396 samples for
+ * 27 parameters); A and V hold nf x nf matrices (leading dimension nf) as
+ * before. */
 typedef struct rc_solve_work {
     double ev[RC_MAX_PARAMS];                 /* (nf) eigenvalues */
     double g[RC_MAX_PARAMS];                  /* (nf) gradient J^T r */
@@ -180,11 +181,13 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
                    const rc_sample *samples, size_t n);
 
 /* Workspace sized by the parameter count (as cminpack's lwa): the bytes
- * rc_solve_buf needs for a model of n_params parameters, and with
- * n_samples > 0 also for the tables of those samples' joint sines and
- * cosines (12 doubles a sample), which spare every pass 12 sines per sample.
- * 0 when n_params is outside 27..RC_MAX_PARAMS. For 27 parameters: 23 KB
- * without tables, sizeof(rc_solve_work) is 159 KB. */
+ * rc_solve_buf needs for a model of n_params parameters (the prefix of
+ * rc_solve_work up to A, the two n_params^2 matrices and 4 x n_params for the
+ * normal-equation row blocks), and with n_samples > 0 also for the tables of
+ * those samples' joint sines and cosines (12 doubles a sample), which spare
+ * every pass 12 sines per sample. 0 when n_params is outside
+ * 27..RC_MAX_PARAMS. For 27 parameters: 25,512 bytes without tables;
+ * sizeof(rc_solve_work) is 160,440 bytes (RC_MAX_PARAMS 96). */
 size_t rc_solve_work_size(unsigned n_params, size_t n_samples);
 
 /* rc_solve in caller-provided storage work (work_bytes, aligned for
