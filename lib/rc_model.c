@@ -53,18 +53,11 @@ static void chain_axes(chain *c, const rc_model *m, const double ct[RC_NJ], cons
 {
     static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     const double a0 = m->x[RC_P_A(0)], d0 = m->x[RC_P_D(0)];
-    double *R1 = c->R[1];
+    const double R1[9] = {ct[0], -st[0] * ca[0], st[0] * sa[0], st[0], ct[0] * ca[0], -ct[0] * sa[0],
+                          0.0,   sa[0],          ca[0]};
     memcpy(c->R[0], eye, sizeof eye);
+    memcpy(c->R[1], R1, sizeof R1);
     c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
-    R1[0] = ct[0];
-    R1[1] = -st[0] * ca[0];
-    R1[2] = st[0] * sa[0];
-    R1[3] = st[0];
-    R1[4] = ct[0] * ca[0];
-    R1[5] = -ct[0] * sa[0];
-    R1[6] = 0.0;
-    R1[7] = sa[0];
-    R1[8] = ca[0];
     c->o[1][0] = a0 * ct[0];
     c->o[1][1] = a0 * st[0];
     c->o[1][2] = d0;

@@ -734,7 +734,7 @@ rc_status rc_solve_buf(rc_model *m, rc_solve_result *res, void *work, size_t wor
      * tables */
     const size_t np = m->n_params;
     rc_solve_work *w = (rc_solve_work *)work;
-    double *A = (double *)((unsigned char *)work + offsetof(rc_solve_work, A));
+    double *A = w->A; /* at offsetof(rc_solve_work, A): inside the buffer */
     double *V = A + np * np, *jblk = V + np * np;
     double *sin_q = NULL, *cos_q = NULL;
     const size_t full = rc_solve_work_size(m->n_params, n);
