@@ -74,11 +74,9 @@ static void test_param_jacobian_base(void **state)
     check_param_jacobian(&m, &g);
 }
 
-static void test_param_jacobian_effects(void **state)
+/* The nominal model with every effect kind, effect parameters ~1e-3. */
+static rc_model model_with_effects(rc_rng *g)
 {
-    (void)state;
-    rc_rng g;
-    rc_rng_seed(&g, 2);
     rc_model m = nominal();
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_OFFSET, 0, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 1, 0), RC_OK);
@@ -90,7 +88,16 @@ static void test_param_jacobian_effects(void **state)
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
     assert_int_equal(m.n_params, RC_N_BASE + 1 + 1 + 1 + 4 + 2 + 3 + 1 + 3);
     for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
-        m.x[k] = 1e-3 * rc_rng_normal(&g);
+        m.x[k] = 1e-3 * rc_rng_normal(g);
+    return m;
+}
+
+static void test_param_jacobian_effects(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 2);
+    rc_model m = model_with_effects(&g);
     check_param_jacobian(&m, &g);
 }
 
@@ -283,18 +290,11 @@ static void test_prepared_effects(void **state)
     (void)state;
     rc_rng g;
     rc_rng_seed(&g, 22);
-    rc_model m = nominal();
-    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_OFFSET, 0, 0), RC_OK);
-    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 2, 0), RC_OK);
-    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 4, 0), RC_OK);
-    assert_int_equal(rc_model_add_effect(&m, RC_EFF_GROUP_OFFSET, 0, 3), RC_OK);
-    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_SCALE, 0, 0), RC_OK);
-    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
-    for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
-        m.x[k] = 1e-3 * rc_rng_normal(&g);
+    rc_model m = model_with_effects(&g);
     rc_meas_prep p;
     rc_meas_prepare(&p, &m);
-    assert_true(p.has_joint_effect && p.joint_effect[2] && p.joint_effect[4] && !p.joint_effect[0]);
+    assert_true(p.has_joint_effect && p.joint_effect[1] && p.joint_effect[2] && p.joint_effect[3]);
+    assert_true(!p.joint_effect[0] && !p.joint_effect[4] && !p.joint_effect[5]);
     assert_int_equal(p.tool, m.n_params - 3);
     check_prepared(&m, &g);
 }

@@ -324,10 +324,9 @@ static void test_solve_buf_refuses(void **state)
     free(buf);
 }
 
-/* rc_normal_eq adds the rows in blocks of four; the sums must be those of
- * the row-by-row update (computed here from rc_meas_prepared rows) to the
- * last bit, with a sample count that leaves a partial block and a free set
- * that skips parameters. */
+/* rc_normal_eq: the sums of the row-by-row update of rc_meas_prepared rows
+ * (computed here) to the last bit, for a free set that skips parameters;
+ * its cost is rc_cost's. */
 static void test_normal_eq_rows(void **state)
 {
     (void)state;
@@ -368,6 +367,23 @@ static void test_normal_eq_rows(void **state)
     assert_true(c2 == cost);
 }
 
+/* The solver adds the rows in blocks of four in its workspace; with all
+ * RC_MAX_PARAMS parameters the fixed struct has no room for the blocks (nor
+ * the tables), so rc_solve adds row by row while rc_solve_buf with a full
+ * buffer uses blocks and tables: the same solution to the last bit. 203
+ * samples leave a partial last block. */
+static void test_blocks_equal_rows(void **state)
+{
+    (void)state;
+    enum { N = 203 };
+    static rc_sample s[N];
+    rc_model start, truth;
+    sim_set(&start, &truth, s, N, 35);
+    assert_int_equal(rc_model_add_effect(&start, RC_EFF_GROUP_OFFSET, 0, RC_MAX_PARAMS - RC_N_BASE), RC_OK);
+    assert_int_equal(start.n_params, RC_MAX_PARAMS);
+    solve_three_ways(RC_METHOD_LM, &start, s, N);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -376,6 +392,7 @@ int main(void)
         cmocka_unit_test(test_encoder_guess),   cmocka_unit_test(test_real_data),
         cmocka_unit_test(test_work_size),       cmocka_unit_test(test_solve_buf_same),
         cmocka_unit_test(test_solve_buf_refuses), cmocka_unit_test(test_normal_eq_rows),
+        cmocka_unit_test(test_blocks_equal_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
