@@ -334,6 +334,8 @@ int rch_ffi_calibrate_file(rch_ffi_calib **out, const char *data_path, const cha
         return fail(RCH_FFI_ERR_ARG, err, err_len, "unknown method '%s' (lm, ltlm, lm-paper, ltlm-paper)", method);
     if (!(test_fraction >= 0.0 && test_fraction < 1.0))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "test_fraction must be in [0, 1)");
+    if (truth_path) /* the replicated pipeline has no truth comparison (rch_calib_run will) */
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "truth_path: not supported by this build yet");
     rch_ffi_calib *c = malloc(sizeof *c);
     if (!c)
         return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
