@@ -228,8 +228,12 @@ class Result:
     params:                    list of Param (value, delta in mm or deg)
     encoder_mm:                (ex, ey, ez) identified encoder outlet, mm
     n_train, n_test, converged, exit, iterations, cost_evals, method, seed
+    truth_flange:              with truth=: flange errors against the truth
+                               (before/after RMS and max, mm), else None
+    json(), json_text():       the report as `rcal calibrate --json` prints it
     model:                     the identified Model (full precision)
-    write(path):               the calibrated model file (`--out`)
+    write(path):               the calibrated model file (`--out`), never
+                               over one of the inputs
     """
 
     def __init__(self, handle, method, data, seed):
@@ -259,6 +263,26 @@ class Result:
                                            ctypes.byref(u)))
             self.params.append(Param(name.value.decode(), _UNITS[u.value], v.value, dv.value))
         self.encoder_mm = tuple(p.value for p in self.params[24:27])
+        truth = (ctypes.c_double * 4)()
+        self.truth_flange = None
+        if lib.rch_ffi_calib_truth(self._h, truth) == 0:
+            self.truth_flange = dict(zip(("before_rms_mm", "before_max_mm", "after_rms_mm", "after_max_mm"),
+                                         truth[:4]))
+
+    def json_text(self):
+        """The report exactly as `rcal calibrate --json` prints it (the same
+        writer; time_ms is this run's)."""
+        lib = _lib.lib()
+        needed = ctypes.c_size_t()
+        lib.rch_ffi_calib_json(self._h, None, 0, ctypes.byref(needed))
+        buf = ctypes.create_string_buffer(needed.value)
+        _check(lib.rch_ffi_calib_json(self._h, buf, needed.value, None))
+        return buf.value.decode()
+
+    def json(self):
+        """json_text() parsed: a dict."""
+        import json
+        return json.loads(self.json_text())
 
     def __del__(self):
         if getattr(self, "_h", None) and self._h.value:
@@ -307,7 +331,7 @@ def calibrate(data_csv=None, q_deg=None, L_mm=None, robot=None, method="lm", tes
     max_iter:      iteration cap, 0 for the method's default
     fix:           parameters held at nominal: "a1,theta6" or a list of names
     tool_offset:   also identify where the cable is attached on the flange
-    truth:         a simulated truth model file (reported by the CLI only)
+    truth:         a simulated truth model file: Result.truth_flange
     Returns a Result. Raises RcalError (bad file with file:line:col, too few
     samples, unknown method) or ValueError (bad arguments)."""
     if (data_csv is None) == (q_deg is None):

@@ -62,6 +62,8 @@ def _declare(lib):
         "rch_ffi_calib_param": (i, [vp, u, cp, sz, _c_double_p, _c_double_p, _c_int_p]),
         "rch_ffi_calib_model": (i, [pvp, vp, cp, sz]),
         "rch_ffi_calib_write": (i, [vp, cp, cp, sz]),
+        "rch_ffi_calib_truth": (i, [vp, _c_double_p]),
+        "rch_ffi_calib_json": (i, [vp, cp, sz, _c_size_p]),
         "rch_ffi_compensate": (i, [vp, vp, _c_double_p, _c_int_p, _c_double_p, sz, i, d, cp, sz]),
     }
     for name, (res, args) in sigs.items():

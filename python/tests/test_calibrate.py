@@ -127,3 +127,31 @@ def test_identified_model_handle(py):
     q = [10.0, 20.0, -30.0, 40.0, 50.0, 60.0]
     assert m.fk(q) != m.fk(q, nominal=True)
     assert [round(v, 12) for (_, _, v) in m.params()][:24] == [round(p.value, 12) for p in py.params][:24]
+
+
+def test_json_report_is_the_cli_one(py, cli):
+    mine = py.json()
+    for doc in (mine, cli):
+        assert doc.pop("time_ms") >= 0.0
+    assert mine == cli
+
+
+def test_truth_figures_match_cli(run_cli):
+    truth = "data/sim_irb120_truth.json"
+    cli = json.loads(run_cli("calibrate", "--data", DATA, "--truth", truth, "--json").stdout)["truth_flange"]
+    r = rcal.calibrate(data_csv=DATA, truth=truth)
+    assert set(r.truth_flange) == set(cli)
+    for key, v in r.truth_flange.items():
+        assert float("%.6f" % v) == cli[key], key
+    assert r.truth_flange["after_rms_mm"] < r.truth_flange["before_rms_mm"] / 10
+    assert rcal.calibrate(data_csv=DATA).truth_flange is None
+
+
+def test_write_never_over_an_input(tmp_path):
+    data = tmp_path / "data.csv"
+    data.write_bytes(open(DATA, "rb").read())
+    r = rcal.calibrate(data_csv=str(data))
+    with pytest.raises(rcal.RcalError) as e:
+        r.write(str(data))
+    assert e.value.kind == "output failed"
+    assert data.read_bytes() == open(DATA, "rb").read()

@@ -5,14 +5,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "rc_comp.h"
 #include "rc_model.h"
 #include "rc_solve.h"
 #include "rch_calib.h"
-#include "rch_data.h"
 #include "rch_diag.h"
 #include "rch_robot.h"
 
@@ -26,141 +24,11 @@ struct rch_ffi_model {
     rch_robot robot; /* robot.model is the model, robot.nominal its nominal table */
 };
 
-/* ------------------------------------------------------------------------
- * Calibration pipeline of `rcal calibrate` on main before the pipeline moves
- * into the host library (rch_calib_run on branch h-cal): the same calls in
- * the same order as tools/cmd_calibrate.c. Replaced by rch_calib_run when
- * that lands. */
-typedef struct calib_cfg {
-    const char *data_path, *robot_path, *truth_path, *fix;
-    rc_method method;
-    double test_fraction;
-    unsigned long seed;
-    unsigned max_iter;
-    int tool_offset;
-} calib_cfg;
-
-typedef struct calib_result {
-    calib_cfg cfg;
-    rch_robot robot;
-    size_t n_data, n_train, n_test;
-    rc_model before, model;
-    rc_solve_result solve;
-    int finite, after_ok;
-    rc_metrics before_m, after_m, train_before, train_after;
-} calib_result;
-
-static int calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d)
-{
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", list);
-    char *save = NULL;
-    for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        unsigned k;
-        char name[64];
-        for (k = 0; k < m->n_params; ++k)
-            if (strcmp(rc_param_name(name, sizeof name, m, k), tok) == 0)
-                break;
-        if (k == m->n_params) {
-            rch_diag_set(d, "", 0, 0, "--fix: unknown parameter '%s'", tok);
-            return -1;
-        }
-        fixed[k] = 1;
-    }
-    return 0;
-}
-
-static int calib_fit(calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test, rch_diag *d)
-{
-    if (rch_calib_start(&r->before, w, &r->robot, train, r->n_train, d) != 0)
-        return -1;
-    r->model = r->before;
-    uint8_t fixed[RC_MAX_PARAMS];
-    memset(fixed, 0, sizeof fixed);
-    if (r->cfg.fix && calib_fix(fixed, &r->model, r->cfg.fix, d) != 0)
-        return -2;
-    rc_solve_config cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.method = r->cfg.method;
-    cfg.fixed = fixed;
-    cfg.max_iter = r->cfg.max_iter;
-    cfg.seed = r->cfg.seed;
-    const rc_status st = rc_solve(&r->model, &r->solve, w, &cfg, train, r->n_train);
-    if (st != RC_OK) {
-        rch_diag_set(d, "", 0, 0, "solver failed: %s", rc_strerror(st));
-        return -1;
-    }
-    r->finite = 1;
-    for (unsigned k = 0; k < r->model.n_params; ++k)
-        r->finite &= isfinite(r->model.x[k]) != 0;
-    const rc_sample *eval_set = r->n_test ? test : train;
-    const size_t n_eval = r->n_test ? r->n_test : r->n_train;
-    rc_eval(&r->before_m, &r->before, eval_set, n_eval);
-    r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
-    rc_eval(&r->train_before, &r->before, train, r->n_train);
-    if (!r->after_ok || rc_eval(&r->train_after, &r->model, train, r->n_train) != RC_OK)
-        memset(&r->train_after, 0, sizeof r->train_after);
-    return 0;
-}
-
-static int calib_run(calib_result *r, const calib_cfg *cfg, rch_diag *d)
-{
-    memset(r, 0, sizeof *r);
-    r->cfg = *cfg;
-    rch_data data;
-    if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || rch_data_load(&data, cfg->data_path, 0, d) != 0)
-        return -1;
-    r->n_data = data.n;
-    int rc = -1;
-    size_t *idx = malloc(data.n * sizeof *idx);
-    rc_solve_work *w = malloc(sizeof *w);
-    rc_sample *train = NULL, *test = NULL;
-    if (cfg->tool_offset && rc_model_add_effect(&r->robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
-        rch_diag_set(d, "", 0, 0, "cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
-        goto done;
-    }
-    if (!idx || !w) {
-        rch_diag_set(d, "", 0, 0, "out of memory");
-        goto done;
-    }
-    rch_split(idx, data.n, cfg->seed);
-    r->n_test = (size_t)floor(cfg->test_fraction * (double)data.n + 0.5);
-    r->n_train = data.n - r->n_test;
-    if (r->n_train < RC_N_BASE) {
-        rch_diag_set(d, "", 0, 0, "%zu training samples; at least %d are needed for 27 parameters", r->n_train,
-                     RC_N_BASE);
-        goto done;
-    }
-    test = rch_data_pick(data.s, idx, r->n_test);
-    train = rch_data_pick(data.s, idx + r->n_test, r->n_train);
-    if (!test || !train) {
-        rch_diag_set(d, "", 0, 0, "out of memory");
-        goto done;
-    }
-    rc = calib_fit(r, w, train, test, d);
-done:
-    free(idx);
-    free(w);
-    free(train);
-    free(test);
-    rch_data_free(&data);
-    return rc;
-}
-
-static int calib_write_model(FILE *f, const calib_result *r)
-{
-    char cal[512];
-    snprintf(cal, sizeof cal,
-             "{\"method\": \"%s\", \"data\": \"%s\", \"n_train\": %zu, \"n_test\": %zu, \"seed\": %lu, "
-             "\"rmse_before_mm\": %.6f, \"rmse_after_mm\": %.6f}",
-             rc_method_name(r->cfg.method), r->cfg.data_path, r->n_train, r->n_test, r->cfg.seed, r->before_m.rmse_mm,
-             r->after_m.rmse_mm);
-    return r->finite ? rch_robot_write(f, r->robot.name, &r->model, &r->robot.nominal, cal) : -1;
-}
-/* ------------------------------------------------------------------------ */
-
+/* A calibration: the host pipeline's result (rch_calib_run), with copies of
+ * the paths its cfg points at (the caller's strings need not outlive the
+ * call). */
 struct rch_ffi_calib {
-    calib_result r;
+    rch_calib_result r;
     char data_path[PATH_LEN], robot_path[PATH_LEN], truth_path[PATH_LEN], fix[PATH_LEN];
 };
 
@@ -328,14 +196,12 @@ int rch_ffi_calibrate_file(rch_ffi_calib **out, const char *data_path, const cha
     if (!out || !data_path || !robot_path)
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: NULL argument (data and robot are required)");
     *out = NULL;
-    calib_cfg cfg;
+    rch_calib_cfg cfg;
     memset(&cfg, 0, sizeof cfg);
     if (rch_method_parse(&cfg.method, method ? method : "lm") != 0)
         return fail(RCH_FFI_ERR_ARG, err, err_len, "unknown method '%s' (lm, ltlm, lm-paper, ltlm-paper)", method);
     if (!(test_fraction >= 0.0 && test_fraction < 1.0))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "test_fraction must be in [0, 1)");
-    if (truth_path) /* the replicated pipeline has no truth comparison (rch_calib_run will) */
-        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "truth_path: not supported by this build yet");
     rch_ffi_calib *c = malloc(sizeof *c);
     if (!c)
         return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
@@ -353,7 +219,7 @@ int rch_ffi_calibrate_file(rch_ffi_calib **out, const char *data_path, const cha
     cfg.tool_offset = tool_offset != 0;
     rch_diag d;
     memset(&d, 0, sizeof d);
-    const int rc = calib_run(&c->r, &cfg, &d);
+    const int rc = rch_calib_run(&c->r, &cfg, &d);
     if (rc != 0) {
         free(c);
         const int input = d.file[0] != '\0';
@@ -450,7 +316,7 @@ int rch_ffi_calib_param(const rch_ffi_calib *c, unsigned k, char *name, size_t l
 {
     if (!c || k >= c->r.model.n_params)
         return RCH_FFI_ERR_ARG;
-    const calib_result *r = &c->r;
+    const rch_calib_result *r = &c->r;
     const double nominal = k < RC_N_DH ? r->robot.model.x[k] : (k < RC_N_BASE ? r->before.x[k] : 0.0);
     double v = 0.0, dv = 0.0;
     param_out(&r->model, k, r->finite ? r->model.x[k] : 0.0, name, len, &v, unit);
@@ -483,13 +349,45 @@ int rch_ffi_calib_write(const rch_ffi_calib *c, const char *path, char *err, siz
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calib_write: NULL argument");
     if (!c->r.finite)
         return fail(RCH_FFI_ERR_NUMERIC, err, err_len, "not writing %s: the model is not finite", path);
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return fail(RCH_FFI_ERR_IO, err, err_len, "cannot write %s", path);
-    const int bad = calib_write_model(f, &c->r) != 0;
-    if ((fclose(f) != 0) | bad)
-        return fail(RCH_FFI_ERR_IO, err, err_len, "cannot write %s", path);
+    rch_diag d;
+    memset(&d, 0, sizeof d);
+    if (rch_calib_save_model(&c->r, path, &d) != 0)
+        return fail_diag(RCH_FFI_ERR_IO, err, err_len, &d);
     return RCH_FFI_OK;
+}
+
+int rch_ffi_calib_truth(const rch_ffi_calib *c, double *out)
+{
+    if (!c || !out || !c->r.have_truth)
+        return RCH_FFI_ERR_ARG;
+    out[0] = c->r.truth_before_rms_mm;
+    out[1] = c->r.truth_before_max_mm;
+    out[2] = c->r.truth_after_rms_mm;
+    out[3] = c->r.truth_after_max_mm;
+    return RCH_FFI_OK;
+}
+
+int rch_ffi_calib_json(const rch_ffi_calib *c, char *buf, size_t len, size_t *needed)
+{
+    if (!c)
+        return RCH_FFI_ERR_ARG;
+    char *text = NULL;
+    size_t n = 0;
+    FILE *f = open_memstream(&text, &n);
+    if (!f)
+        return RCH_FFI_ERR_NOMEM;
+    const int bad = rch_calib_json(f, &c->r) != 0;
+    if ((fclose(f) != 0) | bad) {
+        free(text);
+        return RCH_FFI_ERR_IO;
+    }
+    if (needed)
+        *needed = n + 1;
+    const int fits = buf && len > n;
+    if (fits)
+        memcpy(buf, text, n + 1);
+    free(text);
+    return fits ? RCH_FFI_OK : RCH_FFI_ERR_ARG;
 }
 
 /* ---- compensation ---- */

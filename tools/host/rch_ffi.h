@@ -21,7 +21,7 @@
  *    library's diagnostic, "file:line:col: message" when the failure is in
  *    an input file. rch_ffi_strerror() names a status.
  *
- * Depends on: rcal_core, rcal_host (rch_robot, rch_data, rch_calib, rc_comp).
+ * Depends on: rcal_core, rcal_host (rch_robot, rch_calib, rc_comp).
  * Memory: handles are heap-allocated by this module and owned by the caller
  * until *_free; every array is the caller's. Thread safety: no global
  * state; a handle may be read from several threads, never freed while in use.
@@ -94,10 +94,11 @@ int rch_ffi_cable_length(const rch_ffi_model *m, double *len_mm, const double *q
  * "ltlm-paper" (NULL: "lm"); test_fraction in [0, 1); seed: split and LTLM
  * seed; max_iter: 0 for the method's default; fix: parameters held nominal
  * ("a1,theta6") or NULL; tool_offset: 1 to identify the cable attachment;
- * truth_path: a simulated truth model or NULL. */
+ * truth_path: a simulated truth model or NULL (rch_ffi_calib_truth). */
 
-/* Calibrate from a measurements CSV (q1..q6 in degrees, L in mm). The
- * result is that of `rcal calibrate --data data_path ...` bit for bit. */
+/* Calibrate from a measurements CSV (q1..q6 in degrees, L in mm) with the
+ * host function `rcal calibrate` runs (rch_calib_run): the result is the
+ * CLI's bit for bit. */
 int rch_ffi_calibrate_file(rch_ffi_calib **out, const char *data_path, const char *robot_path, const char *method,
                            double test_fraction, unsigned long seed, unsigned max_iter, const char *fix,
                            int tool_offset, const char *truth_path, char *err, size_t err_len);
@@ -134,9 +135,21 @@ int rch_ffi_calib_param(const rch_ffi_calib *c, unsigned k, char *name, size_t l
 /* A new model handle holding the identified model and the robot's nominal
  * table (the model `rcal calibrate --out` writes, at full precision). */
 int rch_ffi_calib_model(rch_ffi_model **out, const rch_ffi_calib *c, char *err, size_t err_len);
-/* Write the calibrated model file (what `rcal calibrate --out path` writes).
- * RCH_FFI_ERR_NUMERIC when the model is not finite. */
+/* Write the calibrated model file (what `rcal calibrate --out path` writes),
+ * whole or not at all, never over one of the calibration's inputs.
+ * RCH_FFI_ERR_NUMERIC when the model is not finite, RCH_FFI_ERR_IO on a
+ * write error or when path names an input. */
 int rch_ffi_calib_write(const rch_ffi_calib *c, const char *path, char *err, size_t err_len);
+/* Flange positions against the simulated truth (truth_path given), mm, over
+ * the CLI's random poses with base heading and height aligned. out: (4)
+ * before_rms, before_max, after_rms, after_max. RCH_FFI_ERR_ARG when the
+ * calibration had no truth. */
+int rch_ffi_calib_truth(const rch_ffi_calib *c, double *out);
+/* The report as `rcal calibrate --json` prints it (one JSON object, the same
+ * writer), NUL-terminated into buf (len bytes). *needed (may be NULL): the
+ * bytes it takes with the NUL. RCH_FFI_ERR_ARG when buf is NULL or too
+ * small (call again with *needed bytes). */
+int rch_ffi_calib_json(const rch_ffi_calib *c, char *buf, size_t len, size_t *needed);
 
 /* ---- compensation (rcal compensate) ---- */
 
