@@ -8,13 +8,29 @@
 #include "rch_comp.h"
 #include "rch_opt.h"
 
+/* Which parameters the corrections came from (issue 10). */
+static void print_sources(const rch_comp_result *r, const char *model)
+{
+    fprintf(stderr, "rcal compensate: corrections from %u of 24 DH parameters of %s%s; held at nominal: %s\n",
+            24u - r->n_held, model,
+            r->version1 ? " (a version-1 model: the held ones from the nominal model's identifiability)" : "",
+            r->n_held ? r->held : "none");
+    fprintf(stderr,
+            "rcal compensate: the held parameters' fitted values would have moved the flange by up to %.4f mm at "
+            "these targets; mode %s (orientation %s by the data); largest 95 %% position uncertainty at a "
+            "compensated target %.4f mm; %lu targets left uncompensated for their uncertainty\n",
+            r->max_held_mm, r->position_only_used ? "position only" : "position and orientation",
+            r->orientation_determined ? "determined" : "not determined", r->max_pos95_mm, r->n_uncertain);
+}
+
 int rcal_cmd_compensate(int argc, char **argv)
 {
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
-    int position_only = 0, summary = 0;
+    int position_only = 0, full_pose = 0, summary = 0;
+    double max_unc_mm = 1.0;
     const rch_opt opts[] = {
-        {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/1, from rcal calibrate --out)",
+        {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/2 or /1, from rcal calibrate --out)",
          RCH_OPT_REQUIRED, NULL},
         {"--nominal", RCH_OPT_STR, &nominal, 0, 0, "ROBOT.json",
          "nominal model the targets were made with (default: the model file's \"nominal\" table)", 0, NULL},
@@ -23,8 +39,14 @@ int rcal_cmd_compensate(int argc, char **argv)
          "result (default standard output, flushed per line); a file is replaced only when complete, and never "
          "when it is the input or a model",
          0, NULL},
-        {"--position-only", RCH_OPT_FLAG, &position_only, 0, 0, NULL,
-         "match the flange position only (default: position and orientation)", 0, NULL},
+        {"--position-only", RCH_OPT_FLAG, &position_only, 0, 0, NULL, "match the flange position only", 0, NULL},
+        {"--full-pose", RCH_OPT_FLAG, &full_pose, 0, 0, NULL,
+         "match position and orientation even when the model file says the data did not determine the "
+         "orientation (default: full pose only when it did)",
+         0, NULL},
+        {"--max-uncertainty-mm", RCH_OPT_DOUBLE, &max_unc_mm, 0.001, 1000.0, "MM",
+         "leave a target uncompensated (with a warning) where the model's 95 % position uncertainty is larger", 0,
+         NULL},
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
         {"--summary", RCH_OPT_FLAG, &summary, 0, 0, NULL, "targets, iterations, largest correction and time on stderr",
@@ -43,6 +65,10 @@ int rcal_cmd_compensate(int argc, char **argv)
     const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, &seen, stdout, stderr);
     if (ps != RCH_OPT_OK)
         return ps == RCH_OPT_HELP ? 0 : 2;
+    if (position_only && full_pose) {
+        fprintf(stderr, "rcal compensate: --position-only and --full-pose exclude each other\n");
+        return 2;
+    }
 
     const rch_comp_job job = {
         .model_path = model,
@@ -51,6 +77,8 @@ int rcal_cmd_compensate(int argc, char **argv)
         .out_path = out,
         .format = strcmp(format, "csv") == 0 ? RCH_COMP_CSV : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID : RCH_COMP_AUTO,
         .position_only = position_only,
+        .full_pose = full_pose,
+        .max_unc_mm = max_unc_mm,
         .max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0, /* 0: the core's 0.1 rad */
     };
     rch_comp_result r;
@@ -63,6 +91,8 @@ int rcal_cmd_compensate(int argc, char **argv)
         fprintf(stderr, "rcal compensate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
+    if (summary)
+        print_sources(&r, model);
     if (summary) {
         char fails[160] = "";
         if (r.n_fail > 0)

@@ -189,11 +189,13 @@ class Model:
             out.append((name.value.decode(), _UNITS[u.value], v.value))
         return out
 
-    def fk(self, q_deg, nominal=False, rotation=False):
+    def fk(self, q_deg, nominal=False, rotation=False, determined=False):
         """Forward kinematics: the flange point (x, y, z) in mm, base frame, at
         joint angles q_deg (degrees). One pose (6 numbers) gives one (x, y, z);
         a batch (n x 6) gives n of them ((n, 3) numpy array for numpy input).
-        nominal=True uses the nominal table of a calibrated model.
+        nominal=True uses the nominal table of a calibrated model;
+        determined=True the part of it compensation uses (the DH parameters
+        the data did not determine held nominal).
         rotation=True also returns the flange rotation(s) as 9 numbers,
         row-major: ((x, y, z), R)."""
         lib = _lib.lib()
@@ -201,7 +203,8 @@ class Model:
         pos = (ctypes.c_double * max(3 * n, 1))()
         rot = (ctypes.c_double * max(9 * n, 1))() if rotation else None
         err = ctypes.create_string_buffer(_ERR_LEN)
-        _check(lib.rch_ffi_fk(self._h, 1 if nominal else 0, pos, rot, q, n, err, _ERR_LEN), err)
+        which = 1 if nominal else (2 if determined else 0)
+        _check(lib.rch_ffi_fk(self._h, which, pos, rot, q, n, err, _ERR_LEN), err)
         p = _rows(pos, n, 3, single, numpy)
         return (p, _rows(rot, n, 9, single, numpy)) if rotation else p
 
@@ -360,7 +363,7 @@ def calibrate(data_csv=None, q_deg=None, L_mm=None, robot=None, method="lm", tes
     return Result(h.value, method, data, int(seed))
 
 
-def compensate(model, targets_deg, nominal=None, position_only=False, max_dev_deg=0.0, return_status=False):
+def compensate(model, targets_deg, nominal=None, position_only=None, max_dev_deg=0.0, return_status=False):
     """Correct joint targets made with the nominal model so that the
     calibrated robot reaches the nominal flange pose: q' with
     FK_cal(q') = FK_nom(q), target by target in order with one stream, as
@@ -370,12 +373,18 @@ def compensate(model, targets_deg, nominal=None, position_only=False, max_dev_de
     targets_deg:   one target (6 joint angles, degrees) or a batch (n x 6)
     nominal:       the Model the targets were made with (default: the
                    calibrated model's nominal table)
-    position_only: match the flange position only
+    position_only: True position only, False position and orientation,
+                   None (default) as the model file says, like `rcal
+                   compensate` (position only unless the data determined
+                   the orientation). The model used is the determined part
+                   of the calibration (parameters the data did not
+                   determine held nominal).
     max_dev_deg:   largest correction per joint, degrees (0: 0.1 rad)
     Returns the corrected targets in degrees, shaped like the input; with
     return_status=True also a list of per-target codes: 0 converged, 1
     position matched with the orientation best effort, 2 not converged
-    (target plus the last good correction). A target outside the joint limits
+    (target plus the last good correction), 3 left uncompensated (the
+    model's 95 % position uncertainty there is above 1 mm). A target outside the joint limits
     raises RcalError."""
     lib = _lib.lib()
     q, n, single, numpy = _doubles(targets_deg, 6, "targets_deg")
@@ -383,7 +392,8 @@ def compensate(model, targets_deg, nominal=None, position_only=False, max_dev_de
     status = (ctypes.c_int * max(n, 1))()
     err = ctypes.create_string_buffer(_ERR_LEN)
     _check(lib.rch_ffi_compensate(model._h, nominal._h if nominal is not None else None, out, status, q, n,
-                                  1 if position_only else 0, float(max_dev_deg), err, _ERR_LEN), err)
+                                  0 if position_only is None else (1 if position_only else 2),
+                                  float(max_dev_deg), err, _ERR_LEN), err)
     corrected = _rows(out, n, 6, single, numpy)
     if return_status:
         codes = list(status[:n])

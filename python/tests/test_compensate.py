@@ -45,9 +45,9 @@ def test_batch_matches_cli_exactly(cal_file, run_cli, tmp_path):
     # (near a wrist singularity) with the orientation best effort
     assert (len(status), status.count(2), status.count(1)) == tuple(int(c) for c in counts.groups())
     assert set(status) <= {0, 1} and status.count(0) > 90
-    # the point of it: FK_cal(q') == FK_nom(q)
+    # the point of it: FK_cal(q') == FK_nom(q), with the determined model
     q = [[float(v) for v in r] for r in rows]
-    for p_cal, p_nom in zip(model.fk(corrected), model.fk(q, nominal=True)):
+    for p_cal, p_nom in zip(model.fk(corrected, determined=True), model.fk(q, nominal=True)):
         assert max(abs(a - b) for a, b in zip(p_cal, p_nom)) < 1e-4
     moved = max(abs(a - b) for qa, qb in zip(corrected, q) for a, b in zip(qa, qb))
     assert moved > 1e-3  # the model differs from nominal: targets did change

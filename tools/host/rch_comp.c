@@ -2,6 +2,8 @@
  * (rch_comp.h): CSV and RAPID line handling, file safety. */
 #include "rch_comp.h"
 
+#include "rc_rand.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -23,6 +25,7 @@
 typedef struct {
     rc_comp_stream *stream;
     const rc_model *cal;
+    const rch_comp_gate *gate;
     rch_comp_result *res;
     FILE *out, *warn;
     const char *in_name;
@@ -93,6 +96,36 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
             rch_diag_set(d, c->in_name, line, cols[i], "q%u = %g deg is outside the joint limits [%g, %g] deg", i + 1,
                          in_deg[i], m->q_min_rad[i] / DEG, m->q_max_rad[i] / DEG);
             return -1;
+        }
+    }
+    if (c->gate) {
+        double qd[RC_NJ], pf[3], pd[3];
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            qd[i] = (double)q[i];
+        if (c->gate->fit) {
+            rc_fk(pf, NULL, c->gate->fit, qd);
+            rc_fk(pd, NULL, m, qd);
+            double e = sqrt((pf[0] - pd[0]) * (pf[0] - pd[0]) + (pf[1] - pd[1]) * (pf[1] - pd[1]) +
+                            (pf[2] - pd[2]) * (pf[2] - pd[2]));
+            if (e > c->res->max_held_mm)
+                c->res->max_held_mm = e;
+        }
+        if (c->gate->unc && c->gate->unc->present) {
+            double u95 = rch_model_unc_pos95_mm(c->gate->unc, m, qd);
+            double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm : 1.0;
+            if (!(u95 <= lim)) {
+                for (unsigned i = 0; i < RC_NJ; ++i)
+                    out_deg[i] = in_deg[i];
+                c->res->n_uncertain++;
+                if (c->warn)
+                    fprintf(c->warn,
+                            "%s:%u: warning: target left uncompensated: the model's 95 %% position uncertainty here "
+                            "is %.4f mm, above %.4f mm (the data did not determine the model at this pose)\n",
+                            c->in_name, line, u95, lim);
+                return 1;
+            }
+            if (u95 > c->res->max_pos95_mm)
+                c->res->max_pos95_mm = u95;
         }
     }
     rc_comp_result res;
@@ -297,7 +330,14 @@ static int do_rapid(comp_ctx *c, const char *line, size_t n, unsigned lineno, rc
 int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
                    const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d)
 {
-    comp_ctx c = {.stream = s, .cal = cal, .res = res, .out = out, .warn = warn, .in_name = in_name,
+    return rch_comp_lines_gated(out, res, in, in_name, s, cal, NULL, format, warn, d);
+}
+
+int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
+                         const rc_model *cal, const rch_comp_gate *gate, rch_comp_format format, FILE *warn,
+                         rch_diag *d)
+{
+    comp_ctx c = {.stream = s, .cal = cal, .gate = gate, .res = res, .out = out, .warn = warn, .in_name = in_name,
                   .format = (int)format};
     char *line = NULL;
     size_t cap = 0;
@@ -372,12 +412,22 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
         return -1;
     const rc_model *nom = job->nominal_path ? &nominal_robot.model : &robot.nominal;
     res->no_nominal = !job->nominal_path && !robot.has_nominal;
+    static rc_model det;
+    static rch_model_unc unc;
+    det = robot.model;
+    memset(&unc, 0, sizeof unc);
+    if (robot.has_nominal || robot.unc.present)
+        res->n_held = rch_comp_determined(&det, &unc, &res->version1, res->held, sizeof res->held, &robot,
+                                          &robot.nominal);
+    res->orientation_determined = unc.present && !res->version1 && unc.orientation_determined;
+    res->position_only_used = job->position_only || (!job->full_pose && !res->orientation_determined &&
+                                                     (robot.has_nominal || robot.unc.present));
     rc_comp_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.max_dev_rad = (rc_real)(job->max_dev_deg * DEG);
-    cfg.flags = job->position_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
+    cfg.flags = res->position_only_used ? RC_COMP_FLAG_POSITION_ONLY : 0u;
     static rc_comp_stream s;
-    rc_status st = rc_comp_stream_init(&s, &robot.model, nom, &cfg);
+    rc_status st = rc_comp_stream_init(&s, &det, nom, &cfg);
     if (st != RC_OK) {
         rch_diag_set(d, job->model_path, 0, 0, "the model cannot be used for compensation: %s", rc_strerror(st));
         return -1;
@@ -399,7 +449,8 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     }
     if (o.f == stdout)
         setvbuf(stdout, NULL, _IOLBF, 0);
-    int rc = rch_comp_lines(o.f, res, in, in_name, &s, &robot.model, job->format, warn, d);
+    const rch_comp_gate gate = {&robot.model, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm};
+    int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);
     if (rc < 0) {
@@ -412,4 +463,53 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     if (rch_out_commit(&o, d) != 0)
         return -1;
     return rc;
+}
+
+unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, char *held, size_t held_len,
+                             const rch_robot *robot, const rc_model *nominal)
+{
+    *version1 = 0;
+    if (robot->unc.present) {
+        *unc = robot->unc;
+    } else {
+        /* version 1: what the nominal model's geometry lets cable lengths see */
+        enum { N = 400 };
+        static rc_sample s[N];
+        rc_model m = *nominal;
+        memcpy(&m.x[RC_P_ENC], &robot->model.x[RC_P_ENC], 3 * sizeof m.x[0]);
+        memcpy(m.q_min_rad, robot->model.q_min_rad, sizeof m.q_min_rad);
+        memcpy(m.q_max_rad, robot->model.q_max_rad, sizeof m.q_max_rad);
+        rc_rng g;
+        rc_rng_seed(&g, 20261129u);
+        size_t k = 0;
+        for (size_t i = 0; i < N; ++i) {
+            for (unsigned j = 0; j < RC_NJ; ++j)
+                s[k].q_rad[j] = m.q_min_rad[j] + (m.q_max_rad[j] - m.q_min_rad[j]) * rc_rng_u01(&g);
+            if (rc_meas(&s[k].len_mm, NULL, &m, &s[k]) == RC_OK)
+                ++k;
+        }
+        rch_uncert u;
+        char err[128];
+        memset(unc, 0, sizeof *unc);
+        if (rch_uncert_compute(&u, &m, NULL, s, k, 0, err, sizeof err) == 0) {
+            rch_model_unc_from(unc, &u);
+            rch_uncert_free(&u);
+        }
+        memset(unc->cov_dh, 0, sizeof unc->cov_dh);
+        *version1 = 1;
+    }
+    rch_model_unc_determined(det, &robot->model, nominal, unc);
+    unsigned n = 0;
+    size_t len = 0;
+    if (held_len)
+        held[0] = '\0';
+    for (unsigned k = 0; k < RC_N_DH && k < unc->n; ++k)
+        if (unc->comp_nominal[k]) {
+            char nm[32];
+            rc_param_name(nm, sizeof nm, &robot->model, k);
+            if (len < held_len)
+                len += (size_t)snprintf(held + len, held_len - len, "%s%s", n ? " " : "", nm);
+            ++n;
+        }
+    return n;
 }

@@ -35,6 +35,8 @@
 
 #include "rc_comp.h"
 #include "rch_diag.h"
+#include "rch_robot.h"
+#include "rch_uncert.h"
 
 typedef enum rch_comp_format {
     RCH_COMP_AUTO = 0, /* detect from the first line */
@@ -49,9 +51,20 @@ typedef struct rch_comp_job {
     const char *in_path;      /* targets; NULL or "-": standard input */
     const char *out_path;     /* result; NULL or "-": standard output */
     rch_comp_format format;
-    int position_only;        /* match the flange position only */
+    int position_only;        /* match the flange position only (forced) */
+    int full_pose;            /* position and orientation (forced); neither: from the model file */
     double max_dev_deg;       /* largest correction per joint; 0: the default 0.1 rad */
+    double max_unc_mm;        /* a target where the model's 95 % position uncertainty exceeds this is left
+                                 uncompensated, with a warning; 0: 1 mm */
 } rch_comp_job;
+
+/* What the compensation may act on (issue 10): the determined model is
+ * compiled into the stream; these say where it can be trusted. */
+typedef struct rch_comp_gate {
+    const rc_model *fit;       /* the full fit (for the size of what the held parameters would have moved) */
+    const rch_model_unc *unc;  /* covariance of the determined DH parameters; NULL: no gate */
+    double max_unc_mm;         /* see rch_comp_job */
+} rch_comp_gate;
 
 typedef struct rch_comp_result {
     rch_comp_format format;       /* the form read (detected or forced) */
@@ -64,6 +77,15 @@ typedef struct rch_comp_result {
     double max_fail_err_mm;       /* largest position error of a flagged target, as written */
     double t_ns;                  /* time spent in the compensation */
     int no_nominal;               /* the model file has no "nominal" table and none was given */
+    int version1;                 /* the model file carries no uncertainty (rcal-model/1): the held
+                                     parameters come from the nominal model's identifiability */
+    int position_only_used;       /* the mode compensation ran in */
+    int orientation_determined;   /* as the model file says */
+    unsigned n_held;              /* DH parameters held nominal */
+    char held[256];               /* their names */
+    double max_held_mm;           /* largest flange move the held parameters' fitted values would have made */
+    unsigned long n_uncertain;    /* targets left uncompensated: uncertainty above max_unc_mm */
+    double max_pos95_mm;          /* largest 95 % position uncertainty at a compensated target */
 } rch_comp_result;
 
 /* Compensate lines of `in` (named in_name in messages) to `out` with the
@@ -72,6 +94,21 @@ typedef struct rch_comp_result {
  * complete), -1 (an input error: d set; the output is incomplete). */
 int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
                    const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d);
+/* The same with a gate (may be NULL): targets where the determined model's
+ * 95 % position uncertainty exceeds gate->max_unc_mm are written unchanged
+ * with a warning and counted (return 1). */
+int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
+                         const rc_model *cal, const rch_comp_gate *gate, rch_comp_format format, FILE *warn,
+                         rch_diag *d);
+
+/* The model compensation uses, from a model file: its determined part
+ * (rcal-model/2), or for a version-1 calibrated model the fit with every DH
+ * parameter the nominal model's identifiability (400 random poses in the
+ * joint limits) ties to an undetermined combination that moves the robot
+ * held nominal (unc->present is then 1 with a zero covariance, *version1 1).
+ * held/held_len: the held parameters' names. Returns how many are held. */
+unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, char *held, size_t held_len,
+                             const rch_robot *robot, const rc_model *nominal);
 
 /* The whole command: load the models, open the input, refuse an output
  * that is one of the inputs, compensate, commit the output. res: counts

@@ -1,6 +1,8 @@
 /* rch_ffi.c - the flat C API for foreign-function use (see rch_ffi.h). */
 #include "rch_ffi.h"
 
+#include "rch_comp.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -154,7 +156,17 @@ int rch_ffi_fk(const rch_ffi_model *m, int nominal, double *pos_mm, double *rot,
 {
     if (!m || !pos_mm || (!q_deg && n > 0))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "fk: NULL argument");
-    const rc_model *model = nominal ? &m->robot.nominal : &m->robot.model;
+    static rc_model det; /* only for nominal == 2 */
+    const rc_model *model = nominal == 1 ? &m->robot.nominal : &m->robot.model;
+    if (nominal == 2) {
+        rch_model_unc unc;
+        int v1;
+        char held[8];
+        det = m->robot.model;
+        if (m->robot.has_nominal || m->robot.unc.present)
+            rch_comp_determined(&det, &unc, &v1, held, sizeof held, &m->robot, &m->robot.nominal);
+        model = &det;
+    }
     for (size_t i = 0; i < n; ++i) {
         rc_sample s;
         to_sample(&s, &q_deg[RC_NJ * i]);
@@ -400,12 +412,24 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate: NULL argument");
     if (!(max_dev_deg >= 0.0))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate: max_dev_deg must be >= 0");
-    const rc_model *m = &cal->robot.model;
+    /* the same model and mode as rcal compensate (rch_comp_run) */
+    static rc_model det;
+    static rch_model_unc unc;
+    int version1 = 0;
+    char held[256];
+    det = cal->robot.model;
+    memset(&unc, 0, sizeof unc);
+    const int calibrated = cal->robot.has_nominal || cal->robot.unc.present;
+    if (calibrated)
+        rch_comp_determined(&det, &unc, &version1, held, sizeof held, &cal->robot, &cal->robot.nominal);
+    const rc_model *m = &det;
     const rc_model *nom = nominal ? &nominal->robot.model : &cal->robot.nominal;
+    const int orient = unc.present && !version1 && unc.orientation_determined;
+    const int pos_only = position_only == 1 || (position_only == 0 && calibrated && !orient);
     rc_comp_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.max_dev_rad = max_dev_deg * DEG;
-    cfg.flags = position_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
+    cfg.flags = pos_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
     rc_comp_stream s;
     rc_comp_stream_init(&s, m, nom, &cfg);
     for (size_t i = 0; i < n; ++i) {
@@ -419,6 +443,13 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
                              j + 1, in[j], m->q_min_rad[j] / DEG, m->q_max_rad[j] / DEG);
                 return RCH_FFI_ERR_RANGE;
             }
+        }
+        if (unc.present && !version1 && !(rch_model_unc_pos95_mm(&unc, m, q) <= 1.0)) {
+            for (unsigned j = 0; j < RC_NJ; ++j)
+                out_deg[RC_NJ * i + j] = in[j]; /* left uncompensated: uncertainty above 1 mm */
+            if (status)
+                status[i] = 3;
+            continue;
         }
         rc_comp_result res;
         const rc_status st = rc_comp_stream_step(&s, qc, &res, q);

@@ -78,6 +78,8 @@ int rch_ffi_model_param(const rch_ffi_model *m, unsigned k, int nominal, char *n
 /* Forward kinematics at n poses. pos_mm: (n x 3) flange point (the tool
  * point when the model has a tool offset); rot: (n x 9) row-major flange
  * rotation, or NULL; q_deg: (n x 6). nominal: 1 to use the nominal table. */
+/* nominal: 0 the model, 1 its nominal table, 2 its determined part (what
+ * compensation uses). */
 int rch_ffi_fk(const rch_ffi_model *m, int nominal, double *pos_mm, double *rot, const double *q_deg, size_t n,
                char *err, size_t err_len);
 /* Predicted cable length at n poses (rc_meas; samples with t = 0 and group
@@ -159,8 +161,12 @@ int rch_ffi_calib_json(const rch_ffi_calib *c, char *buf, size_t len, size_t *ne
  * NULL for cal's "nominal" table. out_deg: (n x 6) corrected targets;
  * status: (n) or NULL, per target 0 converged, 1 position matched with the
  * orientation best effort, 2 not converged (written as the target plus the
- * last good correction); q_deg: (n x 6) targets. position_only: 1 to match
- * the position alone; max_dev_deg: largest correction per joint, 0 for the
+ * last good correction), 3 left uncompensated (the model's 95 % position
+ * uncertainty there is above 1 mm); q_deg: (n x 6) targets. The model is
+ * the determined part of cal (rch_comp_determined), as in `rcal compensate`.
+ * position_only: 0 as the model file says (position only unless it says
+ * the orientation was determined), 1 position only, 2 position and
+ * orientation; max_dev_deg: largest correction per joint, 0 for the
  * default (0.1 rad). A target outside cal's joint limits stops the batch
  * with RCH_FFI_ERR_RANGE ("target i: q j = ... is outside ..."). */
 int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, double *out_deg, int *status,

@@ -204,82 +204,107 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
  * (position, or orientation at a 100 mm lever) at the poses s? Relative to
  * the largest such effect of any direction: below 1e-6 it does not (d2 - d3
  * of parallel joints moves nothing the robot does). rel_out (nf). */
-/* FK effect of a small step along direction d (scaled coordinates): flange
- * position and orientation (at a 100 mm lever) at up to 40 of the poses s,
- * into g (RCH_FKREL_ROWS). */
+/* Physical size of a parameter step: mm as they are, angles at a 500 mm
+ * lever (the IRB120's reach), other units (effects) not counted. */
+static double phys_weight(const rc_model *m, unsigned k)
+{
+    int unit = rc_param_unit(m, k);
+    return unit == 0 ? 1.0 : unit == 1 ? 500.0 : 0.0;
+}
+
+/* FK effect (flange position, and orientation at a 100 mm lever) at up to
+ * RCH_FKREL_POSES of the poses s of the parameter step h * u (u: n_params,
+ * unscaled), divided by h, into g (RCH_FKREL_ROWS). Returns the poses used. */
 #define RCH_FKREL_POSES 40
 #define RCH_FKREL_ROWS (RCH_FKREL_POSES * 12)
-static void fk_effect(double *g, const scaled *z, unsigned d, const rc_model *m, const rc_sample *s, size_t n)
+static size_t fk_effect(double *g, const double *u, const rc_model *m, const rc_sample *s, size_t n)
 {
-    unsigned nf = z->nf;
-    size_t step = n > RCH_FKREL_POSES ? n / RCH_FKREL_POSES : 1, row = 0;
+    const double h = 1e-5;
+    size_t step = n > RCH_FKREL_POSES ? n / RCH_FKREL_POSES : 1, row = 0, used = 0;
     memset(g, 0, RCH_FKREL_ROWS * sizeof *g);
-    for (size_t i = 0; i < n && row + 12 <= RCH_FKREL_ROWS; i += step) {
+    for (size_t i = 0; i < n && row + 12 <= RCH_FKREL_ROWS; i += step, ++used) {
         rc_model a = *m, b = *m;
-        for (unsigned k = 0; k < nf; ++k) {
-            double v = z->V[k * nf + d] / z->D[k] * 1e-4; /* a small step, unscaled */
-            a.x[z->idx[k]] += v;
-            b.x[z->idx[k]] -= v;
+        for (unsigned k = 0; k < m->n_params; ++k) {
+            a.x[k] += h * u[k];
+            b.x[k] -= h * u[k];
         }
         double pa[3], pb[3], Ra[9], Rb[9];
         rc_fk(pa, Ra, &a, s[i].q_rad);
         rc_fk(pb, Rb, &b, s[i].q_rad);
         for (int c = 0; c < 3; ++c)
-            g[row++] = pa[c] - pb[c];
+            g[row++] = (pa[c] - pb[c]) / (2.0 * h);
         for (int c = 0; c < 9; ++c)
-            g[row++] = 100.0 * (Ra[c] - Rb[c]);
+            g[row++] = 100.0 * (Ra[c] - Rb[c]) / (2.0 * h);
     }
+    return used;
 }
 
-/* Parameters compensation must keep nominal. Within the span of the weak
+/* Parameters compensation must keep nominal. Within the span S of the weak
  * and not-identifiable directions (eigenvectors of a near-degenerate
  * eigenvalue are arbitrary mixtures of it, so single directions do not
- * tell), the combinations that move the flange (FK effect above 1e-6 of the
- * largest of any direction) are undetermined for the robot: every parameter
- * tied to one of them (squared share >= RC_IDENT_SHARE) stays nominal. The
- * combinations that move nothing the robot does (d2 - d3 of the parallel
- * joints 2 and 3) hold nothing. Parameters weak by their standard error
- * alone stay nominal too. */
+ * tell), the FK effects of unit steps along an orthonormal basis of S give
+ * G; the eigenvectors of G^T G split S into combinations that move the
+ * flange and ones that do not. A combination that moves the flange by more
+ * than 1e-3 mm (RMS over the poses) per mm of its physical size (mm, and
+ * rad at a 500 mm lever) is undetermined for the robot, and every parameter
+ * with a squared share >= RC_IDENT_SHARE (scaled coordinates) in those
+ * combinations stays nominal. Combinations that move nothing the
+ * robot does (d2 - d3 of the parallel joints 2 and 3) hold nothing.
+ * Parameters weak by their standard error alone stay nominal too. */
 static int comp_nominal(rch_uncert *u, const scaled *z, const rc_model *m, const rc_sample *s, size_t n)
 {
-    unsigned nf = z->nf, nn = 0, dir[RC_MAX_PARAMS];
-    double *g = malloc((size_t)RCH_FKREL_ROWS * nf * sizeof *g), big = 0.0;
+    unsigned nf = z->nf, nn = 0, np = m->n_params, dir[RC_MAX_PARAMS];
+    double *g = calloc((size_t)RCH_FKREL_ROWS * nf, sizeof *g), *U = calloc((size_t)nf * np, sizeof *U);
     double *M = calloc((size_t)nf * nf, sizeof *M), ev[RC_MAX_PARAMS];
-    if (!g || !M) {
+    size_t used = 1;
+    if (!g || !U || !M) {
         free(g);
+        free(U);
         free(M);
         return -1;
     }
     for (unsigned d = 0; d < nf; ++d) {
-        fk_effect(g + (size_t)d * RCH_FKREL_ROWS, z, d, m, s, n);
-        double e = 0.0;
-        for (unsigned r = 0; r < RCH_FKREL_ROWS; ++r)
-            e += g[(size_t)d * RCH_FKREL_ROWS + r] * g[(size_t)d * RCH_FKREL_ROWS + r];
-        big = fmax(big, sqrt(e));
-        if (z->dir_class[d] != RC_IDENT_IDENTIFIABLE)
-            dir[nn++] = d;
+        if (z->dir_class[d] == RC_IDENT_IDENTIFIABLE)
+            continue;
+        double *ud = U + (size_t)nn * np; /* a unit step in scaled coordinates, unscaled */
+        for (unsigned a = 0; a < nf; ++a)
+            ud[z->idx[a]] = z->V[a * nf + d] / z->D[a];
+        used = fk_effect(g + (size_t)nn * RCH_FKREL_ROWS, ud, m, s, n);
+        dir[nn++] = d;
     }
     for (unsigned a = 0; a < nn; ++a)
         for (unsigned b = 0; b < nn; ++b)
             for (unsigned r = 0; r < RCH_FKREL_ROWS; ++r)
-                M[a * nn + b] += g[(size_t)dir[a] * RCH_FKREL_ROWS + r] * g[(size_t)dir[b] * RCH_FKREL_ROWS + r];
+                M[a * nn + b] += g[(size_t)a * RCH_FKREL_ROWS + r] * g[(size_t)b * RCH_FKREL_ROWS + r];
     if (nn > 0 && LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', (lapack_int)nn, M, (lapack_int)nn, ev) != 0)
         nn = 0;
+    double share[RC_MAX_PARAMS] = {0};
     for (unsigned e = 0; e < nn; ++e) {
-        if (!(sqrt(fmax(ev[e], 0.0)) >= 1e-6 * big))
+        double c[RC_MAX_PARAMS], cn = 0.0; /* the combination, unscaled, and its physical size */
+        for (unsigned k = 0; k < np; ++k) {
+            c[k] = 0.0;
+            for (unsigned j = 0; j < nn; ++j)
+                c[k] += M[j * nn + e] * U[(size_t)j * np + k];
+            cn += pow(c[k] * phys_weight(m, k), 2);
+        }
+        double moves = sqrt(fmax(ev[e], 0.0) / (double)used) / fmax(sqrt(cn), 1e-300);
+        if (!(moves >= 1e-3))
             continue; /* moves nothing the robot does */
         for (unsigned a = 0; a < nf; ++a) {
-            double c = 0.0; /* component of parameter a in this combination */
+            double w = 0.0; /* component of parameter a in the combination, scaled coordinates */
             for (unsigned j = 0; j < nn; ++j)
-                c += z->V[a * nf + dir[j]] * M[j * nn + e];
-            if (c * c >= RC_IDENT_SHARE)
-                u->comp_nominal[z->idx[a]] = 1;
+                w += z->V[a * nf + dir[j]] * M[j * nn + e];
+            share[a] += w * w; /* the combinations are orthonormal: shares add */
         }
     }
+    for (unsigned a = 0; a < nf; ++a)
+        if (share[a] >= RC_IDENT_SHARE)
+            u->comp_nominal[z->idx[a]] = 1;
     for (unsigned a = 0; a < nf; ++a)
         if (u->cls[z->idx[a]] == RCH_PARAM_WEAK)
             u->comp_nominal[z->idx[a]] = 1;
     free(g);
+    free(U);
     free(M);
     return 0;
 }
