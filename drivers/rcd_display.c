@@ -1,14 +1,13 @@
 /* rcd_display.c - display reader: port + protocol + format lock. */
 #include <string.h>
-#include <time.h>
 
 #include "rcd_display.h"
 
-static long long now_ms(void)
+/* Milliseconds left of timeout_ms since t0 on the port's clock (modulo 2^32). */
+static long long left_ms(const rcd_display *d, uint32_t t0, unsigned timeout_ms)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+    uint32_t elapsed = rcd_port_now_ms(d->port) - t0;
+    return (long long)timeout_ms - (long long)elapsed;
 }
 
 static int is_polled(const rcd_display *d)
@@ -77,10 +76,10 @@ static rc_status check_shape(rcd_display *d, const rcd_reading *r)
 
 rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms)
 {
-    long long deadline;
+    uint32_t t0;
     if (!d || !d->port)
         return RC_ERR_ARG;
-    deadline = now_ms() + timeout_ms;
+    t0 = rcd_port_now_ms(d->port);
     for (;;) {
         rc_status st;
         size_t n = 0;
@@ -95,7 +94,7 @@ rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms
             st = rcd_build_request(req, &rl, sizeof req, &d->cfg);
             if (st != RC_OK)
                 return st;
-            left = deadline - now_ms();
+            left = left_ms(d, t0, timeout_ms);
             st = rcd_port_write(d->port, &wn, req, rl, left > 0 ? (unsigned)left : 1u);
             if (st == RC_ERR_TIMEOUT)
                 d->stats.timeouts++;
@@ -139,7 +138,7 @@ rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms
             drop(d, sizeof d->buf / 2); /* cannot happen with the parsers' limits */
         if (is_polled(d) && d->need_poll)
             continue;
-        left = deadline - now_ms();
+        left = left_ms(d, t0, timeout_ms);
         if (left <= 0) {
             d->stats.timeouts++;
             d->need_poll = 1;

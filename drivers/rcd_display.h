@@ -13,7 +13,8 @@
  * rejected (RC_ERR_FORMAT, stats.shape_rejects). A byte dropped from or added
  * to a line changes its shape, so it is never returned as a value.
  *
- * Depends on: rcd_port.h, rcd_proto.h, POSIX clock_gettime (timeouts).
+ * Depends on: rcd_port.h, rcd_proto.h. Time comes from the port's clock
+ * (rcd_port_now_ms): no OS call here, so it builds for a microcontroller.
  * Memory: rcd_display is caller-owned (a 512-byte receive buffer inside);
  * the port is borrowed and must outlive it.
  * Thread safety: one display per thread.
