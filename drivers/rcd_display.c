@@ -32,6 +32,18 @@ rc_status rcd_display_init(rcd_display *d, rcd_port *port, const rcd_proto_confi
     return RC_OK;
 }
 
+const char *rcd_display_why_silent(const rcd_display *d)
+{
+    if (!d)
+        return "";
+    if (d->last_reject == RCD_REJECT_MB_SLAVE)
+        return "; replies from another Modbus slave address were ignored: check --mb-addr";
+    if (d->last_reject == RCD_REJECT_MB_FUNCTION)
+        return "; replies with another Modbus function code were ignored: the display does not answer "
+               "holding-register reads (0x03) at this register";
+    return "";
+}
+
 void rcd_display_reset(rcd_display *d)
 {
     d->len = 0;
@@ -106,6 +118,7 @@ rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms
         while (d->len > 0) {
             rcd_reading r;
             size_t c = 0;
+            memset(&r, 0, sizeof r);
             st = rcd_parse(&r, &c, &d->cfg, d->buf, d->len);
             drop(d, c);
             if (st == RC_ERR_INCOMPLETE)
@@ -132,6 +145,17 @@ rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms
                 return st;
             }
             d->stats.bad_frames++;
+            d->last_reject = r.reject;
+            if (st == RC_ERR_FORMAT && r.reject == RCD_REJECT_MB_SLAVE)
+                d->stats.wrong_slave++;
+            if (st == RC_ERR_FORMAT && r.reject == RCD_REJECT_MB_FUNCTION)
+                d->stats.wrong_function++;
+            if (st == RC_ERR_FORMAT && r.reject != RCD_REJECT_NONE) {
+                d->last_mb_addr = r.mb_addr;
+                d->last_mb_fn = r.mb_fn;
+                if (out)
+                    *out = r;
+            }
             return st;
         }
         if (d->len == sizeof d->buf)

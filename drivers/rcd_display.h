@@ -44,6 +44,8 @@ typedef struct rcd_display_stats {
     unsigned long timeouts;
     unsigned long polls;          /* requests sent */
     unsigned long bytes;          /* bytes received */
+    unsigned long wrong_slave;    /* Modbus replies from another slave address */
+    unsigned long wrong_function; /* Modbus replies with another function code */
 } rcd_display_stats;
 
 typedef struct rcd_display {
@@ -58,12 +60,18 @@ typedef struct rcd_display {
     uint8_t cand_unit;
     unsigned cand_count;
     rcd_display_stats stats;
+    uint8_t last_reject;            /* rcd_reject of the last rejected frame */
+    uint8_t last_mb_addr, last_mb_fn;
 } rcd_display;
 
 /* Bind a display to an open port. cfg NULL: ASCII streaming. */
 rc_status rcd_display_init(rcd_display *d, rcd_port *port, const rcd_proto_config *cfg);
 /* Next event within timeout_ms (see the file comment). out may be NULL. */
 rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms);
+/* Why nothing usable arrived, as a static text to append to a timeout
+ * message ("" when there is no known reason): replies from another Modbus
+ * slave or with another function code were seen and ignored. */
+const char *rcd_display_why_silent(const rcd_display *d);
 /* Drop buffered bytes and pending poll state (after a reconnect). The format
  * lock is kept: the display's format does not change with the cable. */
 void rcd_display_reset(rcd_display *d);

@@ -111,7 +111,7 @@ static void test_long_mid_line_refused(void **state)
     write_file("data.csv", data, n);
     assert_int_not_equal(try_resume(), 0);
     assert_int_equal(file_size("data.csv"), (long long)n);
-    assert_true(err_contains("data.csv:3: not a sample of this plan"));
+    assert_true(err_contains("data.csv:3:"));
 }
 
 /* an interrupted write at the very end: the fragment is cut off, but kept in
@@ -152,7 +152,7 @@ static void test_out_of_range_numbers_refused(void **state)
         write_file("data.csv", data, (size_t)n);
         assert_int_not_equal(try_resume(), 0);
         assert_int_equal(file_size("data.csv"), (long long)n);
-        if (!err_contains("data.csv:3: not a sample of this plan"))
+        if (!err_contains("data.csv:3:"))
             fail_msg("case %zu (%s) not refused at line 3", k, bad[k]);
         assert_int_equal(file_size("data.csv.dropped"), -1);
     }

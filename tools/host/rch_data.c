@@ -8,13 +8,16 @@
 #include <strings.h>
 
 #include "rc_rand.h"
+#include "rch_file.h"
+#include "rch_opt.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 
-enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_N = 12 };
-static const char *const col_names[C_N] = {"q1", "q2", "q3", "q4", "q5", "q6", "L", "x", "y", "z", "t", "group"};
+enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_P = 12, C_N = 13 };
+static const char *const col_names[C_N] = {"q1", "q2", "q3", "q4", "q5", "q6", "L",
+                                           "x",  "y",  "z",  "t",  "group", "pose"};
 
 typedef struct {
     const char *p; /* field start */
@@ -45,19 +48,62 @@ static size_t split_line(field *f, size_t max, const char *line, size_t len)
     return n;
 }
 
+/* The one strict number reader (rch_parse_double: decimal only, no blanks,
+ * no hex, no overflow). NaN and infinity words come back as such, so that
+ * the caller names them ("not finite") rather than "not a number". */
 static int parse_number(double *v, const field *f)
 {
     char buf[64];
-    char *end;
     if (f->len == 0 || f->len >= sizeof buf)
         return -1;
     memcpy(buf, f->p, f->len);
     buf[f->len] = '\0';
-    errno = 0;
-    *v = strtod(buf, &end);
-    if (end != buf + f->len || errno == ERANGE)
-        return -1;
-    return 0;
+    if (rch_parse_double(buf, v) == 0)
+        return 0;
+    {
+        const char *w = buf + (buf[0] == '+' || buf[0] == '-');
+        if (strcasecmp(w, "nan") == 0) {
+            *v = NAN;
+            return 0;
+        }
+        if (strcasecmp(w, "inf") == 0 || strcasecmp(w, "infinity") == 0) {
+            *v = buf[0] == '-' ? -INFINITY : INFINITY;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+/* 1 when nothing but NUL bytes and blanks follows text[from..len). */
+static int is_last_line(const char *text, size_t from, size_t len)
+{
+    for (size_t i = from; i < len; ++i)
+        if (text[i] != '\0' && !isspace((unsigned char)text[i]))
+            return 0;
+    return 1;
+}
+
+/* What a header without the needed columns looks like, when it is a
+ * known other convention ("" otherwise). */
+static const char *header_hint(const char *line, size_t len)
+{
+    if (memchr(line, '\t', len))
+        return "; the header is separated by tabs: rcal reads comma-separated values";
+    if (memchr(line, ';', len))
+        return "; the header is separated by semicolons: rcal reads comma-separated values with '.' decimals";
+    return "";
+}
+
+static const char *number_hint(const field *f)
+{
+    if (f->len > 0 && (f->p[0] == '"' || f->p[0] == '\''))
+        return " (quoted: write numbers without quotes)";
+    size_t i = f->len > 0 && (f->p[0] == '+' || f->p[0] == '-') ? 1u : 0u;
+    if (f->len > i + 1 && f->p[i] == '0' && (f->p[i + 1] == 'x' || f->p[i + 1] == 'X'))
+        return " (hexadecimal numbers are not accepted: write decimals)";
+    if (memchr(f->p, ';', f->len) || memchr(f->p, '\t', f->len))
+        return " (separators must be commas)";
+    return "";
 }
 
 int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
@@ -71,9 +117,12 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
     for (int k = 0; k < C_N; ++k)
         col_of[k] = -1;
 
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
+        pos = 3; /* UTF-8 byte-order mark (spreadsheet export) */
     while (pos < len) {
         size_t e = pos;
-        while (e < len && text[e] != '\n')
+        /* a line ends at '\n', or at a '\r' not followed by '\n' (CR-only files) */
+        while (e < len && text[e] != '\n' && !(text[e] == '\r' && (e + 1 == len || text[e + 1] != '\n')))
             ++e;
         const char *line = text + pos;
         size_t ll = e - pos;
@@ -88,7 +137,13 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
             continue;
         for (size_t i = 0; i < ll; ++i) {
             if (line[i] == '\0') {
-                rch_diag_set(d, name, (unsigned)line_no, (unsigned)i + 1, "NUL byte in text");
+                if (is_last_line(text, pos, len))
+                    rch_diag_set(d, name, (unsigned)line_no, (unsigned)i + 1,
+                                 "the last line holds NUL bytes, what a power cut during a write leaves: "
+                                 "rerun `rcal acquire` with the same --out to move it to %s.dropped, or "
+                                 "delete that line", name);
+                else
+                    rch_diag_set(d, name, (unsigned)line_no, (unsigned)i + 1, "NUL byte in text");
                 goto fail;
             }
         }
@@ -99,6 +154,10 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
         }
         if (!have_header) {
             for (size_t i = 0; i < nf; ++i) {
+                if (fields[i].len >= 2 && fields[i].p[0] == '"' && fields[i].p[fields[i].len - 1] == '"') {
+                    fields[i].p++; /* "q1": a quoted header name is the name */
+                    fields[i].len -= 2;
+                }
                 for (int k = 0; k < C_N; ++k) {
                     if (fields[i].len == strlen(col_names[k]) &&
                         strncasecmp(fields[i].p, col_names[k], fields[i].len) == 0) {
@@ -111,11 +170,15 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
                     }
                 }
             }
-            for (int k = 0; k <= C_L; ++k) {
-                if (col_of[k] < 0 && !(k == C_L && (flags & RCH_DATA_NO_LEN))) {
+            for (int k = 0; k <= C_P; ++k) {
+                if (k > C_L && k != C_P)
+                    continue;
+                if (col_of[k] < 0 && !(k == C_L && (flags & RCH_DATA_NO_LEN)) &&
+                    !(k == C_P && !(flags & RCH_DATA_POSE))) {
                     rch_diag_set(d, name, (unsigned)line_no, 1,
-                                 "header has no '%s' column (need q1..q6 in degrees%s)", col_names[k],
-                                 (flags & RCH_DATA_NO_LEN) ? "" : " and L in mm");
+                                 "header has no '%s' column (need %sq1..q6 in degrees%s)%s", col_names[k],
+                                 (flags & RCH_DATA_POSE) ? "pose, " : "",
+                                 (flags & RCH_DATA_NO_LEN) ? "" : " and L in mm", header_hint(line, ll));
                     goto fail;
                 }
             }
@@ -136,6 +199,14 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
                 rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
                 goto fail;
             }
+            if (col_of[C_P] >= 0 && (flags & RCH_DATA_POSE)) {
+                unsigned long *pz = realloc(out->pose, nc * sizeof *pz);
+                if (!pz) {
+                    rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
+                    goto fail;
+                }
+                out->pose = pz;
+            }
             if (col_of[C_X] >= 0) {
                 double(*xyz)[3] = realloc(out->xyz, nc * sizeof *xyz);
                 if (!xyz) {
@@ -150,7 +221,7 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
         memset(s, 0, sizeof *s);
         double v[C_N] = {0};
         for (int k = 0; k < C_N; ++k) {
-            if (col_of[k] < 0)
+            if (col_of[k] < 0 || (k == C_P && !(flags & RCH_DATA_POSE)))
                 continue;
             const size_t c = (size_t)col_of[k];
             if (c >= nf) {
@@ -160,8 +231,9 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
                 goto fail;
             }
             if (parse_number(&v[k], &fields[c]) != 0) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': '%.*s' is not a number",
-                             col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p);
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': '%.*s' is not a number%s",
+                             col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
+                             number_hint(&fields[c]));
                 goto fail;
             }
             if (!isfinite(v[k])) {
@@ -188,6 +260,11 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
                 rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field 't': %g is absurd", v[k]);
                 goto fail;
             }
+            if (k == C_P && (v[k] < 0.0 || v[k] > 1e9 || v[k] != floor(v[k]))) {
+                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
+                             "field 'pose': %g is not an integer in 0..1000000000", v[k]);
+                goto fail;
+            }
             if (k == C_G && (v[k] < 0.0 || v[k] > 65535.0 || v[k] != floor(v[k]))) {
                 rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
                              "field 'group': %g is not an integer in 0..65535", v[k]);
@@ -204,6 +281,8 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
             out->xyz[out->n][1] = v[C_Y];
             out->xyz[out->n][2] = v[C_Z];
         }
+        if (out->pose)
+            out->pose[out->n] = (unsigned long)v[C_P];
         out->line[out->n] = (unsigned)line_no;
         ++out->n;
     }
@@ -211,7 +290,7 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
         rch_diag_set(d, name, 0, 0, "empty file: no header line");
         goto fail;
     }
-    if (out->n == 0) {
+    if (out->n == 0 && !(flags & RCH_DATA_ALLOW_EMPTY)) {
         rch_diag_set(d, name, (unsigned)line_no, 0, "no data rows after the header");
         goto fail;
     }
@@ -237,41 +316,11 @@ fail:
 
 int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d)
 {
+    char *buf = NULL;
+    size_t len = 0;
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        rch_diag_set(d, path, 0, 0, "cannot open: %s", strerror(errno));
+    if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
         return -1;
-    }
-    size_t cap = 1 << 16, len = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t got = fread(buf + len, 1, cap - len, f);
-        len += got;
-        if (len < cap)
-            break;
-        if (cap >= (size_t)1 << 30) {
-            free(buf);
-            fclose(f);
-            rch_diag_set(d, path, 0, 0, "file larger than 1 GiB");
-            return -1;
-        }
-        char *nb = realloc(buf, cap * 2);
-        if (!nb) {
-            free(buf);
-            buf = NULL;
-            break;
-        }
-        buf = nb;
-        cap *= 2;
-    }
-    int err = ferror(f);
-    fclose(f);
-    if (!buf || err) {
-        free(buf);
-        rch_diag_set(d, path, 0, 0, err ? "read error" : "out of memory");
-        return -1;
-    }
     int rc = rch_data_parse(out, buf, len, path, flags, d);
     free(buf);
     return rc;
@@ -282,6 +331,7 @@ void rch_data_free(rch_data *data)
     free(data->s);
     free(data->xyz);
     free(data->line);
+    free(data->pose);
     memset(data, 0, sizeof *data);
 }
 
