@@ -365,8 +365,8 @@ static int check_paths(acq *a)
     const char *const ins_name[4] = {"--poses", "--robot", "--announce", "--out"};
     for (int o = 0; o < 2; ++o)
         for (int k = 0; k < 4; ++k) {
-            if (!outs[o] || !ins[k] || outs[o] == ins[k])
-                continue;
+            if (!outs[o] || !ins[k] || (o == 0 && k == 3) || (o == 1 && k == 2))
+                continue; /* an output against itself */
             if (strcmp(outs[o], ins[k]) == 0 || rch_same_file(outs[o], ins[k])) {
                 WARN(a, "%s %s is also %s %s: refused (it would be destroyed); choose another file\n", outs_name[o],
                      outs[o], ins_name[k], ins[k]);
