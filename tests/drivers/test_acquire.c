@@ -20,6 +20,8 @@
 
 #include "rch_acqfile.h"
 #include "rch_acquire.h"
+#include "rch_data.h"
+#include "rch_poses.h"
 #include "rch_robot.h"
 
 #define ROBOT RCAL_SOURCE_DIR "/data/irb120.json"
@@ -423,6 +425,56 @@ static void test_nul_last_line_dropped(void **state)
     assert_int_equal(fsize("powercut.csv.dropped"), 65);
 }
 
+/* the pose plan: inside the joint limits less the margin, written and read
+ * back through rch_data (one reader, one writer); absurd requests refused
+ * with the limit named (issue 12: --count 100000 ran for minutes, --margin-deg
+ * 500 wrote poses outside the limits) */
+static void test_plan_limits(void **state)
+{
+    rch_robot rb;
+    rch_diag dg;
+    rch_poses_config pc = {12, 0, 4, 3, 250, 800, 20};
+    rch_poses_result res;
+    rch_data back;
+    char p[512];
+    FILE *f;
+    (void)state;
+    assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
+    rb.model.x[RC_P_ENC] = 250.0;
+    rb.model.x[RC_P_ENC + 1] = -460.0;
+    rb.model.x[RC_P_ENC + 2] = 10.0;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
+    assert_int_equal(res.n, 12);
+    assert_true(res.o1_plan > res.o1_random);
+    path_in(p, sizeof p, "plan12.csv");
+    f = fopen(p, "w");
+    assert_non_null(f);
+    assert_int_equal(rch_data_write_plan(f, res.poses, res.n), 0);
+    fclose(f);
+    assert_int_equal(rch_data_load(&back, p, RCH_DATA_NO_LEN, &dg), 0);
+    assert_int_equal(back.n, 12);
+    for (size_t i = 0; i < res.n; ++i)
+        for (int j = 0; j < RC_NJ; ++j) {
+            const double mg = 20.0 * 3.14159265358979323846 / 180.0;
+            assert_true(res.poses[i].q_rad[j] >= rb.model.q_min_rad[j] + mg - 1e-12);
+            assert_true(res.poses[i].q_rad[j] <= rb.model.q_max_rad[j] - mg + 1e-12);
+            assert_true(fabs(back.s[i].q_rad[j] - res.poses[i].q_rad[j]) < 1e-6);
+        }
+    rch_data_free(&back);
+    rch_poses_free(&res);
+    pc.margin_deg = 500;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), -1);
+    assert_non_null(strstr(dg.msg, "leaves no room"));
+    pc.margin_deg = 5;
+    pc.count = 100000;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), -1);
+    assert_non_null(strstr(dg.msg, "1..1000"));
+    pc.count = 10;
+    pc.candidates = 5;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), -1);
+    assert_null(res.poses);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -434,6 +486,7 @@ int main(void)
         cmocka_unit_test(test_plan_outside_limits),
         cmocka_unit_test(test_scan_bounded),
         cmocka_unit_test(test_nul_last_line_dropped),
+        cmocka_unit_test(test_plan_limits),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

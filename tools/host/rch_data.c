@@ -363,6 +363,20 @@ int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nomina
     return fflush(f) == 0 ? 0 : -1;
 }
 
+int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n)
+{
+    if (fprintf(f, "pose,q1,q2,q3,q4,q5,q6\n") < 0)
+        return -1;
+    for (size_t t = 0; t < n; ++t) {
+        fprintf(f, "%zu", t);
+        for (int j = 0; j < RC_NJ; ++j)
+            fprintf(f, ",%.4f", s[t].q_rad[j] * 180.0 / M_PI);
+        if (fprintf(f, "\n") < 0)
+            return -1;
+    }
+    return fflush(f) == 0 && !ferror(f) ? 0 : -1;
+}
+
 void rch_split(size_t *idx, size_t n, unsigned long long seed)
 {
     rc_rng g;

@@ -52,6 +52,10 @@ rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k);
  * q1..q6 (deg, %.4f), L (mm, %.4f). Returns 0 or -1 (errno set). */
 int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nominal);
 
+/* Write a pose plan: "pose,q1,..,q6" then one line per sample, q in degrees
+ * (%.4f). Read back with rch_data_load(..., RCH_DATA_NO_LEN). 0 or -1. */
+int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n);
+
 /* Random train/test split: a permutation of 0..n-1 from seed; the first
  * n_test indices go to test. idx: (n) output. */
 void rch_split(size_t *idx, size_t n, unsigned long long seed);
