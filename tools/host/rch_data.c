@@ -106,197 +106,155 @@ static const char *number_hint(const field *f)
     return "";
 }
 
-int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
-                   rch_diag *d)
-{
-    int col_of[C_N];
-    field fields[256];
-    size_t cap = 0, line_no = 0, pos = 0;
-    int have_header = 0;
-    memset(out, 0, sizeof *out);
-    for (int k = 0; k < C_N; ++k)
-        col_of[k] = -1;
+/* The parser's state while it walks the text. */
+typedef struct parse_ctx {
+    const char *name;
+    unsigned flags;
+    rch_diag *d;
+    int col_of[C_N]; /* field index of each known column, -1 absent */
+    size_t cap;      /* allocated rows */
+    unsigned line_no;
+} parse_ctx;
 
-    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
-        pos = 3; /* UTF-8 byte-order mark (spreadsheet export) */
-    while (pos < len) {
-        size_t e = pos;
-        /* a line ends at '\n', or at a '\r' not followed by '\n' (CR-only files) */
-        while (e < len && text[e] != '\n' && !(text[e] == '\r' && (e + 1 == len || text[e + 1] != '\n')))
-            ++e;
-        const char *line = text + pos;
-        size_t ll = e - pos;
-        pos = e + 1;
-        ++line_no;
-        if (ll > 0 && line[ll - 1] == '\r')
-            --ll;
-        size_t blank = 0;
-        while (blank < ll && isspace((unsigned char)line[blank]))
-            ++blank;
-        if (blank == ll || line[blank] == '#')
-            continue;
-        for (size_t i = 0; i < ll; ++i) {
-            if (line[i] == '\0') {
-                if (is_last_line(text, pos, len))
-                    rch_diag_set(d, name, (unsigned)line_no, (unsigned)i + 1,
-                                 "the last line holds NUL bytes, what a power cut during a write leaves: "
-                                 "rerun `rcal acquire` with the same --out to move it to %s.dropped, or "
-                                 "delete that line", name);
-                else
-                    rch_diag_set(d, name, (unsigned)line_no, (unsigned)i + 1, "NUL byte in text");
-                goto fail;
-            }
+/* The header line: find the known columns. 0 or -1 with d set. */
+static int parse_header(parse_ctx *pc, field *fields, size_t nf, const char *line, size_t ll)
+{
+    const unsigned flags = pc->flags;
+    for (size_t i = 0; i < nf; ++i) {
+        if (fields[i].len >= 2 && fields[i].p[0] == '"' && fields[i].p[fields[i].len - 1] == '"') {
+            fields[i].p++; /* "q1": a quoted header name is the name */
+            fields[i].len -= 2;
         }
-        const size_t nf = split_line(fields, 256, line, ll);
-        if (nf > 256) {
-            rch_diag_set(d, name, (unsigned)line_no, 1, "too many columns (%zu, at most 256)", nf);
-            goto fail;
-        }
-        if (!have_header) {
-            for (size_t i = 0; i < nf; ++i) {
-                if (fields[i].len >= 2 && fields[i].p[0] == '"' && fields[i].p[fields[i].len - 1] == '"') {
-                    fields[i].p++; /* "q1": a quoted header name is the name */
-                    fields[i].len -= 2;
-                }
-                for (int k = 0; k < C_N; ++k) {
-                    if (fields[i].len == strlen(col_names[k]) &&
-                        strncasecmp(fields[i].p, col_names[k], fields[i].len) == 0) {
-                        if (col_of[k] >= 0) {
-                            rch_diag_set(d, name, (unsigned)line_no, fields[i].col,
-                                         "column '%s' appears twice in the header", col_names[k]);
-                            goto fail;
-                        }
-                        col_of[k] = (int)i;
-                    }
-                }
-            }
-            for (int k = 0; k <= C_P; ++k) {
-                if (k > C_L && k != C_P)
-                    continue;
-                if (col_of[k] < 0 && !(k == C_L && (flags & RCH_DATA_NO_LEN)) &&
-                    !(k == C_P && !(flags & RCH_DATA_POSE))) {
-                    rch_diag_set(d, name, (unsigned)line_no, 1,
-                                 "header has no '%s' column (need %sq1..q6 in degrees%s)%s", col_names[k],
-                                 (flags & RCH_DATA_POSE) ? "pose, " : "",
-                                 (flags & RCH_DATA_NO_LEN) ? "" : " and L in mm", header_hint(line, ll));
-                    goto fail;
-                }
-            }
-            if ((col_of[C_X] >= 0) != (col_of[C_Y] >= 0) || (col_of[C_X] >= 0) != (col_of[C_Z] >= 0))
-                col_of[C_X] = col_of[C_Y] = col_of[C_Z] = -1; /* use x,y,z only as a triple */
-            have_header = 1;
-            continue;
-        }
-        if (out->n == cap) {
-            size_t nc = cap ? 2 * cap : 256;
-            rc_sample *s = realloc(out->s, nc * sizeof *s);
-            unsigned *ln = s ? realloc(out->line, nc * sizeof *ln) : NULL;
-            if (s)
-                out->s = s;
-            if (ln)
-                out->line = ln;
-            if (!s || !ln) {
-                rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
-                goto fail;
-            }
-            if (col_of[C_P] >= 0 && (flags & RCH_DATA_POSE)) {
-                unsigned long *pz = realloc(out->pose, nc * sizeof *pz);
-                if (!pz) {
-                    rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
-                    goto fail;
-                }
-                out->pose = pz;
-            }
-            if (col_of[C_X] >= 0) {
-                double(*xyz)[3] = realloc(out->xyz, nc * sizeof *xyz);
-                if (!xyz) {
-                    rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
-                    goto fail;
-                }
-                out->xyz = xyz;
-            }
-            cap = nc;
-        }
-        rc_sample *s = &out->s[out->n];
-        memset(s, 0, sizeof *s);
-        double v[C_N] = {0};
         for (int k = 0; k < C_N; ++k) {
-            if (col_of[k] < 0 || (k == C_P && !(flags & RCH_DATA_POSE)))
-                continue;
-            const size_t c = (size_t)col_of[k];
-            if (c >= nf) {
-                rch_diag_set(d, name, (unsigned)line_no, (unsigned)ll + 1,
-                             "missing field '%s' (column %zu; the line has %zu fields)", col_names[k],
-                             c + 1, nf);
-                goto fail;
-            }
-            if (parse_number(&v[k], &fields[c]) != 0) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': '%.*s' is not a number%s",
-                             col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
-                             number_hint(&fields[c]));
-                goto fail;
-            }
-            if (!isfinite(v[k])) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': %s is not finite",
-                             col_names[k], isnan(v[k]) ? "NaN" : "infinity");
-                goto fail;
-            }
-            if (k < C_L && fabs(v[k]) > 720.0) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
-                             "field '%s': %g degrees is outside -720..720", col_names[k], v[k]);
-                goto fail;
-            }
-            if (k == C_L && !(v[k] > 0.0 && v[k] <= 20000.0)) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
-                             "field 'L': %g mm is not a cable length (0 < L <= 20000)", v[k]);
-                goto fail;
-            }
-            if ((k == C_X || k == C_Y || k == C_Z) && fabs(v[k]) > 1e5) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': %g mm is absurd",
-                             col_names[k], v[k]);
-                goto fail;
-            }
-            if (k == C_T && fabs(v[k]) > 1e300) { /* t_max - t_min must stay finite when scaling */
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field 't': %g is absurd", v[k]);
-                goto fail;
-            }
-            if (k == C_P && (v[k] < 0.0 || v[k] > 1e9 || v[k] != floor(v[k]))) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
-                             "field 'pose': %g is not an integer in 0..1000000000", v[k]);
-                goto fail;
-            }
-            if (k == C_G && (v[k] < 0.0 || v[k] > 65535.0 || v[k] != floor(v[k]))) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
-                             "field 'group': %g is not an integer in 0..65535", v[k]);
-                goto fail;
+            if (fields[i].len == strlen(col_names[k]) && strncasecmp(fields[i].p, col_names[k], fields[i].len) == 0) {
+                if (pc->col_of[k] >= 0) {
+                    rch_diag_set(pc->d, pc->name, pc->line_no, fields[i].col, "column '%s' appears twice in the header",
+                                 col_names[k]);
+                    return -1;
+                }
+                pc->col_of[k] = (int)i;
             }
         }
-        for (int j = 0; j < RC_NJ; ++j)
-            s->q_rad[j] = v[C_Q1 + j] * (M_PI / 180.0);
-        s->len_mm = v[C_L];
-        s->t = v[C_T];
-        s->group = (uint16_t)v[C_G];
-        if (out->xyz) {
-            out->xyz[out->n][0] = v[C_X];
-            out->xyz[out->n][1] = v[C_Y];
-            out->xyz[out->n][2] = v[C_Z];
+    }
+    for (int k = 0; k <= C_P; ++k) {
+        if (k > C_L && k != C_P)
+            continue;
+        if (pc->col_of[k] < 0 && !(k == C_L && (flags & RCH_DATA_NO_LEN)) && !(k == C_P && !(flags & RCH_DATA_POSE))) {
+            rch_diag_set(pc->d, pc->name, pc->line_no, 1, "header has no '%s' column (need %sq1..q6 in degrees%s)%s",
+                         col_names[k], (flags & RCH_DATA_POSE) ? "pose, " : "",
+                         (flags & RCH_DATA_NO_LEN) ? "" : " and L in mm", header_hint(line, ll));
+            return -1;
         }
-        if (out->pose)
-            out->pose[out->n] = (unsigned long)v[C_P];
-        out->line[out->n] = (unsigned)line_no;
-        ++out->n;
     }
-    if (!have_header) {
-        rch_diag_set(d, name, 0, 0, "empty file: no header line");
-        goto fail;
+    if ((pc->col_of[C_X] >= 0) != (pc->col_of[C_Y] >= 0) || (pc->col_of[C_X] >= 0) != (pc->col_of[C_Z] >= 0))
+        pc->col_of[C_X] = pc->col_of[C_Y] = pc->col_of[C_Z] = -1; /* use x,y,z only as a triple */
+    return 0;
+}
+
+/* Room for one more row. 0 or -1 with d set. */
+static int grow(rch_data *out, parse_ctx *pc)
+{
+    size_t nc;
+    if (out->n < pc->cap)
+        return 0;
+    nc = pc->cap ? 2 * pc->cap : 256;
+    rc_sample *s = realloc(out->s, nc * sizeof *s);
+    if (s)
+        out->s = s;
+    unsigned *ln = s ? realloc(out->line, nc * sizeof *ln) : NULL;
+    if (ln)
+        out->line = ln;
+    if (s && ln && pc->col_of[C_P] >= 0 && (pc->flags & RCH_DATA_POSE)) {
+        unsigned long *pz = realloc(out->pose, nc * sizeof *pz);
+        if (pz)
+            out->pose = pz;
+        s = pz ? s : NULL;
     }
-    if (out->n == 0 && !(flags & RCH_DATA_ALLOW_EMPTY)) {
-        rch_diag_set(d, name, (unsigned)line_no, 0, "no data rows after the header");
-        goto fail;
+    if (s && ln && pc->col_of[C_X] >= 0) {
+        double(*xyz)[3] = realloc(out->xyz, nc * sizeof *xyz);
+        if (xyz)
+            out->xyz = xyz;
+        s = xyz ? s : NULL;
     }
-    out->has_t = col_of[C_T] >= 0;
-    out->has_group = col_of[C_G] >= 0;
-    /* acquisition order scaled to [0, 1]: the t column if present, else the row order */
+    if (!s || !ln) {
+        rch_diag_set(pc->d, pc->name, pc->line_no, 0, "out of memory");
+        return -1;
+    }
+    pc->cap = nc;
+    return 0;
+}
+
+/* Range of one field's value v of column k: 0, or -1 with d set. */
+static int check_value(const parse_ctx *pc, int k, double v, const field *f)
+{
+    const char *nm = col_names[k];
+    const unsigned ln = pc->line_no, col = f->col;
+    if (!isfinite(v))
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %s is not finite", nm, isnan(v) ? "NaN" : "infinity");
+    else if (k < C_L && fabs(v) > 720.0)
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g degrees is outside -720..720", nm, v);
+    else if (k == C_L && !(v > 0.0 && v <= 20000.0))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'L': %g mm is not a cable length (0 < L <= 20000)", v);
+    else if ((k == C_X || k == C_Y || k == C_Z) && fabs(v) > 1e5)
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g mm is absurd", nm, v);
+    else if (k == C_T && fabs(v) > 1e300) /* t_max - t_min must stay finite when scaling */
+        rch_diag_set(pc->d, pc->name, ln, col, "field 't': %g is absurd", v);
+    else if (k == C_P && (v < 0.0 || v > 1e9 || v != floor(v)))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'pose': %g is not an integer in 0..1000000000", v);
+    else if (k == C_G && (v < 0.0 || v > 65535.0 || v != floor(v)))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'group': %g is not an integer in 0..65535", v);
+    else
+        return 0;
+    return -1;
+}
+
+/* One data row into out->[n]. 0 or -1 with d set. */
+static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t nf, size_t ll)
+{
+    double v[C_N] = {0};
+    rc_sample *s;
+    if (grow(out, pc) != 0)
+        return -1;
+    for (int k = 0; k < C_N; ++k) {
+        if (pc->col_of[k] < 0 || (k == C_P && !(pc->flags & RCH_DATA_POSE)))
+            continue;
+        const size_t c = (size_t)pc->col_of[k];
+        if (c >= nf) {
+            rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)ll + 1,
+                         "missing field '%s' (column %zu; the line has %zu fields)", col_names[k], c + 1, nf);
+            return -1;
+        }
+        if (parse_number(&v[k], &fields[c]) != 0) {
+            rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s",
+                         col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
+                         number_hint(&fields[c]));
+            return -1;
+        }
+        if (check_value(pc, k, v[k], &fields[c]) != 0)
+            return -1;
+    }
+    s = &out->s[out->n];
+    memset(s, 0, sizeof *s);
+    for (int j = 0; j < RC_NJ; ++j)
+        s->q_rad[j] = v[C_Q1 + j] * (M_PI / 180.0);
+    s->len_mm = v[C_L];
+    s->t = v[C_T];
+    s->group = (uint16_t)v[C_G];
+    if (out->xyz) {
+        out->xyz[out->n][0] = v[C_X];
+        out->xyz[out->n][1] = v[C_Y];
+        out->xyz[out->n][2] = v[C_Z];
+    }
+    if (out->pose)
+        out->pose[out->n] = (unsigned long)v[C_P];
+    out->line[out->n] = pc->line_no;
+    ++out->n;
+    return 0;
+}
+
+/* Acquisition order scaled to [0, 1]: the t column if present, else the row order. */
+static void scale_t(rch_data *out)
+{
     double tmin = 0.0, tmax = 0.0;
     for (size_t i = 0; i < out->n; ++i) {
         if (!out->has_t)
@@ -308,6 +266,80 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
     }
     for (size_t i = 0; i < out->n; ++i)
         out->s[i].t = tmax > tmin ? (out->s[i].t - tmin) / (tmax - tmin) : 0.0;
+}
+
+/* A NUL byte in line: its message (what a power cut leaves, when last). */
+static int nul_check(const parse_ctx *pc, const char *line, size_t ll, const char *text, size_t next, size_t len)
+{
+    const char *z = memchr(line, '\0', ll);
+    if (!z)
+        return 0;
+    if (is_last_line(text, next, len))
+        rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)(z - line) + 1,
+                     "the last line holds NUL bytes, what a power cut during a write leaves: rerun `rcal acquire` "
+                     "with the same --out to move it to %s.dropped, or delete that line", pc->name);
+    else
+        rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)(z - line) + 1, "NUL byte in text");
+    return -1;
+}
+
+int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                   rch_diag *d)
+{
+    field fields[256];
+    size_t pos = 0;
+    int have_header = 0;
+    parse_ctx pc;
+    memset(out, 0, sizeof *out);
+    memset(&pc, 0, sizeof pc);
+    pc.name = name;
+    pc.flags = flags;
+    pc.d = d;
+    for (int k = 0; k < C_N; ++k)
+        pc.col_of[k] = -1;
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
+        pos = 3; /* UTF-8 byte-order mark (spreadsheet export) */
+    while (pos < len) {
+        size_t e = pos, blank = 0;
+        /* a line ends at '\n', or at a '\r' not followed by '\n' (CR-only files) */
+        while (e < len && text[e] != '\n' && !(text[e] == '\r' && (e + 1 == len || text[e + 1] != '\n')))
+            ++e;
+        const char *line = text + pos;
+        size_t ll = e - pos;
+        pos = e + 1;
+        ++pc.line_no;
+        if (ll > 0 && line[ll - 1] == '\r')
+            --ll;
+        while (blank < ll && isspace((unsigned char)line[blank]))
+            ++blank;
+        if (blank == ll || line[blank] == '#')
+            continue;
+        if (nul_check(&pc, line, ll, text, pos, len) != 0)
+            goto fail;
+        const size_t nf = split_line(fields, 256, line, ll);
+        if (nf > 256) {
+            rch_diag_set(d, name, pc.line_no, 1, "too many columns (%zu, at most 256)", nf);
+            goto fail;
+        }
+        if (!have_header) {
+            if (parse_header(&pc, fields, nf, line, ll) != 0)
+                goto fail;
+            have_header = 1;
+        } else if (parse_row(out, &pc, fields, nf, ll) != 0) {
+            goto fail;
+        }
+    }
+    if (!have_header) {
+        rch_diag_set(d, name, 0, 0, "empty file: no header line");
+        goto fail;
+    }
+    if (out->n == 0 && !(flags & RCH_DATA_ALLOW_EMPTY)) {
+        rch_diag_set(d, name, pc.line_no, 0, "no data rows after the header");
+        goto fail;
+    }
+    out->has_t = pc.col_of[C_T] >= 0;
+    out->has_group = pc.col_of[C_G] >= 0;
+    scale_t(out);
     return 0;
 fail:
     rch_data_free(out);

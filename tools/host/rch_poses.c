@@ -194,6 +194,26 @@ static void progress_line(FILE *f, const char *what, size_t k, size_t n)
     }
 }
 
+/* The candidate outside the design with the largest x^T A^-1 x (A = L L^T
+ * in w->L): its index (none_idx when there is none) and *bq that value (-1). */
+static size_t best_candidate(plan_work *w, size_t none_idx, double *bq)
+{
+    const unsigned r = w->r;
+    size_t best = none_idx;
+    *bq = -1;
+    for (size_t i = 0; i < w->n_cand; ++i) {
+        double q;
+        if (w->in_design[i])
+            continue;
+        q = quad(w->L, w->X + i * r, w->tmp, r);
+        if (q > *bq) {
+            *bq = q;
+            best = i;
+        }
+    }
+    return best;
+}
+
 /* 4a: greedy D-optimal start (a tiny ridge keeps A invertible early on) */
 static void greedy(plan_work *w, FILE *progress)
 {
@@ -202,19 +222,10 @@ static void greedy(plan_work *w, FILE *progress)
     for (unsigned k = 0; k < r; ++k)
         w->A[k * r + k] = ridge;
     for (size_t t = 0; t < w->n; ++t) {
-        size_t best = 0;
-        double bq = -1;
+        double bq;
+        size_t best;
         chol(w->L, w->A, r);
-        for (size_t i = 0; i < w->n_cand; ++i) {
-            double q;
-            if (w->in_design[i])
-                continue;
-            q = quad(w->L, w->X + i * r, w->tmp, r);
-            if (q > bq) {
-                bq = q;
-                best = i;
-            }
-        }
+        best = best_candidate(w, 0, &bq);
         w->design[t] = best;
         w->in_design[best] = 1;
         add_outer(w->A, w->X + best * r, 1.0, r);
@@ -229,24 +240,15 @@ static unsigned exchange(plan_work *w)
     unsigned swaps = 0;
     for (size_t t = 0; t < w->n; ++t) {
         double ld_now = chol(w->L, w->A, r), ld_minus;
-        size_t best = w->n_cand;
-        double bq = -1;
+        size_t best;
+        double bq;
         add_outer(w->A, w->X + w->design[t] * r, -1.0, r);
         ld_minus = chol(w->L, w->A, r);
         if (!isfinite(ld_minus)) {
             add_outer(w->A, w->X + w->design[t] * r, 1.0, r);
             continue;
         }
-        for (size_t i = 0; i < w->n_cand; ++i) {
-            double q;
-            if (w->in_design[i])
-                continue;
-            q = quad(w->L, w->X + i * r, w->tmp, r);
-            if (q > bq) {
-                bq = q;
-                best = i;
-            }
-        }
+        best = best_candidate(w, w->n_cand, &bq);
         /* det(A- + x x^T) = det(A-) (1 + x^T A-^-1 x) */
         if (best < w->n_cand && ld_minus + log1p(bq) > ld_now + 1e-9) {
             w->in_design[w->design[t]] = 0;
