@@ -146,7 +146,7 @@ static void config(rch_acq_config *c, const char *out_name)
 static int run(rch_acq_result *r, const rch_acq_config *c, tio *t)
 {
     t->m[0].max_chunk = t->m[1].max_chunk = g_frame;
-    rch_acq_io io = {t_open, t_close, t_sleep, t_wall, t_confirm, t};
+    rch_acq_io io = {t_open, t_close, t_sleep, t_wall, t_confirm, NULL, t};
     FILE *e;
     memset(g_err, 0, sizeof g_err);
     e = fmemopen(g_err, sizeof g_err, "w");

@@ -402,7 +402,11 @@ static int run_poses(acq *a)
             return 1;
         }
         a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
-        memcpy(q_deg, a->plan_deg[i], sizeof q_deg); /* the joint source: the plan */
+        memcpy(q_deg, a->plan_deg[i], sizeof q_deg); /* default joint source: the plan */
+        if (a->io->joints && a->io->joints(a->io->ctx, q_deg, a->plan_deg[i], i) != 0) {
+            WARN(a, "pose %zu: the joint-angle source failed; stopped (rerun to resume)\n", i);
+            return 1;
+        }
         st = measure_checked(&r, a, i);
         if (st != RC_OK) {
             a->res->stopped = 1;
@@ -428,7 +432,7 @@ static int run_poses(acq *a)
 
 int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_io *io, FILE *out, FILE *err)
 {
-    static const rch_acq_io sys_ops = {sys_open, sys_close, sys_sleep, sys_wall, sys_confirm, NULL};
+    static const rch_acq_io sys_ops = {sys_open, sys_close, sys_sleep, sys_wall, sys_confirm, NULL, NULL};
     sys_io sys;
     rch_acq_io real;
     acq a;

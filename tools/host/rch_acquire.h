@@ -33,6 +33,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "rc_model.h"
 #include "rc_stable.h"
 #include "rcd_display.h"
 
@@ -46,6 +47,11 @@ typedef struct rch_acq_io {
     void (*sleep_ms)(void *ctx, rcd_port *port, unsigned long ms);
     long long (*wall_ms)(void *ctx);   /* recorded in t_unix_ms */
     int (*confirm)(void *ctx, size_t pose); /* --confirm: 0 go on, -1 stop */
+    /* The joint-angle source: the q1..q6 (deg) recorded for pose `pose`.
+     * NULL: the plan's own angles (the robot program visits the planned
+     * poses). A controller stream (RAPID socket, EGM) plugs in here; it may
+     * block until the motion is finished. 0, or -1 to stop the run. */
+    int (*joints)(void *ctx, double q_deg[RC_NJ], const double plan_deg[RC_NJ], size_t pose);
     void *ctx;
 } rch_acq_io;
 
