@@ -290,7 +290,8 @@ static rc_status measure_checked(rc_stable_result *r, acq *a, size_t i)
              r->mean_mm - a->ref_len_mm, miss, c->follow_tol_mm,
              fabs(r->mean_mm - a->ref_len_mm) <= c->stable.tol_mm
                  ? "the display did not change: frozen (HOLD pressed, firmware hung) or the robot did not move"
-                 : "another device on the port, a slipped cable, or the robot is not at the pose",
+                 : "a frozen display (HOLD pressed, firmware hung), another device on the port, a slipped "
+                   "cable, or the robot is not at the pose",
              attempt + 1, c->retries);
         if (attempt + 1 >= c->retries) {
             WARN(a, "pose %zu: the display does not follow the robot; nothing recorded. Check the display (HOLD?), "

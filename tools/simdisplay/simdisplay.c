@@ -41,6 +41,11 @@
  *                       with --reconnect-ms R open a new pty R ms later (its
  *                       path printed as a new stdout line, --link re-pointed),
  *                       else exit
+ *   --freeze-after N    after N frames the shown value never changes again
+ *                       (HOLD pressed, firmware hung): `rcal acquire` must
+ *                       refuse it (follow check)
+ *   --foreign-offset-mm X  the device found after a reconnect is another
+ *                       one: it shows the true length + X mm
  *   --seed S            random faults and noise are reproducible
  */
 #include <errno.h>
@@ -94,6 +99,9 @@ typedef struct sim {
     int disconnected;
     double shown_mm, next_refresh_s;
     int have_shown;
+    unsigned long freeze_after; /* 0: never */
+    double foreign_offset_mm;   /* added after a reconnect */
+    int foreign;                /* the reconnected device is another one */
 } sim;
 
 static double now_s(void)
@@ -261,9 +269,11 @@ static void follow_pose(sim *s)
 static double shown_value(sim *s)
 {
     double t = now_s();
+    if (s->freeze_after && s->frames >= s->freeze_after && s->have_shown)
+        return s->shown_mm; /* frozen: HOLD pressed or firmware hung */
     if (s->pc.protocol != RCD_PROTO_ASCII && s->rate_hz > 0 && s->have_shown && t < s->next_refresh_s)
         return s->shown_mm;
-    s->shown_mm = true_value(s);
+    s->shown_mm = true_value(s) + (s->foreign ? s->foreign_offset_mm : 0.0);
     if (s->noise_mm > 0)
         s->shown_mm += s->noise_mm * rc_rng_normal(&s->rng);
     s->have_shown = 1;
@@ -434,7 +444,8 @@ static void usage(FILE *f)
                "         [--rate-hz R] [--baud B] [--poll-cmd TEXT] [--mb-addr A] [--mb-reg R]\n"
                "         [--mb-format int32|float] [--mb-order abcd|cdab|badc|dcba] [--mb-decimals D]\n"
                "         [--drop P] [--corrupt P] [--garbage P] [--silence-every N --silence-ms T]\n"
-               "         [--disconnect-after N [--reconnect-ms R]] [--settle-ms T] [--reply-delay-ms T]\n"
+               "         [--disconnect-after N [--reconnect-ms R] [--foreign-offset-mm X]] [--freeze-after N]\n"
+               "         [--settle-ms T] [--reply-delay-ms T]\n"
                "         [--link PATH] [--seed S] [--exit-after-frames N] [--max-seconds T]\n"
                "  Prints the pty path as the first line of stdout. See the comment of simdisplay.c.\n");
 }
@@ -598,6 +609,12 @@ int main(int argc, char **argv)
         } else if (OPT("--disconnect-after")) {
             if (opt_ulong(a, v, 10, ULONG_MAX - 1, &s.disconnect_after) != 0)
                 return 2;
+        } else if (OPT("--freeze-after")) {
+            if (opt_ulong(a, v, 10, ULONG_MAX - 1, &s.freeze_after) != 0)
+                return 2;
+        } else if (OPT("--foreign-offset-mm")) {
+            if (opt_double(a, v, -1e5, 1e5, &s.foreign_offset_mm) != 0)
+                return 2;
         } else if (OPT("--reconnect-ms")) {
             if (opt_long(a, v, -1, (long)SIM_MAX_MS, &s.reconnect_ms) != 0)
                 return 2;
@@ -669,6 +686,7 @@ int main(int argc, char **argv)
             sleep_s((double)s.reconnect_ms / 1000.0);
             s.disconnected = 0;
             s.disconnect_after = 0;
+            s.foreign = s.foreign_offset_mm != 0.0;
             rq_len = 0;
             if (open_pty(&s) != 0) {
                 rc = 1;
