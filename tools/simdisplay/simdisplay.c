@@ -63,6 +63,7 @@
 #include "rc_rand.h"
 #include "rcd_proto.h"
 #include "rch_data.h"
+#include "rch_opt.h"
 #include "rch_robot.h"
 
 /* longest delay an option may ask for: one day */
@@ -208,11 +209,9 @@ static long read_follow(const sim *s)
         return -1;
     }
     fclose(f);
-    if (buf[0] < '0' || buf[0] > '9')
-        return -1;
-    errno = 0;
-    idx = strtol(buf, &end, 10);
-    if (errno != 0 || (*end != '\0' && *end != ' ' && *end != '\t' && *end != '\r' && *end != '\n'))
+    end = buf + strcspn(buf, " \t\r\n"); /* "INDEX q1 .. q6": the index */
+    *end = '\0';
+    if (rch_parse_long(buf, &idx) != 0 || idx < 0)
         return -1;
     return idx;
 }
@@ -360,11 +359,10 @@ static int load_script(sim *s, const char *path)
             ++p;
         if (*p == '#' || *p == '\n' || *p == '\r' || *p == '\0')
             continue; /* comment or blank line */
-        errno = 0;
-        v = strtod(p, &end);
-        while (*end == ' ' || *end == '\t' || *end == '\r' || *end == '\n')
-            ++end;
-        if (end == p || *end != '\0' || errno != 0 || !isfinite(v)) {
+        end = p + strlen(p);
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r' || end[-1] == '\n'))
+            *--end = '\0';
+        if (rch_parse_double(p, &v) != 0) {
             fprintf(stderr, "simdisplay: %s:%u: not a number (one value in mm per line, # for comments)\n", path,
                     lineno);
             fclose(f);
@@ -450,16 +448,14 @@ static void usage(FILE *f)
                "  Prints the pty path as the first line of stdout. See the comment of simdisplay.c.\n");
 }
 
-/* Number options: the whole value must be a number in [lo, hi] (strtod /
- * strtoul / strtol with end, ERANGE and finiteness checks), else a message
+/* Number options: the whole value must be a decimal number in [lo, hi]
+ * (the shared strict readers rch_parse_double / rch_parse_ulong /
+ * rch_parse_long: no blanks, no hex, no inf/nan, no wrap), else a message
  * naming the option and the value and -1 (main then exits 2, a usage error). */
 static int opt_double(const char *name, const char *v, double lo, double hi, double *out)
 {
-    char *end;
     double x;
-    errno = 0;
-    x = strtod(v, &end);
-    if (end == v || *end != '\0' || errno != 0 || !isfinite(x)) {
+    if (rch_parse_double(v, &x) != 0) {
         fprintf(stderr, "simdisplay: option %s: '%s' is not a number\n", name, v);
         return -1;
     }
@@ -471,18 +467,15 @@ static int opt_double(const char *name, const char *v, double lo, double hi, dou
     return 0;
 }
 
-/* base 10, or 0 to also accept 0x.. (register numbers) */
-static int opt_ulong(const char *name, const char *v, int base, unsigned long hi, unsigned long *out)
+static int opt_ulong(const char *name, const char *v, unsigned long hi, unsigned long *out)
 {
-    char *end;
     unsigned long x;
-    errno = 0;
-    x = strtoul(v, &end, base);
-    if (*v < '0' || *v > '9' || *end != '\0' || (errno != 0 && errno != ERANGE)) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is not a non-negative integer\n", name, v);
+    if (rch_parse_ulong(v, &x) != 0) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is not a non-negative decimal integer (at most %lu)\n", name, v,
+                hi);
         return -1;
     }
-    if (errno == ERANGE || x > hi) {
+    if (x > hi) {
         fprintf(stderr, "simdisplay: option %s: '%s' is more than %lu\n", name, v, hi);
         return -1;
     }
@@ -492,16 +485,9 @@ static int opt_ulong(const char *name, const char *v, int base, unsigned long hi
 
 static int opt_long(const char *name, const char *v, long lo, long hi, long *out)
 {
-    char *end;
     long x;
-    errno = 0;
-    x = strtol(v, &end, 10);
-    if (end == v || *end != '\0' || (errno != 0 && errno != ERANGE)) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is not an integer\n", name, v);
-        return -1;
-    }
-    if (errno == ERANGE || x < lo || x > hi) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is outside %ld..%ld\n", name, v, lo, hi);
+    if (rch_parse_long(v, &x) != 0 || x < lo || x > hi) {
+        fprintf(stderr, "simdisplay: option %s: '%s' is not an integer in %ld..%ld\n", name, v, lo, hi);
         return -1;
     }
     *out = x;
@@ -549,7 +535,7 @@ int main(int argc, char **argv)
             if (opt_double(a, v, 0.0, 1e9, &s.noise_mm) != 0)
                 return 2;
         } else if (OPT("--decimals")) {
-            if (opt_ulong(a, v, 10, 6, &u) != 0)
+            if (opt_ulong(a, v, 6, &u) != 0)
                 return 2;
             s.decimals = (unsigned)u;
         } else if (OPT("--style")) {
@@ -561,7 +547,7 @@ int main(int argc, char **argv)
             if (opt_double(a, v, 0.0, 1e6, &s.rate_hz) != 0)
                 return 2;
         } else if (OPT("--baud")) {
-            if (opt_ulong(a, v, 10, 100000000UL, &s.baud) != 0)
+            if (opt_ulong(a, v, 100000000UL, &s.baud) != 0)
                 return 2;
         } else if (OPT("--poll-cmd")) {
             /* C escapes \r and \n are understood */
@@ -575,11 +561,11 @@ int main(int argc, char **argv)
                 }
             }
         } else if (OPT("--mb-addr")) {
-            if (opt_ulong(a, v, 10, 247, &u) != 0)
+            if (opt_ulong(a, v, 247, &u) != 0)
                 return 2;
             s.pc.mb_addr = (uint8_t)u;
         } else if (OPT("--mb-reg")) {
-            if (opt_ulong(a, v, 0, 65535, &u) != 0)
+            if (opt_ulong(a, v, 65535, &u) != 0)
                 return 2;
             s.pc.mb_reg = (uint16_t)u;
         } else if (OPT("--mb-format")) {
@@ -588,7 +574,7 @@ int main(int argc, char **argv)
             if (rcd_word_order_from_name(&s.pc.mb_order, v) != RC_OK)
                 return 2;
         } else if (OPT("--mb-decimals")) {
-            if (opt_ulong(a, v, 10, 9, &u) != 0)
+            if (opt_ulong(a, v, 9, &u) != 0)
                 return 2;
             s.pc.mb_decimals = (uint8_t)u;
         } else if (OPT("--drop")) {
@@ -601,16 +587,16 @@ int main(int argc, char **argv)
             if (opt_double(a, v, 0.0, 1.0, &s.p_garbage) != 0)
                 return 2;
         } else if (OPT("--silence-every")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX, &s.silence_every) != 0)
+            if (opt_ulong(a, v, ULONG_MAX, &s.silence_every) != 0)
                 return 2;
         } else if (OPT("--silence-ms")) {
-            if (opt_ulong(a, v, 10, SIM_MAX_MS, &s.silence_ms) != 0)
+            if (opt_ulong(a, v, SIM_MAX_MS, &s.silence_ms) != 0)
                 return 2;
         } else if (OPT("--disconnect-after")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX - 1, &s.disconnect_after) != 0)
+            if (opt_ulong(a, v, ULONG_MAX - 1, &s.disconnect_after) != 0)
                 return 2;
         } else if (OPT("--freeze-after")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX - 1, &s.freeze_after) != 0)
+            if (opt_ulong(a, v, ULONG_MAX - 1, &s.freeze_after) != 0)
                 return 2;
         } else if (OPT("--foreign-offset-mm")) {
             if (opt_double(a, v, -1e5, 1e5, &s.foreign_offset_mm) != 0)
@@ -619,18 +605,18 @@ int main(int argc, char **argv)
             if (opt_long(a, v, -1, (long)SIM_MAX_MS, &s.reconnect_ms) != 0)
                 return 2;
         } else if (OPT("--settle-ms")) {
-            if (opt_ulong(a, v, 10, SIM_MAX_MS, &s.settle_ms) != 0)
+            if (opt_ulong(a, v, SIM_MAX_MS, &s.settle_ms) != 0)
                 return 2;
         } else if (OPT("--reply-delay-ms")) {
-            if (opt_ulong(a, v, 10, SIM_MAX_MS, &reply_delay_ms) != 0)
+            if (opt_ulong(a, v, SIM_MAX_MS, &reply_delay_ms) != 0)
                 return 2;
         } else if (OPT("--link")) {
             s.link = v;
         } else if (OPT("--seed")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX, &seed) != 0)
+            if (opt_ulong(a, v, ULONG_MAX, &seed) != 0)
                 return 2;
         } else if (OPT("--exit-after-frames")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX, &s.exit_after) != 0)
+            if (opt_ulong(a, v, ULONG_MAX, &s.exit_after) != 0)
                 return 2;
         } else if (OPT("--max-seconds")) {
             if (opt_double(a, v, 0.0, 1e9, &s.max_seconds) != 0)
