@@ -375,7 +375,9 @@ rc_status rcd_build_request(uint8_t *buf, size_t *n, size_t cap, const rcd_proto
     case RCD_PROTO_ASCII_POLL:
     case RCD_PROTO_STX: {
         const char *cmd = cfg->poll_cmd[0] ? cfg->poll_cmd : "R\r";
-        size_t l = strnlen(cmd, sizeof cfg->poll_cmd);
+        size_t l = 0; /* strnlen is POSIX, not C99 */
+        while (l < sizeof cfg->poll_cmd && cmd[l] != '\0')
+            ++l;
         if (l > cap)
             return RC_ERR_CAPACITY;
         memcpy(buf, cmd, l);
