@@ -20,9 +20,10 @@
 static const char details[] =
     "Plans N poses inside the joint limits of MODEL less --margin-deg whose cable length (encoder at the\n"
     "file's encoder_mm, else --encoder) is within [--len-min-mm, --len-max-mm], chosen among M random candidates\n"
-    "(default max(2000, 40 N)) to maximise det(J^T J) of the identifiable parameters (greedy + exchange).\n"
+    "(default max(2000, 40 N)) to maximise det(J^T J) over the identifiable directions (rc_ident; greedy +\n"
+    "exchange).\n"
     "Writes pose,q1..q6 (degrees, 0.01 deg steps); prints the observability index O1 beside that of a random\n"
-    "plan of the same size. The design costs about N^2/28000 s (1000 poses: about 36 s; progress on stderr).";
+    "plan of the same size. The design cost grows as N^2 (1000 poses: about 25 s; progress on stderr).";
 
 int rcal_cmd_poses(int argc, char **argv)
 {
@@ -76,8 +77,8 @@ int rcal_cmd_poses(int argc, char **argv)
         free(robot);
         return 1;
     }
-    printf("rcal poses: %zu poses from %zu candidates, %u identifiable parameters of %u\n", res.n, res.n_candidates,
-           res.n_ident, res.n_params);
+    printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
+           res.n, res.n_candidates, res.n_ident, res.n_params);
     printf("  observability O1 (rch_ident): planned %.5g (rank %u), random %.5g (rank %u), ratio %.2f\n",
            res.o1_plan, res.rank_plan, res.o1_random, res.rank_random,
            res.o1_random > 0 ? res.o1_plan / res.o1_random : 0.0);

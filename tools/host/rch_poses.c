@@ -1,5 +1,5 @@
 /* rch_poses.c - D-optimal pose planning (see rch_poses.h). Moved from
- * tools/cmd_poses.c with the same arithmetic, so plans are unchanged. */
+ * tools/cmd_poses.c; the identifiable part now comes from lib/rc_ident. */
 #include "rch_poses.h"
 
 #include <math.h>
@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "rc_rand.h"
+#include "rc_ident.h"
 #include "rch_ident.h"
 
 #define PI_ 3.14159265358979323846
@@ -76,8 +77,7 @@ typedef struct plan_work {
     unsigned P, r;
     rc_sample *cand;       /* (n_cand) */
     double *G;             /* (n_cand x P) Jacobian rows */
-    double *scale;         /* (P) */
-    unsigned *cols;        /* (P) identifiable columns, r used */
+    double *scale;         /* (P) column norms of the candidates' Jacobian (rc_ident_scale) */
     double *X, *A, *L, *tmp;
     size_t *design, *rnd;  /* (n) */
     unsigned char *in_design; /* (n_cand) */
@@ -88,7 +88,6 @@ static void work_free(plan_work *w)
     free(w->cand);
     free(w->G);
     free(w->scale);
-    free(w->cols);
     free(w->X);
     free(w->A);
     free(w->L);
@@ -129,61 +128,60 @@ static int draw_candidates(plan_work *w, const rc_model *m, const rch_poses_conf
     return 0;
 }
 
-/* 3: identifiable columns by pivoted Gram-Schmidt over the candidates */
-static int ident_columns(plan_work *w)
+/* 3: the identifiable subspace (rc_ident, the one definition): the
+ * candidates' information matrix G^T G, scaled by its column norms, split
+ * into directions; the rank directions that are not null span what the data
+ * can identify. X (n_cand x r) = the scaled rows in those directions, times
+ * sqrt(n_cand) so that a column's RMS over the candidates is its singular
+ * value over sqrt(n_cand) (the ridge of the greedy start stays small). */
+static int ident_subspace(plan_work *w, rch_diag *d)
 {
     const unsigned P = w->P;
-    double *Q = malloc(w->n_cand * P * sizeof *Q), first = 0;
-    unsigned char *used = calloc(P, 1);
-    for (unsigned j = 0; j < P; ++j) {
-        double ss = 0;
-        for (size_t i = 0; i < w->n_cand; ++i)
-            ss += w->G[i * P + j] * w->G[i * P + j];
-        w->scale[j] = ss > 0 ? 1.0 / sqrt(ss / (double)w->n_cand) : 0.0;
+    double *AtA = calloc((size_t)P * P, sizeof *AtA), *V = malloc((size_t)P * P * sizeof *V);
+    double *work = malloc(rc_ident_work_size(P) * sizeof *work), *diag = malloc(P * sizeof *diag);
+    rc_ident *id = calloc(1, sizeof *id);
+    int rc = -1;
+    if (!AtA || !V || !work || !diag || !id) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto out;
     }
-    if (!Q || !used) {
-        free(Q);
-        free(used);
-        return -1;
-    }
-    for (size_t i = 0; i < w->n_cand; ++i)
+    for (size_t i = 0; i < w->n_cand; ++i) {
+        const double *g = w->G + i * P;
         for (unsigned j = 0; j < P; ++j)
-            Q[i * P + j] = w->G[i * P + j] * w->scale[j];
-    for (;;) {
-        unsigned best = P;
-        double bn = 0;
-        for (unsigned j = 0; j < P; ++j) {
-            double s2 = 0;
-            if (used[j])
-                continue;
-            for (size_t i = 0; i < w->n_cand; ++i)
-                s2 += Q[i * P + j] * Q[i * P + j];
-            if (s2 > bn) {
-                bn = s2;
-                best = j;
-            }
-        }
-        if (best == P)
-            break;
-        if (w->r == 0)
-            first = sqrt(bn);
-        if (sqrt(bn) < 1e-6 * first)
-            break;
-        used[best] = 1;
-        w->cols[w->r++] = best;
-        for (unsigned j = 0; j < P; ++j) { /* remove the chosen direction */
-            double dot = 0, nb = sqrt(bn);
-            if (used[j])
-                continue;
-            for (size_t i = 0; i < w->n_cand; ++i)
-                dot += Q[i * P + j] * Q[i * P + best] / nb;
-            for (size_t i = 0; i < w->n_cand; ++i)
-                Q[i * P + j] -= dot * Q[i * P + best] / nb;
-        }
+            for (unsigned k = 0; k <= j; ++k)
+                AtA[j * P + k] += g[j] * g[k];
     }
-    free(Q);
-    free(used);
-    return 0;
+    for (unsigned j = 0; j < P; ++j)
+        for (unsigned k = 0; k < j; ++k)
+            AtA[k * P + j] = AtA[j * P + k];
+    if (rc_ident_normal(id, V, work, AtA, P, w->n_cand) != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "the identifiability analysis of the candidates failed");
+        goto out;
+    }
+    rc_ident_scale(w->scale, AtA, P, (size_t)P + 1);
+    w->r = id->rank;
+    w->X = calloc(w->n_cand * (w->r ? w->r : 1), sizeof *w->X);
+    if (!w->X) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto out;
+    }
+    for (unsigned j = 0; j < P; ++j)
+        diag[j] = w->scale[j] > 0 ? sqrt((double)w->n_cand) / w->scale[j] : 0.0;
+    for (size_t i = 0; i < w->n_cand; ++i)
+        for (unsigned j = 0; j < P; ++j) {
+            const double gj = w->G[i * P + j] * diag[j];
+            if (gj != 0.0)
+                for (unsigned k = 0; k < w->r; ++k)
+                    w->X[i * w->r + k] += gj * V[j * P + k];
+        }
+    rc = 0;
+out:
+    free(AtA);
+    free(V);
+    free(work);
+    free(diag);
+    free(id);
+    return rc;
 }
 
 static void progress_line(FILE *f, const char *what, size_t k, size_t n)
@@ -264,8 +262,8 @@ static unsigned exchange(plan_work *w)
 static int check_config(const rc_model *m, const rch_poses_config *c, size_t *n_cand, rch_diag *d)
 {
     if (c->count < 1 || c->count > RCH_POSES_MAX_COUNT) {
-        rch_diag_set(d, "", 0, 0, "--count %zu: a plan has 1..%u poses (the design costs about N^2/28000 s; "
-                     "1000 poses take about 36 s)", c->count, RCH_POSES_MAX_COUNT);
+        rch_diag_set(d, "", 0, 0, "--count %zu: a plan has 1..%u poses (the design cost grows as N^2; "
+                     "1000 poses take about 25 s)", c->count, RCH_POSES_MAX_COUNT);
         return -1;
     }
     *n_cand = c->candidates ? c->candidates : (c->count * 40 > 2000 ? c->count * 40 : 2000);
@@ -303,34 +301,27 @@ int rch_poses_plan(rch_poses_result *res, const rc_model *m, const rch_poses_con
     w.cand = malloc(w.n_cand * sizeof *w.cand);
     w.G = malloc(w.n_cand * w.P * sizeof *w.G);
     w.scale = calloc(w.P, sizeof *w.scale);
-    w.cols = malloc(w.P * sizeof *w.cols);
     w.design = malloc(w.n * sizeof *w.design);
     w.rnd = malloc(w.n * sizeof *w.rnd);
     w.in_design = calloc(w.n_cand, 1);
-    if (!w.cand || !w.G || !w.scale || !w.cols || !w.design || !w.rnd || !w.in_design) {
+    if (!w.cand || !w.G || !w.scale || !w.design || !w.rnd || !w.in_design) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
     if (progress && w.n >= 200)
         fprintf(progress, "rcal poses: %zu poses from %zu candidates: about %.0f s\n", w.n, w.n_cand,
-                (double)w.n * (double)w.n / 28000.0);
+                (double)w.n * (double)w.n / 40000.0);
     if (draw_candidates(&w, m, c, d) != 0)
         goto done;
-    if (ident_columns(&w) != 0) {
-        rch_diag_set(d, "", 0, 0, "out of memory");
+    if (ident_subspace(&w, d) != 0)
         goto done;
-    }
-    w.X = malloc(w.n_cand * w.r * sizeof *w.X);
     w.A = calloc((size_t)w.r * w.r, sizeof *w.A);
     w.L = calloc((size_t)w.r * w.r, sizeof *w.L);
     w.tmp = malloc((w.r ? w.r : 1) * sizeof *w.tmp);
-    if (!w.X || !w.A || !w.L || !w.tmp) {
+    if (!w.A || !w.L || !w.tmp) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
-    for (size_t i = 0; i < w.n_cand; ++i)
-        for (unsigned k = 0; k < w.r; ++k)
-            w.X[i * w.r + k] = w.G[i * w.P + w.cols[k]] * w.scale[w.cols[k]];
     greedy(&w, w.n >= 200 ? progress : NULL);
     for (unsigned long pass = 0; pass < c->passes; ++pass) {
         if (progress && w.n >= 200)

@@ -7,19 +7,20 @@
  *  2. one row per candidate of the identification Jacobian d l / d x (rc_meas,
  *     nominal model with the encoder position), each column scaled by its
  *     RMS over the candidates so that mm and rad compare;
- *  3. keep the identifiable parameter subset: pivoted Gram-Schmidt on the
- *     scaled columns drops those that are combinations of others (alpha6; the
- *     base heading/height vs the encoder; d2 vs d3) - r columns remain
- *     (the core identifiability module rc_ident was not on main when this
- *     moved; this is the computation `rcal poses` always used);
- *  4. maximise log det(J_S^T J_S) over N poses: greedy additions (each adds the
+ *  3. keep what the candidates can identify (lib/rc_ident, the project's one
+ *     definition): the eigen-directions of the column-scaled information
+ *     matrix that are not null (rank r; alpha6, the base heading/height vs
+ *     the encoder, d2 vs d3 ... drop out); each candidate's scaled row is
+ *     expressed in those r directions;
+ *  4. maximise log det(X_S^T X_S) over N poses (X: the rows of step 3): greedy additions (each adds the
  *     candidate with the largest x^T A^-1 x), then exchange passes that swap a
  *     chosen pose for a candidate while the determinant grows.
  * The plan is reported with the observability index O1 of rch_ident beside
  * that of N random poses from the same candidates. Collisions of the cable
  * with the arm are not modelled: review the plan before running it.
  *
- * Cost: about N^2 / 28,000 s on one core (N = 1000: 36 s), memory
+ * Cost: grows as N^2 (one core: 100 poses 0.2 s, 300 poses 2 s, 1000 poses
+ * 25 s), memory
  * candidates x n_params doubles; hence the limits below, named in the error.
  * Host side (prefix rch_): heap; progress lines on a caller-given stream.
  */
@@ -48,7 +49,7 @@ typedef struct rch_poses_result {
     rc_sample *poses;          /* (n) the plan, q at 0.01 deg steps; rch_poses_free */
     size_t n;
     size_t n_candidates;
-    unsigned n_ident;          /* identifiable parameters kept (r) */
+    unsigned n_ident;          /* identifiable directions (rc_ident rank of the candidates) */
     unsigned n_params;
     double o1_plan, o1_random; /* observability O1 (rch_ident) of the plan and of N random candidates */
     unsigned rank_plan, rank_random;
