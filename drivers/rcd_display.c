@@ -1,14 +1,13 @@
 /* rcd_display.c - display reader: port + protocol + format lock. */
 #include <string.h>
-#include <time.h>
 
 #include "rcd_display.h"
 
-static long long now_ms(void)
+/* Milliseconds left of timeout_ms since t0 on the port's clock (modulo 2^32). */
+static long long left_ms(const rcd_display *d, uint32_t t0, unsigned timeout_ms)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+    uint32_t elapsed = rcd_port_now_ms(d->port) - t0;
+    return (long long)timeout_ms - (long long)elapsed;
 }
 
 static int is_polled(const rcd_display *d)
@@ -31,6 +30,18 @@ rc_status rcd_display_init(rcd_display *d, rcd_port *port, const rcd_proto_confi
     d->lock_decimals = -2;
     d->cand_decimals = -2;
     return RC_OK;
+}
+
+const char *rcd_display_why_silent(const rcd_display *d)
+{
+    if (!d)
+        return "";
+    if (d->last_reject == RCD_REJECT_MB_SLAVE)
+        return "; replies from another Modbus slave address were ignored: check --mb-addr";
+    if (d->last_reject == RCD_REJECT_MB_FUNCTION)
+        return "; replies with another Modbus function code were ignored: the display does not answer "
+               "holding-register reads (0x03) at this register";
+    return "";
 }
 
 void rcd_display_reset(rcd_display *d)
@@ -75,86 +86,125 @@ static rc_status check_shape(rcd_display *d, const rcd_reading *r)
     return RC_ERR_INCOMPLETE; /* still learning the format: keep reading */
 }
 
+/* Flush stale input and send one request, within what is left of the timeout. */
+static rc_status send_poll(rcd_display *d, uint32_t t0, unsigned timeout_ms)
+{
+    uint8_t req[32];
+    size_t rl = 0, wn = 0;
+    long long left;
+    rc_status st;
+    d->len = 0;
+    st = rcd_port_flush(d->port);
+    if (st != RC_OK)
+        return st;
+    st = rcd_build_request(req, &rl, sizeof req, &d->cfg);
+    if (st != RC_OK)
+        return st;
+    left = left_ms(d, t0, timeout_ms);
+    st = rcd_port_write(d->port, &wn, req, rl, left > 0 ? (unsigned)left : 1u);
+    if (st == RC_ERR_TIMEOUT)
+        d->stats.timeouts++;
+    if (st != RC_OK)
+        return st;
+    d->stats.polls++;
+    d->need_poll = 0;
+    return RC_OK;
+}
+
+/* A rejected frame: count it; a named Modbus reject goes to out. */
+static rc_status reject(rcd_display *d, rc_status st, const rcd_reading *r, rcd_reading *out)
+{
+    d->stats.bad_frames++;
+    d->last_reject = r->reject;
+    if (st == RC_ERR_FORMAT && r->reject == RCD_REJECT_MB_SLAVE)
+        d->stats.wrong_slave++;
+    if (st == RC_ERR_FORMAT && r->reject == RCD_REJECT_MB_FUNCTION)
+        d->stats.wrong_function++;
+    if (st == RC_ERR_FORMAT && r->reject != RCD_REJECT_NONE) {
+        d->last_mb_addr = r->mb_addr;
+        d->last_mb_fn = r->mb_fn;
+        if (out)
+            *out = *r;
+    }
+    return st;
+}
+
+/* The next event from the buffered bytes, or RC_ERR_INCOMPLETE when more
+ * bytes (or, polled, a new request) are needed. */
+static rc_status parse_buffered(rcd_display *d, rcd_reading *out)
+{
+    while (d->len > 0) {
+        rcd_reading r;
+        size_t c = 0;
+        rc_status st;
+        memset(&r, 0, sizeof r);
+        st = rcd_parse(&r, &c, &d->cfg, d->buf, d->len);
+        drop(d, c);
+        if (st == RC_ERR_INCOMPLETE)
+            return st;
+        d->need_poll = 1;
+        if (st == RC_OK) {
+            st = check_shape(d, &r);
+            if (st == RC_ERR_INCOMPLETE) {
+                if (is_polled(d))
+                    return st; /* warm-up frame: poll again */
+                continue;      /* warm-up frame: keep parsing */
+            }
+            if (st == RC_OK) {
+                d->stats.readings++;
+                if (out)
+                    *out = r;
+            }
+            return st;
+        }
+        if (st == RC_ERR_DEVICE) {
+            d->stats.device_errors++;
+            if (out)
+                *out = r;
+            return st;
+        }
+        return reject(d, st, &r, out);
+    }
+    return RC_ERR_INCOMPLETE;
+}
+
 rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms)
 {
-    long long deadline;
+    uint32_t t0;
     if (!d || !d->port)
         return RC_ERR_ARG;
-    deadline = now_ms() + timeout_ms;
+    t0 = rcd_port_now_ms(d->port);
     for (;;) {
         rc_status st;
         size_t n = 0;
         long long left;
         if (is_polled(d) && d->need_poll) {
-            uint8_t req[32];
-            size_t rl = 0, wn = 0;
-            d->len = 0;
-            st = rcd_port_flush(d->port);
+            st = send_poll(d, t0, timeout_ms);
             if (st != RC_OK)
                 return st;
-            st = rcd_build_request(req, &rl, sizeof req, &d->cfg);
-            if (st != RC_OK)
-                return st;
-            left = deadline - now_ms();
-            st = rcd_port_write(d->port, &wn, req, rl, left > 0 ? (unsigned)left : 1u);
-            if (st == RC_ERR_TIMEOUT)
-                d->stats.timeouts++;
-            if (st != RC_OK)
-                return st;
-            d->stats.polls++;
-            d->need_poll = 0;
         }
-        while (d->len > 0) {
-            rcd_reading r;
-            size_t c = 0;
-            st = rcd_parse(&r, &c, &d->cfg, d->buf, d->len);
-            drop(d, c);
-            if (st == RC_ERR_INCOMPLETE)
-                break;
-            d->need_poll = 1;
-            if (st == RC_OK) {
-                st = check_shape(d, &r);
-                if (st == RC_ERR_INCOMPLETE) {
-                    if (is_polled(d))
-                        break; /* warm-up frame: poll again */
-                    continue;  /* warm-up frame: keep parsing */
-                }
-                if (st == RC_OK) {
-                    d->stats.readings++;
-                    if (out)
-                        *out = r;
-                }
-                return st;
-            }
-            if (st == RC_ERR_DEVICE) {
-                d->stats.device_errors++;
-                if (out)
-                    *out = r;
-                return st;
-            }
-            d->stats.bad_frames++;
+        st = parse_buffered(d, out);
+        if (st != RC_ERR_INCOMPLETE)
             return st;
-        }
         if (d->len == sizeof d->buf)
             drop(d, sizeof d->buf / 2); /* cannot happen with the parsers' limits */
         if (is_polled(d) && d->need_poll)
             continue;
-        left = deadline - now_ms();
+        left = left_ms(d, t0, timeout_ms);
         if (left <= 0) {
             d->stats.timeouts++;
             d->need_poll = 1;
             return RC_ERR_TIMEOUT;
         }
         st = rcd_port_read(d->port, &n, d->buf + d->len, sizeof d->buf - d->len, (unsigned)left);
-        if (st == RC_OK) {
-            d->len += n;
-            d->stats.bytes += n;
-        } else if (st == RC_ERR_TIMEOUT) {
-            d->stats.timeouts++; /* the port waited for what was left */
-            d->need_poll = 1;
-            return st;
-        } else {
+        if (st != RC_OK) {
+            if (st == RC_ERR_TIMEOUT) {
+                d->stats.timeouts++; /* the port waited for what was left */
+                d->need_poll = 1;
+            }
             return st;
         }
+        d->len += n;
+        d->stats.bytes += n;
     }
 }

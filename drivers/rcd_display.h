@@ -13,7 +13,8 @@
  * rejected (RC_ERR_FORMAT, stats.shape_rejects). A byte dropped from or added
  * to a line changes its shape, so it is never returned as a value.
  *
- * Depends on: rcd_port.h, rcd_proto.h, POSIX clock_gettime (timeouts).
+ * Depends on: rcd_port.h, rcd_proto.h. Time comes from the port's clock
+ * (rcd_port_now_ms): no OS call here, so it builds for a microcontroller.
  * Memory: rcd_display is caller-owned (a 512-byte receive buffer inside);
  * the port is borrowed and must outlive it.
  * Thread safety: one display per thread.
@@ -43,6 +44,8 @@ typedef struct rcd_display_stats {
     unsigned long timeouts;
     unsigned long polls;          /* requests sent */
     unsigned long bytes;          /* bytes received */
+    unsigned long wrong_slave;    /* Modbus replies from another slave address */
+    unsigned long wrong_function; /* Modbus replies with another function code */
 } rcd_display_stats;
 
 typedef struct rcd_display {
@@ -57,12 +60,18 @@ typedef struct rcd_display {
     uint8_t cand_unit;
     unsigned cand_count;
     rcd_display_stats stats;
+    uint8_t last_reject;            /* rcd_reject of the last rejected frame */
+    uint8_t last_mb_addr, last_mb_fn;
 } rcd_display;
 
 /* Bind a display to an open port. cfg NULL: ASCII streaming. */
 rc_status rcd_display_init(rcd_display *d, rcd_port *port, const rcd_proto_config *cfg);
 /* Next event within timeout_ms (see the file comment). out may be NULL. */
 rc_status rcd_display_read(rcd_display *d, rcd_reading *out, unsigned timeout_ms);
+/* Why nothing usable arrived, as a static text to append to a timeout
+ * message ("" when there is no known reason): replies from another Modbus
+ * slave or with another function code were seen and ignored. */
+const char *rcd_display_why_silent(const rcd_display *d);
 /* Drop buffered bytes and pending poll state (after a reconnect). The format
  * lock is kept: the display's format does not change with the cable. */
 void rcd_display_reset(rcd_display *d);

@@ -28,12 +28,9 @@ static rc_status mk_close(void *ctx)
     return RC_OK;
 }
 
-static rc_status mk_read(void *ctx, size_t *n_read, uint8_t *buf, size_t cap, unsigned timeout_ms)
+static rc_status mk_read_(rcd_mock_ctx *m, size_t *n_read, uint8_t *buf, size_t cap)
 {
-    rcd_mock_ctx *m = ctx;
     size_t n, left;
-    (void)timeout_ms;
-    *n_read = 0;
     m->n_reads++;
     if (!m->is_open)
         return RC_ERR_CLOSED;
@@ -59,6 +56,23 @@ static rc_status mk_read(void *ctx, size_t *n_read, uint8_t *buf, size_t cap, un
     m->rx_pos += n;
     *n_read = n;
     return RC_OK;
+}
+
+static rc_status mk_read(void *ctx, size_t *n_read, uint8_t *buf, size_t cap, unsigned timeout_ms)
+{
+    rcd_mock_ctx *m = ctx;
+    rc_status st;
+    *n_read = 0;
+    st = mk_read_(m, n_read, buf, cap);
+    if (st == RC_ERR_TIMEOUT)
+        m->clock_ms += (uint32_t)timeout_ms; /* the wait a real port would have done */
+    return st;
+}
+
+static uint32_t mk_now_ms(void *ctx)
+{
+    const rcd_mock_ctx *m = ctx;
+    return m->clock_ms;
 }
 
 static rc_status mk_write(void *ctx, size_t *n_written, const uint8_t *buf, size_t len,
@@ -116,6 +130,7 @@ const rcd_port_ops rcd_mock_ops = {
     .flush = mk_flush,
     .drain = mk_drain,
     .last_error = mk_last_error,
+    .now_ms = mk_now_ms,
 };
 
 void rcd_mock_init(rcd_port *p, rcd_mock_ctx *ctx)

@@ -78,3 +78,10 @@ const char *rcd_port_last_error(const rcd_port *p)
     s = p->ops->last_error(p->ctx);
     return s ? s : "";
 }
+
+uint32_t rcd_port_now_ms(const rcd_port *p)
+{
+    if (!p || !p->ops || !p->ops->now_ms)
+        return 0u;
+    return p->ops->now_ms(p->ctx);
+}

@@ -68,7 +68,12 @@ rc_status rcd_serial_config_resolve(rcd_serial_config *out, const rcd_serial_con
  *  flush: discards pending input and output.
  *  drain: waits until pending output has been transmitted.
  *  last_error: static or ctx-owned text of the last OS/device error ("" if
- *         none); never NULL. */
+ *         none); never NULL.
+ *  now_ms: a monotonic millisecond clock (any origin). The display reader
+ *         and the acquisition take their time from here and nowhere else, so
+ *         the reading path runs wherever a backend can supply a clock (a
+ *         microcontroller's tick counter). 32 bits: it wraps after 49.7 days;
+ *         callers take differences modulo 2^32. */
 typedef struct rcd_port_ops {
     const char *name;
     rc_status (*open)(void *ctx, const char *path, const rcd_serial_config *cfg);
@@ -79,6 +84,7 @@ typedef struct rcd_port_ops {
     rc_status (*flush)(void *ctx);
     rc_status (*drain)(void *ctx);
     const char *(*last_error)(void *ctx);
+    uint32_t (*now_ms)(void *ctx);
 } rcd_port_ops;
 
 typedef struct rcd_port {
@@ -95,6 +101,8 @@ rc_status rcd_port_write(rcd_port *p, size_t *n_written, const uint8_t *buf, siz
 rc_status rcd_port_flush(rcd_port *p);
 rc_status rcd_port_drain(rcd_port *p);
 const char *rcd_port_last_error(const rcd_port *p);
+/* The backend's clock (0 when the port has none: a contract violation). */
+uint32_t rcd_port_now_ms(const rcd_port *p);
 
 /* ---- libserialport backend (rcd_serialport.c) ---------------------------
  * Opens by name through sp_get_port_by_name, configures baud/bits/parity/
@@ -125,6 +133,9 @@ extern const rcd_port_ops rcd_posix_ops;
 void rcd_posix_init(rcd_port *p, rcd_posix_ctx *ctx);
 /* Use an open fd (set non-blocking here); owned: close it on port close. */
 rc_status rcd_posix_attach(rcd_port *p, rcd_posix_ctx *ctx, int fd, int owned);
+/* CLOCK_MONOTONIC in milliseconds, modulo 2^32: the clock of the POSIX and
+ * libserialport backends (ctx unused). */
+uint32_t rcd_posix_now_ms(void *ctx);
 
 /* ---- mock backend (rcd_mock.c) -------------------------------------------
  * Reads deliver the scripted rx bytes; writes append to tx. Faults:
@@ -135,7 +146,9 @@ rc_status rcd_posix_attach(rcd_port *p, rcd_posix_ctx *ctx, int fd, int owned);
  *  - at the end of the script (or of the released segments) a read returns
  *    RC_ERR_TIMEOUT, or RC_ERR_CLOSED when closed_at_end is set.
  * flush only counts (scripted bytes are the device's future output).
- * No time passes: a timeout is reported at once. */
+ * Simulated time: the clock (now_ms) starts at clock_ms and advances only
+ * when a read times out (by that read's timeout_ms) or when a test moves it;
+ * a timeout is reported at once. */
 #define RCD_MOCK_NEVER ((size_t)-1)
 
 typedef struct rcd_mock_ctx {
@@ -152,6 +165,7 @@ typedef struct rcd_mock_ctx {
     unsigned timeout_every; /* 0: never */
     int closed_at_end;
     int fail_open;          /* open returns fail_status */
+    uint32_t clock_ms;      /* the simulated clock (state; tests may set it) */
     /* polled device: when n_segments > 0, the script is cut into segments
      * (segments: (n_segments) byte counts) and each write releases the next
      * one: a reply only after a request. */

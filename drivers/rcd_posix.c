@@ -30,6 +30,12 @@ static long long now_ms(void)
     return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
 }
 
+uint32_t rcd_posix_now_ms(void *ctx)
+{
+    (void)ctx;
+    return (uint32_t)((unsigned long long)now_ms() & 0xFFFFFFFFull);
+}
+
 static int baud_const(unsigned baud, speed_t *out)
 {
     static const struct {
@@ -250,6 +256,7 @@ const rcd_port_ops rcd_posix_ops = {
     .flush = px_flush,
     .drain = px_drain,
     .last_error = px_last_error,
+    .now_ms = rcd_posix_now_ms,
 };
 
 void rcd_posix_init(rcd_port *p, rcd_posix_ctx *ctx)

@@ -106,6 +106,9 @@ rc_status rcd_parse_value(rcd_reading *out, const uint8_t *t, size_t len)
         out->decimals = (int8_t)(dec < 0 ? 0 : dec);
         out->unit = (uint8_t)unit;
         out->exception = 0;
+        out->reject = RCD_REJECT_NONE;
+        out->mb_addr = 0;
+        out->mb_fn = 0;
     }
     return RC_OK;
 }
@@ -231,8 +234,33 @@ static rc_status decode_value(rcd_reading *out, const uint8_t r[4], const rcd_pr
         out->decimals = -1;
         out->unit = RCD_UNIT_MM;
         out->exception = 0;
+        out->reject = RCD_REJECT_NONE;
+        out->mb_addr = 0;
+        out->mb_fn = 0;
     }
     return RC_OK;
+}
+
+/* Length of a complete, CRC-valid Modbus reply at f that is not for us:
+ * another slave address (fn 0x03 response or any exception), or our address
+ * with another function (a 4-byte response of fn 0x04, or an exception
+ * other than 0x83); 0 otherwise. */
+static size_t foreign_frame(const uint8_t *f, size_t left, uint8_t addr)
+{
+    if (left < RCD_MODBUS_EXC_LEN || f[0] == 0 || f[0] > 247)
+        return 0;
+    if (f[0] != addr) {
+        if (f[1] == 0x03 && left >= RCD_MODBUS_RESP_LEN && f[2] == 4 && crc_ok(f, 7))
+            return RCD_MODBUS_RESP_LEN;
+        if ((f[1] & 0x80u) && crc_ok(f, 3))
+            return RCD_MODBUS_EXC_LEN;
+        return 0;
+    }
+    if (f[1] == 0x04 && left >= RCD_MODBUS_RESP_LEN && f[2] == 4 && crc_ok(f, 7))
+        return RCD_MODBUS_RESP_LEN;
+    if ((f[1] & 0x80u) && f[1] != 0x83 && crc_ok(f, 3))
+        return RCD_MODBUS_EXC_LEN;
+    return 0;
 }
 
 rc_status rcd_parse_modbus(rcd_reading *out, size_t *consumed, const rcd_proto_config *cfg,
@@ -246,6 +274,20 @@ rc_status rcd_parse_modbus(rcd_reading *out, size_t *consumed, const rcd_proto_c
     addr = cfg->mb_addr ? cfg->mb_addr : 1;
     for (size_t p = 0; p < len; ++p) {
         size_t left = len - p;
+        size_t flen = foreign_frame(buf + p, left, addr);
+        if (flen) {
+            if (out) {
+                out->len_mm = 0.0;
+                out->decimals = -1;
+                out->unit = RCD_UNIT_NONE;
+                out->exception = 0;
+                out->reject = (uint8_t)(buf[p] != addr ? RCD_REJECT_MB_SLAVE : RCD_REJECT_MB_FUNCTION);
+                out->mb_addr = buf[p];
+                out->mb_fn = buf[p + 1];
+            }
+            *consumed = p + flen;
+            return RC_ERR_FORMAT;
+        }
         if (buf[p] != addr)
             continue;
         if (left < 2) {
@@ -285,6 +327,9 @@ rc_status rcd_parse_modbus(rcd_reading *out, size_t *consumed, const rcd_proto_c
                     out->decimals = -1;
                     out->unit = RCD_UNIT_NONE;
                     out->exception = buf[p + 2];
+                    out->reject = RCD_REJECT_NONE;
+                    out->mb_addr = 0;
+                    out->mb_fn = 0;
                 }
                 *consumed = p + RCD_MODBUS_EXC_LEN;
                 return RC_ERR_DEVICE;
@@ -330,7 +375,9 @@ rc_status rcd_build_request(uint8_t *buf, size_t *n, size_t cap, const rcd_proto
     case RCD_PROTO_ASCII_POLL:
     case RCD_PROTO_STX: {
         const char *cmd = cfg->poll_cmd[0] ? cfg->poll_cmd : "R\r";
-        size_t l = strnlen(cmd, sizeof cfg->poll_cmd);
+        size_t l = 0; /* strnlen is POSIX, not C99 */
+        while (l < sizeof cfg->poll_cmd && cmd[l] != '\0')
+            ++l;
         if (l > cap)
             return RC_ERR_CAPACITY;
         memcpy(buf, cmd, l);

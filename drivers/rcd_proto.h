@@ -49,7 +49,11 @@
  *    float in mm. A response is recognised by addr, 0x03, 0x04 and a good
  *    CRC; a CRC failure drops one byte and searches again (RTU has no
  *    delimiter), so an incomplete false start never hides a complete frame
- *    behind it.
+ *    behind it. A CRC-valid reply from another slave address, or from this
+ *    one with another function code (0x04 response, 0x84 exception, ...), is
+ *    consumed and named (RC_ERR_FORMAT, out->reject, mb_addr, mb_fn) rather
+ *    than silently skipped: a wrong --mb-addr or register type then says so
+ *    instead of "no reading".
  *
  * Depends on: rc_status.h only; no heap, no stdio, no libm.
  * Memory: caller-owned buffers; nothing is kept between calls.
@@ -112,12 +116,22 @@ typedef struct rcd_proto_config {
     uint8_t mb_decimals;        /* int32: digits after the point, 0..9 */
 } rcd_proto_config;
 
+/* Why a well-formed frame was not taken (RC_ERR_FORMAT). */
+typedef enum rcd_reject {
+    RCD_REJECT_NONE = 0,
+    RCD_REJECT_MB_SLAVE = 1,   /* a valid Modbus reply from another slave address (mb_addr) */
+    RCD_REJECT_MB_FUNCTION = 2 /* a valid Modbus reply with another function code (mb_fn) */
+} rcd_reject;
+
 /* One parsed reading. */
 typedef struct rcd_reading {
     double len_mm;     /* converted to mm */
     int8_t decimals;   /* ASCII/STX: digits after the point; Modbus: -1 */
     uint8_t unit;      /* rcd_unit as written */
     uint8_t exception; /* Modbus exception code when RC_ERR_DEVICE */
+    uint8_t reject;    /* rcd_reject, with RC_ERR_FORMAT */
+    uint8_t mb_addr;   /* RCD_REJECT_MB_*: the frame's slave address */
+    uint8_t mb_fn;     /* RCD_REJECT_MB_*: the frame's function code */
 } rcd_reading;
 
 /* Parsers: see the file comment for the contract. out may be NULL. */

@@ -269,6 +269,7 @@ const rcd_port_ops rcd_serialport_ops = {
     .flush = sp_flush_,
     .drain = sp_drain_,
     .last_error = sp_last_error_,
+    .now_ms = rcd_posix_now_ms,
 };
 
 void rcd_serialport_init(rcd_port *p, rcd_serialport_ctx *ctx)

@@ -1,5 +1,6 @@
 /* fuzz_data_common.h - one fuzz body for the CSV reader (rch_data_parse),
- * used with flags 0 (measurement files) and RCH_DATA_NO_LEN (pose plans). */
+ * used with flags 0 (measurement files), RCH_DATA_NO_LEN (pose plans) and
+ * RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY (acquisition files, as rch_acqfile reads them). */
 #ifndef FUZZ_DATA_COMMON_H
 #define FUZZ_DATA_COMMON_H
 
@@ -22,10 +23,16 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
     if (rc != 0) {
         /* refused: a message, nothing left allocated */
         FZ_CHECK(diag.msg[0] != '\0');
-        FZ_CHECK(d.s == NULL && d.xyz == NULL && d.line == NULL && d.n == 0);
+        FZ_CHECK(d.s == NULL && d.xyz == NULL && d.line == NULL && d.pose == NULL && d.n == 0);
         return;
     }
-    FZ_CHECK(d.n >= 1 && d.s != NULL && d.line != NULL);
+    if (d.n == 0) { /* only with RCH_DATA_ALLOW_EMPTY (an acquisition file holding its header) */
+        FZ_CHECK(flags & RCH_DATA_ALLOW_EMPTY);
+        rch_data_free(&d);
+        return;
+    }
+    FZ_CHECK(d.s != NULL && d.line != NULL);
+    FZ_CHECK(((flags & RCH_DATA_POSE) != 0) == (d.pose != NULL));
     for (size_t i = 0; i < d.n; ++i) {
         const rc_sample *s = &d.s[i];
         for (int j = 0; j < RC_NJ; ++j)
@@ -39,6 +46,8 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
         FZ_CHECK(d.line[i] >= 2);
         if (i > 0)
             FZ_CHECK(d.line[i] > d.line[i - 1]);
+        if (d.pose)
+            FZ_CHECK(d.pose[i] <= 1000000000ul);
         if (d.xyz)
             for (int k = 0; k < 3; ++k)
                 FZ_CHECK(isfinite(d.xyz[i][k]));

@@ -322,13 +322,37 @@ static void test_port_contract(void **state)
     assert_string_equal(rcd_port_last_error(&p), "mock fault");
 }
 
+/* Time comes from the port: the mock's clock advances by the timeout of each
+ * read that times out, and the display's deadline follows that clock (also
+ * across a wrap of the 32-bit counter). */
+static void test_port_clock(void **state)
+{
+    rcd_port p;
+    rcd_mock_ctx m;
+    rcd_display d;
+    rcd_reading r;
+    (void)state;
+    rcd_mock_init(&p, &m);
+    m.clock_ms = UINT32_MAX - 100u;
+    assert_int_equal(rcd_port_open(&p, "mock", NULL), RC_OK);
+    assert_int_equal(rcd_port_now_ms(&p), UINT32_MAX - 100u);
+    assert_int_equal(rcd_display_init(&d, &p, NULL), RC_OK);
+    assert_int_equal(rcd_display_read(&d, &r, 300), RC_ERR_TIMEOUT);
+    assert_int_equal(rcd_port_now_ms(&p), (uint32_t)(UINT32_MAX - 100u + 300u));
+    assert_int_equal(m.n_reads, 1);
+    {
+        rcd_port none = {NULL, NULL};
+        assert_int_equal(rcd_port_now_ms(&none), 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stream_chunks),      cmocka_unit_test(test_fail_after_every_byte),
         cmocka_unit_test(test_timeouts_and_close), cmocka_unit_test(test_format_lock),
         cmocka_unit_test(test_modbus_polled),      cmocka_unit_test(test_ascii_poll_and_stx),
-        cmocka_unit_test(test_port_contract),
+        cmocka_unit_test(test_port_contract),      cmocka_unit_test(test_port_clock),
     };
     return cmocka_run_group_tests_name("drv_display", tests, NULL, NULL);
 }

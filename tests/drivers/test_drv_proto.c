@@ -246,12 +246,39 @@ static void test_modbus_vectors(void **state)
         nan_f[8] = (uint8_t)(crc >> 8);
         assert_int_equal(parse_exact(&r, &c, &fc, nan_f, 9), RC_ERR_FORMAT);
     }
-    /* another slave's answer is ignored */
+    /* another slave's answer is consumed and named, not taken (issue 12) */
     {
         rcd_proto_config other = cfg;
         other.mb_addr = 7;
-        assert_int_equal(parse_exact(&r, &c, &other, i32, 9), RC_ERR_INCOMPLETE);
+        assert_int_equal(parse_exact(&r, &c, &other, i32, 9), RC_ERR_FORMAT);
         assert_int_equal(c, 9);
+        assert_int_equal(r.reject, RCD_REJECT_MB_SLAVE);
+        assert_int_equal(r.mb_addr, 1);
+        assert_int_equal(r.mb_fn, 0x03);
+    }
+    /* our slave answering another function (input registers 0x04, or an
+     * exception of another function): named as such */
+    {
+        uint8_t f4[9], e4[5];
+        uint16_t crc;
+        memcpy(f4, i32, 9);
+        f4[1] = 0x04;
+        crc = rcd_crc16_modbus(f4, 7);
+        f4[7] = (uint8_t)crc;
+        f4[8] = (uint8_t)(crc >> 8);
+        assert_int_equal(parse_exact(&r, &c, &cfg, f4, 9), RC_ERR_FORMAT);
+        assert_int_equal(c, 9);
+        assert_int_equal(r.reject, RCD_REJECT_MB_FUNCTION);
+        assert_int_equal(r.mb_fn, 0x04);
+        e4[0] = 0x01;
+        e4[1] = 0x84;
+        e4[2] = 0x01;
+        crc = rcd_crc16_modbus(e4, 3);
+        e4[3] = (uint8_t)crc;
+        e4[4] = (uint8_t)(crc >> 8);
+        assert_int_equal(parse_exact(&r, &c, &cfg, e4, 5), RC_ERR_FORMAT);
+        assert_int_equal(r.reject, RCD_REJECT_MB_FUNCTION);
+        assert_int_equal(r.mb_fn, 0x84);
     }
 }
 

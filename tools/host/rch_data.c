@@ -8,13 +8,16 @@
 #include <strings.h>
 
 #include "rc_rand.h"
+#include "rch_file.h"
+#include "rch_opt.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 
-enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_N = 12 };
-static const char *const col_names[C_N] = {"q1", "q2", "q3", "q4", "q5", "q6", "L", "x", "y", "z", "t", "group"};
+enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_P = 12, C_N = 13 };
+static const char *const col_names[C_N] = {"q1", "q2", "q3", "q4", "q5", "q6", "L",
+                                           "x",  "y",  "z",  "t",  "group", "pose"};
 
 typedef struct {
     const char *p; /* field start */
@@ -45,179 +48,213 @@ static size_t split_line(field *f, size_t max, const char *line, size_t len)
     return n;
 }
 
+/* The one strict number reader (rch_parse_double: decimal only, no blanks,
+ * no hex, no overflow). NaN and infinity words come back as such, so that
+ * the caller names them ("not finite") rather than "not a number". */
 static int parse_number(double *v, const field *f)
 {
     char buf[64];
-    char *end;
     if (f->len == 0 || f->len >= sizeof buf)
         return -1;
     memcpy(buf, f->p, f->len);
     buf[f->len] = '\0';
-    errno = 0;
-    *v = strtod(buf, &end);
-    if (end != buf + f->len || errno == ERANGE)
-        return -1;
+    if (rch_parse_double(buf, v) == 0)
+        return 0;
+    {
+        const char *w = buf + (buf[0] == '+' || buf[0] == '-');
+        if (strcasecmp(w, "nan") == 0) {
+            *v = NAN;
+            return 0;
+        }
+        if (strcasecmp(w, "inf") == 0 || strcasecmp(w, "infinity") == 0) {
+            *v = buf[0] == '-' ? -INFINITY : INFINITY;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+/* 1 when nothing but NUL bytes and blanks follows text[from..len). */
+static int is_last_line(const char *text, size_t from, size_t len)
+{
+    for (size_t i = from; i < len; ++i)
+        if (text[i] != '\0' && !isspace((unsigned char)text[i]))
+            return 0;
+    return 1;
+}
+
+/* What a header without the needed columns looks like, when it is a
+ * known other convention ("" otherwise). */
+static const char *header_hint(const char *line, size_t len)
+{
+    if (memchr(line, '\t', len))
+        return "; the header is separated by tabs: rcal reads comma-separated values";
+    if (memchr(line, ';', len))
+        return "; the header is separated by semicolons: rcal reads comma-separated values with '.' decimals";
+    return "";
+}
+
+static const char *number_hint(const field *f)
+{
+    if (f->len > 0 && (f->p[0] == '"' || f->p[0] == '\''))
+        return " (quoted: write numbers without quotes)";
+    size_t i = f->len > 0 && (f->p[0] == '+' || f->p[0] == '-') ? 1u : 0u;
+    if (f->len > i + 1 && f->p[i] == '0' && (f->p[i + 1] == 'x' || f->p[i + 1] == 'X'))
+        return " (hexadecimal numbers are not accepted: write decimals)";
+    if (memchr(f->p, ';', f->len) || memchr(f->p, '\t', f->len))
+        return " (separators must be commas)";
+    return "";
+}
+
+/* The parser's state while it walks the text. */
+typedef struct parse_ctx {
+    const char *name;
+    unsigned flags;
+    rch_diag *d;
+    int col_of[C_N]; /* field index of each known column, -1 absent */
+    size_t cap;      /* allocated rows */
+    unsigned line_no;
+} parse_ctx;
+
+/* The header line: find the known columns. 0 or -1 with d set. */
+static int parse_header(parse_ctx *pc, field *fields, size_t nf, const char *line, size_t ll)
+{
+    const unsigned flags = pc->flags;
+    for (size_t i = 0; i < nf; ++i) {
+        if (fields[i].len >= 2 && fields[i].p[0] == '"' && fields[i].p[fields[i].len - 1] == '"') {
+            fields[i].p++; /* "q1": a quoted header name is the name */
+            fields[i].len -= 2;
+        }
+        for (int k = 0; k < C_N; ++k) {
+            if (fields[i].len == strlen(col_names[k]) && strncasecmp(fields[i].p, col_names[k], fields[i].len) == 0) {
+                if (pc->col_of[k] >= 0) {
+                    rch_diag_set(pc->d, pc->name, pc->line_no, fields[i].col, "column '%s' appears twice in the header",
+                                 col_names[k]);
+                    return -1;
+                }
+                pc->col_of[k] = (int)i;
+            }
+        }
+    }
+    for (int k = 0; k <= C_P; ++k) {
+        if (k > C_L && k != C_P)
+            continue;
+        if (pc->col_of[k] < 0 && !(k == C_L && (flags & RCH_DATA_NO_LEN)) && !(k == C_P && !(flags & RCH_DATA_POSE))) {
+            rch_diag_set(pc->d, pc->name, pc->line_no, 1, "header has no '%s' column (need %sq1..q6 in degrees%s)%s",
+                         col_names[k], (flags & RCH_DATA_POSE) ? "pose, " : "",
+                         (flags & RCH_DATA_NO_LEN) ? "" : " and L in mm", header_hint(line, ll));
+            return -1;
+        }
+    }
+    if ((pc->col_of[C_X] >= 0) != (pc->col_of[C_Y] >= 0) || (pc->col_of[C_X] >= 0) != (pc->col_of[C_Z] >= 0))
+        pc->col_of[C_X] = pc->col_of[C_Y] = pc->col_of[C_Z] = -1; /* use x,y,z only as a triple */
     return 0;
 }
 
-int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
-                   rch_diag *d)
+/* Room for one more row. 0 or -1 with d set. */
+static int grow(rch_data *out, parse_ctx *pc)
 {
-    int col_of[C_N];
-    field fields[256];
-    size_t cap = 0, line_no = 0, pos = 0;
-    int have_header = 0;
-    memset(out, 0, sizeof *out);
-    for (int k = 0; k < C_N; ++k)
-        col_of[k] = -1;
+    size_t nc;
+    if (out->n < pc->cap)
+        return 0;
+    nc = pc->cap ? 2 * pc->cap : 256;
+    rc_sample *s = realloc(out->s, nc * sizeof *s);
+    if (s)
+        out->s = s;
+    unsigned *ln = s ? realloc(out->line, nc * sizeof *ln) : NULL;
+    if (ln)
+        out->line = ln;
+    if (s && ln && pc->col_of[C_P] >= 0 && (pc->flags & RCH_DATA_POSE)) {
+        unsigned long *pz = realloc(out->pose, nc * sizeof *pz);
+        if (pz)
+            out->pose = pz;
+        s = pz ? s : NULL;
+    }
+    if (s && ln && pc->col_of[C_X] >= 0) {
+        double(*xyz)[3] = realloc(out->xyz, nc * sizeof *xyz);
+        if (xyz)
+            out->xyz = xyz;
+        s = xyz ? s : NULL;
+    }
+    if (!s || !ln) {
+        rch_diag_set(pc->d, pc->name, pc->line_no, 0, "out of memory");
+        return -1;
+    }
+    pc->cap = nc;
+    return 0;
+}
 
-    while (pos < len) {
-        size_t e = pos;
-        while (e < len && text[e] != '\n')
-            ++e;
-        const char *line = text + pos;
-        size_t ll = e - pos;
-        pos = e + 1;
-        ++line_no;
-        if (ll > 0 && line[ll - 1] == '\r')
-            --ll;
-        size_t blank = 0;
-        while (blank < ll && isspace((unsigned char)line[blank]))
-            ++blank;
-        if (blank == ll || line[blank] == '#')
+/* Range of one field's value v of column k: 0, or -1 with d set. */
+static int check_value(const parse_ctx *pc, int k, double v, const field *f)
+{
+    const char *nm = col_names[k];
+    const unsigned ln = pc->line_no, col = f->col;
+    if (!isfinite(v))
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %s is not finite", nm, isnan(v) ? "NaN" : "infinity");
+    else if (k < C_L && fabs(v) > 720.0)
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g degrees is outside -720..720", nm, v);
+    else if (k == C_L && !(v > 0.0 && v <= 20000.0))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'L': %g mm is not a cable length (0 < L <= 20000)", v);
+    else if ((k == C_X || k == C_Y || k == C_Z) && fabs(v) > 1e5)
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g mm is absurd", nm, v);
+    else if (k == C_T && fabs(v) > 1e300) /* t_max - t_min must stay finite when scaling */
+        rch_diag_set(pc->d, pc->name, ln, col, "field 't': %g is absurd", v);
+    else if (k == C_P && (v < 0.0 || v > 1e9 || v != floor(v)))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'pose': %g is not an integer in 0..1000000000", v);
+    else if (k == C_G && (v < 0.0 || v > 65535.0 || v != floor(v)))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'group': %g is not an integer in 0..65535", v);
+    else
+        return 0;
+    return -1;
+}
+
+/* One data row into out->[n]. 0 or -1 with d set. */
+static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t nf, size_t ll)
+{
+    double v[C_N] = {0};
+    rc_sample *s;
+    if (grow(out, pc) != 0)
+        return -1;
+    for (int k = 0; k < C_N; ++k) {
+        if (pc->col_of[k] < 0 || (k == C_P && !(pc->flags & RCH_DATA_POSE)))
             continue;
-        for (size_t i = 0; i < ll; ++i) {
-            if (line[i] == '\0') {
-                rch_diag_set(d, name, (unsigned)line_no, (unsigned)i + 1, "NUL byte in text");
-                goto fail;
-            }
+        const size_t c = (size_t)pc->col_of[k];
+        if (c >= nf) {
+            rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)ll + 1,
+                         "missing field '%s' (column %zu; the line has %zu fields)", col_names[k], c + 1, nf);
+            return -1;
         }
-        const size_t nf = split_line(fields, 256, line, ll);
-        if (nf > 256) {
-            rch_diag_set(d, name, (unsigned)line_no, 1, "too many columns (%zu, at most 256)", nf);
-            goto fail;
+        if (parse_number(&v[k], &fields[c]) != 0) {
+            rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s",
+                         col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
+                         number_hint(&fields[c]));
+            return -1;
         }
-        if (!have_header) {
-            for (size_t i = 0; i < nf; ++i) {
-                for (int k = 0; k < C_N; ++k) {
-                    if (fields[i].len == strlen(col_names[k]) &&
-                        strncasecmp(fields[i].p, col_names[k], fields[i].len) == 0) {
-                        if (col_of[k] >= 0) {
-                            rch_diag_set(d, name, (unsigned)line_no, fields[i].col,
-                                         "column '%s' appears twice in the header", col_names[k]);
-                            goto fail;
-                        }
-                        col_of[k] = (int)i;
-                    }
-                }
-            }
-            for (int k = 0; k <= C_L; ++k) {
-                if (col_of[k] < 0 && !(k == C_L && (flags & RCH_DATA_NO_LEN))) {
-                    rch_diag_set(d, name, (unsigned)line_no, 1,
-                                 "header has no '%s' column (need q1..q6 in degrees%s)", col_names[k],
-                                 (flags & RCH_DATA_NO_LEN) ? "" : " and L in mm");
-                    goto fail;
-                }
-            }
-            if ((col_of[C_X] >= 0) != (col_of[C_Y] >= 0) || (col_of[C_X] >= 0) != (col_of[C_Z] >= 0))
-                col_of[C_X] = col_of[C_Y] = col_of[C_Z] = -1; /* use x,y,z only as a triple */
-            have_header = 1;
-            continue;
-        }
-        if (out->n == cap) {
-            size_t nc = cap ? 2 * cap : 256;
-            rc_sample *s = realloc(out->s, nc * sizeof *s);
-            unsigned *ln = s ? realloc(out->line, nc * sizeof *ln) : NULL;
-            if (s)
-                out->s = s;
-            if (ln)
-                out->line = ln;
-            if (!s || !ln) {
-                rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
-                goto fail;
-            }
-            if (col_of[C_X] >= 0) {
-                double(*xyz)[3] = realloc(out->xyz, nc * sizeof *xyz);
-                if (!xyz) {
-                    rch_diag_set(d, name, (unsigned)line_no, 0, "out of memory");
-                    goto fail;
-                }
-                out->xyz = xyz;
-            }
-            cap = nc;
-        }
-        rc_sample *s = &out->s[out->n];
-        memset(s, 0, sizeof *s);
-        double v[C_N] = {0};
-        for (int k = 0; k < C_N; ++k) {
-            if (col_of[k] < 0)
-                continue;
-            const size_t c = (size_t)col_of[k];
-            if (c >= nf) {
-                rch_diag_set(d, name, (unsigned)line_no, (unsigned)ll + 1,
-                             "missing field '%s' (column %zu; the line has %zu fields)", col_names[k],
-                             c + 1, nf);
-                goto fail;
-            }
-            if (parse_number(&v[k], &fields[c]) != 0) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': '%.*s' is not a number",
-                             col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p);
-                goto fail;
-            }
-            if (!isfinite(v[k])) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': %s is not finite",
-                             col_names[k], isnan(v[k]) ? "NaN" : "infinity");
-                goto fail;
-            }
-            if (k < C_L && fabs(v[k]) > 720.0) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
-                             "field '%s': %g degrees is outside -720..720", col_names[k], v[k]);
-                goto fail;
-            }
-            if (k == C_L && !(v[k] > 0.0 && v[k] <= 20000.0)) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
-                             "field 'L': %g mm is not a cable length (0 < L <= 20000)", v[k]);
-                goto fail;
-            }
-            if ((k == C_X || k == C_Y || k == C_Z) && fabs(v[k]) > 1e5) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field '%s': %g mm is absurd",
-                             col_names[k], v[k]);
-                goto fail;
-            }
-            if (k == C_T && fabs(v[k]) > 1e300) { /* t_max - t_min must stay finite when scaling */
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col, "field 't': %g is absurd", v[k]);
-                goto fail;
-            }
-            if (k == C_G && (v[k] < 0.0 || v[k] > 65535.0 || v[k] != floor(v[k]))) {
-                rch_diag_set(d, name, (unsigned)line_no, fields[c].col,
-                             "field 'group': %g is not an integer in 0..65535", v[k]);
-                goto fail;
-            }
-        }
-        for (int j = 0; j < RC_NJ; ++j)
-            s->q_rad[j] = v[C_Q1 + j] * (M_PI / 180.0);
-        s->len_mm = v[C_L];
-        s->t = v[C_T];
-        s->group = (uint16_t)v[C_G];
-        if (out->xyz) {
-            out->xyz[out->n][0] = v[C_X];
-            out->xyz[out->n][1] = v[C_Y];
-            out->xyz[out->n][2] = v[C_Z];
-        }
-        out->line[out->n] = (unsigned)line_no;
-        ++out->n;
+        if (check_value(pc, k, v[k], &fields[c]) != 0)
+            return -1;
     }
-    if (!have_header) {
-        rch_diag_set(d, name, 0, 0, "empty file: no header line");
-        goto fail;
+    s = &out->s[out->n];
+    memset(s, 0, sizeof *s);
+    for (int j = 0; j < RC_NJ; ++j)
+        s->q_rad[j] = v[C_Q1 + j] * (M_PI / 180.0);
+    s->len_mm = v[C_L];
+    s->t = v[C_T];
+    s->group = (uint16_t)v[C_G];
+    if (out->xyz) {
+        out->xyz[out->n][0] = v[C_X];
+        out->xyz[out->n][1] = v[C_Y];
+        out->xyz[out->n][2] = v[C_Z];
     }
-    if (out->n == 0) {
-        rch_diag_set(d, name, (unsigned)line_no, 0, "no data rows after the header");
-        goto fail;
-    }
-    out->has_t = col_of[C_T] >= 0;
-    out->has_group = col_of[C_G] >= 0;
-    /* acquisition order scaled to [0, 1]: the t column if present, else the row order */
+    if (out->pose)
+        out->pose[out->n] = (unsigned long)v[C_P];
+    out->line[out->n] = pc->line_no;
+    ++out->n;
+    return 0;
+}
+
+/* Acquisition order scaled to [0, 1]: the t column if present, else the row order. */
+static void scale_t(rch_data *out)
+{
     double tmin = 0.0, tmax = 0.0;
     for (size_t i = 0; i < out->n; ++i) {
         if (!out->has_t)
@@ -229,6 +266,80 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
     }
     for (size_t i = 0; i < out->n; ++i)
         out->s[i].t = tmax > tmin ? (out->s[i].t - tmin) / (tmax - tmin) : 0.0;
+}
+
+/* A NUL byte in line: its message (what a power cut leaves, when last). */
+static int nul_check(const parse_ctx *pc, const char *line, size_t ll, const char *text, size_t next, size_t len)
+{
+    const char *z = memchr(line, '\0', ll);
+    if (!z)
+        return 0;
+    if (is_last_line(text, next, len))
+        rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)(z - line) + 1,
+                     "the last line holds NUL bytes, what a power cut during a write leaves: rerun `rcal acquire` "
+                     "with the same --out to move it to %s.dropped, or delete that line", pc->name);
+    else
+        rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)(z - line) + 1, "NUL byte in text");
+    return -1;
+}
+
+int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                   rch_diag *d)
+{
+    field fields[256];
+    size_t pos = 0;
+    int have_header = 0;
+    parse_ctx pc;
+    memset(out, 0, sizeof *out);
+    memset(&pc, 0, sizeof pc);
+    pc.name = name;
+    pc.flags = flags;
+    pc.d = d;
+    for (int k = 0; k < C_N; ++k)
+        pc.col_of[k] = -1;
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
+        pos = 3; /* UTF-8 byte-order mark (spreadsheet export) */
+    while (pos < len) {
+        size_t e = pos, blank = 0;
+        /* a line ends at '\n', or at a '\r' not followed by '\n' (CR-only files) */
+        while (e < len && text[e] != '\n' && !(text[e] == '\r' && (e + 1 == len || text[e + 1] != '\n')))
+            ++e;
+        const char *line = text + pos;
+        size_t ll = e - pos;
+        pos = e + 1;
+        ++pc.line_no;
+        if (ll > 0 && line[ll - 1] == '\r')
+            --ll;
+        while (blank < ll && isspace((unsigned char)line[blank]))
+            ++blank;
+        if (blank == ll || line[blank] == '#')
+            continue;
+        if (nul_check(&pc, line, ll, text, pos, len) != 0)
+            goto fail;
+        const size_t nf = split_line(fields, 256, line, ll);
+        if (nf > 256) {
+            rch_diag_set(d, name, pc.line_no, 1, "too many columns (%zu, at most 256)", nf);
+            goto fail;
+        }
+        if (!have_header) {
+            if (parse_header(&pc, fields, nf, line, ll) != 0)
+                goto fail;
+            have_header = 1;
+        } else if (parse_row(out, &pc, fields, nf, ll) != 0) {
+            goto fail;
+        }
+    }
+    if (!have_header) {
+        rch_diag_set(d, name, 0, 0, "empty file: no header line");
+        goto fail;
+    }
+    if (out->n == 0 && !(flags & RCH_DATA_ALLOW_EMPTY)) {
+        rch_diag_set(d, name, pc.line_no, 0, "no data rows after the header");
+        goto fail;
+    }
+    out->has_t = pc.col_of[C_T] >= 0;
+    out->has_group = pc.col_of[C_G] >= 0;
+    scale_t(out);
     return 0;
 fail:
     rch_data_free(out);
@@ -237,41 +348,11 @@ fail:
 
 int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d)
 {
+    char *buf = NULL;
+    size_t len = 0;
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        rch_diag_set(d, path, 0, 0, "cannot open: %s", strerror(errno));
+    if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
         return -1;
-    }
-    size_t cap = 1 << 16, len = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t got = fread(buf + len, 1, cap - len, f);
-        len += got;
-        if (len < cap)
-            break;
-        if (cap >= (size_t)1 << 30) {
-            free(buf);
-            fclose(f);
-            rch_diag_set(d, path, 0, 0, "file larger than 1 GiB");
-            return -1;
-        }
-        char *nb = realloc(buf, cap * 2);
-        if (!nb) {
-            free(buf);
-            buf = NULL;
-            break;
-        }
-        buf = nb;
-        cap *= 2;
-    }
-    int err = ferror(f);
-    fclose(f);
-    if (!buf || err) {
-        free(buf);
-        rch_diag_set(d, path, 0, 0, err ? "read error" : "out of memory");
-        return -1;
-    }
     int rc = rch_data_parse(out, buf, len, path, flags, d);
     free(buf);
     return rc;
@@ -282,6 +363,7 @@ void rch_data_free(rch_data *data)
     free(data->s);
     free(data->xyz);
     free(data->line);
+    free(data->pose);
     memset(data, 0, sizeof *data);
 }
 
@@ -311,6 +393,20 @@ int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nomina
             return -1;
     }
     return fflush(f) == 0 ? 0 : -1;
+}
+
+int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n)
+{
+    if (fprintf(f, "pose,q1,q2,q3,q4,q5,q6\n") < 0)
+        return -1;
+    for (size_t t = 0; t < n; ++t) {
+        fprintf(f, "%zu", t);
+        for (int j = 0; j < RC_NJ; ++j)
+            fprintf(f, ",%.4f", s[t].q_rad[j] * 180.0 / M_PI);
+        if (fprintf(f, "\n") < 0)
+            return -1;
+    }
+    return fflush(f) == 0 && !ferror(f) ? 0 : -1;
 }
 
 void rch_split(size_t *idx, size_t n, unsigned long long seed)

@@ -8,7 +8,7 @@
  * starting with '#' are skipped.
  * A bad field is refused with file, line and column: missing fields, text
  * that is not a number, NaN, infinity, and absurd values (|q| > 720 deg,
- * L <= 0 or L > 20000 mm). Nothing is silently used.
+ * L <= 0 or L > 20000 mm), hexadecimal floats. Nothing is silently used.
  * Memory: the loader allocates; rch_data_free releases.
  */
 #ifndef RCH_DATA_H
@@ -21,7 +21,9 @@
 #include "rch_diag.h"
 
 enum {
-    RCH_DATA_NO_LEN = 1u /* pose plan: L is not required (len_mm = 0) */
+    RCH_DATA_NO_LEN = 1u,      /* pose plan: L is not required (len_mm = 0) */
+    RCH_DATA_POSE = 2u,        /* a 'pose' column (index 0..1e9) is required: pose[] */
+    RCH_DATA_ALLOW_EMPTY = 4u  /* a header without rows is not an error */
 };
 
 typedef struct rch_data {
@@ -29,11 +31,14 @@ typedef struct rch_data {
     size_t n;
     double (*xyz)[3];   /* (n x 3) x, y, z columns, or NULL when absent */
     unsigned *line;     /* (n) source line of each sample */
+    unsigned long *pose; /* (n) pose column (RCH_DATA_POSE), else NULL */
     int has_t;          /* a t column was present */
     int has_group;      /* a group column was present */
 } rch_data;
 
-/* Load a file; on failure returns non-zero with d filled in. */
+#define RCH_DATA_MAX_BYTES ((size_t)1 << 30) /* largest file loaded (1 GiB) */
+
+/* Load a file (at most RCH_DATA_MAX_BYTES); on failure returns non-zero with d filled in. */
 int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d);
 /* The same from memory (name is used in the diagnostics). */
 int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
@@ -46,6 +51,10 @@ rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k);
 /* Write samples as CSV: x,y,z (nominal FK at q when nominal is not NULL),
  * q1..q6 (deg, %.4f), L (mm, %.4f). Returns 0 or -1 (errno set). */
 int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nominal);
+
+/* Write a pose plan: "pose,q1,..,q6" then one line per sample, q in degrees
+ * (%.4f). Read back with rch_data_load(..., RCH_DATA_NO_LEN). 0 or -1. */
+int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n);
 
 /* Random train/test split: a permutation of 0..n-1 from seed; the first
  * n_test indices go to test. idx: (n) output. */

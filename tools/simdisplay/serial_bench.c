@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "rcd_display.h"
+#include "rch_opt.h"
 
 static double now_s(void)
 {
@@ -183,33 +184,19 @@ int main(int argc, char **argv)
     double seconds = 1.0, v[32] = {0};
     int runs = 5;
     static const rcd_protocol protos[] = {RCD_PROTO_ASCII, RCD_PROTO_STX, RCD_PROTO_MODBUS};
-    for (int i = 1; i + 1 < argc; i += 2) {
-        char *end = NULL;
-        if (strcmp(argv[i], "--baud") == 0) {
-            long b = strtol(argv[i + 1], &end, 10);
-            if (*end != '\0' || b <= 0 || b > 4000000) {
-                fprintf(stderr, "rcal_serial_bench: --baud: '%s' is not a baud rate\n", argv[i + 1]);
-                return 2;
-            }
-            baud = (unsigned)b;
-        } else if (strcmp(argv[i], "--seconds") == 0) {
-            seconds = strtod(argv[i + 1], &end);
-            if (*end != '\0' || !(seconds > 0.0) || seconds > 3600.0) {
-                fprintf(stderr, "rcal_serial_bench: --seconds: '%s' is not a duration in (0, 3600]\n", argv[i + 1]);
-                return 2;
-            }
-        } else if (strcmp(argv[i], "--runs") == 0) {
-            long r = strtol(argv[i + 1], &end, 10);
-            if (*end != '\0' || r < 1 || r > 32) {
-                fprintf(stderr, "rcal_serial_bench: --runs: '%s' is not in 1..32\n", argv[i + 1]);
-                return 2;
-            }
-            runs = (int)r;
-        } else {
-            fprintf(stderr, "rcal_serial_bench: unknown option '%s'\n", argv[i]);
-            return 2;
-        }
-    }
+    unsigned long baud_ul = baud, runs_ul = (unsigned long)runs;
+    const rch_opt opts[] = {
+        {"--baud", RCH_OPT_UINT, &baud_ul, 1, 4000000, "B", "pty line rate to pace at", 0, NULL},
+        {"--seconds", RCH_OPT_DOUBLE, &seconds, 0.001, 3600, "T", "duration of the pty measurement", 0, NULL},
+        {"--runs", RCH_OPT_UINT, &runs_ul, 1, 32, "N", "runs (median reported)", 0, NULL},
+    };
+    const rch_cmdspec spec = {"serial_bench", "serial reading benchmark: parsers alone and the POSIX backend on a pty",
+                              NULL, opts, sizeof opts / sizeof opts[0]};
+    rch_opt_status ost = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (ost != RCH_OPT_OK)
+        return ost == RCH_OPT_HELP ? 0 : 2;
+    baud = (unsigned)baud_ul;
+    runs = (int)runs_ul;
     printf("parser alone (median of %d runs over 200000 frames):\n", runs);
     for (int k = 0; k < 3; ++k) {
         for (int r = 0; r < runs; ++r)

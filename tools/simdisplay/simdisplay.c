@@ -41,6 +41,11 @@
  *                       with --reconnect-ms R open a new pty R ms later (its
  *                       path printed as a new stdout line, --link re-pointed),
  *                       else exit
+ *   --freeze-after N    after N frames the shown value never changes again
+ *                       (HOLD pressed, firmware hung): `rcal acquire` must
+ *                       refuse it (follow check)
+ *   --foreign-offset-mm X  the device found after a reconnect is another
+ *                       one: it shows the true length + X mm
  *   --seed S            random faults and noise are reproducible
  */
 #include <errno.h>
@@ -58,6 +63,7 @@
 #include "rc_rand.h"
 #include "rcd_proto.h"
 #include "rch_data.h"
+#include "rch_opt.h"
 #include "rch_robot.h"
 
 /* longest delay an option may ask for: one day */
@@ -94,6 +100,9 @@ typedef struct sim {
     int disconnected;
     double shown_mm, next_refresh_s;
     int have_shown;
+    unsigned long freeze_after; /* 0: never */
+    double foreign_offset_mm;   /* added after a reconnect */
+    int foreign;                /* the reconnected device is another one */
 } sim;
 
 static double now_s(void)
@@ -200,11 +209,9 @@ static long read_follow(const sim *s)
         return -1;
     }
     fclose(f);
-    if (buf[0] < '0' || buf[0] > '9')
-        return -1;
-    errno = 0;
-    idx = strtol(buf, &end, 10);
-    if (errno != 0 || (*end != '\0' && *end != ' ' && *end != '\t' && *end != '\r' && *end != '\n'))
+    end = buf + strcspn(buf, " \t\r\n"); /* "INDEX q1 .. q6": the index */
+    *end = '\0';
+    if (rch_parse_long(buf, &idx) != 0 || idx < 0)
         return -1;
     return idx;
 }
@@ -261,9 +268,11 @@ static void follow_pose(sim *s)
 static double shown_value(sim *s)
 {
     double t = now_s();
+    if (s->freeze_after && s->frames >= s->freeze_after && s->have_shown)
+        return s->shown_mm; /* frozen: HOLD pressed or firmware hung */
     if (s->pc.protocol != RCD_PROTO_ASCII && s->rate_hz > 0 && s->have_shown && t < s->next_refresh_s)
         return s->shown_mm;
-    s->shown_mm = true_value(s);
+    s->shown_mm = true_value(s) + (s->foreign ? s->foreign_offset_mm : 0.0);
     if (s->noise_mm > 0)
         s->shown_mm += s->noise_mm * rc_rng_normal(&s->rng);
     s->have_shown = 1;
@@ -350,11 +359,10 @@ static int load_script(sim *s, const char *path)
             ++p;
         if (*p == '#' || *p == '\n' || *p == '\r' || *p == '\0')
             continue; /* comment or blank line */
-        errno = 0;
-        v = strtod(p, &end);
-        while (*end == ' ' || *end == '\t' || *end == '\r' || *end == '\n')
-            ++end;
-        if (end == p || *end != '\0' || errno != 0 || !isfinite(v)) {
+        end = p + strlen(p);
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r' || end[-1] == '\n'))
+            *--end = '\0';
+        if (rch_parse_double(p, &v) != 0) {
             fprintf(stderr, "simdisplay: %s:%u: not a number (one value in mm per line, # for comments)\n", path,
                     lineno);
             fclose(f);
@@ -426,333 +434,225 @@ static int load_robot(sim *s, const char *truth_path, const char *poses_path)
     return s->n_poses ? 0 : -1;
 }
 
-static void usage(FILE *f)
-{
-    fprintf(f, "usage: rcal_simdisplay --protocol ascii|ascii-poll|stx|modbus\n"
-               "         (--value MM | --script FILE | --truth MODEL.json --poses POSES.csv [--follow FILE])\n"
-               "         [--noise-mm S] [--decimals D] [--style zero|unit] [--unit mm|cm|m|in]\n"
-               "         [--rate-hz R] [--baud B] [--poll-cmd TEXT] [--mb-addr A] [--mb-reg R]\n"
-               "         [--mb-format int32|float] [--mb-order abcd|cdab|badc|dcba] [--mb-decimals D]\n"
-               "         [--drop P] [--corrupt P] [--garbage P] [--silence-every N --silence-ms T]\n"
-               "         [--disconnect-after N [--reconnect-ms R]] [--settle-ms T] [--reply-delay-ms T]\n"
-               "         [--link PATH] [--seed S] [--exit-after-frames N] [--max-seconds T]\n"
-               "  Prints the pty path as the first line of stdout. See the comment of simdisplay.c.\n");
-}
+/* Options of the simulated display, parsed with the shared table-driven
+ * parser (rch_opt: strict numbers, --opt=value, -h, generated usage). */
+typedef struct sim_args {
+    const char *protocol, *script, *truth, *poses, *style, *unit, *mb_format, *mb_order, *poll_cmd;
+    unsigned long decimals, mb_addr, mb_reg, mb_decimals, reply_delay_ms, seed;
+    long reconnect_ms;
+} sim_args;
 
-/* Number options: the whole value must be a number in [lo, hi] (strtod /
- * strtoul / strtol with end, ERANGE and finiteness checks), else a message
- * naming the option and the value and -1 (main then exits 2, a usage error). */
-static int opt_double(const char *name, const char *v, double lo, double hi, double *out)
+/* 0 run, 1 help printed, 2 usage error. */
+static int parse_options(sim *s, sim_args *g, int argc, char **argv)
 {
-    char *end;
-    double x;
-    errno = 0;
-    x = strtod(v, &end);
-    if (end == v || *end != '\0' || errno != 0 || !isfinite(x)) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is not a number\n", name, v);
-        return -1;
+    unsigned long long seen = 0;
+    const rch_opt opts[] = {
+        {"--protocol", RCH_OPT_CHOICE, &g->protocol, 0, 0, NULL, "protocol spoken", 0, "ascii|ascii-poll|stx|modbus"},
+        {"--value", RCH_OPT_DOUBLE, &s->const_mm, -1e9, 1e9, "MM", "constant value", 0, NULL},
+        {"--script", RCH_OPT_STR, &g->script, 0, 0, "FILE", "one value per line, the next per frame", 0, NULL},
+        {"--truth", RCH_OPT_STR, &g->truth, 0, 0, "MODEL.json", "true robot (with --poses)", 0, NULL},
+        {"--poses", RCH_OPT_STR, &g->poses, 0, 0, "POSES.csv", "the plan the acquisition follows", 0, NULL},
+        {"--follow", RCH_OPT_STR, &s->follow, 0, 0, "FILE", "the pose announced by rcal acquire", 0, NULL},
+        {"--noise-mm", RCH_OPT_DOUBLE, &s->noise_mm, 0, 1e9, "S", "Gaussian noise per value", 0, NULL},
+        {"--decimals", RCH_OPT_UINT, &g->decimals, 0, 6, "D", "digits after the point", 0, NULL},
+        {"--style", RCH_OPT_CHOICE, &g->style, 0, 0, NULL, "+0509.190 or + 509.190, MM", 0, "zero|unit"},
+        {"--unit", RCH_OPT_CHOICE, &g->unit, 0, 0, NULL, "unit in the unit style", 0, "mm|cm|m|in"},
+        {"--rate-hz", RCH_OPT_DOUBLE, &s->rate_hz, 0, 1e6, "R", "measuring rate", 0, NULL},
+        {"--baud", RCH_OPT_UINT, &s->baud, 0, 100000000, "B", "pace output (0: no pacing)", 0, NULL},
+        {"--poll-cmd", RCH_OPT_STR, &g->poll_cmd, 0, 0, "TEXT", "poll command (\\r, \\n allowed)", 0, NULL},
+        {"--mb-addr", RCH_OPT_UINT, &g->mb_addr, 0, 247, "A", "Modbus slave address (0: 1)", 0, NULL},
+        {"--mb-reg", RCH_OPT_UINT, &g->mb_reg, 0, 65535, "R", "first holding register", 0, NULL},
+        {"--mb-format", RCH_OPT_CHOICE, &g->mb_format, 0, 0, NULL, NULL, 0, "int32|float"},
+        {"--mb-order", RCH_OPT_CHOICE, &g->mb_order, 0, 0, NULL, NULL, 0, "abcd|cdab|badc|dcba"},
+        {"--mb-decimals", RCH_OPT_UINT, &g->mb_decimals, 0, 9, "D", NULL, 0, NULL},
+        {"--drop", RCH_OPT_DOUBLE, &s->p_drop, 0, 1, "P", "per-byte drop probability", 0, NULL},
+        {"--corrupt", RCH_OPT_DOUBLE, &s->p_corrupt, 0, 1, "P", "per-byte corruption probability", 0, NULL},
+        {"--garbage", RCH_OPT_DOUBLE, &s->p_garbage, 0, 1, "P", "per-frame garbage probability", 0, NULL},
+        {"--silence-every", RCH_OPT_UINT, &s->silence_every, 0, 4294967295.0, "N", "frames between silences", 0, NULL},
+        {"--silence-ms", RCH_OPT_UINT, &s->silence_ms, 0, SIM_MAX_MS, "T", NULL, 0, NULL},
+        {"--disconnect-after", RCH_OPT_UINT, &s->disconnect_after, 0, 4294967294.0, "N", "frames, then hang up", 0, NULL},
+        {"--reconnect-ms", RCH_OPT_INT, &g->reconnect_ms, -1, SIM_MAX_MS, "R", "reopen after R ms (-1: exit)", 0, NULL},
+        {"--foreign-offset-mm", RCH_OPT_DOUBLE, &s->foreign_offset_mm, -1e5, 1e5, "X", "another device after a reconnect", 0, NULL},
+        {"--freeze-after", RCH_OPT_UINT, &s->freeze_after, 0, 4294967294.0, "N", "frames, then the value freezes", 0, NULL},
+        {"--settle-ms", RCH_OPT_UINT, &s->settle_ms, 0, SIM_MAX_MS, "T", "move transient", 0, NULL},
+        {"--reply-delay-ms", RCH_OPT_UINT, &g->reply_delay_ms, 0, SIM_MAX_MS, "T", NULL, 0, NULL},
+        {"--link", RCH_OPT_STR, &s->link, 0, 0, "PATH", "symlink to the current pty", 0, NULL},
+        {"--seed", RCH_OPT_UINT, &g->seed, 0, 4294967295.0, "S", "random faults and noise", 0, NULL},
+        {"--exit-after-frames", RCH_OPT_UINT, &s->exit_after, 0, 4294967295.0, "N", NULL, 0, NULL},
+        {"--max-seconds", RCH_OPT_DOUBLE, &s->max_seconds, 0, 1e9, "T", NULL, 0, NULL},
+    };
+    const rch_cmdspec spec = {"simdisplay", "a simulated cable-encoder display on a pseudo-terminal",
+                              "Needs --value, --script, or --truth with --poses. Prints the pty path as the first line "
+                              "of stdout.\nSee the comment of tools/simdisplay/simdisplay.c.",
+                              opts, sizeof opts / sizeof opts[0]};
+    rch_opt_status st = rch_opt_parse(&spec, argc, argv, &seen, stdout, stderr);
+    if (st != RCH_OPT_OK)
+        return st == RCH_OPT_HELP ? 1 : 2;
+    rcd_protocol_from_name(&s->pc.protocol, g->protocol);
+    rcd_unit_from_name(&s->unit, g->unit);
+    rcd_word_order_from_name(&s->pc.mb_order, g->mb_order);
+    s->style = strcmp(g->style, "unit") == 0 ? RCD_STYLE_SPACE_UNIT : RCD_STYLE_ZERO_PAD;
+    s->pc.mb_format = strcmp(g->mb_format, "float") == 0 ? RCD_MB_FLOAT32 : RCD_MB_INT32;
+    s->decimals = (unsigned)g->decimals;
+    s->pc.mb_addr = (uint8_t)g->mb_addr;
+    s->pc.mb_reg = (uint16_t)g->mb_reg;
+    s->pc.mb_decimals = (uint8_t)g->mb_decimals;
+    s->reconnect_ms = g->reconnect_ms;
+    if (g->poll_cmd) { /* C escapes \r and \n are understood */
+        size_t k = 0;
+        for (const char *p = g->poll_cmd; *p && k + 1 < sizeof s->pc.poll_cmd; ++p) {
+            if (p[0] == '\\' && (p[1] == 'r' || p[1] == 'n')) {
+                s->pc.poll_cmd[k++] = p[1] == 'r' ? '\r' : '\n';
+                ++p;
+            } else {
+                s->pc.poll_cmd[k++] = *p;
+            }
+        }
     }
-    if (x < lo || x > hi) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is outside %g..%g\n", name, v, lo, hi);
-        return -1;
+    if ((g->truth != NULL) != (g->poses != NULL)) {
+        fprintf(stderr, "simdisplay: --truth and --poses go together\n");
+        return 2;
     }
-    *out = x;
+    if (!g->script && !g->truth && !rch_opt_given(&spec, seen, "--value")) {
+        fprintf(stderr, "simdisplay: give --value MM, --script FILE, or --truth MODEL.json --poses POSES.csv\n");
+        return 2;
+    }
     return 0;
 }
 
-/* base 10, or 0 to also accept 0x.. (register numbers) */
-static int opt_ulong(const char *name, const char *v, int base, unsigned long hi, unsigned long *out)
+/* Modbus: answer every complete request in rq (fn 03 for --mb-reg, else exception 2). */
+static void serve_modbus(sim *s, uint8_t *rq, size_t *rq_len, unsigned long reply_delay_ms)
 {
-    char *end;
-    unsigned long x;
-    errno = 0;
-    x = strtoul(v, &end, base);
-    if (*v < '0' || *v > '9' || *end != '\0' || (errno != 0 && errno != ERANGE)) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is not a non-negative integer\n", name, v);
-        return -1;
+    for (;;) {
+        uint16_t reg = 0, cnt = 0;
+        size_t c = 0;
+        rc_status st = rcd_parse_modbus_request(&reg, &cnt, &c, s->pc.mb_addr ? s->pc.mb_addr : 1, rq, *rq_len);
+        memmove(rq, rq + c, *rq_len - c);
+        *rq_len -= c;
+        if (st == RC_ERR_INCOMPLETE)
+            break;
+        if (st != RC_OK)
+            continue;
+        sleep_s((double)reply_delay_ms / 1000.0);
+        if (reg != s->pc.mb_reg || cnt != 2) {
+            uint8_t e[8];
+            size_t n;
+            rcd_encode_modbus_exception(e, &n, sizeof e, s->pc.mb_addr ? s->pc.mb_addr : 1, 2);
+            send_bytes(s, e, n);
+        } else {
+            emit(s);
+        }
+        if (s->disconnected)
+            break;
     }
-    if (errno == ERANGE || x > hi) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is more than %lu\n", name, v, hi);
-        return -1;
-    }
-    *out = x;
-    return 0;
 }
 
-static int opt_long(const char *name, const char *v, long lo, long hi, long *out)
+/* ASCII polled and STX: one frame per poll command found in rq. */
+static void serve_polled(sim *s, uint8_t *rq, size_t *rq_len, unsigned long reply_delay_ms)
 {
-    char *end;
-    long x;
-    errno = 0;
-    x = strtol(v, &end, 10);
-    if (end == v || *end != '\0' || (errno != 0 && errno != ERANGE)) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is not an integer\n", name, v);
-        return -1;
+    const char *cmd = s->pc.poll_cmd[0] ? s->pc.poll_cmd : "R\r";
+    size_t cl = strlen(cmd);
+    for (;;) {
+        size_t p = 0;
+        while (p + cl <= *rq_len && memcmp(rq + p, cmd, cl) != 0)
+            ++p;
+        if (p + cl > *rq_len) {
+            if (*rq_len >= cl) { /* keep a possible partial command */
+                memmove(rq, rq + *rq_len - (cl - 1), cl - 1);
+                *rq_len = cl - 1;
+            }
+            break;
+        }
+        memmove(rq, rq + p + cl, *rq_len - p - cl);
+        *rq_len -= p + cl;
+        sleep_s((double)reply_delay_ms / 1000.0);
+        emit(s);
+        if (s->disconnected)
+            break;
     }
-    if (errno == ERANGE || x < lo || x > hi) {
-        fprintf(stderr, "simdisplay: option %s: '%s' is outside %ld..%ld\n", name, v, lo, hi);
-        return -1;
+}
+
+/* The display's life: frames, requests, silences, disconnects. 0 or 1. */
+static int serve(sim *s, unsigned long reply_delay_ms)
+{
+    uint8_t rq[512];
+    size_t rq_len = 0;
+    const double t_start = now_s();
+    double next_frame = t_start;
+    for (;;) {
+        struct pollfd pfd;
+        int timeout_ms = 20;
+        double t = now_s();
+        if (t - t_start > s->max_seconds || (s->exit_after && s->frames >= s->exit_after))
+            return 0;
+        if (s->disconnected) {
+            if (s->reconnect_ms < 0)
+                return 0;
+            sleep_s((double)s->reconnect_ms / 1000.0);
+            s->disconnected = 0;
+            s->disconnect_after = 0;
+            s->foreign = s->foreign_offset_mm != 0.0;
+            rq_len = 0;
+            if (open_pty(s) != 0)
+                return 1;
+            continue;
+        }
+        if (s->pc.protocol == RCD_PROTO_ASCII)
+            timeout_ms = t < next_frame ? (int)((next_frame - t) * 1000.0) : 0;
+        pfd.fd = s->master;
+        pfd.events = POLLIN;
+        pfd.revents = 0;
+        if (poll(&pfd, 1, timeout_ms) > 0 && (pfd.revents & POLLIN)) {
+            ssize_t r = read(s->master, rq + rq_len, sizeof rq - rq_len);
+            if (r > 0)
+                rq_len += (size_t)r;
+        }
+        follow_pose(s);
+        if (is_silent(s)) {
+            rq_len = 0; /* a silent display ignores requests */
+            continue;
+        }
+        if (s->pc.protocol == RCD_PROTO_ASCII) {
+            if (now_s() >= next_frame) {
+                emit(s);
+                next_frame += s->rate_hz > 0 ? 1.0 / s->rate_hz : 0.0;
+                if (next_frame < now_s() - 1.0)
+                    next_frame = now_s(); /* do not burst after a stall */
+            }
+        } else if (s->pc.protocol == RCD_PROTO_MODBUS) {
+            serve_modbus(s, rq, &rq_len, reply_delay_ms);
+        } else {
+            serve_polled(s, rq, &rq_len, reply_delay_ms);
+        }
+        if (rq_len == sizeof rq)
+            rq_len = 0;
     }
-    *out = x;
-    return 0;
 }
 
 int main(int argc, char **argv)
 {
     sim s;
-    const char *script = NULL, *truth = NULL, *poses = NULL;
-    unsigned long reply_delay_ms = 0, seed = 1;
-    uint8_t rq[512];
-    size_t rq_len = 0;
-    double t_start, next_frame;
-    int have_value = 0, rc = 0;
-    unsigned long u;
+    sim_args g = {"ascii", NULL, NULL, NULL, "zero", "mm", "int32", "abcd", NULL, 3, 0, 0, 0, 0, 1, -1};
+    int rc;
     memset(&s, 0, sizeof s);
-    s.decimals = 3;
     s.rate_hz = 20;
-    s.reconnect_ms = -1;
     s.max_seconds = 600;
     s.master = s.keeper = -1;
-    s.pc.protocol = RCD_PROTO_ASCII;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-#define OPT(name) (strcmp(a, name) == 0 && v && (++i, 1))
-        if (OPT("--protocol")) {
-            if (rcd_protocol_from_name(&s.pc.protocol, v) != RC_OK) {
-                fprintf(stderr, "simdisplay: unknown protocol '%s'\n", v);
-                return 2;
-            }
-        } else if (OPT("--value")) {
-            if (opt_double(a, v, -1e9, 1e9, &s.const_mm) != 0)
-                return 2;
-            have_value = 1;
-        } else if (OPT("--script")) {
-            script = v;
-        } else if (OPT("--truth")) {
-            truth = v;
-        } else if (OPT("--poses")) {
-            poses = v;
-        } else if (OPT("--follow")) {
-            s.follow = v;
-        } else if (OPT("--noise-mm")) {
-            if (opt_double(a, v, 0.0, 1e9, &s.noise_mm) != 0)
-                return 2;
-        } else if (OPT("--decimals")) {
-            if (opt_ulong(a, v, 10, 6, &u) != 0)
-                return 2;
-            s.decimals = (unsigned)u;
-        } else if (OPT("--style")) {
-            s.style = strcmp(v, "unit") == 0 ? RCD_STYLE_SPACE_UNIT : RCD_STYLE_ZERO_PAD;
-        } else if (OPT("--unit")) {
-            if (rcd_unit_from_name(&s.unit, v) != RC_OK)
-                return 2;
-        } else if (OPT("--rate-hz")) {
-            if (opt_double(a, v, 0.0, 1e6, &s.rate_hz) != 0)
-                return 2;
-        } else if (OPT("--baud")) {
-            if (opt_ulong(a, v, 10, 100000000UL, &s.baud) != 0)
-                return 2;
-        } else if (OPT("--poll-cmd")) {
-            /* C escapes \r and \n are understood */
-            size_t k = 0;
-            for (const char *p = v; *p && k + 1 < sizeof s.pc.poll_cmd; ++p) {
-                if (p[0] == '\\' && (p[1] == 'r' || p[1] == 'n')) {
-                    s.pc.poll_cmd[k++] = p[1] == 'r' ? '\r' : '\n';
-                    ++p;
-                } else {
-                    s.pc.poll_cmd[k++] = *p;
-                }
-            }
-        } else if (OPT("--mb-addr")) {
-            if (opt_ulong(a, v, 10, 247, &u) != 0)
-                return 2;
-            s.pc.mb_addr = (uint8_t)u;
-        } else if (OPT("--mb-reg")) {
-            if (opt_ulong(a, v, 0, 65535, &u) != 0)
-                return 2;
-            s.pc.mb_reg = (uint16_t)u;
-        } else if (OPT("--mb-format")) {
-            s.pc.mb_format = strcmp(v, "float") == 0 ? RCD_MB_FLOAT32 : RCD_MB_INT32;
-        } else if (OPT("--mb-order")) {
-            if (rcd_word_order_from_name(&s.pc.mb_order, v) != RC_OK)
-                return 2;
-        } else if (OPT("--mb-decimals")) {
-            if (opt_ulong(a, v, 10, 9, &u) != 0)
-                return 2;
-            s.pc.mb_decimals = (uint8_t)u;
-        } else if (OPT("--drop")) {
-            if (opt_double(a, v, 0.0, 1.0, &s.p_drop) != 0)
-                return 2;
-        } else if (OPT("--corrupt")) {
-            if (opt_double(a, v, 0.0, 1.0, &s.p_corrupt) != 0)
-                return 2;
-        } else if (OPT("--garbage")) {
-            if (opt_double(a, v, 0.0, 1.0, &s.p_garbage) != 0)
-                return 2;
-        } else if (OPT("--silence-every")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX, &s.silence_every) != 0)
-                return 2;
-        } else if (OPT("--silence-ms")) {
-            if (opt_ulong(a, v, 10, SIM_MAX_MS, &s.silence_ms) != 0)
-                return 2;
-        } else if (OPT("--disconnect-after")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX - 1, &s.disconnect_after) != 0)
-                return 2;
-        } else if (OPT("--reconnect-ms")) {
-            if (opt_long(a, v, -1, (long)SIM_MAX_MS, &s.reconnect_ms) != 0)
-                return 2;
-        } else if (OPT("--settle-ms")) {
-            if (opt_ulong(a, v, 10, SIM_MAX_MS, &s.settle_ms) != 0)
-                return 2;
-        } else if (OPT("--reply-delay-ms")) {
-            if (opt_ulong(a, v, 10, SIM_MAX_MS, &reply_delay_ms) != 0)
-                return 2;
-        } else if (OPT("--link")) {
-            s.link = v;
-        } else if (OPT("--seed")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX, &seed) != 0)
-                return 2;
-        } else if (OPT("--exit-after-frames")) {
-            if (opt_ulong(a, v, 10, ULONG_MAX, &s.exit_after) != 0)
-                return 2;
-        } else if (OPT("--max-seconds")) {
-            if (opt_double(a, v, 0.0, 1e9, &s.max_seconds) != 0)
-                return 2;
-        } else if (strcmp(a, "--help") == 0) {
-            usage(stdout);
-            return 0;
-        } else {
-            fprintf(stderr, "simdisplay: unknown or incomplete option '%s'\n", a);
-            usage(stderr);
-            return 2;
-        }
-#undef OPT
-    }
-    rc_rng_seed(&s.rng, seed);
-    if (script) {
+    rc = parse_options(&s, &g, argc, argv);
+    if (rc != 0)
+        return rc == 1 ? 0 : 2;
+    rc_rng_seed(&s.rng, g.seed);
+    if (g.script) {
         s.src = SRC_SCRIPT;
-        if (load_script(&s, script) != 0) {
-            rc = 1;
-            goto out;
-        }
-    } else if (truth || poses) {
-        if (!truth || !poses) {
-            fprintf(stderr, "simdisplay: --truth and --poses go together\n");
-            return 2;
-        }
+        rc = load_script(&s, g.script) != 0;
+    } else if (g.truth) {
         s.src = SRC_ROBOT;
-        if (load_robot(&s, truth, poses) != 0) {
-            rc = 1;
-            goto out;
-        }
-    } else if (have_value) {
-        s.src = SRC_CONST;
+        rc = load_robot(&s, g.truth, g.poses) != 0;
     } else {
-        usage(stderr);
-        return 2;
+        s.src = SRC_CONST;
     }
-    if (open_pty(&s) != 0) {
-        rc = 1;
-        goto out;
-    }
-    t_start = now_s();
-    next_frame = t_start;
-    for (;;) {
-        struct pollfd pfd;
-        int timeout_ms = 20;
-        double t = now_s();
-        if (t - t_start > s.max_seconds || (s.exit_after && s.frames >= s.exit_after))
-            break;
-        if (s.disconnected) {
-            if (s.reconnect_ms < 0)
-                break;
-            sleep_s((double)s.reconnect_ms / 1000.0);
-            s.disconnected = 0;
-            s.disconnect_after = 0;
-            rq_len = 0;
-            if (open_pty(&s) != 0) {
-                rc = 1;
-                break;
-            }
-            continue;
-        }
-        if (s.pc.protocol == RCD_PROTO_ASCII) {
-            if (t < next_frame) {
-                double w = next_frame - t;
-                timeout_ms = (int)(w * 1000.0);
-            } else {
-                timeout_ms = 0;
-            }
-        }
-        pfd.fd = s.master;
-        pfd.events = POLLIN;
-        pfd.revents = 0;
-        if (poll(&pfd, 1, timeout_ms) > 0 && (pfd.revents & POLLIN)) {
-            ssize_t r = read(s.master, rq + rq_len, sizeof rq - rq_len);
-            if (r > 0)
-                rq_len += (size_t)r;
-        }
-        follow_pose(&s);
-        if (is_silent(&s)) {
-            rq_len = 0; /* a silent display ignores requests */
-            continue;
-        }
-        if (s.pc.protocol == RCD_PROTO_ASCII) {
-            if (now_s() >= next_frame) {
-                emit(&s);
-                next_frame += s.rate_hz > 0 ? 1.0 / s.rate_hz : 0.0;
-                if (next_frame < now_s() - 1.0)
-                    next_frame = now_s(); /* do not burst after a stall */
-            }
-        } else if (s.pc.protocol == RCD_PROTO_MODBUS) {
-            for (;;) {
-                uint16_t reg = 0, cnt = 0;
-                size_t c = 0;
-                rc_status st = rcd_parse_modbus_request(&reg, &cnt, &c, s.pc.mb_addr ? s.pc.mb_addr : 1, rq, rq_len);
-                memmove(rq, rq + c, rq_len - c);
-                rq_len -= c;
-                if (st == RC_ERR_INCOMPLETE)
-                    break;
-                if (st != RC_OK)
-                    continue;
-                sleep_s((double)reply_delay_ms / 1000.0);
-                if (reg != s.pc.mb_reg || cnt != 2) {
-                    uint8_t e[8];
-                    size_t n;
-                    rcd_encode_modbus_exception(e, &n, sizeof e, s.pc.mb_addr ? s.pc.mb_addr : 1, 2);
-                    send_bytes(&s, e, n);
-                } else {
-                    emit(&s);
-                }
-                if (s.disconnected)
-                    break;
-            }
-        } else {
-            const char *cmd = s.pc.poll_cmd[0] ? s.pc.poll_cmd : "R\r";
-            size_t cl = strlen(cmd);
-            for (;;) {
-                size_t p = 0;
-                while (p + cl <= rq_len && memcmp(rq + p, cmd, cl) != 0)
-                    ++p;
-                if (p + cl > rq_len) {
-                    if (rq_len >= cl) { /* keep a possible partial command */
-                        memmove(rq, rq + rq_len - (cl - 1), cl - 1);
-                        rq_len = cl - 1;
-                    }
-                    break;
-                }
-                memmove(rq, rq + p + cl, rq_len - p - cl);
-                rq_len -= p + cl;
-                sleep_s((double)reply_delay_ms / 1000.0);
-                emit(&s);
-                if (s.disconnected)
-                    break;
-            }
-        }
-        if (rq_len == sizeof rq)
-            rq_len = 0;
-    }
-out:
+    if (rc == 0)
+        rc = open_pty(&s) != 0 ? 1 : serve(&s, g.reply_delay_ms);
     close_pty(&s);
     free(s.script);
     free(s.pose_len);

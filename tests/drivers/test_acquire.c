@@ -1,0 +1,492 @@
+/* test_acquire.c - the acquisition run in-process over the mock port
+ * (rch_acquire_run with a test io): a frozen display and a foreign device
+ * are refused and never recorded, a second acquisition on the same file is
+ * refused with the holder's pid, outputs that name inputs are refused by
+ * inode, plan poses outside the joint limits are refused, the resume scan
+ * is bounded (/dev/full, endless line). Issue 12. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "rch_acqfile.h"
+#include "rch_acquire.h"
+#include "rch_data.h"
+#include "rch_poses.h"
+#include "rch_robot.h"
+
+#define ROBOT RCAL_SOURCE_DIR "/data/irb120.json"
+#define NP 4
+
+static const double plan_deg[NP][RC_NJ] = {
+    {0, 0, 0, 0, 30, 0}, {40, 20, -30, 10, 45, 0}, {-60, 30, 10, -20, 60, 30}, {90, -20, 20, 40, -50, 10}};
+static char dir_[256];
+static double nominal_mm[NP];
+
+/* ---- a test io: mock ports, simulated clock ------------------------------ */
+typedef struct tio {
+    rcd_port port;
+    rcd_mock_ctx m[2]; /* the display, and what appears after a reconnect */
+    int opened;        /* opens so far */
+    uint8_t rx[2][8192];
+} tio;
+
+static rc_status t_open(void *ctx, rcd_port **port, const char *path, const rcd_serial_config *cfg)
+{
+    tio *t = ctx;
+    int k = t->opened++ == 0 ? 0 : 1;
+    t->port.ops = &rcd_mock_ops;
+    t->port.ctx = &t->m[k];
+    if (k == 1)
+        t->m[1].clock_ms = t->m[0].clock_ms;
+    *port = &t->port;
+    return rcd_port_open(&t->port, path, cfg);
+}
+static void t_close(void *ctx)
+{
+    tio *t = ctx;
+    rcd_port_close(&t->port);
+}
+static void t_sleep(void *ctx, rcd_port *port, unsigned long ms)
+{
+    (void)ctx;
+    ((rcd_mock_ctx *)port->ctx)->clock_ms += (uint32_t)ms;
+}
+static long long t_wall(void *ctx)
+{
+    (void)ctx;
+    return 1700000000000ll;
+}
+static int t_confirm(void *ctx, size_t pose)
+{
+    (void)ctx;
+    (void)pose;
+    return 0;
+}
+
+/* ASCII stream of `count` frames per value. Returns the length. The mock
+ * delivers one frame per read (max_chunk), as a display that streams: a
+ * flush at a new pose drops nothing that was not yet "sent". */
+static size_t g_frame;
+static size_t script(uint8_t *s, size_t cap, const double *v, size_t nv, unsigned count)
+{
+    size_t len = 0;
+    for (size_t i = 0; i < nv; ++i)
+        for (unsigned k = 0; k < count; ++k) {
+            size_t n;
+            assert_int_equal(rcd_encode_ascii(s + len, &n, cap - len, v[i], RCD_STYLE_ZERO_PAD, RCD_UNIT_NONE, 2),
+                             RC_OK);
+            len += n;
+            g_frame = n;
+        }
+    return len;
+}
+
+static void tio_init(tio *t)
+{
+    memset(t, 0, sizeof *t);
+    for (int k = 0; k < 2; ++k) {
+        rcd_port p;
+        rcd_mock_init(&p, &t->m[k]);
+        t->m[k].rx = t->rx[k];
+    }
+}
+
+static void path_in(char *buf, size_t cap, const char *name)
+{
+    snprintf(buf, cap, "%s/%s", dir_, name);
+}
+
+static void write_text(const char *name, const char *text)
+{
+    char p[512];
+    FILE *f;
+    path_in(p, sizeof p, name);
+    f = fopen(p, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static long long fsize(const char *name)
+{
+    char p[512];
+    struct stat sb;
+    path_in(p, sizeof p, name);
+    return stat(p, &sb) == 0 ? (long long)sb.st_size : -1;
+}
+
+static char g_plan[512], g_out[512], g_err[8192];
+
+static void config(rch_acq_config *c, const char *out_name)
+{
+    rch_acq_config_default(c);
+    c->port_path = "mock";
+    c->poses_path = g_plan;
+    path_in(g_out, sizeof g_out, out_name);
+    remove(g_out);
+    c->out_path = g_out;
+    c->robot_path = ROBOT;
+    c->settle_ms = 100;
+    c->read_timeout_ms = 50;
+    c->retries = 3;
+    c->reconnect_s = 1;
+    c->quiet = 1;
+}
+
+static int run(rch_acq_result *r, const rch_acq_config *c, tio *t)
+{
+    t->m[0].max_chunk = t->m[1].max_chunk = g_frame;
+    rch_acq_io io = {t_open, t_close, t_sleep, t_wall, t_confirm, NULL, t};
+    FILE *e;
+    memset(g_err, 0, sizeof g_err);
+    e = fmemopen(g_err, sizeof g_err, "w");
+    int rc;
+    assert_non_null(e);
+    rc = rch_acquire_run(r, c, &io, NULL, e);
+    fclose(e);
+    print_message("%s", g_err);
+    return rc;
+}
+
+static int setup(void **state)
+{
+    rch_robot rb;
+    rch_diag dg;
+    char text[1024];
+    size_t n = 0;
+    (void)state;
+    snprintf(dir_, sizeof dir_, "%s/tests/drivers/acq_inproc", RCAL_BINARY_DIR);
+    (void)mkdir(dir_, 0755);
+    assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
+    rb.model.x[RC_P_ENC] = 250.0;
+    rb.model.x[RC_P_ENC + 1] = -460.0;
+    rb.model.x[RC_P_ENC + 2] = 10.0;
+    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6\n");
+    for (int i = 0; i < NP; ++i) {
+        rc_sample s;
+        memset(&s, 0, sizeof s);
+        n += (size_t)snprintf(text + n, sizeof text - n, "%d", i);
+        for (int j = 0; j < RC_NJ; ++j) {
+            s.q_rad[j] = plan_deg[i][j] * 3.14159265358979323846 / 180.0;
+            n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
+        }
+        n += (size_t)snprintf(text + n, sizeof text - n, "\n");
+        assert_int_equal(rc_meas(&nominal_mm[i], NULL, &rb.model, &s), RC_OK);
+    }
+    write_text("plan.csv", text);
+    path_in(g_plan, sizeof g_plan, "plan.csv");
+    return 0;
+}
+
+/* a display that follows the robot (true lengths 1.5 mm off the nominal
+ * ones, as a real robot is): every pose recorded */
+static void test_follows(void **state)
+{
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    double v[NP];
+    (void)state;
+    tio_init(&t);
+    for (int i = 0; i < NP; ++i)
+        v[i] = nominal_mm[i] + 1.5 * (i % 2 ? 1 : -1);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+    config(&c, "follows.csv");
+    c.stable.n = 5;
+    assert_int_equal(run(&r, &c, &t), 0);
+    assert_int_equal(r.n_new, NP);
+    assert_int_equal(r.follow_refusals, 0);
+    assert_true(r.worst_follow_mm > 2.9 && r.worst_follow_mm < 3.1);
+}
+
+/* frozen display (HOLD pressed, firmware hung): every reading 509.19 mm.
+ * Pose 0 has nothing to compare with; pose 1 is refused `retries` times,
+ * the run stops, and the file holds pose 0 only (issue 12: 20 poses at
+ * 509.19 mm with spread 0 were recorded). */
+static void test_frozen_refused(void **state)
+{
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    const double frozen = 509.19;
+    (void)state;
+    tio_init(&t);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], &frozen, 1, 60);
+    config(&c, "frozen.csv");
+    assert_int_equal(run(&r, &c, &t), 1);
+    assert_int_equal(r.n_new, 1);
+    assert_int_equal(r.follow_refusals, 3);
+    assert_true(r.stopped);
+    assert_int_equal(r.stopped_at, 1);
+    assert_non_null(strstr(g_err, "the display did not change: frozen"));
+    assert_int_equal(fsize("frozen.csv"), (long long)(strlen(RCH_ACQ_HEADER) + 1) +
+                                              (long long)strlen("0,0.0000,0.0000,0.0000,0.0000,30.0000,0.0000,"
+                                                                "509.1900,0.0000,5,1700000000000\n"));
+}
+
+/* after a hang-up another device answers on the same path, 254 mm off:
+ * its readings do not follow the move and are never recorded */
+static void test_foreign_after_reconnect_refused(void **state)
+{
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    double v[NP], w[NP];
+    (void)state;
+    tio_init(&t);
+    for (int i = 0; i < NP; ++i) {
+        v[i] = nominal_mm[i];
+        w[i] = nominal_mm[i] + 254.0;
+    }
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, 2, 8); /* poses 0 and 1, then it hangs up */
+    t.m[0].closed_at_end = 1;
+    t.m[1].rx_len = script(t.rx[1], sizeof t.rx[1], w + 2, 1, 40);
+    config(&c, "foreign.csv");
+    assert_int_equal(run(&r, &c, &t), 1);
+    assert_int_equal(r.n_new, 2);
+    assert_true(r.follow_refusals >= 1);
+    assert_int_equal(r.stopped_at, 2);
+    assert_non_null(strstr(g_err, "another device"));
+    /* the file holds poses 0 and 1 only; resuming with a good display finishes it */
+    tio_init(&t);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v + 2, 2, 8);
+    c.out_path = g_out; /* same file, not removed */
+    assert_int_equal(run(&r, &c, &t), 0);
+    assert_int_equal(r.n_before, 2);
+    assert_int_equal(r.n_new, 2);
+}
+
+/* a second acquisition on the same file is refused with the holder's pid */
+static void test_lock_names_holder(void **state)
+{
+    char out[512], msg[900];
+    int go[2], done[2];
+    pid_t pid;
+    unsigned char dn[NP];
+    rch_acqfile a;
+    rch_acqfile_state st;
+    rch_diag dg;
+    (void)state;
+    path_in(out, sizeof out, "locked.csv");
+    remove(out);
+    assert_int_equal(pipe(go), 0);
+    assert_int_equal(pipe(done), 0);
+    pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        char b = 0;
+        int ok = rch_acqfile_open(&a, &st, dn, out, plan_deg, NP, &dg) == 0;
+        if (write(go[1], &b, 1) != 1 || read(done[0], &b, 1) != 1)
+            _exit(2);
+        _exit(ok ? 0 : 1);
+    }
+    {
+        char b = 0;
+        int status = 0;
+        assert_int_equal(read(go[0], &b, 1), 1);
+        assert_int_equal(rch_acqfile_open(&a, &st, dn, out, plan_deg, NP, &dg), -1);
+        rch_diag_str(&dg, msg, sizeof msg);
+        print_message("%s\n", msg);
+        {
+            char want[64];
+            snprintf(want, sizeof want, "pid %ld", (long)pid);
+            assert_non_null(strstr(msg, want));
+        }
+        assert_int_equal(write(done[1], &b, 1), 1);
+        assert_int_equal(waitpid(pid, &status, 0), pid);
+        assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+        /* the holder is gone: the file opens */
+        assert_int_equal(rch_acqfile_open(&a, &st, dn, out, plan_deg, NP, &dg), 0);
+        assert_int_equal(rch_acqfile_close(&a, &dg), 0);
+    }
+}
+
+/* --out or --announce naming an input (another spelling, a hard link) is
+ * refused before anything is written (issue 12: --out a.csv --announce
+ * a.csv left one announce line) */
+static void test_outputs_naming_inputs(void **state)
+{
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    char alias[600], link_[512];
+    const char data[] = RCH_ACQ_HEADER "\n";
+    (void)state;
+    config(&c, "keep.csv");
+    write_text("keep.csv", data);
+    snprintf(alias, sizeof alias, "%s/./keep.csv", dir_);
+    c.announce_path = alias;
+    tio_init(&t);
+    assert_int_equal(run(&r, &c, &t), 1);
+    assert_non_null(strstr(g_err, "--out"));
+    assert_non_null(strstr(g_err, "--announce"));
+    assert_int_equal(fsize("keep.csv"), (long long)strlen(data));
+    assert_int_equal(t.opened, 0);
+    /* --announce is the plan (through a hard link) */
+    path_in(link_, sizeof link_, "plan_link.csv");
+    remove(link_);
+    assert_int_equal(link(g_plan, link_), 0);
+    config(&c, "x.csv");
+    c.announce_path = link_;
+    assert_int_equal(run(&r, &c, &t), 1);
+    assert_non_null(strstr(g_err, "--poses"));
+    assert_int_equal(fsize("x.csv"), -1);
+    /* --out is the plan */
+    config(&c, "y.csv");
+    c.out_path = g_plan;
+    assert_int_equal(run(&r, &c, &t), 1);
+    assert_int_equal(t.opened, 0);
+}
+
+/* a plan pose outside the joint limits is refused, nothing recorded */
+static void test_plan_outside_limits(void **state)
+{
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    char p[512];
+    (void)state;
+    write_text("bad_plan.csv", "pose,q1,q2,q3,q4,q5,q6\n0,0,0,0,0,30,0\n1,170,0,0,0,30,0\n");
+    path_in(p, sizeof p, "bad_plan.csv");
+    config(&c, "z.csv");
+    c.poses_path = p;
+    tio_init(&t);
+    assert_int_equal(run(&r, &c, &t), 1);
+    assert_non_null(strstr(g_err, "outside the joint limits"));
+    assert_int_equal(fsize("z.csv"), -1);
+}
+
+/* the resume scan is bounded: a device (/dev/full reads zeros forever) is
+ * refused at once, and so is a file whose line never ends */
+static void test_scan_bounded(void **state)
+{
+    unsigned char dn[NP];
+    rch_acqfile a;
+    rch_acqfile_state st;
+    rch_diag dg;
+    char msg[900], p[512];
+    FILE *f;
+    (void)state;
+    if (access("/dev/full", R_OK | W_OK) == 0) {
+        assert_int_equal(rch_acqfile_open(&a, &st, dn, "/dev/full", plan_deg, NP, &dg), -1);
+        assert_non_null(strstr(rch_diag_str(&dg, msg, sizeof msg), "not a regular file"));
+    }
+    path_in(p, sizeof p, "endless.csv");
+    f = fopen(p, "w");
+    assert_non_null(f);
+    fputs(RCH_ACQ_HEADER "\n", f);
+    for (int i = 0; i < 100000; ++i)
+        fputc('7', f);
+    fclose(f);
+    assert_int_equal(rch_acqfile_open(&a, &st, dn, p, plan_deg, NP, &dg), -1);
+    assert_non_null(strstr(rch_diag_str(&dg, msg, sizeof msg), "longer than 4096 bytes"));
+    assert_int_equal(fsize("endless.csv"), (long long)strlen(RCH_ACQ_HEADER) + 1 + 100000);
+}
+
+/* a power cut leaves NUL bytes for the last line: moved to .dropped, the
+ * samples before it stay */
+static void test_nul_last_line_dropped(void **state)
+{
+    unsigned char dn[NP];
+    rch_acqfile a;
+    rch_acqfile_state st;
+    rch_diag dg;
+    char p[512], dp[600];
+    static const char good[] = RCH_ACQ_HEADER "\n"
+                               "0,0.0000,0.0000,0.0000,0.0000,30.0000,0.0000,500.0000,0.0100,5,1\n";
+    FILE *f;
+    (void)state;
+    path_in(p, sizeof p, "powercut.csv");
+    snprintf(dp, sizeof dp, "%s.dropped", p);
+    remove(dp);
+    f = fopen(p, "wb");
+    assert_non_null(f);
+    fwrite(good, 1, sizeof good - 1, f);
+    for (int i = 0; i < 64; ++i)
+        fputc(0, f);
+    fputc('\n', f);
+    fclose(f);
+    assert_int_equal(rch_acqfile_open(&a, &st, dn, p, plan_deg, NP, &dg), 0);
+    assert_int_equal(st.n_done, 1);
+    assert_int_equal(st.dropped_bytes, 65);
+    assert_true(st.has_last && st.last_pose == 0 && fabs(st.last_len_mm - 500.0) < 1e-12);
+    assert_int_equal(rch_acqfile_close(&a, &dg), 0);
+    assert_int_equal(fsize("powercut.csv"), (long long)sizeof good - 1);
+    assert_int_equal(fsize("powercut.csv.dropped"), 65);
+}
+
+/* the pose plan: inside the joint limits less the margin, written and read
+ * back through rch_data (one reader, one writer); absurd requests refused
+ * with the limit named (issue 12: --count 100000 ran for minutes, --margin-deg
+ * 500 wrote poses outside the limits) */
+static void test_plan_limits(void **state)
+{
+    rch_robot rb;
+    rch_diag dg;
+    rch_poses_config pc = {12, 0, 4, 3, 250, 800, 20};
+    rch_poses_result res;
+    rch_data back;
+    char p[512];
+    FILE *f;
+    (void)state;
+    assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
+    rb.model.x[RC_P_ENC] = 250.0;
+    rb.model.x[RC_P_ENC + 1] = -460.0;
+    rb.model.x[RC_P_ENC + 2] = 10.0;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
+    assert_int_equal(res.n, 12);
+    assert_true(res.o1_plan > res.o1_random);
+    path_in(p, sizeof p, "plan12.csv");
+    f = fopen(p, "w");
+    assert_non_null(f);
+    assert_int_equal(rch_data_write_plan(f, res.poses, res.n), 0);
+    fclose(f);
+    assert_int_equal(rch_data_load(&back, p, RCH_DATA_NO_LEN, &dg), 0);
+    assert_int_equal(back.n, 12);
+    for (size_t i = 0; i < res.n; ++i)
+        for (int j = 0; j < RC_NJ; ++j) {
+            const double mg = 20.0 * 3.14159265358979323846 / 180.0;
+            assert_true(res.poses[i].q_rad[j] >= rb.model.q_min_rad[j] + mg - 1e-12);
+            assert_true(res.poses[i].q_rad[j] <= rb.model.q_max_rad[j] - mg + 1e-12);
+            assert_true(fabs(back.s[i].q_rad[j] - res.poses[i].q_rad[j]) < 1e-6);
+        }
+    rch_data_free(&back);
+    rch_poses_free(&res);
+    pc.margin_deg = 500;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), -1);
+    assert_non_null(strstr(dg.msg, "leaves no room"));
+    pc.margin_deg = 5;
+    pc.count = 100000;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), -1);
+    assert_non_null(strstr(dg.msg, "1..1000"));
+    pc.count = 10;
+    pc.candidates = 5;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), -1);
+    assert_null(res.poses);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_follows),
+        cmocka_unit_test(test_frozen_refused),
+        cmocka_unit_test(test_foreign_after_reconnect_refused),
+        cmocka_unit_test(test_lock_names_holder),
+        cmocka_unit_test(test_outputs_naming_inputs),
+        cmocka_unit_test(test_plan_outside_limits),
+        cmocka_unit_test(test_scan_bounded),
+        cmocka_unit_test(test_nul_last_line_dropped),
+        cmocka_unit_test(test_plan_limits),
+    };
+    return cmocka_run_group_tests(tests, setup, NULL);
+}

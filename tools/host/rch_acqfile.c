@@ -1,0 +1,274 @@
+/* rch_acqfile.c - the acquisition file (see rch_acqfile.h). */
+#include "rch_acqfile.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "rch_data.h"
+
+#define DEG_PER_RAD (180.0 / 3.14159265358979323846)
+
+static int write_all(int fd, const char *p, size_t n)
+{
+    while (n > 0) {
+        ssize_t w = write(fd, p, n);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return -1;
+        p += w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
+/* Appends text[from..len) to "<path>.dropped": even the fragment of an
+ * interrupted write is never destroyed. */
+static int save_tail(const char *path, const char *text, size_t from, size_t len, rch_diag *d)
+{
+    char dpath[1100];
+    int fd, rc;
+    snprintf(dpath, sizeof dpath, "%s.dropped", path);
+    fd = open(dpath, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        rch_diag_set(d, path, 0, 0, "cannot save the unfinished last line to %s: %s", dpath, strerror(errno));
+        return -1;
+    }
+    rc = write_all(fd, text + from, len - from);
+    if (rc == 0)
+        rc = fsync(fd);
+    if (close(fd) != 0 || rc != 0) {
+        rch_diag_set(d, path, 0, 0, "cannot save the unfinished last line to %s", dpath);
+        return -1;
+    }
+    return 0;
+}
+
+/* Exclusive lock on the whole file; -1 with d naming the holder. */
+static int lock_file(int fd, const char *path, rch_diag *d)
+{
+    struct flock fl;
+    memset(&fl, 0, sizeof fl);
+    fl.l_type = F_WRLCK;
+    fl.l_whence = SEEK_SET;
+    if (fcntl(fd, F_SETLK, &fl) == 0)
+        return 0;
+    if (errno == EACCES || errno == EAGAIN) {
+        memset(&fl, 0, sizeof fl);
+        fl.l_type = F_WRLCK;
+        fl.l_whence = SEEK_SET;
+        if (fcntl(fd, F_GETLK, &fl) == 0 && fl.l_type != F_UNLCK)
+            rch_diag_set(d, path, 0, 0,
+                         "another acquisition (pid %ld) is writing this file; wait for it to end or choose "
+                         "another --out", (long)fl.l_pid);
+        else
+            rch_diag_set(d, path, 0, 0, "another acquisition is writing this file; choose another --out");
+        return -1;
+    }
+    rch_diag_set(d, path, 0, 0, "cannot lock: %s", strerror(errno));
+    return -1;
+}
+
+/* Where the complete, trustworthy part of text ends: after the last line
+ * ending in '\n', less a last line holding NUL bytes (power cut).
+ * -1 with d set when a line is longer than RCH_ACQ_MAX_LINE. */
+static long good_prefix(const char *text, size_t len, const char *path, rch_diag *d)
+{
+    size_t start = 0, good = 0, prev_good = 0;
+    unsigned line = 0;
+    for (size_t i = 0; i < len; ++i) {
+        if (text[i] != '\n')
+            continue;
+        ++line;
+        if (i - start > RCH_ACQ_MAX_LINE) {
+            rch_diag_set(d, path, line, 1, "line longer than %u bytes: not an acquisition file; choose another "
+                         "--out (nothing was changed)", RCH_ACQ_MAX_LINE);
+            return -1;
+        }
+        prev_good = good;
+        good = i + 1;
+        start = i + 1;
+    }
+    if (len - start > RCH_ACQ_MAX_LINE) {
+        rch_diag_set(d, path, line + 1, 1, "unfinished last line longer than %u bytes: not an acquisition file; "
+                     "choose another --out (nothing was changed)", RCH_ACQ_MAX_LINE);
+        return -1;
+    }
+    if (good > 0) { /* the last complete line holds NUL bytes (power cut) */
+        size_t a = prev_good, nul = 0;
+        for (size_t i = a; i + 1 < good; ++i)
+            nul += text[i] == '\0';
+        if (nul > 0)
+            good = prev_good;
+    }
+    return (long)good;
+}
+
+static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state *st,
+                      const double (*plan_deg)[RC_NJ], size_t n_poses, const char *path, rch_diag *d)
+{
+    for (size_t i = 0; i < f->n; ++i) {
+        const unsigned long pose = f->pose[i];
+        if (pose >= n_poses) {
+            rch_diag_set(d, path, f->line[i], 1, "pose %lu is not in the plan (%zu poses): the file belongs to "
+                         "another plan; choose another --out", pose, n_poses);
+            return -1;
+        }
+        for (int j = 0; j < RC_NJ; ++j) {
+            const double q = f->s[i].q_rad[j] * DEG_PER_RAD;
+            if (fabs(q - plan_deg[pose][j]) > 1e-3) {
+                rch_diag_set(d, path, f->line[i], 1, "pose %lu has q%d = %.4f but the plan says %.4f: the file "
+                             "belongs to another plan; choose another --out", pose, j + 1, q, plan_deg[pose][j]);
+                return -1;
+            }
+        }
+        if (!done[pose])
+            st->n_done++;
+        done[pose] = 1;
+    }
+    if (f->n > 0) {
+        st->has_last = 1;
+        st->last_pose = (size_t)f->pose[f->n - 1];
+        st->last_len_mm = f->s[f->n - 1].len_mm;
+    }
+    return 0;
+}
+
+/* Read the file (bounded), drop an unfinished tail, check the rest. */
+static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *path,
+                const double (*plan_deg)[RC_NJ], size_t n_poses, rch_diag *d)
+{
+    struct stat sb;
+    char *text;
+    size_t len = 0;
+    long good;
+    int rc = -1;
+    if (fstat(fd, &sb) != 0) {
+        rch_diag_set(d, path, 0, 0, "cannot stat: %s", strerror(errno));
+        return -1;
+    }
+    if (!S_ISREG(sb.st_mode)) {
+        rch_diag_set(d, path, 0, 0, "is not a regular file (a device or pipe cannot hold an acquisition); "
+                     "choose another --out");
+        return -1;
+    }
+    if ((unsigned long long)sb.st_size > RCH_ACQ_MAX_BYTES) {
+        rch_diag_set(d, path, 0, 0, "holds %lld bytes, more than the %u an acquisition file may have; choose "
+                     "another --out", (long long)sb.st_size, RCH_ACQ_MAX_BYTES);
+        return -1;
+    }
+    text = malloc((size_t)sb.st_size + 1);
+    if (!text) {
+        rch_diag_set(d, path, 0, 0, "out of memory");
+        return -1;
+    }
+    while (len < (size_t)sb.st_size) {
+        ssize_t r = pread(fd, text + len, (size_t)sb.st_size - len, (off_t)len);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            break;
+        len += (size_t)r;
+    }
+    good = good_prefix(text, len, path, d);
+    if (good < 0)
+        goto out;
+    if (good > 0 && strncmp(text, RCH_ACQ_HEADER "\n", strlen(RCH_ACQ_HEADER) + 1) != 0 &&
+        strncmp(text, RCH_ACQ_HEADER "\r\n", strlen(RCH_ACQ_HEADER) + 2) != 0) {
+        rch_diag_set(d, path, 1, 1, "exists but is not an acquisition file (header '%s' expected); choose "
+                     "another --out (nothing was changed)", RCH_ACQ_HEADER);
+        goto out;
+    }
+    if (good > 0) {
+        rch_data f;
+        if (rch_data_parse(&f, text, (size_t)good, path, RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY, d) != 0)
+            goto out;
+        rc = check_plan(&f, done, st, plan_deg, n_poses, path, d);
+        rch_data_free(&f);
+        if (rc != 0)
+            goto out;
+        rc = -1;
+    }
+    if ((size_t)good < len) {
+        if (save_tail(path, text, (size_t)good, len, d) != 0)
+            goto out;
+        if (ftruncate(fd, (off_t)good) != 0) {
+            rch_diag_set(d, path, 0, 0, "cannot truncate: %s", strerror(errno));
+            goto out;
+        }
+        st->dropped_bytes = len - (size_t)good;
+    }
+    if (good == 0 && write_all(fd, RCH_ACQ_HEADER "\n", strlen(RCH_ACQ_HEADER) + 1) != 0) {
+        rch_diag_set(d, path, 0, 0, "cannot write the header: %s", strerror(errno));
+        goto out;
+    }
+    if (fsync(fd) != 0) {
+        rch_diag_set(d, path, 0, 0, "fsync: %s", strerror(errno));
+        goto out;
+    }
+    rc = 0;
+out:
+    free(text);
+    return rc;
+}
+
+int rch_acqfile_open(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
+                     const double (*plan_deg)[RC_NJ], size_t n_poses, rch_diag *d)
+{
+    memset(st, 0, sizeof *st);
+    memset(done, 0, n_poses);
+    a->fd = -1;
+    if (strlen(path) >= sizeof a->path) {
+        rch_diag_set(d, path, 0, 0, "path too long");
+        return -1;
+    }
+    strcpy(a->path, path);
+    a->fd = open(path, O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC | O_NOCTTY | O_NONBLOCK, 0644);
+    if (a->fd < 0) {
+        rch_diag_set(d, path, 0, 0, "cannot open for appending: %s", strerror(errno));
+        return -1;
+    }
+    if (lock_file(a->fd, path, d) != 0 || scan(st, done, a->fd, path, plan_deg, n_poses, d) != 0) {
+        close(a->fd);
+        a->fd = -1;
+        return -1;
+    }
+    return 0;
+}
+
+int rch_acqfile_append(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], const rc_stable_result *r,
+                       long long t_unix_ms, rch_diag *d)
+{
+    char line[512];
+    int n = snprintf(line, sizeof line, "%zu", pose);
+    for (int j = 0; j < RC_NJ; ++j)
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f", q_deg[j]);
+    n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f,%.4f,%u,%lld\n", r->mean_mm, r->spread_mm, r->count,
+                  t_unix_ms);
+    if (n <= 0 || (size_t)n >= sizeof line) {
+        rch_diag_set(d, a->path, 0, 0, "sample line too long");
+        return -1;
+    }
+    if (write_all(a->fd, line, (size_t)n) != 0 || fsync(a->fd) != 0) {
+        rch_diag_set(d, a->path, 0, 0, "writing failed: %s", strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+int rch_acqfile_close(rch_acqfile *a, rch_diag *d)
+{
+    int rc = 0;
+    if (a->fd >= 0 && close(a->fd) != 0) {
+        rch_diag_set(d, a->path, 0, 0, "close: %s", strerror(errno));
+        rc = -1;
+    }
+    a->fd = -1;
+    return rc;
+}

@@ -1,0 +1,516 @@
+/* rch_acquire.c - the acquisition state machine (see rch_acquire.h). */
+#include "rch_acquire.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "rch_acqfile.h"
+#include "rch_data.h"
+#include "rch_file.h"
+#include "rch_robot.h"
+
+#define DEG_PER_RAD (180.0 / 3.14159265358979323846)
+
+void rch_acq_config_default(rch_acq_config *c)
+{
+    memset(c, 0, sizeof *c);
+    c->backend = "serialport";
+    c->encoder_mm[0] = 250.0;
+    c->encoder_mm[1] = -460.0;
+    c->encoder_mm[2] = 10.0;
+    rc_stable_config_default(&c->stable);
+    c->settle_ms = 2000;
+    c->read_timeout_ms = 2000;
+    c->retries = 5;
+    c->reconnect_s = 10;
+    c->poll_interval_ms = 100;
+    c->follow_tol_mm = 10.0;
+}
+
+int rch_acq_follows(double *miss_mm, double len_mm, double pred_mm, double ref_len_mm, double ref_pred_mm,
+                    double tol_mm)
+{
+    *miss_mm = fabs((len_mm - ref_len_mm) - (pred_mm - ref_pred_mm));
+    return *miss_mm <= tol_mm ? 0 : -1;
+}
+
+/* ---- the real io: POSIX or libserialport backend, nanosleep, wall clock -- */
+
+typedef struct sys_io {
+    const char *backend;
+    rcd_port port;
+    rcd_posix_ctx px;
+    rcd_serialport_ctx sp;
+    int open;
+} sys_io;
+
+static rc_status sys_open(void *ctx, rcd_port **port, const char *path, const rcd_serial_config *cfg)
+{
+    sys_io *s = ctx;
+    rc_status st;
+    if (strcmp(s->backend, "posix") == 0)
+        rcd_posix_init(&s->port, &s->px);
+    else
+        rcd_serialport_init(&s->port, &s->sp);
+    st = rcd_port_open(&s->port, path, cfg);
+    s->open = st == RC_OK;
+    *port = &s->port;
+    return st;
+}
+
+static void sys_close(void *ctx)
+{
+    sys_io *s = ctx;
+    if (s->open)
+        rcd_port_close(&s->port);
+    s->open = 0;
+}
+
+static void sys_sleep(void *ctx, rcd_port *port, unsigned long ms)
+{
+    struct timespec ts;
+    (void)ctx;
+    (void)port;
+    ts.tv_sec = (time_t)(ms / 1000);
+    ts.tv_nsec = (long)(ms % 1000) * 1000000L;
+    while (nanosleep(&ts, &ts) != 0 && errno == EINTR)
+        ;
+}
+
+static long long sys_wall(void *ctx)
+{
+    struct timespec ts;
+    (void)ctx;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+static int sys_confirm(void *ctx, size_t pose)
+{
+    int ch;
+    (void)ctx;
+    (void)pose;
+    printf("  move the robot there, then press Enter ");
+    fflush(stdout);
+    while ((ch = getchar()) != '\n' && ch != EOF)
+        ;
+    return ch == EOF ? -1 : 0;
+}
+
+/* ---- one run ------------------------------------------------------------- */
+
+typedef struct acq {
+    const rch_acq_config *c;
+    const rch_acq_io *io;
+    FILE *out, *err;
+    rch_acq_result *res;
+    rcd_port *port;
+    rcd_display d;
+    size_t n;                 /* plan poses */
+    double (*plan_deg)[RC_NJ]; /* (n x 6) */
+    double *pred_mm;          /* (n) nominal length, NaN when unknown */
+    unsigned char *done;      /* (n) */
+    rch_acqfile file;
+    int has_ref;              /* a recorded sample to check the next against */
+    size_t ref_pose;
+    double ref_len_mm;
+} acq;
+
+#define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
+#define WARN(a, ...) ((a)->err ? (void)fprintf((a)->err, "rcal acquire: " __VA_ARGS__) : (void)0)
+#define NOTE(a, ...) (!(a)->c->quiet ? WARN(a, __VA_ARGS__) : (void)0)
+
+static uint32_t now_ms(const acq *a)
+{
+    return rcd_port_now_ms(a->port);
+}
+
+/* Close and reopen until it works or reconnect_s passes. */
+static rc_status reconnect(acq *a)
+{
+    const uint32_t t0 = now_ms(a);
+    const unsigned long limit_ms = a->c->reconnect_s * 1000ul;
+    rc_status st;
+    a->io->close(a->io->ctx);
+    do {
+        st = a->io->open(a->io->ctx, &a->port, a->c->port_path, &a->c->ser);
+        if (st == RC_OK) {
+            a->d.port = a->port;
+            rcd_display_reset(&a->d); /* the format lock is kept: the device must show the same format */
+            WARN(a, "%s reopened\n", a->c->port_path);
+            return RC_OK;
+        }
+        a->io->sleep_ms(a->io->ctx, a->port, 250);
+    } while ((unsigned long)(uint32_t)(now_ms(a) - t0) < limit_ms);
+    WARN(a, "cannot reopen %s within %lu s: %s: %s\n", a->c->port_path, a->c->reconnect_s, rc_strerror(st),
+         rcd_port_last_error(a->port));
+    return st;
+}
+
+/* A failure or hang-up: count it, maybe reopen. RC_OK to go on. */
+static rc_status handle_failure(acq *a, rc_status st, const rcd_reading *r, size_t pose, unsigned long *fails,
+                                unsigned long *reopens, rc_stable *s)
+{
+    const rch_acq_config *c = a->c;
+    if (st == RC_ERR_CLOSED || st == RC_ERR_IO) {
+        WARN(a, "pose %zu: display disconnected (%s: %s); reconnecting\n", pose, rc_strerror(st),
+             rcd_port_last_error(a->port));
+    } else {
+        ++*fails;
+        if (st == RC_ERR_TIMEOUT) {
+            a->res->timeouts++;
+            WARN(a, "pose %zu: no reading within %lu ms (%lu/%lu)%s\n", pose, c->read_timeout_ms, *fails,
+                 c->retries, rcd_display_why_silent(&a->d));
+        } else if (st == RC_ERR_DEVICE) {
+            a->res->device++;
+            WARN(a, "pose %zu: the display answered Modbus exception %u (%lu/%lu)\n", pose, (unsigned)r->exception,
+                 *fails, c->retries);
+        } else if (st == RC_ERR_FORMAT || st == RC_ERR_CHECKSUM) {
+            if (r->reject == RCD_REJECT_MB_SLAVE)
+                WARN(a, "pose %zu: a reply from Modbus slave %u ignored (--mb-addr is %u)\n", pose,
+                     (unsigned)r->mb_addr, (unsigned)(c->proto.mb_addr ? c->proto.mb_addr : 1u));
+            else if (r->reject == RCD_REJECT_MB_FUNCTION)
+                WARN(a, "pose %zu: a reply with Modbus function 0x%02X ignored (0x03 was asked)\n", pose,
+                     (unsigned)r->mb_fn);
+            else
+                NOTE(a, "pose %zu: %s frame dropped\n", pose,
+                     st == RC_ERR_CHECKSUM ? "corrupted (checksum)" : "malformed");
+            if (*fails < c->retries * 10)
+                return RC_OK; /* corruption: cheap to retry, the next frame is near */
+        } else {
+            WARN(a, "pose %zu: %s\n", pose, rc_strerror(st));
+            return st;
+        }
+        if (*fails < c->retries)
+            return RC_OK;
+        WARN(a, "pose %zu: %lu failures in a row; reopening the port\n", pose, *fails);
+    }
+    a->res->reconnects++;
+    *fails = 0;
+    rc_stable_clear_window(s);
+    if (++*reopens > c->retries) {
+        WARN(a, "pose %zu: %lu reconnects did not help\n", pose, c->retries);
+        return st;
+    }
+    return reconnect(a);
+}
+
+/* Read until the stability rule gives a sample. */
+static rc_status measure(rc_stable_result *out, acq *a, size_t pose)
+{
+    const rch_acq_config *c = a->c;
+    rc_stable s;
+    unsigned long fails = 0, reopens = 0;
+    uint32_t last_poll = 0;
+    int polled_once = 0;
+    rc_status st;
+    rc_stable_init(&s, &c->stable);
+    for (;;) {
+        rcd_reading r;
+        memset(&r, 0, sizeof r);
+        if (a->d.cfg.protocol != RCD_PROTO_ASCII && c->poll_interval_ms) {
+            uint32_t since = now_ms(a) - last_poll;
+            if (polled_once && since < c->poll_interval_ms)
+                a->io->sleep_ms(a->io->ctx, a->port, c->poll_interval_ms - since);
+            last_poll = now_ms(a);
+            polled_once = 1;
+        }
+        st = rcd_display_read(&a->d, &r, (unsigned)c->read_timeout_ms);
+        if (st == RC_OK) {
+            fails = 0;
+            st = rc_stable_push(&s, out, r.len_mm, now_ms(a));
+            if (st == RC_OK || st == RC_ERR_TIMEOUT)
+                break;
+            if (st == RC_ERR_RANGE)
+                NOTE(a, "pose %zu: reading %.4f mm outside [%g, %g] mm rejected\n", pose, r.len_mm,
+                     c->stable.min_mm, c->stable.max_mm);
+            continue;
+        }
+        st = handle_failure(a, st, &r, pose, &fails, &reopens, &s);
+        if (st != RC_OK)
+            return st;
+        if (s.started && c->stable.timeout_ms && (uint32_t)(now_ms(a) - s.t_start_ms) > c->stable.timeout_ms) {
+            st = RC_ERR_TIMEOUT;
+            break;
+        }
+    }
+    a->res->range += s.range_rejects;
+    a->res->unstable += s.restarts;
+    if (st == RC_ERR_TIMEOUT)
+        WARN(a, "pose %zu: no %u consecutive readings within %g mm in %lu s (robot still moving or vibrating? "
+                "raise --stable-mm or --pose-timeout-s)\n", pose, c->stable.n, c->stable.tol_mm,
+             (unsigned long)(c->stable.timeout_ms / 1000u));
+    return st;
+}
+
+static int announce(const char *path, size_t pose, const double q_deg[RC_NJ])
+{
+    char tmp[1100];
+    FILE *f;
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    f = fopen(tmp, "w");
+    if (!f)
+        return -1;
+    fprintf(f, "%zu", pose);
+    for (int j = 0; j < RC_NJ; ++j)
+        fprintf(f, " %.4f", q_deg[j]);
+    fprintf(f, "\n");
+    if (fclose(f) != 0)
+        return -1;
+    return rename(tmp, path);
+}
+
+/* Measure pose i until its sample follows the move (or give up). */
+static rc_status measure_checked(rc_stable_result *r, acq *a, size_t i)
+{
+    const rch_acq_config *c = a->c;
+    for (unsigned long attempt = 0;; ++attempt) {
+        double miss = 0.0;
+        rc_status st;
+        rcd_port_flush(a->port); /* nothing from while the arm was moving */
+        rcd_display_reset(&a->d);
+        st = measure(r, a, i);
+        if (st != RC_OK)
+            return st;
+        if (c->no_follow_check || !a->has_ref || !isfinite(a->pred_mm[i]) || !isfinite(a->pred_mm[a->ref_pose]) ||
+            rch_acq_follows(&miss, r->mean_mm, a->pred_mm[i], a->ref_len_mm, a->pred_mm[a->ref_pose],
+                            c->follow_tol_mm) == 0) {
+            if (a->has_ref && miss > a->res->worst_follow_mm)
+                a->res->worst_follow_mm = miss;
+            return RC_OK;
+        }
+        a->res->follow_refusals++;
+        WARN(a, "pose %zu: REFUSED L = %.4f mm: from pose %zu (L = %.4f mm) the nominal model predicts a change of "
+                "%+.2f mm, the display shows %+.2f mm (off by %.2f mm, tolerance %g mm): %s (%lu/%lu)\n",
+             i, r->mean_mm, a->ref_pose, a->ref_len_mm, a->pred_mm[i] - a->pred_mm[a->ref_pose],
+             r->mean_mm - a->ref_len_mm, miss, c->follow_tol_mm,
+             fabs(r->mean_mm - a->ref_len_mm) <= c->stable.tol_mm
+                 ? "the display did not change: frozen (HOLD pressed, firmware hung) or the robot did not move"
+                 : "a frozen display (HOLD pressed, firmware hung), another device on the port, a slipped "
+                   "cable, or the robot is not at the pose",
+             attempt + 1, c->retries);
+        if (attempt + 1 >= c->retries) {
+            WARN(a, "pose %zu: the display does not follow the robot; nothing recorded. Check the display (HOLD?), "
+                    "the port (--port %s), the robot's position and --robot/--encoder, then rerun to resume "
+                    "(--follow-tol-mm sets the tolerance)\n", i, c->port_path);
+            return RC_ERR_RANGE;
+        }
+        a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
+    }
+}
+
+/* Plan, robot, limits and nominal lengths. 0, or 1 with a message. */
+static int load_inputs(acq *a)
+{
+    const rch_acq_config *c = a->c;
+    rch_data plan;
+    rch_robot *robot;
+    rch_diag dg;
+    char buf[900];
+    int rc = 1;
+    if (rch_data_load(&plan, c->poses_path, RCH_DATA_NO_LEN, &dg) != 0) {
+        WARN(a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
+        return 1;
+    }
+    robot = calloc(1, sizeof *robot);
+    if (!robot || rch_robot_load(robot, c->robot_path, &dg) != 0) {
+        WARN(a, "%s\n", robot ? rch_diag_str(&dg, buf, sizeof buf) : "out of memory");
+        goto out;
+    }
+    if (!robot->has_encoder)
+        memcpy(&robot->model.x[RC_P_ENC], c->encoder_mm, sizeof c->encoder_mm);
+    a->n = plan.n;
+    a->plan_deg = calloc(plan.n, sizeof *a->plan_deg);
+    a->pred_mm = calloc(plan.n, sizeof *a->pred_mm);
+    a->done = calloc(plan.n, 1);
+    if (!a->plan_deg || !a->pred_mm || !a->done) {
+        WARN(a, "out of memory\n");
+        goto out;
+    }
+    for (size_t i = 0; i < plan.n; ++i) {
+        rc_sample s = plan.s[i];
+        for (int j = 0; j < RC_NJ; ++j) {
+            const double q = s.q_rad[j];
+            if (!(q >= robot->model.q_min_rad[j] - 1e-9 && q <= robot->model.q_max_rad[j] + 1e-9)) {
+                WARN(a, "%s:%u: pose %zu: q%d = %.4f deg is outside the joint limits [%.2f, %.2f] deg of %s; "
+                        "nothing was recorded\n", c->poses_path, plan.line[i], i, j + 1, q * DEG_PER_RAD,
+                     robot->model.q_min_rad[j] * DEG_PER_RAD, robot->model.q_max_rad[j] * DEG_PER_RAD,
+                     c->robot_path);
+                goto out;
+            }
+            /* back to the file's degrees, at its 4 decimals */
+            a->plan_deg[i][j] = round(q * DEG_PER_RAD * 1e4) / 1e4;
+        }
+        s.len_mm = 0.0;
+        if (rc_meas(&a->pred_mm[i], NULL, &robot->model, &s) != RC_OK)
+            a->pred_mm[i] = NAN;
+    }
+    rc = 0;
+out:
+    free(robot);
+    rch_data_free(&plan);
+    return rc;
+}
+
+/* Refuse an output that names an input (device and inode). */
+static int check_paths(acq *a)
+{
+    const rch_acq_config *c = a->c;
+    const char *const outs[2] = {c->out_path, c->announce_path};
+    const char *const outs_name[2] = {"--out", "--announce"};
+    const char *const ins[4] = {c->poses_path, c->robot_path, c->announce_path, c->out_path};
+    const char *const ins_name[4] = {"--poses", "--robot", "--announce", "--out"};
+    for (int o = 0; o < 2; ++o)
+        for (int k = 0; k < 4; ++k) {
+            if (!outs[o] || !ins[k] || (o == 0 && k == 3) || (o == 1 && k == 2))
+                continue; /* an output against itself */
+            if (strcmp(outs[o], ins[k]) == 0 || rch_same_file(outs[o], ins[k])) {
+                WARN(a, "%s %s is also %s %s: refused (it would be destroyed); choose another file\n", outs_name[o],
+                     outs[o], ins_name[k], ins[k]);
+                return 1;
+            }
+        }
+    return 0;
+}
+
+static int run_poses(acq *a)
+{
+    const rch_acq_config *c = a->c;
+    rch_diag dg;
+    char buf[900];
+    for (size_t i = 0; i < a->n; ++i) {
+        rc_stable_result r;
+        double q_deg[RC_NJ];
+        rc_status st;
+        if (a->done[i])
+            continue;
+        SAY(a, "pose %zu/%zu: q =", i + 1, a->n);
+        for (int j = 0; j < RC_NJ; ++j)
+            SAY(a, " %.4f", a->plan_deg[i][j]);
+        SAY(a, " deg\n");
+        if (a->out)
+            fflush(a->out);
+        if (c->announce_path && announce(c->announce_path, i, a->plan_deg[i]) != 0) {
+            WARN(a, "cannot write --announce %s: %s\n", c->announce_path, strerror(errno));
+            return 1;
+        }
+        if (c->confirm && a->io->confirm(a->io->ctx, i) != 0) {
+            WARN(a, "end of input; stopped (rerun to resume)\n");
+            return 1;
+        }
+        a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
+        memcpy(q_deg, a->plan_deg[i], sizeof q_deg); /* default joint source: the plan */
+        if (a->io->joints && a->io->joints(a->io->ctx, q_deg, a->plan_deg[i], i) != 0) {
+            WARN(a, "pose %zu: the joint-angle source failed; stopped (rerun to resume)\n", i);
+            return 1;
+        }
+        st = measure_checked(&r, a, i);
+        if (st != RC_OK) {
+            a->res->stopped = 1;
+            a->res->stopped_at = i;
+            WARN(a, "stopped at pose %zu; %zu of %zu poses recorded in %s; rerun the same command to resume\n", i,
+                 a->res->n_before + a->res->n_new, a->n, c->out_path);
+            return 1;
+        }
+        if (rch_acqfile_append(&a->file, i, q_deg, &r, a->io->wall_ms(a->io->ctx), &dg) != 0) {
+            WARN(a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
+            return 1;
+        }
+        a->has_ref = 1;
+        a->ref_pose = i;
+        a->ref_len_mm = r.mean_mm;
+        a->res->n_new++;
+        SAY(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
+        if (a->out)
+            fflush(a->out);
+    }
+    return 0;
+}
+
+int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_io *io, FILE *out, FILE *err)
+{
+    static const rch_acq_io sys_ops = {sys_open, sys_close, sys_sleep, sys_wall, sys_confirm, NULL, NULL};
+    sys_io sys;
+    rch_acq_io real;
+    acq a;
+    rch_acqfile_state fst;
+    rch_diag dg;
+    char buf[900];
+    rc_stable chk;
+    rc_status st;
+    int rc = 1, file_open = 0, port_open = 0;
+
+    memset(res, 0, sizeof *res);
+    memset(&a, 0, sizeof a);
+    a.c = c;
+    a.out = out;
+    a.err = err;
+    a.res = res;
+    a.file.fd = -1;
+    if (!c->port_path || !c->poses_path || !c->out_path || !c->robot_path || c->read_timeout_ms < 1 ||
+        c->read_timeout_ms > 3600000ul || c->retries < 1 || rc_stable_init(&chk, &c->stable) != RC_OK ||
+        !(c->follow_tol_mm > 0.0) || rcd_display_init(&a.d, &(rcd_port){&rcd_mock_ops, NULL}, &c->proto) != RC_OK) {
+        WARN(&a, "invalid settings\n");
+        return 2;
+    }
+    if (!io) {
+        memset(&sys, 0, sizeof sys);
+        sys.backend = c->backend ? c->backend : "serialport";
+        real = sys_ops;
+        real.ctx = &sys;
+        io = &real;
+    }
+    a.io = io;
+    if (check_paths(&a) != 0 || load_inputs(&a) != 0)
+        goto out;
+    res->n_poses = a.n;
+    if (rch_acqfile_open(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n, &dg) != 0) {
+        WARN(&a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
+        goto out;
+    }
+    file_open = 1;
+    res->n_before = fst.n_done;
+    res->dropped_bytes = fst.dropped_bytes;
+    if (fst.dropped_bytes)
+        WARN(&a, "%s: unfinished last line (%zu bytes, an interrupted write) dropped; it is kept in %s.dropped\n",
+             c->out_path, fst.dropped_bytes, c->out_path);
+    a.has_ref = fst.has_last;
+    a.ref_pose = fst.last_pose;
+    a.ref_len_mm = fst.last_len_mm;
+    if (fst.n_done == a.n) {
+        SAY(&a, "rcal acquire: %s already holds all %zu poses; nothing to do\n", c->out_path, a.n);
+        rc = 0;
+        goto out;
+    }
+    if (fst.n_done)
+        SAY(&a, "rcal acquire: resuming: %zu of %zu poses already in %s\n", fst.n_done, a.n, c->out_path);
+    st = io->open(io->ctx, &a.port, c->port_path, &c->ser);
+    if (st != RC_OK) {
+        WARN(&a, "cannot open %s (%s backend): %s: %s\n", c->port_path, c->backend ? c->backend : "given",
+             rc_strerror(st), rcd_port_last_error(a.port));
+        if (c->backend && strcmp(c->backend, "serialport") == 0 && strncmp(c->port_path, "/dev/pts/", 9) == 0)
+            WARN(&a, "libserialport refuses pseudo-terminals: use --backend posix\n");
+        goto out;
+    }
+    port_open = 1;
+    rcd_display_init(&a.d, a.port, &c->proto);
+    rc = run_poses(&a);
+    res->readings = a.d.stats.readings;
+    res->bad_frames = a.d.stats.bad_frames;
+    res->shape_rejects = a.d.stats.shape_rejects;
+out:
+    if (file_open && rch_acqfile_close(&a.file, &dg) != 0) {
+        WARN(&a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
+        rc = 1;
+    }
+    if (port_open)
+        io->close(io->ctx);
+    free(a.plan_deg);
+    free(a.pred_mm);
+    free(a.done);
+    return rc;
+}
