@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 enum { PLOT_LINE = 0, PLOT_SCATTER = 1 };
 
@@ -680,4 +681,67 @@ int rch_plot_write_svg(const rch_plot *p, const char *path)
     if (fclose(f) != 0)
         rc = -1;
     return rc;
+}
+
+void rch_plot_xml_text(FILE *f, const char *s) { plot_esc(f, s); }
+
+int rch_plot_mkdir(const char *dir)
+{
+    char buf[4096];
+    struct stat sb;
+    size_t n = dir ? strlen(dir) : 0;
+    if (n == 0 || n >= sizeof buf) {
+        errno = n ? ENAMETOOLONG : EINVAL;
+        return -1;
+    }
+    memcpy(buf, dir, n + 1);
+    for (size_t i = 1; i <= n; ++i) {
+        if (buf[i] != '/' && buf[i] != '\0')
+            continue;
+        const char c = buf[i];
+        buf[i] = '\0';
+        if (stat(buf, &sb) != 0) {
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return -1;
+        } else if (!S_ISDIR(sb.st_mode)) {
+            errno = ENOTDIR;
+            return -1;
+        }
+        buf[i] = c;
+    }
+    return 0;
+}
+
+int rch_plot_save(rch_plot *p, const char *dir, const char *name, FILE *log, char *errmsg, size_t len)
+{
+    char path[4096];
+    int rc = 0;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    if (!p || p->failed) {
+        errno = ENOMEM;
+        rc = -1;
+    } else
+        rc = rch_plot_write_svg(p, path);
+    if (rc != 0)
+        snprintf(errmsg, len, "cannot write %s: %s", path, strerror(errno));
+    else if (log)
+        fprintf(log, "  wrote %s\n", path);
+    rch_plot_free(p);
+    return rc;
+}
+
+void rch_plot_viridis(char out[8], double t)
+{
+    static const double stops[5][3] = {
+        {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    const double u = t * 4.0;
+    int i = (int)floor(u);
+    if (i > 3)
+        i = 3;
+    const double f = u - i;
+    int rgb[3];
+    for (int c = 0; c < 3; ++c)
+        rgb[c] = (int)lround(stops[i][c] + f * (stops[i + 1][c] - stops[i][c]));
+    snprintf(out, 8, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
 }

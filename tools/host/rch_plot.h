@@ -61,4 +61,22 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f);
 
 void rch_plot_free(rch_plot *p);
 
+/* ---- plot files in a directory (the --plots DIR of the commands) ---- */
+
+/* Create dir and its missing parents (mkdir -p). 0, or -1 with errno set
+ * (ENOTDIR when a component exists and is not a directory). */
+int rch_plot_mkdir(const char *dir);
+
+/* Write p as dir/name and free it (also on failure; p NULL counts as an
+ * allocation failure). log (may be NULL) gets "  wrote dir/name". 0, or -1
+ * with errmsg (len) set to "cannot write dir/name: reason". */
+int rch_plot_save(rch_plot *p, const char *dir, const char *name, FILE *log, char *errmsg, size_t len);
+
+/* A perceptually ordered colour map (viridis, 5 stops) at t in [0, 1]
+ * (clamped): "#rrggbb" into out. */
+void rch_plot_viridis(char out[8], double t);
+
+/* Write s XML-escaped (&, <, >, ", ') to f. */
+void rch_plot_xml_text(FILE *f, const char *s);
+
 #endif

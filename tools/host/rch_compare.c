@@ -1,0 +1,451 @@
+/* rch_compare.c - the seven-method comparison protocol; see rch_compare.h. */
+#include "rch_compare.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rch_calib.h"
+#include "rch_plot.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+void rch_compare_defaults(rch_compare_config *cfg)
+{
+    memset(cfg, 0, sizeof *cfg);
+    cfg->cases = 10;
+    cfg->samples = 300;
+    cfg->test_fraction = 0.1;
+    cfg->seed = 1;
+    for (int i = 0; i < RCH_EST_COUNT; ++i)
+        cfg->run[i] = 1;
+}
+
+int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d)
+{
+    char buf[256];
+    size_t n_sel = 0;
+    if (strlen(list) >= sizeof buf) {
+        rch_diag_set(d, "", 0, 0, "--methods: list longer than %zu characters", sizeof buf - 1);
+        return -1;
+    }
+    for (int i = 0; i < RCH_EST_COUNT; ++i)
+        run[i] = 0;
+    strcpy(buf, list);
+    for (char *tok = buf, *next; tok; tok = next) {
+        int id;
+        next = strchr(tok, ',');
+        if (next)
+            *next++ = '\0';
+        id = rch_est_parse(tok);
+        if (id < 0) {
+            rch_diag_set(d, "", 0, 0, "--methods: %s '%s' (LM, EKF, PF, SCA, QIBAS, SSLM, LTLM or M1..M7)",
+                         *tok ? "unknown method" : "empty method name in", *tok ? tok : list);
+            return -1;
+        }
+        run[id] = 1;
+        ++n_sel;
+    }
+    return n_sel ? 0 : -1;
+}
+
+const char *rch_compare_row_name(int row) { return row == 0 ? "BC" : rch_est_name((rch_est_id)(row - 1)); }
+
+double rch_compare_lm_time_ms(const rch_compare_result *res)
+{
+    const rch_compare_row *r = &res->row[RCH_EST_LM + 1];
+    return r->used && r->time_ms.n > 0 ? r->time_ms.mean : NAN;
+}
+
+int rch_compare_any_failed(const rch_compare_result *res)
+{
+    for (int r = 1; r < RCH_COMPARE_ROWS; ++r)
+        if (res->row[r].used && res->row[r].failed)
+            return 1;
+    return 0;
+}
+
+void rch_compare_free(rch_compare_result *res)
+{
+    for (int id = 0; id < RCH_EST_COUNT; ++id)
+        rch_curve_free(&res->curve[id]);
+    free(res->case_rmse_mm);
+    free(res->err_case1_mm);
+    res->case_rmse_mm = res->err_case1_mm = NULL;
+}
+
+/* err (n): model - measured length of every sample, NaN where m fails. */
+static void sample_errors(double *err, const rc_model *m, const rc_sample *s, size_t n)
+{
+    for (size_t k = 0; k < n; ++k) {
+        double l;
+        err[k] = rc_meas(&l, NULL, m, &s[k]) == RC_OK ? l - s[k].len_mm : NAN;
+    }
+}
+
+static void add_metrics(rch_compare_row *r, const rc_metrics *m)
+{
+    rch_stat_add(&r->rmse_mm, m->rmse_mm);
+    rch_stat_add(&r->mean_abs_mm, m->mean_abs_mm);
+    rch_stat_add(&r->max_mm, m->max_mm);
+}
+
+static void add_ltlm(rch_compare_result *res, const rc_model *m)
+{
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        for (unsigned k = 0; k < 4; ++k)
+            rch_stat_add(&res->ltlm_dh[j][k], m->x[4 * j + k] / (k >= 2 ? DEG : 1.0));
+    for (unsigned k = 0; k < 3; ++k)
+        rch_stat_add(&res->ltlm_enc_mm[k], m->x[RC_P_ENC + k]);
+    res->n_ltlm++;
+}
+
+/* Case c: BC from the training part, then every selected method from it. */
+static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_est_ws *ws,
+                    const rch_robot *robot, const rch_holdout *h, unsigned long c, FILE *progress, rch_diag *d)
+{
+    const unsigned long long cseed = cfg->seed * 1000003ull + c;
+    double *row_rmse = res->case_rmse_mm + c * RCH_COMPARE_ROWS;
+    const int first = c == 0 && cfg->curves;
+    rc_model start;
+    rc_metrics mt, trm;
+    if (rch_calib_start(&start, &ws->solve, robot, h->train, h->n_train, d) != 0)
+        return -1;
+    if (rc_eval(&mt, &start, h->test, h->n_test) != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "the start model cannot be evaluated on the held-out samples");
+        return -1;
+    }
+    res->row[0].used = 1;
+    add_metrics(&res->row[0], &mt);
+    if (rc_eval(&trm, &start, h->train, h->n_train) == RC_OK)
+        rch_stat_add(&res->row[0].train_rmse_mm, trm.rmse_mm);
+    row_rmse[0] = mt.rmse_mm;
+    if (first)
+        sample_errors(res->err_case1_mm, &start, h->test, h->n_test);
+    for (int id = 0; id < RCH_EST_COUNT; ++id) {
+        rch_compare_row *r = &res->row[id + 1];
+        rc_model m = start;
+        rch_est_out out;
+        rc_metrics me;
+        if (!cfg->run[id])
+            continue;
+        r->used = 1;
+        rc_status st = rch_est_run(&m, &out, first ? &res->curve[id] : NULL, ws, (rch_est_id)id, cseed, NULL,
+                                   h->train, h->n_train);
+        if (st != RC_OK || rc_eval(&me, &m, h->test, h->n_test) != RC_OK) {
+            if (progress)
+                fprintf(progress, "rcal compare: case %lu: %s failed: %s\n", c + 1, rch_est_name((rch_est_id)id),
+                        rc_strerror(st));
+            r->failed++;
+            continue;
+        }
+        add_metrics(r, &me);
+        rch_stat_add(&r->time_ms, out.time_ms);
+        rch_stat_add(&r->train_rmse_mm, out.rms_final_mm);
+        rch_stat_add(&r->iterations, (double)out.iterations);
+        rch_stat_add(&r->cost_evals, (double)out.cost_evals);
+        row_rmse[id + 1] = me.rmse_mm;
+        if (id == RCH_EST_LTLM)
+            add_ltlm(res, &m);
+        if (first)
+            sample_errors(res->err_case1_mm + (size_t)(id + 1) * h->n_test, &m, h->test, h->n_test);
+    }
+    return 0;
+}
+
+/* Sizes of a case from the configuration; 0 or -1 with d set. */
+static int case_sizes(rch_compare_result *res, const rch_compare_config *cfg, size_t n, rch_diag *d)
+{
+    size_t sel = 0;
+    for (int i = 0; i < RCH_EST_COUNT; ++i)
+        sel += cfg->run[i] != 0;
+    if (sel == 0 || cfg->cases < 1 || cfg->cases > RCH_COMPARE_MAX_CASES ||
+        !(cfg->test_fraction > 0.0 && cfg->test_fraction < 1.0)) {
+        rch_diag_set(d, "", 0, 0, "need at least one method, 1..%lu cases and a test fraction in (0, 1)",
+                     RCH_COMPARE_MAX_CASES);
+        return -1;
+    }
+    res->n_draw = cfg->samples ? cfg->samples : n;
+    if (res->n_draw > n) {
+        rch_diag_set(d, "", 0, 0, "--samples %zu but the data has %zu rows", res->n_draw, n);
+        return -1;
+    }
+    res->n_test = (size_t)floor(cfg->test_fraction * (double)res->n_draw + 0.5);
+    if (res->n_test < 1)
+        res->n_test = 1;
+    res->n_train = res->n_draw > res->n_test ? res->n_draw - res->n_test : 0;
+    if (res->n_train < RC_N_BASE) {
+        rch_diag_set(d, "", 0, 0, "%zu training samples per case; at least %d are needed", res->n_train,
+                     RC_N_BASE);
+        return -1;
+    }
+    return 0;
+}
+
+int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, const rch_robot *robot,
+                    const rc_sample *s, size_t n, FILE *progress, rch_diag *d)
+{
+    memset(res, 0, sizeof *res);
+    res->rows_in_data = n;
+    res->cases = cfg->cases;
+    if (case_sizes(res, cfg, n, d) != 0)
+        return -1;
+    int rc = -1;
+    size_t *idx = malloc((n ? n : 1) * sizeof *idx);
+    rch_est_ws *ws = rch_est_ws_new();
+    res->case_rmse_mm = malloc(cfg->cases * RCH_COMPARE_ROWS * sizeof(double));
+    res->err_case1_mm = malloc(RCH_COMPARE_ROWS * res->n_test * sizeof(double));
+    if (!idx || !ws || !res->case_rmse_mm || !res->err_case1_mm) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    for (size_t k = 0; k < cfg->cases * RCH_COMPARE_ROWS; ++k)
+        res->case_rmse_mm[k] = NAN;
+    for (size_t k = 0; k < RCH_COMPARE_ROWS * res->n_test; ++k)
+        res->err_case1_mm[k] = NAN;
+    for (unsigned long c = 0; c < cfg->cases; ++c) {
+        rch_holdout h;
+        /* the case's draw: the first n_test rows of the permutation are held out */
+        if (rch_holdout_draw(&h, idx, s, n, res->n_draw, res->n_test, cfg->seed * 1000003ull + c) != 0) {
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            goto done;
+        }
+        const int st = run_case(res, cfg, ws, robot, &h, c, progress, d);
+        rch_holdout_free(&h);
+        if (st != 0) {
+            char msg[600];
+            rch_diag_str(d, msg, sizeof msg);
+            rch_diag_set(d, "", 0, 0, "case %lu: %s", c + 1, msg);
+            goto done;
+        }
+        if (progress)
+            fprintf(progress, "case %lu/%lu done\n", c + 1, cfg->cases);
+    }
+    rc = 0;
+done:
+    rch_est_ws_free(ws);
+    free(idx);
+    return rc;
+}
+
+/* ---- reports ----------------------------------------------------------- */
+
+static void report_rows(FILE *f, const rch_compare_result *res)
+{
+    const double lm_time = rch_compare_lm_time_ms(res);
+    fprintf(f, "Held-out errors, mean +- std over cases (mm); time of the identification alone (ms, one core)\n");
+    fprintf(f, "  %-6s %-17s %-17s %-17s %-19s %8s %10s %9s\n", "method", "RMSE", "mean|e| (\"SD\")", "MAX",
+            "time (ms)", "x LM", "train RMS", "iters");
+    for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
+        const rch_compare_row *s = &res->row[r];
+        char tbuf[64], rbuf[32];
+        if (!s->used)
+            continue;
+        snprintf(tbuf, sizeof tbuf, "%s", "-");
+        snprintf(rbuf, sizeof rbuf, "%s", "-");
+        if (r > 0) {
+            snprintf(tbuf, sizeof tbuf, "%8.2f +- %-7.2f", s->time_ms.mean, rch_stat_sd(&s->time_ms));
+            if (isfinite(lm_time) && lm_time > 0)
+                snprintf(rbuf, sizeof rbuf, "%.2f", s->time_ms.mean / lm_time);
+        }
+        fprintf(f, "  %-6s %6.4f +- %-7.4f %6.4f +- %-7.4f %6.4f +- %-7.4f %-19s %8s %10.4f %9.0f%s\n",
+                rch_compare_row_name(r), s->rmse_mm.mean, rch_stat_sd(&s->rmse_mm), s->mean_abs_mm.mean,
+                rch_stat_sd(&s->mean_abs_mm), s->max_mm.mean, rch_stat_sd(&s->max_mm), tbuf, rbuf,
+                s->train_rmse_mm.mean, r == 0 ? 0.0 : s->iterations.mean,
+                s->failed ? "  (failed in some cases)" : "");
+    }
+    fprintf(f, "  (BC: nominal DH with the encoder fitted alone; mean|e| is what the paper's Eq. 20 calls SD)\n");
+}
+
+static void report_ltlm(FILE *f, const rch_compare_result *res)
+{
+    const rch_stat *e = res->ltlm_enc_mm;
+    fprintf(f, "\nLTLM identified parameters, the paper's Table 7 form (mean +- std over %u cases):\n", res->n_ltlm);
+    fprintf(f, "  joint           a (mm)               d (mm)            alpha (deg)            theta (deg)\n");
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        const rch_stat *s = res->ltlm_dh[j];
+        fprintf(f, "  %5u %9.4f +- %-7.4f %9.4f +- %-7.4f %10.5f +- %-8.5f %10.5f +- %-8.5f\n", j + 1, s[0].mean,
+                rch_stat_sd(&s[0]), s[1].mean, rch_stat_sd(&s[1]), s[2].mean, rch_stat_sd(&s[2]), s[3].mean,
+                rch_stat_sd(&s[3]));
+    }
+    fprintf(f, "  encoder e = (%.3f, %.3f, %.3f) mm  (+- %.3f, %.3f, %.3f)\n", e[0].mean, e[1].mean, e[2].mean,
+            rch_stat_sd(&e[0]), rch_stat_sd(&e[1]), rch_stat_sd(&e[2]));
+    fprintf(f, "  Parameters the data cannot separate (e.g. d1 against e_z, theta1 against a rotation of e)\n"
+               "  stay at their start values; their spread over cases shows how weakly the rest is determined.\n");
+}
+
+void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg,
+                        const char *data_name)
+{
+    fprintf(f, "rcal compare: %s, %zu rows; %lu cases of %zu random rows (%zu train / %zu held out), seed %llu\n",
+            data_name, res->rows_in_data, res->cases, res->n_draw, res->n_train, res->n_test, cfg->seed);
+    report_rows(f, res);
+    if (res->n_ltlm > 0)
+        report_ltlm(f, res);
+}
+
+static void json_row(FILE *f, const rch_compare_result *res, int r)
+{
+    const rch_compare_row *s = &res->row[r];
+    const double lm_time = rch_compare_lm_time_ms(res);
+    fprintf(f, "  {\"name\": \"%s\", \"cases_ok\": %.0f, \"rmse_mm\": %.6f, \"rmse_std_mm\": %.6f, "
+               "\"mean_abs_mm\": %.6f, \"mean_abs_std_mm\": %.6f, \"max_mm\": %.6f, \"max_std_mm\": %.6f, "
+               "\"train_rmse_mm\": %.6f",
+            rch_compare_row_name(r), s->rmse_mm.n, s->rmse_mm.mean, rch_stat_sd(&s->rmse_mm), s->mean_abs_mm.mean,
+            rch_stat_sd(&s->mean_abs_mm), s->max_mm.mean, rch_stat_sd(&s->max_mm), s->train_rmse_mm.mean);
+    if (r == 0)
+        fprintf(f, ", \"time_ms\": 0}");
+    else
+        fprintf(f, ", \"time_ms\": %.4f, \"time_std_ms\": %.4f, \"time_ratio_lm\": %.4g, \"iterations\": %.1f, "
+                   "\"cost_evals\": %.0f}",
+                s->time_ms.mean, rch_stat_sd(&s->time_ms),
+                isfinite(lm_time) && lm_time > 0 ? s->time_ms.mean / lm_time : 0.0, s->iterations.mean,
+                s->cost_evals.mean);
+}
+
+static void json_ltlm(FILE *f, const rch_compare_result *res)
+{
+    fprintf(f, ",\n \"ltlm_parameters\": {\"cases\": %u, \"joints\": [", res->n_ltlm);
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        const rch_stat *s = res->ltlm_dh[j];
+        fprintf(f, "%s{\"joint\": %u, \"a_mm\": %.5f, \"d_mm\": %.5f, \"alpha_deg\": %.6f, \"theta_deg\": %.6f, "
+                   "\"a_std_mm\": %.5f, \"d_std_mm\": %.5f, \"alpha_std_deg\": %.6f, \"theta_std_deg\": %.6f}",
+                j ? ", " : "", j + 1, s[0].mean, s[1].mean, s[2].mean, s[3].mean, rch_stat_sd(&s[0]),
+                rch_stat_sd(&s[1]), rch_stat_sd(&s[2]), rch_stat_sd(&s[3]));
+    }
+    fprintf(f, "], \"encoder_mm\": [%.4f, %.4f, %.4f]}", res->ltlm_enc_mm[0].mean, res->ltlm_enc_mm[1].mean,
+            res->ltlm_enc_mm[2].mean);
+}
+
+void rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg,
+                      const char *data_name)
+{
+    fprintf(f, "{\"command\": \"compare\", \"data\": \"");
+    for (const char *s = data_name; *s; ++s)
+        fprintf(f, *s == '"' || *s == '\\' ? "\\%c" : "%c", *s);
+    fprintf(f, "\", \"rows_in_file\": %zu, \"cases\": %lu, \"samples\": %zu, \"n_train\": %zu, \"n_test\": %zu, "
+               "\"test_fraction\": %.6g, \"seed\": %llu,\n \"methods\": [",
+            res->rows_in_data, res->cases, res->n_draw, res->n_train, res->n_test, cfg->test_fraction, cfg->seed);
+    int first = 1;
+    for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
+        if (!res->row[r].used)
+            continue;
+        fprintf(f, "%s\n", first ? "" : ",");
+        json_row(f, res, r);
+        first = 0;
+    }
+    fprintf(f, "\n ],\n \"cases_rmse_mm\": [");
+    for (unsigned long c = 0; c < res->cases; ++c) {
+        int f2 = 1;
+        fprintf(f, "%s[", c ? ", " : "");
+        for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
+            if (!res->row[r].used)
+                continue;
+            const double v = res->case_rmse_mm[c * RCH_COMPARE_ROWS + (size_t)r];
+            if (isfinite(v))
+                fprintf(f, "%s%.6f", f2 ? "" : ", ", v);
+            else
+                fprintf(f, "%snull", f2 ? "" : ", ");
+            f2 = 0;
+        }
+        fprintf(f, "]");
+    }
+    fprintf(f, "]");
+    if (res->n_ltlm > 0)
+        json_ltlm(f, res);
+    fprintf(f, "\n}\n");
+}
+
+/* ---- plots ------------------------------------------------------------- */
+
+/* A line through (k, y[k]), k = x0, x0 + 1, ... */
+static void plot_indexed(rch_plot *p, const char *label, const double *y, size_t n, double x0)
+{
+    double *x = malloc((n ? n : 1) * sizeof *x);
+    if (!x)
+        return;
+    for (size_t k = 0; k < n; ++k)
+        x[k] = x0 + (double)k;
+    rch_plot_line(p, label, x, y, n);
+    free(x);
+}
+
+static rch_plot *plot_convergence(const rch_compare_result *res, const rch_compare_config *cfg, int zoom)
+{
+    rch_plot *p = rch_plot_new(zoom ? "Convergence, first 60 iterations (case 1)"
+                                    : "Convergence: training RMS per iteration (case 1)",
+                               "iteration", "training RMS (mm)");
+    for (int id = 0; id < RCH_EST_COUNT; ++id)
+        if (cfg->run[id] && res->curve[id].n > 0)
+            plot_indexed(p, rch_est_name((rch_est_id)id), res->curve[id].rms_mm, res->curve[id].n, 0.0);
+    rch_plot_logy(p, 1);
+    if (zoom)
+        rch_plot_xrange(p, 0.0, 60.0);
+    return p;
+}
+
+/* Bars of held-out RMSE (time = 0) or identification time (time = 1, methods only). */
+static rch_plot *plot_bars(const rch_compare_result *res, int time)
+{
+    const char *labels[RCH_COMPARE_ROWS];
+    double vals[RCH_COMPARE_ROWS], errs[RCH_COMPARE_ROWS];
+    size_t nb = 0;
+    char title[160];
+    for (int r = time ? 1 : 0; r < RCH_COMPARE_ROWS; ++r) {
+        const rch_compare_row *row = &res->row[r];
+        const rch_stat *st = time ? &row->time_ms : &row->rmse_mm;
+        if (!row->used || row->rmse_mm.n == 0)
+            continue;
+        labels[nb] = rch_compare_row_name(r);
+        vals[nb] = st->mean;
+        errs[nb] = rch_stat_sd(st);
+        ++nb;
+    }
+    if (time)
+        snprintf(title, sizeof title, "Identification time per case, mean +- std");
+    else
+        snprintf(title, sizeof title, "Held-out RMSE, mean +- std over %lu cases (%zu train / %zu test)", res->cases,
+                 res->n_train, res->n_test);
+    rch_plot *p = rch_plot_new(title, "method", time ? "time (ms)" : "RMSE (mm)");
+    rch_plot_bars(p, labels, vals, errs, nb);
+    rch_plot_logy(p, time);
+    return p;
+}
+
+static rch_plot *plot_per_sample(const rch_compare_result *res, const rch_compare_config *cfg)
+{
+    const size_t n = res->n_test;
+    rch_plot *p = rch_plot_new("Held-out error of each sample, case 1 (Fig. 7 kind)", "held-out sample",
+                               "model - measured length (mm)");
+    plot_indexed(p, "before (BC)", res->err_case1_mm, n, 1.0);
+    if (cfg->run[RCH_EST_LM])
+        plot_indexed(p, "after LM", res->err_case1_mm + (size_t)(RCH_EST_LM + 1) * n, n, 1.0);
+    if (cfg->run[RCH_EST_LTLM])
+        plot_indexed(p, "after LTLM", res->err_case1_mm + (size_t)(RCH_EST_LTLM + 1) * n, n, 1.0);
+    return p;
+}
+
+int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *cfg, const char *dir, FILE *log,
+                      rch_diag *d)
+{
+    char msg[512];
+    int rc = 0;
+    if (rch_plot_mkdir(dir) != 0) {
+        rch_diag_set(d, "", 0, 0, "cannot use %s as a plot directory: %s", dir, strerror(errno));
+        return -1;
+    }
+    if (log)
+        fprintf(log, "\nplots:\n");
+    rc |= rch_plot_save(plot_convergence(res, cfg, 0), dir, "convergence.svg", log, msg, sizeof msg);
+    rc |= rch_plot_save(plot_convergence(res, cfg, 1), dir, "convergence_zoom.svg", log, msg, sizeof msg);
+    rc |= rch_plot_save(plot_bars(res, 0), dir, "rmse_bars.svg", log, msg, sizeof msg);
+    rc |= rch_plot_save(plot_bars(res, 1), dir, "time_bars.svg", log, msg, sizeof msg);
+    rc |= rch_plot_save(plot_per_sample(res, cfg), dir, "per_sample.svg", log, msg, sizeof msg);
+    if (rc != 0)
+        rch_diag_set(d, "", 0, 0, "%s", msg);
+    return rc ? -1 : 0;
+}
