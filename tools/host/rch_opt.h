@@ -39,7 +39,8 @@ typedef struct {
     const char *name;    /* "--samples" */
     rch_opt_kind kind;
     void *out;           /* see rch_opt_kind; its value before parsing is the default shown */
-    double min, max;     /* inclusive range for numbers (ignored otherwise) */
+    double min, max;     /* inclusive range for numbers, checked when min < max (so a
+                          * table entry that leaves both 0 has no range) */
     const char *arg;     /* value name in the usage ("N", "FILE"); NULL: from the kind */
     const char *help;    /* one line; may be NULL */
     unsigned flags;      /* RCH_OPT_REQUIRED */

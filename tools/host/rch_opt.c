@@ -1,0 +1,353 @@
+/* rch_opt.c - table-driven option parser (see rch_opt.h). */
+#include "rch_opt.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int is_digit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+int rch_parse_ulong(const char *s, unsigned long *out)
+{
+    if (!s || !is_digit(*s))
+        return -1; /* no blank, no sign, no empty string */
+    for (const char *p = s; *p; ++p)
+        if (!is_digit(*p))
+            return -1;
+    errno = 0;
+    char *end;
+    unsigned long v = strtoul(s, &end, 10);
+    if (errno != 0 || *end != '\0')
+        return -1; /* ERANGE: never wraps */
+    *out = v;
+    return 0;
+}
+
+int rch_parse_long(const char *s, long *out)
+{
+    if (!s)
+        return -1;
+    const char *p = (*s == '-') ? s + 1 : s;
+    if (!is_digit(*p))
+        return -1;
+    for (const char *q = p; *q; ++q)
+        if (!is_digit(*q))
+            return -1;
+    errno = 0;
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (errno != 0 || *end != '\0')
+        return -1;
+    *out = v;
+    return 0;
+}
+
+int rch_parse_double(const char *s, double *out)
+{
+    if (!s || !*s)
+        return -1;
+    /* Only a decimal number: sign, digits, one point, exponent. strtod
+     * alone would take blanks, hex floats, "inf" and "nan". */
+    const char *p = s;
+    if (*p == '+' || *p == '-')
+        ++p;
+    int digits = 0;
+    while (is_digit(*p)) {
+        ++p;
+        ++digits;
+    }
+    if (*p == '.') {
+        ++p;
+        while (is_digit(*p)) {
+            ++p;
+            ++digits;
+        }
+    }
+    if (!digits)
+        return -1;
+    if (*p == 'e' || *p == 'E') {
+        ++p;
+        if (*p == '+' || *p == '-')
+            ++p;
+        if (!is_digit(*p))
+            return -1;
+        while (is_digit(*p))
+            ++p;
+    }
+    if (*p != '\0')
+        return -1;
+    errno = 0;
+    char *end;
+    double v = strtod(s, &end);
+    if (*end != '\0' || !isfinite(v) || (errno == ERANGE && fabs(v) > 1.0))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+int rch_parse_triple(const char *s, double out[3])
+{
+    double v[3];
+    char buf[128];
+    size_t len = s ? strlen(s) : 0;
+    if (!s || len >= sizeof buf)
+        return -1;
+    memcpy(buf, s, len + 1);
+    char *p = buf;
+    for (int k = 0; k < 3; ++k) {
+        char *sep = strchr(p, ',');
+        if ((k < 2) != (sep != NULL))
+            return -1;
+        if (sep)
+            *sep = '\0';
+        while (*p == ' ' || *p == '\t')
+            ++p;
+        char *e = p + strlen(p);
+        while (e > p && (e[-1] == ' ' || e[-1] == '\t'))
+            *--e = '\0';
+        if (rch_parse_double(p, &v[k]) != 0)
+            return -1;
+        p = sep ? sep + 1 : p;
+    }
+    memcpy(out, v, sizeof v);
+    return 0;
+}
+
+static const char *kind_arg(const rch_opt *o)
+{
+    if (o->arg)
+        return o->arg;
+    switch (o->kind) {
+    case RCH_OPT_FLAG: return NULL;
+    case RCH_OPT_STR:
+    case RCH_OPT_STRS: return "TEXT";
+    case RCH_OPT_CHOICE: return o->choices;
+    case RCH_OPT_UINT:
+    case RCH_OPT_INT: return "N";
+    case RCH_OPT_DOUBLE: return "X";
+    case RCH_OPT_TRIPLE: return "X,Y,Z";
+    }
+    return "VALUE";
+}
+
+static int in_range(const rch_opt *o, double v)
+{
+    return !(o->min < o->max) || (v >= o->min && v <= o->max);
+}
+
+static void range_text(const rch_opt *o, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    if (o->min < o->max)
+        snprintf(buf, len, " (%.10g to %.10g)", o->min, o->max);
+}
+
+static int choice_ok(const char *choices, const char *v)
+{
+    size_t n = strlen(v);
+    const char *p = choices;
+    while (p && *p) {
+        const char *bar = strchr(p, '|');
+        size_t len = bar ? (size_t)(bar - p) : strlen(p);
+        if (len == n && n > 0 && strncmp(p, v, n) == 0)
+            return 1;
+        p = bar ? bar + 1 : NULL;
+    }
+    return 0;
+}
+
+/* Store value v of option o; 0, or -1 with the message on err. */
+static int store(const rch_cmdspec *spec, const rch_opt *o, const char *v, FILE *err)
+{
+    char rng[96];
+    range_text(o, rng, sizeof rng);
+    switch (o->kind) {
+    case RCH_OPT_FLAG: return 0;
+    case RCH_OPT_STR:
+        if (!*v) {
+            fprintf(err, "rcal %s: %s needs a non-empty value\n", spec->cmd, o->name);
+            return -1;
+        }
+        *(const char **)o->out = v;
+        return 0;
+    case RCH_OPT_STRS: {
+        rch_opt_strs *s = o->out;
+        if (!*v) {
+            fprintf(err, "rcal %s: %s needs a non-empty value\n", spec->cmd, o->name);
+            return -1;
+        }
+        if (s->n >= RCH_OPT_MAX_STRS) {
+            fprintf(err, "rcal %s: %s given more than %d times\n", spec->cmd, o->name, RCH_OPT_MAX_STRS);
+            return -1;
+        }
+        s->v[s->n++] = v;
+        return 0;
+    }
+    case RCH_OPT_CHOICE:
+        if (!choice_ok(o->choices, v)) {
+            fprintf(err, "rcal %s: %s '%s' is not one of %s\n", spec->cmd, o->name, v, o->choices);
+            return -1;
+        }
+        *(const char **)o->out = v;
+        return 0;
+    case RCH_OPT_UINT: {
+        unsigned long u;
+        if (rch_parse_ulong(v, &u) != 0 || !in_range(o, (double)u)) {
+            fprintf(err, "rcal %s: %s '%s' is not a whole number%s\n", spec->cmd, o->name, v,
+                    *rng ? rng : " (0 or more)");
+            return -1;
+        }
+        *(unsigned long *)o->out = u;
+        return 0;
+    }
+    case RCH_OPT_INT: {
+        long l;
+        if (rch_parse_long(v, &l) != 0 || !in_range(o, (double)l)) {
+            fprintf(err, "rcal %s: %s '%s' is not a whole number%s\n", spec->cmd, o->name, v, rng);
+            return -1;
+        }
+        *(long *)o->out = l;
+        return 0;
+    }
+    case RCH_OPT_DOUBLE: {
+        double d;
+        if (rch_parse_double(v, &d) != 0 || !in_range(o, d)) {
+            fprintf(err, "rcal %s: %s '%s' is not a decimal number%s\n", spec->cmd, o->name, v, rng);
+            return -1;
+        }
+        *(double *)o->out = d;
+        return 0;
+    }
+    case RCH_OPT_TRIPLE: {
+        double t[3];
+        if (rch_parse_triple(v, t) != 0 || !in_range(o, t[0]) || !in_range(o, t[1]) || !in_range(o, t[2])) {
+            fprintf(err, "rcal %s: %s '%s' is not three numbers X,Y,Z%s\n", spec->cmd, o->name, v, rng);
+            return -1;
+        }
+        memcpy(o->out, t, sizeof t);
+        return 0;
+    }
+    }
+    return -1;
+}
+
+static const rch_opt *find(const rch_cmdspec *spec, const char *name, size_t len, size_t *idx)
+{
+    for (size_t i = 0; i < spec->n; ++i)
+        if (strlen(spec->opts[i].name) == len && strncmp(spec->opts[i].name, name, len) == 0) {
+            *idx = i;
+            return &spec->opts[i];
+        }
+    return NULL;
+}
+
+rch_opt_status rch_opt_parse(const rch_cmdspec *spec, int argc, char **argv, unsigned long long *seen_out, FILE *out,
+                             FILE *err)
+{
+    unsigned long long seen = 0;
+    if (spec->n > 64) {
+        fprintf(err, "rcal %s: internal error: more than 64 options\n", spec->cmd);
+        return RCH_OPT_ERROR;
+    }
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            rch_opt_usage(spec, out);
+            return RCH_OPT_HELP;
+        }
+        const char *eq = strncmp(a, "--", 2) == 0 ? strchr(a, '=') : NULL;
+        size_t len = eq ? (size_t)(eq - a) : strlen(a);
+        size_t k = 0;
+        const rch_opt *o = find(spec, a, len, &k);
+        if (!o) {
+            fprintf(err, "rcal %s: unknown %s '%.*s' (rcal %s --help lists the options)\n", spec->cmd,
+                    a[0] == '-' ? "option" : "argument", (int)len, a, spec->cmd);
+            return RCH_OPT_ERROR;
+        }
+        if ((seen >> k & 1u) && o->kind != RCH_OPT_STRS) {
+            fprintf(err, "rcal %s: %s given twice\n", spec->cmd, o->name);
+            return RCH_OPT_ERROR;
+        }
+        seen |= 1ull << k;
+        if (o->kind == RCH_OPT_FLAG) {
+            if (eq) {
+                fprintf(err, "rcal %s: %s takes no value\n", spec->cmd, o->name);
+                return RCH_OPT_ERROR;
+            }
+            *(int *)o->out = 1;
+            continue;
+        }
+        const char *v = eq ? eq + 1 : NULL;
+        if (!v) {
+            if (i + 1 >= argc) {
+                fprintf(err, "rcal %s: %s needs a value (%s)\n", spec->cmd, o->name, kind_arg(o));
+                return RCH_OPT_ERROR;
+            }
+            v = argv[++i];
+        }
+        if (store(spec, o, v, err) != 0)
+            return RCH_OPT_ERROR;
+    }
+    for (size_t k = 0; k < spec->n; ++k)
+        if ((spec->opts[k].flags & RCH_OPT_REQUIRED) && !(seen >> k & 1u)) {
+            fprintf(err, "rcal %s: %s is required (rcal %s --help)\n", spec->cmd, spec->opts[k].name, spec->cmd);
+            return RCH_OPT_ERROR;
+        }
+    if (seen_out)
+        *seen_out = seen;
+    return RCH_OPT_OK;
+}
+
+int rch_opt_given(const rch_cmdspec *spec, unsigned long long seen, const char *name)
+{
+    size_t k = 0;
+    return find(spec, name, strlen(name), &k) ? (int)(seen >> k & 1u) : 0;
+}
+
+static void default_text(const rch_opt *o, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    switch (o->kind) {
+    case RCH_OPT_STR:
+    case RCH_OPT_CHOICE: {
+        const char *s = *(const char *const *)o->out;
+        if (s)
+            snprintf(buf, len, " [default %s]", s);
+        break;
+    }
+    case RCH_OPT_UINT: snprintf(buf, len, " [default %lu]", *(const unsigned long *)o->out); break;
+    case RCH_OPT_INT: snprintf(buf, len, " [default %ld]", *(const long *)o->out); break;
+    case RCH_OPT_DOUBLE: snprintf(buf, len, " [default %.10g]", *(const double *)o->out); break;
+    case RCH_OPT_TRIPLE: {
+        const double *t = o->out;
+        snprintf(buf, len, " [default %.10g,%.10g,%.10g]", t[0], t[1], t[2]);
+        break;
+    }
+    case RCH_OPT_FLAG:
+    case RCH_OPT_STRS: break;
+    }
+}
+
+void rch_opt_usage(const rch_cmdspec *spec, FILE *f)
+{
+    fprintf(f, "usage: rcal %s [options]\n  %s\n\noptions (--name VALUE or --name=VALUE):\n", spec->cmd,
+            spec->summary ? spec->summary : "");
+    for (size_t k = 0; k < spec->n; ++k) {
+        const rch_opt *o = &spec->opts[k];
+        char head[160], rng[96], def[160];
+        const char *arg = kind_arg(o);
+        snprintf(head, sizeof head, "%s%s%s", o->name, arg ? " " : "", arg ? arg : "");
+        range_text(o, rng, sizeof rng);
+        default_text(o, def, sizeof def);
+        fprintf(f, "  %-28s %s%s%s%s%s\n", head, o->help ? o->help : "", (o->flags & RCH_OPT_REQUIRED) ? " (required)" : "",
+                o->kind == RCH_OPT_STRS ? " (repeatable)" : "", rng, def);
+    }
+    fprintf(f, "  %-28s %s\n", "-h, --help", "this text");
+    if (spec->details)
+        fprintf(f, "\n%s\n", spec->details);
+}

@@ -1,0 +1,385 @@
+/* rch_uncert.c - parameter covariance, identifiability per parameter,
+ * predicted position uncertainty and the determined part of a model
+ * (see rch_uncert.h). */
+#include "rch_uncert.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rc_rand.h"
+
+/* chi-square quantile with 3 degrees of freedom at 0.95 */
+#define CHI2_3_95 7.814727903251178
+
+const char *rch_param_class_name(rch_param_class c)
+{
+    switch (c) {
+    case RCH_PARAM_FIXED: return "fixed";
+    case RCH_PARAM_IDENTIFIABLE: return "identifiable";
+    case RCH_PARAM_WEAK: return "weak";
+    case RCH_PARAM_NOT_IDENTIFIABLE: return "not identifiable";
+    }
+    return "?";
+}
+
+void rch_uncert_free(rch_uncert *u)
+{
+    free(u->cov);
+    u->cov = NULL;
+}
+
+/* Scaled Jacobian (n x nf, row-major), residuals (n), column norms (nf). */
+static int jacobian(double *J, double *r, double *D, const rc_model *m, const unsigned *idx, unsigned nf,
+                    const rc_sample *s, size_t n)
+{
+    double jrow[RC_MAX_PARAMS];
+    memset(D, 0, nf * sizeof *D);
+    for (size_t i = 0; i < n; ++i) {
+        double l;
+        if (rc_meas(&l, jrow, m, &s[i]) != RC_OK || !isfinite(l))
+            return -1;
+        r[i] = l - s[i].len_mm;
+        for (unsigned k = 0; k < nf; ++k) {
+            J[i * nf + k] = jrow[idx[k]];
+            D[k] += jrow[idx[k]] * jrow[idx[k]];
+        }
+    }
+    for (unsigned k = 0; k < nf; ++k) {
+        D[k] = sqrt(D[k]);
+        if (!(D[k] > 0.0))
+            D[k] = 1.0; /* a column of zeros: the parameter has no effect at all */
+        for (size_t i = 0; i < n; ++i)
+            J[i * nf + k] /= D[k];
+    }
+    return 0;
+}
+
+/* Groups usable as clusters: at least 5 groups with >= 2 samples each. */
+static unsigned count_groups(const rc_sample *s, size_t n, unsigned *gmax)
+{
+    unsigned mx = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (s[i].group > mx)
+            mx = s[i].group;
+    unsigned *cnt = calloc((size_t)mx + 1, sizeof *cnt);
+    if (!cnt)
+        return 0;
+    for (size_t i = 0; i < n; ++i)
+        cnt[s[i].group]++;
+    unsigned g = 0, small = 0;
+    for (unsigned k = 0; k <= mx; ++k) {
+        g += cnt[k] > 0;
+        small += cnt[k] == 1;
+    }
+    free(cnt);
+    *gmax = mx;
+    return (g >= 5 && small * 2 < g) ? g : 0;
+}
+
+typedef struct {
+    unsigned nf;
+    unsigned idx[RC_MAX_PARAMS];
+    double D[RC_MAX_PARAMS];
+    double ev[RC_MAX_PARAMS];
+    double *V;  /* (nf x nf) eigenvectors in columns */
+    double *Cz; /* (nf x nf) covariance in scaled coordinates */
+} scaled;
+
+/* Covariance in scaled coordinates: classical or cluster-robust. */
+static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r, const rc_sample *s, size_t n,
+                      int want_cluster)
+{
+    unsigned nf = z->nf;
+    double emax = z->ev[nf - 1] > 0 ? z->ev[nf - 1] : 1.0;
+    /* pseudo-inverse A+ = sum over kept directions v v^T / ev */
+    double *Ap = calloc((size_t)nf * nf, sizeof *Ap);
+    double *M = calloc((size_t)nf * nf, sizeof *M);
+    if (!Ap || !M) {
+        free(Ap);
+        free(M);
+        return -1;
+    }
+    u->rank = u->n_weak = 0;
+    for (unsigned d = 0; d < nf; ++d) {
+        double sv = sqrt(fmax(z->ev[d], 0.0) / emax);
+        if (sv < RCH_UNCERT_NULL_SV)
+            continue;
+        u->rank++;
+        u->n_weak += sv < RCH_UNCERT_WEAK_SV;
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned b = 0; b < nf; ++b)
+                Ap[a * nf + b] += z->V[a * nf + d] * z->V[b * nf + d] / z->ev[d];
+    }
+    double ssr = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        ssr += r[i] * r[i];
+    double dof = (double)n - (double)u->rank;
+    u->sigma_mm = dof > 0 ? sqrt(ssr / dof) : NAN;
+    unsigned gmax = 0, G = want_cluster ? count_groups(s, n, &gmax) : 0;
+    if (G) {
+        double *ug = calloc(((size_t)gmax + 1) * nf, sizeof *ug);
+        if (!ug) {
+            free(Ap);
+            free(M);
+            return -1;
+        }
+        for (size_t i = 0; i < n; ++i)
+            for (unsigned k = 0; k < nf; ++k)
+                ug[(size_t)s[i].group * nf + k] += J[i * nf + k] * r[i];
+        for (unsigned g = 0; g <= gmax; ++g)
+            for (unsigned a = 0; a < nf; ++a)
+                for (unsigned b = 0; b < nf; ++b)
+                    M[a * nf + b] += ug[(size_t)g * nf + a] * ug[(size_t)g * nf + b];
+        free(ug);
+        double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 0 ? dof : 1.0));
+        /* Cz = c Ap M Ap */
+        double *T = calloc((size_t)nf * nf, sizeof *T);
+        if (!T) {
+            free(Ap);
+            free(M);
+            return -1;
+        }
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned k = 0; k < nf; ++k)
+                for (unsigned b = 0; b < nf; ++b)
+                    T[a * nf + b] += Ap[a * nf + k] * M[k * nf + b];
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned b = 0; b < nf; ++b) {
+                double v = 0.0;
+                for (unsigned k = 0; k < nf; ++k)
+                    v += T[a * nf + k] * Ap[k * nf + b];
+                z->Cz[a * nf + b] = c * v;
+            }
+        free(T);
+        u->kind = RCH_COV_CLUSTER;
+        u->n_groups = G;
+    } else {
+        double s2 = u->sigma_mm * u->sigma_mm;
+        for (size_t k = 0; k < (size_t)nf * nf; ++k)
+            z->Cz[k] = s2 * Ap[k];
+        u->kind = RCH_COV_CLASSICAL;
+        u->n_groups = 0;
+    }
+    free(Ap);
+    free(M);
+    return 0;
+}
+
+/* Classes, standard errors and the parameter-space covariance. */
+static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
+{
+    unsigned nf = z->nf, np = u->n_params;
+    double emax = z->ev[nf - 1] > 0 ? z->ev[nf - 1] : 1.0;
+    for (unsigned d = 0; d < nf; ++d) {
+        double sv = sqrt(fmax(z->ev[d], 0.0) / emax);
+        for (unsigned a = 0; a < nf; ++a) {
+            double w = z->V[a * nf + d] * z->V[a * nf + d];
+            unsigned k = z->idx[a];
+            if (sv < RCH_UNCERT_NULL_SV)
+                u->null_share[k] += w;
+            else if (sv < RCH_UNCERT_WEAK_SV)
+                u->weak_share[k] += w;
+        }
+    }
+    for (unsigned k = 0; k < np; ++k)
+        u->cls[k] = RCH_PARAM_FIXED;
+    for (unsigned a = 0; a < nf; ++a) {
+        unsigned k = z->idx[a];
+        double se = sqrt(fmax(z->Cz[a * nf + a], 0.0)) / z->D[a];
+        double tol = rc_param_unit(m, k) == 1 ? RCH_UNCERT_WEAK_RAD : RCH_UNCERT_WEAK_MM;
+        if (u->null_share[k] > RCH_UNCERT_SHARE) {
+            u->cls[k] = RCH_PARAM_NOT_IDENTIFIABLE;
+            u->se[k] = NAN;
+        } else {
+            int weak = u->weak_share[k] > RCH_UNCERT_SHARE || (rc_param_unit(m, k) != 2 && se > tol);
+            u->cls[k] = weak ? RCH_PARAM_WEAK : RCH_PARAM_IDENTIFIABLE;
+            u->se[k] = se;
+        }
+        for (unsigned b = 0; b < nf; ++b) {
+            unsigned l = z->idx[b];
+            u->cov[(size_t)k * np + l] = z->Cz[a * nf + b] / (z->D[a] * z->D[b]);
+        }
+    }
+}
+
+int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s, size_t n,
+                       int want_cluster, char *err, size_t errlen)
+{
+    memset(u, 0, sizeof *u);
+    u->n_params = m->n_params;
+    u->n_samples = n;
+    scaled z;
+    memset(&z, 0, sizeof z);
+    for (unsigned k = 0; k < m->n_params; ++k)
+        if (!fixed || !fixed[k])
+            z.idx[z.nf++] = k;
+    u->nf = z.nf;
+    if (z.nf == 0 || n <= z.nf) {
+        snprintf(err, errlen, "uncertainty needs more samples (%zu) than free parameters (%u)", n, z.nf);
+        return -1;
+    }
+    size_t np = m->n_params, nf = z.nf;
+    double *J = malloc(n * nf * sizeof *J), *r = malloc(n * sizeof *r), *A = calloc(nf * nf, sizeof *A);
+    z.V = calloc(nf * nf, sizeof *z.V);
+    z.Cz = calloc(nf * nf, sizeof *z.Cz);
+    u->cov = calloc(np * np, sizeof *u->cov);
+    int rc = -1;
+    if (!J || !r || !A || !z.V || !z.Cz || !u->cov) {
+        snprintf(err, errlen, "out of memory");
+        goto done;
+    }
+    if (jacobian(J, r, z.D, m, z.idx, z.nf, s, n) != 0) {
+        snprintf(err, errlen, "a sample has no defined length derivative (flange on the outlet?)");
+        goto done;
+    }
+    for (size_t i = 0; i < n; ++i)
+        for (size_t a = 0; a < nf; ++a)
+            for (size_t b = a; b < nf; ++b)
+                A[a * nf + b] += J[i * nf + a] * J[i * nf + b];
+    for (size_t a = 0; a < nf; ++a)
+        for (size_t b = 0; b < a; ++b)
+            A[a * nf + b] = A[b * nf + a];
+    memcpy(z.V, A, nf * nf * sizeof *A);
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', (lapack_int)nf, z.V, (lapack_int)nf, z.ev) != 0) {
+        snprintf(err, errlen, "eigen-decomposition of the normal matrix failed");
+        goto done;
+    }
+    if (covariance(&z, u, J, r, s, n, want_cluster) != 0) {
+        snprintf(err, errlen, "out of memory");
+        goto done;
+    }
+    classify(u, &z, m);
+    rc = 0;
+done:
+    free(J);
+    free(r);
+    free(A);
+    free(z.V);
+    free(z.Cz);
+    if (rc != 0)
+        rch_uncert_free(u);
+    return rc;
+}
+
+void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_uncert *u)
+{
+    *out = *fit;
+    for (unsigned k = 0; k < u->n_params && k < RC_P_ENC; ++k)
+        if (u->cls[k] == RCH_PARAM_WEAK || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE)
+            out->x[k] = nominal->x[k];
+}
+
+double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    unsigned np = u->n_params;
+    double Jp[3][RC_MAX_PARAMS];
+    rc_model t = *m;
+    for (unsigned k = 0; k < np; ++k) {
+        if (u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE) {
+            Jp[0][k] = Jp[1][k] = Jp[2][k] = 0.0;
+            continue;
+        }
+        double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5;
+        double pp[3], pm[3];
+        t.x[k] = m->x[k] + h;
+        rc_fk(pp, NULL, &t, q_rad);
+        t.x[k] = m->x[k] - h;
+        rc_fk(pm, NULL, &t, q_rad);
+        t.x[k] = m->x[k];
+        for (int i = 0; i < 3; ++i)
+            Jp[i][k] = (pp[i] - pm[i]) / (2.0 * h);
+    }
+    double C[9] = {0};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (unsigned k = 0; k < np; ++k) {
+                if (Jp[i][k] == 0.0)
+                    continue;
+                for (unsigned l = 0; l < np; ++l)
+                    C[i * 3 + j] += Jp[i][k] * u->cov[(size_t)k * np + l] * Jp[j][l];
+            }
+    double ev[3];
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
+        return NAN;
+    return sqrt(CHI2_3_95 * fmax(ev[2], 0.0));
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void med_max(double *med, double *mx, double *v, size_t n)
+{
+    qsort(v, n, sizeof *v, cmp_double);
+    *med = n ? (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2])) : NAN;
+    *mx = n ? v[n - 1] : NAN;
+}
+
+int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
+                           size_t n_random, uint64_t seed)
+{
+    memset(out, 0, sizeof *out);
+    double *v = malloc((n > n_random ? n : n_random) * sizeof *v + 1);
+    if (!v)
+        return -1;
+    for (size_t i = 0; i < n; ++i)
+        v[i] = rch_uncert_pos95_mm(u, m, s[i].q_rad);
+    med_max(&out->data_median_mm, &out->data_max_mm, v, n);
+    for (size_t i = 0; i < n; ++i)
+        v[i] = rch_uncert_rot95_deg(u, m, s[i].q_rad);
+    med_max(&out->rot_data_median_deg, &out->rot_data_max_deg, v, n);
+    out->n_data = n;
+    rc_rng g;
+    rc_rng_seed(&g, seed);
+    for (size_t i = 0; i < n_random; ++i) {
+        double q[RC_NJ];
+        for (int j = 0; j < RC_NJ; ++j)
+            q[j] = m->q_min_rad[j] + (m->q_max_rad[j] - m->q_min_rad[j]) * rc_rng_u01(&g);
+        v[i] = rch_uncert_pos95_mm(u, m, q);
+    }
+    med_max(&out->work_median_mm, &out->work_max_mm, v, n_random);
+    out->n_work = n_random;
+    free(v);
+    return 0;
+}
+
+double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    unsigned np = u->n_params;
+    double Jr[3][RC_MAX_PARAMS];
+    rc_model t = *m;
+    for (unsigned k = 0; k < np; ++k) {
+        Jr[0][k] = Jr[1][k] = Jr[2][k] = 0.0;
+        if (u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE)
+            continue;
+        double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5, p[3], Rp[9], Rm[9];
+        t.x[k] = m->x[k] + h;
+        rc_fk(p, Rp, &t, q_rad);
+        t.x[k] = m->x[k] - h;
+        rc_fk(p, Rm, &t, q_rad);
+        t.x[k] = m->x[k];
+        /* small rotation Rp Rm^T ~ I + [w]x, w = 2 h dw/dx */
+        double D[9];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                D[i * 3 + j] = Rp[i * 3] * Rm[j * 3] + Rp[i * 3 + 1] * Rm[j * 3 + 1] + Rp[i * 3 + 2] * Rm[j * 3 + 2];
+        Jr[0][k] = 0.5 * (D[7] - D[5]) / (2.0 * h);
+        Jr[1][k] = 0.5 * (D[2] - D[6]) / (2.0 * h);
+        Jr[2][k] = 0.5 * (D[3] - D[1]) / (2.0 * h);
+    }
+    double C[9] = {0};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (unsigned k = 0; k < np; ++k)
+                for (unsigned l = 0; Jr[i][k] != 0.0 && l < np; ++l)
+                    C[i * 3 + j] += Jr[i][k] * u->cov[(size_t)k * np + l] * Jr[j][l];
+    double ev[3];
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
+        return NAN;
+    return sqrt(CHI2_3_95 * fmax(ev[2], 0.0)) * 57.29577951308232;
+}

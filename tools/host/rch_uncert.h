@@ -1,0 +1,108 @@
+/* rch_uncert.h - uncertainty of a calibration: parameter covariance and
+ * standard errors, what the data determined, the flange-position uncertainty
+ * the covariance predicts, and the "determined part" of a model that
+ * compensation may act on.
+ *
+ * Covariance. At the solution x (free parameters F, nf of them), with the
+ * Jacobian J (n x nf) of the residuals r = l(q; x) - L, columns scaled to
+ * unit norm (S = diag of the column norms), A = Js^T Js = V diag(ev) V^T:
+ *  - directions with relative singular value sqrt(ev/ev_max) below the
+ *    identifiability limit are NOT IDENTIFIABLE: the data carry no
+ *    information on them; the pseudo-inverse A+ leaves them out and the
+ *    parameters that lie in them get no standard error;
+ *  - classical:     Cov = s^2 S^-1 A+ S^-1,  s^2 = r^T r / (n - rank);
+ *  - cluster-robust (samples that share a set-up group are not independent):
+ *    Cov = c S^-1 A+ (sum_g u_g u_g^T) A+ S^-1, u_g = Js_g^T r_g summed over
+ *    the samples of group g, c = G/(G-1) (n-1)/(n-rank) (the usual small-sample
+ *    factor); used when the samples carry at least 5 groups of >= 2 samples.
+ * Per parameter: standard error sqrt(Cov_kk) and a class: the share of the
+ * parameter's scaled unit vector that lies in not-identifiable directions
+ * (> 1/2: not identifiable), in weak directions (> 1/2 with the former:
+ * weak), else identifiable; and relative to the standard error.
+ *
+ * Host side (prefix rch_): heap and LAPACKE. */
+#ifndef RCH_UNCERT_H
+#define RCH_UNCERT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rc_model.h"
+
+typedef enum {
+    RCH_PARAM_FIXED = 0,          /* held fixed by the user or the solver set-up */
+    RCH_PARAM_IDENTIFIABLE = 1,
+    RCH_PARAM_WEAK = 2,           /* determined only with a large standard error */
+    RCH_PARAM_NOT_IDENTIFIABLE = 3
+} rch_param_class;
+
+typedef enum { RCH_COV_CLASSICAL = 0, RCH_COV_CLUSTER = 1 } rch_cov_kind;
+
+/* Relative singular values below these are not identifiable / weak: the
+ * words and limits of the identifiability report. */
+#define RCH_UNCERT_NULL_SV 1e-6
+#define RCH_UNCERT_WEAK_SV 1e-3
+/* A parameter with more than this share of its (scaled) unit vector in
+ * not-identifiable directions is not identifiable on its own (only in
+ * combination); in weak directions, weak. */
+#define RCH_UNCERT_SHARE 0.01
+/* Also weak: a standard error above a typical DH error (0.1 mm, 0.1 deg):
+ * the data do not determine the parameter to the size of what it corrects. */
+#define RCH_UNCERT_WEAK_MM 0.1
+#define RCH_UNCERT_WEAK_RAD 1.7453292519943295e-3
+
+typedef struct rch_uncert {
+    unsigned n_params;                /* of the model */
+    unsigned nf;                      /* free parameters */
+    unsigned rank;                    /* directions with sv_rel >= RCH_UNCERT_NULL_SV */
+    unsigned n_weak;                  /* of them below RCH_UNCERT_WEAK_SV */
+    rch_cov_kind kind;
+    unsigned n_groups;                /* clusters used (cluster-robust) */
+    size_t n_samples;
+    double sigma_mm;                  /* residual standard deviation s */
+    double se[RC_MAX_PARAMS];         /* (n_params) standard error (mm or rad); 0 when fixed, NaN when not identifiable */
+    uint8_t cls[RC_MAX_PARAMS];       /* (n_params) rch_param_class */
+    double null_share[RC_MAX_PARAMS]; /* (n_params) share in not-identifiable directions, 0..1 */
+    double weak_share[RC_MAX_PARAMS]; /* (n_params) share in weak directions, 0..1 */
+    double *cov;                      /* (n_params x n_params) heap, row-major; rows/cols of fixed params 0 */
+} rch_uncert;
+
+/* Compute the covariance at m over the training samples (n). fixed
+ * (n_params, may be NULL) marks parameters held fixed. want_cluster: 1 uses
+ * the cluster-robust form when the groups allow it (else classical, and kind
+ * says which was used). 0, or -1 (message in err[errlen]). */
+int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s, size_t n,
+                       int want_cluster, char *err, size_t errlen);
+void rch_uncert_free(rch_uncert *u);
+
+/* The determined part of a calibration, for compensation: the fit with
+ * every DH parameter the data did not determine (weak or not identifiable)
+ * back at its nominal value. The encoder outlet and effects are kept (they
+ * do not move the robot). */
+void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_uncert *u);
+
+/* 95 % uncertainty of the flange position predicted at q: the longest
+ * semi-axis of the 95 % confidence ellipsoid of p(q; x),
+ * sqrt(chi2_3(0.95) * lambda_max(Jp Cov Jp^T)), Jp = dp/dx by central
+ * differences. Returns the figure in mm. */
+double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ]);
+
+/* Summary over poses: the median and the largest pos95 over the samples'
+ * poses (inside the data) and over n_random poses uniform in the joint
+ * limits (whole workspace, seed). */
+/* The same for the flange orientation: longest semi-axis of the 95 %
+ * ellipsoid of the small-rotation vector, in degrees. */
+double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ]);
+
+typedef struct rch_uncert_map {
+    double data_median_mm, data_max_mm;
+    double rot_data_median_deg, rot_data_max_deg; /* orientation, over the data's poses */
+    double work_median_mm, work_max_mm;
+    size_t n_data, n_work;
+} rch_uncert_map;
+int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
+                           size_t n_random, uint64_t seed);
+
+const char *rch_param_class_name(rch_param_class c);
+
+#endif
