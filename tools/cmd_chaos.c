@@ -3,20 +3,17 @@
  * (tools/host/rch_chaos.h); this file parses options and reports.
  */
 #include <stdio.h>
-#include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h"
 #include "rch_chaos.h"
+#include "rch_opt.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f, "usage: rcal chaos [--r R] [--points 1000] [--bins 50] [--starts 100] [--step 0.01]\n"
-               "                  [--seed 1] [--plots DIR] [--json]\n"
-               "  Uniformity of the logistic-tent map (paper Eq. 11) for r in [0, 4]: the standard\n"
-               "  deviation of the bin counts of --points iterates in --bins bins (Eq. 12), averaged\n"
-               "  over --starts initial values; the histogram at --r (default: the minimiser).\n");
-}
+/* the usage text: rch_opt_usage prints the option table between these */
+static const char chaos_summary[] = "uniformity of the logistic-tent map (paper Eq. 11) for r in [0, 4]";
+static const char chaos_details[] =
+    "The standard deviation of the bin counts of --points iterates in --bins bins (Eq. 12), averaged\n"
+    "over --starts initial values; the histogram at --r. The study may take at most 1e9 map iterations\n"
+    "((4 / --step + 2) x --starts x --points, about 8 s); larger requests are refused.";
 
 int rcal_cmd_chaos(int argc, char **argv)
 {
@@ -27,36 +24,32 @@ int rcal_cmd_chaos(int argc, char **argv)
     unsigned long seed = 1;
     int json = 0;
     rch_chaos_defaults(&cfg);
-    for (int i = 1; i < argc; ++i) {
-        if (rcal_opt_str(argc, argv, &i, "--plots", &plots) || rcal_opt_double(argc, argv, &i, "--r", &cfg.r_hist) ||
-            rcal_opt_double(argc, argv, &i, "--step", &cfg.step) ||
-            rcal_opt_uint(argc, argv, &i, "--points", &cfg.points) || rcal_opt_uint(argc, argv, &i, "--bins", &cfg.bins) ||
-            rcal_opt_uint(argc, argv, &i, "--starts", &cfg.starts) || rcal_opt_uint(argc, argv, &i, "--seed", &seed))
-            continue;
-        if (strcmp(argv[i], "--json") == 0) {
-            json = 1;
-            continue;
-        }
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage(stdout);
-            return 0;
-        }
-        return rcal_opt_unknown("chaos", argv[i]);
-    }
+    const rch_opt opts[] = {
+        {"--r", RCH_OPT_DOUBLE, &cfg.r_hist, 0, 4, "R", "r of the histogram (not given: the minimiser)", 0, NULL},
+        {"--points", RCH_OPT_UINT, &cfg.points, 1, 1e7, NULL, "iterates per initial value", 0, NULL},
+        {"--bins", RCH_OPT_UINT, &cfg.bins, 2, 1024, NULL, "histogram bins on [0, 1)", 0, NULL},
+        {"--starts", RCH_OPT_UINT, &cfg.starts, 1, 1e5, NULL, "initial values averaged over", 0, NULL},
+        {"--step", RCH_OPT_DOUBLE, &cfg.step, 1e-4, 4, NULL, "r step over [0, 4]", 0, NULL},
+        {"--seed", RCH_OPT_UINT, &seed, 0, 4294967295.0, NULL, "seed of the initial values", 0, NULL},
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "chaos_sd.svg and chaos_hist.svg", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
+    };
+    const rch_cmdspec spec = {"chaos", chaos_summary, chaos_details, opts, sizeof opts / sizeof opts[0]};
+    const rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (st != RCH_OPT_OK)
+        return st == RCH_OPT_HELP ? 0 : 2; /* usage printed, or the error named */
     cfg.seed = seed;
     if (rch_chaos_check(&cfg, &d) != 0) {
         fprintf(stderr, "rcal chaos: %s\n", d.msg);
         return 2;
     }
     int rc = rch_chaos_run(&res, &cfg, stderr, &d) == 0 ? 0 : 1;
-    if (rc == 0) {
-        if (json)
-            rch_chaos_json(stdout, &res, &cfg);
-        else
-            rch_chaos_report(stdout, &res, &cfg);
-        if (plots && rch_chaos_plots(&res, &cfg, plots, json ? NULL : stdout, &d) != 0)
-            rc = 1;
-    }
+    if (rc == 0 && json)
+        rc = rch_chaos_json(stdout, &res, &cfg) != 0;
+    else if (rc == 0)
+        rch_chaos_report(stdout, &res, &cfg);
+    if (rc == 0 && plots && rch_chaos_plots(&res, &cfg, plots, json ? NULL : stdout, &d) != 0)
+        rc = 1;
     if (rc != 0)
         fprintf(stderr, "rcal chaos: %s\n", d.msg);
     rch_chaos_free(&res);

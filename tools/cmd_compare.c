@@ -1,40 +1,27 @@
 /* cmd_compare.c - rcal compare: the LTLM paper's comparison of seven
  * identification methods (its Table 6, Fig. 6d, Figs. 7-8) on your data.
- *
- * Protocol, per case c = 0..cases-1: draw `samples` rows at random (seed
- * derived from --seed and c), hold out round(test_fraction * samples) of
- * them, build the start (BC) model from the training part only
- * (rch_calib_start: nominal DH + encoder fitted alone), run every method from
- * that same start on the same training samples, evaluate on the held-out
- * samples. Nothing is tuned on held-out samples: every hyperparameter is a
- * fixed default documented in rc_est.h / rc_solve.h.
+ * The protocol is rch_compare_run (tools/host/rch_compare.h); this file
+ * parses options, loads the robot and the data, and reports.
  */
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h"
+#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_compare.h"
 #include "rch_data.h"
+#include "rch_opt.h"
 #include "rch_plot.h"
 #include "rch_robot.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: rcal compare --data FILE [--robot MODEL.json] [--cases 10] [--samples 300]\n"
-            "                    [--test-fraction 0.1] [--seed S] [--methods LIST] [--plots DIR] [--json]\n"
-            "  The LTLM paper's protocol: in each case draw --samples rows at random, hold out\n"
-            "  --test-fraction of them, fit every method from the same start on the rest, and\n"
-            "  report held-out errors (mean +- std over --cases cases) and times.\n"
-            "  --samples 0 uses every row. The paper's other protocol: --samples 200 --test-fraction 0.2.\n"
-            "  --methods  comma list of LM,EKF,PF,SCA,QIBAS,SSLM,LTLM (or M1..M7); default all\n"
-            "  --plots    directory for SVG charts: convergence, bars, times, per-sample errors\n"
-            "  --json     one JSON object on stdout instead of the report\n"
-            "  --robot    nominal robot model (default %s)\n",
-            RCAL_DEFAULT_ROBOT);
-}
+/* the usage text: rch_opt_usage prints the option table between these */
+static const char compare_summary[] = "the LTLM paper's comparison of seven identification methods on your data";
+static const char compare_details[] =
+    "In each case --samples rows are drawn at random, --test-fraction of them held out, every method\n"
+    "fitted from the same start (nominal DH + encoder fitted alone) on the rest; the report gives the\n"
+    "held-out errors (mean +- std over --cases cases) and times. The paper's other protocol:\n"
+    "--samples 200 --test-fraction 0.2.";
 
 /* Load, run the protocol, report. */
 static int compare_run(const rch_compare_config *cfg, const char *data_path, const char *robot_path,
@@ -60,16 +47,14 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
         return 2;
     }
     int rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, json ? NULL : stderr, &d) != 0 ? 1 : 0;
-    if (rc == 0) {
-        if (json)
-            rch_compare_json(stdout, &res, cfg, data_path);
-        else
-            rch_compare_report(stdout, &res, cfg, data_path);
-        if (plots && rch_compare_plots(&res, cfg, plots, json ? NULL : stdout, &d) != 0)
-            rc = 1;
-        else if (rch_compare_any_failed(&res))
-            rc = 1;
-    }
+    if (rc == 0 && json)
+        rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
+    else if (rc == 0)
+        rch_compare_report(stdout, &res, cfg, data_path);
+    if (rc == 0 && plots && rch_compare_plots(&res, cfg, plots, json ? NULL : stdout, &d) != 0)
+        rc = 1;
+    if (rc == 0 && rch_compare_any_failed(&res))
+        rc = 1; /* reported per case on stderr and in the table */
     if (rc != 0 && d.msg[0])
         fprintf(stderr, "rcal compare: %s\n", rch_diag_str(&d, msg, sizeof msg));
     rch_compare_free(&res);
@@ -79,49 +64,39 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
 
 int rcal_cmd_compare(int argc, char **argv)
 {
-    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL;
-    const char *methods = NULL;
-    rch_compare_config cfg;
+    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *methods = NULL;
     unsigned long cases = 10, samples = 300, seed = 1;
+    double test_fraction = 0.1;
     int json = 0;
+    const rch_opt opts[] = {
+        {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements (CSV with q1..q6 in deg and L in mm)",
+         RCH_OPT_REQUIRED, NULL},
+        {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
+        {"--cases", RCH_OPT_UINT, &cases, 1, (double)RCH_COMPARE_MAX_CASES, NULL, "random cases", 0, NULL},
+        {"--samples", RCH_OPT_UINT, &samples, 0, 1e7, NULL, "rows drawn per case; 0 means every row", 0, NULL},
+        {"--test-fraction", RCH_OPT_DOUBLE, &test_fraction, 0.001, 0.999, "F", "share of each case held out", 0,
+         NULL},
+        {"--seed", RCH_OPT_UINT, &seed, 0, 4294967295.0, NULL, "case c draws with seed * 1000003 + c", 0, NULL},
+        {"--methods", RCH_OPT_STR, &methods, 0, 0, "LIST",
+         "comma list of LM,EKF,PF,SCA,QIBAS,SSLM,LTLM (or M1..M7); default all", 0, NULL},
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "SVG charts: convergence, bars, times, per-sample errors", 0,
+         NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
+    };
+    const rch_cmdspec spec = {"compare", compare_summary, compare_details, opts, sizeof opts / sizeof opts[0]};
+    rch_compare_config cfg;
     rch_diag d;
+    const rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (st != RCH_OPT_OK)
+        return st == RCH_OPT_HELP ? 0 : 2; /* usage printed, or the error named */
     rch_compare_defaults(&cfg);
-    for (int i = 1; i < argc; ++i) {
-        if (rcal_opt_str(argc, argv, &i, "--data", &data_path) ||
-            rcal_opt_str(argc, argv, &i, "--robot", &robot_path) ||
-            rcal_opt_str(argc, argv, &i, "--plots", &plots) ||
-            rcal_opt_str(argc, argv, &i, "--methods", &methods) ||
-            rcal_opt_double(argc, argv, &i, "--test-fraction", &cfg.test_fraction) ||
-            rcal_opt_uint(argc, argv, &i, "--cases", &cases) ||
-            rcal_opt_uint(argc, argv, &i, "--samples", &samples) ||
-            rcal_opt_uint(argc, argv, &i, "--seed", &seed))
-            continue;
-        if (strcmp(argv[i], "--json") == 0) {
-            json = 1;
-            continue;
-        }
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage(stdout);
-            return 0;
-        }
-        return rcal_opt_unknown("compare", argv[i]);
-    }
-    if (!data_path)
-        return rcal_opt_missing("compare", "--data");
     if (methods && rch_compare_methods(cfg.run, methods, &d) != 0) {
         fprintf(stderr, "rcal compare: %s\n", d.msg);
         return 2;
     }
-    if (!(cfg.test_fraction > 0.0 && cfg.test_fraction < 1.0)) {
-        fprintf(stderr, "rcal compare: --test-fraction must be in (0, 1)\n");
-        return 2;
-    }
-    if (cases < 1 || cases > 10000) {
-        fprintf(stderr, "rcal compare: --cases must be within 1..10000\n");
-        return 2;
-    }
     cfg.cases = cases;
     cfg.samples = samples;
+    cfg.test_fraction = test_fraction;
     cfg.seed = seed;
     cfg.curves = plots != NULL;
     return compare_run(&cfg, data_path, robot_path, plots, json);

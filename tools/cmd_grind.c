@@ -6,10 +6,9 @@
  */
 #include <math.h>
 #include <stdio.h>
-#include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h"
+#include "rch_opt.h"
 #include "rch_grind.h"
 #include "rch_robot.h"
 
@@ -17,29 +16,19 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: rcal grind --model MODEL.json --truth TRUTH.json [--surface SPEC] [--plots DIR]\n"
-            "                  [--nominal ROBOT.json] [--position-only] [--max-dev-deg D] [--no-align] [--json]\n"
-            "  --model    calibrated model used for compensation (rcal calibrate --out)\n"
-            "  --truth    the simulated true robot (rcal simulate --truth-out, or any model file)\n"
-            "  --nominal  nominal model the path is programmed with (default: the model's \"nominal\")\n"
-            "  --surface  NAME[:key=value,...] (lengths mm, angles deg); NAME one of\n"
-            "               plane              z = z0\n"
-            "               tilted             z = z0 + tan(ax) (x - cx) + tan(ay) (y - cy)    ax=15 ay=0\n"
-            "               cylinder           z = z0 + sqrt(r^2 - (y - cy)^2) - r, axis along x   r=150\n"
-            "               saddle             z = z0 + k (x - cx)(y - cy) / (w/2 h/2)             k=20\n"
-            "               sine               z = z0 + amp sin(2 pi (x - cx)/wl) cos(2 pi (y - cy)/wl)  amp=10 wl=100\n"
-            "             common keys: cx=400 cy=0 z0=300 (patch centre), w=200 h=120 (patch size along\n"
-            "             x and y), step=10 (raster line spacing), ds=5 (point spacing). Default: tilted\n"
-            "  --plots    directory for grind_path.svg, grind_deviation.svg, grind_points.csv\n"
-            "  --position-only  compensate the flange position only (default: full pose)\n"
-            "  --max-dev-deg    largest joint correction (default 30: an offline experiment, not a\n"
-            "                   controller; rcal compensate's default is 5.73 = 0.1 rad)\n"
-            "  --no-align keep the calibrated model's base heading and height as identified\n"
-            "  --json     one JSON object on stdout instead of the table\n");
-}
+/* the usage text: rch_opt_usage prints the option table between these */
+static const char grind_summary[] = "the grinding-path experiment (the paper's Table 8) on a simulated true robot";
+static const char grind_details[] =
+    "--surface NAME[:key=value,...] (lengths mm, angles deg); NAME one of\n"
+    "  plane     z = z0\n"
+    "  tilted    z = z0 + tan(ax) (x - cx) + tan(ay) (y - cy)                    ax=15 ay=0\n"
+    "  cylinder  z = z0 + sqrt(r^2 - (y - cy)^2) - r, axis along x               r=150\n"
+    "  saddle    z = z0 + k (x - cx)(y - cy) / (w/2 h/2)                         k=20\n"
+    "  sine      z = z0 + amp sin(2 pi (x - cx)/wl) cos(2 pi (y - cy)/wl)        amp=10 wl=100\n"
+    "common keys: cx=400 cy=0 z0=300 (patch centre), w=200 h=120 (patch size along x and y),\n"
+    "step=10 (raster line spacing), ds=5 (point spacing).\n"
+    "Cable lengths cannot see the base heading and height: by default they are taken from the truth\n"
+    "(--no-align compares raw frames).";
 
 /* Load the three models, run, report. */
 static int grind_run(const rch_grind_config *cfg, const char *model_path, const char *truth_path,
@@ -60,11 +49,11 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
         rch_grind_free(&res);
         return 1;
     }
+    int rc = 0;
     if (json)
-        rch_grind_json(stdout, &res, cfg);
+        rc = rch_grind_json(stdout, &res, cfg) != 0;
     else
         rch_grind_report(stdout, &res, cfg, model_path, truth_path);
-    int rc = 0;
     if (plots && rch_grind_plots(&res, cfg, plots, &d) != 0) {
         fprintf(stderr, "rcal grind: %s\n", d.msg);
         rc = 1;
@@ -78,44 +67,39 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
 
 int rcal_cmd_grind(int argc, char **argv)
 {
-    const char *model_path = NULL, *truth_path = NULL, *nominal_path = NULL, *spec = NULL, *plots = NULL;
-    int json = 0;
+    const char *model_path = NULL, *truth_path = NULL, *nominal_path = NULL, *spec_s = NULL, *plots = NULL;
+    int json = 0, no_align = 0;
     double max_dev_deg = 30.0;
     rch_grind_config cfg;
     rch_diag d;
     rch_grind_defaults(&cfg);
-    for (int i = 1; i < argc; ++i) {
-        if (rcal_opt_double(argc, argv, &i, "--max-dev-deg", &max_dev_deg))
-            continue;
-        if (rcal_opt_str(argc, argv, &i, "--model", &model_path) ||
-            rcal_opt_str(argc, argv, &i, "--truth", &truth_path) ||
-            rcal_opt_str(argc, argv, &i, "--nominal", &nominal_path) ||
-            rcal_opt_str(argc, argv, &i, "--surface", &spec) || rcal_opt_str(argc, argv, &i, "--plots", &plots))
-            continue;
-        if (strcmp(argv[i], "--json") == 0)
-            json = 1;
-        else if (strcmp(argv[i], "--position-only") == 0)
-            cfg.position_only = 1;
-        else if (strcmp(argv[i], "--no-align") == 0)
-            cfg.align = 0;
-        else if (strcmp(argv[i], "--help") == 0) {
-            usage(stdout);
-            return 0;
-        } else
-            return rcal_opt_unknown("grind", argv[i]);
-    }
-    if (!model_path)
-        return rcal_opt_missing("grind", "--model");
-    if (!truth_path)
-        return rcal_opt_missing("grind", "--truth");
-    if (rch_surface_parse(&cfg.surface, spec, &d) != 0) {
-        fprintf(stderr, "rcal grind: %s\n", d.msg);
+    const rch_opt opts[] = {
+        {"--model", RCH_OPT_STR, &model_path, 0, 0, "MODEL.json",
+         "calibrated model used for compensation (rcal calibrate --out)", RCH_OPT_REQUIRED, NULL},
+        {"--truth", RCH_OPT_STR, &truth_path, 0, 0, "TRUTH.json",
+         "the simulated true robot (rcal simulate --truth-out, or any model file)", RCH_OPT_REQUIRED, NULL},
+        {"--nominal", RCH_OPT_STR, &nominal_path, 0, 0, "ROBOT.json",
+         "nominal model the path is programmed with (default: the model's \"nominal\")", 0, NULL},
+        {"--surface", RCH_OPT_STR, &spec_s, 0, 0, "SPEC", "NAME[:key=value,...], see below (default tilted)", 0, NULL},
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "grind_path.svg, grind_deviation.svg, grind_points.csv", 0,
+         NULL},
+        {"--position-only", RCH_OPT_FLAG, &cfg.position_only, 0, 0, NULL,
+         "compensate the flange position only (default: full pose)", 0, NULL},
+        {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 180, "D",
+         "largest joint correction (an offline experiment; rcal compensate's default is 5.73)", 0, NULL},
+        {"--no-align", RCH_OPT_FLAG, &no_align, 0, 0, NULL,
+         "keep the calibrated model's base heading and height as identified", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the table", 0, NULL},
+    };
+    const rch_cmdspec spec = {"grind", grind_summary, grind_details, opts, sizeof opts / sizeof opts[0]};
+    const rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (st != RCH_OPT_OK)
+        return st == RCH_OPT_HELP ? 0 : 2; /* usage printed, or the error named */
+    if (rch_surface_parse(&cfg.surface, spec_s, &d) != 0) {
+        fprintf(stderr, "rcal grind: --surface: %s\n", d.msg);
         return 2;
     }
-    if (!(max_dev_deg > 0.0 && max_dev_deg <= 180.0)) {
-        fprintf(stderr, "rcal grind: --max-dev-deg must be within (0, 180]\n");
-        return 2;
-    }
+    cfg.align = !no_align;
     cfg.max_dev_rad = max_dev_deg * (M_PI / 180.0);
     return grind_run(&cfg, model_path, truth_path, nominal_path, plots, json);
 }

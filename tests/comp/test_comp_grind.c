@@ -77,7 +77,9 @@ static double json_num(const char *txt, const char *case_name, const char *key)
     assert_non_null(c);
     const char *k = strstr(c, key);
     assert_non_null(k);
-    return strtod(k + strlen(key) + 3, NULL);
+    const char *colon = strchr(k + strlen(key), ':');
+    assert_non_null(colon);
+    return strtod(colon + 1, NULL);
 }
 
 static void test_perfect_calibration(void **state)

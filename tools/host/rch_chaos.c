@@ -8,17 +8,13 @@
 
 #include "rc_rand.h"
 #include "rch_est.h"
+#include "rch_jw.h"
 #include "rch_plot.h"
 
 void rch_chaos_defaults(rch_chaos_config *cfg)
 {
-    memset(cfg, 0, sizeof *cfg);
-    cfg->points = 1000;
-    cfg->bins = 50;
-    cfg->starts = 100;
-    cfg->seed = 1;
-    cfg->step = 0.01;
-    cfg->r_hist = NAN;
+    const rch_chaos_config def = {.points = 1000, .bins = 50, .starts = 100, .seed = 1, .step = 0.01, .r_hist = NAN};
+    *cfg = def;
 }
 
 static size_t n_r(double step) { return (size_t)floor(4.0 / step + 1e-9) + 1; }
@@ -161,40 +157,39 @@ void rch_chaos_report(FILE *f, const rch_chaos_result *res, const rch_chaos_conf
     fprintf(f, "\n");
 }
 
-/* %.6f, or null when not finite */
-static void json_num(FILE *f, const char *fmt, double v)
-{
-    if (isfinite(v))
-        fprintf(f, fmt, v);
-    else
-        fputs("null", f);
-}
-
-void rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg)
+int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg)
 {
     const size_t b = res->best;
-    fprintf(f, "{\"command\": \"chaos\", \"points\": %lu, \"bins\": %lu, \"starts\": %lu, \"seed\": %llu, "
-               "\"step\": %.6g,\n \"r_best\": %.6g, \"sd_best\": ",
-            cfg->points, cfg->bins, cfg->starts, cfg->seed, cfg->step, res->r[b]);
-    json_num(f, "%.6f", res->sd[b]);
-    fputs(", \"se_best\": ", f);
-    json_num(f, "%.6f", res->se[b]);
-    fputs(", \"sd_iid\": ", f);
-    json_num(f, "%.6f", res->sd_iid);
-    fputs(", \"sd_at_0_5\": ", f);
-    json_num(f, "%.6f", res->sd_at_05);
-    fprintf(f, ", \"r_hist\": %.6g,\n \"curve\": [", res->r_hist);
+    rch_jw w;
+    rch_jw_init(&w, f, 1);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "command", "chaos");
+    rch_jw_uint(&w, "points", cfg->points);
+    rch_jw_uint(&w, "bins", cfg->bins);
+    rch_jw_uint(&w, "starts", cfg->starts);
+    rch_jw_uint(&w, "seed", cfg->seed);
+    rch_jw_numf(&w, "step", cfg->step, "%.6g");
+    rch_jw_numf(&w, "r_best", res->r[b], "%.6g");
+    rch_jw_numf(&w, "sd_best", res->sd[b], "%.6f");
+    rch_jw_numf(&w, "se_best", res->se[b], "%.6f");
+    rch_jw_numf(&w, "sd_iid", res->sd_iid, "%.6f");
+    rch_jw_numf(&w, "sd_at_0_5", res->sd_at_05, "%.6f"); /* null when r = 0.5 is not on the grid */
+    rch_jw_numf(&w, "r_hist", res->r_hist, "%.6g");
+    rch_jw_arr(&w, "curve"); /* [r, sd, se] */
     for (size_t k = 0; k < res->nr; ++k) {
-        fprintf(f, "%s[%.6g, ", k ? ", " : "", res->r[k]);
-        json_num(f, "%.6f", res->sd[k]);
-        fputs(", ", f);
-        json_num(f, "%.6f", res->se[k]);
-        fputs("]", f);
+        rch_jw_arr(&w, NULL);
+        rch_jw_numf(&w, NULL, res->r[k], "%.6g");
+        rch_jw_numf(&w, NULL, res->sd[k], "%.6f");
+        rch_jw_numf(&w, NULL, res->se[k], "%.6f");
+        rch_jw_end(&w);
     }
-    fprintf(f, "],\n \"histogram\": [");
+    rch_jw_end(&w);
+    rch_jw_arr(&w, "histogram");
     for (unsigned long k = 0; k < cfg->bins; ++k)
-        fprintf(f, "%s%u", k ? ", " : "", res->hist[k]);
-    fprintf(f, "]}\n");
+        rch_jw_uint(&w, NULL, res->hist[k]);
+    rch_jw_end(&w);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
 }
 
 static rch_plot *plot_curve(const rch_chaos_result *res, const rch_chaos_config *cfg)

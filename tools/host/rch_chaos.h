@@ -13,7 +13,7 @@
  * Cost: (number of r values + 1) x starts x points map iterations; a
  * request above RCH_CHAOS_MAX_ITERATES is refused (rch_chaos_check).
  *
- * Depends on: rch_est (rch_chaos_sd*), rc_rand (core), rch_plot.
+ * Depends on: rch_est (rch_chaos_sd*), rc_rand (core), rch_plot, rch_jw.
  * Memory: rch_chaos_run allocates inside the result; rch_chaos_free
  * releases it (also after a failed run). Errors: 0, or -1 with d set.
  */
@@ -64,7 +64,9 @@ int rch_chaos_run(rch_chaos_result *res, const rch_chaos_config *cfg, FILE *prog
 void rch_chaos_free(rch_chaos_result *res);
 
 void rch_chaos_report(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg);
-void rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg);
+/* One JSON object (rch_jw: null where a figure is absent, never nan).
+ * 0, or -1 on a write error. */
+int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg);
 /* chaos_sd.svg and chaos_hist.svg into dir (created when missing); log
  * (may be NULL) gets "  wrote PATH". 0, or -1 with d set. */
 int rch_chaos_plots(const rch_chaos_result *res, const rch_chaos_config *cfg, const char *dir, FILE *log,

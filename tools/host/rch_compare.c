@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "rch_calib.h"
+#include "rch_jw.h"
 #include "rch_plot.h"
 
 #ifndef M_PI
@@ -16,11 +17,8 @@
 
 void rch_compare_defaults(rch_compare_config *cfg)
 {
-    memset(cfg, 0, sizeof *cfg);
-    cfg->cases = 10;
-    cfg->samples = 300;
-    cfg->test_fraction = 0.1;
-    cfg->seed = 1;
+    const rch_compare_config def = {.cases = 10, .samples = 300, .test_fraction = 0.1, .seed = 1};
+    *cfg = def;
     for (int i = 0; i < RCH_EST_COUNT; ++i)
         cfg->run[i] = 1;
 }
@@ -288,76 +286,89 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
         report_ltlm(f, res);
 }
 
-static void json_row(FILE *f, const rch_compare_result *res, int r)
+static void json_row(rch_jw *w, const rch_compare_result *res, int r)
 {
     const rch_compare_row *s = &res->row[r];
     const double lm_time = rch_compare_lm_time_ms(res);
-    fprintf(f, "  {\"name\": \"%s\", \"cases_ok\": %.0f, \"rmse_mm\": %.6f, \"rmse_std_mm\": %.6f, "
-               "\"mean_abs_mm\": %.6f, \"mean_abs_std_mm\": %.6f, \"max_mm\": %.6f, \"max_std_mm\": %.6f, "
-               "\"train_rmse_mm\": %.6f",
-            rch_compare_row_name(r), s->rmse_mm.n, s->rmse_mm.mean, rch_stat_sd(&s->rmse_mm), s->mean_abs_mm.mean,
-            rch_stat_sd(&s->mean_abs_mm), s->max_mm.mean, rch_stat_sd(&s->max_mm), s->train_rmse_mm.mean);
-    if (r == 0)
-        fprintf(f, ", \"time_ms\": 0}");
-    else
-        fprintf(f, ", \"time_ms\": %.4f, \"time_std_ms\": %.4f, \"time_ratio_lm\": %.4g, \"iterations\": %.1f, "
-                   "\"cost_evals\": %.0f}",
-                s->time_ms.mean, rch_stat_sd(&s->time_ms),
-                isfinite(lm_time) && lm_time > 0 ? s->time_ms.mean / lm_time : 0.0, s->iterations.mean,
-                s->cost_evals.mean);
+    rch_jw_obj(w, NULL);
+    rch_jw_str(w, "name", rch_compare_row_name(r));
+    rch_jw_numf(w, "cases_ok", s->rmse_mm.n, "%.0f");
+    rch_jw_numf(w, "rmse_mm", s->rmse_mm.mean, "%.6f");
+    rch_jw_numf(w, "rmse_std_mm", rch_stat_sd(&s->rmse_mm), "%.6f");
+    rch_jw_numf(w, "mean_abs_mm", s->mean_abs_mm.mean, "%.6f");
+    rch_jw_numf(w, "mean_abs_std_mm", rch_stat_sd(&s->mean_abs_mm), "%.6f");
+    rch_jw_numf(w, "max_mm", s->max_mm.mean, "%.6f");
+    rch_jw_numf(w, "max_std_mm", rch_stat_sd(&s->max_mm), "%.6f");
+    rch_jw_numf(w, "train_rmse_mm", s->train_rmse_mm.mean, "%.6f");
+    if (r == 0) {
+        rch_jw_int(w, "time_ms", 0);
+    } else {
+        rch_jw_numf(w, "time_ms", s->time_ms.mean, "%.4f");
+        rch_jw_numf(w, "time_std_ms", rch_stat_sd(&s->time_ms), "%.4f");
+        rch_jw_numf(w, "time_ratio_lm", isfinite(lm_time) && lm_time > 0 ? s->time_ms.mean / lm_time : 0.0, "%.4g");
+        rch_jw_numf(w, "iterations", s->iterations.mean, "%.1f");
+        rch_jw_numf(w, "cost_evals", s->cost_evals.mean, "%.0f");
+        rch_jw_uint(w, "cases_failed", s->failed);
+    }
+    rch_jw_end(w);
 }
 
-static void json_ltlm(FILE *f, const rch_compare_result *res)
+static void json_ltlm(rch_jw *w, const rch_compare_result *res)
 {
-    fprintf(f, ",\n \"ltlm_parameters\": {\"cases\": %u, \"joints\": [", res->n_ltlm);
+    static const char *const keys[4] = {"a_mm", "d_mm", "alpha_deg", "theta_deg"};
+    static const char *const std_keys[4] = {"a_std_mm", "d_std_mm", "alpha_std_deg", "theta_std_deg"};
+    rch_jw_obj(w, "ltlm_parameters");
+    rch_jw_uint(w, "cases", res->n_ltlm);
+    rch_jw_arr(w, "joints");
     for (unsigned j = 0; j < RC_NJ; ++j) {
-        const rch_stat *s = res->ltlm_dh[j];
-        fprintf(f, "%s{\"joint\": %u, \"a_mm\": %.5f, \"d_mm\": %.5f, \"alpha_deg\": %.6f, \"theta_deg\": %.6f, "
-                   "\"a_std_mm\": %.5f, \"d_std_mm\": %.5f, \"alpha_std_deg\": %.6f, \"theta_std_deg\": %.6f}",
-                j ? ", " : "", j + 1, s[0].mean, s[1].mean, s[2].mean, s[3].mean, rch_stat_sd(&s[0]),
-                rch_stat_sd(&s[1]), rch_stat_sd(&s[2]), rch_stat_sd(&s[3]));
+        rch_jw_obj(w, NULL);
+        rch_jw_uint(w, "joint", j + 1);
+        for (unsigned k = 0; k < 4; ++k)
+            rch_jw_numf(w, keys[k], res->ltlm_dh[j][k].mean, k < 2 ? "%.5f" : "%.6f");
+        for (unsigned k = 0; k < 4; ++k)
+            rch_jw_numf(w, std_keys[k], rch_stat_sd(&res->ltlm_dh[j][k]), k < 2 ? "%.5f" : "%.6f");
+        rch_jw_end(w);
     }
-    fprintf(f, "], \"encoder_mm\": [%.4f, %.4f, %.4f]}", res->ltlm_enc_mm[0].mean, res->ltlm_enc_mm[1].mean,
-            res->ltlm_enc_mm[2].mean);
+    rch_jw_end(w);
+    rch_jw_arr(w, "encoder_mm");
+    for (unsigned k = 0; k < 3; ++k)
+        rch_jw_numf(w, NULL, res->ltlm_enc_mm[k].mean, "%.4f");
+    rch_jw_end(w);
+    rch_jw_end(w);
 }
 
-void rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg,
-                      const char *data_name)
+int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name)
 {
-    fprintf(f, "{\"command\": \"compare\", \"data\": \"");
-    for (const char *s = data_name; *s; ++s)
-        fprintf(f, *s == '"' || *s == '\\' ? "\\%c" : "%c", *s);
-    fprintf(f, "\", \"rows_in_file\": %zu, \"cases\": %lu, \"samples\": %zu, \"n_train\": %zu, \"n_test\": %zu, "
-               "\"test_fraction\": %.6g, \"seed\": %llu,\n \"methods\": [",
-            res->rows_in_data, res->cases, res->n_draw, res->n_train, res->n_test, cfg->test_fraction, cfg->seed);
-    int first = 1;
-    for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
-        if (!res->row[r].used)
-            continue;
-        fprintf(f, "%s\n", first ? "" : ",");
-        json_row(f, res, r);
-        first = 0;
-    }
-    fprintf(f, "\n ],\n \"cases_rmse_mm\": [");
+    rch_jw w;
+    rch_jw_init(&w, f, 1);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "command", "compare");
+    rch_jw_str(&w, "data", data_name);
+    rch_jw_uint(&w, "rows_in_file", res->rows_in_data);
+    rch_jw_uint(&w, "cases", res->cases);
+    rch_jw_uint(&w, "samples", res->n_draw);
+    rch_jw_uint(&w, "n_train", res->n_train);
+    rch_jw_uint(&w, "n_test", res->n_test);
+    rch_jw_numf(&w, "test_fraction", cfg->test_fraction, "%.6g");
+    rch_jw_uint(&w, "seed", cfg->seed);
+    rch_jw_arr(&w, "methods");
+    for (int r = 0; r < RCH_COMPARE_ROWS; ++r)
+        if (res->row[r].used)
+            json_row(&w, res, r);
+    rch_jw_end(&w);
+    rch_jw_arr(&w, "cases_rmse_mm"); /* per case: the rows of "methods", null where a method failed */
     for (unsigned long c = 0; c < res->cases; ++c) {
-        int f2 = 1;
-        fprintf(f, "%s[", c ? ", " : "");
-        for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
-            if (!res->row[r].used)
-                continue;
-            const double v = res->case_rmse_mm[c * RCH_COMPARE_ROWS + (size_t)r];
-            if (isfinite(v))
-                fprintf(f, "%s%.6f", f2 ? "" : ", ", v);
-            else
-                fprintf(f, "%snull", f2 ? "" : ", ");
-            f2 = 0;
-        }
-        fprintf(f, "]");
+        rch_jw_arr(&w, NULL);
+        for (int r = 0; r < RCH_COMPARE_ROWS; ++r)
+            if (res->row[r].used)
+                rch_jw_numf(&w, NULL, res->case_rmse_mm[c * RCH_COMPARE_ROWS + (size_t)r], "%.6f");
+        rch_jw_end(&w);
     }
-    fprintf(f, "]");
+    rch_jw_end(&w);
     if (res->n_ltlm > 0)
-        json_ltlm(f, res);
-    fprintf(f, "\n}\n");
+        json_ltlm(&w, res);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
 }
 
 /* ---- plots ------------------------------------------------------------- */

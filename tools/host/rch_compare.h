@@ -18,7 +18,7 @@
  * errors of case 1.
  *
  * Depends on: rch_calib, rch_est, rch_eval, rch_robot (host), rc_solve
- * (core); rch_plot for rch_compare_plots.
+ * (core); rch_plot for rch_compare_plots, rch_jw for rch_compare_json.
  * Memory: rch_compare_run allocates inside the result; rch_compare_free
  * releases it (also after a failed run). Thread safety: one result per
  * thread. Errors: 0, or -1 with d set (bad configuration, too few rows,
@@ -99,9 +99,9 @@ int rch_compare_any_failed(const rch_compare_result *res);
  * printed in the header line. */
 void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg,
                         const char *data_name);
-/* The same as one JSON object. */
-void rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg,
-                      const char *data_name);
+/* The same as one JSON object (rch_jw: strings escaped, null where a
+ * figure is absent). 0, or -1 on a write error. */
+int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name);
 
 /* Write convergence.svg, convergence_zoom.svg (need cfg.curves), rmse_bars.svg,
  * time_bars.svg and per_sample.svg into dir (created with its parents when

@@ -8,6 +8,7 @@
 
 #include "rc_comp.h"
 #include "rc_rand.h"
+#include "rch_jw.h"
 #include "rch_plot.h"
 
 #ifndef M_PI
@@ -401,23 +402,39 @@ void rch_grind_report(FILE *f, const rch_grind_result *res, const rch_grind_conf
                 res->n_orient_best_effort);
 }
 
-void rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg)
+int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg)
 {
     static const char *const keys[3] = {"uncompensated", "compensated_calibrated", "compensated_true"};
-    fprintf(f, "{\"surface\": \"%s\", \"points\": %zu, \"lines\": %zu, \"mode\": \"%s\", \"align\": {\"on\": %s, "
-               "\"heading_deg\": %.6f, \"height_mm\": %.6f}, \"cases\": {",
-            rch_surface_name(cfg->surface.kind), res->n, res->ny, cfg->position_only ? "position" : "pose",
-            cfg->align ? "true" : "false", res->heading_rad / DEG, res->height_mm);
+    rch_jw w;
+    rch_jw_init(&w, f, 1);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "surface", rch_surface_name(cfg->surface.kind));
+    rch_jw_uint(&w, "points", res->n);
+    rch_jw_uint(&w, "lines", res->ny);
+    rch_jw_str(&w, "mode", cfg->position_only ? "position" : "pose");
+    rch_jw_obj(&w, "align");
+    rch_jw_bool(&w, "on", cfg->align);
+    rch_jw_numf(&w, "heading_deg", res->heading_rad / DEG, "%.6f");
+    rch_jw_numf(&w, "height_mm", res->height_mm, "%.6f");
+    rch_jw_end(&w);
+    rch_jw_obj(&w, "cases");
     for (int c = 0; c < RCH_GRIND_CASES; ++c) {
         const rch_stat *s = &res->cases[c].dev_mm;
-        fprintf(f, "%s\"%s\": {\"mean_mm\": %.6f, \"sd_mm\": %.6f, \"max_mm\": %.6f, \"rms_mm\": %.6f, "
-                   "\"not_converged\": %zu, \"named\": [",
-                c ? ", " : "", keys[c], s->mean, rch_stat_sd(s), s->max, rch_stat_rms(s), res->cases[c].n_flag);
+        rch_jw_obj(&w, keys[c]);
+        rch_jw_numf(&w, "mean_mm", s->mean, "%.6f");
+        rch_jw_numf(&w, "sd_mm", rch_stat_sd(s), "%.6f");
+        rch_jw_numf(&w, "max_mm", s->max, "%.6f");
+        rch_jw_numf(&w, "rms_mm", rch_stat_rms(s), "%.6f");
+        rch_jw_uint(&w, "not_converged", res->cases[c].n_flag);
+        rch_jw_arr(&w, "named");
         for (int m = 0; m < 5; ++m)
-            fprintf(f, "%s%.6f", m ? ", " : "", res->pts[res->named[m]].dev_mm[c]);
-        fprintf(f, "]}");
+            rch_jw_numf(&w, NULL, res->pts[res->named[m]].dev_mm[c], "%.6f");
+        rch_jw_end(&w);
+        rch_jw_end(&w);
     }
-    fprintf(f, "}}\n");
+    rch_jw_end(&w);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
 }
 
 /* ---- plots ------------------------------------------------------------- */

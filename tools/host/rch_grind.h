@@ -19,7 +19,7 @@
  * the rotation and shift that best map its flange points onto the truth's
  * over 2000 random poses (closed form).
  *
- * Depends on: rc_comp, rc_model, rc_rand (core); rch_eval, rch_plot (host).
+ * Depends on: rc_comp, rc_model, rc_rand (core); rch_eval, rch_plot, rch_jw (host).
  * Memory: rch_grind_run allocates the path inside the result;
  * rch_grind_free releases it (also after a failed run). Errors: 0, or -1
  * with d set (unreachable path, out of memory).
@@ -120,7 +120,8 @@ const char *rch_grind_point_name(int m);
 
 void rch_grind_report(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg, const char *model_name,
                       const char *truth_name);
-void rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg);
+/* One JSON object through rch_jw. 0, or -1 on a write error. */
+int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg);
 
 /* grind_path.svg (top view, segments coloured by deviation, uncompensated
  * and compensated side by side), grind_deviation.svg (deviation along the
