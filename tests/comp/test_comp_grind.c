@@ -150,6 +150,10 @@ static void test_bad_specs(void **state)
         assert_int_equal(run(cmd), 2);
     }
     char cmd[768];
+    /* issue 12: the nominal model as the "calibrated" one is named as such */
+    snprintf(cmd, sizeof cmd, "'%s' grind --model '%s/data/irb120.json' --truth '%s' | grep -q 'not calibrated'", RCAL,
+             RCAL_SOURCE_DIR, truth_path);
+    assert_int_equal(run(cmd), 0);
     /* unreachable patch: a clear failure, not a wrong table */
     snprintf(cmd, sizeof cmd, "'%s' grind --model '%s' --truth '%s' --surface 'plane:cx=2000' > /dev/null 2>&1", RCAL,
              model_path, truth_path);
@@ -217,7 +221,23 @@ static void test_run_inprocess(void **state)
     for (size_t k = 0; k < res.n; ++k)
         s += res.pts[k].dev_mm[RCH_GRIND_UNCOMP];
     assert_true(fabs(s / 105.0 - u->mean) < 1e-12);
+    assert_false(res.model_is_nominal);
+    assert_true(res.align_only_mm.n == 105.0);
     rch_grind_free(&res);
+    /* issue 12: a nominal model is not credited with what the alignment
+     * (taken from the truth) removes: it is flagged, and the alignment alone
+     * accounts for all of its gain */
+    assert_int_equal(rch_grind_run(&res, &cfg, &g_nom, &g_truth, &g_nom, &d), 0);
+    assert_true(res.model_is_nominal);
+    assert_true(fabs(res.align_only_mm.mean - res.cases[RCH_GRIND_COMP_CAL].dev_mm.mean) < 1e-12);
+    rch_grind_free(&res);
+    cfg.align = 0;
+    assert_int_equal(rch_grind_run(&res, &cfg, &g_nom, &g_truth, &g_nom, &d), 0);
+    assert_true(res.align_only_mm.n == 0.0);
+    /* nominal compensated by nominal: the joints do not move, the deviation stays */
+    assert_true(fabs(res.cases[RCH_GRIND_COMP_CAL].dev_mm.mean - res.cases[RCH_GRIND_UNCOMP].dev_mm.mean) < 1e-6);
+    rch_grind_free(&res);
+    cfg.align = 1;
     /* unreachable: refused with the reason */
     assert_int_equal(rch_surface_parse(&cfg.surface, "plane:cx=2000", &d), 0);
     assert_int_equal(rch_grind_run(&res, &cfg, &g_truth, &g_truth, &g_nom, &d), -1);

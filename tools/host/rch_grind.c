@@ -255,33 +255,70 @@ static double dist3(const double a[3], const double b[3])
     return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-/* Deviation of the true flange at every point, for the three cases. */
-static void deviations(rch_grind_result *res, const rch_grind_config *gc, const rc_model *cal,
-                       const rc_model *truth, const rc_model *nom)
+/* Compensate every path point with model m (a stream, as a controller
+ * would) and measure the true flange's deviation: into dev_mm[c] and
+ * flag[c] of every point, or (c < 0) into *only. Returns the points whose
+ * orientation was matched as best effort only. */
+static size_t comp_pass(rch_grind_result *res, const rch_grind_config *gc, int c, const rc_model *m,
+                        const rc_model *truth, const rc_model *nom, rch_stat *only)
 {
     rc_comp_config cfg;
-    rc_comp_stream st_cal, st_true;
+    rc_comp_stream st;
+    size_t n_best_effort = 0;
     memset(&cfg, 0, sizeof cfg);
     cfg.flags = gc->position_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
     cfg.max_dev_rad = gc->max_dev_rad;
     cfg.max_iter = 50;
-    rc_comp_stream_init(&st_cal, cal, nom, &cfg);
-    rc_comp_stream_init(&st_true, truth, nom, &cfg);
+    rc_comp_stream_init(&st, m, nom, &cfg);
     for (size_t k = 0; k < res->n; ++k) {
         rch_grind_point *p = &res->pts[k];
         double qc[RC_NJ], pt[3];
         rc_comp_result cr;
-        rc_fk(pt, NULL, truth, p->q_nom_rad);
-        p->dev_mm[RCH_GRIND_UNCOMP] = dist3(pt, p->p_mm);
-        for (int c = RCH_GRIND_COMP_CAL; c <= RCH_GRIND_COMP_TRUE; ++c) {
-            rc_status stc = rc_comp_stream_step(c == RCH_GRIND_COMP_CAL ? &st_cal : &st_true, qc, &cr, p->q_nom_rad);
-            p->flag[c] = stc != RC_OK;
-            if (stc == RC_OK && cr.exit == RC_COMP_POSITION_ONLY && c == RCH_GRIND_COMP_CAL)
-                ++res->n_orient_best_effort;
-            rc_fk(pt, NULL, truth, qc);
-            p->dev_mm[c] = dist3(pt, p->p_mm);
+        const rc_status stc = rc_comp_stream_step(&st, qc, &cr, p->q_nom_rad);
+        if (stc == RC_OK && cr.exit == RC_COMP_POSITION_ONLY)
+            ++n_best_effort;
+        rc_fk(pt, NULL, truth, qc);
+        if (c < 0) {
+            rch_stat_add(only, dist3(pt, p->p_mm));
+            continue;
         }
+        p->flag[c] = stc != RC_OK;
+        p->dev_mm[c] = dist3(pt, p->p_mm);
     }
+    return n_best_effort;
+}
+
+/* Deviation of the true flange at every point, for the three cases; with
+ * alignment also the nominal model aligned the same way (what the alignment
+ * alone is worth). */
+static void deviations(rch_grind_result *res, const rch_grind_config *gc, const rc_model *cal,
+                       const rc_model *truth, const rc_model *nom)
+{
+    for (size_t k = 0; k < res->n; ++k) {
+        double pt[3];
+        rc_fk(pt, NULL, truth, res->pts[k].q_nom_rad);
+        res->pts[k].dev_mm[RCH_GRIND_UNCOMP] = dist3(pt, res->pts[k].p_mm);
+    }
+    res->n_orient_best_effort = comp_pass(res, gc, RCH_GRIND_COMP_CAL, cal, truth, nom, NULL);
+    (void)comp_pass(res, gc, RCH_GRIND_COMP_TRUE, truth, truth, nom, NULL);
+    rch_stat_init(&res->align_only_mm);
+    if (gc->align) {
+        rc_model nom_aligned = *nom;
+        double phi, dz;
+        rch_grind_align_base(&phi, &dz, &nom_aligned, truth);
+        nom_aligned.x[RC_P_THETA(0)] += phi;
+        nom_aligned.x[RC_P_D(0)] += dz;
+        (void)comp_pass(res, gc, -1, &nom_aligned, truth, nom, &res->align_only_mm);
+    }
+}
+
+/* 1 when the geometry of m is its nominal table (nothing was calibrated). */
+static int is_nominal(const rc_model *m, const rc_model *nom)
+{
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        if (m->x[k] != nom->x[k])
+            return 0;
+    return 1;
 }
 
 /* Path indices nearest to the patch's corners and centre. */
@@ -308,6 +345,7 @@ int rch_grind_run(rch_grind_result *res, const rch_grind_config *cfg, const rc_m
 {
     rc_model cal = *cal_in;
     memset(res, 0, sizeof *res);
+    res->model_is_nominal = is_nominal(cal_in, nom);
     if (cfg->align) {
         rch_grind_align_base(&res->heading_rad, &res->height_mm, &cal, truth);
         cal.x[RC_P_THETA(0)] += res->heading_rad;
@@ -393,6 +431,13 @@ void rch_grind_report(FILE *f, const rch_grind_result *res, const rch_grind_conf
     if (unc > 0)
         fprintf(f, "  compensation with the calibrated model removes %.1f%% of the mean deviation\n",
                 100.0 * (1.0 - cal / unc));
+    if (unc > 0 && res->align_only_mm.n > 0)
+        fprintf(f, "  of which the base alignment taken from the truth alone (the nominal model aligned the same "
+                   "way) removes %.1f%%\n",
+                100.0 * (1.0 - res->align_only_mm.mean / unc));
+    if (res->model_is_nominal)
+        fprintf(f, "  warning: the model's geometry is its nominal table: it is not calibrated, and whatever the\n"
+                   "  compensation removes comes from the base alignment taken from the truth (--no-align: none)\n");
     if (res->cases[RCH_GRIND_COMP_CAL].n_flag || res->cases[RCH_GRIND_COMP_TRUE].n_flag)
         fprintf(f, "  warning: %zu / %zu points not compensated (flagged)\n", res->cases[RCH_GRIND_COMP_CAL].n_flag,
                 res->cases[RCH_GRIND_COMP_TRUE].n_flag);
@@ -416,7 +461,10 @@ int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config 
     rch_jw_bool(&w, "on", cfg->align);
     rch_jw_numf(&w, "heading_deg", res->heading_rad / DEG, "%.6f");
     rch_jw_numf(&w, "height_mm", res->height_mm, "%.6f");
+    /* the nominal model with the same alignment: what the alignment alone is worth */
+    rch_jw_numf(&w, "alignment_only_mean_mm", res->align_only_mm.n > 0 ? res->align_only_mm.mean : NAN, "%.6f");
     rch_jw_end(&w);
+    rch_jw_bool(&w, "model_is_nominal", res->model_is_nominal);
     rch_jw_obj(&w, "cases");
     for (int c = 0; c < RCH_GRIND_CASES; ++c) {
         const rch_stat *s = &res->cases[c].dev_mm;

@@ -17,7 +17,11 @@
  * those from the workpiece frame. With cfg.align they are taken from the
  * truth (rch_grind_align_base): theta1 and d1 of the calibrated model get
  * the rotation and shift that best map its flange points onto the truth's
- * over 2000 random poses (closed form).
+ * over 2000 random poses (closed form). Because that alignment uses the
+ * truth, the result also says what it alone is worth (the nominal model
+ * aligned the same way, compensated) and whether the "calibrated" model is
+ * the nominal one (issue 12: a nominal model must not be credited with what
+ * the alignment removes).
  *
  * Depends on: rc_comp, rc_model, rc_rand (core); rch_eval, rch_plot, rch_jw (host).
  * Memory: rch_grind_run allocates the path inside the result;
@@ -103,6 +107,9 @@ typedef struct rch_grind_result {
     rch_grind_case cases[RCH_GRIND_CASES];
     size_t named[5];       /* path indices of P1..P5 (corners x-y-, x+y-, centre, x-y+, x+y+) */
     size_t n_orient_best_effort; /* calibrated compensation matched the position only */
+    rch_stat align_only_mm; /* with align: deviation when compensating with the nominal model aligned to the
+                               truth the same way (what the alignment alone is worth); empty without align */
+    int model_is_nominal;   /* the calibrated model's geometry equals the nominal table */
 } rch_grind_result;
 
 /* cal: calibrated model, truth: the true robot, nom: the nominal model the
