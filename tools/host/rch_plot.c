@@ -159,12 +159,7 @@ void rch_plot_bars(rch_plot *p, const char *const *labels, const double *values,
     p->bar_val = plot_dupd(values, n);
     p->bar_err = errs ? plot_dupd(errs, n) : NULL;
     if (!p->bar_labels || !p->bar_val || (errs && !p->bar_err)) {
-        free(p->bar_labels);
-        free(p->bar_val);
-        free(p->bar_err);
-        p->bar_labels = NULL;
-        p->bar_val = NULL;
-        p->bar_err = NULL;
+        plot_free_bars(p); /* n_bars is still 0: frees the arrays only */
         p->failed = 1;
         return;
     }
@@ -378,6 +373,15 @@ static void plot_fmt(char *buf, size_t len, double v, double step)
     snprintf(buf, len, "%g", v);
 }
 
+/* One y tick at pixel row py: grid line across the plot (left L, width pw),
+ * tick mark, label. */
+static void plot_ytick(FILE *f, double L, double pw, double py, const char *label)
+{
+    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e0e0e0\"/>\n", L, py, L + pw, py);
+    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n", L - 5, py, L, py);
+    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8, py + 4, label);
+}
+
 int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
 {
     plot_axis ax, ay;
@@ -456,16 +460,8 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
                 if (y0 <= 0.0)
                     continue;
                 py = PY(log10(y0));
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                        "stroke=\"#e0e0e0\"/>\n",
-                        L, py, L + pw, py);
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
-                        L - 5, py, L, py);
                 plot_fmt(buf, sizeof buf, y0, step);
-                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8,
-                        py + 4, buf);
+                plot_ytick(f, L, pw, py, buf);
             }
         } else if (ay.log) {
             double span = ay.hi - ay.lo;
@@ -484,16 +480,8 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
                     if (tv < ay.lo - 1e-9 || tv > ay.hi + 1e-9)
                         continue;
                     py = PY(tv);
-                    fprintf(f,
-                            "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                            "stroke=\"#e0e0e0\"/>\n",
-                            L, py, L + pw, py);
-                    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                               "stroke=\"black\"/>\n",
-                            L - 5, py, L, py);
                     snprintf(buf, sizeof buf, "%g", v);
-                    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n",
-                            L - 8, py + 4, buf);
+                    plot_ytick(f, L, pw, py, buf);
                 }
             }
         } else {
@@ -501,16 +489,8 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
             for (y0 = ceil(ay.lo / step - 1e-9) * step; y0 <= ay.hi + 1e-9 * step && guard < 100;
                  y0 += step, guard++) {
                 double py = PY(y0);
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                        "stroke=\"#e0e0e0\"/>\n",
-                        L, py, L + pw, py);
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
-                        L - 5, py, L, py);
                 plot_fmt(buf, sizeof buf, y0, step);
-                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8,
-                        py + 4, buf);
+                plot_ytick(f, L, pw, py, buf);
             }
         }
     }
