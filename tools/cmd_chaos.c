@@ -21,6 +21,7 @@ int rcal_cmd_chaos(int argc, char **argv)
     rch_chaos_config cfg;
     rch_chaos_result res;
     rch_diag d;
+    char msg[1024];
     unsigned long seed = 1;
     int json = 0;
     rch_chaos_defaults(&cfg);
@@ -48,10 +49,11 @@ int rcal_cmd_chaos(int argc, char **argv)
         rc = rch_chaos_json(stdout, &res, &cfg) != 0;
     else if (rc == 0)
         rch_chaos_report(stdout, &res, &cfg);
-    if (rc == 0 && plots && rch_chaos_plots(&res, &cfg, plots, json ? NULL : stdout, &d) != 0)
+    const rch_plot_dir pd = {plots, NULL, 0, json ? NULL : stdout};
+    if (rc == 0 && plots && rch_chaos_plots(&res, &cfg, &pd, &d) != 0)
         rc = 1;
     if (rc != 0)
-        fprintf(stderr, "rcal chaos: %s\n", d.msg);
+        fprintf(stderr, "rcal chaos: %s\n", rch_diag_str(&d, msg, sizeof msg));
     rch_chaos_free(&res);
     return rc;
 }

@@ -51,7 +51,9 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
         rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
     else if (rc == 0)
         rch_compare_report(stdout, &res, cfg, data_path);
-    if (rc == 0 && plots && rch_compare_plots(&res, cfg, plots, json ? NULL : stdout, &d) != 0)
+    const char *const inputs[2] = {data_path, robot_path};
+    const rch_plot_dir pd = {plots, inputs, 2, json ? NULL : stdout};
+    if (rc == 0 && plots && rch_compare_plots(&res, cfg, &pd, &d) != 0)
         rc = 1;
     if (rc == 0 && rch_compare_any_failed(&res))
         rc = 1; /* reported per case on stderr and in the table */

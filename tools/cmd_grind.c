@@ -54,8 +54,10 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
         rc = rch_grind_json(stdout, &res, cfg) != 0;
     else
         rch_grind_report(stdout, &res, cfg, model_path, truth_path);
-    if (plots && rch_grind_plots(&res, cfg, plots, &d) != 0) {
-        fprintf(stderr, "rcal grind: %s\n", d.msg);
+    const char *const inputs[3] = {model_path, truth_path, nominal_path};
+    const rch_plot_dir pd = {plots, inputs, 3, NULL};
+    if (plots && rch_grind_plots(&res, cfg, &pd, &d) != 0) {
+        fprintf(stderr, "rcal grind: %s\n", rch_diag_str(&d, msg, sizeof msg));
         rc = 1;
     }
     if (plots && !json && rc == 0)

@@ -228,18 +228,14 @@ static rch_plot *plot_hist(const rch_chaos_result *res, const rch_chaos_config *
     return p;
 }
 
-int rch_chaos_plots(const rch_chaos_result *res, const rch_chaos_config *cfg, const char *dir, FILE *log,
-                    rch_diag *d)
+int rch_chaos_plots(const rch_chaos_result *res, const rch_chaos_config *cfg, const rch_plot_dir *pd, rch_diag *d)
 {
-    char msg[512];
-    if (rch_plot_mkdir(dir) != 0) {
-        rch_diag_set(d, "", 0, 0, "cannot create %s: %s", dir, strerror(errno));
+    if (rch_plot_mkdir(pd->dir) != 0) {
+        rch_diag_set(d, "", 0, 0, "cannot create %s: %s", pd->dir, strerror(errno));
         return -1;
     }
-    if (rch_plot_save(plot_curve(res, cfg), dir, "chaos_sd.svg", log, msg, sizeof msg) != 0 ||
-        rch_plot_save(plot_hist(res, cfg), dir, "chaos_hist.svg", log, msg, sizeof msg) != 0) {
-        rch_diag_set(d, "", 0, 0, "%s", msg);
+    if (rch_plot_save(plot_curve(res, cfg), pd, "chaos_sd.svg", d) != 0 ||
+        rch_plot_save(plot_hist(res, cfg), pd, "chaos_hist.svg", d) != 0)
         return -1;
-    }
     return 0;
 }

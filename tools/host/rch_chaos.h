@@ -24,6 +24,7 @@
 #include <stdio.h>
 
 #include "rch_diag.h"
+#include "rch_plot.h"
 
 /* The most map iterations one study may take (about 8 s on one core). */
 #define RCH_CHAOS_MAX_ITERATES 1000000000.0
@@ -67,9 +68,8 @@ void rch_chaos_report(FILE *f, const rch_chaos_result *res, const rch_chaos_conf
 /* One JSON object (rch_jw: null where a figure is absent, never nan).
  * 0, or -1 on a write error. */
 int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg);
-/* chaos_sd.svg and chaos_hist.svg into dir (created when missing); log
- * (may be NULL) gets "  wrote PATH". 0, or -1 with d set. */
-int rch_chaos_plots(const rch_chaos_result *res, const rch_chaos_config *cfg, const char *dir, FILE *log,
-                    rch_diag *d);
+/* chaos_sd.svg and chaos_hist.svg into pd->dir (created when missing). 0,
+ * or -1 with d set. */
+int rch_chaos_plots(const rch_chaos_result *res, const rch_chaos_config *cfg, const rch_plot_dir *pd, rch_diag *d);
 
 #endif

@@ -440,23 +440,20 @@ static rch_plot *plot_per_sample(const rch_compare_result *res, const rch_compar
     return p;
 }
 
-int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *cfg, const char *dir, FILE *log,
+int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *cfg, const rch_plot_dir *pd,
                       rch_diag *d)
 {
-    char msg[512];
-    int rc = 0;
-    if (rch_plot_mkdir(dir) != 0) {
-        rch_diag_set(d, "", 0, 0, "cannot use %s as a plot directory: %s", dir, strerror(errno));
+    if (rch_plot_mkdir(pd->dir) != 0) {
+        rch_diag_set(d, "", 0, 0, "cannot use %s as a plot directory: %s", pd->dir, strerror(errno));
         return -1;
     }
-    if (log)
-        fprintf(log, "\nplots:\n");
-    rc |= rch_plot_save(plot_convergence(res, cfg, 0), dir, "convergence.svg", log, msg, sizeof msg);
-    rc |= rch_plot_save(plot_convergence(res, cfg, 1), dir, "convergence_zoom.svg", log, msg, sizeof msg);
-    rc |= rch_plot_save(plot_bars(res, 0), dir, "rmse_bars.svg", log, msg, sizeof msg);
-    rc |= rch_plot_save(plot_bars(res, 1), dir, "time_bars.svg", log, msg, sizeof msg);
-    rc |= rch_plot_save(plot_per_sample(res, cfg), dir, "per_sample.svg", log, msg, sizeof msg);
-    if (rc != 0)
-        rch_diag_set(d, "", 0, 0, "%s", msg);
-    return rc ? -1 : 0;
+    if (pd->log)
+        fprintf(pd->log, "\nplots:\n");
+    if (rch_plot_save(plot_convergence(res, cfg, 0), pd, "convergence.svg", d) != 0 ||
+        rch_plot_save(plot_convergence(res, cfg, 1), pd, "convergence_zoom.svg", d) != 0 ||
+        rch_plot_save(plot_bars(res, 0), pd, "rmse_bars.svg", d) != 0 ||
+        rch_plot_save(plot_bars(res, 1), pd, "time_bars.svg", d) != 0 ||
+        rch_plot_save(plot_per_sample(res, cfg), pd, "per_sample.svg", d) != 0)
+        return -1;
+    return 0;
 }

@@ -34,6 +34,7 @@
 #include "rch_diag.h"
 #include "rch_est.h"
 #include "rch_eval.h"
+#include "rch_plot.h"
 #include "rch_robot.h"
 
 /* Rows of the result: 0 = BC (the start model), id + 1 = method id. */
@@ -104,9 +105,10 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
 int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name);
 
 /* Write convergence.svg, convergence_zoom.svg (need cfg.curves), rmse_bars.svg,
- * time_bars.svg and per_sample.svg into dir (created with its parents when
- * missing). log (may be NULL) gets "  wrote PATH" per file. 0, or -1 with d set. */
-int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *cfg, const char *dir, FILE *log,
+ * time_bars.svg and per_sample.svg into pd->dir (created with its parents
+ * when missing; never over one of pd->inputs). Stops at the first failure:
+ * 0, or -1 with d set. */
+int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *cfg, const rch_plot_dir *pd,
                       rch_diag *d);
 
 #endif

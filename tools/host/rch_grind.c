@@ -562,12 +562,9 @@ static void svg_panel(FILE *f, const rch_grind_result *res, int c, const rch_sur
     svg_panel_axes(f, &m);
 }
 
-static int write_path_svg(const char *path, const rch_grind_result *res, const rch_surface *s)
+static void write_path_svg(FILE *f, const rch_grind_result *res, const rch_surface *s)
 {
     char subtitle[160];
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return -1;
     spec_line(subtitle, sizeof subtitle, s);
     const double pw = 420, ph = fmax(120.0, fmin(420.0, 420.0 * s->h / s->w)), W = 2 * pw + 360, H = ph + 150;
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -583,7 +580,6 @@ static int write_path_svg(const char *path, const rch_grind_result *res, const r
     svg_panel(f, res, RCH_GRIND_UNCOMP, s, 90, 95, pw, ph, "uncompensated");
     svg_panel(f, res, RCH_GRIND_COMP_CAL, s, 90 + pw + 180, 95, pw, ph, "compensated (calibrated model)");
     fprintf(f, "</svg>\n");
-    return fclose(f) == 0 ? 0 : -1;
 }
 
 static rch_plot *plot_deviation(const rch_grind_result *res)
@@ -607,11 +603,8 @@ static rch_plot *plot_deviation(const rch_grind_result *res)
     return pl;
 }
 
-static int write_points_csv(const char *path, const rch_grind_result *res)
+static void write_points_csv(FILE *f, const rch_grind_result *res)
 {
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return -1;
     fprintf(f, "k,x,y,z,q1,q2,q3,q4,q5,q6,dev_uncomp_mm,dev_comp_cal_mm,dev_comp_true_mm\n");
     for (size_t k = 0; k < res->n; ++k) {
         const rch_grind_point *p = &res->pts[k];
@@ -620,30 +613,21 @@ static int write_points_csv(const char *path, const rch_grind_result *res)
             fprintf(f, ",%.6f", p->q_nom_rad[i] / DEG);
         fprintf(f, ",%.6f,%.6f,%.6f\n", p->dev_mm[0], p->dev_mm[1], p->dev_mm[2]);
     }
-    return fclose(f) == 0 ? 0 : -1;
 }
 
-int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, const char *dir, rch_diag *d)
+int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, const rch_plot_dir *pd, rch_diag *d)
 {
-    char path[4096], msg[512];
-    int rc = 0;
-    if (rch_plot_mkdir(dir) != 0) {
-        rch_diag_set(d, "", 0, 0, "cannot create %s: %s", dir, strerror(errno));
+    rch_out o;
+    if (rch_plot_mkdir(pd->dir) != 0) {
+        rch_diag_set(d, "", 0, 0, "cannot create %s: %s", pd->dir, strerror(errno));
         return -1;
     }
-    snprintf(path, sizeof path, "%s/grind_path.svg", dir);
-    if (write_path_svg(path, res, &cfg->surface) != 0) {
-        rch_diag_set(d, "", 0, 0, "cannot write %s: %s", path, strerror(errno));
-        rc = -1;
-    }
-    if (rch_plot_save(plot_deviation(res), dir, "grind_deviation.svg", NULL, msg, sizeof msg) != 0) {
-        rch_diag_set(d, "", 0, 0, "%s", msg);
-        rc = -1;
-    }
-    snprintf(path, sizeof path, "%s/grind_points.csv", dir);
-    if (write_points_csv(path, res) != 0) {
-        rch_diag_set(d, "", 0, 0, "cannot write %s: %s", path, strerror(errno));
-        rc = -1;
-    }
-    return rc;
+    if (rch_plot_open(&o, pd, "grind_path.svg", d) != 0)
+        return -1;
+    write_path_svg(o.f, res, &cfg->surface);
+    if (rch_plot_close(&o, pd, 0, d) != 0 || rch_plot_save(plot_deviation(res), pd, "grind_deviation.svg", d) != 0 ||
+        rch_plot_open(&o, pd, "grind_points.csv", d) != 0)
+        return -1;
+    write_points_csv(o.f, res);
+    return rch_plot_close(&o, pd, 0, d);
 }

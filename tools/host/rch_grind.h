@@ -37,6 +37,7 @@
 #include "rc_model.h"
 #include "rch_diag.h"
 #include "rch_eval.h"
+#include "rch_plot.h"
 
 /* ---- surfaces ---- */
 
@@ -132,8 +133,8 @@ int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config 
 
 /* grind_path.svg (top view, segments coloured by deviation, uncompensated
  * and compensated side by side), grind_deviation.svg (deviation along the
- * path, log scale) and grind_points.csv (every point) into dir (created
- * when missing). 0, or -1 with d set. */
-int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, const char *dir, rch_diag *d);
+ * path, log scale) and grind_points.csv (every point) into pd->dir (created
+ * when missing; never over one of pd->inputs). 0, or -1 with d set. */
+int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, const rch_plot_dir *pd, rch_diag *d);
 
 #endif

@@ -692,20 +692,39 @@ int rch_plot_mkdir(const char *dir)
     return 0;
 }
 
-int rch_plot_save(rch_plot *p, const char *dir, const char *name, FILE *log, char *errmsg, size_t len)
+int rch_plot_open(rch_out *o, const rch_plot_dir *pd, const char *name, rch_diag *d)
 {
-    char path[4096];
-    int rc = 0;
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    if (!p || p->failed) {
-        errno = ENOMEM;
-        rc = -1;
-    } else
-        rc = rch_plot_write_svg(p, path);
-    if (rc != 0)
-        snprintf(errmsg, len, "cannot write %s: %s", path, strerror(errno));
-    else if (log)
-        fprintf(log, "  wrote %s\n", path);
+    char path[1024];
+    if ((size_t)snprintf(path, sizeof path, "%s/%s", pd->dir, name) >= sizeof path) {
+        memset(o, 0, sizeof *o);
+        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: path too long", pd->dir, name);
+        return -1;
+    }
+    return rch_out_open(o, path, "plot file", pd->inputs, pd->n_inputs, d);
+}
+
+int rch_plot_close(rch_out *o, const rch_plot_dir *pd, int failed, rch_diag *d)
+{
+    if (failed || ferror(o->f)) {
+        rch_diag_set(d, "", 0, 0, "cannot write %s: %s", o->path, failed ? "out of memory" : "write error");
+        rch_out_abort(o);
+        return -1;
+    }
+    if (rch_out_commit(o, d) != 0)
+        return -1;
+    if (pd->log)
+        fprintf(pd->log, "  wrote %s\n", o->path);
+    return 0;
+}
+
+int rch_plot_save(rch_plot *p, const rch_plot_dir *pd, const char *name, rch_diag *d)
+{
+    rch_out o;
+    int rc = -1;
+    if (!p || p->failed)
+        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: out of memory", pd->dir, name);
+    else if (rch_plot_open(&o, pd, name, d) == 0)
+        rc = rch_plot_close(&o, pd, rch_plot_write_svg_stream(p, o.f) != 0, d);
     rch_plot_free(p);
     return rc;
 }
