@@ -85,7 +85,7 @@ static void test_compare_run(void **state)
             continue;
         assert_true(a.row[r].rmse_mm.n == 2.0);
         /* the per-case table is what the statistics were built from */
-        const double m = 0.5 * (a.case_rmse_mm[r] + a.case_rmse_mm[RCH_COMPARE_ROWS + (size_t)r]);
+        const double m = 0.5 * (a.cell[r].held_out.rmse_mm + a.cell[RCH_COMPARE_ROWS + (size_t)r].held_out.rmse_mm);
         assert_true(fabs(m - a.row[r].rmse_mm.mean) < 1e-12);
         assert_true(a.row[r].mean_abs_mm.mean <= a.row[r].rmse_mm.mean + 1e-12);
         assert_true(a.row[r].max_mm.mean >= a.row[r].rmse_mm.mean - 1e-12);
@@ -94,7 +94,8 @@ static void test_compare_run(void **state)
             assert_true(isfinite(a.err_case1_mm[(size_t)r * a.n_test]));
         }
     }
-    assert_true(isnan(a.case_rmse_mm[RCH_EST_PF + 1]));
+    assert_false(a.cell[RCH_EST_PF + 1].ok); /* not run */
+    assert_int_equal(a.row[RCH_EST_PF + 1].failed, 0);
     const double bc = a.row[0].rmse_mm.mean;
     assert_true(bc > 0.2);
     assert_true(a.row[RCH_EST_LM + 1].rmse_mm.mean < 0.5 * bc);
@@ -105,7 +106,9 @@ static void test_compare_run(void **state)
     cfg.curves = 0;
     assert_int_equal(rch_compare_run(&b, &cfg, &g_robot, g_s, NS, NULL, &d), 0);
     for (size_t k = 0; k < 2 * RCH_COMPARE_ROWS; ++k)
-        assert_true(a.case_rmse_mm[k] == b.case_rmse_mm[k] || (isnan(a.case_rmse_mm[k]) && isnan(b.case_rmse_mm[k])));
+        assert_true(a.cell[k].ok == b.cell[k].ok && a.cell[k].held_out.rmse_mm == b.cell[k].held_out.rmse_mm &&
+                    a.cell[k].held_out.max_mm == b.cell[k].held_out.max_mm &&
+                    a.cell[k].iterations == b.cell[k].iterations);
     assert_int_equal(b.curve[RCH_EST_LM].n, 0);
     /* JSON: valid, every method run present */
     {

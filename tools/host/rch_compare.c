@@ -71,9 +71,10 @@ void rch_compare_free(rch_compare_result *res)
 {
     for (int id = 0; id < RCH_EST_COUNT; ++id)
         rch_curve_free(&res->curve[id]);
-    free(res->case_rmse_mm);
+    free(res->cell);
     free(res->err_case1_mm);
-    res->case_rmse_mm = res->err_case1_mm = NULL;
+    res->cell = NULL;
+    res->err_case1_mm = NULL;
 }
 
 /* err (n): model - measured length of every sample, NaN where m fails. */
@@ -85,11 +86,29 @@ static void sample_errors(double *err, const rc_model *m, const rc_sample *s, si
     }
 }
 
-static void add_metrics(rch_compare_row *r, const rc_metrics *m)
+/* Row statistics over the cases, from the per-case cells (ok cells only). */
+static void summarise(rch_compare_result *res)
 {
-    rch_stat_add(&r->rmse_mm, m->rmse_mm);
-    rch_stat_add(&r->mean_abs_mm, m->mean_abs_mm);
-    rch_stat_add(&r->max_mm, m->max_mm);
+    for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
+        rch_compare_row *row = &res->row[r];
+        for (unsigned long c = 0; c < res->cases && row->used; ++c) {
+            const rch_compare_cell *e = &res->cell[c * RCH_COMPARE_ROWS + (size_t)r];
+            if (!e->ok) {
+                row->failed++;
+                continue;
+            }
+            rch_stat_add(&row->rmse_mm, e->held_out.rmse_mm);
+            rch_stat_add(&row->mean_abs_mm, e->held_out.mean_abs_mm);
+            rch_stat_add(&row->max_mm, e->held_out.max_mm);
+            if (isfinite(e->train_rmse_mm))
+                rch_stat_add(&row->train_rmse_mm, e->train_rmse_mm);
+            if (r == 0)
+                continue; /* BC: no identification */
+            rch_stat_add(&row->time_ms, e->time_ms);
+            rch_stat_add(&row->iterations, (double)e->iterations);
+            rch_stat_add(&row->cost_evals, (double)e->cost_evals);
+        }
+    }
 }
 
 static void add_ltlm(rch_compare_result *res, const rc_model *m)
@@ -102,51 +121,45 @@ static void add_ltlm(rch_compare_result *res, const rc_model *m)
     res->n_ltlm++;
 }
 
-/* Case c: BC from the training part, then every selected method from it. */
+/* Case c: BC from the training part, then every selected method from it;
+ * one cell per row. */
 static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_est_ws *ws,
                     const rch_robot *robot, const rch_holdout *h, unsigned long c, FILE *progress, rch_diag *d)
 {
     const unsigned long long cseed = cfg->seed * 1000003ull + c;
-    double *row_rmse = res->case_rmse_mm + c * RCH_COMPARE_ROWS;
+    rch_compare_cell *cell = res->cell + c * RCH_COMPARE_ROWS;
     const int first = c == 0 && cfg->curves;
     rc_model start;
-    rc_metrics mt, trm;
+    rc_metrics trm;
     if (rch_calib_start(&start, &ws->solve, robot, h->train, h->n_train, d) != 0)
         return -1;
-    if (rc_eval(&mt, &start, h->test, h->n_test) != RC_OK) {
+    if (rc_eval(&cell[0].held_out, &start, h->test, h->n_test) != RC_OK) {
         rch_diag_set(d, "", 0, 0, "the start model cannot be evaluated on the held-out samples");
         return -1;
     }
-    res->row[0].used = 1;
-    add_metrics(&res->row[0], &mt);
-    if (rc_eval(&trm, &start, h->train, h->n_train) == RC_OK)
-        rch_stat_add(&res->row[0].train_rmse_mm, trm.rmse_mm);
-    row_rmse[0] = mt.rmse_mm;
+    cell[0].ok = 1;
+    cell[0].train_rmse_mm = rc_eval(&trm, &start, h->train, h->n_train) == RC_OK ? trm.rmse_mm : NAN;
     if (first)
         sample_errors(res->err_case1_mm, &start, h->test, h->n_test);
     for (int id = 0; id < RCH_EST_COUNT; ++id) {
-        rch_compare_row *r = &res->row[id + 1];
+        rch_compare_cell *e = &cell[id + 1];
         rc_model m = start;
         rch_est_out out;
-        rc_metrics me;
         if (!cfg->run[id])
             continue;
-        r->used = 1;
         rc_status st = rch_est_run(&m, &out, first ? &res->curve[id] : NULL, ws, (rch_est_id)id, cseed, NULL,
                                    h->train, h->n_train);
-        if (st != RC_OK || rc_eval(&me, &m, h->test, h->n_test) != RC_OK) {
+        if (st != RC_OK || rc_eval(&e->held_out, &m, h->test, h->n_test) != RC_OK) {
             if (progress)
                 fprintf(progress, "rcal compare: case %lu: %s failed: %s\n", c + 1, rch_est_name((rch_est_id)id),
                         rc_strerror(st));
-            r->failed++;
             continue;
         }
-        add_metrics(r, &me);
-        rch_stat_add(&r->time_ms, out.time_ms);
-        rch_stat_add(&r->train_rmse_mm, out.rms_final_mm);
-        rch_stat_add(&r->iterations, (double)out.iterations);
-        rch_stat_add(&r->cost_evals, (double)out.cost_evals);
-        row_rmse[id + 1] = me.rmse_mm;
+        e->ok = 1;
+        e->time_ms = out.time_ms;
+        e->train_rmse_mm = out.rms_final_mm;
+        e->iterations = out.iterations;
+        e->cost_evals = out.cost_evals;
         if (id == RCH_EST_LTLM)
             add_ltlm(res, &m);
         if (first)
@@ -195,14 +208,15 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
     int rc = -1;
     size_t *idx = malloc((n ? n : 1) * sizeof *idx);
     rch_est_ws *ws = rch_est_ws_new();
-    res->case_rmse_mm = malloc(cfg->cases * RCH_COMPARE_ROWS * sizeof(double));
+    res->cell = calloc(cfg->cases * RCH_COMPARE_ROWS, sizeof *res->cell);
     res->err_case1_mm = malloc(RCH_COMPARE_ROWS * res->n_test * sizeof(double));
-    if (!idx || !ws || !res->case_rmse_mm || !res->err_case1_mm) {
+    if (!idx || !ws || !res->cell || !res->err_case1_mm) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
-    for (size_t k = 0; k < cfg->cases * RCH_COMPARE_ROWS; ++k)
-        res->case_rmse_mm[k] = NAN;
+    res->row[0].used = 1;
+    for (int id = 0; id < RCH_EST_COUNT; ++id)
+        res->row[id + 1].used = cfg->run[id] != 0;
     for (size_t k = 0; k < RCH_COMPARE_ROWS * res->n_test; ++k)
         res->err_case1_mm[k] = NAN;
     for (unsigned long c = 0; c < cfg->cases; ++c) {
@@ -223,6 +237,7 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
         if (progress)
             fprintf(progress, "case %lu/%lu done\n", c + 1, cfg->cases);
     }
+    summarise(res);
     rc = 0;
 done:
     rch_est_ws_free(ws);
@@ -360,8 +375,10 @@ int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_c
     for (unsigned long c = 0; c < res->cases; ++c) {
         rch_jw_arr(&w, NULL);
         for (int r = 0; r < RCH_COMPARE_ROWS; ++r)
-            if (res->row[r].used)
-                rch_jw_numf(&w, NULL, res->case_rmse_mm[c * RCH_COMPARE_ROWS + (size_t)r], "%.6f");
+            if (res->row[r].used) {
+                const rch_compare_cell *e = &res->cell[c * RCH_COMPARE_ROWS + (size_t)r];
+                rch_jw_numf(&w, NULL, e->ok ? e->held_out.rmse_mm : NAN, "%.6f");
+            }
         rch_jw_end(&w);
     }
     rch_jw_end(&w);

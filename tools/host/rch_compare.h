@@ -58,6 +58,16 @@ void rch_compare_defaults(rch_compare_config *cfg);
  * list, an empty name or an unknown name is refused: -1 with d set. */
 int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d);
 
+/* One row (BC or a method) in one case. */
+typedef struct rch_compare_cell {
+    int ok;                   /* ran and succeeded (0: not run, or failed) */
+    rc_metrics held_out;      /* on the case's held-out samples */
+    double train_rmse_mm;     /* training RMS at the end (NaN when it could not be evaluated) */
+    double time_ms;           /* the identification alone (methods only) */
+    unsigned iterations, cost_evals; /* methods only */
+} rch_compare_cell;
+
+/* Statistics of one row over the cases where it succeeded. */
 typedef struct rch_compare_row {
     int used;            /* the row was run */
     unsigned failed;     /* cases where the method failed (not counted in the stats) */
@@ -71,7 +81,7 @@ typedef struct rch_compare_result {
     unsigned long cases;
     size_t n_draw, n_train, n_test;
     rch_compare_row row[RCH_COMPARE_ROWS];
-    double *case_rmse_mm;  /* (cases x RCH_COMPARE_ROWS) held-out RMSE; NaN where failed or not run */
+    rch_compare_cell *cell; /* (cases x RCH_COMPARE_ROWS) every row in every case, row-major by case */
     /* LTLM parameters over the cases where it succeeded (the paper's Table 7):
      * dh[j][0..3] = a (mm), d (mm), alpha (deg), theta (deg) of joint j; enc_mm[k] = e_x, e_y, e_z. */
     unsigned n_ltlm;
