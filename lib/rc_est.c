@@ -386,11 +386,16 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
     const unsigned nf = c->nf;
     const double res_mm = cfg->resolution_mm > 0.0 ? cfg->resolution_mm : 0.004;
     const double sig = cfg->noise_mm > 0.0 ? cfg->noise_mm : res_mm / sqrt(12.0);
-    const double R = sig * sig;
+    const double alpha = cfg->ekf_alpha > 0.0 ? (cfg->ekf_alpha < 1.0 ? cfg->ekf_alpha : 1.0) : 0.3;
     const double q = cfg->ekf_q > 0.0 ? cfg->ekf_q : 1e-9;
     const double tol = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-10;
     double *h = w->g, *Ph = w->dx, *K = w->v, *Mh = w->D;
     double prev = c->best_cost;
+    /* R starts at the caller's noise, else at the start's mean squared
+     * residual (what the residual-based rule would converge to at x0) */
+    double R = cfg->noise_mm > 0.0 ? sig * sig : c->best_cost / (double)c->n;
+    if (!(R >= sig * sig))
+        R = sig * sig;
     rc_model *x = &w->trial; /* the filter state lives in a model */
     *x = *m;
     for (unsigned pass = 0; pass < T; ++pass) {
@@ -398,7 +403,7 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
         for (unsigned j = 0; j < nf; ++j)
             w->P[(size_t)j * nf + j] = w->bound[j] * w->bound[j];
         for (size_t s = 0; s < c->n; ++s) {
-            double l, S = R;
+            double l, hph = 0.0;
             if (rc_meas(&l, w->jrow, x, &c->s[s]) != RC_OK)
                 continue; /* degenerate sample: no information */
             const double innov = c->s[s].len_mm - l;
@@ -411,8 +416,9 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
                 for (unsigned k = 0; k < nf; ++k)
                     acc += w->P[(size_t)i * nf + k] * h[k];
                 Ph[i] = acc;
-                S += h[i] * acc;
+                hph += h[i] * acc;
             }
+            const double S = hph + R;
             if (!(S > 0.0) || !isfinite(S))
                 return RC_ERR_NUMERIC;
             for (unsigned i = 0; i < nf; ++i) {
@@ -436,12 +442,22 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
                     const double b = w->T[(size_t)k * nf + i] - Mh[k] * K[i] + R * K[k] * K[i];
                     w->P[(size_t)i * nf + k] = w->P[(size_t)k * nf + i] = 0.5 * (a + b);
                 }
+            /* Residual-based adaptive measurement noise: the post-update
+             * residual eps = innov R / S and h^T P+ h = hph R / S (both exact
+             * for the linearised measurement) give
+             * R <- alpha R + (1 - alpha) (eps^2 + h^T P+ h). */
+            {
+                const double eps = innov * R / S;
+                R = alpha * R + (1.0 - alpha) * (eps * eps + hph * R / S);
+                if (!(R > 1e-300) || !isfinite(R))
+                    R = sig * sig;
+            }
         }
         double cost;
         ++c->res->cost_evals;
         rc_status st = rc_cost(&cost, x, c->s, c->n);
-        if (st == RC_OK && cost < c->best_cost) {
-            c->best_cost = cost;
+        if (st == RC_OK) {
+            c->best_cost = cost; /* the filter's estimate after this pass */
             w->best = *x;
         }
         c->res->iterations = pass + 1;

@@ -27,16 +27,24 @@
  * prior standard deviation.
  *
  * The methods and their hyperparameters (defaults when the config field is 0):
- *  - RC_EST_EKF: extended Kalman filter, state = the parameters, constant
- *    model with process noise Q = ekf_q * P0 per measurement (0: 1e-9),
- *    P0 = diag(bound_j^2). Each cable length is a scalar measurement with
- *    R = noise_mm^2 (0: resolution_mm / sqrt(12), resolution 0: 0.004 mm),
- *    Jacobian row from rc_meas at the current state, Joseph-form covariance
- *    update (symmetrised). Sequential updates over the training samples in
- *    their order; max_iter passes (0: 10). Each pass restarts from P0 at the
- *    current state (re-linearised; no sample counted twice in one
- *    covariance); the best pass (training cost) is returned; stops early
- *    when a pass lowers the cost by less than tol_cost (0: 1e-10) relative.
+ *  - RC_EST_EKF: extended Kalman filter with a residual-based adaptive
+ *    measurement noise (the paper's M2 cites an adaptive-residual EKF, its
+ *    ref. 10; we use the residual-based rule of Akhlaghi, Zhou & Huang 2017).
+ *    State = the parameters, constant model with process noise
+ *    Q = ekf_q * P0 per measurement (0: 1e-9), P0 = diag(bound_j^2). Each
+ *    cable length is a scalar measurement, Jacobian row h from rc_meas at
+ *    the current state, Joseph-form covariance update (symmetrised). After
+ *    each update the measurement variance adapts to the post-update residual
+ *    eps = innov R / S: R <- ekf_alpha R + (1 - ekf_alpha) (eps^2 + h^T P h)
+ *    with P the updated covariance (ekf_alpha 0: 0.3); R starts at
+ *    noise_mm^2 when noise_mm is given, else at the start's mean squared
+ *    residual, never below (resolution_mm / sqrt(12))^2 (resolution 0:
+ *    0.004 mm), and carries over from pass to pass. Sequential updates over the training
+ *    samples in their order; max_iter passes (0: 10). Each pass restarts
+ *    from P0 at the current state (re-linearised; no sample counted twice
+ *    in one covariance); the state after the last pass is returned (the
+ *    curve shows every pass); stops early when a pass lowers the cost by
+ *    less than tol_cost (0: 1e-10) relative.
  *  - RC_EST_PF: regularised particle filter. pop particles (0: 100) drawn
  *    around the start (normalised sd 1/3, clamped to the box; particle 0 is
  *    the start). Each of max_iter passes (0: 100) over the training samples:
@@ -117,6 +125,7 @@ typedef struct rc_est_config {
     double noise_mm;        /* EKF measurement sd; 0: resolution_mm / sqrt(12) */
     double resolution_mm;   /* encoder resolution; 0: 0.004 mm */
     double ekf_q;           /* EKF process noise per update, relative to P0; 0: 1e-9 */
+    double ekf_alpha;       /* EKF forgetting factor of the adaptive R, (0, 1]; 0: 0.3; 1: R fixed */
     double qibas_d0;        /* QIBAS initial antenna length (normalised); 0: 0.2 */
     double tol_cost;        /* relative cost decrease to stop (EKF, SSLM); 0: 1e-10 */
     double subset_tol;      /* identifiable-subset threshold; 0: 1e-8 */

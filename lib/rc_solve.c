@@ -7,15 +7,37 @@
 #include "rc_linalg.h"
 #include "rc_rand.h"
 
+static const struct {
+    rc_method method;
+    const char *name;
+} method_names[] = {
+    {RC_METHOD_LM, "lm"},
+    {RC_METHOD_LTLM, "ltlm"},
+    {RC_METHOD_LM_PAPER, "lm-paper"},
+    {RC_METHOD_LTLM_PAPER, "ltlm-paper"},
+    {RC_METHOD_LM_PAPER_DEG, "lm-paper-deg"},
+    {RC_METHOD_LTLM_PAPER_DEG, "ltlm-paper-deg"},
+};
+
 const char *rc_method_name(rc_method method)
 {
-    switch (method) {
-    case RC_METHOD_LM: return "lm";
-    case RC_METHOD_LTLM: return "ltlm";
-    case RC_METHOD_LM_PAPER: return "lm-paper";
-    case RC_METHOD_LTLM_PAPER: return "ltlm-paper";
-    }
+    for (size_t i = 0; i < sizeof method_names / sizeof method_names[0]; ++i)
+        if (method_names[i].method == method)
+            return method_names[i].name;
     return "unknown";
+}
+
+rc_status rc_method_from_name(rc_method *out, const char *name)
+{
+    RC_ASSERT(out != NULL);
+    if (name == NULL)
+        return RC_ERR_ARG;
+    for (size_t i = 0; i < sizeof method_names / sizeof method_names[0]; ++i)
+        if (strcmp(method_names[i].name, name) == 0) {
+            *out = method_names[i].method;
+            return RC_OK;
+        }
+    return RC_ERR_ARG;
 }
 
 const char *rc_exit_str(rc_exit e)
@@ -119,49 +141,112 @@ static void apply_step(rc_model *trial, const rc_model *base, const rc_solve_wor
 
 static double rms_of(double cost, size_t n) { return sqrt(cost / (double)n); }
 
-/* LTLM, after the LM candidate cand (cost *cand_cost) was formed from the
- * step dx (scaled): map M chaotic sequences into the interval
- * cand +- span*|dx_i| per free parameter and keep the best point.
- * Returns 1 when a chaotic candidate beat the LM candidate. */
-static int ltlm_candidates(rc_model *cand, double *cand_cost, rc_solve_work *w, unsigned nf,
-                           const rc_solve_config *cfg, const rc_sample *samples, size_t n,
-                           unsigned *evals)
+static void ltlm_report(const rc_solve_config *cfg, unsigned iter, rc_ltlm_point kind, unsigned mi,
+                        double n_m, const rc_model *x, double cost)
+{
+    rc_ltlm_event ev;
+    if (cfg->on_ltlm == NULL)
+        return;
+    ev.iter = iter;
+    ev.kind = kind;
+    ev.m = mi;
+    ev.n_m = n_m;
+    ev.x = x;
+    ev.cost_mm2 = cost;
+    cfg->on_ltlm(cfg->cb_ctx, &ev);
+}
+
+/* N_0 of the scalar chaotic sequence: the caller's, or drawn from the seed. */
+static double ltlm_n0(const rc_solve_config *cfg)
+{
+    rc_rng g;
+    if (cfg->chaos_n0 > 0.0 && cfg->chaos_n0 < 1.0)
+        return cfg->chaos_n0;
+    rc_rng_seed(&g, cfg->seed ^ 0x4C544C4Dull);
+    return 0.05 + 0.9 * rc_rng_u01(&g);
+}
+
+/* Algorithm I steps 9-15. In: x_k (xk), x1 with its cost c1, x2 on the free
+ * parameters (w->lt_x2, nf), the sequence state *chaos_n (N_{m-1}).
+ * Forms a and b (w->lt_a, w->lt_b), continues the sequence by M values and
+ * evaluates xl(m) = x1 - (x1 - a) N_m and xr(m) = x1 + (x2 - b) N_m in the
+ * order xl(1), xr(1), xl(2), ...; *best (cost *best_cost) = the strict
+ * minimum of {x1, xl, xr} (ties keep the earlier point). skip_flat: do not
+ * evaluate a segment of zero length (its candidates all equal x1).
+ * Returns 1 when a candidate beat x1. */
+static int ltlm_segments(rc_model *best, double *best_cost, const rc_model *xk, const rc_model *x1,
+                         double c1, rc_solve_work *w, unsigned nf, const rc_solve_config *cfg,
+                         double *chaos_n, unsigned iter, int skip_flat, const rc_sample *samples,
+                         size_t n, unsigned *evals)
 {
     const unsigned M = cfg->n_candidates ? cfg->n_candidates : 10u;
     const double r = cfg->chaos_r > 0.0 ? cfg->chaos_r : 0.5;
-    const double span = cfg->ltlm_span > 0.0 ? cfg->ltlm_span : 1.0;
-    int won = 0;
-    w->best = *cand;
-    for (unsigned k = 0; k < M; ++k) {
-        rc_model *t = &w->cand;
-        *t = w->best;
-        for (unsigned i = 0; i < nf; ++i) {
-            w->chaos[i] = rc_lt_map(w->chaos[i], r);
-            /* guard against the map's fixed points and cycles collapsing */
-            if (w->chaos[i] < 1e-9 || w->chaos[i] > 1.0 - 1e-9)
-                w->chaos[i] = 0.5 * (w->chaos[i] + 0.123456789);
-            const double half = span * fabs(w->dx[i]) / w->D[i];
-            t->x[w->idx[i]] = cand->x[w->idx[i]] + (2.0 * w->chaos[i] - 1.0) * half;
-        }
-        double c;
-        ++*evals;
-        if (rc_cost(&c, t, samples, n) == RC_OK && c < *cand_cost) {
-            *cand_cost = c;
-            w->best = *t;
-            won = 1;
+    int won = 0, flat_l = 1, flat_r = 1;
+    for (unsigned i = 0; i < nf; ++i) {
+        const double v1 = x1->x[w->idx[i]];
+        w->lt_a[i] = 0.5 * (xk->x[w->idx[i]] + v1);
+        w->lt_b[i] = 0.5 * (v1 + w->lt_x2[i]);
+        flat_l &= w->lt_a[i] == v1;
+        flat_r &= w->lt_b[i] == v1;
+    }
+    if (cfg->on_ltlm != NULL) {
+        const double *pts[3] = {w->lt_x2, w->lt_a, w->lt_b};
+        static const rc_ltlm_point kinds[3] = {RC_LTLM_X2, RC_LTLM_A, RC_LTLM_B};
+        ltlm_report(cfg, iter, RC_LTLM_X1, 0, 0.0, x1, c1);
+        for (unsigned p = 0; p < 3; ++p) {
+            w->cand = *x1;
+            for (unsigned i = 0; i < nf; ++i)
+                w->cand.x[w->idx[i]] = pts[p][i];
+            ltlm_report(cfg, iter, kinds[p], 0, 0.0, &w->cand, -1.0);
         }
     }
-    if (won)
-        *cand = w->best;
+    *best = *x1;
+    *best_cost = c1;
+    for (unsigned mi = 1; mi <= M; ++mi) {
+        const double nm = rc_lt_map(*chaos_n, r);
+        *chaos_n = nm;
+        for (unsigned side = 0; side < 2; ++side) {
+            if (skip_flat && (side == 0 ? flat_l : flat_r))
+                continue;
+            rc_model *t = &w->cand;
+            *t = *x1;
+            for (unsigned i = 0; i < nf; ++i) {
+                const double v1 = x1->x[w->idx[i]];
+                t->x[w->idx[i]] = side == 0 ? v1 - (v1 - w->lt_a[i]) * nm /* Eq. 16 */
+                                            : v1 + (w->lt_x2[i] - w->lt_b[i]) * nm; /* Eq. 17 */
+            }
+            double c;
+            ++*evals;
+            const int ok = rc_cost(&c, t, samples, n) == RC_OK;
+            ltlm_report(cfg, iter, side == 0 ? RC_LTLM_XL : RC_LTLM_XR, mi, nm, t, ok ? c : -1.0);
+            if (ok && c < *best_cost) { /* Eq. 18 */
+                *best_cost = c;
+                *best = *t;
+                won = 1;
+            }
+        }
+    }
+    ltlm_report(cfg, iter, RC_LTLM_CHOSEN, 0, 0.0, best, *best_cost);
     return won;
 }
 
-static void chaos_init(rc_solve_work *w, unsigned nf, uint64_t seed)
+/* Eq. 10 in the variables u = D x: dx (nf, in u) = -(A_s + mu I)^-1 g_s with
+ * A_s = D^-1 A D^-1, g_s = D^-1 g (A, g are overwritten). */
+static rc_status paper_step(double *dx, rc_solve_work *w, unsigned nf, double mu)
 {
-    rc_rng g;
-    rc_rng_seed(&g, seed ^ 0x4C544C4Dull);
-    for (unsigned i = 0; i < nf; ++i)
-        w->chaos[i] = 0.05 + 0.9 * rc_rng_u01(&g);
+    for (unsigned i = 0; i < nf; ++i) {
+        for (unsigned k = 0; k < nf; ++k)
+            w->A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
+        w->A[(size_t)i * nf + i] += mu;
+        dx[i] = -w->g[i] / w->D[i];
+    }
+    return rcu_chol_solve(w->A, dx, nf);
+}
+
+static int method_is_paper(rc_method mt)
+{
+    return mt == RC_METHOD_LM_PAPER || mt == RC_METHOD_LTLM_PAPER || mt == RC_METHOD_LM_PAPER_DEG ||
+           mt == RC_METHOD_LTLM_PAPER_DEG;
 }
 
 static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w,
@@ -170,12 +255,12 @@ static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w
 {
     const double mu = cfg->mu0 > 0.0 ? cfg->mu0 : 5.0;
     const unsigned max_iter = cfg->max_iter ? cfg->max_iter : 50u;
-    const int ltlm = cfg->method == RC_METHOD_LTLM_PAPER;
-    double cost = 0.0;
+    const int ltlm = cfg->method == RC_METHOD_LTLM_PAPER || cfg->method == RC_METHOD_LTLM_PAPER_DEG;
+    const int deg = cfg->method == RC_METHOD_LM_PAPER_DEG || cfg->method == RC_METHOD_LTLM_PAPER_DEG;
+    double cost = 0.0, chaos_n = ltlm ? ltlm_n0(cfg) : 0.0;
+    /* raw units, as Eq. 10 is written; the -deg variants count angles in degrees */
     for (unsigned i = 0; i < nf; ++i)
-        w->D[i] = 1.0; /* raw units, as Eq. 10 is written */
-    if (ltlm)
-        chaos_init(w, nf, cfg->seed);
+        w->D[i] = deg && rc_param_unit(m, w->idx[i]) == 1 ? 180.0 / 3.14159265358979323846 : 1.0;
     res->exit = RC_EXIT_MAX_ITER;
     for (unsigned it = 0; it < max_iter; ++it) {
         rc_status st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
@@ -186,30 +271,39 @@ static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w
         }
         if (it == 0)
             res->rms_start_mm = rms_of(cost, n);
-        for (unsigned i = 0; i < nf; ++i) {
-            w->A[(size_t)i * nf + i] += mu;
-            w->dx[i] = -w->g[i];
-        }
-        if (rcu_chol_solve(w->A, w->dx, nf) != RC_OK) {
+        if (paper_step(w->dx, w, nf, mu) != RC_OK) { /* Eq. 13 */
             res->exit = RC_EXIT_NONFINITE;
             break;
         }
-        apply_step(&w->trial, m, w, nf, w->dx);
-        if (ltlm) {
-            double c;
-            ++res->cost_evals;
-            if (rc_cost(&c, &w->trial, samples, n) == RC_OK &&
-                ltlm_candidates(&w->trial, &c, w, nf, cfg, samples, n, &res->cost_evals))
-                ++res->ltlm_wins;
-        }
-        *m = w->trial; /* no acceptance test: Eq. 10 as written */
-        res->iterations = it + 1;
+        apply_step(&w->trial, m, w, nf, w->dx); /* x1 */
         double c2;
-        if (rc_cost(&c2, m, samples, n) != RC_OK) {
-            res->exit = RC_EXIT_NONFINITE;
-            return RC_OK;
+        if (ltlm) {
+            double c1;
+            /* Eq. 14: a new Jacobian at x1, the same fixed mu */
+            st = rc_normal_eq(w->A, w->g, &c1, w->jrow, &w->trial, w->idx, nf, samples, n);
+            ++res->cost_evals;
+            if (st != RC_OK || paper_step(w->lt_x2, w, nf, mu) != RC_OK) {
+                *m = w->trial;
+                res->iterations = it + 1;
+                res->exit = RC_EXIT_NONFINITE;
+                return RC_OK;
+            }
+            for (unsigned i = 0; i < nf; ++i)
+                w->lt_x2[i] = w->trial.x[w->idx[i]] + w->lt_x2[i] / w->D[i];
+            if (ltlm_segments(&w->best, &c2, m, &w->trial, c1, w, nf, cfg, &chaos_n, it + 1, 0, samples,
+                              n, &res->cost_evals))
+                ++res->ltlm_wins;
+            *m = w->best; /* no acceptance test: x_k is not among the candidates */
+        } else {
+            *m = w->trial; /* no acceptance test: Eq. 10 as written */
+            if (rc_cost(&c2, m, samples, n) != RC_OK) {
+                res->iterations = it + 1;
+                res->exit = RC_EXIT_NONFINITE;
+                return RC_OK;
+            }
+            ++res->cost_evals;
         }
-        ++res->cost_evals;
+        res->iterations = it + 1;
         res->rms_final_mm = rms_of(c2, n);
         if (cfg->on_iter)
             cfg->on_iter(cfg->cb_ctx, it + 1, res->rms_final_mm, m);
@@ -222,6 +316,72 @@ static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w
         }
     }
     return RC_OK;
+}
+
+/* Robust LM, the subspace: scale the normal equations at the current point
+ * (w->A, w->g unscaled, cost) by D, take the eigen-decomposition (w->ev,
+ * w->V) and keep the identifiable directions (eigenvalue above rcond *
+ * largest: *rank of them) whose Gauss-Newton step is significant: w->c[k] =
+ * v_k^T g_s for those, 0 for the others; *gnorm = sum of the kept c^2. */
+static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_work *w, unsigned nf,
+                             double cost, size_t n, double rcond, double snr_min)
+{
+    /* scale: A_s = D^-1 A D^-1, g_s = D^-1 g */
+    for (unsigned i = 0; i < nf; ++i) {
+        w->g[i] /= w->D[i];
+        for (unsigned k = 0; k < nf; ++k)
+            w->A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
+    }
+    rc_status st = rcu_eig_sym(w->ev, w->V, w->A, nf, 0);
+    if (st == RC_ERR_NUMERIC)
+        return st;
+    const double lmax = w->ev[0];
+    if (!(lmax > 0.0))
+        return RC_ERR_RANK;
+    unsigned rank = 0;
+    double gnorm = 0.0, gn_gain = 0.0;
+    for (unsigned k = 0; k < nf; ++k) {
+        if (w->ev[k] <= rcond * lmax)
+            break;
+        ++rank;
+        double c = 0.0;
+        for (unsigned i = 0; i < nf; ++i)
+            c += w->V[(size_t)i * nf + k] * w->g[i];
+        w->c[k] = c;
+        gn_gain += c * c / w->ev[k];
+    }
+    /* Significance: the Gauss-Newton step along v_k is -c/lambda with
+     * standard error sigma/sqrt(lambda); below snr_min standard errors the
+     * data cannot resolve it from noise, so it is not taken. sigma^2 is
+     * the residual the full Gauss-Newton step predicts, per degree of
+     * freedom (the current residual would overstate it far from the
+     * solution and stop a small data set at its first iteration). */
+    const double resid = cost - gn_gain > 1e-12 * cost ? cost - gn_gain : 1e-12 * cost;
+    const double sigma2 = n > rank ? resid / (double)(n - rank) : 0.0;
+    for (unsigned k = 0; k < rank; ++k) {
+        if (snr_min > 0.0 && sigma2 > 0.0 && w->c[k] * w->c[k] < snr_min * snr_min * sigma2 * w->ev[k])
+            w->c[k] = 0.0;
+        gnorm += w->c[k] * w->c[k];
+    }
+    *rank_out = rank;
+    *gnorm_out = gnorm;
+    return RC_OK;
+}
+
+/* Robust LM, the damped step in the kept subspace: dx (nf, scaled) =
+ * sum_k -c_k / (lambda_k + mu) v_k; returns the predicted cost decrease. */
+static double lm_subspace_step(double *dx, const rc_solve_work *w, unsigned nf, unsigned rank, double mu)
+{
+    double pred = 0.0;
+    for (unsigned i = 0; i < nf; ++i)
+        dx[i] = 0.0;
+    for (unsigned k = 0; k < rank; ++k) {
+        const double lam = w->ev[k], coef = -w->c[k] / (lam + mu);
+        pred += -2.0 * coef * w->c[k] - lam * coef * coef;
+        for (unsigned i = 0; i < nf; ++i)
+            dx[i] += coef * w->V[(size_t)i * nf + k];
+    }
+    return pred;
 }
 
 rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
@@ -248,7 +408,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     if (nf == 0)
         return RC_ERR_RANK;
 
-    if (cfg->method == RC_METHOD_LM_PAPER || cfg->method == RC_METHOD_LTLM_PAPER) {
+    if (method_is_paper(cfg->method)) {
         const rc_status sp = solve_paper(m, res, w, cfg, nf, samples, n);
         rc_model_wrap_angles(m);
         return sp;
@@ -305,54 +465,26 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         const double a = w->A[(size_t)i * nf + i];
         w->D[i] = a > 1e-24 * dmax ? sqrt(a) : 1.0;
     }
-    if (ltlm)
-        chaos_init(w, nf, cfg->seed);
+    double chaos_n = ltlm ? ltlm_n0(cfg) : 0.0;
+    unsigned rank = 0;
+    double gnorm = 0.0;
+    int have_eig = 0; /* the decomposition at m is already in w (LTLM kept x1) */
 
     res->exit = RC_EXIT_MAX_ITER;
     for (unsigned it = 0; it < max_iter; ++it) {
-        if (it > 0) {
-            st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
-            ++res->cost_evals;
+        if (!have_eig) {
+            if (it > 0) {
+                st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+                ++res->cost_evals;
+                if (st != RC_OK)
+                    return st;
+            }
+            st = lm_subspace(&rank, &gnorm, w, nf, cost, n, rcond, snr_min);
             if (st != RC_OK)
                 return st;
         }
-        /* scale: A_s = D^-1 A D^-1, g_s = D^-1 g */
-        for (unsigned i = 0; i < nf; ++i) {
-            w->g[i] /= w->D[i];
-            for (unsigned k = 0; k < nf; ++k)
-                w->A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
-        }
-        st = rcu_eig_sym(w->ev, w->V, w->A, nf, 0);
-        if (st == RC_ERR_NUMERIC)
-            return st;
+        have_eig = 0;
         const double lmax = w->ev[0];
-        if (!(lmax > 0.0))
-            return RC_ERR_RANK;
-        unsigned rank = 0;
-        double gnorm = 0.0, gn_gain = 0.0;
-        for (unsigned k = 0; k < nf; ++k) {
-            if (w->ev[k] <= rcond * lmax)
-                break;
-            ++rank;
-            double c = 0.0;
-            for (unsigned i = 0; i < nf; ++i)
-                c += w->V[(size_t)i * nf + k] * w->g[i];
-            w->c[k] = c;
-            gn_gain += c * c / w->ev[k];
-        }
-        /* Significance: the Gauss-Newton step along v_k is -c/lambda with
-         * standard error sigma/sqrt(lambda); below snr_min standard errors the
-         * data cannot resolve it from noise, so it is not taken. sigma^2 is
-         * the residual the full Gauss-Newton step predicts, per degree of
-         * freedom (the current residual would overstate it far from the
-         * solution and stop a small data set at its first iteration). */
-        const double resid = cost - gn_gain > 1e-12 * cost ? cost - gn_gain : 1e-12 * cost;
-        const double sigma2 = n > rank ? resid / (double)(n - rank) : 0.0;
-        for (unsigned k = 0; k < rank; ++k) {
-            if (snr_min > 0.0 && sigma2 > 0.0 && w->c[k] * w->c[k] < snr_min * snr_min * sigma2 * w->ev[k])
-                w->c[k] = 0.0;
-            gnorm += w->c[k] * w->c[k];
-        }
         res->rank = rank;
         res->cond = sqrt(lmax / w->ev[rank - 1]);
         if (gnorm == 0.0 || sqrt(gnorm) <= 1e-14 * (cost + 1e-300)) {
@@ -364,15 +496,8 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
 
         int accepted = 0, done = 0;
         for (unsigned tries = 0; tries < 60 && !accepted; ++tries) {
-            double pred = 0.0, xs = 0.0, ds = 0.0;
-            for (unsigned i = 0; i < nf; ++i)
-                w->dx[i] = 0.0;
-            for (unsigned k = 0; k < rank; ++k) {
-                const double lam = w->ev[k], coef = -w->c[k] / (lam + mu);
-                pred += -2.0 * coef * w->c[k] - lam * coef * coef;
-                for (unsigned i = 0; i < nf; ++i)
-                    w->dx[i] += coef * w->V[(size_t)i * nf + k];
-            }
+            double xs = 0.0, ds = 0.0;
+            const double pred = lm_subspace_step(w->dx, w, nf, rank, mu);
             for (unsigned i = 0; i < nf; ++i) {
                 ds += w->dx[i] * w->dx[i];
                 xs += (m->x[w->idx[i]] * w->D[i]) * (m->x[w->idx[i]] * w->D[i]);
@@ -381,18 +506,43 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             double cnew;
             ++res->cost_evals;
             st = rc_cost(&cnew, &w->trial, samples, n);
-            if (st == RC_OK && ltlm &&
-                ltlm_candidates(&w->trial, &cnew, w, nf, cfg, samples, n, &res->cost_evals))
-                ++res->ltlm_wins;
             const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
             if (rho > 0.0) {
                 accepted = 1;
-                const double rel = (cost - cnew) / (cost + 1e-300);
-                *m = w->trial;
                 const double t = 2.0 * rho - 1.0;
                 double f = 1.0 - t * t * t;
                 mu *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
                 nu = 2.0;
+                if (ltlm) {
+                    /* Algorithm I on the accepted x1: x2 is the robust LM's
+                     * own next step from x1 (new normal equations, the
+                     * updated damping, the same truncation), so both
+                     * segments lie in subspaces the robust LM steps in. */
+                    double c1, cbest;
+                    st = rc_normal_eq(w->A, w->g, &c1, w->jrow, &w->trial, w->idx, nf, samples, n);
+                    ++res->cost_evals;
+                    if (st == RC_OK)
+                        st = lm_subspace(&rank, &gnorm, w, nf, c1, n, rcond, snr_min);
+                    if (st == RC_OK) {
+                        if (gnorm > 0.0)
+                            (void)lm_subspace_step(w->lt_x2, w, nf, rank, mu);
+                        else
+                            memset(w->lt_x2, 0, nf * sizeof w->lt_x2[0]);
+                        for (unsigned i = 0; i < nf; ++i)
+                            w->lt_x2[i] = w->trial.x[w->idx[i]] + w->lt_x2[i] / w->D[i];
+                        if (ltlm_segments(&w->best, &cbest, m, &w->trial, cnew, w, nf, cfg, &chaos_n,
+                                          it + 1, 1, samples, n, &res->cost_evals)) {
+                            ++res->ltlm_wins;
+                            w->trial = w->best;
+                            cnew = cbest;
+                        } else {
+                            have_eig = 1; /* x1 kept: its decomposition serves the next iteration */
+                            cnew = c1;
+                        }
+                    }
+                }
+                const double rel = (cost - cnew) / (cost + 1e-300);
+                *m = w->trial;
                 cost = cnew;
                 if (sqrt(ds) <= tol_step * (sqrt(xs) + tol_step) || rel < tol_cost) {
                     res->exit = sqrt(ds) <= tol_step * (sqrt(xs) + tol_step) ? RC_EXIT_SMALL_STEP

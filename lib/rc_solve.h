@@ -15,13 +15,30 @@
  *    and a direction is moved only while its step is significant against the
  *    residual noise (snr_min), which ends the slow creep along weakly
  *    identified directions that would only fit noise.
- *  - RC_METHOD_LTLM: the robust LM step, then M logistic-tent chaotic
- *    candidates in an interval around the LM candidate (paper Algorithm I);
- *    the best of LM candidate and chaotic candidates is kept if it lowers the
- *    cost.
+ *  - RC_METHOD_LTLM: the paper's Algorithm I construction on top of the
+ *    robust LM: x1 = an accepted robust LM step from x_k, x2 = the robust
+ *    LM's next step from x1 (new normal equations at x1, same damping and
+ *    eigen-truncation), a = (x_k + x1)/2, b = (x1 + x2)/2, M candidates on
+ *    the two segments from ONE scalar logistic-tent sequence; the best of
+ *    {x1, candidates} is kept. Both steps lie in the identifiable,
+ *    significant subspace, so no candidate moves along a direction the
+ *    robust LM excludes.
  *  - RC_METHOD_LM_PAPER: the paper's Eq. 10 verbatim: x <- x - (J^T J + mu I)^-1
- *    J^T r with fixed mu (default 5), raw units, no step acceptance.
- *  - RC_METHOD_LTLM_PAPER: Algorithm I on top of the paper's LM step.
+ *    J^T r with fixed mu (default 5), raw units (mm, rad), no step acceptance.
+ *  - RC_METHOD_LTLM_PAPER: Algorithm I literally (Eqs. 13-18): x1 and x2 are
+ *    two consecutive Eq. 10 steps (new Jacobian at x1), a and b the
+ *    midpoints, xl(m) = x1 - (x1 - a) N_m, xr(m) = x1 + (x2 - b) N_m for
+ *    m = 1..M with one scalar sequence N_m of Eq. 11, and x_{k+1} = the best
+ *    of {xl(m), xr(m), x1} (x_k itself is not a candidate: the cost may rise).
+ *    Left open by the paper, chosen here: M = n_candidates (10), K = max_iter
+ *    (50), N_0 = chaos_n0 (drawn from seed in (0.05, 0.95) when 0), and the
+ *    sequence continues across iterations (iteration k uses N_{(k-1)M+1} ..
+ *    N_{kM}); ties keep the earlier point in the order x1, xl(1), xr(1),
+ *    xl(2), ...
+ *  - RC_METHOD_LM_PAPER_DEG, RC_METHOD_LTLM_PAPER_DEG: the same with the
+ *    angles measured in degrees inside Eq. 10 (J columns of angles divided
+ *    by 180/pi, steps multiplied back), the likely reading of mu = 5 since
+ *    the paper reports angles in degrees (Table 7).
  *
  * Memory: rc_solve_work is large (two RC_MAX_PARAMS^2 matrices); callers own
  * it (static or heap on the host). Thread safety: reentrant.
@@ -38,8 +55,32 @@ typedef enum rc_method {
     RC_METHOD_LM = 0,
     RC_METHOD_LTLM = 1,
     RC_METHOD_LM_PAPER = 2,
-    RC_METHOD_LTLM_PAPER = 3
+    RC_METHOD_LTLM_PAPER = 3,
+    RC_METHOD_LM_PAPER_DEG = 4,
+    RC_METHOD_LTLM_PAPER_DEG = 5
 } rc_method;
+
+/* Points of one LTLM iteration, reported to rc_solve_config.on_ltlm. */
+typedef enum rc_ltlm_point {
+    RC_LTLM_X1 = 0,     /* x_{k+1,1}: one LM step from x_k */
+    RC_LTLM_X2 = 1,     /* x_{k+1,2}: the next LM step from x1 (cost not evaluated: -1) */
+    RC_LTLM_A = 2,      /* a = (x_k + x1)/2 (cost not evaluated: -1) */
+    RC_LTLM_B = 3,      /* b = (x1 + x2)/2 (cost not evaluated: -1) */
+    RC_LTLM_XL = 4,     /* xl(m) = x1 - (x1 - a) N_m */
+    RC_LTLM_XR = 5,     /* xr(m) = x1 + (x2 - b) N_m */
+    RC_LTLM_CHOSEN = 6  /* the best of {x1, xl, xr}: x_{k+1} */
+} rc_ltlm_point;
+
+typedef struct rc_ltlm_event {
+    unsigned iter;          /* 1-based iteration k+1 */
+    rc_ltlm_point kind;
+    unsigned m;             /* candidate index 1..M (XL, XR), else 0 */
+    double n_m;             /* N_m (XL, XR), else 0 */
+    const rc_model *x;      /* the point (valid during the call only) */
+    double cost_mm2;        /* sum of squared residuals; -1: not evaluated or not finite */
+} rc_ltlm_event;
+
+typedef void (*rc_ltlm_cb)(void *ctx, const rc_ltlm_event *ev);
 
 /* Why the solver stopped. */
 typedef enum rc_exit {
@@ -67,13 +108,14 @@ typedef struct rc_solve_config {
     double snr_min;          /* 0: 1: an eigen-direction is stepped along only when its
                                 Gauss-Newton step is at least snr_min standard errors
                                 (sigma from the current residual); negative: off */
-    unsigned n_candidates;   /* LTLM M, 0: 10 */
+    unsigned n_candidates;   /* LTLM M (candidates per segment), 0: 10 */
     double chaos_r;          /* LTLM map parameter r, 0: 0.5 */
-    double ltlm_span;        /* LTLM interval half-width as a multiple of |step|, 0: 1 */
-    uint64_t seed;           /* LTLM chaotic seed */
+    double chaos_n0;         /* LTLM N_0 in (0, 1); 0: drawn from seed */
+    uint64_t seed;           /* LTLM chaotic seed (for N_0) */
     const uint8_t *fixed;    /* (n_params) nonzero: parameter held fixed; NULL: none */
     rc_iter_cb on_iter;
-    void *cb_ctx;
+    rc_ltlm_cb on_ltlm;      /* LTLM variants: every point of every iteration; may be NULL */
+    void *cb_ctx;            /* passed to on_iter and on_ltlm */
 } rc_solve_config;
 
 typedef struct rc_solve_result {
@@ -85,7 +127,7 @@ typedef struct rc_solve_result {
     unsigned n_free;          /* parameters the solver was allowed to move */
     unsigned rank;            /* identifiable directions among them (last iteration) */
     double cond;              /* sqrt(largest / smallest kept eigenvalue), scaled */
-    unsigned ltlm_wins;       /* LTLM: iterations where a chaotic candidate won */
+    unsigned ltlm_wins;       /* LTLM: iterations where a chaotic candidate beat x1 */
 } rc_solve_result;
 
 typedef struct rc_solve_work {
@@ -97,14 +139,21 @@ typedef struct rc_solve_work {
     double D[RC_MAX_PARAMS];                  /* (nf) column scaling */
     double dx[RC_MAX_PARAMS];                 /* (nf) step */
     double jrow[RC_MAX_PARAMS];               /* (n_params) one Jacobian row */
-    double chaos[RC_MAX_PARAMS];              /* (nf) chaotic variables */
+    double lt_a[RC_MAX_PARAMS];               /* (nf) LTLM a on the free parameters */
+    double lt_b[RC_MAX_PARAMS];               /* (nf) LTLM b */
+    double lt_x2[RC_MAX_PARAMS];              /* (nf) LTLM x2 (first the scaled step x2 - x1) */
     uint16_t idx[RC_MAX_PARAMS];              /* (nf) free parameter indices */
     rc_model trial;
     rc_model best;
-    rc_model cand;                            /* LTLM chaotic candidate */
+    rc_model cand;                            /* LTLM candidate */
 } rc_solve_work;
 
+/* Name of a method ("lm", "ltlm", "lm-paper", "ltlm-paper", "lm-paper-deg",
+ * "ltlm-paper-deg"); "unknown" otherwise. */
 const char *rc_method_name(rc_method method);
+/* The method named name (as rc_method_name spells it): RC_OK, or RC_ERR_ARG
+ * for an unknown name (out untouched). */
+rc_status rc_method_from_name(rc_method *out, const char *name);
 const char *rc_exit_str(rc_exit e);
 
 /* Sum of squared residuals over samples (n). RC_ERR_NUMERIC on a degenerate

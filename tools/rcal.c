@@ -22,7 +22,9 @@ static const rcal_command commands[] = {
     {"compensate", rcal_cmd_compensate, "correct joint targets with a calibrated model"},
     {"grind", rcal_cmd_grind, "grinding-path experiment: deviation with and without compensation"},
     {"diagnose", rcal_cmd_diagnose, "find the physical effect the model misses"},
+    {"evaluate", rcal_cmd_evaluate, "a calibrated model on new data, no refit; ISO 9283 distance figures"},
     {"bench", rcal_cmd_bench, "benchmarks: calibration time, compensation latency, parser speed"},
+    {"export", rcal_cmd_export, "export a model as a URDF or a DH table in CSV"},
 };
 
 static void usage(FILE *f)

@@ -18,42 +18,11 @@
 #include "rch_calib.h"
 #include "rch_robot.h"
 #include "rch_uncert.h"
+#include "rct_indep.h"
 
-/* --- independent generator ------------------------------------------- */
-static uint64_t st;
-static double u01(void)
-{
-    uint64_t z = (st += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return ((double)(z >> 11) + 0.5) / 9007199254740992.0;
-}
-static double gauss(void)
-{
-    return sqrt(-2.0 * log(u01())) * cos(6.283185307179586 * u01());
-}
-
-/* Standard DH chain written out with 4x4 homogeneous matrices. */
-static void flange(double p[3], double dh[6][4], const double q[6])
-{
-    double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
-    for (int i = 0; i < 6; ++i) {
-        double th = q[i] + dh[i][3], ct = cos(th), s = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
-        double A[4][4] = {{ct, -s * ca, s * sa, dh[i][0] * ct},
-                          {s, ct * ca, -ct * sa, dh[i][0] * s},
-                          {0, sa, ca, dh[i][1]},
-                          {0, 0, 0, 1}};
-        double R[4][4];
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c)
-                R[r][c] = T[r][0] * A[0][c] + T[r][1] * A[1][c] + T[r][2] * A[2][c] + T[r][3] * A[3][c];
-        memcpy(T, R, sizeof T);
-    }
-    p[0] = T[0][3];
-    p[1] = T[1][3];
-    p[2] = T[2][3];
-}
+static rct_rng G;
+#define u01() rct_u01(&G)
+#define gauss() rct_gauss(&G)
 
 typedef struct {
     unsigned checked, covered;
@@ -79,7 +48,7 @@ static void one_robot(tally *t, const rch_robot *nom, double noise_mm, size_t n,
             s[i].q_rad[j] = lo + (hi - lo) * u01();
         }
         double p[3];
-        flange(p, dh, s[i].q_rad);
+        rct_flange(p, dh, s[i].q_rad);
         s[i].len_mm = sqrt((p[0] - enc[0]) * (p[0] - enc[0]) + (p[1] - enc[1]) * (p[1] - enc[1]) +
                            (p[2] - enc[2]) * (p[2] - enc[2])) +
                       noise_mm * gauss();
@@ -120,7 +89,7 @@ static void coverage(const char *label, double noise_lo, double noise_hi, int gr
     rc_solve_work *w = malloc(sizeof *w);
     assert_non_null(w);
     tally t = {0, 0, 0};
-    st = 12345u + (uint64_t)(noise_lo * 1e6) + (uint64_t)grouped;
+    G.s = 12345u + (uint64_t)(noise_lo * 1e6) + (uint64_t)grouped;
     for (int seed = 0; seed < 50; ++seed) {
         double noise = noise_lo + (noise_hi - noise_lo) * u01();
         one_robot(&t, &nom, noise, 300, grouped, w);

@@ -34,8 +34,34 @@ static void test_map_definition(void **state)
     assert_true(fabs(rc_lt_map(0.3, 4.0) - 4.0 * 0.3 * 0.7) < 1e-15);
     assert_true(fabs(rc_lt_map(0.2, 0.0) - 0.4) < 1e-15);
     assert_true(fabs(rc_lt_map(0.8, 0.0) - 0.4) < 1e-15);
-    /* continuity at 0.5 (both branches give r/4 + (4 - r)/4 = 1 -> 0 mod 1) */
-    assert_true(fabs(eq11(0.5 - 1e-12, 0.5) - 1.0) < 1e-9 || eq11(0.5 - 1e-12, 0.5) < 1e-9);
+}
+
+/* Distance on the circle [0, 1) (the map is taken mod 1). */
+static double circ(double a, double b)
+{
+    const double d = fabs(a - b);
+    return d < 0.5 ? d : 1.0 - d;
+}
+
+/* The library's map is continuous on the circle, across the branch switch
+ * at 0.5 too (both branches give r/4 + (4 - r)/4 = 1 -> 0 mod 1): its slope
+ * is at most |r (1 - 2N)| + (4 - r)/2 <= 2 + r/2. */
+static void test_map_continuity(void **state)
+{
+    (void)state;
+    for (int ri = 0; ri <= 8; ++ri) {
+        const double r = 0.5 * ri;
+        const double at = rc_lt_map(0.5, r), left = rc_lt_map(0.5 - 1e-12, r);
+        assert_true(circ(at, 0.0) < 1e-9);
+        assert_true(circ(left, at) < 1e-9);
+        /* consecutive points of a fine grid over the whole circle */
+        double prev = rc_lt_map(0.0, r);
+        for (int k = 1; k <= 100000; ++k) {
+            const double v = rc_lt_map(k < 100000 ? k * 1e-5 : 0.0, r);
+            assert_true(circ(v, prev) <= (2.0 + r / 2) * 1e-5 * 1.001 + 1e-15);
+            prev = v;
+        }
+    }
 }
 
 /* Doubles: the tent map x -> 2x mod 1 loses one bit per step and reaches 0
@@ -94,6 +120,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_map_definition),
+        cmocka_unit_test(test_map_continuity),
         cmocka_unit_test(test_tent_collapse),
         cmocka_unit_test(test_uniformity_measure),
     };

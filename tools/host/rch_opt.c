@@ -198,8 +198,8 @@ static int store(const rch_cmdspec *spec, const rch_opt *o, const char *v, FILE 
     case RCH_OPT_UINT: {
         unsigned long u;
         if (rch_parse_ulong(v, &u) != 0 || !in_range(o, (double)u)) {
-            fprintf(err, "rcal %s: %s '%s' is not a whole number%s\n", spec->cmd, o->name, v,
-                    *rng ? rng : " (0 or more)");
+            fprintf(err, "rcal %s: %s '%s' is %s%s\n", spec->cmd, o->name, v,
+                    rch_parse_ulong(v, &u) != 0 ? "not a whole number" : "out of range", *rng ? rng : " (0 or more)");
             return -1;
         }
         *(unsigned long *)o->out = u;
@@ -208,7 +208,8 @@ static int store(const rch_cmdspec *spec, const rch_opt *o, const char *v, FILE 
     case RCH_OPT_INT: {
         long l;
         if (rch_parse_long(v, &l) != 0 || !in_range(o, (double)l)) {
-            fprintf(err, "rcal %s: %s '%s' is not a whole number%s\n", spec->cmd, o->name, v, rng);
+            fprintf(err, "rcal %s: %s '%s' is %s%s\n", spec->cmd, o->name, v,
+                    rch_parse_long(v, &l) != 0 ? "not a whole number" : "out of range", rng);
             return -1;
         }
         *(long *)o->out = l;
@@ -217,7 +218,8 @@ static int store(const rch_cmdspec *spec, const rch_opt *o, const char *v, FILE 
     case RCH_OPT_DOUBLE: {
         double d;
         if (rch_parse_double(v, &d) != 0 || !in_range(o, d)) {
-            fprintf(err, "rcal %s: %s '%s' is not a decimal number%s\n", spec->cmd, o->name, v, rng);
+            fprintf(err, "rcal %s: %s '%s' is %s%s\n", spec->cmd, o->name, v,
+                    rch_parse_double(v, &d) != 0 ? "not a decimal number" : "out of range", rng);
             return -1;
         }
         *(double *)o->out = d;

@@ -1,0 +1,60 @@
+/* rct_indep.h - an independent data generator for tests: its own random
+ * numbers (splitmix64 + Box-Muller) and its own forward kinematics
+ * (standard DH with 4 x 4 homogeneous matrices), written apart from the
+ * code under test (lib/rc_model.c, tools/host/rch_sim.c). Tests draw the
+ * truth, the poses and the noise here and never pass the noise level, the
+ * effect or its location to the code under test. */
+#ifndef RCT_INDEP_H
+#define RCT_INDEP_H
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+typedef struct {
+    uint64_t s;
+} rct_rng;
+
+static inline double rct_u01(rct_rng *g)
+{
+    uint64_t z = (g->s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return ((double)(z >> 11) + 0.5) / 9007199254740992.0;
+}
+
+static inline double rct_gauss(rct_rng *g)
+{
+    double u = rct_u01(g), v = rct_u01(g);
+    return sqrt(-2.0 * log(u)) * cos(6.283185307179586 * v);
+}
+
+/* Flange position of a standard-DH arm: dh[i] = {a_mm, d_mm, alpha_rad,
+ * theta_off_rad}, joint angle q[i] added to theta. */
+static inline void rct_flange(double p[3], double dh[6][4], const double q[6])
+{
+    double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+    for (int i = 0; i < 6; ++i) {
+        double th = q[i] + dh[i][3], ct = cos(th), st = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
+        double A[4][4] = {{ct, -st * ca, st * sa, dh[i][0] * ct},
+                          {st, ct * ca, -ct * sa, dh[i][0] * st},
+                          {0, sa, ca, dh[i][1]},
+                          {0, 0, 0, 1}};
+        double R[4][4];
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+                R[r][c] = T[r][0] * A[0][c] + T[r][1] * A[1][c] + T[r][2] * A[2][c] + T[r][3] * A[3][c];
+        memcpy(T, R, sizeof T);
+    }
+    p[0] = T[0][3];
+    p[1] = T[1][3];
+    p[2] = T[2][3];
+}
+
+static inline double rct_dist(const double p[3], const double e[3])
+{
+    return sqrt((p[0] - e[0]) * (p[0] - e[0]) + (p[1] - e[1]) * (p[1] - e[1]) + (p[2] - e[2]) * (p[2] - e[2]));
+}
+
+#endif

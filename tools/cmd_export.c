@@ -1,0 +1,72 @@
+/* cmd_export.c - rcal export: a model as a URDF or as a DH table in CSV
+ * (tools/host/rch_export.h, docs/export.md). */
+#include <stdio.h>
+#include <string.h>
+
+#include "rcal_cmds.h"
+#include "rch_export.h"
+#include "rch_file.h"
+#include "rch_opt.h"
+
+int rcal_cmd_export(int argc, char **argv)
+{
+    const char *model = NULL, *format = NULL, *out_path = "-", *nominal = NULL;
+    int drop = 0;
+    const rch_opt opts[] = {
+        {"--model", RCH_OPT_STR, &model, 0, 0, "M.json", "the model to export (rcal calibrate --out, or a robot file)",
+         RCH_OPT_REQUIRED, NULL},
+        {"--format", RCH_OPT_CHOICE, &format, 0, 0, "F", "urdf: the robot as a URDF; dh-csv: the DH table as CSV",
+         RCH_OPT_REQUIRED, "urdf|dh-csv"},
+        {"--out", RCH_OPT_STR, &out_path, 0, 0, "FILE", "write here (written whole or not at all); - is stdout", 0,
+         NULL},
+        {"--nominal-urdf", RCH_OPT_STR, &nominal, 0, 0, "NOMINAL.urdf",
+         "urdf: take the robot, joint and link names from this URDF", 0, NULL},
+        {"--drop-joint-effects", RCH_OPT_FLAG, &drop, 0, 0, NULL,
+         "urdf: write the geometry of a model with joint-side effects (its FK then differs)", 0, NULL},
+    };
+    const rch_cmdspec spec = {
+        "export", "export a model as a URDF or as a DH table in CSV",
+        "URDF: joint origins from the model's DH table (lengths in m, angles in rad, %.17g), the joint-zero\n"
+        "offsets folded into the origins' yaw; the robot, joint and link names of --nominal-urdf when given,\n"
+        "else joint_1..joint_6, link_0..link_6, flange. DH CSV: one row per parameter with the nominal,\n"
+        "calibrated and correction values (mm, deg) and the standard error when the model has one.\n"
+        "See docs/export.md.",
+        opts, sizeof opts / sizeof opts[0]};
+    rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (st != RCH_OPT_OK)
+        return st == RCH_OPT_HELP ? 0 : 2;
+    const rch_export_format fmt = strcmp(format, "urdf") == 0 ? RCH_EXPORT_URDF : RCH_EXPORT_DH_CSV;
+    if (nominal && fmt != RCH_EXPORT_URDF) {
+        fprintf(stderr, "rcal export: --nominal-urdf applies to --format urdf only\n");
+        return 2;
+    }
+    const char *inputs[2] = {model, nominal};
+    rch_out out;
+    rch_export_result res;
+    rch_diag d;
+    char msg[1024];
+    if (rch_out_open(&out, out_path, "--out", inputs, 2, &d) != 0) {
+        fprintf(stderr, "rcal export: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (rch_export_file(&res, out.f, fmt, model, nominal, drop, &d) != 0) {
+        rch_out_abort(&out);
+        fprintf(stderr, "rcal export: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (rch_out_commit(&out, &d) != 0) {
+        fprintf(stderr, "rcal export: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (res.n_effects_left)
+        fprintf(stderr, "rcal export: %u model effect(s) not carried by the URDF (listed in its comments)\n",
+                res.n_effects_left);
+    if (strcmp(out_path, "-") != 0) {
+        if (fmt == RCH_EXPORT_URDF)
+            fprintf(stderr, "rcal export: URDF with %u joints written to %s\n", res.n_joints, out_path);
+        else
+            fprintf(stderr, "rcal export: %u DH CSV rows%s written to %s\n", res.n_rows,
+                    res.has_se ? " with standard errors" : "", out_path);
+    }
+    return 0;
+}

@@ -1,0 +1,240 @@
+/* rch_jumps.c - change-point detection of length jumps (see rch_jumps.h). */
+#include "rch_jumps.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rch_uncert.h"
+
+unsigned rch_jumps_segment(const rch_jumps *j, double t)
+{
+    unsigned k = 0;
+    while (k < j->n_jumps && j->at_t[k] <= t)
+        ++k;
+    return k;
+}
+
+/* Model = start + segment offsets (first held at 0), fitted on s labelled
+ * by the change points at[0..m-1] (indices into s). */
+static int fit_segments(rc_model *out, double *ssr, const rc_model *start, const uint8_t *fixed, rc_sample *s,
+                        size_t n, const size_t *at, unsigned m, rc_solve_work *w)
+{
+    rc_model mdl = *start;
+    unsigned seg = 0;
+    for (size_t i = 0; i < n; ++i) {
+        while (seg < m && at[seg] <= i)
+            ++seg;
+        s[i].group = (uint16_t)seg;
+    }
+    uint8_t fx[RC_MAX_PARAMS];
+    memset(fx, 0, sizeof fx);
+    if (fixed)
+        memcpy(fx, fixed, start->n_params);
+    if (m > 0) {
+        if (rc_model_add_effect(&mdl, RC_EFF_GROUP_OFFSET, 0, m + 1) != RC_OK)
+            return -1;
+        fx[mdl.effects[mdl.n_effects - 1].first] = 1; /* first segment: the reference */
+    }
+    rc_solve_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.fixed = fx;
+    if (rc_solve(&mdl, NULL, w, &cfg, s, n) != RC_OK)
+        return -1;
+    if (rc_cost(ssr, &mdl, s, n) != RC_OK)
+        return -1;
+    *out = mdl;
+    return 0;
+}
+
+/* Best new change point for the model mdl: index or 0 when none. */
+static size_t best_candidate(const rc_model *mdl, const uint8_t *fixed, const rc_sample *s, size_t n, const size_t *at,
+                             unsigned m, size_t min_seg)
+{
+    unsigned p = 0;
+    uint16_t idx[RC_MAX_PARAMS];
+    unsigned first_off = mdl->n_effects ? mdl->effects[mdl->n_effects - 1].first : mdl->n_params;
+    for (unsigned k = 0; k < mdl->n_params; ++k)
+        if (!((k < RC_P_ENC + 3 && fixed && fixed[k]) || k == first_off))
+            idx[p++] = (uint16_t)k;
+    double *Q = malloc(n * p * sizeof *Q), *r = malloc(n * sizeof *r), *tau = malloc(p * sizeof *tau);
+    double *a = calloc(p, sizeof *a), jrow[RC_MAX_PARAMS];
+    size_t best = 0;
+    if (!Q || !r || !tau || !a)
+        goto done;
+    for (size_t i = 0; i < n; ++i) {
+        double l;
+        if (rc_meas(&l, jrow, mdl, &s[i]) != RC_OK)
+            goto done;
+        r[i] = l - s[i].len_mm;
+        for (unsigned k = 0; k < p; ++k)
+            Q[i * p + k] = jrow[idx[k]];
+    }
+    if (LAPACKE_dgeqrf(LAPACK_ROW_MAJOR, (lapack_int)n, (lapack_int)p, Q, (lapack_int)p, tau) != 0 ||
+        LAPACKE_dorgqr(LAPACK_ROW_MAJOR, (lapack_int)n, (lapack_int)p, (lapack_int)p, Q, (lapack_int)p, tau) != 0)
+        goto done;
+    /* r_perp = r - Q Q^T r */
+    for (unsigned k = 0; k < p; ++k) {
+        double c = 0.0;
+        for (size_t i = 0; i < n; ++i)
+            c += Q[i * p + k] * r[i];
+        for (size_t i = 0; i < n; ++i)
+            r[i] -= c * Q[i * p + k];
+    }
+    double best_red = 0.0, sr = 0.0;
+    for (size_t k = n; k-- > 1;) {
+        sr += r[k];
+        double aa = 0.0;
+        for (unsigned c = 0; c < p; ++c) {
+            a[c] += Q[k * p + c];
+            aa += a[c] * a[c];
+        }
+        if (k < min_seg || n - k < min_seg)
+            continue;
+        int near = 0;
+        for (unsigned j = 0; j < m; ++j)
+            near |= (k + min_seg > at[j]) && (k < at[j] + min_seg);
+        double v = (double)(n - k) - aa;
+        if (near || v < 1e-9)
+            continue;
+        double red = sr * sr / v;
+        if (red > best_red) {
+            best_red = red;
+            best = k;
+        }
+    }
+done:
+    free(Q);
+    free(r);
+    free(tau);
+    free(a);
+    return best;
+}
+
+static int cmp_size(const void *x, const void *y)
+{
+    size_t a = *(const size_t *)x, b = *(const size_t *)y;
+    return (a > b) - (a < b);
+}
+
+/* Jump sizes and standard errors from the segment offsets of j->model. */
+static void jump_sizes(rch_jumps *j, const rc_sample *s, size_t n)
+{
+    if (j->n_jumps == 0)
+        return;
+    const rc_effect *e = &j->model.effects[j->model.n_effects - 1];
+    rch_uncert u;
+    char err[128];
+    uint8_t fx[RC_MAX_PARAMS];
+    memset(fx, 0, sizeof fx);
+    fx[e->first] = 1;
+    int have = rch_uncert_compute(&u, &j->model, fx, s, n, 0, err, sizeof err) == 0;
+    for (unsigned k = 0; k < j->n_jumps; ++k) {
+        unsigned a = e->first + k, b = e->first + k + 1;
+        j->size_mm[k] = j->model.x[b] - j->model.x[a];
+        j->se_mm[k] = NAN;
+        if (have) {
+            size_t np = u.n_params;
+            double v = u.cov[b * np + b] + u.cov[a * np + a] - 2.0 * u.cov[a * np + b];
+            j->se_mm[k] = sqrt(fmax(v, 0.0));
+        }
+    }
+    if (have)
+        rch_uncert_free(&u);
+}
+
+int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, const rc_sample *s, size_t n,
+                   const rch_jumps_config *cfg, rc_solve_work *w, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    size_t min_seg = cfg && cfg->min_seg ? cfg->min_seg : 5;
+    unsigned max_j = cfg && cfg->max_jumps ? cfg->max_jumps : (unsigned)(n / 20);
+    double factor = cfg && cfg->size_factor > 0 ? cfg->size_factor : 3.0;
+    if (max_j > RCH_JUMPS_MAX)
+        max_j = RCH_JUMPS_MAX;
+    if (n < 2 * min_seg + 30) {
+        snprintf(err, errlen, "jump detection needs at least %zu samples (have %zu)", 2 * min_seg + 30, n);
+        return -1;
+    }
+    rc_sample *c = malloc(n * sizeof *c);
+    if (!c) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    memcpy(c, s, n * sizeof *c);
+    size_t at[RCH_JUMPS_MAX + 1] = {0};
+    unsigned m = 0;
+    double ssr;
+    rc_model cur;
+    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, w) != 0) {
+        snprintf(err, errlen, "the geometric fit failed");
+        free(c);
+        return -1;
+    }
+    out->geometry = cur;
+    out->rms_before_mm = sqrt(ssr / (double)n);
+    double pen = 3.0 * log((double)n);
+    /* forward: add the best change point while the penalised fit improves */
+    while (m < max_j) {
+        size_t k = best_candidate(&cur, fixed, c, n, at, m, min_seg);
+        if (k == 0)
+            break;
+        size_t trial[RCH_JUMPS_MAX + 1];
+        memcpy(trial, at, m * sizeof *at);
+        trial[m] = k;
+        qsort(trial, m + 1, sizeof *trial, cmp_size);
+        rc_model nm;
+        double ssr2;
+        if (fit_segments(&nm, &ssr2, start, fixed, c, n, trial, m + 1, w) != 0)
+            break;
+        if (!((double)n * log(ssr / ssr2) > pen))
+            break;
+        memcpy(at, trial, (m + 1) * sizeof *at);
+        ++m;
+        cur = nm;
+        ssr = ssr2;
+    }
+    /* backward: a jump smaller than size_factor x the final RMS residual is
+     * not told apart from the noise: drop the smallest such, refit, repeat */
+    while (m > 0) {
+        const rc_effect *e = &cur.effects[cur.n_effects - 1];
+        double rms = sqrt(ssr / (double)n), smallest = INFINITY;
+        unsigned drop = m;
+        for (unsigned k = 0; k < m; ++k) {
+            double size = fabs(cur.x[e->first + k + 1] - cur.x[e->first + k]);
+            if (size < factor * rms && size < smallest) {
+                smallest = size;
+                drop = k;
+            }
+        }
+        if (drop == m)
+            break;
+        memmove(&at[drop], &at[drop + 1], (m - drop - 1) * sizeof *at);
+        --m;
+        if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, w) != 0) {
+            snprintf(err, errlen, "refit without a jump failed");
+            free(c);
+            return -1;
+        }
+    }
+    out->n_jumps = m;
+    out->model = cur;
+    out->rms_after_mm = sqrt(ssr / (double)n);
+    for (unsigned k = 0; k < m; ++k) {
+        out->at[k] = at[k];
+        out->at_t[k] = s[at[k]].t;
+    }
+    /* the geometry of the final fit, without the nuisance offsets */
+    out->geometry = cur;
+    if (m > 0) {
+        out->geometry.n_effects--;
+        out->geometry.n_params = (uint16_t)cur.effects[cur.n_effects - 1].first;
+    }
+    for (size_t i = 0; i < n; ++i)
+        c[i].group = (uint16_t)rch_jumps_segment(out, c[i].t);
+    jump_sizes(out, c, n);
+    free(c);
+    return 0;
+}

@@ -1,0 +1,66 @@
+/* rch_jumps.h - length jumps at change points in acquisition order.
+ *
+ * A draw-wire encoder that loses or gains counts, or a display re-zeroed
+ * between two readings, shifts every later length by the same amount: the
+ * lengths carry a piecewise-constant offset in acquisition order. The jumps
+ * are nuisance parameters: they are fitted with the geometry so that the
+ * geometry is estimated honestly, and are not used to predict a new pose.
+ *
+ * Detection (greedy binary segmentation on the linearised problem):
+ *  1. fit the geometry (and the offsets of the segments found so far: the
+ *     RC_EFF_GROUP_OFFSET effect on segment labels, the first segment's
+ *     offset held at 0);
+ *  2. for every candidate row k (at least min_seg rows from the ends and
+ *     from every change point already found), the step s_k = [i >= k] with
+ *     the column space of the Jacobian projected out: the reduction of the
+ *     residual sum of squares it would bring, (s_k^T r_perp)^2 / |s_k,perp|^2,
+ *     all candidates in O(n p) with suffix sums;
+ *  3. the best candidate is refitted and kept while the information it
+ *     adds beats a penalty of 3 ln n (size and location of the jump: a
+ *     modified BIC), up to max_jumps;
+ *  4. backward: while some jump is smaller than size_factor times the final
+ *     RMS residual, the smallest is dropped and the rest refitted (a jump the
+ *     size of the noise is not a sensor event but a description of the
+ *     noise, or of structure another effect should explain).
+ *
+ * Host side (prefix rch_): heap, LAPACKE. */
+#ifndef RCH_JUMPS_H
+#define RCH_JUMPS_H
+
+#include <stddef.h>
+
+#include "rc_solve.h"
+
+#define RCH_JUMPS_MAX 32
+
+typedef struct rch_jumps_config {
+    size_t min_seg;       /* rows between change points, 0: 5 */
+    unsigned max_jumps;   /* 0: min(RCH_JUMPS_MAX, n / 20) */
+    double size_factor;   /* 0: 3 */
+} rch_jumps_config;
+
+typedef struct rch_jumps {
+    unsigned n_jumps;
+    size_t at[RCH_JUMPS_MAX];         /* (n_jumps) index (in s) of the first sample after the jump */
+    double at_t[RCH_JUMPS_MAX];       /* (n_jumps) its acquisition time t, ascending */
+    double size_mm[RCH_JUMPS_MAX];    /* (n_jumps) length change at that sample */
+    double se_mm[RCH_JUMPS_MAX];      /* (n_jumps) its standard error (classical) */
+    double rms_before_mm;             /* training RMS of the geometry alone */
+    double rms_after_mm;              /* training RMS with the jumps */
+    rc_model model;                   /* geometry + segment offsets (RC_EFF_GROUP_OFFSET) */
+    rc_model geometry;                /* the same geometry without the nuisance offsets */
+} rch_jumps;
+
+/* Find the jumps in samples s (n, in acquisition order: t ascending)
+ * starting from the model start (no group-offset effect). fixed
+ * (start->n_params, may be NULL) holds geometric parameters fixed. The
+ * samples' group fields are not read. 0, or -1 with err[errlen] set. */
+int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, const rc_sample *s, size_t n,
+                   const rch_jumps_config *cfg, rc_solve_work *w, char *err, size_t errlen);
+
+/* Segment of a sample at acquisition time t: the number of jumps at or
+ * before t. Relabel samples with it (group = segment) to evaluate
+ * j->model on rows the detection did not see. */
+unsigned rch_jumps_segment(const rch_jumps *j, double t);
+
+#endif
