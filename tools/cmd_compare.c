@@ -46,7 +46,8 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
         rch_data_free(&data);
         return 2;
     }
-    int rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, json ? NULL : stderr, &d) != 0 ? 1 : 0;
+    /* progress and per-case failures on stderr, whatever the report format */
+    int rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, stderr, &d) != 0 ? 1 : 0;
     if (rc == 0 && json)
         rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
     else if (rc == 0)
