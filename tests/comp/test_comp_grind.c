@@ -174,7 +174,8 @@ static void test_surface_parse(void **state)
     assert_true(fabs(rch_surface_z(&s, 350 + 20, 0) - (300 + 5)) < 1e-9); /* a quarter wave: the crest */
     static const char *const bad[][2] = {{"cone", "unknown surface"}, {"plane:w=-1", "positive"},
                                          {"tilted:ax=x", "not a number"}, {"sine:foo=1", "unknown surface key"},
-                                         {"plane:w", "key=value"},         {"plane:ds=0.01", "5000 points"}};
+                                         {"plane:w", "key=value"},         {"plane:ds=0.01", "5000 points"},
+                                         {"plane:ds=0.05,step=0.2,h=100", "limit of 200000"}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         memset(&d, 0, sizeof d);
         if (rch_surface_parse(&s, bad[i][0], &d) != -1 || !strstr(d.msg, bad[i][1]))

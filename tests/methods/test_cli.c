@@ -324,6 +324,7 @@ static void test_issue12_options(void **state)
         {"grind --model a --truth b --max-dev-deg 0", 2, "--max-dev-deg"},
         {"grind --model a --truth b --max-dev-deg -1", 2, "--max-dev-deg"},
         {"grind --model a", 2, "--truth"},
+        {"grind --model a --truth b --surface plane:ds=0.05,step=0.2,h=100", 2, "limit of 200000"},
     };
     char cmd[1024], args[512], *out = NULL;
     (void)state;

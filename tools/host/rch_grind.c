@@ -130,6 +130,12 @@ int rch_surface_parse(rch_surface *s, const char *spec, rch_diag *d)
                                   "at most 5000 points per line and 1000 lines");
         return -1;
     }
+    const double n_pts = (floor(s->w / s->ds + 1e-9) + 1.0) * (floor(s->h / s->step + 1e-9) + 1.0);
+    if (n_pts > RCH_GRIND_MAX_POINTS) {
+        rch_diag_set(d, "", 0, 0, "%.0f path points, above the limit of %d (about %d MB); raise ds or step",
+                     n_pts, RCH_GRIND_MAX_POINTS, (int)(RCH_GRIND_MAX_POINTS * sizeof(rch_grind_point) >> 20));
+        return -1;
+    }
     return 0;
 }
 

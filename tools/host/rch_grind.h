@@ -60,11 +60,15 @@ typedef struct rch_surface {
     double amp, wl;         /* sine amplitude and wavelength (mm) */
 } rch_surface;
 
+/* The most path points a surface may give (memory about 36 MB, a few seconds). */
+#define RCH_GRIND_MAX_POINTS 200000
+
 /* tilted, centre (400, 0, 300), 200 x 120, step 10, ds 5, ax 15, r 150, k 20, amp 10, wl 100. */
 void rch_surface_defaults(rch_surface *s);
 /* "NAME[:key=value,...]" (keys cx cy z0 w h step ds ax ay r k amp wl) over
  * the defaults; NULL: the defaults. Sizes must be positive, r > h/2, slopes
- * below 80 deg, at most 5000 points per line and 1000 lines. 0 or -1 with d. */
+ * below 80 deg, at most 5000 points per line, 1000 lines and
+ * RCH_GRIND_MAX_POINTS in all. 0 or -1 with d. */
 int rch_surface_parse(rch_surface *s, const char *spec, rch_diag *d);
 const char *rch_surface_name(rch_surface_kind kind);
 double rch_surface_z(const rch_surface *s, double x_mm, double y_mm);
