@@ -173,7 +173,9 @@ static void test_surface_parse(void **state)
     assert_true(s.amp == 5 && s.wl == 80 && s.cx == 350 && s.w == 200);
     assert_true(fabs(rch_surface_z(&s, 350 + 20, 0) - (300 + 5)) < 1e-9); /* a quarter wave: the crest */
     static const char *const bad[][2] = {{"cone", "unknown surface"}, {"plane:w=-1", "positive"},
-                                         {"tilted:ax=x", "not a number"}, {"sine:foo=1", "unknown surface key"},
+                                         {"tilted:ax=x", "not a number"},
+                                         {"tilted:ax=0x1p3", "not a number"}, {"plane:w= 100", "not a number"},
+                                         {"plane:w=inf", "not a number"}, {"sine:foo=1", "unknown surface key"},
                                          {"plane:w", "key=value"},         {"plane:ds=0.01", "5000 points"},
                                          {"plane:ds=0.05,step=0.2,h=100", "limit of 200000"}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {

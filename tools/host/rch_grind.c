@@ -9,6 +9,7 @@
 #include "rc_comp.h"
 #include "rc_rand.h"
 #include "rch_jw.h"
+#include "rch_opt.h"
 #include "rch_plot.h"
 
 #ifndef M_PI
@@ -73,15 +74,14 @@ static int surf_key(rch_surface *s, char *kv, rch_diag *d)
     static const char *const keys[] = {"cx", "cy", "z0", "w", "h", "step", "ds", "ax", "ay", "r", "k", "amp", "wl"};
     double *dst[] = {&s->cx, &s->cy, &s->z0, &s->w, &s->h, &s->step, &s->ds, &s->ax_deg, &s->ay_deg,
                      &s->r, &s->k, &s->amp, &s->wl};
-    char *eq = strchr(kv, '='), *end;
+    char *eq = strchr(kv, '=');
+    double v;
     if (!eq) {
         rch_diag_set(d, "", 0, 0, "surface option '%s' is not key=value", kv);
         return -1;
     }
     *eq = '\0';
-    errno = 0;
-    const double v = strtod(eq + 1, &end);
-    if (eq[1] == '\0' || *end != '\0' || errno != 0 || !isfinite(v)) {
+    if (rch_parse_double(eq + 1, &v) != 0) { /* strict: decimal, finite, nothing around it */
         rch_diag_set(d, "", 0, 0, "surface option %s: '%s' is not a number", kv, eq + 1);
         return -1;
     }
