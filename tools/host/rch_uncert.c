@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rc_ident.h"
 #include "rc_rand.h"
 
 /* chi-square quantile with 3 degrees of freedom at 0.95 */
@@ -84,16 +85,41 @@ typedef struct {
     unsigned idx[RC_MAX_PARAMS];
     double D[RC_MAX_PARAMS];
     double ev[RC_MAX_PARAMS];
-    double *V;  /* (nf x nf) eigenvectors in columns */
+    double *V;  /* (nf x nf) eigenvectors in columns, ascending eigenvalues */
+    uint8_t dir_class[RC_MAX_PARAMS];   /* (nf) rc_ident_class of direction d (ascending order) */
+    uint8_t param_class[RC_MAX_PARAMS]; /* (nf) rc_ident_class of free parameter a */
     double *Cz; /* (nf x nf) covariance in scaled coordinates */
 } scaled;
+
+/* Classes of directions and parameters from the one definition (rc_ident),
+ * on the eigen-decomposition in ascending order. */
+static int ident(scaled *z, size_t n_rows)
+{
+    unsigned nf = z->nf;
+    double evd[RC_MAX_PARAMS], *Vd = malloc((size_t)nf * nf * sizeof *Vd);
+    rc_ident id;
+    if (!Vd)
+        return -1;
+    for (unsigned d = 0; d < nf; ++d) {
+        evd[d] = z->ev[nf - 1 - d];
+        for (unsigned a = 0; a < nf; ++a)
+            Vd[a * nf + d] = z->V[a * nf + (nf - 1 - d)];
+    }
+    rc_status st = rc_ident_classify_eig(&id, evd, Vd, nf, n_rows);
+    free(Vd);
+    if (st != RC_OK)
+        return -1;
+    for (unsigned d = 0; d < nf; ++d)
+        z->dir_class[d] = id.dir_class[nf - 1 - d];
+    memcpy(z->param_class, id.param_class, nf);
+    return 0;
+}
 
 /* Covariance in scaled coordinates: classical or cluster-robust. */
 static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r, const rc_sample *s, size_t n,
                       int want_cluster)
 {
     unsigned nf = z->nf;
-    double emax = z->ev[nf - 1] > 0 ? z->ev[nf - 1] : 1.0;
     /* pseudo-inverse A+ = sum over kept directions v v^T / ev */
     double *Ap = calloc((size_t)nf * nf, sizeof *Ap);
     double *M = calloc((size_t)nf * nf, sizeof *M);
@@ -104,11 +130,10 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
     }
     u->rank = u->n_weak = 0;
     for (unsigned d = 0; d < nf; ++d) {
-        double sv = sqrt(fmax(z->ev[d], 0.0) / emax);
-        if (sv < RCH_UNCERT_NULL_SV)
+        if (z->dir_class[d] == RC_IDENT_NONE)
             continue;
         u->rank++;
-        u->n_weak += sv < RCH_UNCERT_WEAK_SV;
+        u->n_weak += z->dir_class[d] == RC_IDENT_WEAK;
         for (unsigned a = 0; a < nf; ++a)
             for (unsigned b = 0; b < nf; ++b)
                 Ap[a * nf + b] += z->V[a * nf + d] * z->V[b * nf + d] / z->ev[d];
@@ -126,13 +151,19 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
             free(M);
             return -1;
         }
-        for (size_t i = 0; i < n; ++i)
+        for (size_t i = 0; i < n; ++i) {
+            if (s[i].group > gmax)
+                continue; /* cannot happen: gmax is the largest group */
+            double *ui = ug + (size_t)s[i].group * nf;
             for (unsigned k = 0; k < nf; ++k)
-                ug[(size_t)s[i].group * nf + k] += J[i * nf + k] * r[i];
-        for (unsigned g = 0; g <= gmax; ++g)
+                ui[k] += J[i * nf + k] * r[i];
+        }
+        for (unsigned g = 0; g <= gmax; ++g) {
+            const double *ua = ug + (size_t)g * nf; /* score of cluster g, (nf) */
             for (unsigned a = 0; a < nf; ++a)
                 for (unsigned b = 0; b < nf; ++b)
-                    M[a * nf + b] += ug[(size_t)g * nf + a] * ug[(size_t)g * nf + b];
+                    M[a * nf + b] += ua[a] * ua[b];
+        }
         free(ug);
         double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 0 ? dof : 1.0));
         /* Cz = c Ap M Ap */
@@ -172,15 +203,13 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
 static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
 {
     unsigned nf = z->nf, np = u->n_params;
-    double emax = z->ev[nf - 1] > 0 ? z->ev[nf - 1] : 1.0;
     for (unsigned d = 0; d < nf; ++d) {
-        double sv = sqrt(fmax(z->ev[d], 0.0) / emax);
         for (unsigned a = 0; a < nf; ++a) {
             double w = z->V[a * nf + d] * z->V[a * nf + d];
             unsigned k = z->idx[a];
-            if (sv < RCH_UNCERT_NULL_SV)
+            if (z->dir_class[d] == RC_IDENT_NONE)
                 u->null_share[k] += w;
-            else if (sv < RCH_UNCERT_WEAK_SV)
+            else if (z->dir_class[d] == RC_IDENT_WEAK)
                 u->weak_share[k] += w;
         }
     }
@@ -190,11 +219,11 @@ static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
         unsigned k = z->idx[a];
         double se = sqrt(fmax(z->Cz[a * nf + a], 0.0)) / z->D[a];
         double tol = rc_param_unit(m, k) == 1 ? RCH_UNCERT_WEAK_RAD : RCH_UNCERT_WEAK_MM;
-        if (u->null_share[k] > RCH_UNCERT_SHARE) {
+        if (z->param_class[a] == RC_IDENT_NONE) {
             u->cls[k] = RCH_PARAM_NOT_IDENTIFIABLE;
             u->se[k] = NAN;
         } else {
-            int weak = u->weak_share[k] > RCH_UNCERT_SHARE || (rc_param_unit(m, k) != 2 && se > tol);
+            int weak = z->param_class[a] == RC_IDENT_WEAK || (rc_param_unit(m, k) != 2 && se > tol);
             u->cls[k] = weak ? RCH_PARAM_WEAK : RCH_PARAM_IDENTIFIABLE;
             u->se[k] = se;
         }
@@ -222,12 +251,13 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
         return -1;
     }
     size_t np = m->n_params, nf = z.nf;
-    double *J = malloc(n * nf * sizeof *J), *r = malloc(n * sizeof *r), *A = calloc(nf * nf, sizeof *A);
-    z.V = calloc(nf * nf, sizeof *z.V);
-    z.Cz = calloc(nf * nf, sizeof *z.Cz);
+    double *J = calloc(n * nf, sizeof *J), *r = calloc(n, sizeof *r), *A = calloc(nf * nf, sizeof *A);
+    double *V = calloc(nf * nf, sizeof *V), *Cz = calloc(nf * nf, sizeof *Cz);
+    z.V = V;
+    z.Cz = Cz;
     u->cov = calloc(np * np, sizeof *u->cov);
     int rc = -1;
-    if (!J || !r || !A || !z.V || !z.Cz || !u->cov) {
+    if (!J || !r || !A || !V || !Cz || !u->cov) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
@@ -247,6 +277,10 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
         snprintf(err, errlen, "eigen-decomposition of the normal matrix failed");
         goto done;
     }
+    if (ident(&z, n) != 0) {
+        snprintf(err, errlen, "the identifiability analysis failed (non-finite normal matrix)");
+        goto done;
+    }
     if (covariance(&z, u, J, r, s, n, want_cluster) != 0) {
         snprintf(err, errlen, "out of memory");
         goto done;
@@ -257,8 +291,8 @@ done:
     free(J);
     free(r);
     free(A);
-    free(z.V);
-    free(z.Cz);
+    free(V);
+    free(Cz);
     if (rc != 0)
         rch_uncert_free(u);
     return rc;

@@ -6,8 +6,7 @@
  * Covariance. At the solution x (free parameters F, nf of them), with the
  * Jacobian J (n x nf) of the residuals r = l(q; x) - L, columns scaled to
  * unit norm (S = diag of the column norms), A = Js^T Js = V diag(ev) V^T:
- *  - directions with relative singular value sqrt(ev/ev_max) below the
- *    identifiability limit are NOT IDENTIFIABLE: the data carry no
+ *  - directions rc_ident classes as null are NOT IDENTIFIABLE: the data carry no
  *    information on them; the pseudo-inverse A+ leaves them out and the
  *    parameters that lie in them get no standard error;
  *  - classical:     Cov = s^2 S^-1 A+ S^-1,  s^2 = r^T r / (n - rank);
@@ -15,10 +14,8 @@
  *    Cov = c S^-1 A+ (sum_g u_g u_g^T) A+ S^-1, u_g = Js_g^T r_g summed over
  *    the samples of group g, c = G/(G-1) (n-1)/(n-rank) (the usual small-sample
  *    factor); used when the samples carry at least 5 groups of >= 2 samples.
- * Per parameter: standard error sqrt(Cov_kk) and a class: the share of the
- * parameter's scaled unit vector that lies in not-identifiable directions
- * (> 1/2: not identifiable), in weak directions (> 1/2 with the former:
- * weak), else identifiable; and relative to the standard error.
+ * Per parameter: standard error sqrt(Cov_kk) and a class: rc_ident's class,
+ * made weak also when the standard error exceeds a typical DH error.
  *
  * Host side (prefix rch_): heap and LAPACKE. */
 #ifndef RCH_UNCERT_H
@@ -38,15 +35,10 @@ typedef enum {
 
 typedef enum { RCH_COV_CLASSICAL = 0, RCH_COV_CLUSTER = 1 } rch_cov_kind;
 
-/* Relative singular values below these are not identifiable / weak: the
- * words and limits of the identifiability report. */
-#define RCH_UNCERT_NULL_SV 1e-6
-#define RCH_UNCERT_WEAK_SV 1e-3
-/* A parameter with more than this share of its (scaled) unit vector in
- * not-identifiable directions is not identifiable on its own (only in
- * combination); in weak directions, weak. */
-#define RCH_UNCERT_SHARE 0.01
-/* Also weak: a standard error above a typical DH error (0.1 mm, 0.1 deg):
+/* Directions and parameters are classed by the one definition, lib/rc_ident.h
+ * (not identifiable below a relative singular value of 1e-6, weak below
+ * 1e-3, a parameter tied to a direction by a squared share of 0.01). Also
+ * weak here: a standard error above a typical DH error (0.1 mm, 0.1 deg):
  * the data do not determine the parameter to the size of what it corrects. */
 #define RCH_UNCERT_WEAK_MM 0.1
 #define RCH_UNCERT_WEAK_RAD 1.7453292519943295e-3
@@ -54,8 +46,8 @@ typedef enum { RCH_COV_CLASSICAL = 0, RCH_COV_CLUSTER = 1 } rch_cov_kind;
 typedef struct rch_uncert {
     unsigned n_params;                /* of the model */
     unsigned nf;                      /* free parameters */
-    unsigned rank;                    /* directions with sv_rel >= RCH_UNCERT_NULL_SV */
-    unsigned n_weak;                  /* of them below RCH_UNCERT_WEAK_SV */
+    unsigned rank;                    /* directions rc_ident does not class as null */
+    unsigned n_weak;                  /* of them weak */
     rch_cov_kind kind;
     unsigned n_groups;                /* clusters used (cluster-robust) */
     size_t n_samples;
