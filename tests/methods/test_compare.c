@@ -83,7 +83,7 @@ static void test_compare_run(void **state)
         assert_int_equal(a.row[r].used, want);
         if (!want)
             continue;
-        assert_true(a.row[r].rmse_mm.n == 2.0);
+        assert_int_equal(a.row[r].rmse_mm.n, 2);
         /* the per-case table is what the statistics were built from */
         const double m = 0.5 * (a.cell[r].held_out.rmse_mm + a.cell[RCH_COMPARE_ROWS + (size_t)r].held_out.rmse_mm);
         assert_true(fabs(m - a.row[r].rmse_mm.mean) < 1e-12);

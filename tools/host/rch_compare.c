@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "rch_calib.h"
+#include "rch_eval.h"
 #include "rch_jw.h"
 #include "rch_plot.h"
 
@@ -97,16 +98,16 @@ static void summarise(rch_compare_result *res)
                 row->failed++;
                 continue;
             }
-            rch_stat_add(&row->rmse_mm, e->held_out.rmse_mm);
-            rch_stat_add(&row->mean_abs_mm, e->held_out.mean_abs_mm);
-            rch_stat_add(&row->max_mm, e->held_out.max_mm);
+            rch_stats_add(&row->rmse_mm, e->held_out.rmse_mm);
+            rch_stats_add(&row->mean_abs_mm, e->held_out.mean_abs_mm);
+            rch_stats_add(&row->max_mm, e->held_out.max_mm);
             if (isfinite(e->train_rmse_mm))
-                rch_stat_add(&row->train_rmse_mm, e->train_rmse_mm);
+                rch_stats_add(&row->train_rmse_mm, e->train_rmse_mm);
             if (r == 0)
                 continue; /* BC: no identification */
-            rch_stat_add(&row->time_ms, e->time_ms);
-            rch_stat_add(&row->iterations, (double)e->iterations);
-            rch_stat_add(&row->cost_evals, (double)e->cost_evals);
+            rch_stats_add(&row->time_ms, e->time_ms);
+            rch_stats_add(&row->iterations, (double)e->iterations);
+            rch_stats_add(&row->cost_evals, (double)e->cost_evals);
         }
     }
 }
@@ -115,9 +116,9 @@ static void add_ltlm(rch_compare_result *res, const rc_model *m)
 {
     for (unsigned j = 0; j < RC_NJ; ++j)
         for (unsigned k = 0; k < 4; ++k)
-            rch_stat_add(&res->ltlm_dh[j][k], m->x[4 * j + k] / (k >= 2 ? DEG : 1.0));
+            rch_stats_add(&res->ltlm_dh[j][k], m->x[4 * j + k] / (k >= 2 ? DEG : 1.0));
     for (unsigned k = 0; k < 3; ++k)
-        rch_stat_add(&res->ltlm_enc_mm[k], m->x[RC_P_ENC + k]);
+        rch_stats_add(&res->ltlm_enc_mm[k], m->x[RC_P_ENC + k]);
     res->n_ltlm++;
 }
 
@@ -261,13 +262,13 @@ static void report_rows(FILE *f, const rch_compare_result *res)
         snprintf(tbuf, sizeof tbuf, "%s", "-");
         snprintf(rbuf, sizeof rbuf, "%s", "-");
         if (r > 0) {
-            snprintf(tbuf, sizeof tbuf, "%8.2f +- %-7.2f", s->time_ms.mean, rch_stat_sd(&s->time_ms));
+            snprintf(tbuf, sizeof tbuf, "%8.2f +- %-7.2f", s->time_ms.mean, rch_stats_sd(&s->time_ms));
             if (isfinite(lm_time) && lm_time > 0)
                 snprintf(rbuf, sizeof rbuf, "%.2f", s->time_ms.mean / lm_time);
         }
         fprintf(f, "  %-6s %6.4f +- %-7.4f %6.4f +- %-7.4f %6.4f +- %-7.4f %-19s %8s %10.4f %9.0f%s\n",
-                rch_compare_row_name(r), s->rmse_mm.mean, rch_stat_sd(&s->rmse_mm), s->mean_abs_mm.mean,
-                rch_stat_sd(&s->mean_abs_mm), s->max_mm.mean, rch_stat_sd(&s->max_mm), tbuf, rbuf,
+                rch_compare_row_name(r), s->rmse_mm.mean, rch_stats_sd(&s->rmse_mm), s->mean_abs_mm.mean,
+                rch_stats_sd(&s->mean_abs_mm), s->max_mm.mean, rch_stats_sd(&s->max_mm), tbuf, rbuf,
                 s->train_rmse_mm.mean, r == 0 ? 0.0 : s->iterations.mean,
                 s->failed ? "  (failed in some cases)" : "");
     }
@@ -276,17 +277,17 @@ static void report_rows(FILE *f, const rch_compare_result *res)
 
 static void report_ltlm(FILE *f, const rch_compare_result *res)
 {
-    const rch_stat *e = res->ltlm_enc_mm;
+    const rch_stats *e = res->ltlm_enc_mm;
     fprintf(f, "\nLTLM identified parameters, the paper's Table 7 form (mean +- std over %u cases):\n", res->n_ltlm);
     fprintf(f, "  joint           a (mm)               d (mm)            alpha (deg)            theta (deg)\n");
     for (unsigned j = 0; j < RC_NJ; ++j) {
-        const rch_stat *s = res->ltlm_dh[j];
+        const rch_stats *s = res->ltlm_dh[j];
         fprintf(f, "  %5u %9.4f +- %-7.4f %9.4f +- %-7.4f %10.5f +- %-8.5f %10.5f +- %-8.5f\n", j + 1, s[0].mean,
-                rch_stat_sd(&s[0]), s[1].mean, rch_stat_sd(&s[1]), s[2].mean, rch_stat_sd(&s[2]), s[3].mean,
-                rch_stat_sd(&s[3]));
+                rch_stats_sd(&s[0]), s[1].mean, rch_stats_sd(&s[1]), s[2].mean, rch_stats_sd(&s[2]), s[3].mean,
+                rch_stats_sd(&s[3]));
     }
     fprintf(f, "  encoder e = (%.3f, %.3f, %.3f) mm  (+- %.3f, %.3f, %.3f)\n", e[0].mean, e[1].mean, e[2].mean,
-            rch_stat_sd(&e[0]), rch_stat_sd(&e[1]), rch_stat_sd(&e[2]));
+            rch_stats_sd(&e[0]), rch_stats_sd(&e[1]), rch_stats_sd(&e[2]));
     fprintf(f, "  Parameters the data cannot separate (e.g. d1 against e_z, theta1 against a rotation of e)\n"
                "  stay at their start values; their spread over cases shows how weakly the rest is determined.\n");
 }
@@ -307,19 +308,19 @@ static void json_row(rch_jw *w, const rch_compare_result *res, int r)
     const double lm_time = rch_compare_lm_time_ms(res);
     rch_jw_obj(w, NULL);
     rch_jw_str(w, "name", rch_compare_row_name(r));
-    rch_jw_numf(w, "cases_ok", s->rmse_mm.n, "%.0f");
+    rch_jw_uint(w, "cases_ok", s->rmse_mm.n);
     rch_jw_numf(w, "rmse_mm", s->rmse_mm.mean, "%.6f");
-    rch_jw_numf(w, "rmse_std_mm", rch_stat_sd(&s->rmse_mm), "%.6f");
+    rch_jw_numf(w, "rmse_std_mm", rch_stats_sd(&s->rmse_mm), "%.6f");
     rch_jw_numf(w, "mean_abs_mm", s->mean_abs_mm.mean, "%.6f");
-    rch_jw_numf(w, "mean_abs_std_mm", rch_stat_sd(&s->mean_abs_mm), "%.6f");
+    rch_jw_numf(w, "mean_abs_std_mm", rch_stats_sd(&s->mean_abs_mm), "%.6f");
     rch_jw_numf(w, "max_mm", s->max_mm.mean, "%.6f");
-    rch_jw_numf(w, "max_std_mm", rch_stat_sd(&s->max_mm), "%.6f");
+    rch_jw_numf(w, "max_std_mm", rch_stats_sd(&s->max_mm), "%.6f");
     rch_jw_numf(w, "train_rmse_mm", s->train_rmse_mm.mean, "%.6f");
     if (r == 0) {
         rch_jw_int(w, "time_ms", 0);
     } else {
         rch_jw_numf(w, "time_ms", s->time_ms.mean, "%.4f");
-        rch_jw_numf(w, "time_std_ms", rch_stat_sd(&s->time_ms), "%.4f");
+        rch_jw_numf(w, "time_std_ms", rch_stats_sd(&s->time_ms), "%.4f");
         rch_jw_numf(w, "time_ratio_lm", isfinite(lm_time) && lm_time > 0 ? s->time_ms.mean / lm_time : 0.0, "%.4g");
         rch_jw_numf(w, "iterations", s->iterations.mean, "%.1f");
         rch_jw_numf(w, "cost_evals", s->cost_evals.mean, "%.0f");
@@ -341,7 +342,7 @@ static void json_ltlm(rch_jw *w, const rch_compare_result *res)
         for (unsigned k = 0; k < 4; ++k)
             rch_jw_numf(w, keys[k], res->ltlm_dh[j][k].mean, k < 2 ? "%.5f" : "%.6f");
         for (unsigned k = 0; k < 4; ++k)
-            rch_jw_numf(w, std_keys[k], rch_stat_sd(&res->ltlm_dh[j][k]), k < 2 ? "%.5f" : "%.6f");
+            rch_jw_numf(w, std_keys[k], rch_stats_sd(&res->ltlm_dh[j][k]), k < 2 ? "%.5f" : "%.6f");
         rch_jw_end(w);
     }
     rch_jw_end(w);
@@ -425,12 +426,12 @@ static rch_plot *plot_bars(const rch_compare_result *res, int time)
     char title[160];
     for (int r = time ? 1 : 0; r < RCH_COMPARE_ROWS; ++r) {
         const rch_compare_row *row = &res->row[r];
-        const rch_stat *st = time ? &row->time_ms : &row->rmse_mm;
+        const rch_stats *st = time ? &row->time_ms : &row->rmse_mm;
         if (!row->used || row->rmse_mm.n == 0)
             continue;
         labels[nb] = rch_compare_row_name(r);
         vals[nb] = st->mean;
-        errs[nb] = rch_stat_sd(st);
+        errs[nb] = rch_stats_sd(st);
         ++nb;
     }
     if (time)

@@ -17,7 +17,7 @@
  * asked), the convergence curve of every method and the per-sample held-out
  * errors of case 1.
  *
- * Depends on: rch_calib, rch_est, rch_eval, rch_robot (host), rc_solve
+ * Depends on: rch_calib, rch_est, rch_eval, rch_stats, rch_robot (host), rc_solve
  * (core); rch_plot for rch_compare_plots, rch_jw for rch_compare_json.
  * Memory: rch_compare_run allocates inside the result; rch_compare_free
  * releases it (also after a failed run). Thread safety: one result per
@@ -33,7 +33,7 @@
 
 #include "rch_diag.h"
 #include "rch_est.h"
-#include "rch_eval.h"
+#include "rch_stats.h"
 #include "rch_plot.h"
 #include "rch_robot.h"
 
@@ -71,9 +71,9 @@ typedef struct rch_compare_cell {
 typedef struct rch_compare_row {
     int used;            /* the row was run */
     unsigned failed;     /* cases where the method failed (not counted in the stats) */
-    rch_stat rmse_mm, mean_abs_mm, max_mm; /* held-out, over the cases */
-    rch_stat train_rmse_mm;                /* training RMS at the end */
-    rch_stat time_ms, iterations, cost_evals; /* methods only (BC: empty) */
+    rch_stats rmse_mm, mean_abs_mm, max_mm; /* held-out, over the cases */
+    rch_stats train_rmse_mm;                /* training RMS at the end */
+    rch_stats time_ms, iterations, cost_evals; /* methods only (BC: empty) */
 } rch_compare_row;
 
 typedef struct rch_compare_result {
@@ -85,8 +85,8 @@ typedef struct rch_compare_result {
     /* LTLM parameters over the cases where it succeeded (the paper's Table 7):
      * dh[j][0..3] = a (mm), d (mm), alpha (deg), theta (deg) of joint j; enc_mm[k] = e_x, e_y, e_z. */
     unsigned n_ltlm;
-    rch_stat ltlm_dh[RC_NJ][4];
-    rch_stat ltlm_enc_mm[3];
+    rch_stats ltlm_dh[RC_NJ][4];
+    rch_stats ltlm_enc_mm[3];
     /* with cfg.curves: case 1 only */
     rch_curve curve[RCH_EST_COUNT];  /* training RMS per iteration of each method run */
     double *err_case1_mm;            /* (RCH_COMPARE_ROWS x n_test) model - measured length; NaN where absent */

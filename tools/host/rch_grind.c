@@ -266,7 +266,7 @@ static double dist3(const double a[3], const double b[3])
  * flag[c] of every point, or (c < 0) into *only. Returns the points whose
  * orientation was matched as best effort only. */
 static size_t comp_pass(rch_grind_result *res, const rch_grind_config *gc, int c, const rc_model *m,
-                        const rc_model *truth, const rc_model *nom, rch_stat *only)
+                        const rc_model *truth, const rc_model *nom, rch_stats *only)
 {
     rc_comp_config cfg;
     rc_comp_stream st;
@@ -285,7 +285,7 @@ static size_t comp_pass(rch_grind_result *res, const rch_grind_config *gc, int c
             ++n_best_effort;
         rc_fk(pt, NULL, truth, qc);
         if (c < 0) {
-            rch_stat_add(only, dist3(pt, p->p_mm));
+            rch_stats_add(only, dist3(pt, p->p_mm));
             continue;
         }
         p->flag[c] = stc != RC_OK;
@@ -307,7 +307,7 @@ static void deviations(rch_grind_result *res, const rch_grind_config *gc, const 
     }
     res->n_orient_best_effort = comp_pass(res, gc, RCH_GRIND_COMP_CAL, cal, truth, nom, NULL);
     (void)comp_pass(res, gc, RCH_GRIND_COMP_TRUE, truth, truth, nom, NULL);
-    rch_stat_init(&res->align_only_mm);
+    memset(&res->align_only_mm, 0, sizeof res->align_only_mm);
     if (gc->align) {
         rc_model nom_aligned = *nom;
         double phi, dz;
@@ -365,9 +365,9 @@ int rch_grind_run(rch_grind_result *res, const rch_grind_config *cfg, const rc_m
         return -1;
     deviations(res, cfg, &cal, truth, nom);
     for (int c = 0; c < RCH_GRIND_CASES; ++c) {
-        rch_stat_init(&res->cases[c].dev_mm);
+        memset(&res->cases[c].dev_mm, 0, sizeof res->cases[c].dev_mm);
         for (size_t k = 0; k < res->n; ++k) {
-            rch_stat_add(&res->cases[c].dev_mm, res->pts[k].dev_mm[c]);
+            rch_stats_add(&res->cases[c].dev_mm, res->pts[k].dev_mm[c]);
             res->cases[c].n_flag += res->pts[k].flag[c] != 0;
         }
     }
@@ -406,8 +406,8 @@ static void report_table(FILE *f, const rch_grind_result *res)
         fprintf(f, " %8s", point_names[m]);
     fprintf(f, "\n");
     for (int c = 0; c < RCH_GRIND_CASES; ++c) {
-        const rch_stat *s = &res->cases[c].dev_mm;
-        fprintf(f, "  %-34s %9.4f %9.4f %9.4f", case_names[c], s->mean, rch_stat_sd(s), s->max);
+        const rch_stats *s = &res->cases[c].dev_mm;
+        fprintf(f, "  %-34s %9.4f %9.4f %9.4f", case_names[c], s->mean, rch_stats_sd(s), s->max_abs);
         for (int m = 0; m < 5; ++m)
             fprintf(f, " %8.4f", res->pts[res->named[m]].dev_mm[c]);
         fprintf(f, "\n");
@@ -473,12 +473,12 @@ int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config 
     rch_jw_bool(&w, "model_is_nominal", res->model_is_nominal);
     rch_jw_obj(&w, "cases");
     for (int c = 0; c < RCH_GRIND_CASES; ++c) {
-        const rch_stat *s = &res->cases[c].dev_mm;
+        const rch_stats *s = &res->cases[c].dev_mm;
         rch_jw_obj(&w, keys[c]);
         rch_jw_numf(&w, "mean_mm", s->mean, "%.6f");
-        rch_jw_numf(&w, "sd_mm", rch_stat_sd(s), "%.6f");
-        rch_jw_numf(&w, "max_mm", s->max, "%.6f");
-        rch_jw_numf(&w, "rms_mm", rch_stat_rms(s), "%.6f");
+        rch_jw_numf(&w, "sd_mm", rch_stats_sd(s), "%.6f");
+        rch_jw_numf(&w, "max_mm", s->max_abs, "%.6f"); /* deviations are >= 0 */
+        rch_jw_numf(&w, "rms_mm", rch_stats_rms(s), "%.6f");
         rch_jw_uint(&w, "not_converged", res->cases[c].n_flag);
         rch_jw_arr(&w, "named");
         for (int m = 0; m < 5; ++m)

@@ -23,7 +23,7 @@
  * the nominal one (issue 12: a nominal model must not be credited with what
  * the alignment removes).
  *
- * Depends on: rc_comp, rc_model, rc_rand (core); rch_eval, rch_plot, rch_jw (host).
+ * Depends on: rc_comp, rc_model, rc_rand (core); rch_stats, rch_plot, rch_jw (host).
  * Memory: rch_grind_run allocates the path inside the result;
  * rch_grind_free releases it (also after a failed run). Errors: 0, or -1
  * with d set (unreachable path, out of memory).
@@ -36,7 +36,7 @@
 
 #include "rc_model.h"
 #include "rch_diag.h"
-#include "rch_eval.h"
+#include "rch_stats.h"
 #include "rch_plot.h"
 
 /* ---- surfaces ---- */
@@ -101,7 +101,7 @@ typedef struct rch_grind_point {
 } rch_grind_point;
 
 typedef struct rch_grind_case {
-    rch_stat dev_mm;  /* over the path */
+    rch_stats dev_mm;  /* over the path */
     size_t n_flag;    /* points not compensated */
 } rch_grind_case;
 
@@ -112,7 +112,7 @@ typedef struct rch_grind_result {
     rch_grind_case cases[RCH_GRIND_CASES];
     size_t named[5];       /* path indices of P1..P5 (corners x-y-, x+y-, centre, x-y+, x+y+) */
     size_t n_orient_best_effort; /* calibrated compensation matched the position only */
-    rch_stat align_only_mm; /* with align: deviation when compensating with the nominal model aligned to the
+    rch_stats align_only_mm; /* with align: deviation when compensating with the nominal model aligned to the
                                truth the same way (what the alignment alone is worth); empty without align */
     int model_is_nominal;   /* the calibrated model's geometry equals the nominal table */
 } rch_grind_result;
