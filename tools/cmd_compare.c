@@ -8,10 +8,10 @@
 #include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_compare.h"
 #include "rch_data.h"
 #include "rch_opt.h"
+#include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_plot.h"
 #include "rch_robot.h"
 
