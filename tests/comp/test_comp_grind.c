@@ -1,7 +1,9 @@
-/* test_comp_grind.c - rcal grind on a simulated truth: with the true model
- * as the calibrated one, the compensated path is on the programmed one where
- * the uncompensated path is off by about a millimetre; every surface runs;
- * the plots are written; bad specs are usage errors. Runs the built rcal. */
+/* test_comp_grind.c - the grinding experiment on a simulated truth: with the
+ * true model as the calibrated one, the compensated path is on the programmed
+ * one where the uncompensated path is off by about a millimetre; every
+ * surface runs; the plots are written; bad specs are usage errors. In-process
+ * through rch_grind (surface parsing, base alignment, the run and its
+ * statistics) and end to end through the built rcal. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,13 +15,17 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <math.h>
+
 #include "rc_rand.h"
+#include "rch_grind.h"
 #include "rch_robot.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 #define RCAL RCAL_BINARY_DIR "/tools/rcal"
 
 static char dir[64], truth_path[128], model_path[128];
+static rc_model g_nom, g_truth;
 
 static int run(const char *cmd)
 {
@@ -51,6 +57,8 @@ static int setup(void **state)
     assert_non_null(f);
     assert_int_equal(rch_robot_write(f, "calibrated", &truth, &nom.model, NULL), 0);
     fclose(f);
+    g_nom = nom.model;
+    g_truth = truth;
     return 0;
 }
 
@@ -69,7 +77,9 @@ static double json_num(const char *txt, const char *case_name, const char *key)
     assert_non_null(c);
     const char *k = strstr(c, key);
     assert_non_null(k);
-    return strtod(k + strlen(key) + 3, NULL);
+    const char *colon = strchr(k + strlen(key), ':');
+    assert_non_null(colon);
+    return strtod(colon + 1, NULL);
 }
 
 static void test_perfect_calibration(void **state)
@@ -140,15 +150,110 @@ static void test_bad_specs(void **state)
         assert_int_equal(run(cmd), 2);
     }
     char cmd[768];
+    /* issue 12: the nominal model as the "calibrated" one is named as such */
+    snprintf(cmd, sizeof cmd, "'%s' grind --model '%s/data/irb120.json' --truth '%s' | grep -q 'not calibrated'", RCAL,
+             RCAL_SOURCE_DIR, truth_path);
+    assert_int_equal(run(cmd), 0);
     /* unreachable patch: a clear failure, not a wrong table */
     snprintf(cmd, sizeof cmd, "'%s' grind --model '%s' --truth '%s' --surface 'plane:cx=2000' > /dev/null 2>&1", RCAL,
              model_path, truth_path);
     assert_int_equal(run(cmd), 1);
 }
 
+static void test_surface_parse(void **state)
+{
+    rch_surface s;
+    rch_diag d;
+    (void)state;
+    assert_int_equal(rch_surface_parse(&s, NULL, &d), 0);
+    assert_int_equal(s.kind, RCH_SURF_TILTED);
+    assert_true(s.cx == 400 && s.z0 == 300 && s.w == 200 && s.h == 120);
+    assert_int_equal(rch_surface_parse(&s, "sine:amp=5,wl=80,cx=350", &d), 0);
+    assert_int_equal(s.kind, RCH_SURF_SINE);
+    assert_true(s.amp == 5 && s.wl == 80 && s.cx == 350 && s.w == 200);
+    assert_true(fabs(rch_surface_z(&s, 350 + 20, 0) - (300 + 5)) < 1e-9); /* a quarter wave: the crest */
+    static const char *const bad[][2] = {{"cone", "unknown surface"}, {"plane:w=-1", "positive"},
+                                         {"tilted:ax=x", "not a number"},
+                                         {"tilted:ax=0x1p3", "not a number"}, {"plane:w= 100", "not a number"},
+                                         {"plane:w=inf", "not a number"}, {"sine:foo=1", "unknown surface key"},
+                                         {"plane:w", "key=value"},         {"plane:ds=0.01", "5000 points"},
+                                         {"plane:ds=0.05,step=0.2,h=100", "limit of 200000"}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        memset(&d, 0, sizeof d);
+        if (rch_surface_parse(&s, bad[i][0], &d) != -1 || !strstr(d.msg, bad[i][1]))
+            fail_msg("surface '%s': expected a message with '%s', got '%s'", bad[i][0], bad[i][1], d.msg);
+    }
+}
+
+/* A calibrated model whose base is turned by 0.01 rad and lowered by 0.5 mm
+ * gets exactly that back from the alignment. */
+static void test_align_base(void **state)
+{
+    rc_model cal = g_truth;
+    double phi, dz;
+    (void)state;
+    cal.x[RC_P_THETA(0)] -= 0.01;
+    cal.x[RC_P_D(0)] -= 0.5;
+    rch_grind_align_base(&phi, &dz, &cal, &g_truth);
+    assert_true(fabs(phi - 0.01) < 1e-9);
+    assert_true(fabs(dz - 0.5) < 1e-9);
+    rch_grind_align_base(&phi, &dz, &g_truth, &g_truth);
+    assert_true(fabs(phi) < 1e-12 && fabs(dz) < 1e-12);
+}
+
+static void test_run_inprocess(void **state)
+{
+    rch_grind_config cfg;
+    rch_grind_result res;
+    rch_diag d;
+    (void)state;
+    rch_grind_defaults(&cfg);
+    assert_int_equal(rch_surface_parse(&cfg.surface, "plane:w=100,h=40", &d), 0);
+    assert_int_equal(rch_grind_run(&res, &cfg, &g_truth, &g_truth, &g_nom, &d), 0);
+    assert_int_equal(res.nx, 21);
+    assert_int_equal(res.ny, 5);
+    assert_int_equal(res.n, 105);
+    assert_int_equal(res.named[0], 0); /* P1: the path start */
+    assert_true(res.pts[res.named[2]].p_mm[0] == 400 && res.pts[res.named[2]].p_mm[1] == 0);
+    const rch_stats *u = &res.cases[RCH_GRIND_UNCOMP].dev_mm, *c = &res.cases[RCH_GRIND_COMP_CAL].dev_mm;
+    assert_true(u->n == 105 && u->mean > 0.3 && u->max_abs >= u->mean);
+    assert_true(c->max_abs < 1e-3);
+    assert_int_equal(res.cases[RCH_GRIND_COMP_CAL].n_flag, 0);
+    /* the statistics are those of the per-point deviations */
+    double s = 0.0;
+    for (size_t k = 0; k < res.n; ++k)
+        s += res.pts[k].dev_mm[RCH_GRIND_UNCOMP];
+    assert_true(fabs(s / 105.0 - u->mean) < 1e-12);
+    assert_false(res.model_is_nominal);
+    assert_true(res.align_only_mm.n == 105);
+    rch_grind_free(&res);
+    /* issue 12: a nominal model is not credited with what the alignment
+     * (taken from the truth) removes: it is flagged, and the alignment alone
+     * accounts for all of its gain */
+    assert_int_equal(rch_grind_run(&res, &cfg, &g_nom, &g_truth, &g_nom, &d), 0);
+    assert_true(res.model_is_nominal);
+    assert_true(fabs(res.align_only_mm.mean - res.cases[RCH_GRIND_COMP_CAL].dev_mm.mean) < 1e-12);
+    rch_grind_free(&res);
+    cfg.align = 0;
+    assert_int_equal(rch_grind_run(&res, &cfg, &g_nom, &g_truth, &g_nom, &d), 0);
+    assert_true(res.align_only_mm.n == 0);
+    /* nominal compensated by nominal: the joints do not move, the deviation stays */
+    assert_true(fabs(res.cases[RCH_GRIND_COMP_CAL].dev_mm.mean - res.cases[RCH_GRIND_UNCOMP].dev_mm.mean) < 1e-6);
+    rch_grind_free(&res);
+    cfg.align = 1;
+    /* unreachable: refused with the reason */
+    assert_int_equal(rch_surface_parse(&cfg.surface, "plane:cx=2000", &d), 0);
+    assert_int_equal(rch_grind_run(&res, &cfg, &g_truth, &g_truth, &g_nom, &d), -1);
+    assert_non_null(strstr(d.msg, "cannot reach"));
+    rch_grind_free(&res);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_surface_parse),
+        cmocka_unit_test(test_align_base),
+        cmocka_unit_test(test_run_inprocess),
         cmocka_unit_test(test_perfect_calibration),
         cmocka_unit_test(test_plots),
         cmocka_unit_test(test_bad_specs),

@@ -290,6 +290,60 @@ static void test_encoder_option(void **state)
     free(out);
 }
 
+/* Issue 12 regressions for compare, chaos and grind: every number checked
+ * against its stated range (no wrap, no "0 means default"), an empty method
+ * list refused, an absurd chaos request refused naming the limit, no nan in
+ * the JSON, --opt=value and -h accepted. Each case: exit code and a word the
+ * message must contain. */
+static void test_issue12_options(void **state)
+{
+    static const struct {
+        const char *args;
+        int rc;
+        const char *needle;
+    } cases[] = {
+        {"compare --data '%s' --methods ''", 2, "--methods"},
+        {"compare --data '%s' --methods 'lm,'", 2, "--methods"},
+        {"compare --data '%s' --methods=,", 2, "--methods"},
+        {"compare --data '%s' --cases 4294967297", 2, "--cases"},
+        {"compare --data '%s' --cases 0", 2, "--cases"},
+        {"compare --data '%s' --seed ' -1'", 2, "--seed"},
+        {"compare --data '%s' --test-fraction 1", 2, "--test-fraction"},
+        {"compare --data '%s' --test-fraction 0x1p-2", 2, "--test-fraction"},
+        {"compare --data='%s' --samples=40 --cases=1 --methods=LM --test-fraction=0.25", 0, "LM "},
+        {"compare -h", 0, "--methods"},
+        {"chaos --points 1e8 --starts 1e5", 2, "10000000"},
+        {"chaos --points 100000000 --starts 100000", 2, "10000000"},
+        {"chaos --points 10000000 --starts 100000", 2, "limit of 1e+09"},
+        {"chaos --starts 0", 2, "--starts"},
+        {"chaos --bins 4294967298", 2, "--bins"},
+        {"chaos --r 4.5", 2, "--r"},
+        {"chaos --step=0.3 --starts=5 --json", 0, "\"sd_at_0_5\": null"},
+        {"chaos -h", 0, "1e9"},
+        {"grind -h", 0, "--surface"},
+        {"grind --model a --truth b --max-dev-deg 0", 2, "--max-dev-deg"},
+        {"grind --model a --truth b --max-dev-deg -1", 2, "--max-dev-deg"},
+        {"grind --model a", 2, "--truth"},
+        {"grind --model a --truth b --surface plane:ds=0.05,step=0.2,h=100", 2, "limit of 200000"},
+    };
+    char cmd[1024], args[512], *out = NULL;
+    (void)state;
+    if (!have_rcal())
+        skip();
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        snprintf(args, sizeof args, cases[k].args, g_csv);
+        if (strncmp(args, "compare --data", 14) == 0)
+            snprintf(cmd, sizeof cmd, "'%s' %s --robot '%s' 2>&1", RCAL, args, ROBOT);
+        else
+            snprintf(cmd, sizeof cmd, "'%s' %s 2>&1", RCAL, args);
+        const int rc = run(cmd, &out);
+        if (rc != cases[k].rc || !strstr(out, cases[k].needle))
+            fail_msg("rcal %s: expected exit %d and '%s', got %d: %s", args, cases[k].rc, cases[k].needle, rc, out);
+        assert_null(strstr(out, "nan,"));
+        free(out);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -297,6 +351,7 @@ int main(void)
         cmocka_unit_test(test_compare_human_and_errors),
         cmocka_unit_test(test_chaos),
         cmocka_unit_test(test_encoder_option),
+        cmocka_unit_test(test_issue12_options),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -10,6 +10,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "rch_plot.h"
@@ -160,6 +162,78 @@ static void test_degenerate(void **state)
     rch_plot_line(NULL, "x", &one, &one, 1);
     assert_int_equal(rch_plot_write_svg(NULL, "/tmp/x.svg"), -1);
 }
+/* The plot-directory helpers the commands share: mkdir -p (refusing a file
+ * in the way), save-into-dir with its log line and error text, never over
+ * one of the command's inputs (the input survives byte for byte), the
+ * colour map's ends, XML text escaping. */
+static void test_dir_helpers(void **state)
+{
+    char dir[64], sub[128], path[192], *buf = NULL;
+    size_t len = 0;
+    struct stat sb;
+    rch_diag d;
+    (void)state;
+    strcpy(dir, "/tmp/rcal_plotdir_XXXXXX");
+    assert_non_null(mkdtemp(dir));
+    snprintf(sub, sizeof sub, "%s/a/b/c", dir);
+    assert_int_equal(rch_plot_mkdir(sub), 0);
+    assert_int_equal(stat(sub, &sb), 0);
+    assert_true(S_ISDIR(sb.st_mode));
+    assert_int_equal(rch_plot_mkdir(sub), 0); /* existing: fine */
+    FILE *log = open_memstream(&buf, &len);
+    assert_non_null(log);
+    /* an input of the command that happens to carry a plot's name */
+    char input[192];
+    snprintf(input, sizeof input, "%s/q.svg", sub);
+    FILE *in = fopen(input, "w");
+    assert_non_null(in);
+    fputs("measurements\n", in);
+    fclose(in);
+    const char *const inputs[2] = {NULL, input};
+    const rch_plot_dir pd = {sub, inputs, 2, log};
+    rch_plot *p = rch_plot_new("t", "x", "y");
+    const double x[2] = {0, 1}, y[2] = {1, 2};
+    rch_plot_line(p, "l", x, y, 2);
+    assert_int_equal(rch_plot_save(p, &pd, "p.svg", &d), 0);
+    fclose(log);
+    snprintf(path, sizeof path, "  wrote %s/p.svg\n", sub);
+    assert_string_equal(buf, path);
+    free(buf);
+    snprintf(path, sizeof path, "%s/p.svg", sub);
+    assert_int_equal(stat(path, &sb), 0);
+    assert_int_equal(rch_plot_save(rch_plot_new("t", "x", "y"), &pd, "q.svg", &d), -1);
+    assert_non_null(strstr(d.msg, "same file as the input"));
+    assert_int_equal(stat(input, &sb), 0);
+    assert_int_equal(sb.st_size, 13); /* untouched */
+    /* a file where a directory is wanted */
+    snprintf(path, sizeof path, "%s/p.svg/d", sub);
+    errno = 0;
+    assert_int_equal(rch_plot_mkdir(path), -1);
+    assert_int_equal(errno, ENOTDIR);
+    /* unwritable target and a failed allocation (NULL chart) are errors naming the file */
+    const rch_plot_dir bad = {path, NULL, 0, NULL};
+    assert_int_equal(rch_plot_save(rch_plot_new("t", "x", "y"), &bad, "q.svg", &d), -1);
+    assert_int_equal(rch_plot_save(NULL, &pd, "r.svg", &d), -1);
+    assert_non_null(strstr(d.msg, "r.svg"));
+    snprintf(path, sizeof path, "rm -rf '%s'", dir);
+    assert_int_equal(system(path), 0);
+    /* colour map ends and clamping */
+    char c[8];
+    rch_plot_viridis(c, 0.0);
+    assert_string_equal(c, "#440154");
+    rch_plot_viridis(c, 1.0);
+    assert_string_equal(c, "#fde725");
+    rch_plot_viridis(c, 7.0);
+    assert_string_equal(c, "#fde725");
+    rch_plot_viridis(c, -1.0);
+    assert_string_equal(c, "#440154");
+    buf = NULL;
+    log = open_memstream(&buf, &len);
+    rch_plot_xml_text(log, "a<b & \"c\"");
+    fclose(log);
+    assert_string_equal(buf, "a&lt;b &amp; &quot;c&quot;");
+    free(buf);
+}
 
 int main(void)
 {
@@ -167,6 +241,7 @@ int main(void)
         cmocka_unit_test(test_lines_legend_escape),
         cmocka_unit_test(test_logy_bars_file),
         cmocka_unit_test(test_degenerate),
+        cmocka_unit_test(test_dir_helpers),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 enum { PLOT_LINE = 0, PLOT_SCATTER = 1 };
 
@@ -158,12 +159,7 @@ void rch_plot_bars(rch_plot *p, const char *const *labels, const double *values,
     p->bar_val = plot_dupd(values, n);
     p->bar_err = errs ? plot_dupd(errs, n) : NULL;
     if (!p->bar_labels || !p->bar_val || (errs && !p->bar_err)) {
-        free(p->bar_labels);
-        free(p->bar_val);
-        free(p->bar_err);
-        p->bar_labels = NULL;
-        p->bar_val = NULL;
-        p->bar_err = NULL;
+        plot_free_bars(p); /* n_bars is still 0: frees the arrays only */
         p->failed = 1;
         return;
     }
@@ -377,291 +373,274 @@ static void plot_fmt(char *buf, size_t len, double v, double step)
     snprintf(buf, len, "%g", v);
 }
 
-int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
+/* One y tick at pixel row py: grid line across the plot (left L, width pw),
+ * tick mark, label. */
+static void plot_ytick(FILE *f, double L, double pw, double py, const char *label)
 {
-    plot_axis ax, ay;
-    double W, H, L = 75.0, R = 20.0, T = 45.0, B = 60.0, pw, ph, legw = 0.0;
-    double xs, ys;
-    size_t i, k, nleg = 0, maxlab = 0;
-    int rot_labels = 0;
-    if (!p || !f || p->failed) {
-        errno = EINVAL;
-        return -1;
-    }
-    W = (double)p->width;
-    H = (double)p->height;
-    plot_ranges(p, &ax, &ay);
+    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e0e0e0\"/>\n", L, py, L + pw, py);
+    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n", L - 5, py, L, py);
+    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8, py + 4, label);
+}
 
-    /* legend: one entry per series (and one for the bars when labelled) */
-    for (i = 0; i < p->n_series; i++) {
+/* Page layout of one chart: axes, margins (left L, right R, top T, bottom
+ * B), plot area pw x ph, pixels per unit, legend size. */
+typedef struct plot_frame {
+    plot_axis ax, ay;
+    double W, H, L, R, T, B, pw, ph, legw, xs, ys;
+    size_t nleg;
+    int rot_labels; /* bar labels at -45 deg (too long for their slot) */
+} plot_frame;
+
+static double plot_px(const plot_frame *fr, double v) { return fr->L + (v - fr->ax.lo) * fr->xs; }
+static double plot_py(const plot_frame *fr, double v) { return fr->T + fr->ph - (v - fr->ay.lo) * fr->ys; }
+
+static void plot_layout(plot_frame *fr, const rch_plot *p)
+{
+    size_t maxlab = 0;
+    fr->L = 75.0;
+    fr->R = 20.0;
+    fr->T = 45.0;
+    fr->B = 60.0;
+    fr->legw = 0.0;
+    fr->nleg = 0;
+    fr->rot_labels = 0;
+    fr->W = (double)p->width;
+    fr->H = (double)p->height;
+    plot_ranges(p, &fr->ax, &fr->ay);
+    /* legend: one entry per labelled series */
+    for (size_t i = 0; i < p->n_series; i++) {
         size_t l = strlen(p->series[i].label);
         if (l > 0) {
-            nleg++;
+            fr->nleg++;
             if (l > maxlab)
                 maxlab = l;
         }
     }
-    if (nleg > 0) {
-        legw = 40.0 + 7.2 * (double)(maxlab > 40 ? 40 : maxlab);
-        R += legw + 10.0;
+    if (fr->nleg > 0) {
+        fr->legw = 40.0 + 7.2 * (double)(maxlab > 40 ? 40 : maxlab);
+        fr->R += fr->legw + 10.0;
     }
     if (p->n_bars > 0) {
         size_t ml = 0;
-        for (k = 0; k < p->n_bars; k++)
+        for (size_t k = 0; k < p->n_bars; k++)
             if (strlen(p->bar_labels[k]) > ml)
                 ml = strlen(p->bar_labels[k]);
-        if ((double)ml * 7.0 > (W - L - R) / (double)p->n_bars) {
-            rot_labels = 1;
-            B += 5.0 * (double)(ml > 20 ? 20 : ml);
+        if ((double)ml * 7.0 > (fr->W - fr->L - fr->R) / (double)p->n_bars) {
+            fr->rot_labels = 1;
+            fr->B += 5.0 * (double)(ml > 20 ? 20 : ml);
         }
     }
-    if (H - T - B < 60.0)
-        B = H - T - 60.0;
-    pw = W - L - R;
-    ph = H - T - B;
-    if (pw < 50.0)
-        pw = 50.0;
-    xs = pw / (ax.hi - ax.lo);
-    ys = ph / (ay.hi - ay.lo);
-#define PX(v) (L + ((v) - ax.lo) * xs)
-#define PY(v) (T + ph - ((v) - ay.lo) * ys)
+    if (fr->H - fr->T - fr->B < 60.0)
+        fr->B = fr->H - fr->T - 60.0;
+    fr->pw = fr->W - fr->L - fr->R;
+    fr->ph = fr->H - fr->T - fr->B;
+    if (fr->pw < 50.0)
+        fr->pw = 50.0;
+    fr->xs = fr->pw / (fr->ax.hi - fr->ax.lo);
+    fr->ys = fr->ph / (fr->ay.hi - fr->ay.lo);
+}
 
+/* y ticks and grid: linear, log by decades, or log over less than a decade. */
+static void plot_yticks(FILE *f, const plot_frame *fr)
+{
+    const plot_axis *ay = &fr->ay;
+    double y0, step;
+    int guard = 0;
+    char buf[64];
+    if (ay->log && ay->hi - ay->lo < 0.7) {
+        /* less than a decade: linear 1-2-5 ticks placed on the log axis */
+        const double vlo = pow(10.0, ay->lo), vhi = pow(10.0, ay->hi);
+        step = plot_nice_step(vhi - vlo, 5);
+        for (y0 = ceil(vlo / step - 1e-9) * step; y0 <= vhi + 1e-9 * step && guard < 100; y0 += step, guard++) {
+            if (y0 <= 0.0)
+                continue;
+            plot_fmt(buf, sizeof buf, y0, step);
+            plot_ytick(f, fr->L, fr->pw, plot_py(fr, log10(y0)), buf);
+        }
+    } else if (ay->log) {
+        double span = ay->hi - ay->lo;
+        int d0 = (int)floor(ay->lo), d1 = (int)ceil(ay->hi), d;
+        static const double sub3[3] = {1.0, 2.0, 5.0};
+        static const double sub9[9] = {1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0};
+        const double *sub = span < 1.2 ? sub9 : sub3;
+        int nsub = span < 1.2 ? 9 : (span < 2.5 ? 3 : 1);
+        int every = span > 12 ? (int)ceil(span / 8.0) : 1;
+        for (d = d0; d <= d1 && guard < 400; d++, guard++) {
+            if ((d - d0) % every != 0)
+                continue;
+            for (int s = 0; s < nsub; s++) {
+                double v = pow(10.0, (double)d) * sub[s], tv = log10(v);
+                if (tv < ay->lo - 1e-9 || tv > ay->hi + 1e-9)
+                    continue;
+                snprintf(buf, sizeof buf, "%g", v);
+                plot_ytick(f, fr->L, fr->pw, plot_py(fr, tv), buf);
+            }
+        }
+    } else {
+        step = plot_nice_step(ay->hi - ay->lo, 6);
+        for (y0 = ceil(ay->lo / step - 1e-9) * step; y0 <= ay->hi + 1e-9 * step && guard < 100;
+             y0 += step, guard++) {
+            plot_fmt(buf, sizeof buf, y0, step);
+            plot_ytick(f, fr->L, fr->pw, plot_py(fr, y0), buf);
+        }
+    }
+}
+
+/* x ticks and grid (numeric x axis). */
+static void plot_xticks(FILE *f, const plot_frame *fr)
+{
+    const double step = plot_nice_step(fr->ax.hi - fr->ax.lo, 8), T = fr->T, ph = fr->ph;
+    int guard = 0;
+    char buf[64];
+    for (double x0 = ceil(fr->ax.lo / step - 1e-9) * step; x0 <= fr->ax.hi + 1e-9 * step && guard < 100;
+         x0 += step, guard++) {
+        double px = plot_px(fr, x0);
+        fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e0e0e0\"/>\n", px, T, px, T + ph);
+        fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n", px, T + ph, px,
+                T + ph + 5);
+        plot_fmt(buf, sizeof buf, x0, step);
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">%s</text>\n", px, T + ph + 18, buf);
+    }
+}
+
+/* Bar k (value, error bar, value label) when its value can be drawn, and its category label. */
+static void plot_bar(FILE *f, const rch_plot *p, const plot_frame *fr, size_t k)
+{
+    const plot_axis *ay = &fr->ay;
+    const double bw = 0.6 * fr->xs, v = p->bar_val[k], cx = plot_px(fr, (double)k);
+    const double base = ay->log ? ay->lo : (ay->lo > 0.0 ? ay->lo : (ay->hi < 0.0 ? ay->hi : 0.0));
+    const char *col = plot_colours[k % PLOT_NCOL];
+    if (plot_ok(ay, v)) {
+        double tv = plot_tr(ay, v), top, bot;
+        char buf[64];
+        if (tv > ay->hi) tv = ay->hi;
+        if (tv < ay->lo) tv = ay->lo;
+        top = plot_py(fr, tv > base ? tv : base);
+        bot = plot_py(fr, tv > base ? base : tv);
+        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"%s\" fill-opacity=\"0.85\"><title>",
+                cx - bw / 2.0, top, bw, bot - top, col);
+        plot_esc(f, p->bar_labels[k]);
+        fprintf(f, ": %g</title></rect>\n", v);
+        if (p->bar_err && isfinite(p->bar_err[k]) && p->bar_err[k] != 0.0) {
+            double e = fabs(p->bar_err[k]), hi = v + e, lo = v - e, yh, yl;
+            yh = plot_tr(ay, hi);
+            yl = (ay->log && lo <= 0.0) ? ay->lo : plot_tr(ay, lo);
+            if (yh > ay->hi) yh = ay->hi;
+            if (yl < ay->lo) yl = ay->lo;
+            fprintf(f, "<path d=\"M%.2f %.2fV%.2fM%.2f %.2fH%.2fM%.2f %.2fH%.2f\" stroke=\"black\" "
+                       "stroke-width=\"1.2\" fill=\"none\"/>\n",
+                    cx, plot_py(fr, yl), plot_py(fr, yh), cx - bw / 6.0, plot_py(fr, yl), cx + bw / 6.0,
+                    cx - bw / 6.0, plot_py(fr, yh), cx + bw / 6.0);
+        }
+        snprintf(buf, sizeof buf, "%.3g", v);
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\" font-size=\"10\">%s</text>\n",
+                cx + (p->bar_err ? bw / 4.0 : 0.0), top - 3.0, buf);
+    }
+    if (fr->rot_labels)
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\" transform=\"rotate(-45 %.2f %.2f)\">", cx,
+                fr->T + fr->ph + 14, cx, fr->T + fr->ph + 14);
+    else
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", cx, fr->T + fr->ph + 18);
+    plot_esc(f, p->bar_labels[k]);
+    fprintf(f, "</text>\n");
+}
+
+/* Every series, clipped to the plot area. */
+static void plot_series_all(FILE *f, const rch_plot *p, const plot_frame *fr)
+{
+    const plot_axis *ay = &fr->ay;
+    fprintf(f,
+            "<defs><clipPath id=\"plotarea\"><rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" "
+            "height=\"%.2f\"/></clipPath></defs>\n<g clip-path=\"url(#plotarea)\">\n",
+            fr->L, fr->T, fr->pw, fr->ph);
+    for (size_t i = 0; i < p->n_series; i++) {
+        const plot_series *s = &p->series[i];
+        const char *col = plot_colours[i % PLOT_NCOL];
+        if (s->kind == PLOT_LINE) {
+            int pen = 0;
+            fprintf(f, "<path fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\" d=\"", col);
+            for (size_t k = 0; k < s->n; k++) {
+                if (!isfinite(s->x[k]) || !plot_ok(ay, s->y[k])) {
+                    pen = 0;
+                    continue;
+                }
+                fprintf(f, "%s%.2f %.2f", pen ? "L" : "M", plot_px(fr, s->x[k]), plot_py(fr, plot_tr(ay, s->y[k])));
+                pen = 1;
+            }
+            fprintf(f, "\"/>\n");
+            if (s->n == 1 && isfinite(s->x[0]) && plot_ok(ay, s->y[0]))
+                plot_marker(f, 0, plot_px(fr, s->x[0]), plot_py(fr, plot_tr(ay, s->y[0])), col);
+        } else {
+            for (size_t k = 0; k < s->n; k++)
+                if (isfinite(s->x[k]) && plot_ok(ay, s->y[k]))
+                    plot_marker(f, (int)i, plot_px(fr, s->x[k]), plot_py(fr, plot_tr(ay, s->y[k])), col);
+        }
+    }
+    fprintf(f, "</g>\n");
+}
+
+/* Frame, axis labels and the legend. */
+static void plot_frame_legend(FILE *f, const rch_plot *p, const plot_frame *fr)
+{
+    const double L = fr->L, T = fr->T, pw = fr->pw, ph = fr->ph;
+    fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"none\" stroke=\"black\"/>\n", L, T,
+            pw, ph);
+    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", L + pw / 2.0, fr->H - 12.0);
+    plot_esc(f, p->xlabel);
+    fprintf(f, "</text>\n");
+    fprintf(f, "<text x=\"16\" y=\"%.2f\" text-anchor=\"middle\" transform=\"rotate(-90 16 %.2f)\">", T + ph / 2.0,
+            T + ph / 2.0);
+    plot_esc(f, p->ylabel);
+    fprintf(f, "</text>\n");
+    if (fr->nleg == 0)
+        return;
+    double lx = L + pw + 10.0, ly = T;
+    fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"white\" stroke=\"#999999\"/>\n", lx,
+            ly, fr->legw, 8.0 + 18.0 * (double)fr->nleg);
+    for (size_t i = 0; i < p->n_series; i++) {
+        const plot_series *s = &p->series[i];
+        const char *col = plot_colours[i % PLOT_NCOL];
+        const double yy = ly + 16.0;
+        if (s->label[0] == '\0')
+            continue;
+        if (s->kind == PLOT_LINE)
+            fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" stroke-width=\"2.5\"/>\n",
+                    lx + 6, yy - 4, lx + 26, yy - 4, col);
+        else
+            plot_marker(f, (int)i, lx + 16, yy - 4, col);
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">", lx + 30, yy);
+        plot_esc(f, s->label);
+        fprintf(f, "</text>\n");
+        ly += 18.0;
+    }
+}
+
+int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
+{
+    plot_frame fr;
+    if (!p || !f || p->failed) {
+        errno = EINVAL;
+        return -1;
+    }
+    plot_layout(&fr, p);
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     fprintf(f,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%u\" height=\"%u\" "
             "viewBox=\"0 0 %u %u\" font-family=\"Helvetica, Arial, sans-serif\" "
             "font-size=\"12\">\n",
             p->width, p->height, p->width, p->height);
-    fprintf(f, "<rect x=\"0\" y=\"0\" width=\"%u\" height=\"%u\" fill=\"white\"/>\n", p->width,
-            p->height);
-    fprintf(f, "<text x=\"%.1f\" y=\"24\" text-anchor=\"middle\" font-size=\"16\" "
-               "font-weight=\"bold\">",
-            W / 2.0);
+    fprintf(f, "<rect x=\"0\" y=\"0\" width=\"%u\" height=\"%u\" fill=\"white\"/>\n", p->width, p->height);
+    fprintf(f, "<text x=\"%.1f\" y=\"24\" text-anchor=\"middle\" font-size=\"16\" font-weight=\"bold\">", fr.W / 2.0);
     plot_esc(f, p->title);
     fprintf(f, "</text>\n");
-
-    /* y ticks and grid */
-    {
-        double y0, step;
-        int guard = 0;
-        char buf[64];
-        if (ay.log && ay.hi - ay.lo < 0.7) {
-            /* less than a decade: linear 1-2-5 ticks placed on the log axis */
-            const double vlo = pow(10.0, ay.lo), vhi = pow(10.0, ay.hi);
-            step = plot_nice_step(vhi - vlo, 5);
-            for (y0 = ceil(vlo / step - 1e-9) * step; y0 <= vhi + 1e-9 * step && guard < 100;
-                 y0 += step, guard++) {
-                double py;
-                if (y0 <= 0.0)
-                    continue;
-                py = PY(log10(y0));
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                        "stroke=\"#e0e0e0\"/>\n",
-                        L, py, L + pw, py);
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
-                        L - 5, py, L, py);
-                plot_fmt(buf, sizeof buf, y0, step);
-                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8,
-                        py + 4, buf);
-            }
-        } else if (ay.log) {
-            double span = ay.hi - ay.lo;
-            int d0 = (int)floor(ay.lo), d1 = (int)ceil(ay.hi), d;
-            static const double sub3[3] = {1.0, 2.0, 5.0};
-            static const double sub9[9] = {1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0};
-            const double *sub = span < 1.2 ? sub9 : sub3;
-            int nsub = span < 1.2 ? 9 : (span < 2.5 ? 3 : 1);
-            int every = span > 12 ? (int)ceil(span / 8.0) : 1;
-            for (d = d0; d <= d1 && guard < 400; d++, guard++) {
-                int s;
-                if ((d - d0) % every != 0)
-                    continue;
-                for (s = 0; s < nsub; s++) {
-                    double v = pow(10.0, (double)d) * sub[s], tv = log10(v), py;
-                    if (tv < ay.lo - 1e-9 || tv > ay.hi + 1e-9)
-                        continue;
-                    py = PY(tv);
-                    fprintf(f,
-                            "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                            "stroke=\"#e0e0e0\"/>\n",
-                            L, py, L + pw, py);
-                    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                               "stroke=\"black\"/>\n",
-                            L - 5, py, L, py);
-                    snprintf(buf, sizeof buf, "%g", v);
-                    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n",
-                            L - 8, py + 4, buf);
-                }
-            }
-        } else {
-            step = plot_nice_step(ay.hi - ay.lo, 6);
-            for (y0 = ceil(ay.lo / step - 1e-9) * step; y0 <= ay.hi + 1e-9 * step && guard < 100;
-                 y0 += step, guard++) {
-                double py = PY(y0);
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
-                        "stroke=\"#e0e0e0\"/>\n",
-                        L, py, L + pw, py);
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
-                        L - 5, py, L, py);
-                plot_fmt(buf, sizeof buf, y0, step);
-                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8,
-                        py + 4, buf);
-            }
-        }
-    }
-    /* x ticks (numeric unless this is a pure bar chart) */
-    if (p->n_bars == 0) {
-        double step = plot_nice_step(ax.hi - ax.lo, 8), x0;
-        int guard = 0;
-        char buf[64];
-        for (x0 = ceil(ax.lo / step - 1e-9) * step; x0 <= ax.hi + 1e-9 * step && guard < 100;
-             x0 += step, guard++) {
-            double px = PX(x0);
-            fprintf(f,
-                    "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e0e0e0\"/>\n",
-                    px, T, px, T + ph);
-            fprintf(f,
-                    "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n",
-                    px, T + ph, px, T + ph + 5);
-            plot_fmt(buf, sizeof buf, x0, step);
-            fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">%s</text>\n", px,
-                    T + ph + 18, buf);
-        }
-    }
-
-    /* bars */
-    if (p->n_bars > 0) {
-        double bw = 0.6 * xs;
-        double base = ay.log ? ay.lo : (ay.lo > 0.0 ? ay.lo : (ay.hi < 0.0 ? ay.hi : 0.0));
-        for (k = 0; k < p->n_bars; k++) {
-            double v = p->bar_val[k], cx = PX((double)k), top, bot;
-            const char *col = plot_colours[k % PLOT_NCOL];
-            if (plot_ok(&ay, v)) {
-                double tv = plot_tr(&ay, v);
-                if (tv > ay.hi) tv = ay.hi;
-                if (tv < ay.lo) tv = ay.lo;
-                top = PY(tv > base ? tv : base);
-                bot = PY(tv > base ? base : tv);
-                fprintf(f,
-                        "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"%s\" "
-                        "fill-opacity=\"0.85\"><title>",
-                        cx - bw / 2.0, top, bw, bot - top, col);
-                plot_esc(f, p->bar_labels[k]);
-                fprintf(f, ": %g</title></rect>\n", v);
-                if (p->bar_err && isfinite(p->bar_err[k]) && p->bar_err[k] != 0.0) {
-                    double e = fabs(p->bar_err[k]), hi = v + e, lo = v - e, yh, yl;
-                    yh = plot_tr(&ay, hi);
-                    yl = (ay.log && lo <= 0.0) ? ay.lo : plot_tr(&ay, lo);
-                    if (yh > ay.hi) yh = ay.hi;
-                    if (yl < ay.lo) yl = ay.lo;
-                    fprintf(f,
-                            "<path d=\"M%.2f %.2fV%.2fM%.2f %.2fH%.2fM%.2f %.2fH%.2f\" "
-                            "stroke=\"black\" stroke-width=\"1.2\" fill=\"none\"/>\n",
-                            cx, PY(yl), PY(yh), cx - bw / 6.0, PY(yl), cx + bw / 6.0,
-                            cx - bw / 6.0, PY(yh), cx + bw / 6.0);
-                }
-                {
-                    char buf[64];
-                    snprintf(buf, sizeof buf, "%.3g", v);
-                    fprintf(f,
-                            "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\" "
-                            "font-size=\"10\">%s</text>\n",
-                            cx + (p->bar_err ? bw / 4.0 : 0.0), top - 3.0, buf);
-                }
-            }
-            if (rot_labels) {
-                fprintf(f,
-                        "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\" "
-                        "transform=\"rotate(-45 %.2f %.2f)\">",
-                        cx, T + ph + 14, cx, T + ph + 14);
-            } else {
-                fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", cx,
-                        T + ph + 18);
-            }
-            plot_esc(f, p->bar_labels[k]);
-            fprintf(f, "</text>\n");
-        }
-    }
-
-    /* series, clipped to the plot area */
-    fprintf(f,
-            "<defs><clipPath id=\"plotarea\"><rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" "
-            "height=\"%.2f\"/></clipPath></defs>\n<g clip-path=\"url(#plotarea)\">\n",
-            L, T, pw, ph);
-    for (i = 0; i < p->n_series; i++) {
-        const plot_series *s = &p->series[i];
-        const char *col = plot_colours[i % PLOT_NCOL];
-        if (s->kind == PLOT_LINE) {
-            int pen = 0;
-            fprintf(f, "<path fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\" d=\"", col);
-            for (k = 0; k < s->n; k++) {
-                if (!isfinite(s->x[k]) || !plot_ok(&ay, s->y[k])) {
-                    pen = 0;
-                    continue;
-                }
-                fprintf(f, "%s%.2f %.2f", pen ? "L" : "M", PX(s->x[k]),
-                        PY(plot_tr(&ay, s->y[k])));
-                pen = 1;
-            }
-            fprintf(f, "\"/>\n");
-            if (s->n == 1 && isfinite(s->x[0]) && plot_ok(&ay, s->y[0]))
-                plot_marker(f, 0, PX(s->x[0]), PY(plot_tr(&ay, s->y[0])), col);
-        } else {
-            for (k = 0; k < s->n; k++)
-                if (isfinite(s->x[k]) && plot_ok(&ay, s->y[k]))
-                    plot_marker(f, (int)i, PX(s->x[k]), PY(plot_tr(&ay, s->y[k])), col);
-        }
-    }
-    fprintf(f, "</g>\n");
-
-    /* frame and axis labels */
-    fprintf(f,
-            "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"none\" "
-            "stroke=\"black\"/>\n",
-            L, T, pw, ph);
-    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", L + pw / 2.0, H - 12.0);
-    plot_esc(f, p->xlabel);
-    fprintf(f, "</text>\n");
-    fprintf(f,
-            "<text x=\"16\" y=\"%.2f\" text-anchor=\"middle\" transform=\"rotate(-90 16 %.2f)\">",
-            T + ph / 2.0, T + ph / 2.0);
-    plot_esc(f, p->ylabel);
-    fprintf(f, "</text>\n");
-
-    /* legend */
-    if (nleg > 0) {
-        double lx = L + pw + 10.0, ly = T;
-        fprintf(f,
-                "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"white\" "
-                "stroke=\"#999999\"/>\n",
-                lx, ly, legw, 8.0 + 18.0 * (double)nleg);
-        for (i = 0; i < p->n_series; i++) {
-            const plot_series *s = &p->series[i];
-            const char *col = plot_colours[i % PLOT_NCOL];
-            double yy;
-            if (s->label[0] == '\0')
-                continue;
-            yy = ly + 16.0;
-            if (s->kind == PLOT_LINE)
-                fprintf(f,
-                        "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" "
-                        "stroke-width=\"2.5\"/>\n",
-                        lx + 6, yy - 4, lx + 26, yy - 4, col);
-            else
-                plot_marker(f, (int)i, lx + 16, yy - 4, col);
-            fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">", lx + 30, yy);
-            plot_esc(f, s->label);
-            fprintf(f, "</text>\n");
-            ly += 18.0;
-        }
-    }
+    plot_yticks(f, &fr);
+    if (p->n_bars == 0)
+        plot_xticks(f, &fr); /* numeric x axis unless this is a pure bar chart */
+    for (size_t k = 0; k < p->n_bars; k++)
+        plot_bar(f, p, &fr, k);
+    plot_series_all(f, p, &fr);
+    plot_frame_legend(f, p, &fr);
     fprintf(f, "</svg>\n");
-#undef PX
-#undef PY
     return ferror(f) ? -1 : 0;
 }
 
@@ -680,4 +659,86 @@ int rch_plot_write_svg(const rch_plot *p, const char *path)
     if (fclose(f) != 0)
         rc = -1;
     return rc;
+}
+
+void rch_plot_xml_text(FILE *f, const char *s) { plot_esc(f, s); }
+
+int rch_plot_mkdir(const char *dir)
+{
+    char buf[4096];
+    struct stat sb;
+    size_t n = dir ? strlen(dir) : 0;
+    if (n == 0 || n >= sizeof buf) {
+        errno = n ? ENAMETOOLONG : EINVAL;
+        return -1;
+    }
+    memcpy(buf, dir, n + 1);
+    for (size_t i = 1; i <= n; ++i) {
+        if (buf[i] != '/' && buf[i] != '\0')
+            continue;
+        const char c = buf[i];
+        buf[i] = '\0';
+        if (stat(buf, &sb) != 0) {
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return -1;
+        } else if (!S_ISDIR(sb.st_mode)) {
+            errno = ENOTDIR;
+            return -1;
+        }
+        buf[i] = c;
+    }
+    return 0;
+}
+
+int rch_plot_open(rch_out *o, const rch_plot_dir *pd, const char *name, rch_diag *d)
+{
+    char path[1024];
+    if ((size_t)snprintf(path, sizeof path, "%s/%s", pd->dir, name) >= sizeof path) {
+        memset(o, 0, sizeof *o);
+        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: path too long", pd->dir, name);
+        return -1;
+    }
+    return rch_out_open(o, path, "plot file", pd->inputs, pd->n_inputs, d);
+}
+
+int rch_plot_close(rch_out *o, const rch_plot_dir *pd, int failed, rch_diag *d)
+{
+    if (failed || ferror(o->f)) {
+        rch_diag_set(d, "", 0, 0, "cannot write %s: %s", o->path, failed ? "out of memory" : "write error");
+        rch_out_abort(o);
+        return -1;
+    }
+    if (rch_out_commit(o, d) != 0)
+        return -1;
+    if (pd->log)
+        fprintf(pd->log, "  wrote %s\n", o->path);
+    return 0;
+}
+
+int rch_plot_save(rch_plot *p, const rch_plot_dir *pd, const char *name, rch_diag *d)
+{
+    rch_out o;
+    int rc = -1;
+    if (!p || p->failed)
+        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: out of memory", pd->dir, name);
+    else if (rch_plot_open(&o, pd, name, d) == 0)
+        rc = rch_plot_close(&o, pd, rch_plot_write_svg_stream(p, o.f) != 0, d);
+    rch_plot_free(p);
+    return rc;
+}
+
+void rch_plot_viridis(char out[8], double t)
+{
+    static const double stops[5][3] = {
+        {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    const double u = t * 4.0;
+    int i = (int)floor(u);
+    if (i > 3)
+        i = 3;
+    const double f = u - i;
+    int rgb[3];
+    for (int c = 0; c < 3; ++c)
+        rgb[c] = (int)lround(stops[i][c] + f * (stops[i + 1][c] - stops[i][c]));
+    snprintf(out, 8, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
 }

@@ -15,7 +15,8 @@
  * Non-finite points (NaN, inf) are skipped and break a line; on a log y axis
  * points with y <= 0 are skipped too.
  *
- * Depends on: the C library (stdio, stdlib, string, math). Memory: the chart
+ * Depends on: the C library (stdio, stdlib, string, math); rch_file for
+ * the plot-directory helpers. Memory: the chart
  * copies every string and array it is given (callers may free theirs at once);
  * rch_plot_free releases it. Thread safety: one object per thread.
  * Errors: rch_plot_new returns NULL on allocation failure; an allocation
@@ -28,6 +29,9 @@
 
 #include <stddef.h>
 #include <stdio.h>
+
+#include "rch_diag.h"
+#include "rch_file.h"
 
 typedef struct rch_plot rch_plot;
 
@@ -60,5 +64,38 @@ int rch_plot_write_svg(const rch_plot *p, const char *path);
 int rch_plot_write_svg_stream(const rch_plot *p, FILE *f);
 
 void rch_plot_free(rch_plot *p);
+
+/* ---- plot files in a directory (the --plots DIR of the commands) ---- */
+
+/* Create dir and its missing parents (mkdir -p). 0, or -1 with errno set
+ * (ENOTDIR when a component exists and is not a directory). */
+int rch_plot_mkdir(const char *dir);
+
+/* Where a command writes its plots: every file goes through rch_file (never
+ * over one of the command's inputs, temporary file renamed into place only
+ * when complete). */
+typedef struct rch_plot_dir {
+    const char *dir;            /* the directory (rch_plot_mkdir first) */
+    const char *const *inputs;  /* (n_inputs) the command's input files; NULL entries skipped */
+    size_t n_inputs;
+    FILE *log;                  /* gets "  wrote DIR/NAME" per file, or NULL */
+} rch_plot_dir;
+
+/* Open DIR/NAME for writing (rch_out_open with the inputs). 0, or -1 with d set. */
+int rch_plot_open(rch_out *o, const rch_plot_dir *pd, const char *name, rch_diag *d);
+/* Commit a file opened by rch_plot_open (abort it when failed != 0 or on a
+ * write error) and log it. 0, or -1 with d set. */
+int rch_plot_close(rch_out *o, const rch_plot_dir *pd, int failed, rch_diag *d);
+
+/* Write p as DIR/NAME and free it (also on failure; p NULL counts as an
+ * allocation failure). 0, or -1 with d set ("cannot write DIR/NAME: ..."). */
+int rch_plot_save(rch_plot *p, const rch_plot_dir *pd, const char *name, rch_diag *d);
+
+/* A perceptually ordered colour map (viridis, 5 stops) at t in [0, 1]
+ * (clamped): "#rrggbb" into out. */
+void rch_plot_viridis(char out[8], double t);
+
+/* Write s XML-escaped (&, <, >, ", ') to f. */
+void rch_plot_xml_text(FILE *f, const char *s);
 
 #endif

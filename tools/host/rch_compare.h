@@ -1,0 +1,124 @@
+/* rch_compare.h - the LTLM paper's comparison of seven identification
+ * methods (its Table 6, Fig. 6d, Figs. 7-8) on measured data: the protocol
+ * behind `rcal compare`.
+ *
+ * Protocol, per case c = 0..cases-1: draw `samples` rows at random (seed
+ * seed * 1000003 + c), hold out round(test_fraction * samples) of them
+ * (at least one), build the start (BC) model from the training part only
+ * (rch_calib_start: nominal DH + encoder fitted alone), run every selected
+ * method from that same start on the same training samples (rch_est_run),
+ * evaluate on the held-out samples. Nothing is tuned on held-out samples:
+ * every hyperparameter is a fixed default documented in rc_est.h / rc_solve.h.
+ *
+ * Results: per row (BC and the seven methods) the mean and spread over cases
+ * of the held-out RMSE, mean |e|, max |e|, the identification time, the
+ * training RMS, iterations and cost evaluations; the held-out RMSE of every
+ * case; the LTLM parameters in the paper's Table 7 form; for plots (when
+ * asked), the convergence curve of every method and the per-sample held-out
+ * errors of case 1.
+ *
+ * Depends on: rch_calib, rch_est, rch_eval, rch_stats, rch_robot (host), rc_solve
+ * (core); rch_plot for rch_compare_plots, rch_jw for rch_compare_json.
+ * Memory: rch_compare_run allocates inside the result; rch_compare_free
+ * releases it (also after a failed run). Thread safety: one result per
+ * thread. Errors: 0, or -1 with d set (bad configuration, too few rows,
+ * out of memory, the BC model cannot be built); a method that fails in a
+ * case is counted in its row (failed), not an error of the run.
+ */
+#ifndef RCH_COMPARE_H
+#define RCH_COMPARE_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "rch_diag.h"
+#include "rch_est.h"
+#include "rch_stats.h"
+#include "rch_plot.h"
+#include "rch_robot.h"
+
+/* Rows of the result: 0 = BC (the start model), id + 1 = method id. */
+enum { RCH_COMPARE_ROWS = RCH_EST_COUNT + 1 };
+
+#define RCH_COMPARE_MAX_CASES 10000ul
+
+typedef struct rch_compare_config {
+    unsigned long cases;      /* 1..RCH_COMPARE_MAX_CASES */
+    size_t samples;           /* rows drawn per case, <= rows in the data; 0: every row */
+    double test_fraction;     /* share held out, in (0, 1) */
+    unsigned long long seed;  /* case c uses seed * 1000003 + c */
+    int run[RCH_EST_COUNT];   /* 1: run method id; at least one */
+    int curves;               /* 1: keep case 1's convergence curves and per-sample errors (plots) */
+} rch_compare_config;
+
+/* Defaults: 10 cases of 300 rows, 0.1 held out, seed 1, every method, no curves. */
+void rch_compare_defaults(rch_compare_config *cfg);
+
+/* "LM,EKF,m7" (rch_est_parse names, comma separated) into run[]. An empty
+ * list, an empty name or an unknown name is refused: -1 with d set. */
+int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d);
+
+/* One row (BC or a method) in one case. */
+typedef struct rch_compare_cell {
+    int ok;                   /* ran and succeeded (0: not run, or failed) */
+    rc_metrics held_out;      /* on the case's held-out samples */
+    double train_rmse_mm;     /* training RMS at the end (NaN when it could not be evaluated) */
+    double time_ms;           /* the identification alone (methods only) */
+    unsigned iterations, cost_evals; /* methods only */
+} rch_compare_cell;
+
+/* Statistics of one row over the cases where it succeeded. */
+typedef struct rch_compare_row {
+    int used;            /* the row was run */
+    unsigned failed;     /* cases where the method failed (not counted in the stats) */
+    rch_stats rmse_mm, mean_abs_mm, max_mm; /* held-out, over the cases */
+    rch_stats train_rmse_mm;                /* training RMS at the end */
+    rch_stats time_ms, iterations, cost_evals; /* methods only (BC: empty) */
+} rch_compare_row;
+
+typedef struct rch_compare_result {
+    size_t rows_in_data;
+    unsigned long cases;
+    size_t n_draw, n_train, n_test;
+    rch_compare_row row[RCH_COMPARE_ROWS];
+    rch_compare_cell *cell; /* (cases x RCH_COMPARE_ROWS) every row in every case, row-major by case */
+    /* LTLM parameters over the cases where it succeeded (the paper's Table 7):
+     * dh[j][0..3] = a (mm), d (mm), alpha (deg), theta (deg) of joint j; enc_mm[k] = e_x, e_y, e_z. */
+    unsigned n_ltlm;
+    rch_stats ltlm_dh[RC_NJ][4];
+    rch_stats ltlm_enc_mm[3];
+    /* with cfg.curves: case 1 only */
+    rch_curve curve[RCH_EST_COUNT];  /* training RMS per iteration of each method run */
+    double *err_case1_mm;            /* (RCH_COMPARE_ROWS x n_test) model - measured length; NaN where absent */
+} rch_compare_result;
+
+/* Run the protocol on s (n) with the nominal robot. progress (may be NULL)
+ * gets one line per case and one per failed method. Returns 0 or -1 with d
+ * set; res must be released with rch_compare_free either way. */
+int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, const rch_robot *robot,
+                    const rc_sample *s, size_t n, FILE *progress, rch_diag *d);
+void rch_compare_free(rch_compare_result *res);
+
+/* "BC", "LM", ..., "LTLM". */
+const char *rch_compare_row_name(int row);
+/* Mean identification time of LM (NaN when LM was not run or has no time). */
+double rch_compare_lm_time_ms(const rch_compare_result *res);
+/* 1 when some method failed in some case (the command then exits 1). */
+int rch_compare_any_failed(const rch_compare_result *res);
+
+/* The report (the paper's Table 6 and Table 7 forms) as text. data_name is
+ * printed in the header line. */
+void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg,
+                        const char *data_name);
+/* The same as one JSON object (rch_jw: strings escaped, null where a
+ * figure is absent). 0, or -1 on a write error. */
+int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name);
+
+/* Write convergence.svg, convergence_zoom.svg (need cfg.curves), rmse_bars.svg,
+ * time_bars.svg and per_sample.svg into pd->dir (created with its parents
+ * when missing; never over one of pd->inputs). Stops at the first failure:
+ * 0, or -1 with d set. */
+int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *cfg, const rch_plot_dir *pd,
+                      rch_diag *d);
+
+#endif
