@@ -8,7 +8,7 @@
 #include <time.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
 #include "rch_data.h"
 #include "rch_jw.h"

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
 #include "rch_file.h"
 #include "rch_opt.h"

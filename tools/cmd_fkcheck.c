@@ -4,7 +4,7 @@
 #include <stdio.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
 #include "rch_jw.h"
 #include "rch_opt.h"

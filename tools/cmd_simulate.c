@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_opt.h"
 #include "rch_sim.h"
 
