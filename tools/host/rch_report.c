@@ -229,30 +229,29 @@ static void csv_num(FILE *f, double v)
         fprintf(f, "%.9g", v);
 }
 
+static void cl_put(char *buf, size_t len, size_t *k, const char *s)
+{
+    while (*s && *k + 1 < len)
+        buf[(*k)++] = *s++;
+    buf[*k] = '\0';
+}
+
 const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *argv)
 {
     size_t k = 0;
     if (len == 0)
         return buf;
     buf[0] = '\0';
-    for (int i = 0; i < argc && k + 1 < len; ++i) {
+    for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         const int quote = !*a || strpbrk(a, " \t\n'\"\\$`&|;<>()*?[]{}~!#") != NULL;
-        if (i && k + 1 < len)
-            buf[k++] = ' ';
-        if (quote && k + 1 < len)
-            buf[k++] = '\'';
-        for (; *a && k + 5 < len; ++a) {
-            if (quote && *a == '\'') {
-                memcpy(buf + k, "'\\''", 4);
-                k += 4;
-            } else {
-                buf[k++] = *a;
-            }
+        cl_put(buf, len, &k, i ? " " : "");
+        cl_put(buf, len, &k, quote ? "'" : "");
+        for (; *a; ++a) {
+            const char c[2] = {*a, '\0'};
+            cl_put(buf, len, &k, quote && *a == '\'' ? "'\\''" : c);
         }
-        if (quote && k + 1 < len)
-            buf[k++] = '\'';
-        buf[k] = '\0';
+        cl_put(buf, len, &k, quote ? "'" : "");
     }
     return buf;
 }
@@ -326,8 +325,8 @@ static void chart_range(const chart *c, double *lo, double *hi)
         b = m;
     }
     const double step = nice_step(b - a, 6.0);
-    *lo = floor(a / step - 1e-9) * step;
-    *hi = ceil(b / step + 1e-9) * step;
+    *lo = floor(a / step + 1e-9) * step;
+    *hi = ceil(b / step - 1e-9) * step;
 }
 
 static double clampd(double x, double a, double b) { return x < a ? a : x > b ? b : x; }
@@ -975,11 +974,19 @@ static void params_table(rep *r, const prow *p, size_t n)
         fputs("</td><td>", f);
         put_num(r, p[k].delta, "%+.4g");
         if (have_se) {
+            /* no standard error by design for a parameter the data cannot determine or that was fixed */
+            const int none = !isfinite(p[k].se) && (strcmp(p[k].cls, "not identifiable") == 0 ||
+                                                    strcmp(p[k].cls, "fixed") == 0);
             fputs("</td><td>", f);
-            put_num(r, p[k].se, "%.2g");
+            if (none)
+                fputs("&mdash;", f);
+            else
+                put_num(r, p[k].se, "%.2g");
             fputs("</td><td>", f);
             if (isfinite(p[k].ci_lo))
                 fprintf(f, "%+.3g &hellip; %+.3g", p[k].ci_lo, p[k].ci_hi);
+            else if (none)
+                fputs("&mdash;", f);
             else
                 put_num(r, NAN, "");
         }
@@ -992,7 +999,7 @@ static void params_table(rep *r, const prow *p, size_t n)
     }
     fputs("</table>\n", f);
     if (!have_se || !have_cls) {
-        fprintf(f, "<p class=\"note\">%s%s%s: " NA ".</p>\n", have_se ? "" : "standard errors and 95 % intervals",
+        fprintf(f, "<p class=\"note\" style=\"max-width:520px\">%s%s%s: " NA ".</p>\n", have_se ? "" : "standard errors and 95 % intervals",
                 !have_se && !have_cls ? ", " : "", have_cls ? "" : "identifiability class of each parameter");
         r->res->n_missing++;
     }
@@ -1128,9 +1135,9 @@ static void sec_params(rep *r, const prow *p, size_t n)
         put_num(r, jnum(r->unc, "sigma_mm"), "%.4g mm");
         fprintf(f, " (%s)", r->unc_from);
     }
-    fputs("</p>\n<div class=\"row\"><div style=\"flex:0 1 auto;max-width:540px\">\n", f);
+    fputs("</p>\n<div class=\"row\"><div style=\"flex:0 0 auto\">\n", f);
     params_table(r, p, n);
-    fputs("<p class=\"note\">correction: against the nominal table (DH) or the encoder outlet's first estimate "
+    fputs("<p class=\"note\" style=\"max-width:520px\">correction: against the nominal table (DH) or the encoder outlet's first estimate "
           "(ex, ey, ez).</p>\n</div><div style=\"display:flex;flex-direction:column;gap:10px\">\n",
           f);
     params_chart(r, p, n, "mm", "Corrections, lengths (mm)");
