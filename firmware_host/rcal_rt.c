@@ -26,6 +26,8 @@
 #include "fw_model_data.h"
 #include "rc_comp.h"
 #include "rch_diag.h"
+#include "rch_emit.h"
+#include "rch_opt.h"
 #include "rch_robot.h"
 
 #ifndef M_PI
@@ -118,7 +120,7 @@ static void synth_target(double q[RC_NJ], size_t k, double rate_hz)
         q[i] = c[i] + a[i] * sin(2.0 * M_PI * f[i] * t + i);
 }
 
-static int load_targets(targets *t, const char *path, const rc_model *m)
+static int load_targets(targets *t, const char *path, const rc_kin *m)
 {
     FILE *f = fopen(path, "r");
     if (!f) {
@@ -168,7 +170,7 @@ static int load_targets(targets *t, const char *path, const rc_model *m)
         }
         for (int i = 0; i < RC_NJ; ++i) {
             v[i] *= DEG;
-            if (v[i] < m->q_min_rad[i] || v[i] > m->q_max_rad[i]) {
+            if (v[i] < (double)m->q_min_rad[i] || v[i] > (double)m->q_max_rad[i]) {
                 fprintf(stderr, "rcal-rt: %s:%u: q%d outside the joint limits\n", path, lineno, i + 1);
                 fclose(f);
                 free(t->q);
@@ -214,7 +216,7 @@ static void print_stats(const char *label, const stats *s, int json)
                s->p99, s->p9999, s->max, s->mean);
 }
 
-static int run_bench(const rc_model *cal, const rc_model *nom, const rc_comp_config *cfg, const targets *t,
+static int run_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg, const targets *t,
                      size_t n, unsigned repeat, int cold, int json)
 {
     if (n == 0 || repeat == 0) {
@@ -241,11 +243,11 @@ static int run_bench(const rc_model *cal, const rc_model *nom, const rc_comp_con
                     : "stream: seeded with the last correction, targets 1 ms apart");
     for (size_t k = 0; k < n; ++k)
         get_target(tq[k], t, k, 1000.0);
+    static rc_comp_stream s;
     for (unsigned r = 0; r < repeat; ++r) {
-        rc_comp_stream s;
         double qc[RC_NJ], sink = 0.0;
         /* throughput: back to back, no per-call timing */
-        rc_comp_stream_init(&s, cal, nom, cfg);
+        rc_comp_stream_init_kin(&s, cal, nom, cfg);
         const double t0 = now_ns();
         for (size_t k = 0; k < n; ++k) {
             if (cold)
@@ -256,7 +258,7 @@ static int run_bench(const rc_model *cal, const rc_model *nom, const rc_comp_con
         }
         const double total_s = (now_ns() - t0) / 1e9;
         /* latency: each call timed */
-        rc_comp_stream_init(&s, cal, nom, cfg);
+        rc_comp_stream_init_kin(&s, cal, nom, cfg);
         for (size_t k = 0; k < n; ++k) {
             rc_comp_result res;
             if (cold)
@@ -295,7 +297,7 @@ static int run_bench(const rc_model *cal, const rc_model *nom, const rc_comp_con
     return fails ? 1 : 0;
 }
 
-static int run_loop(const rc_model *cal, const rc_model *nom, const rc_comp_config *cfg, const targets *t,
+static int run_loop(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg, const targets *t,
                     double rate_hz, double seconds, int json)
 {
     const size_t n = (size_t)(rate_hz * seconds + 0.5);
@@ -312,8 +314,8 @@ static int run_loop(const rc_model *cal, const rc_model *nom, const rc_comp_conf
         free(done);
         return 1;
     }
-    rc_comp_stream s;
-    rc_comp_stream_init(&s, cal, nom, cfg);
+    static rc_comp_stream s;
+    rc_comp_stream_init_kin(&s, cal, nom, cfg);
     /* warm up caches and the stream's correction */
     double q[RC_NJ], qc[RC_NJ];
     get_target(q, t, 0, rate_hz);
@@ -384,96 +386,46 @@ static int run_loop(const rc_model *cal, const rc_model *nom, const rc_comp_conf
     return misses ? 1 : 0;
 }
 
-/* C tables of a model for the firmware (designated initialisers). */
-static void emit_model(FILE *f, const char *name, const rc_model *m)
-{
-    fprintf(f, "static const rc_model %s = {\n    .n_params = %u,\n    .n_effects = %u,\n", name, m->n_params,
-            m->n_effects);
-    if (m->n_effects > 0) {
-        fprintf(f, "    .effects = {\n");
-        for (unsigned i = 0; i < m->n_effects; ++i) {
-            const rc_effect *e = &m->effects[i];
-            fprintf(f, "        {.kind = %u, .joint = %u, .first = %u, .count = %u, .ref_dh = {", e->kind, e->joint,
-                    e->first, e->count);
-            for (int r = 0; r < 4; ++r)
-                fprintf(f, "{%.17g, %.17g, %.17g, %.17g}%s", e->ref_dh[r][0], e->ref_dh[r][1], e->ref_dh[r][2],
-                        e->ref_dh[r][3], r < 3 ? ", " : "");
-            fprintf(f, "}},\n");
-        }
-        fprintf(f, "    },\n");
-    }
-    fprintf(f, "    .x = {");
-    for (unsigned k = 0; k < m->n_params; ++k)
-        fprintf(f, "%s%.17g", k % 4 == 0 ? "\n        " : " ", m->x[k]), (void)(k + 1 < m->n_params && fprintf(f, ","));
-    fprintf(f, "},\n    .q_min_rad = {");
-    for (int i = 0; i < RC_NJ; ++i)
-        fprintf(f, "%.17g%s", m->q_min_rad[i], i < RC_NJ - 1 ? ", " : "");
-    fprintf(f, "},\n    .q_max_rad = {");
-    for (int i = 0; i < RC_NJ; ++i)
-        fprintf(f, "%.17g%s", m->q_max_rad[i], i < RC_NJ - 1 ? ", " : "");
-    fprintf(f, "},\n};\n");
-}
-
+/* --emit-c: the firmware's compiled tables (rch_emit_c) on stdout. */
 static int emit_c(const char *path, const char *nominal_path, int position_only)
 {
     static rch_robot robot, nominal;
     rch_diag d;
-    char msg[1024];
+    char msg[1024], cmd[2200];
     if (rch_robot_load(&robot, path, &d) != 0 || (nominal_path && rch_robot_load(&nominal, nominal_path, &d) != 0)) {
         fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
-    const rc_model *nom = nominal_path ? &nominal.model : &robot.nominal;
-    const unsigned need = robot.model.n_params > nom->n_params ? robot.model.n_params : nom->n_params;
-    printf("/* fw_model_data.h - generated by `rcal-rt --emit-c %s%s`: do not edit.\n"
-           " * Model \"%s\": the calibrated model (fw_model_cal) and the nominal table the\n"
-           " * robot program's targets were computed with (fw_model_nom), as const data\n"
-           " * (flash on a microcontroller). */\n"
-           "#ifndef FW_MODEL_DATA_H\n#define FW_MODEL_DATA_H\n\n#include \"rc_comp.h\"\n\n"
-           "RC_STATIC_ASSERT(RC_MAX_PARAMS >= %u, fw_model_fits_rc_max_params);\n"
-           "RC_STATIC_ASSERT(RC_MAX_EFFECTS >= %u, fw_model_fits_rc_max_effects);\n\n"
-           "/* rc_comp_config.flags the model is meant to be used with */\n#define FW_MODEL_COMP_FLAGS %s\n\n",
-           path, position_only ? " --position-only" : "", robot.name, need,
-           robot.model.n_effects > 0 ? robot.model.n_effects : 1u, position_only ? "RC_COMP_FLAG_POSITION_ONLY" : "0u");
-    emit_model(stdout, "fw_model_cal", &robot.model);
-    printf("\n");
-    emit_model(stdout, "fw_model_nom", nom);
-    printf("\n#endif /* FW_MODEL_DATA_H */\n");
+    snprintf(cmd, sizeof cmd, "rcal-rt --emit-c %s%s%s%s", path, nominal_path ? " --nominal " : "",
+             nominal_path ? nominal_path : "", position_only ? " --position-only" : "");
+    const rch_emit_src src = {robot.name, cmd, position_only ? (unsigned)RC_COMP_FLAG_POSITION_ONLY : 0u};
+    if (rch_emit_c(stdout, &src, &robot.model, nominal_path ? &nominal.model : &robot.nominal, &d) != 0 ||
+        fflush(stdout) != 0) {
+        fprintf(stderr, "rcal-rt: %s: %s\n", path, d.msg);
+        return 1;
+    }
     return 0;
 }
 
-/* Number options: the whole value must be a number (strtod/strtoul with end,
- * ERANGE and finiteness checks), else a message naming the option and the
- * value and -1 (main then exits 2, a usage error). Ranges are checked by main. */
+/* Number options: the whole value must be a number (the strict readers of
+ * rch_opt.h: no blanks, no hex, finite, no wrap), else a message naming the
+ * option and the value and -1 (main then exits 2, a usage error). Ranges are
+ * checked by main. */
 static int opt_double(const char *name, const char *v, double *out)
 {
-    char *end;
-    double x;
-    errno = 0;
-    x = strtod(v, &end);
-    if (end == v || *end != '\0' || errno != 0 || !isfinite(x)) {
-        fprintf(stderr, "rcal-rt: option %s: '%s' is not a number\n", name, v);
+    if (rch_parse_double(v, out) != 0) {
+        fprintf(stderr, "rcal-rt: option %s: '%s' is not a finite decimal number\n", name, v);
         return -1;
     }
-    *out = x;
     return 0;
 }
 
 static int opt_ulong(const char *name, const char *v, unsigned long *out)
 {
-    char *end;
-    unsigned long x;
-    errno = 0;
-    x = strtoul(v, &end, 10);
-    if (*v < '0' || *v > '9' || *end != '\0' || (errno != 0 && errno != ERANGE)) {
-        fprintf(stderr, "rcal-rt: option %s: '%s' is not a non-negative integer\n", name, v);
+    if (rch_parse_ulong(v, out) != 0) {
+        fprintf(stderr, "rcal-rt: option %s: '%s' is not a non-negative integer that fits\n", name, v);
         return -1;
     }
-    if (errno == ERANGE) {
-        fprintf(stderr, "rcal-rt: option %s: '%s' is too large\n", name, v);
-        return -1;
-    }
-    *out = x;
     return 0;
 }
 
@@ -546,7 +498,8 @@ int main(int argc, char **argv)
     }
 
     static rch_robot robot, nominal;
-    const rc_model *cal = &fw_model_cal, *nom = &fw_model_nom;
+    static rc_kin kin_cal, kin_nom;
+    const rc_kin *cal = &fw_kin_cal, *nom = &fw_kin_nom;
     unsigned flags = FW_MODEL_COMP_FLAGS;
     if (model_path) {
         rch_diag d;
@@ -556,8 +509,15 @@ int main(int argc, char **argv)
             fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
             return 1;
         }
-        cal = &robot.model;
-        nom = nominal_path ? &nominal.model : &robot.nominal;
+        rc_status st = rc_kin_compile(&kin_cal, &robot.model);
+        if (st == RC_OK)
+            st = rc_kin_compile(&kin_nom, nominal_path ? &nominal.model : &robot.nominal);
+        if (st != RC_OK) {
+            fprintf(stderr, "rcal-rt: %s: the model cannot be compiled: %s\n", model_path, rc_strerror(st));
+            return 1;
+        }
+        cal = &kin_cal;
+        nom = &kin_nom;
         flags = 0;
     }
     if (position_only)

@@ -25,6 +25,8 @@ STEPS=${STATIC_STEPS:-warnings cppcheck tidy}
 SUPP="$ROOT/scripts/static_suppressions.txt"
 DIRS=(lib tools drivers firmware_host)
 cd "$ROOT" || exit 1
+# rc_version.h (version and compile-time limits) for the steps that read lib/
+cmake -DRCAL_HEADER_DIR="$BUILD_DIR/include" -P cmake/rcal_version_header.cmake || exit 1
 fail=0
 start=$(date +%s)
 
@@ -42,7 +44,7 @@ if [[ " $STEPS " == *" warnings "* ]]; then
     echo "== static: core warnings (-Wconversion -Wdouble-promotion -Wshadow ...)"
     WFLAGS=(-std=c99 -Wall -Wextra -Werror -pedantic -Wconversion -Wdouble-promotion -Wshadow
         -Wsign-conversion -Wundef -Wmissing-prototypes -Wstrict-prototypes -Wcast-align
-        -Wpointer-arith -Wwrite-strings -fsyntax-only -I lib)
+        -Wpointer-arith -Wwrite-strings -fsyntax-only -I lib -I "$BUILD_DIR/include")
     nw=0
     for cc in gcc clang; do
         if ! command -v $cc >/dev/null; then
@@ -70,7 +72,7 @@ if [[ " $STEPS " == *" cppcheck "* ]]; then
     cpp_supp=$(mktemp)
     supp_of cppcheck | while read -r id path; do echo "$id:$ROOT/$path"; echo "$id:$path"; done >"$cpp_supp"
     mapfile -t src_dirs < <(existing_dirs)
-    inc=()
+    inc=(-I "$BUILD_DIR/include")
     while IFS= read -r d; do inc+=(-I "$d"); done < <(find "${src_dirs[@]}" -name '*.h' -printf '%h\n' | sort -u)
     cpp_out=$(mktemp)
     # RC_MAX_PARAMS as the build sets it; one configuration per file (the

@@ -3,7 +3,10 @@
 #  1. build + ctest (Release),
 #  2. build + ctest with AddressSanitizer and UndefinedBehaviorSanitizer,
 #  3. extra checks that exist: cross-build of the core for Cortex-M7,
-#     static analysis, fuzzing (bounded time), valgrind.
+#     static analysis, fuzzing (bounded time), valgrind, the package
+#     (fresh-tree install, static and shared, consumer built with find_package
+#     and with pkg-config: scripts/install_check.sh, about 30 s) and the SPDX
+#     licence line of every source file (scripts/spdx_check.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -22,7 +25,8 @@ cmake --build build-asan -j"$JOBS" >/dev/null
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-asan --output-on-failure -j"$JOBS" || status=1
 
-for extra in firmware_host/cross_build.sh scripts/static_analysis.sh fuzz/run.sh scripts/valgrind_tests.sh; do
+for extra in firmware_host/cross_build.sh scripts/static_analysis.sh fuzz/run.sh scripts/valgrind_tests.sh \
+  scripts/install_check.sh scripts/spdx_check.sh; do
   if [ -x "$extra" ]; then
     echo "== $extra"
     "$extra" || status=1

@@ -1,109 +1,89 @@
 /* cmd_diagnose.c - rcal diagnose: where model and measurement disagree,
  * which missing physical effect explains it, and how much the held-out gap
- * shrinks when it is added (issue 6). The work is in rch_diagnose. */
+ * shrinks when it is added (issue 6). The work is rch_diagnose_file
+ * (tools/host/rch_diagnose.h). */
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h"
-#include "rch_data.h"
+#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_diagnose.h"
-#include "rch_robot.h"
+#include "rch_opt.h"
 
-static int usage(FILE *f)
+static const char details[] =
+    "Fits the geometric model with K-fold cross-validation (folds random within set-up\n"
+    "groups), compares the held-out residuals with the noise floor (length step and the\n"
+    "joint display step through the Jacobian), tests the residuals for structure, and\n"
+    "tries each candidate effect (length_offset, length_scale, time_drift, group_offset,\n"
+    "joint_compliance j2/j3, joint_periodic j1..j6) jointly with the geometry. An effect\n"
+    "is chosen only on a significant held-out gain; the verdict is the effect, 'none'\n"
+    "or 'unexplained'. Up to N effects are added one after the other.\n"
+    "Steps are detected from the data unless given (a negative value: no quantization).";
+
+static int report(rch_diagnose_result *r, const char *plots, int json)
 {
-    fprintf(f,
-            "usage: rcal diagnose --data FILE [--robot MODEL] [--seed S] [--folds K] [--steps N]\n"
-            "                     [--plots DIR] [--json] [--q-step-deg D] [--len-step-mm D]\n"
-            "                     [--len-noise-mm S] [--alpha A] [--max-iter N] [--verbose]\n"
-            "Fits the geometric model with K-fold cross-validation (folds random within set-up\n"
-            "groups), compares the held-out residuals with the noise floor (length step and the\n"
-            "joint display step through the Jacobian), tests the residuals for structure, and\n"
-            "tries each candidate effect (length_offset, length_scale, time_drift, group_offset,\n"
-            "joint_compliance j2/j3, joint_periodic j1..j6) jointly with the geometry. An effect\n"
-            "is chosen only on a significant held-out gain; the verdict is the effect, 'none'\n"
-            "or 'unexplained'. Up to N effects (default 3) are added one after the other.\n"
-            "Steps are detected from the data unless given (a negative value: no quantization).\n"
-            "--len-noise-mm adds the encoder's stated noise to the floor; --max-iter caps the LM\n"
-            "iterations of each warm-started fold fit (default 100).\n");
-    return f == stdout ? 0 : 2;
+    rch_diag d;
+    char msg[1024], paths[4096] = "";
+    if (plots && rch_diagnose_plots(r, plots, paths, sizeof paths, &d) != 0) {
+        fprintf(stderr, "rcal diagnose: plots: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (json)
+        return rch_diagnose_json(stdout, r) == 0 ? 0 : 1;
+    if (rch_diagnose_print(stdout, r) != 0)
+        return 1;
+    if (plots)
+        printf("\nPlots:\n%s", paths);
+    return 0;
 }
 
 int rcal_cmd_diagnose(int argc, char **argv)
 {
     const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL;
-    unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0;
-    int json = 0;
+    unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0, verbosity = 0;
+    int json = 0, verbose = 0;
     rch_diagnose_cfg cfg;
     memset(&cfg, 0, sizeof cfg);
-    for (int i = 1; i < argc; ++i) {
-        if (rcal_opt_str(argc, argv, &i, "--data", &data_path) ||
-            rcal_opt_str(argc, argv, &i, "--robot", &robot_path) ||
-            rcal_opt_str(argc, argv, &i, "--plots", &plots) || rcal_opt_uint(argc, argv, &i, "--seed", &seed) ||
-            rcal_opt_uint(argc, argv, &i, "--folds", &folds) || rcal_opt_uint(argc, argv, &i, "--steps", &steps) ||
-            rcal_opt_uint(argc, argv, &i, "--max-iter", &max_iter) ||
-            rcal_opt_double(argc, argv, &i, "--q-step-deg", &cfg.q_step_deg) ||
-            rcal_opt_double(argc, argv, &i, "--len-step-mm", &cfg.len_step_mm) ||
-            rcal_opt_double(argc, argv, &i, "--len-noise-mm", &cfg.len_noise_mm) ||
-            rcal_opt_double(argc, argv, &i, "--alpha", &cfg.alpha))
-            continue;
-        if (strcmp(argv[i], "--json") == 0) {
-            json = 1;
-            continue;
-        }
-        if (strcmp(argv[i], "--verbose") == 0) {
-            cfg.verbose++;
-            continue;
-        }
-        if (strcmp(argv[i], "--help") == 0)
-            return usage(stdout);
-        return rcal_opt_unknown("diagnose", argv[i]);
-    }
-    if (!data_path)
-        return rcal_opt_missing("diagnose", "--data");
-    if (folds < 2 || folds > RCH_DIAGNOSE_MAX_FOLDS || steps < 1 || steps > RCH_DIAGNOSE_MAX_STEPS ||
-        cfg.alpha < 0.0 || cfg.alpha >= 1.0) {
-        fprintf(stderr, "rcal diagnose: --folds must be 2..%d, --steps 1..%d, --alpha in (0, 1)\n",
-                RCH_DIAGNOSE_MAX_FOLDS, RCH_DIAGNOSE_MAX_STEPS);
-        return 2;
-    }
+    const rch_opt opts[] = {
+        {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements CSV", RCH_OPT_REQUIRED, NULL},
+        {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL", "nominal robot model", 0, NULL},
+        {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "fold assignment seed", 0, NULL},
+        {"--folds", RCH_OPT_UINT, &folds, 2, RCH_DIAGNOSE_MAX_FOLDS, "K", "cross-validation folds", 0, NULL},
+        {"--steps", RCH_OPT_UINT, &steps, 1, RCH_DIAGNOSE_MAX_STEPS, "N", "effects added at most", 0, NULL},
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "write residual plots (SVG) into DIR", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
+        {"--q-step-deg", RCH_OPT_DOUBLE, &cfg.q_step_deg, -1, 10, "D", "joint display step (0: detected)", 0, NULL},
+        {"--len-step-mm", RCH_OPT_DOUBLE, &cfg.len_step_mm, -1, 10, "D", "length display step (0: detected)", 0,
+         NULL},
+        {"--len-noise-mm", RCH_OPT_DOUBLE, &cfg.len_noise_mm, 0, 100, "S", "the encoder's stated noise, added", 0,
+         NULL},
+        {"--alpha", RCH_OPT_DOUBLE, &cfg.alpha, 0, 0.5, "A", "family-wise level of each decision (0: 0.01)", 0,
+         NULL},
+        {"--max-iter", RCH_OPT_UINT, &max_iter, 0, 100000, "N",
+         "LM iterations of each warm-started fold fit (0: 100)", 0, NULL},
+        {"--verbose", RCH_OPT_FLAG, &verbose, 0, 0, NULL, "progress to stderr", 0, NULL},
+        {"--verbosity", RCH_OPT_UINT, &verbosity, 0, 3, "V", "progress level (3: also singular values)", 0, NULL},
+    };
+    const rch_cmdspec spec = {"diagnose", "which missing physical effect explains the residuals", details, opts,
+                              sizeof opts / sizeof opts[0]};
+    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (ps != RCH_OPT_OK)
+        return ps == RCH_OPT_HELP ? 0 : 2;
     cfg.folds = (unsigned)folds;
     cfg.max_steps = (unsigned)steps;
     cfg.seed = seed;
     cfg.max_iter = (unsigned)max_iter;
+    cfg.verbose = verbosity > 0 ? (int)verbosity : verbose;
 
-    rch_robot robot;
-    rch_data data;
+    rch_diagnose_result r;
     rch_diag d;
     char msg[1024];
-    if (rch_robot_load(&robot, robot_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
-        fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
-    cfg.groups_given = data.has_group;
-    cfg.have_encoder = robot.has_encoder;
-    rch_diagnose_result r;
-    int rc = rch_diagnose_run(&r, data.s, data.n, &robot.nominal, &cfg, &d);
-    rch_data_free(&data);
-    if (rc != 0) {
+    if (rch_diagnose_file(&r, data_path, robot_path, &cfg, &d) != 0) {
         fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
         rch_diagnose_free(&r);
         return 1;
     }
-    char paths[4096] = "";
-    if (plots && rch_diagnose_plots(&r, plots, paths, sizeof paths, &d) != 0) {
-        fprintf(stderr, "rcal diagnose: plots: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        rch_diagnose_free(&r);
-        return 1;
-    }
-    if (json) {
-        rc = rch_diagnose_json(stdout, &r);
-    } else {
-        rc = rch_diagnose_print(stdout, &r);
-        if (plots)
-            printf("\nPlots:\n%s", paths);
-    }
+    const int rc = report(&r, plots, json);
     rch_diagnose_free(&r);
-    return rc == 0 ? 0 : 1;
+    return rc;
 }

@@ -1,123 +1,78 @@
 /* cmd_fkcheck.c - rcal fkcheck: does our forward kinematics reproduce the
- * controller's nominal x, y, z columns? Reports every row that does not. */
-#include <math.h>
+ * controller's nominal x, y, z columns? Reports every row that does not. The
+ * work is rch_fkcheck_run (tools/host/rch_calib.h). */
 #include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
 
 #include "rcal_cmds.h"
-#include "rch_data.h"
-#include "rch_robot.h"
-#include "rcal_opts.h"
+#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_calib.h"
+#include "rch_jw.h"
+#include "rch_opt.h"
+
+static const char details[] = "A row further than T mm is a fault unless a joint change within the 0.1 deg\n"
+                              "display rounding explains it.";
+
+static int report_json(const rch_fkcheck_result *r)
+{
+    rch_jw w;
+    rch_jw_init(&w, stdout, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_uint(&w, "rows", r->rows);
+    rch_jw_uint(&w, "faults", r->faults);
+    rch_jw_uint(&w, "explained_by_rounding", r->rounding);
+    rch_jw_numf(&w, "rms_mm", r->rms_mm, "%.6f");
+    rch_jw_numf(&w, "max_mm", r->max_mm, "%.6f");
+    rch_jw_numf(&w, "max_consistent_mm", r->max_consistent_mm, "%.6f");
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}
+
+static void report_text(const rch_fkcheck_result *r, const char *data_path, double tol_mm)
+{
+    printf("FK check of %s against %s (tolerance %.3f mm)\n", data_path, r->robot_name, tol_mm);
+    for (size_t i = 0; i < r->faults; ++i) {
+        const rch_fk_fault *f = &r->fault[i];
+        printf("  FAULT line %u: |FK - xyz| = %.3f mm, needs a joint change of %.3f deg (FK %.2f %.2f %.2f, "
+               "file %.2f %.2f %.2f)\n",
+               f->line, f->dist_mm, f->dq_deg, f->fk_mm[0], f->fk_mm[1], f->fk_mm[2], f->file_mm[0], f->file_mm[1],
+               f->file_mm[2]);
+    }
+    printf("rows %zu: %zu within %.2f mm, %zu further but explained by the 0.1 deg angle rounding "
+           "(|dq| <= %.2f deg), %zu FAULTS.\nlargest consistent difference %.3f mm; RMS of all %.4f mm\n",
+           r->rows, r->rows - r->faults - r->rounding, tol_mm, r->rounding, RCH_FK_ROUNDING_DEG, r->faults,
+           r->max_consistent_mm, r->rms_mm);
+}
 
 int rcal_cmd_fkcheck(int argc, char **argv)
 {
     const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT;
     double tol_mm = 0.5;
     int json = 0;
-    for (int i = 1; i < argc; ++i) {
-        if (rcal_opt_str(argc, argv, &i, "--data", &data_path) || rcal_opt_str(argc, argv, &i, "--robot", &robot_path))
-            continue;
-        if (rcal_opt_double(argc, argv, &i, "--tol-mm", &tol_mm))
-            continue;
-        if (strcmp(argv[i], "--json") == 0) {
-            json = 1;
-            continue;
-        }
-        if (strcmp(argv[i], "--help") == 0) {
-            printf("usage: rcal fkcheck --data FILE [--robot MODEL.json] [--tol-mm T] [--json]\n"
-                   "Compares the nominal FK at each row's joint angles with its x, y, z columns.\n"
-                   "Rows further than T mm (default 0.5) are listed.\n");
-            return 0;
-        }
-        return rcal_opt_unknown("fkcheck", argv[i]);
-    }
-    if (!data_path)
-        return rcal_opt_missing("fkcheck", "--data");
-    rch_robot robot;
-    rch_data data;
+    const rch_opt opts[] = {
+        {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements with x, y, z columns", RCH_OPT_REQUIRED,
+         NULL},
+        {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
+        {"--tol-mm", RCH_OPT_DOUBLE, &tol_mm, 0, 1e6, "T", "rows further than T mm are listed", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
+    };
+    const rch_cmdspec spec = {"fkcheck", "compare the nominal FK at each row's joint angles with its x, y, z",
+                              details, opts, sizeof opts / sizeof opts[0]};
+    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (ps != RCH_OPT_OK)
+        return ps == RCH_OPT_HELP ? 0 : 2;
+    rch_fkcheck_result r;
     rch_diag d;
     char msg[1024];
-    if (rch_robot_load(&robot, robot_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
+    if (rch_fkcheck_run(&r, data_path, robot_path, tol_mm, &d) != 0) {
         fprintf(stderr, "rcal fkcheck: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        rch_fkcheck_free(&r);
         return 1;
     }
-    if (!data.xyz) {
-        fprintf(stderr, "rcal fkcheck: %s has no x, y, z columns\n", data_path);
-        rch_data_free(&data);
-        return 1;
-    }
-    size_t bad = 0, rounding = 0;
-    const double rounding_deg = 0.1; /* the 0.1 deg display step: the minimum-norm dq overestimates the
-                                        * smallest max-norm change, so one full step is allowed */
-    double sum2 = 0.0, maxd = 0.0, maxd_good = 0.0;
-    if (!json)
-        printf("FK check of %s against %s (tolerance %.3f mm)\n", data_path, robot.name, tol_mm);
-    for (size_t i = 0; i < data.n; ++i) {
-        double p[3];
-        rc_fk(p, NULL, &robot.nominal, data.s[i].q_rad);
-        const double dx = p[0] - data.xyz[i][0], dy = p[1] - data.xyz[i][1], dz = p[2] - data.xyz[i][2];
-        const double dist = sqrt(dx * dx + dy * dy + dz * dz);
-        sum2 += dist * dist;
-        if (dist > maxd)
-            maxd = dist;
-        /* The file's angles are rounded to 0.1 deg: a row is consistent when a
-         * joint change within that rounding explains the difference. Minimum-norm
-         * dq = J^T (J J^T)^-1 dp over the position rows of the joint Jacobian. */
-        double jac[36], pp[3], dq_max_deg = 0.0;
-        rc_fk_jac(pp, NULL, jac, &robot.nominal, data.s[i].q_rad);
-        {
-            double M[9], r[3] = {-dx, -dy, -dz};
-            for (int a = 0; a < 3; ++a)
-                for (int b = 0; b < 3; ++b) {
-                    double s = 0.0;
-                    for (int k = 0; k < 6; ++k)
-                        s += jac[6 * a + k] * jac[6 * b + k];
-                    M[3 * a + b] = s;
-                }
-            const double det = M[0] * (M[4] * M[8] - M[5] * M[7]) - M[1] * (M[3] * M[8] - M[5] * M[6]) +
-                               M[2] * (M[3] * M[7] - M[4] * M[6]);
-            double y[3] = {0, 0, 0};
-            if (fabs(det) > 1e-12) { /* Cramer's rule on the 3x3 system M y = r */
-                for (int c = 0; c < 3; ++c) {
-                    double T[9];
-                    memcpy(T, M, sizeof T);
-                    for (int a = 0; a < 3; ++a)
-                        T[3 * a + c] = r[a];
-                    y[c] = (T[0] * (T[4] * T[8] - T[5] * T[7]) - T[1] * (T[3] * T[8] - T[5] * T[6]) +
-                            T[2] * (T[3] * T[7] - T[4] * T[6])) / det;
-                }
-            }
-            for (int k = 0; k < 6; ++k) {
-                const double dqk = (jac[k] * y[0] + jac[6 + k] * y[1] + jac[12 + k] * y[2]) * (180.0 / 3.14159265358979323846);
-                if (fabs(dqk) > dq_max_deg)
-                    dq_max_deg = fabs(dqk);
-            }
-        }
-        if (dist > tol_mm && dq_max_deg <= rounding_deg) {
-            ++rounding;
-            if (dist > maxd_good)
-                maxd_good = dist;
-        } else if (dist > tol_mm) {
-            ++bad;
-            if (!json)
-                printf("  FAULT line %u: |FK - xyz| = %.3f mm, needs a joint change of %.3f deg (FK %.2f %.2f %.2f, "
-                       "file %.2f %.2f %.2f)\n",
-                       data.line[i], dist, dq_max_deg, p[0], p[1], p[2], data.xyz[i][0], data.xyz[i][1],
-                       data.xyz[i][2]);
-        } else if (dist > maxd_good) {
-            maxd_good = dist;
-        }
-    }
+    int rc = 0;
     if (json)
-        printf("{\"rows\": %zu, \"faults\": %zu, \"explained_by_rounding\": %zu, \"rms_mm\": %.6f, "
-               "\"max_mm\": %.6f, \"max_consistent_mm\": %.6f}\n",
-               data.n, bad, rounding, sqrt(sum2 / (double)data.n), maxd, maxd_good);
+        rc = report_json(&r) != 0;
     else
-        printf("rows %zu: %zu within %.2f mm, %zu further but explained by the 0.1 deg angle rounding "
-               "(|dq| <= %.2f deg), %zu FAULTS.\nlargest consistent difference %.3f mm; RMS of all %.4f mm\n",
-               data.n, data.n - bad - rounding, tol_mm, rounding, rounding_deg, bad, maxd_good,
-               sqrt(sum2 / (double)data.n));
-    rch_data_free(&data);
-    return 0;
+        report_text(&r, data_path, tol_mm);
+    rch_fkcheck_free(&r);
+    return rc;
 }

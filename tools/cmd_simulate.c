@@ -1,111 +1,71 @@
 /* cmd_simulate.c - rcal simulate: a data set from a simulated robot with
- * known DH errors and encoder position, in the same CSV format as real data. */
+ * known DH errors and encoder position, in the same CSV format as real data.
+ * The work is rch_sim_make (tools/host/rch_sim.h). */
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "rcal_cmds.h"
-#include "rcal_opts.h"
-#include "rch_data.h"
-#include "rch_robot.h"
+#include "rcal_opts.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_opt.h"
 #include "rch_sim.h"
-
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: rcal simulate --out DATA.csv [--truth-out TRUTH.json] [--robot MODEL.json] [--truth TRUTH.json]\n"
-            "                     [--samples N] [--seed S] [--noise-mm S] [--resolution-mm R] [--q-step-deg D]\n"
-            "                     [--err-len-mm S] [--err-ang-deg S] [--encoder X,Y,Z] [--group-size G]\n"
-            "  The true robot is --truth if given, else the nominal --robot (default %s) plus random DH\n"
-            "  errors (sigma --err-len-mm 0.3 mm for a, d; --err-ang-deg 0.05 deg for alpha, theta) and the\n"
-            "  encoder at --encoder (default 250,-460,10 mm). Lengths get Gaussian noise (--noise-mm 0.01,\n"
-            "  negative for none) and the encoder resolution (--resolution-mm 0.004); joint angles are\n"
-            "  recorded at the display step (--q-step-deg 0.1). --group-size G keeps the wrist joints fixed\n"
-            "  for G consecutive poses, like a real acquisition (default 0: independent poses).\n",
-            RCAL_DEFAULT_ROBOT);
-}
 
 int rcal_cmd_simulate(int argc, char **argv)
 {
-    const char *out_path = NULL, *truth_out = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *truth_path = NULL;
+    rch_sim_job job;
+    memset(&job, 0, sizeof job);
+    job.robot_path = RCAL_DEFAULT_ROBOT;
+    job.enc_mm[0] = 250.0;
+    job.enc_mm[1] = -460.0;
+    job.enc_mm[2] = 10.0;
+    const char *out_path = NULL, *truth_out = NULL;
     unsigned long n = 500, seed = 1, group = 0;
-    double enc[3] = {250.0, -460.0, 10.0};
-    rch_sim_config c;
-    memset(&c, 0, sizeof c);
-    for (int i = 1; i < argc; ++i) {
-        if (rcal_opt_str(argc, argv, &i, "--out", &out_path) || rcal_opt_str(argc, argv, &i, "--truth-out", &truth_out) ||
-            rcal_opt_str(argc, argv, &i, "--robot", &robot_path) || rcal_opt_str(argc, argv, &i, "--truth", &truth_path) ||
-            rcal_opt_triple(argc, argv, &i, "--encoder", enc) || rcal_opt_uint(argc, argv, &i, "--samples", &n) ||
-            rcal_opt_uint(argc, argv, &i, "--seed", &seed) || rcal_opt_uint(argc, argv, &i, "--group-size", &group) ||
-            rcal_opt_double(argc, argv, &i, "--noise-mm", &c.noise_mm) ||
-            rcal_opt_double(argc, argv, &i, "--resolution-mm", &c.resolution_mm) ||
-            rcal_opt_double(argc, argv, &i, "--q-step-deg", &c.q_step_deg) ||
-            rcal_opt_double(argc, argv, &i, "--err-len-mm", &c.err_len_mm) ||
-            rcal_opt_double(argc, argv, &i, "--err-ang-deg", &c.err_ang_deg))
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage(stdout);
-            return 0;
-        }
-        return rcal_opt_unknown("simulate", argv[i]);
-    }
-    if (!out_path)
-        return rcal_opt_missing("simulate", "--out");
-    if (n < 1 || n > 10000000) {
-        fprintf(stderr, "rcal simulate: --samples must be 1..10000000\n");
-        return 2;
-    }
-    c.group_size = (unsigned)group;
-    rch_sim_defaults(&c);
-    rch_robot robot;
+    rch_sim_config *c = &job.sim;
+    const rch_opt opts[] = {
+        {"--out", RCH_OPT_STR, &out_path, 0, 0, "DATA.csv", "the simulated measurements", RCH_OPT_REQUIRED, NULL},
+        {"--truth-out", RCH_OPT_STR, &truth_out, 0, 0, "TRUTH.json", "the true model", 0, NULL},
+        {"--robot", RCH_OPT_STR, &job.robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
+        {"--truth", RCH_OPT_STR, &job.truth_path, 0, 0, "TRUTH.json", "a given true model (no random errors)", 0,
+         NULL},
+        {"--samples", RCH_OPT_UINT, &n, 1, 10000000, NULL, "number of samples", 0, NULL},
+        {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "random seed", 0, NULL},
+        {"--noise-mm", RCH_OPT_DOUBLE, &c->noise_mm, -1, 100, "S", "length noise sigma (0: 0.01; negative: none)", 0,
+         NULL},
+        {"--resolution-mm", RCH_OPT_DOUBLE, &c->resolution_mm, -1, 100, "R",
+         "encoder resolution (0: 0.004; negative: none)", 0, NULL},
+        {"--q-step-deg", RCH_OPT_DOUBLE, &c->q_step_deg, -1, 10, "D",
+         "joint display step (0: 0.1; negative: none)", 0, NULL},
+        {"--err-len-mm", RCH_OPT_DOUBLE, &c->err_len_mm, -100, 100, "S", "sigma of the a, d errors (0: 0.3)", 0,
+         NULL},
+        {"--err-ang-deg", RCH_OPT_DOUBLE, &c->err_ang_deg, -10, 10, "S",
+         "sigma of the alpha, theta errors (0: 0.05)", 0, NULL},
+        {"--encoder", RCH_OPT_TRIPLE, job.enc_mm, -10000, 10000, NULL, "encoder outlet (mm)", 0, NULL},
+        {"--group-size", RCH_OPT_UINT, &group, 0, 1000000, "G",
+         "keep the wrist joints fixed for G consecutive poses (0: independent poses)", 0, NULL},
+    };
+    const rch_cmdspec spec = {"simulate", "a data set from a simulated robot with known errors",
+                              "The true robot is --truth if given, else the nominal --robot plus random DH errors\n"
+                              "and the encoder at --encoder. Lengths get Gaussian noise and the encoder\n"
+                              "resolution; joint angles are recorded at the display step.",
+                              opts, sizeof opts / sizeof opts[0]};
+    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
+    if (ps != RCH_OPT_OK)
+        return ps == RCH_OPT_HELP ? 0 : 2;
+    job.n = n;
+    job.seed = seed;
+    c->group_size = (unsigned)group;
+
+    rch_sim_set set;
     rch_diag d;
     char msg[1024];
-    if (rch_robot_load(&robot, truth_path ? truth_path : robot_path, &d) != 0) {
+    if (rch_sim_make(&set, &job, &d) != 0) {
         fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
-    rc_rng g;
-    rc_rng_seed(&g, seed);
-    rc_model truth;
-    if (truth_path) {
-        truth = robot.model;
-        if (!robot.has_encoder)
-            memcpy(&truth.x[RC_P_ENC], enc, sizeof enc);
-    } else {
-        rch_sim_truth(&truth, &robot.model, enc, &c, &g);
-    }
-    rc_sample *s = malloc(n * sizeof *s);
-    if (!s)
+    const int rc = rch_sim_save(&set, &job, out_path, truth_out, &d);
+    rch_sim_set_free(&set);
+    if (rc != 0) {
+        fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
-    if (rch_sim_samples(s, NULL, n, &truth, &c, &g) != 0) {
-        fprintf(stderr, "rcal simulate: no pose puts the cable within %.0f..%.0f mm; check --encoder\n",
-                c.len_min_mm, c.len_max_mm);
-        free(s);
-        return 1;
-    }
-    FILE *f = fopen(out_path, "w");
-    if (!f || rch_data_write(f, s, n, &robot.nominal) != 0) {
-        fprintf(stderr, "rcal simulate: cannot write %s\n", out_path);
-        if (f)
-            fclose(f);
-        free(s);
-        return 1;
-    }
-    fclose(f);
-    free(s);
-    if (truth_out) {
-        char info[256];
-        snprintf(info, sizeof info,
-                 "{\"simulated\": true, \"seed\": %lu, \"noise_mm\": %g, \"resolution_mm\": %g, \"q_step_deg\": %g}",
-                 seed, c.noise_mm, c.resolution_mm, c.q_step_deg);
-        f = fopen(truth_out, "w");
-        if (!f || rch_robot_write(f, "simulated truth", &truth, &robot.nominal, info) != 0) {
-            fprintf(stderr, "rcal simulate: cannot write %s\n", truth_out);
-            if (f)
-                fclose(f);
-            return 1;
-        }
-        fclose(f);
     }
     printf("rcal simulate: %lu samples written to %s%s%s\n", n, out_path, truth_out ? ", truth to " : "",
            truth_out ? truth_out : "");

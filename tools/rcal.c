@@ -3,7 +3,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "rc_config.h"
 #include "rcal_cmds.h"
+#include "rch_paths.h"
 
 typedef struct {
     const char *name;
@@ -30,9 +32,23 @@ static const rcal_command commands[] = {
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: rcal COMMAND [options]   (rcal COMMAND --help for options)\n\ncommands:\n");
+    fprintf(f, "usage: rcal COMMAND [options]   (rcal COMMAND --help for options)\n"
+               "       rcal --version | -V\n\ncommands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)
         fprintf(f, "  %-11s %s\n", commands[i].name, commands[i].help);
+}
+
+/* Version of the program and of the core it runs with, the compile-time
+ * limits and the robot model it would load by default. */
+static int version(void)
+{
+    char robot[4096];
+    int found = rch_data_path(robot, sizeof robot, "irb120.json") == 0;
+    printf("rcal %s\n", RC_VERSION_STRING);
+    printf("core library %s\n", rc_version());
+    printf("limits: RC_MAX_PARAMS %d, RC_MAX_EFFECTS %d\n", RC_MAX_PARAMS, RC_MAX_EFFECTS);
+    printf("robot model: %s%s\n", robot, found ? "" : " (not found; set RCAL_DATA_DIR)");
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -45,6 +61,8 @@ int main(int argc, char **argv)
         usage(stdout);
         return 0;
     }
+    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "-V") == 0)
+        return version();
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; ++i)
         if (strcmp(argv[1], commands[i].name) == 0)
             return commands[i].fn(argc - 1, argv + 1);

@@ -2,15 +2,9 @@
 #ifndef RCAL_OPTS_H
 #define RCAL_OPTS_H
 
-/* The nominal robot shipped in data/ (absolute path of the source tree, so
- * that rcal works from any directory). */
-#ifndef RCAL_DEFAULT_ROBOT
-#ifdef RCAL_DATA_DIR
-#define RCAL_DEFAULT_ROBOT RCAL_DATA_DIR "/irb120.json"
-#else
-#define RCAL_DEFAULT_ROBOT "data/irb120.json"
-#endif
-#endif
+/* The nominal robot shipped in data/, found at run time (rch_paths.h):
+ * RCAL_DEFAULT_ROBOT is rch_default_robot(), an expression. */
+#include "rch_paths.h"
 
 /* If argv[*i] is NAME, consume its value into *out (advancing *i) and return
  * 1; exits with a usage error when the value is missing or malformed. */

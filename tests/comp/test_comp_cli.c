@@ -1,6 +1,9 @@
 /* test_comp_cli.c - rcal compensate round trips: a target list with a header
  * and extra columns, plain lines on stdin, a RAPID module, and bad lines
- * reported with file:line:col. Runs the built rcal binary. */
+ * reported with file:line:col; outputs that would destroy an input refused
+ * (issue 12); the warning of a target that could not be compensated names a
+ * joint limit and gives the error of what was written (issue 12); the host
+ * library's rch_comp_lines in-process. Runs the built rcal binary. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +17,7 @@
 #include <unistd.h>
 
 #include "rc_rand.h"
+#include "rch_comp.h"
 #include "rch_robot.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
@@ -43,6 +47,15 @@ static char *read_file(const char *path)
     return buf;
 }
 
+static char *read_file_copy(const char *path)
+{
+    const char *t = read_file(path);
+    char *c = malloc(strlen(t) + 1);
+    assert_non_null(c);
+    strcpy(c, t);
+    return c;
+}
+
 static int run(const char *cmd)
 {
     int st = system(cmd);
@@ -50,15 +63,22 @@ static int run(const char *cmd)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+static double fk_gap_on(const rch_robot *r, const double q_deg[6], const double qc_deg[6]);
+
 static double fk_gap(const double q_deg[6], const double qc_deg[6])
+{
+    return fk_gap_on(&robot, q_deg, qc_deg);
+}
+
+static double fk_gap_on(const rch_robot *r, const double q_deg[6], const double qc_deg[6])
 {
     double q[6], qc[6], pn[3], pc[3];
     for (int i = 0; i < 6; ++i) {
         q[i] = q_deg[i] * DEG;
         qc[i] = qc_deg[i] * DEG;
     }
-    rc_fk(pn, NULL, &robot.nominal, q);
-    rc_fk(pc, NULL, &robot.model, qc);
+    rc_fk(pn, NULL, &r->nominal, q);
+    rc_fk(pc, NULL, &r->model, qc);
     return sqrt((pn[0] - pc[0]) * (pn[0] - pc[0]) + (pn[1] - pc[1]) * (pn[1] - pc[1]) +
                 (pn[2] - pc[2]) * (pn[2] - pc[2]));
 }
@@ -214,6 +234,131 @@ static void test_bad_lines(void **state)
     assert_int_equal(run(cmd), 2);
 }
 
+/* An output that names an input is refused before anything is written:
+ * --out = --in (a RAPID program), --out = --model, also through another
+ * spelling of the path; and an input error halfway leaves an existing output
+ * as it was (issue 12). */
+static void test_output_never_destroys(void **state)
+{
+    (void)state;
+    char prog[128], out[128], err[128], cmd[1024];
+    snprintf(prog, sizeof prog, "%s/prog.mod", dir);
+    snprintf(out, sizeof out, "%s/out.csv", dir);
+    snprintf(err, sizeof err, "%s/err.txt", dir);
+    write_file(prog, "MODULE M\n  CONST jointtarget j1:=[[10,20,-30,40,50,60],[9E9,9E9,9E9,9E9,9E9,9E9]];\nENDMODULE\n");
+    char *prog_before = read_file_copy(prog), *model_before = read_file_copy(model_path);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' 2> '%s'", RCAL, model_path, prog, prog,
+             err);
+    assert_int_equal(run(cmd), 1);
+    assert_string_equal(read_file(prog), prog_before);
+    assert_non_null(strstr(read_file(err), "same file as the input"));
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' compensate --model model.json --in prog.mod --out ./model.json 2> '%s'",
+             dir, RCAL, err);
+    assert_int_equal(run(cmd), 1);
+    assert_string_equal(read_file(model_path), model_before);
+    assert_non_null(strstr(read_file(err), "same file as the input"));
+    /* a bad line at the end: the existing output keeps its content */
+    write_file(out, "precious\n");
+    write_file(prog, "10,20,-30,40,50,60\n1,2,x,4,5,6\n");
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' 2> '%s'", RCAL, model_path, prog, out,
+             err);
+    assert_int_equal(run(cmd), 1);
+    assert_string_equal(read_file(out), "precious\n");
+    /* 0 is not silently the default */
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --max-dev-deg 0 < /dev/null 2> '%s'", RCAL, model_path, err);
+    assert_int_equal(run(cmd), 2);
+    assert_non_null(strstr(read_file(err), "--max-dev-deg"));
+    free(prog_before);
+    free(model_before);
+}
+
+/* A target that needs joint 1 beyond its limit: the warning says a joint
+ * limit is in the way (not "iteration limit") and its position error is the
+ * error of what was written (issue 12: "0.19 mm" for a target written
+ * 21.8 mm off). */
+static void test_failure_reported_truthfully(void **state)
+{
+    (void)state;
+    char mp[128], in[128], out[128], err[128], cmd[1024];
+    snprintf(mp, sizeof mp, "%s/limit_model.json", dir);
+    snprintf(in, sizeof in, "%s/limit.csv", dir);
+    snprintf(out, sizeof out, "%s/limit_out.csv", dir);
+    snprintf(err, sizeof err, "%s/limit_err.txt", dir);
+    rc_model cal = robot.nominal;
+    cal.x[RC_P_THETA(0)] -= 0.05;
+    FILE *f = fopen(mp, "w");
+    assert_non_null(f);
+    assert_int_equal(rch_robot_write(f, "joint 1 off", &cal, &robot.nominal, NULL), 0);
+    fclose(f);
+    rch_robot lim;
+    rch_diag d;
+    assert_int_equal(rch_robot_load(&lim, mp, &d), 0);
+    const double tq[6] = {165, 20, -10, 10, 40, 5};
+    write_file(in, "165,20,-10,10,40,5\n");
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --position-only --in '%s' --out '%s' 2> '%s'", RCAL, mp, in,
+             out, err);
+    assert_int_equal(run(cmd), 1);
+    const char *msg = read_file(err);
+    assert_non_null(strstr(msg, "joint limit"));
+    assert_null(strstr(msg, "iteration limit"));
+    const char *at = strstr(msg, "correction, ");
+    assert_non_null(at);
+    double said = -1.0;
+    assert_int_equal(sscanf(at, "correction, %lf mm", &said), 1);
+    double qo[6];
+    f = fopen(out, "r");
+    assert_non_null(f);
+    assert_int_equal(fscanf(f, "%lf,%lf,%lf,%lf,%lf,%lf", &qo[0], &qo[1], &qo[2], &qo[3], &qo[4], &qo[5]), 6);
+    fclose(f);
+    const double gap = fk_gap_on(&lim, tq, qo);
+    assert_true(gap > 1.0);
+    if (fabs(gap - said) > 1e-3)
+        fail_msg("warning says %.4f mm, the written target is %.4f mm off", said, gap);
+}
+
+/* The host library in-process: rch_comp_lines on a CSV with a header. */
+static void test_lines_in_process(void **state)
+{
+    (void)state;
+    static rc_comp_stream s;
+    assert_int_equal(rc_comp_stream_init(&s, &robot.model, &robot.nominal, NULL), RC_OK);
+    FILE *in = tmpfile(), *out = tmpfile();
+    assert_non_null(in);
+    assert_non_null(out);
+    fputs("id,j1,j2,j3,j4,j5,j6\na,10,20,-30,40,50,60\n# note\nb,0,0,0,0,30,0\n", in);
+    rewind(in);
+    rch_comp_result r;
+    rch_diag d;
+    memset(&r, 0, sizeof r);
+    assert_int_equal(rch_comp_lines(out, &r, in, "mem", &s, &robot.model, RCH_COMP_AUTO, NULL, &d), 0);
+    assert_int_equal(r.format, RCH_COMP_CSV);
+    assert_int_equal(r.n, 2);
+    assert_int_equal(r.n_fail, 0);
+    assert_true(r.max_corr_deg > 1e-3 && r.max_corr_deg < 5.73);
+    rewind(out);
+    char line[256];
+    assert_non_null(fgets(line, sizeof line, out));
+    assert_string_equal(line, "id,j1,j2,j3,j4,j5,j6\n");
+    double q[6];
+    char id[8];
+    assert_non_null(fgets(line, sizeof line, out));
+    assert_int_equal(sscanf(line, "%7[^,],%lf,%lf,%lf,%lf,%lf,%lf", id, &q[0], &q[1], &q[2], &q[3], &q[4], &q[5]), 7);
+    const double tq[6] = {10, 20, -30, 40, 50, 60};
+    assert_string_equal(id, "a");
+    assert_true(fk_gap(tq, q) < 1e-3);
+    fclose(in);
+    fclose(out);
+    /* an error names file:line:col */
+    in = tmpfile();
+    out = tmpfile();
+    fputs("1,2,3,4,5,6\n1,2,3,4,5\n", in);
+    rewind(in);
+    assert_int_equal(rch_comp_lines(out, &r, in, "mem", &s, &robot.model, RCH_COMP_CSV, NULL, &d), -1);
+    assert_int_equal(d.line, 2);
+    fclose(in);
+    fclose(out);
+}
+
 /* rcal-rt refuses malformed or out-of-range number options with a message
  * naming the option (exit 2), before it loads or runs anything. */
 static void test_rt_bad_numbers(void **state)
@@ -249,6 +394,9 @@ int main(void)
         cmocka_unit_test(test_stdin_plain),
         cmocka_unit_test(test_rapid_module),
         cmocka_unit_test(test_bad_lines),
+        cmocka_unit_test(test_output_never_destroys),
+        cmocka_unit_test(test_failure_reported_truthfully),
+        cmocka_unit_test(test_lines_in_process),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

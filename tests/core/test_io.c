@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "rch_data.h"
+#include "rch_json.h"
 #include "rch_robot.h"
 
 static const char *HDR = "x,y,z,q1,q2,q3,q4,q5,q6,L\n";
@@ -104,7 +105,14 @@ static void test_robot_json(void **state)
     assert_int_equal(rch_robot_parse(&r, trunc, strlen(trunc), "m.json", &dg), -1);
 }
 
-/* write -> read round trip of a calibrated model with effects */
+static void info_k(rch_jw *w, const void *ctx)
+{
+    rch_jw_str(w, "data", (const char *)ctx);
+    rch_jw_int(w, "k", 1);
+}
+
+/* write -> read round trip of a calibrated model with effects; a name and a
+ * data path with quotes, backslashes and control characters stay valid JSON */
 static void test_model_round_trip(void **state)
 {
     (void)state;
@@ -116,17 +124,29 @@ static void test_model_round_trip(void **state)
     m.x[RC_P_ENC] = 240.5;
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 2, 0), RC_OK);
     m.x[m.n_params - 1] = 1e-4;
-    char buf[16384];
+    char buf[32768];
     FILE *f = fmemopen(buf, sizeof buf, "w");
     assert_non_null(f);
-    assert_int_equal(rch_robot_write(f, "cal \"x\"", &m, &r.nominal, "{\"k\": 1}"), 0);
+    const char *path = "C:\\data\\\"q\".csv\t\x01";
+    const rch_robot_info info = {info_k, path};
+    assert_int_equal(rch_robot_write(f, "cal \"x\" \\y", &m, &r.nominal, &info), 0);
     fclose(f);
     assert_int_equal(rch_robot_parse(&back, buf, strlen(buf), "rt.json", &dg), 0);
     assert_int_equal(back.model.n_params, m.n_params);
     for (unsigned k = 0; k < m.n_params; ++k)
         assert_true(fabs(back.model.x[k] - m.x[k]) < 1e-9 * (1.0 + fabs(m.x[k])));
     assert_true(back.has_nominal && back.has_encoder);
-    assert_string_equal(back.name, "cal \"x\"");
+    assert_string_equal(back.name, "cal \"x\" \\y");
+    /* the calibration member is JSON the project's own reader accepts, with the path intact */
+    rch_json *root = rch_json_parse(buf, strlen(buf), "rt.json", &dg);
+    assert_non_null(root);
+    const rch_json *cal = rch_json_get(root, "calibration");
+    assert_non_null(cal);
+    const rch_json *data = rch_json_get(cal, "data");
+    assert_non_null(data);
+    assert_int_equal(data->type, RCH_JSTR);
+    assert_string_equal(data->str, path);
+    rch_json_free(root);
 }
 
 int main(void)

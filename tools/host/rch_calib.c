@@ -1,14 +1,29 @@
+/* rch_calib.c - the calibration pipeline and the nominal-FK check (see rch_calib.h). */
 #include "rch_calib.h"
 
+#include <math.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
-int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, const rc_sample *train,
-                    size_t n, rch_diag *d)
+#include "rch_data.h"
+#include "rch_jw.h"
+#include "rch_save.h"
+#include "rch_sim.h"
+#include "rch_stats.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int has_encoder, const rc_sample *s,
+                 size_t n, rch_diag *d)
 {
-    *start = robot->model;
-    if (!robot->has_encoder) {
+    *start = *nominal;
+    if (!has_encoder) {
         double e[3];
-        rc_status st = rc_encoder_guess(e, start, train, n);
+        rc_status st = rc_encoder_guess(e, start, s, n);
         if (st != RC_OK) {
             rch_diag_set(d, "", 0, 0,
                          "cannot place the encoder: %s (the poses must spread in all three directions)",
@@ -22,14 +37,22 @@ int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, c
     fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 0;
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
+    cfg.method = RC_METHOD_LM;
+    cfg.max_iter = RCH_CALIB_BC_MAX_ITER;
     cfg.fixed = fixed;
     rc_solve_result res;
-    rc_status st = rc_solve(start, &res, w, &cfg, train, n);
+    rc_status st = rc_solve(start, &res, w, &cfg, s, n);
     if (st != RC_OK) {
         rch_diag_set(d, "", 0, 0, "fitting the encoder position failed: %s", rc_strerror(st));
         return -1;
     }
     return 0;
+}
+
+int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, const rc_sample *train, size_t n,
+                    rch_diag *d)
+{
+    return rch_calib_bc(start, w, &robot->model, robot->has_encoder, train, n, d);
 }
 
 int rch_method_parse(rc_method *out, const char *name)
@@ -41,4 +64,424 @@ int rch_method_parse(rc_method *out, const char *name)
             return 0;
         }
     return -1;
+}
+
+int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d)
+{
+    const char *p = list;
+    while (p && *p) {
+        const char *end = strchr(p, ',');
+        const size_t len = end ? (size_t)(end - p) : strlen(p);
+        unsigned k;
+        char name[64];
+        for (k = 0; k < m->n_params; ++k) {
+            rc_param_name(name, sizeof name, m, k);
+            if (len > 0 && strlen(name) == len && strncmp(name, p, len) == 0)
+                break;
+        }
+        if (len > 0 && k == m->n_params) {
+            rch_diag_set(d, "", 0, 0, "--fix: unknown parameter '%.*s'", (int)(len < 64 ? len : 64), p);
+            return -1;
+        }
+        if (len > 0)
+            fixed[k] = 1;
+        p = end ? end + 1 : NULL;
+    }
+    return 0;
+}
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+}
+
+/* Flange positions of the BC and the identified model against a simulated
+ * truth over random poses, base heading and height aligned (cable lengths
+ * cannot see them). */
+static int truth_flange(rch_calib_result *r, rch_diag *d)
+{
+    rch_robot truth;
+    if (rch_robot_load(&truth, r->cfg.truth_path, d) != 0)
+        return -1;
+    rc_sample *ws = malloc(RCH_CALIB_TRUTH_POSES * sizeof *ws);
+    if (!ws) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    rc_rng g;
+    rc_rng_seed(&g, RCH_CALIB_TRUTH_SEED);
+    rch_sim_poses(ws, RCH_CALIB_TRUTH_POSES, &truth.model, 0.0, &g);
+    rch_sim_flange_diff(&r->truth_before_rms_mm, &r->truth_before_max_mm, &r->before, &truth.model, ws,
+                        RCH_CALIB_TRUTH_POSES, 1);
+    rch_sim_flange_diff(&r->truth_after_rms_mm, &r->truth_after_max_mm, &r->model, &truth.model, ws,
+                        RCH_CALIB_TRUTH_POSES, 1);
+    free(ws);
+    r->have_truth = 1;
+    return 0;
+}
+
+/* Identification and the figures, once the split is made. */
+static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
+                          rch_diag *d)
+{
+    if (rch_calib_start(&r->before, w, &r->robot, train, r->n_train, d) != 0)
+        return -1;
+    r->model = r->before;
+    uint8_t fixed[RC_MAX_PARAMS];
+    memset(fixed, 0, sizeof fixed);
+    if (r->cfg.fix && rch_calib_fix(fixed, &r->model, r->cfg.fix, d) != 0)
+        return -2;
+    rc_solve_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.method = r->cfg.method;
+    cfg.fixed = fixed;
+    cfg.max_iter = r->cfg.max_iter;
+    cfg.seed = r->cfg.seed;
+    const double t0 = now_ms();
+    rc_status st = rc_solve(&r->model, &r->solve, w, &cfg, train, r->n_train);
+    r->time_ms = now_ms() - t0;
+    if (st != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "solver failed: %s", rc_strerror(st));
+        return -1;
+    }
+    r->finite = 1;
+    for (unsigned k = 0; k < r->model.n_params; ++k)
+        r->finite &= isfinite(r->model.x[k]) != 0;
+    const rc_sample *eval_set = r->n_test ? test : train;
+    const size_t n_eval = r->n_test ? r->n_test : r->n_train;
+    rc_eval(&r->before_m, &r->before, eval_set, n_eval);
+    r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
+    rc_eval(&r->train_before, &r->before, train, r->n_train);
+    if (!r->after_ok || rc_eval(&r->train_after, &r->model, train, r->n_train) != RC_OK)
+        memset(&r->train_after, 0, sizeof r->train_after);
+    if (r->cfg.truth_path && r->finite && truth_flange(r, d) != 0)
+        return -1;
+    r->have_ident = r->finite && rch_ident_compute(&r->ident, &r->model, train, r->n_train) == 0;
+    return 0;
+}
+
+int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    memset(r, 0, sizeof *r);
+    r->cfg = *cfg;
+    rch_data data;
+    if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || rch_data_load(&data, cfg->data_path, 0, d) != 0)
+        return -1;
+    r->n_data = data.n;
+    int rc = -1;
+    size_t *idx = malloc(data.n * sizeof *idx);
+    rc_solve_work *w = malloc(sizeof *w);
+    rc_sample *train = NULL, *test = NULL;
+    if (cfg->tool_offset && rc_model_add_effect(&r->robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
+        goto done;
+    }
+    if (!idx || !w) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    rch_split(idx, data.n, cfg->seed);
+    r->n_test = (size_t)floor(cfg->test_fraction * (double)data.n + 0.5);
+    r->n_train = data.n - r->n_test;
+    if (r->n_train < RC_N_BASE) {
+        rch_diag_set(d, "", 0, 0, "%zu training samples; at least %d are needed for 27 parameters", r->n_train,
+                     RC_N_BASE);
+        goto done;
+    }
+    test = rch_data_pick(data.s, idx, r->n_test);
+    train = rch_data_pick(data.s, idx + r->n_test, r->n_train);
+    if (!test || !train) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    rc = fit_and_report(r, w, train, test, d);
+done:
+    free(idx);
+    free(w);
+    free(train);
+    free(test);
+    rch_data_free(&data);
+    return rc;
+}
+
+static void print_metrics_row(FILE *f, const char *label, const rc_metrics *m)
+{
+    fprintf(f, "  %-38s %8.4f %8.4f %8.4f %8.4f\n", label, m->rmse_mm, m->mean_abs_mm, m->sd_mm, m->max_mm);
+}
+
+static void print_model(FILE *f, const rch_calib_result *r)
+{
+    const rc_model *m = &r->model, *nom = &r->robot.model, *bc = &r->before;
+    fprintf(f, "identified model (the paper's Table 7 form; deltas against nominal):\n");
+    fprintf(f, "  joint     a (mm)     d (mm)   alpha (deg)  theta (deg) |   da (mm)    dd (mm)  dalpha(deg)  "
+               "dtheta(deg)\n");
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        const double *x = &m->x[4 * j], *x0 = &nom->x[4 * j];
+        fprintf(f, "  %5u %10.4f %10.4f %12.5f %12.5f | %9.4f %10.4f %12.5f %12.5f\n", j + 1, x[0], x[1],
+                x[2] / DEG, x[3] / DEG, x[0] - x0[0], x[1] - x0[1], (x[2] - x0[2]) / DEG, (x[3] - x0[3]) / DEG);
+    }
+    fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
+            m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
+}
+
+static void print_ident(FILE *f, const rch_ident *id)
+{
+    fprintf(f,
+            "identifiability (%u parameters, at the solution): rank %u, %u not identifiable, %u weakly "
+            "identifiable;\n  condition number %.3g over the identifiable part, observability index O1 %.4g\n",
+            id->n_params, id->rank, id->n_params - id->rank, id->n_weak, id->cond, id->observability);
+    for (unsigned k = 0; k < id->n_dirs; ++k) {
+        fprintf(f, "  - %s (relative singular value %.1e): %s\n", id->dirs[k].weak ? "weak" : "NOT identifiable",
+                id->dirs[k].sv_rel, id->dirs[k].combo);
+        if (id->dirs[k].why[0])
+            fprintf(f, "      %s\n", id->dirs[k].why);
+    }
+    fprintf(f, "  The solver leaves directions it cannot identify where they started (nominal).\n\n");
+}
+
+void rch_calib_print(FILE *f, const rch_calib_result *r)
+{
+    const char *method = rc_method_name(r->cfg.method);
+    fprintf(f, "rcal calibrate: %s (%zu samples), robot \"%s\", method %s\n", r->cfg.data_path, r->n_data,
+            r->robot.name, method);
+    fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
+            r->cfg.test_fraction, r->cfg.seed);
+    fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
+            r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
+    print_metrics_row(f, "before (nominal DH, fitted encoder)", &r->before_m);
+    if (r->after_ok)
+        print_metrics_row(f, "after", &r->after_m);
+    else
+        fprintf(f, "  after: the solver diverged (non-finite model or cable length): no figures\n");
+    fprintf(f, "  (mean|e| is what the paper's Eq. 20 calls SD; SD here is the true standard deviation)\n");
+    fprintf(f, "training RMSE: before %.4f mm, after %.4f mm\n\n", r->train_before.rmse_mm, r->train_after.rmse_mm);
+    if (r->have_truth)
+        fprintf(f,
+                "flange position against the truth (%d random poses, base heading/height aligned):\n"
+                "  before RMS %.4f mm, max %.4f mm;  after RMS %.4f mm, max %.4f mm\n\n",
+                RCH_CALIB_TRUTH_POSES, r->truth_before_rms_mm, r->truth_before_max_mm, r->truth_after_rms_mm,
+                r->truth_after_max_mm);
+    print_model(f, r);
+    if (r->have_ident)
+        print_ident(f, &r->ident);
+    fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
+            r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
+}
+
+static void json_metrics(rch_jw *w, const char *name, const rc_metrics *m)
+{
+    rch_jw_obj(w, name);
+    rch_jw_uint(w, "n", m->n);
+    rch_jw_numf(w, "rmse_mm", m->rmse_mm, "%.6f");
+    rch_jw_numf(w, "mean_abs_mm", m->mean_abs_mm, "%.6f");
+    rch_jw_numf(w, "sd_mm", m->sd_mm, "%.6f");
+    rch_jw_numf(w, "mean_mm", m->mean_mm, "%.6f");
+    rch_jw_numf(w, "max_mm", m->max_mm, "%.6f");
+    rch_jw_end(w);
+}
+
+static void json_params(rch_jw *w, const rch_calib_result *r)
+{
+    const rc_model *m = &r->model;
+    rch_jw_arr(w, "params");
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        char name[64];
+        const int unit = rc_param_unit(m, k);
+        const double scale = unit == 1 ? 1.0 / DEG : 1.0;
+        const double nominal = k < RC_N_DH ? r->robot.model.x[k] : (k < RC_N_BASE ? r->before.x[k] : 0.0);
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "name", rc_param_name(name, sizeof name, m, k));
+        rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "-");
+        rch_jw_numf(w, "value", r->finite ? m->x[k] * scale : 0.0, "%.9g");
+        rch_jw_numf(w, "delta", r->finite ? (m->x[k] - nominal) * scale : 0.0, "%.9g");
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_arr(w, "encoder_mm");
+    for (unsigned k = 0; k < 3; ++k)
+        rch_jw_numf(w, NULL, m->x[RC_P_ENC + k], "%.6f");
+    rch_jw_end(w);
+}
+
+static void json_ident(rch_jw *w, const rch_ident *id)
+{
+    rch_jw_obj(w, "identifiability");
+    rch_jw_uint(w, "params", id->n_params);
+    rch_jw_uint(w, "rank", id->rank);
+    rch_jw_uint(w, "weak", id->n_weak);
+    rch_jw_numf(w, "cond", id->cond, "%.6g");
+    rch_jw_numf(w, "observability", id->observability, "%.6g");
+    rch_jw_arr(w, "directions");
+    for (unsigned k = 0; k < id->n_dirs; ++k) {
+        rch_jw_obj(w, NULL);
+        rch_jw_numf(w, "sv_rel", id->dirs[k].sv_rel, "%.3g");
+        rch_jw_str(w, "identifiable", id->dirs[k].weak ? "weakly" : "no");
+        rch_jw_str(w, "combo", id->dirs[k].combo);
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_end(w);
+}
+
+int rch_calib_json(FILE *f, const rch_calib_result *r)
+{
+    rch_jw w;
+    rch_jw_init(&w, f, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "method", rc_method_name(r->cfg.method));
+    rch_jw_str(&w, "data", r->cfg.data_path);
+    rch_jw_uint(&w, "n_train", r->n_train);
+    rch_jw_uint(&w, "n_test", r->n_test);
+    rch_jw_uint(&w, "seed", r->cfg.seed);
+    json_metrics(&w, "before", &r->before_m);
+    json_metrics(&w, "after", &r->after_m);
+    json_metrics(&w, "train_before", &r->train_before);
+    json_metrics(&w, "train_after", &r->train_after);
+    rch_jw_bool(&w, "held_out", r->n_test > 0);
+    rch_jw_bool(&w, "converged", r->after_ok);
+    rch_jw_str(&w, "exit", rc_exit_str(r->solve.exit));
+    rch_jw_uint(&w, "iterations", r->solve.iterations);
+    rch_jw_uint(&w, "cost_evals", r->solve.cost_evals);
+    rch_jw_numf(&w, "time_ms", r->time_ms, "%.3f");
+    json_params(&w, r);
+    if (r->cfg.truth_path) {
+        rch_jw_obj(&w, "truth_flange");
+        rch_jw_numf(&w, "before_rms_mm", r->truth_before_rms_mm, "%.6f");
+        rch_jw_numf(&w, "before_max_mm", r->truth_before_max_mm, "%.6f");
+        rch_jw_numf(&w, "after_rms_mm", r->truth_after_rms_mm, "%.6f");
+        rch_jw_numf(&w, "after_max_mm", r->truth_after_max_mm, "%.6f");
+        rch_jw_end(&w);
+    }
+    if (r->have_ident)
+        json_ident(&w, &r->ident);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}
+
+static void calib_info(rch_jw *w, const void *ctx)
+{
+    const rch_calib_result *r = ctx;
+    rch_jw_str(w, "method", rc_method_name(r->cfg.method));
+    rch_jw_str(w, "data", r->cfg.data_path);
+    rch_jw_uint(w, "n_train", r->n_train);
+    rch_jw_uint(w, "n_test", r->n_test);
+    rch_jw_uint(w, "seed", r->cfg.seed);
+    rch_jw_numf(w, "rmse_before_mm", r->before_m.rmse_mm, "%.6f");
+    rch_jw_numf(w, "rmse_after_mm", r->after_m.rmse_mm, "%.6f");
+}
+
+int rch_calib_write_model(FILE *f, const rch_calib_result *r)
+{
+    if (!r->finite)
+        return -1;
+    const rch_robot_info info = {calib_info, r};
+    return rch_robot_write(f, r->robot.name, &r->model, &r->robot.nominal, &info);
+}
+
+static int write_model_fn(FILE *f, const void *ctx)
+{
+    return rch_calib_write_model(f, ctx);
+}
+
+int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
+{
+    const char *inputs[3] = {r->cfg.data_path, r->cfg.robot_path, r->cfg.truth_path};
+    return rch_save(path, "--out", inputs, 3, write_model_fn, r, d);
+}
+
+/* ------------------------------------------------------------ fkcheck */
+
+/* Largest joint change (deg) of the minimum-norm dq = J^T (J J^T)^-1 dp that
+ * moves the flange by dp, over the position rows of the joint Jacobian. */
+static double explaining_dq_deg(const double jac[36], const double dp[3])
+{
+    double M[9], y[3] = {0, 0, 0}, dq_max = 0.0;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+            double s = 0.0;
+            for (int k = 0; k < 6; ++k)
+                s += jac[6 * a + k] * jac[6 * b + k];
+            M[3 * a + b] = s;
+        }
+    const double det = M[0] * (M[4] * M[8] - M[5] * M[7]) - M[1] * (M[3] * M[8] - M[5] * M[6]) +
+                       M[2] * (M[3] * M[7] - M[4] * M[6]);
+    if (fabs(det) > 1e-12) { /* Cramer's rule on the 3x3 system M y = dp */
+        for (int c = 0; c < 3; ++c) {
+            double T[9];
+            memcpy(T, M, sizeof T);
+            for (int a = 0; a < 3; ++a)
+                T[3 * a + c] = dp[a];
+            y[c] = (T[0] * (T[4] * T[8] - T[5] * T[7]) - T[1] * (T[3] * T[8] - T[5] * T[6]) +
+                    T[2] * (T[3] * T[7] - T[4] * T[6])) / det;
+        }
+    }
+    for (int k = 0; k < 6; ++k) {
+        const double dqk = (jac[k] * y[0] + jac[6 + k] * y[1] + jac[12 + k] * y[2]) * (180.0 / M_PI);
+        if (fabs(dqk) > dq_max)
+            dq_max = fabs(dqk);
+    }
+    return dq_max;
+}
+
+static int fk_rows(rch_fkcheck_result *r, const rch_data *data, const rc_model *nominal, double tol_mm)
+{
+    rch_stats all;
+    memset(&all, 0, sizeof all);
+    for (size_t i = 0; i < data->n; ++i) {
+        double p[3], pp[3], jac[36];
+        rc_fk(p, NULL, nominal, data->s[i].q_rad);
+        const double dp[3] = {data->xyz[i][0] - p[0], data->xyz[i][1] - p[1], data->xyz[i][2] - p[2]};
+        const double dist = sqrt(dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2]);
+        rch_stats_add(&all, dist);
+        /* the file's angles are rounded to 0.1 deg: a row is consistent when
+         * a joint change within that rounding explains the difference */
+        rc_fk_jac(pp, NULL, jac, nominal, data->s[i].q_rad);
+        const double dq_deg = explaining_dq_deg(jac, dp);
+        if (dist > tol_mm && dq_deg <= RCH_FK_ROUNDING_DEG) {
+            ++r->rounding;
+            if (dist > r->max_consistent_mm)
+                r->max_consistent_mm = dist;
+        } else if (dist > tol_mm) {
+            rch_fk_fault *f = &r->fault[r->faults++];
+            f->line = data->line[i];
+            f->dist_mm = dist;
+            f->dq_deg = dq_deg;
+            memcpy(f->fk_mm, p, sizeof p);
+            memcpy(f->file_mm, data->xyz[i], sizeof f->file_mm);
+        } else if (dist > r->max_consistent_mm) {
+            r->max_consistent_mm = dist;
+        }
+    }
+    r->rows = data->n;
+    r->rms_mm = rch_stats_rms(&all);
+    r->max_mm = all.max_abs;
+    return 0;
+}
+
+int rch_fkcheck_run(rch_fkcheck_result *r, const char *data_path, const char *robot_path, double tol_mm,
+                    rch_diag *d)
+{
+    memset(r, 0, sizeof *r);
+    rch_robot robot;
+    rch_data data;
+    if (rch_robot_load(&robot, robot_path, d) != 0 || rch_data_load(&data, data_path, 0, d) != 0)
+        return -1;
+    snprintf(r->robot_name, sizeof r->robot_name, "%s", robot.name);
+    int rc = -1;
+    if (!data.xyz)
+        rch_diag_set(d, data_path, 0, 0, "no x, y, z columns");
+    else if (!(r->fault = malloc((data.n ? data.n : 1) * sizeof *r->fault)))
+        rch_diag_set(d, "", 0, 0, "out of memory");
+    else
+        rc = fk_rows(r, &data, &robot.nominal, tol_mm);
+    rch_data_free(&data);
+    return rc;
+}
+
+void rch_fkcheck_free(rch_fkcheck_result *r)
+{
+    free(r->fault);
+    r->fault = NULL;
 }

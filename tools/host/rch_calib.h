@@ -1,25 +1,128 @@
-/* rch_calib.h - the calibration pipeline shared by rcal's commands.
+/* rch_calib.h - the calibration pipeline behind `rcal calibrate` and the
+ * nominal-FK check behind `rcal fkcheck`.
  *
- * Start: nominal geometry; the encoder outlet from the robot file when it
- * has one, else from rc_encoder_guess; then the encoder alone is refined by
- * LM with the geometry held fixed. That start is also the "before
- * calibration" (BC) model: nominal robot, best encoder position. Then every
- * parameter is identified with the chosen method.
+ * Before calibration (BC): the one definition of the start model. Nominal
+ * geometry; the encoder outlet from the robot file when it has one, else from
+ * rc_encoder_guess; then the encoder alone is refined by LM with everything
+ * else held (rch_calib_bc). `rcal calibrate`, `rcal compare`, `rcal bench`
+ * and `rcal diagnose` all start from it. Then every parameter is identified
+ * with the chosen method (rch_calib_run), the held-out samples give the
+ * before/after figures, an optional simulated truth gives flange errors over
+ * random poses, and rch_ident describes what the data could not identify.
+ *
+ * Depends on: the core (rc_model, rc_solve), rch_data, rch_robot, rch_sim,
+ * rch_ident, rch_jw. Memory: the result owns nothing on the heap (the pipeline
+ * frees its scratch before returning). Errors: 0, or a negative code with a
+ * message in rch_diag (see rch_calib_run). Not thread-safe only in that a
+ * result must not be shared while it is written.
  */
 #ifndef RCH_CALIB_H
 #define RCH_CALIB_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #include "rc_solve.h"
 #include "rch_diag.h"
+#include "rch_ident.h"
 #include "rch_robot.h"
 
-/* BC model from the training samples. Returns 0 or -1 with d set. */
-int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, const rc_sample *train,
-                    size_t n, rch_diag *d);
+/* Poses (and their seed) of the flange comparison against a simulated truth. */
+#define RCH_CALIB_TRUTH_POSES 2000
+#define RCH_CALIB_TRUTH_SEED 12345
+/* Iteration cap of the encoder-only fit of the BC model. */
+#define RCH_CALIB_BC_MAX_ITER 200
+
+/* BC model from the samples (n): start = nominal as given (the caller chooses
+ * which effects it carries; they stay at their values), encoder from nominal
+ * when has_encoder, else from rc_encoder_guess; then the encoder alone fitted
+ * (LM, at most RCH_CALIB_BC_MAX_ITER iterations). w: solver scratch. Returns 0
+ * or -1 with d set. */
+int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int has_encoder, const rc_sample *s,
+                 size_t n, rch_diag *d);
+
+/* rch_calib_bc with the robot file's model and encoder. */
+int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, const rc_sample *train, size_t n,
+                    rch_diag *d);
 
 /* Parse a method name (lm, ltlm, lm-paper, ltlm-paper). Returns 0 or -1. */
 int rch_method_parse(rc_method *out, const char *name);
+
+/* Mark the comma-separated parameter names of list (e.g. "a1,theta6") in
+ * fixed (m->n_params). 0, or -1 with d naming the unknown parameter. */
+int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d);
+
+typedef struct rch_calib_cfg {
+    const char *data_path;  /* measurements CSV (required) */
+    const char *robot_path; /* nominal robot model (required) */
+    const char *truth_path; /* simulated truth model, or NULL */
+    const char *fix;        /* parameters held at nominal ("a1,theta6"), or NULL */
+    rc_method method;
+    double test_fraction;   /* share held out, [0, 1) */
+    unsigned long seed;     /* split and LTLM seed */
+    unsigned max_iter;      /* 0: the method's default */
+    int tool_offset;        /* 1: also identify the cable attachment in the flange frame */
+} rch_calib_cfg;
+
+typedef struct rch_calib_result {
+    rch_calib_cfg cfg;        /* as given (paths point at the caller's strings) */
+    rch_robot robot;          /* the robot file; robot.model has the tool offset when asked */
+    size_t n_data, n_train, n_test;
+    rc_model before;          /* BC model */
+    rc_model model;           /* identified model */
+    rc_solve_result solve;
+    double time_ms;           /* the identification alone */
+    int finite;               /* every parameter of model is finite */
+    int after_ok;             /* model is finite and gives finite lengths */
+    rc_metrics before_m;      /* on the held-out samples (the training ones when none is held out) */
+    rc_metrics after_m;
+    rc_metrics train_before;
+    rc_metrics train_after;   /* zero when !after_ok */
+    int have_truth;
+    double truth_before_rms_mm, truth_before_max_mm; /* flange vs truth, base heading/height aligned */
+    double truth_after_rms_mm, truth_after_max_mm;
+    int have_ident;
+    rch_ident ident;          /* at the solution, over the training samples */
+} rch_calib_result;
+
+/* The whole calibration. Returns 0 (the solver ran; r->after_ok says whether
+ * the result is usable), -1 on a failure of the work (unreadable file, too few
+ * samples, solver error: d set), -2 on a bad request (unknown --fix name: d
+ * set). */
+int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d);
+
+/* The text report (the paper's Table 7 form, identifiability, solver line). */
+void rch_calib_print(FILE *f, const rch_calib_result *r);
+/* The report as one JSON object (rch_jw). 0, or -1 on a write error. */
+int rch_calib_json(FILE *f, const rch_calib_result *r);
+/* The calibrated model file (rcal-model/1) with a "calibration" member.
+ * -1 when the model is not finite or on a write error. */
+int rch_calib_write_model(FILE *f, const rch_calib_result *r);
+/* rch_calib_write_model into path, whole or not at all (rch_save), never over
+ * one of the inputs (--data, --robot, --truth). 0, or -1 with d set. */
+int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d);
+
+/* rcal fkcheck: the nominal FK at each row's joint angles against the row's
+ * x, y, z columns. A row further than tol_mm is explained by the display
+ * rounding when a joint change of at most RCH_FK_ROUNDING_DEG (max over the
+ * joints of the minimum-norm change) reproduces the difference, else a fault. */
+#define RCH_FK_ROUNDING_DEG 0.1
+typedef struct rch_fk_fault {
+    unsigned line;        /* line in the data file */
+    double dist_mm;       /* |FK - xyz| */
+    double dq_deg;        /* joint change that would explain it */
+    double fk_mm[3], file_mm[3];
+} rch_fk_fault;
+typedef struct rch_fkcheck_result {
+    size_t rows, faults, rounding;
+    double rms_mm, max_mm, max_consistent_mm;
+    rch_fk_fault *fault;      /* (faults) on the heap: rch_fkcheck_free */
+    char robot_name[128];
+} rch_fkcheck_result;
+
+/* 0, or -1 with d set (unreadable files, no x, y, z columns, no memory). */
+int rch_fkcheck_run(rch_fkcheck_result *r, const char *data_path, const char *robot_path, double tol_mm,
+                    rch_diag *d);
+void rch_fkcheck_free(rch_fkcheck_result *r);
 
 #endif

@@ -6,8 +6,14 @@
 #include <string.h>
 #include <time.h>
 
+#include "rc_ident.h"
 #include "rc_linalg.h"
 #include "rc_rand.h"
+#include "rch_calib.h"
+#include "rch_data.h"
+#include "rch_jw.h"
+#include "rch_robot.h"
+#include "rch_stats.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -100,13 +106,6 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
-static double rms(const double *r, size_t n)
-{
-    double s = 0.0;
-    for (size_t i = 0; i < n; ++i)
-        s += r[i] * r[i];
-    return n ? sqrt(s / (double)n) : 0.0;
-}
 
 /* ------------------------------------------------------- structure tests */
 
@@ -397,37 +396,26 @@ static int cv_run(rc_model *models, double *res, ctx *c)
     return 0;
 }
 
-/* Relative eigenvalue of the scaled normal matrix below which a direction
- * counts as not identifiable at all (singular value ratio 1e-6). */
-#define RANK_TOL 1e-12
-
-/* Rank of the column-scaled normal matrix of the first np parameters of m
- * over the samples: eigenvalues above tol_rel * largest. ev: scratch. */
-static unsigned rank_at(const rc_model *m, unsigned np, const rc_sample *s, size_t n, rc_solve_work *w,
-                        double tol_rel, int dump)
+/* Rank of the first np parameters of m over the samples: the number of
+ * directions rc_ident (the one definition of identifiability) does not call
+ * null. dump: print the relative singular values to stderr. */
+static unsigned rank_at(const rc_model *m, unsigned np, const rc_sample *s, size_t n, rc_solve_work *w, int dump)
 {
     double cost;
     for (unsigned i = 0; i < np; ++i)
         w->idx[i] = (uint16_t)i;
     if (rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, np, s, n) != RC_OK)
         return 0;
-    for (unsigned i = 0; i < np; ++i) {
-        const double a = w->A[(size_t)i * np + i];
-        w->D[i] = a > 0.0 ? sqrt(a) : 1.0;
-    }
-    for (unsigned i = 0; i < np; ++i)
-        for (unsigned k = 0; k < np; ++k)
-            w->A[(size_t)i * np + k] /= w->D[i] * w->D[k];
-    if (rcu_eig_sym(w->ev, w->V, w->A, np, 0) == RC_ERR_NUMERIC || !(w->ev[0] > 0.0))
+    double *work = malloc(rc_ident_work_size(np) * sizeof *work);
+    rc_ident id;
+    const rc_status st = work ? rc_ident_normal(&id, w->V, work, w->A, np, n) : RC_ERR_CAPACITY;
+    free(work);
+    if (st != RC_OK)
         return 0;
-    unsigned r = 0;
-    for (unsigned k = 0; k < np; ++k) {
-        if (dump)
-            fprintf(stderr, "  ev[%u] = %.3e\n", k, w->ev[k] / w->ev[0]);
-        if (w->ev[k] > tol_rel * w->ev[0])
-            ++r;
-    }
-    return r;
+    if (dump)
+        for (unsigned k = 0; k < np; ++k)
+            fprintf(stderr, "  sv_rel[%u] = %.3e\n", k, id.sv_rel[k]);
+    return id.rank;
 }
 
 /* Largest joint-side error that is still physical for a gear or joint
@@ -629,514 +617,633 @@ static void scale_note(rch_diagnose_result *r)
              sqrt(e2 / (double)r->n), sqrt(d2 / (double)r->n));
 }
 
-int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t n, const rc_model *nominal,
-                     const rch_diagnose_cfg *cfg_in, rch_diag *d)
-{
-    const double t0 = now_ms();
-    rch_diagnose_cfg cfg = *cfg_in;
-    ctx c;
-    int rc = -1;
-    rc_model *base_folds = NULL, *cand_folds = NULL, *cand_full = NULL;
-    double *r0 = NULL, *cand_res = NULL, *tmp = NULL;
-    double (*var)[V_N] = NULL;
-    unsigned *order = NULL;
+/* The state of one diagnosis run, handed from phase to phase. The phases run
+ * in order (setup, steps, 1 geometry, 2 floor, 3 folds, 4 cross-validated
+ * geometry, 5 candidate search, 6 after, 7 report); each reads what the ones
+ * before it left here and in the result. Everything on the heap is freed by
+ * run_free. */
+typedef struct run_state {
+    rch_diagnose_cfg cfg;     /* with the defaults filled in */
+    rch_diagnose_result *out; /* the caller's result, filled phase by phase */
+    ctx c;                    /* samples (out->s), folds, training sets, solver scratch */
+    rc_model base;            /* the model entering the current search step (geometry + chosen effects) */
+    rc_model *base_folds;     /* (k) that model fitted on each fold's training samples */
+    rc_model *cand_full;      /* (N_ALL_CANDS) each candidate fitted on all samples */
+    rc_model *cand_folds;     /* (N_ALL_CANDS x k) each candidate fitted per fold */
+    double *cand_res;         /* (N_ALL_CANDS x n) held-out residuals per candidate */
+    double *r0;               /* (n) held-out residuals of the current model */
+    double *tmp;              /* (n x 6) scratch */
+    double (*var)[V_N];       /* (n) explanatory variables of the structure tests */
+    unsigned *order;          /* (n) shuffled sample order */
+} run_state;
 
-    memset(out, 0, sizeof *out);
-    memset(&c, 0, sizeof c);
-    if (cfg.folds == 0)
-        cfg.folds = 5;
-    if (cfg.max_steps == 0)
-        cfg.max_steps = 3;
-    if (cfg.max_steps > RCH_DIAGNOSE_MAX_STEPS)
-        cfg.max_steps = RCH_DIAGNOSE_MAX_STEPS;
-    if (cfg.alpha <= 0.0)
-        cfg.alpha = 0.01;
-    if (cfg.gap_factor <= 0.0)
-        cfg.gap_factor = 1.25;
-    if (cfg.folds < 2 || cfg.folds > RCH_DIAGNOSE_MAX_FOLDS) {
+static void run_free(run_state *S)
+{
+    for (unsigned f = 0; f < RCH_DIAGNOSE_MAX_FOLDS; ++f)
+        free(S->c.train[f]);
+    free(S->c.w);
+    free(S->c.fold);
+    free(S->r0);
+    free(S->tmp);
+    free(S->var);
+    free(S->order);
+    free(S->base_folds);
+    free(S->cand_folds);
+    free(S->cand_full);
+    free(S->cand_res);
+}
+
+/* Defaults, size checks and the allocations. 0 or -1 (d set). */
+static int phase_setup(run_state *S, rch_diagnose_result *out, const rc_sample *samples, size_t n,
+                       const rch_diagnose_cfg *cfg_in, rch_diag *d)
+{
+    rch_diagnose_cfg *cfg = &S->cfg;
+    *cfg = *cfg_in;
+    S->out = out;
+    if (cfg->folds == 0)
+        cfg->folds = 5;
+    if (cfg->max_steps == 0)
+        cfg->max_steps = 3;
+    if (cfg->max_steps > RCH_DIAGNOSE_MAX_STEPS)
+        cfg->max_steps = RCH_DIAGNOSE_MAX_STEPS;
+    if (cfg->alpha <= 0.0)
+        cfg->alpha = 0.01;
+    if (cfg->gap_factor <= 0.0)
+        cfg->gap_factor = 1.25;
+    if (cfg->folds < 2 || cfg->folds > RCH_DIAGNOSE_MAX_FOLDS) {
         rch_diag_set(d, "", 0, 0, "folds must be within 2..%d", RCH_DIAGNOSE_MAX_FOLDS);
         return -1;
     }
-    if (n < 10u * cfg.folds || n < 60) {
+    if (n < 10u * cfg->folds || n < 60) {
         rch_diag_set(d, "", 0, 0, "%zu samples are too few to diagnose (need at least %u)", n,
-                     10u * cfg.folds > 60 ? 10u * cfg.folds : 60u);
+                     10u * cfg->folds > 60 ? 10u * cfg->folds : 60u);
         return -1;
     }
     out->n = n;
-    out->folds = cfg.folds;
+    out->folds = cfg->folds;
     out->s = malloc(n * sizeof *out->s);
     out->res_before_mm = calloc(n, sizeof(double));
     out->res_after_mm = calloc(n, sizeof(double));
     out->floor_mm = calloc(n, sizeof(double));
-    c.w = malloc(sizeof *c.w);
-    c.fold = calloc(n, sizeof *c.fold);
-    r0 = calloc(n, sizeof *r0);
-    tmp = calloc(n * RC_NJ, sizeof *tmp);
-    var = calloc(n, sizeof *var);
-    order = calloc(n, sizeof *order);
-    base_folds = calloc(cfg.folds, sizeof *base_folds);
-    cand_folds = calloc((size_t)N_ALL_CANDS * cfg.folds, sizeof *cand_folds);
-    cand_full = calloc(N_ALL_CANDS, sizeof *cand_full);
-    cand_res = calloc(N_ALL_CANDS * n, sizeof *cand_res);
-    if (!out->s || !out->res_before_mm || !out->res_after_mm || !out->floor_mm || !c.w || !c.fold || !r0 ||
-        !tmp || !var || !order || !base_folds || !cand_folds || !cand_full || !cand_res) {
+    S->c.w = malloc(sizeof *S->c.w);
+    S->c.fold = calloc(n, sizeof *S->c.fold);
+    S->r0 = calloc(n, sizeof *S->r0);
+    S->tmp = calloc(n * RC_NJ, sizeof *S->tmp);
+    S->var = calloc(n, sizeof *S->var);
+    S->order = calloc(n, sizeof *S->order);
+    S->base_folds = calloc(cfg->folds, sizeof *S->base_folds);
+    S->cand_folds = calloc((size_t)N_ALL_CANDS * cfg->folds, sizeof *S->cand_folds);
+    S->cand_full = calloc(N_ALL_CANDS, sizeof *S->cand_full);
+    S->cand_res = calloc(N_ALL_CANDS * n, sizeof *S->cand_res);
+    if (!out->s || !out->res_before_mm || !out->res_after_mm || !out->floor_mm || !S->c.w || !S->c.fold ||
+        !S->r0 || !S->tmp || !S->var || !S->order || !S->base_folds || !S->cand_folds || !S->cand_full ||
+        !S->cand_res) {
         rch_diag_set(d, "", 0, 0, "out of memory");
-        goto done;
+        return -1;
     }
     memcpy(out->s, samples, n * sizeof *samples);
-    if (cfg.groups_given) {
+    S->c.s = out->s;
+    S->c.n = n;
+    S->c.k = cfg->folds;
+    S->c.max_iter = cfg->max_iter ? cfg->max_iter : 100u;
+    S->c.verbose = cfg->verbose;
+    return 0;
+}
+
+/* Display steps (given or detected) and the set-up groups (given or by wrist). */
+static void phase_steps(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    const size_t n = out->n;
+    if (S->cfg.groups_given) {
         unsigned g = 0;
         for (size_t i = 0; i < n; ++i)
             g = out->s[i].group > g ? out->s[i].group : g;
         out->n_groups = g + 1;
     }
-    c.s = out->s;
-    c.n = n;
-    c.k = cfg.folds;
-    c.max_iter = cfg.max_iter ? cfg.max_iter : 100u;
-    c.verbose = cfg.verbose;
-
-    /* display steps */
     for (size_t i = 0; i < n; ++i)
         for (unsigned j = 0; j < RC_NJ; ++j)
-            tmp[i * RC_NJ + j] = out->s[i].q_rad[j] / DEG;
-    out->q_step_deg = cfg.q_step_deg > 0.0 ? cfg.q_step_deg
-                      : cfg.q_step_deg < 0.0 ? 0.0
-                                             : rch_diagnose_detect_step(tmp, n * RC_NJ);
+            S->tmp[i * RC_NJ + j] = out->s[i].q_rad[j] / DEG;
+    out->q_step_deg = S->cfg.q_step_deg > 0.0   ? S->cfg.q_step_deg
+                      : S->cfg.q_step_deg < 0.0 ? 0.0
+                                                : rch_diagnose_detect_step(S->tmp, n * RC_NJ);
     for (size_t i = 0; i < n; ++i)
-        tmp[i] = out->s[i].len_mm;
-    out->len_step_mm = cfg.len_step_mm > 0.0 ? cfg.len_step_mm
-                       : cfg.len_step_mm < 0.0 ? 0.0
-                                               : rch_diagnose_detect_step(tmp, n);
-    out->len_noise_mm = cfg.len_noise_mm > 0.0 ? cfg.len_noise_mm : 0.0;
-    if (!cfg.groups_given)
+        S->tmp[i] = out->s[i].len_mm;
+    out->len_step_mm = S->cfg.len_step_mm > 0.0   ? S->cfg.len_step_mm
+                       : S->cfg.len_step_mm < 0.0 ? 0.0
+                                                  : rch_diagnose_detect_step(S->tmp, n);
+    out->len_noise_mm = S->cfg.len_noise_mm > 0.0 ? S->cfg.len_noise_mm : 0.0;
+    if (!S->cfg.groups_given)
         out->n_groups = group_by_wrist(out->s, n, out->q_step_deg, &out->n_flicker);
+}
 
-    /* 1. geometric fit on all samples */
-    {
-        rc_model *g = &out->geo;
-        rc_solve_result res;
-        uint8_t fixed[RC_MAX_PARAMS];
-        *g = *nominal;
-        g->n_effects = 0;
-        g->n_params = RC_N_BASE;
-        if (!cfg.have_encoder) {
-            double e[3];
-            if (rc_encoder_guess(e, g, out->s, n) != RC_OK) {
-                rch_diag_set(d, "", 0, 0, "cannot place the encoder: the poses must spread in all directions");
-                goto done;
-            }
-            memcpy(&g->x[RC_P_ENC], e, sizeof e);
-        }
-        memset(fixed, 1, sizeof fixed);
-        fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 0;
-        if (fit(g, NULL, &c, fixed, out->s, n) != 0 || fit(g, &res, &c, NULL, out->s, n) != 0) {
-            rch_diag_set(d, "", 0, 0, "the geometric fit failed");
-            goto done;
-        }
-        out->train_rmse_geo_mm = res.rms_final_mm;
-        out->geo_rank = res.rank;
-        out->geo_free = res.n_free;
+/* 1. Geometric fit on all samples, from the "before calibration" model of
+ * rcal calibrate (rch_calib_bc: nominal geometry, encoder fitted alone). */
+static int phase_geometry(run_state *S, const rc_model *nominal, rch_diag *d)
+{
+    rch_diagnose_result *out = S->out;
+    rc_model geometry = *nominal;
+    rc_solve_result res;
+    geometry.n_effects = 0;
+    geometry.n_params = RC_N_BASE;
+    if (rch_calib_bc(&out->geo, S->c.w, &geometry, S->cfg.have_encoder, out->s, out->n, d) != 0)
+        return -1;
+    if (fit(&out->geo, &res, &S->c, NULL, out->s, out->n) != 0) {
+        rch_diag_set(d, "", 0, 0, "the geometric fit failed");
+        return -1;
     }
+    out->train_rmse_geo_mm = res.rms_final_mm;
+    out->geo_rank = res.rank;
+    out->geo_free = res.n_free;
+    return 0;
+}
 
-    /* 2. noise floor and explanatory variables */
-    {
-        const double qs = out->q_step_deg * DEG, ls = out->len_step_mm, ln = out->len_noise_mm;
-        double jac[RC_MAX_PARAMS], vq = 0.0, vl = 0.0;
-        const rc_model *g = &out->geo;
-        double ref[4][4];
-        for (unsigned i = 0; i < 4; ++i)
-            for (unsigned k = 0; k < 4; ++k)
-                ref[i][k] = g->x[4 * i + k];
-        for (size_t i = 0; i < n; ++i) {
-            double l, p[3];
-            if (rc_meas(&l, jac, g, &out->s[i]) != RC_OK) {
-                rch_diag_set(d, "", 0, 0, "sample %zu: the flange meets the encoder outlet", i + 1);
-                goto done;
-            }
-            double sq = 0.0;
-            for (unsigned j = 0; j < RC_NJ; ++j)
-                sq += jac[RC_P_THETA(j)] * jac[RC_P_THETA(j)];
-            const double viq = sq * qs * qs / 12.0, vil = ls * ls / 12.0 + ln * ln;
-            out->floor_mm[i] = sqrt(viq + vil);
-            vq += viq;
-            vl += vil;
-            rc_fk(p, NULL, g, out->s[i].q_rad);
-            double u[3], nu = 0.0;
-            for (unsigned k = 0; k < 3; ++k) {
-                u[k] = p[k] - g->x[RC_P_ENC + k];
-                nu += u[k] * u[k];
-            }
-            nu = sqrt(nu);
-            var[i][V_LEV2] = rc_gravity_lever_m((const double(*)[4])ref, 1, out->s[i].q_rad);
-            var[i][V_LEV3] = rc_gravity_lever_m((const double(*)[4])ref, 2, out->s[i].q_rad);
-            var[i][V_LEN] = out->s[i].len_mm;
-            var[i][V_UX] = u[0] / nu;
-            var[i][V_UY] = u[1] / nu;
-            var[i][V_UZ] = u[2] / nu;
-            var[i][V_T] = out->s[i].t;
+/* 2. Noise floor per sample and the explanatory variables. */
+static int phase_floor(run_state *S, rch_diag *d)
+{
+    rch_diagnose_result *out = S->out;
+    const size_t n = out->n;
+    const double qs = out->q_step_deg * DEG, ls = out->len_step_mm, ln = out->len_noise_mm;
+    double jac[RC_MAX_PARAMS], vq = 0.0, vl = 0.0, ref[4][4];
+    const rc_model *g = &out->geo;
+    for (unsigned i = 0; i < 4; ++i)
+        for (unsigned k = 0; k < 4; ++k)
+            ref[i][k] = g->x[4 * i + k];
+    for (size_t i = 0; i < n; ++i) {
+        double l, p[3], u[3], nu = 0.0, sq = 0.0;
+        if (rc_meas(&l, jac, g, &out->s[i]) != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "sample %zu: the flange meets the encoder outlet", i + 1);
+            return -1;
         }
-        out->floor_joints_mm = sqrt(vq / (double)n);
-        out->floor_len_mm = sqrt(vl / (double)n);
-        out->noise_floor_mm = sqrt((vq + vl) / (double)n);
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            sq += jac[RC_P_THETA(j)] * jac[RC_P_THETA(j)];
+        const double viq = sq * qs * qs / 12.0, vil = ls * ls / 12.0 + ln * ln;
+        out->floor_mm[i] = sqrt(viq + vil);
+        vq += viq;
+        vl += vil;
+        rc_fk(p, NULL, g, out->s[i].q_rad);
+        for (unsigned k = 0; k < 3; ++k) {
+            u[k] = p[k] - g->x[RC_P_ENC + k];
+            nu += u[k] * u[k];
+        }
+        nu = sqrt(nu);
+        S->var[i][V_LEV2] = rc_gravity_lever_m((const double(*)[4])ref, 1, out->s[i].q_rad);
+        S->var[i][V_LEV3] = rc_gravity_lever_m((const double(*)[4])ref, 2, out->s[i].q_rad);
+        S->var[i][V_LEN] = out->s[i].len_mm;
+        S->var[i][V_UX] = u[0] / nu;
+        S->var[i][V_UY] = u[1] / nu;
+        S->var[i][V_UZ] = u[2] / nu;
+        S->var[i][V_T] = out->s[i].t;
     }
+    out->floor_joints_mm = sqrt(vq / (double)n);
+    out->floor_len_mm = sqrt(vl / (double)n);
+    out->noise_floor_mm = sqrt((vq + vl) / (double)n);
+    return 0;
+}
 
-    /* 3. folds: random within each group, dealt round-robin */
-    {
-        rc_rng rng;
-        rc_rng_seed(&rng, cfg.seed ^ 0x6469616700000000ull);
-        for (size_t i = 0; i < n; ++i)
-            order[i] = (unsigned)i;
-        for (size_t i = n; i > 1; --i) {
-            const size_t j = rc_rng_below(&rng, (uint32_t)i);
-            const unsigned t = order[i - 1];
-            order[i - 1] = order[j];
-            order[j] = t;
-        }
-        /* stable pass per group in shuffled order: counter continues across groups */
-        unsigned *gorder = calloc(out->n_groups, sizeof *gorder);
-        if (!gorder) {
-            rch_diag_set(d, "", 0, 0, "out of memory");
-            goto done;
-        }
-        for (unsigned g = 0; g < out->n_groups; ++g)
-            gorder[g] = g;
-        for (unsigned g = out->n_groups; g > 1; --g) {
-            const unsigned j = rc_rng_below(&rng, g);
-            const unsigned t = gorder[g - 1];
-            gorder[g - 1] = gorder[j];
-            gorder[j] = t;
-        }
-        /* bucket samples by group, in shuffled order */
-        size_t *start = calloc((size_t)out->n_groups + 1, sizeof *start);
-        unsigned *byg = calloc(n, sizeof *byg);
-        if (!start || !byg) {
-            free(gorder);
-            free(start);
-            free(byg);
-            rch_diag_set(d, "", 0, 0, "out of memory");
-            goto done;
-        }
-        for (size_t i = 0; i < n; ++i)
-            start[out->s[i].group + 1]++;
-        for (unsigned g = 0; g < out->n_groups; ++g)
-            start[g + 1] += start[g];
-        {
-            size_t *pos = calloc(out->n_groups, sizeof *pos);
-            if (!pos) {
-                free(gorder);
-                free(start);
-                free(byg);
-                rch_diag_set(d, "", 0, 0, "out of memory");
-                goto done;
-            }
-            for (size_t i = 0; i < n; ++i) {
-                const unsigned s = order[i], g = out->s[s].group;
-                byg[start[g] + pos[g]++] = s;
-            }
-            free(pos);
-        }
-        unsigned counter = 0;
-        for (unsigned gi = 0; gi < out->n_groups; ++gi) {
-            const unsigned g = gorder[gi];
-            for (size_t p = start[g]; p < start[g + 1]; ++p)
-                c.fold[byg[p]] = counter++ % c.k;
-        }
-        free(gorder);
-        free(start);
-        free(byg);
-        for (unsigned f = 0; f < c.k; ++f) {
-            size_t nt = 0;
-            for (size_t i = 0; i < n; ++i)
-                nt += c.fold[i] != f;
-            c.train[f] = malloc(nt * sizeof *c.train[f]);
-            if (!c.train[f]) {
-                rch_diag_set(d, "", 0, 0, "out of memory");
-                goto done;
-            }
-            c.n_train[f] = 0;
-            for (size_t i = 0; i < n; ++i)
-                if (c.fold[i] != f)
-                    c.train[f][c.n_train[f]++] = out->s[i];
-        }
+/* Fisher-Yates shuffle of v (n) with the generator's bounded draws. */
+static void shuffle(unsigned *v, size_t n, rc_rng *rng)
+{
+    for (size_t i = n; i > 1; --i) {
+        const size_t j = rc_rng_below(rng, (uint32_t)i);
+        const unsigned t = v[i - 1];
+        v[i - 1] = v[j];
+        v[j] = t;
     }
+}
 
-    /* 4. cross-validated geometry */
-    for (unsigned f = 0; f < c.k; ++f)
-        base_folds[f] = out->geo;
-    if (cv_run(base_folds, r0, &c) != 0) {
-        rch_diag_set(d, "", 0, 0, "a cross-validation fit failed");
+/* Fold of every sample: the groups in shuffled order, within each group the
+ * samples in shuffled order, dealt round-robin (the counter runs on across
+ * groups). 0 or -1 (out of memory). */
+static int assign_folds(run_state *S)
+{
+    const rch_diagnose_result *out = S->out;
+    const size_t n = out->n;
+    const unsigned ng = out->n_groups;
+    rc_rng rng;
+    rc_rng_seed(&rng, S->cfg.seed ^ 0x6469616700000000ull);
+    for (size_t i = 0; i < n; ++i)
+        S->order[i] = (unsigned)i;
+    shuffle(S->order, n, &rng);
+    unsigned *gorder = calloc(ng, sizeof *gorder), *byg = calloc(n, sizeof *byg);
+    size_t *start = calloc((size_t)ng + 1, sizeof *start), *pos = calloc(ng, sizeof *pos);
+    int rc = -1;
+    if (!gorder || !byg || !start || !pos)
         goto done;
+    for (unsigned g = 0; g < ng; ++g)
+        gorder[g] = g;
+    shuffle(gorder, ng, &rng);
+    for (size_t i = 0; i < n; ++i) /* bucket the samples by group, in shuffled order */
+        start[out->s[i].group + 1]++;
+    for (unsigned g = 0; g < ng; ++g)
+        start[g + 1] += start[g];
+    for (size_t i = 0; i < n; ++i) {
+        const unsigned s = S->order[i], g = out->s[s].group;
+        byg[start[g] + pos[g]++] = s;
     }
-    memcpy(out->res_before_mm, r0, n * sizeof *r0);
-    out->rmse_before_mm = rms(r0, n);
-    out->n_tests = structure_tests(out->before, r0, out->s, n, (const double(*)[V_N])var, out->n_groups,
-                                   cfg.alpha);
-    if (cfg.verbose)
+    unsigned counter = 0;
+    for (unsigned gi = 0; gi < ng; ++gi)
+        for (size_t p = start[gorder[gi]]; p < start[gorder[gi] + 1]; ++p)
+            S->c.fold[byg[p]] = counter++ % S->c.k;
+    rc = 0;
+done:
+    free(gorder);
+    free(byg);
+    free(start);
+    free(pos);
+    return rc;
+}
+
+/* 3. Folds and each fold's training samples. */
+static int phase_folds(run_state *S, rch_diag *d)
+{
+    ctx *c = &S->c;
+    if (assign_folds(S) != 0) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    for (unsigned f = 0; f < c->k; ++f) {
+        size_t nt = 0;
+        for (size_t i = 0; i < c->n; ++i)
+            nt += c->fold[i] != f;
+        c->train[f] = malloc(nt * sizeof *c->train[f]);
+        if (!c->train[f]) {
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            return -1;
+        }
+        c->n_train[f] = 0;
+        for (size_t i = 0; i < c->n; ++i)
+            if (c->fold[i] != f)
+                c->train[f][c->n_train[f]++] = c->s[i];
+    }
+    return 0;
+}
+
+/* 4. Cross-validated geometry: held-out residuals and structure tests. */
+static int phase_cv_geometry(run_state *S, rch_diag *d)
+{
+    rch_diagnose_result *out = S->out;
+    const size_t n = out->n;
+    for (unsigned f = 0; f < S->c.k; ++f)
+        S->base_folds[f] = out->geo;
+    if (cv_run(S->base_folds, S->r0, &S->c) != 0) {
+        rch_diag_set(d, "", 0, 0, "a cross-validation fit failed");
+        return -1;
+    }
+    memcpy(out->res_before_mm, S->r0, n * sizeof *S->r0);
+    out->rmse_before_mm = rch_rms(S->r0, n);
+    out->n_tests = structure_tests(out->before, S->r0, out->s, n, (const double(*)[V_N])S->var, out->n_groups,
+                                   S->cfg.alpha);
+    if (S->cfg.verbose)
         fprintf(stderr, "diagnose: geometry held-out RMSE %.4f mm, floor %.4f mm\n", out->rmse_before_mm,
                 out->noise_floor_mm);
+    return 0;
+}
 
-    /* 5. candidate search, one effect per step */
-    {
-        rc_model base = out->geo;
-        for (unsigned step = 0; step < cfg.max_steps; ++step) {
-            rch_diagnose_step *st = &out->steps[out->n_steps++];
-            unsigned n_tested = 0;
-            memset(st, 0, sizeof *st);
-            st->chosen = -1;
-            st->rmse_base_mm = rms(r0, n);
-            for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci) {
-                const cdef *cd = &all_cands[ci];
-                rch_diagnose_cand *ca = &st->cand[st->n_cand];
-                memset(ca, 0, sizeof *ca);
-                ca->kind = cd->kind;
-                ca->joint = is_joint_kind(cd->kind) ? cd->joint0 + 1 : 0;
-                cand_name(ca->name, sizeof ca->name, cd->kind, cd->joint0);
-                if (has_effect(&base, cd->kind, cd->joint0))
-                    continue; /* already in the model */
-                st->n_cand++;
-                unsigned count = 0;
-                if (cd->kind == RC_EFF_GROUP_OFFSET) {
-                    if (!groups_usable(out->n_groups, n)) {
-                        snprintf(ca->note, sizeof ca->note,
-                                 "not applicable: %u groups for %zu samples (need 2..n/3)", out->n_groups, n);
-                        continue;
-                    }
-                    count = out->n_groups;
-                }
-                if (cd->kind == RC_EFF_TIME_DRIFT) {
-                    double lo = 1e300, hi = -1e300;
-                    for (size_t i = 0; i < n; ++i) {
-                        lo = out->s[i].t < lo ? out->s[i].t : lo;
-                        hi = out->s[i].t > hi ? out->s[i].t : hi;
-                    }
-                    if (!(hi > lo)) {
-                        snprintf(ca->note, sizeof ca->note, "not applicable: no acquisition order");
-                        continue;
-                    }
-                }
-                rc_model *full = &cand_full[ci];
-                *full = base;
-                if (rc_model_add_effect(full, cd->kind, cd->joint0, count) != RC_OK) {
-                    snprintf(ca->note, sizeof ca->note, "not applicable: model capacity (RC_MAX_PARAMS %d)",
-                             RC_MAX_PARAMS);
-                    continue;
-                }
-                ca->n_params = full->n_params - base.n_params;
-                rc_solve_result res;
-                if (fit(full, &res, &c, NULL, out->s, n) != 0) {
-                    snprintf(ca->note, sizeof ca->note, "fit failed");
-                    continue;
-                }
-                {
-                    const unsigned ra = rank_at(full, full->n_params, out->s, n, c.w, RANK_TOL, cfg.verbose > 2);
-                    const unsigned rb = rank_at(full, base.n_params, out->s, n, c.w, RANK_TOL, 0);
-                    ca->n_ident = ra > rb ? ra - rb : 0;
-                }
-                if (ca->n_ident > ca->n_params)
-                    ca->n_ident = ca->n_params;
-                if (ca->n_ident == 0) {
-                    snprintf(ca->note, sizeof ca->note, "not identifiable: %s",
-                             known_reason(cd->kind, cd->joint0, &base));
-                    continue;
-                }
-                if (ca->n_ident < ca->n_params)
-                    snprintf(ca->note, sizeof ca->note, "%u of %u parameters identifiable (%s)", ca->n_ident,
-                             ca->n_params, known_reason(cd->kind, cd->joint0, &base));
-                {
-                    double worst_deg = implausible_deg(full, (const double(*)[V_N])var, n);
-                    if (worst_deg > 0.0) {
-                        ca->implausible = 1;
-                        snprintf(ca->note, sizeof ca->note,
-                                 "implausible: fitted joint error up to %.3g deg (limit %.3g): it stands in for "
-                                 "something else",
-                                 worst_deg, PLAUSIBLE_DEG);
-                    }
-                }
-                rc_model *fm = &cand_folds[(size_t)ci * c.k];
-                double *rc_ = &cand_res[(size_t)ci * n];
-                for (unsigned f = 0; f < c.k; ++f) {
-                    fm[f] = base_folds[f];
-                    if (cd->kind == RC_EFF_JOINT_COMPLIANCE) {
-                        /* same frozen lever geometry as the full model */
-                        rc_model_add_effect(&fm[f], cd->kind, cd->joint0, count);
-                        memcpy(fm[f].effects[fm[f].n_effects - 1].ref_dh,
-                               full->effects[full->n_effects - 1].ref_dh, sizeof full->effects[0].ref_dh);
-                    } else {
-                        rc_model_add_effect(&fm[f], cd->kind, cd->joint0, count);
-                    }
-                }
-                if (cv_run(fm, rc_, &c) != 0) {
-                    snprintf(ca->note, sizeof ca->note, "a cross-validation fit failed");
-                    continue;
-                }
-                double sd = 0.0, sd2 = 0.0;
-                for (size_t i = 0; i < n; ++i) {
-                    const double di = r0[i] * r0[i] - rc_[i] * rc_[i];
-                    sd += di;
-                    sd2 += di * di;
-                }
-                const double mean = sd / (double)n;
-                const double var_d = (sd2 - (double)n * mean * mean) / (double)(n - 1);
-                ca->tested = 1;
-                ca->rmse_cv_mm = rms(rc_, n);
-                ca->gain_mm2 = mean;
-                ca->gain_se_mm2 = sqrt(var_d > 0.0 ? var_d / (double)n : 0.0);
-                ca->z = ca->gain_se_mm2 > 0.0 ? mean / ca->gain_se_mm2 : 0.0;
-                ca->p_value = 0.5 * erfc(ca->z / sqrt(2.0));
-                ++n_tested;
-                if (cfg.verbose) {
-                    fprintf(stderr, "diagnose: step %u %-22s held-out %.4f mm  z %.2f train %.4f\n", step + 1,
-                            ca->name, ca->rmse_cv_mm, ca->z, res.rms_final_mm);
-                    if (cfg.verbose > 1)
-                        for (size_t i = 0; i < n; ++i)
-                            if (fabs(rc_[i]) > 4.0 || fabs(r0[i]) > 4.0)
-                                fprintf(stderr, "   sample %zu group %u fold %u r0 %.3f rc %.3f\n", i + 1,
-                                        out->s[i].group, c.fold[i], r0[i], rc_[i]);
-                }
-            }
-            /* significance and choice */
-            int best = -1;
-            for (unsigned k = 0; k < st->n_cand; ++k) {
-                rch_diagnose_cand *ca = &st->cand[k];
-                if (!ca->tested)
-                    continue;
-                ca->significant = ca->p_value < cfg.alpha / n_tested && ca->gain_mm2 > 0.0 && !ca->implausible;
-                if (ca->significant && (best < 0 || ca->gain_mm2 > st->cand[best].gain_mm2))
-                    best = (int)k;
-            }
-            if (best < 0) {
-                snprintf(st->why, sizeof st->why,
-                         "no candidate improves the held-out error significantly (one-sided p < %.2g each)",
-                         cfg.alpha / (n_tested ? n_tested : 1));
-                break;
-            }
-            /* map candidate slot -> all_cands index */
-            unsigned slot_ci[RCH_DIAGNOSE_MAX_CAND];
-            {
-                unsigned k = 0;
-                for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci)
-                    if (!has_effect(&base, all_cands[ci].kind, all_cands[ci].joint0))
-                        slot_ci[k++] = ci;
-            }
-            int chosen = best;
-            const double *rb = &cand_res[(size_t)slot_ci[best] * n];
-            for (unsigned k = 0; k < st->n_cand; ++k) {
-                const rch_diagnose_cand *ca = &st->cand[k];
-                if ((int)k == best || !ca->significant || ca->n_params >= st->cand[best].n_params)
-                    continue;
-                const double *rk = &cand_res[(size_t)slot_ci[k] * n];
-                double s1 = 0.0, s2 = 0.0;
-                for (size_t i = 0; i < n; ++i) {
-                    const double di = rk[i] * rk[i] - rb[i] * rb[i];
-                    s1 += di;
-                    s2 += di * di;
-                }
-                const double m1 = s1 / (double)n;
-                const double se = sqrt(fmax(s2 - (double)n * m1 * m1, 0.0) / (double)(n - 1) / (double)n);
-                if (m1 <= se &&
-                    (chosen == best || ca->n_params < st->cand[chosen].n_params ||
-                     (ca->n_params == st->cand[chosen].n_params && ca->gain_mm2 > st->cand[chosen].gain_mm2)))
-                    chosen = (int)k;
-            }
-            st->chosen = chosen;
-            {
-                char cn[40], bn[40], why[240];
-                memcpy(cn, st->cand[chosen].name, sizeof cn);
-                memcpy(bn, st->cand[best].name, sizeof bn);
-                if (chosen != best)
-                    snprintf(why, sizeof why,
-                             "%s: significant, and within one standard error of the best (%s) with fewer "
-                             "parameters",
-                             cn, bn);
-                else
-                    snprintf(why, sizeof why, "%s: largest significant held-out gain (z = %.1f)", cn,
-                             st->cand[chosen].z);
-                memcpy(st->why, why, sizeof why);
-            }
-            const unsigned ci = slot_ci[chosen];
-            base = cand_full[ci];
-            memcpy(base_folds, &cand_folds[(size_t)ci * c.k], c.k * sizeof *base_folds);
-            memcpy(r0, &cand_res[(size_t)ci * n], n * sizeof *r0);
-            out->n_chosen++;
-            if (out->n_chosen == 1) {
-                snprintf(out->effect, sizeof out->effect, "%s", rc_effect_name(cand_kind_of(st, chosen)));
-                out->joint = st->cand[chosen].joint;
-            }
+/* Whether candidate cd can be tried on the data: 1, or 0 with ca->note set.
+ * count: its parameter count when it has a variable one (group offsets). */
+static int cand_applicable(const run_state *S, const cdef *cd, rch_diagnose_cand *ca, unsigned *count)
+{
+    const rch_diagnose_result *out = S->out;
+    const size_t n = out->n;
+    *count = 0;
+    if (cd->kind == RC_EFF_GROUP_OFFSET) {
+        if (!groups_usable(out->n_groups, n)) {
+            snprintf(ca->note, sizeof ca->note, "not applicable: %u groups for %zu samples (need 2..n/3)",
+                     out->n_groups, n);
+            return 0;
         }
-        out->final = base;
+        *count = out->n_groups;
     }
-
-    /* 6. after */
-    memcpy(out->res_after_mm, r0, n * sizeof *r0);
-    out->rmse_after_mm = rms(r0, n);
-    structure_tests(out->after, r0, out->s, n, (const double(*)[V_N])var, out->n_groups, cfg.alpha);
-    {
-        size_t pos = 0;
-        int unexpl = 0;
-        out->remaining_why[0] = '\0';
-        if (out->rmse_after_mm > cfg.gap_factor * out->noise_floor_mm) {
-            unexpl = 1;
-            pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
-                                    "held-out RMSE %.3f mm is %.2f x the noise floor", out->rmse_after_mm,
-                                    out->rmse_after_mm / out->noise_floor_mm);
-        }
-        for (unsigned k = 0; k < out->n_tests; ++k)
-            if (out->after[k].significant && pos < sizeof out->remaining_why) {
-                pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
-                                        "%sstructure against %s (p = %.1e)", unexpl ? "; " : "",
-                                        out->after[k].name, out->after[k].p_value);
-                unexpl = 1;
-            }
-        snprintf(out->remaining, sizeof out->remaining, "%s", unexpl ? "unexplained" : "none");
-        if (out->n_chosen == 0) {
-            memcpy(out->effect, unexpl ? "unexplained" : "none", unexpl ? 12 : 5);
-            out->joint = 0;
-        }
-    }
-    /* 7. effect parameters and their size, notes */
-    report_params(out, base_folds, c.k);
-    {
-        rc_model z = out->final;
-        for (unsigned e = 0; e < z.n_effects; ++e)
-            for (unsigned p = 0; p < z.effects[e].count; ++p)
-                z.x[z.effects[e].first + p] = 0.0;
-        double s2 = 0.0;
+    if (cd->kind == RC_EFF_TIME_DRIFT) {
+        double lo = 1e300, hi = -1e300;
         for (size_t i = 0; i < n; ++i) {
-            double la, lb;
-            if (rc_meas(&la, NULL, &out->final, &out->s[i]) == RC_OK && rc_meas(&lb, NULL, &z, &out->s[i]) == RC_OK)
-                s2 += (la - lb) * (la - lb);
+            lo = out->s[i].t < lo ? out->s[i].t : lo;
+            hi = out->s[i].t > hi ? out->s[i].t : hi;
         }
-        out->effect_rms_mm = sqrt(s2 / (double)n);
+        if (!(hi > lo)) {
+            snprintf(ca->note, sizeof ca->note, "not applicable: no acquisition order");
+            return 0;
+        }
     }
+    return 1;
+}
+
+/* Fit candidate ci on all samples (into cand_full[ci]) and count the
+ * directions it adds that the data identify. 1 when it is worth
+ * cross-validating, else 0 with ca->note set. */
+static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose_cand *ca, rc_solve_result *res)
+{
+    const cdef *cd = &all_cands[ci];
+    const rch_diagnose_result *out = S->out;
+    rc_model *full = &S->cand_full[ci];
+    *full = S->base;
+    if (rc_model_add_effect(full, cd->kind, cd->joint0, count) != RC_OK) {
+        snprintf(ca->note, sizeof ca->note, "not applicable: model capacity (RC_MAX_PARAMS %d)", RC_MAX_PARAMS);
+        return 0;
+    }
+    ca->n_params = full->n_params - S->base.n_params;
+    if (fit(full, res, &S->c, NULL, out->s, out->n) != 0) {
+        snprintf(ca->note, sizeof ca->note, "fit failed");
+        return 0;
+    }
+    const unsigned ra = rank_at(full, full->n_params, out->s, out->n, S->c.w, S->cfg.verbose > 2);
+    const unsigned rb = rank_at(full, S->base.n_params, out->s, out->n, S->c.w, 0);
+    ca->n_ident = ra > rb ? ra - rb : 0;
+    if (ca->n_ident > ca->n_params)
+        ca->n_ident = ca->n_params;
+    if (ca->n_ident == 0) {
+        snprintf(ca->note, sizeof ca->note, "not identifiable: %s", known_reason(cd->kind, cd->joint0, &S->base));
+        return 0;
+    }
+    if (ca->n_ident < ca->n_params)
+        snprintf(ca->note, sizeof ca->note, "%u of %u parameters identifiable (%s)", ca->n_ident, ca->n_params,
+                 known_reason(cd->kind, cd->joint0, &S->base));
+    const double worst_deg = implausible_deg(full, (const double(*)[V_N])S->var, out->n);
+    if (worst_deg > 0.0) {
+        ca->implausible = 1;
+        snprintf(ca->note, sizeof ca->note,
+                 "implausible: fitted joint error up to %.3g deg (limit %.3g): it stands in for something else",
+                 worst_deg, PLAUSIBLE_DEG);
+    }
+    return 1;
+}
+
+/* Cross-validate candidate ci (per-fold models from the current ones) and
+ * test its held-out gain: paired differences of squared errors. 0 or -1. */
+static int cand_cv(run_state *S, unsigned ci, unsigned count, rch_diagnose_cand *ca)
+{
+    const cdef *cd = &all_cands[ci];
+    const size_t n = S->out->n;
+    const rc_model *full = &S->cand_full[ci];
+    rc_model *fm = &S->cand_folds[(size_t)ci * S->c.k];
+    double *rc_ = &S->cand_res[(size_t)ci * n];
+    for (unsigned f = 0; f < S->c.k; ++f) {
+        fm[f] = S->base_folds[f];
+        rc_model_add_effect(&fm[f], cd->kind, cd->joint0, count);
+        if (cd->kind == RC_EFF_JOINT_COMPLIANCE) /* same frozen lever geometry as the full model */
+            memcpy(fm[f].effects[fm[f].n_effects - 1].ref_dh, full->effects[full->n_effects - 1].ref_dh,
+                   sizeof full->effects[0].ref_dh);
+    }
+    if (cv_run(fm, rc_, &S->c) != 0) {
+        snprintf(ca->note, sizeof ca->note, "a cross-validation fit failed");
+        return -1;
+    }
+    double sd = 0.0, sd2 = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double di = S->r0[i] * S->r0[i] - rc_[i] * rc_[i];
+        sd += di;
+        sd2 += di * di;
+    }
+    const double mean = sd / (double)n;
+    const double var_d = (sd2 - (double)n * mean * mean) / (double)(n - 1);
+    ca->tested = 1;
+    ca->rmse_cv_mm = rch_rms(rc_, n);
+    ca->gain_mm2 = mean;
+    ca->gain_se_mm2 = sqrt(var_d > 0.0 ? var_d / (double)n : 0.0);
+    ca->z = ca->gain_se_mm2 > 0.0 ? mean / ca->gain_se_mm2 : 0.0;
+    ca->p_value = 0.5 * erfc(ca->z / sqrt(2.0));
+    return 0;
+}
+
+/* Progress lines of a tested candidate (verbose). */
+static void cand_verbose(const run_state *S, unsigned step, unsigned ci, const rch_diagnose_cand *ca,
+                         const rc_solve_result *res)
+{
+    const double *rc_ = &S->cand_res[(size_t)ci * S->out->n];
+    fprintf(stderr, "diagnose: step %u %-22s held-out %.4f mm  z %.2f train %.4f\n", step + 1, ca->name,
+            ca->rmse_cv_mm, ca->z, res->rms_final_mm);
+    if (S->cfg.verbose > 1)
+        for (size_t i = 0; i < S->out->n; ++i)
+            if (fabs(rc_[i]) > 4.0 || fabs(S->r0[i]) > 4.0)
+                fprintf(stderr, "   sample %zu group %u fold %u r0 %.3f rc %.3f\n", i + 1, S->out->s[i].group,
+                        S->c.fold[i], S->r0[i], rc_[i]);
+}
+
+/* Every candidate not yet in the model, tried in one step. Returns the number
+ * cross-validated. */
+static unsigned step_candidates(run_state *S, rch_diagnose_step *st, unsigned step)
+{
+    unsigned n_tested = 0;
+    for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci) {
+        const cdef *cd = &all_cands[ci];
+        rch_diagnose_cand *ca = &st->cand[st->n_cand];
+        unsigned count;
+        rc_solve_result res;
+        memset(ca, 0, sizeof *ca);
+        ca->kind = cd->kind;
+        ca->joint = is_joint_kind(cd->kind) ? cd->joint0 + 1 : 0;
+        cand_name(ca->name, sizeof ca->name, cd->kind, cd->joint0);
+        if (has_effect(&S->base, cd->kind, cd->joint0))
+            continue; /* already in the model */
+        st->n_cand++;
+        if (!cand_applicable(S, cd, ca, &count) || !cand_identify(S, ci, count, ca, &res) ||
+            cand_cv(S, ci, count, ca) != 0)
+            continue;
+        ++n_tested;
+        if (S->cfg.verbose)
+            cand_verbose(S, step, ci, ca, &res);
+    }
+    return n_tested;
+}
+
+/* One-standard-error rule: among the significant candidates with fewer
+ * parameters than the best, the one whose held-out MSE is within one standard
+ * error of the best (the fewest parameters, then the largest gain). slot_ci:
+ * candidate slot -> all_cands index. */
+static int one_se_rule(const run_state *S, const rch_diagnose_step *st, int best, const unsigned *slot_ci)
+{
+    const size_t n = S->out->n;
+    int chosen = best;
+    const double *rb = &S->cand_res[(size_t)slot_ci[best] * n];
+    for (unsigned k = 0; k < st->n_cand; ++k) {
+        const rch_diagnose_cand *ca = &st->cand[k];
+        if ((int)k == best || !ca->significant || ca->n_params >= st->cand[best].n_params)
+            continue;
+        const double *rk = &S->cand_res[(size_t)slot_ci[k] * n];
+        double s1 = 0.0, s2 = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            const double di = rk[i] * rk[i] - rb[i] * rb[i];
+            s1 += di;
+            s2 += di * di;
+        }
+        const double m1 = s1 / (double)n;
+        const double se = sqrt(fmax(s2 - (double)n * m1 * m1, 0.0) / (double)(n - 1) / (double)n);
+        if (m1 <= se &&
+            (chosen == best || ca->n_params < st->cand[chosen].n_params ||
+             (ca->n_params == st->cand[chosen].n_params && ca->gain_mm2 > st->cand[chosen].gain_mm2)))
+            chosen = (int)k;
+    }
+    return chosen;
+}
+
+/* Significance (Bonferroni over the tested candidates) and the choice of one
+ * step; the chosen candidate becomes the current model. 1 when one was
+ * chosen, 0 when the search ends. */
+static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
+{
+    rch_diagnose_result *out = S->out;
+    int best = -1;
+    for (unsigned k = 0; k < st->n_cand; ++k) {
+        rch_diagnose_cand *ca = &st->cand[k];
+        if (!ca->tested)
+            continue;
+        ca->significant = ca->p_value < S->cfg.alpha / n_tested && ca->gain_mm2 > 0.0 && !ca->implausible;
+        if (ca->significant && (best < 0 || ca->gain_mm2 > st->cand[best].gain_mm2))
+            best = (int)k;
+    }
+    if (best < 0) {
+        snprintf(st->why, sizeof st->why,
+                 "no candidate improves the held-out error significantly (one-sided p < %.2g each)",
+                 S->cfg.alpha / (n_tested ? n_tested : 1));
+        return 0;
+    }
+    unsigned slot_ci[RCH_DIAGNOSE_MAX_CAND], k = 0;
+    for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci)
+        if (!has_effect(&S->base, all_cands[ci].kind, all_cands[ci].joint0))
+            slot_ci[k++] = ci;
+    const int chosen = one_se_rule(S, st, best, slot_ci);
+    st->chosen = chosen;
+    char cn[40], bn[40]; /* copies: snprintf must not read from the object it writes */
+    memcpy(cn, st->cand[chosen].name, sizeof cn);
+    memcpy(bn, st->cand[best].name, sizeof bn);
+    if (chosen != best)
+        snprintf(st->why, sizeof st->why,
+                 "%s: significant, and within one standard error of the best (%s) with fewer parameters", cn, bn);
+    else
+        snprintf(st->why, sizeof st->why, "%s: largest significant held-out gain (z = %.1f)", cn,
+                 st->cand[chosen].z);
+    const unsigned ci = slot_ci[chosen];
+    S->base = S->cand_full[ci];
+    memcpy(S->base_folds, &S->cand_folds[(size_t)ci * S->c.k], S->c.k * sizeof *S->base_folds);
+    memcpy(S->r0, &S->cand_res[(size_t)ci * out->n], out->n * sizeof *S->r0);
+    out->n_chosen++;
+    if (out->n_chosen == 1) {
+        snprintf(out->effect, sizeof out->effect, "%s", rc_effect_name(cand_kind_of(st, chosen)));
+        out->joint = st->cand[chosen].joint;
+    }
+    return 1;
+}
+
+/* 5. Candidate search, one effect per step, at most max_steps. */
+static void phase_search(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    S->base = out->geo;
+    for (unsigned step = 0; step < S->cfg.max_steps; ++step) {
+        rch_diagnose_step *st = &out->steps[out->n_steps++];
+        memset(st, 0, sizeof *st);
+        st->chosen = -1;
+        st->rmse_base_mm = rch_rms(S->r0, out->n);
+        const unsigned n_tested = step_candidates(S, st, step);
+        if (!step_choose(S, st, n_tested))
+            break;
+    }
+    out->final = S->base;
+}
+
+/* 6. The final model's held-out residuals, structure tests and verdict. */
+static void phase_after(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    size_t pos = 0;
+    int unexpl = 0;
+    memcpy(out->res_after_mm, S->r0, out->n * sizeof *S->r0);
+    out->rmse_after_mm = rch_rms(S->r0, out->n);
+    structure_tests(out->after, S->r0, out->s, out->n, (const double(*)[V_N])S->var, out->n_groups, S->cfg.alpha);
+    out->remaining_why[0] = '\0';
+    if (out->rmse_after_mm > S->cfg.gap_factor * out->noise_floor_mm) {
+        unexpl = 1;
+        pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
+                                "held-out RMSE %.3f mm is %.2f x the noise floor", out->rmse_after_mm,
+                                out->rmse_after_mm / out->noise_floor_mm);
+    }
+    for (unsigned k = 0; k < out->n_tests; ++k)
+        if (out->after[k].significant && pos < sizeof out->remaining_why) {
+            pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
+                                    "%sstructure against %s (p = %.1e)", unexpl ? "; " : "", out->after[k].name,
+                                    out->after[k].p_value);
+            unexpl = 1;
+        }
+    snprintf(out->remaining, sizeof out->remaining, "%s", unexpl ? "unexplained" : "none");
+    if (out->n_chosen == 0) {
+        snprintf(out->effect, sizeof out->effect, "%s", unexpl ? "unexplained" : "none");
+        out->joint = 0;
+    }
+}
+
+/* 7. Effect parameters (fold jackknife), the effects' size, and the notes on
+ * what cable lengths cannot identify. */
+static void phase_report(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    report_params(out, S->base_folds, S->c.k);
+    rc_model z = out->final;
+    for (unsigned e = 0; e < z.n_effects; ++e)
+        for (unsigned p = 0; p < z.effects[e].count; ++p)
+            z.x[z.effects[e].first + p] = 0.0;
+    double s2 = 0.0;
+    for (size_t i = 0; i < out->n; ++i) {
+        double la, lb;
+        if (rc_meas(&la, NULL, &out->final, &out->s[i]) == RC_OK && rc_meas(&lb, NULL, &z, &out->s[i]) == RC_OK)
+            s2 += (la - lb) * (la - lb);
+    }
+    out->effect_rms_mm = sqrt(s2 / (double)out->n);
     scale_note(out);
     for (unsigned st = 0; st < out->n_steps; ++st)
         for (unsigned k = 0; k < out->steps[st].n_cand; ++k) {
             const rch_diagnose_cand *ca = &out->steps[st].cand[k];
             if (st == 0 && ca->n_params > 0 && ca->n_ident < ca->n_params && ca->kind != RC_EFF_LENGTH_SCALE &&
-                out->n_notes < RCH_DIAGNOSE_MAX_NOTES)
-            {
+                out->n_notes < RCH_DIAGNOSE_MAX_NOTES) {
                 char nm[40], nt[160];
                 memcpy(nm, ca->name, sizeof nm);
                 memcpy(nt, ca->note, sizeof nt);
                 snprintf(out->notes[out->n_notes++], sizeof out->notes[0], "%s: %s", nm, nt);
             }
         }
-    rc = 0;
-done:
+}
+
+int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t n, const rc_model *nominal,
+                     const rch_diagnose_cfg *cfg, rch_diag *d)
+{
+    const double t0 = now_ms();
+    run_state S;
+    memset(out, 0, sizeof *out);
+    memset(&S, 0, sizeof S);
+    int rc = phase_setup(&S, out, samples, n, cfg, d);
+    if (rc == 0) {
+        phase_steps(&S);
+        rc = phase_geometry(&S, nominal, d);
+    }
+    if (rc == 0)
+        rc = phase_floor(&S, d);
+    if (rc == 0)
+        rc = phase_folds(&S, d);
+    if (rc == 0)
+        rc = phase_cv_geometry(&S, d);
+    if (rc == 0) {
+        phase_search(&S);
+        phase_after(&S);
+        phase_report(&S);
+    }
     out->time_ms = now_ms() - t0;
-    for (unsigned f = 0; f < RCH_DIAGNOSE_MAX_FOLDS; ++f)
-        free(c.train[f]);
-    free(c.w);
-    free(c.fold);
-    free(r0);
-    free(tmp);
-    free(var);
-    free(order);
-    free(base_folds);
-    free(cand_folds);
-    free(cand_full);
-    free(cand_res);
+    run_free(&S);
+    return rc;
+}
+
+int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const char *robot_path,
+                      const rch_diagnose_cfg *cfg, rch_diag *d)
+{
+    memset(out, 0, sizeof *out);
+    rch_robot robot;
+    rch_data data;
+    if (rch_robot_load(&robot, robot_path, d) != 0 || rch_data_load(&data, data_path, 0, d) != 0)
+        return -1;
+    rch_diagnose_cfg c = *cfg;
+    c.groups_given = data.has_group;
+    c.have_encoder = robot.has_encoder;
+    const int rc = rch_diagnose_run(out, data.s, data.n, &robot.nominal, &c, d);
+    rch_data_free(&data);
     return rc;
 }
 
@@ -1229,137 +1336,109 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
     return ferror(f) ? -1 : 0;
 }
 
-static void json_str(FILE *f, const char *s)
+static void json_num(rch_jw *w, const char *key, double v)
 {
-    fputc('"', f);
-    for (; *s; ++s) {
-        if (*s == '"' || *s == '\\')
-            fprintf(f, "\\%c", *s);
-        else if ((unsigned char)*s < 0x20)
-            fprintf(f, "\\u%04x", (unsigned)(unsigned char)*s);
-        else
-            fputc(*s, f);
-    }
-    fputc('"', f);
+    rch_jw_numf(w, key, v, "%.6g");
 }
 
-static void json_num(FILE *f, double v)
+static void json_joint(rch_jw *w, unsigned joint)
 {
-    if (isfinite(v))
-        fprintf(f, "%.6g", v);
+    if (joint)
+        rch_jw_uint(w, "joint", joint);
     else
-        fprintf(f, "null");
+        rch_jw_null(w, "joint");
 }
 
-static void json_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
+static void json_tests(rch_jw *w, const char *key, const rch_diagnose_test *t, unsigned n)
 {
-    fprintf(f, "[");
+    rch_jw_arr(w, key);
     for (unsigned k = 0; k < n; ++k) {
-        fprintf(f, "%s{\"variable\":", k ? "," : "");
-        json_str(f, t[k].name);
-        fprintf(f, ",\"dof1\":%u,\"dof2\":%u,\"f\":", t[k].dof1, t[k].dof2);
-        json_num(f, t[k].f_stat);
-        fprintf(f, ",\"p\":");
-        json_num(f, t[k].p_value);
-        fprintf(f, ",\"r2\":");
-        json_num(f, t[k].r2);
-        fprintf(f, ",\"significant\":%s}", t[k].significant ? "true" : "false");
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "variable", t[k].name);
+        rch_jw_uint(w, "dof1", t[k].dof1);
+        rch_jw_uint(w, "dof2", t[k].dof2);
+        json_num(w, "f", t[k].f_stat);
+        json_num(w, "p", t[k].p_value);
+        json_num(w, "r2", t[k].r2);
+        rch_jw_bool(w, "significant", t[k].significant);
+        rch_jw_end(w);
     }
-    fprintf(f, "]");
+    rch_jw_end(w);
+}
+
+static void json_cands(rch_jw *w, const rch_diagnose_result *r)
+{
+    rch_jw_arr(w, "candidates");
+    for (unsigned s = 0; s < r->n_steps; ++s)
+        for (unsigned k = 0; k < r->steps[s].n_cand; ++k) {
+            const rch_diagnose_cand *ca = &r->steps[s].cand[k];
+            rch_jw_obj(w, NULL);
+            rch_jw_uint(w, "step", s + 1);
+            rch_jw_str(w, "effect", rc_effect_name(ca->kind));
+            json_joint(w, ca->joint);
+            rch_jw_uint(w, "params", ca->n_params);
+            rch_jw_uint(w, "identifiable", ca->n_ident);
+            rch_jw_bool(w, "tested", ca->tested);
+            if (ca->tested) {
+                json_num(w, "rmse_cv_mm", ca->rmse_cv_mm);
+                json_num(w, "gain_mm2", ca->gain_mm2);
+                json_num(w, "gain_se_mm2", ca->gain_se_mm2);
+                json_num(w, "z", ca->z);
+                json_num(w, "p", ca->p_value);
+            }
+            rch_jw_bool(w, "significant", ca->significant);
+            rch_jw_bool(w, "chosen", (int)k == r->steps[s].chosen);
+            rch_jw_str(w, "note", ca->note);
+            rch_jw_end(w);
+        }
+    rch_jw_end(w);
 }
 
 int rch_diagnose_json(FILE *f, const rch_diagnose_result *r)
 {
-    fprintf(f, "{\"effect\":");
-    json_str(f, r->effect);
-    fprintf(f, ",\"joint\":");
-    if (r->joint)
-        fprintf(f, "%u", r->joint);
-    else
-        fprintf(f, "null");
-    fprintf(f, ",\"rmse_before_mm\":");
-    json_num(f, r->rmse_before_mm);
-    fprintf(f, ",\"rmse_after_mm\":");
-    json_num(f, r->rmse_after_mm);
-    fprintf(f, ",\"noise_floor_mm\":");
-    json_num(f, r->noise_floor_mm);
-    fprintf(f, ",\"noise_floor_joints_mm\":");
-    json_num(f, r->floor_joints_mm);
-    fprintf(f, ",\"noise_floor_length_mm\":");
-    json_num(f, r->floor_len_mm);
-    fprintf(f, ",\"q_step_deg\":");
-    json_num(f, r->q_step_deg);
-    fprintf(f, ",\"len_step_mm\":");
-    json_num(f, r->len_step_mm);
-    fprintf(f, ",\"train_rmse_geometry_mm\":");
-    json_num(f, r->train_rmse_geo_mm);
-    fprintf(f, ",\"n\":%zu,\"groups\":%u,\"wrist_flicker_samples\":%u,\"folds\":%u,\"remaining\":", r->n,
-            r->n_groups, r->n_flicker, r->folds);
-    json_str(f, r->remaining);
-    fprintf(f, ",\"remaining_why\":");
-    json_str(f, r->remaining_why);
-    fprintf(f, ",\"sequence\":[");
-    for (unsigned s = 0, first = 1; s < r->n_steps; ++s)
-        if (r->steps[s].chosen >= 0) {
-            fprintf(f, "%s", first ? "" : ",");
-            json_str(f, r->steps[s].cand[r->steps[s].chosen].name);
-            first = 0;
-        }
-    fprintf(f, "],\"candidates\":[");
+    rch_jw w;
+    rch_jw_init(&w, f, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "effect", r->effect);
+    json_joint(&w, r->joint);
+    json_num(&w, "rmse_before_mm", r->rmse_before_mm);
+    json_num(&w, "rmse_after_mm", r->rmse_after_mm);
+    json_num(&w, "noise_floor_mm", r->noise_floor_mm);
+    json_num(&w, "noise_floor_joints_mm", r->floor_joints_mm);
+    json_num(&w, "noise_floor_length_mm", r->floor_len_mm);
+    json_num(&w, "q_step_deg", r->q_step_deg);
+    json_num(&w, "len_step_mm", r->len_step_mm);
+    json_num(&w, "train_rmse_geometry_mm", r->train_rmse_geo_mm);
+    rch_jw_uint(&w, "n", r->n);
+    rch_jw_uint(&w, "groups", r->n_groups);
+    rch_jw_uint(&w, "wrist_flicker_samples", r->n_flicker);
+    rch_jw_uint(&w, "folds", r->folds);
+    rch_jw_str(&w, "remaining", r->remaining);
+    rch_jw_str(&w, "remaining_why", r->remaining_why);
+    rch_jw_arr(&w, "sequence");
     for (unsigned s = 0; s < r->n_steps; ++s)
-        for (unsigned k = 0; k < r->steps[s].n_cand; ++k) {
-            const rch_diagnose_cand *ca = &r->steps[s].cand[k];
-            fprintf(f, "%s{\"step\":%u,\"effect\":", (s || k) ? "," : "", s + 1);
-            json_str(f, rc_effect_name(ca->kind));
-            fprintf(f, ",\"joint\":");
-            if (ca->joint)
-                fprintf(f, "%u", ca->joint);
-            else
-                fprintf(f, "null");
-            fprintf(f, ",\"params\":%u,\"identifiable\":%u,\"tested\":%s", ca->n_params, ca->n_ident,
-                    ca->tested ? "true" : "false");
-            if (ca->tested) {
-                fprintf(f, ",\"rmse_cv_mm\":");
-                json_num(f, ca->rmse_cv_mm);
-                fprintf(f, ",\"gain_mm2\":");
-                json_num(f, ca->gain_mm2);
-                fprintf(f, ",\"gain_se_mm2\":");
-                json_num(f, ca->gain_se_mm2);
-                fprintf(f, ",\"z\":");
-                json_num(f, ca->z);
-                fprintf(f, ",\"p\":");
-                json_num(f, ca->p_value);
-            }
-            fprintf(f, ",\"significant\":%s,\"chosen\":%s,\"note\":", ca->significant ? "true" : "false",
-                    (int)k == r->steps[s].chosen ? "true" : "false");
-            json_str(f, ca->note);
-            fprintf(f, "}");
-        }
-    fprintf(f, "],\"params\":[");
+        if (r->steps[s].chosen >= 0)
+            rch_jw_str(&w, NULL, r->steps[s].cand[r->steps[s].chosen].name);
+    rch_jw_end(&w);
+    json_cands(&w, r);
+    rch_jw_arr(&w, "params");
     for (unsigned k = 0; k < r->n_params; ++k) {
-        fprintf(f, "%s{\"name\":", k ? "," : "");
-        json_str(f, r->params[k].name);
-        fprintf(f, ",\"value\":");
-        json_num(f, r->params[k].value);
-        fprintf(f, ",\"se\":");
-        json_num(f, r->params[k].se);
-        fprintf(f, ",\"unit\":");
-        json_str(f, r->params[k].unit);
-        fprintf(f, "}");
+        rch_jw_obj(&w, NULL);
+        rch_jw_str(&w, "name", r->params[k].name);
+        json_num(&w, "value", r->params[k].value);
+        json_num(&w, "se", r->params[k].se);
+        rch_jw_str(&w, "unit", r->params[k].unit);
+        rch_jw_end(&w);
     }
-    fprintf(f, "],\"effect_rms_mm\":");
-    json_num(f, r->effect_rms_mm);
-    fprintf(f, ",\"structure_before\":");
-    json_tests(f, r->before, r->n_tests);
-    fprintf(f, ",\"structure_after\":");
-    json_tests(f, r->after, r->n_tests);
-    fprintf(f, ",\"not_identifiable\":[");
-    for (unsigned k = 0; k < r->n_notes; ++k) {
-        fprintf(f, "%s", k ? "," : "");
-        json_str(f, r->notes[k]);
-    }
-    fprintf(f, "],\"time_ms\":");
-    json_num(f, r->time_ms);
-    fprintf(f, "}\n");
-    return ferror(f) ? -1 : 0;
+    rch_jw_end(&w);
+    json_num(&w, "effect_rms_mm", r->effect_rms_mm);
+    json_tests(&w, "structure_before", r->before, r->n_tests);
+    json_tests(&w, "structure_after", r->after, r->n_tests);
+    rch_jw_arr(&w, "not_identifiable");
+    for (unsigned k = 0; k < r->n_notes; ++k)
+        rch_jw_str(&w, NULL, r->notes[k]);
+    rch_jw_end(&w);
+    json_num(&w, "time_ms", r->time_ms);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
 }

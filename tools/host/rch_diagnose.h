@@ -170,6 +170,12 @@ typedef struct rch_diagnose_result {
 int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t n,
                      const rc_model *nominal, const rch_diagnose_cfg *cfg, rch_diag *d);
 
+/* rch_diagnose_run on a data file and a robot file: cfg->groups_given and
+ * cfg->have_encoder are taken from the files (the group column, the robot's
+ * encoder_mm). Same returns; free the result also after a failure. */
+int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const char *robot_path,
+                      const rch_diagnose_cfg *cfg, rch_diag *d);
+
 void rch_diagnose_free(rch_diagnose_result *r);
 
 /* Human report and one JSON object. 0 or -1 on a write error. */

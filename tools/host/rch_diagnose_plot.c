@@ -67,24 +67,20 @@ static double test_x(const rch_diagnose_result *r, unsigned k, size_t i, const c
     return s->t;
 }
 
-int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *paths, size_t paths_len,
-                       rch_diag *d)
+/* Where the plots go: the directory, the list of written files. */
+typedef struct plot_out {
+    const char *dir;
+    char *paths;
+    size_t len;
+} plot_out;
+
+/* 1. Held-out residuals in acquisition order, before and after, within the
+ * noise floor. x, fl, fh: (n) scratch. */
+static int plot_order(const rch_diagnose_result *r, const plot_out *o, double *x, double *fl, double *fh,
+                      rch_diag *d)
 {
     const size_t n = r->n;
-    double *x = malloc(n * sizeof *x), *fl = malloc(n * sizeof *fl), *fh = malloc(n * sizeof *fh);
-    int rc = -1;
-    if (paths_len)
-        paths[0] = '\0';
-    if (!x || !fl || !fh) {
-        rch_diag_set(d, "", 0, 0, "out of memory");
-        goto done;
-    }
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
-        rch_diag_set(d, dir, 0, 0, "cannot create the directory: %s", strerror(errno));
-        goto done;
-    }
     char title[256];
-    /* 1. held-out residuals in acquisition order, before and after */
     for (size_t i = 0; i < n; ++i) {
         x[i] = (double)i;
         fl[i] = -r->noise_floor_mm;
@@ -99,92 +95,111 @@ int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *path
     rch_plot_line(p, "+ noise floor", x, fh, n);
     rch_plot_line(p, "- noise floor", x, fl, n);
     rch_plot_size(p, 1000, 500);
-    if (save(p, dir, "residuals_order.svg", paths, paths_len, d) != 0)
+    return save(p, o->dir, "residuals_order.svg", o->paths, o->len, d);
+}
+
+/* 2. Mean held-out residual per set-up group (when there are 2..n/2 groups). */
+static int plot_groups(const rch_diagnose_result *r, const plot_out *o, rch_diag *d)
+{
+    const size_t n = r->n;
+    if (!(r->n_groups >= 2 && r->n_groups <= n / 2))
+        return 0;
+    const unsigned G = r->n_groups;
+    double *gb = calloc(G, sizeof *gb), *ga = calloc(G, sizeof *ga), *gx = calloc(G, sizeof *gx);
+    size_t *cnt = calloc(G, sizeof *cnt);
+    int rc = -1;
+    if (!gb || !ga || !gx || !cnt) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
-
-    /* 2. mean held-out residual per group */
-    if (r->n_groups >= 2 && r->n_groups <= n / 2) {
-        const unsigned G = r->n_groups;
-        double *gb = calloc(G, sizeof *gb), *ga = calloc(G, sizeof *ga), *gx = calloc(G, sizeof *gx);
-        size_t *cnt = calloc(G, sizeof *cnt);
-        if (!gb || !ga || !gx || !cnt) {
-            free(gb);
-            free(ga);
-            free(gx);
-            free(cnt);
-            rch_diag_set(d, "", 0, 0, "out of memory");
-            goto done;
-        }
-        for (size_t i = 0; i < n; ++i) {
-            gb[r->s[i].group] += r->res_before_mm[i];
-            ga[r->s[i].group] += r->res_after_mm[i];
-            cnt[r->s[i].group]++;
-        }
-        for (unsigned g = 0; g < G; ++g) {
-            gx[g] = g + 1;
-            gb[g] = cnt[g] ? gb[g] / (double)cnt[g] : NAN;
-            ga[g] = cnt[g] ? ga[g] / (double)cnt[g] : NAN;
-        }
-        p = rch_plot_new("Mean held-out residual per set-up group", "group (consecutive samples, fixed wrist)",
-                         "mean residual (mm)");
-        rch_plot_scatter(p, "geometry only", gx, gb, G);
-        if (r->n_chosen)
-            rch_plot_scatter(p, "with the chosen effects", gx, ga, G);
-        const int ok = save(p, dir, "group_means.svg", paths, paths_len, d);
-        free(gb);
-        free(ga);
-        free(gx);
-        free(cnt);
-        if (ok != 0)
-            goto done;
     }
-
-    /* 3. candidates of the first step: held-out RMSE */
-    if (r->n_steps > 0) {
-        const rch_diagnose_step *st = &r->steps[0];
-        const char *labels[RCH_DIAGNOSE_MAX_CAND];
-        double v[RCH_DIAGNOSE_MAX_CAND], cx[RCH_DIAGNOSE_MAX_CAND + 2], cy[RCH_DIAGNOSE_MAX_CAND + 2],
-            fy[RCH_DIAGNOSE_MAX_CAND + 2];
-        size_t m = 0;
-        for (unsigned k = 0; k < st->n_cand; ++k)
-            if (st->cand[k].tested) {
-                labels[m] = st->cand[k].name;
-                v[m++] = st->cand[k].rmse_cv_mm;
-            }
-        for (size_t k = 0; k < m + 2; ++k) {
-            cx[k] = (double)k - 1.0;
-            cy[k] = st->rmse_base_mm;
-            fy[k] = r->noise_floor_mm;
-        }
-        p = rch_plot_new("Held-out RMSE of each candidate (step 1)", "candidate effect", "held-out RMSE (mm)");
-        rch_plot_bars(p, labels, v, NULL, m);
-        rch_plot_line(p, "geometry only", cx, cy, m + 2);
-        rch_plot_line(p, "noise floor", cx, fy, m + 2);
-        rch_plot_size(p, 1100, 500);
-        if (save(p, dir, "candidates.svg", paths, paths_len, d) != 0)
-            goto done;
+    for (size_t i = 0; i < n; ++i) {
+        gb[r->s[i].group] += r->res_before_mm[i];
+        ga[r->s[i].group] += r->res_after_mm[i];
+        cnt[r->s[i].group]++;
     }
-
-    /* 4. residuals against the variable of the strongest structure test */
-    {
-        unsigned best = 0;
-        for (unsigned k = 1; k < r->n_tests; ++k)
-            if (r->before[k].p_value < r->before[best].p_value)
-                best = k;
-        const char *label = "";
-        for (size_t i = 0; i < n; ++i)
-            x[i] = test_x(r, best, i, &label);
-        snprintf(title, sizeof title, "Held-out residuals against %s (strongest structure, p = %.1e)",
-                 r->before[best].name, r->before[best].p_value);
-        p = rch_plot_new(title, label, "residual (mm)");
-        rch_plot_scatter(p, "geometry only", x, r->res_before_mm, n);
-        if (r->n_chosen)
-            rch_plot_scatter(p, "with the chosen effects", x, r->res_after_mm, n);
-        if (save(p, dir, "residuals_structure.svg", paths, paths_len, d) != 0)
-            goto done;
+    for (unsigned g = 0; g < G; ++g) {
+        gx[g] = g + 1;
+        gb[g] = cnt[g] ? gb[g] / (double)cnt[g] : NAN;
+        ga[g] = cnt[g] ? ga[g] / (double)cnt[g] : NAN;
     }
-    rc = 0;
+    rch_plot *p = rch_plot_new("Mean held-out residual per set-up group", "group (consecutive samples, fixed wrist)",
+                               "mean residual (mm)");
+    rch_plot_scatter(p, "geometry only", gx, gb, G);
+    if (r->n_chosen)
+        rch_plot_scatter(p, "with the chosen effects", gx, ga, G);
+    rc = save(p, o->dir, "group_means.svg", o->paths, o->len, d);
 done:
+    free(gb);
+    free(ga);
+    free(gx);
+    free(cnt);
+    return rc;
+}
+
+/* 3. Held-out RMSE of each candidate of the first step. */
+static int plot_candidates(const rch_diagnose_result *r, const plot_out *o, rch_diag *d)
+{
+    if (r->n_steps == 0)
+        return 0;
+    const rch_diagnose_step *st = &r->steps[0];
+    const char *labels[RCH_DIAGNOSE_MAX_CAND];
+    double v[RCH_DIAGNOSE_MAX_CAND], cx[RCH_DIAGNOSE_MAX_CAND + 2], cy[RCH_DIAGNOSE_MAX_CAND + 2],
+        fy[RCH_DIAGNOSE_MAX_CAND + 2];
+    size_t m = 0;
+    for (unsigned k = 0; k < st->n_cand; ++k)
+        if (st->cand[k].tested) {
+            labels[m] = st->cand[k].name;
+            v[m++] = st->cand[k].rmse_cv_mm;
+        }
+    for (size_t k = 0; k < m + 2; ++k) {
+        cx[k] = (double)k - 1.0;
+        cy[k] = st->rmse_base_mm;
+        fy[k] = r->noise_floor_mm;
+    }
+    rch_plot *p = rch_plot_new("Held-out RMSE of each candidate (step 1)", "candidate effect", "held-out RMSE (mm)");
+    rch_plot_bars(p, labels, v, NULL, m);
+    rch_plot_line(p, "geometry only", cx, cy, m + 2);
+    rch_plot_line(p, "noise floor", cx, fy, m + 2);
+    rch_plot_size(p, 1100, 500);
+    return save(p, o->dir, "candidates.svg", o->paths, o->len, d);
+}
+
+/* 4. Residuals against the variable of the strongest structure test. x: (n). */
+static int plot_structure(const rch_diagnose_result *r, const plot_out *o, double *x, rch_diag *d)
+{
+    unsigned best = 0;
+    char title[256];
+    for (unsigned k = 1; k < r->n_tests; ++k)
+        if (r->before[k].p_value < r->before[best].p_value)
+            best = k;
+    const char *label = "";
+    for (size_t i = 0; i < r->n; ++i)
+        x[i] = test_x(r, best, i, &label);
+    snprintf(title, sizeof title, "Held-out residuals against %s (strongest structure, p = %.1e)",
+             r->before[best].name, r->before[best].p_value);
+    rch_plot *p = rch_plot_new(title, label, "residual (mm)");
+    rch_plot_scatter(p, "geometry only", x, r->res_before_mm, r->n);
+    if (r->n_chosen)
+        rch_plot_scatter(p, "with the chosen effects", x, r->res_after_mm, r->n);
+    return save(p, o->dir, "residuals_structure.svg", o->paths, o->len, d);
+}
+
+int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *paths, size_t paths_len,
+                       rch_diag *d)
+{
+    const size_t n = r->n;
+    double *x = malloc(n * sizeof *x), *fl = malloc(n * sizeof *fl), *fh = malloc(n * sizeof *fh);
+    const plot_out o = {dir, paths, paths_len};
+    int rc = -1;
+    if (paths_len)
+        paths[0] = '\0';
+    if (!x || !fl || !fh)
+        rch_diag_set(d, "", 0, 0, "out of memory");
+    else if (mkdir(dir, 0777) != 0 && errno != EEXIST)
+        rch_diag_set(d, dir, 0, 0, "cannot create the directory: %s", strerror(errno));
+    else if (plot_order(r, &o, x, fl, fh, d) == 0 && plot_groups(r, &o, d) == 0 && plot_candidates(r, &o, d) == 0 &&
+             plot_structure(r, &o, x, d) == 0)
+        rc = 0;
     free(x);
     free(fl);
     free(fh);

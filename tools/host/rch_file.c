@@ -124,7 +124,8 @@ int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, 
     }
     size_t cap = max_bytes < 4096 ? max_bytes : 4096, n = 0;
     char *buf = malloc(cap + 1);
-    while (buf) {
+    int oom = buf == NULL;
+    while (!oom) {
         if (n == cap) {
             if (cap >= max_bytes) {
                 int c = fgetc(f);
@@ -138,8 +139,7 @@ int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, 
             size_t ncap = cap * 2 > max_bytes ? max_bytes : cap * 2;
             char *nb = realloc(buf, ncap + 1);
             if (!nb) {
-                free(buf);
-                buf = NULL;
+                oom = 1;
                 break;
             }
             buf = nb;
@@ -149,6 +149,10 @@ int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, 
         n += got;
         if (got == 0)
             break;
+    }
+    if (oom) {
+        free(buf);
+        buf = NULL;
     }
     if (!buf) {
         rch_diag_set(d, path, 0, 0, "out of memory");

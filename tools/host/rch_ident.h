@@ -2,8 +2,10 @@
  *
  * The identification Jacobian J (n samples x n_params, each column scaled to
  * unit norm so that mm and rad compare) is decomposed by SVD (LAPACKE
- * dgesvd). Directions whose relative singular value is below 1e-6 are not
- * identifiable at all; below 1e-3 weakly identifiable. Each such direction is
+ * dgesvd: small singular values to high accuracy). The thresholds, the rank
+ * and the figures come from rc_ident (lib/rc_ident.h), the one definition:
+ * relative singular value below RC_IDENT_NULL_REL (1e-6) not identifiable,
+ * below RC_IDENT_WEAK_REL (1e-3) weakly identifiable. Each such direction is
  * described with the parameters it mixes and, for the known cases, why (for
  * example "moving the robot base up is the same as moving the encoder down").
  */
@@ -13,6 +15,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "rc_ident.h"
 #include "rc_model.h"
 
 #define RCH_IDENT_MAX_DIRS 24
@@ -27,12 +30,13 @@ typedef struct rch_ident_dir {
 typedef struct rch_ident {
     unsigned n_params;
     double sv_rel[RC_MAX_PARAMS]; /* (n_params) descending */
-    unsigned rank;                /* sv_rel >= 1e-6 */
-    unsigned n_weak;              /* 1e-6 <= sv_rel < 1e-3 */
+    unsigned rank;                /* sv_rel >= RC_IDENT_NULL_REL */
+    unsigned n_weak;              /* RC_IDENT_NULL_REL <= sv_rel < RC_IDENT_WEAK_REL */
     double cond;                  /* s_max / s_min over the identifiable ones */
     double observability;         /* O1 = (prod s_i)^(1/r) / sqrt(n), identifiable part */
     unsigned n_dirs;
     rch_ident_dir dirs[RCH_IDENT_MAX_DIRS];
+    rc_ident core;                /* rc_ident's classes per direction and per parameter, log det */
 } rch_ident;
 
 /* Analyse model m at its current parameters over samples (n). Returns 0, or

@@ -52,6 +52,71 @@ static rch_json *jnew(jp *p, rch_jtype t)
     return j;
 }
 
+/* The four hex digits of a \\u escape at p->pos into v. 0 or -1 (failed). */
+static int jhex4(jp *p, unsigned *v)
+{
+    *v = 0;
+    if (p->pos + 4 > p->len) {
+        jfail(p, "truncated \\u escape");
+        return -1;
+    }
+    for (int k = 0; k < 4; ++k) {
+        char h = p->s[p->pos + (size_t)k];
+        *v <<= 4;
+        if (h >= '0' && h <= '9') *v |= (unsigned)(h - '0');
+        else if (h >= 'a' && h <= 'f') *v |= (unsigned)(h - 'a' + 10);
+        else if (h >= 'A' && h <= 'F') *v |= (unsigned)(h - 'A' + 10);
+        else {
+            jfail(p, "bad hex digit in \\u escape");
+            return -1;
+        }
+    }
+    p->pos += 4;
+    if (*v == 0) {
+        jfail(p, "\\u0000 is not allowed");
+        return -1;
+    }
+    return 0;
+}
+
+/* One escape at p->pos (at the backslash) appended to o[*n] (room for 3
+ * bytes). 0 or -1 (failed). */
+static int jescape(jp *p, char *o, size_t *n)
+{
+    if (p->pos + 1 >= p->len) {
+        jfail(p, "unterminated escape");
+        return -1;
+    }
+    char e = p->s[p->pos + 1];
+    unsigned v;
+    p->pos += 2;
+    switch (e) {
+    case '"': o[(*n)++] = '"'; return 0;
+    case '\\': o[(*n)++] = '\\'; return 0;
+    case '/': o[(*n)++] = '/'; return 0;
+    case 'b': o[(*n)++] = '\b'; return 0;
+    case 'f': o[(*n)++] = '\f'; return 0;
+    case 'n': o[(*n)++] = '\n'; return 0;
+    case 'r': o[(*n)++] = '\r'; return 0;
+    case 't': o[(*n)++] = '\t'; return 0;
+    case 'u':
+        if (jhex4(p, &v) != 0)
+            return -1;
+        if (v < 0x80) {
+            o[(*n)++] = (char)v;
+        } else if (v < 0x800) {
+            o[(*n)++] = (char)(0xC0 | (v >> 6));
+            o[(*n)++] = (char)(0x80 | (v & 0x3F));
+        } else { /* surrogates kept as-is: names only, never interpreted */
+            o[(*n)++] = (char)(0xE0 | (v >> 12));
+            o[(*n)++] = (char)(0x80 | ((v >> 6) & 0x3F));
+            o[(*n)++] = (char)(0x80 | (v & 0x3F));
+        }
+        return 0;
+    default: jfail(p, "unknown escape in string"); return -1;
+    }
+}
+
 static char *jstring(jp *p)
 {
     /* at '"' */
@@ -93,61 +158,10 @@ static char *jstring(jp *p)
         if (c != '\\') {
             o[n++] = (char)c;
             ++p->pos;
-            continue;
-        }
-        if (p->pos + 1 >= p->len) {
-            jfail(p, "unterminated escape");
+        } else if (jescape(p, o, &n) != 0) {
             break;
-        }
-        char e = p->s[p->pos + 1];
-        p->pos += 2;
-        switch (e) {
-        case '"': o[n++] = '"'; break;
-        case '\\': o[n++] = '\\'; break;
-        case '/': o[n++] = '/'; break;
-        case 'b': o[n++] = '\b'; break;
-        case 'f': o[n++] = '\f'; break;
-        case 'n': o[n++] = '\n'; break;
-        case 'r': o[n++] = '\r'; break;
-        case 't': o[n++] = '\t'; break;
-        case 'u': {
-            unsigned v = 0;
-            if (p->pos + 4 > p->len) {
-                jfail(p, "truncated \\u escape");
-                goto bad;
-            }
-            for (int k = 0; k < 4; ++k) {
-                char h = p->s[p->pos + (size_t)k];
-                v <<= 4;
-                if (h >= '0' && h <= '9') v |= (unsigned)(h - '0');
-                else if (h >= 'a' && h <= 'f') v |= (unsigned)(h - 'a' + 10);
-                else if (h >= 'A' && h <= 'F') v |= (unsigned)(h - 'A' + 10);
-                else {
-                    jfail(p, "bad hex digit in \\u escape");
-                    goto bad;
-                }
-            }
-            p->pos += 4;
-            if (v == 0) {
-                jfail(p, "\\u0000 is not allowed");
-                goto bad;
-            }
-            if (v < 0x80) {
-                o[n++] = (char)v;
-            } else if (v < 0x800) {
-                o[n++] = (char)(0xC0 | (v >> 6));
-                o[n++] = (char)(0x80 | (v & 0x3F));
-            } else { /* surrogates kept as-is: names only, never interpreted */
-                o[n++] = (char)(0xE0 | (v >> 12));
-                o[n++] = (char)(0x80 | ((v >> 6) & 0x3F));
-                o[n++] = (char)(0x80 | (v & 0x3F));
-            }
-            break;
-        }
-        default: jfail(p, "unknown escape in string"); goto bad;
         }
     }
-bad:
     free(o);
     return NULL;
 }

@@ -59,6 +59,8 @@ static size_t best_candidate(const rc_model *mdl, const uint8_t *fixed, const rc
     for (unsigned k = 0; k < mdl->n_params; ++k)
         if (!((k < RC_P_ENC + 3 && fixed && fixed[k]) || k == first_off))
             idx[p++] = (uint16_t)k;
+    if (p == 0 || n <= p)
+        return 0;
     double *Q = malloc(n * p * sizeof *Q), *r = malloc(n * sizeof *r), *tau = malloc(p * sizeof *tau);
     double *a = calloc(p, sizeof *a), jrow[RC_MAX_PARAMS];
     size_t best = 0;

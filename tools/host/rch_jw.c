@@ -26,6 +26,34 @@ static void indent(rch_jw *w)
         put(w, "  ");
 }
 
+/* Length of the well-formed UTF-8 sequence at p (1..4), or 0 when the
+ * bytes there are not one (overlong forms, surrogates and code points above
+ * U+10FFFF are not well-formed). */
+static size_t utf8_len(const unsigned char *p)
+{
+    unsigned char c = p[0];
+    size_t n;
+    unsigned cp;
+    if (c < 0x80)
+        return 1;
+    if (c >= 0xc2 && c <= 0xdf)
+        n = 2, cp = c & 0x1fu;
+    else if (c >= 0xe0 && c <= 0xef)
+        n = 3, cp = c & 0x0fu;
+    else if (c >= 0xf0 && c <= 0xf4)
+        n = 4, cp = c & 0x07u;
+    else
+        return 0;
+    for (size_t i = 1; i < n; ++i) {
+        if ((p[i] & 0xc0) != 0x80)
+            return 0;
+        cp = cp << 6 | (p[i] & 0x3fu);
+    }
+    if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10ffff)) || (cp >= 0xd800 && cp <= 0xdfff))
+        return 0;
+    return n;
+}
+
 static void write_string(rch_jw *w, const char *s)
 {
     char buf[8];
@@ -42,11 +70,21 @@ static void write_string(rch_jw *w, const char *s)
             put(w, "\\t");
         else if (c == '\r')
             put(w, "\\r");
-        else if (c < 0x20 || c >= 0x80) {
-            /* Control characters, and bytes outside ASCII as \u00XX so the
-             * output is valid UTF-8 whatever the input path holds. */
+        else if (c < 0x20) {
             snprintf(buf, sizeof buf, "\\u%04x", (unsigned)c);
             put(w, buf);
+        } else if (c >= 0x80) {
+            /* Well-formed UTF-8 is copied; any other byte becomes U+FFFD,
+             * so the output is valid UTF-8 whatever the input path holds. */
+            size_t n = utf8_len(p);
+            if (n) {
+                memcpy(buf, p, n);
+                buf[n] = '\0';
+                put(w, buf);
+                p += n - 1;
+            } else {
+                put(w, "\\ufffd");
+            }
         } else {
             buf[0] = (char)c;
             buf[1] = '\0';
@@ -77,7 +115,7 @@ static void member(rch_jw *w, const char *key)
     }
 }
 
-static void open(rch_jw *w, const char *key, char o, char c)
+static void jw_open(rch_jw *w, const char *key, char o, char c)
 {
     char s[2] = {o, '\0'};
     member(w, key);
@@ -93,12 +131,12 @@ static void open(rch_jw *w, const char *key, char o, char c)
 
 void rch_jw_obj(rch_jw *w, const char *key)
 {
-    open(w, key, '{', '}');
+    jw_open(w, key, '{', '}');
 }
 
 void rch_jw_arr(rch_jw *w, const char *key)
 {
-    open(w, key, '[', ']');
+    jw_open(w, key, '[', ']');
 }
 
 void rch_jw_end(rch_jw *w)
@@ -214,8 +252,17 @@ const char *rch_jw_escape(const char *s, char *buf, size_t len)
             tmp[0] = '\\';
             tmp[1] = (char)c;
             tmp[2] = '\0';
-        } else if (c < 0x20 || c >= 0x80) {
+        } else if (c < 0x20) {
             snprintf(tmp, sizeof tmp, "\\u%04x", (unsigned)c);
+        } else if (c >= 0x80) {
+            size_t k = utf8_len(p);
+            if (k) {
+                memcpy(tmp, p, k);
+                tmp[k] = '\0';
+                p += k - 1;
+            } else {
+                snprintf(tmp, sizeof tmp, "\\ufffd");
+            }
         } else {
             tmp[0] = (char)c;
             tmp[1] = '\0';

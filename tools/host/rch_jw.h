@@ -1,5 +1,6 @@
 /* rch_jw.h - the one JSON writer of rcal: every string escaped (quotes,
- * backslashes, control characters; non-UTF-8 bytes as \u00XX), numbers that
+ * backslashes, control characters; well-formed UTF-8 copied, any other
+ * byte written as U+FFFD), numbers that
  * are not finite written as null, nesting and commas tracked for the caller.
  *
  * Usage:

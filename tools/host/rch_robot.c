@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "rch_json.h"
+#include "rch_jw.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -134,6 +135,77 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
     return 0;
 }
 
+/* "encoder_mm": [x, y, z] when present (has_encoder set). 0 or -1 (d set). */
+static int read_encoder(rch_robot *out, double enc[3], const rch_json *root, const char *name, rch_diag *d)
+{
+    const rch_json *e = rch_json_get(root, "encoder_mm");
+    if (!e)
+        return 0;
+    if (e->type != RCH_JARR || e->n != 3) {
+        rch_diag_set(d, name, e->line, e->col, "\"encoder_mm\" must be [x, y, z]");
+        return -1;
+    }
+    for (unsigned k = 0; k < 3; ++k) {
+        if (want_num(&enc[k], e->items[k], "encoder_mm value", name, d, e) != 0)
+            return -1;
+        if (fabs(enc[k]) > 1e5) {
+            rch_diag_set(d, name, e->items[k]->line, e->items[k]->col, "encoder_mm value is absurd");
+            return -1;
+        }
+    }
+    out->has_encoder = 1;
+    return 0;
+}
+
+/* "joint_limits_deg" into m (default +-180 deg). 0 or -1 (d set). */
+static int read_limits(rc_model *m, const rch_json *root, const char *name, rch_diag *d)
+{
+    const rch_json *lim = rch_json_get(root, "joint_limits_deg");
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        m->q_min_rad[i] = -M_PI;
+        m->q_max_rad[i] = M_PI;
+    }
+    if (!lim)
+        return 0;
+    if (lim->type != RCH_JARR || lim->n != RC_NJ) {
+        rch_diag_set(d, name, lim->line, lim->col, "\"joint_limits_deg\" must be 6 [min, max] pairs");
+        return -1;
+    }
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const rch_json *pr = lim->items[i];
+        double lo, hi;
+        if (pr->type != RCH_JARR || pr->n != 2 || want_num(&lo, pr->items[0], "joint limit", name, d, pr) != 0 ||
+            want_num(&hi, pr->items[1], "joint limit", name, d, pr) != 0 || !(lo < hi) || fabs(lo) > 720 ||
+            fabs(hi) > 720) {
+            rch_diag_set(d, name, pr->line, pr->col, "joint %u limits must be [min, max] degrees, min < max", i + 1);
+            return -1;
+        }
+        m->q_min_rad[i] = lo * DEG;
+        m->q_max_rad[i] = hi * DEG;
+    }
+    return 0;
+}
+
+/* "nominal": {"dh": [...]} of a calibrated model (has_nominal set). */
+static int read_nominal(rch_robot *out, const rch_json *root, const char *name, rch_diag *d)
+{
+    const rch_json *nom = rch_json_get(root, "nominal");
+    double ndh[RC_NJ][4];
+    if (!nom)
+        return 0;
+    if (nom->type != RCH_JOBJ) {
+        rch_diag_set(d, name, nom->line, nom->col, "\"nominal\" must be an object with \"dh\"");
+        return -1;
+    }
+    if (read_dh(ndh, rch_json_get(nom, "dh"), name, d, nom) != 0)
+        return -1;
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        for (unsigned k = 0; k < 4; ++k)
+            out->nominal.x[4 * i + k] = ndh[i][k];
+    out->has_nominal = 1;
+    return 0;
+}
+
 int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d)
 {
     double dh[RC_NJ][4], enc[3] = {0, 0, 0};
@@ -153,67 +225,17 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     }
     const rch_json *nm = rch_json_get(root, "name");
     snprintf(out->name, sizeof out->name, "%s", nm && nm->type == RCH_JSTR ? nm->str : "robot");
-    if (read_dh(dh, rch_json_get(root, "dh"), name, d, root) != 0)
+    if (read_dh(dh, rch_json_get(root, "dh"), name, d, root) != 0 || read_encoder(out, enc, root, name, d) != 0)
         goto done;
-    const rch_json *e = rch_json_get(root, "encoder_mm");
-    if (e) {
-        if (e->type != RCH_JARR || e->n != 3) {
-            rch_diag_set(d, name, e->line, e->col, "\"encoder_mm\" must be [x, y, z]");
-            goto done;
-        }
-        for (unsigned k = 0; k < 3; ++k) {
-            if (want_num(&enc[k], e->items[k], "encoder_mm value", name, d, e) != 0)
-                goto done;
-            if (fabs(enc[k]) > 1e5) {
-                rch_diag_set(d, name, e->items[k]->line, e->items[k]->col, "encoder_mm value is absurd");
-                goto done;
-            }
-        }
-        out->has_encoder = 1;
-    }
     if (rc_model_init(&out->model, (const double(*)[4])dh, enc) != RC_OK) {
         rch_diag_set(d, name, root->line, root->col, "invalid DH table");
         goto done;
     }
-    const rch_json *lim = rch_json_get(root, "joint_limits_deg");
-    for (unsigned i = 0; i < RC_NJ; ++i) {
-        out->model.q_min_rad[i] = -M_PI;
-        out->model.q_max_rad[i] = M_PI;
-    }
-    if (lim) {
-        if (lim->type != RCH_JARR || lim->n != RC_NJ) {
-            rch_diag_set(d, name, lim->line, lim->col, "\"joint_limits_deg\" must be 6 [min, max] pairs");
-            goto done;
-        }
-        for (unsigned i = 0; i < RC_NJ; ++i) {
-            const rch_json *pr = lim->items[i];
-            double lo, hi;
-            if (pr->type != RCH_JARR || pr->n != 2 ||
-                want_num(&lo, pr->items[0], "joint limit", name, d, pr) != 0 ||
-                want_num(&hi, pr->items[1], "joint limit", name, d, pr) != 0 || !(lo < hi) || fabs(lo) > 720 ||
-                fabs(hi) > 720) {
-                rch_diag_set(d, name, pr->line, pr->col, "joint %u limits must be [min, max] degrees, min < max",
-                             i + 1);
-                goto done;
-            }
-            out->model.q_min_rad[i] = lo * DEG;
-            out->model.q_max_rad[i] = hi * DEG;
-        }
-    }
+    if (read_limits(&out->model, root, name, d) != 0)
+        goto done;
     out->nominal = out->model;
-    const rch_json *nom = rch_json_get(root, "nominal");
-    if (nom) {
-        double ndh[RC_NJ][4];
-        if (nom->type != RCH_JOBJ || read_dh(ndh, rch_json_get(nom, "dh"), name, d, nom) != 0) {
-            if (nom->type != RCH_JOBJ)
-                rch_diag_set(d, name, nom->line, nom->col, "\"nominal\" must be an object with \"dh\"");
-            goto done;
-        }
-        for (unsigned i = 0; i < RC_NJ; ++i)
-            for (unsigned k = 0; k < 4; ++k)
-                out->nominal.x[4 * i + k] = ndh[i][k];
-        out->has_nominal = 1;
-    }
+    if (read_nominal(out, root, name, d) != 0)
+        goto done;
     const rch_json *eff = rch_json_get(root, "effects");
     if (eff && read_effects(&out->model, eff, name, d) != 0)
         goto done;
@@ -241,55 +263,73 @@ int rch_robot_load(rch_robot *out, const char *path, rch_diag *d)
     return rch_robot_parse(out, buf, len, path, d);
 }
 
-static void write_dh(FILE *f, const rc_model *m, const char *indent)
+static void write_dh(rch_jw *w, const char *key, const rc_model *m)
 {
-    fprintf(f, "[\n");
-    for (unsigned i = 0; i < RC_NJ; ++i)
-        fprintf(f, "%s  {\"a_mm\": %.9g, \"d_mm\": %.9g, \"alpha_deg\": %.9g, \"theta_deg\": %.9g}%s\n", indent,
-                m->x[RC_P_A(i)], m->x[RC_P_D(i)], m->x[RC_P_ALPHA(i)] / DEG, m->x[RC_P_THETA(i)] / DEG,
-                i + 1 < RC_NJ ? "," : "");
-    fprintf(f, "%s]", indent);
+    rch_jw_arr(w, key);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        rch_jw_obj(w, NULL);
+        rch_jw_numf(w, "a_mm", m->x[RC_P_A(i)], "%.9g");
+        rch_jw_numf(w, "d_mm", m->x[RC_P_D(i)], "%.9g");
+        rch_jw_numf(w, "alpha_deg", m->x[RC_P_ALPHA(i)] / DEG, "%.9g");
+        rch_jw_numf(w, "theta_deg", m->x[RC_P_THETA(i)] / DEG, "%.9g");
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+}
+
+static void write_numsf(rch_jw *w, const char *key, const double *v, size_t n, const char *fmt)
+{
+    rch_jw_arr(w, key);
+    for (size_t i = 0; i < n; ++i)
+        rch_jw_numf(w, NULL, v[i], fmt);
+    rch_jw_end(w);
 }
 
 int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model *nominal,
-                    const char *calibration_json)
+                    const rch_robot_info *info)
 {
-    fprintf(f, "{\n  \"format\": \"rcal-model/1\",\n  \"name\": \"");
-    for (const char *p = name ? name : "robot"; *p; ++p) {
-        if (*p == '"' || *p == '\\')
-            fputc('\\', f);
-        if ((unsigned char)*p >= 0x20)
-            fputc(*p, f);
+    rch_jw w;
+    rch_jw_init(&w, f, 1);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "format", "rcal-model/1");
+    rch_jw_str(&w, "name", name ? name : "robot");
+    write_dh(&w, "dh", m);
+    rch_jw_arr(&w, "joint_limits_deg");
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const double lim[2] = {m->q_min_rad[i] / DEG, m->q_max_rad[i] / DEG};
+        write_numsf(&w, NULL, lim, 2, "%.9g");
     }
-    fprintf(f, "\",\n  \"dh\": ");
-    write_dh(f, m, "  ");
-    fprintf(f, ",\n  \"joint_limits_deg\": [");
-    for (unsigned i = 0; i < RC_NJ; ++i)
-        fprintf(f, "[%.9g, %.9g]%s", m->q_min_rad[i] / DEG, m->q_max_rad[i] / DEG, i + 1 < RC_NJ ? ", " : "");
-    fprintf(f, "],\n  \"encoder_mm\": [%.9g, %.9g, %.9g]", m->x[RC_P_ENC], m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2]);
+    rch_jw_end(&w);
+    write_numsf(&w, "encoder_mm", &m->x[RC_P_ENC], 3, "%.9g");
     if (m->n_effects) {
-        fprintf(f, ",\n  \"effects\": [\n");
+        rch_jw_arr(&w, "effects");
         for (unsigned i = 0; i < m->n_effects; ++i) {
             const rc_effect *e = &m->effects[i];
-            fprintf(f, "    {\"kind\": \"%s\", \"joint\": %u, \"params\": [", rc_effect_name((rc_effect_kind)e->kind),
-                    e->joint + 1u);
-            for (unsigned k = 0; k < e->count; ++k)
-                fprintf(f, "%.12g%s", m->x[e->first + k], k + 1 < e->count ? ", " : "");
-            fprintf(f, "], \"ref_dh\": [");
-            for (unsigned r = 0; r < 4; ++r)
-                fprintf(f, "[%.9g, %.9g, %.9g, %.9g]%s", e->ref_dh[r][0], e->ref_dh[r][1], e->ref_dh[r][2] / DEG,
-                        e->ref_dh[r][3] / DEG, r < 3 ? ", " : "");
-            fprintf(f, "]}%s\n", i + 1 < m->n_effects ? "," : "");
+            rch_jw_obj(&w, NULL);
+            rch_jw_str(&w, "kind", rc_effect_name((rc_effect_kind)e->kind));
+            rch_jw_uint(&w, "joint", e->joint + 1u);
+            write_numsf(&w, "params", &m->x[e->first], e->count, "%.12g");
+            rch_jw_arr(&w, "ref_dh");
+            for (unsigned r = 0; r < 4; ++r) {
+                const double row[4] = {e->ref_dh[r][0], e->ref_dh[r][1], e->ref_dh[r][2] / DEG,
+                                       e->ref_dh[r][3] / DEG};
+                write_numsf(&w, NULL, row, 4, "%.9g");
+            }
+            rch_jw_end(&w);
+            rch_jw_end(&w);
         }
-        fprintf(f, "  ]");
+        rch_jw_end(&w);
     }
     if (nominal) {
-        fprintf(f, ",\n  \"nominal\": {\"dh\": ");
-        write_dh(f, nominal, "  ");
-        fprintf(f, "}");
+        rch_jw_obj(&w, "nominal");
+        write_dh(&w, "dh", nominal);
+        rch_jw_end(&w);
     }
-    if (calibration_json)
-        fprintf(f, ",\n  \"calibration\": %s", calibration_json);
-    fprintf(f, "\n}\n");
-    return fflush(f) == 0 && !ferror(f) ? 0 : -1;
+    if (info && info->write) {
+        rch_jw_obj(&w, "calibration");
+        info->write(&w, info->ctx);
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
+    return rch_jw_finish(&w) == 0 && !ferror(f) ? 0 : -1;
 }

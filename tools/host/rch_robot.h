@@ -22,6 +22,7 @@
 
 #include "rc_model.h"
 #include "rch_diag.h"
+#include "rch_jw.h"
 
 typedef struct rch_robot {
     char name[128];
@@ -34,9 +35,17 @@ typedef struct rch_robot {
 int rch_robot_load(rch_robot *out, const char *path, rch_diag *d);
 int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d);
 
-/* Write a model file. nominal may be NULL; calibration_json is inserted
- * verbatim as the "calibration" member when not NULL (must be a JSON object). */
+/* The "calibration" member of a model file: write() adds its members through
+ * the JSON writer (so every string is escaped); ctx is passed through. */
+typedef struct rch_robot_info {
+    void (*write)(rch_jw *w, const void *ctx);
+    const void *ctx;
+} rch_robot_info;
+
+/* Write a model file through rch_jw (every string escaped, non-finite numbers
+ * null). nominal may be NULL; info may be NULL (no "calibration" member).
+ * Returns 0, or -1 on a write error. */
 int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model *nominal,
-                    const char *calibration_json);
+                    const rch_robot_info *info);
 
 #endif

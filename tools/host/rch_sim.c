@@ -1,7 +1,13 @@
 #include "rch_sim.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "rch_data.h"
+#include "rch_file.h"
+#include "rch_save.h"
+#include "rch_stats.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -47,6 +53,31 @@ static void range_of(double *lo, double *hi, const rc_model *m, const rch_sim_co
     }
 }
 
+/* q uniform in [lo, hi] per joint, joint 1 first: one rc_rng_u01 per joint */
+static void uniform_pose(double q[RC_NJ], const double lo[RC_NJ], const double hi[RC_NJ], rc_rng *g)
+{
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        q[j] = lo[j] + (hi[j] - lo[j]) * rc_rng_u01(g);
+}
+
+void rch_sim_pose(double q_rad[RC_NJ], const rc_model *m, double margin_rad, rc_rng *g)
+{
+    double lo[RC_NJ], hi[RC_NJ];
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        lo[j] = m->q_min_rad[j] + margin_rad;
+        hi[j] = m->q_max_rad[j] - margin_rad;
+    }
+    uniform_pose(q_rad, lo, hi, g);
+}
+
+void rch_sim_poses(rc_sample *out, size_t n, const rc_model *m, double margin_rad, rc_rng *g)
+{
+    for (size_t i = 0; i < n; ++i) {
+        memset(&out[i], 0, sizeof out[i]);
+        rch_sim_pose(out[i].q_rad, m, margin_rad, g);
+    }
+}
+
 int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const rc_model *truth,
                     const rch_sim_config *c, rc_rng *g)
 {
@@ -61,11 +92,11 @@ int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const
         int found = 0;
         for (unsigned tries = 0; tries < 100000 && !found; ++tries) {
             if (c->group_size == 0 || new_group) {
-                for (unsigned j = 0; j < RC_NJ; ++j) {
-                    double lo, hi;
-                    range_of(&lo, &hi, truth, c, j);
-                    centre[j] = q[j] = lo + (hi - lo) * rc_rng_u01(g);
-                }
+                double lo[RC_NJ], hi[RC_NJ];
+                for (unsigned j = 0; j < RC_NJ; ++j)
+                    range_of(&lo[j], &hi[j], truth, c, j);
+                uniform_pose(q, lo, hi, g);
+                memcpy(centre, q, sizeof q);
             } else {
                 for (unsigned j = 0; j < RC_NJ; ++j) {
                     double lo, hi;
@@ -107,7 +138,9 @@ int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const
 void rch_sim_flange_diff(double *rms_mm, double *max_mm, const rc_model *a, const rc_model *b,
                          const rc_sample *poses, size_t n, int align)
 {
-    double sxy = 0.0, sxx = 0.0, dz = 0.0, phi = 0.0, sum2 = 0.0, mx = 0.0;
+    double sxy = 0.0, sxx = 0.0, dz = 0.0, phi = 0.0;
+    rch_stats st;
+    memset(&st, 0, sizeof st);
     if (align) {
         for (size_t i = 0; i < n; ++i) {
             double pa[3], pb[3];
@@ -125,11 +158,87 @@ void rch_sim_flange_diff(double *rms_mm, double *max_mm, const rc_model *a, cons
         rc_fk(pa, NULL, a, poses[i].q_rad);
         rc_fk(pb, NULL, b, poses[i].q_rad);
         const double x = c * pa[0] - s * pa[1], y = s * pa[0] + c * pa[1], z = pa[2] + dz;
-        const double d = sqrt((x - pb[0]) * (x - pb[0]) + (y - pb[1]) * (y - pb[1]) + (z - pb[2]) * (z - pb[2]));
-        sum2 += d * d;
-        if (d > mx)
-            mx = d;
+        rch_stats_add(&st, sqrt((x - pb[0]) * (x - pb[0]) + (y - pb[1]) * (y - pb[1]) + (z - pb[2]) * (z - pb[2])));
     }
-    *rms_mm = n ? sqrt(sum2 / (double)n) : 0.0;
-    *max_mm = mx;
+    *rms_mm = rch_stats_rms(&st);
+    *max_mm = st.max_abs;
+}
+
+int rch_sim_make(rch_sim_set *out, const rch_sim_job *job, rch_diag *d)
+{
+    memset(out, 0, sizeof *out);
+    out->sim = job->sim;
+    out->seed = job->seed;
+    rch_sim_defaults(&out->sim);
+    if (rch_robot_load(&out->robot, job->truth_path ? job->truth_path : job->robot_path, d) != 0)
+        return -1;
+    rc_rng g;
+    rc_rng_seed(&g, job->seed);
+    if (job->truth_path) {
+        out->truth = out->robot.model;
+        if (!out->robot.has_encoder)
+            memcpy(&out->truth.x[RC_P_ENC], job->enc_mm, sizeof job->enc_mm);
+    } else {
+        rch_sim_truth(&out->truth, &out->robot.model, job->enc_mm, &out->sim, &g);
+    }
+    out->s = malloc((job->n ? job->n : 1) * sizeof *out->s);
+    if (!out->s) {
+        rch_diag_set(d, "", 0, 0, "out of memory for %zu samples", job->n);
+        return -1;
+    }
+    if (rch_sim_samples(out->s, NULL, job->n, &out->truth, &out->sim, &g) != 0) {
+        rch_diag_set(d, "", 0, 0, "no pose puts the cable within %.0f..%.0f mm; check --encoder",
+                     out->sim.len_min_mm, out->sim.len_max_mm);
+        rch_sim_set_free(out);
+        return -1;
+    }
+    out->n = job->n;
+    return 0;
+}
+
+void rch_sim_set_free(rch_sim_set *set)
+{
+    free(set->s);
+    set->s = NULL;
+    set->n = 0;
+}
+
+static void sim_info(rch_jw *w, const void *ctx)
+{
+    const rch_sim_set *set = ctx;
+    rch_jw_bool(w, "simulated", 1);
+    rch_jw_uint(w, "seed", set->seed);
+    rch_jw_numf(w, "noise_mm", set->sim.noise_mm, "%g");
+    rch_jw_numf(w, "resolution_mm", set->sim.resolution_mm, "%g");
+    rch_jw_numf(w, "q_step_deg", set->sim.q_step_deg, "%g");
+}
+
+int rch_sim_write_truth(FILE *f, const rch_sim_set *set)
+{
+    const rch_robot_info info = {sim_info, set};
+    return rch_robot_write(f, "simulated truth", &set->truth, &set->robot.nominal, &info);
+}
+
+static int write_csv_fn(FILE *f, const void *ctx)
+{
+    const rch_sim_set *set = ctx;
+    return rch_data_write(f, set->s, set->n, &set->robot.nominal);
+}
+
+static int write_truth_fn(FILE *f, const void *ctx)
+{
+    return rch_sim_write_truth(f, ctx);
+}
+
+int rch_sim_save(const rch_sim_set *set, const rch_sim_job *job, const char *out_path, const char *truth_out,
+                 rch_diag *d)
+{
+    const char *inputs[3] = {job->robot_path, job->truth_path, out_path};
+    if (truth_out && (strcmp(truth_out, out_path) == 0 || rch_same_file(truth_out, out_path))) {
+        rch_diag_set(d, "", 0, 0, "--truth-out %s is also --out: refused, nothing written", truth_out);
+        return -1;
+    }
+    if (rch_save(out_path, "--out", inputs, 2, write_csv_fn, set, d) != 0)
+        return -1;
+    return truth_out ? rch_save(truth_out, "--truth-out", inputs, 3, write_truth_fn, set, d) : 0;
 }

@@ -126,13 +126,19 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
             free(M);
             return -1;
         }
-        for (size_t i = 0; i < n; ++i)
+        for (size_t i = 0; i < n; ++i) {
+            if (s[i].group > gmax)
+                continue; /* cannot happen: gmax is the largest group */
+            double *ui = ug + (size_t)s[i].group * nf;
             for (unsigned k = 0; k < nf; ++k)
-                ug[(size_t)s[i].group * nf + k] += J[i * nf + k] * r[i];
-        for (unsigned g = 0; g <= gmax; ++g)
+                ui[k] += J[i * nf + k] * r[i];
+        }
+        for (unsigned g = 0; g <= gmax; ++g) {
+            const double *ua = ug + (size_t)g * nf; /* score of cluster g, (nf) */
             for (unsigned a = 0; a < nf; ++a)
                 for (unsigned b = 0; b < nf; ++b)
-                    M[a * nf + b] += ug[(size_t)g * nf + a] * ug[(size_t)g * nf + b];
+                    M[a * nf + b] += ua[a] * ua[b];
+        }
         free(ug);
         double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 0 ? dof : 1.0));
         /* Cz = c Ap M Ap */
@@ -222,12 +228,13 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
         return -1;
     }
     size_t np = m->n_params, nf = z.nf;
-    double *J = malloc(n * nf * sizeof *J), *r = malloc(n * sizeof *r), *A = calloc(nf * nf, sizeof *A);
-    z.V = calloc(nf * nf, sizeof *z.V);
-    z.Cz = calloc(nf * nf, sizeof *z.Cz);
+    double *J = calloc(n * nf, sizeof *J), *r = calloc(n, sizeof *r), *A = calloc(nf * nf, sizeof *A);
+    double *V = calloc(nf * nf, sizeof *V), *Cz = calloc(nf * nf, sizeof *Cz);
+    z.V = V;
+    z.Cz = Cz;
     u->cov = calloc(np * np, sizeof *u->cov);
     int rc = -1;
-    if (!J || !r || !A || !z.V || !z.Cz || !u->cov) {
+    if (!J || !r || !A || !V || !Cz || !u->cov) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
@@ -257,8 +264,8 @@ done:
     free(J);
     free(r);
     free(A);
-    free(z.V);
-    free(z.Cz);
+    free(V);
+    free(Cz);
     if (rc != 0)
         rch_uncert_free(u);
     return rc;

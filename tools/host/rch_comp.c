@@ -1,0 +1,415 @@
+/* rch_comp.c - a robot program's joint targets through the compensation
+ * (rch_comp.h): CSV and RAPID line handling, file safety. */
+#include "rch_comp.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/types.h>
+#include <time.h>
+
+#include "rch_file.h"
+#include "rch_opt.h"
+#include "rch_robot.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+#define MAX_FIELDS 64
+
+typedef struct {
+    rc_comp_stream *stream;
+    const rc_model *cal;
+    rch_comp_result *res;
+    FILE *out, *warn;
+    const char *in_name;
+    int format; /* 0 auto, 1 csv, 2 rapid */
+    int have_header;
+    int qcol[RC_NJ]; /* header column of each joint */
+    unsigned nfields_header;
+} comp_ctx;
+
+static double now_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+}
+
+/* Split a line at commas. start[k]/len[k]: field k (trimmed); returns the
+ * number of fields, or -1 when more than MAX_FIELDS. */
+static int split_csv(const char *line, size_t n, size_t start[MAX_FIELDS], size_t len[MAX_FIELDS])
+{
+    int k = 0;
+    size_t i = 0;
+    for (;;) {
+        if (k >= MAX_FIELDS)
+            return -1;
+        size_t b = i;
+        while (b < n && (line[b] == ' ' || line[b] == '\t'))
+            ++b;
+        size_t e = b;
+        while (e < n && line[e] != ',')
+            ++e;
+        size_t end = e;
+        while (end > b && (line[end - 1] == ' ' || line[end - 1] == '\t' || line[end - 1] == '\r'))
+            --end;
+        start[k] = b;
+        len[k] = end - b;
+        ++k;
+        if (e >= n)
+            break;
+        i = e + 1;
+    }
+    return k;
+}
+
+/* Parse a number occupying exactly text[0..len) (the strict reader of
+ * rch_opt.h: no blanks, no hex, finite). */
+static int parse_num(double *v, const char *text, size_t len)
+{
+    char buf[64];
+    if (len == 0 || len >= sizeof buf)
+        return -1;
+    memcpy(buf, text, len);
+    buf[len] = '\0';
+    return rch_parse_double(buf, v);
+}
+
+/* Compensate one target (degrees in, degrees out). 0 ok, 1 not converged
+ * (output still written), -1 range error (d set). cols: (6) columns of the
+ * fields for diagnostics. */
+static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC_NJ], unsigned line,
+                      const unsigned cols[RC_NJ], rch_diag *d)
+{
+    rc_real q[RC_NJ], qc[RC_NJ];
+    const rc_model *m = c->cal;
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        q[i] = (rc_real)(in_deg[i] * DEG);
+        if ((double)q[i] < m->q_min_rad[i] || (double)q[i] > m->q_max_rad[i]) {
+            rch_diag_set(d, c->in_name, line, cols[i], "q%u = %g deg is outside the joint limits [%g, %g] deg", i + 1,
+                         in_deg[i], m->q_min_rad[i] / DEG, m->q_max_rad[i] / DEG);
+            return -1;
+        }
+    }
+    rc_comp_result res;
+    const double t0 = now_ns();
+    rc_status st = rc_comp_stream_step(c->stream, qc, &res, q);
+    rch_comp_result *r = c->res;
+    r->t_ns += now_ns() - t0;
+    r->n++;
+    r->iters += res.iterations;
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        out_deg[i] = (double)qc[i] / DEG;
+    if ((double)res.corr_max_rad / DEG > r->max_corr_deg)
+        r->max_corr_deg = (double)res.corr_max_rad / DEG;
+    if (st == RC_OK) {
+        if (res.exit == RC_COMP_POSITION_ONLY)
+            r->n_pos_only++;
+        return 0;
+    }
+    r->n_fail++;
+    if ((double)res.pos_err_mm > r->max_fail_err_mm)
+        r->max_fail_err_mm = (double)res.pos_err_mm;
+    char joints[64] = "";
+    if (res.exit == RC_COMP_JOINT_LIMIT || res.exit == RC_COMP_MAX_DEV) {
+        const unsigned mask = res.exit == RC_COMP_JOINT_LIMIT ? res.limit_mask : res.bound_mask;
+        size_t k = (size_t)snprintf(joints, sizeof joints, " (joint%s", (mask & (mask - 1u)) ? "s" : "");
+        for (unsigned i = 0; i < RC_NJ && k < sizeof joints; ++i)
+            if (mask & (1u << i))
+                k += (size_t)snprintf(joints + k, sizeof joints - k, " %u", i + 1);
+        if (k < sizeof joints)
+            snprintf(joints + k, sizeof joints - k, ")");
+    }
+    if (res.exit == RC_COMP_JOINT_LIMIT)
+        r->n_joint_limit++;
+    if (c->warn != NULL)
+        fprintf(c->warn,
+                "%s:%u: warning: target not compensated: %s%s; wrote the target plus the last good correction, "
+                "%.4f mm from the nominal position\n",
+                c->in_name, line, st == RC_ERR_NOCONV ? rc_comp_exit_str(res.exit) : rc_strerror(st), joints,
+                (double)res.pos_err_mm);
+    return 1;
+}
+
+static int is_comment_or_blank(const char *s, size_t n)
+{
+    size_t i = 0;
+    while (i < n && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r'))
+        ++i;
+    return i == n || s[i] == '#';
+}
+
+static int starts_with_ci(const char *s, size_t n, const char *w)
+{
+    size_t k = strlen(w);
+    while (n > 0 && (*s == ' ' || *s == '\t')) {
+        ++s;
+        --n;
+    }
+    return n >= k && strncasecmp(s, w, k) == 0;
+}
+
+static const char *find_ci(const char *s, size_t n, const char *w)
+{
+    size_t k = strlen(w);
+    for (size_t i = 0; i + k <= n; ++i)
+        if (strncasecmp(s + i, w, k) == 0)
+            return s + i;
+    return NULL;
+}
+
+/* One CSV line (not blank, not a comment). 0 ok, 1 not converged, -1 error. */
+static int do_csv(comp_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d)
+{
+    size_t st[MAX_FIELDS], ln[MAX_FIELDS];
+    const int nf = split_csv(line, n, st, ln);
+    if (nf < 0) {
+        rch_diag_set(d, c->in_name, lineno, 1, "more than %d fields", MAX_FIELDS);
+        return -1;
+    }
+    if (!c->have_header) {
+        if (nf != RC_NJ) {
+            rch_diag_set(d, c->in_name, lineno, (unsigned)(nf > RC_NJ ? st[RC_NJ] + 1 : n + 1),
+                         "expected 6 joint angles q1..q6 in degrees, found %d field%s", nf, nf == 1 ? "" : "s");
+            return -1;
+        }
+    } else if ((unsigned)nf != c->nfields_header) {
+        rch_diag_set(d, c->in_name, lineno, (unsigned)((unsigned)nf > c->nfields_header ? st[c->nfields_header] + 1 : n + 1),
+                     "expected %u fields as in the header, found %d", c->nfields_header, nf);
+        return -1;
+    }
+    double qd[RC_NJ], qo[RC_NJ];
+    unsigned cols[RC_NJ];
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const int k = c->have_header ? c->qcol[i] : (int)i;
+        cols[i] = (unsigned)st[k] + 1;
+        if (parse_num(&qd[i], line + st[k], ln[k]) != 0) {
+            rch_diag_set(d, c->in_name, lineno, cols[i], "q%u: '%.*s' is not a finite number", i + 1,
+                         (int)(ln[k] > 40 ? 40 : ln[k]), line + st[k]);
+            return -1;
+        }
+    }
+    const int r = compensate(c, qo, qd, lineno, cols, d);
+    if (r < 0)
+        return r;
+    for (int k = 0; k < nf; ++k) {
+        int j = -1;
+        for (int i = 0; i < RC_NJ; ++i)
+            if ((c->have_header ? c->qcol[i] : i) == k)
+                j = i;
+        if (k > 0)
+            fputc(',', c->out);
+        if (j >= 0)
+            fprintf(c->out, "%.6f", qo[j]);
+        else
+            fwrite(line + st[k], 1, ln[k], c->out);
+    }
+    fputc('\n', c->out);
+    return r;
+}
+
+/* Header line: find q1..q6 (or j1..j6). 0 or -1. */
+static int do_header(comp_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d)
+{
+    size_t st[MAX_FIELDS], ln[MAX_FIELDS];
+    const int nf = split_csv(line, n, st, ln);
+    if (nf < 0) {
+        rch_diag_set(d, c->in_name, lineno, 1, "more than %d header fields", MAX_FIELDS);
+        return -1;
+    }
+    for (int i = 0; i < RC_NJ; ++i) {
+        c->qcol[i] = -1;
+        for (int k = 0; k < nf; ++k) {
+            char qn[3] = {'q', (char)('1' + i), '\0'}, jn[3] = {'j', (char)('1' + i), '\0'};
+            if (ln[k] == 2 && (strncasecmp(line + st[k], qn, 2) == 0 || strncasecmp(line + st[k], jn, 2) == 0)) {
+                if (c->qcol[i] >= 0) {
+                    rch_diag_set(d, c->in_name, lineno, (unsigned)st[k] + 1, "column q%d appears twice", i + 1);
+                    return -1;
+                }
+                c->qcol[i] = k;
+            }
+        }
+        if (c->qcol[i] < 0) {
+            rch_diag_set(d, c->in_name, lineno, 1, "header has no q%d column (need q1..q6, degrees)", i + 1);
+            return -1;
+        }
+    }
+    c->have_header = 1;
+    c->nfields_header = (unsigned)nf;
+    fwrite(line, 1, n, c->out);
+    fputc('\n', c->out);
+    return 0;
+}
+
+/* RAPID: rewrite the robax of a jointtarget declaration; other lines copied. */
+static int do_rapid(comp_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d)
+{
+    const char *jt = find_ci(line, n, "jointtarget");
+    const char *as = jt ? find_ci(jt, n - (size_t)(jt - line), ":=") : NULL;
+    if (as == NULL) { /* not a declaration with a value: copy */
+        fwrite(line, 1, n, c->out);
+        fputc('\n', c->out);
+        return 0;
+    }
+    const char *p = as + 2, *end = line + n;
+    while (p < end && (*p == ' ' || *p == '\t'))
+        ++p;
+    if (end - p < 2 || p[0] != '[' || p[1] != '[') {
+        rch_diag_set(d, c->in_name, lineno, (unsigned)(p - line) + 1, "expected [[q1,...,q6],[...]] after :=");
+        return -1;
+    }
+    const char *body = p + 2;
+    const char *close = memchr(body, ']', (size_t)(end - body));
+    if (close == NULL) {
+        rch_diag_set(d, c->in_name, lineno, (unsigned)(body - line) + 1, "missing ']' after the robot axes");
+        return -1;
+    }
+    size_t st[MAX_FIELDS], ln[MAX_FIELDS];
+    const int nf = split_csv(body, (size_t)(close - body), st, ln);
+    if (nf != RC_NJ) {
+        rch_diag_set(d, c->in_name, lineno, (unsigned)(body - line) + 1, "expected 6 robot axes, found %d", nf);
+        return -1;
+    }
+    double qd[RC_NJ], qo[RC_NJ];
+    unsigned cols[RC_NJ];
+    for (int i = 0; i < RC_NJ; ++i) {
+        cols[i] = (unsigned)(body - line) + (unsigned)st[i] + 1;
+        if (parse_num(&qd[i], body + st[i], ln[i]) != 0) {
+            rch_diag_set(d, c->in_name, lineno, cols[i], "axis %d: '%.*s' is not a finite number", i + 1,
+                         (int)(ln[i] > 40 ? 40 : ln[i]), body + st[i]);
+            return -1;
+        }
+    }
+    const int r = compensate(c, qo, qd, lineno, cols, d);
+    if (r < 0)
+        return r;
+    fwrite(line, 1, (size_t)(body - line), c->out);
+    fprintf(c->out, "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f", qo[0], qo[1], qo[2], qo[3], qo[4], qo[5]);
+    fwrite(close, 1, (size_t)(end - close), c->out);
+    fputc('\n', c->out);
+    return r;
+}
+
+int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
+                   const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d)
+{
+    comp_ctx c = {.stream = s, .cal = cal, .res = res, .out = out, .warn = warn, .in_name = in_name,
+                  .format = (int)format};
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t got;
+    unsigned lineno = 0;
+    int rc = 0, decided = c.format != 0;
+    while ((got = getline(&line, &cap, in)) >= 0) {
+        size_t n = (size_t)got;
+        ++lineno;
+        while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'))
+            --n;
+        if (memchr(line, '\0', n) != NULL) {
+            rch_diag_set(d, c.in_name, lineno, (unsigned)((const char *)memchr(line, '\0', n) - line) + 1,
+                         "NUL byte in text input");
+            rc = -1;
+            break;
+        }
+        if (c.format != 2 && is_comment_or_blank(line, n)) {
+            fwrite(line, 1, n, c.out);
+            fputc('\n', c.out);
+            continue;
+        }
+        int r;
+        if (!decided) {
+            decided = 1;
+            if (starts_with_ci(line, n, "MODULE") || starts_with_ci(line, n, "%%%") || find_ci(line, n, "jointtarget")) {
+                c.format = 2;
+            } else {
+                size_t st[MAX_FIELDS], ln[MAX_FIELDS];
+                double v;
+                c.format = 1;
+                if (split_csv(line, n, st, ln) > 0 && parse_num(&v, line + st[0], ln[0]) != 0) {
+                    if (do_header(&c, line, n, lineno, d) < 0) {
+                        rc = -1;
+                        break;
+                    }
+                    continue;
+                }
+            }
+        }
+        r = c.format == 2 ? do_rapid(&c, line, n, lineno, d) : do_csv(&c, line, n, lineno, d);
+        if (r < 0) {
+            rc = -1;
+            break;
+        }
+        if (r > 0)
+            rc = 1;
+    }
+    free(line);
+    res->format = (rch_comp_format)c.format;
+    if (rc >= 0 && ferror(in)) {
+        rch_diag_set(d, c.in_name, 0, 0, "read error: %s", strerror(errno));
+        rc = -1;
+    }
+    return rc;
+}
+
+int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_diag *d)
+{
+    static rch_robot robot, nominal_robot;
+    memset(res, 0, sizeof *res);
+    if (job->model_path == NULL) {
+        rch_diag_set(d, "", 0, 0, "no calibrated model given");
+        return -1;
+    }
+    if (!(job->max_dev_deg >= 0.0) || !isfinite(job->max_dev_deg)) {
+        rch_diag_set(d, "", 0, 0, "the largest correction must be a finite positive angle (0: default)");
+        return -1;
+    }
+    if (rch_robot_load(&robot, job->model_path, d) != 0 ||
+        (job->nominal_path && rch_robot_load(&nominal_robot, job->nominal_path, d) != 0))
+        return -1;
+    const rc_model *nom = job->nominal_path ? &nominal_robot.model : &robot.nominal;
+    res->no_nominal = !job->nominal_path && !robot.has_nominal;
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.max_dev_rad = (rc_real)(job->max_dev_deg * DEG);
+    cfg.flags = job->position_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
+    static rc_comp_stream s;
+    rc_status st = rc_comp_stream_init(&s, &robot.model, nom, &cfg);
+    if (st != RC_OK) {
+        rch_diag_set(d, job->model_path, 0, 0, "the model cannot be used for compensation: %s", rc_strerror(st));
+        return -1;
+    }
+
+    const int from_stdin = job->in_path == NULL || strcmp(job->in_path, "-") == 0;
+    const char *in_name = from_stdin ? "<stdin>" : job->in_path;
+    FILE *in = stdin;
+    if (!from_stdin && (in = fopen(job->in_path, "r")) == NULL) {
+        rch_diag_set(d, job->in_path, 0, 0, "%s", strerror(errno));
+        return -1;
+    }
+    const char *const inputs[3] = {from_stdin ? NULL : job->in_path, job->model_path, job->nominal_path};
+    rch_out o;
+    if (rch_out_open(&o, job->out_path ? job->out_path : "-", "--out", inputs, 3, d) != 0) {
+        if (in != stdin)
+            fclose(in);
+        return -1;
+    }
+    if (o.f == stdout)
+        setvbuf(stdout, NULL, _IOLBF, 0);
+    int rc = rch_comp_lines(o.f, res, in, in_name, &s, &robot.model, job->format, warn, d);
+    if (in != stdin)
+        fclose(in);
+    if (rc < 0) {
+        if (o.f != stdout)
+            rch_out_abort(&o);
+        else
+            fflush(stdout);
+        return -1;
+    }
+    if (rch_out_commit(&o, d) != 0)
+        return -1;
+    return rc;
+}

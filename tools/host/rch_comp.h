@@ -1,0 +1,82 @@
+/* rch_comp.h - compensate a robot program's joint targets (prefix rch_comp_).
+ *
+ * What: streams a program's target list through the compensation
+ * (rc_comp_stream_step, lib/rc_comp.h): q' with FK_cal(q') = FK_nom(q) for
+ * every target, everything else copied unchanged. Input forms, detected from
+ * the first line that is not blank or a comment (or forced):
+ *  - CSV without a header: six numbers per line, q1..q6 in degrees; output:
+ *    the six corrected angles ("%.6f").
+ *  - CSV with a header (first field not a number): the columns q1..q6 (or
+ *    j1..j6), any case, are corrected; every other column is copied, so a
+ *    whole target list (names, speeds, ...) goes through. The header is copied.
+ *  - ABB RAPID (a line starting with MODULE or %%%, or holding
+ *    "jointtarget"): every "jointtarget NAME := [[q1,...,q6], [...]]" has its
+ *    six robot axes corrected ("%.4f"); every other line is copied.
+ * Blank lines and lines starting with '#' are copied. A malformed line or a
+ * target outside the joint limits is an error with file:line:col. A target
+ * that does not converge is written as the target plus the last good
+ * correction (the stream's fallback) and counted; its warning names the
+ * cause (a joint limit, the largest allowed correction, the iteration limit)
+ * and the position error of what was written.
+ *
+ * Files (rch_comp_run): the output is written to a temporary file beside it
+ * and renamed into place only when the whole input went through (rch_out,
+ * rch_file.h); an output that names the input, the model or the nominal
+ * model is refused before anything is written, so a typo never destroys a
+ * program or a model (issue 12). "-" is standard input / output (streamed,
+ * flushed per line).
+ *
+ * Host side: stdio and the heap. Errors: -1 with rch_diag set.
+ */
+#ifndef RCH_COMP_H
+#define RCH_COMP_H
+
+#include <stdio.h>
+
+#include "rc_comp.h"
+#include "rch_diag.h"
+
+typedef enum rch_comp_format {
+    RCH_COMP_AUTO = 0, /* detect from the first line */
+    RCH_COMP_CSV = 1,
+    RCH_COMP_RAPID = 2
+} rch_comp_format;
+
+/* What rch_comp_run does; zero-initialise, then set the paths. */
+typedef struct rch_comp_job {
+    const char *model_path;   /* calibrated model (rcal-model/1); required */
+    const char *nominal_path; /* nominal model the targets were made with; NULL: the model file's "nominal" */
+    const char *in_path;      /* targets; NULL or "-": standard input */
+    const char *out_path;     /* result; NULL or "-": standard output */
+    rch_comp_format format;
+    int position_only;        /* match the flange position only */
+    double max_dev_deg;       /* largest correction per joint; 0: the default 0.1 rad */
+} rch_comp_job;
+
+typedef struct rch_comp_result {
+    rch_comp_format format;       /* the form read (detected or forced) */
+    unsigned long n;              /* targets compensated */
+    unsigned long n_fail;         /* not converged: written as target + last good correction */
+    unsigned long n_pos_only;     /* position matched, orientation best effort */
+    unsigned long n_joint_limit;  /* of n_fail: a joint limit was the cause */
+    unsigned long iters;          /* iterations, all targets */
+    double max_corr_deg;          /* largest correction written */
+    double max_fail_err_mm;       /* largest position error of a flagged target, as written */
+    double t_ns;                  /* time spent in the compensation */
+    int no_nominal;               /* the model file has no "nominal" table and none was given */
+} rch_comp_result;
+
+/* Compensate lines of `in` (named in_name in messages) to `out` with the
+ * stream s. warn (may be NULL): one warning line per flagged target.
+ * Returns 0 (every target converged), 1 (some flagged; the output is
+ * complete), -1 (an input error: d set; the output is incomplete). */
+int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
+                   const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d);
+
+/* The whole command: load the models, open the input, refuse an output
+ * that is one of the inputs, compensate, commit the output. res: counts
+ * (set even on failure). Returns as rch_comp_lines, -1 also for a model or
+ * file error (d set; no output file created or changed). */
+int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_diag *d);
+
+#endif

@@ -1,0 +1,59 @@
+/* rch_stats.c - summary statistics (see rch_stats.h). */
+#include "rch_stats.h"
+
+#include <math.h>
+#include <string.h>
+
+void rch_stats_add(rch_stats *s, double e)
+{
+    const double a = fabs(e);
+    s->n++;
+    s->sum_sq += e * e;
+    s->sum_abs += a;
+    const double d = e - s->mean;
+    s->mean += d / (double)s->n;
+    s->m2 += d * (e - s->mean);
+    if (a > s->max_abs)
+        s->max_abs = a;
+}
+
+void rch_stats_of(rch_stats *s, const double *v, size_t n)
+{
+    memset(s, 0, sizeof *s);
+    for (size_t i = 0; i < n; ++i)
+        rch_stats_add(s, v[i]);
+}
+
+double rch_stats_rms(const rch_stats *s)
+{
+    return s->n ? sqrt(s->sum_sq / (double)s->n) : 0.0;
+}
+
+double rch_stats_mean_abs(const rch_stats *s)
+{
+    return s->n ? s->sum_abs / (double)s->n : 0.0;
+}
+
+double rch_stats_sd(const rch_stats *s)
+{
+    return s->n > 1 ? sqrt(s->m2 / (double)(s->n - 1)) : 0.0;
+}
+
+void rch_stats_metrics(rc_metrics *out, const rch_stats *s)
+{
+    memset(out, 0, sizeof *out);
+    out->n = s->n;
+    out->rmse_mm = rch_stats_rms(s);
+    out->mean_abs_mm = rch_stats_mean_abs(s);
+    out->sd_mm = rch_stats_sd(s);
+    out->mean_mm = s->mean;
+    out->max_mm = s->max_abs;
+}
+
+double rch_rms(const double *v, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        s += v[i] * v[i];
+    return n ? sqrt(s / (double)n) : 0.0;
+}

@@ -1,0 +1,44 @@
+/* rch_stats.h - summary statistics of a series of errors: the one definition
+ * of RMSE, mean |e|, SD, mean and max used by the reports.
+ *
+ * Accumulate values one at a time (rch_stats_add) or take an array
+ * (rch_stats_of); read the figures from the accumulator. The sum of squares is
+ * accumulated in input order (RMSE = sqrt(sum e^2 / n), bit for bit what a
+ * plain loop gives), the mean and SD with Welford's update (SD with n - 1 in
+ * the denominator, 0 for fewer than two values). These are the same
+ * definitions as the core's rc_metrics (rc_eval), which computes them for the
+ * cable-length residuals of a model; rch_stats_metrics converts.
+ *
+ * Host side (prefix rch_): no heap, no I/O. An all-zero rch_stats is empty.
+ */
+#ifndef RCH_STATS_H
+#define RCH_STATS_H
+
+#include <stddef.h>
+
+#include "rc_solve.h"
+
+typedef struct rch_stats {
+    size_t n;
+    double sum_sq;  /* sum e^2 */
+    double sum_abs; /* sum |e| */
+    double mean;    /* running mean (Welford) */
+    double m2;      /* running sum of squared deviations (Welford) */
+    double max_abs; /* max |e| */
+} rch_stats;
+
+void rch_stats_add(rch_stats *s, double e);
+/* s reset, then every v[i] (n) added. */
+void rch_stats_of(rch_stats *s, const double *v, size_t n);
+
+double rch_stats_rms(const rch_stats *s);      /* sqrt(sum e^2 / n); 0 when empty */
+double rch_stats_mean_abs(const rch_stats *s); /* mean |e|; 0 when empty */
+double rch_stats_sd(const rch_stats *s);       /* standard deviation, n - 1; 0 below two values */
+
+/* The same figures in the core's rc_metrics (rmse, mean |e|, SD, mean, max). */
+void rch_stats_metrics(rc_metrics *out, const rch_stats *s);
+
+/* RMS of v (n): sqrt(sum v^2 / n), 0 for n = 0. */
+double rch_rms(const double *v, size_t n);
+
+#endif
