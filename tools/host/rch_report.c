@@ -946,6 +946,38 @@ static void sec_metrics(rep *r)
     fputs("</div></section>\n", f);
 }
 
+/* A table with one row per object of the JSON array `arr`: one column per
+ * jcol, a string ('s'), a number with fmt ('n') or a p-value ('p'). */
+typedef struct {
+    const char *head, *key;
+    char kind;
+    const char *fmt;
+} jcol;
+
+static void json_table(rep *r, const rch_json *arr, const jcol *cols, size_t n_cols)
+{
+    FILE *f = r->f;
+    fputs("<table><tr>", f);
+    for (size_t c = 0; c < n_cols; ++c)
+        fprintf(f, "<th%s>%s</th>", cols[c].kind == 's' ? " class=\"l\"" : "", cols[c].head);
+    fputs("</tr>\n", f);
+    for (size_t k = 0; arr && k < arr->n; ++k) {
+        fputs("<tr>", f);
+        for (size_t c = 0; c < n_cols; ++c) {
+            fputs(cols[c].kind == 's' ? "<td class=\"l\">" : "<td>", f);
+            if (cols[c].kind == 's')
+                put_str(r, jstr(arr->items[k], cols[c].key));
+            else if (cols[c].kind == 'p')
+                put_p(r, jnum(arr->items[k], cols[c].key));
+            else
+                put_num(r, jnum(arr->items[k], cols[c].key), cols[c].fmt);
+            fputs("</td>", f);
+        }
+        fputs("</tr>\n", f);
+    }
+    fputs("</table>\n", f);
+}
+
 static void params_table(rep *r, const prow *p, size_t n)
 {
     FILE *f = r->f;
@@ -1096,19 +1128,10 @@ static void ident_block(rep *r)
     const rch_json *dirs = jarr(id, "directions");
     if (!dirs || dirs->n == 0)
         return;
-    fputs("<table><tr><th class=\"l\">direction the data do not (or barely) see</th><th>relative singular value</th>"
-          "<th class=\"l\">identifiable</th></tr>\n",
-          f);
-    for (size_t k = 0; k < dirs->n; ++k) {
-        fputs("<tr><td class=\"l mono\">", f);
-        put_str(r, jstr(dirs->items[k], "combo"));
-        fputs("</td><td>", f);
-        put_num(r, jnum(dirs->items[k], "sv_rel"), "%.2g");
-        fputs("</td><td class=\"l\">", f);
-        put_str(r, jstr(dirs->items[k], "identifiable"));
-        fputs("</td></tr>\n", f);
-    }
-    fputs("</table>\n", f);
+    static const jcol cols[] = {{"direction the data do not (or barely) see", "combo", 's', NULL},
+                                {"relative singular value", "sv_rel", 'n', "%.2g"},
+                                {"identifiable", "identifiable", 's', NULL}};
+    json_table(r, dirs, cols, sizeof cols / sizeof cols[0]);
 }
 
 static void sec_params(rep *r, const prow *p, size_t n)
@@ -1306,21 +1329,12 @@ static void sec_diag(rep *r, const crow *c, size_t n)
     }
     const rch_json *ps = jarr(r->diag, "params");
     if (ps && ps->n) {
-        fputs("<h3>Parameters of the chosen effects</h3><table><tr><th class=\"l\">name</th><th>value</th>"
-              "<th>std error</th><th class=\"l\">unit</th></tr>\n",
-              f);
-        for (size_t k = 0; k < ps->n; ++k) {
-            fputs("<tr><td class=\"l\">", f);
-            put_str(r, jstr(ps->items[k], "name"));
-            fputs("</td><td>", f);
-            put_num(r, jnum(ps->items[k], "value"), "%.5g");
-            fputs("</td><td>", f);
-            put_num(r, jnum(ps->items[k], "se"), "%.2g");
-            fputs("</td><td class=\"l\">", f);
-            put_str(r, jstr(ps->items[k], "unit"));
-            fputs("</td></tr>\n", f);
-        }
-        fputs("</table>\n", f);
+        static const jcol cols[] = {{"name", "name", 's', NULL},
+                                    {"value", "value", 'n', "%.5g"},
+                                    {"std error", "se", 'n', "%.2g"},
+                                    {"unit", "unit", 's', NULL}};
+        fputs("<h3>Parameters of the chosen effects</h3>\n", f);
+        json_table(r, ps, cols, sizeof cols / sizeof cols[0]);
     }
     structure_table(r);
     const rch_json *notes = jarr(r->diag, "not_identifiable");
