@@ -1296,9 +1296,16 @@ static void sec_diag(rep *r, const crow *c, size_t n)
     put_str(r, jstr(r->diag, "effect"));
     if (isfinite(jnum(r->diag, "joint")))
         fprintf(f, " (joint %.0f)", jnum(r->diag, "joint"));
-    fputs("</b> &mdash; ", f);
-    put_str(r, jstr(r->diag, "remaining_why"));
+    fputs("</b>", f);
+    const char *why = jstr(r->diag, "remaining_why");
+    if (why && *why) {
+        fputs(" &mdash; ", f);
+        put_esc(f, why);
+    }
     fputs("</p>\n<table class=\"kv\">\n", f);
+    kv(r, "after the chosen effects");
+    put_str(r, jstr(r->diag, "remaining"));
+    kv_end(r);
     kv(r, "held-out RMSE");
     fputs("geometry only ", f);
     put_num(r, jnum(r->diag, "rmse_before_mm"), "%.4f mm");
