@@ -281,6 +281,37 @@ static void test_minimal_run(void **state)
     free(h);
 }
 
+/* Members of the wrong type are "not in this run", never a crash. */
+static void test_wrong_types(void **state)
+{
+    (void)state;
+    put_file("odd.json",
+             "{\"before\": \"x\", \"after\": {\"rmse_mm\": \"0.1\"}, \"data\": [\"a\"], \"held_out\": 1,"
+             " \"params\": [1, \"x\", {}, {\"name\": 5, \"unit\": null, \"value\": \"v\", \"class\": 2}],"
+             " \"identifiability\": {\"directions\": [null, 3], \"rank\": \"r\"},"
+             " \"uncertainty\": {\"parameters\": \"no\", \"position95_mm\": []},"
+             " \"provenance\": {\"data\": [7, {\"file\": 3}], \"tool\": {}}, \"warnings\": [1, \"ok <1>\"]}");
+    put_file("odd_diag.json",
+             "{\"candidates\": [null, {\"step\": \"1\", \"tested\": true}, 4], \"sequence\": [1],"
+             " \"effect\": 3, \"structure_before\": [5, {}], \"structure_after\": null,"
+             " \"not_identifiable\": [3], \"params\": [null]}");
+    rch_report_result res;
+    rch_diag d;
+    char msg[1024];
+    if (report(&res, "odd.json", "odd_diag.json", "odd.html", &d) != 0)
+        fail_msg("%s", rch_diag_str(&d, msg, sizeof msg));
+    char *h = get_file("odd.html");
+    assert_non_null(h);
+    assert_true(res.n_missing > 20);
+    assert_non_null(strstr(h, "ok &lt;1&gt;"));
+    assert_null(strstr(h, ">nan"));   /* a NaN printed as a number ("provenance" holds "nan") */
+    assert_null(strstr(h, ">-nan"));
+    assert_null(strstr(h, " nan"));
+    assert_int_equal(count(h, "<svg"), res.n_plots);
+    assert_non_null(strstr(h, "</html>"));
+    free(h);
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
@@ -328,6 +359,7 @@ int main(void)
         cmocka_unit_test(test_cmdline),
         cmocka_unit_test(test_full_run_escaped),
         cmocka_unit_test(test_minimal_run),
+        cmocka_unit_test(test_wrong_types),
         cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "rc_version.h"
 #include "rch_file.h"
 #include "rch_json.h"
 #include "rch_sha256.h"
@@ -704,9 +705,20 @@ static void warn_diag(rep *r)
         return;
     if (effect && strcmp(effect, "unexplained") == 0)
         warnf(r, "The diagnosis finds error the model does not explain: %s.", why ? why : "not in this run");
-    else if (effect && strcmp(effect, "none") != 0)
-        warnf(r, "The diagnosis finds an effect the geometric model misses: %s (held-out RMSE %.4g mm without it, "
-                 "%.4g mm with it).", effect, jnum(r->diag, "rmse_before_mm"), jnum(r->diag, "rmse_after_mm"));
+    else if (effect && strcmp(effect, "none") != 0) {
+        char seq[256] = "";
+        const rch_json *q = jarr(r->diag, "sequence");
+        for (size_t k = 0; q && k < q->n; ++k)
+            if (q->items[k]->type == RCH_JSTR && strlen(seq) + strlen(q->items[k]->str) + 3 < sizeof seq)
+                snprintf(seq + strlen(seq), sizeof seq - strlen(seq), "%s%s", k ? ", " : "", q->items[k]->str);
+        const double b = jnum(r->diag, "rmse_before_mm"), a = jnum(r->diag, "rmse_after_mm");
+        char fig[128] = "";
+        if (isfinite(a) && isfinite(b))
+            snprintf(fig, sizeof fig, " (held-out RMSE %.4g mm with the geometry alone, %.4g mm with %s)", b, a,
+                     q && q->n > 1 ? "them" : "it");
+        warnf(r, "The diagnosis finds what the geometric model misses: %s%s. The calibration above does not model "
+                 "it.", seq[0] ? seq : effect, fig);
+    }
     const double nd = jnum(r->diag, "n"), nc = jnum(r->cal, "n_train") + jnum(r->cal, "n_test");
     if (isfinite(nd) && isfinite(nc) && nd != nc)
         warnf(r, "The diagnosis ran on %.0f samples, the calibration on %.0f: are they from the same data?", nd, nc);
@@ -830,9 +842,13 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
     kv_end(r);
     kv(r, "noise floor");
     put_num(r, jnum(r->diag, "noise_floor_mm"), "%.4g mm rms");
-    if (r->diag)
-        fprintf(f, " (joint display step through the Jacobian %.4g mm, length step %.4g mm)",
-                jnum(r->diag, "noise_floor_joints_mm"), jnum(r->diag, "noise_floor_length_mm"));
+    if (r->diag) {
+        fputs(" (joint display step through the Jacobian ", f);
+        put_num(r, jnum(r->diag, "noise_floor_joints_mm"), "%.4g mm");
+        fputs(", length step ", f);
+        put_num(r, jnum(r->diag, "noise_floor_length_mm"), "%.4g mm");
+        fputs(")", f);
+    }
     kv_end(r);
     for (size_t i = 0; i < n_df; ++i) {
         kv(r, "file, SHA-256");
@@ -1182,7 +1198,11 @@ static void cands_table(rep *r, const crow *c, size_t n)
     for (size_t k = 0; k < n; ++k) {
         fputs("<tr><td class=\"l\">", f);
         put_esc(f, c[k].label);
-        fprintf(f, "</td><td>%.0f (%.0f)</td><td>", c[k].params, c[k].ident);
+        fputs("</td><td>", f);
+        put_num(r, c[k].params, "%.0f");
+        fputs(" (", f);
+        put_num(r, c[k].ident, "%.0f");
+        fputs(")</td><td>", f);
         if (c[k].tested) {
             put_num(r, c[k].rmse_cv, "%.5f");
             fputs("</td><td>", f);
@@ -1264,7 +1284,11 @@ static void structure_table(rep *r)
         const rch_json *t = b->items[k], *u = a && k < a->n ? a->items[k] : NULL;
         fputs("<tr><td class=\"l\">", f);
         put_str(r, jstr(t, "variable"));
-        fprintf(f, "</td><td>%.0f, %.0f</td><td>", jnum(t, "dof1"), jnum(t, "dof2"));
+        fputs("</td><td>", f);
+        put_num(r, jnum(t, "dof1"), "%.0f");
+        fputs(", ", f);
+        put_num(r, jnum(t, "dof2"), "%.0f");
+        fputs("</td><td>", f);
         put_num(r, jnum(t, "f"), "%.3g");
         fputs("</td><td>", f);
         put_p(r, jnum(t, "p"));
@@ -1507,7 +1531,7 @@ static void sec_provenance(rep *r, const dfile *df, size_t n_df, const char *dat
     kv(r, "this report");
     fputs("<span class=\"mono\">", f);
     put_esc(f, r->cfg->command_line ? r->cfg->command_line : "rcal report");
-    fputs("</span>, ", f);
+    fprintf(f, "</span>, rcal %s, ", rc_version());
     put_esc(f, date);
     fputs("; plot data beside it: ", f);
     for (unsigned k = 0; k < r->res->n_csv; ++k) {
