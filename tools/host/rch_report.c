@@ -776,7 +776,8 @@ static const char css[] =
     "ul.warn li{background:#fff6e5;border-left:4px solid #E69F00;padding:4px 10px;margin:4px 0}"
     "svg.chart{border:1px solid #e4e7eb;border-radius:4px;background:#fff}"
     ".sw{display:inline-block;width:10px;height:10px;margin-right:4px;vertical-align:baseline}"
-    "details summary{cursor:pointer;color:#234}";
+    "details summary{cursor:pointer;color:#234}"
+    "@media print{body{background:#fff}main{max-width:none;padding:0}section{break-inside:avoid;border:none}}";
 
 static void kv(rep *r, const char *key) { fprintf(r->f, "<tr><th>%s</th><td>", key); }
 static void kv_end(rep *r) { fputs("</td></tr>\n", r->f); }
@@ -1377,6 +1378,51 @@ static void sec_diag(rep *r, const crow *c, size_t n)
     fputs("</section>\n", f);
 }
 
+static void accuracy_chart(rep *r, const arow *a, size_t n)
+{
+    if (n == 0)
+        return;
+    const char *labels[10];
+    double v[10];
+    unsigned char col[10], leg[3];
+    const char *leg_label[3];
+    int used[C_N] = {0};
+    size_t n_leg = 0;
+    for (size_t k = 0; k < n; ++k) {
+        labels[k] = a[k].label;
+        v[k] = a[k].v;
+        col[k] = a[k].col;
+        used[a[k].col] = 1;
+    }
+    if (used[C_PRED]) {
+        leg[n_leg] = C_PRED;
+        leg_label[n_leg++] = "predicted 95 % (longest semi-axis)";
+    }
+    if (used[C_BEFORE]) {
+        leg[n_leg] = C_BEFORE;
+        leg_label[n_leg++] = "nominal, against the truth";
+    }
+    if (used[C_AFTER]) {
+        leg[n_leg] = C_AFTER;
+        leg_label[n_leg++] = "calibrated, against the truth";
+    }
+    chart c;
+    memset(&c, 0, sizeof c);
+    c.title = "Flange-position accuracy over the workspace";
+    c.xlabel = "flange position (mm)";
+    c.n_rows = n;
+    c.n_sub = 1;
+    c.label = labels;
+    c.v = v;
+    c.col = col;
+    c.bars = 1;
+    c.leg = leg;
+    c.leg_label = leg_label;
+    c.n_leg = n_leg;
+    c.width_px = 700;
+    chart_svg(r, &c);
+}
+
 static void sec_accuracy(rep *r, const arow *a, size_t n)
 {
     FILE *f = r->f;
@@ -1422,47 +1468,7 @@ static void sec_accuracy(rep *r, const arow *a, size_t n)
     fputs("</table>\n", f);
     if (r->unc)
         fprintf(f, "<p class=\"note\">Uncertainty %s.</p>\n", r->unc_from);
-    if (n) {
-        const char *labels[10];
-        double v[10];
-        unsigned char col[10], leg[3];
-        const char *leg_label[3];
-        int used[C_N] = {0};
-        size_t n_leg = 0;
-        for (size_t k = 0; k < n; ++k) {
-            labels[k] = a[k].label;
-            v[k] = a[k].v;
-            col[k] = a[k].col;
-            used[a[k].col] = 1;
-        }
-        if (used[C_PRED]) {
-            leg[n_leg] = C_PRED;
-            leg_label[n_leg++] = "predicted 95 % (longest semi-axis)";
-        }
-        if (used[C_BEFORE]) {
-            leg[n_leg] = C_BEFORE;
-            leg_label[n_leg++] = "nominal, against the truth";
-        }
-        if (used[C_AFTER]) {
-            leg[n_leg] = C_AFTER;
-            leg_label[n_leg++] = "calibrated, against the truth";
-        }
-        chart c;
-        memset(&c, 0, sizeof c);
-        c.title = "Flange-position accuracy over the workspace";
-        c.xlabel = "flange position (mm)";
-        c.n_rows = n;
-        c.n_sub = 1;
-        c.label = labels;
-        c.v = v;
-        c.col = col;
-        c.bars = 1;
-        c.leg = leg;
-        c.leg_label = leg_label;
-        c.n_leg = n_leg;
-        c.width_px = 700;
-        chart_svg(r, &c);
-    }
+    accuracy_chart(r, a, n);
     fputs("</section>\n", f);
 }
 
