@@ -17,17 +17,19 @@ typedef struct {
     double R[RC_NJ + 1][9];
 } chain;
 
-static void chain_compute(chain *c, const double dh[][4], const double theta_rad[], unsigned nj)
+/* The chain from the DH lengths (dh[i][0] a, dh[i][1] d) and the cosines and
+ * sines of the joint angles (ct, st) and of the alphas (ca, sa), (nj) each. */
+static void chain_trig(chain *c, const double dh[][4], const double ct[], const double st[], const double ca[],
+                       const double sa[], unsigned nj)
 {
     static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     memcpy(c->R[0], eye, sizeof eye);
     c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
     for (unsigned i = 0; i < nj; ++i) {
-        const double a = dh[i][0], d = dh[i][1], al = dh[i][2];
-        const double ct = cos(theta_rad[i]), st = sin(theta_rad[i]);
-        const double ca = cos(al), sa = sin(al);
-        const double L[9] = {ct, -st * ca, st * sa, st, ct * ca, -ct * sa, 0.0, sa, ca};
-        const double t[3] = {a * ct, a * st, d};
+        const double a = dh[i][0], d = dh[i][1];
+        const double L[9] = {ct[i], -st[i] * ca[i], st[i] * sa[i], st[i], ct[i] * ca[i], -ct[i] * sa[i],
+                             0.0,   sa[i],          ca[i]};
+        const double t[3] = {a * ct[i], a * st[i], d};
         const double *P = c->R[i];
         double *N = c->R[i + 1];
         for (int r = 0; r < 3; ++r) {
@@ -36,6 +38,59 @@ static void chain_compute(chain *c, const double dh[][4], const double theta_rad
             c->o[i + 1][r] = c->o[i][r] + P[3 * r] * t[0] + P[3 * r + 1] * t[1] + P[3 * r + 2] * t[2];
         }
     }
+}
+
+/* chain_trig for the six joints of a model, with fewer operations (the
+ * solver's passes): R' = R Rz(theta) Rx(alpha) written on the columns x, y, z
+ * of R, o' = o + R (a ct, a st, d):
+ *   x' = x ct + y st,  v = y ct - x st,  y' = v ca + z sa,  z' = z ca - v sa,
+ *   o' = o + a x' + d z.
+ * Joint 1 starts from the base (R = I). With full = 0 the last rotation R6 is
+ * left out (a length without Jacobian or tool offset needs o6 only).
+ * Equal to chain_trig up to rounding. */
+static void chain_axes(chain *c, const rc_model *m, const double ct[RC_NJ], const double st[RC_NJ],
+                       const double ca[RC_NJ], const double sa[RC_NJ], int full)
+{
+    static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const double a0 = m->x[RC_P_A(0)], d0 = m->x[RC_P_D(0)];
+    const double R1[9] = {ct[0], -st[0] * ca[0], st[0] * sa[0], st[0], ct[0] * ca[0], -ct[0] * sa[0],
+                          0.0,   sa[0],          ca[0]};
+    memcpy(c->R[0], eye, sizeof eye);
+    memcpy(c->R[1], R1, sizeof R1);
+    c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
+    c->o[1][0] = a0 * ct[0];
+    c->o[1][1] = a0 * st[0];
+    c->o[1][2] = d0;
+    for (unsigned i = 1; i < RC_NJ; ++i) {
+        const double a = m->x[RC_P_A(i)], d = m->x[RC_P_D(i)];
+        const double *P = c->R[i];
+        double *N = c->R[i + 1];
+        if (i == RC_NJ - 1 && !full) {
+            for (unsigned r = 0; r < 3; ++r)
+                c->o[i + 1][r] = c->o[i][r] + a * (P[3 * r] * ct[i] + P[3 * r + 1] * st[i]) + d * P[3 * r + 2];
+            break;
+        }
+        for (unsigned r = 0; r < 3; ++r) {
+            const double xr = P[3 * r], yr = P[3 * r + 1], zr = P[3 * r + 2];
+            const double nx = xr * ct[i] + yr * st[i], v = yr * ct[i] - xr * st[i];
+            N[3 * r] = nx;
+            N[3 * r + 1] = v * ca[i] + zr * sa[i];
+            N[3 * r + 2] = zr * ca[i] - v * sa[i];
+            c->o[i + 1][r] = c->o[i][r] + a * nx + d * zr;
+        }
+    }
+}
+
+static void chain_compute(chain *c, const double dh[][4], const double theta_rad[], unsigned nj)
+{
+    double ct[RC_NJ], st[RC_NJ], ca[RC_NJ], sa[RC_NJ];
+    for (unsigned i = 0; i < nj; ++i) {
+        ct[i] = cos(theta_rad[i]);
+        st[i] = sin(theta_rad[i]);
+        ca[i] = cos(dh[i][2]);
+        sa[i] = sin(dh[i][2]);
+    }
+    chain_trig(c, dh, ct, st, ca, sa, nj);
 }
 
 static void cross3(double out[3], const double a[3], const double b[3])
@@ -113,7 +168,10 @@ void rc_model_wrap_angles(rc_model *m)
     for (unsigned i = 0; i < RC_NJ; ++i) {
         for (unsigned k = RC_P_ALPHA(i); k <= RC_P_THETA(i); ++k) {
             double a = m->x[k];
-            if (!isfinite(a))
+            /* fmod by the double nearest 2 pi is exact but shifts the angle
+             * by 2.4e-16 rad per turn: beyond 1e6 rad (4e-11 rad) wrapping
+             * would change the model, so such angles stay as they are. */
+            if (!isfinite(a) || fabs(a) > 1e6)
                 continue;
             a = fmod(a, 2.0 * M_PI); /* (-2 pi, 2 pi) */
             if (a > M_PI)
@@ -307,17 +365,10 @@ static int tool_index(const rc_model *m)
     return -1;
 }
 
-/* Chain of the model at q; tool (3) receives the measured point: the flange
- * origin, plus R6 t with a tool offset. */
-static void model_chain(chain *c, double tool[3], const rc_model *m, const double q_rad[RC_NJ])
+/* The measured point tool (3) of chain c: the flange origin, plus R6 t with
+ * a tool offset at x[ti] (ti < 0: none). */
+static void chain_tool(double tool[3], const chain *c, const rc_model *m, int ti)
 {
-    double dh[RC_NJ][4], th[RC_NJ];
-    for (unsigned i = 0; i < RC_NJ; ++i)
-        for (unsigned k = 0; k < 4; ++k)
-            dh[i][k] = m->x[4 * i + k];
-    rc_model_theta(th, m, q_rad);
-    chain_compute(c, (const double(*)[4])dh, th, RC_NJ);
-    const int ti = tool_index(m);
     for (unsigned r = 0; r < 3; ++r) {
         tool[r] = c->o[RC_NJ][r];
         if (ti >= 0) {
@@ -326,6 +377,15 @@ static void model_chain(chain *c, double tool[3], const rc_model *m, const doubl
             tool[r] += R[3 * r] * t[0] + R[3 * r + 1] * t[1] + R[3 * r + 2] * t[2];
         }
     }
+}
+
+/* Chain of the model at q; tool (3) receives the measured point. */
+static void model_chain(chain *c, double tool[3], const rc_model *m, const double q_rad[RC_NJ])
+{
+    double th[RC_NJ];
+    rc_model_theta(th, m, q_rad);
+    chain_compute(c, (const double(*)[4])m->x, th, RC_NJ);
+    chain_tool(tool, c, m, tool_index(m));
 }
 
 void rc_fk(double pos_mm[3], double rot[9], const rc_model *m, const double q_rad[RC_NJ])
@@ -370,12 +430,102 @@ void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *
         memcpy(rot, c.R[RC_NJ], 9 * sizeof rot[0]);
 }
 
+void rc_qtrig_fill(double *sin_q, double *cos_q, const rc_sample *samples, size_t n)
+{
+    RC_ASSERT(sin_q != NULL && cos_q != NULL && (samples != NULL || n == 0));
+    for (size_t k = 0; k < n; ++k)
+        for (unsigned i = 0; i < RC_NJ; ++i) {
+            const double q = samples[k].q_rad[i]; /* one load: sin and cos fuse to sincos */
+            sin_q[RC_NJ * k + i] = sin(q);
+            cos_q[RC_NJ * k + i] = cos(q);
+        }
+}
+
+void rc_meas_prepare(rc_meas_prep *p, const rc_model *m)
+{
+    RC_ASSERT(p != NULL && m != NULL);
+    memset(p, 0, sizeof *p);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const double th = m->x[RC_P_THETA(i)], al = m->x[RC_P_ALPHA(i)];
+        p->cos_off[i] = cos(th);
+        p->sin_off[i] = sin(th);
+        p->cos_alpha[i] = cos(al);
+        p->sin_alpha[i] = sin(al);
+    }
+    p->tool = (int16_t)tool_index(m);
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *e = &m->effects[i];
+        if (e->kind == RC_EFF_JOINT_COMPLIANCE || e->kind == RC_EFF_JOINT_PERIODIC) {
+            p->joint_effect[e->joint] = 1;
+            p->has_joint_effect = 1;
+        }
+    }
+}
+
+static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, const rc_sample *s, const chain *c,
+                            const double p[3]);
+
 rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sample *s)
 {
     chain c;
-    double u[3], dl_dtheta[RC_NJ], p[3];
+    double p[3];
     RC_ASSERT(len_mm != NULL && m != NULL && s != NULL);
     model_chain(&c, p, m, s->q_rad);
+    return meas_chain(len_mm, jac, m, s, &c, p);
+}
+
+/* Chain of the model at sample s by angle addition; p (3) the measured point.
+ * full = 0: R[6] is not needed (rc_meas_prepared without jac). */
+static void chain_prepared(chain *c, double p[3], const rc_model *m, const rc_meas_prep *pr, const rc_sample *s,
+                           const double *sin_q, const double *cos_q, int full)
+{
+    double own_s[RC_NJ], own_c[RC_NJ], ct[RC_NJ], st[RC_NJ];
+    if (sin_q == NULL || cos_q == NULL) {
+        rc_qtrig_fill(own_s, own_c, s, 1);
+        sin_q = own_s;
+        cos_q = own_c;
+    }
+    for (unsigned i = 0; i < RC_NJ; ++i) { /* angle addition: q_i + theta_off_i */
+        ct[i] = cos_q[i] * pr->cos_off[i] - sin_q[i] * pr->sin_off[i];
+        st[i] = sin_q[i] * pr->cos_off[i] + cos_q[i] * pr->sin_off[i];
+    }
+    if (pr->has_joint_effect) {
+        double th[RC_NJ];
+        rc_model_theta(th, m, s->q_rad);
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            if (pr->joint_effect[i]) {
+                ct[i] = cos(th[i]);
+                st[i] = sin(th[i]);
+            }
+    }
+    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || pr->tool >= 0);
+    chain_tool(p, c, m, pr->tool);
+}
+
+void rc_point_prepared(double pos_mm[3], const rc_model *m, const rc_meas_prep *p, const rc_sample *s,
+                       const double *sin_q, const double *cos_q)
+{
+    chain c;
+    RC_ASSERT(pos_mm != NULL && m != NULL && p != NULL && s != NULL);
+    chain_prepared(&c, pos_mm, m, p, s, sin_q, cos_q, 0);
+}
+
+rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const rc_meas_prep *pr,
+                           const rc_sample *s, const double *sin_q, const double *cos_q)
+{
+    chain c;
+    double p[3];
+    RC_ASSERT(len_mm != NULL && m != NULL && pr != NULL && s != NULL);
+    chain_prepared(&c, p, m, pr, s, sin_q, cos_q, jac != NULL);
+    return meas_chain(len_mm, jac, m, s, &c, p);
+}
+
+/* Length (and its Jacobian) of sample s from the model's chain c at s and
+ * the measured point p. */
+static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, const rc_sample *s, const chain *c,
+                            const double p[3])
+{
+    double u[3], dl_dtheta[RC_NJ];
     const double *e = &m->x[RC_P_ENC];
     for (int r = 0; r < 3; ++r)
         u[r] = p[r] - e[r];
@@ -406,15 +556,15 @@ rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sampl
         return RC_OK;
 
     for (unsigned i = 0; i < RC_NJ; ++i) {
-        const double z[3] = {c.R[i][2], c.R[i][5], c.R[i][8]};
-        const double x1[3] = {c.R[i + 1][0], c.R[i + 1][3], c.R[i + 1][6]};
+        const double z[3] = {c->R[i][2], c->R[i][5], c->R[i][8]};
+        const double x1[3] = {c->R[i + 1][0], c->R[i + 1][3], c->R[i + 1][6]};
         double v[3], w[3];
         for (int r = 0; r < 3; ++r)
-            v[r] = p[r] - c.o[i][r];
+            v[r] = p[r] - c->o[i][r];
         cross3(w, z, v);
         dl_dtheta[i] = scale * dot3(u, w);
         for (int r = 0; r < 3; ++r)
-            v[r] = p[r] - c.o[i + 1][r];
+            v[r] = p[r] - c->o[i + 1][r];
         cross3(w, x1, v);
         jac[RC_P_A(i)] = scale * dot3(u, x1);
         jac[RC_P_D(i)] = scale * dot3(u, z);
@@ -450,7 +600,7 @@ rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sampl
             break;
         }
         case RC_EFF_TOOL_OFFSET: { /* dp/dt = R6 */
-            const double *R = c.R[RC_NJ];
+            const double *R = c->R[RC_NJ];
             for (unsigned k = 0; k < 3; ++k)
                 J[k] = scale * (u[0] * R[k] + u[1] * R[3 + k] + u[2] * R[6 + k]);
             break;

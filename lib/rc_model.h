@@ -88,7 +88,8 @@ rc_status rc_model_init(rc_model *m, const double dh[RC_NJ][4], const double enc
 rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, unsigned count);
 
 /* Wrap every DH angle (alpha_i, theta_i) into (-pi, pi]: the model is
- * unchanged (angles enter through sin and cos only). */
+ * unchanged (angles enter through sin and cos only). Angles beyond 1e6 rad
+ * (a diverged solve) are left alone: reducing them would move them. */
 void rc_model_wrap_angles(rc_model *m);
 
 /* Short machine name of an effect kind ("length_offset", ...); never NULL. */
@@ -125,7 +126,45 @@ void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *
 /* Predicted cable length of one sample and, when jac is not NULL, its
  * analytic derivative with respect to every model parameter.
  * jac: (m->n_params). Returns RC_ERR_NUMERIC when the flange point
- * coincides with the encoder outlet (length derivative undefined). */
+ * coincides with the encoder outlet (length derivative undefined).
+ * Same as rc_meas_prepare + rc_meas_prepared(no tables): bit for bit what a
+ * solver computes for the same model and sample. */
 rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sample *s);
+
+/* Many measurements of one model (a solver's pass over the data).
+ * The joint angle is theta_i = q_i + theta_off_i; its sine and cosine come
+ * from angle addition, sin(q + t) = sin q cos t + cos q sin t, so the
+ * offsets' and alphas' sines are taken once per model (rc_meas_prep) and
+ * the readings' once per data set (rc_qtrig_fill), never per pass. Joints with a
+ * joint-side effect (compliance, periodic) take sin and cos of their full
+ * angle directly. */
+
+/* Sines and cosines of the joint readings of samples (n), as two tables:
+ * sin_q (n x 6) and cos_q (n x 6), row k for samples[k]. */
+void rc_qtrig_fill(double *sin_q, double *cos_q, const rc_sample *samples, size_t n);
+
+/* What a model needs once per pass: sines and cosines of its DH angles and
+ * where its effects are. Valid while the model is unchanged. */
+typedef struct rc_meas_prep {
+    double cos_off[RC_NJ], sin_off[RC_NJ];     /* (6) of theta_off_i */
+    double cos_alpha[RC_NJ], sin_alpha[RC_NJ]; /* (6) of alpha_i */
+    uint8_t joint_effect[RC_NJ];               /* nonzero: joint i has a joint-side effect */
+    uint8_t has_joint_effect;                  /* any of joint_effect */
+    int16_t tool;                              /* index of the tool offset in x, -1: none */
+} rc_meas_prep;
+
+void rc_meas_prepare(rc_meas_prep *p, const rc_model *m);
+
+/* The measured point (the flange point, or the tool point with
+ * RC_EFF_TOOL_OFFSET) of sample s as rc_meas_prepared sees it: pos_mm (3).
+ * sin_q, cos_q as there. */
+void rc_point_prepared(double pos_mm[3], const rc_model *m, const rc_meas_prep *p, const rc_sample *s,
+                       const double *sin_q, const double *cos_q);
+
+/* rc_meas with p = rc_meas_prepare(m) and the reading's sines and cosines
+ * sin_q, cos_q (6 each, rc_qtrig_fill of s; both NULL: computed here).
+ * The result does not depend on whether they are given. */
+rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const rc_meas_prep *p,
+                           const rc_sample *s, const double *sin_q, const double *cos_q);
 
 #endif /* RC_MODEL_H */

@@ -2,6 +2,8 @@
 #include "rc_solve.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "rc_linalg.h"
@@ -54,13 +56,27 @@ const char *rc_exit_str(rc_exit e)
     return "unknown";
 }
 
-rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples, size_t n)
+/* What a pass over the samples may use besides the samples: it evaluates them
+ * with rc_meas_prepared (the model's sines once per pass), the readings'
+ * sines from the tables sin_q, cos_q ((n x 6) each, rc_qtrig_fill; both
+ * NULL: per sample), and rc_normal_eq's row blocks in jblk (NE_BLOCK x nf;
+ * NULL: row by row). */
+typedef struct {
+    const double *sin_q, *cos_q;
+    double *jblk;
+} passbuf;
+
+static const double *tab_row(const double *t, size_t k) { return t != NULL ? t + (size_t)RC_NJ * k : NULL; }
+
+static rc_status cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *samples, passbuf t, size_t n)
 {
+    rc_meas_prep p;
     double sum = 0.0;
     RC_ASSERT(cost_mm2 != NULL && m != NULL && (samples != NULL || n == 0));
+    rc_meas_prepare(&p, m);
     for (size_t i = 0; i < n; ++i) {
         double l;
-        rc_status st = rc_meas(&l, NULL, m, &samples[i]);
+        rc_status st = rc_meas_prepared(&l, NULL, m, &p, &samples[i], tab_row(t.sin_q, i), tab_row(t.cos_q, i));
         if (st != RC_OK)
             return st;
         const double r = l - samples[i].len_mm;
@@ -70,15 +86,75 @@ rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples,
     return isfinite(sum) ? RC_OK : RC_ERR_NUMERIC;
 }
 
-rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
-                       const uint16_t *idx, unsigned nf, const rc_sample *samples, size_t n)
+rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples, size_t n)
+{
+    const passbuf none = {NULL, NULL, NULL};
+    return cost_tab(cost_mm2, m, samples, none, n);
+}
+
+/* Samples per block of the normal-equation update: A += Jb^T Jb with NE_BLOCK
+ * rows at a time reads and writes A once per block instead of once per row.
+ * The rows are added one after the other (left to right), so the sums are
+ * those of the row-by-row update to the last bit. */
+#define NE_BLOCK 4
+
+/* The rows of samples [s0, s0 + NE_BLOCK) (zero rows past n) into jb
+ * (NE_BLOCK x nf, free parameters only) and their residuals into rb. */
+static rc_status block_rows(double *jb, double rb[NE_BLOCK], double *sum, double *jrow, const rc_model *m,
+                            const rc_meas_prep *p, const uint16_t *idx, unsigned nf, const rc_sample *samples,
+                            passbuf t, size_t s0, size_t n)
+{
+    for (unsigned b = 0; b < NE_BLOCK; ++b) {
+        const size_t s = s0 + b;
+        double *row = jb + (size_t)b * nf, l;
+        if (s >= n) { /* past the last sample: a zero row adds nothing */
+            rb[b] = 0.0;
+            memset(row, 0, nf * sizeof row[0]);
+            continue;
+        }
+        rc_status st = rc_meas_prepared(&l, jrow, m, p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
+        if (st != RC_OK)
+            return st;
+        rb[b] = l - samples[s].len_mm;
+        *sum += rb[b] * rb[b];
+        for (unsigned i = 0; i < nf; ++i)
+            row[i] = jrow[idx[i]];
+    }
+    return RC_OK;
+}
+
+/* A (nf x nf, upper triangle) += Jb^T Jb, g += Jb^T rb for the NE_BLOCK rows
+ * j0..j3 (nf each), a symmetric rank-NE_BLOCK update; restrict: A, g and the
+ * rows never overlap, so the inner loop vectorises. */
+static void rank_block_update(double *restrict A, double *restrict g, const double *restrict j0,
+                              const double *restrict j1, const double *restrict j2, const double *restrict j3,
+                              const double rb[NE_BLOCK], unsigned nf)
+{
+    const double r0 = rb[0], r1 = rb[1], r2 = rb[2], r3 = rb[3];
+    for (size_t i = 0; i < nf; ++i) {
+        const double a0 = j0[i], a1 = j1[i], a2 = j2[i], a3 = j3[i];
+        if (a0 == 0.0 && a1 == 0.0 && a2 == 0.0 && a3 == 0.0)
+            continue;
+        g[i] = g[i] + a0 * r0 + a1 * r1 + a2 * r2 + a3 * r3;
+        double *restrict Ai = A + i * nf;
+        for (size_t k = i; k < nf; ++k)
+            Ai[k] = Ai[k] + a0 * j0[k] + a1 * j1[k] + a2 * j2[k] + a3 * j3[k];
+    }
+}
+
+static rc_status normal_eq_tab(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
+                               const uint16_t *idx, unsigned nf, const rc_sample *samples, passbuf t, size_t n)
 {
     double sum = 0.0;
+    rc_meas_prep p;
+    RC_ASSERT(A != NULL && g != NULL && cost_mm2 != NULL && jrow != NULL && m != NULL && idx != NULL);
+    RC_ASSERT(samples != NULL || n == 0);
+    rc_meas_prepare(&p, m);
     memset(A, 0, (size_t)nf * nf * sizeof A[0]);
     memset(g, 0, nf * sizeof g[0]);
-    for (size_t s = 0; s < n; ++s) {
+    for (size_t s = 0; s < n && t.jblk == NULL; ++s) { /* row by row */
         double l;
-        rc_status st = rc_meas(&l, jrow, m, &samples[s]);
+        rc_status st = rc_meas_prepared(&l, jrow, m, &p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
         if (st != RC_OK)
             return st;
         const double r = l - samples[s].len_mm;
@@ -93,6 +169,13 @@ rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, con
                 Ai[k] += ji * jrow[idx[k]];
         }
     }
+    for (size_t s0 = 0; s0 < n && t.jblk != NULL; s0 += NE_BLOCK) {
+        double rb[NE_BLOCK];
+        rc_status st = block_rows(t.jblk, rb, &sum, jrow, m, &p, idx, nf, samples, t, s0, n);
+        if (st != RC_OK)
+            return st;
+        rank_block_update(A, g, t.jblk, t.jblk + nf, t.jblk + 2 * nf, t.jblk + 3 * nf, rb, nf);
+    }
     for (unsigned i = 0; i < nf; ++i)
         for (unsigned k = 0; k < i; ++k)
             A[(size_t)i * nf + k] = A[(size_t)k * nf + i];
@@ -100,16 +183,25 @@ rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, con
     return isfinite(sum) ? RC_OK : RC_ERR_NUMERIC;
 }
 
+rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
+                       const uint16_t *idx, unsigned nf, const rc_sample *samples, size_t n)
+{
+    const passbuf none = {NULL, NULL, NULL};
+    return normal_eq_tab(A, g, cost_mm2, jrow, m, idx, nf, samples, none, n);
+}
+
 rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, size_t n)
 {
     double mean = 0.0, m2 = 0.0, sq = 0.0, abs_sum = 0.0, mx = 0.0;
+    rc_meas_prep p;
     RC_ASSERT(out != NULL && m != NULL);
     memset(out, 0, sizeof *out);
     if (n == 0)
         return RC_ERR_ARG;
+    rc_meas_prepare(&p, m);
     for (size_t i = 0; i < n; ++i) {
         double l;
-        rc_status st = rc_meas(&l, NULL, m, &samples[i]);
+        rc_status st = rc_meas_prepared(&l, NULL, m, &p, &samples[i], NULL, NULL);
         if (st != RC_OK)
             return st;
         const double e = l - samples[i].len_mm;
@@ -319,20 +411,20 @@ static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w
 }
 
 /* Robust LM, the subspace: scale the normal equations at the current point
- * (w->A, w->g unscaled, cost) by D, take the eigen-decomposition (w->ev,
- * w->V) and keep the identifiable directions (eigenvalue above rcond *
+ * (A, w->g unscaled, cost) by D, take the eigen-decomposition (w->ev,
+ * V) and keep the identifiable directions (eigenvalue above rcond *
  * largest: *rank of them) whose Gauss-Newton step is significant: w->c[k] =
  * v_k^T g_s for those, 0 for the others; *gnorm = sum of the kept c^2. */
-static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_work *w, unsigned nf,
-                             double cost, size_t n, double rcond, double snr_min)
+static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_work *w, double *A, double *V,
+                             unsigned nf, double cost, size_t n, double rcond, double snr_min)
 {
     /* scale: A_s = D^-1 A D^-1, g_s = D^-1 g */
     for (unsigned i = 0; i < nf; ++i) {
         w->g[i] /= w->D[i];
         for (unsigned k = 0; k < nf; ++k)
-            w->A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
+            A[(size_t)i * nf + k] /= w->D[i] * w->D[k];
     }
-    rc_status st = rcu_eig_sym(w->ev, w->V, w->A, nf, 0);
+    rc_status st = rcu_eig_sym(w->ev, V, A, nf, 0);
     if (st == RC_ERR_NUMERIC)
         return st;
     const double lmax = w->ev[0];
@@ -346,7 +438,7 @@ static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_wor
         ++rank;
         double c = 0.0;
         for (unsigned i = 0; i < nf; ++i)
-            c += w->V[(size_t)i * nf + k] * w->g[i];
+            c += V[(size_t)i * nf + k] * w->g[i];
         w->c[k] = c;
         gn_gain += c * c / w->ev[k];
     }
@@ -370,7 +462,8 @@ static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_wor
 
 /* Robust LM, the damped step in the kept subspace: dx (nf, scaled) =
  * sum_k -c_k / (lambda_k + mu) v_k; returns the predicted cost decrease. */
-static double lm_subspace_step(double *dx, const rc_solve_work *w, unsigned nf, unsigned rank, double mu)
+static double lm_subspace_step(double *dx, const rc_solve_work *w, const double *V, unsigned nf, unsigned rank,
+                               double mu)
 {
     double pred = 0.0;
     for (unsigned i = 0; i < nf; ++i)
@@ -379,13 +472,15 @@ static double lm_subspace_step(double *dx, const rc_solve_work *w, unsigned nf, 
         const double lam = w->ev[k], coef = -w->c[k] / (lam + mu);
         pred += -2.0 * coef * w->c[k] - lam * coef * coef;
         for (unsigned i = 0; i < nf; ++i)
-            dx[i] += coef * w->V[(size_t)i * nf + k];
+            dx[i] += coef * V[(size_t)i * nf + k];
     }
     return pred;
 }
 
-rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
-                   const rc_sample *samples, size_t n)
+/* rc_solve on w's small fields and the matrices A, V ((nf x nf) each, n_params^2
+ * entries of room) and the sample tables t. */
+static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, passbuf tab,
+                            const rc_solve_config *cfg, const rc_sample *samples, size_t n)
 {
     static const rc_solve_config defaults;
     rc_solve_result local;
@@ -425,7 +520,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     const int ltlm = cfg->method == RC_METHOD_LTLM;
     double cost, mu = 0.0, nu = 2.0;
 
-    rc_status st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+    rc_status st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
     ++res->cost_evals;
     if (st != RC_OK)
         return st;
@@ -435,7 +530,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
      * falls in the null space below. */
     double dmax = 0.0;
     for (unsigned i = 0; i < nf; ++i) {
-        const double a = w->A[(size_t)i * nf + i];
+        const double a = A[(size_t)i * nf + i];
         if (a > dmax)
             dmax = a;
     }
@@ -447,7 +542,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     {
         unsigned keep = 0;
         for (unsigned i = 0; i < nf; ++i) {
-            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || w->A[(size_t)i * nf + i] > 1e-24 * dmax)
+            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || A[(size_t)i * nf + i] > 1e-24 * dmax)
                 w->D[keep++] = (double)i;
         }
         if (keep == 0)
@@ -455,14 +550,14 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         for (unsigned a = 0; a < keep; ++a) {
             const unsigned ia = (unsigned)w->D[a];
             for (unsigned b = 0; b < keep; ++b)
-                w->A[(size_t)a * keep + b] = w->A[(size_t)ia * nf + (unsigned)w->D[b]];
+                A[(size_t)a * keep + b] = A[(size_t)ia * nf + (unsigned)w->D[b]];
             w->g[a] = w->g[ia];
             w->idx[a] = w->idx[ia];
         }
         nf = keep;
     }
     for (unsigned i = 0; i < nf; ++i) {
-        const double a = w->A[(size_t)i * nf + i];
+        const double a = A[(size_t)i * nf + i];
         w->D[i] = a > 1e-24 * dmax ? sqrt(a) : 1.0;
     }
     double chaos_n = ltlm ? ltlm_n0(cfg) : 0.0;
@@ -474,12 +569,12 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     for (unsigned it = 0; it < max_iter; ++it) {
         if (!have_eig) {
             if (it > 0) {
-                st = rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
+                st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
                 ++res->cost_evals;
                 if (st != RC_OK)
                     return st;
             }
-            st = lm_subspace(&rank, &gnorm, w, nf, cost, n, rcond, snr_min);
+            st = lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, rcond, snr_min);
             if (st != RC_OK)
                 return st;
         }
@@ -497,7 +592,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
         int accepted = 0, done = 0;
         for (unsigned tries = 0; tries < 60 && !accepted; ++tries) {
             double xs = 0.0, ds = 0.0;
-            const double pred = lm_subspace_step(w->dx, w, nf, rank, mu);
+            const double pred = lm_subspace_step(w->dx, w, V, nf, rank, mu);
             for (unsigned i = 0; i < nf; ++i) {
                 ds += w->dx[i] * w->dx[i];
                 xs += (m->x[w->idx[i]] * w->D[i]) * (m->x[w->idx[i]] * w->D[i]);
@@ -505,7 +600,7 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
             apply_step(&w->trial, m, w, nf, w->dx);
             double cnew;
             ++res->cost_evals;
-            st = rc_cost(&cnew, &w->trial, samples, n);
+            st = cost_tab(&cnew, &w->trial, samples, tab, n);
             const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
             if (rho > 0.0) {
                 accepted = 1;
@@ -519,13 +614,13 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
                      * updated damping, the same truncation), so both
                      * segments lie in subspaces the robust LM steps in. */
                     double c1, cbest;
-                    st = rc_normal_eq(w->A, w->g, &c1, w->jrow, &w->trial, w->idx, nf, samples, n);
+                    st = normal_eq_tab(A, w->g, &c1, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
                     ++res->cost_evals;
                     if (st == RC_OK)
-                        st = lm_subspace(&rank, &gnorm, w, nf, c1, n, rcond, snr_min);
+                        st = lm_subspace(&rank, &gnorm, w, A, V, nf, c1, n, rcond, snr_min);
                     if (st == RC_OK) {
                         if (gnorm > 0.0)
-                            (void)lm_subspace_step(w->lt_x2, w, nf, rank, mu);
+                            (void)lm_subspace_step(w->lt_x2, w, V, nf, rank, mu);
                         else
                             memset(w->lt_x2, 0, nf * sizeof w->lt_x2[0]);
                         for (unsigned i = 0; i < nf; ++i)
@@ -574,23 +669,101 @@ rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc
     return RC_OK;
 }
 
+/* solve_core after filling the sample tables sin_q, cos_q ((n x 6) each, or
+ * both NULL: none); jblk (NE_BLOCK x n_params) or NULL. */
+static rc_status solve_with(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V,
+                            double *sin_q, double *cos_q, double *jblk, const rc_solve_config *cfg,
+                            const rc_sample *samples, size_t n)
+{
+    passbuf tab = {NULL, NULL, jblk};
+    if (sin_q != NULL && cos_q != NULL) {
+        rc_qtrig_fill(sin_q, cos_q, samples, n);
+        tab.sin_q = sin_q;
+        tab.cos_q = cos_q;
+    }
+    return solve_core(m, res, w, A, V, tab, cfg, samples, n);
+}
+
+rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
+                   const rc_sample *samples, size_t n)
+{
+    RC_ASSERT(m != NULL && w != NULL);
+    double *sin_q = NULL, *cos_q = NULL, *jblk = NULL;
+    /* In the unused tails of A and V (beyond n_params^2 entries), when they
+     * fit: the row blocks and sin_q in A's, cos_q in V's. (n_params out of
+     * range: solve_core refuses it.) */
+    if (m->n_params <= RC_MAX_PARAMS) {
+        const size_t cap = sizeof w->A / sizeof w->A[0], np = m->n_params;
+        size_t room = cap - np * np;
+        double *tail = w->A + np * np;
+        if (room >= NE_BLOCK * np) {
+            jblk = tail;
+            tail += NE_BLOCK * np;
+            room -= NE_BLOCK * np;
+        }
+        if (samples != NULL && n <= room / RC_NJ) {
+            sin_q = tail;
+            cos_q = w->V + np * np;
+        }
+    }
+    return solve_with(m, res, w, w->A, w->V, sin_q, cos_q, jblk, cfg, samples, n);
+}
+
+size_t rc_solve_work_size(unsigned n_params, size_t n_samples)
+{
+    if (n_params < RC_N_BASE || n_params > RC_MAX_PARAMS)
+        return 0;
+    const size_t np = n_params, fixed = 2 * np * np + NE_BLOCK * np;
+    if (n_samples > (SIZE_MAX / sizeof(double) - fixed - offsetof(rc_solve_work, A)) / (2 * RC_NJ))
+        return 0;
+    return offsetof(rc_solve_work, A) + (fixed + 2 * RC_NJ * n_samples) * sizeof(double);
+}
+
+rc_status rc_solve_buf(rc_model *m, rc_solve_result *res, void *work, size_t work_bytes,
+                       const rc_solve_config *cfg, const rc_sample *samples, size_t n)
+{
+    RC_ASSERT(m != NULL && work != NULL);
+    const size_t need = rc_solve_work_size(m->n_params, 0);
+    if (need == 0)
+        return RC_ERR_ARG;
+    if ((uintptr_t)work % sizeof(double) != 0)
+        return RC_ERR_ARG;
+    if (work_bytes < need)
+        return RC_ERR_CAPACITY;
+    /* the prefix of rc_solve_work up to A, then A, V, the row blocks and the
+     * tables */
+    const size_t np = m->n_params;
+    rc_solve_work *w = (rc_solve_work *)work;
+    double *A = w->A; /* at offsetof(rc_solve_work, A): inside the buffer */
+    double *V = A + np * np, *jblk = V + np * np;
+    double *sin_q = NULL, *cos_q = NULL;
+    const size_t full = rc_solve_work_size(m->n_params, n);
+    if (samples != NULL && full != 0 && work_bytes >= full) {
+        sin_q = jblk + NE_BLOCK * np;
+        cos_q = sin_q + (size_t)RC_NJ * n;
+    }
+    return solve_with(m, res, w, A, V, sin_q, cos_q, jblk, cfg, samples, n);
+}
+
 rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample *samples, size_t n)
 {
     double A[16] = {0}, b[4] = {0}, c[3] = {0, 0, 0};
+    rc_meas_prep mp;
     RC_ASSERT(enc_mm != NULL && m != NULL);
     if (n < 4)
         return RC_ERR_RANK;
+    rc_meas_prepare(&mp, m);
     /* centre the points for conditioning: unknowns e' = e - c, k = |e'|^2 */
     for (size_t i = 0; i < n; ++i) {
         double p[3];
-        rc_fk(p, NULL, m, samples[i].q_rad);
+        rc_point_prepared(p, m, &mp, &samples[i], NULL, NULL);
         for (int r = 0; r < 3; ++r)
             c[r] += p[r] / (double)n;
     }
     double trace = 0.0;
     for (size_t i = 0; i < n; ++i) {
         double p[3];
-        rc_fk(p, NULL, m, samples[i].q_rad);
+        rc_point_prepared(p, m, &mp, &samples[i], NULL, NULL);
         for (int r = 0; r < 3; ++r)
             p[r] -= c[r];
         /* -2 p.e' + k = L^2 - |p|^2 */
@@ -628,7 +801,7 @@ rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample 
         e[r] = b[r] + c[r];
     for (size_t i = 0; i < n; ++i) {
         double p[3];
-        rc_fk(p, NULL, m, samples[i].q_rad);
+        rc_point_prepared(p, m, &mp, &samples[i], NULL, NULL);
         const double dx = p[0] - e[0], dy = p[1] - e[1], dz = p[2] - e[2];
         const double d = sqrt(dx * dx + dy * dy + dz * dz) - samples[i].len_mm;
         res2 += d * d;

@@ -41,7 +41,8 @@
  *    the paper reports angles in degrees (Table 7).
  *
  * Memory: rc_solve_work is large (two RC_MAX_PARAMS^2 matrices); callers own
- * it (static or heap on the host). Thread safety: reentrant.
+ * it (static or heap on the host), or pass a buffer of rc_solve_work_size()
+ * bytes to rc_solve_buf. Thread safety: reentrant.
  */
 #ifndef RC_SOLVE_H
 #define RC_SOLVE_H
@@ -130,9 +131,15 @@ typedef struct rc_solve_result {
     unsigned ltlm_wins;       /* LTLM: iterations where a chaotic candidate beat x1 */
 } rc_solve_result;
 
+/* Workspace of rc_solve. The two matrices come last so that a workspace
+ * sized by the parameter count (rc_solve_work_size, rc_solve_buf) is this
+ * struct's prefix followed by the matrices at their real size. rc_solve
+ * keeps its normal-equation row blocks (4 x n_params) and the samples' joint
+ * sines and cosines (rc_qtrig_fill) in the unused tails of A and V (beyond
+ * n_params^2 entries) when they fit there (the tables up to 1,396 samples for
+ * 27 parameters); A and V hold nf x nf matrices (leading dimension nf) as
+ * before. */
 typedef struct rc_solve_work {
-    double A[RC_MAX_PARAMS * RC_MAX_PARAMS];  /* (nf x nf) normal matrix */
-    double V[RC_MAX_PARAMS * RC_MAX_PARAMS];  /* (nf x nf) eigenvectors */
     double ev[RC_MAX_PARAMS];                 /* (nf) eigenvalues */
     double g[RC_MAX_PARAMS];                  /* (nf) gradient J^T r */
     double c[RC_MAX_PARAMS];                  /* (nf) V^T g */
@@ -146,6 +153,8 @@ typedef struct rc_solve_work {
     rc_model trial;
     rc_model best;
     rc_model cand;                            /* LTLM candidate */
+    double A[RC_MAX_PARAMS * RC_MAX_PARAMS];  /* (nf x nf) normal matrix */
+    double V[RC_MAX_PARAMS * RC_MAX_PARAMS];  /* (nf x nf) eigenvectors */
 } rc_solve_work;
 
 /* Name of a method ("lm", "ltlm", "lm-paper", "ltlm-paper", "lm-paper-deg",
@@ -170,6 +179,24 @@ rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, con
  * res may be NULL. RC_ERR_RANK when no parameter is free. */
 rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
                    const rc_sample *samples, size_t n);
+
+/* Workspace sized by the parameter count (as cminpack's lwa): the bytes
+ * rc_solve_buf needs for a model of n_params parameters (the prefix of
+ * rc_solve_work up to A, the two n_params^2 matrices and 4 x n_params for the
+ * normal-equation row blocks), and with n_samples > 0 also for the tables of
+ * those samples' joint sines and cosines (12 doubles a sample), which spare
+ * every pass 12 sines per sample. 0 when n_params is outside
+ * 27..RC_MAX_PARAMS. For 27 parameters: 25,512 bytes without tables;
+ * sizeof(rc_solve_work) is 160,440 bytes (RC_MAX_PARAMS 96). */
+size_t rc_solve_work_size(unsigned n_params, size_t n_samples);
+
+/* rc_solve in caller-provided storage work (work_bytes, aligned for
+ * double, e.g. from malloc or a double array): at least
+ * rc_solve_work_size(m->n_params, 0) bytes, else RC_ERR_CAPACITY; with
+ * rc_solve_work_size(m->n_params, n) bytes or more the sample tables are
+ * kept too. The result is the same as rc_solve's to the last bit. */
+rc_status rc_solve_buf(rc_model *m, rc_solve_result *res, void *work, size_t work_bytes,
+                       const rc_solve_config *cfg, const rc_sample *samples, size_t n);
 
 /* Residual statistics of a model on samples (residual e = l_model - L). */
 typedef struct rc_metrics {

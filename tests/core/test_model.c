@@ -74,11 +74,9 @@ static void test_param_jacobian_base(void **state)
     check_param_jacobian(&m, &g);
 }
 
-static void test_param_jacobian_effects(void **state)
+/* The nominal model with every effect kind, effect parameters ~1e-3. */
+static rc_model model_with_effects(rc_rng *g)
 {
-    (void)state;
-    rc_rng g;
-    rc_rng_seed(&g, 2);
     rc_model m = nominal();
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_OFFSET, 0, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 1, 0), RC_OK);
@@ -90,7 +88,16 @@ static void test_param_jacobian_effects(void **state)
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
     assert_int_equal(m.n_params, RC_N_BASE + 1 + 1 + 1 + 4 + 2 + 3 + 1 + 3);
     for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
-        m.x[k] = 1e-3 * rc_rng_normal(&g);
+        m.x[k] = 1e-3 * rc_rng_normal(g);
+    return m;
+}
+
+static void test_param_jacobian_effects(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 2);
+    rc_model m = model_with_effects(&g);
     check_param_jacobian(&m, &g);
 }
 
@@ -232,6 +239,81 @@ static void test_lt_map(void **state)
     assert_true(fabs(rc_lt_map(0.8, 0.5) - 0.43) < 1e-12);
 }
 
+/* The solver's passes (rc_meas_prepared: angle addition from the model's
+ * and the readings' sines) against the single measurement rc_meas: the same
+ * length and Jacobian to rounding, for the base model and one with every
+ * effect; with the readings' tables or without them, bit for bit the same;
+ * rc_point_prepared is rc_fk's point. */
+static void check_prepared(const rc_model *m, rc_rng *g)
+{
+    rc_meas_prep p;
+    rc_meas_prepare(&p, m);
+    for (int trial = 0; trial < 200; ++trial) {
+        rc_sample s;
+        random_pose(&s, g);
+        double sq[RC_NJ], cq[RC_NJ], l0, l1, l2, j0[RC_MAX_PARAMS], j1[RC_MAX_PARAMS], j2[RC_MAX_PARAMS];
+        rc_qtrig_fill(sq, cq, &s, 1);
+        for (unsigned i = 0; i < RC_NJ; ++i) {
+            assert_true(sq[i] == sin(s.q_rad[i]));
+            assert_true(cq[i] == cos(s.q_rad[i]));
+        }
+        assert_int_equal(rc_meas(&l0, j0, m, &s), RC_OK);
+        assert_int_equal(rc_meas_prepared(&l1, j1, m, &p, &s, sq, cq), RC_OK);
+        assert_int_equal(rc_meas_prepared(&l2, j2, m, &p, &s, NULL, NULL), RC_OK);
+        assert_true(l1 == l2);
+        assert_memory_equal(j1, j2, m->n_params * sizeof j1[0]);
+        assert_true(fabs(l1 - l0) < 1e-9 * (1.0 + l0));
+        for (unsigned k = 0; k < m->n_params; ++k)
+            assert_true(fabs(j1[k] - j0[k]) < 1e-9 * (1.0 + fabs(j0[k])));
+        double pf[3], pp[3];
+        rc_fk(pf, NULL, m, s.q_rad);
+        rc_point_prepared(pp, m, &p, &s, NULL, NULL);
+        for (int r = 0; r < 3; ++r)
+            assert_true(fabs(pf[r] - pp[r]) < 1e-9 * (1.0 + fabs(pf[r])));
+    }
+}
+
+static void test_prepared_base(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 21);
+    rc_model m = nominal();
+    for (unsigned k = 0; k < RC_N_BASE; ++k)
+        m.x[k] += 0.01 * rc_rng_normal(&g);
+    m.x[RC_P_THETA(1)] += 40.0; /* an offset of many turns: angle addition does not care */
+    check_prepared(&m, &g);
+}
+
+static void test_prepared_effects(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 22);
+    rc_model m = model_with_effects(&g);
+    rc_meas_prep p;
+    rc_meas_prepare(&p, &m);
+    assert_true(p.has_joint_effect && p.joint_effect[1] && p.joint_effect[2] && p.joint_effect[3]);
+    assert_true(!p.joint_effect[0] && !p.joint_effect[4] && !p.joint_effect[5]);
+    assert_int_equal(p.tool, m.n_params - 3);
+    check_prepared(&m, &g);
+}
+
+/* An angle of a diverged solve (beyond 1e6 rad) is not reduced: reducing it
+ * by the double nearest 2 pi would move it. */
+static void test_wrap_leaves_huge_angles(void **state)
+{
+    (void)state;
+    rc_model m = nominal();
+    m.x[RC_P_THETA(2)] = 1.25e147;
+    m.x[RC_P_ALPHA(3)] = -3.0e7;
+    m.x[RC_P_THETA(4)] = 7.0;
+    rc_model_wrap_angles(&m);
+    assert_true(m.x[RC_P_THETA(2)] == 1.25e147);
+    assert_true(m.x[RC_P_ALPHA(3)] == -3.0e7);
+    assert_true(fabs(m.x[RC_P_THETA(4)] - (7.0 - 2.0 * 3.14159265358979323846)) < 1e-15);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -239,6 +321,8 @@ int main(void)
         cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
         cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_fk_real_file),
         cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
+        cmocka_unit_test(test_prepared_base),       cmocka_unit_test(test_prepared_effects),
+        cmocka_unit_test(test_wrap_leaves_huge_angles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

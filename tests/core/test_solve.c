@@ -223,12 +223,178 @@ static void test_real_data(void **state)
     rch_data_free(&d);
 }
 
+/* A simulated data set of n samples (noise 0.01 mm, groups of 20) from a
+ * truth near the nominal robot; *start the nominal with the true outlet. */
+static void sim_set(rc_model *start, rc_model *truth, rc_sample *s, size_t n, unsigned long long seed)
+{
+    rch_robot r = load_robot();
+    rch_sim_config c;
+    memset(&c, 0, sizeof c);
+    c.q_step_deg = -1.0;
+    c.group_size = 20;
+    rch_sim_defaults(&c);
+    rc_rng g;
+    rc_rng_seed(&g, seed);
+    const double enc[3] = {250.0, -460.0, 10.0};
+    rch_sim_truth(truth, &r.model, enc, &c, &g);
+    assert_int_equal(rch_sim_samples(s, NULL, n, truth, &c, &g), 0);
+    *start = r.model;
+    memcpy(&start->x[RC_P_ENC], enc, sizeof enc);
+}
+
+/* rc_solve_work_size: the prefix of rc_solve_work up to A, two n_params^2
+ * matrices and 12 doubles a sample; 0 outside 27..RC_MAX_PARAMS. */
+static void test_work_size(void **state)
+{
+    (void)state;
+    const size_t head = offsetof(rc_solve_work, A);
+    assert_int_equal(rc_solve_work_size(27, 0), head + (2 * 27 * 27 + 4 * 27) * sizeof(double));
+    assert_int_equal(rc_solve_work_size(27, 1000), head + (2 * 27 * 27 + 4 * 27 + 12 * 1000) * sizeof(double));
+    assert_int_equal(rc_solve_work_size(RC_MAX_PARAMS, 0), sizeof(rc_solve_work) + 4 * RC_MAX_PARAMS * sizeof(double));
+    assert_true(rc_solve_work_size(27, 0) < sizeof(rc_solve_work) / 6);
+    assert_int_equal(rc_solve_work_size(26, 0), 0);
+    assert_int_equal(rc_solve_work_size(RC_MAX_PARAMS + 1, 0), 0);
+    assert_int_equal(rc_solve_work_size(27, SIZE_MAX / 8), 0); /* would overflow */
+    print_message("workspace for 27 parameters: %zu B (fixed rc_solve_work: %zu B); with 1000 samples' tables %zu B\n",
+                  rc_solve_work_size(27, 0), sizeof(rc_solve_work), rc_solve_work_size(27, 1000));
+}
+
+/* One solve in the fixed struct and in caller buffers (the smallest one,
+ * without the sample tables, and one with them): the same model and result
+ * to the last bit. */
+static void solve_three_ways(rc_method method, const rc_model *start, const rc_sample *s, size_t n)
+{
+    rc_solve_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.method = method;
+    cfg.seed = 3;
+    rc_model m0 = *start, m1 = *start, m2 = *start;
+    rc_solve_result r0, r1, r2;
+    assert_int_equal(rc_solve(&m0, &r0, &W, &cfg, s, n), RC_OK);
+    const size_t small = rc_solve_work_size(start->n_params, 0), big = rc_solve_work_size(start->n_params, n);
+    double *buf = malloc(big);
+    assert_non_null(buf);
+    assert_int_equal(rc_solve_buf(&m1, &r1, buf, small, &cfg, s, n), RC_OK);
+    memset(buf, 0xA5, big); /* no state carried between calls */
+    assert_int_equal(rc_solve_buf(&m2, &r2, buf, big, &cfg, s, n), RC_OK);
+    free(buf);
+    assert_memory_equal(m0.x, m1.x, start->n_params * sizeof m0.x[0]);
+    assert_memory_equal(m0.x, m2.x, start->n_params * sizeof m0.x[0]);
+    assert_int_equal(r0.iterations, r1.iterations);
+    assert_int_equal(r0.iterations, r2.iterations);
+    assert_int_equal(r0.cost_evals, r2.cost_evals);
+    assert_true(r0.rms_final_mm == r1.rms_final_mm && r0.rms_final_mm == r2.rms_final_mm);
+    assert_true(r0.rms_final_mm < 0.5 * r0.rms_start_mm);
+}
+
+static void test_solve_buf_same(void **state)
+{
+    (void)state;
+    enum { N = 301 };
+    static rc_sample s[N];
+    rc_model start, truth;
+    sim_set(&start, &truth, s, N, 31);
+    solve_three_ways(RC_METHOD_LM, &start, s, N);
+    solve_three_ways(RC_METHOD_LTLM, &start, s, N);
+    solve_three_ways(RC_METHOD_LM_PAPER, &start, s, N);
+    /* more samples than the fixed struct's tails hold (1,396 for 27
+     * parameters): rc_solve computes the sines per pass, same result */
+    enum { NB = 1500 };
+    rc_sample *b = malloc(NB * sizeof *b);
+    assert_non_null(b);
+    sim_set(&start, &truth, b, NB, 32);
+    solve_three_ways(RC_METHOD_LM, &start, b, NB);
+    free(b);
+}
+
+static void test_solve_buf_refuses(void **state)
+{
+    (void)state;
+    enum { N = 50 };
+    static rc_sample s[N];
+    rc_model start, truth;
+    sim_set(&start, &truth, s, N, 33);
+    const size_t small = rc_solve_work_size(start.n_params, 0);
+    double *buf = malloc(small + sizeof(double));
+    assert_non_null(buf);
+    rc_model m = start;
+    assert_int_equal(rc_solve_buf(&m, NULL, buf, small - 1, NULL, s, N), RC_ERR_CAPACITY);
+    assert_int_equal(rc_solve_buf(&m, NULL, (char *)buf + 4, small, NULL, s, N), RC_ERR_ARG); /* misaligned */
+    assert_memory_equal(m.x, start.x, sizeof m.x); /* untouched */
+    m.n_params = 26;
+    assert_int_equal(rc_solve_buf(&m, NULL, buf, small, NULL, s, N), RC_ERR_ARG);
+    free(buf);
+}
+
+/* rc_normal_eq: the sums of the row-by-row update of rc_meas_prepared rows
+ * (computed here) to the last bit, for a free set that skips parameters;
+ * its cost is rc_cost's. */
+static void test_normal_eq_rows(void **state)
+{
+    (void)state;
+    enum { N = 203 };
+    static rc_sample s[N];
+    rc_model start, truth;
+    sim_set(&start, &truth, s, N, 34);
+    uint16_t idx[RC_N_BASE];
+    unsigned nf = 0;
+    for (unsigned k = 0; k < RC_N_BASE; ++k)
+        if (k % 5 != 2)
+            idx[nf++] = (uint16_t)k;
+    static double A[RC_N_BASE * RC_N_BASE], Ar[RC_N_BASE * RC_N_BASE];
+    double g[RC_N_BASE], gr[RC_N_BASE], jrow[RC_MAX_PARAMS], cost, costr = 0.0;
+    assert_int_equal(rc_normal_eq(A, g, &cost, jrow, &truth, idx, nf, s, N), RC_OK);
+    memset(Ar, 0, sizeof Ar);
+    memset(gr, 0, sizeof gr);
+    rc_meas_prep p;
+    rc_meas_prepare(&p, &truth);
+    for (size_t i = 0; i < N; ++i) {
+        double l, J[RC_MAX_PARAMS];
+        assert_int_equal(rc_meas_prepared(&l, J, &truth, &p, &s[i], NULL, NULL), RC_OK);
+        const double r = l - s[i].len_mm;
+        costr += r * r;
+        for (unsigned a = 0; a < nf; ++a) {
+            gr[a] += J[idx[a]] * r;
+            for (unsigned b = a; b < nf; ++b)
+                Ar[a * nf + b] += J[idx[a]] * J[idx[b]];
+        }
+    }
+    assert_true(cost == costr);
+    assert_memory_equal(g, gr, nf * sizeof g[0]);
+    for (unsigned a = 0; a < nf; ++a)
+        for (unsigned b = 0; b < nf; ++b)
+            assert_true(A[a * nf + b] == Ar[(a < b ? a : b) * nf + (a < b ? b : a)]);
+    double c2;
+    assert_int_equal(rc_cost(&c2, &truth, s, N), RC_OK);
+    assert_true(c2 == cost);
+}
+
+/* The solver adds the rows in blocks of four in its workspace; with all
+ * RC_MAX_PARAMS parameters the fixed struct has no room for the blocks (nor
+ * the tables), so rc_solve adds row by row while rc_solve_buf with a full
+ * buffer uses blocks and tables: the same solution to the last bit. 203
+ * samples leave a partial last block. */
+static void test_blocks_equal_rows(void **state)
+{
+    (void)state;
+    enum { N = 203 };
+    static rc_sample s[N];
+    rc_model start, truth;
+    sim_set(&start, &truth, s, N, 35);
+    assert_int_equal(rc_model_add_effect(&start, RC_EFF_GROUP_OFFSET, 0, RC_MAX_PARAMS - RC_N_BASE), RC_OK);
+    assert_int_equal(start.n_params, RC_MAX_PARAMS);
+    solve_three_ways(RC_METHOD_LM, &start, s, N);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_recover_lm),      cmocka_unit_test(test_recover_ltlm),
         cmocka_unit_test(test_fixed_mask),      cmocka_unit_test(test_identifiability),
         cmocka_unit_test(test_encoder_guess),   cmocka_unit_test(test_real_data),
+        cmocka_unit_test(test_work_size),       cmocka_unit_test(test_solve_buf_same),
+        cmocka_unit_test(test_solve_buf_refuses), cmocka_unit_test(test_normal_eq_rows),
+        cmocka_unit_test(test_blocks_equal_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,7 +6,11 @@
 #include <string.h>
 #include <time.h>
 
+#include "rc_version.h"
 #include "rch_data.h"
+#include "rch_diagnose.h"
+#include "rch_groups.h"
+#include "rch_sha256.h"
 #include "rch_jw.h"
 #include "rch_save.h"
 #include "rch_sim.h"
@@ -122,6 +126,65 @@ static int truth_flange(rch_calib_result *r, rch_diag *d)
     return 0;
 }
 
+/* Covariance (cluster-robust by set-up group when the groups allow it),
+ * standard errors, classes, predicted uncertainty over the data and the
+ * workspace, and the determined model. Leaves have_unc 0 when it cannot be
+ * computed (too few samples for the free parameters). */
+static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train)
+{
+    rch_uncert u;
+    char err[256];
+    if (rch_uncert_compute(&u, &r->model, fixed, train, r->n_train, 1, err, sizeof err) != 0)
+        return;
+    rch_model_unc_from(&r->unc, &u);
+    if (rch_uncert_map_compute(&r->unc.map, &u, &r->model, train, r->n_train, RCH_CALIB_TRUTH_POSES,
+                               RCH_CALIB_TRUTH_SEED) == 0) {
+        r->unc.orientation_determined = r->unc.map.rot_data_median_deg < RCH_ORIENT_DETERMINED_DEG;
+        r->have_unc = 1;
+    }
+    rch_uncert_free(&u);
+    rch_model_unc_determined(&r->determined, &r->model, &r->robot.nominal, &r->unc);
+}
+
+/* Provenance: the data file, its samples and digest, the date, the tool. */
+static void provenance(rch_calib_result *r)
+{
+    rch_provenance *p = &r->prov;
+    p->n_files = 1;
+    p->file[0] = r->cfg.data_path;
+    p->samples[0] = r->n_data;
+    if (rch_sha256_file(p->sha256[0], r->cfg.data_path) != 0)
+        snprintf(p->sha256[0], sizeof p->sha256[0], "unreadable");
+    time_t now = time(NULL);
+    struct tm tmv;
+    if (gmtime_r(&now, &tmv))
+        strftime(p->date, sizeof p->date, "%Y-%m-%dT%H:%M:%SZ", &tmv);
+    p->tool = "rcal " RC_VERSION_STRING;
+}
+
+/* Set-up groups: the file's group column, else consecutive samples sharing
+ * the wrist joints at the joints' display step. */
+static void groups(rch_calib_result *r, rch_data *data)
+{
+    r->groups_from_file = data->has_group;
+    if (data->has_group) {
+        unsigned mx = 0;
+        for (size_t i = 0; i < data->n; ++i)
+            mx = data->s[i].group > mx ? data->s[i].group : mx;
+        r->n_groups = mx + 1;
+        return;
+    }
+    double *q = malloc(data->n * 3 * sizeof *q), step = 0.0;
+    if (q) {
+        for (size_t i = 0; i < data->n; ++i)
+            for (unsigned j = 0; j < 3; ++j)
+                q[i * 3 + j] = data->s[i].q_rad[3 + j] / DEG;
+        step = rch_diagnose_detect_step(q, data->n * 3);
+        free(q);
+    }
+    r->n_groups = rch_groups_by_wrist(data->s, data->n, step, NULL);
+}
+
 /* Identification and the figures, once the split is made. */
 static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
                           rch_diag *d)
@@ -159,6 +222,8 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     if (r->cfg.truth_path && r->finite && truth_flange(r, d) != 0)
         return -1;
     r->have_ident = r->finite && rch_ident_compute(&r->ident, &r->model, train, r->n_train) == 0;
+    if (r->finite)
+        uncertainty(r, fixed, train);
     return 0;
 }
 
@@ -170,6 +235,8 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || rch_data_load(&data, cfg->data_path, 0, d) != 0)
         return -1;
     r->n_data = data.n;
+    groups(r, &data);
+    provenance(r);
     int rc = -1;
     size_t *idx = malloc(data.n * sizeof *idx);
     rc_solve_work *w = malloc(sizeof *w);
@@ -226,6 +293,51 @@ static void print_model(FILE *f, const rch_calib_result *r)
             m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
 }
 
+static void print_uncertainty(FILE *f, const rch_calib_result *r)
+{
+    const rch_model_unc *u = &r->unc;
+    const rc_model *m = &r->model;
+    if (u->kind == RCH_COV_CLUSTER)
+        fprintf(f, "uncertainty (cluster-robust covariance over %u set-up groups%s; residual sigma %.4f mm):\n",
+                u->n_groups, r->groups_from_file ? " of the file" : " found from the wrist joints", u->sigma_mm);
+    else
+        fprintf(f, "uncertainty (classical covariance: the samples carry no usable set-up groups; residual sigma "
+                   "%.4f mm):\n",
+                u->sigma_mm);
+    fprintf(f, "  parameter        value   1 std.error  class\n");
+    unsigned held = 0;
+    char list[512] = "";
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        char nm[64], se[32];
+        const int unit = rc_param_unit(m, k);
+        const double sc = unit == 1 ? 1.0 / DEG : 1.0;
+        if (isfinite(u->se[k]))
+            snprintf(se, sizeof se, "%11.5f", u->se[k] * sc);
+        else
+            snprintf(se, sizeof se, "%11s", "-");
+        rc_param_name(nm, sizeof nm, m, k);
+        fprintf(f, "  %-10s %12.5f %s %-3s %s\n", nm, m->x[k] * sc, se, unit == 0 ? "mm" : unit == 1 ? "deg" : "",
+                rch_param_class_name((rch_param_class)u->cls[k]));
+        if (k < RC_N_DH && u->comp_nominal[k]) {
+            size_t len = strlen(list);
+            snprintf(list + len, sizeof list - len, "%s%s", held ? " " : "", nm);
+            ++held;
+        }
+    }
+    fprintf(f,
+            "predicted flange-position uncertainty (95 %%, longest semi-axis): inside the data: +-%.4f mm "
+            "(median; max %.4f), whole workspace: +-%.4f mm (median over %d random poses; max %.4f)\n",
+            u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
+            u->map.work_max_mm);
+    fprintf(f, "predicted flange-orientation uncertainty (95 %%) inside the data: +-%.4f deg: orientation %s\n",
+            u->map.rot_data_median_deg, u->orientation_determined ? "determined" : "NOT determined (compensation "
+                                                                                 "defaults to position-only)");
+    fprintf(f,
+            "compensation uses %u of 24 DH parameters as fitted; held at nominal (tied to a weak or not-identifiable "
+            "combination that moves the robot): %s\n\n",
+            RC_N_DH - held, held ? list : "none");
+}
+
 static void print_ident(FILE *f, const rch_ident *id)
 {
     fprintf(f,
@@ -264,6 +376,8 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 RCH_CALIB_TRUTH_POSES, r->truth_before_rms_mm, r->truth_before_max_mm, r->truth_after_rms_mm,
                 r->truth_after_max_mm);
     print_model(f, r);
+    if (r->have_unc)
+        print_uncertainty(f, r);
     if (r->have_ident)
         print_ident(f, &r->ident);
     fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
@@ -325,6 +439,62 @@ static void json_ident(rch_jw *w, const rch_ident *id)
     rch_jw_end(w);
 }
 
+static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
+{
+    const rch_model_unc *u = &r->unc;
+    const rc_model *m = &r->model;
+    rch_jw_obj(w, "uncertainty");
+    rch_jw_str(w, "covariance", u->kind == RCH_COV_CLUSTER ? "cluster-robust" : "classical");
+    rch_jw_uint(w, "groups", u->n_groups);
+    rch_jw_str(w, "groups_from", r->groups_from_file ? "file" : "wrist joints");
+    rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
+    rch_jw_uint(w, "rank", u->rank);
+    rch_jw_arr(w, "parameters");
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        char nm[64];
+        const int unit = rc_param_unit(m, k);
+        const double sc = unit == 1 ? 1.0 / DEG : 1.0;
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "name", rc_param_name(nm, sizeof nm, m, k));
+        rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "SI");
+        rch_jw_numf(w, "value", m->x[k] * sc, "%.9g");
+        rch_jw_numf(w, "std_error", u->se[k] * sc, "%.6g");
+        rch_jw_str(w, "class", rch_param_class_name((rch_param_class)u->cls[k]));
+        rch_jw_str(w, "compensation", k < RC_N_DH ? (u->comp_nominal[k] ? "nominal" : "fitted") : "not used");
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_obj(w, "position95_mm");
+    rch_jw_numf(w, "data_median", u->map.data_median_mm, "%.6g");
+    rch_jw_numf(w, "data_max", u->map.data_max_mm, "%.6g");
+    rch_jw_numf(w, "workspace_median", u->map.work_median_mm, "%.6g");
+    rch_jw_numf(w, "workspace_max", u->map.work_max_mm, "%.6g");
+    rch_jw_end(w);
+    rch_jw_obj(w, "orientation95_deg");
+    rch_jw_numf(w, "data_median", u->map.rot_data_median_deg, "%.6g");
+    rch_jw_numf(w, "data_max", u->map.rot_data_max_deg, "%.6g");
+    rch_jw_end(w);
+    rch_jw_bool(w, "orientation_determined", u->orientation_determined);
+    rch_jw_end(w);
+}
+
+static void json_provenance(rch_jw *w, const rch_provenance *p)
+{
+    rch_jw_obj(w, "provenance");
+    rch_jw_arr(w, "data");
+    for (unsigned i = 0; i < p->n_files; ++i) {
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "file", p->file[i]);
+        rch_jw_uint(w, "samples", p->samples[i]);
+        rch_jw_str(w, "sha256", p->sha256[i]);
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_str(w, "date", p->date);
+    rch_jw_str(w, "tool", p->tool);
+    rch_jw_end(w);
+}
+
 int rch_calib_json(FILE *f, const rch_calib_result *r)
 {
     rch_jw w;
@@ -356,6 +526,9 @@ int rch_calib_json(FILE *f, const rch_calib_result *r)
     }
     if (r->have_ident)
         json_ident(&w, &r->ident);
+    if (r->have_unc)
+        json_uncertainty(&w, r);
+    json_provenance(&w, &r->prov);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
 }
@@ -376,7 +549,8 @@ int rch_calib_write_model(FILE *f, const rch_calib_result *r)
 {
     if (!r->finite)
         return -1;
-    const rch_robot_info info = {calib_info, r};
+    const rch_robot_info info = {calib_info, r, r->have_unc ? &r->unc : NULL, r->have_unc ? &r->determined : NULL,
+                                 &r->prov};
     return rch_robot_write(f, r->robot.name, &r->model, &r->robot.nominal, &info);
 }
 

@@ -26,6 +26,7 @@
 #include "rch_diag.h"
 #include "rch_ident.h"
 #include "rch_robot.h"
+#include "rch_uncert.h"
 
 /* Poses (and their seed) of the flange comparison against a simulated truth. */
 #define RCH_CALIB_TRUTH_POSES 2000
@@ -83,6 +84,12 @@ typedef struct rch_calib_result {
     double truth_after_rms_mm, truth_after_max_mm;
     int have_ident;
     rch_ident ident;          /* at the solution, over the training samples */
+    int have_unc;             /* uncertainty computed (model finite, enough samples) */
+    rch_model_unc unc;        /* covariance, standard errors, classes, predicted uncertainty */
+    rc_model determined;      /* the model compensation uses (undetermined DH nominal) */
+    unsigned n_groups;        /* set-up groups of the data (file column, else from the wrist) */
+    int groups_from_file;
+    rch_provenance prov;      /* data file, samples, sha256, date, tool */
 } rch_calib_result;
 
 /* The whole calibration. Returns 0 (the solver ran; r->after_ok says whether

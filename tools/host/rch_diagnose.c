@@ -1,5 +1,6 @@
 /* rch_diagnose.c - the `rcal diagnose` workflow; see rch_diagnose.h. */
 #include "rch_diagnose.h"
+#include "rch_groups.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -349,33 +350,6 @@ static void unseen_groups(rc_model *m, const rc_sample *train, size_t n)
                 m->x[ef->first + g] = sum / (double)tot;
         free(cnt);
     }
-}
-
-/* Set-up groups: consecutive samples whose wrist joints (q4..q6) stay the
- * same. A wrist reading that flickers by one display step (the angle sits
- * on a rounding boundary) does not start a new group; such samples are
- * counted in *flicker. Returns the number of groups. */
-static unsigned group_by_wrist(rc_sample *s, size_t n, double q_step_deg, unsigned *flicker)
-{
-    const double tol = (q_step_deg > 0.0 ? 1.5 * q_step_deg : 1e-9) * DEG;
-    unsigned g = 0;
-    *flicker = 0;
-    for (size_t i = 0; i < n; ++i) {
-        if (i > 0) {
-            int same = 1, exact = 1;
-            for (unsigned j = 3; j < RC_NJ; ++j) {
-                const double dq = fabs(s[i].q_rad[j] - s[i - 1].q_rad[j]);
-                same = same && dq <= tol;
-                exact = exact && dq == 0.0;
-            }
-            if (!same)
-                ++g;
-            else if (!exact)
-                ++*flicker;
-        }
-        s[i].group = (uint16_t)(g > 65535 ? 65535 : g);
-    }
-    return n ? g + 1 : 0;
 }
 
 /* Cross-validate: models (k) in: starts, out: fitted on each fold's training
@@ -734,7 +708,7 @@ static void phase_steps(run_state *S)
                                                   : rch_diagnose_detect_step(S->tmp, n);
     out->len_noise_mm = S->cfg.len_noise_mm > 0.0 ? S->cfg.len_noise_mm : 0.0;
     if (!S->cfg.groups_given)
-        out->n_groups = group_by_wrist(out->s, n, out->q_step_deg, &out->n_flicker);
+        out->n_groups = rch_groups_by_wrist(out->s, n, out->q_step_deg, &out->n_flicker);
 }
 
 /* 1. Geometric fit on all samples, from the "before calibration" model of

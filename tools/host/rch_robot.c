@@ -206,6 +206,71 @@ static int read_nominal(rch_robot *out, const rch_json *root, const char *name, 
     return 0;
 }
 
+static const char *const class_words[] = {"fixed", "identifiable", "weak", "not identifiable"};
+
+/* One "parameters" entry k: class and standard error (file units: mm, deg). */
+static int read_unc_param(rch_robot *out, unsigned k, const rch_json *p, const char *name, rch_diag *d)
+{
+    const rch_json *cl = rch_json_get(p, "class"), *se = rch_json_get(p, "std_error");
+    if (p->type != RCH_JOBJ || !cl || cl->type != RCH_JSTR) {
+        rch_diag_set(d, name, p->line, p->col, "uncertainty parameter %u: needs \"class\"", k + 1);
+        return -1;
+    }
+    unsigned c = 0;
+    while (c < 4 && strcmp(cl->str, class_words[c]) != 0)
+        ++c;
+    if (c == 4) {
+        rch_diag_set(d, name, cl->line, cl->col, "unknown class \"%s\" (identifiable, weak, not identifiable, fixed)",
+                     cl->str);
+        return -1;
+    }
+    out->unc.cls[k] = (uint8_t)c;
+    const rch_json *cp = rch_json_get(p, "compensation");
+    /* version-2 files before this member: weak and not identifiable held nominal */
+    out->unc.comp_nominal[k] = cp && cp->type == RCH_JSTR ? strcmp(cp->str, "nominal") == 0 : (c == 2 || c == 3);
+    out->unc.se[k] = NAN;
+    if (se && se->type == RCH_JNUM) {
+        if (!(se->num >= 0.0) || !isfinite(se->num)) {
+            rch_diag_set(d, name, se->line, se->col, "std_error must be a finite number >= 0");
+            return -1;
+        }
+        out->unc.se[k] = se->num * (rc_param_unit(&out->model, k) == 1 ? DEG : 1.0);
+    }
+    return 0;
+}
+
+/* "uncertainty" of an rcal-model/2 file. */
+static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name, rch_diag *d)
+{
+    const rch_json *ps = rch_json_get(u, "parameters"), *cov = rch_json_get(u, "covariance_dh"),
+                   *od = rch_json_get(u, "orientation_determined"), *sg = rch_json_get(u, "sigma_mm");
+    if (u->type != RCH_JOBJ || !ps || ps->type != RCH_JARR || ps->n != out->model.n_params) {
+        rch_diag_set(d, name, u->line, u->col, "\"uncertainty\" needs \"parameters\", one per model parameter (%u)",
+                     out->model.n_params);
+        return -1;
+    }
+    for (unsigned k = 0; k < ps->n; ++k)
+        if (read_unc_param(out, k, ps->items[k], name, d) != 0)
+            return -1;
+    if (!cov || cov->type != RCH_JARR || cov->n != RC_N_DH * RC_N_DH) {
+        rch_diag_set(d, name, u->line, u->col, "\"uncertainty\" needs \"covariance_dh\": %d numbers (24 x 24, mm and rad)",
+                     RC_N_DH * RC_N_DH);
+        return -1;
+    }
+    for (unsigned k = 0; k < cov->n; ++k) {
+        if (cov->items[k]->type != RCH_JNUM || !isfinite(cov->items[k]->num)) {
+            rch_diag_set(d, name, cov->items[k]->line, cov->items[k]->col, "covariance_dh: not a finite number");
+            return -1;
+        }
+        out->unc.cov_dh[k] = cov->items[k]->num;
+    }
+    out->unc.orientation_determined = od && od->type == RCH_JBOOL && od->num != 0.0;
+    out->unc.sigma_mm = sg && sg->type == RCH_JNUM ? sg->num : NAN;
+    out->unc.n = out->model.n_params;
+    out->unc.present = 1;
+    return 0;
+}
+
 int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d)
 {
     double dh[RC_NJ][4], enc[3] = {0, 0, 0};
@@ -219,8 +284,10 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
         goto done;
     }
     const rch_json *fmt = rch_json_get(root, "format");
-    if (fmt && (fmt->type != RCH_JSTR || strcmp(fmt->str, "rcal-model/1") != 0)) {
-        rch_diag_set(d, name, fmt->line, fmt->col, "unsupported format (expected \"rcal-model/1\")");
+    if (fmt && (fmt->type != RCH_JSTR ||
+                (strcmp(fmt->str, "rcal-model/1") != 0 && strcmp(fmt->str, "rcal-model/2") != 0))) {
+        rch_diag_set(d, name, fmt->line, fmt->col,
+                     "unsupported format (expected \"rcal-model/1\" or \"rcal-model/2\")");
         goto done;
     }
     const rch_json *nm = rch_json_get(root, "name");
@@ -238,6 +305,9 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
         goto done;
     const rch_json *eff = rch_json_get(root, "effects");
     if (eff && read_effects(&out->model, eff, name, d) != 0)
+        goto done;
+    const rch_json *unc = rch_json_get(root, "uncertainty");
+    if (unc && read_uncertainty(out, unc, name, d) != 0)
         goto done;
     rc = 0;
 done:
@@ -285,13 +355,80 @@ static void write_numsf(rch_jw *w, const char *key, const double *v, size_t n, c
     rch_jw_end(w);
 }
 
+static void write_map(rch_jw *w, const rch_uncert_map *mp)
+{
+    rch_jw_obj(w, "position95_mm");
+    rch_jw_numf(w, "data_median", mp->data_median_mm, "%.6g");
+    rch_jw_numf(w, "data_max", mp->data_max_mm, "%.6g");
+    rch_jw_numf(w, "workspace_median", mp->work_median_mm, "%.6g");
+    rch_jw_numf(w, "workspace_max", mp->work_max_mm, "%.6g");
+    rch_jw_end(w);
+    rch_jw_obj(w, "orientation95_deg");
+    rch_jw_numf(w, "data_median", mp->rot_data_median_deg, "%.6g");
+    rch_jw_numf(w, "data_max", mp->rot_data_max_deg, "%.6g");
+    rch_jw_end(w);
+}
+
+static void write_uncertainty(rch_jw *w, const rc_model *m, const rch_model_unc *u, const rc_model *det)
+{
+    rch_jw_obj(w, "uncertainty");
+    rch_jw_str(w, "covariance", u->kind == RCH_COV_CLUSTER ? "cluster-robust" : "classical");
+    rch_jw_uint(w, "groups", u->n_groups);
+    rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
+    rch_jw_uint(w, "rank", u->rank);
+    rch_jw_arr(w, "parameters");
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        char nm[64];
+        const int unit = rc_param_unit(m, k);
+        const double sc = unit == 1 ? 1.0 / DEG : 1.0;
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "name", rc_param_name(nm, sizeof nm, m, k));
+        rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "SI");
+        rch_jw_numf(w, "value", m->x[k] * sc, "%.12g");
+        rch_jw_numf(w, "std_error", u->se[k] * sc, "%.6g"); /* NaN -> null */
+        rch_jw_str(w, "class", class_words[u->cls[k] < 4 ? u->cls[k] : 0]);
+        rch_jw_str(w, "compensation", k < RC_N_DH ? (u->comp_nominal[k] ? "nominal" : "fitted") : "not used");
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_arr(w, "covariance_dh");
+    for (unsigned k = 0; k < RC_N_DH * RC_N_DH; ++k)
+        rch_jw_numf(w, NULL, u->cov_dh[k], "%.9g");
+    rch_jw_end(w);
+    if (det) {
+        rch_jw_obj(w, "determined");
+        write_dh(w, "dh", det);
+        rch_jw_end(w);
+    }
+    rch_jw_bool(w, "orientation_determined", u->orientation_determined);
+    write_map(w, &u->map);
+    rch_jw_end(w);
+}
+
+static void write_provenance(rch_jw *w, const rch_provenance *p)
+{
+    rch_jw_obj(w, "provenance");
+    rch_jw_arr(w, "data");
+    for (unsigned i = 0; i < p->n_files; ++i) {
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "file", p->file[i]);
+        rch_jw_uint(w, "samples", p->samples[i]);
+        rch_jw_str(w, "sha256", p->sha256[i]);
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_str(w, "date", p->date);
+    rch_jw_str(w, "tool", p->tool);
+    rch_jw_end(w);
+}
+
 int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model *nominal,
                     const rch_robot_info *info)
 {
     rch_jw w;
     rch_jw_init(&w, f, 1);
     rch_jw_obj(&w, NULL);
-    rch_jw_str(&w, "format", "rcal-model/1");
+    rch_jw_str(&w, "format", info && info->unc ? "rcal-model/2" : "rcal-model/1");
     rch_jw_str(&w, "name", name ? name : "robot");
     write_dh(&w, "dh", m);
     rch_jw_arr(&w, "joint_limits_deg");
@@ -330,6 +467,10 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
         info->write(&w, info->ctx);
         rch_jw_end(&w);
     }
+    if (info && info->unc)
+        write_uncertainty(&w, m, info->unc, info->determined);
+    if (info && info->prov)
+        write_provenance(&w, info->prov);
     rch_jw_end(&w);
     return rch_jw_finish(&w) == 0 && !ferror(f) ? 0 : -1;
 }

@@ -1,6 +1,7 @@
 /* rch_robot.h - robot-model and calibrated-model files (JSON).
  *
- * Format "rcal-model/1" (lengths in mm, angles in degrees):
+ * Formats "rcal-model/1" and "rcal-model/2" (docs/model-format.md; lengths
+ * in mm, angles in degrees); version 2 adds "uncertainty", "provenance":
  * {
  *   "format": "rcal-model/1",
  *   "name": "ABB IRB120",
@@ -23,6 +24,7 @@
 #include "rc_model.h"
 #include "rch_diag.h"
 #include "rch_jw.h"
+#include "rch_uncert.h"
 
 typedef struct rch_robot {
     char name[128];
@@ -30,7 +32,19 @@ typedef struct rch_robot {
     rc_model nominal;   /* "nominal" member if present, else == model without effects */
     int has_encoder;    /* encoder_mm was given */
     int has_nominal;    /* the file is a calibrated model with a nominal table */
+    rch_model_unc unc;  /* rcal-model/2 "uncertainty" (unc.present == 0 for version 1) */
 } rch_robot;
+
+/* Where a calibration came from (rcal-model/2 "provenance"). */
+#define RCH_PROV_MAX_FILES 16
+typedef struct rch_provenance {
+    unsigned n_files;
+    const char *file[RCH_PROV_MAX_FILES];   /* as given */
+    size_t samples[RCH_PROV_MAX_FILES];
+    char sha256[RCH_PROV_MAX_FILES][65];
+    char date[32];                          /* UTC, ISO 8601 */
+    const char *tool;                       /* "rcal 0.1.0" */
+} rch_provenance;
 
 int rch_robot_load(rch_robot *out, const char *path, rch_diag *d);
 int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d);
@@ -40,6 +54,10 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
 typedef struct rch_robot_info {
     void (*write)(rch_jw *w, const void *ctx);
     const void *ctx;
+    /* rcal-model/2 (all may be NULL; with unc the file is version 2): */
+    const rch_model_unc *unc;      /* uncertainty, classes, determined model */
+    const rc_model *determined;    /* the model compensation uses */
+    const rch_provenance *prov;
 } rch_robot_info;
 
 /* Write a model file through rch_jw (every string escaped, non-finite numbers

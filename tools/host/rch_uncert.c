@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rc_ident.h"
 #include "rc_rand.h"
 
 /* chi-square quantile with 3 degrees of freedom at 0.95 */
@@ -84,16 +85,41 @@ typedef struct {
     unsigned idx[RC_MAX_PARAMS];
     double D[RC_MAX_PARAMS];
     double ev[RC_MAX_PARAMS];
-    double *V;  /* (nf x nf) eigenvectors in columns */
+    double *V;  /* (nf x nf) eigenvectors in columns, ascending eigenvalues */
+    uint8_t dir_class[RC_MAX_PARAMS];   /* (nf) rc_ident_class of direction d (ascending order) */
+    uint8_t param_class[RC_MAX_PARAMS]; /* (nf) rc_ident_class of free parameter a */
     double *Cz; /* (nf x nf) covariance in scaled coordinates */
 } scaled;
+
+/* Classes of directions and parameters from the one definition (rc_ident),
+ * on the eigen-decomposition in ascending order. */
+static int ident(scaled *z, size_t n_rows)
+{
+    unsigned nf = z->nf;
+    double evd[RC_MAX_PARAMS], *Vd = malloc((size_t)nf * nf * sizeof *Vd);
+    rc_ident id;
+    if (!Vd)
+        return -1;
+    for (unsigned d = 0; d < nf; ++d) {
+        evd[d] = z->ev[nf - 1 - d];
+        for (unsigned a = 0; a < nf; ++a)
+            Vd[a * nf + d] = z->V[a * nf + (nf - 1 - d)];
+    }
+    rc_status st = rc_ident_classify_eig(&id, evd, Vd, nf, n_rows);
+    free(Vd);
+    if (st != RC_OK)
+        return -1;
+    for (unsigned d = 0; d < nf; ++d)
+        z->dir_class[d] = id.dir_class[nf - 1 - d];
+    memcpy(z->param_class, id.param_class, nf);
+    return 0;
+}
 
 /* Covariance in scaled coordinates: classical or cluster-robust. */
 static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r, const rc_sample *s, size_t n,
                       int want_cluster)
 {
     unsigned nf = z->nf;
-    double emax = z->ev[nf - 1] > 0 ? z->ev[nf - 1] : 1.0;
     /* pseudo-inverse A+ = sum over kept directions v v^T / ev */
     double *Ap = calloc((size_t)nf * nf, sizeof *Ap);
     double *M = calloc((size_t)nf * nf, sizeof *M);
@@ -104,11 +130,10 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
     }
     u->rank = u->n_weak = 0;
     for (unsigned d = 0; d < nf; ++d) {
-        double sv = sqrt(fmax(z->ev[d], 0.0) / emax);
-        if (sv < RCH_UNCERT_NULL_SV)
+        if (z->dir_class[d] == RC_IDENT_NONE)
             continue;
         u->rank++;
-        u->n_weak += sv < RCH_UNCERT_WEAK_SV;
+        u->n_weak += z->dir_class[d] == RC_IDENT_WEAK;
         for (unsigned a = 0; a < nf; ++a)
             for (unsigned b = 0; b < nf; ++b)
                 Ap[a * nf + b] += z->V[a * nf + d] * z->V[b * nf + d] / z->ev[d];
@@ -175,18 +200,100 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
 }
 
 /* Classes, standard errors and the parameter-space covariance. */
+/* Does a step along direction d (scaled coordinates) move the flange
+ * (position, or orientation at a 100 mm lever) at the poses s? Relative to
+ * the largest such effect of any direction: below 1e-6 it does not (d2 - d3
+ * of parallel joints moves nothing the robot does). rel_out (nf). */
+/* FK effect of a small step along direction d (scaled coordinates): flange
+ * position and orientation (at a 100 mm lever) at up to 40 of the poses s,
+ * into g (RCH_FKREL_ROWS). */
+#define RCH_FKREL_POSES 40
+#define RCH_FKREL_ROWS (RCH_FKREL_POSES * 12)
+static void fk_effect(double *g, const scaled *z, unsigned d, const rc_model *m, const rc_sample *s, size_t n)
+{
+    unsigned nf = z->nf;
+    size_t step = n > RCH_FKREL_POSES ? n / RCH_FKREL_POSES : 1, row = 0;
+    memset(g, 0, RCH_FKREL_ROWS * sizeof *g);
+    for (size_t i = 0; i < n && row + 12 <= RCH_FKREL_ROWS; i += step) {
+        rc_model a = *m, b = *m;
+        for (unsigned k = 0; k < nf; ++k) {
+            double v = z->V[k * nf + d] / z->D[k] * 1e-4; /* a small step, unscaled */
+            a.x[z->idx[k]] += v;
+            b.x[z->idx[k]] -= v;
+        }
+        double pa[3], pb[3], Ra[9], Rb[9];
+        rc_fk(pa, Ra, &a, s[i].q_rad);
+        rc_fk(pb, Rb, &b, s[i].q_rad);
+        for (int c = 0; c < 3; ++c)
+            g[row++] = pa[c] - pb[c];
+        for (int c = 0; c < 9; ++c)
+            g[row++] = 100.0 * (Ra[c] - Rb[c]);
+    }
+}
+
+/* Parameters compensation must keep nominal. Within the span of the weak
+ * and not-identifiable directions (eigenvectors of a near-degenerate
+ * eigenvalue are arbitrary mixtures of it, so single directions do not
+ * tell), the combinations that move the flange (FK effect above 1e-6 of the
+ * largest of any direction) are undetermined for the robot: every parameter
+ * tied to one of them (squared share >= RC_IDENT_SHARE) stays nominal. The
+ * combinations that move nothing the robot does (d2 - d3 of the parallel
+ * joints 2 and 3) hold nothing. Parameters weak by their standard error
+ * alone stay nominal too. */
+static int comp_nominal(rch_uncert *u, const scaled *z, const rc_model *m, const rc_sample *s, size_t n)
+{
+    unsigned nf = z->nf, nn = 0, dir[RC_MAX_PARAMS];
+    double *g = malloc((size_t)RCH_FKREL_ROWS * nf * sizeof *g), big = 0.0;
+    double *M = calloc((size_t)nf * nf, sizeof *M), ev[RC_MAX_PARAMS];
+    if (!g || !M) {
+        free(g);
+        free(M);
+        return -1;
+    }
+    for (unsigned d = 0; d < nf; ++d) {
+        fk_effect(g + (size_t)d * RCH_FKREL_ROWS, z, d, m, s, n);
+        double e = 0.0;
+        for (unsigned r = 0; r < RCH_FKREL_ROWS; ++r)
+            e += g[(size_t)d * RCH_FKREL_ROWS + r] * g[(size_t)d * RCH_FKREL_ROWS + r];
+        big = fmax(big, sqrt(e));
+        if (z->dir_class[d] != RC_IDENT_IDENTIFIABLE)
+            dir[nn++] = d;
+    }
+    for (unsigned a = 0; a < nn; ++a)
+        for (unsigned b = 0; b < nn; ++b)
+            for (unsigned r = 0; r < RCH_FKREL_ROWS; ++r)
+                M[a * nn + b] += g[(size_t)dir[a] * RCH_FKREL_ROWS + r] * g[(size_t)dir[b] * RCH_FKREL_ROWS + r];
+    if (nn > 0 && LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', (lapack_int)nn, M, (lapack_int)nn, ev) != 0)
+        nn = 0;
+    for (unsigned e = 0; e < nn; ++e) {
+        if (!(sqrt(fmax(ev[e], 0.0)) >= 1e-6 * big))
+            continue; /* moves nothing the robot does */
+        for (unsigned a = 0; a < nf; ++a) {
+            double c = 0.0; /* component of parameter a in this combination */
+            for (unsigned j = 0; j < nn; ++j)
+                c += z->V[a * nf + dir[j]] * M[j * nn + e];
+            if (c * c >= RC_IDENT_SHARE)
+                u->comp_nominal[z->idx[a]] = 1;
+        }
+    }
+    for (unsigned a = 0; a < nf; ++a)
+        if (u->cls[z->idx[a]] == RCH_PARAM_WEAK)
+            u->comp_nominal[z->idx[a]] = 1;
+    free(g);
+    free(M);
+    return 0;
+}
+
 static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
 {
     unsigned nf = z->nf, np = u->n_params;
-    double emax = z->ev[nf - 1] > 0 ? z->ev[nf - 1] : 1.0;
     for (unsigned d = 0; d < nf; ++d) {
-        double sv = sqrt(fmax(z->ev[d], 0.0) / emax);
         for (unsigned a = 0; a < nf; ++a) {
             double w = z->V[a * nf + d] * z->V[a * nf + d];
             unsigned k = z->idx[a];
-            if (sv < RCH_UNCERT_NULL_SV)
+            if (z->dir_class[d] == RC_IDENT_NONE)
                 u->null_share[k] += w;
-            else if (sv < RCH_UNCERT_WEAK_SV)
+            else if (z->dir_class[d] == RC_IDENT_WEAK)
                 u->weak_share[k] += w;
         }
     }
@@ -196,11 +303,11 @@ static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
         unsigned k = z->idx[a];
         double se = sqrt(fmax(z->Cz[a * nf + a], 0.0)) / z->D[a];
         double tol = rc_param_unit(m, k) == 1 ? RCH_UNCERT_WEAK_RAD : RCH_UNCERT_WEAK_MM;
-        if (u->null_share[k] > RCH_UNCERT_SHARE) {
+        if (z->param_class[a] == RC_IDENT_NONE) {
             u->cls[k] = RCH_PARAM_NOT_IDENTIFIABLE;
             u->se[k] = NAN;
         } else {
-            int weak = u->weak_share[k] > RCH_UNCERT_SHARE || (rc_param_unit(m, k) != 2 && se > tol);
+            int weak = z->param_class[a] == RC_IDENT_WEAK || (rc_param_unit(m, k) != 2 && se > tol);
             u->cls[k] = weak ? RCH_PARAM_WEAK : RCH_PARAM_IDENTIFIABLE;
             u->se[k] = se;
         }
@@ -254,11 +361,19 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
         snprintf(err, errlen, "eigen-decomposition of the normal matrix failed");
         goto done;
     }
+    if (ident(&z, n) != 0) {
+        snprintf(err, errlen, "the identifiability analysis failed (non-finite normal matrix)");
+        goto done;
+    }
     if (covariance(&z, u, J, r, s, n, want_cluster) != 0) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
     classify(u, &z, m);
+    if (comp_nominal(u, &z, m, s, n) != 0) {
+        snprintf(err, errlen, "out of memory");
+        goto done;
+    }
     rc = 0;
 done:
     free(J);
@@ -274,21 +389,22 @@ done:
 void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_uncert *u)
 {
     *out = *fit;
-    for (unsigned k = 0; k < u->n_params && k < RC_P_ENC; ++k)
-        if (u->cls[k] == RCH_PARAM_WEAK || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE)
+    for (unsigned k = 0; k < u->n_params && k < RC_N_DH; ++k)
+        if (u->comp_nominal[k])
             out->x[k] = nominal->x[k];
 }
 
-double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
+/* 95 % position semi-axis at q from a covariance cov (n x n, leading
+ * dimension ld) over the parameters k < n with use[k] set. */
+static double pos95_cov(const double *cov, size_t ld, const uint8_t *use, unsigned n, const rc_model *m,
+                        const double q_rad[RC_NJ])
 {
-    unsigned np = u->n_params;
     double Jp[3][RC_MAX_PARAMS];
     rc_model t = *m;
-    for (unsigned k = 0; k < np; ++k) {
-        if (u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE) {
-            Jp[0][k] = Jp[1][k] = Jp[2][k] = 0.0;
+    for (unsigned k = 0; k < n; ++k) {
+        Jp[0][k] = Jp[1][k] = Jp[2][k] = 0.0;
+        if (!use[k])
             continue;
-        }
         double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5;
         double pp[3], pm[3];
         t.x[k] = m->x[k] + h;
@@ -302,16 +418,54 @@ double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double 
     double C[9] = {0};
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
-            for (unsigned k = 0; k < np; ++k) {
-                if (Jp[i][k] == 0.0)
-                    continue;
-                for (unsigned l = 0; l < np; ++l)
-                    C[i * 3 + j] += Jp[i][k] * u->cov[(size_t)k * np + l] * Jp[j][l];
-            }
+            for (unsigned k = 0; k < n; ++k)
+                for (unsigned l = 0; use[k] && l < n; ++l)
+                    C[i * 3 + j] += Jp[i][k] * cov[(size_t)k * ld + l] * Jp[j][l];
     double ev[3];
     if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
         return NAN;
     return sqrt(CHI2_3_95 * fmax(ev[2], 0.0));
+}
+
+double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    uint8_t use[RC_MAX_PARAMS];
+    for (unsigned k = 0; k < u->n_params; ++k)
+        use[k] = u->cls[k] == RCH_PARAM_IDENTIFIABLE || u->cls[k] == RCH_PARAM_WEAK;
+    return pos95_cov(u->cov, u->n_params, use, u->n_params, m, q_rad);
+}
+
+void rch_model_unc_from(rch_model_unc *out, const rch_uncert *u)
+{
+    memset(out, 0, sizeof *out);
+    out->present = 1;
+    out->n = u->n_params;
+    out->kind = u->kind;
+    out->n_groups = u->n_groups;
+    out->rank = u->rank;
+    out->sigma_mm = u->sigma_mm;
+    memcpy(out->cls, u->cls, u->n_params);
+    memcpy(out->comp_nominal, u->comp_nominal, u->n_params);
+    memcpy(out->se, u->se, u->n_params * sizeof *u->se);
+    for (unsigned k = 0; k < RC_N_DH && k < u->n_params; ++k)
+        for (unsigned l = 0; l < RC_N_DH && l < u->n_params; ++l)
+            out->cov_dh[k * RC_N_DH + l] = u->cov[(size_t)k * u->n_params + l];
+}
+
+double rch_model_unc_pos95_mm(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    uint8_t use[RC_N_DH];
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        use[k] = u->cls[k] != RCH_PARAM_FIXED && !u->comp_nominal[k] && isfinite(u->se[k]);
+    return pos95_cov(u->cov_dh, RC_N_DH, use, RC_N_DH, m, q_rad);
+}
+
+void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_model_unc *u)
+{
+    *out = *fit;
+    for (unsigned k = 0; k < RC_N_DH && k < u->n; ++k)
+        if (u->comp_nominal[k])
+            out->x[k] = nominal->x[k];
 }
 
 static int cmp_double(const void *a, const void *b)

@@ -6,8 +6,7 @@
  * Covariance. At the solution x (free parameters F, nf of them), with the
  * Jacobian J (n x nf) of the residuals r = l(q; x) - L, columns scaled to
  * unit norm (S = diag of the column norms), A = Js^T Js = V diag(ev) V^T:
- *  - directions with relative singular value sqrt(ev/ev_max) below the
- *    identifiability limit are NOT IDENTIFIABLE: the data carry no
+ *  - directions rc_ident classes as null are NOT IDENTIFIABLE: the data carry no
  *    information on them; the pseudo-inverse A+ leaves them out and the
  *    parameters that lie in them get no standard error;
  *  - classical:     Cov = s^2 S^-1 A+ S^-1,  s^2 = r^T r / (n - rank);
@@ -15,10 +14,8 @@
  *    Cov = c S^-1 A+ (sum_g u_g u_g^T) A+ S^-1, u_g = Js_g^T r_g summed over
  *    the samples of group g, c = G/(G-1) (n-1)/(n-rank) (the usual small-sample
  *    factor); used when the samples carry at least 5 groups of >= 2 samples.
- * Per parameter: standard error sqrt(Cov_kk) and a class: the share of the
- * parameter's scaled unit vector that lies in not-identifiable directions
- * (> 1/2: not identifiable), in weak directions (> 1/2 with the former:
- * weak), else identifiable; and relative to the standard error.
+ * Per parameter: standard error sqrt(Cov_kk) and a class: rc_ident's class,
+ * made weak also when the standard error exceeds a typical DH error.
  *
  * Host side (prefix rch_): heap and LAPACKE. */
 #ifndef RCH_UNCERT_H
@@ -38,15 +35,10 @@ typedef enum {
 
 typedef enum { RCH_COV_CLASSICAL = 0, RCH_COV_CLUSTER = 1 } rch_cov_kind;
 
-/* Relative singular values below these are not identifiable / weak: the
- * words and limits of the identifiability report. */
-#define RCH_UNCERT_NULL_SV 1e-6
-#define RCH_UNCERT_WEAK_SV 1e-3
-/* A parameter with more than this share of its (scaled) unit vector in
- * not-identifiable directions is not identifiable on its own (only in
- * combination); in weak directions, weak. */
-#define RCH_UNCERT_SHARE 0.01
-/* Also weak: a standard error above a typical DH error (0.1 mm, 0.1 deg):
+/* Directions and parameters are classed by the one definition, lib/rc_ident.h
+ * (not identifiable below a relative singular value of 1e-6, weak below
+ * 1e-3, a parameter tied to a direction by a squared share of 0.01). Also
+ * weak here: a standard error above a typical DH error (0.1 mm, 0.1 deg):
  * the data do not determine the parameter to the size of what it corrects. */
 #define RCH_UNCERT_WEAK_MM 0.1
 #define RCH_UNCERT_WEAK_RAD 1.7453292519943295e-3
@@ -54,8 +46,8 @@ typedef enum { RCH_COV_CLASSICAL = 0, RCH_COV_CLUSTER = 1 } rch_cov_kind;
 typedef struct rch_uncert {
     unsigned n_params;                /* of the model */
     unsigned nf;                      /* free parameters */
-    unsigned rank;                    /* directions with sv_rel >= RCH_UNCERT_NULL_SV */
-    unsigned n_weak;                  /* of them below RCH_UNCERT_WEAK_SV */
+    unsigned rank;                    /* directions rc_ident does not class as null */
+    unsigned n_weak;                  /* of them weak */
     rch_cov_kind kind;
     unsigned n_groups;                /* clusters used (cluster-robust) */
     size_t n_samples;
@@ -64,6 +56,8 @@ typedef struct rch_uncert {
     uint8_t cls[RC_MAX_PARAMS];       /* (n_params) rch_param_class */
     double null_share[RC_MAX_PARAMS]; /* (n_params) share in not-identifiable directions, 0..1 */
     double weak_share[RC_MAX_PARAMS]; /* (n_params) share in weak directions, 0..1 */
+    uint8_t comp_nominal[RC_MAX_PARAMS]; /* (n_params) 1: compensation keeps it nominal (tied to a weak or
+                                            not-identifiable direction that moves the robot, or weak) */
     double *cov;                      /* (n_params x n_params) heap, row-major; rows/cols of fixed params 0 */
 } rch_uncert;
 
@@ -76,9 +70,14 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
 void rch_uncert_free(rch_uncert *u);
 
 /* The determined part of a calibration, for compensation: the fit with
- * every DH parameter the data did not determine (weak or not identifiable)
- * back at its nominal value. The encoder outlet and effects are kept (they
- * do not move the robot). */
+ * every DH parameter the data did not determine back at its nominal value:
+ * those tied to a weak or not-identifiable direction that moves the robot
+ * (d1 with the encoder height, the base heading, a weak wrist combination),
+ * and those whose standard error makes them weak (theta6 with a6 near 0).
+ * A not-identifiable direction that moves nothing the robot does (d2 - d3 of
+ * the parallel joints 2 and 3) does not hold its parameters: their
+ * determined combination (d2 + d3) is kept. The encoder outlet and effects
+ * are kept (they do not move the robot). */
 void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_uncert *u);
 
 /* 95 % uncertainty of the flange position predicted at q: the longest
@@ -104,5 +103,37 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
                            size_t n_random, uint64_t seed);
 
 const char *rch_param_class_name(rch_param_class c);
+
+/* What a model file (rcal-model/2) carries of a calibration's uncertainty:
+ * enough for compensation to act only on what the data determined and to
+ * know where the model can be trusted. Fixed size (no heap): the covariance
+ * of the 24 DH parameters only (the encoder and nuisance effects do not move
+ * the robot). */
+/* Orientation counts as determined when its 95 % uncertainty over the data's
+ * poses (median) is below this (deg). */
+#define RCH_ORIENT_DETERMINED_DEG 0.05
+typedef struct rch_model_unc {
+    int present;                        /* the file had an "uncertainty" member */
+    unsigned n;                         /* parameters described */
+    rch_cov_kind kind;
+    unsigned n_groups, rank;
+    double sigma_mm;
+    uint8_t cls[RC_MAX_PARAMS];         /* (n) rch_param_class */
+    uint8_t comp_nominal[RC_MAX_PARAMS]; /* (n) 1: held nominal for compensation */
+    double se[RC_MAX_PARAMS];           /* (n) SI units; NaN when none */
+    double cov_dh[RC_N_DH * RC_N_DH];   /* (24 x 24) SI units (mm, rad) */
+    int orientation_determined;
+    rch_uncert_map map;                 /* figures over the data and the workspace */
+} rch_model_unc;
+
+/* Fill from a computed rch_uncert (map and orientation_determined are set by
+ * the caller). */
+void rch_model_unc_from(rch_model_unc *out, const rch_uncert *u);
+/* 95 % position uncertainty at q of the determined model (identifiable DH
+ * parameters only: the others are held nominal and carry no information). */
+double rch_model_unc_pos95_mm(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ]);
+/* The determined model: fit with its weak and not-identifiable DH
+ * parameters at their nominal values. */
+void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_model_unc *u);
 
 #endif
