@@ -105,12 +105,12 @@ static const char cal_full[] =
     " \"params\": [{\"name\": \"a1\", \"unit\": \"mm\", \"value\": 0.25, \"delta\": 0.25},"
     "  {\"name\": \"a\\\"1,x<i>\", \"unit\": \"mm\", \"value\": 270.1, \"delta\": 0.1},"
     "  {\"name\": \"theta6\", \"unit\": \"deg\", \"value\": -3.2, \"delta\": -3.2}],"
-    " \"uncertainty\": {\"covariance\": \"cluster-robust\", \"groups\": 12, \"sigma_mm\": 0.0187, \"rank\": 2,"
+    " \"uncertainty\": {\"covariance\": \"cluster-robust\", \"groups\": 12, \"groups_from\": \"<g>\", \"sigma_mm\": 0.0187, \"rank\": 2,"
     "  \"parameters\": [{\"name\": \"a1\", \"unit\": \"mm\", \"value\": 0.25, \"std_error\": 0.0123, \"class\": "
     "\"identifiable\"},"
     "   {\"name\": \"a\\\"1,x<i>\", \"unit\": \"mm\", \"value\": 270.1, \"std_error\": 0.5, \"class\": \"weak\"},"
     "   {\"name\": \"theta6\", \"unit\": \"deg\", \"value\": -3.2, \"std_error\": null, \"class\": \"not "
-    "identifiable\"}],"
+    "identifiable\", \"compensation\": \"nominal\"}],"
     "  \"orientation_determined\": false,"
     "  \"position95_mm\": {\"data_median\": 0.0456, \"data_max\": 0.09, \"workspace_median\": 0.71, "
     "\"workspace_max\": 2.5},"
@@ -220,7 +220,8 @@ static void test_full_run_escaped(void **state)
     assert_true(count(h, "a&quot;1,x&lt;i&gt;") >= 3);
     /* issue 10's members rendered */
     assert_non_null(strstr(h, "0.012"));                 /* std error of a1 */
-    assert_non_null(strstr(h, "cluster-robust"));
+    assert_non_null(strstr(h, "cluster-robust covariance over 12 set-up groups (from the &lt;g&gt;)"));
+    assert_non_null(strstr(h, "compensation uses"));
     assert_non_null(strstr(h, "not identifiable"));
     assert_non_null(strstr(h, "inside the data &plusmn;0.0456 mm"));
     assert_non_null(strstr(h, "whole workspace &plusmn;0.71 mm"));
@@ -244,7 +245,8 @@ static void test_full_run_escaped(void **state)
     char *c = get_file("report_params.csv");
     assert_non_null(c);
     assert_non_null(strstr(c, "\n\"a\"\"1,x<i>\",mm,270,270.1,0.1,0.5,"));
-    assert_non_null(strstr(c, ",weak\n"));
+    assert_non_null(strstr(c, ",weak,\n"));
+    assert_non_null(strstr(c, ",not identifiable,nominal\n"));
     free(c);
     c = get_file("report_candidates.csv");
     assert_non_null(c);

@@ -206,6 +206,13 @@ def check_csvs(work, cal, diag):
           % len(cal['params']))
     check(all(abs(float(r['correction']) - p['delta']) <= 1e-8 * max(1.0, abs(p['delta']))
               for r, p in zip(rows, cal['params'])), 'report_params.csv: corrections equal the JSON deltas')
+    unc = {u['name']: u for u in cal.get('uncertainty', {}).get('parameters', [])}
+    if unc:
+        se_ok = all((r['std_error'] == '') == (unc[r['name']]['std_error'] is None) and
+                    (r['std_error'] == '' or abs(float(r['std_error']) - unc[r['name']]['std_error'])
+                     <= 1e-8 * unc[r['name']]['std_error']) and r['class'] == unc[r['name']]['class']
+                    for r in rows)
+        check(se_ok, 'report_params.csv: standard errors and classes equal the JSON uncertainty')
     rows = list(csv.DictReader(open(os.path.join(work, 'report_candidates.csv'))))
     check([r['effect'] for r in rows] == [c['effect'] for c in diag['candidates']],
           'report_candidates.csv: the %d candidates of the diagnosis' % len(diag['candidates']))

@@ -468,7 +468,7 @@ static const metric_def metric_defs[] = {
 #define N_METRICS (sizeof metric_defs / sizeof metric_defs[0])
 
 typedef struct {
-    char name[64], unit[16], cls[24];
+    char name[64], unit[16], cls[24], comp[24]; /* comp: "fitted", "nominal", "not used" or "" */
     double nominal, value, delta, se, ci_lo, ci_hi; /* NaN when absent */
 } prow;
 
@@ -502,7 +502,7 @@ static unsigned char class_colour(const char *cls)
  * params[k] (std_error or se, class), else in uncertainty.parameters[]. */
 static void param_unc(const rep *r, const rch_json *pk, prow *p)
 {
-    const char *cls = jstr(pk, "class");
+    const char *cls = jstr(pk, "class"), *comp = jstr(pk, "compensation");
     p->se = jnum(pk, "std_error");
     if (!isfinite(p->se))
         p->se = jnum(pk, "se");
@@ -515,9 +515,12 @@ static void param_unc(const rep *r, const rch_json *pk, prow *p)
             p->se = jnum(list->items[i], "std_error");
         if (!cls)
             cls = jstr(list->items[i], "class");
+        if (!comp)
+            comp = jstr(list->items[i], "compensation");
         break;
     }
     snprintf(p->cls, sizeof p->cls, "%s", cls ? cls : "");
+    snprintf(p->comp, sizeof p->comp, "%s", comp ? comp : "");
 }
 
 static prow *params_read(const rep *r, size_t *n)
@@ -998,10 +1001,11 @@ static void json_table(rep *r, const rch_json *arr, const jcol *cols, size_t n_c
 static void params_table(rep *r, const prow *p, size_t n)
 {
     FILE *f = r->f;
-    int have_se = 0, have_cls = 0;
+    int have_se = 0, have_cls = 0, have_comp = 0;
     for (size_t k = 0; k < n; ++k) {
         have_se |= isfinite(p[k].se);
         have_cls |= p[k].cls[0] != '\0';
+        have_comp |= p[k].comp[0] != '\0';
     }
     fputs("<table><tr><th class=\"l\">parameter</th><th>unit</th><th>nominal</th><th>calibrated</th>"
           "<th>correction</th>",
@@ -1010,6 +1014,8 @@ static void params_table(rep *r, const prow *p, size_t n)
         fputs("<th>std error</th><th>95 % interval of the correction</th>", f);
     if (have_cls)
         fputs("<th class=\"l\">class</th>", f);
+    if (have_comp)
+        fputs("<th class=\"l\">compensation uses</th>", f);
     fputs("</tr>\n", f);
     for (size_t k = 0; k < n; ++k) {
         fputs("<tr><td class=\"l\">", f);
@@ -1043,6 +1049,10 @@ static void params_table(rep *r, const prow *p, size_t n)
             fprintf(f, "</td><td class=\"l\"><span class=\"sw\" style=\"background:%s\"></span>",
                     colour[class_colour(p[k].cls)]);
             put_str(r, p[k].cls[0] ? p[k].cls : NULL);
+        }
+        if (have_comp) {
+            fputs("</td><td class=\"l\">", f);
+            put_str(r, p[k].comp[0] ? p[k].comp : NULL);
         }
         fputs("</td></tr>\n", f);
     }
@@ -1169,8 +1179,14 @@ static void sec_params(rep *r, const prow *p, size_t n)
     if (r->unc) {
         fputs(" covariance", f);
         const double g = jnum(r->unc, "groups");
+        const char *from = jstr(r->unc, "groups_from");
         if (isfinite(g) && g > 0)
             fprintf(f, " over %.0f set-up groups", g);
+        if (from) {
+            fputs(" (from the ", f);
+            put_esc(f, from);
+            fputs(")", f);
+        }
         fputs(", residual &sigma; ", f);
         put_num(r, jnum(r->unc, "sigma_mm"), "%.4g mm");
         fprintf(f, " (%s)", r->unc_from);
@@ -1569,7 +1585,7 @@ static void csv_metrics(FILE *f, const rep *r)
 
 static void csv_params(FILE *f, const prow *p, size_t n)
 {
-    fputs("name,unit,nominal,calibrated,correction,std_error,ci95_low,ci95_high,class\n", f);
+    fputs("name,unit,nominal,calibrated,correction,std_error,ci95_low,ci95_high,class,compensation\n", f);
     for (size_t k = 0; k < n; ++k) {
         const double v[6] = {p[k].nominal, p[k].value, p[k].delta, p[k].se, p[k].ci_lo, p[k].ci_hi};
         csv_str(f, p[k].name);
@@ -1581,6 +1597,8 @@ static void csv_params(FILE *f, const prow *p, size_t n)
         }
         fputc(',', f);
         csv_str(f, p[k].cls);
+        fputc(',', f);
+        csv_str(f, p[k].comp);
         fputc('\n', f);
     }
 }
