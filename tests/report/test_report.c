@@ -224,7 +224,7 @@ static void test_full_run_escaped(void **state)
     assert_non_null(strstr(h, "compensation uses"));
     assert_non_null(strstr(h, "not identifiable"));
     assert_non_null(strstr(h, "inside the data &plusmn;0.0456 mm"));
-    assert_non_null(strstr(h, "whole workspace &plusmn;0.71 mm"));
+    assert_non_null(strstr(h, "whole workspace &plusmn;0.710 mm"));
     assert_non_null(strstr(h, "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef"));
     assert_non_null(strstr(h, "2026-11-29T12:00:00Z"));
     assert_non_null(strstr(h, "&lt; 1e-300")); /* p = 0 is not printed as 0 */

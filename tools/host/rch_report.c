@@ -198,6 +198,21 @@ static void put_num(rep *r, double v, const char *fmt)
     }
 }
 
+/* Three significant digits without an exponent between 1e-3 and 1e6
+ * ("1610 mm", not "1.61e+03 mm"), then `unit`; or "not in this run". */
+static void put_sig(rep *r, double v, const char *unit)
+{
+    const double a = fabs(v);
+    if (isfinite(v) && a >= 1e-3 && a < 1e6) {
+        const int dec = 2 - (int)floor(log10(a));
+        fprintf(r->f, "%.*f%s", dec > 0 ? dec : 0, v, unit);
+    } else {
+        put_num(r, v, "%.3g");
+        if (isfinite(v))
+            fputs(unit, r->f);
+    }
+}
+
 static void put_p(rep *r, double p)
 {
     if (isfinite(p) && p <= 0.0)
@@ -815,9 +830,9 @@ static void page_head(rep *r, size_t n_warn)
     fputs(" &middot; predicted position uncertainty (95 %): ", f);
     if (isfinite(in) || isfinite(ws)) {
         fputs("inside the data &plusmn;", f);
-        put_num(r, in, "%.3g mm");
+        put_sig(r, in, " mm");
         fputs(", whole workspace &plusmn;", f);
-        put_num(r, ws, "%.3g mm");
+        put_sig(r, ws, " mm");
     } else {
         put_num(r, NAN, "");
     }
@@ -1445,20 +1460,20 @@ static void sec_accuracy(rep *r, const arow *a, size_t n)
     fputs("<section id=\"accuracy\"><h2>6. Predicted accuracy over the workspace</h2>\n<table class=\"kv\">\n", f);
     kv(r, "flange position, 95 %");
     fputs("inside the data &plusmn;", f);
-    put_num(r, jnum(r->unc, "position95_mm.data_median"), "%.3g mm");
+    put_sig(r, jnum(r->unc, "position95_mm.data_median"), " mm");
     fputs(" (median; up to &plusmn;", f);
-    put_num(r, jnum(r->unc, "position95_mm.data_max"), "%.3g mm");
+    put_sig(r, jnum(r->unc, "position95_mm.data_max"), " mm");
     fputs("), whole workspace &plusmn;", f);
-    put_num(r, jnum(r->unc, "position95_mm.workspace_median"), "%.3g mm");
+    put_sig(r, jnum(r->unc, "position95_mm.workspace_median"), " mm");
     fputs(" (median; up to &plusmn;", f);
-    put_num(r, jnum(r->unc, "position95_mm.workspace_max"), "%.3g mm");
+    put_sig(r, jnum(r->unc, "position95_mm.workspace_max"), " mm");
     fputs(")", f);
     kv_end(r);
     kv(r, "flange orientation, 95 %");
     fputs("inside the data &plusmn;", f);
-    put_num(r, jnum(r->unc, "orientation95_deg.data_median"), "%.3g&deg;");
+    put_sig(r, jnum(r->unc, "orientation95_deg.data_median"), "&deg;");
     fputs(" (median; up to &plusmn;", f);
-    put_num(r, jnum(r->unc, "orientation95_deg.data_max"), "%.3g&deg;");
+    put_sig(r, jnum(r->unc, "orientation95_deg.data_max"), "&deg;");
     fputs("); orientation determined: ", f);
     const int od = jbool(r->unc, "orientation_determined");
     put_str(r, od < 0 ? NULL : od ? "yes" : "no (compensate position only)");
