@@ -1051,7 +1051,7 @@ static void params_table(rep *r, const prow *p, size_t n)
             if (none)
                 fputs("&mdash;", f);
             else
-                put_num(r, p[k].se, "%.2g");
+                put_sig(r, p[k].se, "");
             fputs("</td><td>", f);
             if (isfinite(p[k].ci_lo))
                 fprintf(f, "%+.3g &hellip; %+.3g", p[k].ci_lo, p[k].ci_hi);
