@@ -27,6 +27,7 @@ static const rcal_command commands[] = {
     {"evaluate", rcal_cmd_evaluate, "a calibrated model on new data, no refit; ISO 9283 distance figures"},
     {"bench", rcal_cmd_bench, "benchmarks: calibration time, compensation latency, parser speed"},
     {"export", rcal_cmd_export, "export a model as a URDF or a DH table in CSV"},
+    {"report", rcal_cmd_report, "an HTML report of a calibration run (self-contained, plots inline)"},
 };
 
 static void usage(FILE *f)

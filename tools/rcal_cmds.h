@@ -20,5 +20,6 @@ int rcal_cmd_grind(int argc, char **argv);      /* issue 5 */
 int rcal_cmd_diagnose(int argc, char **argv);   /* issue 6 */
 int rcal_cmd_evaluate(int argc, char **argv);   /* issue 10 */
 int rcal_cmd_export(int argc, char **argv);     /* issue 13 */
+int rcal_cmd_report(int argc, char **argv);     /* issue 13 */
 
 #endif

@@ -1,0 +1,1840 @@
+/* rch_report.c - the HTML report of a calibration; see rch_report.h and
+ * docs/report.md (which members are read, and from where). */
+#include "rch_report.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "rc_version.h"
+#include "rch_file.h"
+#include "rch_json.h"
+#include "rch_sha256.h"
+
+#define NA "<span class=\"na\">not in this run</span>"
+#define Z95 1.959963984540054 /* two-sided 95 % normal quantile */
+
+/* ---- colours: one meaning each, named in every chart's legend (Okabe-Ito) */
+enum {
+    C_BEFORE,  /* nominal model */
+    C_AFTER,   /* calibrated model */
+    C_IDENT,   /* parameter classes */
+    C_WEAK,
+    C_NOTID,
+    C_FIXED,
+    C_UNKNOWN,
+    C_CHOSEN,  /* diagnosis candidates */
+    C_SIGNIF,
+    C_NOTSIG,
+    C_PRED,    /* predicted uncertainty */
+    C_N
+};
+static const char *const colour[C_N] = {"#999999", "#0072B2", "#0072B2", "#E69F00", "#D55E00", "#555555",
+                                        "#000000", "#009E73", "#E69F00", "#999999", "#CC79A7"};
+
+typedef struct {
+    FILE *f; /* the HTML */
+    const rch_json *cal, *diag, *model;
+    const rch_json *unc;  /* uncertainty block: calibration's, else the model file's, or NULL */
+    const rch_json *prov; /* provenance block: likewise */
+    const char *unc_from, *prov_from;
+    const rch_report_cfg *cfg;
+    rch_report_result *res;
+    char warn[RCH_REPORT_MAX_WARN][640];
+    unsigned n_warn;
+} rep;
+
+/* ---- JSON access by dotted path ("uncertainty.position95_mm.data_max") */
+
+static const rch_json *jpath(const rch_json *o, const char *path)
+{
+    char key[128];
+    while (o && *path) {
+        const char *dot = strchr(path, '.');
+        const size_t n = dot ? (size_t)(dot - path) : strlen(path);
+        if (n >= sizeof key)
+            return NULL;
+        memcpy(key, path, n);
+        key[n] = '\0';
+        o = rch_json_get(o, key);
+        path += n + (dot ? 1 : 0);
+    }
+    return o;
+}
+
+static double jnum(const rch_json *o, const char *path)
+{
+    const rch_json *j = jpath(o, path);
+    return j && j->type == RCH_JNUM ? j->num : NAN;
+}
+
+static const char *jstr(const rch_json *o, const char *path)
+{
+    const rch_json *j = jpath(o, path);
+    return j && j->type == RCH_JSTR ? j->str : NULL;
+}
+
+/* 1 true, 0 false, -1 absent */
+static int jbool(const rch_json *o, const char *path)
+{
+    const rch_json *j = jpath(o, path);
+    return j && j->type == RCH_JBOOL ? j->num != 0.0 : -1;
+}
+
+static const rch_json *jarr(const rch_json *o, const char *path)
+{
+    const rch_json *j = jpath(o, path);
+    return j && j->type == RCH_JARR ? j : NULL;
+}
+
+/* ---- escaping */
+
+/* Length of the valid UTF-8 sequence at s (1..4), or 0. */
+static size_t utf8_len(const unsigned char *s)
+{
+    size_t n;
+    unsigned long cp, min;
+    if (s[0] < 0x80)
+        return 1;
+    if ((s[0] & 0xE0) == 0xC0) {
+        n = 2;
+        min = 0x80;
+    } else if ((s[0] & 0xF0) == 0xE0) {
+        n = 3;
+        min = 0x800;
+    } else if ((s[0] & 0xF8) == 0xF0) {
+        n = 4;
+        min = 0x10000;
+    } else {
+        return 0;
+    }
+    cp = s[0] & (0x7Fu >> n);
+    for (size_t i = 1; i < n; ++i) {
+        if ((s[i] & 0xC0) != 0x80)
+            return 0;
+        cp = (cp << 6) | (s[i] & 0x3Fu);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+        return 0;
+    return n;
+}
+
+/* The HTML text for the character at s into out; *used gets the bytes read. */
+static const char *esc_piece(char out[8], const char *s, size_t *used)
+{
+    const unsigned char c = (unsigned char)*s;
+    *used = 1;
+    switch (c) {
+    case '&': return "&amp;";
+    case '<': return "&lt;";
+    case '>': return "&gt;";
+    case '"': return "&quot;";
+    case '\'': return "&#39;";
+    default: break;
+    }
+    if ((c < 0x20 && c != '\t' && c != '\n') || c == 0x7F)
+        return "&#xFFFD;";
+    const size_t n = utf8_len((const unsigned char *)s);
+    if (n == 0)
+        return "&#xFFFD;";
+    memcpy(out, s, n);
+    out[n] = '\0';
+    *used = n;
+    return out;
+}
+
+const char *rch_report_escape(char *buf, size_t len, const char *s)
+{
+    size_t k = 0;
+    if (len == 0)
+        return buf;
+    buf[0] = '\0';
+    while (s && *s) {
+        char tmp[8];
+        size_t used;
+        const char *p = esc_piece(tmp, s, &used);
+        const size_t n = strlen(p);
+        if (k + n >= len)
+            break;
+        memcpy(buf + k, p, n + 1);
+        k += n;
+        s += used;
+    }
+    return buf;
+}
+
+static void put_esc(FILE *f, const char *s)
+{
+    while (s && *s) {
+        char tmp[8];
+        size_t used;
+        fputs(esc_piece(tmp, s, &used), f);
+        s += used;
+    }
+}
+
+/* A JSON string escaped, or "not in this run". */
+static void put_str(rep *r, const char *s)
+{
+    if (s) {
+        put_esc(r->f, s);
+    } else {
+        fputs(NA, r->f);
+        r->res->n_missing++;
+    }
+}
+
+/* A number with printf format fmt, or "not in this run". */
+static void put_num(rep *r, double v, const char *fmt)
+{
+    if (isfinite(v)) {
+        fprintf(r->f, fmt, v);
+    } else {
+        fputs(NA, r->f);
+        r->res->n_missing++;
+    }
+}
+
+/* Three significant digits without an exponent between 1e-3 and 1e6
+ * ("1610 mm", not "1.61e+03 mm"), then `unit`; or "not in this run". */
+static void put_sig(rep *r, double v, const char *unit)
+{
+    const double a = fabs(v);
+    if (isfinite(v) && a >= 1e-3 && a < 1e6) {
+        const int dec = 2 - (int)floor(log10(a));
+        fprintf(r->f, "%.*f%s", dec > 0 ? dec : 0, v, unit);
+    } else {
+        put_num(r, v, "%.3g");
+        if (isfinite(v))
+            fputs(unit, r->f);
+    }
+}
+
+static void put_p(rep *r, double p)
+{
+    if (isfinite(p) && p <= 0.0)
+        fputs("&lt; 1e-300", r->f);
+    else
+        put_num(r, p, "%.3g");
+}
+
+/* RFC 4180 field. */
+static void csv_str(FILE *f, const char *s)
+{
+    if (!s)
+        return;
+    if (!strpbrk(s, ",\"\r\n")) {
+        fputs(s, f);
+        return;
+    }
+    fputc('"', f);
+    for (; *s; ++s) {
+        if (*s == '"')
+            fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+static void csv_num(FILE *f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.9g", v);
+}
+
+static void cl_put(char *buf, size_t len, size_t *k, const char *s)
+{
+    while (*s && *k + 1 < len)
+        buf[(*k)++] = *s++;
+    buf[*k] = '\0';
+}
+
+const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *argv)
+{
+    size_t k = 0;
+    if (len == 0)
+        return buf;
+    buf[0] = '\0';
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        const int quote = !*a || strpbrk(a, " \t\n'\"\\$`&|;<>()*?[]{}~!#") != NULL;
+        cl_put(buf, len, &k, i ? " " : "");
+        cl_put(buf, len, &k, quote ? "'" : "");
+        for (; *a; ++a) {
+            const char c[2] = {*a, '\0'};
+            cl_put(buf, len, &k, quote && *a == '\'' ? "'\\''" : c);
+        }
+        cl_put(buf, len, &k, quote ? "'" : "");
+    }
+    return buf;
+}
+
+static void warnf(rep *r, const char *fmt, ...) RCH_PRINTF(2, 3);
+static void warnf(rep *r, const char *fmt, ...)
+{
+    va_list ap;
+    if (r->n_warn >= RCH_REPORT_MAX_WARN)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(r->warn[r->n_warn++], sizeof r->warn[0], fmt, ap);
+    va_end(ap);
+}
+
+/* ---- charts: horizontal rows, bars from zero or dots with 95 % intervals */
+
+typedef struct {
+    const char *title, *xlabel;
+    size_t n_rows, n_sub;
+    const char *const *label;   /* (n_rows) */
+    const double *v;            /* (n_rows x n_sub), NaN: no value */
+    const double *lo, *hi;      /* (n_rows x n_sub) interval ends, NaN: none; or NULL */
+    const unsigned char *col;   /* (n_rows x n_sub) colour */
+    const char *const *missing; /* (n_rows) text where v is NaN, or NULL: "not in this run" */
+    int bars;
+    const unsigned char *leg; /* (n_leg) colours */
+    const char *const *leg_label;
+    size_t n_leg;
+    double ref[2];
+    const char *ref_label[2];
+    size_t n_ref;
+    double clip; /* > 0: the axis ends at |x| <= clip, longer intervals end in an arrow */
+    unsigned width_px;
+} chart;
+
+static double nice_step(double span, double n)
+{
+    const double raw = span / n, p = pow(10.0, floor(log10(raw))), m = raw / p;
+    return (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * p;
+}
+
+static void chart_range(const chart *c, double *lo, double *hi)
+{
+    double a = 0.0, b = 0.0;
+    const size_t n = c->n_rows * c->n_sub;
+    for (size_t i = 0; i < n; ++i) {
+        const double xs[3] = {c->v[i], c->lo ? c->lo[i] : NAN, c->hi ? c->hi[i] : NAN};
+        for (int k = 0; k < 3; ++k)
+            if (isfinite(xs[k])) {
+                a = xs[k] < a ? xs[k] : a;
+                b = xs[k] > b ? xs[k] : b;
+            }
+    }
+    for (size_t k = 0; k < c->n_ref; ++k)
+        if (isfinite(c->ref[k])) {
+            a = c->ref[k] < a ? c->ref[k] : a;
+            b = c->ref[k] > b ? c->ref[k] : b;
+        }
+    if (c->clip > 0.0) {
+        a = a < -c->clip ? -c->clip : a;
+        b = b > c->clip ? c->clip : b;
+    }
+    if (!(b - a > 0.0)) {
+        a = c->bars ? 0.0 : -1.0;
+        b = 1.0;
+    }
+    if (!c->bars && a < 0.0 && b > 0.0) { /* dots around zero: symmetric axis */
+        const double m = -a > b ? -a : b;
+        a = -m;
+        b = m;
+    }
+    const double step = nice_step(b - a, 6.0);
+    *lo = floor(a / step + 1e-9) * step;
+    *hi = ceil(b / step - 1e-9) * step;
+}
+
+static double clampd(double x, double a, double b) { return x < a ? a : x > b ? b : x; }
+
+static void chart_axes(FILE *f, const chart *c, double L, double T, double pw, double ph, double lo, double hi)
+{
+    const double step = nice_step(hi - lo, 6.0);
+#define CX(x) (L + ((x) - lo) / (hi - lo) * pw)
+    for (int i = 0; i <= 40; ++i) {
+        double t = lo + step * i;
+        if (t > hi + 1e-9 * step)
+            break;
+        if (fabs(t) < 1e-9 * step)
+            t = 0.0;
+        fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\"/>", CX(t), T, CX(t), T + ph,
+                t == 0.0 ? "#333" : "#e4e4e4");
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" fill=\"#333\">%.6g</text>\n", CX(t),
+                T + ph + 14.0, t);
+    }
+    for (size_t k = 0; k < c->n_ref; ++k) {
+        if (!isfinite(c->ref[k]))
+            continue;
+        const double x = CX(clampd(c->ref[k], lo, hi));
+        fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#444\" stroke-dasharray=\"4 3\"/>",
+                x, T - 4.0, x, T + ph);
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"%s\" font-size=\"11\" fill=\"#333\">", x, T - 7.0,
+                k ? "start" : "end");
+        put_esc(f, c->ref_label[k]);
+        fprintf(f, "</text>\n");
+    }
+    fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#999\"/>\n", L, T,
+            pw, ph);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", L + pw / 2.0, T + ph + 32.0);
+    put_esc(f, c->xlabel);
+    fprintf(f, "</text>\n");
+#undef CX
+}
+
+static void chart_cell(FILE *f, const chart *c, size_t i, double y, double L, double pw, double lo, double hi)
+{
+#define CX(x) (L + ((x) - lo) / (hi - lo) * pw)
+    const double v = c->v[i];
+    const double a = c->lo ? c->lo[i] : NAN, b = c->hi ? c->hi[i] : NAN;
+    const char *col = colour[c->col[i]];
+    if (!isfinite(v)) {
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-style=\"italic\" fill=\"#777\">",
+                CX(clampd(0.0, lo, hi)) + 4.0, y + 4.0);
+        put_esc(f, c->missing ? c->missing[i / c->n_sub] : "not in this run");
+        fprintf(f, "</text>\n");
+        return;
+    }
+    fprintf(f, "<g><title>");
+    put_esc(f, c->label[i / c->n_sub]);
+    fprintf(f, ": %.6g", v);
+    if (isfinite(a) && isfinite(b))
+        fprintf(f, " (95 %% interval %.6g to %.6g)", a, b);
+    fprintf(f, "</title>");
+    if (c->bars) {
+        const double x0 = CX(clampd(0.0, lo, hi)), x1 = CX(clampd(v, lo, hi));
+        fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"12\" fill=\"%s\"/>", x0 < x1 ? x0 : x1,
+                y - 6.0, fabs(x1 - x0) > 0.5 ? fabs(x1 - x0) : 0.5, col);
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\"%s>%.4g</text>", x1 + (v < 0 ? -3.0 : 3.0), y + 4.0,
+                v < 0 ? " text-anchor=\"end\"" : "", v);
+    }
+    if (isfinite(a) && isfinite(b)) {
+        const double xa = CX(clampd(a, lo, hi)), xb = CX(clampd(b, lo, hi));
+        fprintf(f, "<path d=\"M%.1f %.1fH%.1f\" stroke=\"%s\" stroke-width=\"1.6\"/>", xa, y, xb, col);
+        fprintf(f, "<path d=\"%s%.1f %.1fv8M%.1f %.1fv8\" stroke=\"%s\" stroke-width=\"1.6\"/>", "M",
+                xa, y - 4.0, xb, y - 4.0, col);
+        if (a < lo)
+            fprintf(f, "<path d=\"M%.1f %.1fl7 -5v10z\" fill=\"%s\"/>", xa - 1.0, y, col);
+        if (b > hi)
+            fprintf(f, "<path d=\"M%.1f %.1fl-7 -5v10z\" fill=\"%s\"/>", xb + 1.0, y, col);
+    }
+    if (!c->bars)
+        fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>", CX(clampd(v, lo, hi)), y, col);
+    fprintf(f, "</g>\n");
+#undef CX
+}
+
+static void chart_svg(rep *r, const chart *c)
+{
+    FILE *f = r->f;
+    size_t maxl = 8, legw = 0;
+    for (size_t i = 0; i < c->n_rows; ++i)
+        maxl = strlen(c->label[i]) > maxl ? strlen(c->label[i]) : maxl;
+    if (maxl > 30)
+        maxl = 30;
+    const double W = c->width_px, L = 14.0 + 6.6 * (double)maxl, R = 28.0;
+    const double T = 30.0 + (c->n_leg ? 20.0 : 0.0) + (c->n_ref ? 16.0 : 0.0);
+    const double sub_h = 16.0, row_h = sub_h * (double)c->n_sub + 6.0;
+    const double pw = W - L - R, ph = row_h * (double)c->n_rows, H = T + ph + 44.0;
+    double lo, hi;
+    chart_range(c, &lo, &hi);
+    fprintf(f, "<svg class=\"chart\" width=\"%u\" height=\"%.0f\" viewBox=\"0 0 %u %.0f\" role=\"img\" aria-label=\"",
+            c->width_px, H, c->width_px, H);
+    put_esc(f, c->title);
+    fprintf(f, "\" font-family=\"system-ui, Helvetica, Arial, sans-serif\" font-size=\"12\">\n<title>");
+    put_esc(f, c->title);
+    fprintf(f, "</title><rect width=\"%u\" height=\"%.0f\" fill=\"#fff\"/>\n", c->width_px, H);
+    fprintf(f, "<text x=\"%.1f\" y=\"18\" font-size=\"14\" font-weight=\"bold\">", L);
+    put_esc(f, c->title);
+    fprintf(f, "</text>\n");
+    for (size_t k = 0; k < c->n_leg; ++k) {
+        const double x = L + (double)legw;
+        fprintf(f, "<rect x=\"%.1f\" y=\"33\" width=\"11\" height=\"11\" fill=\"%s\"/>", x, colour[c->leg[k]]);
+        fprintf(f, "<text x=\"%.1f\" y=\"43\" font-size=\"11.5\">", x + 15.0);
+        put_esc(f, c->leg_label[k]);
+        fprintf(f, "</text>\n");
+        legw += 30 + (size_t)(6.3 * (double)strlen(c->leg_label[k]));
+    }
+    for (size_t i = 0; i < c->n_rows; ++i) {
+        const double y0 = T + row_h * (double)i;
+        if (i % 2)
+            fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f3f5f8\"/>", L, y0, pw,
+                    row_h);
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">", L - 6.0, y0 + row_h / 2.0 + 4.0);
+        put_esc(f, c->label[i]);
+        fprintf(f, "</text>\n");
+    }
+    chart_axes(f, c, L, T, pw, ph, lo, hi);
+    for (size_t i = 0; i < c->n_rows; ++i)
+        for (size_t k = 0; k < c->n_sub; ++k)
+            chart_cell(f, c, i * c->n_sub + k, T + row_h * (double)i + 3.0 + sub_h * ((double)k + 0.5), L, pw, lo,
+                       hi);
+    fprintf(f, "</svg>\n");
+    r->res->n_plots++;
+}
+
+/* ---- the tables the page, the charts and the CSVs share */
+
+typedef struct {
+    const char *label;
+    const char *key; /* member of a metrics object */
+} metric_def;
+static const metric_def metric_defs[] = {
+    {"RMSE", "rmse_mm"}, {"mean |e|", "mean_abs_mm"}, {"SD", "sd_mm"}, {"MAX", "max_mm"}};
+#define N_METRICS (sizeof metric_defs / sizeof metric_defs[0])
+
+typedef struct {
+    char name[64], unit[16], cls[24], comp[24]; /* comp: "fitted", "nominal", "not used" or "" */
+    double nominal, value, delta, se, ci_lo, ci_hi; /* NaN when absent */
+} prow;
+
+typedef struct {
+    char label[96];
+    const char *effect, *note;
+    double step, joint, params, ident, rmse_cv, gain, gain_se, z, p;
+    int tested, significant, chosen;
+} crow;
+
+typedef struct {
+    const char *label;
+    double v;
+    unsigned char col;
+} arow;
+
+static unsigned char class_colour(const char *cls)
+{
+    if (strcmp(cls, "identifiable") == 0)
+        return C_IDENT;
+    if (strcmp(cls, "weak") == 0)
+        return C_WEAK;
+    if (strcmp(cls, "not identifiable") == 0)
+        return C_NOTID;
+    if (strcmp(cls, "fixed") == 0)
+        return C_FIXED;
+    return C_UNKNOWN;
+}
+
+/* Standard error and class of parameter `name`: on the calibration's own
+ * params[k] (std_error or se, class), else in uncertainty.parameters[]. */
+static void param_unc(const rep *r, const rch_json *pk, prow *p)
+{
+    const char *cls = jstr(pk, "class"), *comp = jstr(pk, "compensation");
+    p->se = jnum(pk, "std_error");
+    if (!isfinite(p->se))
+        p->se = jnum(pk, "se");
+    const rch_json *list = jarr(r->unc, "parameters");
+    for (size_t i = 0; list && i < list->n; ++i) {
+        const char *nm = jstr(list->items[i], "name");
+        if (!nm || strcmp(nm, p->name) != 0)
+            continue;
+        if (!isfinite(p->se))
+            p->se = jnum(list->items[i], "std_error");
+        if (!cls)
+            cls = jstr(list->items[i], "class");
+        if (!comp)
+            comp = jstr(list->items[i], "compensation");
+        break;
+    }
+    snprintf(p->cls, sizeof p->cls, "%s", cls ? cls : "");
+    snprintf(p->comp, sizeof p->comp, "%s", comp ? comp : "");
+}
+
+static prow *params_read(const rep *r, size_t *n)
+{
+    const rch_json *ps = jarr(r->cal, "params");
+    *n = 0;
+    if (!ps || ps->n == 0)
+        return NULL;
+    prow *rows = calloc(ps->n, sizeof *rows);
+    if (!rows)
+        return NULL;
+    for (size_t k = 0; k < ps->n; ++k) {
+        const rch_json *pk = ps->items[k];
+        prow *p = &rows[*n];
+        const char *nm = jstr(pk, "name"), *un = jstr(pk, "unit");
+        snprintf(p->name, sizeof p->name, "%s", nm ? nm : "?");
+        snprintf(p->unit, sizeof p->unit, "%s", un ? un : "");
+        p->value = jnum(pk, "value");
+        p->delta = jnum(pk, "delta");
+        p->nominal = p->value - p->delta;
+        param_unc(r, pk, p);
+        p->ci_lo = p->delta - Z95 * p->se;
+        p->ci_hi = p->delta + Z95 * p->se;
+        (*n)++;
+    }
+    return rows;
+}
+
+static crow *cands_read(const rep *r, size_t *n)
+{
+    const rch_json *cs = jarr(r->diag, "candidates");
+    *n = 0;
+    if (!cs || cs->n == 0)
+        return NULL;
+    crow *rows = calloc(cs->n, sizeof *rows);
+    if (!rows)
+        return NULL;
+    for (size_t k = 0; k < cs->n; ++k) {
+        const rch_json *c = cs->items[k];
+        crow *w = &rows[k];
+        w->effect = jstr(c, "effect");
+        w->note = jstr(c, "note");
+        w->step = jnum(c, "step");
+        w->joint = jnum(c, "joint");
+        w->params = jnum(c, "params");
+        w->ident = jnum(c, "identifiable");
+        w->rmse_cv = jnum(c, "rmse_cv_mm");
+        w->gain = jnum(c, "gain_mm2");
+        w->gain_se = jnum(c, "gain_se_mm2");
+        w->z = jnum(c, "z");
+        w->p = jnum(c, "p");
+        w->tested = jbool(c, "tested") == 1;
+        w->significant = jbool(c, "significant") == 1;
+        w->chosen = jbool(c, "chosen") == 1;
+        char j[24] = "";
+        if (isfinite(w->joint))
+            snprintf(j, sizeof j, " j%.0f", w->joint);
+        snprintf(w->label, sizeof w->label, "%.0f: %s%s", isfinite(w->step) ? w->step : 0.0,
+                 w->effect ? w->effect : "?", j);
+    }
+    *n = cs->n;
+    return rows;
+}
+
+/* Accuracy figures: predicted 95 % uncertainty and, on a simulation, the
+ * flange error against the truth. Rows with no number are left out. */
+static size_t accuracy_read(const rep *r, arow out[10])
+{
+    static const struct {
+        const char *label, *path;
+        int truth;
+        unsigned char col;
+    } defs[] = {
+        {"95 % inside the data, median", "position95_mm.data_median", 0, C_PRED},
+        {"95 % inside the data, max", "position95_mm.data_max", 0, C_PRED},
+        {"95 % whole workspace, median", "position95_mm.workspace_median", 0, C_PRED},
+        {"95 % whole workspace, max", "position95_mm.workspace_max", 0, C_PRED},
+        {"truth, before: RMS", "truth_flange.before_rms_mm", 1, C_BEFORE},
+        {"truth, before: max", "truth_flange.before_max_mm", 1, C_BEFORE},
+        {"truth, after: RMS", "truth_flange.after_rms_mm", 1, C_AFTER},
+        {"truth, after: max", "truth_flange.after_max_mm", 1, C_AFTER},
+    };
+    size_t n = 0;
+    for (size_t k = 0; k < sizeof defs / sizeof defs[0]; ++k) {
+        const double v = jnum(defs[k].truth ? r->cal : r->unc, defs[k].path);
+        if (isfinite(v)) {
+            out[n].label = defs[k].label;
+            out[n].v = v;
+            out[n].col = defs[k].col;
+            n++;
+        }
+    }
+    return n;
+}
+
+/* ---- what the page needs before it starts: data hashes and warnings */
+
+#define MAX_DFILES 8
+typedef struct {
+    const char *file, *sha_rec; /* as recorded; sha_rec NULL when not recorded */
+    double samples;
+    char sha_now[65];           /* "" when the file cannot be read from here */
+} dfile;
+
+static size_t data_files(const rep *r, dfile out[MAX_DFILES])
+{
+    const rch_json *list = jarr(r->prov, "data");
+    size_t n = 0;
+    for (size_t i = 0; list && i < list->n && n < MAX_DFILES; ++i) {
+        const char *file = jstr(list->items[i], "file");
+        if (!file)
+            continue;
+        out[n].file = file;
+        out[n].sha_rec = jstr(list->items[i], "sha256");
+        out[n].samples = jnum(list->items[i], "samples");
+        n++;
+    }
+    if (n == 0 && jstr(r->cal, "data")) {
+        out[0].file = jstr(r->cal, "data");
+        out[0].sha_rec = NULL;
+        out[0].samples = jnum(r->cal, "n_train") + jnum(r->cal, "n_test");
+        n = 1;
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (rch_sha256_file(out[i].sha_now, out[i].file) != 0)
+            out[i].sha_now[0] = '\0';
+    return n;
+}
+
+static const char *prov_str(const rep *r, const char *key)
+{
+    const char *s = jstr(r->prov, key);
+    return s ? s : jstr(r->cal, key);
+}
+
+static void warn_fit(rep *r)
+{
+    const double before = jnum(r->cal, "before.rmse_mm"), after = jnum(r->cal, "after.rmse_mm");
+    const char *exit_why = jstr(r->cal, "exit");
+    if (jbool(r->cal, "converged") == 0)
+        warnf(r, "The solver did not converge (exit: %s): the after figures and the parameters are not meaningful.",
+              exit_why ? exit_why : "not in this run");
+    if (jbool(r->cal, "held_out") == 0)
+        warnf(r, "No held-out samples: the before/after figures are on the training data and flatter the model.");
+    if (isfinite(before) && isfinite(after) && after > before)
+        warnf(r, "The calibrated model is worse than the nominal one on the held-out samples (RMSE %.4f mm against "
+                 "%.4f mm).", after, before);
+    const double rank = jnum(r->cal, "identifiability.rank"), np = jnum(r->cal, "identifiability.params"),
+                 weak = jnum(r->cal, "identifiability.weak");
+    if (isfinite(rank) && isfinite(np) && rank < np)
+        warnf(r, "%.0f of %.0f parameter directions are not identifiable from these data; the solver left them at "
+                 "their starting values (see the identifiability table).", np - rank, np);
+    if (isfinite(weak) && weak > 0)
+        warnf(r, "%.0f direction(s) are only weakly identifiable: their values carry little information.", weak);
+    const double tb = jnum(r->cal, "truth_flange.before_rms_mm"), ta = jnum(r->cal, "truth_flange.after_rms_mm");
+    if (isfinite(tb) && isfinite(ta) && ta > tb)
+        warnf(r, "Against the simulated truth the calibrated flange positions are worse than the nominal ones "
+                 "(RMS %.4f mm against %.4f mm).", ta, tb);
+}
+
+static void warn_params(rep *r, const prow *p, size_t n)
+{
+    char weak[512] = "", notid[512] = "";
+    for (size_t k = 0; k < n; ++k) {
+        char *dst = strcmp(p[k].cls, "weak") == 0 ? weak : strcmp(p[k].cls, "not identifiable") == 0 ? notid : NULL;
+        if (dst && strlen(dst) + strlen(p[k].name) + 3 < sizeof weak)
+            snprintf(dst + strlen(dst), sizeof weak - strlen(dst), "%s%s", dst[0] ? ", " : "", p[k].name);
+    }
+    if (notid[0])
+        warnf(r, "Not identifiable (their values mean nothing alone; compensation keeps them nominal): %s.", notid);
+    if (weak[0])
+        warnf(r, "Weakly identified (large standard error): %s.", weak);
+    if (jbool(r->unc, "orientation_determined") == 0)
+        warnf(r, "The data do not determine the flange orientation: compensate position only.");
+    const double in = jnum(r->unc, "position95_mm.data_max"), ws = jnum(r->unc, "position95_mm.workspace_max");
+    if (isfinite(in) && isfinite(ws) && ws > 3.0 * in)
+        warnf(r, "The model extrapolates: predicted 95 %% position uncertainty up to %.3g mm over the whole workspace "
+                 "against %.3g mm inside the data; trust it only near the measured poses.", ws, in);
+}
+
+static void warn_diag(rep *r)
+{
+    const char *effect = jstr(r->diag, "effect"), *why = jstr(r->diag, "remaining_why");
+    if (!r->diag)
+        return;
+    if (effect && strcmp(effect, "unexplained") == 0)
+        warnf(r, "The diagnosis finds error the model does not explain: %s.", why ? why : "not in this run");
+    else if (effect && strcmp(effect, "none") != 0) {
+        char seq[256] = "";
+        const rch_json *q = jarr(r->diag, "sequence");
+        for (size_t k = 0; q && k < q->n; ++k)
+            if (q->items[k]->type == RCH_JSTR && strlen(seq) + strlen(q->items[k]->str) + 3 < sizeof seq)
+                snprintf(seq + strlen(seq), sizeof seq - strlen(seq), "%s%s", k ? ", " : "", q->items[k]->str);
+        const double b = jnum(r->diag, "rmse_before_mm"), a = jnum(r->diag, "rmse_after_mm");
+        char fig[128] = "";
+        if (isfinite(a) && isfinite(b))
+            snprintf(fig, sizeof fig, " (held-out RMSE %.4g mm with the geometry alone, %.4g mm with %s)", b, a,
+                     q && q->n > 1 ? "them" : "it");
+        warnf(r, "The diagnosis finds what the geometric model misses: %s%s. The calibration above does not model "
+                 "it.", seq[0] ? seq : effect, fig);
+    }
+    const double nd = jnum(r->diag, "n"), nc = jnum(r->cal, "n_train") + jnum(r->cal, "n_test");
+    if (isfinite(nd) && isfinite(nc) && nd != nc)
+        warnf(r, "The diagnosis ran on %.0f samples, the calibration on %.0f: are they from the same data?", nd, nc);
+    const double flick = jnum(r->diag, "wrist_flicker_samples");
+    if (isfinite(flick) && flick > 0)
+        warnf(r, "%.0f sample(s) have a wrist reading that moved by one display step within their set-up.", flick);
+}
+
+static void warn_inputs(rep *r, const dfile *df, size_t n_df)
+{
+    const char *md = jstr(r->model, "calibration.data"), *cd = jstr(r->cal, "data");
+    if (md && cd && strcmp(md, cd) != 0)
+        warnf(r, "The model file was calibrated on %s, this calibration on %s: the model may be from another run.",
+              md, cd);
+    for (size_t i = 0; i < n_df; ++i) {
+        if (df[i].sha_rec && df[i].sha_now[0] && strcmp(df[i].sha_rec, df[i].sha_now) != 0)
+            warnf(r, "The data file %s changed since the calibration (its SHA-256 differs from the one recorded).",
+                  df[i].file);
+        if (!df[i].sha_now[0])
+            warnf(r, "The data file %s cannot be read from here: its content cannot be checked.", df[i].file);
+    }
+    if (!r->prov && !jstr(r->cal, "tool"))
+        warnf(r, "No provenance in this run (tool version, command line, data hash, date): the result cannot be "
+                 "traced to its data and its program.");
+    const rch_json *w = jarr(r->cal, "warnings");
+    for (size_t i = 0; w && i < w->n; ++i)
+        if (w->items[i]->type == RCH_JSTR)
+            warnf(r, "%s", w->items[i]->str);
+}
+
+/* ---- the page */
+
+static const char css[] =
+    "body{font:14px/1.45 system-ui,-apple-system,'Segoe UI',Helvetica,Arial,sans-serif;margin:0;"
+    "background:#eef0f3;color:#1d2330}"
+    "main{max-width:1130px;margin:0 auto;padding:10px 20px}"
+    "header{padding:6px 0}h1{font-size:22px;margin:6px 0 2px}"
+    ".sub{color:#445;margin:0}"
+    ".glance{margin:8px 0 0;padding:8px 12px;background:#fff;border-left:5px solid #0072B2;border-radius:4px}"
+    "section{background:#fff;border:1px solid #d6dae0;border-radius:6px;padding:8px 16px 12px;margin:12px 0}"
+    "h2{font-size:17px;margin:2px 0 8px;padding-bottom:3px;border-bottom:1px solid #e4e7eb}"
+    "h3{font-size:14px;margin:10px 0 4px}"
+    "table{border-collapse:collapse;font-size:13px;margin:4px 0}"
+    "td,th{padding:1px 8px;border-bottom:1px solid #eceef1;text-align:right;vertical-align:top;white-space:nowrap}"
+    "td.w{white-space:normal}.two{display:grid;grid-template-columns:1fr 1fr;gap:12px}.two section{margin:0}"
+    "th{background:#f1f3f6;font-weight:600}td.l,th.l{text-align:left}"
+    "table.kv th{text-align:left;background:none;color:#445;font-weight:normal;white-space:nowrap}"
+    "table.kv td{text-align:left;white-space:normal}"
+    ".na{color:#888;font-style:italic}.mono{font-family:ui-monospace,'DejaVu Sans Mono',monospace;"
+    "font-size:12px;word-break:break-all}"
+    ".row{display:flex;flex-wrap:wrap;gap:14px;align-items:flex-start}"
+    ".note{color:#556;font-size:12.5px;margin:4px 0}"
+    ".verdict{font-size:15px;padding:6px 10px;background:#f4f8fb;border-left:4px solid #009E73}"
+    "ul.warn{margin:4px 0;padding-left:0;list-style:none}"
+    "ul.warn li{background:#fff6e5;border-left:4px solid #E69F00;padding:4px 10px;margin:4px 0}"
+    "svg.chart{border:1px solid #e4e7eb;border-radius:4px;background:#fff}"
+    ".sw{display:inline-block;width:10px;height:10px;margin-right:4px;vertical-align:baseline}"
+    "details summary{cursor:pointer;color:#234}"
+    "@media print{body{background:#fff}main{max-width:none;padding:0}section{break-inside:avoid;border:none}}";
+
+static void kv(rep *r, const char *key) { fprintf(r->f, "<tr><th>%s</th><td>", key); }
+static void kv_end(rep *r) { fputs("</td></tr>\n", r->f); }
+
+static void page_head(rep *r, size_t n_warn)
+{
+    FILE *f = r->f;
+    const char *data = jstr(r->cal, "data"), *robot = jstr(r->model, "name");
+    fputs("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>Calibration report: ",
+          f);
+    put_esc(f, data ? data : "?");
+    fprintf(f, "</title>\n<style>%s</style>\n</head>\n<body>\n<main>\n<header>\n<h1>Calibration report</h1>\n", css);
+    fputs("<p class=\"sub\">robot <b>", f);
+    put_str(r, robot ? robot : jstr(r->cal, "robot"));
+    fputs("</b> &middot; data <b>", f);
+    put_str(r, data);
+    fputs("</b> &middot; method <b>", f);
+    put_str(r, jstr(r->cal, "method"));
+    fputs("</b> &middot; calibrated ", f);
+    put_str(r, prov_str(r, "date"));
+    fputs("</p>\n<div class=\"glance\">", f);
+    const double b = jnum(r->cal, "before.rmse_mm"), a = jnum(r->cal, "after.rmse_mm");
+    fprintf(f, "%s RMSE of the cable length: <b>", jbool(r->cal, "held_out") == 0 ? "Training" : "Held-out");
+    put_num(r, b, "%.4f");
+    fputs(" mm &rarr; ", f);
+    put_num(r, a, "%.4f");
+    fputs(" mm</b>", f);
+    if (isfinite(a) && isfinite(b) && b > 0)
+        fprintf(f, " (%+.1f %%)", 100.0 * (a - b) / b);
+    const double in = jnum(r->unc, "position95_mm.data_median"), ws = jnum(r->unc, "position95_mm.workspace_median");
+    fputs(" &middot; predicted position uncertainty (95 %): ", f);
+    if (isfinite(in) || isfinite(ws)) {
+        fputs("inside the data &plusmn;", f);
+        put_sig(r, in, " mm");
+        fputs(", whole workspace &plusmn;", f);
+        put_sig(r, ws, " mm");
+    } else {
+        put_num(r, NAN, "");
+    }
+    fprintf(f, " &middot; <a href=\"#warnings\">%zu warning%s</a></div>\n</header>\n", n_warn, n_warn == 1 ? "" : "s");
+}
+
+static void sec_data(rep *r, const dfile *df, size_t n_df)
+{
+    FILE *f = r->f;
+    fputs("<div class=\"two\"><section id=\"data\"><h2>1. Data</h2>\n<table class=\"kv\">\n", f);
+    kv(r, "data file");
+    put_str(r, jstr(r->cal, "data"));
+    kv_end(r);
+    kv(r, "samples");
+    put_num(r, jnum(r->cal, "n_train") + jnum(r->cal, "n_test"), "%.0f");
+    kv_end(r);
+    kv(r, "set-up groups");
+    put_num(r, jnum(r->diag, "groups"), "%.0f");
+    fputs(r->diag ? " (from the diagnosis)" : "", f);
+    kv_end(r);
+    kv(r, "display resolution");
+    fputs("joints ", f);
+    put_num(r, jnum(r->diag, "q_step_deg"), "%.4g&deg;");
+    fputs(", cable length ", f);
+    put_num(r, jnum(r->diag, "len_step_mm"), "%.4g mm");
+    kv_end(r);
+    kv(r, "noise floor");
+    put_num(r, jnum(r->diag, "noise_floor_mm"), "%.4g mm rms");
+    if (r->diag) {
+        fputs(" (joint display step through the Jacobian ", f);
+        put_num(r, jnum(r->diag, "noise_floor_joints_mm"), "%.4g mm");
+        fputs(", length step ", f);
+        put_num(r, jnum(r->diag, "noise_floor_length_mm"), "%.4g mm");
+        fputs(")", f);
+    }
+    kv_end(r);
+    for (size_t i = 0; i < n_df; ++i) {
+        kv(r, "file, SHA-256");
+        fputs("<span class=\"mono\">", f);
+        put_esc(f, df[i].file);
+        fputs("</span>", f);
+        if (isfinite(df[i].samples))
+            fprintf(f, ", %.0f samples", df[i].samples);
+        fputs("<br>recorded: <span class=\"mono\">", f);
+        put_str(r, df[i].sha_rec);
+        fputs("</span><br>now: <span class=\"mono\">", f);
+        fputs(df[i].sha_now[0] ? df[i].sha_now : "<span class=\"na\">cannot be read from here</span>", f);
+        fputs(df[i].sha_rec && df[i].sha_now[0] ? (strcmp(df[i].sha_rec, df[i].sha_now) ? " (DIFFERS)" : " (same)")
+                                                 : "",
+              f);
+        fputs("</span>", f);
+        kv_end(r);
+    }
+    fputs("</table></section>\n", f);
+}
+
+static void sec_split(rep *r)
+{
+    FILE *f = r->f;
+    const double ntr = jnum(r->cal, "n_train"), nte = jnum(r->cal, "n_test");
+    fputs("<section id=\"split\"><h2>2. Split</h2>\n<table class=\"kv\">\n", f);
+    kv(r, "training samples");
+    put_num(r, ntr, "%.0f");
+    kv_end(r);
+    kv(r, "held-out samples");
+    put_num(r, nte, "%.0f");
+    if (isfinite(ntr) && isfinite(nte) && ntr + nte > 0)
+        fprintf(f, " (%.1f %% of the data)", 100.0 * nte / (ntr + nte));
+    kv_end(r);
+    kv(r, "seed");
+    put_num(r, jnum(r->cal, "seed"), "%.0f");
+    kv_end(r);
+    if (r->diag) {
+        kv(r, "diagnosis");
+        put_num(r, jnum(r->diag, "folds"), "%.0f-fold");
+        fputs(" cross-validation, folds random within set-up groups", f);
+        kv_end(r);
+    }
+    fputs("</table>\n<p class=\"note\">", f);
+    fputs(jbool(r->cal, "held_out") == 0
+              ? "No held-out set: the before/after figures are on the training samples."
+              : "The before/after figures are on the held-out samples, which the fit never saw.",
+          f);
+    fputs("</p></section></div>\n", f);
+}
+
+static void metrics_row(rep *r, const char *label, const char *key)
+{
+    const rch_json *m = jpath(r->cal, key);
+    static const char *const keys[] = {"n", "rmse_mm", "mean_abs_mm", "sd_mm", "mean_mm", "max_mm"};
+    fprintf(r->f, "<tr><td class=\"l\">%s</td>", label);
+    for (size_t k = 0; k < sizeof keys / sizeof keys[0]; ++k) {
+        fputs("<td>", r->f);
+        put_num(r, jnum(m, keys[k]), k ? "%.4f" : "%.0f");
+        fputs("</td>", r->f);
+    }
+    fputs("</tr>\n", r->f);
+}
+
+static void sec_metrics(rep *r)
+{
+    FILE *f = r->f;
+    const int held = jbool(r->cal, "held_out") != 0;
+    fputs("<section id=\"metrics\"><h2>3. Before and after calibration</h2>\n<div class=\"row\"><div style=\"flex:1 1 500px\">\n"
+          "<table><tr><th class=\"l\">cable-length residual (mm)</th><th>samples</th><th>RMSE</th>"
+          "<th>mean |e|</th><th>SD</th><th>mean</th><th>MAX</th></tr>\n",
+          f);
+    metrics_row(r, held ? "held-out, before (nominal DH)" : "evaluated, before (nominal DH)", "before");
+    metrics_row(r, held ? "held-out, after" : "evaluated, after", "after");
+    metrics_row(r, "training, before", "train_before");
+    metrics_row(r, "training, after", "train_after");
+    fputs("</table>\n<p class=\"note\">before: the nominal DH table with the encoder outlet fitted alone; after: "
+          "the calibrated model. mean |e| is what the paper's Eq. 20 calls SD; SD here is the standard deviation."
+          "</p></div>\n",
+          f);
+    const char *labels[N_METRICS];
+    double v[2 * N_METRICS];
+    unsigned char col[2 * N_METRICS];
+    for (size_t k = 0; k < N_METRICS; ++k) {
+        char path[64];
+        labels[k] = metric_defs[k].label;
+        snprintf(path, sizeof path, "before.%s", metric_defs[k].key);
+        v[2 * k] = jnum(r->cal, path);
+        snprintf(path, sizeof path, "after.%s", metric_defs[k].key);
+        v[2 * k + 1] = jnum(r->cal, path);
+        col[2 * k] = C_BEFORE;
+        col[2 * k + 1] = C_AFTER;
+    }
+    static const unsigned char leg[2] = {C_BEFORE, C_AFTER};
+    static const char *const leg_label[2] = {"before (nominal DH)", "after (calibrated)"};
+    chart c;
+    memset(&c, 0, sizeof c);
+    c.title = held ? "Held-out residuals, before and after" : "Residuals (training set), before and after";
+    c.xlabel = "cable-length residual (mm)";
+    c.n_rows = N_METRICS;
+    c.n_sub = 2;
+    c.label = labels;
+    c.v = v;
+    c.col = col;
+    c.bars = 1;
+    c.leg = leg;
+    c.leg_label = leg_label;
+    c.n_leg = 2;
+    c.width_px = 440;
+    chart_svg(r, &c);
+    fputs("</div></section>\n", f);
+}
+
+/* A table with one row per object of the JSON array `arr`: one column per
+ * jcol, a string ('s'), a number with fmt ('n') or a p-value ('p'). */
+typedef struct {
+    const char *head, *key;
+    char kind;
+    const char *fmt;
+} jcol;
+
+static void json_table(rep *r, const rch_json *arr, const jcol *cols, size_t n_cols)
+{
+    FILE *f = r->f;
+    fputs("<table><tr>", f);
+    for (size_t c = 0; c < n_cols; ++c)
+        fprintf(f, "<th%s>%s</th>", cols[c].kind == 's' ? " class=\"l\"" : "", cols[c].head);
+    fputs("</tr>\n", f);
+    for (size_t k = 0; arr && k < arr->n; ++k) {
+        fputs("<tr>", f);
+        for (size_t c = 0; c < n_cols; ++c) {
+            fputs(cols[c].kind == 's' ? "<td class=\"l\">" : "<td>", f);
+            if (cols[c].kind == 's')
+                put_str(r, jstr(arr->items[k], cols[c].key));
+            else if (cols[c].kind == 'p')
+                put_p(r, jnum(arr->items[k], cols[c].key));
+            else
+                put_num(r, jnum(arr->items[k], cols[c].key), cols[c].fmt);
+            fputs("</td>", f);
+        }
+        fputs("</tr>\n", f);
+    }
+    fputs("</table>\n", f);
+}
+
+static void params_table(rep *r, const prow *p, size_t n)
+{
+    FILE *f = r->f;
+    int have_se = 0, have_cls = 0, have_comp = 0;
+    for (size_t k = 0; k < n; ++k) {
+        have_se |= isfinite(p[k].se);
+        have_cls |= p[k].cls[0] != '\0';
+        have_comp |= p[k].comp[0] != '\0';
+    }
+    fputs("<table><tr><th class=\"l\">parameter</th><th>unit</th><th>nominal</th><th>calibrated</th>"
+          "<th>correction</th>",
+          f);
+    if (have_se)
+        fputs("<th>std error</th><th>95 % interval of the correction</th>", f);
+    if (have_cls)
+        fputs("<th class=\"l\">class</th>", f);
+    if (have_comp)
+        fputs("<th class=\"l\">compensation uses</th>", f);
+    fputs("</tr>\n", f);
+    for (size_t k = 0; k < n; ++k) {
+        fputs("<tr><td class=\"l\">", f);
+        put_esc(f, p[k].name);
+        fputs("</td><td>", f);
+        put_esc(f, p[k].unit);
+        fputs("</td><td>", f);
+        put_num(r, p[k].nominal, "%.6g");
+        fputs("</td><td>", f);
+        put_num(r, p[k].value, "%.6g");
+        fputs("</td><td>", f);
+        put_num(r, p[k].delta, "%+.4g");
+        if (have_se) {
+            /* no standard error by design for a parameter the data cannot determine or that was fixed */
+            const int none = !isfinite(p[k].se) && (strcmp(p[k].cls, "not identifiable") == 0 ||
+                                                    strcmp(p[k].cls, "fixed") == 0);
+            fputs("</td><td>", f);
+            if (none)
+                fputs("&mdash;", f);
+            else
+                put_sig(r, p[k].se, "");
+            fputs("</td><td>", f);
+            if (isfinite(p[k].ci_lo))
+                fprintf(f, "%+.3g &hellip; %+.3g", p[k].ci_lo, p[k].ci_hi);
+            else if (none)
+                fputs("&mdash;", f);
+            else
+                put_num(r, NAN, "");
+        }
+        if (have_cls) {
+            fprintf(f, "</td><td class=\"l\"><span class=\"sw\" style=\"background:%s\"></span>",
+                    colour[class_colour(p[k].cls)]);
+            put_str(r, p[k].cls[0] ? p[k].cls : NULL);
+        }
+        if (have_comp) {
+            fputs("</td><td class=\"l\">", f);
+            put_str(r, p[k].comp[0] ? p[k].comp : NULL);
+        }
+        fputs("</td></tr>\n", f);
+    }
+    fputs("</table>\n", f);
+    if (!have_se || !have_cls) {
+        fprintf(f, "<p class=\"note\" style=\"max-width:520px\">%s%s%s: " NA ".</p>\n", have_se ? "" : "standard errors and 95 % intervals",
+                !have_se && !have_cls ? ", " : "", have_cls ? "" : "identifiability class of each parameter");
+        r->res->n_missing++;
+    }
+}
+
+/* One panel of corrections: the parameters whose unit is `unit`. */
+static void params_chart(rep *r, const prow *p, size_t n, const char *unit, const char *title)
+{
+    const char **labels = calloc(n ? n : 1, sizeof *labels);
+    double *v = calloc(n ? 3 * n : 1, sizeof *v);
+    unsigned char *col = calloc(n ? n : 1, 1);
+    unsigned char leg[C_N];
+    const char *leg_label[C_N];
+    int used[C_N] = {0};
+    size_t m = 0, n_leg = 0;
+    double maxd = 0.0;
+    if (!labels || !v || !col)
+        goto done;
+    for (size_t k = 0; k < n; ++k) {
+        if (strcmp(p[k].unit, unit) != 0)
+            continue;
+        labels[m] = p[k].name;
+        v[m] = p[k].delta;
+        v[n + m] = p[k].ci_lo;
+        v[2 * n + m] = p[k].ci_hi;
+        col[m] = class_colour(p[k].cls);
+        used[col[m]] = 1;
+        if (isfinite(p[k].delta) && fabs(p[k].delta) > maxd)
+            maxd = fabs(p[k].delta);
+        m++;
+    }
+    if (m == 0)
+        goto done;
+    static const struct {
+        unsigned char c;
+        const char *label;
+    } classes[] = {{C_IDENT, "identifiable"},
+                   {C_WEAK, "weak"},
+                   {C_NOTID, "not identifiable"},
+                   {C_FIXED, "fixed"},
+                   {C_UNKNOWN, "class not in this run"}};
+    for (size_t k = 0; k < sizeof classes / sizeof classes[0]; ++k)
+        if (used[classes[k].c]) {
+            leg[n_leg] = classes[k].c;
+            leg_label[n_leg++] = classes[k].label;
+        }
+    char xlabel[96];
+    snprintf(xlabel, sizeof xlabel, "correction (%s), 95 %% interval = \xC2\xB1" "1.96 standard errors", unit);
+    chart c;
+    memset(&c, 0, sizeof c);
+    c.title = title;
+    c.xlabel = xlabel;
+    c.n_rows = m;
+    c.n_sub = 1;
+    c.label = labels;
+    c.v = v;
+    c.lo = v + n;
+    c.hi = v + 2 * n;
+    c.col = col;
+    c.leg = leg;
+    c.leg_label = leg_label;
+    c.n_leg = n_leg;
+    c.clip = maxd > 0.0 ? 3.0 * maxd : 0.0;
+    c.width_px = 520;
+    chart_svg(r, &c);
+done:
+    free(labels);
+    free(v);
+    free(col);
+}
+
+static void ident_block(rep *r)
+{
+    FILE *f = r->f;
+    const rch_json *id = jpath(r->cal, "identifiability");
+    fputs("<h3>Identifiability at the solution</h3>\n", f);
+    if (!id) {
+        fputs("<p>", f);
+        put_str(r, NULL);
+        fputs("</p>\n", f);
+        return;
+    }
+    fputs("<p>rank ", f);
+    put_num(r, jnum(id, "rank"), "%.0f");
+    fputs(" of ", f);
+    put_num(r, jnum(id, "params"), "%.0f");
+    fputs(" parameters, ", f);
+    put_num(r, jnum(id, "weak"), "%.0f");
+    fputs(" weak direction(s); condition number ", f);
+    put_num(r, jnum(id, "cond"), "%.3g");
+    fputs(" over the identifiable part; observability index O1 ", f);
+    put_num(r, jnum(id, "observability"), "%.4g");
+    fputs("</p>\n", f);
+    const rch_json *dirs = jarr(id, "directions");
+    if (!dirs || dirs->n == 0)
+        return;
+    static const jcol cols[] = {{"direction the data do not (or barely) see", "combo", 's', NULL},
+                                {"relative singular value", "sv_rel", 'n', "%.2g"},
+                                {"identifiable", "identifiable", 's', NULL}};
+    json_table(r, dirs, cols, sizeof cols / sizeof cols[0]);
+}
+
+static void sec_params(rep *r, const prow *p, size_t n)
+{
+    FILE *f = r->f;
+    fputs("<section id=\"params\"><h2>4. Identified parameters</h2>\n<p>solver ", f);
+    put_str(r, jstr(r->cal, "method"));
+    fputs(": ", f);
+    put_num(r, jnum(r->cal, "iterations"), "%.0f iterations");
+    fputs(", ", f);
+    put_num(r, jnum(r->cal, "cost_evals"), "%.0f passes over the data");
+    fputs(", exit: ", f);
+    put_str(r, jstr(r->cal, "exit"));
+    fputs(", ", f);
+    put_num(r, jnum(r->cal, "time_ms"), "%.1f ms");
+    fputs(".<br>standard errors: ", f);
+    put_str(r, jstr(r->unc, "covariance"));
+    if (r->unc) {
+        fputs(" covariance", f);
+        const double g = jnum(r->unc, "groups");
+        const char *from = jstr(r->unc, "groups_from");
+        if (isfinite(g) && g > 0)
+            fprintf(f, " over %.0f set-up groups", g);
+        if (from) {
+            fputs(" (from the ", f);
+            put_esc(f, from);
+            fputs(")", f);
+        }
+        fputs(", residual &sigma; ", f);
+        put_num(r, jnum(r->unc, "sigma_mm"), "%.4g mm");
+        fprintf(f, " (%s)", r->unc_from);
+    }
+    fputs("</p>\n<div class=\"row\"><div style=\"flex:0 0 auto\">\n", f);
+    params_table(r, p, n);
+    fputs("<p class=\"note\" style=\"max-width:520px\">correction: against the nominal table (DH) or the encoder outlet's first estimate "
+          "(ex, ey, ez).</p>\n</div><div style=\"display:flex;flex-direction:column;gap:10px\">\n",
+          f);
+    params_chart(r, p, n, "mm", "Corrections, lengths (mm)");
+    params_chart(r, p, n, "deg", "Corrections, angles (deg)");
+    params_chart(r, p, n, "-", "Corrections, other parameters");
+    params_chart(r, p, n, "SI", "Corrections, effect parameters (SI)");
+    fputs("</div></div>\n", f);
+    ident_block(r);
+    fputs("</section>\n", f);
+}
+
+static void cands_table(rep *r, const crow *c, size_t n)
+{
+    FILE *f = r->f;
+    fputs("<table><tr><th class=\"l\">step: effect</th><th>params (identifiable)</th><th>held-out RMSE (mm)</th>"
+          "<th>gain (mm&sup2;)</th><th>&plusmn; SE</th><th>z</th><th>p</th><th class=\"l\">verdict</th>"
+          "<th class=\"l\">note</th></tr>\n",
+          f);
+    for (size_t k = 0; k < n; ++k) {
+        fputs("<tr><td class=\"l\">", f);
+        put_esc(f, c[k].label);
+        fputs("</td><td>", f);
+        put_num(r, c[k].params, "%.0f");
+        fputs(" (", f);
+        put_num(r, c[k].ident, "%.0f");
+        fputs(")</td><td>", f);
+        if (c[k].tested) {
+            put_num(r, c[k].rmse_cv, "%.5f");
+            fputs("</td><td>", f);
+            put_num(r, c[k].gain, "%.3g");
+            fputs("</td><td>", f);
+            put_num(r, c[k].gain_se, "%.2g");
+            fputs("</td><td>", f);
+            put_num(r, c[k].z, "%.2f");
+            fputs("</td><td>", f);
+            put_p(r, c[k].p);
+        } else {
+            fputs("not tested</td><td></td><td></td><td></td><td>", f);
+        }
+        fprintf(f, "</td><td class=\"l\"><span class=\"sw\" style=\"background:%s\"></span>%s</td><td class=\"l w\">",
+                colour[c[k].chosen ? C_CHOSEN : c[k].significant ? C_SIGNIF : C_NOTSIG],
+                c[k].chosen ? "chosen" : c[k].significant ? "significant" : c[k].tested ? "no gain" : "&mdash;");
+        put_esc(f, c[k].note);
+        fputs("</td></tr>\n", f);
+    }
+    fputs("</table>\n", f);
+}
+
+static void cands_chart(rep *r, const crow *c, size_t n)
+{
+    const char **labels = calloc(n, sizeof *labels), **missing = calloc(n, sizeof *missing);
+    double *v = calloc(3 * n, sizeof *v);
+    unsigned char *col = calloc(n, 1);
+    if (labels && missing && v && col) {
+        for (size_t k = 0; k < n; ++k) {
+            labels[k] = c[k].label;
+            missing[k] = c[k].tested ? "no figure" : "not tested (not identifiable here)";
+            v[k] = c[k].tested ? c[k].gain : NAN;
+            v[n + k] = c[k].gain - Z95 * c[k].gain_se;
+            v[2 * n + k] = c[k].gain + Z95 * c[k].gain_se;
+            col[k] = c[k].chosen ? C_CHOSEN : c[k].significant ? C_SIGNIF : C_NOTSIG;
+        }
+        static const unsigned char leg[3] = {C_CHOSEN, C_SIGNIF, C_NOTSIG};
+        static const char *const leg_label[3] = {"chosen", "significant, not chosen", "no significant gain"};
+        chart ch;
+        memset(&ch, 0, sizeof ch);
+        ch.title = "Held-out gain of each candidate effect";
+        ch.xlabel = "reduction of the held-out mean squared residual (mm\xC2\xB2), 95 % interval";
+        ch.n_rows = n;
+        ch.n_sub = 1;
+        ch.label = labels;
+        ch.v = v;
+        ch.lo = v + n;
+        ch.hi = v + 2 * n;
+        ch.col = col;
+        ch.missing = missing;
+        ch.leg = leg;
+        ch.leg_label = leg_label;
+        ch.n_leg = 3;
+        ch.width_px = 1060;
+        chart_svg(r, &ch);
+    }
+    free(labels);
+    free(missing);
+    free(v);
+    free(col);
+}
+
+static void structure_table(rep *r)
+{
+    FILE *f = r->f;
+    const rch_json *b = jarr(r->diag, "structure_before"), *a = jarr(r->diag, "structure_after");
+    size_t sb = 0, sa = 0;
+    for (size_t k = 0; b && k < b->n; ++k)
+        sb += jbool(b->items[k], "significant") == 1;
+    for (size_t k = 0; a && k < a->n; ++k)
+        sa += jbool(a->items[k], "significant") == 1;
+    fprintf(f, "<details><summary>Structure of the residuals: %zu of %zu tests significant with the geometry alone, "
+               "%zu with the chosen effects</summary>\n",
+            sb, b ? b->n : 0, sa);
+    fputs("<table><tr><th class=\"l\">regressor</th><th>dof</th><th>F before</th><th>p before</th><th>R&sup2; before"
+          "</th><th>F after</th><th>p after</th></tr>\n",
+          f);
+    for (size_t k = 0; b && k < b->n; ++k) {
+        const rch_json *t = b->items[k], *u = a && k < a->n ? a->items[k] : NULL;
+        fputs("<tr><td class=\"l\">", f);
+        put_str(r, jstr(t, "variable"));
+        fputs("</td><td>", f);
+        put_num(r, jnum(t, "dof1"), "%.0f");
+        fputs(", ", f);
+        put_num(r, jnum(t, "dof2"), "%.0f");
+        fputs("</td><td>", f);
+        put_num(r, jnum(t, "f"), "%.3g");
+        fputs("</td><td>", f);
+        put_p(r, jnum(t, "p"));
+        fputs("</td><td>", f);
+        put_num(r, jnum(t, "r2"), "%.3g");
+        fputs("</td><td>", f);
+        put_num(r, jnum(u, "f"), "%.3g");
+        fputs("</td><td>", f);
+        put_p(r, jnum(u, "p"));
+        fputs("</td></tr>\n", f);
+    }
+    fputs("</table></details>\n", f);
+}
+
+static void sec_diag(rep *r, const crow *c, size_t n)
+{
+    FILE *f = r->f;
+    fputs("<section id=\"diagnosis\"><h2>5. Diagnosis: what the model misses</h2>\n", f);
+    if (!r->diag) {
+        fputs("<p>", f);
+        put_str(r, NULL);
+        fputs(": no diagnosis was given (run <code>rcal diagnose --data FILE --json</code> and pass its output "
+              "with <code>--diagnosis</code>).</p></section>\n",
+              f);
+        return;
+    }
+    const double fl = jnum(r->diag, "noise_floor_mm"), ra = jnum(r->diag, "rmse_after_mm");
+    fputs("<p class=\"verdict\">verdict: <b>", f);
+    put_str(r, jstr(r->diag, "effect"));
+    if (isfinite(jnum(r->diag, "joint")))
+        fprintf(f, " (joint %.0f)", jnum(r->diag, "joint"));
+    fputs("</b>", f);
+    const char *why = jstr(r->diag, "remaining_why");
+    if (why && *why) {
+        fputs(" &mdash; ", f);
+        put_esc(f, why);
+    }
+    fputs("</p>\n<table class=\"kv\">\n", f);
+    kv(r, "after the chosen effects");
+    put_str(r, jstr(r->diag, "remaining"));
+    kv_end(r);
+    kv(r, "held-out RMSE");
+    fputs("geometry only ", f);
+    put_num(r, jnum(r->diag, "rmse_before_mm"), "%.4f mm");
+    fputs(", with the chosen effects ", f);
+    put_num(r, ra, "%.4f mm");
+    if (isfinite(fl) && fl > 0 && isfinite(ra))
+        fprintf(f, " = %.2f &times; the noise floor (%.4g mm)", ra / fl, fl);
+    kv_end(r);
+    kv(r, "effects added, in order");
+    const rch_json *seq = jarr(r->diag, "sequence");
+    for (size_t k = 0; seq && k < seq->n; ++k) {
+        fputs(k ? ", " : "", f);
+        put_str(r, seq->items[k]->type == RCH_JSTR ? seq->items[k]->str : NULL);
+    }
+    fputs(!seq ? NA : seq->n == 0 ? "none" : "", f);
+    kv_end(r);
+    kv(r, "samples, groups, folds");
+    put_num(r, jnum(r->diag, "n"), "%.0f");
+    fputs(", ", f);
+    put_num(r, jnum(r->diag, "groups"), "%.0f");
+    fputs(", ", f);
+    put_num(r, jnum(r->diag, "folds"), "%.0f");
+    kv_end(r);
+    fputs("</table>\n", f);
+    if (n) {
+        cands_chart(r, c, n);
+        cands_table(r, c, n);
+    }
+    const rch_json *ps = jarr(r->diag, "params");
+    if (ps && ps->n) {
+        static const jcol cols[] = {{"name", "name", 's', NULL},
+                                    {"value", "value", 'n', "%.5g"},
+                                    {"std error", "se", 'n', "%.2g"},
+                                    {"unit", "unit", 's', NULL}};
+        fputs("<h3>Parameters of the chosen effects</h3>\n", f);
+        json_table(r, ps, cols, sizeof cols / sizeof cols[0]);
+    }
+    structure_table(r);
+    const rch_json *notes = jarr(r->diag, "not_identifiable");
+    for (size_t k = 0; notes && k < notes->n; ++k) {
+        fputs(k ? "<br>" : "<p class=\"note\">Not identifiable from these data: ", f);
+        put_str(r, notes->items[k]->type == RCH_JSTR ? notes->items[k]->str : NULL);
+        fputs(k + 1 == notes->n ? "</p>\n" : "", f);
+    }
+    fputs("</section>\n", f);
+}
+
+static void accuracy_chart(rep *r, const arow *a, size_t n)
+{
+    if (n == 0)
+        return;
+    const char *labels[10];
+    double v[10];
+    unsigned char col[10], leg[3];
+    const char *leg_label[3];
+    int used[C_N] = {0};
+    size_t n_leg = 0;
+    for (size_t k = 0; k < n; ++k) {
+        labels[k] = a[k].label;
+        v[k] = a[k].v;
+        col[k] = a[k].col;
+        used[a[k].col] = 1;
+    }
+    if (used[C_PRED]) {
+        leg[n_leg] = C_PRED;
+        leg_label[n_leg++] = "predicted 95 % (longest semi-axis)";
+    }
+    if (used[C_BEFORE]) {
+        leg[n_leg] = C_BEFORE;
+        leg_label[n_leg++] = "nominal, against the truth";
+    }
+    if (used[C_AFTER]) {
+        leg[n_leg] = C_AFTER;
+        leg_label[n_leg++] = "calibrated, against the truth";
+    }
+    chart c;
+    memset(&c, 0, sizeof c);
+    c.title = "Flange-position accuracy over the workspace";
+    c.xlabel = "flange position (mm)";
+    c.n_rows = n;
+    c.n_sub = 1;
+    c.label = labels;
+    c.v = v;
+    c.col = col;
+    c.bars = 1;
+    c.leg = leg;
+    c.leg_label = leg_label;
+    c.n_leg = n_leg;
+    c.width_px = 700;
+    chart_svg(r, &c);
+}
+
+static void sec_accuracy(rep *r, const arow *a, size_t n)
+{
+    FILE *f = r->f;
+    fputs("<section id=\"accuracy\"><h2>6. Predicted accuracy over the workspace</h2>\n<table class=\"kv\">\n", f);
+    kv(r, "flange position, 95 %");
+    fputs("inside the data &plusmn;", f);
+    put_sig(r, jnum(r->unc, "position95_mm.data_median"), " mm");
+    fputs(" (median; up to &plusmn;", f);
+    put_sig(r, jnum(r->unc, "position95_mm.data_max"), " mm");
+    fputs("), whole workspace &plusmn;", f);
+    put_sig(r, jnum(r->unc, "position95_mm.workspace_median"), " mm");
+    fputs(" (median; up to &plusmn;", f);
+    put_sig(r, jnum(r->unc, "position95_mm.workspace_max"), " mm");
+    fputs(")", f);
+    kv_end(r);
+    kv(r, "flange orientation, 95 %");
+    fputs("inside the data &plusmn;", f);
+    put_sig(r, jnum(r->unc, "orientation95_deg.data_median"), "&deg;");
+    fputs(" (median; up to &plusmn;", f);
+    put_sig(r, jnum(r->unc, "orientation95_deg.data_max"), "&deg;");
+    fputs("); orientation determined: ", f);
+    const int od = jbool(r->unc, "orientation_determined");
+    put_str(r, od < 0 ? NULL : od ? "yes" : "no (compensate position only)");
+    kv_end(r);
+    kv(r, "against a simulated truth");
+    const rch_json *t = jpath(r->cal, "truth_flange");
+    if (t) {
+        fputs("flange-position error over random poses in the joint limits (base heading and height aligned): "
+              "before RMS ",
+              f);
+        put_num(r, jnum(t, "before_rms_mm"), "%.4f mm");
+        fputs(", max ", f);
+        put_num(r, jnum(t, "before_max_mm"), "%.4f mm");
+        fputs("; after RMS ", f);
+        put_num(r, jnum(t, "after_rms_mm"), "%.4f mm");
+        fputs(", max ", f);
+        put_num(r, jnum(t, "after_max_mm"), "%.4f mm");
+    } else {
+        fputs(NA " (only a simulation has a truth: <code>rcal calibrate --truth</code>)", f);
+        r->res->n_missing++;
+    }
+    kv_end(r);
+    fputs("</table>\n", f);
+    if (r->unc)
+        fprintf(f, "<p class=\"note\">Uncertainty %s.</p>\n", r->unc_from);
+    accuracy_chart(r, a, n);
+    fputs("</section>\n", f);
+}
+
+static void sec_warnings(rep *r)
+{
+    FILE *f = r->f;
+    fputs("<section id=\"warnings\"><h2>7. Warnings</h2>\n", f);
+    if (r->n_warn == 0)
+        fputs("<p>none</p>\n", f);
+    else
+        fputs("<ul class=\"warn\">\n", f);
+    for (unsigned k = 0; k < r->n_warn; ++k) {
+        fputs("<li>", f);
+        put_esc(f, r->warn[k]);
+        fputs("</li>\n", f);
+    }
+    fputs(r->n_warn ? "</ul></section>\n" : "</section>\n", f);
+    r->res->n_warnings = r->n_warn;
+}
+
+static void input_row(rep *r, const char *what, const char *path, const rch_json *j)
+{
+    char hex[65];
+    if (!path)
+        return;
+    kv(r, what);
+    fputs("<span class=\"mono\">", r->f);
+    put_esc(r->f, path);
+    fputs("</span>, format ", r->f);
+    put_str(r, jstr(j, "format"));
+    fputs(", SHA-256 <span class=\"mono\">", r->f);
+    fputs(rch_sha256_file(hex, path) == 0 ? hex : "?", r->f);
+    fputs("</span>", r->f);
+    kv_end(r);
+}
+
+static void sec_provenance(rep *r, const dfile *df, size_t n_df, const char *date)
+{
+    FILE *f = r->f;
+    fputs("<section id=\"provenance\"><h2>8. Provenance</h2>\n<table class=\"kv\">\n", f);
+    kv(r, "tool version");
+    put_str(r, prov_str(r, "tool"));
+    kv_end(r);
+    kv(r, "command line");
+    fputs("<span class=\"mono\">", f);
+    put_str(r, prov_str(r, "command_line"));
+    fputs("</span>", f);
+    kv_end(r);
+    kv(r, "date (UTC)");
+    put_str(r, prov_str(r, "date"));
+    kv_end(r);
+    for (size_t i = 0; i < n_df; ++i) {
+        kv(r, "data, SHA-256");
+        fputs("<span class=\"mono\">", f);
+        put_esc(f, df[i].file);
+        fputs(": ", f);
+        put_str(r, df[i].sha_rec);
+        fputs("</span>", f);
+        kv_end(r);
+    }
+    if (r->prov)
+        fprintf(f, "<tr><th></th><td class=\"note\">provenance %s</td></tr>\n", r->prov_from);
+    input_row(r, "calibration", r->cfg->cal_path, r->cal);
+    input_row(r, "diagnosis", r->cfg->diag_path, r->diag);
+    input_row(r, "model file", r->cfg->model_path, r->model);
+    kv(r, "this report");
+    fputs("<span class=\"mono\">", f);
+    put_esc(f, r->cfg->command_line ? r->cfg->command_line : "rcal report");
+    fprintf(f, "</span>, rcal %s, ", rc_version());
+    put_esc(f, date);
+    fputs("; plot data beside it: ", f);
+    for (unsigned k = 0; k < r->res->n_csv; ++k) {
+        const char *base = strrchr(r->res->csv[k], '/');
+        fputs(k ? ", " : "", f);
+        put_esc(f, base ? base + 1 : r->res->csv[k]);
+    }
+    kv_end(r);
+    fputs("</table></section>\n</main>\n</body>\n</html>\n", f);
+}
+
+/* ---- CSV files of the plots */
+
+static void csv_metrics(FILE *f, const rep *r)
+{
+    static const char *const sets[4][2] = {
+        {"evaluated", "before"}, {"evaluated", "after"}, {"training", "train_before"}, {"training", "train_after"}};
+    fputs("set,model,metric,value_mm\n", f);
+    for (size_t s = 0; s < 4; ++s)
+        for (size_t k = 0; k < N_METRICS; ++k) {
+            char path[64];
+            snprintf(path, sizeof path, "%s.%s", sets[s][1], metric_defs[k].key);
+            fprintf(f, "%s,%s,%s,", s < 2 && jbool(r->cal, "held_out") != 0 ? "held-out" : sets[s][0],
+                    strstr(sets[s][1], "before") ? "before" : "after", metric_defs[k].key);
+            csv_num(f, jnum(r->cal, path));
+            fputc('\n', f);
+        }
+}
+
+static void csv_params(FILE *f, const prow *p, size_t n)
+{
+    fputs("name,unit,nominal,calibrated,correction,std_error,ci95_low,ci95_high,class,compensation\n", f);
+    for (size_t k = 0; k < n; ++k) {
+        const double v[6] = {p[k].nominal, p[k].value, p[k].delta, p[k].se, p[k].ci_lo, p[k].ci_hi};
+        csv_str(f, p[k].name);
+        fputc(',', f);
+        csv_str(f, p[k].unit);
+        for (size_t i = 0; i < 6; ++i) {
+            fputc(',', f);
+            csv_num(f, v[i]);
+        }
+        fputc(',', f);
+        csv_str(f, p[k].cls);
+        fputc(',', f);
+        csv_str(f, p[k].comp);
+        fputc('\n', f);
+    }
+}
+
+static void csv_accuracy(FILE *f, const arow *a, size_t n)
+{
+    fputs("quantity,value_mm\n", f);
+    for (size_t k = 0; k < n; ++k) {
+        csv_str(f, a[k].label);
+        fputc(',', f);
+        csv_num(f, a[k].v);
+        fputc('\n', f);
+    }
+}
+
+static void csv_cands(FILE *f, const crow *c, size_t n)
+{
+    fputs("step,effect,joint,params,identifiable,tested,rmse_cv_mm,gain_mm2,gain_se_mm2,gain_ci95_low,"
+          "gain_ci95_high,z,p,significant,chosen,note\n",
+          f);
+    for (size_t k = 0; k < n; ++k) {
+        const double v[4] = {c[k].step, c[k].joint, c[k].params, c[k].ident};
+        const double w[7] = {c[k].rmse_cv, c[k].gain, c[k].gain_se, c[k].gain - Z95 * c[k].gain_se,
+                             c[k].gain + Z95 * c[k].gain_se, c[k].z, c[k].p};
+        csv_num(f, v[0]);
+        fputc(',', f);
+        csv_str(f, c[k].effect);
+        for (size_t i = 1; i < 4; ++i) {
+            fputc(',', f);
+            csv_num(f, v[i]);
+        }
+        fprintf(f, ",%d", c[k].tested);
+        for (size_t i = 0; i < 7; ++i) {
+            fputc(',', f);
+            if (c[k].tested)
+                csv_num(f, w[i]);
+        }
+        fprintf(f, ",%d,%d,", c[k].significant, c[k].chosen);
+        csv_str(f, c[k].note);
+        fputc('\n', f);
+    }
+}
+
+/* ---- driver */
+
+static rch_json *load_kind(const char *path, const char *opt, const char *need, const char *kind, rch_diag *d)
+{
+    rch_json *j = rch_json_load(path, d);
+    if (j && (j->type != RCH_JOBJ || !rch_json_get(j, need))) {
+        rch_diag_set(d, path, 0, 0, "%s: not %s (it has no member \"%s\")", opt, kind, need);
+        rch_json_free(j);
+        return NULL;
+    }
+    return j;
+}
+
+typedef struct {
+    rch_json *cal, *diag, *model;
+    prow *p;
+    crow *c;
+    size_t n_p, n_c, n_a, n_df;
+    arow a[10];
+    dfile df[MAX_DFILES];
+    rch_out out[1 + RCH_REPORT_MAX_CSV];
+    unsigned n_out;
+} job;
+
+static void job_free(job *j)
+{
+    for (unsigned k = 0; k < j->n_out; ++k)
+        rch_out_abort(&j->out[k]);
+    rch_json_free(j->cal);
+    rch_json_free(j->diag);
+    rch_json_free(j->model);
+    free(j->p);
+    free(j->c);
+}
+
+static int job_load(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
+{
+    j->cal = load_kind(cfg->cal_path, "--calibration", "before", "the output of rcal calibrate --json", d);
+    if (!j->cal)
+        return -1;
+    if (cfg->diag_path && !(j->diag = load_kind(cfg->diag_path, "--diagnosis", "candidates",
+                                                "the output of rcal diagnose --json", d)))
+        return -1;
+    if (cfg->model_path &&
+        !(j->model = load_kind(cfg->model_path, "--model", "dh", "a model file (rcal-model/1 or /2)", d)))
+        return -1;
+    r->cal = j->cal;
+    r->diag = j->diag;
+    r->model = j->model;
+    r->unc = jpath(j->cal, "uncertainty");
+    r->unc_from = "from the calibration run";
+    if (!r->unc && j->model) {
+        r->unc = jpath(j->model, "uncertainty");
+        r->unc_from = "from the model file";
+    }
+    r->prov = jpath(j->cal, "provenance");
+    r->prov_from = "from the calibration run";
+    if (!r->prov && j->model) {
+        r->prov = jpath(j->model, "provenance");
+        r->prov_from = "from the model file";
+    }
+    j->p = params_read(r, &j->n_p);
+    j->c = cands_read(r, &j->n_c);
+    j->n_a = accuracy_read(r, j->a);
+    j->n_df = data_files(r, j->df);
+    return 0;
+}
+
+/* Open the HTML and the CSVs beside it (temporary files until committed). */
+static int job_open(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
+{
+    const char *inputs[3 + MAX_DFILES] = {cfg->cal_path, cfg->diag_path, cfg->model_path};
+    for (size_t i = 0; i < j->n_df; ++i)
+        inputs[3 + i] = j->df[i].file;
+    const size_t n_in = 3 + j->n_df;
+    if (rch_out_open(&j->out[0], cfg->out_path, "--out", inputs, n_in, d) != 0)
+        return -1;
+    j->n_out = 1;
+    const char *names[RCH_REPORT_MAX_CSV];
+    unsigned n = 0;
+    names[n++] = "metrics";
+    if (j->n_p)
+        names[n++] = "params";
+    if (j->n_a)
+        names[n++] = "accuracy";
+    if (j->n_c)
+        names[n++] = "candidates";
+    const char *slash = strrchr(cfg->out_path, '/');
+    const int dir_len = slash ? (int)(slash - cfg->out_path + 1) : 0;
+    for (unsigned k = 0; k < n; ++k) {
+        char *path = r->res->csv[k];
+        snprintf(path, sizeof r->res->csv[k], "%.*sreport_%s.csv", dir_len, cfg->out_path, names[k]);
+        if (strcmp(path, cfg->out_path) == 0) {
+            rch_diag_set(d, path, 0, 0, "--out: the page would be overwritten by its own plot data; name it "
+                                        "otherwise");
+            return -1;
+        }
+        if (rch_out_open(&j->out[j->n_out], path, "--out (plot data beside the page)", inputs, n_in, d) != 0)
+            return -1;
+        j->n_out++;
+        r->res->n_csv++;
+    }
+    return 0;
+}
+
+static void job_write(job *j, rep *r, const char *date)
+{
+    warn_fit(r);
+    warn_params(r, j->p, j->n_p);
+    warn_diag(r);
+    warn_inputs(r, j->df, j->n_df);
+    r->f = j->out[0].f;
+    page_head(r, r->n_warn);
+    sec_data(r, j->df, j->n_df);
+    sec_split(r);
+    sec_metrics(r);
+    sec_params(r, j->p, j->n_p);
+    sec_diag(r, j->c, j->n_c);
+    sec_accuracy(r, j->a, j->n_a);
+    sec_warnings(r);
+    sec_provenance(r, j->df, j->n_df, date);
+    unsigned k = 1;
+    csv_metrics(j->out[k++].f, r);
+    if (j->n_p)
+        csv_params(j->out[k++].f, j->p, j->n_p);
+    if (j->n_a)
+        csv_accuracy(j->out[k++].f, j->a, j->n_a);
+    if (j->n_c)
+        csv_cands(j->out[k++].f, j->c, j->n_c);
+}
+
+int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag *d)
+{
+    memset(res, 0, sizeof *res);
+    if (!cfg || !cfg->cal_path || !cfg->out_path) {
+        rch_diag_set(d, "", 0, 0, "report: --calibration and --out are required");
+        return -1;
+    }
+    if (strcmp(cfg->out_path, "-") == 0) {
+        rch_diag_set(d, "", 0, 0, "--out: the report needs a file (its plot data are written beside it)");
+        return -1;
+    }
+    char date[32];
+    if (cfg->date_utc) {
+        snprintf(date, sizeof date, "%s", cfg->date_utc);
+    } else {
+        const time_t t = time(NULL);
+        struct tm tm;
+        if (!gmtime_r(&t, &tm) || strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &tm) == 0)
+            snprintf(date, sizeof date, "?");
+    }
+    rep *r = calloc(1, sizeof *r);
+    job j;
+    memset(&j, 0, sizeof j);
+    int rc = -1;
+    if (!r) {
+        rch_diag_set(d, "", 0, 0, "report: out of memory");
+        return -1;
+    }
+    r->cfg = cfg;
+    r->res = res;
+    if (job_load(&j, r, cfg, d) != 0 || job_open(&j, r, cfg, d) != 0)
+        goto done;
+    job_write(&j, r, date);
+    for (unsigned k = 0; k < j.n_out; ++k)
+        if (ferror(j.out[k].f)) {
+            rch_diag_set(d, j.out[k].path, 0, 0, "write error");
+            goto done;
+        }
+    for (unsigned k = 0; k < j.n_out; ++k)
+        if (rch_out_commit(&j.out[k], d) != 0)
+            goto done; /* the outputs not yet committed are removed by job_free */
+    j.n_out = 0;
+    rc = 0;
+done:
+    job_free(&j);
+    free(r);
+    if (rc != 0)
+        memset(res, 0, sizeof *res);
+    return rc;
+}

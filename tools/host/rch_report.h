@@ -1,0 +1,74 @@
+/* rch_report.h - the HTML report of a calibration (issue 13): one
+ * self-contained file a user can hand on, built from what the commands
+ * already wrote.
+ *
+ * What: reads the output of `rcal calibrate --json` (required), of
+ * `rcal diagnose --json` and a model file (rcal-model/1 or /2; both
+ * optional), and writes one HTML page with its CSS inline and every plot as
+ * inline SVG (no script, no font, image or link that leaves the file):
+ * data summary, split, before/after metrics, the identified parameters with
+ * their standard errors, 95 % intervals and identifiability classes, the
+ * diagnosis, the predicted accuracy over the workspace, warnings and the
+ * provenance. Members a run does not carry (older outputs, a calibration
+ * without uncertainty) are shown as "not in this run", so the report keeps
+ * working while the JSON grows. The members read, and where each is looked
+ * for, are listed in docs/report.md.
+ *
+ * The data of every plot is written beside the HTML as report_<plot>.csv
+ * (metrics, params, accuracy when the run has accuracy figures, candidates
+ * when a diagnosis is given), in the HTML's directory.
+ *
+ * Every string that comes from a JSON file is HTML-escaped (& < > " ' and
+ * control characters; bytes that are not UTF-8 become U+FFFD), also inside
+ * the SVG text and in tooltips; CSV fields are quoted per RFC 4180.
+ *
+ * Depends on: rch_json (reader), rch_file (outputs: refuses to write over an
+ * input, temporary file + rename, so an old report survives any failure
+ * intact), rch_sha256 (the data file's hash as it is now, against the one
+ * recorded at calibration time). Memory: heap, freed before return.
+ * Thread safety: none needed (no global state).
+ * Errors: 0, or -1 with d set ("file:line:col: what"); nothing is left
+ * behind on failure (all outputs are committed only once all were written).
+ *
+ * Host side (prefix rch_): stdio, heap, POSIX. */
+#ifndef RCH_REPORT_H
+#define RCH_REPORT_H
+
+#include <stddef.h>
+
+#include "rch_diag.h"
+
+#define RCH_REPORT_MAX_CSV 4
+#define RCH_REPORT_MAX_WARN 32
+
+typedef struct {
+    const char *cal_path;     /* output of rcal calibrate --json (required) */
+    const char *diag_path;    /* output of rcal diagnose --json, or NULL */
+    const char *model_path;   /* model file (rcal-model/1 or /2), or NULL */
+    const char *out_path;     /* the HTML page (required; not "-": the CSVs go beside it) */
+    const char *command_line; /* the report's own command line, shown in the provenance; may be NULL */
+    const char *date_utc;     /* "2026-11-29T17:00:00Z" shown as the report's date; NULL: now */
+} rch_report_cfg;
+
+typedef struct {
+    char csv[RCH_REPORT_MAX_CSV][1024]; /* paths of the CSV files written */
+    unsigned n_csv;
+    unsigned n_plots;                   /* inline SVG charts in the page */
+    unsigned n_warnings;                /* entries in the warnings section */
+    unsigned n_missing;                 /* places that say "not in this run" */
+} rch_report_result;
+
+/* Read the inputs named in cfg, write the HTML page and its CSV files.
+ * 0, or -1 with d set (unreadable or malformed input, an input that is not
+ * what its option says, an output that names an input, a write failure). */
+int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag *d);
+
+/* s HTML-escaped into buf (always NUL-terminated; truncated only between
+ * whole characters or entities). Returns buf. */
+const char *rch_report_escape(char *buf, size_t len, const char *s);
+
+/* argv joined by blanks into buf, each argument that holds a blank, a quote
+ * or a shell character single-quoted, as a user would type it. Returns buf. */
+const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *argv);
+
+#endif
