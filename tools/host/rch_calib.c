@@ -222,13 +222,20 @@ static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch
     if (nf == 1) {
         int rc = rch_data_load(out, file_at(cfg, 0), 0, d);
         counts[0] = out->n;
+        if (rc == 0 && rch_data_check_units(out, file_at(cfg, 0), d) != 0) {
+            rch_data_free(out);
+            return -1;
+        }
         return rc;
     }
     rch_data part[RCH_CALIB_MAX_FILES];
     size_t total = 0, k = 0;
     int all_xyz = 1, all_group = 1;
     for (size_t f = 0; f < nf; ++f) {
-        if (rch_data_load(&part[f], file_at(cfg, f), 0, d) != 0) {
+        if (rch_data_load(&part[f], file_at(cfg, f), 0, d) != 0 ||
+            rch_data_check_units(&part[f], file_at(cfg, f), d) != 0) {
+            if (part[f].s)
+                rch_data_free(&part[f]);
             for (size_t g = 0; g < f; ++g)
                 rch_data_free(&part[g]);
             return -1;
