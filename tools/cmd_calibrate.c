@@ -38,7 +38,7 @@ int rcal_cmd_calibrate(int argc, char **argv)
     const char *out_path = NULL, *method = "lm";
     rch_opt_strs data;
     memset(&data, 0, sizeof data);
-    unsigned long seed = 1, max_iter = 0;
+    unsigned long seed = 1, max_iter = 0, cases = 1, case_samples = 0;
     int json = 0;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STRS, &data, 0, 0, "FILE",
@@ -60,6 +60,18 @@ int rcal_cmd_calibrate(int argc, char **argv)
         {"--fix", RCH_OPT_STR, &cfg.fix, 0, 0, "LIST",
          "parameters held at nominal, e.g. a1,theta6 (a1..a6, d1..d6, alpha1..alpha6, theta1..theta6, ex, ey, ez)",
          0, NULL},
+        {"--jumps", RCH_OPT_FLAG, &cfg.jumps, 0, 0, NULL,
+         "fit length jumps at change points in acquisition order (a display re-zeroed, counts lost) with the "
+         "geometry; they are not used at a new pose",
+         0, NULL},
+        {"--dequantize-joints", RCH_OPT_FLAG, &cfg.dequantize, 0, 0, NULL,
+         "recover joint angles rounded for the file from its x, y, z columns (nominal FK); inconsistent rows refused",
+         0, NULL},
+        {"--holdout-groups", RCH_OPT_FLAG, &cfg.holdout_groups, 0, 0, NULL,
+         "hold out whole set-up groups (the file's group column, else from the wrist joints) instead of random rows",
+         0, NULL},
+        {"--cases", RCH_OPT_UINT, &cases, 1, 1000, "N", "repeat on N random subsets (the paper's protocol)", 0, NULL},
+        {"--samples", RCH_OPT_UINT, &case_samples, 0, 10000000, "M", "rows per case (0: every row)", 0, NULL},
         {"--tool-offset", RCH_OPT_FLAG, &cfg.tool_offset, 0, 0, NULL,
          "also identify where the cable is attached in the flange frame (tx, ty, tz)", 0, NULL},
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
@@ -78,6 +90,8 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return 2; /* unreachable: the choice list is the method list */
     cfg.seed = seed;
     cfg.max_iter = (unsigned)max_iter;
+    cfg.cases = cases;
+    cfg.case_samples = case_samples;
     cfg.data_path = data.v[0];
     cfg.data_paths = data.v;
     cfg.n_data_paths = data.n;

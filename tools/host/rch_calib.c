@@ -178,11 +178,11 @@ done:
  * standard errors, classes, predicted uncertainty over the data and the
  * workspace, and the determined model. Leaves have_unc 0 when it cannot be
  * computed (too few samples for the free parameters). */
-static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train)
+static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit)
 {
     rch_uncert u;
     char err[256];
-    if (rch_uncert_compute(&u, &r->model, fixed, train, r->n_train, 1, err, sizeof err) != 0)
+    if (rch_uncert_compute(&u, fit, fixed, train, r->n_train, 1, err, sizeof err) != 0)
         return;
     rch_model_unc_from(&r->unc, &u);
     if (rch_uncert_map_compute(&r->unc.map, &u, &r->model, train, r->n_train, RCH_CALIB_TRUTH_POSES,
@@ -339,6 +339,85 @@ static void groups(rch_calib_result *r, rch_data *data, const size_t *counts)
     }
 }
 
+/* After the fit: truth, identifiability, uncertainty, validation. fit:
+ * the model fitted to train (r->model, or with the jumps' offsets). */
+static int finish(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit,
+                  rch_diag *d)
+{
+    if (r->cfg.truth_path && r->finite && truth_flange(r, d) != 0)
+        return -1;
+    r->have_ident = r->finite && rch_ident_compute(&r->ident, fit, train, r->n_train) == 0;
+    if (r->finite)
+        uncertainty(r, fixed, train, fit);
+    if (r->cfg.validate_path && r->after_ok) {
+        rc_solve_work *w = malloc(sizeof *w);
+        int rc = w ? validate(r, w, d) : -1;
+        free(w);
+        if (rc != 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int cmp_t(const void *a, const void *b)
+{
+    double x = ((const rc_sample *)a)->t, y = ((const rc_sample *)b)->t;
+    return (x > y) - (x < y);
+}
+
+/* Length jumps (nuisance): detected on the training samples in acquisition
+ * order and fitted with the geometry; r->model becomes the geometry alone
+ * (what predicts a new pose). Held-out samples are labelled with their
+ * segment to evaluate; those between a jump and the training samples around
+ * it cannot be placed (their segment is a guess) and are counted apart. */
+static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rc_sample *train,
+                     const rc_sample *eval_set, size_t n_eval, rch_diag *d)
+{
+    rc_sample *tr = malloc(r->n_train * sizeof *tr), *ev = malloc(n_eval * sizeof *ev);
+    char err[256];
+    int rc = -1;
+    if (!tr || !ev) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    memcpy(tr, train, r->n_train * sizeof *tr);
+    memcpy(ev, eval_set, n_eval * sizeof *ev);
+    qsort(tr, r->n_train, sizeof *tr, cmp_t);
+    if (rch_jumps_find(&r->jumps, &r->before, fixed, tr, r->n_train, NULL, w, err, sizeof err) != 0) {
+        rch_diag_set(d, "", 0, 0, "length jumps: %s", err);
+        goto done;
+    }
+    r->have_jumps = 1;
+    r->model = r->jumps.geometry;
+    rch_stats sa;
+    memset(&sa, 0, sizeof sa);
+    r->n_ambiguous = 0;
+    for (size_t i = 0; i < n_eval; ++i) {
+        ev[i].group = (uint16_t)rch_jumps_segment(&r->jumps, ev[i].t);
+        int amb = 0;
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+            size_t a = r->jumps.at[k]; /* first training sample after the jump; a - 1 the last before */
+            amb |= a > 0 && ev[i].t > tr[a - 1].t && ev[i].t < tr[a].t;
+        }
+        double l;
+        if (!amb && rc_meas(&l, NULL, &r->jumps.model, &ev[i]) == RC_OK)
+            rch_stats_add(&sa, l - ev[i].len_mm);
+        r->n_ambiguous += (size_t)amb;
+    }
+    rch_stats_metrics(&r->after_unambiguous, &sa);
+    r->after_ok = rc_eval(&r->after_m, &r->jumps.model, ev, n_eval) == RC_OK;
+    for (size_t i = 0; i < r->n_train; ++i)
+        tr[i].group = (uint16_t)rch_jumps_segment(&r->jumps, tr[i].t);
+    rc_eval(&r->train_before, &r->before, tr, r->n_train);
+    if (!r->after_ok || rc_eval(&r->train_after, &r->jumps.model, tr, r->n_train) != RC_OK)
+        memset(&r->train_after, 0, sizeof r->train_after);
+    rc = finish(r, fixed, tr, &r->jumps.model, d);
+done:
+    free(tr);
+    free(ev);
+    return rc;
+}
+
 /* Identification and the figures, once the split is made. */
 static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
                           rch_diag *d)
@@ -369,18 +448,165 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     const rc_sample *eval_set = r->n_test ? test : train;
     const size_t n_eval = r->n_test ? r->n_test : r->n_train;
     rc_eval(&r->before_m, &r->before, eval_set, n_eval);
+    if (r->cfg.jumps) {
+        return fit_jumps(r, w, fixed, train, eval_set, n_eval, d);
+    }
     r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
     rc_eval(&r->train_before, &r->before, train, r->n_train);
     if (!r->after_ok || rc_eval(&r->train_after, &r->model, train, r->n_train) != RC_OK)
         memset(&r->train_after, 0, sizeof r->train_after);
-    if (r->cfg.truth_path && r->finite && truth_flange(r, d) != 0)
+    return finish(r, fixed, train, &r->model, d);
+}
+
+/* Joint angles from the file's x, y, z; inconsistent rows dropped. */
+static int dequantize(rch_calib_result *r, rch_data *data, rch_diag *d)
+{
+    if (!data->xyz) {
+        rch_diag_set(d, r->cfg.data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
         return -1;
-    r->have_ident = r->finite && rch_ident_compute(&r->ident, &r->model, train, r->n_train) == 0;
-    if (r->finite)
-        uncertainty(r, fixed, train);
-    if (r->cfg.validate_path && r->after_ok && validate(r, w, d) != 0)
+    }
+    uint8_t *bad = calloc(data->n, 1);
+    if (!bad) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
+    }
+    rch_dequant(&r->dequant, bad, data->s, data->n, (const double(*)[3])data->xyz, &r->robot.nominal, 0.0);
+    size_t k = 0;
+    unsigned nr = 0;
+    for (size_t i = 0; i < data->n; ++i) {
+        if (bad[i]) {
+            if (nr < 16)
+                r->dequant_refused_lines[nr++] = data->line[i];
+            continue;
+        }
+        data->s[k] = data->s[i];
+        data->line[k] = data->line[i];
+        memcpy(data->xyz[k], data->xyz[i], sizeof data->xyz[k]);
+        ++k;
+    }
+    data->n = k;
+    free(bad);
+    r->have_dequant = 1;
     return 0;
+}
+
+/* The split: random rows, or whole set-up groups drawn at random until the
+ * held-out share is reached. idx (n): held-out indices first. */
+static size_t split(size_t *idx, const rc_sample *s, size_t n, double fraction, int by_group, unsigned long long seed)
+{
+    size_t want = (size_t)floor(fraction * (double)n + 0.5);
+    rch_split(idx, n, seed);
+    if (!by_group || want == 0)
+        return want;
+    size_t *tmp = malloc(n * sizeof *tmp), k = 0;
+    if (!tmp)
+        return want;
+    /* take the groups of the shuffled rows in the order they come */
+    uint8_t *taken = calloc(65536, 1);
+    if (!taken) {
+        free(tmp);
+        return want;
+    }
+    for (size_t i = 0; i < n && k < want; ++i) {
+        unsigned g = s[idx[i]].group;
+        if (taken[g])
+            continue;
+        taken[g] = 1;
+        for (size_t j = 0; j < n; ++j)
+            if (s[j].group == g)
+                tmp[k++] = j;
+    }
+    size_t nt = k;
+    for (size_t j = 0; j < n; ++j)
+        if (!taken[s[j].group])
+            tmp[k++] = j;
+    memcpy(idx, tmp, n * sizeof *idx);
+    free(tmp);
+    free(taken);
+    return nt;
+}
+
+/* One calibration on the rows sub (m) of data. */
+static int run_once(rch_calib_result *r, rc_solve_work *w, const rc_sample *s, size_t m, unsigned long long seed,
+                    rch_diag *d)
+{
+    size_t *idx = malloc((m ? m : 1) * sizeof *idx);
+    rc_sample *train = NULL, *test = NULL;
+    int rc = -1;
+    if (!idx) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    r->n_test = split(idx, s, m, r->cfg.test_fraction, r->cfg.holdout_groups, seed);
+    r->n_train = m - r->n_test;
+    if (r->n_train < RC_N_BASE) {
+        rch_diag_set(d, "", 0, 0, "%zu training samples; at least %d are needed for 27 parameters", r->n_train,
+                     RC_N_BASE);
+        goto done;
+    }
+    test = rch_data_pick(s, idx, r->n_test);
+    train = rch_data_pick(s, idx + r->n_test, r->n_train);
+    if (!test || !train) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    rc = fit_and_report(r, w, train, test, d);
+done:
+    free(idx);
+    free(train);
+    free(test);
+    return rc;
+}
+
+/* The paper's protocol: `cases` random subsets of case_samples rows, each
+ * split and calibrated; the held-out RMSE before and after over the cases. */
+static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data, rch_diag *d)
+{
+    rch_calib_result *c = malloc(sizeof *c);
+    size_t *idx = malloc(data->n * sizeof *idx);
+    size_t m = r->cfg.case_samples && r->cfg.case_samples < data->n ? r->cfg.case_samples : data->n;
+    rc_sample *sub = NULL;
+    int rc = -1;
+    if (!c || !idx) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    for (unsigned long k = 0; k < r->cfg.cases; ++k) {
+        rch_split(idx, data->n, r->cfg.seed * 1000003ull + k);
+        free(sub);
+        sub = rch_data_pick(data->s, idx, m);
+        if (!sub) {
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            goto done;
+        }
+        rch_calib_result *into = k == 0 ? r : c;
+        if (k > 0) {
+            memcpy(c, r, sizeof *c);
+            c->cfg.truth_path = NULL;
+            c->cfg.validate_path = NULL;
+            c->cfg.plots_dir = NULL;
+        }
+        int one = run_once(into, w, sub, m, r->cfg.seed * 1000003ull + k + 7, d);
+        if (one != 0) {
+            rc = one;
+            goto done;
+        }
+        rch_stats_add(&r->case_before, into->before_m.rmse_mm);
+        rch_stats_add(&r->case_after, into->after_ok ? into->after_m.rmse_mm : NAN);
+        if (into->have_jumps) {
+            rch_stats_add(&r->case_unamb, into->after_unambiguous.rmse_mm);
+            r->case_ambiguous += into->n_ambiguous;
+        }
+        r->cases_done++;
+        fprintf(stderr, "rcal calibrate: case %lu of %lu: held-out RMSE %.4f -> %.4f mm\n", k + 1, r->cfg.cases,
+                into->before_m.rmse_mm, into->after_m.rmse_mm);
+    }
+    rc = 0;
+done:
+    free(c);
+    free(idx);
+    free(sub);
+    return rc;
 }
 
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
@@ -395,37 +621,30 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     groups(r, &data, counts);
     provenance(r, counts);
     int rc = -1;
-    size_t *idx = malloc(data.n * sizeof *idx);
     rc_solve_work *w = malloc(sizeof *w);
-    rc_sample *train = NULL, *test = NULL;
     if (cfg->tool_offset && rc_model_add_effect(&r->robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
         rch_diag_set(d, "", 0, 0, "cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
         goto done;
     }
-    if (!idx || !w) {
+    if (!w) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
-    rch_split(idx, data.n, cfg->seed);
-    r->n_test = (size_t)floor(cfg->test_fraction * (double)data.n + 0.5);
-    r->n_train = data.n - r->n_test;
-    if (r->n_train < RC_N_BASE) {
-        rch_diag_set(d, "", 0, 0, "%zu training samples; at least %d are needed for 27 parameters", r->n_train,
-                     RC_N_BASE);
+    if (cfg->dequantize && dequantize(r, &data, d) != 0)
         goto done;
-    }
-    test = rch_data_pick(data.s, idx, r->n_test);
-    train = rch_data_pick(data.s, idx + r->n_test, r->n_train);
-    if (!test || !train) {
-        rch_diag_set(d, "", 0, 0, "out of memory");
-        goto done;
-    }
-    rc = fit_and_report(r, w, train, test, d);
+    if (cfg->cases > 1)
+        rc = run_cases(r, w, &data, d);
+    else
+        rc = run_once(r, w, data.s, data.n, cfg->seed, d);
+    if (rc == 0 && r->have_jumps && r->prov.n_files == 1)
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k)
+            for (size_t i = 0; i < data.n; ++i)
+                if (data.s[i].t == r->jumps.at_t[k]) {
+                    r->jump_lines[k] = data.line[i];
+                    break;
+                }
 done:
-    free(idx);
     free(w);
-    free(train);
-    free(test);
     rch_data_free(&data);
     return rc;
 }
@@ -448,6 +667,53 @@ static void print_model(FILE *f, const rch_calib_result *r)
     }
     fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
             m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
+}
+
+/* Dequantized joints, length jumps, the protocol over cases. */
+static void print_effects(FILE *f, const rch_calib_result *r)
+{
+    if (r->have_dequant) {
+        const rch_dequant_result *q = &r->dequant;
+        fprintf(f,
+                "joints dequantized from x, y, z: %zu rows corrected (RMS %.4f deg, largest %.4f deg; |FK - xyz| "
+                "%.4f -> %.6f mm), %zu refused as inconsistent",
+                q->n_corrected, q->dq_rms_deg, q->dq_max_deg, q->fk_rms_before_mm, q->fk_rms_after_mm, q->n_refused);
+        for (size_t i = 0; i < q->n_refused && i < 16; ++i)
+            fprintf(f, "%s%u", i ? ", " : " (lines ", r->dequant_refused_lines[i]);
+        fprintf(f, "%s\n", q->n_refused ? ")" : "");
+    }
+    if (r->have_jumps) {
+        const rch_jumps *j = &r->jumps;
+        fprintf(f, "length jumps in acquisition order (nuisance, not used at a new pose): %u found; training RMS "
+                   "%.4f mm without them, %.4f mm with them\n",
+                j->n_jumps, j->rms_before_mm, j->rms_after_mm);
+        for (unsigned k = 0; k < j->n_jumps; ++k) {
+            char where[48] = "";
+            if (r->jump_lines[k])
+                snprintf(where, sizeof where, " at line %u", r->jump_lines[k]);
+            fprintf(f, "  jump %u%s (t %.4f): %+.4f +- %.4f mm\n", k + 1, where, j->at_t[k], j->size_mm[k],
+                    j->se_mm[k]);
+        }
+        if (r->n_ambiguous)
+            fprintf(f,
+                    "  %zu held-out samples lie between a jump and the training samples around it (their segment "
+                    "cannot be known): RMSE without them %.4f mm\n",
+                    r->n_ambiguous, r->after_unambiguous.rmse_mm);
+    }
+    if (r->cases_done > 1)
+        fprintf(f,
+                "protocol: %lu cases of %zu random rows, %.0f %% held out%s: held-out RMSE before %.4f +- %.4f mm, "
+                "after %.4f +- %.4f mm (mean +- sd over the cases; the figures below are case 1's)\n",
+                r->cases_done, r->n_train + r->n_test, 100.0 * r->cfg.test_fraction,
+                r->cfg.holdout_groups ? " (whole set-up groups)" : "", r->case_before.mean,
+                rch_stats_sd(&r->case_before), r->case_after.mean, rch_stats_sd(&r->case_after));
+    if (r->cases_done > 1 && r->case_unamb.n)
+        fprintf(f,
+                "  without the %zu held-out samples (of all cases) that lie between a jump and the training samples "
+                "around it: after %.4f +- %.4f mm\n",
+                r->case_ambiguous, r->case_unamb.mean, rch_stats_sd(&r->case_unamb));
+    if (r->have_dequant || r->have_jumps || r->cases_done > 1)
+        fprintf(f, "\n");
 }
 
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
@@ -539,6 +805,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 "  before RMS %.4f mm, max %.4f mm;  after RMS %.4f mm, max %.4f mm\n\n",
                 RCH_CALIB_TRUTH_POSES, r->truth_before_rms_mm, r->truth_before_max_mm, r->truth_after_rms_mm,
                 r->truth_after_max_mm);
+    print_effects(f, r);
     print_model(f, r);
     if (r->have_unc)
         print_uncertainty(f, r);
@@ -707,6 +974,39 @@ int rch_calib_json(FILE *f, const rch_calib_result *r)
         json_ident(&w, &r->ident);
     if (r->have_unc)
         json_uncertainty(&w, r);
+    if (r->have_jumps) {
+        rch_jw_arr(&w, "length_jumps");
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+            rch_jw_obj(&w, NULL);
+            rch_jw_uint(&w, "line", r->jump_lines[k]);
+            rch_jw_numf(&w, "t", r->jumps.at_t[k], "%.6f");
+            rch_jw_numf(&w, "size_mm", r->jumps.size_mm[k], "%.6f");
+            rch_jw_numf(&w, "se_mm", r->jumps.se_mm[k], "%.6f");
+            rch_jw_end(&w);
+        }
+        rch_jw_end(&w);
+        rch_jw_uint(&w, "held_out_ambiguous", r->n_ambiguous);
+        json_metrics(&w, "after_unambiguous", &r->after_unambiguous);
+    }
+    if (r->have_dequant) {
+        rch_jw_obj(&w, "dequantized");
+        rch_jw_uint(&w, "corrected", r->dequant.n_corrected);
+        rch_jw_uint(&w, "refused", r->dequant.n_refused);
+        rch_jw_numf(&w, "dq_rms_deg", r->dequant.dq_rms_deg, "%.6f");
+        rch_jw_end(&w);
+    }
+    if (r->cases_done > 1) {
+        rch_jw_obj(&w, "protocol");
+        rch_jw_uint(&w, "cases", r->cases_done);
+        rch_jw_numf(&w, "before_rmse_mean_mm", r->case_before.mean, "%.6f");
+        rch_jw_numf(&w, "before_rmse_sd_mm", rch_stats_sd(&r->case_before), "%.6f");
+        rch_jw_numf(&w, "after_rmse_mean_mm", r->case_after.mean, "%.6f");
+        rch_jw_numf(&w, "after_rmse_sd_mm", rch_stats_sd(&r->case_after), "%.6f");
+        rch_jw_uint(&w, "held_out_ambiguous", r->case_ambiguous);
+        rch_jw_numf(&w, "after_unambiguous_rmse_mean_mm", r->case_unamb.n ? r->case_unamb.mean : NAN, "%.6f");
+        rch_jw_numf(&w, "after_unambiguous_rmse_sd_mm", r->case_unamb.n ? rch_stats_sd(&r->case_unamb) : NAN, "%.6f");
+        rch_jw_end(&w);
+    }
     if (r->have_validate) {
         rch_jw_obj(&w, "validation");
         rch_jw_str(&w, "data", r->cfg.validate_path);

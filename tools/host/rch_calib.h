@@ -26,7 +26,10 @@
 #include "rch_diag.h"
 #include "rch_ident.h"
 #include "rch_robot.h"
+#include "rch_dequant.h"
 #include "rch_evaluate.h"
+#include "rch_jumps.h"
+#include "rch_stats.h"
 #include "rch_uncert.h"
 
 /* Poses (and their seed) of the flange comparison against a simulated truth. */
@@ -69,6 +72,11 @@ typedef struct rch_calib_cfg {
     unsigned long seed;     /* split and LTLM seed */
     unsigned max_iter;      /* 0: the method's default */
     int tool_offset;        /* 1: also identify the cable attachment in the flange frame */
+    int jumps;              /* 1: fit length jumps at change points in acquisition order (nuisance, rch_jumps) */
+    int dequantize;         /* 1: recover rounded joint angles from the file's x, y, z (rch_dequant) */
+    int holdout_groups;     /* 1: hold out whole set-up groups instead of random rows */
+    unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
+    size_t case_samples;    /* rows per case (0: every row) */
 } rch_calib_cfg;
 
 typedef struct rch_calib_result {
@@ -96,6 +104,18 @@ typedef struct rch_calib_result {
     unsigned n_groups;        /* set-up groups of the data (file column, else from the wrist) */
     int groups_from_file;
     rch_provenance prov;      /* data file, samples, sha256, date, tool */
+    int have_dequant;
+    rch_dequant_result dequant;   /* with cfg.dequantize */
+    unsigned dequant_refused_lines[16]; /* first refused rows (file lines) */
+    int have_jumps;
+    rch_jumps jumps;              /* with cfg.jumps: on the training samples */
+    unsigned jump_lines[RCH_JUMPS_MAX]; /* file line of the first sample after each jump (one file) */
+    size_t n_ambiguous;           /* held-out samples between a jump and the training rows around it */
+    rc_metrics after_unambiguous; /* held-out without them */
+    unsigned long cases_done;     /* with cfg.cases > 1 */
+    rch_stats case_before, case_after; /* held-out RMSE over the cases */
+    rch_stats case_unamb;              /* with --jumps: held-out RMSE without the ambiguous samples */
+    size_t case_ambiguous;             /* ambiguous held-out samples over the cases */
     int have_validate;
     rch_evaluate_result validate; /* on cfg.validate_path */
     char plot_paths[2400];    /* files written into plots_dir, "\n"-separated */
