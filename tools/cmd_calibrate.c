@@ -36,11 +36,19 @@ int rcal_cmd_calibrate(int argc, char **argv)
     cfg.robot_path = RCAL_DEFAULT_ROBOT;
     cfg.test_fraction = 0.1;
     const char *out_path = NULL, *method = "lm";
+    rch_opt_strs data;
+    memset(&data, 0, sizeof data);
     unsigned long seed = 1, max_iter = 0;
     int json = 0;
     const rch_opt opts[] = {
-        {"--data", RCH_OPT_STR, &cfg.data_path, 0, 0, "FILE", "measurements: CSV with q1..q6 (deg) and L (mm)",
+        {"--data", RCH_OPT_STRS, &data, 0, 0, "FILE",
+         "measurements: CSV with q1..q6 (deg) and L (mm); several --data are merged (set-up groups never span two files)",
          RCH_OPT_REQUIRED, NULL},
+        {"--validate", RCH_OPT_STR, &cfg.validate_path, 0, 0, "FILE",
+         "data the fit never sees: the model evaluated on it with no refit (RMSE, ISO 9283 from repeated poses)", 0,
+         NULL},
+        {"--plots", RCH_OPT_STR, &cfg.plots_dir, 0, 0, "DIR",
+         "write the predicted-uncertainty plot (uncertainty_position.svg and .csv)", 0, NULL},
         {"--robot", RCH_OPT_STR, &cfg.robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
         {"--method", RCH_OPT_CHOICE, &method, 0, 0, NULL,
          "lm (robust), ltlm (robust + chaotic candidates), lm-paper / ltlm-paper (the paper's update)", 0,
@@ -55,7 +63,7 @@ int rcal_cmd_calibrate(int argc, char **argv)
         {"--tool-offset", RCH_OPT_FLAG, &cfg.tool_offset, 0, 0, NULL,
          "also identify where the cable is attached in the flange frame (tx, ty, tz)", 0, NULL},
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
-         "write the calibrated model (rcal-model/1) for compensation; never over an input", 0, NULL},
+         "write the calibrated model (rcal-model/2) for compensation; never over an input", 0, NULL},
         {"--truth", RCH_OPT_STR, &cfg.truth_path, 0, 0, "TRUTH.json",
          "a simulated truth: flange errors over 2000 random poses, before and after", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
@@ -70,9 +78,14 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return 2; /* unreachable: the choice list is the method list */
     cfg.seed = seed;
     cfg.max_iter = (unsigned)max_iter;
+    cfg.data_path = data.v[0];
+    cfg.data_paths = data.v;
+    cfg.n_data_paths = data.n;
 
-    const char *inputs[3] = {cfg.data_path, cfg.robot_path, cfg.truth_path};
-    for (size_t i = 0; out_path && i < 3; ++i)
+    const char *inputs[RCH_OPT_MAX_STRS + 3] = {cfg.robot_path, cfg.truth_path, cfg.validate_path};
+    for (size_t i = 0; i < data.n; ++i)
+        inputs[3 + i] = data.v[i];
+    for (size_t i = 0; out_path && i < 3 + data.n; ++i)
         if (inputs[i] && rch_same_file(out_path, inputs[i])) {
             fprintf(stderr, "rcal calibrate: --out %s is also the input %s\n", out_path, inputs[i]);
             return 2;

@@ -52,6 +52,29 @@ static inline void rct_flange(double p[3], double dh[6][4], const double q[6])
     p[2] = T[2][3];
 }
 
+/* Flange pose: position p (3) and rotation R (3 x 3, row-major). */
+static inline void rct_pose(double p[3], double R[9], double dh[6][4], const double q[6])
+{
+    double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+    for (int i = 0; i < 6; ++i) {
+        double th = q[i] + dh[i][3], ct = cos(th), st = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
+        double A[4][4] = {{ct, -st * ca, st * sa, dh[i][0] * ct},
+                          {st, ct * ca, -ct * sa, dh[i][0] * st},
+                          {0, sa, ca, dh[i][1]},
+                          {0, 0, 0, 1}};
+        double X[4][4];
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+                X[r][c] = T[r][0] * A[0][c] + T[r][1] * A[1][c] + T[r][2] * A[2][c] + T[r][3] * A[3][c];
+        memcpy(T, X, sizeof T);
+    }
+    for (int r = 0; r < 3; ++r) {
+        p[r] = T[r][3];
+        for (int c = 0; c < 3; ++c)
+            R[r * 3 + c] = T[r][c];
+    }
+}
+
 static inline double rct_dist(const double p[3], const double e[3])
 {
     return sqrt((p[0] - e[0]) * (p[0] - e[0]) + (p[1] - e[1]) * (p[1] - e[1]) + (p[2] - e[2]) * (p[2] - e[2]));

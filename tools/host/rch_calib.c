@@ -10,6 +10,8 @@
 #include "rch_data.h"
 #include "rch_diagnose.h"
 #include "rch_groups.h"
+#include "rch_plot.h"
+#include "rc_rand.h"
 #include "rch_sha256.h"
 #include "rch_jw.h"
 #include "rch_save.h"
@@ -126,6 +128,52 @@ static int truth_flange(rch_calib_result *r, rch_diag *d)
     return 0;
 }
 
+/* Predicted 95 % flange-position uncertainty against the horizontal reach
+ * of the flange, at the training poses and at random poses in the joint
+ * limits: uncertainty_position.svg and .csv in plots_dir. */
+static void uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_sample *train)
+{
+    const size_t nw = 1000, nt = r->n_train;
+    double *x = malloc((nt + nw) * sizeof *x), *y = malloc((nt + nw) * sizeof *y);
+    rch_plot *p = rch_plot_new("predicted flange-position uncertainty (95 %)", "horizontal reach of the flange (mm)",
+                               "uncertainty (mm)");
+    char path[1100];
+    if (!x || !y || !p || rch_plot_mkdir(r->cfg.plots_dir) != 0)
+        goto done;
+    rc_rng g;
+    rc_rng_seed(&g, RCH_CALIB_TRUTH_SEED);
+    for (size_t i = 0; i < nt + nw; ++i) {
+        double q[RC_NJ], pos[3];
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            q[j] = i < nt ? train[i].q_rad[j]
+                          : r->model.q_min_rad[j] + (r->model.q_max_rad[j] - r->model.q_min_rad[j]) * rc_rng_u01(&g);
+        rc_fk(pos, NULL, &r->model, q);
+        x[i] = sqrt(pos[0] * pos[0] + pos[1] * pos[1]);
+        y[i] = rch_uncert_pos95_mm(u, &r->model, q);
+    }
+    rch_plot_scatter(p, "random poses in the joint limits (whole workspace)", x + nt, y + nt, nw);
+    rch_plot_scatter(p, "the data's poses", x, y, nt);
+    rch_plot_logy(p, 1);
+    snprintf(path, sizeof path, "%s/uncertainty_position.svg", r->cfg.plots_dir);
+    if (rch_plot_write_svg(p, path) == 0)
+        snprintf(r->plot_paths, sizeof r->plot_paths, "%s\n", path);
+    snprintf(path, sizeof path, "%s/uncertainty_position.csv", r->cfg.plots_dir);
+    FILE *f = fopen(path, "w");
+    if (f) {
+        fprintf(f, "set,reach_mm,pos95_mm\n");
+        for (size_t i = 0; i < nt + nw; ++i)
+            fprintf(f, "%s,%.6f,%.6g\n", i < nt ? "data" : "workspace", x[i], y[i]);
+        if (fclose(f) == 0) {
+            size_t len = strlen(r->plot_paths);
+            snprintf(r->plot_paths + len, sizeof r->plot_paths - len, "%s\n", path);
+        }
+    }
+done:
+    free(x);
+    free(y);
+    rch_plot_free(p);
+}
+
 /* Covariance (cluster-robust by set-up group when the groups allow it),
  * standard errors, classes, predicted uncertainty over the data and the
  * workspace, and the determined model. Leaves have_unc 0 when it cannot be
@@ -139,22 +187,122 @@ static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_samp
     rch_model_unc_from(&r->unc, &u);
     if (rch_uncert_map_compute(&r->unc.map, &u, &r->model, train, r->n_train, RCH_CALIB_TRUTH_POSES,
                                RCH_CALIB_TRUTH_SEED) == 0) {
-        r->unc.orientation_determined = r->unc.map.rot_data_median_deg < RCH_ORIENT_DETERMINED_DEG;
+        r->unc.orientation_determined = r->unc.map.rot_det_median_deg < RCH_ORIENT_DETERMINED_DEG;
         r->have_unc = 1;
     }
+    if (r->cfg.plots_dir)
+        uncertainty_plot(r, &u, train);
     rch_uncert_free(&u);
     rch_model_unc_determined(&r->determined, &r->model, &r->robot.nominal, &r->unc);
 }
 
-/* Provenance: the data file, its samples and digest, the date, the tool. */
-static void provenance(rch_calib_result *r)
+static size_t n_files(const rch_calib_cfg *cfg)
+{
+    return cfg->data_paths && cfg->n_data_paths ? cfg->n_data_paths : 1;
+}
+
+static const char *file_at(const rch_calib_cfg *cfg, size_t i)
+{
+    return cfg->data_paths && cfg->n_data_paths ? cfg->data_paths[i] : cfg->data_path;
+}
+
+/* Load every data file and merge them in the order given: samples, x, y, z
+ * (kept only when every file has them), source lines; t becomes the
+ * acquisition order over all files; the group column is kept only when
+ * every file has one (numbers offset per file). counts (files): samples
+ * of each. */
+static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    const size_t nf = n_files(cfg);
+    memset(out, 0, sizeof *out);
+    if (nf > RCH_CALIB_MAX_FILES) {
+        rch_diag_set(d, "", 0, 0, "at most %d data files", RCH_CALIB_MAX_FILES);
+        return -1;
+    }
+    if (nf == 1) {
+        int rc = rch_data_load(out, file_at(cfg, 0), 0, d);
+        counts[0] = out->n;
+        if (rc == 0 && rch_data_check_units(out, file_at(cfg, 0), d) != 0) {
+            rch_data_free(out);
+            return -1;
+        }
+        return rc;
+    }
+    rch_data part[RCH_CALIB_MAX_FILES];
+    size_t total = 0, k = 0;
+    int all_xyz = 1, all_group = 1;
+    for (size_t f = 0; f < nf; ++f) {
+        if (rch_data_load(&part[f], file_at(cfg, f), 0, d) != 0 ||
+            rch_data_check_units(&part[f], file_at(cfg, f), d) != 0) {
+            if (part[f].s)
+                rch_data_free(&part[f]);
+            for (size_t g = 0; g < f; ++g)
+                rch_data_free(&part[g]);
+            return -1;
+        }
+        counts[f] = part[f].n;
+        total += part[f].n;
+        all_xyz &= part[f].xyz != NULL;
+        all_group &= part[f].has_group;
+    }
+    out->s = malloc(total * sizeof *out->s);
+    out->line = malloc(total * sizeof *out->line);
+    out->xyz = all_xyz ? malloc(total * sizeof *out->xyz) : NULL;
+    int ok = out->s && out->line && (!all_xyz || out->xyz);
+    unsigned goff = 0;
+    for (size_t f = 0; f < nf; ++f) {
+        unsigned gmax = 0;
+        for (size_t i = 0; ok && i < part[f].n; ++i, ++k) {
+            out->s[k] = part[f].s[i];
+            out->s[k].t = total > 1 ? (double)k / (double)(total - 1) : 0.0;
+            gmax = out->s[k].group > gmax ? out->s[k].group : gmax;
+            out->s[k].group = (uint16_t)(all_group ? goff + out->s[k].group : f);
+            out->line[k] = part[f].line[i];
+            if (all_xyz)
+                memcpy(out->xyz[k], part[f].xyz[i], sizeof out->xyz[k]);
+        }
+        goff += gmax + 1;
+        rch_data_free(&part[f]);
+    }
+    out->n = total;
+    out->has_group = all_group;
+    out->has_t = 1;
+    if (!ok) {
+        rch_data_free(out);
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
+/* The model on data the fit never saw (no refit). */
+static int validate(rch_calib_result *r, rc_solve_work *w, rch_diag *d)
+{
+    rch_data v;
+    char err[256];
+    if (rch_data_load(&v, r->cfg.validate_path, 0, d) != 0)
+        return -1;
+    int rc = rch_evaluate(&r->validate, &r->model, v.s, v.n, NULL, w, err, sizeof err);
+    rch_data_free(&v);
+    if (rc != 0) {
+        rch_diag_set(d, r->cfg.validate_path, 0, 0, "%s", err);
+        return -1;
+    }
+    r->have_validate = 1;
+    return 0;
+}
+
+/* Provenance: the data files, their samples and digests, the date, the tool. */
+static void provenance(rch_calib_result *r, const size_t *counts)
 {
     rch_provenance *p = &r->prov;
-    p->n_files = 1;
-    p->file[0] = r->cfg.data_path;
-    p->samples[0] = r->n_data;
-    if (rch_sha256_file(p->sha256[0], r->cfg.data_path) != 0)
-        snprintf(p->sha256[0], sizeof p->sha256[0], "unreadable");
+    p->n_files = (unsigned)n_files(&r->cfg);
+    for (unsigned f = 0; f < p->n_files; ++f) {
+        p->file[f] = file_at(&r->cfg, f);
+        p->samples[f] = counts[f];
+        if (rch_sha256_file(p->sha256[f], p->file[f]) != 0)
+            snprintf(p->sha256[f], sizeof p->sha256[f], "unreadable");
+    }
     time_t now = time(NULL);
     struct tm tmv;
     if (gmtime_r(&now, &tmv))
@@ -163,8 +311,8 @@ static void provenance(rch_calib_result *r)
 }
 
 /* Set-up groups: the file's group column, else consecutive samples sharing
- * the wrist joints at the joints' display step. */
-static void groups(rch_calib_result *r, rch_data *data)
+ * the wrist joints at the joints' display step, never across two files. */
+static void groups(rch_calib_result *r, rch_data *data, const size_t *counts)
 {
     r->groups_from_file = data->has_group;
     if (data->has_group) {
@@ -182,7 +330,13 @@ static void groups(rch_calib_result *r, rch_data *data)
         step = rch_diagnose_detect_step(q, data->n * 3);
         free(q);
     }
-    r->n_groups = rch_groups_by_wrist(data->s, data->n, step, NULL);
+    r->n_groups = 0;
+    for (size_t f = 0, at = 0; f < n_files(&r->cfg); at += counts[f], ++f) {
+        unsigned g = rch_groups_by_wrist(data->s + at, counts[f], step, NULL);
+        for (size_t i = at; i < at + counts[f]; ++i)
+            data->s[i].group = (uint16_t)(data->s[i].group + r->n_groups);
+        r->n_groups += g;
+    }
 }
 
 /* Identification and the figures, once the split is made. */
@@ -224,6 +378,8 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     r->have_ident = r->finite && rch_ident_compute(&r->ident, &r->model, train, r->n_train) == 0;
     if (r->finite)
         uncertainty(r, fixed, train);
+    if (r->cfg.validate_path && r->after_ok && validate(r, w, d) != 0)
+        return -1;
     return 0;
 }
 
@@ -232,11 +388,12 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     memset(r, 0, sizeof *r);
     r->cfg = *cfg;
     rch_data data;
-    if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || rch_data_load(&data, cfg->data_path, 0, d) != 0)
+    size_t counts[RCH_CALIB_MAX_FILES];
+    if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || load_all(&data, counts, cfg, d) != 0)
         return -1;
     r->n_data = data.n;
-    groups(r, &data);
-    provenance(r);
+    groups(r, &data, counts);
+    provenance(r, counts);
     int rc = -1;
     size_t *idx = malloc(data.n * sizeof *idx);
     rc_solve_work *w = malloc(sizeof *w);
@@ -329,9 +486,12 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
             "(median; max %.4f), whole workspace: +-%.4f mm (median over %d random poses; max %.4f)\n",
             u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
             u->map.work_max_mm);
-    fprintf(f, "predicted flange-orientation uncertainty (95 %%) inside the data: +-%.4f deg: orientation %s\n",
-            u->map.rot_data_median_deg, u->orientation_determined ? "determined" : "NOT determined (compensation "
-                                                                                 "defaults to position-only)");
+    fprintf(f,
+            "predicted flange-orientation uncertainty (95 %%) inside the data: +-%.4f deg with every parameter, "
+            "+-%.4f deg with those compensation uses: orientation %s\n",
+            u->map.rot_data_median_deg, u->map.rot_det_median_deg,
+            u->orientation_determined ? "determined (compensation matches position and orientation)"
+                                      : "NOT determined (compensation defaults to position-only)");
     fprintf(f,
             "compensation uses %u of 24 DH parameters as fitted; held at nominal (tied to a weak or not-identifiable "
             "combination that moves the robot): %s\n\n",
@@ -356,8 +516,12 @@ static void print_ident(FILE *f, const rch_ident *id)
 void rch_calib_print(FILE *f, const rch_calib_result *r)
 {
     const char *method = rc_method_name(r->cfg.method);
-    fprintf(f, "rcal calibrate: %s (%zu samples), robot \"%s\", method %s\n", r->cfg.data_path, r->n_data,
-            r->robot.name, method);
+    if (r->prov.n_files > 1)
+        fprintf(f, "rcal calibrate: %u files merged (%zu samples), robot \"%s\", method %s\n", r->prov.n_files,
+                r->n_data, r->robot.name, method);
+    else
+        fprintf(f, "rcal calibrate: %s (%zu samples), robot \"%s\", method %s\n", r->cfg.data_path, r->n_data,
+                r->robot.name, method);
     fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
             r->cfg.test_fraction, r->cfg.seed);
     fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
@@ -380,6 +544,19 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
         print_uncertainty(f, r);
     if (r->have_ident)
         print_ident(f, &r->ident);
+    if (r->have_validate) {
+        const rch_evaluate_result *v = &r->validate;
+        fprintf(f,
+                "validation on %s (%zu samples the fit never saw, no refit): RMSE %.4f mm, mean|e| %.4f, SD %.4f, "
+                "MAX %.4f mm\n",
+                r->cfg.validate_path, v->m.n, v->m.rmse_mm, v->m.mean_abs_mm, v->m.sd_mm, v->m.max_mm);
+        if (v->n_repeated)
+            fprintf(f, "  ISO 9283 over %zu repeated poses: AD mean %.4f / max %.4f mm, RD mean %.4f / max %.4f mm\n",
+                    v->n_repeated, v->ad_mean_mm, v->ad_max_mm, v->rd_mean_mm, v->rd_max_mm);
+        fprintf(f, "\n");
+    }
+    if (r->plot_paths[0])
+        fprintf(f, "plots:\n%s\n", r->plot_paths);
     fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
             r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
 }
@@ -473,6 +650,8 @@ static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
     rch_jw_obj(w, "orientation95_deg");
     rch_jw_numf(w, "data_median", u->map.rot_data_median_deg, "%.6g");
     rch_jw_numf(w, "data_max", u->map.rot_data_max_deg, "%.6g");
+    rch_jw_numf(w, "determined_median", u->map.rot_det_median_deg, "%.6g");
+    rch_jw_numf(w, "determined_max", u->map.rot_det_max_deg, "%.6g");
     rch_jw_end(w);
     rch_jw_bool(w, "orientation_determined", u->orientation_determined);
     rch_jw_end(w);
@@ -528,6 +707,17 @@ int rch_calib_json(FILE *f, const rch_calib_result *r)
         json_ident(&w, &r->ident);
     if (r->have_unc)
         json_uncertainty(&w, r);
+    if (r->have_validate) {
+        rch_jw_obj(&w, "validation");
+        rch_jw_str(&w, "data", r->cfg.validate_path);
+        json_metrics(&w, "residual", &r->validate.m);
+        rch_jw_uint(&w, "repeated_poses", r->validate.n_repeated);
+        rch_jw_numf(&w, "iso9283_ad_mean_mm", r->validate.ad_mean_mm, "%.6f");
+        rch_jw_numf(&w, "iso9283_ad_max_mm", r->validate.ad_max_mm, "%.6f");
+        rch_jw_numf(&w, "iso9283_rd_mean_mm", r->validate.rd_mean_mm, "%.6f");
+        rch_jw_numf(&w, "iso9283_rd_max_mm", r->validate.rd_max_mm, "%.6f");
+        rch_jw_end(&w);
+    }
     json_provenance(&w, &r->prov);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
@@ -561,8 +751,11 @@ static int write_model_fn(FILE *f, const void *ctx)
 
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
 {
-    const char *inputs[3] = {r->cfg.data_path, r->cfg.robot_path, r->cfg.truth_path};
-    return rch_save(path, "--out", inputs, 3, write_model_fn, r, d);
+    const char *inputs[RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
+    size_t n = 3;
+    for (size_t f = 0; f < n_files(&r->cfg); ++f)
+        inputs[n++] = file_at(&r->cfg, f);
+    return rch_save(path, "--out", inputs, n, write_model_fn, r, d);
 }
 
 /* ------------------------------------------------------------ fkcheck */

@@ -26,6 +26,7 @@
 #include "rch_diag.h"
 #include "rch_ident.h"
 #include "rch_robot.h"
+#include "rch_evaluate.h"
 #include "rch_uncert.h"
 
 /* Poses (and their seed) of the flange comparison against a simulated truth. */
@@ -53,8 +54,13 @@ int rch_method_parse(rc_method *out, const char *name);
  * fixed (m->n_params). 0, or -1 with d naming the unknown parameter. */
 int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d);
 
+#define RCH_CALIB_MAX_FILES 16
 typedef struct rch_calib_cfg {
-    const char *data_path;  /* measurements CSV (required) */
+    const char *data_path;  /* measurements CSV (required; the first of data_paths when several) */
+    const char *const *data_paths; /* (n_data_paths) several files merged, NULL: data_path alone */
+    size_t n_data_paths;
+    const char *validate_path; /* data the fit never sees: evaluated with no refit, or NULL */
+    const char *plots_dir;  /* predicted-uncertainty plot and its CSV, or NULL */
     const char *robot_path; /* nominal robot model (required) */
     const char *truth_path; /* simulated truth model, or NULL */
     const char *fix;        /* parameters held at nominal ("a1,theta6"), or NULL */
@@ -90,6 +96,9 @@ typedef struct rch_calib_result {
     unsigned n_groups;        /* set-up groups of the data (file column, else from the wrist) */
     int groups_from_file;
     rch_provenance prov;      /* data file, samples, sha256, date, tool */
+    int have_validate;
+    rch_evaluate_result validate; /* on cfg.validate_path */
+    char plot_paths[2400];    /* files written into plots_dir, "\n"-separated */
 } rch_calib_result;
 
 /* The whole calibration. Returns 0 (the solver ran; r->after_ok says whether

@@ -422,3 +422,30 @@ void rch_split(size_t *idx, size_t n, unsigned long long seed)
         idx[j] = t;
     }
 }
+
+int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d)
+{
+    double qmax = 0.0, lmax = 0.0;
+    if (data->n < 5)
+        return 0;
+    for (size_t i = 0; i < data->n; ++i) {
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            qmax = fmax(qmax, fabs(data->s[i].q_rad[j]));
+        lmax = fmax(lmax, data->s[i].len_mm);
+    }
+    /* the loader converted degrees to radians: a file written in radians
+     * leaves every joint within 7 "degrees" (400 deg is 6.98 rad) */
+    if (qmax > 0.0 && qmax < 7.0 * 3.14159265358979323846 / 180.0) {
+        rch_diag_set(d, name, 0, 0,
+                     "every joint angle is within +-7: the q columns look like radians, rcal reads degrees "
+                     "(multiply by 180/pi)");
+        return -1;
+    }
+    if (lmax < 20.0) {
+        rch_diag_set(d, name, 0, 0,
+                     "every cable length is below 20: the L column looks like metres, rcal reads millimetres "
+                     "(multiply by 1000)");
+        return -1;
+    }
+    return 0;
+}

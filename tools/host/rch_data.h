@@ -45,6 +45,11 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
                    rch_diag *d);
 void rch_data_free(rch_data *data);
 
+/* Units: joint angles that all stay within +-7 (degrees, as read) look
+ * like radians, cable lengths all below 20 mm look like metres: refused
+ * with a message naming the likely unit (file name in d). 0 or -1. */
+int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d);
+
 /* Copy of the samples selected by idx (k). Returns NULL on allocation failure. */
 rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k);
 

@@ -366,6 +366,8 @@ static void write_map(rch_jw *w, const rch_uncert_map *mp)
     rch_jw_obj(w, "orientation95_deg");
     rch_jw_numf(w, "data_median", mp->rot_data_median_deg, "%.6g");
     rch_jw_numf(w, "data_max", mp->rot_data_max_deg, "%.6g");
+    rch_jw_numf(w, "determined_median", mp->rot_det_median_deg, "%.6g");
+    rch_jw_numf(w, "determined_max", mp->rot_det_max_deg, "%.6g");
     rch_jw_end(w);
 }
 

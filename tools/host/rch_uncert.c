@@ -519,6 +519,9 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
     for (size_t i = 0; i < n; ++i)
         v[i] = rch_uncert_rot95_deg(u, m, s[i].q_rad);
     med_max(&out->rot_data_median_deg, &out->rot_data_max_deg, v, n);
+    for (size_t i = 0; i < n; ++i)
+        v[i] = rch_uncert_rot95_det_deg(u, m, s[i].q_rad);
+    med_max(&out->rot_det_median_deg, &out->rot_det_max_deg, v, n);
     out->n_data = n;
     rc_rng g;
     rc_rng_seed(&g, seed);
@@ -534,14 +537,27 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
     return 0;
 }
 
+static double rot95(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ], int determined_only);
+
 double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    return rot95(u, m, q_rad, 0);
+}
+
+double rch_uncert_rot95_det_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    return rot95(u, m, q_rad, 1);
+}
+
+static double rot95(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ], int determined_only)
 {
     unsigned np = u->n_params;
     double Jr[3][RC_MAX_PARAMS];
     rc_model t = *m;
     for (unsigned k = 0; k < np; ++k) {
         Jr[0][k] = Jr[1][k] = Jr[2][k] = 0.0;
-        if (u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE)
+        if (u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE ||
+            (determined_only && u->comp_nominal[k]))
             continue;
         double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5, p[3], Rp[9], Rm[9];
         t.x[k] = m->x[k] + h;

@@ -92,10 +92,14 @@ double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double 
 /* The same for the flange orientation: longest semi-axis of the 95 %
  * ellipsoid of the small-rotation vector, in degrees. */
 double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ]);
+/* The same over the parameters compensation uses (not comp_nominal). */
+double rch_uncert_rot95_det_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ]);
 
 typedef struct rch_uncert_map {
     double data_median_mm, data_max_mm;
     double rot_data_median_deg, rot_data_max_deg; /* orientation, over the data's poses */
+    double rot_det_median_deg, rot_det_max_deg;   /* orientation of the determined model (held parameters
+                                                     nominal, their uncertainty not counted) */
     double work_median_mm, work_max_mm;
     size_t n_data, n_work;
 } rch_uncert_map;
@@ -109,8 +113,9 @@ const char *rch_param_class_name(rch_param_class c);
  * know where the model can be trusted. Fixed size (no heap): the covariance
  * of the 24 DH parameters only (the encoder and nuisance effects do not move
  * the robot). */
-/* Orientation counts as determined when its 95 % uncertainty over the data's
- * poses (median) is below this (deg). */
+/* The determined model's orientation counts as determined when its 95 %
+ * uncertainty over the data's poses (median; the parameters compensation
+ * holds nominal not counted) is below this (deg). */
 #define RCH_ORIENT_DETERMINED_DEG 0.05
 typedef struct rch_model_unc {
     int present;                        /* the file had an "uncertainty" member */
