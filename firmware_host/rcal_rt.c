@@ -26,6 +26,7 @@
 #include "fw_model_data.h"
 #include "rc_comp.h"
 #include "rch_diag.h"
+#include "rch_comp.h"
 #include "rch_emit.h"
 #include "rch_opt.h"
 #include "rch_robot.h"
@@ -386,6 +387,22 @@ static int run_loop(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *
     return misses ? 1 : 0;
 }
 
+/* The model compensation uses (rch_comp_determined): det; returns 1 when
+ * the model file says the orientation was not determined (position only). */
+static int determined(rc_model *det, const rch_robot *robot)
+{
+    *det = robot->model;
+    if (!robot->has_nominal && !robot->unc.present)
+        return 0; /* a plain robot file: nothing was calibrated */
+    static rch_model_unc unc;
+    int v1 = 0;
+    char held[256];
+    unsigned n = rch_comp_determined(det, &unc, &v1, held, sizeof held, robot, &robot->nominal);
+    fprintf(stderr, "rcal-rt: compensating with %u of 24 DH parameters as fitted; held nominal: %s\n", 24u - n,
+            n ? held : "none");
+    return v1 || !unc.orientation_determined;
+}
+
 /* --emit-c: the firmware's compiled tables (rch_emit_c) on stdout. */
 static int emit_c(const char *path, const char *nominal_path, int position_only)
 {
@@ -398,8 +415,11 @@ static int emit_c(const char *path, const char *nominal_path, int position_only)
     }
     snprintf(cmd, sizeof cmd, "rcal-rt --emit-c %s%s%s%s", path, nominal_path ? " --nominal " : "",
              nominal_path ? nominal_path : "", position_only ? " --position-only" : "");
-    const rch_emit_src src = {robot.name, cmd, position_only ? (unsigned)RC_COMP_FLAG_POSITION_ONLY : 0u};
-    if (rch_emit_c(stdout, &src, &robot.model, nominal_path ? &nominal.model : &robot.nominal, &d) != 0 ||
+    /* the firmware compensates with what the data determined, as rcal compensate does (issue 10) */
+    static rc_model det;
+    int pos_only = determined(&det, &robot) || position_only;
+    const rch_emit_src src = {robot.name, cmd, pos_only ? (unsigned)RC_COMP_FLAG_POSITION_ONLY : 0u};
+    if (rch_emit_c(stdout, &src, &det, nominal_path ? &nominal.model : &robot.nominal, &d) != 0 ||
         fflush(stdout) != 0) {
         fprintf(stderr, "rcal-rt: %s: %s\n", path, d.msg);
         return 1;
@@ -509,7 +529,10 @@ int main(int argc, char **argv)
             fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
             return 1;
         }
-        rc_status st = rc_kin_compile(&kin_cal, &robot.model);
+        static rc_model det;
+        if (determined(&det, &robot))
+            position_only = 1;
+        rc_status st = rc_kin_compile(&kin_cal, &det);
         if (st == RC_OK)
             st = rc_kin_compile(&kin_nom, nominal_path ? &nominal.model : &robot.nominal);
         if (st != RC_OK) {
