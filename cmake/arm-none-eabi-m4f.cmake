@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # arm-none-eabi-m4f.cmake - CMake toolchain for the core on a Cortex-M4F with
 # single-precision FPU (Debian gcc-arm-none-eabi + libnewlib-arm-none-eabi):
 # rc_real = float (RC_REAL_FLOAT), so the compensation path (rc_kin, rc_comp)

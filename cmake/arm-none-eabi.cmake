@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # arm-none-eabi.cmake - CMake toolchain for the core on a Cortex-M7 with
 # double-precision FPU (Debian gcc-arm-none-eabi + libnewlib-arm-none-eabi).
 #

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_display.c - display reader: port + protocol + format lock. */
 #include <string.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_display.h - reading lengths from a cable-encoder display over a port.
  *
  * What: joins a port (rcd_port.h) and a protocol (rcd_proto.h). Each

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_mock.c - scripted port with fault injection, for tests. */
 #include <string.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_port.c - dispatchers of the port interface and line-setting checks. */
 #include "rcd_port.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_port.h - byte-stream port interface for the cable-encoder display.
  *
  * What: a small `const` table of function pointers (open, close, read with a

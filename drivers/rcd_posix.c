@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_posix.c - POSIX file-descriptor backend (termios, poll).
  *
  * For devices libserialport refuses, chiefly pseudo-terminals of the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_proto.c - display protocol parsers and encoders (pure, no heap/stdio). */
 #include <string.h>
 

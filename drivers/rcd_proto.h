@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_proto.h - wire protocols of cable-encoder displays: parsers and encoders.
  *
  * What: pure functions over byte buffers. A parser looks at buf[0..len) only

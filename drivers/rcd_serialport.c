@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcd_serialport.c - libserialport backend of the port interface.
  *
  * The only file of the project that includes libserialport.h. Every

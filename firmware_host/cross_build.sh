@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # cross_build.sh - the rcal core and the firmware example for two
 # microcontrollers, warnings as errors, with size reports and symbol checks:
 #   m7   Cortex-M7 with double-precision FPU (fpv5-d16), rc_real = double

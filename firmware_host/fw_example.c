@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fw_example.c - the rcal core embedded as controller firmware would do it:
  * compiled models in const tables (flash, fw_model_data.h), the stream state
  * with its scratch in .bss, one call per control cycle, no heap and no

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fw_example.h - how controller firmware embeds the rcal compensation.
  *
  * What: one call per control cycle turns the motion planner's joint target

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fw_port.h - what a firmware build of the rcal core redirects.
  *
  * Force-included (-include fw_port.h) when the core is compiled for the

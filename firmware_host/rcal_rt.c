@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcal_rt.c - rcal-rt: the compensation in a host real-time loop, its
  * benchmark, and the generator of the firmware's compiled-in model tables.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_acq.c - acquisition files (rch_data_parse with RCH_DATA_POSE |
  * RCH_DATA_ALLOW_EMPTY), the reader `rcal acquire` resumes with
  * (tools/host/rch_acqfile.c). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_ascii.c - ASCII line protocol (streaming and polled share
  * rcd_parse_ascii) and the reading grammar rcd_parse_value.
  * Input: byte 0 chooses the chunk size of the chunked pass, the rest is

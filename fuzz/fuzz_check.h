@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_check.h - invariant checks inside fuzz targets.
  * A broken invariant aborts, which libFuzzer reports as a crash and saves the
  * input (crash-<sha1>), exactly like a sanitizer finding. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_csv.c - measurement CSV files (rch_data_parse, flags 0). */
 #include "fuzz_data_common.h"
 

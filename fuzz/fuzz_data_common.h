@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_data_common.h - one fuzz body for the CSV reader (rch_data_parse),
  * used with flags 0 (measurement files), RCH_DATA_NO_LEN (pose plans) and
  * RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY (acquisition files, as rch_acqfile reads them). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_display.c - the display reader (rcd_display_read) over the mock port:
  * fuzzed bytes arrive in short reads with injected timeouts, for every
  * protocol, until the mock hangs up. Checks that every call returns a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_json.c - the strict JSON reader (rch_json_parse). Checks the tree it
  * builds: types, counts, keys, positions, the documented depth limit. */
 #include <math.h>

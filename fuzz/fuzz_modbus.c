@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_modbus.c - Modbus RTU responses (rcd_parse_modbus) with every
  * register format and word order.
  * Input: byte 0 slave address (0: default 1), byte 1 format/word order/

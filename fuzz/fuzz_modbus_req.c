@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_modbus_req.c - the device side of Modbus RTU: requests read by the
  * simulated display (rcd_parse_modbus_request).
  * Input: byte 0 the slave address, the rest the byte stream from the host. */

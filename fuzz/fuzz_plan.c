@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_plan.c - pose plans (rch_data_parse with RCH_DATA_NO_LEN: no L column
  * needed), the reader `rcal acquire` uses for its plan. */
 #include "fuzz_data_common.h"

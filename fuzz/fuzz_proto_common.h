@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_proto_common.h - checks shared by the display protocol fuzz targets.
  *
  * Every parser of rcd_proto.h has the same contract (see its header):

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_robot.c - robot-model and calibrated-model files (rch_robot_parse).
  * An accepted file must give a usable model: finite parameters, consistent
  * effect table, and forward kinematics / cable length that stay finite. */

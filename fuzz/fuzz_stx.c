@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fuzz_stx.c - STX payload ETX BCC frames (rcd_parse_stx).
  * Input: byte 0 chooses the chunk size of the chunked pass, the rest is
  * the byte stream from the display. */

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # fuzz/run.sh - build the libFuzzer targets (clang, ASan + UBSan) and run each
 # for a bounded time. Fails when any target crashes, leaks, times out on one
 # input or breaks one of its invariants; prints executions per target.

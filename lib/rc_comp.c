@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_comp.c - damped Gauss-Newton compensation and inverse kinematics on
  * compiled tables (rc_kin), in rc_real, with every intermediate in the
  * caller's rc_comp_work. The rc_model wrappers are in rc_comp_model.c. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_comp.h - compensation of joint targets with a calibrated model (prefix rc_comp_).
  *
  * What: a robot program's joint targets q were computed with the nominal

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_comp_model.c - the compensation on the solver's rc_model: compile it
  * into an rc_kin (rc_kin_compile), then run the engine of rc_comp.c. Host
  * code calls these; firmware links generated rc_kin tables and the engine

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_config.h - compile-time limits and contract checks of the rcal core.
  *
  * The core (lib/) is C99 with no heap, no stdio and no global state. Every

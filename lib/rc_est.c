@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_est.c - EKF, PF, SCA, QIBAS and SSLM identification; see rc_est.h. */
 #include "rc_est.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_est.h - the other identification methods of the LTLM paper's comparison
  * (its Table 5): EKF, PF, SCA, QIBAS and SSLM. LM and LTLM are rc_solve's.
  *

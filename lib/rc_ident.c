@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_ident.c - what the data can identify (see rc_ident.h for the thresholds). */
 #include "rc_ident.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_ident.h - what the data can identify: the one definition (prefix rc_ident_).
  *
  * Given n model parameters and the data, the question "which parameters, and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_kin.c - forward kinematics and joint Jacobian of the compiled model, in rc_real.
  *
  * The arithmetic follows rc_model.c's chain (same operations in the same

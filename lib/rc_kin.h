@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_kin.h - the compiled kinematic model of the compensation path (prefix rc_kin_).
  *
  * What: forward kinematics and the 6x6 geometric joint Jacobian of a

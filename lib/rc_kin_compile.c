@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_kin_compile.c - the solver model (rc_model, double) compiled into the
  * compensation's constant kinematic table (rc_kin, rc_real). Kept apart from
  * rc_kin.c so that a firmware linking generated tables carries no double

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_linalg.c - Cholesky and Jacobi eigen-decomposition. */
 #include "rc_linalg.h"
 

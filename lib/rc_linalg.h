@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_linalg.h - small dense linear algebra for the core (prefix rcu_).
  *
  * Symmetric matrices are stored full, row-major, with leading dimension n.

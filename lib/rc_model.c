@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_model.c - kinematics and the cable-length measurement model. */
 #include "rc_model.h"
 

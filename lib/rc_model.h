@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_model.h - robot model, forward kinematics and the cable-length measurement.
  *
  * What: a six-joint serial arm in standard Denavit-Hartenberg form,

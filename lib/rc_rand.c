@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "rc_rand.h"
 
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_rand.h - deterministic random numbers and the logistic-tent chaotic map.
  *
  * No global state: every generator is a caller-owned struct, so runs are

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_solve.c - LM, LTLM and the paper's variants over streamed normal equations. */
 #include "rc_solve.h"
 

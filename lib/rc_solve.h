@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_solve.h - identification of model parameters from cable lengths.
  *
  * Least squares on r_i = l(q_i; x) - L_i over the training samples, with

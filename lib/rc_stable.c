@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_stable.c - the stability rule (see rc_stable.h). */
 #include "rc_stable.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_stable.h - the stability rule: display readings in, one sample out.
  *
  * What: a pose's cable length is the mean of `n` consecutive readings whose

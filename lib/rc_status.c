@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "rc_status.h"
 
 const char *rc_strerror(rc_status st)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_status.h - the single status enum of the project.
  *
  * RC_OK is zero; every error is negative. "Called wrong" (RC_ERR_ARG) is kept

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The main job: install what is missing, build, and calibrate the shipped
 # simulated data set (data/sim_irb120.csv) with a readable report, compared
 # with the simulation's known truth; writes build/calibrated.json.

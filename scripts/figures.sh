@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Regenerates every figure quoted in README.md, in one run, into out/figures/
 # (text) and docs/figures/ (SVG). Needs a Release build in build/ (scripts/demo.sh)
 # and ../shared/data/robotcali.csv for the real-data figures. Takes a few minutes.

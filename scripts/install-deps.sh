@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Install what is missing (Debian packages only). Root or sudo required.
 set -euo pipefail
 PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev libcmocka-dev

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # scripts/stack_usage.sh - stack use of the core's public functions (issue 7).
 #
 # Compiles lib/rc_*.c with gcc -fstack-usage -fcallgraph-info=su and prints,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # scripts/static_analysis.sh - static analysis of rcal (issue 7). Zero
 # findings or it fails.
 #

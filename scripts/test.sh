@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The whole test suite: install what is missing, then
 #  1. build + ctest (Release),
 #  2. build + ctest with AddressSanitizer and UndefinedBehaviorSanitizer,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # scripts/valgrind_tests.sh - the ctest suite under valgrind memcheck (issue 7).
 #
 # Builds a non-sanitized RelWithDebInfo tree, asks ctest for every test's

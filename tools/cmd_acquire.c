@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_acquire.c - rcal acquire: record cable lengths from the encoder display.
  *
  * Parses the options and runs rch_acquire_run (tools/host/rch_acquire.h: the

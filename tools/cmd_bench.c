@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_bench.c - rcal bench: calibration speed, median of repeated runs.
  * Times are wall-clock on one core; these machines are shared, so quote the
  * median and the ratios measured in the same run. The comparison with Ceres

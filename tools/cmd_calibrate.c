@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_calibrate.c - rcal calibrate: identify the DH errors and the encoder
  * position from cable lengths, with a held-out before/after report. The work
  * is rch_calib_run (tools/host/rch_calib.h). */

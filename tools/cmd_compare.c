@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_compare.c - rcal compare: the LTLM paper's comparison of seven
  * identification methods (its Table 6, Fig. 6d, Figs. 7-8) on your data.
  * The protocol is rch_compare_run (tools/host/rch_compare.h); this file

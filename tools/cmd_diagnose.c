@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_diagnose.c - rcal diagnose: where model and measurement disagree,
  * which missing physical effect explains it, and how much the held-out gap
  * shrinks when it is added (issue 6). The work is rch_diagnose_file

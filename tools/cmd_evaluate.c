@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_evaluate.c - rcal evaluate: a calibrated model on data the fit never
  * saw (no refit of the robot). */
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_fkcheck.c - rcal fkcheck: does our forward kinematics reproduce the
  * controller's nominal x, y, z columns? Reports every row that does not. The
  * work is rch_fkcheck_run (tools/host/rch_calib.h). */

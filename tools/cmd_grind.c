@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_grind.c - rcal grind: the grinding-path experiment (the paper's
  * Table 8). The experiment (surface, path, nominal IK, base alignment,
  * compensation, deviations, SVG) is rch_grind_run and rch_grind_plots

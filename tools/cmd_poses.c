@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* cmd_poses.c - rcal poses: plan an identifiable pose set.
  *
  * Parses the options, runs rch_poses_plan (tools/host/rch_poses.h: the

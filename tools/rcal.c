@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcal - command-line tool: acquisition, calibration, comparison, diagnosis,
  * compensation. Dispatches to tools/cmd_<name>.c. */
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rcal_cmds.h - the subcommands of the rcal command-line tool.
  *
  * Each subcommand lives in its own file tools/cmd_<name>.c and gets argv

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """rcal: robot calibration with a cable encoder, from Python.
 
 A thin ctypes layer over the C libraries of this repository (the flat API of

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Loading of the shared library rcal_ffi and its ctypes signatures.
 
 The library is tools/host/rch_ffi.h compiled by python/CMakeLists.txt. It is

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Fixtures of the rcal package tests: the repository root (the working
 directory of every test), the rcal binary of the same build (RCAL_BIN, else
 build/tools/rcal) and a runner for it."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Run pytest on the package's tests; exit 77 (ctest: skipped) with a clear
 message when pytest is not installed (Debian: apt-get install python3-pytest)."""
 import sys

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """A Python session that calibrates the demo data and matches the CLI.
 
 The CLI prints metrics with %.6f and parameters with %.9g: the Python value,

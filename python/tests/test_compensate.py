@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Compensation of a batch against `rcal compensate` on the same targets
 (CSV in, CSV out): the Python results printed as the CLI prints them (%.6f)
 must be the CLI's lines exactly; and the corrected targets must put the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Failures raise rcal.RcalError carrying the C library's message: the same
 text the CLI prints after "rcal <command>: "."""
 import pytest

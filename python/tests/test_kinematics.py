@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """FK and cable length against an independent pure-Python DH implementation
 (standard DH, T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), read straight
 from the model file's JSON) at random poses, to 1e-9 mm."""

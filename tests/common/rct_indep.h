@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rct_indep.h - an independent data generator for tests: its own random
  * numbers (splitmix64 + Box-Muller) and its own forward kinematics
  * (standard DH with 4 x 4 homogeneous matrices), written apart from the

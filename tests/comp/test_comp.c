@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_comp.c - compensation of joint targets (rc_comp): accuracy on a
  * simulated truth (given and identified from cable lengths), singular poses,
  * joint limits, non-convergence, bad input, the stream, inverse kinematics,

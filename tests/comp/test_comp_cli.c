@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_comp_cli.c - rcal compensate round trips: a target list with a header
  * and extra columns, plain lines on stdin, a RAPID module, and bad lines
  * reported with file:line:col; outputs that would destroy an input refused

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_comp_emit.c - the firmware table generator (rch_emit_c): a model name
  * made to break out of the C comment and string it lands in ("*" "/", a
  * newline, a backslash, "??/", quotes, a non-ASCII byte) is escaped: the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_comp_grind.c - the grinding experiment on a simulated truth: with the
  * true model as the calibrated one, the compensated path is on the programmed
  * one where the uncompensated path is off by about a millimetre; every

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_calib.c - the calibration pipeline behind `rcal calibrate`, in process
  * (rch_calib_run, the BC model, --fix, random poses, statistics) and through
  * the binary (a data path with '"' and '\' gives valid JSON on stdout and in

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rc_ident: the one definition of what the data can identify. Problems with a
  * known rank deficiency (two columns that differ only by a unit), a known weak
  * direction (two columns 1e-4 apart), a zero column, and a full-rank problem

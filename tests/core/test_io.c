@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Data and model files: bad input is refused with file, line and column. */
 #include <setjmp.h>
 #include <stdarg.h>

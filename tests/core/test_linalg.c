@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Dense linear algebra of the core: QL eigen-solver against Jacobi and
  * against the definition, Cholesky solve. */
 #include <setjmp.h>

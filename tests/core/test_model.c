@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Kinematics and measurement model: analytic Jacobians against finite
  * differences, FK against the real file's nominal x, y, z. */
 #include <setjmp.h>

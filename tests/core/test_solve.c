@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Identification: recovery of a simulated robot, masks, null directions,
  * and the real data (skipped when absent). */
 #include <setjmp.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The stability rule (rc_stable): readings in one at a time, one sample out. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* diag_rates.c - detection rate of `rcal diagnose` on simulated data with
  * each effect hidden (not a test: a measurement). For every case of
  * diag_sim_common.h and seeds 1..S: simulate, diagnose, compare the verdict.

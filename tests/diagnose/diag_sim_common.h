@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* diag_sim_common.h - simulated data sets with one hidden effect, shared by
  * the diagnose tests and the detection-rate runs.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_diag_cli.c - `rcal diagnose` end to end: a simulated CSV with a
  * hidden length offset (JSON output checked with the project's strict JSON
  * reader, plots written), usage errors, and the real data (skipped with a

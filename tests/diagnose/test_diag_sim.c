@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_diag_sim.c - rch_diagnose on simulated data with one effect hidden.
  *
  * For every case of diag_sim_common.h (each candidate effect at a sub-mm

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_diag_stats.c - the statistics helpers of rch_diagnose. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # reading_path_cross.sh - the reading path builds for a microcontroller.
 #
 # Compiles the portable half of the data path (drivers/rcd_proto.c,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_acquire.c - the acquisition run in-process over the mock port
  * (rch_acquire_run with a test io): a frozen display and a foreign device
  * are refused and never recorded, a second acquisition on the same file is

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_drv_display.c - mock port and display reader: short reads, timeouts,
  * failure after every byte N, polled protocols, format lock. */
 #include <setjmp.h>

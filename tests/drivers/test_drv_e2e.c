@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_drv_e2e.c - end to end: rcal_simdisplay on a pty, `rcal acquire`
  * through the POSIX backend, the file calibrated with `rcal calibrate`.
  *  - clean ASCII stream with noise: the file calibrates to the truth;

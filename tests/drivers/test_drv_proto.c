@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_drv_proto.c - display protocol parsers: valid frames, every
  * truncation point, corruption of every byte, random garbage, encoders. */
 #include <setjmp.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_drv_serialport.c - the libserialport backend with every sp_* call
  * substituted at link time (-Wl,--wrap): every failure point of open, every
  * sp_return of read/write/flush/drain/close, and no leaked port, config or

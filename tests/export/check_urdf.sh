@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # check_urdf.sh RCAL SOURCE_DIR SHARED_CSV WORK_DIR
 # Debian's check_urdf (package liburdfdom-tools) accepts the URDF that `rcal
 # export` writes of the nominal robot, of a calibrated model (simulated data,

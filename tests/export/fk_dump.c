@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* fk_dump.c - rcal's forward kinematics at random joint vectors, for the
  * independent URDF reader (urdf_fk.py).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_export.c - rch_export in-process: the URDF origins against rc_fk (with
  * this file's own matrix code), the DH CSV read back, escaping of hostile
  * names, the nominal-URDF reader on good and bad documents, standard errors,

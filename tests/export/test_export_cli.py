@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """test_export_cli.py - `rcal export` end to end, checked by readers that are
 not rcal's code.
 

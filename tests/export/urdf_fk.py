@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """urdf_fk.py - flange position from a URDF's joint origins, independent of rcal.
 
 Reads the URDF with xml.etree (Python's own XML parser), walks the kinematic

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_comp_truth.c - compensation acts only on what the data determined
  * (issue 10): on simulated truths (this file's own FK and random numbers),
  * calibrated from cable lengths the way `rcal calibrate` does, the

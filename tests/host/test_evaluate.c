@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_evaluate.c - a model evaluated on data it never saw, and the ISO 9283
  * distance figures from repeated poses, against values computed here from
  * the independent generator (tests/common/rct_indep.h). */

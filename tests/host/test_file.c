@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_file.c - outputs never destroy an input or a finished file:
  * refusal by device and inode whatever the spelling, atomic replacement, and
  * a fault injected after every byte of the new file (RLIMIT_FSIZE in a child

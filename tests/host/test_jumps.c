@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_jumps.c - length jumps found at the right rows with the right sizes,
  * and no jump invented on data without one; joint angles recovered from
  * reported positions. Data from tests/common/rct_indep.h (own FK, own

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_jw.c - the JSON writer: whatever the strings and numbers, the output
  * parses back (with the project's strict reader) to the same values. */
 #include <math.h>

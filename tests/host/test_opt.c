@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_opt.c - the shared option parser: strict numbers, ranges, --opt=value,
  * -h, repeated and required options, no exit(). */
 #include <setjmp.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_sha256.c - FIPS 180-4 test vectors, and a file digest equal to
  * sha256sum's. */
 #include <setjmp.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_uncert.c - the reported standard errors against the spread of the
  * estimates: coverage of the 95 % intervals over 50 simulated robots, at two
  * noise levels. The data come from this file's own forward kinematics and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_units.c - data in radians or metres is refused with the likely unit
  * named (issue 10, bad input), and degrees/millimetres pass. */
 #include <setjmp.h>

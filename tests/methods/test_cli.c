@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_cli.c - rcal compare and rcal chaos end to end on small simulated
  * data: strict JSON out, every method present, the expected ordering of
  * errors, SVG files written, usage errors. Skips (with a message) when the

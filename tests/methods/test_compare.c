@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_compare.c - the compare protocol and the chaos study in-process,
  * through their host-library calls (rch_compare_run, rch_chaos_run): sizes
  * and bookkeeping of the result, the ordering of errors on simulated data,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_ltmap.c - properties of the logistic-tent map (paper Eq. 11) and of
  * the uniformity measure of the chaos study (Eq. 12). */
 #include <setjmp.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_methods.c - the seven identification methods on a simulated robot
  * with known errors: held-out RMSE near the noise level (gradient methods and
  * EKF) or a measured, bounded shortfall (population methods); determinism

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_paper.c - the paper's update rules, point by point, against a small
  * independent implementation written here (issue 11, "Tests that can fail").
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_plot.c - rch_plot writes well-formed SVG with escaped text, legend,
  * ticks, log axis and bars, and survives degenerate input. */
 #include <setjmp.h>

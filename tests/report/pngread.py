@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """pngread.py - a small PNG reader (zlib from Python's standard library) for the
 report tests: 8-bit greyscale/RGB/RGBA, non-interlaced, which is what headless
 Chromium writes. Returns the pixels as rows of bytes."""

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_report.c - rch_report in-process: HTML escaping of every string that
  * comes from the JSON (a data path with <, &, " and ' in it, hostile names,
  * notes, provenance and warnings), in the page, in the SVG text and in the

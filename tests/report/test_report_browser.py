@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """test_report_browser.py - rcal report rendered in a real headless browser.
 
 Builds the report of a real run on the demo data (rcal calibrate --truth --json,

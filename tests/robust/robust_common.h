@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* robust_common.h - shared helpers of the robustness tests: the IRB120
  * nominal model, a perturbed "true" robot, and pose generators (random,
  * one pose, collinear and coplanar flange points). Test code only. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_robust_acquire.c - resuming an acquisition never deletes samples
  * (issue 7 hardening; found as a data-loss bug, fixed in tools/cmd_acquire.c).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_robust_parsers.c - parser regressions found by fuzzing (issue 7), and
  * a replay of the checked-in fuzz seed corpora through the host parsers in
  * the ordinary build (so the sanitizer and valgrind runs of ctest cover them

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_robust_solve.c - numeric robustness of the identification (issue 7).
  *
  * Degenerate data sets go through rc_solve with every method (LM, LTLM,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_acqfile.c - the acquisition file (see rch_acqfile.h). */
 #include "rch_acqfile.h"
 

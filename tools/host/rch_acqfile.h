@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_acqfile.h - the acquisition file: append-only, locked, resumable.
  *
  * Format (CSV, written here and nowhere else; read back by rch_data_parse,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_acquire.c - the acquisition state machine (see rch_acquire.h). */
 #include "rch_acquire.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_acquire.h - recording cable lengths pose by pose (`rcal acquire`).
  *
  * For each pose of a plan not yet in the output: announce it (for the robot

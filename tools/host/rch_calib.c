@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_calib.c - the calibration pipeline and the nominal-FK check (see rch_calib.h). */
 #include "rch_calib.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_calib.h - the calibration pipeline behind `rcal calibrate` and the
  * nominal-FK check behind `rcal fkcheck`.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_chaos.c - the logistic-tent map uniformity study; see rch_chaos.h. */
 #include "rch_chaos.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_chaos.h - the LTLM paper's uniformity study of its logistic-tent map
  * (its Figs. 2-3 and Eq. 12): the study behind `rcal chaos`.
  *

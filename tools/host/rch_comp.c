@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_comp.c - a robot program's joint targets through the compensation
  * (rch_comp.h): CSV and RAPID line handling, file safety. */
 #include "rch_comp.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_comp.h - compensate a robot program's joint targets (prefix rch_comp_).
  *
  * What: streams a program's target list through the compensation

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_compare.c - the seven-method comparison protocol; see rch_compare.h. */
 #include "rch_compare.h"
 

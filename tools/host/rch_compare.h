@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_compare.h - the LTLM paper's comparison of seven identification
  * methods (its Table 6, Fig. 6d, Figs. 7-8) on measured data: the protocol
  * behind `rcal compare`.

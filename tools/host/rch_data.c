@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "rch_data.h"
 
 #include <ctype.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_data.h - reading and writing measurement files (CSV).
  *
  * Format: comma-separated, first line a header; columns are found by name

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_dequant.c - joint angles from the reported flange position (see
  * rch_dequant.h). */
 #include "rch_dequant.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_dequant.h - recover joint angles rounded for the file from the
  * controller's reported flange position.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "rch_diag.h"
 
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_diag.h - error reports that say what and where (file, line, column).
  * Host side (prefix rch_): may use stdio and the heap. */
 #ifndef RCH_DIAG_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_diagnose.c - the `rcal diagnose` workflow; see rch_diagnose.h. */
 #include "rch_diagnose.h"
 #include "rch_groups.h"

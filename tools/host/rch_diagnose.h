@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_diagnose.h - where model and measurement disagree, and which missing
  * physical effect explains it (issue 6, `rcal diagnose`).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_diagnose_plot.c - the residual plots of `rcal diagnose` (SVG via rch_plot). */
 #include <errno.h>
 #include <math.h>

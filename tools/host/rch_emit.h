@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_emit.h - C source of the firmware's compiled model tables (prefix rch_emit_).
  *
  * What: writes a header (fw_model_data.h) that defines the calibrated and

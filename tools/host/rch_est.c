@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_est.c - the seven methods behind one call; see rch_est.h. */
 #include "rch_est.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_est.h - the seven identification methods of the LTLM paper's
  * comparison (its Table 5) behind one call, with timing and convergence
  * curves, for rcal compare and tests.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_eval.c - the held-out split; see rch_eval.h. */
 #include "rch_eval.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_eval.h - the held-out split of an evaluation protocol: a seeded draw
  * of rows split into a held-out and a training set (rcal compare draws one
  * per case; the same rule as rcal calibrate's split: the permutation of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_evaluate.c - a model on new data, RMSE and ISO 9283 distance
  * characteristics (see rch_evaluate.h). */
 #include "rch_evaluate.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_evaluate.h - a calibrated model on data the fit never saw.
  *
  * No refit of the robot: the model predicts every cable length of the new

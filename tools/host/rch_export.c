@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_export.c - URDF and DH-CSV exports of a model (see rch_export.h). */
 #include "rch_export.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_export.h - hand a model on: a URDF of the calibrated robot and the DH
  * table as CSV (docs/export.md).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_ffi.c - the flat C API for foreign-function use (see rch_ffi.h). */
 #include "rch_ffi.h"
 

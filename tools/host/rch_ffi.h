@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_ffi.h - a flat C API over the core and host libraries for foreign-
  * function use (Python ctypes, python/rcal/), prefix rch_ffi_.
  *

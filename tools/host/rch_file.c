@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_file.c - outputs that never destroy an input or a finished file
  * (see rch_file.h). */
 #include "rch_file.h"

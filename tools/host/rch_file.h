@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_file.h - output files that never destroy anything already written.
  *
  * rch_out_open() refuses an output path that names one of the command's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_grind.c - the grinding-path experiment; see rch_grind.h. */
 #include "rch_grind.h"
 

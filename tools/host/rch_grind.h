@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_grind.h - the grinding-path experiment (the paper's Table 8): the
  * algorithm behind `rcal grind`.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_groups.c - set-up groups from the wrist joints (see rch_groups.h). */
 #include "rch_groups.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_groups.h - set-up groups of an acquisition when the file does not
  * name them: consecutive samples whose wrist joints (q4..q6) stay the same
  * were taken in one set-up (the wrist is re-oriented between set-ups). A

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "rch_ident.h"
 
 #include "rc_ident.h"

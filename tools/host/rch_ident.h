@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_ident.h - identifiability of the model parameters from cable lengths.
  *
  * The identification Jacobian J (n samples x n_params, each column scaled to

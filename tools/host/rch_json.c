@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "rch_json.h"
 
 #include <errno.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_json.h - a small strict JSON reader (RFC 8259) for model files.
  * Builds a tree on the heap; every node remembers its line and column so that
  * callers can report "file:line:col: what is wrong". Depth is limited to 64,

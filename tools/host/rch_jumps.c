@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_jumps.c - change-point detection of length jumps (see rch_jumps.h). */
 #include "rch_jumps.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_jumps.h - length jumps at change points in acquisition order.
  *
  * A draw-wire encoder that loses or gains counts, or a display re-zeroed

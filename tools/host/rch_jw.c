@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_jw.c - the one JSON writer (see rch_jw.h). */
 #include "rch_jw.h"
 

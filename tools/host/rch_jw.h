@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_jw.h - the one JSON writer of rcal: every string escaped (quotes,
  * backslashes, control characters; well-formed UTF-8 copied, any other
  * byte written as U+FFFD), numbers that

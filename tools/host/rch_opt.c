@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_opt.c - table-driven option parser (see rch_opt.h). */
 #include "rch_opt.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_opt.h - the one table-driven option parser of every rcal command.
  *
  * A command describes its options in a const table; rch_opt_parse() fills the

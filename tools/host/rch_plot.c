@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_plot.c - a small SVG chart writer; see rch_plot.h. */
 #include "rch_plot.h"
 

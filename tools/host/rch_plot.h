@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_plot.h - a small SVG chart writer (lines, scatter, bars).
  *
  * What: one chart per rch_plot object: a title, axis labels, any number of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_poses.c - D-optimal pose planning (see rch_poses.h). Moved from
  * tools/cmd_poses.c; the identifiable part now comes from lib/rc_ident. */
 #include "rch_poses.h"

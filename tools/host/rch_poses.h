@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_poses.h - planning an identifiable pose set (`rcal poses`).
  *
  * Method (D-optimal design, greedy start + Fedorov exchange):

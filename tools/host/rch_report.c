@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_report.c - the HTML report of a calibration; see rch_report.h and
  * docs/report.md (which members are read, and from where). */
 #include "rch_report.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_report.h - the HTML report of a calibration (issue 13): one
  * self-contained file a user can hand on, built from what the commands
  * already wrote.

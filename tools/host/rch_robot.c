@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "rch_robot.h"
 
 #include <math.h>

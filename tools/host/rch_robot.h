@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_robot.h - robot-model and calibrated-model files (JSON).
  *
  * Formats "rcal-model/1" and "rcal-model/2" (docs/model-format.md; lengths

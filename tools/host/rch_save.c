@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_save.c - one output file, whole or not at all (see rch_save.h). */
 #include "rch_save.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_save.h - write one output file whole or not at all, through a writer
  * callback: rch_out_open (refuses a path naming an input; temporary file),
  * the writer, then rch_out_commit (rename into place) or rch_out_abort.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_sha256.c - SHA-256 after FIPS 180-4 (see rch_sha256.h). */
 #include "rch_sha256.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_sha256.h - SHA-256 (FIPS 180-4) of a file or a buffer, for the
  * provenance of a calibration (which data a model came from).
  * Host side (prefix rch_). */

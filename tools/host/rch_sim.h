@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_sim.h - simulated robot and cable encoder with known truth.
  *
  * A true robot is the nominal model plus DH errors (chosen or random), an

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_stats.c - summary statistics (see rch_stats.h). */
 #include "rch_stats.h"
 

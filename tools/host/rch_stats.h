@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_stats.h - summary statistics of a series of errors: the one definition
  * of RMSE, mean |e|, SD, mean and max used by the reports.
  *

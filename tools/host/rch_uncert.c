@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_uncert.c - parameter covariance, identifiability per parameter,
  * predicted position uncertainty and the determined part of a model
  * (see rch_uncert.h). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* rch_uncert.h - uncertainty of a calibration: parameter covariance and
  * standard errors, what the data determined, the flange-position uncertainty
  * the covariance predicts, and the "determined part" of a model that

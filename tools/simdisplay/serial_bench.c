@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* serial_bench.c - reading speed of the display path.
  *
  *  1. parser alone: readings/s of rcd_parse over a buffer of frames (ascii,

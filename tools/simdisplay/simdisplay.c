@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* simdisplay.c - a simulated cable-encoder display on a pseudo-terminal.
  *
  * Opens a pty, puts its slave side in raw mode, prints the slave's path as
