@@ -62,6 +62,11 @@ int rcal_cmd_diagnose(int argc, char **argv)
          NULL},
         {"--max-iter", RCH_OPT_UINT, &max_iter, 0, 100000, "N",
          "LM iterations of each warm-started fold fit (0: 100)", 0, NULL},
+        {"--no-jumps", RCH_OPT_FLAG, &cfg.no_jumps, 0, 0, NULL, "do not look for length jumps in acquisition order", 0,
+         NULL},
+        {"--dequantize-joints", RCH_OPT_FLAG, &cfg.dequantize, 0, 0, NULL,
+         "recover joint angles rounded for the file from its x, y, z columns (nominal FK); inconsistent rows refused",
+         0, NULL},
         {"--verbose", RCH_OPT_FLAG, &verbose, 0, 0, NULL, "progress to stderr", 0, NULL},
         {"--verbosity", RCH_OPT_UINT, &verbosity, 0, 3, "V", "progress level (3: also singular values)", 0, NULL},
     };

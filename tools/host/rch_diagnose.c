@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_diagnose.c - the `rcal diagnose` workflow; see rch_diagnose.h. */
 #include "rch_diagnose.h"
+#include "rch_dequant.h"
 #include "rch_groups.h"
 
 #include <math.h>
@@ -875,6 +876,93 @@ static int phase_cv_geometry(run_state *S, rch_diag *d)
     return 0;
 }
 
+/* A sharp step inside a set-up: the geometry's residuals of the (up to) 8
+ * samples of the same set-up after sample a and before it differ by at
+ * least 4 standard errors, the noise taken from the residuals' spread within
+ * the two windows. A pose-dependent effect read in acquisition order is noise
+ * within a set-up and fails; a sensor jump passes. */
+static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t a)
+{
+    double sum[2] = {0, 0}, sq[2] = {0, 0};
+    unsigned cnt[2] = {0, 0};
+    for (int side = 0; side < 2; ++side)
+        for (size_t k = 0; k < 8; ++k) {
+            size_t i = side ? a + k : a - 1 - k;
+            if ((side == 0 && k + 1 > a) || i >= n || s[i].group != s[side ? a : a - 1].group)
+                break;
+            double l;
+            if (rc_meas(&l, NULL, geo, &s[i]) != RC_OK)
+                return 0;
+            const double r = l - s[i].len_mm;
+            sum[side] += r;
+            sq[side] += r * r;
+            cnt[side]++;
+        }
+    if (cnt[0] < 3 || cnt[1] < 3)
+        return 0;
+    const double m0 = sum[0] / cnt[0], m1 = sum[1] / cnt[1];
+    const double v = (sq[0] - cnt[0] * m0 * m0 + sq[1] - cnt[1] * m1 * m1) / (double)(cnt[0] + cnt[1] - 2);
+    const double se = sqrt(fmax(v, 0.0) * (1.0 / cnt[0] + 1.0 / cnt[1]));
+    return fabs(m1 - m0) > 4.0 * se;
+}
+
+/* 4b. Length jumps in acquisition order: found, removed from the lengths
+ * (their offsets fitted on all samples: a nuisance), geometry refitted and
+ * cross-validated again. */
+static int phase_jumps(run_state *S, rch_diag *d)
+{
+    rch_diagnose_result *out = S->out;
+    const size_t n = out->n;
+    char err[256];
+    if (S->cfg.no_jumps)
+        return 0;
+    for (size_t i = 1; i < n; ++i)
+        if (out->s[i].t < out->s[i - 1].t)
+            return 0; /* not in acquisition order: no change points to look for */
+    if (rch_jumps_find(&out->jumps, &out->geo, NULL, out->s, n, NULL, S->c.w, err, sizeof err) != 0 ||
+        out->jumps.n_jumps == 0) {
+        out->jumps.n_jumps = 0;
+        return 0;
+    }
+    /* A step where the set-up changes is confounded with anything that
+     * depends on the set-up (group offsets, wrist-dependent effects): the
+     * jumps are taken as a sensor event only when one lies inside a set-up
+     * (2 or more samples from its ends) and is a sharp step there. */
+    unsigned inside = 0;
+    for (unsigned k = 0; k < out->jumps.n_jumps; ++k) {
+        size_t a = out->jumps.at[k];
+        int near = 0;
+        for (size_t i = a >= 2 ? a - 2 : 1; i <= a + 1 && i < n; ++i)
+            near |= out->s[i].group != out->s[i - 1].group;
+        inside += !near && sharp_step(&out->jumps.geometry, out->s, n, a);
+        out->jumps_at_setup_change += (unsigned)near;
+    }
+    if (inside == 0) {
+        out->jumps_confounded = out->jumps.n_jumps;
+        out->jumps.n_jumps = 0;
+        return 0;
+    }
+    const rc_effect *e = &out->jumps.model.effects[out->jumps.model.n_effects - 1];
+    for (size_t i = 0; i < n; ++i)
+        out->s[i].len_mm -= out->jumps.model.x[e->first + rch_jumps_segment(&out->jumps, out->s[i].t)];
+    for (unsigned f = 0; f < S->c.k; ++f) /* the folds' training copies too */
+        for (size_t i = 0; i < S->c.n_train[f]; ++i)
+            S->c.train[f][i].len_mm -=
+                out->jumps.model.x[e->first + rch_jumps_segment(&out->jumps, S->c.train[f][i].t)];
+    out->geo = out->jumps.geometry;
+    for (unsigned f = 0; f < S->c.k; ++f)
+        S->base_folds[f] = out->geo;
+    if (cv_run(S->base_folds, S->r0, &S->c) != 0) {
+        rch_diag_set(d, "", 0, 0, "a cross-validation fit failed (after removing the length jumps)");
+        return -1;
+    }
+    out->rmse_jumps_mm = rch_rms(S->r0, n);
+    if (S->cfg.verbose)
+        fprintf(stderr, "diagnose: %u length jumps; geometry held-out RMSE %.4f mm without them\n",
+                out->jumps.n_jumps, out->rmse_jumps_mm);
+    return 0;
+}
+
 /* Whether candidate cd can be tried on the data: 1, or 0 with ca->note set.
  * count: its parameter count when it has a variable one (group offsets). */
 static int cand_applicable(const run_state *S, const cdef *cd, rch_diagnose_cand *ca, unsigned *count)
@@ -1127,12 +1215,10 @@ static void phase_after(run_state *S)
     out->rmse_after_mm = rch_rms(S->r0, out->n);
     structure_tests(out->after, S->r0, out->s, out->n, (const double(*)[V_N])S->var, out->n_groups, S->cfg.alpha);
     out->remaining_why[0] = '\0';
-    if (out->rmse_after_mm > S->cfg.gap_factor * out->noise_floor_mm) {
-        unexpl = 1;
-        pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
-                                "held-out RMSE %.3f mm is %.2f x the noise floor", out->rmse_after_mm,
-                                out->rmse_after_mm / out->noise_floor_mm);
-    }
+    /* Structure decides, not the size of the residual: residuals with no
+     * significant structure against any explanatory variable are noise,
+     * whatever their size; their RMS is the noise estimate (the stated
+     * resolution and the quantization floor are lower bounds, not the noise). */
     for (unsigned k = 0; k < out->n_tests; ++k)
         if (out->after[k].significant && pos < sizeof out->remaining_why) {
             pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
@@ -1140,8 +1226,17 @@ static void phase_after(run_state *S)
                                     out->after[k].p_value);
             unexpl = 1;
         }
+    out->noise_est_mm = out->rmse_after_mm;
+    if (!unexpl)
+        snprintf(out->remaining_why, sizeof out->remaining_why,
+                 "no structure test is significant: the held-out residual is noise, estimated at %.4f mm "
+                 "(%.2f x the quantization floor %.4f mm)",
+                 out->noise_est_mm, out->noise_est_mm / out->noise_floor_mm, out->noise_floor_mm);
     snprintf(out->remaining, sizeof out->remaining, "%s", unexpl ? "unexplained" : "none");
-    if (out->n_chosen == 0) {
+    if (out->jumps.n_jumps > 0) {
+        snprintf(out->effect, sizeof out->effect, "length_jump");
+        out->joint = 0;
+    } else if (out->n_chosen == 0) {
         snprintf(out->effect, sizeof out->effect, "%s", unexpl ? "unexplained" : "none");
         out->joint = 0;
     }
@@ -1196,6 +1291,8 @@ int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t 
         rc = phase_folds(&S, d);
     if (rc == 0)
         rc = phase_cv_geometry(&S, d);
+    if (rc == 0)
+        rc = phase_jumps(&S, d);
     if (rc == 0) {
         phase_search(&S);
         phase_after(&S);
@@ -1217,7 +1314,41 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
     rch_diagnose_cfg c = *cfg;
     c.groups_given = data.has_group;
     c.have_encoder = robot.has_encoder;
+    rch_dequant_result dq;
+    memset(&dq, 0, sizeof dq);
+    if (cfg->dequantize) {
+        /* set-ups from the wrist angles as recorded (on the display grid), before they are recovered */
+        if (!c.groups_given) {
+            double *q = malloc(data.n * 3 * sizeof *q);
+            double step = 0.0;
+            for (size_t i = 0; q && i < data.n; ++i)
+                for (unsigned j = 0; j < 3; ++j)
+                    q[i * 3 + j] = data.s[i].q_rad[3 + j] / DEG;
+            if (q)
+                step = rch_diagnose_detect_step(q, data.n * 3);
+            free(q);
+            rch_groups_by_wrist(data.s, data.n, step, NULL);
+            c.groups_given = 1;
+        }
+        uint8_t *bad = data.xyz ? calloc(data.n, 1) : NULL;
+        if (!bad) {
+            rch_diag_set(d, data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
+            rch_data_free(&data);
+            return -1;
+        }
+        rch_dequant(&dq, bad, data.s, data.n, (const double(*)[3])data.xyz, &robot.nominal, 0.0);
+        size_t k = 0;
+        for (size_t i = 0; i < data.n; ++i)
+            if (!bad[i])
+                data.s[k++] = data.s[i];
+        data.n = k;
+        free(bad);
+        if (c.q_step_deg == 0.0)
+            c.q_step_deg = -1.0; /* the joints are no longer on the display grid */
+    }
     const int rc = rch_diagnose_run(out, data.s, data.n, &robot.nominal, &c, d);
+    out->dequant_corrected = dq.n_corrected;
+    out->dequant_refused = dq.n_refused;
     rch_data_free(&data);
     return rc;
 }
@@ -1285,6 +1416,30 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
     if (r->joint)
         fprintf(f, " (joint %u)", r->joint);
     fprintf(f, "\n");
+    if (r->dequant_corrected)
+        fprintf(f, "Joints recovered from x, y, z: %zu rows corrected, %zu refused as inconsistent.\n",
+                r->dequant_corrected, r->dequant_refused);
+    if (r->jumps.n_jumps > 0) {
+        fprintf(f,
+                "Length jumps in acquisition order (the lengths shift at a row and stay shifted: a display "
+                "re-zeroed or counts lost; removed as a nuisance before the search below):\n");
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k)
+            fprintf(f, "  before sample %zu (1-based, in file order; t %.4f): %+.4f +- %.4f mm\n", r->jumps.at[k] + 1,
+                    r->jumps.at_t[k], r->jumps.size_mm[k], r->jumps.se_mm[k]);
+        fprintf(f, "  geometry held-out RMSE %.4f mm with the jumps in the data, %.4f mm with them removed\n",
+                r->rmse_before_mm, r->rmse_jumps_mm);
+        if (r->jumps_at_setup_change)
+            fprintf(f,
+                    "  %u of them fall where the set-up changes: there a jump is confounded with anything that depends "
+                    "on the set-up; revisiting set-ups in shuffled order would separate them\n",
+                    r->jumps_at_setup_change);
+    } else if (r->jumps_confounded) {
+        fprintf(f,
+                "Steps in acquisition order (%u) were found only where the set-up changes: confounded with set-up "
+                "dependent effects (left to the candidates below); revisiting set-ups in shuffled order would "
+                "separate them.\n",
+                r->jumps_confounded);
+    }
     if (r->n_chosen > 0) {
         fprintf(f, "Effects added, in order:");
         for (unsigned s = 0; s < r->n_steps; ++s)
@@ -1390,6 +1545,18 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r)
     rch_jw_uint(&w, "folds", r->folds);
     rch_jw_str(&w, "remaining", r->remaining);
     rch_jw_str(&w, "remaining_why", r->remaining_why);
+    json_num(&w, "noise_est_mm", r->noise_est_mm);
+    rch_jw_arr(&w, "length_jumps");
+    for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+        rch_jw_obj(&w, NULL);
+        rch_jw_uint(&w, "sample", r->jumps.at[k]);
+        json_num(&w, "t", r->jumps.at_t[k]);
+        json_num(&w, "size_mm", r->jumps.size_mm[k]);
+        json_num(&w, "se_mm", r->jumps.se_mm[k]);
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
+    json_num(&w, "rmse_jumps_removed_mm", r->jumps.n_jumps ? r->rmse_jumps_mm : NAN);
     rch_jw_arr(&w, "sequence");
     for (unsigned s = 0; s < r->n_steps; ++s)
         if (r->steps[s].chosen >= 0)

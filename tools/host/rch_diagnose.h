@@ -31,11 +31,19 @@
  *     Among the significant ones the best gain wins, except that a candidate
  *     with fewer parameters whose held-out MSE is within one standard error
  *     of the best is preferred (one-standard-error rule).
+ *  4b. Length jumps in acquisition order (rch_jumps: a display re-zeroed,
+ *     counts lost): when found, and at least one lies inside a set-up (a
+ *     step where the set-up changes is confounded with set-up dependent
+ *     effects, and then left to those candidates), their offsets (fitted on all samples, a
+ *     nuisance) are removed from the lengths, the geometry is refitted and
+ *     cross-validated again, and the candidate search runs on top; the
+ *     verdict is then "length_jump".
  *  6. The chosen effect joins the model and the search repeats (at most
  *     max_steps effects). The first chosen effect is the verdict; when none
- *     is significant the verdict is "none", or "unexplained" when the
- *     held-out RMSE stays above gap_factor * floor or a structure test
- *     remains significant.
+ *     is significant the verdict is "none" (the residual is noise, its RMS
+ *     the noise estimate, whatever its size against the quantization floor),
+ *     or "unexplained" when a structure test remains significant (the
+ *     strongest named).
  *
  * Depends on: rcal core (rc_model, rc_solve, rc_rand), rch_data (groups).
  * Memory: rch_diagnose_run allocates the per-sample arrays of the result;
@@ -50,6 +58,7 @@
 
 #include "rc_solve.h"
 #include "rch_diag.h"
+#include "rch_jumps.h"
 
 #define RCH_DIAGNOSE_MAX_CAND 16
 #define RCH_DIAGNOSE_MAX_STEPS 4
@@ -75,6 +84,9 @@ typedef struct rch_diagnose_cfg {
                                 identified directions (e.g. the common level of group offsets)
                                 less converged, which inflates held-out errors a little. */
     int verbose;             /* progress to stderr */
+    int no_jumps;            /* 1: do not look for length jumps in acquisition order */
+    int dequantize;          /* rch_diagnose_file: recover rounded joints from x, y, z (rch_dequant); the
+                                joint step of the floor is then the 0.05 mm rounding of x, y, z */
 } rch_diagnose_cfg;
 
 /* One structure test of residuals against an explanatory variable. */
@@ -134,6 +146,12 @@ typedef struct rch_diagnose_result {
     double train_rmse_geo_mm;  /* geometric fit on all samples */
     double rmse_before_mm;     /* held-out, geometry only */
     double rmse_after_mm;      /* held-out, with the chosen effects */
+    double noise_est_mm;       /* the held-out RMS when no structure remains: the noise, estimated */
+    rch_jumps jumps;           /* length jumps in acquisition order (n_jumps 0: none found) */
+    double rmse_jumps_mm;      /* held-out, geometry on the lengths with the jumps removed */
+    unsigned jumps_at_setup_change; /* of the jumps found, at a set-up change (confounded) */
+    unsigned jumps_confounded; /* steps found only at set-up changes: not taken as jumps */
+    size_t dequant_corrected, dequant_refused; /* with cfg.dequantize */
     unsigned geo_rank, geo_free;
 
     unsigned n_tests;

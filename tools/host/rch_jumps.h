@@ -21,8 +21,11 @@
  *     modified BIC), up to max_jumps;
  *  4. backward: while some jump is smaller than size_factor times the final
  *     RMS residual, the smallest is dropped and the rest refitted (a jump the
- *     size of the noise is not a sensor event but a description of the
- *     noise, or of structure another effect should explain).
+ *     size of the noise is not a sensor event but a description of the noise).
+ * Where the samples come in set-ups (the wrist fixed for a run of poses), a
+ * step at a set-up change is confounded with anything that depends on the
+ * set-up; rcal diagnose therefore takes the jumps as a sensor event only when
+ * one lies inside a set-up.
  *
  * Host side (prefix rch_): heap, LAPACKE. */
 #ifndef RCH_JUMPS_H
