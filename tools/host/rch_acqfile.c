@@ -229,7 +229,7 @@ int rch_acqfile_open(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done,
         rch_diag_set(d, path, 0, 0, "path too long");
         return -1;
     }
-    strcpy(a->path, path);
+    memcpy(a->path, path, strlen(path) + 1);
     a->fd = open(path, O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC | O_NOCTTY | O_NONBLOCK, 0644);
     if (a->fd < 0) {
         rch_diag_set(d, path, 0, 0, "cannot open for appending: %s", strerror(errno));

@@ -323,7 +323,7 @@ static void groups(rch_calib_result *r, rch_data *data, const size_t *counts)
         r->n_groups = mx + 1;
         return;
     }
-    double *q = malloc(data->n * 3 * sizeof *q), step = 0.0;
+    double *q = calloc(data->n * 3 + 1, sizeof *q), step = 0.0;
     if (q) {
         for (size_t i = 0; i < data->n; ++i)
             for (unsigned j = 0; j < 3; ++j)
@@ -466,7 +466,7 @@ static int dequantize(rch_calib_result *r, rch_data *data, rch_diag *d)
         rch_diag_set(d, r->cfg.data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
         return -1;
     }
-    uint8_t *bad = calloc(data->n, 1);
+    uint8_t *bad = calloc(data->n + 1, 1);
     if (!bad) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
@@ -499,7 +499,7 @@ static size_t split(size_t *idx, const rc_sample *s, size_t n, double fraction, 
     rch_split(idx, n, seed);
     if (!by_group || want == 0)
         return want;
-    size_t *tmp = malloc(n * sizeof *tmp), k = 0;
+    size_t *tmp = n ? malloc(n * sizeof *tmp) : NULL, k = 0;
     if (!tmp)
         return want;
     /* take the groups of the shuffled rows in the order they come */
@@ -564,7 +564,7 @@ done:
 static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data, rch_diag *d)
 {
     rch_calib_result *c = malloc(sizeof *c);
-    size_t *idx = malloc(data->n * sizeof *idx);
+    size_t *idx = malloc((data->n ? data->n : 1) * sizeof *idx);
     size_t m = r->cfg.case_samples && r->cfg.case_samples < data->n ? r->cfg.case_samples : data->n;
     rc_sample *sub = NULL;
     int rc = -1;
@@ -615,7 +615,7 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     memset(r, 0, sizeof *r);
     r->cfg = *cfg;
     rch_data data;
-    size_t counts[RCH_CALIB_MAX_FILES];
+    size_t counts[RCH_CALIB_MAX_FILES] = {0};
     if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || load_all(&data, counts, cfg, d) != 0)
         return -1;
     r->n_data = data.n;

@@ -35,7 +35,7 @@ int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d)
     }
     for (int i = 0; i < RCH_EST_COUNT; ++i)
         run[i] = 0;
-    strcpy(buf, list);
+    memcpy(buf, list, strlen(list) + 1);
     for (char *tok = buf, *next; tok; tok = next) {
         int id;
         next = strchr(tok, ',');

@@ -801,8 +801,8 @@ static int assign_folds(run_state *S)
     for (size_t i = 0; i < n; ++i)
         S->order[i] = (unsigned)i;
     shuffle(S->order, n, &rng);
-    unsigned *gorder = calloc(ng, sizeof *gorder), *byg = calloc(n, sizeof *byg);
-    size_t *start = calloc((size_t)ng + 1, sizeof *start), *pos = calloc(ng, sizeof *pos);
+    unsigned *gorder = calloc(ng ? ng : 1, sizeof *gorder), *byg = calloc(n ? n : 1, sizeof *byg);
+    size_t *start = calloc((size_t)ng + 1, sizeof *start), *pos = calloc(ng ? ng : 1, sizeof *pos);
     int rc = -1;
     if (!gorder || !byg || !start || !pos)
         goto done;
@@ -842,7 +842,7 @@ static int phase_folds(run_state *S, rch_diag *d)
         size_t nt = 0;
         for (size_t i = 0; i < c->n; ++i)
             nt += c->fold[i] != f;
-        c->train[f] = malloc(nt * sizeof *c->train[f]);
+        c->train[f] = malloc((nt ? nt : 1) * sizeof *c->train[f]);
         if (!c->train[f]) {
             rch_diag_set(d, "", 0, 0, "out of memory");
             return -1;
@@ -1319,7 +1319,7 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
     if (cfg->dequantize) {
         /* set-ups from the wrist angles as recorded (on the display grid), before they are recovered */
         if (!c.groups_given) {
-            double *q = malloc(data.n * 3 * sizeof *q);
+            double *q = calloc(data.n * 3 + 1, sizeof *q);
             double step = 0.0;
             for (size_t i = 0; q && i < data.n; ++i)
                 for (unsigned j = 0; j < 3; ++j)
@@ -1330,7 +1330,7 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
             rch_groups_by_wrist(data.s, data.n, step, NULL);
             c.groups_given = 1;
         }
-        uint8_t *bad = data.xyz ? calloc(data.n, 1) : NULL;
+        uint8_t *bad = data.xyz ? calloc(data.n + 1, 1) : NULL;
         if (!bad) {
             rch_diag_set(d, data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
             rch_data_free(&data);

@@ -106,7 +106,7 @@ int rch_surface_parse(rch_surface *s, const char *spec, rch_diag *d)
         rch_diag_set(d, "", 0, 0, "surface spec longer than %zu characters", sizeof buf - 1);
         return -1;
     }
-    strcpy(buf, spec);
+    memcpy(buf, spec, strlen(spec) + 1);
     char *colon = strchr(buf, ':');
     if (colon)
         *colon = '\0';

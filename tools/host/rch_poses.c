@@ -57,7 +57,7 @@ static void add_outer(double *A, const double *x, double w, unsigned r)
 
 static double observability(const rc_model *m, const rc_sample *c, const size_t *idx, size_t n, unsigned *rank)
 {
-    rc_sample *s = malloc(n * sizeof *s);
+    rc_sample *s = malloc((n ? n : 1) * sizeof *s);
     rch_ident *id = calloc(1, sizeof *id);
     double o = -1;
     if (s && id) {
@@ -161,7 +161,7 @@ static int ident_subspace(plan_work *w, rch_diag *d)
     }
     rc_ident_scale(w->scale, AtA, P, (size_t)P + 1);
     w->r = id->rank;
-    w->X = calloc(w->n_cand * (w->r ? w->r : 1), sizeof *w->X);
+    w->X = calloc((w->n_cand ? w->n_cand : 1) * (w->r ? w->r : 1), sizeof *w->X);
     if (!w->X) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto out;
@@ -346,7 +346,7 @@ int rch_poses_plan(rch_poses_result *res, const rc_model *m, const rch_poses_con
         res->o1_plan = observability(m, w.cand, w.design, w.n, &res->rank_plan);
         res->o1_random = observability(m, w.cand, w.rnd, w.n, &res->rank_random);
     }
-    res->poses = malloc(w.n * sizeof *res->poses);
+    res->poses = malloc((w.n ? w.n : 1) * sizeof *res->poses);
     if (!res->poses) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
