@@ -19,7 +19,7 @@ int rcal_cmd_simulate(int argc, char **argv)
     job.enc_mm[1] = -460.0;
     job.enc_mm[2] = 10.0;
     const char *out_path = NULL, *truth_out = NULL;
-    unsigned long n = 500, seed = 1, group = 0;
+    unsigned long repeats = 1, n = 500, seed = 1, group = 0;
     rch_sim_config *c = &job.sim;
     const rch_opt opts[] = {
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "DATA.csv", "the simulated measurements", RCH_OPT_REQUIRED, NULL},
@@ -42,6 +42,8 @@ int rcal_cmd_simulate(int argc, char **argv)
         {"--encoder", RCH_OPT_TRIPLE, job.enc_mm, -10000, 10000, NULL, "encoder outlet (mm)", 0, NULL},
         {"--group-size", RCH_OPT_UINT, &group, 0, 1000000, "G",
          "keep the wrist joints fixed for G consecutive poses (0: independent poses)", 0, NULL},
+        {"--repeats", RCH_OPT_UINT, &repeats, 1, 1000, "R",
+         "read every pose R times in a row (fresh length noise): repeatability, ISO 9283", 0, NULL},
     };
     const rch_cmdspec spec = {"simulate", "a data set from a simulated robot with known errors",
                               "The true robot is --truth if given, else the nominal --robot plus random DH errors\n"
@@ -54,6 +56,7 @@ int rcal_cmd_simulate(int argc, char **argv)
     job.n = n;
     job.seed = seed;
     c->group_size = (unsigned)group;
+    c->repeats = (unsigned)repeats;
 
     rch_sim_set set;
     rch_diag d;

@@ -82,9 +82,25 @@ void rch_sim_poses(rc_sample *out, size_t n, const rc_model *m, double margin_ra
 int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const rc_model *truth,
                     const rch_sim_config *c, rc_rng *g)
 {
-    double centre[RC_NJ] = {0};
+    double centre[RC_NJ] = {0}, last_q[RC_NJ] = {0};
     unsigned group = 0;
     for (size_t i = 0; i < n; ++i) {
+        if (c->repeats > 1 && i % c->repeats != 0) {
+            /* the same pose read again: the same joints, fresh length noise */
+            rc_sample s = out[i - 1];
+            double l;
+            memcpy(s.q_rad, last_q, sizeof last_q);
+            if (rc_meas(&l, NULL, truth, &s) != RC_OK)
+                return -1;
+            double noise = c->noise_mm > 0.0 ? c->noise_mm * rc_rng_normal(g) : 0.0;
+            s.len_mm = quant(l + noise, c->resolution_mm);
+            memcpy(s.q_rad, out[i - 1].q_rad, sizeof s.q_rad);
+            s.t = n > 1 ? (double)i / (double)(n - 1) : 0.0;
+            if (true_q_rad)
+                memcpy(true_q_rad[i], last_q, sizeof last_q);
+            out[i] = s;
+            continue;
+        }
         const int new_group = c->group_size > 0 && i % c->group_size == 0;
         if (new_group && i > 0)
             ++group;
@@ -129,6 +145,7 @@ int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const
             return -1;
         if (true_q_rad)
             memcpy(true_q_rad[i], q, sizeof q);
+        memcpy(last_q, q, sizeof q);
         for (unsigned j = 0; j < RC_NJ; ++j)
             s.q_rad[j] = quant(q[j] / DEG, c->q_step_deg) * DEG;
         out[i] = s;

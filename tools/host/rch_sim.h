@@ -34,6 +34,7 @@ typedef struct rch_sim_config {
     double q_hi_deg[RC_NJ];
     unsigned group_size;    /* 0: every pose independent; else wrist fixed per group */
     double group_span_deg;  /* spread of q1..q3 around a group's centre; default 25 */
+    unsigned repeats;       /* 0 or 1: every sample a new pose; R: each pose read R times in a row (fresh noise) */
 } rch_sim_config;
 
 /* Fill zero fields with the defaults above. */
