@@ -179,11 +179,12 @@ done:
  * standard errors, classes, predicted uncertainty over the data and the
  * workspace, and the determined model. Leaves have_unc 0 when it cannot be
  * computed (too few samples for the free parameters). */
-static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit)
+static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit,
+                        const uint16_t *setup)
 {
     rch_uncert u;
     char err[256];
-    if (rch_uncert_compute(&u, fit, fixed, train, r->n_train, 1, err, sizeof err) != 0)
+    if (rch_uncert_compute_cl(&u, fit, fixed, train, setup, r->n_train, 1, err, sizeof err) != 0)
         return;
     rch_model_unc_from(&r->unc, &u);
     if (rch_uncert_map_compute(&r->unc.map, &u, &r->model, train, r->n_train, RCH_CALIB_TRUTH_POSES,
@@ -343,13 +344,13 @@ static void groups(rch_calib_result *r, rch_data *data, const size_t *counts)
 /* After the fit: truth, identifiability, uncertainty, validation. fit:
  * the model fitted to train (r->model, or with the jumps' offsets). */
 static int finish(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit,
-                  rch_diag *d)
+                  const uint16_t *setup, rch_diag *d)
 {
     if (r->cfg.truth_path && r->finite && truth_flange(r, d) != 0)
         return -1;
     r->have_ident = r->finite && rch_ident_compute(&r->ident, fit, train, r->n_train) == 0;
     if (r->finite)
-        uncertainty(r, fixed, train, fit);
+        uncertainty(r, fixed, train, fit, setup);
     if (r->cfg.validate_path && r->after_ok) {
         rc_solve_work *w = malloc(sizeof *w);
         int rc = w ? validate(r, w, d) : -1;
@@ -375,6 +376,7 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
                      const rc_sample *eval_set, size_t n_eval, rch_diag *d)
 {
     rc_sample *tr = malloc(r->n_train * sizeof *tr), *ev = malloc(n_eval * sizeof *ev);
+    uint16_t *setup = NULL;
     char err[256];
     int rc = -1;
     if (!tr || !ev) {
@@ -384,6 +386,13 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     memcpy(tr, train, r->n_train * sizeof *tr);
     memcpy(ev, eval_set, n_eval * sizeof *ev);
     qsort(tr, r->n_train, sizeof *tr, cmp_t);
+    setup = malloc((r->n_train ? r->n_train : 1) * sizeof *setup);
+    if (!setup) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < r->n_train; ++i)
+        setup[i] = tr[i].group; /* set-up groups: the clusters of the covariance */
     if (rch_jumps_find(&r->jumps, &r->before, fixed, tr, r->n_train, NULL, w, err, sizeof err) != 0) {
         rch_diag_set(d, "", 0, 0, "length jumps: %s", err);
         goto done;
@@ -412,10 +421,11 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     rc_eval(&r->train_before, &r->before, tr, r->n_train);
     if (!r->after_ok || rc_eval(&r->train_after, &r->jumps.model, tr, r->n_train) != RC_OK)
         memset(&r->train_after, 0, sizeof r->train_after);
-    rc = finish(r, fixed, tr, &r->jumps.model, d);
+    rc = finish(r, fixed, tr, &r->jumps.model, setup, d);
 done:
     free(tr);
     free(ev);
+    free(setup);
     return rc;
 }
 
@@ -456,7 +466,7 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     rc_eval(&r->train_before, &r->before, train, r->n_train);
     if (!r->after_ok || rc_eval(&r->train_after, &r->model, train, r->n_train) != RC_OK)
         memset(&r->train_after, 0, sizeof r->train_after);
-    return finish(r, fixed, train, &r->model, d);
+    return finish(r, fixed, train, &r->model, NULL, d);
 }
 
 /* Joint angles from the file's x, y, z; inconsistent rows dropped. */

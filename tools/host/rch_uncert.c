@@ -60,17 +60,19 @@ static int jacobian(double *J, double *r, double *D, const rc_model *m, const un
 }
 
 /* Groups usable as clusters: at least 5 groups with >= 2 samples each. */
-static unsigned count_groups(const rc_sample *s, size_t n, unsigned *gmax)
+#define CL(i) (cl ? cl[i] : s[i].group)
+
+static unsigned count_groups(const rc_sample *s, const uint16_t *cl, size_t n, unsigned *gmax)
 {
     unsigned mx = 0;
     for (size_t i = 0; i < n; ++i)
-        if (s[i].group > mx)
-            mx = s[i].group;
+        if (CL(i) > mx)
+            mx = CL(i);
     unsigned *cnt = calloc((size_t)mx + 1, sizeof *cnt);
     if (!cnt)
         return 0;
     for (size_t i = 0; i < n; ++i)
-        cnt[s[i].group]++;
+        cnt[CL(i)]++;
     unsigned g = 0, small = 0;
     for (unsigned k = 0; k <= mx; ++k) {
         g += cnt[k] > 0;
@@ -117,8 +119,8 @@ static int ident(scaled *z, size_t n_rows)
 }
 
 /* Covariance in scaled coordinates: classical or cluster-robust. */
-static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r, const rc_sample *s, size_t n,
-                      int want_cluster)
+static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r, const rc_sample *s,
+                      const uint16_t *cl, size_t n, int want_cluster)
 {
     unsigned nf = z->nf;
     /* pseudo-inverse A+ = sum over kept directions v v^T / ev */
@@ -144,7 +146,7 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
         ssr += r[i] * r[i];
     double dof = (double)n - (double)u->rank;
     u->sigma_mm = dof > 0 ? sqrt(ssr / dof) : NAN;
-    unsigned gmax = 0, G = want_cluster ? count_groups(s, n, &gmax) : 0;
+    unsigned gmax = 0, G = want_cluster ? count_groups(s, cl, n, &gmax) : 0;
     if (G) {
         double *ug = calloc(((size_t)gmax + 1) * nf, sizeof *ug);
         if (!ug) {
@@ -153,9 +155,9 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
             return -1;
         }
         for (size_t i = 0; i < n; ++i) {
-            if (s[i].group > gmax)
+            if (CL(i) > gmax)
                 continue; /* cannot happen: gmax is the largest group */
-            double *ui = ug + (size_t)s[i].group * nf;
+            double *ui = ug + (size_t)CL(i) * nf;
             for (unsigned k = 0; k < nf; ++k)
                 ui[k] += J[i * nf + k] * r[i];
         }
@@ -347,6 +349,12 @@ static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
 int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s, size_t n,
                        int want_cluster, char *err, size_t errlen)
 {
+    return rch_uncert_compute_cl(u, m, fixed, s, NULL, n, want_cluster, err, errlen);
+}
+
+int rch_uncert_compute_cl(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s,
+                          const uint16_t *cl, size_t n, int want_cluster, char *err, size_t errlen)
+{
     memset(u, 0, sizeof *u);
     u->n_params = m->n_params;
     u->n_samples = n;
@@ -391,7 +399,7 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
         snprintf(err, errlen, "the identifiability analysis failed (non-finite normal matrix)");
         goto done;
     }
-    if (covariance(&z, u, J, r, s, n, want_cluster) != 0) {
+    if (covariance(&z, u, J, r, s, cl, n, want_cluster) != 0) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }

@@ -68,6 +68,11 @@ typedef struct rch_uncert {
  * says which was used). 0, or -1 (message in err[errlen]). */
 int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s, size_t n,
                        int want_cluster, char *err, size_t errlen);
+/* The same with the clusters given apart from the samples' group field
+ * (cl: n labels, NULL: s[i].group), for a model whose effects use the group
+ * field for something else (segments of length jumps). */
+int rch_uncert_compute_cl(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s,
+                          const uint16_t *cl, size_t n, int want_cluster, char *err, size_t errlen);
 void rch_uncert_free(rch_uncert *u);
 
 /* The determined part of a calibration, for compensation: the fit with
