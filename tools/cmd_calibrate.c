@@ -30,94 +30,120 @@ static int write_model(const rch_calib_result *r, const char *out_path, int quie
     return 0;
 }
 
-int rcal_cmd_calibrate(int argc, char **argv)
-{
+/* Options of rcal calibrate into cfg (and out_path, json, data). Returns
+ * RCH_OPT_OK, or the status to return (0 for --help, 2 for an error). */
+typedef struct {
     rch_calib_cfg cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.robot_path = RCAL_DEFAULT_ROBOT;
-    cfg.test_fraction = 0.1;
-    const char *out_path = NULL, *method = "lm";
+    const char *out_path, *method;
     rch_opt_strs data;
-    memset(&data, 0, sizeof data);
-    unsigned long seed = 1, max_iter = 0, cases = 1, case_samples = 0;
-    int json = 0;
+    unsigned long seed, max_iter, cases, case_samples;
+    int json;
+} calib_args;
+
+static rch_opt_status parse(calib_args *a, int argc, char **argv)
+{
+    rch_calib_cfg *cfg = &a->cfg;
     const rch_opt opts[] = {
-        {"--data", RCH_OPT_STRS, &data, 0, 0, "FILE",
+        {"--data", RCH_OPT_STRS, &a->data, 0, 0, "FILE",
          "measurements: CSV with q1..q6 (deg) and L (mm); several --data are merged (set-up groups never span two files)",
          RCH_OPT_REQUIRED, NULL},
-        {"--validate", RCH_OPT_STR, &cfg.validate_path, 0, 0, "FILE",
+        {"--validate", RCH_OPT_STR, &cfg->validate_path, 0, 0, "FILE",
          "data the fit never sees: the model evaluated on it with no refit (RMSE, ISO 9283 from repeated poses)", 0,
          NULL},
-        {"--plots", RCH_OPT_STR, &cfg.plots_dir, 0, 0, "DIR",
+        {"--plots", RCH_OPT_STR, &cfg->plots_dir, 0, 0, "DIR",
          "write the predicted-uncertainty plot (uncertainty_position.svg and .csv)", 0, NULL},
-        {"--robot", RCH_OPT_STR, &cfg.robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
-        {"--method", RCH_OPT_CHOICE, &method, 0, 0, NULL,
-         "lm (robust), ltlm (robust + chaotic candidates), lm-paper / ltlm-paper (the paper's update)", 0,
-         "lm|ltlm|lm-paper|ltlm-paper"},
-        {"--test-fraction", RCH_OPT_DOUBLE, &cfg.test_fraction, 0, 0.999, "F",
+        {"--robot", RCH_OPT_STR, &cfg->robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
+        {"--method", RCH_OPT_CHOICE, &a->method, 0, 0, NULL,
+         "lm (robust), ltlm (robust + chaotic candidates), lm-paper / ltlm-paper (the paper's update, angles in "
+         "rad), lm-paper-deg / ltlm-paper-deg (the same with angles in degrees)",
+         0, "lm|ltlm|lm-paper|ltlm-paper|lm-paper-deg|ltlm-paper-deg"},
+        {"--test-fraction", RCH_OPT_DOUBLE, &cfg->test_fraction, 0, 0.999, "F",
          "share of samples held out for the before/after report", 0, NULL},
-        {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "split (and LTLM) seed", 0, NULL},
-        {"--max-iter", RCH_OPT_UINT, &max_iter, 0, 100000, "N", "iteration cap (0: the method's default)", 0, NULL},
-        {"--fix", RCH_OPT_STR, &cfg.fix, 0, 0, "LIST",
+        {"--seed", RCH_OPT_UINT, &a->seed, 0, 0, "S", "split (and LTLM) seed", 0, NULL},
+        {"--max-iter", RCH_OPT_UINT, &a->max_iter, 0, 100000, "N", "iteration cap (0: the method's default)", 0, NULL},
+        {"--fix", RCH_OPT_STR, &cfg->fix, 0, 0, "LIST",
          "parameters held at nominal, e.g. a1,theta6 (a1..a6, d1..d6, alpha1..alpha6, theta1..theta6, ex, ey, ez)",
          0, NULL},
-        {"--jumps", RCH_OPT_FLAG, &cfg.jumps, 0, 0, NULL,
+        {"--jumps", RCH_OPT_FLAG, &cfg->jumps, 0, 0, NULL,
          "fit length jumps at change points in acquisition order (a display re-zeroed, counts lost) with the "
          "geometry; they are not used at a new pose",
          0, NULL},
-        {"--dequantize-joints", RCH_OPT_FLAG, &cfg.dequantize, 0, 0, NULL,
+        {"--dequantize-joints", RCH_OPT_FLAG, &cfg->dequantize, 0, 0, NULL,
          "recover joint angles rounded for the file from its x, y, z columns (nominal FK); inconsistent rows refused",
          0, NULL},
-        {"--holdout-groups", RCH_OPT_FLAG, &cfg.holdout_groups, 0, 0, NULL,
+        {"--holdout-groups", RCH_OPT_FLAG, &cfg->holdout_groups, 0, 0, NULL,
          "hold out whole set-up groups (the file's group column, else from the wrist joints) instead of random rows",
          0, NULL},
-        {"--cases", RCH_OPT_UINT, &cases, 1, 1000, "N", "repeat on N random subsets (the paper's protocol)", 0, NULL},
-        {"--samples", RCH_OPT_UINT, &case_samples, 0, 10000000, "M", "rows per case (0: every row)", 0, NULL},
-        {"--tool-offset", RCH_OPT_FLAG, &cfg.tool_offset, 0, 0, NULL,
+        {"--cases", RCH_OPT_UINT, &a->cases, 1, 1000, "N", "repeat on N random subsets (the paper's protocol)", 0,
+         NULL},
+        {"--samples", RCH_OPT_UINT, &a->case_samples, 0, 10000000, "M", "rows per case (0: every row)", 0, NULL},
+        {"--tool-offset", RCH_OPT_FLAG, &cfg->tool_offset, 0, 0, NULL,
          "also identify where the cable is attached in the flange frame (tx, ty, tz)", 0, NULL},
-        {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
+        {"--out", RCH_OPT_STR, &a->out_path, 0, 0, "MODEL.json",
          "write the calibrated model (rcal-model/2) for compensation; never over an input", 0, NULL},
-        {"--truth", RCH_OPT_STR, &cfg.truth_path, 0, 0, "TRUTH.json",
+        {"--truth", RCH_OPT_STR, &cfg->truth_path, 0, 0, "TRUTH.json",
          "a simulated truth: flange errors over 2000 random poses, before and after", 0, NULL},
-        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &a->json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
     };
     const rch_cmdspec spec = {"calibrate", "identify the DH errors and the encoder position from cable lengths",
                               "mean|e| is what the paper's Eq. 20 calls SD; SD is the true standard deviation.",
                               opts, sizeof opts / sizeof opts[0]};
     const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
     if (ps != RCH_OPT_OK)
-        return ps == RCH_OPT_HELP ? 0 : 2;
-    if (rch_method_parse(&cfg.method, method) != 0)
-        return 2; /* unreachable: the choice list is the method list */
-    cfg.seed = seed;
-    cfg.max_iter = (unsigned)max_iter;
-    cfg.cases = cases;
-    cfg.case_samples = case_samples;
-    cfg.data_path = data.v[0];
-    cfg.data_paths = data.v;
-    cfg.n_data_paths = data.n;
+        return ps;
+    if (rch_method_parse(&cfg->method, a->method) != 0)
+        return RCH_OPT_ERROR; /* unreachable: the choice list is the method list */
+    cfg->seed = a->seed;
+    cfg->max_iter = (unsigned)a->max_iter;
+    cfg->cases = a->cases;
+    cfg->case_samples = a->case_samples;
+    cfg->data_path = a->data.v[0];
+    cfg->data_paths = a->data.v;
+    cfg->n_data_paths = a->data.n;
+    return RCH_OPT_OK;
+}
 
-    const char *inputs[RCH_OPT_MAX_STRS + 3] = {cfg.robot_path, cfg.truth_path, cfg.validate_path};
-    for (size_t i = 0; i < data.n; ++i)
-        inputs[3 + i] = data.v[i];
-    for (size_t i = 0; out_path && i < 3 + data.n; ++i)
-        if (inputs[i] && rch_same_file(out_path, inputs[i])) {
-            fprintf(stderr, "rcal calibrate: --out %s is also the input %s\n", out_path, inputs[i]);
-            return 2;
+/* 1 (with the message) when --out names one of the inputs. */
+static int out_is_input(const calib_args *a)
+{
+    const char *inputs[RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
+    for (size_t i = 0; i < a->data.n; ++i)
+        inputs[3 + i] = a->data.v[i];
+    for (size_t i = 0; a->out_path && i < 3 + a->data.n; ++i)
+        if (inputs[i] && rch_same_file(a->out_path, inputs[i])) {
+            fprintf(stderr, "rcal calibrate: --out %s is also the input %s\n", a->out_path, inputs[i]);
+            return 1;
         }
+    return 0;
+}
+
+int rcal_cmd_calibrate(int argc, char **argv)
+{
+    calib_args a;
+    memset(&a, 0, sizeof a);
+    a.cfg.robot_path = RCAL_DEFAULT_ROBOT;
+    a.cfg.test_fraction = 0.1;
+    a.method = "lm";
+    a.seed = 1;
+    a.cases = 1;
+    const rch_opt_status ps = parse(&a, argc, argv);
+    if (ps != RCH_OPT_OK)
+        return ps == RCH_OPT_HELP ? 0 : 2;
+    if (out_is_input(&a))
+        return 2;
     rch_calib_result *r = malloc(sizeof *r); /* large: two models, the identifiability report */
     rch_diag d;
     char msg[1024];
-    const int rc = r ? rch_calib_run(r, &cfg, &d) : -1;
+    const int rc = r ? rch_calib_run(r, &a.cfg, &d) : -1;
     if (rc != 0) {
         fprintf(stderr, "rcal calibrate: %s\n", r ? rch_diag_str(&d, msg, sizeof msg) : "out of memory");
         free(r);
         return rc == -2 ? 2 : 1;
     }
     int status = r->after_ok ? 0 : 1;
-    if (json ? rch_calib_json(stdout, r) != 0 : (rch_calib_print(stdout, r), 0))
+    if (a.json ? rch_calib_json(stdout, r) != 0 : (rch_calib_print(stdout, r), 0))
         status = 1;
-    else if (out_path && write_model(r, out_path, json) != 0)
+    else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
         status = 1;
     free(r);
     return status;

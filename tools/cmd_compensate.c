@@ -24,6 +24,21 @@ static void print_sources(const rch_comp_result *r, const char *model)
             r->orientation_determined ? "determined" : "not determined", r->max_pos95_mm, r->n_uncertain);
 }
 
+/* Targets, iterations, largest correction and time (--summary). */
+static void print_summary(const rch_comp_result *rp)
+{
+    const rch_comp_result r = *rp;
+    char fails[160] = "";
+    if (r.n_fail > 0)
+        snprintf(fails, sizeof fails, " (%lu at a joint limit; largest position error written %.4f mm)",
+                 r.n_joint_limit, r.max_fail_err_mm);
+    fprintf(stderr,
+            "rcal compensate: %lu targets, %lu not converged%s, %lu with the orientation best effort (position "
+            "matched), %.2f iterations/target, largest correction %.4f deg, %.2f us/target\n",
+            r.n, r.n_fail, fails, r.n_pos_only, r.n ? (double)r.iters / (double)r.n : 0.0, r.max_corr_deg,
+            r.n ? r.t_ns / (double)r.n / 1e3 : 0.0);
+}
+
 int rcal_cmd_compensate(int argc, char **argv)
 {
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
@@ -92,18 +107,9 @@ int rcal_cmd_compensate(int argc, char **argv)
         fprintf(stderr, "rcal compensate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
-    if (summary)
-        print_sources(&r, model);
     if (summary) {
-        char fails[160] = "";
-        if (r.n_fail > 0)
-            snprintf(fails, sizeof fails, " (%lu at a joint limit; largest position error written %.4f mm)",
-                     r.n_joint_limit, r.max_fail_err_mm);
-        fprintf(stderr,
-                "rcal compensate: %lu targets, %lu not converged%s, %lu with the orientation best effort (position "
-                "matched), %.2f iterations/target, largest correction %.4f deg, %.2f us/target\n",
-                r.n, r.n_fail, fails, r.n_pos_only, r.n ? (double)r.iters / (double)r.n : 0.0, r.max_corr_deg,
-                r.n ? r.t_ns / (double)r.n / 1e3 : 0.0);
+        print_sources(&r, model);
+        print_summary(&r);
     }
     return rc == 0 ? 0 : 1;
 }

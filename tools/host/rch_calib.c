@@ -64,13 +64,7 @@ int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, c
 
 int rch_method_parse(rc_method *out, const char *name)
 {
-    static const rc_method all[] = {RC_METHOD_LM, RC_METHOD_LTLM, RC_METHOD_LM_PAPER, RC_METHOD_LTLM_PAPER};
-    for (size_t i = 0; i < sizeof all / sizeof all[0]; ++i)
-        if (strcmp(name, rc_method_name(all[i])) == 0) {
-            *out = all[i];
-            return 0;
-        }
-    return -1;
+    return rc_method_from_name(out, name) == RC_OK ? 0 : -1;
 }
 
 int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d)
