@@ -43,7 +43,7 @@ int rcal_cmd_compensate(int argc, char **argv)
 {
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
-    int position_only = 0, full_pose = 0, summary = 0;
+    int position_only = 0, full_pose = 0, summary = 0, accept_rt = 0;
     double max_unc_mm = 1.0;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/2 or /1, from rcal calibrate --out)",
@@ -64,6 +64,10 @@ int rcal_cmd_compensate(int argc, char **argv)
          "leave a target uncompensated (with a warning) where the model's 95 % position uncertainty is larger", 0,
          NULL},
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
+        {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
+         "RAPID robtargets (Cartesian) are copied uncorrected, each with a warning; with this flag that is not a "
+         "failure",
+         0, NULL},
         {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
         {"--summary", RCH_OPT_FLAG, &summary, 0, 0, NULL, "targets, iterations, largest correction and time on stderr",
          0, NULL},
@@ -95,6 +99,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         .position_only = position_only,
         .full_pose = full_pose,
         .max_unc_mm = max_unc_mm,
+        .accept_robtargets = accept_rt,
         .max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0, /* 0: the core's 0.1 rad */
     };
     rch_comp_result r;

@@ -402,6 +402,32 @@ static void test_rt_bad_numbers(void **state)
     }
 }
 
+/* A RAPID robtarget is copied uncorrected: never silently (issue 13). */
+static void test_robtargets_not_silent(void **state)
+{
+    (void)state;
+    char in[128], out[128], err[128], cmd[640];
+    snprintf(in, sizeof in, "%s/mixed.mod", dir);
+    snprintf(out, sizeof out, "%s/mixed_comp.mod", dir);
+    snprintf(err, sizeof err, "%s/mixed.err", dir);
+    write_file(in, "MODULE m\n"
+                   "  CONST jointtarget j1 := [[10,20,30,40,50,60],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                   "  CONST robtarget p1 := [[500,0,400],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                   "ENDMODULE\n");
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' 2> '%s'", RCAL, model_path, in, out,
+             err);
+    assert_int_equal(run(cmd), 1);
+    const char *msg = read_file(err);
+    assert_non_null(strstr(msg, "mixed.mod:3: warning: robtarget copied uncorrected"));
+    const char *txt = read_file(out);
+    assert_non_null(strstr(txt, "CONST robtarget p1 := [[500,0,400]"));
+    assert_null(strstr(txt, "[[10,20,30,40,50,60]")); /* the jointtarget was corrected */
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' --accept-robtargets 2> '%s'", RCAL,
+             model_path, in, out, err);
+    assert_int_equal(run(cmd), 0);
+    assert_non_null(strstr(read_file(err), "robtarget copied uncorrected"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -413,6 +439,7 @@ int main(void)
         cmocka_unit_test(test_output_never_destroys),
         cmocka_unit_test(test_failure_reported_truthfully),
         cmocka_unit_test(test_lines_in_process),
+        cmocka_unit_test(test_robtargets_not_silent),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -27,6 +27,7 @@ typedef struct {
     rc_comp_stream *stream;
     const rc_model *cal;
     const rch_comp_gate *gate;
+    int accept_robtargets;
     rch_comp_result *res;
     FILE *out, *warn;
     const char *in_name;
@@ -285,8 +286,21 @@ static int do_rapid(comp_ctx *c, const char *line, size_t n, unsigned lineno, rc
     const char *jt = find_ci(line, n, "jointtarget");
     const char *as = jt ? find_ci(jt, n - (size_t)(jt - line), ":=") : NULL;
     if (as == NULL) { /* not a declaration with a value: copy */
+        const char *rt = find_ci(line, n, "robtarget");
+        int uncorrected = rt && find_ci(rt, n - (size_t)(rt - line), ":=") != NULL;
         fwrite(line, 1, n, c->out);
         fputc('\n', c->out);
+        if (uncorrected) {
+            /* a Cartesian target: the controller's own inverse kinematics
+             * picks its joints, so a joint correction cannot be written here */
+            c->res->n_robtargets++;
+            if (c->warn)
+                fprintf(c->warn,
+                        "%s:%u: warning: robtarget copied uncorrected (rcal corrects jointtargets; convert it to a "
+                        "jointtarget, or pass --accept-robtargets)\n",
+                        c->in_name, lineno);
+            return c->accept_robtargets ? 0 : 1;
+        }
         return 0;
     }
     const char *p = as + 2, *end = line + n;
@@ -339,7 +353,7 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                          rch_diag *d)
 {
     comp_ctx c = {.stream = s, .cal = cal, .gate = gate, .res = res, .out = out, .warn = warn, .in_name = in_name,
-                  .format = (int)format};
+                  .format = (int)format, .accept_robtargets = gate ? gate->accept_robtargets : 0};
     char *line = NULL;
     size_t cap = 0;
     ssize_t got;
@@ -450,7 +464,8 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     }
     if (o.f == stdout)
         setvbuf(stdout, NULL, _IOLBF, 0);
-    const rch_comp_gate gate = {&robot.model, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm};
+    const rch_comp_gate gate = {&robot.model, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
+                                job->accept_robtargets};
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);

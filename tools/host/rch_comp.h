@@ -57,6 +57,8 @@ typedef struct rch_comp_job {
     double max_dev_deg;       /* largest correction per joint; 0: the default 0.1 rad */
     double max_unc_mm;        /* a target where the model's 95 % position uncertainty exceeds this is left
                                  uncompensated, with a warning; 0: 1 mm */
+    int accept_robtargets;    /* RAPID robtargets are copied uncorrected with a warning each; 1: that is
+                                 not a failure (exit 0) */
 } rch_comp_job;
 
 /* What the compensation may act on (issue 10): the determined model is
@@ -65,6 +67,7 @@ typedef struct rch_comp_gate {
     const rc_model *fit;       /* the full fit (for the size of what the held parameters would have moved) */
     const rch_model_unc *unc;  /* covariance of the determined DH parameters; NULL: no gate */
     double max_unc_mm;         /* see rch_comp_job */
+    int accept_robtargets;     /* see rch_comp_job */
 } rch_comp_gate;
 
 typedef struct rch_comp_result {
@@ -87,6 +90,7 @@ typedef struct rch_comp_result {
     double max_held_mm;           /* largest flange move the held parameters' fitted values would have made */
     unsigned long n_uncertain;    /* targets left uncompensated: uncertainty above max_unc_mm */
     double max_pos95_mm;          /* largest 95 % position uncertainty at a compensated target */
+    unsigned long n_robtargets;   /* RAPID robtargets copied uncorrected (each warned with its line) */
 } rch_comp_result;
 
 /* Compensate lines of `in` (named in_name in messages) to `out` with the
