@@ -133,7 +133,12 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     case RC_EFF_LENGTH_OFFSET: n = 1; joint = 0; break;
     case RC_EFF_LENGTH_SCALE: n = 1; joint = 0; break;
     case RC_EFF_TOOL_OFFSET: n = 3; joint = 0; break;
-    case RC_EFF_TIME_DRIFT: n = 2; joint = 0; break;
+    case RC_EFF_TIME_DRIFT: /* polynomial in t without constant, degree 1..4; 0: 3 */
+        n = count == 0 ? 3u : count;
+        joint = 0;
+        if (n > 4)
+            return RC_ERR_ARG;
+        break;
     case RC_EFF_GROUP_OFFSET: n = count; joint = 0; break;
     case RC_EFF_JOINT_PERIODIC: n = 4; break;
     case RC_EFF_JOINT_COMPLIANCE:
@@ -254,7 +259,8 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
             put_str(buf, buf_len, &pos, per_names[j & 3u]);
             break;
         case RC_EFF_TIME_DRIFT:
-            put_str(buf, buf_len, &pos, j == 0 ? ".d1" : ".d2");
+            put_str(buf, buf_len, &pos, ".d");
+            put_uint(buf, buf_len, &pos, j + 1u);
             break;
         case RC_EFF_GROUP_OFFSET:
             put_str(buf, buf_len, &pos, ".g");
@@ -544,7 +550,12 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         switch ((rc_effect_kind)ef->kind) {
         case RC_EFF_LENGTH_OFFSET: add += x[0]; break;
         case RC_EFF_LENGTH_SCALE: scale += x[0]; break;
-        case RC_EFF_TIME_DRIFT: add += x[0] * s->t + x[1] * s->t * s->t; break;
+        case RC_EFF_TIME_DRIFT: {
+            double tp = s->t;
+            for (unsigned k = 0; k < ef->count; ++k, tp *= s->t)
+                add += x[k] * tp;
+            break;
+        }
         case RC_EFF_GROUP_OFFSET:
             if (s->group < ef->count)
                 add += x[s->group];
@@ -581,10 +592,12 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         switch ((rc_effect_kind)ef->kind) {
         case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
         case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
-        case RC_EFF_TIME_DRIFT:
-            J[0] = s->t;
-            J[1] = s->t * s->t;
+        case RC_EFF_TIME_DRIFT: {
+            double tp = s->t;
+            for (unsigned k = 0; k < ef->count; ++k, tp *= s->t)
+                J[k] = tp;
             break;
+        }
         case RC_EFF_GROUP_OFFSET:
             for (unsigned k = 0; k < ef->count; ++k)
                 J[k] = (k == s->group) ? 1.0 : 0.0;

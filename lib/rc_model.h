@@ -43,7 +43,8 @@ typedef enum rc_effect_kind {
     RC_EFF_LENGTH_OFFSET = 1,   /* l += b;                         1 param, mm */
     RC_EFF_JOINT_COMPLIANCE = 2, /* theta_j += k * tau_j(q);       1 param, rad per m of lever */
     RC_EFF_JOINT_PERIODIC = 3,  /* theta_j += s1 sin q + c1 cos q + s2 sin 2q + c2 cos 2q; 4 params, rad */
-    RC_EFF_TIME_DRIFT = 4,      /* l += d1 t + d2 t^2, t in [0,1] acquisition order; 2 params, mm */
+    RC_EFF_TIME_DRIFT = 4,      /* l += d1 t + d2 t^2 (+ d3 t^3 + d4 t^4), t in [0,1] acquisition order;
+                                   count params (1..4; 0: 3), mm */
     RC_EFF_GROUP_OFFSET = 5,    /* l += g_k for samples of group k; count params, mm */
     RC_EFF_LENGTH_SCALE = 6,    /* l *= (1 + s) (encoder scale);   1 param, unitless */
     RC_EFF_TOOL_OFFSET = 7      /* measured point = flange + R6 (tx, ty, tz): where the cable

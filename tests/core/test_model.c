@@ -87,7 +87,7 @@ static rc_model model_with_effects(rc_rng *g)
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_GROUP_OFFSET, 0, 3), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_SCALE, 0, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
-    assert_int_equal(m.n_params, RC_N_BASE + 1 + 1 + 1 + 4 + 2 + 3 + 1 + 3);
+    assert_int_equal(m.n_params, RC_N_BASE + 1 + 1 + 1 + 4 + 3 + 3 + 1 + 3); /* drift: t, t^2, t^3 */
     for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
         m.x[k] = 1e-3 * rc_rng_normal(g);
     return m;

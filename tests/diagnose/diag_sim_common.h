@@ -63,7 +63,7 @@ static inline int diag_simulate(rc_sample *s, size_t n, const rc_model *nominal,
     rch_sim_truth(&truth, nominal, enc, &sc, &g);
     if (c->kind != RC_EFF_NONE) {
         const unsigned groups = (unsigned)((n + DIAG_GROUP_SIZE - 1) / DIAG_GROUP_SIZE);
-        if (rc_model_add_effect(&truth, c->kind, c->joint0, groups) != RC_OK)
+        if (rc_model_add_effect(&truth, c->kind, c->joint0, c->kind == RC_EFF_GROUP_OFFSET ? groups : 0) != RC_OK)
             return -1;
         double *x = &truth.x[truth.effects[truth.n_effects - 1].first];
         const double sgn = rc_rng_u01(&g) < 0.5 ? -1.0 : 1.0;

@@ -879,9 +879,9 @@ static int phase_cv_geometry(run_state *S, rch_diag *d)
 /* A sharp step inside a set-up: the geometry's residuals of the (up to) 8
  * samples of the same set-up after sample a and before it differ by at
  * least 4 standard errors, the noise taken from the residuals' spread within
- * the two windows. A pose-dependent effect read in acquisition order is noise
+ * the two windows, and by the fitted jump size within half of it. A pose-dependent effect read in acquisition order is noise
  * within a set-up and fails; a sensor jump passes. */
-static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t a)
+static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t a, double size)
 {
     double sum[2] = {0, 0}, sq[2] = {0, 0};
     unsigned cnt[2] = {0, 0};
@@ -903,7 +903,9 @@ static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t 
     const double m0 = sum[0] / cnt[0], m1 = sum[1] / cnt[1];
     const double v = (sq[0] - cnt[0] * m0 * m0 + sq[1] - cnt[1] * m1 * m1) / (double)(cnt[0] + cnt[1] - 2);
     const double se = sqrt(fmax(v, 0.0) * (1.0 / cnt[0] + 1.0 / cnt[1]));
-    return fabs(m1 - m0) > 4.0 * se;
+    /* a step the size of the fitted jump, not a slope that a long fit
+     * summarised as one (residual = model - L: a jump up in L moves it down) */
+    return fabs(m1 - m0) > 4.0 * se && fabs((m0 - m1) - size) < 0.5 * fabs(size);
 }
 
 /* 4b. Length jumps in acquisition order: found, removed from the lengths
@@ -934,7 +936,7 @@ static int phase_jumps(run_state *S, rch_diag *d)
         int near = 0;
         for (size_t i = a >= 2 ? a - 2 : 1; i <= a + 1 && i < n; ++i)
             near |= out->s[i].group != out->s[i - 1].group;
-        inside += !near && sharp_step(&out->jumps.geometry, out->s, n, a);
+        inside += !near && sharp_step(&out->jumps.geometry, out->s, n, a, out->jumps.size_mm[k]);
         out->jumps_at_setup_change += (unsigned)near;
     }
     if (inside == 0) {
@@ -1146,14 +1148,27 @@ static int one_se_rule(const run_state *S, const rch_diagnose_step *st, int best
 static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
 {
     rch_diagnose_result *out = S->out;
-    int best = -1;
+    int best = -1, second = -1;
+    /* Among the significant candidates the simpler cause wins unless the
+     * larger one explains clearly more: held-out MSE penalised by the
+     * parameters it adds (n ln MSE + p ln n, BIC-like), so 30 set-up offsets
+     * do not beat a 2-parameter drift that explains nearly the same. */
+    double crit[RCH_DIAGNOSE_MAX_CAND];
+    const double nn = (double)out->n;
     for (unsigned k = 0; k < st->n_cand; ++k) {
         rch_diagnose_cand *ca = &st->cand[k];
         if (!ca->tested)
             continue;
         ca->significant = ca->p_value < S->cfg.alpha / n_tested && ca->gain_mm2 > 0.0 && !ca->implausible;
-        if (ca->significant && (best < 0 || ca->gain_mm2 > st->cand[best].gain_mm2))
+        crit[k] = nn * log(ca->rmse_cv_mm * ca->rmse_cv_mm) + (double)ca->n_ident * log(nn);
+        if (!ca->significant)
+            continue;
+        if (best < 0 || crit[k] < crit[best]) {
+            second = best;
             best = (int)k;
+        } else if (second < 0 || crit[k] < crit[second]) {
+            second = (int)k;
+        }
     }
     if (best < 0) {
         snprintf(st->why, sizeof st->why,
@@ -1173,8 +1188,15 @@ static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
     if (chosen != best)
         snprintf(st->why, sizeof st->why,
                  "%s: significant, and within one standard error of the best (%s) with fewer parameters", cn, bn);
-    else
-        snprintf(st->why, sizeof st->why, "%s: largest significant held-out gain (z = %.1f)", cn,
+    else if (second >= 0 && crit[second] - crit[best] < 2.0 * log(nn)) {
+        char sn[40];
+        memcpy(sn, st->cand[second].name, sizeof sn);
+        snprintf(st->why, sizeof st->why,
+                 "%s, confounded with %s (penalised held-out fit within 2 ln n): both explain the same; an acquisition "
+                 "that revisits set-ups in shuffled order would separate them",
+                 cn, sn);
+    } else
+        snprintf(st->why, sizeof st->why, "%s: best significant held-out fit for its parameters (z = %.1f)", cn,
                  st->cand[chosen].z);
     const unsigned ci = slot_ci[chosen];
     S->base = S->cand_full[ci];
