@@ -238,7 +238,7 @@ static void test_chaos(void **state)
         const rch_json *curve = rch_json_get(j, "curve");
         const rch_json *hist = rch_json_get(j, "histogram");
         double sum = 0.0;
-        assert_true(fabs(iid - sqrt(20.0 * (1.0 - 1.0 / 50.0))) < 1e-6);
+        assert_true(fabs(iid - sqrt(20.0)) < 1e-6); /* Eq. 12 with N - 1: points / bins for independent draws */
         assert_true(rb >= 0.0 && rb <= 4.0);
         assert_int_equal(curve->n, 81); /* 0, 0.05, ..., 4 */
         assert_int_equal(hist->n, 50);

@@ -87,10 +87,10 @@ static void test_uniformity_measure(void **state)
     unsigned counts[50];
     double se;
     (void)state;
-    /* all points in one bin: sd = sqrt(((M - M/K)^2 + (K-1)(M/K)^2) / K) */
+    /* all points in one bin: sd = sqrt(((M - M/K)^2 + (K-1)(M/K)^2) / (K - 1)), Eq. 12 with N - 1 */
     {
         const double M = 1000, K = 50;
-        const double want = sqrt(((M - M / K) * (M - M / K) + (K - 1) * (M / K) * (M / K)) / K);
+        const double want = sqrt(((M - M / K) * (M - M / K) + (K - 1) * (M / K) * (M / K)) / (K - 1));
         assert_true(fabs(rch_chaos_sd(counts, 0.0, 0.0, 1000, 50) - want) < 1e-9);
         assert_int_equal(counts[0], 1000);
     }

@@ -274,6 +274,19 @@ static void report_rows(FILE *f, const rch_compare_result *res)
                 s->failed ? "  (failed in some cases)" : "");
     }
     fprintf(f, "  (BC: nominal DH with the encoder fitted alone; mean|e| is what the paper's Eq. 20 calls SD)\n");
+    /* The paper's Table 6 (Liu et al. 2024), as published, beside ours. */
+    static const double paper[RCH_COMPARE_ROWS][3] = {{2.18, 2.01, 3.42}, {0.36, 0.30, 0.91}, {0.63, 0.51, 1.52},
+                                                      {0.73, 0.61, 1.77}, {0.82, 0.66, 1.96}, {0.50, 0.40, 1.31},
+                                                      {0.34, 0.28, 0.85}, {0.32, 0.26, 0.83}};
+    fprintf(f, "\nThe paper's Table 6 beside ours (mm; the paper's SD is its Eq. 20, our mean|e|):\n");
+    fprintf(f, "  %-6s %22s %22s %22s\n", "method", "RMSE paper / ours", "SD paper / ours", "MAX paper / ours");
+    for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
+        const rch_compare_row *s = &res->row[r];
+        if (!s->used)
+            continue;
+        fprintf(f, "  %-6s %12.2f / %-7.3f %12.2f / %-7.3f %12.2f / %-7.3f\n", rch_compare_row_name(r), paper[r][0],
+                s->rmse_mm.mean, paper[r][1], s->mean_abs_mm.mean, paper[r][2], s->max_mm.mean);
+    }
 }
 
 static void report_ltlm(FILE *f, const rch_compare_result *res)

@@ -172,7 +172,7 @@ double rch_chaos_sd(unsigned *counts, double r, double n0, unsigned points, unsi
         const double dv = (double)c[b] - (double)points / (double)bins;
         ss += dv * dv;
     }
-    return sqrt(ss / (double)bins);
+    return bins > 1 ? sqrt(ss / (double)(bins - 1)) : 0.0; /* Eq. 12: N - 1 in the denominator */
 }
 
 double rch_chaos_sd_avg(double *se, double r, unsigned points, unsigned bins, unsigned n_starts,
@@ -200,5 +200,6 @@ double rch_chaos_sd_iid(unsigned points, unsigned bins)
 {
     if (bins == 0)
         return 0.0;
-    return sqrt((double)points / (double)bins * (1.0 - 1.0 / (double)bins));
+    /* E[sum (c - mean)^2] = points (1 - 1/bins) for independent draws; over bins - 1 (Eq. 12) */
+    return bins > 1 ? sqrt((double)points / (double)bins) : 0.0;
 }
