@@ -40,7 +40,7 @@ static int report(rch_diagnose_result *r, const char *plots, int json)
 
 int rcal_cmd_diagnose(int argc, char **argv)
 {
-    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL;
+    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *out_path = NULL;
     unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0, verbosity = 0;
     int json = 0, verbose = 0;
     rch_diagnose_cfg cfg;
@@ -52,6 +52,8 @@ int rcal_cmd_diagnose(int argc, char **argv)
         {"--folds", RCH_OPT_UINT, &folds, 2, RCH_DIAGNOSE_MAX_FOLDS, "K", "cross-validation folds", 0, NULL},
         {"--steps", RCH_OPT_UINT, &steps, 1, RCH_DIAGNOSE_MAX_STEPS, "N", "effects added at most", 0, NULL},
         {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "write residual plots (SVG) into DIR", 0, NULL},
+        {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
+         "write the calibrated model with the effects found (nuisances left out); never over an input", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
         {"--q-step-deg", RCH_OPT_DOUBLE, &cfg.q_step_deg, -1, 10, "D", "joint display step (0: detected)", 0, NULL},
         {"--len-step-mm", RCH_OPT_DOUBLE, &cfg.len_step_mm, -1, 10, "D", "length display step (0: detected)", 0,
@@ -89,7 +91,16 @@ int rcal_cmd_diagnose(int argc, char **argv)
         rch_diagnose_free(&r);
         return 1;
     }
-    const int rc = report(&r, plots, json);
+    int rc = report(&r, plots, json);
+    if (rc == 0 && out_path) {
+        const char *inputs[2] = {data_path, robot_path};
+        if (rch_diagnose_save_model(&r, robot_path, out_path, inputs, 2, &d) != 0) {
+            fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
+            rc = 1;
+        } else if (!json) {
+            printf("model with the effects found written to %s\n", out_path);
+        }
+    }
     rch_diagnose_free(&r);
     return rc;
 }

@@ -11,6 +11,7 @@
 #include "rch_data.h"
 #include "rch_diagnose.h"
 #include "rch_groups.h"
+#include "rch_opt.h"
 #include "rch_plot.h"
 #include "rc_rand.h"
 #include "rch_sha256.h"
@@ -65,6 +66,76 @@ int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, c
 int rch_method_parse(rc_method *out, const char *name)
 {
     return rc_method_from_name(out, name) == RC_OK ? 0 : -1;
+}
+
+int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
+{
+    static const struct {
+        const char *name;
+        rc_effect_kind kind;
+        int joint; /* 1: needs ":J" */
+    } table[] = {{"length_offset", RC_EFF_LENGTH_OFFSET, 0}, {"length_scale", RC_EFF_LENGTH_SCALE, 0},
+                 {"time_drift", RC_EFF_TIME_DRIFT, 0},       {"tool_offset", RC_EFF_TOOL_OFFSET, 0},
+                 {"joint_compliance", RC_EFF_JOINT_COMPLIANCE, 1}, {"joint_periodic", RC_EFF_JOINT_PERIODIC, 1}};
+    char buf[512];
+    if (strlen(list) >= sizeof buf) {
+        rch_diag_set(d, "", 0, 0, "--effects: list longer than %zu characters", sizeof buf - 1);
+        return -1;
+    }
+    memcpy(buf, list, strlen(list) + 1);
+    for (char *tok = buf, *next; tok && *tok; tok = next) {
+        next = strchr(tok, ',');
+        if (next)
+            *next++ = '\0';
+        char *colon = strchr(tok, ':');
+        if (colon)
+            *colon++ = '\0';
+        size_t k = 0;
+        while (k < sizeof table / sizeof table[0] && strcmp(tok, table[k].name) != 0)
+            ++k;
+        if (k == sizeof table / sizeof table[0]) {
+            rch_diag_set(d, "", 0, 0,
+                         "--effects: unknown effect '%s' (length_offset, length_scale, time_drift, tool_offset, "
+                         "joint_compliance:J, joint_periodic:J)",
+                         tok);
+            return -1;
+        }
+        unsigned long j = 0;
+        if (table[k].joint && (!colon || rch_parse_ulong(colon, &j) != 0 || j < 1 || j > 6)) {
+            rch_diag_set(d, "", 0, 0, "--effects: %s needs the joint, e.g. %s:2", tok, tok);
+            return -1;
+        }
+        rc_status st = rc_model_add_effect(m, table[k].kind, table[k].joint ? (unsigned)j - 1u : 0u, 0);
+        if (st != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "--effects: cannot add %s%s%s: %s", tok, colon ? ":" : "", colon ? colon : "",
+                         rc_strerror(st));
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void rch_model_strip_nuisance(rc_model *out, const rc_model *m)
+{
+    double dh[RC_NJ][4];
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        for (unsigned k = 0; k < 4; ++k)
+            dh[i][k] = m->x[4 * i + k];
+    rc_model r;
+    rc_model_init(&r, (const double(*)[4])dh, &m->x[RC_P_ENC]);
+    memcpy(r.q_min_rad, m->q_min_rad, sizeof r.q_min_rad);
+    memcpy(r.q_max_rad, m->q_max_rad, sizeof r.q_max_rad);
+    for (unsigned e = 0; e < m->n_effects; ++e) {
+        const rc_effect *ef = &m->effects[e];
+        if (ef->kind == RC_EFF_GROUP_OFFSET || ef->kind == RC_EFF_TIME_DRIFT)
+            continue;
+        if (rc_model_add_effect(&r, (rc_effect_kind)ef->kind, ef->joint, ef->count) != RC_OK)
+            continue;
+        rc_effect *ne = &r.effects[r.n_effects - 1];
+        memcpy(ne->ref_dh, ef->ref_dh, sizeof ne->ref_dh);
+        memcpy(&r.x[ne->first], &m->x[ef->first], ef->count * sizeof r.x[0]);
+    }
+    *out = r;
 }
 
 int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d)
@@ -633,6 +704,10 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     }
     if (!w) {
         rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    if (cfg->effects && rch_calib_effects(&r->robot.model, cfg->effects, d) != 0) {
+        rc = -2;
         goto done;
     }
     if (cfg->dequantize && dequantize(r, &data, d) != 0)

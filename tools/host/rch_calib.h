@@ -54,6 +54,16 @@ int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, c
 /* Parse a method name (lm, ltlm, lm-paper, ltlm-paper). Returns 0 or -1. */
 int rch_method_parse(rc_method *out, const char *name);
 
+/* Add the effects of list to m: comma-separated, "length_offset",
+ * "length_scale", "time_drift", "tool_offset", "joint_compliance:J" (J = 2
+ * or 3), "joint_periodic:J" (J = 1..6). 0, or -1 with d naming the entry. */
+int rch_calib_effects(rc_model *m, const char *list, rch_diag *d);
+
+/* A copy of m without its nuisance effects (group offsets, time drift):
+ * they describe one acquisition, not the robot, and predict nothing at a new
+ * pose. */
+void rch_model_strip_nuisance(rc_model *out, const rc_model *m);
+
 /* Mark the comma-separated parameter names of list (e.g. "a1,theta6") in
  * fixed (m->n_params). 0, or -1 with d naming the unknown parameter. */
 int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d);
@@ -73,6 +83,7 @@ typedef struct rch_calib_cfg {
     unsigned long seed;     /* split and LTLM seed */
     unsigned max_iter;      /* 0: the method's default */
     int tool_offset;        /* 1: also identify the cable attachment in the flange frame */
+    const char *effects;    /* effects fitted with the geometry (rch_calib_effects), or NULL */
     int jumps;              /* 1: fit length jumps at change points in acquisition order (nuisance, rch_jumps) */
     int dequantize;         /* 1: recover rounded joint angles from the file's x, y, z (rch_dequant) */
     int holdout_groups;     /* 1: hold out whole set-up groups instead of random rows */

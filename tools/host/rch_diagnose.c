@@ -3,6 +3,7 @@
 #include "rch_diagnose.h"
 #include "rch_dequant.h"
 #include "rch_groups.h"
+#include "rch_save.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -1605,4 +1606,29 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r)
     json_num(&w, "time_ms", r->time_ms);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
+}
+
+typedef struct {
+    const rc_model *m, *nominal;
+    const char *name;
+} save_ctx;
+
+static int save_fn(FILE *f, const void *arg)
+{
+    const save_ctx *c = arg;
+    return rch_robot_write(f, c->name, c->m, c->nominal, NULL);
+}
+
+int rch_diagnose_save_model(const rch_diagnose_result *r, const char *robot_path, const char *path,
+                            const char *const *inputs, size_t n_inputs, rch_diag *d)
+{
+    static rch_robot robot;
+    if (rch_robot_load(&robot, robot_path, d) != 0)
+        return -1;
+    rc_model m;
+    rch_model_strip_nuisance(&m, &r->final);
+    memcpy(m.q_min_rad, robot.model.q_min_rad, sizeof m.q_min_rad);
+    memcpy(m.q_max_rad, robot.model.q_max_rad, sizeof m.q_max_rad);
+    const save_ctx c = {&m, &robot.nominal, robot.name};
+    return rch_save(path, "--out", inputs, n_inputs, save_fn, &c, d);
 }

@@ -197,6 +197,14 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
 
 void rch_diagnose_free(rch_diagnose_result *r);
 
+/* The calibrated model with the effects the diagnosis chose (r->final), its
+ * nuisance effects (group offsets, time drift; length jumps are never in it)
+ * left out, as a model file at path (rch_save: whole or not at all, never
+ * over one of inputs). robot_path: the nominal robot (its name and nominal
+ * table). 0, or -1 with d set. */
+int rch_diagnose_save_model(const rch_diagnose_result *r, const char *robot_path, const char *path,
+                            const char *const *inputs, size_t n_inputs, rch_diag *d);
+
 /* Human report and one JSON object. 0 or -1 on a write error. */
 int rch_diagnose_print(FILE *f, const rch_diagnose_result *r);
 int rch_diagnose_json(FILE *f, const rch_diagnose_result *r);
