@@ -906,7 +906,7 @@ static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t 
     const double se = sqrt(fmax(v, 0.0) * (1.0 / cnt[0] + 1.0 / cnt[1]));
     /* a step the size of the fitted jump, not a slope that a long fit
      * summarised as one (residual = model - L: a jump up in L moves it down) */
-    return fabs(m1 - m0) > 4.0 * se && fabs((m0 - m1) - size) < 0.5 * fabs(size);
+    return fabs(m1 - m0) > 5.0 * se && fabs((m0 - m1) - size) < 0.3 * fabs(size);
 }
 
 /* 4b. Length jumps in acquisition order: found, removed from the lengths
