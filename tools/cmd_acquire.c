@@ -109,9 +109,9 @@ int rcal_cmd_acquire(int argc, char **argv)
     };
     const rch_cmdspec spec = {"acquire", "record cable lengths from the encoder display, pose by pose", details,
                               opts, sizeof opts / sizeof opts[0]};
-    rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (st != RCH_OPT_OK)
-        return st == RCH_OPT_HELP ? 0 : 2;
+    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    if (st >= 0)
+        return st;
     if (!(c.stable.min_mm < c.stable.max_mm)) {
         fprintf(stderr, "rcal acquire: need --min-mm < --max-mm\n");
         return 2;

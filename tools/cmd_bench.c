@@ -128,17 +128,14 @@ int rcal_cmd_bench(int argc, char **argv)
                               "'start' = encoder guess + encoder-only fit; 'solve' = the identification itself.\n"
                               "Whole processes against Ceres: scripts/bench_ceres.sh.",
                               opts, sizeof opts / sizeof opts[0]};
-    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (ps != RCH_OPT_OK)
-        return ps == RCH_OPT_HELP ? 0 : 2;
+    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    if (ps >= 0)
+        return ps;
     rch_robot robot;
     rch_data data;
     rch_diag d;
-    char msg[1024];
-    if (rch_robot_load(&robot, robot_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
-        fprintf(stderr, "rcal bench: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
+    if (rch_load_model_and_data(&robot, robot_path, &data, data_path, &d) != 0)
+        return rch_opt_fail(&spec, &d);
     rc_solve_work *w = malloc(sizeof *w);
     double *t_start = malloc(runs * sizeof *t_start), *t_solve = malloc(runs * sizeof *t_solve);
     bench_row rows[N_METHODS];
@@ -146,10 +143,8 @@ int rcal_cmd_bench(int argc, char **argv)
     if (rc != 0)
         fprintf(stderr, "rcal bench: out of memory\n");
     for (size_t k = 0; k < N_METHODS && rc == 0; ++k)
-        if (bench_method(&rows[k], k_methods[k], runs, w, &robot, &data, t_start, t_solve, &d) != 0) {
-            fprintf(stderr, "rcal bench: %s\n", rch_diag_str(&d, msg, sizeof msg));
-            rc = 1;
-        }
+        if (bench_method(&rows[k], k_methods[k], runs, w, &robot, &data, t_start, t_solve, &d) != 0)
+            rc = rch_opt_fail(&spec, &d);
     if (rc == 0 && json)
         rc = report_json(rows, data_path, data.n, runs) == 0 ? 0 : 1;
     else if (rc == 0)

@@ -90,9 +90,9 @@ int rcal_cmd_compare(int argc, char **argv)
     const rch_cmdspec spec = {"compare", compare_summary, compare_details, opts, sizeof opts / sizeof opts[0]};
     rch_compare_config cfg;
     rch_diag d;
-    const rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (st != RCH_OPT_OK)
-        return st == RCH_OPT_HELP ? 0 : 2; /* usage printed, or the error named */
+    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    if (st >= 0)
+        return st; /* usage printed, or the error named */
     rch_compare_defaults(&cfg);
     if (methods && rch_compare_methods(cfg.run, methods, &d) != 0) {
         fprintf(stderr, "rcal compare: %s\n", d.msg);

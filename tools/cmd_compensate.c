@@ -82,9 +82,9 @@ int rcal_cmd_compensate(int argc, char **argv)
         "status is then 1.",
         opts, sizeof opts / sizeof opts[0]};
     unsigned long long seen = 0;
-    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, &seen, stdout, stderr);
-    if (ps != RCH_OPT_OK)
-        return ps == RCH_OPT_HELP ? 0 : 2;
+    const int ps = rch_opt_main(&spec, argc, argv, &seen);
+    if (ps >= 0)
+        return ps;
     if (position_only && full_pose) {
         fprintf(stderr, "rcal compensate: --position-only and --full-pose exclude each other\n");
         return 2;

@@ -74,9 +74,9 @@ int rcal_cmd_diagnose(int argc, char **argv)
     };
     const rch_cmdspec spec = {"diagnose", "which missing physical effect explains the residuals", details, opts,
                               sizeof opts / sizeof opts[0]};
-    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (ps != RCH_OPT_OK)
-        return ps == RCH_OPT_HELP ? 0 : 2;
+    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    if (ps >= 0)
+        return ps;
     cfg.folds = (unsigned)folds;
     cfg.max_steps = (unsigned)steps;
     cfg.seed = seed;

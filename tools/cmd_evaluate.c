@@ -77,17 +77,15 @@ int rcal_cmd_evaluate(int argc, char **argv)
                               "RMSE, mean |e|, SD and MAX of the cable-length residuals, and the ISO 9283 distance\n"
                               "accuracy and repeatability where poses were read more than once.",
                               opts, sizeof opts / sizeof opts[0]};
-    rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (st != RCH_OPT_OK)
-        return st == RCH_OPT_HELP ? 0 : 2;
+    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    if (st >= 0)
+        return st;
     rch_robot robot;
     rch_data data;
     rch_diag d;
     char msg[1024];
-    if (rch_robot_load(&robot, model_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
-        fprintf(stderr, "rcal evaluate: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
+    if (rch_load_model_and_data(&robot, model_path, &data, data_path, &d) != 0)
+        return rch_opt_fail(&spec, &d);
     rch_evaluate_config cfg = {refit, same_deg};
     rch_evaluate_result r;
     rc_solve_work *w = malloc(sizeof *w);

@@ -33,9 +33,9 @@ int rcal_cmd_export(int argc, char **argv)
         "calibrated and correction values (mm, deg) and the standard error when the model has one.\n"
         "See docs/export.md.",
         opts, sizeof opts / sizeof opts[0]};
-    rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (st != RCH_OPT_OK)
-        return st == RCH_OPT_HELP ? 0 : 2;
+    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    if (st >= 0)
+        return st;
     const rch_export_format fmt = strcmp(format, "urdf") == 0 ? RCH_EXPORT_URDF : RCH_EXPORT_DH_CSV;
     if (nominal && fmt != RCH_EXPORT_URDF) {
         fprintf(stderr, "rcal export: --nominal-urdf applies to --format urdf only\n");

@@ -58,9 +58,9 @@ int rcal_cmd_fkcheck(int argc, char **argv)
     };
     const rch_cmdspec spec = {"fkcheck", "compare the nominal FK at each row's joint angles with its x, y, z",
                               details, opts, sizeof opts / sizeof opts[0]};
-    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (ps != RCH_OPT_OK)
-        return ps == RCH_OPT_HELP ? 0 : 2;
+    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    if (ps >= 0)
+        return ps;
     rch_fkcheck_result r;
     rch_diag d;
     char msg[1024];

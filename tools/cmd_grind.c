@@ -95,9 +95,9 @@ int rcal_cmd_grind(int argc, char **argv)
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the table", 0, NULL},
     };
     const rch_cmdspec spec = {"grind", grind_summary, grind_details, opts, sizeof opts / sizeof opts[0]};
-    const rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (st != RCH_OPT_OK)
-        return st == RCH_OPT_HELP ? 0 : 2; /* usage printed, or the error named */
+    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    if (st >= 0)
+        return st; /* usage printed, or the error named */
     if (rch_surface_parse(&cfg.surface, spec_s, &d) != 0) {
         fprintf(stderr, "rcal grind: --surface: %s\n", d.msg);
         return 2;

@@ -52,9 +52,9 @@ int rcal_cmd_poses(int argc, char **argv)
     rch_out out;
     char dbuf[900];
     int rc = 1;
-    rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (st != RCH_OPT_OK)
-        return st == RCH_OPT_HELP ? 0 : 2;
+    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    if (st >= 0)
+        return st;
     pc.count = n;
     pc.candidates = n_cand;
     pc.passes = passes;

@@ -31,19 +31,16 @@ int rcal_cmd_report(int argc, char **argv)
         "over the workspace, warnings, provenance. Members a run does not carry say \"not in this run\".\n"
         "The data of every plot is written beside the page as report_<plot>.csv. See docs/report.md.",
         opts, sizeof opts / sizeof opts[0]};
-    rch_opt_status st = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (st != RCH_OPT_OK)
-        return st == RCH_OPT_HELP ? 0 : 2;
+    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    if (st >= 0)
+        return st;
     char args[4000], cmdline[4096];
     snprintf(cmdline, sizeof cmdline, "rcal %s", rch_report_cmdline(args, sizeof args, argc, argv));
     cfg.command_line = cmdline;
     rch_report_result res;
     rch_diag d;
-    char msg[1024];
-    if (rch_report_write(&res, &cfg, &d) != 0) {
-        fprintf(stderr, "rcal report: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
+    if (rch_report_write(&res, &cfg, &d) != 0)
+        return rch_opt_fail(&spec, &d);
     fprintf(stderr, "rcal report: %s written (%u plots, %u warnings, %u places not in this run)\n", cfg.out_path,
             res.n_plots, res.n_warnings, res.n_missing);
     for (unsigned k = 0; k < res.n_csv; ++k)

@@ -50,9 +50,9 @@ int rcal_cmd_simulate(int argc, char **argv)
                               "and the encoder at --encoder. Lengths get Gaussian noise and the encoder\n"
                               "resolution; joint angles are recorded at the display step.",
                               opts, sizeof opts / sizeof opts[0]};
-    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (ps != RCH_OPT_OK)
-        return ps == RCH_OPT_HELP ? 0 : 2;
+    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    if (ps >= 0)
+        return ps;
     job.n = n;
     job.seed = seed;
     c->group_size = (unsigned)group;
@@ -61,10 +61,8 @@ int rcal_cmd_simulate(int argc, char **argv)
     rch_sim_set set;
     rch_diag d;
     char msg[1024];
-    if (rch_sim_make(&set, &job, &d) != 0) {
-        fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
+    if (rch_sim_make(&set, &job, &d) != 0)
+        return rch_opt_fail(&spec, &d);
     const int rc = rch_sim_save(&set, &job, out_path, truth_out, &d);
     rch_sim_set_free(&set);
     if (rc != 0) {

@@ -2,6 +2,8 @@
 /* rch_opt.c - table-driven option parser (see rch_opt.h). */
 #include "rch_opt.h"
 
+#include "rch_diag.h"
+
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -304,6 +306,19 @@ rch_opt_status rch_opt_parse(const rch_cmdspec *spec, int argc, char **argv, uns
     if (seen_out)
         *seen_out = seen;
     return RCH_OPT_OK;
+}
+
+int rch_opt_main(const rch_cmdspec *spec, int argc, char **argv, unsigned long long *seen)
+{
+    const rch_opt_status st = rch_opt_parse(spec, argc, argv, seen, stdout, stderr);
+    return st == RCH_OPT_OK ? -1 : st == RCH_OPT_HELP ? 0 : 2;
+}
+
+int rch_opt_fail(const rch_cmdspec *spec, const struct rch_diag *d)
+{
+    char msg[1024];
+    fprintf(stderr, "rcal %s: %s\n", spec->cmd, rch_diag_str(d, msg, sizeof msg));
+    return 1;
 }
 
 int rch_opt_given(const rch_cmdspec *spec, unsigned long long seen, const char *name)

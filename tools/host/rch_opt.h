@@ -67,6 +67,16 @@ typedef enum {
 rch_opt_status rch_opt_parse(const rch_cmdspec *spec, int argc, char **argv, unsigned long long *seen, FILE *out,
                              FILE *err);
 
+/* The command's entry: rch_opt_parse on stdout/stderr. Returns -1 when the
+ * command should run, else its exit status (0 after -h/--help, 2 after a
+ * usage error, already reported). */
+int rch_opt_main(const rch_cmdspec *spec, int argc, char **argv, unsigned long long *seen);
+
+/* The command's failure: "rcal CMD: file:line:col: what" on stderr; returns
+ * the exit status 1. */
+struct rch_diag;
+int rch_opt_fail(const rch_cmdspec *spec, const struct rch_diag *d);
+
 /* The usage text generated from the table (options, value names, ranges,
  * defaults, help lines, details). */
 void rch_opt_usage(const rch_cmdspec *spec, FILE *f);
