@@ -424,6 +424,21 @@ static void test_unbounded_work(void **state)
     }
     refused(C, "rcal-rt --in (8 KiB line)", 1, NEED("long.csv:2:", "longer than 1024 bytes"), KEEP("long.csv"),
             RT " --in long.csv --seconds 0.01");
+    {
+        /* 1 GiB of short rows would be 60 million rows (35 GB for a fit): the row limit */
+        char tp[512];
+        FILE *f;
+        path_in(tp, sizeof tp, "tiny.csv");
+        f = fopen(tp, "w");
+        assert_non_null(f);
+        fputs("q1,q2,q3,q4,q5,q6,L\n", f);
+        for (long i = 0; i <= 2000000; ++i)
+            fputs("0,0,0,0,30,0,500\n", f);
+        assert_int_equal(fclose(f), 0);
+        refused(C, "calibrate, 2000001 short rows", 1, NEED("tiny.csv:2000002:1:", "more than 2000000 data rows"),
+                &(files){{"tiny.csv"}, {"tiny.json"}}, R " calibrate --data tiny.csv --out tiny.json");
+        remove(tp);
+    }
     refused(C, "poses --count 100000", 2, NEED("--count", "1000"), &(files){{"r.json"}, {"p.csv"}},
             R " poses --robot r.json --count 100000 --out p.csv");
     refused(C, "chaos --points 1e8 --starts 1e5", 2, NEED("--points"), NULL, R " chaos --points 1e8 --starts 1e5");
