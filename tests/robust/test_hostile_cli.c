@@ -439,6 +439,22 @@ static void test_unbounded_work(void **state)
                 &(files){{"tiny.csv"}, {"tiny.json"}}, R " calibrate --data tiny.csv --out tiny.json");
         remove(tp);
     }
+    {
+        /* a 17 MiB JSON array of numbers (a 64 MiB one took 2.4 GB): the JSON reader's limit */
+        char jp[512];
+        FILE *f;
+        path_in(jp, sizeof jp, "wide.json");
+        f = fopen(jp, "w");
+        assert_non_null(f);
+        fputs("{\"before\": [0", f);
+        for (long i = 0; i < 17L * 1024 * 1024 / 2; ++i)
+            fputs(",0", f);
+        fputs("]}\n", f);
+        assert_int_equal(fclose(f), 0);
+        refused(C, "report --calibration (17 MiB of numbers)", 1, NEED("wide.json", "limit"),
+                &(files){{"wide.json"}, {"wide.html"}}, R " report --calibration wide.json --out wide.html");
+        remove(jp);
+    }
     refused(C, "poses --count 100000", 2, NEED("--count", "1000"), &(files){{"r.json"}, {"p.csv"}},
             R " poses --robot r.json --count 100000 --out p.csv");
     refused(C, "chaos --points 1e8 --starts 1e5", 2, NEED("--points"), NULL, R " chaos --points 1e8 --starts 1e5");
