@@ -462,6 +462,7 @@ static void test_unbounded_work(void **state)
             R " chaos --points 10000000 --starts 100000");
     refused(C, "compare --cases 10000 --samples 0", 1, NEED("--cases", "limit of"), KEEP("d.csv"),
             R " compare --data d.csv --cases 10000 --samples 0");
+    refused(C, "bench --runs 10000", 2, NEED("--runs", "limit of"), KEEP("d.csv"), R " bench --data d.csv --runs 10000");
     refused(C, "rcal-rt --bench --targets 1e7 --repeat 1000", 2, NEED("--targets times --repeat", "limit"), NULL,
             RT " --bench --targets 10000000 --repeat 1000");
     refused(C, "rcal-rt --rate-hz 100000 --seconds 3600", 2, NEED("cycles", "limit"), NULL,
