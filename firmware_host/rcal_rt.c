@@ -540,10 +540,20 @@ int main(int argc, char **argv)
     }
     if (emit)
         return emit_c(emit, nominal_path, position_only);
-    if (!(rate_hz >= 1.0 && rate_hz <= 100000.0) || !(seconds > 0.0 && seconds <= 3600.0) || n_bench == 0 ||
-        n_bench > RT_MAX_TARGETS || repeat == 0 || repeat > 1000) {
-        fprintf(stderr, "rcal-rt: --rate-hz must be 1..100000, --seconds 0..3600 (more than 0), --targets 1..%lu, "
-                        "--repeat 1..1000\n", (unsigned long)RT_MAX_TARGETS);
+    if (!(rate_hz >= 1.0 && rate_hz <= 100000.0)) {
+        fprintf(stderr, "rcal-rt: --rate-hz %g is out of range (1 to 100000)\n", rate_hz);
+        return 2;
+    }
+    if (!(seconds > 0.0 && seconds <= 3600.0)) {
+        fprintf(stderr, "rcal-rt: --seconds %g is out of range (more than 0, at most 3600)\n", seconds);
+        return 2;
+    }
+    if (n_bench == 0 || n_bench > RT_MAX_TARGETS) {
+        fprintf(stderr, "rcal-rt: --targets %lu is out of range (1 to %lu)\n", n_bench, (unsigned long)RT_MAX_TARGETS);
+        return 2;
+    }
+    if (repeat == 0 || repeat > 1000) {
+        fprintf(stderr, "rcal-rt: --repeat %lu is out of range (1 to 1000)\n", repeat);
         return 2;
     }
     if (bench && (double)n_bench * (double)repeat > RT_MAX_BENCH_WORK) {
