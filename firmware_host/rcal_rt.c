@@ -38,6 +38,12 @@
 #define DEG (M_PI / 180.0)
 /* --bench --targets limit: 56 bytes per target (its q and its latency) */
 #define RT_MAX_TARGETS 10000000UL
+/* --in: longest line */
+#define RT_MAX_LINE 1024
+/* --bench: targets times repeats (about 2 minutes at 1 us per target) */
+#define RT_MAX_BENCH_WORK 100000000.0
+/* the loop: cycles (24 bytes of timings each: 240 MB) */
+#define RT_MAX_CYCLES 10000000.0
 
 static void usage(FILE *f)
 {
@@ -122,6 +128,28 @@ static void synth_target(double q[RC_NJ], size_t k, double rate_hz)
         q[i] = c[i] + a[i] * sin(2.0 * M_PI * f[i] * t + i);
 }
 
+/* One line of the targets file into line (at most RT_MAX_LINE bytes, '\n'
+ * dropped): its length, -1 at the end, -2 when longer, -3 at a NUL byte
+ * (*col its column). */
+static long read_target_line(char line[RT_MAX_LINE + 1], FILE *f, long *col)
+{
+    long n = 0;
+    int ch = EOF;
+    while ((ch = getc(f)) != EOF && ch != '\n') {
+        if (ch == '\0') {
+            *col = n + 1;
+            return -3;
+        }
+        if (n == RT_MAX_LINE)
+            return -2;
+        line[n++] = (char)ch;
+    }
+    if (n == 0 && ch == EOF)
+        return -1;
+    line[n] = '\0';
+    return n;
+}
+
 static int load_targets(targets *t, const char *path, const rc_kin *m)
 {
     FILE *f = fopen(path, "r");
@@ -129,18 +157,31 @@ static int load_targets(targets *t, const char *path, const rc_kin *m)
         fprintf(stderr, "rcal-rt: %s: %s\n", path, strerror(errno));
         return -1;
     }
-    char line[1024];
+    char line[RT_MAX_LINE + 1];
     unsigned lineno = 0;
     size_t cap = 0;
+    long got, col = 0;
     t->q = NULL;
     t->n = 0;
-    while (fgets(line, sizeof line, f)) {
+    while ((got = read_target_line(line, f, &col)) != -1) {
         ++lineno;
+        if (got < 0 || t->n == RT_MAX_TARGETS) {
+            if (got == -3)
+                fprintf(stderr, "rcal-rt: %s:%u:%ld: NUL byte in a text file: refused\n", path, lineno, col);
+            else if (got == -2)
+                fprintf(stderr, "rcal-rt: %s:%u: line longer than %d bytes: refused\n", path, lineno, RT_MAX_LINE);
+            else
+                fprintf(stderr, "rcal-rt: %s:%u: more than %lu targets: refused\n", path, lineno,
+                        (unsigned long)RT_MAX_TARGETS);
+            fclose(f);
+            free(t->q);
+            return -1;
+        }
         double v[RC_NJ];
         char *p = line;
         while (*p == ' ' || *p == '\t')
             ++p;
-        if (*p == '#' || *p == '\n' || *p == '\r' || *p == '\0')
+        if (*p == '#' || *p == '\r' || *p == '\0')
             continue;
         int ok = 1;
         for (int i = 0; i < RC_NJ && ok; ++i) {
@@ -162,6 +203,8 @@ static int load_targets(targets *t, const char *path, const rc_kin *m)
                 ++p;
             }
         }
+        if (ok && *p != '\0' && *p != '\r')
+            ok = 0; /* something after q6: a seventh column or a typo */
         if (!ok) {
             if (t->n == 0 && lineno == 1)
                 continue; /* a header */
@@ -190,6 +233,12 @@ static int load_targets(targets *t, const char *path, const rc_kin *m)
             t->q = nq;
         }
         memcpy(t->q[t->n++], v, sizeof v);
+    }
+    if (ferror(f)) {
+        fprintf(stderr, "rcal-rt: %s: read error\n", path);
+        fclose(f);
+        free(t->q);
+        return -1;
     }
     fclose(f);
     if (t->n == 0) {
@@ -497,16 +546,45 @@ int main(int argc, char **argv)
             usage(stdout);
             return 0;
         } else {
+            int takes_value = 0;
+            static const char *const valued[] = {"--model",   "--nominal", "--in",     "--emit-c",
+                                                 "--rate-hz", "--seconds", "--targets", "--repeat", "--cpu"};
+            for (size_t k = 0; k < sizeof valued / sizeof valued[0]; ++k)
+                takes_value |= strcmp(a, valued[k]) == 0;
+            if (takes_value)
+                fprintf(stderr, "rcal-rt: option %s needs a value\n", a);
+            else
+                fprintf(stderr, "rcal-rt: unknown option '%s'\n", a);
             usage(stderr);
             return 2;
         }
     }
     if (emit)
         return emit_c(emit, nominal_path, position_only);
-    if (!(rate_hz >= 1.0 && rate_hz <= 100000.0) || !(seconds > 0.0 && seconds <= 3600.0) || n_bench == 0 ||
-        n_bench > RT_MAX_TARGETS || repeat == 0 || repeat > 1000) {
-        fprintf(stderr, "rcal-rt: --rate-hz must be 1..100000, --seconds 0..3600 (more than 0), --targets 1..%lu, "
-                        "--repeat 1..1000\n", (unsigned long)RT_MAX_TARGETS);
+    if (!(rate_hz >= 1.0 && rate_hz <= 100000.0)) {
+        fprintf(stderr, "rcal-rt: --rate-hz %g is out of range (1 to 100000)\n", rate_hz);
+        return 2;
+    }
+    if (!(seconds > 0.0 && seconds <= 3600.0)) {
+        fprintf(stderr, "rcal-rt: --seconds %g is out of range (more than 0, at most 3600)\n", seconds);
+        return 2;
+    }
+    if (n_bench == 0 || n_bench > RT_MAX_TARGETS) {
+        fprintf(stderr, "rcal-rt: --targets %lu is out of range (1 to %lu)\n", n_bench, (unsigned long)RT_MAX_TARGETS);
+        return 2;
+    }
+    if (repeat == 0 || repeat > 1000) {
+        fprintf(stderr, "rcal-rt: --repeat %lu is out of range (1 to 1000)\n", repeat);
+        return 2;
+    }
+    if (bench && (double)n_bench * (double)repeat > RT_MAX_BENCH_WORK) {
+        fprintf(stderr, "rcal-rt: --targets times --repeat is %.0f, over the limit of %.0f compensations\n",
+                (double)n_bench * (double)repeat, RT_MAX_BENCH_WORK);
+        return 2;
+    }
+    if (!bench && rate_hz * seconds > RT_MAX_CYCLES) {
+        fprintf(stderr, "rcal-rt: --rate-hz times --seconds is %.0f cycles, over the limit of %.0f (24 bytes of "
+                        "timings each)\n", rate_hz * seconds, RT_MAX_CYCLES);
         return 2;
     }
     if (!bench && rate_hz * seconds < 0.5) {

@@ -113,6 +113,9 @@ static int report_json(const bench_row *rows, const char *data_path, size_t n, u
     return rch_jw_finish(&w);
 }
 
+/* runs x rows x methods at most */
+#define RCAL_BENCH_MAX_WORK 1e7
+
 int rcal_cmd_bench(int argc, char **argv)
 {
     const char *data_path = "../shared/data/robotcali.csv", *robot_path = RCAL_DEFAULT_ROBOT;
@@ -136,6 +139,17 @@ int rcal_cmd_bench(int argc, char **argv)
     rch_diag d;
     if (rch_load_model_and_data(&robot, robot_path, &data, data_path, &d) != 0)
         return rch_opt_fail(&spec, &d);
+    /* the cost: every run fits every row with every method (about 50 us per
+     * row fit): 21 runs of the 1043 real rows is about 1e5 */
+    const double work = (double)runs * (double)data.n * (double)N_METHODS;
+    if (work > RCAL_BENCH_MAX_WORK) {
+        fprintf(stderr,
+                "rcal bench: %lu runs x %zu rows x %d methods = %.3g row fits, above the limit of %.0e (about 8 min): "
+                "lower --runs or use a smaller --data\n",
+                runs, data.n, (int)N_METHODS, work, RCAL_BENCH_MAX_WORK);
+        rch_data_free(&data);
+        return 2;
+    }
     rc_solve_work *w = malloc(sizeof *w);
     double *t_start = malloc(runs * sizeof *t_start), *t_solve = malloc(runs * sizeof *t_solve);
     bench_row rows[N_METHODS];

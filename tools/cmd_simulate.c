@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "rcal_cmds.h"
+#include "rch_data.h" /* RCH_DATA_MAX_ROWS */
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_opt.h"
 #include "rch_sim.h"
@@ -27,7 +28,8 @@ int rcal_cmd_simulate(int argc, char **argv)
         {"--robot", RCH_OPT_STR, &job.robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
         {"--truth", RCH_OPT_STR, &job.truth_path, 0, 0, "TRUTH.json", "a given true model (no random errors)", 0,
          NULL},
-        {"--samples", RCH_OPT_UINT, &n, 1, 10000000, NULL, "number of samples", 0, NULL},
+        {"--samples", RCH_OPT_UINT, &n, 1, (double)RCH_DATA_MAX_ROWS, NULL, "number of samples (what rcal reads)", 0,
+         NULL},
         {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "random seed", 0, NULL},
         {"--noise-mm", RCH_OPT_DOUBLE, &c->noise_mm, -1, 100, "S", "length noise sigma (0: 0.01; negative: none)", 0,
          NULL},

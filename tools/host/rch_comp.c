@@ -22,6 +22,9 @@
 #endif
 #define DEG (M_PI / 180.0)
 #define MAX_FIELDS 64
+/* longest input line (a RAPID target line is a few hundred bytes): a longer
+ * one, or a stream without line ends (/dev/zero), is refused, not buffered */
+#define MAX_LINE 65536
 
 typedef struct {
     rc_comp_stream *stream;
@@ -342,6 +345,33 @@ static int do_rapid(comp_ctx *c, const char *line, size_t n, unsigned lineno, rc
     return r;
 }
 
+/* One line of at most MAX_LINE bytes into *line (grown as needed, '\n'
+ * kept): its length, -1 at the end of the input, -2 when longer. */
+static long read_line(char **line, size_t *cap, FILE *in)
+{
+    size_t n = 0;
+    int ch = EOF;
+    while (n <= MAX_LINE && (ch = getc(in)) != EOF) {
+        if (n + 2 > *cap) {
+            const size_t nc = *cap ? 2 * *cap : 256;
+            char *nl = realloc(*line, nc);
+            if (!nl)
+                return -2;
+            *line = nl;
+            *cap = nc;
+        }
+        (*line)[n++] = (char)ch;
+        if (ch == '\n')
+            break;
+    }
+    if (n == 0 && ch == EOF)
+        return -1;
+    if (n > MAX_LINE)
+        return -2;
+    (*line)[n] = '\0';
+    return (long)n;
+}
+
 int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
                    const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d)
 {
@@ -356,12 +386,17 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                   .format = (int)format, .accept_robtargets = gate ? gate->accept_robtargets : 0};
     char *line = NULL;
     size_t cap = 0;
-    ssize_t got;
+    long got;
     unsigned lineno = 0;
     int rc = 0, decided = c.format != 0;
-    while ((got = getline(&line, &cap, in)) >= 0) {
+    while ((got = read_line(&line, &cap, in)) != -1) {
         size_t n = (size_t)got;
         ++lineno;
+        if (got == -2) {
+            rch_diag_set(d, c.in_name, lineno, 1, "line longer than %d bytes (no line end?): refused", MAX_LINE);
+            rc = -1;
+            break;
+        }
         while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'))
             --n;
         if (memchr(line, '\0', n) != NULL) {

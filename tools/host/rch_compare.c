@@ -187,6 +187,18 @@ static int case_sizes(rch_compare_result *res, const rch_compare_config *cfg, si
         rch_diag_set(d, "", 0, 0, "--samples %zu but the data has %zu rows", res->n_draw, n);
         return -1;
     }
+    {
+        /* the cost: one fit per case, method and drawn row (about 0.5 ms
+         * each on one core): 10 cases x 300 rows x 7 methods is 21000 */
+        const double work = (double)cfg->cases * (double)res->n_draw * (double)sel;
+        if (work > RCH_COMPARE_MAX_WORK) {
+            rch_diag_set(d, "", 0, 0,
+                         "%lu cases x %zu rows x %zu methods = %.3g row fits, above the limit of %.0e (about 8 "
+                         "min): lower --cases or --samples",
+                         cfg->cases, res->n_draw, sel, work, RCH_COMPARE_MAX_WORK);
+            return -1;
+        }
+    }
     res->n_test = (size_t)floor(cfg->test_fraction * (double)res->n_draw + 0.5);
     if (res->n_test < 1)
         res->n_test = 1;

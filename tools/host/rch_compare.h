@@ -42,6 +42,8 @@
 enum { RCH_COMPARE_ROWS = RCH_EST_COUNT + 1 };
 
 #define RCH_COMPARE_MAX_CASES 10000ul
+/* cases x rows drawn x methods at most (the cost of a comparison) */
+#define RCH_COMPARE_MAX_WORK 1e6
 
 typedef struct rch_compare_config {
     unsigned long cases;      /* 1..RCH_COMPARE_MAX_CASES */

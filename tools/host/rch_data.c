@@ -159,7 +159,16 @@ static int grow(rch_data *out, parse_ctx *pc)
     size_t nc;
     if (out->n < pc->cap)
         return 0;
+    if (out->n >= RCH_DATA_MAX_ROWS) {
+        rch_diag_set(pc->d, pc->name, pc->line_no, 1,
+                     "more than %lu data rows: refused (a calibration needs about 560 bytes of memory per row; "
+                     "use a subset)",
+                     (unsigned long)RCH_DATA_MAX_ROWS);
+        return -1;
+    }
     nc = pc->cap ? 2 * pc->cap : 256;
+    if (nc > RCH_DATA_MAX_ROWS)
+        nc = RCH_DATA_MAX_ROWS;
     rc_sample *s = realloc(out->s, nc * sizeof *s);
     if (s)
         out->s = s;

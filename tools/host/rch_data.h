@@ -38,6 +38,9 @@ typedef struct rch_data {
 } rch_data;
 
 #define RCH_DATA_MAX_BYTES ((size_t)1 << 30) /* largest file loaded (1 GiB) */
+/* most rows loaded: 1 GiB of short rows is 60 million, about 35 GB for a
+ * calibration; 2 million take about 1.1 GB and 45 s */
+#define RCH_DATA_MAX_ROWS ((size_t)2000000)
 
 /* Load a file (at most RCH_DATA_MAX_BYTES); on failure returns non-zero with d filled in. */
 int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d);

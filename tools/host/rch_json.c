@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "rch_json.h"
+#include "rch_file.h"
 
 #include <errno.h>
 #include <math.h>
@@ -346,37 +347,10 @@ rch_json *rch_json_parse(const char *text, size_t len, const char *name, rch_dia
 
 rch_json *rch_json_load(const char *path, rch_diag *d)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        rch_diag_set(d, path, 0, 0, "cannot open: %s", strerror(errno));
+    char *buf = NULL;
+    size_t len = 0;
+    if (rch_read_file(&buf, &len, path, RCH_JSON_MAX_BYTES, d) != 0)
         return NULL;
-    }
-    size_t cap = 4096, len = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        len += fread(buf + len, 1, cap - len, f);
-        if (len < cap)
-            break;
-        if (cap > ((size_t)64 << 20)) {
-            free(buf);
-            fclose(f);
-            rch_diag_set(d, path, 0, 0, "file larger than 64 MiB");
-            return NULL;
-        }
-        char *nb = realloc(buf, cap * 2);
-        if (!nb) {
-            free(buf);
-            buf = NULL;
-            break;
-        }
-        buf = nb;
-        cap *= 2;
-    }
-    fclose(f);
-    if (!buf) {
-        rch_diag_set(d, path, 0, 0, "out of memory");
-        return NULL;
-    }
     rch_json *j = rch_json_parse(buf, len, path, d);
     free(buf);
     return j;

@@ -23,6 +23,10 @@ typedef struct rch_json {
 } rch_json;
 
 rch_json *rch_json_parse(const char *text, size_t len, const char *name, rch_diag *d);
+/* most bytes rch_json_load reads: a parsed file takes up to about 40 times
+ * its size in memory (a 64 MiB array of numbers took 2.4 GB); the largest
+ * file rcal writes (calibrate --json) is a few KiB */
+#define RCH_JSON_MAX_BYTES ((size_t)16 << 20)
 rch_json *rch_json_load(const char *path, rch_diag *d);
 void rch_json_free(rch_json *j);
 /* Member of an object, or NULL. */

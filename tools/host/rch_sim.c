@@ -2,8 +2,10 @@
 #include "rch_sim.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "rch_data.h"
 #include "rch_file.h"
@@ -248,13 +250,39 @@ static int write_truth_fn(FILE *f, const void *ctx)
     return rch_sim_write_truth(f, ctx);
 }
 
+/* 1 when a and b name one file in one directory (the directories compared
+ * by device and inode): two spellings of a file that does not exist yet. */
+static int same_place(const char *a, const char *b)
+{
+    const char *sa = strrchr(a, '/'), *sb = strrchr(b, '/');
+    const char *ba = sa ? sa + 1 : a, *bb = sb ? sb + 1 : b;
+    char da[4096], db[4096];
+    struct stat xa, xb;
+    if (strcmp(ba, bb) != 0)
+        return 0;
+    snprintf(da, sizeof da, "%.*s", sa ? (sa == a ? 1 : (int)(sa - a)) : 1, sa ? a : ".");
+    snprintf(db, sizeof db, "%.*s", sb ? (sb == b ? 1 : (int)(sb - b)) : 1, sb ? b : ".");
+    return stat(da, &xa) == 0 && stat(db, &xb) == 0 && xa.st_dev == xb.st_dev && xa.st_ino == xb.st_ino;
+}
+
 int rch_sim_save(const rch_sim_set *set, const rch_sim_job *job, const char *out_path, const char *truth_out,
                  rch_diag *d)
 {
     const char *inputs[3] = {job->robot_path, job->truth_path, out_path};
-    if (truth_out && (strcmp(truth_out, out_path) == 0 || rch_same_file(truth_out, out_path))) {
-        rch_diag_set(d, "", 0, 0, "--truth-out %s is also --out: refused, nothing written", truth_out);
-        return -1;
+    if (truth_out) {
+        if (strcmp(truth_out, out_path) == 0 || rch_same_file(truth_out, out_path) || same_place(truth_out, out_path)) {
+            rch_diag_set(d, "", 0, 0, "--truth-out %s is also --out: refused, nothing written", truth_out);
+            return -1;
+        }
+        /* --truth-out naming an input is refused before --out is written */
+        for (int k = 0; k < 2; ++k)
+            if (inputs[k] && rch_same_file(truth_out, inputs[k])) {
+                rch_diag_set(d, truth_out, 0, 0,
+                             "--truth-out names the same file as the input %s: refused, nothing written (choose "
+                             "another output)",
+                             inputs[k]);
+                return -1;
+            }
     }
     if (rch_save(out_path, "--out", inputs, 2, write_csv_fn, set, d) != 0)
         return -1;
