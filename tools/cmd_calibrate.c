@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
@@ -60,7 +61,8 @@ static rch_opt_status parse(calib_args *a, int argc, char **argv)
         {"--test-fraction", RCH_OPT_DOUBLE, &cfg->test_fraction, 0, 0.999, "F",
          "share of samples held out for the before/after report", 0, NULL},
         {"--seed", RCH_OPT_UINT, &a->seed, 0, 0, "S", "split (and LTLM) seed", 0, NULL},
-        {"--max-iter", RCH_OPT_UINT, &a->max_iter, 0, 100000, "N", "iteration cap (0: the method's default)", 0, NULL},
+        {"--max-iter", RCH_OPT_UINT, &a->max_iter, 1, 100000, "N", "iteration cap (not given: the method's default)", 0,
+         NULL},
         {"--fix", RCH_OPT_STR, &cfg->fix, 0, 0, "LIST",
          "parameters held at nominal, e.g. a1,theta6 (a1..a6, d1..d6, alpha1..alpha6, theta1..theta6, ex, ey, ez)",
          0, NULL},
@@ -118,6 +120,11 @@ static int out_is_input(const calib_args *a)
             fprintf(stderr, "rcal calibrate: --out %s is also the input %s\n", a->out_path, inputs[i]);
             return 1;
         }
+    struct stat st;
+    if (a->out_path && strcmp(a->out_path, "-") != 0 && stat(a->out_path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        fprintf(stderr, "rcal calibrate: --out %s is not a regular file: refused before the fit\n", a->out_path);
+        return 1;
+    }
     return 0;
 }
 

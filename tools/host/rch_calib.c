@@ -3,6 +3,7 @@
 #include "rch_calib.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -694,6 +695,8 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || load_all(&data, counts, cfg, d) != 0)
         return -1;
     r->n_data = data.n;
+    if (data.n > 100000)
+        fprintf(stderr, "rcal calibrate: %zu samples: the fit takes about %.0f s\n", data.n, 2e-5 * (double)data.n);
     groups(r, &data, counts);
     provenance(r, counts);
     int rc = -1;

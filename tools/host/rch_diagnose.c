@@ -1369,6 +1369,8 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
         if (c.q_step_deg == 0.0)
             c.q_step_deg = -1.0; /* the joints are no longer on the display grid */
     }
+    if (data.n > 100000)
+        fprintf(stderr, "rcal diagnose: %zu samples, %u folds: this takes minutes\n", data.n, c.folds ? c.folds : 5u);
     const int rc = rch_diagnose_run(out, data.s, data.n, &robot.nominal, &c, d);
     out->dequant_corrected = dq.n_corrected;
     out->dequant_refused = dq.n_refused;

@@ -47,10 +47,13 @@ static int read_dh(double dh[RC_NJ][4], const rch_json *arr, const char *file, r
             snprintf(what, sizeof what, "dh[%u].%s", i + 1, keys[k]);
             if (want_num(&dh[i][k], rch_json_get(row, keys[k]), what, file, d, row) != 0)
                 return -1;
-            const double lim = k < 2 ? 1e5 : 720.0;
+            /* a link longer than 5 m is no industrial robot's: the model file is wrong */
+            const double lim = k < 2 ? RCH_ROBOT_MAX_LINK_MM : 720.0;
             if (fabs(dh[i][k]) > lim) {
                 const rch_json *at = rch_json_get(row, keys[k]);
-                rch_diag_set(d, file, at->line, at->col, "%s = %g is absurd (|value| > %g)", what, dh[i][k], lim);
+                rch_diag_set(d, file, at->line, at->col,
+                             "%s = %g is implausible for a robot model (|value| at most %g): check the model file",
+                             what, dh[i][k], lim);
                 return -1;
             }
             if (k >= 2)
@@ -58,6 +61,33 @@ static int read_dh(double dh[RC_NJ][4], const rch_json *arr, const char *file, r
         }
     }
     return 0;
+}
+
+/* Largest plausible magnitude of an effect parameter (SI as in the file):
+ * beyond it the effect is not a small physical correction but a typo. */
+static double effect_limit(rc_effect_kind k)
+{
+    switch (k) {
+    case RC_EFF_LENGTH_OFFSET:
+    case RC_EFF_TIME_DRIFT:
+    case RC_EFF_GROUP_OFFSET:
+    case RC_EFF_TOOL_OFFSET: return 1000.0; /* mm */
+    case RC_EFF_LENGTH_SCALE: return 0.1;   /* 10 % of the length */
+    case RC_EFF_JOINT_COMPLIANCE: return 0.1; /* rad per m of lever */
+    case RC_EFF_JOINT_PERIODIC: return 0.2;   /* rad (11 deg) */
+    case RC_EFF_NONE: break;
+    }
+    return 0.0;
+}
+
+static const char *effect_unit(rc_effect_kind k)
+{
+    switch (k) {
+    case RC_EFF_LENGTH_SCALE: return "";
+    case RC_EFF_JOINT_COMPLIANCE: return "rad/m";
+    case RC_EFF_JOINT_PERIODIC: return "rad";
+    default: return "mm";
+    }
 }
 
 static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_diag *d)
@@ -110,9 +140,18 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
                          (unsigned)ef->count, params->n);
             return -1;
         }
-        for (size_t p = 0; p < params->n; ++p)
+        for (size_t p = 0; p < params->n; ++p) {
             if (want_num(&m->x[ef->first + p], params->items[p], "effect parameter", file, d, params) != 0)
                 return -1;
+            const double lim = effect_limit((rc_effect_kind)ef->kind);
+            if (fabs(m->x[ef->first + p]) > lim) {
+                rch_diag_set(d, file, params->items[p]->line, params->items[p]->col,
+                             "effect %s: parameter %zu = %g is implausible (|value| at most %g %s): check the model "
+                             "file",
+                             kind->str, p + 1, m->x[ef->first + p], lim, effect_unit((rc_effect_kind)ef->kind));
+                return -1;
+            }
+        }
         if (ref) {
             if (ref->type != RCH_JARR || ref->n != 4) {
                 rch_diag_set(d, file, ref->line, ref->col, "\"ref_dh\" must be 4 rows [a, d, alpha, theta]");

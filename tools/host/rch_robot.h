@@ -27,6 +27,9 @@
 #include "rch_jw.h"
 #include "rch_uncert.h"
 
+/* Link lengths (a, d) beyond this are refused as a wrong model file. */
+#define RCH_ROBOT_MAX_LINK_MM 5000.0
+
 typedef struct rch_robot {
     char name[128];
     rc_model model;     /* the model in the file (calibrated or nominal) */
