@@ -552,8 +552,10 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         case RC_EFF_LENGTH_SCALE: scale += x[0]; break;
         case RC_EFF_TIME_DRIFT: {
             double tp = s->t;
-            for (unsigned k = 0; k < ef->count; ++k, tp *= s->t)
+            for (unsigned k = 0; k < ef->count; ++k) {
                 add += x[k] * tp;
+                tp *= s->t;
+            }
             break;
         }
         case RC_EFF_GROUP_OFFSET:
@@ -594,8 +596,10 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
         case RC_EFF_TIME_DRIFT: {
             double tp = s->t;
-            for (unsigned k = 0; k < ef->count; ++k, tp *= s->t)
+            for (unsigned k = 0; k < ef->count; ++k) {
                 J[k] = tp;
+                tp *= s->t;
+            }
             break;
         }
         case RC_EFF_GROUP_OFFSET:

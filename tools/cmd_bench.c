@@ -141,7 +141,7 @@ int rcal_cmd_bench(int argc, char **argv)
         return rch_opt_fail(&spec, &d);
     /* the cost: every run fits every row with every method (about 50 us per
      * row fit): 21 runs of the 1043 real rows is about 1e5 */
-    const double work = (double)runs * (double)data.n * (double)N_METHODS;
+    const double work = (double)runs * (double)data.n * (double)(unsigned)N_METHODS;
     if (work > RCAL_BENCH_MAX_WORK) {
         fprintf(stderr,
                 "rcal bench: %lu runs x %zu rows x %d methods = %.3g row fits, above the limit of %.0e (about 8 min): "
