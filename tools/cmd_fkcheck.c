@@ -11,19 +11,30 @@
 #include "rch_opt.h"
 
 static const char details[] = "A row further than T mm is a fault unless a joint change within the 0.1 deg\n"
-                              "display rounding explains it.";
+                              "display rounding explains it. Exit status: 0 no fault, 3 faults found (listed),\n"
+                              "1 the check could not run, 2 usage.";
 
-static int report_json(const rch_fkcheck_result *r)
+static int report_json(const rch_fkcheck_result *r, int argc, char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, stdout, 0);
     rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-fkcheck/1", argc, argv);
     rch_jw_uint(&w, "rows", r->rows);
     rch_jw_uint(&w, "faults", r->faults);
     rch_jw_uint(&w, "explained_by_rounding", r->rounding);
     rch_jw_numf(&w, "rms_mm", r->rms_mm, "%.6f");
     rch_jw_numf(&w, "max_mm", r->max_mm, "%.6f");
     rch_jw_numf(&w, "max_consistent_mm", r->max_consistent_mm, "%.6f");
+    rch_jw_arr(&w, "fault_lines");
+    for (size_t i = 0; i < r->faults; ++i) {
+        rch_jw_obj(&w, NULL);
+        rch_jw_uint(&w, "line", r->fault[i].line);
+        rch_jw_numf(&w, "dist_mm", r->fault[i].dist_mm, "%.6f");
+        rch_jw_numf(&w, "dq_deg", r->fault[i].dq_deg, "%.6f");
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
 }
@@ -71,9 +82,11 @@ int rcal_cmd_fkcheck(int argc, char **argv)
     }
     int rc = 0;
     if (json)
-        rc = report_json(&r) != 0;
+        rc = report_json(&r, argc, argv) != 0;
     else
         report_text(&r, data_path, tol_mm);
+    if (rc == 0 && r.faults > 0)
+        rc = 3; /* the file holds rows the nominal model cannot have produced */
     rch_fkcheck_free(&r);
     return rc;
 }

@@ -2,7 +2,10 @@
 /* rch_jw.c - the one JSON writer (see rch_jw.h). */
 #include "rch_jw.h"
 
+#include "rc_version.h"
+
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 void rch_jw_init(rch_jw *w, FILE *f, int pretty)
@@ -276,4 +279,27 @@ const char *rch_jw_escape(const char *s, char *buf, size_t len)
     }
     buf[o] = '\0';
     return buf;
+}
+
+void rch_jw_header(rch_jw *w, const char *format, int argc, char **argv)
+{
+    size_t len = 6;
+    for (int i = 0; i < argc; ++i)
+        len += strlen(argv[i]) + 1;
+    char *cmd = malloc(len);
+    if (cmd) {
+        size_t o = 0;
+        memcpy(cmd, "rcal", 4);
+        o = 4;
+        for (int i = 0; i < argc; ++i) {
+            cmd[o++] = ' ';
+            memcpy(cmd + o, argv[i], strlen(argv[i]));
+            o += strlen(argv[i]);
+        }
+        cmd[o] = '\0';
+    }
+    rch_jw_str(w, "format", format);
+    rch_jw_str(w, "tool", "rcal " RC_VERSION_STRING);
+    rch_jw_str(w, "command", cmd);
+    free(cmd);
 }

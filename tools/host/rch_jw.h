@@ -47,6 +47,11 @@ void rch_jw_nums(rch_jw *w, const char *key, const double *v, size_t n);
 /* Newline at the end; 0 when everything was written and closed, -1 otherwise. */
 int rch_jw_finish(rch_jw *w);
 
+/* The members every command's JSON starts with: "format" (e.g.
+ * "rcal-fkcheck/1"), "tool" ("rcal <version>") and "command" (the command
+ * line, argv[0] the command's name, joined with blanks). */
+void rch_jw_header(rch_jw *w, const char *format, int argc, char **argv);
+
 /* Escape s as a JSON string body into buf (always terminated); returns buf. */
 const char *rch_jw_escape(const char *s, char *buf, size_t len);
 
