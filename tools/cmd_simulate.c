@@ -22,6 +22,7 @@ int rcal_cmd_simulate(int argc, char **argv)
     const char *out_path = NULL, *truth_out = NULL;
     unsigned long repeats = 1, n = 500, seed = 1, group = 0;
     rch_sim_config *c = &job.sim;
+    rch_sim_defaults(c); /* the defaults shown; 0 given on the command line means none, never the default */
     const rch_opt opts[] = {
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "DATA.csv", "the simulated measurements", RCH_OPT_REQUIRED, NULL},
         {"--truth-out", RCH_OPT_STR, &truth_out, 0, 0, "TRUTH.json", "the true model", 0, NULL},
@@ -31,16 +32,16 @@ int rcal_cmd_simulate(int argc, char **argv)
         {"--samples", RCH_OPT_UINT, &n, 1, (double)RCH_DATA_MAX_ROWS, NULL, "number of samples (what rcal reads)", 0,
          NULL},
         {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "random seed", 0, NULL},
-        {"--noise-mm", RCH_OPT_DOUBLE, &c->noise_mm, -1, 100, "S", "length noise sigma (0: 0.01; negative: none)", 0,
+        {"--noise-mm", RCH_OPT_DOUBLE, &c->noise_mm, -1, 100, "S", "length noise sigma (0 or negative: none)", 0,
          NULL},
         {"--resolution-mm", RCH_OPT_DOUBLE, &c->resolution_mm, -1, 100, "R",
-         "encoder resolution (0: 0.004; negative: none)", 0, NULL},
+         "encoder resolution (0 or negative: none)", 0, NULL},
         {"--q-step-deg", RCH_OPT_DOUBLE, &c->q_step_deg, -1, 10, "D",
-         "joint display step (0: 0.1; negative: none)", 0, NULL},
-        {"--err-len-mm", RCH_OPT_DOUBLE, &c->err_len_mm, -100, 100, "S", "sigma of the a, d errors (0: 0.3)", 0,
+         "joint display step (0 or negative: none)", 0, NULL},
+        {"--err-len-mm", RCH_OPT_DOUBLE, &c->err_len_mm, -100, 100, "S", "sigma of the a, d errors (0: none)", 0,
          NULL},
         {"--err-ang-deg", RCH_OPT_DOUBLE, &c->err_ang_deg, -10, 10, "S",
-         "sigma of the alpha, theta errors (0: 0.05)", 0, NULL},
+         "sigma of the alpha, theta errors (0: none)", 0, NULL},
         {"--encoder", RCH_OPT_TRIPLE, job.enc_mm, -10000, 10000, NULL, "encoder outlet (mm)", 0, NULL},
         {"--group-size", RCH_OPT_UINT, &group, 0, 1000000, "G",
          "keep the wrist joints fixed for G consecutive poses (0: independent poses)", 0, NULL},
@@ -59,6 +60,10 @@ int rcal_cmd_simulate(int argc, char **argv)
     job.seed = seed;
     c->group_size = (unsigned)group;
     c->repeats = (unsigned)repeats;
+    double *zero_means_none[] = {&c->noise_mm, &c->resolution_mm, &c->q_step_deg, &c->err_len_mm, &c->err_ang_deg};
+    for (size_t k = 0; k < sizeof zero_means_none / sizeof zero_means_none[0]; ++k)
+        if (*zero_means_none[k] == 0.0)
+            *zero_means_none[k] = -1.0; /* rch_sim_defaults fills only zeros */
 
     rch_sim_set set;
     rch_diag d;

@@ -34,10 +34,11 @@ void rch_sim_truth(rc_model *truth, const rc_model *nominal, const double enc_mm
 {
     *truth = *nominal;
     for (unsigned i = 0; i < RC_NJ; ++i) {
-        truth->x[RC_P_A(i)] += c->err_len_mm * rc_rng_normal(g);
-        truth->x[RC_P_D(i)] += c->err_len_mm * rc_rng_normal(g);
-        truth->x[RC_P_ALPHA(i)] += c->err_ang_deg * DEG * rc_rng_normal(g);
-        truth->x[RC_P_THETA(i)] += c->err_ang_deg * DEG * rc_rng_normal(g);
+        const double sl = c->err_len_mm > 0.0 ? c->err_len_mm : 0.0, sa = c->err_ang_deg > 0.0 ? c->err_ang_deg : 0.0;
+        truth->x[RC_P_A(i)] += sl * rc_rng_normal(g);
+        truth->x[RC_P_D(i)] += sl * rc_rng_normal(g);
+        truth->x[RC_P_ALPHA(i)] += sa * DEG * rc_rng_normal(g);
+        truth->x[RC_P_THETA(i)] += sa * DEG * rc_rng_normal(g);
     }
     for (unsigned k = 0; k < 3; ++k)
         truth->x[RC_P_ENC + k] = enc_mm[k];
