@@ -8,8 +8,27 @@
 #include "rcal_cmds.h"
 #include "rch_data.h" /* RCH_DATA_MAX_ROWS */
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_sim.h"
+
+static int report_json(int argc, char **argv, unsigned long n, const char *out_path, const char *truth_out,
+                       const rch_sim_job *job)
+{
+    rch_jw w;
+    rch_jw_init(&w, stdout, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-simulate/1", argc, argv);
+    rch_jw_uint(&w, "samples", n);
+    rch_jw_str(&w, "data", out_path);
+    rch_jw_str(&w, "truth", truth_out);
+    rch_jw_uint(&w, "seed", job->seed);
+    rch_jw_num(&w, "noise_mm", job->sim.noise_mm > 0 ? job->sim.noise_mm : 0.0);
+    rch_jw_num(&w, "q_step_deg", job->sim.q_step_deg > 0 ? job->sim.q_step_deg : 0.0);
+    rch_jw_uint(&w, "repeats", job->sim.repeats > 1 ? job->sim.repeats : 1u);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w) == 0 ? 0 : 1;
+}
 
 int rcal_cmd_simulate(int argc, char **argv)
 {
@@ -21,6 +40,7 @@ int rcal_cmd_simulate(int argc, char **argv)
     job.enc_mm[2] = 10.0;
     const char *out_path = NULL, *truth_out = NULL;
     unsigned long repeats = 1, n = 500, seed = 1, group = 0;
+    int json = 0;
     rch_sim_config *c = &job.sim;
     rch_sim_defaults(c); /* the defaults shown; 0 given on the command line means none, never the default */
     const rch_opt opts[] = {
@@ -45,6 +65,7 @@ int rcal_cmd_simulate(int argc, char **argv)
         {"--encoder", RCH_OPT_TRIPLE, job.enc_mm, -10000, 10000, NULL, "encoder outlet (mm)", 0, NULL},
         {"--group-size", RCH_OPT_UINT, &group, 0, 1000000, "G",
          "keep the wrist joints fixed for G consecutive poses (0: independent poses)", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was written, as one JSON object on stdout", 0, NULL},
         {"--repeats", RCH_OPT_UINT, &repeats, 1, 1000, "R",
          "read every pose R times in a row (fresh length noise): repeatability, ISO 9283", 0, NULL},
     };
@@ -76,6 +97,8 @@ int rcal_cmd_simulate(int argc, char **argv)
         fprintf(stderr, "rcal simulate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
+    if (json)
+        return report_json(argc, argv, n, out_path, truth_out, &job);
     printf("rcal simulate: %lu samples written to %s%s%s\n", n, out_path, truth_out ? ", truth to " : "",
            truth_out ? truth_out : "");
     return 0;
