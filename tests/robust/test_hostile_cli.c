@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* test_hostile_cli.c - issue 12 ("No typo destroys a file, and no broken
  * display becomes a measurement"): every example of the issue, run through
  * the built binaries (build/tools/rcal, build/firmware_host/rcal-rt) as a
