@@ -31,33 +31,13 @@ static inline double rct_gauss(rct_rng *g)
     return sqrt(-2.0 * log(u)) * cos(6.283185307179586 * v);
 }
 
-/* Flange position of a standard-DH arm: dh[i] = {a_mm, d_mm, alpha_rad,
- * theta_off_rad}, joint angle q[i] added to theta. */
-static inline void rct_flange(double p[3], double dh[6][4], const double q[6])
+/* Frame k (after k joints, 0..6) of a standard-DH arm: dh[i] = {a_mm,
+ * d_mm, alpha_rad, theta_off_rad}, joint angle q[i] added to theta. Origin
+ * p (3), rotation R (3 x 3, row-major; may be NULL). */
+static inline void rct_frame(double p[3], double R[9], double dh[6][4], const double q[6], int k)
 {
     double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
-    for (int i = 0; i < 6; ++i) {
-        double th = q[i] + dh[i][3], ct = cos(th), st = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
-        double A[4][4] = {{ct, -st * ca, st * sa, dh[i][0] * ct},
-                          {st, ct * ca, -ct * sa, dh[i][0] * st},
-                          {0, sa, ca, dh[i][1]},
-                          {0, 0, 0, 1}};
-        double R[4][4];
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c)
-                R[r][c] = T[r][0] * A[0][c] + T[r][1] * A[1][c] + T[r][2] * A[2][c] + T[r][3] * A[3][c];
-        memcpy(T, R, sizeof T);
-    }
-    p[0] = T[0][3];
-    p[1] = T[1][3];
-    p[2] = T[2][3];
-}
-
-/* Flange pose: position p (3) and rotation R (3 x 3, row-major). */
-static inline void rct_pose(double p[3], double R[9], double dh[6][4], const double q[6])
-{
-    double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < k; ++i) {
         double th = q[i] + dh[i][3], ct = cos(th), st = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
         double A[4][4] = {{ct, -st * ca, st * sa, dh[i][0] * ct},
                           {st, ct * ca, -ct * sa, dh[i][0] * st},
@@ -71,9 +51,32 @@ static inline void rct_pose(double p[3], double R[9], double dh[6][4], const dou
     }
     for (int r = 0; r < 3; ++r) {
         p[r] = T[r][3];
-        for (int c = 0; c < 3; ++c)
+        for (int c = 0; R && c < 3; ++c)
             R[r * 3 + c] = T[r][c];
     }
+}
+
+/* Flange position. */
+static inline void rct_flange(double p[3], double dh[6][4], const double q[6])
+{
+    rct_frame(p, NULL, dh, q, 6);
+}
+
+/* Flange pose: position p (3) and rotation R (3 x 3, row-major). */
+static inline void rct_pose(double p[3], double R[9], double dh[6][4], const double q[6])
+{
+    rct_frame(p, R, dh, q, 6);
+}
+
+/* Gravity moment arm about joint 2 (m): the wrist centre's (frame 4)
+ * horizontal offset from joint 2's axis (frame 1), along the arm's heading. */
+static inline double rct_lever2_m(double dh[6][4], const double q[6])
+{
+    double j2[3], w[3];
+    rct_frame(j2, NULL, dh, q, 1);
+    rct_frame(w, NULL, dh, q, 4);
+    const double hx = cos(q[0] + dh[0][3]), hy = sin(q[0] + dh[0][3]);
+    return ((w[0] - j2[0]) * hx + (w[1] - j2[1]) * hy) / 1000.0;
 }
 
 static inline double rct_dist(const double p[3], const double e[3])

@@ -36,38 +36,6 @@ static const char *const expect[E_COUNT] = {"none",        "length_jump",      "
                                             "joint_compliance", "joint_periodic", "unexplained", "none"};
 static const unsigned expect_joint[E_COUNT] = {0, 0, 0, 0, 2, 3, 0, 0};
 
-/* Origin of frame k (after k joints) of a standard-DH chain. */
-static void origin(double p[3], double dh[6][4], const double q[6], int k)
-{
-    double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
-    for (int i = 0; i < k; ++i) {
-        double th = q[i] + dh[i][3], ct = cos(th), st = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
-        double A[4][4] = {{ct, -st * ca, st * sa, dh[i][0] * ct},
-                          {st, ct * ca, -ct * sa, dh[i][0] * st},
-                          {0, sa, ca, dh[i][1]},
-                          {0, 0, 0, 1}};
-        double X[4][4];
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c)
-                X[r][c] = T[r][0] * A[0][c] + T[r][1] * A[1][c] + T[r][2] * A[2][c] + T[r][3] * A[3][c];
-        memcpy(T, X, sizeof T);
-    }
-    p[0] = T[0][3];
-    p[1] = T[1][3];
-    p[2] = T[2][3];
-}
-
-/* Gravity moment arm about joint 2 (m): the wrist centre's horizontal
- * offset from joint 2's axis, along the arm's heading. */
-static double lever2_m(double dh[6][4], const double q[6])
-{
-    double j2[3], w[3];
-    origin(j2, dh, q, 1);
-    origin(w, dh, q, 4);
-    const double hx = cos(q[0] + dh[0][3]), hy = sin(q[0] + dh[0][3]);
-    return ((w[0] - j2[0]) * hx + (w[1] - j2[1]) * hy) / 1000.0;
-}
-
 /* One data set: robot nominal (as its model file), truth = nominal + small
  * DH errors, the effect scaled to an RMS length change of size * noise. */
 static double make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double noise, double size)
@@ -104,7 +72,7 @@ static double make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double 
         double qe[6];
         memcpy(qe, q[i], sizeof qe);
         if (e == E_COMPL2) /* the arm sags under its weight: joint 2 turns with the gravity moment */
-            qe[1] += 1e-3 * lever2_m(dh, q[i]); /* scaled below through the length change */
+            qe[1] += 1e-3 * rct_lever2_m(dh, q[i]); /* scaled below through the length change */
         if (e == E_PERIOD3)
             qe[2] += 1e-3 * sin(q[i][2] + phase);
         double p[3], R[9], base[3];

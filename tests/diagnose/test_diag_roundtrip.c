@@ -26,36 +26,12 @@
 
 static double dh[6][4];
 
-static void frame_origin(double p[3], const double q[6], int k)
-{
-    double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
-    for (int i = 0; i < k; ++i) {
-        double th = q[i] + dh[i][3], ct = cos(th), st = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
-        double A[4][4] = {{ct, -st * ca, st * sa, dh[i][0] * ct},
-                          {st, ct * ca, -ct * sa, dh[i][0] * st},
-                          {0, sa, ca, dh[i][1]},
-                          {0, 0, 0, 1}};
-        double X[4][4];
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c)
-                X[r][c] = T[r][0] * A[0][c] + T[r][1] * A[1][c] + T[r][2] * A[2][c] + T[r][3] * A[3][c];
-        memcpy(T, X, sizeof T);
-    }
-    p[0] = T[0][3];
-    p[1] = T[1][3];
-    p[2] = T[2][3];
-}
-
 /* The true robot: joint 2 turned by the gravity moment of the arm. */
 static void true_flange(double p[3], const double q[6])
 {
-    double j2[3], w[3], qe[6];
-    frame_origin(j2, q, 1);
-    frame_origin(w, q, 4);
-    const double hx = cos(q[0] + dh[0][3]), hy = sin(q[0] + dh[0][3]);
-    const double lever_m = ((w[0] - j2[0]) * hx + (w[1] - j2[1]) * hy) / 1000.0;
+    double qe[6];
     memcpy(qe, q, sizeof qe);
-    qe[1] += K_RAD_PER_M * lever_m;
+    qe[1] += K_RAD_PER_M * rct_lever2_m(dh, q);
     rct_flange(p, dh, qe);
 }
 

@@ -969,58 +969,15 @@ static void json_ident(rch_jw *w, const rch_ident *id)
 static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
 {
     const rch_model_unc *u = &r->unc;
-    const rc_model *m = &r->model;
     rch_jw_obj(w, "uncertainty");
     rch_jw_str(w, "covariance", u->kind == RCH_COV_CLUSTER ? "cluster-robust" : "classical");
     rch_jw_uint(w, "groups", u->n_groups);
     rch_jw_str(w, "groups_from", r->groups_from_file ? "file" : "wrist joints");
     rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
     rch_jw_uint(w, "rank", u->rank);
-    rch_jw_arr(w, "parameters");
-    for (unsigned k = 0; k < m->n_params; ++k) {
-        char nm[64];
-        const int unit = rc_param_unit(m, k);
-        const double sc = unit == 1 ? 1.0 / DEG : 1.0;
-        rch_jw_obj(w, NULL);
-        rch_jw_str(w, "name", rc_param_name(nm, sizeof nm, m, k));
-        rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "SI");
-        rch_jw_numf(w, "value", m->x[k] * sc, "%.9g");
-        rch_jw_numf(w, "std_error", u->se[k] * sc, "%.6g");
-        rch_jw_str(w, "class", rch_param_class_name((rch_param_class)u->cls[k]));
-        rch_jw_str(w, "compensation", k < RC_N_DH ? (u->comp_nominal[k] ? "nominal" : "fitted") : "not used");
-        rch_jw_end(w);
-    }
-    rch_jw_end(w);
-    rch_jw_obj(w, "position95_mm");
-    rch_jw_numf(w, "data_median", u->map.data_median_mm, "%.6g");
-    rch_jw_numf(w, "data_max", u->map.data_max_mm, "%.6g");
-    rch_jw_numf(w, "workspace_median", u->map.work_median_mm, "%.6g");
-    rch_jw_numf(w, "workspace_max", u->map.work_max_mm, "%.6g");
-    rch_jw_end(w);
-    rch_jw_obj(w, "orientation95_deg");
-    rch_jw_numf(w, "data_median", u->map.rot_data_median_deg, "%.6g");
-    rch_jw_numf(w, "data_max", u->map.rot_data_max_deg, "%.6g");
-    rch_jw_numf(w, "determined_median", u->map.rot_det_median_deg, "%.6g");
-    rch_jw_numf(w, "determined_max", u->map.rot_det_max_deg, "%.6g");
-    rch_jw_end(w);
+    rch_robot_write_unc_params(w, &r->model, u, "%.9g");
+    rch_robot_write_unc_map(w, &u->map);
     rch_jw_bool(w, "orientation_determined", u->orientation_determined);
-    rch_jw_end(w);
-}
-
-static void json_provenance(rch_jw *w, const rch_provenance *p)
-{
-    rch_jw_obj(w, "provenance");
-    rch_jw_arr(w, "data");
-    for (unsigned i = 0; i < p->n_files; ++i) {
-        rch_jw_obj(w, NULL);
-        rch_jw_str(w, "file", p->file[i]);
-        rch_jw_uint(w, "samples", p->samples[i]);
-        rch_jw_str(w, "sha256", p->sha256[i]);
-        rch_jw_end(w);
-    }
-    rch_jw_end(w);
-    rch_jw_str(w, "date", p->date);
-    rch_jw_str(w, "tool", p->tool);
     rch_jw_end(w);
 }
 
@@ -1101,7 +1058,7 @@ int rch_calib_json(FILE *f, const rch_calib_result *r)
         rch_jw_numf(&w, "iso9283_rd_max_mm", r->validate.rd_max_mm, "%.6f");
         rch_jw_end(&w);
     }
-    json_provenance(&w, &r->prov);
+    rch_robot_write_provenance(&w, &r->prov);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
 }

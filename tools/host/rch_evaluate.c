@@ -3,6 +3,8 @@
  * characteristics (see rch_evaluate.h). */
 #include "rch_evaluate.h"
 
+#include "rch_calib.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -80,13 +82,9 @@ int rch_evaluate(rch_evaluate_result *out, const rc_model *m, const rc_sample *s
     }
     rc_model use = *m;
     if (cfg && cfg->refit_encoder) {
-        uint8_t fixed[RC_MAX_PARAMS];
-        memset(fixed, 1, sizeof fixed);
-        fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 0;
-        rc_solve_config sc;
-        memset(&sc, 0, sizeof sc);
-        sc.fixed = fixed;
-        if (n < 10 || rc_solve(&use, NULL, w, &sc, s, n) != RC_OK) {
+        rch_diag dg;
+        /* the encoder alone, as the "before calibration" model is made */
+        if (n < 10 || rch_calib_bc(&use, w, m, 1, s, n, &dg) != 0) {
             snprintf(err, errlen, "refitting the encoder outlet failed (%zu samples)", n);
             return -1;
         }

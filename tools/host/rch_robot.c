@@ -246,8 +246,6 @@ static int read_nominal(rch_robot *out, const rch_json *root, const char *name, 
     return 0;
 }
 
-static const char *const class_words[] = {"fixed", "identifiable", "weak", "not identifiable"};
-
 /* One "parameters" entry k: class and standard error (file units: mm, deg). */
 static int read_unc_param(rch_robot *out, unsigned k, const rch_json *p, const char *name, rch_diag *d)
 {
@@ -257,7 +255,7 @@ static int read_unc_param(rch_robot *out, unsigned k, const rch_json *p, const c
         return -1;
     }
     unsigned c = 0;
-    while (c < 4 && strcmp(cl->str, class_words[c]) != 0)
+    while (c < 4 && strcmp(cl->str, rch_param_class_name((rch_param_class)c)) != 0)
         ++c;
     if (c == 4) {
         rch_diag_set(d, name, cl->line, cl->col, "unknown class \"%s\" (identifiable, weak, not identifiable, fixed)",
@@ -395,7 +393,7 @@ static void write_numsf(rch_jw *w, const char *key, const double *v, size_t n, c
     rch_jw_end(w);
 }
 
-static void write_map(rch_jw *w, const rch_uncert_map *mp)
+void rch_robot_write_unc_map(rch_jw *w, const rch_uncert_map *mp)
 {
     rch_jw_obj(w, "position95_mm");
     rch_jw_numf(w, "data_median", mp->data_median_mm, "%.6g");
@@ -411,13 +409,8 @@ static void write_map(rch_jw *w, const rch_uncert_map *mp)
     rch_jw_end(w);
 }
 
-static void write_uncertainty(rch_jw *w, const rc_model *m, const rch_model_unc *u, const rc_model *det)
+void rch_robot_write_unc_params(rch_jw *w, const rc_model *m, const rch_model_unc *u, const char *value_fmt)
 {
-    rch_jw_obj(w, "uncertainty");
-    rch_jw_str(w, "covariance", u->kind == RCH_COV_CLUSTER ? "cluster-robust" : "classical");
-    rch_jw_uint(w, "groups", u->n_groups);
-    rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
-    rch_jw_uint(w, "rank", u->rank);
     rch_jw_arr(w, "parameters");
     for (unsigned k = 0; k < m->n_params; ++k) {
         char nm[64];
@@ -426,13 +419,23 @@ static void write_uncertainty(rch_jw *w, const rc_model *m, const rch_model_unc 
         rch_jw_obj(w, NULL);
         rch_jw_str(w, "name", rc_param_name(nm, sizeof nm, m, k));
         rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "SI");
-        rch_jw_numf(w, "value", m->x[k] * sc, "%.12g");
+        rch_jw_numf(w, "value", m->x[k] * sc, value_fmt);
         rch_jw_numf(w, "std_error", u->se[k] * sc, "%.6g"); /* NaN -> null */
-        rch_jw_str(w, "class", class_words[u->cls[k] < 4 ? u->cls[k] : 0]);
+        rch_jw_str(w, "class", rch_param_class_name((rch_param_class)u->cls[k]));
         rch_jw_str(w, "compensation", k < RC_N_DH ? (u->comp_nominal[k] ? "nominal" : "fitted") : "not used");
         rch_jw_end(w);
     }
     rch_jw_end(w);
+}
+
+static void write_uncertainty(rch_jw *w, const rc_model *m, const rch_model_unc *u, const rc_model *det)
+{
+    rch_jw_obj(w, "uncertainty");
+    rch_jw_str(w, "covariance", u->kind == RCH_COV_CLUSTER ? "cluster-robust" : "classical");
+    rch_jw_uint(w, "groups", u->n_groups);
+    rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
+    rch_jw_uint(w, "rank", u->rank);
+    rch_robot_write_unc_params(w, m, u, "%.12g");
     rch_jw_arr(w, "covariance_dh");
     for (unsigned k = 0; k < RC_N_DH * RC_N_DH; ++k)
         rch_jw_numf(w, NULL, u->cov_dh[k], "%.9g");
@@ -443,11 +446,11 @@ static void write_uncertainty(rch_jw *w, const rc_model *m, const rch_model_unc 
         rch_jw_end(w);
     }
     rch_jw_bool(w, "orientation_determined", u->orientation_determined);
-    write_map(w, &u->map);
+    rch_robot_write_unc_map(w, &u->map);
     rch_jw_end(w);
 }
 
-static void write_provenance(rch_jw *w, const rch_provenance *p)
+void rch_robot_write_provenance(rch_jw *w, const rch_provenance *p)
 {
     rch_jw_obj(w, "provenance");
     rch_jw_arr(w, "data");
@@ -512,7 +515,7 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
     if (info && info->unc)
         write_uncertainty(&w, m, info->unc, info->determined);
     if (info && info->prov)
-        write_provenance(&w, info->prov);
+        rch_robot_write_provenance(&w, info->prov);
     rch_jw_end(&w);
     return rch_jw_finish(&w) == 0 && !ferror(f) ? 0 : -1;
 }

@@ -70,4 +70,12 @@ typedef struct rch_robot_info {
 int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model *nominal,
                     const rch_robot_info *info);
 
+/* Pieces of the uncertainty and provenance members, shared by the model
+ * file and `rcal calibrate --json`: the "parameters" array (value, standard
+ * error, class, compensation use; values printed with value_fmt), the
+ * "position95_mm" and "orientation95_deg" objects, the "provenance" object. */
+void rch_robot_write_unc_params(rch_jw *w, const rc_model *m, const rch_model_unc *u, const char *value_fmt);
+void rch_robot_write_unc_map(rch_jw *w, const rch_uncert_map *mp);
+void rch_robot_write_provenance(rch_jw *w, const rch_provenance *p);
+
 #endif

@@ -428,37 +428,67 @@ void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *n
             out->x[k] = nominal->x[k];
 }
 
+/* Central differences of the flange position (Jp, may be NULL) and of its
+ * small-rotation vector (Jr, may be NULL) with respect to the parameters k
+ * < n with use[k] set; the others' columns are zero. */
+static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARAMS], const uint8_t *use, unsigned n,
+                           const rc_model *m, const double q_rad[RC_NJ])
+{
+    rc_model t = *m;
+    for (unsigned k = 0; k < n; ++k) {
+        for (int i = 0; i < 3; ++i) {
+            if (Jp)
+                Jp[i][k] = 0.0;
+            if (Jr)
+                Jr[i][k] = 0.0;
+        }
+        if (!use[k])
+            continue;
+        const double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5;
+        double pp[3], pm[3], Rp[9], Rm[9];
+        t.x[k] = m->x[k] + h;
+        rc_fk(pp, Rp, &t, q_rad);
+        t.x[k] = m->x[k] - h;
+        rc_fk(pm, Rm, &t, q_rad);
+        t.x[k] = m->x[k];
+        for (int i = 0; Jp && i < 3; ++i)
+            Jp[i][k] = (pp[i] - pm[i]) / (2.0 * h);
+        if (Jr) { /* small rotation Rp Rm^T ~ I + [w]x, w = 2 h dw/dx */
+            double D[9];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    D[i * 3 + j] = Rp[i * 3] * Rm[j * 3] + Rp[i * 3 + 1] * Rm[j * 3 + 1] + Rp[i * 3 + 2] * Rm[j * 3 + 2];
+            Jr[0][k] = 0.5 * (D[7] - D[5]) / (2.0 * h);
+            Jr[1][k] = 0.5 * (D[2] - D[6]) / (2.0 * h);
+            Jr[2][k] = 0.5 * (D[3] - D[1]) / (2.0 * h);
+        }
+    }
+}
+
+/* Longest semi-axis of the 95 % ellipsoid of J Cov J^T, J (3 x n), Cov
+ * (n x n, leading dimension ld). */
+static double ellipsoid95(double J[3][RC_MAX_PARAMS], const double *cov, size_t ld, unsigned n)
+{
+    double C[9] = {0};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (unsigned k = 0; k < n; ++k)
+                for (unsigned l = 0; J[i][k] != 0.0 && l < n; ++l)
+                    C[i * 3 + j] += J[i][k] * cov[(size_t)k * ld + l] * J[j][l];
+    double ev[3];
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
+        return NAN;
+    return sqrt(CHI2_3_95 * fmax(ev[2], 0.0));
+}
+
 /* 95 % position semi-axis at q from a covariance cov (n x n, leading
  * dimension ld) over the parameters k < n with use[k] set. */
 static double pos95_cov(const double *cov, size_t ld, const uint8_t *use, unsigned n, const rc_model *m,
                         const double q_rad[RC_NJ])
 {
     double Jp[3][RC_MAX_PARAMS];
-    rc_model t = *m;
-    for (unsigned k = 0; k < n; ++k) {
-        Jp[0][k] = Jp[1][k] = Jp[2][k] = 0.0;
-        if (!use[k])
-            continue;
-        double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5;
-        double pp[3], pm[3];
-        t.x[k] = m->x[k] + h;
-        rc_fk(pp, NULL, &t, q_rad);
-        t.x[k] = m->x[k] - h;
-        rc_fk(pm, NULL, &t, q_rad);
-        t.x[k] = m->x[k];
-        for (int i = 0; i < 3; ++i)
-            Jp[i][k] = (pp[i] - pm[i]) / (2.0 * h);
-    }
-    double C[9] = {0};
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            for (unsigned k = 0; k < n; ++k)
-                for (unsigned l = 0; use[k] && l < n; ++l)
-                    C[i * 3 + j] += Jp[i][k] * cov[(size_t)k * ld + l] * Jp[j][l];
-    double ev[3];
-    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
-        return NAN;
-    return sqrt(CHI2_3_95 * fmax(ev[2], 0.0));
+    fk_sensitivity(Jp, NULL, use, n, m, q_rad);
+    return ellipsoid95(Jp, cov, ld, n);
 }
 
 double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
@@ -561,36 +591,11 @@ double rch_uncert_rot95_det_deg(const rch_uncert *u, const rc_model *m, const do
 static double rot95(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ], int determined_only)
 {
     unsigned np = u->n_params;
+    uint8_t use[RC_MAX_PARAMS];
     double Jr[3][RC_MAX_PARAMS];
-    rc_model t = *m;
-    for (unsigned k = 0; k < np; ++k) {
-        Jr[0][k] = Jr[1][k] = Jr[2][k] = 0.0;
-        if (u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE ||
-            (determined_only && u->comp_nominal[k]))
-            continue;
-        double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5, p[3], Rp[9], Rm[9];
-        t.x[k] = m->x[k] + h;
-        rc_fk(p, Rp, &t, q_rad);
-        t.x[k] = m->x[k] - h;
-        rc_fk(p, Rm, &t, q_rad);
-        t.x[k] = m->x[k];
-        /* small rotation Rp Rm^T ~ I + [w]x, w = 2 h dw/dx */
-        double D[9];
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                D[i * 3 + j] = Rp[i * 3] * Rm[j * 3] + Rp[i * 3 + 1] * Rm[j * 3 + 1] + Rp[i * 3 + 2] * Rm[j * 3 + 2];
-        Jr[0][k] = 0.5 * (D[7] - D[5]) / (2.0 * h);
-        Jr[1][k] = 0.5 * (D[2] - D[6]) / (2.0 * h);
-        Jr[2][k] = 0.5 * (D[3] - D[1]) / (2.0 * h);
-    }
-    double C[9] = {0};
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            for (unsigned k = 0; k < np; ++k)
-                for (unsigned l = 0; Jr[i][k] != 0.0 && l < np; ++l)
-                    C[i * 3 + j] += Jr[i][k] * u->cov[(size_t)k * np + l] * Jr[j][l];
-    double ev[3];
-    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
-        return NAN;
-    return sqrt(CHI2_3_95 * fmax(ev[2], 0.0)) * 57.29577951308232;
+    for (unsigned k = 0; k < np; ++k)
+        use[k] = !(u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE ||
+                   (determined_only && u->comp_nominal[k]));
+    fk_sensitivity(NULL, Jr, use, np, m, q_rad);
+    return ellipsoid95(Jr, u->cov, np, np) * 57.29577951308232;
 }
