@@ -16,17 +16,6 @@
 /* chi-square quantile with 3 degrees of freedom at 0.95 */
 #define CHI2_3_95 7.814727903251178
 
-const char *rch_param_class_name(rch_param_class c)
-{
-    switch (c) {
-    case RCH_PARAM_FIXED: return "fixed";
-    case RCH_PARAM_IDENTIFIABLE: return "identifiable";
-    case RCH_PARAM_WEAK: return "weak";
-    case RCH_PARAM_NOT_IDENTIFIABLE: return "not identifiable";
-    }
-    return "?";
-}
-
 void rch_uncert_free(rch_uncert *u)
 {
     free(u->cov);

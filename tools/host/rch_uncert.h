@@ -112,7 +112,18 @@ typedef struct rch_uncert_map {
 int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
                            size_t n_random, uint64_t seed);
 
-const char *rch_param_class_name(rch_param_class c);
+/* The words of a class ("identifiable", "weak", "not identifiable",
+ * "fixed"). Inline so that the model-file reader needs no LAPACKE. */
+static inline const char *rch_param_class_name(rch_param_class c)
+{
+    switch (c) {
+    case RCH_PARAM_FIXED: return "fixed";
+    case RCH_PARAM_IDENTIFIABLE: return "identifiable";
+    case RCH_PARAM_WEAK: return "weak";
+    case RCH_PARAM_NOT_IDENTIFIABLE: return "not identifiable";
+    }
+    return "?";
+}
 
 /* What a model file (rcal-model/2) carries of a calibration's uncertainty:
  * enough for compensation to act only on what the data determined and to
