@@ -22,20 +22,31 @@ static const char compare_details[] =
     "In each case --samples rows are drawn at random, --test-fraction of them held out, every method\n"
     "fitted from the same start (nominal DH + encoder fitted alone) on the rest; the report gives the\n"
     "held-out errors (mean +- std over --cases cases) and times. The paper's other protocol:\n"
-    "--samples 200 --test-fraction 0.2.";
+    "--samples 200 --test-fraction 0.2. --params both runs the paper's set-up and the common parameter set\n"
+    "(plots and models then go to DIR/paper and DIR/common).";
 
-/* Load, run the protocol, report. */
-static int compare_run(const rch_compare_config *cfg, const char *data_path, const char *robot_path,
-                       const char *plots, int json)
+/* DIR, or DIR/paper and DIR/common when both sets run; NULL stays NULL. */
+static const char *sub_dir(char *buf, size_t len, const char *dir, int both, rch_compare_params p)
+{
+    if (!dir || !both)
+        return dir;
+    snprintf(buf, len, "%s/%s", dir, rch_compare_params_name(p));
+    return buf;
+}
+
+/* Load, run the protocol (once per parameter set), report. */
+static int compare_run(rch_compare_config *cfg, const char *data_path, const char *robot_path, const char *plots_in,
+                       const char *models_in, int json, int both)
 {
     rch_robot robot;
     rch_data data;
     rch_compare_result res;
     rch_diag d;
-    char msg[1024];
+    char msg[1024], pbuf[1100], mbuf[1100];
+    const char *const inputs[2] = {data_path, robot_path};
     memset(&d, 0, sizeof d);
-    if (plots && rch_plot_mkdir(plots) != 0) {
-        fprintf(stderr, "rcal compare: cannot use %s as a plot directory: %s\n", plots, strerror(errno));
+    if (plots_in && rch_plot_mkdir(plots_in) != 0) {
+        fprintf(stderr, "rcal compare: cannot use %s as a plot directory: %s\n", plots_in, strerror(errno));
         return 1;
     }
     if (rch_robot_load(&robot, robot_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
@@ -47,28 +58,41 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
         rch_data_free(&data);
         return 2;
     }
-    /* progress and per-case failures on stderr, whatever the report format */
-    int rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, stderr, &d) != 0 ? 1 : 0;
-    if (rc == 0 && json)
-        rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
-    else if (rc == 0)
-        rch_compare_report(stdout, &res, cfg, data_path);
-    const char *const inputs[2] = {data_path, robot_path};
-    const rch_plot_dir pd = {plots, inputs, 2, json ? NULL : stdout};
-    if (rc == 0 && plots && rch_compare_plots(&res, cfg, &pd, &d) != 0)
-        rc = 1;
-    if (rc == 0 && rch_compare_any_failed(&res))
-        rc = 1; /* reported per case on stderr and in the table */
-    if (rc != 0 && d.msg[0])
-        fprintf(stderr, "rcal compare: %s\n", rch_diag_str(&d, msg, sizeof msg));
-    rch_compare_free(&res);
+    cfg->inputs = inputs;
+    cfg->n_inputs = 2;
+    int rc = 0;
+    for (int k = 0; k < (both ? 2 : 1) && rc == 0; ++k) {
+        if (both)
+            cfg->params = k == 0 ? RCH_PARAMS_PAPER : RCH_PARAMS_COMMON;
+        const char *plots = sub_dir(pbuf, sizeof pbuf, plots_in, both, cfg->params);
+        cfg->models_dir = sub_dir(mbuf, sizeof mbuf, models_in, both, cfg->params);
+        if (k > 0 && !json)
+            printf("\n");
+        /* progress and per-case failures on stderr, whatever the report format */
+        rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, stderr, &d) != 0 ? 1 : 0;
+        if (rc == 0 && json)
+            rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
+        else if (rc == 0)
+            rch_compare_report(stdout, &res, cfg, data_path);
+        const rch_plot_dir pd = {plots, inputs, 2, json ? NULL : stdout};
+        if (rc == 0 && plots && rch_compare_plots(&res, cfg, &pd, &d) != 0)
+            rc = 1;
+        if (rc == 0 && cfg->models_dir && !json)
+            printf("  models of case 1: %s/BC.json, M1-LM.json .. M7-LTLM.json\n", cfg->models_dir);
+        if (rc == 0 && rch_compare_any_failed(&res))
+            rc = 1; /* reported per case on stderr and in the table */
+        if (rc != 0 && d.msg[0])
+            fprintf(stderr, "rcal compare: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        rch_compare_free(&res);
+    }
     rch_data_free(&data);
     return rc;
 }
 
 int rcal_cmd_compare(int argc, char **argv)
 {
-    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *methods = NULL;
+    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *methods = NULL, *models = NULL;
+    const char *params = "paper";
     unsigned long cases = 10, samples = 300, seed = 1;
     double test_fraction = 0.1;
     int json = 0;
@@ -86,6 +110,12 @@ int rcal_cmd_compare(int argc, char **argv)
          "comma list of LM,EKF,PF,SCA,QIBAS,SSLM,LTLM (or M1..M7); default all", 0, NULL},
         {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "SVG charts: convergence, bars, times, per-sample errors", 0,
          NULL},
+        {"--params", RCH_OPT_CHOICE, &params, 0, 0, "SET",
+         "paper: the paper's set-up (LM/LTLM all parameters, the others a subset, a narrow box); common: every "
+         "method on one identifiable set; both: one table each",
+         0, "paper|common|both"},
+        {"--models", RCH_OPT_STR, &models, 0, 0, "DIR",
+         "write case 1's model of every row (BC.json, M1-LM.json .. M7-LTLM.json) for rcal grind --models", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
     };
     const rch_cmdspec spec = {"compare", compare_summary, compare_details, opts, sizeof opts / sizeof opts[0]};
@@ -104,5 +134,11 @@ int rcal_cmd_compare(int argc, char **argv)
     cfg.test_fraction = test_fraction;
     cfg.seed = seed;
     cfg.curves = plots != NULL;
-    return compare_run(&cfg, data_path, robot_path, plots, json);
+    const int both = strcmp(params, "both") == 0;
+    if (both && json) {
+        fprintf(stderr, "rcal compare: --json writes one parameter set: --params paper or common\n");
+        return 2;
+    }
+    cfg.params = strcmp(params, "common") == 0 ? RCH_PARAMS_COMMON : RCH_PARAMS_PAPER;
+    return compare_run(&cfg, data_path, robot_path, plots, models, json, both);
 }

@@ -11,6 +11,8 @@
 #include "rch_eval.h"
 #include "rch_jw.h"
 #include "rch_plot.h"
+#include "rch_save.h"
+#include "rch_uncert.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -51,6 +53,16 @@ int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d)
         ++n_sel;
     }
     return n_sel ? 0 : -1;
+}
+
+const char *rch_compare_params_name(rch_compare_params p) { return p == RCH_PARAMS_COMMON ? "common" : "paper"; }
+
+void rch_compare_model_file(char *buf, size_t len, int row)
+{
+    if (row <= 0)
+        snprintf(buf, len, "BC.json");
+    else
+        snprintf(buf, len, "M%d-%s.json", row, rch_est_name((rch_est_id)(row - 1)));
 }
 
 const char *rch_compare_row_name(int row) { return row == 0 ? "BC" : rch_est_name((rch_est_id)(row - 1)); }
@@ -109,6 +121,7 @@ static void summarise(rch_compare_result *res)
             rch_stats_add(&row->time_ms, e->time_ms);
             rch_stats_add(&row->iterations, (double)e->iterations);
             rch_stats_add(&row->cost_evals, (double)e->cost_evals);
+            rch_stats_add(&row->n_moved, (double)e->n_moved);
         }
     }
 }
@@ -123,6 +136,73 @@ static void add_ltlm(rch_compare_result *res, const rc_model *m)
     res->n_ltlm++;
 }
 
+/* ---- model files (rcal compare --models DIR) ---------------------------- */
+
+typedef struct model_job {
+    const char *name;            /* the robot's name */
+    const rc_model *m, *nominal;
+    const rch_robot_info *info;
+} model_job;
+
+typedef struct model_note {
+    const char *row, *params;
+    unsigned long long seed;
+    size_t n_train, n_test;
+    double train_rmse_mm, test_rmse_mm;
+} model_note;
+
+static void model_note_write(rch_jw *w, const void *ctx)
+{
+    const model_note *n = ctx;
+    rch_jw_str(w, "source", "rcal compare, case 1");
+    rch_jw_str(w, "method", n->row);
+    rch_jw_str(w, "params", n->params);
+    rch_jw_uint(w, "seed", n->seed);
+    rch_jw_uint(w, "n_train", n->n_train);
+    rch_jw_uint(w, "n_test", n->n_test);
+    rch_jw_numf(w, "train_rmse_mm", n->train_rmse_mm, "%.6f");
+    rch_jw_numf(w, "held_out_rmse_mm", n->test_rmse_mm, "%.6f");
+}
+
+static int model_write_fn(FILE *f, const void *ctx)
+{
+    const model_job *j = ctx;
+    return rch_robot_write(f, j->name, j->m, j->nominal, j->info);
+}
+
+/* Row r's model of case 1 into cfg->models_dir: rcal-model/2 with the
+ * uncertainty at the fit (classical covariance over the training samples,
+ * the parameters the row's set holds fixed counted as fixed); version 1 when
+ * the covariance cannot be computed. 0, or -1 with d set. */
+static int save_row_model(const rch_compare_config *cfg, const rch_robot *robot, const rc_model *m, int r,
+                          const uint8_t *fixed, const rch_holdout *h, const rch_compare_cell *cell, rch_diag *d)
+{
+    char name[64], path[1200];
+    rch_uncert u;
+    char err[256];
+    static rch_model_unc unc;
+    const model_note note = {rch_compare_row_name(r), rch_compare_params_name(cfg->params), cfg->seed * 1000003ull,
+                             h->n_train, h->n_test, cell->train_rmse_mm, cell->held_out.rmse_mm};
+    rch_robot_info info;
+    memset(&info, 0, sizeof info);
+    info.write = model_note_write;
+    info.ctx = &note;
+    if (rch_uncert_compute(&u, m, fixed, h->train, h->n_train, 0, err, sizeof err) == 0) {
+        memset(&unc, 0, sizeof unc);
+        rch_model_unc_from(&unc, &u);
+        if (rch_uncert_map_compute(&unc.map, &u, m, h->train, h->n_train, RCH_CALIB_TRUTH_POSES,
+                                   RCH_CALIB_TRUTH_SEED) == 0) {
+            unc.orientation_determined = unc.map.rot_det_median_deg < RCH_ORIENT_DETERMINED_DEG;
+            info.unc = &unc;
+        }
+        rch_uncert_free(&u);
+    }
+    rch_compare_model_file(name, sizeof name, r);
+    snprintf(path, sizeof path, "%s/%s", cfg->models_dir, name);
+    const model_job job = {robot->name, m, &robot->nominal, &info};
+    return rch_save(path, "--models", cfg->inputs, cfg->n_inputs, model_write_fn, &job, d);
+}
+
 /* Case c: BC from the training part, then every selected method from it;
  * one cell per row. */
 static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_est_ws *ws,
@@ -131,10 +211,31 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
     const unsigned long long cseed = cfg->seed * 1000003ull + c;
     rch_compare_cell *cell = res->cell + c * RCH_COMPARE_ROWS;
     const int first = c == 0 && cfg->curves;
+    const int save = c == 0 && cfg->models_dir != NULL;
     rc_model start;
     rc_metrics trm;
+    uint8_t common[RC_MAX_PARAMS];
+    rch_est_opts eo;
+    memset(&eo, 0, sizeof eo);
     if (rch_calib_start(&start, &ws->solve, robot, h->train, h->n_train, d) != 0)
         return -1;
+    res->n_params = start.n_params;
+    if (cfg->params == RCH_PARAMS_COMMON) {
+        /* one identifiable set for all seven, at the start on the training part */
+        unsigned kept = 0;
+        const rc_status sst = rc_est_subset(common, &kept, &ws->est, &start, NULL, 0.0, h->train, h->n_train);
+        if (sst != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "the common parameter set cannot be found: %s", rc_strerror(sst));
+            return -1;
+        }
+        rch_stats_add(&res->n_common, (double)kept);
+        eo.fixed = common;
+        eo.same_set = 1;
+        eo.bound_len_mm = RCH_COMPARE_COMMON_BOX_MM;
+        eo.bound_ang_rad = RCH_COMPARE_COMMON_BOX_DEG * DEG;
+        eo.bound_enc_mm = RCH_COMPARE_COMMON_BOX_MM;
+        eo.bound_other = 0.0;
+    }
     if (rc_eval(&cell[0].held_out, &start, h->test, h->n_test) != RC_OK) {
         rch_diag_set(d, "", 0, 0, "the start model cannot be evaluated on the held-out samples");
         return -1;
@@ -143,13 +244,15 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
     cell[0].train_rmse_mm = rc_eval(&trm, &start, h->train, h->n_train) == RC_OK ? trm.rmse_mm : NAN;
     if (first)
         sample_errors(res->err_case1_mm, &start, h->test, h->n_test);
+    if (save && save_row_model(cfg, robot, &start, 0, eo.fixed, h, &cell[0], d) != 0)
+        return -1;
     for (int id = 0; id < RCH_EST_COUNT; ++id) {
         rch_compare_cell *e = &cell[id + 1];
         rc_model m = start;
         rch_est_out out;
         if (!cfg->run[id])
             continue;
-        rc_status st = rch_est_run(&m, &out, first ? &res->curve[id] : NULL, ws, (rch_est_id)id, cseed, NULL,
+        rc_status st = rch_est_run(&m, &out, first ? &res->curve[id] : NULL, ws, (rch_est_id)id, cseed, &eo,
                                    h->train, h->n_train);
         if (st != RC_OK || rc_eval(&e->held_out, &m, h->test, h->n_test) != RC_OK) {
             if (progress)
@@ -162,10 +265,13 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
         e->train_rmse_mm = out.rms_final_mm;
         e->iterations = out.iterations;
         e->cost_evals = out.cost_evals;
+        e->n_moved = out.n_moved;
         if (id == RCH_EST_LTLM)
             add_ltlm(res, &m);
         if (first)
             sample_errors(res->err_case1_mm + (size_t)(id + 1) * h->n_test, &m, h->test, h->n_test);
+        if (save && save_row_model(cfg, robot, &m, id + 1, eo.fixed, h, e, d) != 0)
+            return -1;
     }
     return 0;
 }
@@ -217,6 +323,7 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
     memset(res, 0, sizeof *res);
     res->rows_in_data = n;
     res->cases = cfg->cases;
+    res->params = cfg->params;
     if (case_sizes(res, cfg, n, d) != 0)
         return -1;
     int rc = -1;
@@ -226,6 +333,10 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
     res->err_case1_mm = malloc(RCH_COMPARE_ROWS * res->n_test * sizeof(double));
     if (!idx || !ws || !res->cell || !res->err_case1_mm) {
         rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    if (cfg->models_dir && rch_plot_mkdir(cfg->models_dir) != 0) {
+        rch_diag_set(d, "", 0, 0, "cannot use %s as a model directory: %s", cfg->models_dir, strerror(errno));
         goto done;
     }
     res->row[0].used = 1;
@@ -265,8 +376,8 @@ static void report_rows(FILE *f, const rch_compare_result *res)
 {
     const double lm_time = rch_compare_lm_time_ms(res);
     fprintf(f, "Held-out errors, mean +- std over cases (mm); time of the identification alone (ms, one core)\n");
-    fprintf(f, "  %-6s %-17s %-17s %-17s %-19s %8s %10s %9s\n", "method", "RMSE", "mean|e| (\"SD\")", "MAX",
-            "time (ms)", "x LM", "train RMS", "iters");
+    fprintf(f, "  %-6s %-17s %-17s %-17s %-19s %8s %10s %9s %6s\n", "method", "RMSE", "mean|e| (\"SD\")", "MAX",
+            "time (ms)", "x LM", "train RMS", "iters", "moved");
     for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
         const rch_compare_row *s = &res->row[r];
         char tbuf[64], rbuf[32];
@@ -279,13 +390,14 @@ static void report_rows(FILE *f, const rch_compare_result *res)
             if (isfinite(lm_time) && lm_time > 0)
                 snprintf(rbuf, sizeof rbuf, "%.2f", s->time_ms.mean / lm_time);
         }
-        fprintf(f, "  %-6s %6.4f +- %-7.4f %6.4f +- %-7.4f %6.4f +- %-7.4f %-19s %8s %10.4f %9.0f%s\n",
+        fprintf(f, "  %-6s %6.4f +- %-7.4f %6.4f +- %-7.4f %6.4f +- %-7.4f %-19s %8s %10.4f %9.0f %6.1f%s\n",
                 rch_compare_row_name(r), s->rmse_mm.mean, rch_stats_sd(&s->rmse_mm), s->mean_abs_mm.mean,
                 rch_stats_sd(&s->mean_abs_mm), s->max_mm.mean, rch_stats_sd(&s->max_mm), tbuf, rbuf,
-                s->train_rmse_mm.mean, r == 0 ? 0.0 : s->iterations.mean,
+                s->train_rmse_mm.mean, r == 0 ? 0.0 : s->iterations.mean, r == 0 ? 0.0 : s->n_moved.mean,
                 s->failed ? "  (failed in some cases)" : "");
     }
-    fprintf(f, "  (BC: nominal DH with the encoder fitted alone; mean|e| is what the paper's Eq. 20 calls SD)\n");
+    fprintf(f, "  (BC: nominal DH with the encoder fitted alone; mean|e| is what the paper's Eq. 20 calls SD;\n"
+               "   moved: parameters the method moved, for LM/LTLM the rank they found among those they may move)\n");
     /* The paper's Table 6 (Liu et al. 2024), as published, beside ours. */
     static const double paper[RCH_COMPARE_ROWS][3] = {{2.18, 2.01, 3.42}, {0.36, 0.30, 0.91}, {0.63, 0.51, 1.52},
                                                       {0.73, 0.61, 1.77}, {0.82, 0.66, 1.96}, {0.50, 0.40, 1.31},
@@ -323,6 +435,16 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
 {
     fprintf(f, "rcal compare: %s, %zu rows; %lu cases of %zu random rows (%zu train / %zu held out), seed %llu\n",
             data_name, res->rows_in_data, res->cases, res->n_draw, res->n_train, res->n_test, cfg->seed);
+    if (res->params == RCH_PARAMS_COMMON)
+        fprintf(f, "parameter set: common -- every method moves the same identifiable subset (%.1f +- %.1f of %u "
+                   "parameters over the cases);\n  the population methods in one box +-%g mm / +-%g deg around the "
+                   "start (EKF prior sd the same)\n",
+                res->n_common.mean, rch_stats_sd(&res->n_common), res->n_params, RCH_COMPARE_COMMON_BOX_MM,
+                RCH_COMPARE_COMMON_BOX_DEG);
+    else
+        fprintf(f, "parameter set: paper -- LM and LTLM move all %u parameters (own truncation), the other five\n"
+                   "  an identifiable subset; the population methods search +-2 mm / +-0.2 deg / encoder +-5 mm\n",
+                res->n_params);
     report_rows(f, res);
     if (res->n_ltlm > 0)
         report_ltlm(f, res);
@@ -393,6 +515,7 @@ int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_c
     rch_jw_uint(&w, "n_test", res->n_test);
     rch_jw_numf(&w, "test_fraction", cfg->test_fraction, "%.6g");
     rch_jw_uint(&w, "seed", cfg->seed);
+    rch_jw_str(&w, "params", rch_compare_params_name(res->params));
     rch_jw_arr(&w, "methods");
     for (int r = 0; r < RCH_COMPARE_ROWS; ++r)
         if (res->row[r].used)
@@ -413,6 +536,29 @@ int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_c
         json_ltlm(&w, res);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
+}
+
+/* ---- convergence curves as CSV (beside convergence.svg) ------------------ */
+
+/* One row per method and iteration: method,iteration,train_rmse_mm
+ * (iteration 0 is the start). 0, or -1 on a write error. */
+static int write_curves_csv(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg)
+{
+    fprintf(f, "method,iteration,train_rmse_mm\n");
+    for (int id = 0; id < RCH_EST_COUNT; ++id)
+        if (cfg->run[id])
+            for (size_t k = 0; k < res->curve[id].n; ++k)
+                fprintf(f, "%s,%zu,%.9g\n", rch_est_name((rch_est_id)id), k, res->curve[id].rms_mm[k]);
+    return ferror(f) ? -1 : 0;
+}
+
+int rch_compare_curves_csv(const rch_compare_result *res, const rch_compare_config *cfg, const rch_plot_dir *pd,
+                           rch_diag *d)
+{
+    rch_out o;
+    if (rch_plot_open(&o, pd, "convergence_curves.csv", d) != 0)
+        return -1;
+    return rch_plot_close(&o, pd, write_curves_csv(o.f, res, cfg) != 0, d);
 }
 
 /* ---- plots ------------------------------------------------------------- */
@@ -497,7 +643,8 @@ int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *c
         rch_plot_save(plot_convergence(res, cfg, 1), pd, "convergence_zoom.svg", d) != 0 ||
         rch_plot_save(plot_bars(res, 0), pd, "rmse_bars.svg", d) != 0 ||
         rch_plot_save(plot_bars(res, 1), pd, "time_bars.svg", d) != 0 ||
-        rch_plot_save(plot_per_sample(res, cfg), pd, "per_sample.svg", d) != 0)
+        rch_plot_save(plot_per_sample(res, cfg), pd, "per_sample.svg", d) != 0 ||
+        rch_compare_curves_csv(res, cfg, pd, d) != 0)
         return -1;
     return 0;
 }

@@ -104,6 +104,7 @@ rc_status rch_est_run(rc_model *m, rch_est_out *out, rch_curve *curve, rch_est_w
         cfg.method = id == RCH_EST_LM ? RC_METHOD_LM : RC_METHOD_LTLM;
         cfg.max_iter = opts->max_iter;
         cfg.seed = seed;
+        cfg.fixed = opts->fixed;
         cfg.on_iter = curve ? curve_cb : NULL;
         cfg.cb_ctx = curve;
         t0 = now_ms();
@@ -131,6 +132,9 @@ rc_status rch_est_run(rc_model *m, rch_est_out *out, rch_curve *curve, rch_est_w
         cfg.bound_len_mm = opts->bound_len_mm;
         cfg.bound_ang_rad = opts->bound_ang_rad;
         cfg.bound_enc_mm = opts->bound_enc_mm;
+        cfg.bound_other = opts->bound_other;
+        cfg.fixed = opts->fixed;
+        cfg.keep_all = opts->same_set;
         cfg.seed = seed;
         cfg.on_iter = curve ? curve_cb : NULL;
         cfg.cb_ctx = curve;

@@ -61,6 +61,13 @@ typedef struct rch_est_opts {
     double bound_len_mm;   /* see rc_est_config; 0: default */
     double bound_ang_rad;
     double bound_enc_mm;
+    double bound_other;    /* effect parameters outside mm and rad; 0: default */
+    /* The parameter set (rcal compare --params). fixed (n_params, may be
+     * NULL): held at the start value by every method. same_set 1: the
+     * rc_est methods move exactly the parameters not fixed (no subset of
+     * their own), so that all seven methods work on one set. */
+    const uint8_t *fixed;
+    int same_set;
 } rch_est_opts;
 
 typedef struct rch_est_out {
