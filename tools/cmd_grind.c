@@ -7,11 +7,15 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
 #include "rcal_cmds.h"
 #include "rch_opt.h"
 #include "rch_grind.h"
 #include "rch_robot.h"
+#include "rch_compare.h" /* rch_compare_model_file: the names rcal compare --models writes */
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -68,17 +72,52 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
     return rc;
 }
 
+/* The Table 8 form: every model on one path, a row each. */
+static int grind_table(const rch_grind_config *cfg, const char *const *paths, const char *const *names, size_t n,
+                       const char *truth_path, const char *nominal_path, int json)
+{
+    static rch_robot rob[RCH_GRIND_MAX_MODELS], trob, nrob;
+    const rc_model *models[RCH_GRIND_MAX_MODELS];
+    static rch_grind_table t;
+    rch_diag d;
+    char msg[1024];
+    for (size_t k = 0; k < n; ++k) {
+        if (rch_robot_load(&rob[k], paths[k], &d) != 0) {
+            fprintf(stderr, "rcal grind: %s\n", rch_diag_str(&d, msg, sizeof msg));
+            return 1;
+        }
+        models[k] = &rob[k].model;
+    }
+    if (rch_robot_load(&trob, truth_path, &d) != 0 || (nominal_path && rch_robot_load(&nrob, nominal_path, &d) != 0)) {
+        fprintf(stderr, "rcal grind: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    const rc_model *nom = nominal_path ? &nrob.model : &rob[0].nominal;
+    if (rch_grind_table8(&t, cfg, models, names, n, &trob.model, nom, &d) != 0) {
+        fprintf(stderr, "rcal grind: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (json)
+        return rch_grind_table8_json(stdout, &t, cfg) != 0;
+    rch_grind_table8_report(stdout, &t, cfg, truth_path);
+    return 0;
+}
+
 int rcal_cmd_grind(int argc, char **argv)
 {
-    const char *model_path = NULL, *truth_path = NULL, *nominal_path = NULL, *spec_s = NULL, *plots = NULL;
+    rch_opt_strs model_paths = {{NULL}, 0};
+    const char *models_dir = NULL, *truth_path = NULL, *nominal_path = NULL, *spec_s = NULL, *plots = NULL;
     int json = 0, no_align = 0;
     double max_dev_deg = 30.0;
     rch_grind_config cfg;
     rch_diag d;
     rch_grind_defaults(&cfg);
     const rch_opt opts[] = {
-        {"--model", RCH_OPT_STR, &model_path, 0, 0, "MODEL.json",
-         "calibrated model used for compensation (rcal calibrate --out)", RCH_OPT_REQUIRED, NULL},
+        {"--model", RCH_OPT_STRS, &model_paths, 0, 0, "MODEL.json",
+         "calibrated model used for compensation (rcal calibrate --out); repeat it for the Table 8 form, a row each",
+         0, NULL},
+        {"--models", RCH_OPT_STR, &models_dir, 0, 0, "DIR",
+         "the Table 8 form with the models rcal compare --models wrote (M1-LM.json .. M7-LTLM.json)", 0, NULL},
         {"--truth", RCH_OPT_STR, &truth_path, 0, 0, "TRUTH.json",
          "the simulated true robot (rcal simulate --truth-out, or any model file)", RCH_OPT_REQUIRED, NULL},
         {"--nominal", RCH_OPT_STR, &nominal_path, 0, 0, "ROBOT.json",
@@ -104,5 +143,41 @@ int rcal_cmd_grind(int argc, char **argv)
     }
     cfg.align = !no_align;
     cfg.max_dev_rad = max_dev_deg * (M_PI / 180.0);
-    return grind_run(&cfg, model_path, truth_path, nominal_path, plots, json);
+    if (model_paths.n == 1 && !models_dir)
+        return grind_run(&cfg, model_paths.v[0], truth_path, nominal_path, plots, json);
+    if (model_paths.n == 0 && !models_dir) {
+        fprintf(stderr, "rcal grind: --model or --models is required\n");
+        return 2;
+    }
+    if (plots) {
+        fprintf(stderr, "rcal grind: --plots takes one --model\n");
+        return 2;
+    }
+    /* the Table 8 form: the --model files, then DIR's M1..M7 in method order */
+    static char dir_paths[RCH_COMPARE_ROWS][1200], dir_names[RCH_COMPARE_ROWS][32];
+    const char *paths[RCH_GRIND_MAX_MODELS], *names[RCH_GRIND_MAX_MODELS];
+    size_t n = 0;
+    for (size_t k = 0; k < model_paths.n; ++k) {
+        paths[n] = model_paths.v[k];
+        names[n++] = model_paths.v[k];
+    }
+    for (int r = 1; models_dir && r < RCH_COMPARE_ROWS; ++r) {
+        char file[64];
+        rch_compare_model_file(file, sizeof file, r);
+        snprintf(dir_paths[r], sizeof dir_paths[r], "%s/%s", models_dir, file);
+        if (access(dir_paths[r], R_OK) != 0)
+            continue; /* a method compare did not run */
+        if (n == RCH_GRIND_MAX_MODELS) {
+            fprintf(stderr, "rcal grind: at most %d models\n", RCH_GRIND_MAX_MODELS);
+            return 2;
+        }
+        paths[n] = dir_paths[r];
+        snprintf(dir_names[r], sizeof dir_names[r], "M%d %s", r, rch_compare_row_name(r));
+        names[n++] = dir_names[r];
+    }
+    if (n == 0) {
+        fprintf(stderr, "rcal grind: no model file (M1-LM.json .. M7-LTLM.json) in %s\n", models_dir);
+        return 1;
+    }
+    return grind_table(&cfg, paths, names, n, truth_path, nominal_path, json);
 }

@@ -262,6 +262,13 @@ static double dist3(const double a[3], const double b[3])
     return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
+/* Signed deviation of pt from p's programmed point along the outward
+ * surface normal (the tool z axis, column 3 of R, points inward). */
+static double dev_normal(const double pt[3], const rch_grind_point *p)
+{
+    return -((pt[0] - p->p_mm[0]) * p->R[2] + (pt[1] - p->p_mm[1]) * p->R[5] + (pt[2] - p->p_mm[2]) * p->R[8]);
+}
+
 /* Compensate every path point with model m (a stream, as a controller
  * would) and measure the true flange's deviation: into dev_mm[c] and
  * flag[c] of every point, or (c < 0) into *only. Returns the points whose
@@ -291,6 +298,7 @@ static size_t comp_pass(rch_grind_result *res, const rch_grind_config *gc, int c
         }
         p->flag[c] = stc != RC_OK;
         p->dev_mm[c] = dist3(pt, p->p_mm);
+        p->dev_n_mm[c] = dev_normal(pt, p);
     }
     return n_best_effort;
 }
@@ -305,6 +313,7 @@ static void deviations(rch_grind_result *res, const rch_grind_config *gc, const 
         double pt[3];
         rc_fk(pt, NULL, truth, res->pts[k].q_nom_rad);
         res->pts[k].dev_mm[RCH_GRIND_UNCOMP] = dist3(pt, res->pts[k].p_mm);
+        res->pts[k].dev_n_mm[RCH_GRIND_UNCOMP] = dev_normal(pt, &res->pts[k]);
     }
     res->n_orient_best_effort = comp_pass(res, gc, RCH_GRIND_COMP_CAL, cal, truth, nom, NULL);
     (void)comp_pass(res, gc, RCH_GRIND_COMP_TRUE, truth, truth, nom, NULL);
@@ -637,4 +646,119 @@ int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, co
         return -1;
     write_points_csv(o.f, res);
     return rch_plot_close(&o, pd, 0, d);
+}
+
+/* ---- Table 8: several models on one path --------------------------------- */
+
+static void table_row(rch_grind_row *r, const char *name, const rch_grind_result *res, int c)
+{
+    double sum = 0.0, ss = 0.0;
+    memset(r, 0, sizeof *r);
+    snprintf(r->name, sizeof r->name, "%s", name);
+    for (int m = 0; m < 5; ++m) {
+        r->p_mm[m] = res->pts[res->named[m]].dev_n_mm[c];
+        sum += r->p_mm[m];
+    }
+    r->mean_mm = sum / 5.0;
+    for (int m = 0; m < 5; ++m)
+        ss += (r->p_mm[m] - r->mean_mm) * (r->p_mm[m] - r->mean_mm);
+    r->sd_mm = sqrt(ss / 4.0); /* n - 1, as the paper's Table 8 */
+    for (size_t k = 0; k < res->n; ++k) {
+        rch_stats_add(&r->path_mm, res->pts[k].dev_mm[c]);
+        rch_stats_add(&r->path_n_mm, res->pts[k].dev_n_mm[c]);
+        r->n_flag += res->pts[k].flag[c] != 0;
+    }
+}
+
+int rch_grind_table8(rch_grind_table *t, const rch_grind_config *cfg, const rc_model *const *models,
+                     const char *const *names, size_t n_models, const rc_model *truth, const rc_model *nom,
+                     rch_diag *d)
+{
+    memset(t, 0, sizeof *t);
+    if (n_models < 1 || n_models > RCH_GRIND_MAX_MODELS) {
+        rch_diag_set(d, "", 0, 0, "1..%d models, not %zu", RCH_GRIND_MAX_MODELS, n_models);
+        return -1;
+    }
+    for (size_t k = 0; k < n_models; ++k) {
+        rch_grind_result res;
+        if (rch_grind_run(&res, cfg, models[k], truth, nom, d) != 0) {
+            rch_grind_free(&res);
+            return -1;
+        }
+        if (k == 0) {
+            table_row(&t->row[0], "BC", &res, RCH_GRIND_UNCOMP);
+            t->n_points = res.n;
+            for (int m = 0; m < 5; ++m)
+                memcpy(t->named_p_mm[m], res.pts[res.named[m]].p_mm, sizeof t->named_p_mm[m]);
+        }
+        table_row(&t->row[k + 1], names[k], &res, RCH_GRIND_COMP_CAL);
+        t->heading_rad[k] = res.heading_rad;
+        t->height_mm[k] = res.height_mm;
+        if (k + 1 == n_models)
+            table_row(&t->row[k + 2], "true model", &res, RCH_GRIND_COMP_TRUE);
+        rch_grind_free(&res);
+    }
+    t->n_rows = n_models + 2;
+    return 0;
+}
+
+void rch_grind_table8_report(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, const char *truth_name)
+{
+    char spec[160];
+    spec_line(spec, sizeof spec, &cfg->surface);
+    fprintf(f, "rcal grind, the paper's Table 8 form: %s\n  %zu path points; true robot %s; compensation: %s%s\n", spec,
+            t->n_points, truth_name, cfg->position_only ? "flange position" : "flange pose (position first)",
+            cfg->align ? "; base heading and height of each model taken from the truth" : "");
+    fprintf(f, "\nsigned deviation along the outward surface normal at five path points (mm; + above the surface)\n");
+    fprintf(f, "  %-16s %8s %8s %8s %8s %8s %8s %8s | %10s %9s %9s %9s\n", "model", "P1", "P2", "P3", "P4", "P5",
+            "Mean", "SD", "path mean", "path SD", "path max", "normal SD");
+    for (size_t r = 0; r < t->n_rows; ++r) {
+        const rch_grind_row *w = &t->row[r];
+        fprintf(f, "  %-16s", w->name);
+        for (int m = 0; m < 5; ++m)
+            fprintf(f, " %8.3f", w->p_mm[m]);
+        fprintf(f, " %8.3f %8.3f | %10.4f %9.4f %9.4f %9.4f%s\n", w->mean_mm, w->sd_mm, w->path_mm.mean,
+                rch_stats_sd(&w->path_mm), w->path_mm.max_abs, rch_stats_sd(&w->path_n_mm),
+                w->n_flag ? "  (points not compensated)" : "");
+    }
+    fprintf(f, "  Mean, SD: over the five points (SD with n - 1, as the paper); path: |3-D deviation| over all %zu "
+               "points;\n  normal SD: SD of the signed normal deviation over the path. BC: before compensation.\n",
+            t->n_points);
+    fprintf(f, "  points:");
+    for (int m = 0; m < 5; ++m)
+        fprintf(f, " %s = %s (%.0f, %.0f, %.1f)%s", point_names[m], point_where[m], t->named_p_mm[m][0],
+                t->named_p_mm[m][1], t->named_p_mm[m][2], m < 4 ? ";" : "\n");
+}
+
+int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg)
+{
+    rch_jw w;
+    rch_jw_init(&w, f, 1);
+    rch_jw_obj(&w, NULL);
+    rch_jw_str(&w, "command", "grind");
+    rch_jw_str(&w, "form", "table8");
+    rch_jw_str(&w, "surface", rch_surface_name(cfg->surface.kind));
+    rch_jw_uint(&w, "points", t->n_points);
+    rch_jw_bool(&w, "align", cfg->align);
+    rch_jw_arr(&w, "rows");
+    for (size_t r = 0; r < t->n_rows; ++r) {
+        const rch_grind_row *x = &t->row[r];
+        rch_jw_obj(&w, NULL);
+        rch_jw_str(&w, "model", x->name);
+        rch_jw_arr(&w, "points_normal_mm");
+        for (int m = 0; m < 5; ++m)
+            rch_jw_numf(&w, NULL, x->p_mm[m], "%.6f");
+        rch_jw_end(&w);
+        rch_jw_numf(&w, "mean_mm", x->mean_mm, "%.6f");
+        rch_jw_numf(&w, "sd_mm", x->sd_mm, "%.6f");
+        rch_jw_numf(&w, "path_mean_mm", x->path_mm.mean, "%.6f");
+        rch_jw_numf(&w, "path_sd_mm", rch_stats_sd(&x->path_mm), "%.6f");
+        rch_jw_numf(&w, "path_max_mm", x->path_mm.max_abs, "%.6f");
+        rch_jw_numf(&w, "path_normal_sd_mm", rch_stats_sd(&x->path_n_mm), "%.6f");
+        rch_jw_uint(&w, "not_compensated", x->n_flag);
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
 }

@@ -98,6 +98,8 @@ typedef struct rch_grind_point {
     double R[9];                        /* programmed flange orientation, row-major, columns = tool axes */
     double q_nom_rad[RC_NJ];            /* nominal joint target */
     double dev_mm[RCH_GRIND_CASES];     /* deviation of the true flange from p_mm */
+    double dev_n_mm[RCH_GRIND_CASES];   /* its signed part along the outward surface normal (+: above the surface,
+                                           the tool short of the programmed depth; -: into the workpiece) */
     int flag[RCH_GRIND_CASES];          /* compensation failed (0 ok) */
 } rch_grind_point;
 
@@ -141,5 +143,44 @@ int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config 
  * path, log scale) and grind_points.csv (every point) into pd->dir (created
  * when missing; never over one of pd->inputs). 0, or -1 with d set. */
 int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, const rch_plot_dir *pd, rch_diag *d);
+
+/* ---- the paper's Table 8 form: several models on one path ---- */
+
+/* The paper (Table 8) lists five path points per model with signed
+ * deviations, and their Mean and SD (n - 1). It does not say which five
+ * points nor along which direction the sign is taken; we take P1..P5 above
+ * (the patch's four corners and centre: spread over the patch, fixed before
+ * any result) and the deviation of the true flange along the outward
+ * surface normal at the point (dev_n_mm), the direction that sets the
+ * removal depth in grinding. */
+#define RCH_GRIND_MAX_MODELS 16
+
+typedef struct rch_grind_row {
+    char name[64];
+    double p_mm[5];        /* signed normal deviation at P1..P5 */
+    double mean_mm, sd_mm; /* over the five; SD with n - 1 */
+    rch_stats path_mm;     /* |deviation| (3-D) over the whole path */
+    rch_stats path_n_mm;   /* signed normal deviation over the whole path */
+    size_t n_flag;         /* points not compensated */
+} rch_grind_row;
+
+typedef struct rch_grind_table {
+    size_t n_rows;         /* BC, the models, the true-model floor */
+    size_t n_points;
+    double heading_rad[RCH_GRIND_MAX_MODELS], height_mm[RCH_GRIND_MAX_MODELS]; /* alignment applied per model */
+    rch_grind_row row[RCH_GRIND_MAX_MODELS + 2];
+    double named_p_mm[5][3];
+} rch_grind_table;
+
+/* Row 0 "BC": the uncompensated path (FK_true(q_nom), before compensation);
+ * then one row per model (names[k], compensated with models[k], n_models
+ * 1..RCH_GRIND_MAX_MODELS); last "true model": compensated with the truth
+ * (the floor). 0, or -1 with d set. */
+int rch_grind_table8(rch_grind_table *t, const rch_grind_config *cfg, const rc_model *const *models,
+                     const char *const *names, size_t n_models, const rc_model *truth, const rc_model *nom,
+                     rch_diag *d);
+void rch_grind_table8_report(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, const char *truth_name);
+/* One JSON object through rch_jw. 0, or -1 on a write error. */
+int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg);
 
 #endif
