@@ -476,6 +476,9 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
 
 /* ---- M6 SSLM ----------------------------------------------------------- */
 
+/* Variable step-size LM (our reading of the paper's ref. 19; rc_est.h):
+ * the damping mu stays fixed, the step size eta along the LM direction
+ * varies: first tried min(1, 2 eta_prev), halved until the cost falls. */
 static rc_status run_sslm(est_ctx *c, rc_model *m)
 {
     rc_est_work *w = c->w;
@@ -483,7 +486,8 @@ static rc_status run_sslm(est_ctx *c, rc_model *m)
     const unsigned T = cfg->max_iter ? cfg->max_iter : 100u;
     const unsigned nf = c->nf;
     const double tol = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-10;
-    double mu = 1e-3, alpha = 1.0, cost;
+    const double mu = cfg->sslm_mu > 0.0 ? cfg->sslm_mu : 1e-2;
+    double eta = 1.0, cost;
     rc_model *x = &w->best;
     *x = *m;
     for (unsigned it = 0; it < T; ++it) {
@@ -491,65 +495,42 @@ static rc_status run_sslm(est_ctx *c, rc_model *m)
         ++c->res->cost_evals;
         if (st != RC_OK)
             return st;
-        if (it == 0)
+        if (it == 0) /* the scaling of the start, kept (scaled variables u = D x) */
             for (unsigned i = 0; i < nf; ++i) {
                 const double a = w->P[(size_t)i * nf + i];
                 w->D[i] = a > 0.0 ? sqrt(a) : 1.0;
             }
         for (unsigned i = 0; i < nf; ++i) {
-            w->g[i] /= w->D[i];
+            w->dx[i] = -w->g[i] / w->D[i];
             for (unsigned k = 0; k < nf; ++k)
-                w->P[(size_t)i * nf + k] /= w->D[i] * w->D[k];
+                w->T[(size_t)i * nf + k] = w->P[(size_t)i * nf + k] / (w->D[i] * w->D[k]);
+            w->T[(size_t)i * nf + i] += mu;
         }
+        if (rcu_chol_solve(w->T, w->dx, nf) != RC_OK)
+            return RC_ERR_NUMERIC;
         int accepted = 0;
-        double newcost = cost;
-        for (unsigned tries = 0; tries < 12 && !accepted; ++tries) {
-            double slope = 0.0;
-            memcpy(w->T, w->P, (size_t)nf * nf * sizeof(double));
-            for (unsigned i = 0; i < nf; ++i) {
-                w->T[(size_t)i * nf + i] += mu;
-                w->dx[i] = -w->g[i];
-            }
-            if (rcu_chol_solve(w->T, w->dx, nf) != RC_OK) {
-                mu *= 10.0;
-                continue;
-            }
+        double newcost = cost, a = 2.0 * eta < 1.0 ? 2.0 * eta : 1.0;
+        for (unsigned h = 0; h <= 40; ++h, a *= 0.5) {
+            double ct;
+            w->trial = *x;
             for (unsigned i = 0; i < nf; ++i)
-                slope += 2.0 * w->g[i] * w->dx[i]; /* d cost / d alpha at 0 */
-            if (!(slope < 0.0))
-                break; /* no descent direction left: converged */
-            double a = 2.0 * alpha < 1.0 ? 2.0 * alpha : 1.0;
-            const double a_first = a;
-            for (unsigned h = 0; h <= 40; ++h, a *= 0.5) {
-                double ct;
-                w->trial = *x;
-                for (unsigned i = 0; i < nf; ++i)
-                    w->trial.x[w->idx[i]] += a * w->dx[i] / w->D[i];
-                ++c->res->cost_evals;
-                if (rc_cost(&ct, &w->trial, c->s, c->n) == RC_OK &&
-                    ct <= cost + 1e-4 * a * slope) {
-                    accepted = 1;
-                    newcost = ct;
-                    break;
-                }
-            }
-            if (accepted) {
-                *x = w->trial;
-                alpha = a;
-                if (a >= a_first && a_first >= 1.0)
-                    mu = mu / 3.0 > 1e-12 ? mu / 3.0 : 1e-12;
-                else
-                    mu *= 2.0;
-            } else {
-                mu *= 10.0;
-                alpha = 1.0;
+                w->trial.x[w->idx[i]] += a * w->dx[i] / w->D[i];
+            ++c->res->cost_evals;
+            if (rc_cost(&ct, &w->trial, c->s, c->n) == RC_OK && ct < cost) {
+                accepted = 1;
+                newcost = ct;
+                break;
             }
         }
-        c->best_cost = accepted ? newcost : cost;
+        if (!accepted)
+            break; /* no step size lowers the cost: converged */
+        *x = w->trial;
+        eta = a;
+        c->best_cost = newcost;
         c->res->iterations = it + 1;
         if (cfg->on_iter)
             cfg->on_iter(cfg->cb_ctx, it + 1, rms_of(c->best_cost, c->n), x);
-        if (!accepted || cost - newcost < tol * cost)
+        if (cost - newcost < tol * cost)
             break;
     }
     return RC_OK;

@@ -72,14 +72,16 @@
  *    BAS step -step * sign(f_r - f_l) b; the best of the four points becomes x.
  *    d decays geometrically from qibas_d0 (0: 0.2) to 1e-6 over max_iter
  *    iterations (0: 2000); step = 2 d. 3 cost evaluations per iteration.
- *  - RC_EST_SSLM: variable step-size LM: the damped Gauss-Newton direction
- *    (A_s + mu I) delta = -g_s in column-scaled variables (A_s unit diagonal),
- *    then a step length alpha: first tried alpha = min(1, 2 alpha_prev),
- *    halved until the Armijo condition C(x + alpha delta) <= C(x) +
- *    1e-4 * alpha * 2 g_s.delta holds (at most 40 halvings); mu /= 3 after an
- *    unshortened step, mu *= 2 after a shortened one, mu *= 10 and retry when
- *    no step length works. mu starts at 1e-3; max_iter (0: 100); stops on a
- *    relative cost decrease below tol_cost (0: 1e-10).
+ *  - RC_EST_SSLM: variable step-size LM, our reading of the paper's ref. 19
+ *    (Li, Li & Luo 2023; docs/methods.md says what is read and where it
+ *    departs): the LM direction with a FIXED damping, the step size along it
+ *    variable. In column-scaled variables (D = the column norms at the
+ *    start, kept): (A_s + mu I) delta = -g_s, mu = sslm_mu (0: 1e-2); the
+ *    step x <- x + eta delta / D with eta first tried at min(1, 2 eta_prev)
+ *    (eta_0 = 1) and halved (at most 40 times) until the cost falls; that
+ *    eta is kept for the next iteration. No step size lowers the cost:
+ *    converged. max_iter (0: 100); stops on a relative cost decrease below
+ *    tol_cost (0: 1e-10). Plain LM varies mu and always takes eta = 1.
  *
  * Depends on: rc_model, rc_solve (rc_cost, rc_normal_eq, rc_iter_cb),
  * rc_rand, rc_linalg; libm. Memory: rc_est_work is large (about
@@ -128,6 +130,7 @@ typedef struct rc_est_config {
     double ekf_q;           /* EKF process noise per update, relative to P0; 0: 1e-9 */
     double ekf_alpha;       /* EKF forgetting factor of the adaptive R, (0, 1]; 0: 0.3; 1: R fixed */
     double qibas_d0;        /* QIBAS initial antenna length (normalised); 0: 0.2 */
+    double sslm_mu;         /* SSLM fixed damping, scaled variables; 0: 1e-2 */
     double tol_cost;        /* relative cost decrease to stop (EKF, SSLM); 0: 1e-10 */
     double subset_tol;      /* identifiable-subset threshold; 0: 1e-8 */
     int keep_all;           /* nonzero: no subset selection, every free parameter moves */
