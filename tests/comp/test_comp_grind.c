@@ -140,6 +140,103 @@ static void test_plots(void **state)
     assert_non_null(strstr(svg, "compensated (calibrated model)"));
 }
 
+/* The Table 8 form in-process: BC's five signed deviations recomputed from
+ * the true FK at the nominal targets and the tilted plane's own outward
+ * normal; Mean and SD with n - 1; the truth as a model and the floor row at
+ * zero; the whole-path statistics those of the single-model run. */
+static void test_table8_inprocess(void **state)
+{
+    (void)state;
+    rch_grind_config cfg;
+    rch_grind_result res;
+    static rch_grind_table t;
+    rch_diag d;
+    rch_grind_defaults(&cfg);
+    rc_model shifted = g_truth;
+    shifted.x[RC_P_D(1)] += 0.5; /* a model 0.5 mm off in d2 */
+    const rc_model *models[3] = {&g_nom, &g_truth, &shifted};
+    const char *names[3] = {"nominal", "truth", "shifted"};
+    assert_int_equal(rch_grind_table8(&t, &cfg, models, names, 3, &g_truth, &g_nom, &d), 0);
+    assert_int_equal(t.n_rows, 5);
+    assert_string_equal(t.row[0].name, "BC");
+    assert_string_equal(t.row[2].name, "truth");
+    assert_string_equal(t.row[4].name, "true model");
+    assert_int_equal(rch_grind_run(&res, &cfg, &g_nom, &g_truth, &g_nom, &d), 0);
+    /* the tilted default: z = z0 + tan(15 deg) (x - cx); outward normal */
+    const double tx = tan(15.0 * DEG), nl = sqrt(1.0 + tx * tx);
+    const double n_out[3] = {-tx / nl, 0.0, 1.0 / nl};
+    double sum = 0.0, v[5];
+    for (int m = 0; m < 5; ++m) {
+        const rch_grind_point *p = &res.pts[res.named[m]];
+        double pt[3];
+        rc_fk(pt, NULL, &g_truth, p->q_nom_rad);
+        v[m] = (pt[0] - p->p_mm[0]) * n_out[0] + (pt[1] - p->p_mm[1]) * n_out[1] + (pt[2] - p->p_mm[2]) * n_out[2];
+        assert_true(fabs(t.row[0].p_mm[m] - v[m]) < 1e-9);
+        sum += v[m];
+    }
+    double ss = 0.0;
+    for (int m = 0; m < 5; ++m)
+        ss += (v[m] - sum / 5.0) * (v[m] - sum / 5.0);
+    assert_true(fabs(t.row[0].mean_mm - sum / 5.0) < 1e-9);
+    assert_true(fabs(t.row[0].sd_mm - sqrt(ss / 4.0)) < 1e-9);
+    assert_true(fabs(t.row[0].path_mm.mean - res.cases[RCH_GRIND_UNCOMP].dev_mm.mean) < 1e-12);
+    assert_true(t.row[0].path_mm.mean > 0.2); /* the errors are visible before compensation */
+    /* the truth as a model and the floor: on the path */
+    for (int m = 0; m < 5; ++m) {
+        assert_true(fabs(t.row[2].p_mm[m]) < 1e-3);
+        assert_true(fabs(t.row[4].p_mm[m]) < 1e-3);
+    }
+    assert_true(t.row[2].path_mm.max_abs < 1e-3);
+    /* a wrong model leaves a deviation; the signed value never exceeds the 3-D one */
+    assert_true(t.row[3].path_mm.mean > 0.01);
+    for (size_t r = 0; r < t.n_rows; ++r)
+        for (int m = 0; m < 5; ++m)
+            assert_true(fabs(t.row[r].p_mm[m]) <= t.row[r].path_mm.max_abs + 1e-9);
+    rch_grind_free(&res);
+    /* 0 or too many models: refused */
+    assert_int_equal(rch_grind_table8(&t, &cfg, models, names, 0, &g_truth, &g_nom, &d), -1);
+}
+
+/* End to end: several --model, --models DIR with the names rcal compare
+ * writes; a directory without models is an error. */
+static void test_table8_cli(void **state)
+{
+    (void)state;
+    char cmd[1024], mdir[160], buf[8192];
+    snprintf(cmd, sizeof cmd, "'%s' grind --model '%s' --model '%s' --truth '%s' > '%s/t8.txt'", RCAL, truth_path,
+             model_path, truth_path, dir);
+    assert_int_equal(run(cmd), 0);
+    snprintf(mdir, sizeof mdir, "%s/t8.txt", dir);
+    FILE *f = fopen(mdir, "r");
+    assert_non_null(f);
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    assert_non_null(strstr(buf, "Table 8"));
+    assert_non_null(strstr(buf, "BC "));
+    assert_non_null(strstr(buf, "true model"));
+    snprintf(mdir, sizeof mdir, "%s/models", dir);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s' && cp '%s' '%s/M1-LM.json' && cp '%s' '%s/M7-LTLM.json'", mdir,
+             model_path, mdir, model_path, mdir);
+    assert_int_equal(run(cmd), 0);
+    snprintf(cmd, sizeof cmd, "'%s' grind --models '%s' --truth '%s' --json > '%s/t8.json'", RCAL, mdir, truth_path,
+             dir);
+    assert_int_equal(run(cmd), 0);
+    snprintf(mdir, sizeof mdir, "%s/t8.json", dir);
+    f = fopen(mdir, "r");
+    assert_non_null(f);
+    n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    assert_non_null(strstr(buf, "\"M1 LM\""));
+    assert_non_null(strstr(buf, "\"M7 LTLM\""));
+    assert_null(strstr(buf, "M2 EKF"));
+    snprintf(cmd, sizeof cmd, "'%s' grind --models '%s' --truth '%s' >/dev/null 2>&1", RCAL, dir, truth_path);
+    assert_int_equal(run(cmd), 1);
+    snprintf(cmd, sizeof cmd, "'%s' grind --truth '%s' >/dev/null 2>&1", RCAL, truth_path);
+    assert_int_equal(run(cmd), 2);
+}
+
 static void test_bad_specs(void **state)
 {
     (void)state;
@@ -258,6 +355,8 @@ int main(void)
         cmocka_unit_test(test_perfect_calibration),
         cmocka_unit_test(test_plots),
         cmocka_unit_test(test_bad_specs),
+        cmocka_unit_test(test_table8_inprocess),
+        cmocka_unit_test(test_table8_cli),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -186,6 +186,43 @@ static void test_compare_json_and_plots(void **state)
     }
 }
 
+/* --params both: two tables, the models of case 1 under DIR/paper and
+ * DIR/common; --json takes one set. */
+static void test_compare_params_both(void **state)
+{
+    char cmd[1024], dir[64] = "/tmp/rcal_cli_params_XXXXXX", *out = NULL;
+    (void)state;
+    if (!have_rcal())
+        skip();
+    assert_non_null(mkdtemp(dir));
+    snprintf(cmd, sizeof cmd,
+             "'%s' compare --data '%s' --robot '%s' --cases 1 --samples 50 --methods lm,ekf,sslm --params both "
+             "--models '%s/m' --plots '%s/p' 2>/dev/null",
+             RCAL, g_csv, ROBOT, dir, dir);
+    assert_int_equal(run(cmd, &out), 0);
+    assert_non_null(strstr(out, "parameter set: paper"));
+    assert_non_null(strstr(out, "parameter set: common"));
+    free(out);
+    static const char *const files[] = {"m/paper/BC.json", "m/paper/M1-LM.json", "m/common/M6-SSLM.json",
+                                        "m/common/M2-EKF.json", "p/common/convergence_curves.csv"};
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; ++k) {
+        char path[160];
+        snprintf(path, sizeof path, "%s/%s", dir, files[k]);
+        FILE *f = fopen(path, "r");
+        if (!f)
+            fail_msg("%s not written", path);
+        fclose(f);
+    }
+    snprintf(cmd, sizeof cmd, "grep -c '^EKF,' '%s/p/common/convergence_curves.csv' >/dev/null", dir);
+    assert_int_equal(system(cmd), 0); /* the EKF's curve is there */
+    snprintf(cmd, sizeof cmd, "'%s' compare --data '%s' --robot '%s' --params both --json 2>/dev/null", RCAL, g_csv,
+             ROBOT);
+    assert_int_equal(run(cmd, &out), 2);
+    free(out);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 static void test_compare_human_and_errors(void **state)
 {
     char cmd[1024], *out = NULL;
@@ -350,6 +387,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_compare_json_and_plots),
         cmocka_unit_test(test_compare_human_and_errors),
+        cmocka_unit_test(test_compare_params_both),
         cmocka_unit_test(test_chaos),
         cmocka_unit_test(test_encoder_option),
         cmocka_unit_test(test_issue12_options),

@@ -131,6 +131,71 @@ static void test_compare_run(void **state)
     rch_compare_free(&b);
 }
 
+/* --params common: every method moves the one set (rc_est_subset at the
+ * case's start), no parameter outside it; the model files of case 1 are
+ * written (rcal-model/2) and read back. */
+static void test_common_set_and_models(void **state)
+{
+    rch_compare_config cfg;
+    rch_compare_result a;
+    rch_diag d;
+    char dir[64] = "/tmp/rcal_cmp_models_XXXXXX";
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    rch_compare_defaults(&cfg);
+    cfg.cases = 1;
+    cfg.samples = 70;
+    cfg.test_fraction = 0.2;
+    cfg.seed = 4;
+    cfg.run[RCH_EST_SCA] = cfg.run[RCH_EST_QIBAS] = 0;
+    cfg.params = RCH_PARAMS_COMMON;
+    cfg.models_dir = dir;
+    assert_int_equal(rch_compare_run(&a, &cfg, &g_robot, g_s, NS, NULL, &d), 0);
+    assert_int_equal(a.params, RCH_PARAMS_COMMON);
+    assert_int_equal(a.n_common.n, 1);
+    const unsigned nc = (unsigned)a.n_common.mean;
+    assert_true(nc > 10 && nc < a.n_params);
+    for (int id = 0; id < RCH_EST_COUNT; ++id) {
+        if (!cfg.run[id])
+            continue;
+        const rch_compare_cell *e = &a.cell[id + 1];
+        assert_true(e->ok);
+        if (id == RCH_EST_LM || id == RCH_EST_LTLM)
+            assert_true(e->n_moved <= nc); /* the rank they found inside the set */
+        else
+            assert_int_equal(e->n_moved, nc);
+    }
+    /* the files: read back, each the fit of its row; outside the set = BC */
+    rch_robot bc, mr;
+    char path[160], name[64];
+    rch_compare_model_file(name, sizeof name, 0);
+    assert_string_equal(name, "BC.json");
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    assert_int_equal(rch_robot_load(&bc, path, &d), 0);
+    unsigned same_all = 0;
+    for (int r = 1; r < RCH_COMPARE_ROWS; ++r) {
+        if (!cfg.run[r - 1])
+            continue;
+        rch_compare_model_file(name, sizeof name, r);
+        snprintf(path, sizeof path, "%s/%s", dir, name);
+        if (rch_robot_load(&mr, path, &d) != 0)
+            fail_msg("%s: %s", path, d.msg);
+        assert_true(mr.unc.present); /* rcal-model/2 */
+        rc_metrics met;
+        assert_int_equal(rc_eval(&met, &mr.model, g_s, NS), RC_OK);
+        unsigned moved = 0;
+        for (unsigned k = 0; k < RC_N_DH + 3; ++k)
+            moved += fabs(mr.model.x[k] - bc.model.x[k]) > 1e-9;
+        assert_true(moved >= 1 && moved <= nc); /* never outside the common set */
+        same_all += moved == nc;
+    }
+    assert_true(same_all >= 1);
+    rch_compare_free(&a);
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 static void test_compare_refused(void **state)
 {
     rch_compare_config cfg;
@@ -205,6 +270,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_methods_list),
         cmocka_unit_test(test_compare_run),
+        cmocka_unit_test(test_common_set_and_models),
         cmocka_unit_test(test_compare_refused),
         cmocka_unit_test(test_chaos),
     };
