@@ -7,7 +7,8 @@
  * seed * 1000003 + c), hold out round(test_fraction * samples) of them
  * (at least one), build the start (BC) model from the training part only
  * (rch_calib_start: nominal DH + encoder fitted alone), run every selected
- * method from that same start on the same training samples (rch_est_run),
+ * method from that same start on the same training samples (rch_est_run;
+ * the parameter set of cfg.params, below),
  * evaluate on the held-out samples. Nothing is tuned on held-out samples:
  * every hyperparameter is a fixed default documented in rc_est.h / rc_solve.h.
  *

@@ -6,7 +6,9 @@
  * M1 LM and M7 LTLM are rc_solve's robust methods (all free parameters, the
  * solver's own eigen-truncation of unidentifiable directions); M2 EKF, M3 PF,
  * M4 SCA, M5 QIBAS and M6 SSLM are rc_est's (identifiable subset, bounds
- * around the start; see rc_est.h for every hyperparameter). Every method
+ * around the start; see rc_est.h for every hyperparameter). With
+ * rch_est_opts.fixed and same_set all seven move the same parameters
+ * (rcal compare --params common). Every method
  * starts from the model it is given (rch_calib_start's BC model in compare).
  *
  * Depends on: rc_solve, rc_est (core), libc. Memory: rch_est_ws holds both
