@@ -7,9 +7,6 @@
  */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
 
 #include "rcal_cmds.h"
 #include "rch_opt.h"
@@ -76,24 +73,10 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
 static int grind_table(const rch_grind_config *cfg, const char *const *paths, const char *const *names, size_t n,
                        const char *truth_path, const char *nominal_path, int json)
 {
-    static rch_robot rob[RCH_GRIND_MAX_MODELS], trob, nrob;
-    const rc_model *models[RCH_GRIND_MAX_MODELS];
     static rch_grind_table t;
     rch_diag d;
     char msg[1024];
-    for (size_t k = 0; k < n; ++k) {
-        if (rch_robot_load(&rob[k], paths[k], &d) != 0) {
-            fprintf(stderr, "rcal grind: %s\n", rch_diag_str(&d, msg, sizeof msg));
-            return 1;
-        }
-        models[k] = &rob[k].model;
-    }
-    if (rch_robot_load(&trob, truth_path, &d) != 0 || (nominal_path && rch_robot_load(&nrob, nominal_path, &d) != 0)) {
-        fprintf(stderr, "rcal grind: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
-    const rc_model *nom = nominal_path ? &nrob.model : &rob[0].nominal;
-    if (rch_grind_table8(&t, cfg, models, names, n, &trob.model, nom, &d) != 0) {
+    if (rch_grind_table8_files(&t, cfg, paths, names, n, truth_path, nominal_path, &d) != 0) {
         fprintf(stderr, "rcal grind: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
@@ -154,28 +137,17 @@ int rcal_cmd_grind(int argc, char **argv)
         return 2;
     }
     /* the Table 8 form: the --model files, then DIR's M1..M7 in method order */
-    static char dir_paths[RCH_COMPARE_ROWS][1200], dir_names[RCH_COMPARE_ROWS][32];
-    const char *paths[RCH_GRIND_MAX_MODELS], *names[RCH_GRIND_MAX_MODELS];
+    static char dir_paths[RCH_COMPARE_ROWS][RCH_COMPARE_PATH_MAX], dir_names[RCH_COMPARE_ROWS][32];
+    const size_t nd = models_dir ? rch_compare_model_list(dir_paths, dir_names, models_dir) : 0;
+    const char *paths[RCH_OPT_MAX_STRS + RCH_COMPARE_ROWS], *names[RCH_OPT_MAX_STRS + RCH_COMPARE_ROWS];
     size_t n = 0;
-    for (size_t k = 0; k < model_paths.n; ++k) {
-        paths[n] = model_paths.v[k];
-        names[n++] = model_paths.v[k];
+    for (size_t k = 0; k < model_paths.n; ++k, ++n)
+        paths[n] = names[n] = model_paths.v[k];
+    for (size_t k = 0; k < nd; ++k, ++n) {
+        paths[n] = dir_paths[k];
+        names[n] = dir_names[k];
     }
-    for (int r = 1; models_dir && r < RCH_COMPARE_ROWS; ++r) {
-        char file[64];
-        rch_compare_model_file(file, sizeof file, r);
-        snprintf(dir_paths[r], sizeof dir_paths[r], "%s/%s", models_dir, file);
-        if (access(dir_paths[r], R_OK) != 0)
-            continue; /* a method compare did not run */
-        if (n == RCH_GRIND_MAX_MODELS) {
-            fprintf(stderr, "rcal grind: at most %d models\n", RCH_GRIND_MAX_MODELS);
-            return 2;
-        }
-        paths[n] = dir_paths[r];
-        snprintf(dir_names[r], sizeof dir_names[r], "M%d %s", r, rch_compare_row_name(r));
-        names[n++] = dir_names[r];
-    }
-    if (n == 0) {
+    if (models_dir && nd == 0) {
         fprintf(stderr, "rcal grind: no model file (M1-LM.json .. M7-LTLM.json) in %s\n", models_dir);
         return 1;
     }

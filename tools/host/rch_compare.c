@@ -65,6 +65,23 @@ void rch_compare_model_file(char *buf, size_t len, int row)
         snprintf(buf, len, "M%d-%s.json", row, rch_est_name((rch_est_id)(row - 1)));
 }
 
+size_t rch_compare_model_list(char (*paths)[RCH_COMPARE_PATH_MAX], char (*names)[32], const char *dir)
+{
+    size_t n = 0;
+    for (int r = 1; r < RCH_COMPARE_ROWS; ++r) {
+        char file[64];
+        rch_compare_model_file(file, sizeof file, r);
+        snprintf(paths[n], RCH_COMPARE_PATH_MAX, "%s/%s", dir, file);
+        FILE *f = fopen(paths[n], "r");
+        if (!f)
+            continue; /* a method compare did not run */
+        fclose(f);
+        snprintf(names[n], 32, "M%d %s", r, rch_est_name((rch_est_id)(r - 1)));
+        ++n;
+    }
+    return n;
+}
+
 const char *rch_compare_row_name(int row) { return row == 0 ? "BC" : rch_est_name((rch_est_id)(row - 1)); }
 
 double rch_compare_lm_time_ms(const rch_compare_result *res)

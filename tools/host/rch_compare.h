@@ -84,6 +84,10 @@ typedef struct rch_compare_config {
 /* File name of row r's model in models_dir: "BC.json", "M1-LM.json", ...,
  * "M7-LTLM.json" (the order rcal grind --models reads them in). */
 void rch_compare_model_file(char *buf, size_t len, int row);
+/* The model files of M1..M7 (not BC) that exist in dir, in row order:
+ * paths[k] the file, names[k] its row label ("M1 LM"). Returns how many. */
+#define RCH_COMPARE_PATH_MAX 1200
+size_t rch_compare_model_list(char (*paths)[RCH_COMPARE_PATH_MAX], char (*names)[32], const char *dir);
 
 /* Defaults: 10 cases of 300 rows, 0.1 held out, seed 1, every method, no curves. */
 void rch_compare_defaults(rch_compare_config *cfg);

@@ -12,6 +12,7 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_plot.h"
+#include "rch_robot.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -700,6 +701,36 @@ int rch_grind_table8(rch_grind_table *t, const rch_grind_config *cfg, const rc_m
     }
     t->n_rows = n_models + 2;
     return 0;
+}
+
+int rch_grind_table8_files(rch_grind_table *t, const rch_grind_config *cfg, const char *const *paths,
+                           const char *const *names, size_t n, const char *truth_path, const char *nominal_path,
+                           rch_diag *d)
+{
+    const rc_model *models[RCH_GRIND_MAX_MODELS];
+    int rc = -1;
+    if (n < 1 || n > RCH_GRIND_MAX_MODELS) {
+        rch_diag_set(d, "", 0, 0, "1..%d models, not %zu", RCH_GRIND_MAX_MODELS, n);
+        return -1;
+    }
+    rch_robot *rob = malloc((n + 2) * sizeof *rob); /* the models, the truth, the nominal */
+    if (!rob) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        if (rch_robot_load(&rob[k], paths[k], d) != 0)
+            goto done;
+        models[k] = &rob[k].model;
+    }
+    if (rch_robot_load(&rob[n], truth_path, d) != 0 ||
+        (nominal_path && rch_robot_load(&rob[n + 1], nominal_path, d) != 0))
+        goto done;
+    rc = rch_grind_table8(t, cfg, models, names, n, &rob[n].model, nominal_path ? &rob[n + 1].model : &rob[0].nominal,
+                          d);
+done:
+    free(rob);
+    return rc;
 }
 
 void rch_grind_table8_report(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, const char *truth_name)

@@ -24,7 +24,8 @@
  * the nominal one (issue 12: a nominal model must not be credited with what
  * the alignment removes).
  *
- * Depends on: rc_comp, rc_model, rc_rand (core); rch_stats, rch_plot, rch_jw (host).
+ * Depends on: rc_comp, rc_model, rc_rand (core); rch_stats, rch_plot, rch_jw,
+ * rch_robot (host, model files of the Table 8 form).
  * Memory: rch_grind_run allocates the path inside the result;
  * rch_grind_free releases it (also after a failed run). Errors: 0, or -1
  * with d set (unreachable path, out of memory).
@@ -179,6 +180,12 @@ typedef struct rch_grind_table {
 int rch_grind_table8(rch_grind_table *t, const rch_grind_config *cfg, const rc_model *const *models,
                      const char *const *names, size_t n_models, const rc_model *truth, const rc_model *nom,
                      rch_diag *d);
+/* The same on model files (rch_robot_load): paths (n) labelled names, the
+ * true robot truth_path, the nominal the path is programmed with
+ * nominal_path (NULL: the first model's "nominal"). 0, or -1 with d set. */
+int rch_grind_table8_files(rch_grind_table *t, const rch_grind_config *cfg, const char *const *paths,
+                           const char *const *names, size_t n, const char *truth_path, const char *nominal_path,
+                           rch_diag *d);
 void rch_grind_table8_report(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, const char *truth_name);
 /* One JSON object through rch_jw. 0, or -1 on a write error. */
 int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg);
