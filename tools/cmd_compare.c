@@ -35,9 +35,10 @@ static const char *sub_dir(char *buf, size_t len, const char *dir, int both, rch
 }
 
 /* Load, run the protocol (once per parameter set), report. */
-static int compare_run(rch_compare_config *cfg, const char *data_path, const char *robot_path, const char *plots_in,
-                       const char *models_in, int json, int both)
+static int compare_run(const rch_compare_config *cfg_in, const char *data_path, const char *robot_path,
+                       const char *plots_in, const char *models_in, int json, int both)
 {
+    rch_compare_config c = *cfg_in, *cfg = &c; /* gets the inputs and the set's directories */
     rch_robot robot;
     rch_data data;
     rch_compare_result res;
