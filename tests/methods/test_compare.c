@@ -147,7 +147,7 @@ static void test_common_set_and_models(void **state)
     cfg.samples = 70;
     cfg.test_fraction = 0.2;
     cfg.seed = 4;
-    cfg.run[RCH_EST_SCA] = cfg.run[RCH_EST_QIBAS] = 0;
+    cfg.run[RCH_EST_PF] = cfg.run[RCH_EST_SCA] = cfg.run[RCH_EST_QIBAS] = 0; /* the slow ones (valgrind) */
     cfg.params = RCH_PARAMS_COMMON;
     cfg.models_dir = dir;
     assert_int_equal(rch_compare_run(&a, &cfg, &g_robot, g_s, NS, NULL, &d), 0);
