@@ -22,6 +22,7 @@
 #include "rc_comp.h"
 #include "rc_rand.h"
 #include "rc_solve.h"
+#include "rct_irb120.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 
@@ -53,20 +54,16 @@ static void fk_r(double p[3], double R[9], const rc_model *m, const rc_real q[RC
     rc_fk(p, R, m, qd);
 }
 
-static const double irb120_dh[RC_NJ][4] = {
-    {0, 290, -90 * DEG, 0}, {270, 0, 0, -90 * DEG}, {70, 0, -90 * DEG, 0},
-    {0, 302, 90 * DEG, 0},  {0, 0, -90 * DEG, 0},   {0, 72, 0, 0},
-};
-static const double irb120_lim_deg[RC_NJ][2] = {{-165, 165}, {-110, 110}, {-110, 70},
-                                                {-160, 160}, {-120, 120}, {-400, 400}};
 static const double enc_mm[3] = {600, -300, 50};
 
 static void make_nominal(rc_model *m)
 {
-    assert_int_equal(rc_model_init(m, irb120_dh, enc_mm), RC_OK);
+    double dh[RC_NJ][4];
+    rct_irb120_dh(dh);
+    assert_int_equal(rc_model_init(m, (const double(*)[4])dh, enc_mm), RC_OK);
     for (int i = 0; i < RC_NJ; ++i) {
-        m->q_min_rad[i] = irb120_lim_deg[i][0] * DEG;
-        m->q_max_rad[i] = irb120_lim_deg[i][1] * DEG;
+        m->q_min_rad[i] = rct_irb120_lim_deg[i][0] * DEG;
+        m->q_max_rad[i] = rct_irb120_lim_deg[i][1] * DEG;
     }
 }
 
@@ -89,7 +86,7 @@ static void random_pose_d(double q[RC_NJ], rc_rng *g)
     static const double lo[RC_NJ] = {-120, -60, -62, -120, -100, -180};
     static const double hi[RC_NJ] = {120, 80, 50, 120, 100, 180};
     rc_model nom;
-    assert_int_equal(rc_model_init(&nom, irb120_dh, enc_mm), RC_OK);
+    make_nominal(&nom);
     for (;;) {
         double p[3], R[9];
         for (int i = 0; i < RC_NJ; ++i)
