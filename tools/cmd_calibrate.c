@@ -152,7 +152,7 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return rc == -2 ? 2 : 1;
     }
     int status = r->after_ok ? 0 : 1;
-    if (a.json ? rch_calib_json(stdout, r) != 0 : (rch_calib_print(stdout, r), 0))
+    if (a.json ? rch_calib_json(stdout, r, argc, argv) != 0 : (rch_calib_print(stdout, r), 0))
         status = 1;
     else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
         status = 1;

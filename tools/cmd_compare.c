@@ -26,7 +26,7 @@ static const char compare_details[] =
 
 /* Load, run the protocol, report. */
 static int compare_run(const rch_compare_config *cfg, const char *data_path, const char *robot_path,
-                       const char *plots, int json)
+                       const char *plots, int json, int argc, char **argv)
 {
     rch_robot robot;
     rch_data data;
@@ -50,7 +50,7 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
     /* progress and per-case failures on stderr, whatever the report format */
     int rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, stderr, &d) != 0 ? 1 : 0;
     if (rc == 0 && json)
-        rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
+        rc = rch_compare_json(stdout, &res, cfg, data_path, argc, argv) != 0;
     else if (rc == 0)
         rch_compare_report(stdout, &res, cfg, data_path);
     const char *const inputs[2] = {data_path, robot_path};
@@ -104,5 +104,5 @@ int rcal_cmd_compare(int argc, char **argv)
     cfg.test_fraction = test_fraction;
     cfg.seed = seed;
     cfg.curves = plots != NULL;
-    return compare_run(&cfg, data_path, robot_path, plots, json);
+    return compare_run(&cfg, data_path, robot_path, plots, json, argc, argv);
 }

@@ -21,7 +21,7 @@ static const char details[] =
     "or 'unexplained'. Up to N effects are added one after the other.\n"
     "Steps are detected from the data unless given (a negative value: no quantization).";
 
-static int report(rch_diagnose_result *r, const char *plots, int json)
+static int report(rch_diagnose_result *r, const char *plots, int json, int argc, char **argv)
 {
     rch_diag d;
     char msg[1024], paths[4096] = "";
@@ -30,7 +30,7 @@ static int report(rch_diagnose_result *r, const char *plots, int json)
         return 1;
     }
     if (json)
-        return rch_diagnose_json(stdout, r) == 0 ? 0 : 1;
+        return rch_diagnose_json(stdout, r, argc, argv) == 0 ? 0 : 1;
     if (rch_diagnose_print(stdout, r) != 0)
         return 1;
     if (plots)
@@ -91,7 +91,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
         rch_diagnose_free(&r);
         return 1;
     }
-    int rc = report(&r, plots, json);
+    int rc = report(&r, plots, json, argc, argv);
     if (rc == 0 && out_path) {
         const char *inputs[2] = {data_path, robot_path};
         if (rch_diagnose_save_model(&r, robot_path, out_path, inputs, 2, &d) != 0) {

@@ -12,12 +12,12 @@
 #include "rch_opt.h"
 #include "rch_robot.h"
 
-static void report_json(const rch_evaluate_result *r, const char *model, const char *data)
+static int report_json(const rch_evaluate_result *r, const char *model, const char *data, int argc, char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, stdout, 1);
     rch_jw_obj(&w, NULL);
-    rch_jw_str(&w, "format", "rcal-evaluate/1");
+    rch_jw_header(&w, "rcal-evaluate/1", argc, argv);
     rch_jw_str(&w, "model", model);
     rch_jw_str(&w, "data", data);
     rch_jw_uint(&w, "n", r->m.n);
@@ -40,7 +40,7 @@ static void report_json(const rch_evaluate_result *r, const char *model, const c
     rch_jw_num(&w, "rd_max_mm", r->rd_max_mm);
     rch_jw_end(&w);
     rch_jw_end(&w);
-    rch_jw_finish(&w);
+    return rch_jw_finish(&w);
 }
 
 static void report_text(const rch_evaluate_result *r, const char *model, const char *data)
@@ -97,8 +97,8 @@ int rcal_cmd_evaluate(int argc, char **argv)
         return 1;
     }
     if (json)
-        report_json(&r, model_path, data_path);
+        rc = report_json(&r, model_path, data_path, argc, argv) != 0;
     else
         report_text(&r, model_path, data_path);
-    return 0;
+    return rc;
 }

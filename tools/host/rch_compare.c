@@ -379,12 +379,13 @@ static void json_ltlm(rch_jw *w, const rch_compare_result *res)
     rch_jw_end(w);
 }
 
-int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name)
+int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name,
+                     int argc, char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, f, 1);
     rch_jw_obj(&w, NULL);
-    rch_jw_str(&w, "command", "compare");
+    rch_jw_header(&w, "rcal-compare/1", argc, argv);
     rch_jw_str(&w, "data", data_name);
     rch_jw_uint(&w, "rows_in_file", res->rows_in_data);
     rch_jw_uint(&w, "cases", res->cases);

@@ -115,7 +115,8 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
                         const char *data_name);
 /* The same as one JSON object (rch_jw: strings escaped, null where a
  * figure is absent). 0, or -1 on a write error. */
-int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name);
+int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name,
+                     int argc, char **argv);
 
 /* Write convergence.svg, convergence_zoom.svg (need cfg.curves), rmse_bars.svg,
  * time_bars.svg and per_sample.svg into pd->dir (created with its parents
