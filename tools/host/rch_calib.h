@@ -89,6 +89,7 @@ typedef struct rch_calib_cfg {
     int holdout_groups;     /* 1: hold out whole set-up groups instead of random rows */
     unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
     size_t case_samples;    /* rows per case (0: every row) */
+    const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
 } rch_calib_cfg;
 
 typedef struct rch_calib_result {

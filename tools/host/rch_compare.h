@@ -93,6 +93,10 @@ typedef struct rch_compare_result {
     /* with cfg.curves: case 1 only */
     rch_curve curve[RCH_EST_COUNT];  /* training RMS per iteration of each method run */
     double *err_case1_mm;            /* (RCH_COMPARE_ROWS x n_test) model - measured length; NaN where absent */
+    /* always, for --residuals (rch_resid.h): case 1's data rows and models */
+    size_t *idx_case1;               /* (n_draw) indices into s: the n_test held out first, then training */
+    rc_model *model_case1;           /* (RCH_COMPARE_ROWS) the model of each row in case 1 */
+    int ok_case1[RCH_COMPARE_ROWS];  /* 1: that row ran and succeeded in case 1 */
 } rch_compare_result;
 
 /* Run the protocol on s (n) with the nominal robot. progress (may be NULL)
