@@ -146,8 +146,11 @@ int rch_resid_save(const char *path, const char *const *inputs, size_t n_inputs,
 static void step_name(char *dst, size_t len, const char *name)
 {
     size_t k = 0;
-    for (; name[k] && k + 1 < len; ++k)
-        dst[k] = name[k] == ' ' ? '_' : name[k];
+    for (; name[k] && k + 1 < len; ++k) {
+        dst[k] = name[k];
+        if (dst[k] == ' ')
+            dst[k] = '_';
+    }
     dst[k] = '\0';
 }
 
