@@ -189,7 +189,9 @@ int rcal_cmd_calibrate(int argc, char **argv)
                                a.json) != 0)
             status = 1;
     }
-    if (!a.json && status == 0 && a.cfg.residuals_path)
+    if (a.cfg.residuals_path && !r->finite)
+        fprintf(stderr, "rcal calibrate: not writing %s: the model is not finite\n", a.cfg.residuals_path);
+    else if (!a.json && status == 0 && a.cfg.residuals_path)
         printf("per-sample residuals written to %s\n", a.cfg.residuals_path);
     free(r);
     return status;
