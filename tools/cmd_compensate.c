@@ -4,6 +4,7 @@
  * (tools/host/rch_comp.h: CSV and RAPID forms, safe output files). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rcal_cmds.h"
@@ -41,8 +42,40 @@ static void print_summary(const rch_comp_result *rp)
             r.n ? r.t_ns / (double)r.n / 1e3 : 0.0);
 }
 
+/* The targets the warnings name ("IN:LINE: warning: TEXT" lines of
+ * rch_comp_run), each with its line, what happened and the message. */
+static void json_targets(rch_jw *w, const char *warnings)
+{
+    rch_jw_arr(w, "targets_not_corrected");
+    for (const char *p = warnings; p && *p;) {
+        const char *eol = strchr(p, '\n'), *tag = strstr(p, ": warning: ");
+        const size_t len = eol ? (size_t)(eol - p) : strlen(p);
+        if (tag && tag < p + len) {
+            const char *num = tag;
+            while (num > p && num[-1] >= '0' && num[-1] <= '9')
+                --num;
+            const char *text = tag + 11;
+            char msg[512];
+            snprintf(msg, sizeof msg, "%.*s", (int)(p + len - text), text);
+            if (num < tag && num > p && num[-1] == ':') {
+                rch_jw_obj(w, NULL);
+                rch_jw_uint(w, "line", strtoull(num, NULL, 10));
+                rch_jw_str(w, "exit", strstr(msg, "robtarget")          ? "robtarget_copied"
+                                      : strstr(msg, "left uncompensated") ? "left_uncertain"
+                                      : strstr(msg, "not compensated")    ? "not_converged"
+                                                                          : "warning");
+                rch_jw_str(w, "message", msg);
+                rch_jw_end(w);
+            }
+        }
+        p += len + (eol ? 1 : 0);
+    }
+    rch_jw_end(w);
+}
+
 /* The --summary figures as one JSON object on stdout (rcal-compensate/1). */
-static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int rc, int argc, char **argv)
+static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int rc, const char *warnings, int argc,
+                        char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, stdout, 0);
@@ -69,6 +102,7 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
     rch_jw_bool(&w, "orientation_determined", r->orientation_determined);
     rch_jw_num(&w, "max_uncertainty_mm", job->max_unc_mm);
     rch_jw_num(&w, "largest_pos95_mm", r->max_pos95_mm);
+    json_targets(&w, warnings);
     rch_jw_obj(&w, "params");
     rch_jw_uint(&w, "dh_used", 24u - r->n_held);
     rch_jw_arr(&w, "dh_held"); /* names, held at nominal */
@@ -163,18 +197,25 @@ int rcal_cmd_compensate(int argc, char **argv)
     memset(&r, 0, sizeof r);
     rch_diag d;
     char msg[1024];
-    const int rc = rch_comp_run(&r, &job, stderr, &d);
+    /* with --json the warnings are also read back for the JSON (then copied to stderr) */
+    char *warn_text = NULL;
+    size_t warn_len = 0;
+    FILE *warn = json ? open_memstream(&warn_text, &warn_len) : NULL;
+    const int rc = rch_comp_run(&r, &job, warn ? warn : stderr, &d);
+    if (warn && fclose(warn) == 0 && warn_text)
+        fputs(warn_text, stderr);
     if (r.no_nominal)
         fprintf(stderr, "rcal compensate: warning: %s has no \"nominal\" table; only its effects are corrected\n", model);
     if (rc < 0) {
         fprintf(stderr, "rcal compensate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        free(warn_text);
         return 1;
     }
     if (summary) {
         print_sources(&r, model);
         print_summary(&r);
     }
-    if (json && summary_json(&r, &job, rc, argc, argv) != 0)
-        return 1;
-    return rc == 0 ? 0 : 1;
+    const int bad_json = json && summary_json(&r, &job, rc, warn_text, argc, argv) != 0;
+    free(warn_text);
+    return rc == 0 && !bad_json ? 0 : 1;
 }
