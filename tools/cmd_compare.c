@@ -14,6 +14,7 @@
 #include "rch_opt.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_plot.h"
+#include "rch_resid.h"
 #include "rch_robot.h"
 
 /* the usage text: rch_opt_usage prints the option table between these */
@@ -26,7 +27,7 @@ static const char compare_details[] =
 
 /* Load, run the protocol, report. */
 static int compare_run(const rch_compare_config *cfg, const char *data_path, const char *robot_path,
-                       const char *plots, int json)
+                       const char *plots, const char *resid, int json, int argc, char **argv)
 {
     rch_robot robot;
     rch_data data;
@@ -50,13 +51,24 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
     /* progress and per-case failures on stderr, whatever the report format */
     int rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, stderr, &d) != 0 ? 1 : 0;
     if (rc == 0 && json)
-        rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
+        rc = rch_compare_json(stdout, &res, cfg, data_path, argc, argv) != 0;
     else if (rc == 0)
         rch_compare_report(stdout, &res, cfg, data_path);
     const char *const inputs[2] = {data_path, robot_path};
     const rch_plot_dir pd = {plots, inputs, 2, json ? NULL : stdout};
     if (rc == 0 && plots && rch_compare_plots(&res, cfg, &pd, &d) != 0)
         rc = 1;
+    if (rc == 0 && resid) { /* case 1, every method */
+        rch_resid_table t;
+        rch_resid_init(&t, inputs, 1);
+        if (rch_resid_from_compare(&t, &res, data.s, data.line) != 0) {
+            rch_diag_set(&d, "", 0, 0, "out of memory");
+            rc = 1;
+        } else {
+            rc = rch_resid_save(resid, inputs, 2, &t, &d) != 0;
+        }
+        rch_resid_free(&t);
+    }
     if (rc == 0 && rch_compare_any_failed(&res))
         rc = 1; /* reported per case on stderr and in the table */
     if (rc != 0 && d.msg[0])
@@ -68,7 +80,7 @@ static int compare_run(const rch_compare_config *cfg, const char *data_path, con
 
 int rcal_cmd_compare(int argc, char **argv)
 {
-    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *methods = NULL;
+    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *methods = NULL, *resid = NULL;
     unsigned long cases = 10, samples = 300, seed = 1;
     double test_fraction = 0.1;
     int json = 0;
@@ -87,6 +99,9 @@ int rcal_cmd_compare(int argc, char **argv)
         {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "SVG charts: convergence, bars, times, per-sample errors", 0,
          NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
+        {"--residuals", RCH_OPT_STR, &resid, 0, 0, "FILE.csv",
+         "case 1's rows (test and train) with the BC residual and one column per method; never over an input", 0,
+         NULL},
     };
     const rch_cmdspec spec = {"compare", compare_summary, compare_details, opts, sizeof opts / sizeof opts[0]};
     rch_compare_config cfg;
@@ -104,5 +119,5 @@ int rcal_cmd_compare(int argc, char **argv)
     cfg.test_fraction = test_fraction;
     cfg.seed = seed;
     cfg.curves = plots != NULL;
-    return compare_run(&cfg, data_path, robot_path, plots, json);
+    return compare_run(&cfg, data_path, robot_path, plots, resid, json, argc, argv);
 }

@@ -33,7 +33,7 @@ static const char grind_details[] =
 
 /* Load the three models, run, report. */
 static int grind_run(const rch_grind_config *cfg, const char *model_path, const char *truth_path,
-                     const char *nominal_path, const char *plots, int json)
+                     const char *nominal_path, const char *plots, int json, int argc, char **argv)
 {
     static rch_robot mrob, trob, nrob;
     rch_grind_result res;
@@ -52,7 +52,7 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
     }
     int rc = 0;
     if (json)
-        rc = rch_grind_json(stdout, &res, cfg) != 0;
+        rc = rch_grind_json(stdout, &res, cfg, argc, argv) != 0;
     else
         rch_grind_report(stdout, &res, cfg, model_path, truth_path);
     const char *const inputs[3] = {model_path, truth_path, nominal_path};
@@ -104,5 +104,5 @@ int rcal_cmd_grind(int argc, char **argv)
     }
     cfg.align = !no_align;
     cfg.max_dev_rad = max_dev_deg * (M_PI / 180.0);
-    return grind_run(&cfg, model_path, truth_path, nominal_path, plots, json);
+    return grind_run(&cfg, model_path, truth_path, nominal_path, plots, json, argc, argv);
 }

@@ -454,12 +454,13 @@ void rch_grind_report(FILE *f, const rch_grind_result *res, const rch_grind_conf
                 res->n_orient_best_effort);
 }
 
-int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg)
+int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg, int argc, char **argv)
 {
     static const char *const keys[3] = {"uncompensated", "compensated_calibrated", "compensated_true"};
     rch_jw w;
     rch_jw_init(&w, f, 1);
     rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-grind/1", argc, argv);
     rch_jw_str(&w, "surface", rch_surface_name(cfg->surface.kind));
     rch_jw_uint(&w, "points", res->n);
     rch_jw_uint(&w, "lines", res->ny);
