@@ -286,7 +286,8 @@ static size_t comp_pass(rch_grind_result *res, const rch_grind_config *gc, int c
             ++n_best_effort;
         rc_fk(pt, NULL, truth, qc);
         if (c < 0) {
-            rch_stats_add(only, dist3(pt, p->p_mm));
+            if (only != NULL)
+                rch_stats_add(only, dist3(pt, p->p_mm));
             continue;
         }
         p->flag[c] = stc != RC_OK;
