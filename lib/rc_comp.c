@@ -433,13 +433,18 @@ rc_status rc_comp_stream_step(rc_comp_stream *s, rc_real q_out_rad[RC_NJ], rc_co
         res->exit = RC_COMP_NONFINITE;
         return stream_fail(s, RC_ERR_NUMERIC);
     }
+    int warm = s->have_dq;
+    for (unsigned i = 0; warm && i < RC_NJ; ++i)
+        warm = rc_rfabs(q_rad[i] - s->q_prev_rad[i]) <= RC_COMP_WARM_RAD;
     for (unsigned i = 0; i < RC_NJ; ++i)
-        seed[i] = q_rad[i] + (s->have_dq ? s->dq_rad[i] : RC_REAL_C(0.0));
+        seed[i] = q_rad[i] + (warm ? s->dq_rad[i] : RC_REAL_C(0.0));
     params_resolve(&pp, &s->cfg, RC_REAL_C(0.1), 1);
     rc_status st = joint_solve(q_out_rad, res, &s->work, cal, nom, q_rad, seed, &pp);
     if (st == RC_OK) {
-        for (unsigned i = 0; i < RC_NJ; ++i)
+        for (unsigned i = 0; i < RC_NJ; ++i) {
             s->dq_rad[i] = q_out_rad[i] - q_rad[i];
+            s->q_prev_rad[i] = q_rad[i];
+        }
         s->have_dq = 1;
         count(&s->n_ok);
         s->fail_run = 0;

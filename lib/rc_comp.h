@@ -87,6 +87,12 @@ enum {
 #define RC_COMP_TOL_MM (RC_REAL_EPS * RC_REAL_C(32768.0) > RC_REAL_C(1e-5) ? RC_REAL_EPS * RC_REAL_C(32768.0) : RC_REAL_C(1e-5))
 #define RC_COMP_TOL_RAD (RC_REAL_EPS * RC_REAL_C(64.0) > RC_REAL_C(1e-8) ? RC_REAL_EPS * RC_REAL_C(64.0) : RC_REAL_C(1e-8))
 
+/* The stream seeds a target with the last good correction only when no
+ * joint moved more than this since that target (a path); a jump (the next
+ * target of a program) starts from the target itself, so that one
+ * near-singular target cannot steer the next one's solution. */
+#define RC_COMP_WARM_RAD RC_REAL_C(0.05)
+
 /* All-zero means defaults. */
 typedef struct rc_comp_config {
     unsigned max_iter;    /* trial steps per call (both phases), 0: 12 */
@@ -226,7 +232,8 @@ typedef struct rc_comp_stream {
     const rc_kin *nom;      /* nominal model the targets were computed with (NULL: own[1]) */
     rc_comp_config cfg;
     rc_real dq_rad[RC_NJ];  /* (6) last good correction */
-    int have_dq;            /* dq_rad is valid */
+    rc_real q_prev_rad[RC_NJ]; /* (6) the target dq_rad was found for */
+    int have_dq;            /* dq_rad and q_prev_rad are valid */
     rc_status model_status; /* rc_comp_stream_init: how the models compiled (RC_OK) */
     uint32_t n_ok;          /* calls that converged (RC_OK), modulo 2^32 */
     uint32_t n_fail;        /* calls that did not (RC_ERR_NOCONV / RANGE / NUMERIC), modulo 2^32 */

@@ -5,6 +5,7 @@
  * state machine, the follow check; lib/rc_stable.h: the stability rule;
  * tools/host/rch_acqfile.h: the locked, append-only, resumable file).
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -12,6 +13,7 @@
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_acqfile.h"
 #include "rch_acquire.h"
+#include "rch_jw.h"
 #include "rch_opt.h"
 
 static const char details[] =
@@ -61,6 +63,53 @@ static void unescape(char *dst, size_t cap, const char *src)
     dst[k] = '\0';
 }
 
+/* The run summary as one JSON object on stdout (rcal-acquire/1), also when
+ * the run stopped (exit says how it ended). */
+static int report_json(const rch_acq_result *r, const rch_acq_config *c, const char *proto, int rc, int argc,
+                       char **argv)
+{
+    rch_jw w;
+    rch_jw_init(&w, stdout, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-acquire/1", argc, argv);
+    rch_jw_str(&w, "out", c->out_path);
+    rch_jw_str(&w, "poses_file", c->poses_path);
+    rch_jw_str(&w, "port", c->port_path);
+    rch_jw_str(&w, "protocol", proto);
+    rch_jw_int(&w, "exit", rc);
+    rch_jw_bool(&w, "complete", rc == 0 && r->n_new + r->n_before == r->n_poses);
+    rch_jw_bool(&w, "stopped", r->stopped);
+    if (r->stopped)
+        rch_jw_uint(&w, "stopped_at_pose", r->stopped_at);
+    else
+        rch_jw_null(&w, "stopped_at_pose");
+    rch_jw_uint(&w, "poses_in_plan", r->n_poses);
+    rch_jw_uint(&w, "samples_before", r->n_before);
+    rch_jw_uint(&w, "samples_written", r->n_new);
+    rch_jw_uint(&w, "dropped_bytes", r->dropped_bytes);
+    rch_jw_obj(&w, "stability");
+    rch_jw_uint(&w, "samples_per_pose", c->stable.n);
+    rch_jw_num(&w, "stable_mm", c->stable.tol_mm);
+    rch_jw_num(&w, "min_mm", c->stable.min_mm);
+    rch_jw_num(&w, "max_mm", c->stable.max_mm);
+    rch_jw_uint(&w, "unstable_restarts", r->unstable);
+    rch_jw_end(&w);
+    rch_jw_obj(&w, "rejected");
+    rch_jw_uint(&w, "timeouts", r->timeouts);
+    rch_jw_uint(&w, "bad_frames", r->bad_frames);
+    rch_jw_uint(&w, "format_rejects", r->shape_rejects);
+    rch_jw_uint(&w, "device_errors", r->device);
+    rch_jw_uint(&w, "out_of_range", r->range);
+    rch_jw_uint(&w, "follow_refusals", r->follow_refusals);
+    rch_jw_end(&w);
+    rch_jw_uint(&w, "readings", r->readings);
+    rch_jw_uint(&w, "reconnects", r->reconnects);
+    rch_jw_bool(&w, "follow_check", !c->no_follow_check);
+    rch_jw_num(&w, "worst_follow_mm", r->n_new ? r->worst_follow_mm : NAN);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}
+
 int rcal_cmd_acquire(int argc, char **argv)
 {
     rch_acq_config c;
@@ -68,8 +117,9 @@ int rcal_cmd_acquire(int argc, char **argv)
     const char *proto = NULL, *parity = "none", *flow = "none", *mbf = "int32", *mbo = "abcd", *poll = NULL,
                *joints = "plan";
     unsigned long baud = 9600, bits = 8, stop = 1, mb_addr = 1, mb_reg = 0, mb_dec = 0, n = 5, pose_s = 60;
-    int rc;
+    int rc, json = 0;
     rch_acq_config_default(&c);
+    memset(&r, 0, sizeof r);
     c.robot_path = RCAL_DEFAULT_ROBOT;
     const rch_opt opts[] = {
         {"--port", RCH_OPT_STR, &c.port_path, 0, 0, "PATH", "serial device", RCH_OPT_REQUIRED, NULL},
@@ -106,6 +156,8 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--confirm", RCH_OPT_FLAG, &c.confirm, 0, 0, NULL, "wait for Enter at each pose", 0, NULL},
         {"--joints", RCH_OPT_CHOICE, &joints, 0, 0, NULL, "source of q1..q6", 0, "plan"},
         {"--quiet", RCH_OPT_FLAG, &c.quiet, 0, 0, NULL, "fewer messages", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
+         "the run summary as one JSON object on stdout (progress then goes to stderr)", 0, NULL},
     };
     const rch_cmdspec spec = {"acquire", "record cable lengths from the encoder display, pose by pose", details,
                               opts, sizeof opts / sizeof opts[0]};
@@ -131,7 +183,9 @@ int rcal_cmd_acquire(int argc, char **argv)
     c.proto.mb_order = (rcd_word_order)pick(mbo, "abcd|cdab|badc|dcba");
     c.stable.n = (unsigned)n;
     c.stable.timeout_ms = (uint32_t)(pose_s * 1000ul);
-    rc = rch_acquire_run(&r, &c, NULL, stdout, stderr);
+    rc = rch_acquire_run(&r, &c, NULL, json ? stderr : stdout, stderr);
+    if (json)
+        return report_json(&r, &c, proto, rc, argc, argv) != 0 && rc == 0 ? 1 : rc;
     if (rc == 0 && r.n_new + r.n_before == r.n_poses && r.n_new)
         printf("rcal acquire: %zu poses recorded (%zu new) in %s; %lu readings, %lu timeouts, %lu bad frames, "
                "%lu format rejects, %lu device errors, %lu out of range, %lu unstable restarts, %lu reconnects, "

@@ -86,11 +86,13 @@ static void report_text(const bench_row *rows, const char *data_path, size_t n, 
     }
 }
 
-static int report_json(const bench_row *rows, const char *data_path, size_t n, unsigned long runs)
+static int report_json(const bench_row *rows, const char *data_path, size_t n, unsigned long runs, int argc,
+                       char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, stdout, 0);
     rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-bench/1", argc, argv);
     rch_jw_str(&w, "data", data_path);
     rch_jw_uint(&w, "samples", n);
     rch_jw_uint(&w, "runs", runs);
@@ -160,7 +162,7 @@ int rcal_cmd_bench(int argc, char **argv)
         if (bench_method(&rows[k], k_methods[k], runs, w, &robot, &data, t_start, t_solve, &d) != 0)
             rc = rch_opt_fail(&spec, &d);
     if (rc == 0 && json)
-        rc = report_json(rows, data_path, data.n, runs) == 0 ? 0 : 1;
+        rc = report_json(rows, data_path, data.n, runs, argc, argv) == 0 ? 0 : 1;
     else if (rc == 0)
         report_text(rows, data_path, data.n, runs);
     free(w);

@@ -31,11 +31,24 @@ static int write_model(const rch_calib_result *r, const char *out_path, int quie
     return 0;
 }
 
+/* --report: the run's JSON, as --json prints it. */
+typedef struct {
+    const rch_calib_result *r;
+    int argc;
+    char **argv;
+} calib_json_ctx;
+
+static int calib_json_cb(FILE *f, const void *ctx)
+{
+    const calib_json_ctx *c = ctx;
+    return rch_calib_json(f, c->r, c->argc, c->argv);
+}
+
 /* Options of rcal calibrate into cfg (and out_path, json, data). Returns
  * RCH_OPT_OK, or the status to return (0 for --help, 2 for an error). */
 typedef struct {
     rch_calib_cfg cfg;
-    const char *out_path, *method;
+    const char *out_path, *method, *report_path;
     rch_opt_strs data;
     unsigned long seed, max_iter, cases, case_samples;
     int json;
@@ -90,6 +103,12 @@ static rch_opt_status parse(calib_args *a, int argc, char **argv)
         {"--truth", RCH_OPT_STR, &cfg->truth_path, 0, 0, "TRUTH.json",
          "a simulated truth: flange errors over 2000 random poses, before and after", 0, NULL},
         {"--json", RCH_OPT_FLAG, &a->json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
+        {"--residuals", RCH_OPT_STR, &cfg->residuals_path, 0, 0, "FILE.csv",
+         "each sample's residual with its row, file, group and set (train, test, validate); never over an input", 0,
+         NULL},
+        {"--report", RCH_OPT_STR, &a->report_path, 0, 0, "FILE.html",
+         "also the HTML page of rcal report, from this run (its JSON kept beside it as FILE.calibration.json)", 0,
+         NULL},
     };
     const rch_cmdspec spec = {"calibrate", "identify the DH errors and the encoder position from cable lengths",
                               "mean|e| is what the paper's Eq. 20 calls SD; SD is the true standard deviation.",
@@ -109,17 +128,25 @@ static rch_opt_status parse(calib_args *a, int argc, char **argv)
     return RCH_OPT_OK;
 }
 
-/* 1 (with the message) when --out names one of the inputs. */
+/* 1 (with the message) when --out, --residuals or --report names one of the inputs. */
 static int out_is_input(const calib_args *a)
 {
     const char *inputs[RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
+    const char *outs[3] = {a->out_path, a->cfg.residuals_path, a->report_path};
+    static const char *const what[3] = {"--out", "--residuals", "--report"};
     for (size_t i = 0; i < a->data.n; ++i)
         inputs[3 + i] = a->data.v[i];
-    for (size_t i = 0; a->out_path && i < 3 + a->data.n; ++i)
-        if (inputs[i] && rch_same_file(a->out_path, inputs[i])) {
-            fprintf(stderr, "rcal calibrate: --out %s is also the input %s\n", a->out_path, inputs[i]);
-            return 1;
-        }
+    for (size_t o = 0; o < 3; ++o)
+        for (size_t i = 0; outs[o] && i < 3 + a->data.n; ++i)
+            if (inputs[i] && rch_same_file(outs[o], inputs[i])) {
+                fprintf(stderr, "rcal calibrate: %s %s is also the input %s\n", what[o], outs[o], inputs[i]);
+                return 1;
+            }
+    if (a->cfg.residuals_path && (a->cases > 1 || a->cfg.jumps)) {
+        fprintf(stderr, "rcal calibrate: --residuals is for one calibration without --jumps (not with --cases or "
+                        "--jumps)\n");
+        return 1;
+    }
     struct stat st;
     if (a->out_path && strcmp(a->out_path, "-") != 0 && stat(a->out_path, &st) == 0 && !S_ISREG(st.st_mode)) {
         fprintf(stderr, "rcal calibrate: --out %s is not a regular file: refused before the fit\n", a->out_path);
@@ -152,10 +179,20 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return rc == -2 ? 2 : 1;
     }
     int status = r->after_ok ? 0 : 1;
-    if (a.json ? rch_calib_json(stdout, r) != 0 : (rch_calib_print(stdout, r), 0))
+    if (a.json ? rch_calib_json(stdout, r, argc, argv) != 0 : (rch_calib_print(stdout, r), 0))
         status = 1;
     else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
         status = 1;
+    else if (a.report_path && r->finite) {
+        const calib_json_ctx ctx = {r, argc, argv};
+        if (rcal_report_inline(a.report_path, calib_json_cb, &ctx, NULL, NULL, r->finite ? a.out_path : NULL,
+                               a.json) != 0)
+            status = 1;
+    }
+    if (a.cfg.residuals_path && !r->finite)
+        fprintf(stderr, "rcal calibrate: not writing %s: the model is not finite\n", a.cfg.residuals_path);
+    else if (!a.json && status == 0 && a.cfg.residuals_path)
+        printf("per-sample residuals written to %s\n", a.cfg.residuals_path);
     free(r);
     return status;
 }

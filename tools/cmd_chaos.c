@@ -47,7 +47,7 @@ int rcal_cmd_chaos(int argc, char **argv)
     }
     int rc = rch_chaos_run(&res, &cfg, stderr, &d) == 0 ? 0 : 1;
     if (rc == 0 && json)
-        rc = rch_chaos_json(stdout, &res, &cfg) != 0;
+        rc = rch_chaos_json(stdout, &res, &cfg, argc, argv) != 0;
     else if (rc == 0)
         rch_chaos_report(stdout, &res, &cfg);
     const rch_plot_dir pd = {plots, NULL, 0, json ? NULL : stdout};

@@ -14,6 +14,7 @@
 #include "rch_opt.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_plot.h"
+#include "rch_resid.h"
 #include "rch_robot.h"
 
 /* the usage text: rch_opt_usage prints the option table between these */
@@ -34,9 +35,17 @@ static const char *sub_dir(char *buf, size_t len, const char *dir, int both, rch
     return buf;
 }
 
+/* What the command writes besides the report. */
+typedef struct compare_out {
+    const char *plots, *models, *resid; /* directories / file, or NULL */
+    int json, both;                     /* --json; --params both */
+    int argc;                           /* the command line, for the JSON header */
+    char **argv;
+} compare_out;
+
 /* Load, run the protocol (once per parameter set), report. */
 static int compare_run(const rch_compare_config *cfg_in, const char *data_path, const char *robot_path,
-                       const char *plots_in, const char *models_in, int json, int both)
+                       const compare_out *o)
 {
     rch_compare_config c = *cfg_in, *cfg = &c; /* gets the inputs and the set's directories */
     rch_robot robot;
@@ -46,8 +55,8 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
     char msg[1024], pbuf[1100], mbuf[1100];
     const char *const inputs[2] = {data_path, robot_path};
     memset(&d, 0, sizeof d);
-    if (plots_in && rch_plot_mkdir(plots_in) != 0) {
-        fprintf(stderr, "rcal compare: cannot use %s as a plot directory: %s\n", plots_in, strerror(errno));
+    if (o->plots && rch_plot_mkdir(o->plots) != 0) {
+        fprintf(stderr, "rcal compare: cannot use %s as a plot directory: %s\n", o->plots, strerror(errno));
         return 1;
     }
     if (rch_robot_load(&robot, robot_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
@@ -62,24 +71,35 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
     cfg->inputs = inputs;
     cfg->n_inputs = 2;
     int rc = 0;
-    for (int k = 0; k < (both ? 2 : 1) && rc == 0; ++k) {
-        if (both)
+    for (int k = 0; k < (o->both ? 2 : 1) && rc == 0; ++k) {
+        if (o->both)
             cfg->params = k == 0 ? RCH_PARAMS_PAPER : RCH_PARAMS_COMMON;
-        const char *plots = sub_dir(pbuf, sizeof pbuf, plots_in, both, cfg->params);
-        cfg->models_dir = sub_dir(mbuf, sizeof mbuf, models_in, both, cfg->params);
-        if (k > 0 && !json)
+        const char *plots = sub_dir(pbuf, sizeof pbuf, o->plots, o->both, cfg->params);
+        cfg->models_dir = sub_dir(mbuf, sizeof mbuf, o->models, o->both, cfg->params);
+        if (k > 0 && !o->json)
             printf("\n");
         /* progress and per-case failures on stderr, whatever the report format */
         rc = rch_compare_run(&res, cfg, &robot, data.s, data.n, stderr, &d) != 0 ? 1 : 0;
-        if (rc == 0 && json)
-            rc = rch_compare_json(stdout, &res, cfg, data_path) != 0;
+        if (rc == 0 && o->json)
+            rc = rch_compare_json(stdout, &res, cfg, data_path, o->argc, o->argv) != 0;
         else if (rc == 0)
             rch_compare_report(stdout, &res, cfg, data_path);
-        const rch_plot_dir pd = {plots, inputs, 2, json ? NULL : stdout};
+        const rch_plot_dir pd = {plots, inputs, 2, o->json ? NULL : stdout};
         if (rc == 0 && plots && rch_compare_plots(&res, cfg, &pd, &d) != 0)
             rc = 1;
-        if (rc == 0 && cfg->models_dir && !json)
+        if (rc == 0 && cfg->models_dir && !o->json)
             printf("  models of case 1: %s/BC.json, M1-LM.json .. M7-LTLM.json\n", cfg->models_dir);
+        if (rc == 0 && o->resid) { /* case 1, every method */
+            rch_resid_table t;
+            rch_resid_init(&t, inputs, 1);
+            if (rch_resid_from_compare(&t, &res, data.s, data.line) != 0) {
+                rch_diag_set(&d, "", 0, 0, "out of memory");
+                rc = 1;
+            } else {
+                rc = rch_resid_save(o->resid, inputs, 2, &t, &d) != 0;
+            }
+            rch_resid_free(&t);
+        }
         if (rc == 0 && rch_compare_any_failed(&res))
             rc = 1; /* reported per case on stderr and in the table */
         if (rc != 0 && d.msg[0])
@@ -93,7 +113,7 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
 int rcal_cmd_compare(int argc, char **argv)
 {
     const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *methods = NULL, *models = NULL;
-    const char *params = "paper";
+    const char *params = "paper", *resid = NULL;
     unsigned long cases = 10, samples = 300, seed = 1;
     double test_fraction = 0.1;
     int json = 0;
@@ -118,6 +138,9 @@ int rcal_cmd_compare(int argc, char **argv)
         {"--models", RCH_OPT_STR, &models, 0, 0, "DIR",
          "write case 1's model of every row (BC.json, M1-LM.json .. M7-LTLM.json) for rcal grind --models", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
+        {"--residuals", RCH_OPT_STR, &resid, 0, 0, "FILE.csv",
+         "case 1's rows (test and train) with the BC residual and one column per method; never over an input", 0,
+         NULL},
     };
     const rch_cmdspec spec = {"compare", compare_summary, compare_details, opts, sizeof opts / sizeof opts[0]};
     rch_compare_config cfg;
@@ -136,10 +159,12 @@ int rcal_cmd_compare(int argc, char **argv)
     cfg.seed = seed;
     cfg.curves = plots != NULL;
     const int both = strcmp(params, "both") == 0;
-    if (both && json) {
-        fprintf(stderr, "rcal compare: --json writes one parameter set: --params paper or common\n");
+    if (both && (json || resid)) {
+        fprintf(stderr, "rcal compare: --%s takes one parameter set: --params paper or common\n",
+                json ? "json" : "residuals");
         return 2;
     }
     cfg.params = strcmp(params, "common") == 0 ? RCH_PARAMS_COMMON : RCH_PARAMS_PAPER;
-    return compare_run(&cfg, data_path, robot_path, plots, models, json, both);
+    const compare_out o = {plots, models, resid, json, both, argc, argv};
+    return compare_run(&cfg, data_path, robot_path, &o);
 }

@@ -2,11 +2,14 @@
 /* cmd_compensate.c - rcal compensate: correct a robot program's joint targets
  * with a calibrated model. Options here; the work is rch_comp_run
  * (tools/host/rch_comp.h: CSV and RAPID forms, safe output files). */
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rcal_cmds.h"
 #include "rch_comp.h"
+#include "rch_jw.h"
 #include "rch_opt.h"
 
 /* Which parameters the corrections came from (issue 10). */
@@ -39,11 +42,93 @@ static void print_summary(const rch_comp_result *rp)
             r.n ? r.t_ns / (double)r.n / 1e3 : 0.0);
 }
 
+/* The targets the warnings name ("IN:LINE: warning: TEXT" lines of
+ * rch_comp_run), each with its line, what happened and the message. */
+static void json_targets(rch_jw *w, const char *warnings)
+{
+    rch_jw_arr(w, "targets_not_corrected");
+    for (const char *p = warnings; p && *p;) {
+        const char *eol = strchr(p, '\n'), *tag = strstr(p, ": warning: ");
+        const size_t len = eol ? (size_t)(eol - p) : strlen(p);
+        if (tag && tag < p + len) {
+            const char *num = tag;
+            while (num > p && num[-1] >= '0' && num[-1] <= '9')
+                --num;
+            const char *text = tag + 11;
+            char msg[512];
+            snprintf(msg, sizeof msg, "%.*s", (int)(p + len - text), text);
+            if (num < tag && num > p && num[-1] == ':') {
+                rch_jw_obj(w, NULL);
+                rch_jw_uint(w, "line", strtoull(num, NULL, 10));
+                rch_jw_str(w, "exit", strstr(msg, "robtarget")          ? "robtarget_copied"
+                                      : strstr(msg, "left uncompensated") ? "left_uncertain"
+                                      : strstr(msg, "not compensated")    ? "not_converged"
+                                                                          : "warning");
+                rch_jw_str(w, "message", msg);
+                rch_jw_end(w);
+            }
+        }
+        p += len + (eol ? 1 : 0);
+    }
+    rch_jw_end(w);
+}
+
+/* The --summary figures as one JSON object on stdout (rcal-compensate/1). */
+static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int rc, const char *warnings, int argc,
+                        char **argv)
+{
+    rch_jw w;
+    rch_jw_init(&w, stdout, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-compensate/1", argc, argv);
+    rch_jw_str(&w, "model", job->model_path);
+    rch_jw_str(&w, "nominal", job->nominal_path);
+    rch_jw_str(&w, "in", job->in_path);
+    rch_jw_str(&w, "out", job->out_path);
+    rch_jw_str(&w, "input_format", r->format == RCH_COMP_RAPID ? "rapid" : "csv");
+    rch_jw_int(&w, "exit", rc == 0 ? 0 : 1);
+    rch_jw_uint(&w, "targets", r->n + r->n_uncertain + r->n_robtargets);
+    rch_jw_uint(&w, "corrected", r->n - r->n_fail);
+    rch_jw_uint(&w, "not_converged", r->n_fail);
+    rch_jw_uint(&w, "not_converged_joint_limit", r->n_joint_limit);
+    rch_jw_uint(&w, "orientation_best_effort", r->n_pos_only);
+    rch_jw_uint(&w, "left_uncertain", r->n_uncertain);
+    rch_jw_uint(&w, "left_robtargets", r->n_robtargets);
+    rch_jw_num(&w, "largest_correction_deg", r->max_corr_deg);
+    rch_jw_num(&w, "largest_fail_error_mm", r->n_fail ? r->max_fail_err_mm : NAN);
+    rch_jw_num(&w, "iterations_per_target", r->n ? (double)r->iters / (double)r->n : NAN);
+    rch_jw_num(&w, "time_us_per_target", r->n ? r->t_ns / (double)r->n / 1e3 : NAN);
+    rch_jw_str(&w, "mode", r->position_only_used ? "position" : "pose");
+    rch_jw_bool(&w, "orientation_determined", r->orientation_determined);
+    rch_jw_num(&w, "max_uncertainty_mm", job->max_unc_mm);
+    rch_jw_num(&w, "largest_pos95_mm", r->max_pos95_mm);
+    json_targets(&w, warnings);
+    rch_jw_obj(&w, "params");
+    rch_jw_uint(&w, "dh_used", 24u - r->n_held);
+    rch_jw_arr(&w, "dh_held"); /* names, held at nominal */
+    for (const char *p = r->held; *p;) {
+        char nm[32];
+        size_t k = 0;
+        while (p[k] && p[k] != ' ')
+            ++k;
+        snprintf(nm, sizeof nm, "%.*s", (int)k, p);
+        rch_jw_str(&w, NULL, nm);
+        p += k + (p[k] == ' ');
+    }
+    rch_jw_end(&w);
+    rch_jw_bool(&w, "held_from_nominal_identifiability", r->version1);
+    rch_jw_num(&w, "held_max_flange_mm", r->max_held_mm);
+    rch_jw_bool(&w, "model_has_nominal", !r->no_nominal);
+    rch_jw_end(&w);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}
+
 int rcal_cmd_compensate(int argc, char **argv)
 {
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
-    int position_only = 0, full_pose = 0, summary = 0, accept_rt = 0;
+    int position_only = 0, full_pose = 0, summary = 0, accept_rt = 0, json = 0;
     double max_unc_mm = 1.0;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/2 or /1, from rcal calibrate --out)",
@@ -71,6 +156,8 @@ int rcal_cmd_compensate(int argc, char **argv)
         {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
         {"--summary", RCH_OPT_FLAG, &summary, 0, 0, NULL, "targets, iterations, largest correction and time on stderr",
          0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
+         "the summary as one JSON object on stdout (needs --out FILE: the targets do not share stdout)", 0, NULL},
     };
     const rch_cmdspec spec = {
         "compensate",
@@ -89,6 +176,10 @@ int rcal_cmd_compensate(int argc, char **argv)
         fprintf(stderr, "rcal compensate: --position-only and --full-pose exclude each other\n");
         return 2;
     }
+    if (json && strcmp(out, "-") == 0) {
+        fprintf(stderr, "rcal compensate: --json needs --out FILE (the targets would share stdout)\n");
+        return 2;
+    }
 
     const rch_comp_job job = {
         .model_path = model,
@@ -103,18 +194,28 @@ int rcal_cmd_compensate(int argc, char **argv)
         .max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0, /* 0: the core's 0.1 rad */
     };
     rch_comp_result r;
+    memset(&r, 0, sizeof r);
     rch_diag d;
     char msg[1024];
-    const int rc = rch_comp_run(&r, &job, stderr, &d);
+    /* with --json the warnings are also read back for the JSON (then copied to stderr) */
+    char *warn_text = NULL;
+    size_t warn_len = 0;
+    FILE *warn = json ? open_memstream(&warn_text, &warn_len) : NULL;
+    const int rc = rch_comp_run(&r, &job, warn ? warn : stderr, &d);
+    if (warn && fclose(warn) == 0 && warn_text)
+        fputs(warn_text, stderr);
     if (r.no_nominal)
         fprintf(stderr, "rcal compensate: warning: %s has no \"nominal\" table; only its effects are corrected\n", model);
     if (rc < 0) {
         fprintf(stderr, "rcal compensate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        free(warn_text);
         return 1;
     }
     if (summary) {
         print_sources(&r, model);
         print_summary(&r);
     }
-    return rc == 0 ? 0 : 1;
+    const int bad_json = json && summary_json(&r, &job, rc, warn_text, argc, argv) != 0;
+    free(warn_text);
+    return rc == 0 && !bad_json ? 0 : 1;
 }

@@ -4,12 +4,16 @@
  * shrinks when it is added (issue 6). The work is rch_diagnose_file
  * (tools/host/rch_diagnose.h). */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_diagnose.h"
+#include "rch_calib.h"
+#include "rch_data.h"
 #include "rch_opt.h"
+#include "rch_resid.h"
 
 static const char details[] =
     "Fits the geometric model with K-fold cross-validation (folds random within set-up\n"
@@ -21,7 +25,87 @@ static const char details[] =
     "or 'unexplained'. Up to N effects are added one after the other.\n"
     "Steps are detected from the data unless given (a negative value: no quantization).";
 
-static int report(rch_diagnose_result *r, const char *plots, int json)
+/* --residuals: the data lines from the file again (the diagnosis keeps the
+ * samples in file order, less rows --dequantize-joints refused). */
+static int save_residuals(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
+                          const char *path)
+{
+    rch_data data;
+    rch_diag d;
+    char msg[1024];
+    const char *inputs[2] = {data_path, robot_path};
+    if (rch_data_load(&data, data_path, 0, &d) != 0) {
+        fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    int rc = 0;
+    if (data.n != r->n) {
+        fprintf(stderr, "rcal diagnose: --residuals: %zu of %zu rows were refused (--dequantize-joints); their lines "
+                        "cannot be named: not written\n", data.n - r->n, data.n);
+        rc = 1;
+    } else {
+        rch_resid_table t;
+        rch_resid_init(&t, inputs, 1);
+        if (rch_resid_from_diagnose(&t, r, data.line) != 0) {
+            fprintf(stderr, "rcal diagnose: out of memory\n");
+            rc = 1;
+        } else if (rch_resid_save(path, inputs, 2, &t, &d) != 0) {
+            fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
+            rc = 1;
+        }
+        rch_resid_free(&t);
+    }
+    rch_data_free(&data);
+    return rc;
+}
+
+typedef struct {
+    const void *r; /* rch_diagnose_result or rch_calib_result */
+    int argc;
+    char **argv;
+} json_ctx;
+
+static int diag_json_cb(FILE *f, const void *ctx)
+{
+    const json_ctx *c = ctx;
+    return rch_diagnose_json(f, c->r, c->argc, c->argv);
+}
+
+static int calib_json_cb(FILE *f, const void *ctx)
+{
+    const json_ctx *c = ctx;
+    return rch_calib_json(f, c->r, c->argc, c->argv);
+}
+
+/* --report: the page needs a calibration; it is the one `rcal calibrate
+ * --data D --robot R --seed S` makes (with --dequantize-joints when given). */
+static int diagnose_report(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
+                           unsigned long seed, int dequantize, const char *html, int quiet, int argc, char **argv)
+{
+    rch_calib_cfg cc;
+    memset(&cc, 0, sizeof cc);
+    cc.data_path = data_path;
+    cc.robot_path = robot_path;
+    cc.method = RC_METHOD_LM;
+    cc.test_fraction = 0.1;
+    cc.seed = seed;
+    cc.cases = 1;
+    cc.dequantize = dequantize;
+    rch_calib_result *c = malloc(sizeof *c);
+    rch_diag d;
+    char msg[1024];
+    if (!c || rch_calib_run(c, &cc, &d) != 0) {
+        fprintf(stderr, "rcal diagnose: --report: the calibration: %s\n", c ? rch_diag_str(&d, msg, sizeof msg) : "out of memory");
+        free(c);
+        return 1;
+    }
+    const json_ctx cx = {c, argc, argv}, dx = {r, argc, argv}; /* both made by this command line */
+    const int rc = rcal_report_inline(html, calib_json_cb, &cx, diag_json_cb, &dx, NULL, quiet);
+    free(c);
+    return rc;
+}
+
+static int report(rch_diagnose_result *r, const char *plots, int json, int argc, char **argv)
 {
     rch_diag d;
     char msg[1024], paths[4096] = "";
@@ -30,7 +114,7 @@ static int report(rch_diagnose_result *r, const char *plots, int json)
         return 1;
     }
     if (json)
-        return rch_diagnose_json(stdout, r) == 0 ? 0 : 1;
+        return rch_diagnose_json(stdout, r, argc, argv) == 0 ? 0 : 1;
     if (rch_diagnose_print(stdout, r) != 0)
         return 1;
     if (plots)
@@ -40,7 +124,8 @@ static int report(rch_diagnose_result *r, const char *plots, int json)
 
 int rcal_cmd_diagnose(int argc, char **argv)
 {
-    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *out_path = NULL;
+    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *out_path = NULL,
+               *resid = NULL, *report_path = NULL;
     unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0, verbosity = 0;
     int json = 0, verbose = 0;
     rch_diagnose_cfg cfg;
@@ -55,6 +140,14 @@ int rcal_cmd_diagnose(int argc, char **argv)
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
          "write the calibrated model with the effects found (nuisances left out); never over an input", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
+        {"--residuals", RCH_OPT_STR, &resid, 0, 0, "FILE.csv",
+         "each sample's residual under the final model and its cross-validated residual before and after the "
+         "chosen effects; never over an input",
+         0, NULL},
+        {"--report", RCH_OPT_STR, &report_path, 0, 0, "FILE.html",
+         "also the HTML page of rcal report: this diagnosis with a calibration of the same data (rcal calibrate "
+         "--seed S defaults); both JSON kept beside it",
+         0, NULL},
         {"--q-step-deg", RCH_OPT_DOUBLE, &cfg.q_step_deg, -1, 10, "D", "joint display step (0: detected)", 0, NULL},
         {"--len-step-mm", RCH_OPT_DOUBLE, &cfg.len_step_mm, -1, 10, "D", "length display step (0: detected)", 0,
          NULL},
@@ -91,7 +184,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
         rch_diagnose_free(&r);
         return 1;
     }
-    int rc = report(&r, plots, json);
+    int rc = report(&r, plots, json, argc, argv);
     if (rc == 0 && out_path) {
         const char *inputs[2] = {data_path, robot_path};
         if (rch_diagnose_save_model(&r, robot_path, out_path, inputs, 2, &d) != 0) {
@@ -101,6 +194,10 @@ int rcal_cmd_diagnose(int argc, char **argv)
             printf("model with the effects found written to %s\n", out_path);
         }
     }
+    if (rc == 0 && resid)
+        rc = save_residuals(&r, data_path, robot_path, resid);
+    if (rc == 0 && report_path)
+        rc = diagnose_report(&r, data_path, robot_path, seed, cfg.dequantize, report_path, json, argc, argv);
     rch_diagnose_free(&r);
     return rc;
 }

@@ -10,14 +10,15 @@
 #include "rch_evaluate.h"
 #include "rch_jw.h"
 #include "rch_opt.h"
+#include "rch_resid.h"
 #include "rch_robot.h"
 
-static void report_json(const rch_evaluate_result *r, const char *model, const char *data)
+static int report_json(const rch_evaluate_result *r, const char *model, const char *data, int argc, char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, stdout, 1);
     rch_jw_obj(&w, NULL);
-    rch_jw_str(&w, "format", "rcal-evaluate/1");
+    rch_jw_header(&w, "rcal-evaluate/1", argc, argv);
     rch_jw_str(&w, "model", model);
     rch_jw_str(&w, "data", data);
     rch_jw_uint(&w, "n", r->m.n);
@@ -40,7 +41,7 @@ static void report_json(const rch_evaluate_result *r, const char *model, const c
     rch_jw_num(&w, "rd_max_mm", r->rd_max_mm);
     rch_jw_end(&w);
     rch_jw_end(&w);
-    rch_jw_finish(&w);
+    return rch_jw_finish(&w);
 }
 
 static void report_text(const rch_evaluate_result *r, const char *model, const char *data)
@@ -62,7 +63,7 @@ static void report_text(const rch_evaluate_result *r, const char *model, const c
 
 int rcal_cmd_evaluate(int argc, char **argv)
 {
-    const char *model_path = NULL, *data_path = NULL;
+    const char *model_path = NULL, *data_path = NULL, *resid_path = NULL;
     int refit = 0, json = 0;
     double same_deg = 1e-6;
     const rch_opt opts[] = {
@@ -72,6 +73,9 @@ int rcal_cmd_evaluate(int argc, char **argv)
         {"--same-pose-deg", RCH_OPT_DOUBLE, &same_deg, 1e-9, 1.0, "DEG", "rows this close in every joint are one pose",
          0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "JSON on stdout", 0, NULL},
+        {"--residuals", RCH_OPT_STR, &resid_path, 0, 0, "FILE.csv",
+         "each sample's residual (set validate; with the refitted outlet when --refit-encoder); never over an input",
+         0, NULL},
     };
     const rch_cmdspec spec = {"evaluate", "a calibrated model on new data, without refitting the robot",
                               "RMSE, mean |e|, SD and MAX of the cable-length residuals, and the ISO 9283 distance\n"
@@ -91,14 +95,31 @@ int rcal_cmd_evaluate(int argc, char **argv)
     rc_solve_work *w = malloc(sizeof *w);
     int rc = w ? rch_evaluate(&r, &robot.model, data.s, data.n, &cfg, w, msg, sizeof msg) : -1;
     free(w);
-    rch_data_free(&data);
     if (rc != 0) {
+        rch_data_free(&data);
         fprintf(stderr, "rcal evaluate: %s\n", w ? msg : "out of memory");
         return 1;
     }
+    if (resid_path) { /* the model as evaluated: the outlet refitted when asked */
+        const char *inputs[2] = {model_path, data_path};
+        rch_resid_table t;
+        rc_model m = robot.model;
+        for (unsigned k = 0; k < 3; ++k)
+            m.x[RC_P_ENC + k] = r.encoder_mm[k];
+        rch_resid_init(&t, inputs + 1, 1);
+        rc = rch_resid_add_model(&t, &m, data.s, data.line, NULL, data.n, RCH_RESID_VALIDATE, 0);
+        if (rc != 0)
+            fprintf(stderr, "rcal evaluate: out of memory\n");
+        else if ((rc = rch_resid_save(resid_path, inputs, 2, &t, &d)) != 0)
+            fprintf(stderr, "rcal evaluate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        rch_resid_free(&t);
+    }
+    rch_data_free(&data);
+    if (rc != 0)
+        return 1;
     if (json)
-        report_json(&r, model_path, data_path);
+        rc = report_json(&r, model_path, data_path, argc, argv) != 0;
     else
         report_text(&r, model_path, data_path);
-    return 0;
+    return rc;
 }

@@ -7,12 +7,37 @@
 #include "rcal_cmds.h"
 #include "rch_export.h"
 #include "rch_file.h"
+#include "rch_jw.h"
 #include "rch_opt.h"
+
+/* What was written, as one JSON object on stdout (rcal-export/1). */
+static int report_json(const rch_export_result *res, const char *model, const char *format, const char *out_path,
+                       const char *nominal, int drop, int argc, char **argv)
+{
+    const int urdf = strcmp(format, "urdf") == 0;
+    rch_jw w;
+    rch_jw_init(&w, stdout, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-export/1", argc, argv);
+    rch_jw_str(&w, "model", model);
+    rch_jw_str(&w, "export_format", format);
+    rch_jw_str(&w, "out", out_path);
+    rch_jw_str(&w, "nominal_urdf", nominal);
+    if (urdf)
+        rch_jw_uint(&w, "joints", res->n_joints);
+    else
+        rch_jw_uint(&w, "rows", res->n_rows);
+    rch_jw_bool(&w, "standard_errors", res->has_se);
+    rch_jw_uint(&w, "effects_not_carried", res->n_effects_left);
+    rch_jw_bool(&w, "joint_effects_dropped", drop);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}
 
 int rcal_cmd_export(int argc, char **argv)
 {
     const char *model = NULL, *format = NULL, *out_path = "-", *nominal = NULL;
-    int drop = 0;
+    int drop = 0, json = 0;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "M.json", "the model to export (rcal calibrate --out, or a robot file)",
          RCH_OPT_REQUIRED, NULL},
@@ -24,6 +49,8 @@ int rcal_cmd_export(int argc, char **argv)
          "urdf: take the robot, joint and link names from this URDF", 0, NULL},
         {"--drop-joint-effects", RCH_OPT_FLAG, &drop, 0, 0, NULL,
          "urdf: write the geometry of a model with joint-side effects (its FK then differs)", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was written, as one JSON object on stdout (needs --out FILE)",
+         0, NULL},
     };
     const rch_cmdspec spec = {
         "export", "export a model as a URDF or as a DH table in CSV",
@@ -39,6 +66,10 @@ int rcal_cmd_export(int argc, char **argv)
     const rch_export_format fmt = strcmp(format, "urdf") == 0 ? RCH_EXPORT_URDF : RCH_EXPORT_DH_CSV;
     if (nominal && fmt != RCH_EXPORT_URDF) {
         fprintf(stderr, "rcal export: --nominal-urdf applies to --format urdf only\n");
+        return 2;
+    }
+    if (json && strcmp(out_path, "-") == 0) {
+        fprintf(stderr, "rcal export: --json needs --out FILE (the export would share stdout)\n");
         return 2;
     }
     const char *inputs[2] = {model, nominal};
@@ -62,6 +93,8 @@ int rcal_cmd_export(int argc, char **argv)
     if (res.n_effects_left)
         fprintf(stderr, "rcal export: %u model effect(s) not carried by the URDF (listed in its comments)\n",
                 res.n_effects_left);
+    if (json)
+        return report_json(&res, model, format, out_path, nominal, drop, argc, argv) != 0;
     if (strcmp(out_path, "-") != 0) {
         if (fmt == RCH_EXPORT_URDF)
             fprintf(stderr, "rcal export: URDF with %u joints written to %s\n", res.n_joints, out_path);

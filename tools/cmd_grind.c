@@ -34,7 +34,7 @@ static const char grind_details[] =
 
 /* Load the three models, run, report. */
 static int grind_run(const rch_grind_config *cfg, const char *model_path, const char *truth_path,
-                     const char *nominal_path, const char *plots, int json)
+                     const char *nominal_path, const char *plots, int json, int argc, char **argv)
 {
     static rch_robot mrob, trob, nrob;
     rch_grind_result res;
@@ -53,7 +53,7 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
     }
     int rc = 0;
     if (json)
-        rc = rch_grind_json(stdout, &res, cfg) != 0;
+        rc = rch_grind_json(stdout, &res, cfg, argc, argv) != 0;
     else
         rch_grind_report(stdout, &res, cfg, model_path, truth_path);
     const char *const inputs[3] = {model_path, truth_path, nominal_path};
@@ -71,7 +71,7 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
 
 /* The Table 8 form: every model on one path, a row each. */
 static int grind_table(const rch_grind_config *cfg, const char *const *paths, const char *const *names, size_t n,
-                       const char *truth_path, const char *nominal_path, int json)
+                       const char *truth_path, const char *nominal_path, int json, int argc, char **argv)
 {
     static rch_grind_table t;
     rch_diag d;
@@ -81,7 +81,7 @@ static int grind_table(const rch_grind_config *cfg, const char *const *paths, co
         return 1;
     }
     if (json)
-        return rch_grind_table8_json(stdout, &t, cfg) != 0;
+        return rch_grind_table8_json(stdout, &t, cfg, argc, argv) != 0;
     rch_grind_table8_report(stdout, &t, cfg, truth_path);
     return 0;
 }
@@ -127,7 +127,7 @@ int rcal_cmd_grind(int argc, char **argv)
     cfg.align = !no_align;
     cfg.max_dev_rad = max_dev_deg * (M_PI / 180.0);
     if (model_paths.n == 1 && !models_dir)
-        return grind_run(&cfg, model_paths.v[0], truth_path, nominal_path, plots, json);
+        return grind_run(&cfg, model_paths.v[0], truth_path, nominal_path, plots, json, argc, argv);
     if (model_paths.n == 0 && !models_dir) {
         fprintf(stderr, "rcal grind: --model or --models is required\n");
         return 2;
@@ -151,5 +151,5 @@ int rcal_cmd_grind(int argc, char **argv)
         fprintf(stderr, "rcal grind: no model file (M1-LM.json .. M7-LTLM.json) in %s\n", models_dir);
         return 1;
     }
-    return grind_table(&cfg, paths, names, n, truth_path, nominal_path, json);
+    return grind_table(&cfg, paths, names, n, truth_path, nominal_path, json, argc, argv);
 }

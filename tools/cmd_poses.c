@@ -6,6 +6,7 @@
  * temporary file renamed into place (rch_file.h), refusing an --out that
  * names the --robot file.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,7 @@
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_data.h"
 #include "rch_file.h"
+#include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_poses.h"
 #include "rch_robot.h"
@@ -26,12 +28,39 @@ static const char details[] =
     "Writes pose,q1..q6 (degrees, 0.01 deg steps); prints the observability index O1 beside that of a random\n"
     "plan of the same size. The design cost grows as N^2 (1000 poses: about 25 s; progress on stderr).";
 
+/* What was planned and written, as one JSON object on stdout (rcal-poses/1). */
+static int report_json(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path, int argc,
+                       char **argv)
+{
+    rch_jw w;
+    rch_jw_init(&w, stdout, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-poses/1", argc, argv);
+    rch_jw_str(&w, "out", out_path);
+    rch_jw_uint(&w, "poses", res->n);
+    rch_jw_uint(&w, "candidates", res->n_candidates);
+    rch_jw_uint(&w, "seed", pc->seed);
+    rch_jw_uint(&w, "identifiable_directions", res->n_ident);
+    rch_jw_uint(&w, "params", res->n_params);
+    rch_jw_num(&w, "o1_plan", res->o1_plan);
+    rch_jw_uint(&w, "rank_plan", res->rank_plan);
+    rch_jw_num(&w, "o1_random", res->o1_random);
+    rch_jw_uint(&w, "rank_random", res->rank_random);
+    rch_jw_num(&w, "o1_ratio", res->o1_random > 0 ? res->o1_plan / res->o1_random : NAN);
+    rch_jw_numf(&w, "len_min_mm", pc->len_min_mm, "%.6g");
+    rch_jw_numf(&w, "len_max_mm", pc->len_max_mm, "%.6g");
+    rch_jw_numf(&w, "margin_deg", pc->margin_deg, "%.6g");
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}
+
 int rcal_cmd_poses(int argc, char **argv)
 {
     const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL;
     unsigned long n = 0, seed = 1, n_cand = 0, passes = 4;
     double enc[3] = {250.0, -460.0, 10.0};
     rch_poses_config pc = {0, 0, 4, 1, 250, 800, 5};
+    int json = 0;
     const rch_opt opts[] = {
         {"--count", RCH_OPT_UINT, &n, 1, RCH_POSES_MAX_COUNT, "N", "poses to plan", RCH_OPT_REQUIRED, NULL},
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "POSES.csv", "the plan", RCH_OPT_REQUIRED, NULL},
@@ -43,6 +72,8 @@ int rcal_cmd_poses(int argc, char **argv)
         {"--candidates", RCH_OPT_UINT, &n_cand, 0, RCH_POSES_MAX_CANDIDATES, "M", "0: max(2000, 40 N)", 0, NULL},
         {"--margin-deg", RCH_OPT_DOUBLE, &pc.margin_deg, 0, 360, "D", "kept from every joint limit", 0, NULL},
         {"--passes", RCH_OPT_UINT, &passes, 0, 100, "P", "exchange passes", 0, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was planned and written, as one JSON object on stdout", 0,
+         NULL},
     };
     const rch_cmdspec spec = {"poses", "plan an identifiable pose set (D-optimal)", details, opts,
                               sizeof opts / sizeof opts[0]};
@@ -78,16 +109,20 @@ int rcal_cmd_poses(int argc, char **argv)
         free(robot);
         return 1;
     }
-    printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
-           res.n, res.n_candidates, res.n_ident, res.n_params);
-    printf("  observability O1 (rch_ident): planned %.5g (rank %u), random %.5g (rank %u), ratio %.2f\n",
-           res.o1_plan, res.rank_plan, res.o1_random, res.rank_random,
-           res.o1_random > 0 ? res.o1_plan / res.o1_random : 0.0);
+    if (!json) {
+        printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
+               res.n, res.n_candidates, res.n_ident, res.n_params);
+        printf("  observability O1 (rch_ident): planned %.5g (rank %u), random %.5g (rank %u), ratio %.2f\n",
+               res.o1_plan, res.rank_plan, res.o1_random, res.rank_random,
+               res.o1_random > 0 ? res.o1_plan / res.o1_random : 0.0);
+    }
     if (rch_data_write_plan(out.f, res.poses, res.n) != 0) {
         rch_out_abort(&out);
         fprintf(stderr, "rcal poses: writing %s failed; nothing was replaced\n", out_path);
     } else if (rch_out_commit(&out, &dg) != 0) {
         fprintf(stderr, "rcal poses: %s\n", rch_diag_str(&dg, dbuf, sizeof dbuf));
+    } else if (json) {
+        rc = report_json(&res, &pc, out_path, argc, argv) != 0;
     } else {
         printf("  written to %s\n", out_path);
         rc = 0;

@@ -3,14 +3,82 @@
  * (with its diagnosis and model file when given) and the data of its plots as
  * CSV beside it. The work is in tools/host/rch_report.h; see docs/report.md. */
 #include <stdio.h>
+#include <string.h>
 
 #include "rcal_cmds.h"
+#include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_report.h"
+#include "rch_save.h"
+
+/* path's name without a .html or .htm ending, followed by suffix. */
+static void beside(char *buf, size_t len, const char *path, const char *suffix)
+{
+    size_t n = strlen(path);
+    if (n > 5 && strcmp(path + n - 5, ".html") == 0)
+        n -= 5;
+    else if (n > 4 && strcmp(path + n - 4, ".htm") == 0)
+        n -= 4;
+    snprintf(buf, len, "%.*s%s", (int)n, path, suffix);
+}
+
+int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, rcal_json_fn diag,
+                       const void *diag_ctx, const char *model, int quiet)
+{
+    char cal_path[1100], diag_path[1100], msg[1024];
+    rch_diag d;
+    memset(&d, 0, sizeof d);
+    if (strlen(html) >= 1024 || strcmp(html, "-") == 0) {
+        fprintf(stderr, "rcal: --report %s: a file name (under 1024 bytes) is needed, the plot data go beside it\n",
+                html);
+        return 1;
+    }
+    beside(cal_path, sizeof cal_path, html, ".calibration.json");
+    beside(diag_path, sizeof diag_path, html, ".diagnosis.json");
+    const char *inputs[1] = {model};
+    if (rch_save(cal_path, "--report (its calibration JSON)", inputs, 1, cal, cal_ctx, &d) != 0 ||
+        (diag && rch_save(diag_path, "--report (its diagnosis JSON)", inputs, 1, diag, diag_ctx, &d) != 0)) {
+        fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    rch_report_cfg cfg = {cal_path, diag ? diag_path : NULL, model, html, NULL, NULL};
+    rch_report_result res;
+    if (rch_report_write(&res, &cfg, &d) != 0) {
+        fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (!quiet)
+        fprintf(stderr, "rcal: report %s written (%u plots, %u warnings; its JSON: %s%s%s)\n", html, res.n_plots,
+                res.n_warnings, cal_path, diag ? ", " : "", diag ? diag_path : "");
+    return 0;
+}
+
+/* What was written, as one JSON object on stdout (rcal-report/1). */
+static int report_json(const rch_report_result *res, const rch_report_cfg *cfg, int argc, char **argv)
+{
+    rch_jw w;
+    rch_jw_init(&w, stdout, 0);
+    rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-report/1", argc, argv);
+    rch_jw_str(&w, "calibration", cfg->cal_path);
+    rch_jw_str(&w, "diagnosis", cfg->diag_path);
+    rch_jw_str(&w, "model", cfg->model_path);
+    rch_jw_str(&w, "out", cfg->out_path);
+    rch_jw_arr(&w, "plot_data");
+    for (unsigned k = 0; k < res->n_csv; ++k)
+        rch_jw_str(&w, NULL, res->csv[k]);
+    rch_jw_end(&w);
+    rch_jw_uint(&w, "plots", res->n_plots);
+    rch_jw_uint(&w, "warnings", res->n_warnings);
+    rch_jw_uint(&w, "not_in_this_run", res->n_missing);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}
 
 int rcal_cmd_report(int argc, char **argv)
 {
     rch_report_cfg cfg = {NULL, NULL, NULL, NULL, NULL, NULL};
+    int json = 0;
     const rch_opt opts[] = {
         {"--calibration", RCH_OPT_STR, &cfg.cal_path, 0, 0, "CAL.json", "the output of rcal calibrate --json",
          RCH_OPT_REQUIRED, NULL},
@@ -22,6 +90,7 @@ int rcal_cmd_report(int argc, char **argv)
          0, NULL},
         {"--out", RCH_OPT_STR, &cfg.out_path, 0, 0, "report.html",
          "the HTML page (written whole or not at all, never over an input)", RCH_OPT_REQUIRED, NULL},
+        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was written, as one JSON object on stdout", 0, NULL},
     };
     const rch_cmdspec spec = {
         "report", "an HTML report of a calibration: one self-contained file to hand on",
@@ -41,6 +110,8 @@ int rcal_cmd_report(int argc, char **argv)
     rch_diag d;
     if (rch_report_write(&res, &cfg, &d) != 0)
         return rch_opt_fail(&spec, &d);
+    if (json)
+        return report_json(&res, &cfg, argc, argv) != 0;
     fprintf(stderr, "rcal report: %s written (%u plots, %u warnings, %u places not in this run)\n", cfg.out_path,
             res.n_plots, res.n_warnings, res.n_missing);
     for (unsigned k = 0; k < res.n_csv; ++k)

@@ -22,6 +22,7 @@
 #include "rc_comp.h"
 #include "rc_rand.h"
 #include "rc_solve.h"
+#include "rct_irb120.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 
@@ -53,20 +54,16 @@ static void fk_r(double p[3], double R[9], const rc_model *m, const rc_real q[RC
     rc_fk(p, R, m, qd);
 }
 
-static const double irb120_dh[RC_NJ][4] = {
-    {0, 290, -90 * DEG, 0}, {270, 0, 0, -90 * DEG}, {70, 0, -90 * DEG, 0},
-    {0, 302, 90 * DEG, 0},  {0, 0, -90 * DEG, 0},   {0, 72, 0, 0},
-};
-static const double irb120_lim_deg[RC_NJ][2] = {{-165, 165}, {-110, 110}, {-110, 70},
-                                                {-160, 160}, {-120, 120}, {-400, 400}};
 static const double enc_mm[3] = {600, -300, 50};
 
 static void make_nominal(rc_model *m)
 {
-    assert_int_equal(rc_model_init(m, irb120_dh, enc_mm), RC_OK);
+    double dh[RC_NJ][4];
+    rct_irb120_dh(dh);
+    assert_int_equal(rc_model_init(m, (const double(*)[4])dh, enc_mm), RC_OK);
     for (int i = 0; i < RC_NJ; ++i) {
-        m->q_min_rad[i] = irb120_lim_deg[i][0] * DEG;
-        m->q_max_rad[i] = irb120_lim_deg[i][1] * DEG;
+        m->q_min_rad[i] = rct_irb120_lim_deg[i][0] * DEG;
+        m->q_max_rad[i] = rct_irb120_lim_deg[i][1] * DEG;
     }
 }
 
@@ -89,7 +86,7 @@ static void random_pose_d(double q[RC_NJ], rc_rng *g)
     static const double lo[RC_NJ] = {-120, -60, -62, -120, -100, -180};
     static const double hi[RC_NJ] = {120, 80, 50, 120, 100, 180};
     rc_model nom;
-    assert_int_equal(rc_model_init(&nom, irb120_dh, enc_mm), RC_OK);
+    make_nominal(&nom);
     for (;;) {
         double p[3], R[9];
         for (int i = 0; i < RC_NJ; ++i)
@@ -482,6 +479,54 @@ static void test_stream(void **state)
     assert_true(fabs(dist3(pt, pn) - (double)res.pos_err_mm) < (RC_REAL_IS_FLOAT ? 1e-3 : 1e-9));
 }
 
+/* A jump (the next target of a program, more than RC_COMP_WARM_RAD on a
+ * joint) starts from the target itself: the stream then gives exactly what
+ * a cold rc_comp_joint gives, whatever the previous target's correction;
+ * on a path (small moves) the previous correction seeds the next. */
+static void test_stream_jump_is_cold(void **state)
+{
+    (void)state;
+    rc_model nom, truth;
+    static rc_comp_stream s;
+    make_nominal(&nom);
+    make_truth(&truth, &nom, 0.5, 0.1, 23);
+    assert_int_equal(rc_comp_stream_init(&s, &truth, &nom, NULL), RC_OK);
+    uint32_t g = 99u;
+    unsigned same = 0, n = 0, warm_iters = 0, cold_iters = 0;
+    for (int k = 0; k < 60; ++k) {
+        rc_real q[RC_NJ], qs[RC_NJ], qj[RC_NJ];
+        for (int i = 0; i < RC_NJ; ++i) {
+            g = g * 1664525u + 1013904223u;
+            double u = (double)(g >> 8) / 16777216.0;
+            q[i] = (rc_real)(nom.q_min_rad[i] * 0.6 + (nom.q_max_rad[i] - nom.q_min_rad[i]) * 0.6 * u);
+        }
+        if (fabs((double)q[4]) < 0.2)
+            q[4] = RC_REAL_C(0.5);
+        rc_comp_result rs, rj;
+        rc_status a = rc_comp_stream_step(&s, qs, &rs, q);
+        rc_status b = rc_comp_joint(qj, &rj, &truth, &nom, q, NULL, NULL);
+        assert_int_equal(a, b);
+        if (a != RC_OK)
+            continue;
+        ++n;
+        same += memcmp(qs, qj, sizeof qs) == 0;
+        /* a small move from here: seeded by this correction, fewer steps than cold */
+        rc_real q2[RC_NJ], o1[RC_NJ], o2[RC_NJ];
+        for (int i = 0; i < RC_NJ; ++i)
+            q2[i] = q[i] + RC_REAL_C(0.001);
+        rc_comp_result r1, r2;
+        if (rc_comp_stream_step(&s, o1, &r1, q2) == RC_OK && rc_comp_joint(o2, &r2, &truth, &nom, q2, NULL, NULL) == RC_OK) {
+            warm_iters += r1.iterations;
+            cold_iters += r2.iterations;
+        }
+    }
+    print_message("far targets: stream == cold solve at %u of %u; small moves: %u steps seeded, %u cold\n", same, n,
+                  warm_iters, cold_iters);
+    assert_true(n >= 50);
+    assert_int_equal(same, n);
+    assert_true(warm_iters < cold_iters);
+}
+
 /* The 32-bit counters wrap (documented), rc_comp_count_since counts across
  * the wrap, and the run of failures saturates instead of wrapping to 0. */
 static void test_counters_wrap(void **state)
@@ -627,6 +672,7 @@ int main(void)
         cmocka_unit_test(test_nonconvergence),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_stream),
+        cmocka_unit_test(test_stream_jump_is_cold),
         cmocka_unit_test(test_pose_ik),
     };
     print_message("rc_real = %s, sizeof(rc_kin) %zu B, sizeof(rc_comp_stream) %zu B\n", RC_REAL_NAME, sizeof(rc_kin),

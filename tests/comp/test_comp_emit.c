@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "rch_emit.h"
+#include "rct_irb120.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 
@@ -25,10 +26,10 @@ static const char evil_name[] = "evil */ int injected = 1; /* \\\n#error broken 
 
 static void make_model(rc_model *m)
 {
-    static const double dh[RC_NJ][4] = {{0, 290, -90 * DEG, 0}, {270, 0, 0, -90 * DEG}, {70, 0, -90 * DEG, 0},
-                                        {0, 302, 90 * DEG, 0},  {0, 0, -90 * DEG, 0},   {0, 72, 0, 0}};
+    double dh[RC_NJ][4];
+    rct_irb120_dh(dh);
     static const double enc[3] = {600, -300, 50};
-    assert_int_equal(rc_model_init(m, dh, enc), RC_OK);
+    assert_int_equal(rc_model_init(m, (const double(*)[4])dh, enc), RC_OK);
 }
 
 static int run(const char *cmd)

@@ -13,18 +13,20 @@
 
 #include "rc_model.h"
 #include "rc_rand.h"
-#include "rch_data.h"
-#include "rch_robot.h"
+#include "rct_irb120.h"
 
 static rc_model nominal(void)
 {
-    rch_robot r;
-    rch_diag d;
-    assert_int_equal(rch_robot_load(&r, RCAL_SOURCE_DIR "/data/irb120.json", &d), 0);
-    r.model.x[RC_P_ENC] = 250.0;
-    r.model.x[RC_P_ENC + 1] = -460.0;
-    r.model.x[RC_P_ENC + 2] = 10.0;
-    return r.model;
+    rc_model m;
+    double dh[RC_NJ][4];
+    const double enc[3] = {250.0, -460.0, 10.0};
+    rct_irb120_dh(dh);
+    assert_int_equal(rc_model_init(&m, (const double(*)[4])dh, enc), RC_OK);
+    for (int i = 0; i < RC_NJ; ++i) {
+        m.q_min_rad[i] = rct_irb120_lim_deg[i][0] * 3.14159265358979323846 / 180.0;
+        m.q_max_rad[i] = rct_irb120_lim_deg[i][1] * 3.14159265358979323846 / 180.0;
+    }
+    return m;
 }
 
 static void random_pose(rc_sample *s, rc_rng *g)
@@ -170,37 +172,6 @@ static void test_fk_zero_pose(void **state)
     assert_true(fabs(p[2] - 630.0) < 1e-9);
 }
 
-static void test_fk_real_file(void **state)
-{
-    (void)state;
-    FILE *f = fopen(RCAL_SHARED_DATA, "r");
-    if (!f) {
-        print_message("SKIP: %s is absent; FK check against the real file not run\n", RCAL_SHARED_DATA);
-        skip();
-    }
-    fclose(f);
-    rch_data d;
-    rch_diag dg;
-    assert_int_equal(rch_data_load(&d, RCAL_SHARED_DATA, 0, &dg), 0);
-    assert_non_null(d.xyz);
-    rc_model m = nominal();
-    size_t within_1mm = 0, far = 0;
-    for (size_t i = 0; i < d.n; ++i) {
-        double p[3];
-        rc_fk(p, NULL, &m, d.s[i].q_rad);
-        const double dist = sqrt(pow(p[0] - d.xyz[i][0], 2) + pow(p[1] - d.xyz[i][1], 2) + pow(p[2] - d.xyz[i][2], 2));
-        if (dist < 1.0)
-            ++within_1mm;
-        else if (dist > 50.0)
-            ++far;
-    }
-    /* all rows but the faulty ones agree within the 0.1 deg angle rounding */
-    assert_int_equal(d.n, 1042);
-    assert_true(within_1mm >= 1039);
-    assert_int_equal(far, 1); /* line 952: z = 504.5 in the file, FK says 405.35 */
-    rch_data_free(&d);
-}
-
 static void test_wrap_angles(void **state)
 {
     (void)state;
@@ -320,8 +291,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_param_jacobian_base), cmocka_unit_test(test_param_jacobian_effects),
         cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
-        cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_fk_real_file),
-        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
+        cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
         cmocka_unit_test(test_prepared_base),       cmocka_unit_test(test_prepared_effects),
         cmocka_unit_test(test_wrap_leaves_huge_angles),
     };

@@ -117,7 +117,7 @@ static void test_compare_run(void **state)
         size_t len = 0;
         FILE *f = open_memstream(&buf, &len);
         assert_non_null(f);
-        rch_compare_json(f, &a, &cfg, "a \"quoted\\ path");
+        rch_compare_json(f, &a, &cfg, "a \"quoted\\ path", 0, NULL);
         fclose(f);
         rch_json *j = rch_json_parse(buf, len, "compare", &d);
         if (!j)
@@ -251,7 +251,7 @@ static void test_chaos(void **state)
         size_t len = 0;
         FILE *f = open_memstream(&buf, &len);
         assert_non_null(f);
-        rch_chaos_json(f, &r, &cfg);
+        rch_chaos_json(f, &r, &cfg, 0, NULL);
         fclose(f);
         assert_null(strstr(buf, "nan"));
         assert_null(strstr(buf, "inf"));

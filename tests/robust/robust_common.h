@@ -10,6 +10,7 @@
 
 #include "rc_model.h"
 #include "rc_rand.h"
+#include "rct_irb120.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -19,12 +20,10 @@
 /* ABB IRB120, data/irb120.json (a, d, alpha, theta offset). */
 static inline void rb_nominal(rc_model *m)
 {
-    const double dh[RC_NJ][4] = {
-        {0, 290, -90 * RB_DEG, 0},  {270, 0, 0, -90 * RB_DEG}, {70, 0, -90 * RB_DEG, 0},
-        {0, 302, 90 * RB_DEG, 0},   {0, 0, -90 * RB_DEG, 0},   {0, 72, 0, 0},
-    };
+    double dh[RC_NJ][4];
+    rct_irb120_dh(dh);
     const double enc[3] = {250.0, -460.0, 10.0};
-    (void)rc_model_init(m, dh, enc);
+    (void)rc_model_init(m, (const double(*)[4])dh, enc);
 }
 
 /* The "real" robot: nominal plus small geometric errors. */

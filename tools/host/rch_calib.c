@@ -15,6 +15,7 @@
 #include "rch_opt.h"
 #include "rch_plot.h"
 #include "rc_rand.h"
+#include "rch_resid.h"
 #include "rch_sha256.h"
 #include "rch_jw.h"
 #include "rch_save.h"
@@ -535,8 +536,9 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     return finish(r, fixed, train, &r->model, NULL, d);
 }
 
-/* Joint angles from the file's x, y, z; inconsistent rows dropped. */
-static int dequantize(rch_calib_result *r, rch_data *data, rch_diag *d)
+/* Joint angles from the file's x, y, z; inconsistent rows dropped (and from
+ * file_of (n) when given). */
+static int dequantize(rch_calib_result *r, rch_data *data, unsigned *file_of, rch_diag *d)
 {
     if (!data->xyz) {
         rch_diag_set(d, r->cfg.data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
@@ -558,6 +560,8 @@ static int dequantize(rch_calib_result *r, rch_data *data, rch_diag *d)
         }
         data->s[k] = data->s[i];
         data->line[k] = data->line[i];
+        if (file_of)
+            file_of[k] = file_of[i];
         memcpy(data->xyz[k], data->xyz[i], sizeof data->xyz[k]);
         ++k;
     }
@@ -603,9 +607,10 @@ static size_t split(size_t *idx, const rc_sample *s, size_t n, double fraction, 
     return nt;
 }
 
-/* One calibration on the rows sub (m) of data. */
+/* One calibration on the rows sub (m) of data; held (m, or NULL) set to 1
+ * for the held-out rows. */
 static int run_once(rch_calib_result *r, rc_solve_work *w, const rc_sample *s, size_t m, unsigned long long seed,
-                    rch_diag *d)
+                    uint8_t *held, rch_diag *d)
 {
     size_t *idx = malloc((m ? m : 1) * sizeof *idx);
     rc_sample *train = NULL, *test = NULL;
@@ -616,6 +621,8 @@ static int run_once(rch_calib_result *r, rc_solve_work *w, const rc_sample *s, s
     }
     r->n_test = split(idx, s, m, r->cfg.test_fraction, r->cfg.holdout_groups, seed);
     r->n_train = m - r->n_test;
+    for (size_t i = 0; held && i < r->n_test; ++i)
+        held[idx[i]] = 1;
     if (r->n_train < RC_N_BASE) {
         rch_diag_set(d, "", 0, 0, "%zu training samples; at least %d are needed for 27 parameters", r->n_train,
                      RC_N_BASE);
@@ -663,7 +670,7 @@ static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data
             c->cfg.validate_path = NULL;
             c->cfg.plots_dir = NULL;
         }
-        int one = run_once(into, w, sub, m, r->cfg.seed * 1000003ull + k + 7, d);
+        int one = run_once(into, w, sub, m, r->cfg.seed * 1000003ull + k + 7, NULL, d);
         if (one != 0) {
             rc = one;
             goto done;
@@ -686,10 +693,47 @@ done:
     return rc;
 }
 
+/* The per-sample residual CSV (cfg.residuals_path) of a single run: every
+ * row with the identified model, set train or test by held (n); file_of (n)
+ * the input file of each row. */
+static int save_residuals(const rch_calib_result *r, const rch_data *data, const unsigned *file_of,
+                          const uint8_t *held, rch_diag *d)
+{
+    const char *inputs[RCH_CALIB_MAX_FILES + 3] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
+    const size_t nf = n_files(&r->cfg);
+    for (size_t f = 0; f < nf; ++f)
+        inputs[3 + f] = file_at(&r->cfg, f);
+    rch_resid_table t;
+    rch_resid_init(&t, inputs + 3, nf);
+    int rc = 0;
+    for (size_t i = 0; i < data->n && rc == 0; ++i)
+        rc = rch_resid_add_model(&t, &r->model, &data->s[i], &data->line[i], &file_of[i], 1,
+                                 held[i] ? RCH_RESID_TEST : RCH_RESID_TRAIN, 0);
+    rch_data v;
+    if (rc == 0 && r->have_validate) {
+        rc = rch_data_load(&v, r->cfg.validate_path, 0, d);
+        if (rc == 0) {
+            rc = rch_resid_add_model(&t, &r->model, v.s, v.line, NULL, v.n, RCH_RESID_VALIDATE, 0);
+            rch_data_free(&v);
+        }
+    }
+    if (rc != 0 && !d->msg[0])
+        rch_diag_set(d, "", 0, 0, "out of memory");
+    if (rc == 0)
+        rc = rch_resid_save(r->cfg.residuals_path, inputs, 3 + nf, &t, d);
+    rch_resid_free(&t);
+    return rc;
+}
+
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
 {
     memset(r, 0, sizeof *r);
+    memset(d, 0, sizeof *d);
     r->cfg = *cfg;
+    if (cfg->residuals_path && (cfg->cases > 1 || cfg->jumps)) {
+        rch_diag_set(d, "", 0, 0, "--residuals is for one calibration without --jumps (not with --cases or --jumps)");
+        return -2;
+    }
     rch_data data;
     size_t counts[RCH_CALIB_MAX_FILES] = {0};
     if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || load_all(&data, counts, cfg, d) != 0)
@@ -701,6 +745,15 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     provenance(r, counts);
     int rc = -1;
     rc_solve_work *w = malloc(sizeof *w);
+    unsigned *file_of = cfg->residuals_path ? malloc((data.n ? data.n : 1) * sizeof *file_of) : NULL;
+    uint8_t *held = cfg->residuals_path ? calloc(data.n ? data.n : 1, 1) : NULL;
+    if (cfg->residuals_path && (!file_of || !held)) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    for (size_t f = 0, i = 0; file_of && f < RCH_CALIB_MAX_FILES; ++f)
+        for (size_t k = 0; k < counts[f] && i < data.n; ++k)
+            file_of[i++] = (unsigned)f;
     if (cfg->tool_offset && rc_model_add_effect(&r->robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
         rch_diag_set(d, "", 0, 0, "cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
         goto done;
@@ -713,12 +766,14 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
         rc = -2;
         goto done;
     }
-    if (cfg->dequantize && dequantize(r, &data, d) != 0)
+    if (cfg->dequantize && dequantize(r, &data, file_of, d) != 0)
         goto done;
     if (cfg->cases > 1)
         rc = run_cases(r, w, &data, d);
     else
-        rc = run_once(r, w, data.s, data.n, cfg->seed, d);
+        rc = run_once(r, w, data.s, data.n, cfg->seed, held, d);
+    if (rc == 0 && cfg->residuals_path && r->finite && save_residuals(r, &data, file_of, held, d) != 0)
+        rc = -1;
     if (rc == 0 && r->have_jumps && r->prov.n_files == 1)
         for (unsigned k = 0; k < r->jumps.n_jumps; ++k)
             for (size_t i = 0; i < data.n; ++i)
@@ -728,6 +783,8 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
                 }
 done:
     free(w);
+    free(file_of);
+    free(held);
     rch_data_free(&data);
     return rc;
 }
@@ -920,6 +977,7 @@ static void json_metrics(rch_jw *w, const char *name, const rc_metrics *m)
     rch_jw_numf(w, "sd_mm", m->sd_mm, "%.6f");
     rch_jw_numf(w, "mean_mm", m->mean_mm, "%.6f");
     rch_jw_numf(w, "max_mm", m->max_mm, "%.6f");
+    rch_jw_num(w, "rmse_full_mm", m->rmse_mm); /* rmse_mm to the last bit (%.17g): checks of --residuals */
     rch_jw_end(w);
 }
 
@@ -981,11 +1039,12 @@ static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
     rch_jw_end(w);
 }
 
-int rch_calib_json(FILE *f, const rch_calib_result *r)
+int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, f, 0);
     rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-calibrate/1", argc, argv);
     rch_jw_str(&w, "method", rc_method_name(r->cfg.method));
     rch_jw_str(&w, "data", r->cfg.data_path);
     rch_jw_uint(&w, "n_train", r->n_train);

@@ -89,6 +89,7 @@ typedef struct rch_calib_cfg {
     int holdout_groups;     /* 1: hold out whole set-up groups instead of random rows */
     unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
     size_t case_samples;    /* rows per case (0: every row) */
+    const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
 } rch_calib_cfg;
 
 typedef struct rch_calib_result {
@@ -141,8 +142,10 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d);
 
 /* The text report (the paper's Table 7 form, identifiability, solver line). */
 void rch_calib_print(FILE *f, const rch_calib_result *r);
-/* The report as one JSON object (rch_jw). 0, or -1 on a write error. */
-int rch_calib_json(FILE *f, const rch_calib_result *r);
+/* The report as one JSON object (rch_jw), "rcal-calibrate/1", starting with
+ * rch_jw_header's members (argv: the command line from the command's name;
+ * argc 0 gives "rcal"). docs/json-formats.md. 0, or -1 on a write error. */
+int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv);
 /* The calibrated model file (rcal-model/1) with a "calibration" member.
  * -1 when the model is not finite or on a write error. */
 int rch_calib_write_model(FILE *f, const rch_calib_result *r);

@@ -158,13 +158,13 @@ void rch_chaos_report(FILE *f, const rch_chaos_result *res, const rch_chaos_conf
     fprintf(f, "\n");
 }
 
-int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg)
+int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg, int argc, char **argv)
 {
     const size_t b = res->best;
     rch_jw w;
     rch_jw_init(&w, f, 1);
     rch_jw_obj(&w, NULL);
-    rch_jw_str(&w, "command", "chaos");
+    rch_jw_header(&w, "rcal-chaos/1", argc, argv);
     rch_jw_uint(&w, "points", cfg->points);
     rch_jw_uint(&w, "bins", cfg->bins);
     rch_jw_uint(&w, "starts", cfg->starts);

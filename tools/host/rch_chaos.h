@@ -68,7 +68,7 @@ void rch_chaos_free(rch_chaos_result *res);
 void rch_chaos_report(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg);
 /* One JSON object (rch_jw: null where a figure is absent, never nan).
  * 0, or -1 on a write error. */
-int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg);
+int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config *cfg, int argc, char **argv);
 /* chaos_sd.svg and chaos_hist.svg into pd->dir (created when missing). 0,
  * or -1 with d set. */
 int rch_chaos_plots(const rch_chaos_result *res, const rch_chaos_config *cfg, const rch_plot_dir *pd, rch_diag *d);

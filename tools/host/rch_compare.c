@@ -104,8 +104,12 @@ void rch_compare_free(rch_compare_result *res)
         rch_curve_free(&res->curve[id]);
     free(res->cell);
     free(res->err_case1_mm);
+    free(res->idx_case1);
+    free(res->model_case1);
     res->cell = NULL;
     res->err_case1_mm = NULL;
+    res->idx_case1 = NULL;
+    res->model_case1 = NULL;
 }
 
 /* err (n): model - measured length of every sample, NaN where m fails. */
@@ -261,6 +265,10 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
     cell[0].train_rmse_mm = rc_eval(&trm, &start, h->train, h->n_train) == RC_OK ? trm.rmse_mm : NAN;
     if (first)
         sample_errors(res->err_case1_mm, &start, h->test, h->n_test);
+    if (c == 0) {
+        res->model_case1[0] = start;
+        res->ok_case1[0] = 1;
+    }
     if (save && save_row_model(cfg, robot, &start, 0, eo.fixed, h, &cell[0], d) != 0)
         return -1;
     for (int id = 0; id < RCH_EST_COUNT; ++id) {
@@ -287,6 +295,10 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
             add_ltlm(res, &m);
         if (first)
             sample_errors(res->err_case1_mm + (size_t)(id + 1) * h->n_test, &m, h->test, h->n_test);
+        if (c == 0) {
+            res->model_case1[id + 1] = m;
+            res->ok_case1[id + 1] = 1;
+        }
         if (save && save_row_model(cfg, robot, &m, id + 1, eo.fixed, h, e, d) != 0)
             return -1;
     }
@@ -348,7 +360,9 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
     rch_est_ws *ws = rch_est_ws_new();
     res->cell = calloc(cfg->cases * RCH_COMPARE_ROWS, sizeof *res->cell);
     res->err_case1_mm = malloc(RCH_COMPARE_ROWS * res->n_test * sizeof(double));
-    if (!idx || !ws || !res->cell || !res->err_case1_mm) {
+    res->idx_case1 = malloc((res->n_draw ? res->n_draw : 1) * sizeof *res->idx_case1);
+    res->model_case1 = malloc(RCH_COMPARE_ROWS * sizeof *res->model_case1);
+    if (!idx || !ws || !res->cell || !res->err_case1_mm || !res->idx_case1 || !res->model_case1) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
@@ -368,6 +382,8 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
             rch_diag_set(d, "", 0, 0, "out of memory");
             goto done;
         }
+        if (c == 0)
+            memcpy(res->idx_case1, idx, res->n_draw * sizeof *idx);
         const int st = run_case(res, cfg, ws, robot, &h, c, progress, d);
         rch_holdout_free(&h);
         if (st != 0) {
@@ -518,12 +534,13 @@ static void json_ltlm(rch_jw *w, const rch_compare_result *res)
     rch_jw_end(w);
 }
 
-int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name)
+int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name,
+                     int argc, char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, f, 1);
     rch_jw_obj(&w, NULL);
-    rch_jw_str(&w, "command", "compare");
+    rch_jw_header(&w, "rcal-compare/1", argc, argv);
     rch_jw_str(&w, "data", data_name);
     rch_jw_uint(&w, "rows_in_file", res->rows_in_data);
     rch_jw_uint(&w, "cases", res->cases);

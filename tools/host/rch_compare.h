@@ -133,6 +133,10 @@ typedef struct rch_compare_result {
     /* with cfg.curves: case 1 only */
     rch_curve curve[RCH_EST_COUNT];  /* training RMS per iteration of each method run */
     double *err_case1_mm;            /* (RCH_COMPARE_ROWS x n_test) model - measured length; NaN where absent */
+    /* always, for --residuals (rch_resid.h): case 1's data rows and models */
+    size_t *idx_case1;               /* (n_draw) indices into s: the n_test held out first, then training */
+    rc_model *model_case1;           /* (RCH_COMPARE_ROWS) the model of each row in case 1 */
+    int ok_case1[RCH_COMPARE_ROWS];  /* 1: that row ran and succeeded in case 1 */
 } rch_compare_result;
 
 /* Run the protocol on s (n) with the nominal robot. progress (may be NULL)
@@ -155,7 +159,8 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
                         const char *data_name);
 /* The same as one JSON object (rch_jw: strings escaped, null where a
  * figure is absent). 0, or -1 on a write error. */
-int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name);
+int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg, const char *data_name,
+                     int argc, char **argv);
 
 /* Write convergence.svg, convergence_zoom.svg (need cfg.curves), rmse_bars.svg,
  * time_bars.svg and per_sample.svg into pd->dir (created with its parents

@@ -207,7 +207,7 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *robot_path
 
 /* Human report and one JSON object. 0 or -1 on a write error. */
 int rch_diagnose_print(FILE *f, const rch_diagnose_result *r);
-int rch_diagnose_json(FILE *f, const rch_diagnose_result *r);
+int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **argv);
 
 /* Residual plots (SVG) into dir: residuals before/after against acquisition
  * order, per-group mean residuals before/after, the candidate gains, and the

@@ -389,7 +389,9 @@ int rch_ffi_calib_json(const rch_ffi_calib *c, char *buf, size_t len, size_t *ne
     FILE *f = open_memstream(&text, &n);
     if (!f)
         return RCH_FFI_ERR_NOMEM;
-    const int bad = rch_calib_json(f, &c->r) != 0;
+    char name[] = "calibrate"; /* the library call stands for the command */
+    char *av[] = {name};
+    const int bad = rch_calib_json(f, &c->r, 1, av) != 0;
     if ((fclose(f) != 0) | bad) {
         free(text);
         return RCH_FFI_ERR_IO;

@@ -294,7 +294,8 @@ static size_t comp_pass(rch_grind_result *res, const rch_grind_config *gc, int c
             ++n_best_effort;
         rc_fk(pt, NULL, truth, qc);
         if (c < 0) {
-            rch_stats_add(only, dist3(pt, p->p_mm));
+            if (only != NULL)
+                rch_stats_add(only, dist3(pt, p->p_mm));
             continue;
         }
         p->flag[c] = stc != RC_OK;
@@ -464,12 +465,13 @@ void rch_grind_report(FILE *f, const rch_grind_result *res, const rch_grind_conf
                 res->n_orient_best_effort);
 }
 
-int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg)
+int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg, int argc, char **argv)
 {
     static const char *const keys[3] = {"uncompensated", "compensated_calibrated", "compensated_true"};
     rch_jw w;
     rch_jw_init(&w, f, 1);
     rch_jw_obj(&w, NULL);
+    rch_jw_header(&w, "rcal-grind/1", argc, argv);
     rch_jw_str(&w, "surface", rch_surface_name(cfg->surface.kind));
     rch_jw_uint(&w, "points", res->n);
     rch_jw_uint(&w, "lines", res->ny);
@@ -761,13 +763,12 @@ void rch_grind_table8_report(FILE *f, const rch_grind_table *t, const rch_grind_
                 t->named_p_mm[m][1], t->named_p_mm[m][2], m < 4 ? ";" : "\n");
 }
 
-int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg)
+int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, int argc, char **argv)
 {
     rch_jw w;
     rch_jw_init(&w, f, 1);
     rch_jw_obj(&w, NULL);
-    rch_jw_str(&w, "command", "grind");
-    rch_jw_str(&w, "form", "table8");
+    rch_jw_header(&w, "rcal-grind-table8/1", argc, argv);
     rch_jw_str(&w, "surface", rch_surface_name(cfg->surface.kind));
     rch_jw_uint(&w, "points", t->n_points);
     rch_jw_bool(&w, "align", cfg->align);

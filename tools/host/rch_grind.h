@@ -137,7 +137,7 @@ const char *rch_grind_point_name(int m);
 void rch_grind_report(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg, const char *model_name,
                       const char *truth_name);
 /* One JSON object through rch_jw. 0, or -1 on a write error. */
-int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg);
+int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config *cfg, int argc, char **argv);
 
 /* grind_path.svg (top view, segments coloured by deviation, uncompensated
  * and compensated side by side), grind_deviation.svg (deviation along the
@@ -187,7 +187,8 @@ int rch_grind_table8_files(rch_grind_table *t, const rch_grind_config *cfg, cons
                            const char *const *names, size_t n, const char *truth_path, const char *nominal_path,
                            rch_diag *d);
 void rch_grind_table8_report(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, const char *truth_name);
-/* One JSON object through rch_jw. 0, or -1 on a write error. */
-int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg);
+/* One JSON object through rch_jw ("rcal-grind-table8/1"; argc, argv: the
+ * command line for its header). 0, or -1 on a write error. */
+int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, int argc, char **argv);
 
 #endif

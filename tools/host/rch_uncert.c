@@ -513,6 +513,34 @@ double rch_model_unc_pos95_mm(const rch_model_unc *u, const rc_model *m, const d
     return pos95_cov(u->cov_dh, RC_N_DH, use, RC_N_DH, m, q_rad);
 }
 
+double rch_model_unc_tool95_mm(const rch_model_unc *u, const rc_model *det, const rc_model *fit,
+                               const double q_rad[RC_NJ], const double tool_mm[3])
+{
+    uint8_t use[RC_N_DH];
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        use[k] = u->cls[k] != RCH_PARAM_FIXED && isfinite(u->se[k]);
+    double Jp[3][RC_MAX_PARAMS], Jr[3][RC_MAX_PARAMS], p[3], R[9], t[3], shift[3] = {0, 0, 0};
+    fk_sensitivity(Jp, Jr, use, RC_N_DH, det, q_rad);
+    rc_fk(p, R, det, q_rad);
+    for (int i = 0; i < 3; ++i)
+        t[i] = R[i * 3] * tool_mm[0] + R[i * 3 + 1] * tool_mm[1] + R[i * 3 + 2] * tool_mm[2];
+    for (unsigned k = 0; k < RC_N_DH; ++k) { /* d(p + R t) = dp + w x (R t) */
+        double w0 = Jr[0][k], w1 = Jr[1][k], w2 = Jr[2][k];
+        Jp[0][k] += w1 * t[2] - w2 * t[1];
+        Jp[1][k] += w2 * t[0] - w0 * t[2];
+        Jp[2][k] += w0 * t[1] - w1 * t[0];
+        if (u->comp_nominal[k] && use[k])
+            for (int i = 0; i < 3; ++i)
+                shift[i] += Jp[i][k] * (fit->x[k] - det->x[k]);
+    }
+    double cov[RC_N_DH * RC_N_DH];
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        for (unsigned l = 0; l < RC_N_DH; ++l)
+            cov[k * RC_N_DH + l] = use[k] && use[l] ? u->cov_dh[k * RC_N_DH + l] : 0.0;
+    return sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) +
+           ellipsoid95(Jp, cov, RC_N_DH, RC_N_DH);
+}
+
 void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_model_unc *u)
 {
     *out = *fit;

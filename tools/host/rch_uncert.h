@@ -154,6 +154,17 @@ void rch_model_unc_from(rch_model_unc *out, const rch_uncert *u);
 /* 95 % position uncertainty at q of the determined model (identifiable DH
  * parameters only: the others are held nominal and carry no information). */
 double rch_model_unc_pos95_mm(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ]);
+/* 95 % error bound (mm) of a tool point tool_mm (3, in the flange frame)
+ * of the robot compensated with the determined model det
+ * (rch_model_unc_determined of fit), at q: |what resetting the held
+ * parameters moves the point| + the longest semi-axis of the 95 % ellipsoid
+ * of every parameter with a standard error (held ones included: the fit's
+ * covariance is the data's word on how far the truth may lie from the value
+ * compensation keeps). Not-identifiable parameters (the base height and
+ * heading, set by other means) are not counted. Wide 100 mm off the flange
+ * axis when theta6 is weak (cable lengths barely see the roll about it). */
+double rch_model_unc_tool95_mm(const rch_model_unc *u, const rc_model *det, const rc_model *fit,
+                               const double q_rad[RC_NJ], const double tool_mm[3]);
 /* The determined model: fit with its weak and not-identifiable DH
  * parameters at their nominal values. */
 void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_model_unc *u);
