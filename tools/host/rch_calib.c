@@ -197,14 +197,18 @@ static int truth_flange(rch_calib_result *r, rch_diag *d)
 
 /* Predicted 95 % flange-position uncertainty against the horizontal reach
  * of the flange, at the training poses and at random poses in the joint
- * limits: uncertainty_position.svg and .csv in plots_dir. */
+ * limits: uncertainty_position.svg and its data, uncertainty_position.csv,
+ * in plots_dir (rch_plot_save: never over an input, atomic). */
 static void uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_sample *train)
 {
     const size_t nw = 1000, nt = r->n_train;
     double *x = malloc((nt + nw) * sizeof *x), *y = malloc((nt + nw) * sizeof *y);
-    rch_plot *p = rch_plot_new("predicted flange-position uncertainty (95 %)", "horizontal reach of the flange (mm)",
-                               "uncertainty (mm)");
-    char path[1100];
+    rch_plot *p = rch_plot_new("Predicted 95 % flange-position uncertainty of the calibrated model",
+                               "horizontal reach of the flange from the base axis (mm)",
+                               "predicted 95 % position uncertainty (mm)");
+    const char *inputs[RCH_CALIB_MAX_FILES + 4];
+    size_t n_in = 0;
+    rch_diag d;
     if (!x || !y || !p || rch_plot_mkdir(r->cfg.plots_dir) != 0)
         goto done;
     rc_rng g;
@@ -218,23 +222,21 @@ static void uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_
         x[i] = sqrt(pos[0] * pos[0] + pos[1] * pos[1]);
         y[i] = rch_uncert_pos95_mm(u, &r->model, q);
     }
+    rch_plot_subtitle(p, "from the parameter covariance of the fit, at the data's poses and at random poses");
     rch_plot_scatter(p, "random poses in the joint limits (whole workspace)", x + nt, y + nt, nw);
-    rch_plot_scatter(p, "the data's poses", x, y, nt);
+    rch_plot_scatter(p, "the data's poses (training set)", x, y, nt);
     rch_plot_logy(p, 1);
-    snprintf(path, sizeof path, "%s/uncertainty_position.svg", r->cfg.plots_dir);
-    if (rch_plot_write_svg(p, path) == 0)
-        snprintf(r->plot_paths, sizeof r->plot_paths, "%s\n", path);
-    snprintf(path, sizeof path, "%s/uncertainty_position.csv", r->cfg.plots_dir);
-    FILE *f = fopen(path, "w");
-    if (f) {
-        fprintf(f, "set,reach_mm,pos95_mm\n");
-        for (size_t i = 0; i < nt + nw; ++i)
-            fprintf(f, "%s,%.6f,%.6g\n", i < nt ? "data" : "workspace", x[i], y[i]);
-        if (fclose(f) == 0) {
-            size_t len = strlen(r->plot_paths);
-            snprintf(r->plot_paths + len, sizeof r->plot_paths - len, "%s\n", path);
-        }
-    }
+    const int several = r->cfg.data_paths && r->cfg.n_data_paths;
+    for (size_t k = 0; k < (several ? r->cfg.n_data_paths : 1u) && n_in < RCH_CALIB_MAX_FILES; ++k)
+        inputs[n_in++] = several ? r->cfg.data_paths[k] : r->cfg.data_path;
+    inputs[n_in++] = r->cfg.validate_path;
+    inputs[n_in++] = r->cfg.robot_path;
+    inputs[n_in++] = r->cfg.truth_path;
+    const rch_plot_dir pd = {r->cfg.plots_dir, inputs, n_in, NULL};
+    if (rch_plot_save(p, &pd, "uncertainty_position.svg", &d) == 0)
+        snprintf(r->plot_paths, sizeof r->plot_paths, "%s/uncertainty_position.svg\n%s/uncertainty_position.csv\n",
+                 r->cfg.plots_dir, r->cfg.plots_dir);
+    p = NULL; /* freed by rch_plot_save */
 done:
     free(x);
     free(y);
