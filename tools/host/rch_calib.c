@@ -223,7 +223,7 @@ static void uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_
         y[i] = rch_uncert_pos95_mm(u, &r->model, q);
     }
     rch_plot_subtitle(p, "from the parameter covariance of the fit, at the data's poses and at random poses");
-    rch_plot_scatter(p, "random poses in the joint limits (whole workspace)", x + nt, y + nt, nw);
+    rch_plot_scatter(p, "random poses in the joint limits", x + nt, y + nt, nw);
     rch_plot_scatter(p, "the data's poses (training set)", x, y, nt);
     rch_plot_logy(p, 1);
     const int several = r->cfg.data_paths && r->cfg.n_data_paths;

@@ -522,7 +522,7 @@ static void svg_colour_bar(FILE *f, double bx, double by, double bh, double vmax
                 vmax * i / 4.0);
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"middle\" transform=\"rotate(-90 %.1f %.1f)\">"
                "deviation (mm)</text>\n",
-            bx + 70, by + bh / 2, bx + 70, by + bh / 2);
+            bx + 84, by + bh / 2, bx + 84, by + bh / 2);
     fprintf(f, "</g>\n");
 }
 

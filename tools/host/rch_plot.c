@@ -473,7 +473,7 @@ static void plot_layout(plot_frame *fr, const rch_plot *p)
             maxlab = l;
     }
     if (fr->nleg > 0) {
-        fr->legw = 40.0 + 7.2 * (double)(maxlab > 40 ? 40 : maxlab);
+        fr->legw = 40.0 + 7.2 * (double)(maxlab > 48 ? 48 : maxlab);
         fr->R += fr->legw + 10.0;
     }
     if (p->n_bars > 0) {
