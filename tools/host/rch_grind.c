@@ -575,7 +575,7 @@ static void svg_panel(FILE *f, const rch_grind_result *res, int c, const rch_sur
         fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"5\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n",
                 qx, qy);
         fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\" fill=\"#d62728\" text-anchor=\"%s\" "
-                   "font-weight=\"bold\">%s %.3f</text>\n",
+                   "font-weight=\"bold\">%s %.3g</text>\n",
                 qx + (right ? -9 : 9), qy + (below ? 20 : -9), right ? "end" : "start", point_names[i], q->dev_mm[c]);
     }
     svg_colour_bar(f, ox + pw + 30, oy, ph, vmax);
