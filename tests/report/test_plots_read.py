@@ -17,7 +17,8 @@ chaos with --plots) on the demo data, and on the real data when
     text the commands print;
   - titles name no paper figure or equation (that goes in a subtitle);
   - bars have one colour, or each colour is a category named in the legend;
-  - the set-up groups carry the same numbers in diagnose's two group plots.
+  - the set-up groups carry the same numbers in diagnose's two group plots;
+  - the inline charts of rcal report's page keep their text inside them too.
 Exit 0 when every check passes, 1 otherwise.
 
 usage: test_plots_read.py RCAL SOURCE_DIR WORK_DIR
@@ -218,6 +219,36 @@ def text_p_values(name, out):
     check(not zeros, '%s text: no p-value printed as 0%s' % (name, (': ' + zeros[0]) if zeros else ''))
 
 
+def check_report_charts(rcal, src, data, d):
+    """The inline SVG charts of rcal report: XML, every text inside the chart."""
+    os.makedirs(d)
+    cal, diag, page = (os.path.join(d, n) for n in ('cal.json', 'diag.json', 'report.html'))
+    with open(cal, 'w') as f:
+        f.write(run([rcal, 'calibrate', '--data', data, '--json'], src))
+    with open(diag, 'w') as f:
+        f.write(run([rcal, 'diagnose', '--data', data, '--json'], src))
+    run([rcal, 'report', '--calibration', cal, '--diagnosis', diag, '--out', page], src)
+    html = open(page, encoding='utf-8').read()
+    charts = re.findall(r'<svg\b.*?</svg>', html, re.S)
+    check(len(charts) >= 3, 'report: %d inline charts' % len(charts))
+    for k, c in enumerate(charts):
+        c = re.sub(r'^<svg\b', '<svg xmlns="http://www.w3.org/2000/svg"', c) if 'xmlns=' not in c[:300] else c
+        try:
+            root = ET.fromstring(c)
+        except ET.ParseError as e:
+            check(False, 'report chart %d parses as XML (%s)' % (k, e))
+            continue
+        vb = [float(v) for v in root.get('viewBox').split()]
+        title = root.get('aria-label', '')
+        outside = []
+        for e, parents in texts_with_parents(root):
+            x0, y0, x1, y1 = text_box(e, parents)
+            if x0 < vb[0] - 1 or y0 < vb[1] - 1 or x1 > vb[0] + vb[2] + 1 or y1 > vb[1] + vb[3] + 1:
+                outside.append('"%s" at (%.0f..%.0f)' % (text_of(e), x0, x1))
+        check(not outside, 'report chart "%s": every text inside the chart%s' % (title, ('; outside: ' + ', '.join(
+            outside)) if outside else ''))
+
+
 def main():
     global WORK
     if len(sys.argv) != 4:
@@ -243,6 +274,7 @@ def main():
     run([rcal, 'grind', '--model', os.path.join(WORK, 'demo_model.json'), '--truth', truth,
          '--plots', os.path.join(WORK, 'demo', 'grind')], src)
     run([rcal, 'chaos', '--plots', os.path.join(WORK, 'chaos')], src)
+    check_report_charts(rcal, src, sets[-1][1], os.path.join(WORK, 'report'))
     svgs = sorted(os.path.join(dp, f) for dp, _, fs in os.walk(WORK) for f in fs if f.endswith('.svg'))
     check(len(svgs) >= 15, '%d SVG files written' % len(svgs))
     for s in svgs:
