@@ -947,15 +947,16 @@ int rch_plot_close(rch_out *o, const rch_plot_dir *pd, int failed, rch_diag *d)
 /* NAME with .svg (when it ends so) replaced by .csv. 0, or -1 with d set. */
 static int plot_csv_name(char *csv, size_t len, const rch_plot_dir *pd, const char *name, rch_diag *d)
 {
-    size_t n = name ? strlen(name) : 0;
+    if (!name)
+        name = "";
+    size_t n = strlen(name);
     if (n >= 4 && strcmp(name + n - 4, ".svg") == 0)
         n -= 4;
-    if (n + 5 > len) {
-        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: name too long", pd->dir, name ? name : "");
+    if (n + 5 > len || n > 4096) {
+        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: name too long", pd->dir, name);
         return -1;
     }
-    memcpy(csv, name, n);
-    memcpy(csv + n, ".csv", 5);
+    snprintf(csv, len, "%.*s.csv", (int)n, name);
     return 0;
 }
 
