@@ -51,7 +51,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
         {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "fold assignment seed", 0, NULL},
         {"--folds", RCH_OPT_UINT, &folds, 2, RCH_DIAGNOSE_MAX_FOLDS, "K", "cross-validation folds", 0, NULL},
         {"--steps", RCH_OPT_UINT, &steps, 1, RCH_DIAGNOSE_MAX_STEPS, "N", "effects added at most", 0, NULL},
-        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "write residual plots (SVG) into DIR", 0, NULL},
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "write residual plots (SVG, each with its data as .csv) into DIR", 0, NULL},
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
          "write the calibrated model with the effects found (nuisances left out); never over an input", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
