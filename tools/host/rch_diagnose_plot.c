@@ -75,17 +75,13 @@ static double test_x(const rch_diagnose_result *r, unsigned k, size_t i, const c
 }
 
 /* 1. Held-out residuals in acquisition order, before and after, within the
- * noise floor. x, fl, fh: (n) scratch. */
-static int plot_order(const rch_diagnose_result *r, const plot_out *o, double *x, double *fl, double *fh,
-                      rch_diag *d)
+ * noise floor. x: (n) scratch. */
+static int plot_order(const rch_diagnose_result *r, const plot_out *o, double *x, rch_diag *d)
 {
     const size_t n = r->n;
     char title[256];
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < n; ++i)
         x[i] = (double)i;
-        fl[i] = -r->noise_floor_mm;
-        fh[i] = r->noise_floor_mm;
-    }
     rch_plot *p = rch_plot_new("Held-out length residual of each sample, in acquisition order",
                                "sample (acquisition order, from 0)", "model - measured cable length (mm)");
     snprintf(title, sizeof title, "RMS: geometry only %.3f mm, %s %.3f mm; noise floor %.3f mm (verdict: %s)",
@@ -95,8 +91,10 @@ static int plot_order(const rch_diagnose_result *r, const plot_out *o, double *x
     rch_plot_scatter(p, "geometry only", x, r->res_before_mm, n);
     if (r->n_chosen)
         rch_plot_scatter(p, "with the chosen effects", x, r->res_after_mm, n);
-    rch_plot_line(p, "+ noise floor", x, fh, n);
-    rch_plot_line(p, "- noise floor", x, fl, n);
+    const double ends[2] = {0.0, n ? (double)(n - 1) : 0.0}, fh[2] = {r->noise_floor_mm, r->noise_floor_mm},
+                 fl[2] = {-r->noise_floor_mm, -r->noise_floor_mm};
+    rch_plot_line(p, "+ noise floor", ends, fh, 2); /* level lines: their two ends */
+    rch_plot_line(p, "- noise floor", ends, fl, 2);
     rch_plot_size(p, 1000, 500);
     return save(p, o, "residuals_order.svg", d);
 }
@@ -208,20 +206,18 @@ int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *path
                        rch_diag *d)
 {
     const size_t n = r->n;
-    double *x = malloc(n * sizeof *x), *fl = malloc(n * sizeof *fl), *fh = malloc(n * sizeof *fh);
+    double *x = malloc((n ? n : 1) * sizeof *x);
     const plot_out o = {{dir, NULL, 0, NULL}, paths, paths_len};
     int rc = -1;
     if (paths_len)
         paths[0] = '\0';
-    if (!x || !fl || !fh)
+    if (!x)
         rch_diag_set(d, "", 0, 0, "out of memory");
     else if (rch_plot_mkdir(dir) != 0)
         rch_diag_set(d, dir, 0, 0, "cannot create the directory: %s", strerror(errno));
-    else if (plot_order(r, &o, x, fl, fh, d) == 0 && plot_groups(r, &o, d) == 0 && plot_candidates(r, &o, d) == 0 &&
+    else if (plot_order(r, &o, x, d) == 0 && plot_groups(r, &o, d) == 0 && plot_candidates(r, &o, d) == 0 &&
              plot_structure(r, &o, x, d) == 0)
         rc = 0;
     free(x);
-    free(fl);
-    free(fh);
     return rc;
 }
