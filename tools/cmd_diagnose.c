@@ -21,11 +21,11 @@ static const char details[] =
     "or 'unexplained'. Up to N effects are added one after the other.\n"
     "Steps are detected from the data unless given (a negative value: no quantization).";
 
-static int report(rch_diagnose_result *r, const char *plots, int json)
+static int report(rch_diagnose_result *r, const char *plots, const char *const inputs[2], int json)
 {
     rch_diag d;
     char msg[1024], paths[4096] = "";
-    if (plots && rch_diagnose_plots(r, plots, paths, sizeof paths, &d) != 0) {
+    if (plots && rch_diagnose_plots(r, plots, inputs, 2, paths, sizeof paths, &d) != 0) {
         fprintf(stderr, "rcal diagnose: plots: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
@@ -91,9 +91,9 @@ int rcal_cmd_diagnose(int argc, char **argv)
         rch_diagnose_free(&r);
         return 1;
     }
-    int rc = report(&r, plots, json);
+    const char *inputs[2] = {data_path, robot_path};
+    int rc = report(&r, plots, inputs, json);
     if (rc == 0 && out_path) {
-        const char *inputs[2] = {data_path, robot_path};
         if (rch_diagnose_save_model(&r, robot_path, out_path, inputs, 2, &d) != 0) {
             fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
             rc = 1;

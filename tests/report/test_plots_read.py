@@ -18,7 +18,9 @@ chaos with --plots) on the demo data, and on the real data when
   - titles name no paper figure or equation (that goes in a subtitle);
   - bars have one colour, or each colour is a category named in the legend;
   - the set-up groups carry the same numbers in diagnose's two group plots;
-  - the inline charts of rcal report's page keep their text inside them too.
+  - the inline charts of rcal report's page keep their text inside them too;
+  - a plot's CSV never replaces an input that carries its name (calibrate,
+    diagnose, compare: the command refuses, the input is intact).
 Exit 0 when every check passes, 1 otherwise.
 
 usage: test_plots_read.py RCAL SOURCE_DIR WORK_DIR
@@ -249,6 +251,23 @@ def check_report_charts(rcal, src, data, d):
             outside)) if outside else ''))
 
 
+def inputs_survive(rcal, src, demo):
+    """A data file named like a plot's CSV, in the plot directory: refused, intact."""
+    original = open(demo, 'rb').read()
+    for cmd, name in (('calibrate', 'uncertainty_position.csv'), ('diagnose', 'group_means.csv'),
+                      ('compare', 'rmse_bars.csv')):
+        d = os.path.join(WORK, 'clash_' + cmd)
+        os.makedirs(d)
+        data = os.path.join(d, name)
+        shutil.copyfile(demo, data)
+        extra = ['--cases', '1', '--samples', '100'] if cmd == 'compare' else []
+        p = subprocess.run([rcal, cmd, '--data', data, '--plots', d] + extra, cwd=src, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, timeout=600)
+        check(p.returncode != 0 and open(data, 'rb').read() == original,
+              '%s --plots: the input %s is refused as an output and stays intact (exit %d: %s)'
+              % (cmd, name, p.returncode, p.stderr.decode(errors='replace').strip()[:120]))
+
+
 def main():
     global WORK
     if len(sys.argv) != 4:
@@ -275,7 +294,9 @@ def main():
          '--plots', os.path.join(WORK, 'demo', 'grind')], src)
     run([rcal, 'chaos', '--plots', os.path.join(WORK, 'chaos')], src)
     check_report_charts(rcal, src, sets[-1][1], os.path.join(WORK, 'report'))
-    svgs = sorted(os.path.join(dp, f) for dp, _, fs in os.walk(WORK) for f in fs if f.endswith('.svg'))
+    inputs_survive(rcal, src, demo)
+    svgs = sorted(os.path.join(dp, f) for dp, _, fs in os.walk(WORK) for f in fs
+                  if f.endswith('.svg') and '/clash_' not in dp)
     check(len(svgs) >= 15, '%d SVG files written' % len(svgs))
     for s in svgs:
         check_svg(s)

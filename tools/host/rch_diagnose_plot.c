@@ -202,12 +202,12 @@ static int plot_structure(const rch_diagnose_result *r, const plot_out *o, doubl
     return save(p, o, "residuals_structure.svg", d);
 }
 
-int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *paths, size_t paths_len,
-                       rch_diag *d)
+int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, const char *const *inputs, size_t n_inputs,
+                       char *paths, size_t paths_len, rch_diag *d)
 {
     const size_t n = r->n;
     double *x = malloc((n ? n : 1) * sizeof *x);
-    const plot_out o = {{dir, NULL, 0, NULL}, paths, paths_len};
+    const plot_out o = {{dir, inputs, n_inputs, NULL}, paths, paths_len};
     int rc = -1;
     if (paths_len)
         paths[0] = '\0';
