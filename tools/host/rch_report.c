@@ -1441,7 +1441,7 @@ static void accuracy_chart(rep *r, const arow *a, size_t n)
     chart c;
     memset(&c, 0, sizeof c);
     c.title = "Flange-position accuracy over the workspace";
-    c.xlabel = "flange position (mm)";
+    c.xlabel = "predicted 95 % flange-position uncertainty (mm)";
     c.n_rows = n;
     c.n_sub = 1;
     c.label = labels;
