@@ -3,6 +3,9 @@
 # Regenerates every figure quoted in README.md, in one run, into out/figures/
 # (text) and docs/figures/ (SVG). Needs a Release build in build/ (scripts/demo.sh)
 # and ../shared/data/robotcali.csv for the real-data figures. Takes a few minutes.
+# Every plot is written with its data as CSV beside it (same base name).
+# PLOTS_ONLY=1 remakes only the plot directories under docs/ (about a minute:
+# no benchmarks, no real-time loops), then lists any SVG without its CSV.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 R=build/tools/rcal
@@ -11,6 +14,28 @@ O=out/figures
 F=docs/figures
 mkdir -p "$O" "$F"
 run() { local name=$1; shift; echo "== $name: $*"; "$@" > "$O/$name.txt" 2>&1 || echo "   (exit $?)"; }
+
+# every plot quoted in README.md, into docs/ (SVG + CSV)
+plots() {
+  if [ -f "$REAL" ]; then
+    run compare300 $R compare --data $REAL --cases 10 --samples 300 --test-fraction 0.1 --seed 1 --plots $F/compare300
+    run compare200 $R compare --data $REAL --cases 10 --samples 200 --test-fraction 0.2 --seed 1 --plots $F/compare200
+    run diagnose $R diagnose --data $REAL --plots docs/diagnose
+    cp $O/diagnose.txt docs/diagnose/real_data_output.txt
+    run uncertainty_real $R calibrate --data $REAL --plots $F/uncertainty_real
+    run uncertainty_real_jumps $R calibrate --data $REAL --jumps --dequantize-joints --plots $F/uncertainty_real_jumps
+    $R calibrate --data $REAL --out $O/real.json > /dev/null
+    run grind_real_sim $R simulate --truth $O/real.json --out $O/sim_real.csv --samples 1000 --seed 5
+    $R calibrate --data $O/sim_real.csv --out $O/cal_real.json > /dev/null
+    run grind_real $R grind --model $O/cal_real.json --truth $O/real.json --plots $F/grind_real
+  fi
+  run chaos $R chaos --plots $F/chaos
+  run grindA_sim $R simulate --out $O/simA.csv --truth-out $O/truthA.json --samples 1000 --seed 3
+  $R calibrate --data $O/simA.csv --out $O/calA.json > /dev/null
+  run grindA $R grind --model $O/calA.json --truth $O/truthA.json --plots $F/grindA
+  for s in $(find $F docs/diagnose -name '*.svg'); do [ -f "${s%.svg}.csv" ] || echo "   no data beside $s"; done
+}
+if [ "${PLOTS_ONLY:-0}" = 1 ]; then plots; echo "plots in $F and docs/diagnose"; exit 0; fi
 
 # issue 2: simulated truth, real data, FK, speed
 run sim_simulate   $R simulate --seed 7 --samples 600 --q-step-deg -1 --out $O/simr.csv --truth-out $O/simr_truth.json
@@ -24,25 +49,12 @@ if [ -f "$REAL" ]; then
   run real_lm_report   $R calibrate --data $REAL
   run real_tool_offset $R calibrate --data $REAL --tool-offset
   run bench_real $R bench --runs 21
-  # issue 3
-  run compare300 $R compare --data $REAL --cases 10 --samples 300 --test-fraction 0.1 --seed 1 --plots $F/compare300
-  run compare200 $R compare --data $REAL --cases 10 --samples 200 --test-fraction 0.2 --seed 1 --plots $F/compare200
-  # issue 6
-  run diagnose $R diagnose --data $REAL --plots docs/diagnose
-  cp $O/diagnose.txt docs/diagnose/real_data_output.txt
-  # issue 5: grinding with the real data's identified model as the truth
-  $R calibrate --data $REAL --out $O/real.json > /dev/null
-  run grind_real_sim $R simulate --truth $O/real.json --out $O/sim_real.csv --samples 1000 --seed 5
-  $R calibrate --data $O/sim_real.csv --out $O/cal_real.json > /dev/null
-  run grind_real $R grind --model $O/cal_real.json --truth $O/real.json --plots $F/grind_real
-  run grind_real_pos $R grind --model $O/cal_real.json --truth $O/real.json --position-only
 fi
+# issue 3 (compare), 5 (grinding, real and simulated truth), 6 (diagnose), chaos study, uncertainty: the plots
+plots
+[ -f "$REAL" ] && run grind_real_pos $R grind --model $O/cal_real.json --truth $O/real.json --position-only
 run bench_sim $R bench --data data/sim_irb120.csv --runs 21
-run chaos $R chaos --plots $F/chaos
-# issue 5: grinding on a simulated truth, compensation speed, real-time loop, cross-build
-run grindA_sim $R simulate --out $O/simA.csv --truth-out $O/truthA.json --samples 1000 --seed 3
-$R calibrate --data $O/simA.csv --out $O/calA.json > /dev/null
-run grindA $R grind --model $O/calA.json --truth $O/truthA.json --plots $F/grindA
+# issue 5: compensation speed, real-time loop, cross-build
 # the same with the joints recorded at 0.001 deg (a controller readout) instead of 0.1 deg
 run grindA3_sim $R simulate --out $O/simA3.csv --truth-out $O/truthA3.json --samples 1000 --seed 3 --q-step-deg 0.001
 $R calibrate --data $O/simA3.csv --out $O/calA3.json > /dev/null

@@ -33,7 +33,7 @@ int rcal_cmd_chaos(int argc, char **argv)
         {"--starts", RCH_OPT_UINT, &cfg.starts, 1, 1e5, NULL, "initial values averaged over", 0, NULL},
         {"--step", RCH_OPT_DOUBLE, &cfg.step, 1e-4, 4, NULL, "r step over [0, 4]", 0, NULL},
         {"--seed", RCH_OPT_UINT, &seed, 0, 4294967295.0, NULL, "seed of the initial values", 0, NULL},
-        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "chaos_sd.svg and chaos_hist.svg", 0, NULL},
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "chaos_sd.svg and chaos_hist.svg, each with its data as .csv", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
     };
     const rch_cmdspec spec = {"chaos", chaos_summary, chaos_details, opts, sizeof opts / sizeof opts[0]};

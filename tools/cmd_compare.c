@@ -129,7 +129,7 @@ int rcal_cmd_compare(int argc, char **argv)
         {"--seed", RCH_OPT_UINT, &seed, 0, 4294967295.0, NULL, "case c draws with seed * 1000003 + c", 0, NULL},
         {"--methods", RCH_OPT_STR, &methods, 0, 0, "LIST",
          "comma list of LM,EKF,PF,SCA,QIBAS,SSLM,LTLM (or M1..M7); default all", 0, NULL},
-        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "SVG charts: convergence, bars, times, per-sample errors", 0,
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "SVG charts (each with its data as .csv): convergence, bars, times, per-sample errors", 0,
          NULL},
         {"--params", RCH_OPT_CHOICE, &params, 0, 0, "SET",
          "paper: the paper's set-up (LM/LTLM all parameters, the others a subset, a narrow box); common: every "

@@ -105,11 +105,12 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
     return rc;
 }
 
-static int report(rch_diagnose_result *r, const char *plots, int json, int argc, char **argv)
+static int report(rch_diagnose_result *r, const char *plots, const char *const inputs[2], int json, int argc,
+                  char **argv)
 {
     rch_diag d;
     char msg[1024], paths[4096] = "";
-    if (plots && rch_diagnose_plots(r, plots, paths, sizeof paths, &d) != 0) {
+    if (plots && rch_diagnose_plots(r, plots, inputs, 2, paths, sizeof paths, &d) != 0) {
         fprintf(stderr, "rcal diagnose: plots: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
@@ -136,7 +137,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
         {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "fold assignment seed", 0, NULL},
         {"--folds", RCH_OPT_UINT, &folds, 2, RCH_DIAGNOSE_MAX_FOLDS, "K", "cross-validation folds", 0, NULL},
         {"--steps", RCH_OPT_UINT, &steps, 1, RCH_DIAGNOSE_MAX_STEPS, "N", "effects added at most", 0, NULL},
-        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "write residual plots (SVG) into DIR", 0, NULL},
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "write residual plots (SVG, each with its data as .csv) into DIR", 0, NULL},
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
          "write the calibrated model with the effects found (nuisances left out); never over an input", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
@@ -184,9 +185,9 @@ int rcal_cmd_diagnose(int argc, char **argv)
         rch_diagnose_free(&r);
         return 1;
     }
-    int rc = report(&r, plots, json, argc, argv);
+    const char *inputs[2] = {data_path, robot_path};
+    int rc = report(&r, plots, inputs, json, argc, argv);
     if (rc == 0 && out_path) {
-        const char *inputs[2] = {data_path, robot_path};
         if (rch_diagnose_save_model(&r, robot_path, out_path, inputs, 2, &d) != 0) {
             fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
             rc = 1;

@@ -63,7 +63,7 @@ static int grind_run(const rch_grind_config *cfg, const char *model_path, const 
         rc = 1;
     }
     if (plots && !json && rc == 0)
-        printf("  plots: %s/grind_path.svg, %s/grind_deviation.svg; points: %s/grind_points.csv\n", plots, plots,
+        printf("  plots: %s/grind_path.svg, %s/grind_deviation.svg (data beside each as .csv); points: %s/grind_points.csv\n", plots, plots,
                plots);
     rch_grind_free(&res);
     return rc;
@@ -106,7 +106,7 @@ int rcal_cmd_grind(int argc, char **argv)
         {"--nominal", RCH_OPT_STR, &nominal_path, 0, 0, "ROBOT.json",
          "nominal model the path is programmed with (default: the model's \"nominal\")", 0, NULL},
         {"--surface", RCH_OPT_STR, &spec_s, 0, 0, "SPEC", "NAME[:key=value,...], see below (default tilted)", 0, NULL},
-        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "grind_path.svg, grind_deviation.svg, grind_points.csv", 0,
+        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "grind_path.svg, grind_deviation.svg (each with its data as .csv), grind_points.csv", 0,
          NULL},
         {"--position-only", RCH_OPT_FLAG, &cfg.position_only, 0, 0, NULL,
          "compensate the flange position only (default: full pose)", 0, NULL},

@@ -169,7 +169,7 @@ static void test_degenerate(void **state)
  * colour map's ends, XML text escaping. */
 static void test_dir_helpers(void **state)
 {
-    char dir[64], sub[128], path[192], *buf = NULL;
+    char dir[64], sub[128], path[320], *buf = NULL;
     size_t len = 0;
     struct stat sb;
     rch_diag d;
@@ -190,15 +190,17 @@ static void test_dir_helpers(void **state)
     assert_non_null(in);
     fputs("measurements\n", in);
     fclose(in);
-    const char *const inputs[2] = {NULL, input};
-    const rch_plot_dir pd = {sub, inputs, 2, log};
+    char input2[192];
+    snprintf(input2, sizeof input2, "%s/s.csv", sub);
+    const char *const inputs[3] = {NULL, input, input2};
+    const rch_plot_dir pd = {sub, inputs, 3, log};
     rch_plot *p = rch_plot_new("t", "x", "y");
     const double x[2] = {0, 1}, y[2] = {1, 2};
     rch_plot_line(p, "l", x, y, 2);
     assert_int_equal(rch_plot_save(p, &pd, "p.svg", &d), 0);
     fclose(log);
-    snprintf(path, sizeof path, "  wrote %s/p.svg\n", sub);
-    assert_string_equal(buf, path);
+    snprintf(path, sizeof path, "  wrote %s/p.svg\n  wrote %s/p.csv\n", sub, sub);
+    assert_string_equal(buf, path); /* the data beside the plot, always */
     free(buf);
     snprintf(path, sizeof path, "%s/p.svg", sub);
     assert_int_equal(stat(path, &sb), 0);
@@ -206,6 +208,18 @@ static void test_dir_helpers(void **state)
     assert_non_null(strstr(d.msg, "same file as the input"));
     assert_int_equal(stat(input, &sb), 0);
     assert_int_equal(sb.st_size, 13); /* untouched */
+    /* an input named like a plot's CSV: refused before the SVG is written */
+    snprintf(input, sizeof input, "%s", input2);
+    in = fopen(input, "w");
+    assert_non_null(in);
+    fputs("measurements\n", in);
+    fclose(in);
+    assert_int_equal(rch_plot_save(rch_plot_new("t", "x", "y"), &pd, "s.svg", &d), -1);
+    assert_non_null(strstr(d.msg, "same file as the input"));
+    snprintf(path, sizeof path, "%s/s.svg", sub);
+    assert_int_not_equal(stat(path, &sb), 0);
+    assert_int_equal(stat(input, &sb), 0);
+    assert_int_equal(sb.st_size, 13);
     /* a file where a directory is wanted */
     snprintf(path, sizeof path, "%s/p.svg/d", sub);
     errno = 0;
@@ -236,6 +250,107 @@ static void test_dir_helpers(void **state)
     free(buf);
 }
 
+/* Count the points drawn inside each <g class="series">: vertices (M/L)
+ * of an unfilled path, one per marker (circle, rect, filled path). */
+static size_t drawn_points(const char *svg)
+{
+    size_t n = 0;
+    const char *g = svg;
+    while ((g = strstr(g, "<g class=\"series\">")) != NULL) {
+        const char *end = strstr(g, "</g>");
+        assert_non_null(end);
+        for (const char *e = strchr(g + 1, '<'); e && e < end; e = strchr(e + 1, '<')) {
+            if (strncmp(e, "<path fill=\"none\"", 17) == 0) {
+                const char *d = strstr(e, " d=\"");
+                for (d += 4; *d != '"'; d++)
+                    n += *d == 'M' || *d == 'L';
+            } else if (strncmp(e, "<circle", 7) == 0 || strncmp(e, "<rect", 5) == 0 || strncmp(e, "<path", 5) == 0) {
+                n++;
+            }
+        }
+        g = end;
+    }
+    return n;
+}
+
+/* The data of every chart as CSV: one row per point with the axis labels
+ * (and their units) as column names; bars by category with a legend, one
+ * colour without; a subtitle; the drawn points match the rows; a single
+ * point is one marker; p-values never print as 0. */
+static void test_csv_categories(void **state)
+{
+    (void)state;
+    double x[7], y[7];
+    for (int k = 0; k < 7; k++) {
+        x[k] = k;
+        y[k] = 1.0 + k * k;
+    }
+    rch_plot *p = rch_plot_new("T", "iteration (count)", "RMS, length \"error\" (mm)");
+    rch_plot_subtitle(p, "the paper's Fig. 9");
+    rch_plot_line(p, "a", x, y, 7);
+    rch_plot_scatter(p, "b", x, y, 3);
+    rch_plot_line(p, "one", x + 2, y + 2, 1);
+    char *svg = render(p);
+    assert_non_null(strstr(svg, ">the paper&apos;s Fig. 9</text>"));
+    assert_int_equal(drawn_points(svg), 7 + 3 + 1);
+    assert_int_equal(count(svg, "<g class=\"series\">"), 3);
+    free(svg);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    assert_int_equal(rch_plot_write_csv_stream(p, f), 0);
+    fclose(f);
+    assert_true(strncmp(buf, "series,iteration (count),\"RMS, length \"\"error\"\" (mm)\"\n", 50) == 0);
+    assert_int_equal(count(buf, "\n"), 1 + 7 + 3 + 1);
+    assert_non_null(strstr(buf, "\na,6,37\n"));
+    assert_non_null(strstr(buf, "\none,2,5\n"));
+    free(buf);
+    rch_plot_free(p);
+
+    /* bars: one colour unless categories are given; categories get a legend */
+    const char *labels[3] = {"BC", "LM", "EKF"};
+    const double v[3] = {2.5, 1.5, 1.8}, e[3] = {0.2, 0.1, NAN};
+    p = rch_plot_new("bars", "method", "RMSE (mm)");
+    rch_plot_bars(p, labels, v, e, 3);
+    svg = render(p);
+    assert_int_equal(count(svg, "fill=\"#56B4E9\""), 3);
+    assert_int_equal(count(svg, "fill=\"#E69F00\""), 0);
+    free(svg);
+    const unsigned cat[3] = {0, 1, 1};
+    const char *names[2] = {"before calibration", "method"};
+    rch_plot_bar_categories(p, cat, names, 2);
+    svg = render(p);
+    assert_int_equal(count(svg, "fill=\"#56B4E9\""), 1 + 1); /* bar + legend swatch */
+    assert_int_equal(count(svg, "fill=\"#E69F00\""), 2 + 1);
+    assert_non_null(strstr(svg, ">before calibration</text>"));
+    const char *bars = strstr(svg, "<g class=\"bars\">");
+    assert_non_null(bars);
+    free(svg);
+    buf = NULL;
+    f = open_memstream(&buf, &len);
+    assert_int_equal(rch_plot_write_csv_stream(p, f), 0);
+    fclose(f);
+    assert_non_null(strstr(buf, "series,category,method,RMSE (mm),+- RMSE (mm) (error bar half-length)\n"));
+    assert_non_null(strstr(buf, "\nRMSE (mm),LM,1,1.5,0.1\n"));
+    assert_non_null(strstr(buf, "\nRMSE (mm),EKF,2,1.8,nan\n"));
+    free(buf);
+    rch_plot_free(p);
+
+    /* a table with no columns or missing cells is refused */
+    const rch_plot_table bad = {NULL, 0, 0, 0, NULL, NULL};
+    f = open_memstream(&buf, &len);
+    assert_int_equal(rch_plot_table_write(f, &bad), -1);
+    fclose(f);
+    free(buf);
+
+    char pb[32];
+    assert_string_equal(rch_plot_fmt_p(pb, sizeof pb, 0.0), "< 1e-300");
+    assert_string_equal(rch_plot_fmt_p(pb, sizeof pb, 1e-310), "< 1e-300");
+    assert_string_equal(rch_plot_fmt_p(pb, sizeof pb, 3.04e-17), "3.0e-17");
+    assert_string_equal(rch_plot_fmt_p(pb, sizeof pb, 1.0), "1.0e+00");
+    assert_string_equal(rch_plot_fmt_p(pb, sizeof pb, NAN), "-");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -243,6 +358,7 @@ int main(void)
         cmocka_unit_test(test_logy_bars_file),
         cmocka_unit_test(test_degenerate),
         cmocka_unit_test(test_dir_helpers),
+        cmocka_unit_test(test_csv_categories),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,6 +2,7 @@
 /* rch_calib.c - the calibration pipeline and the nominal-FK check (see rch_calib.h). */
 #include "rch_calib.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -198,16 +199,27 @@ static int truth_flange(rch_calib_result *r, rch_diag *d)
 
 /* Predicted 95 % flange-position uncertainty against the horizontal reach
  * of the flange, at the training poses and at random poses in the joint
- * limits: uncertainty_position.svg and .csv in plots_dir. */
-static void uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_sample *train)
+ * limits: uncertainty_position.svg and its data, uncertainty_position.csv,
+ * in plots_dir (rch_plot_save: never over an input, atomic). 0, or -1
+ * with d set. */
+static int uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_sample *train, rch_diag *d)
 {
     const size_t nw = 1000, nt = r->n_train;
     double *x = malloc((nt + nw) * sizeof *x), *y = malloc((nt + nw) * sizeof *y);
-    rch_plot *p = rch_plot_new("predicted flange-position uncertainty (95 %)", "horizontal reach of the flange (mm)",
-                               "uncertainty (mm)");
-    char path[1100];
-    if (!x || !y || !p || rch_plot_mkdir(r->cfg.plots_dir) != 0)
+    rch_plot *p = rch_plot_new("Predicted 95 % flange-position uncertainty of the calibrated model",
+                               "horizontal reach of the flange from the base axis (mm)",
+                               "predicted 95 % position uncertainty (mm)");
+    const char *inputs[RCH_CALIB_MAX_FILES + 4];
+    size_t n_in = 0;
+    int rc = -1;
+    if (!x || !y || !p) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
+    }
+    if (rch_plot_mkdir(r->cfg.plots_dir) != 0) {
+        rch_diag_set(d, "", 0, 0, "cannot create %s: %s", r->cfg.plots_dir, strerror(errno));
+        goto done;
+    }
     rc_rng g;
     rc_rng_seed(&g, RCH_CALIB_TRUTH_SEED);
     for (size_t i = 0; i < nt + nw; ++i) {
@@ -219,40 +231,42 @@ static void uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_
         x[i] = sqrt(pos[0] * pos[0] + pos[1] * pos[1]);
         y[i] = rch_uncert_pos95_mm(u, &r->model, q);
     }
-    rch_plot_scatter(p, "random poses in the joint limits (whole workspace)", x + nt, y + nt, nw);
-    rch_plot_scatter(p, "the data's poses", x, y, nt);
+    rch_plot_subtitle(p, "from the parameter covariance of the fit, at the data's poses and at random poses");
+    rch_plot_scatter(p, "random poses in the joint limits", x + nt, y + nt, nw);
+    rch_plot_scatter(p, "the data's poses (training set)", x, y, nt);
     rch_plot_logy(p, 1);
-    snprintf(path, sizeof path, "%s/uncertainty_position.svg", r->cfg.plots_dir);
-    if (rch_plot_write_svg(p, path) == 0)
-        snprintf(r->plot_paths, sizeof r->plot_paths, "%s\n", path);
-    snprintf(path, sizeof path, "%s/uncertainty_position.csv", r->cfg.plots_dir);
-    FILE *f = fopen(path, "w");
-    if (f) {
-        fprintf(f, "set,reach_mm,pos95_mm\n");
-        for (size_t i = 0; i < nt + nw; ++i)
-            fprintf(f, "%s,%.6f,%.6g\n", i < nt ? "data" : "workspace", x[i], y[i]);
-        if (fclose(f) == 0) {
-            size_t len = strlen(r->plot_paths);
-            snprintf(r->plot_paths + len, sizeof r->plot_paths - len, "%s\n", path);
-        }
-    }
+    const int several = r->cfg.data_paths && r->cfg.n_data_paths;
+    for (size_t k = 0; k < (several ? r->cfg.n_data_paths : 1u) && n_in < RCH_CALIB_MAX_FILES; ++k)
+        inputs[n_in++] = several ? r->cfg.data_paths[k] : r->cfg.data_path;
+    inputs[n_in++] = r->cfg.validate_path;
+    inputs[n_in++] = r->cfg.robot_path;
+    inputs[n_in++] = r->cfg.truth_path;
+    const rch_plot_dir pd = {r->cfg.plots_dir, inputs, n_in, NULL};
+    rc = rch_plot_save(p, &pd, "uncertainty_position.svg", d);
+    if (rc == 0)
+        snprintf(r->plot_paths, sizeof r->plot_paths, "%s/uncertainty_position.svg\n%s/uncertainty_position.csv\n",
+                 r->cfg.plots_dir, r->cfg.plots_dir);
+    p = NULL; /* freed by rch_plot_save */
 done:
     free(x);
     free(y);
     rch_plot_free(p);
+    return rc;
 }
 
 /* Covariance (cluster-robust by set-up group when the groups allow it),
  * standard errors, classes, predicted uncertainty over the data and the
  * workspace, and the determined model. Leaves have_unc 0 when it cannot be
- * computed (too few samples for the free parameters). */
-static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit,
-                        const uint16_t *setup)
+ * computed (too few samples for the free parameters). -1 (d set) only when
+ * the plot asked for (plots_dir) cannot be written. */
+static int uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit,
+                       const uint16_t *setup, rch_diag *d)
 {
     rch_uncert u;
     char err[256];
+    int rc = 0;
     if (rch_uncert_compute_cl(&u, fit, fixed, train, setup, r->n_train, 1, err, sizeof err) != 0)
-        return;
+        return 0;
     rch_model_unc_from(&r->unc, &u);
     if (rch_uncert_map_compute(&r->unc.map, &u, &r->model, train, r->n_train, RCH_CALIB_TRUTH_POSES,
                                RCH_CALIB_TRUTH_SEED) == 0) {
@@ -260,9 +274,10 @@ static void uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_samp
         r->have_unc = 1;
     }
     if (r->cfg.plots_dir)
-        uncertainty_plot(r, &u, train);
+        rc = uncertainty_plot(r, &u, train, d);
     rch_uncert_free(&u);
     rch_model_unc_determined(&r->determined, &r->model, &r->robot.nominal, &r->unc);
+    return rc;
 }
 
 static size_t n_files(const rch_calib_cfg *cfg)
@@ -416,8 +431,8 @@ static int finish(rch_calib_result *r, const uint8_t *fixed, const rc_sample *tr
     if (r->cfg.truth_path && r->finite && truth_flange(r, d) != 0)
         return -1;
     r->have_ident = r->finite && rch_ident_compute(&r->ident, fit, train, r->n_train) == 0;
-    if (r->finite)
-        uncertainty(r, fixed, train, fit, setup);
+    if (r->finite && uncertainty(r, fixed, train, fit, setup, d) != 0)
+        return -1;
     if (r->cfg.validate_path && r->after_ok) {
         rc_solve_work *w = malloc(sizeof *w);
         int rc = w ? validate(r, w, d) : -1;

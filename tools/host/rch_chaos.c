@@ -197,12 +197,15 @@ static rch_plot *plot_curve(const rch_chaos_result *res, const rch_chaos_config 
 {
     char title[160];
     double xl[2] = {0.0, 4.0}, yl[2] = {res->sd_iid, res->sd_iid};
-    snprintf(title, sizeof title, "Uniformity of the logistic-tent map (%lu points, %lu bins, %lu starts)",
-             cfg->points, cfg->bins, cfg->starts);
-    rch_plot *p = rch_plot_new(title, "r", "sd of bin counts (Eq. 12)");
-    rch_plot_line(p, "logistic-tent map", res->r, res->sd, res->nr);
-    rch_plot_line(p, "independent uniform draws", xl, yl, 2);
-    rch_plot_scatter(p, "minimum", &res->r[res->best], &res->sd[res->best], 1);
+    snprintf(title, sizeof title, "How evenly the logistic-tent map fills [0, 1] against its parameter r");
+    rch_plot *p = rch_plot_new(title, "map parameter r (dimensionless)", "standard deviation of the bin counts (count)");
+    snprintf(title, sizeof title,
+             "%lu points from each of %lu starts in %lu bins; lower is more uniform (the paper's Eq. 12)", cfg->points,
+             cfg->starts, cfg->bins);
+    rch_plot_subtitle(p, title);
+    rch_plot_line(p, "logistic-tent map (mean over the starts)", res->r, res->sd, res->nr);
+    rch_plot_line(p, "independent uniform draws (expected)", xl, yl, 2);
+    rch_plot_scatter(p, "most uniform r", &res->r[res->best], &res->sd[res->best], 1);
     rch_plot_logy(p, 1);
     return p;
 }
@@ -213,16 +216,22 @@ static rch_plot *plot_hist(const rch_chaos_result *res, const rch_chaos_config *
     double *x = malloc(cfg->bins * sizeof *x), *y = malloc(cfg->bins * sizeof *y);
     rch_plot *p = NULL;
     if (x && y) {
+        double ymax = 0.0, total = 0.0;
         for (unsigned long b = 0; b < cfg->bins; ++b) {
             x[b] = ((double)b + 0.5) / (double)cfg->bins;
             y[b] = (double)res->hist[b];
+            ymax = y[b] > ymax ? y[b] : ymax;
+            total += y[b];
         }
-        snprintf(title, sizeof title, "Histogram of the map at r = %.2f (%lu x %lu iterates)", res->r_hist,
-                 cfg->starts, cfg->points);
-        p = rch_plot_new(title, "value (bin centre)", "count");
-        rch_plot_line(p, "counts", x, y, cfg->bins);
-        rch_plot_scatter(p, "", x, y, cfg->bins);
-        rch_plot_yrange(p, 0.0, 0.0);
+        snprintf(title, sizeof title, "Histogram of the logistic-tent map's values at r = %.2f", res->r_hist);
+        p = rch_plot_new(title, "value of the map (bin centre, dimensionless)", "values in the bin (count)");
+        snprintf(title, sizeof title, "%lu starts x %lu iterates in %lu bins; a flat histogram is uniform", cfg->starts,
+                 cfg->points, cfg->bins);
+        rch_plot_subtitle(p, title);
+        rch_plot_scatter(p, "count per bin", x, y, cfg->bins);
+        const double ex[2] = {0.0, 1.0}, ey[2] = {total / (double)cfg->bins, total / (double)cfg->bins};
+        rch_plot_line(p, "count expected of a uniform draw", ex, ey, 2);
+        rch_plot_yrange(p, 0.0, 1.15 * ymax); /* from zero: the bars' spread against their height */
     }
     free(x);
     free(y);

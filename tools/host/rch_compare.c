@@ -611,9 +611,9 @@ static void plot_indexed(rch_plot *p, const char *label, const double *y, size_t
 
 static rch_plot *plot_convergence(const rch_compare_result *res, const rch_compare_config *cfg, int zoom)
 {
-    rch_plot *p = rch_plot_new(zoom ? "Convergence, first 60 iterations (case 1)"
-                                    : "Convergence: training RMS per iteration (case 1)",
-                               "iteration", "training RMS (mm)");
+    rch_plot *p = rch_plot_new(zoom ? "Training RMS length error per iteration, first 60 iterations (case 1)"
+                                    : "Training RMS length error per iteration of each method (case 1)",
+                               "iteration (count)", "training RMS length error (mm)");
     for (int id = 0; id < RCH_EST_COUNT; ++id)
         if (cfg->run[id] && res->curve[id].n > 0)
             plot_indexed(p, rch_est_name((rch_est_id)id), res->curve[id].rms_mm, res->curve[id].n, 0.0);
@@ -628,6 +628,8 @@ static rch_plot *plot_bars(const rch_compare_result *res, int time)
 {
     const char *labels[RCH_COMPARE_ROWS];
     double vals[RCH_COMPARE_ROWS], errs[RCH_COMPARE_ROWS];
+    unsigned cat[RCH_COMPARE_ROWS];
+    static const char *const cat_names[2] = {"before calibration (nominal model)", "identification method"};
     size_t nb = 0;
     char title[160];
     for (int r = time ? 1 : 0; r < RCH_COMPARE_ROWS; ++r) {
@@ -638,15 +640,18 @@ static rch_plot *plot_bars(const rch_compare_result *res, int time)
         labels[nb] = rch_compare_row_name(r);
         vals[nb] = st->mean;
         errs[nb] = rch_stats_sd(st);
+        cat[nb] = r == 0 ? 0u : 1u; /* row 0 is BC, the nominal model */
         ++nb;
     }
     if (time)
-        snprintf(title, sizeof title, "Identification time per case, mean +- std");
+        snprintf(title, sizeof title, "Identification time of each method, mean +- std over %lu cases", res->cases);
     else
-        snprintf(title, sizeof title, "Held-out RMSE, mean +- std over %lu cases (%zu train / %zu test)", res->cases,
-                 res->n_train, res->n_test);
-    rch_plot *p = rch_plot_new(title, "method", time ? "time (ms)" : "RMSE (mm)");
+        snprintf(title, sizeof title, "Held-out RMS length error, mean +- std over %lu cases (%zu train / %zu test samples)",
+                 res->cases, res->n_train, res->n_test);
+    rch_plot *p = rch_plot_new(title, "method", time ? "identification time (ms)" : "held-out RMS length error (mm)");
     rch_plot_bars(p, labels, vals, errs, nb);
+    if (!time) /* the time chart has methods only: one colour */
+        rch_plot_bar_categories(p, cat, cat_names, 2);
     rch_plot_logy(p, time);
     return p;
 }
@@ -654,8 +659,9 @@ static rch_plot *plot_bars(const rch_compare_result *res, int time)
 static rch_plot *plot_per_sample(const rch_compare_result *res, const rch_compare_config *cfg)
 {
     const size_t n = res->n_test;
-    rch_plot *p = rch_plot_new("Held-out error of each sample, case 1 (Fig. 7 kind)", "held-out sample",
-                               "model - measured length (mm)");
+    rch_plot *p = rch_plot_new("Length error of each held-out sample, before and after calibration (case 1)",
+                               "held-out sample (number)", "model - measured cable length (mm)");
+    rch_plot_subtitle(p, "the kind of plot of the paper's Fig. 7");
     plot_indexed(p, "before (BC)", res->err_case1_mm, n, 1.0);
     if (cfg->run[RCH_EST_LM])
         plot_indexed(p, "after LM", res->err_case1_mm + (size_t)(RCH_EST_LM + 1) * n, n, 1.0);

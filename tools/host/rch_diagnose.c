@@ -16,6 +16,7 @@
 #include "rch_calib.h"
 #include "rch_data.h"
 #include "rch_jw.h"
+#include "rch_plot.h"
 #include "rch_robot.h"
 #include "rch_stats.h"
 
@@ -1244,9 +1245,11 @@ static void phase_after(run_state *S)
      * resolution and the quantization floor are lower bounds, not the noise). */
     for (unsigned k = 0; k < out->n_tests; ++k)
         if (out->after[k].significant && pos < sizeof out->remaining_why) {
+            char pb[16];
             pos += (size_t)snprintf(out->remaining_why + pos, sizeof out->remaining_why - pos,
-                                    "%sstructure against %s (p = %.1e)", unexpl ? "; " : "", out->after[k].name,
-                                    out->after[k].p_value);
+                                    "%sstructure against %s (p %s%s)", unexpl ? "; " : "", out->after[k].name,
+                                    out->after[k].p_value < 1e-300 ? "" : "= ",
+                                    rch_plot_fmt_p(pb, sizeof pb, out->after[k].p_value));
             unexpl = 1;
         }
     out->noise_est_mm = out->rmse_after_mm;
@@ -1395,9 +1398,10 @@ void rch_diagnose_free(rch_diagnose_result *r)
 static void print_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
 {
     fprintf(f, "  %-28s %5s %6s %10s %9s %7s\n", "variable", "dof1", "dof2", "F", "p", "R^2");
+    char pb[16];
     for (unsigned k = 0; k < n; ++k)
-        fprintf(f, "  %-28s %5u %6u %10.2f %9.1e %6.1f%% %s\n", t[k].name, t[k].dof1, t[k].dof2, t[k].f_stat,
-                t[k].p_value, 100.0 * t[k].r2, t[k].significant ? "STRUCTURE" : "");
+        fprintf(f, "  %-28s %5u %6u %10.2f %9s %6.1f%% %s\n", t[k].name, t[k].dof1, t[k].dof2, t[k].f_stat,
+                rch_plot_fmt_p(pb, sizeof pb, t[k].p_value), 100.0 * t[k].r2, t[k].significant ? "STRUCTURE" : "");
 }
 
 int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
@@ -1426,9 +1430,10 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
                 "gain mm^2", "z", "p", "");
         for (unsigned k = 0; k < st->n_cand; ++k) {
             const rch_diagnose_cand *ca = &st->cand[k];
+            char pb[16];
             if (ca->tested)
-                fprintf(f, "  %-22s %6u %6u %10.4f %11.5f %7.2f %9.1e  %s%s%s\n", ca->name, ca->n_params,
-                        ca->n_ident, ca->rmse_cv_mm, ca->gain_mm2, ca->z, ca->p_value,
+                fprintf(f, "  %-22s %6u %6u %10.4f %11.5f %7.2f %9s  %s%s%s\n", ca->name, ca->n_params,
+                        ca->n_ident, ca->rmse_cv_mm, ca->gain_mm2, ca->z, rch_plot_fmt_p(pb, sizeof pb, ca->p_value),
                         (int)k == st->chosen ? "<- CHOSEN" : ca->significant ? "significant" : "",
                         ca->note[0] ? "  " : "", ca->note);
             else

@@ -209,12 +209,14 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *robot_path
 int rch_diagnose_print(FILE *f, const rch_diagnose_result *r);
 int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **argv);
 
-/* Residual plots (SVG) into dir: residuals before/after against acquisition
- * order, per-group mean residuals before/after, the candidate gains, and the
- * residuals against the variable of the strongest structure test. paths
- * receives the written files, "\n"-separated. 0 or -1 (d set). */
-int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, char *paths, size_t paths_len,
-                       rch_diag *d);
+/* Residual plots (SVG, each with its data as CSV beside it) into dir:
+ * residuals before/after against acquisition order, per-group mean residuals
+ * before/after, the candidate gains, and the residuals against the variable
+ * of the strongest structure test. Never over one of inputs (n_inputs, NULL
+ * entries skipped; rch_plot_save). paths receives the written files,
+ * "\n"-separated. 0 or -1 (d set). */
+int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, const char *const *inputs, size_t n_inputs,
+                       char *paths, size_t paths_len, rch_diag *d);
 
 /* Statistics helpers (exposed for tests). */
 /* Upper tail P(F > f) of the F(d1, d2) distribution. */

@@ -515,8 +515,13 @@ typedef struct panel_map {
 static double px(const panel_map *m, double x) { return m->cx + (x - m->s->cx) * m->sc; }
 static double py(const panel_map *m, double y) { return m->cy - (y - m->s->cy) * m->sc; }
 
+/* The colour bar of one panel at (bx, by), bh high: 0 to vmax mm, its tick
+ * labels right of it and its unit label right of those, all inside the
+ * panel's slot (SVG_BAR_W pixels). */
+#define SVG_BAR_W 110.0
 static void svg_colour_bar(FILE *f, double bx, double by, double bh, double vmax)
 {
+    fprintf(f, "<g class=\"colourbar\">\n");
     for (int i = 0; i < 50; ++i) {
         char col[8];
         rch_plot_viridis(col, (i + 0.5) / 50.0);
@@ -527,7 +532,10 @@ static void svg_colour_bar(FILE *f, double bx, double by, double bh, double vmax
     for (int i = 0; i <= 4; ++i)
         fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\">%.3g</text>\n", bx + 18, by + bh - i * bh / 4.0 + 4,
                 vmax * i / 4.0);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\">mm</text>\n", bx, by - 10);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"middle\" transform=\"rotate(-90 %.1f %.1f)\">"
+               "deviation (mm)</text>\n",
+            bx + 84, by + bh / 2, bx + 84, by + bh / 2);
+    fprintf(f, "</g>\n");
 }
 
 /* Axis labels at the patch edges. */
@@ -557,9 +565,13 @@ static void svg_panel(FILE *f, const rch_grind_result *res, int c, const rch_sur
         vmax = 1e-9;
     const panel_map m = {s, fmin(pw / s->w, ph / fmax(s->h, 1e-9)), ox + 0.5 * pw, oy + 0.5 * ph};
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"15\" text-anchor=\"middle\">%s</text>\n", ox + 0.5 * pw,
-            oy - 28, title);
+            oy - 40, title);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\" text-anchor=\"middle\" fill=\"#555\">own colour "
+               "scale: 0 to %.3g mm</text>\n",
+            ox + 0.5 * pw, oy - 24, vmax);
     fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f4f4f4\" stroke=\"#999\"/>\n",
             px(&m, s->cx - 0.5 * s->w) - 6, py(&m, s->cy + 0.5 * s->h) - 6, s->w * m.sc + 12, s->h * m.sc + 12);
+    fprintf(f, "<g class=\"series\" data-kind=\"segments\">\n"); /* n points: n - 1 segments */
     for (size_t k = 0; k + 1 < res->n; ++k) {
         char col[8];
         rch_plot_viridis(col, 0.5 * (p[k].dev_mm[c] + p[k + 1].dev_mm[c]) / vmax);
@@ -567,6 +579,7 @@ static void svg_panel(FILE *f, const rch_grind_result *res, int c, const rch_sur
                    "stroke-linecap=\"round\"/>\n",
                 px(&m, p[k].p_mm[0]), py(&m, p[k].p_mm[1]), px(&m, p[k + 1].p_mm[0]), py(&m, p[k + 1].p_mm[1]), col);
     }
+    fprintf(f, "</g>\n");
     for (int i = 0; i < 5; ++i) {
         const rch_grind_point *q = &p[res->named[i]];
         const double qx = px(&m, q->p_mm[0]), qy = py(&m, q->p_mm[1]);
@@ -574,7 +587,7 @@ static void svg_panel(FILE *f, const rch_grind_result *res, int c, const rch_sur
         fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"5\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n",
                 qx, qy);
         fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\" fill=\"#d62728\" text-anchor=\"%s\" "
-                   "font-weight=\"bold\">%s %.3f</text>\n",
+                   "font-weight=\"bold\">%s %.3g</text>\n",
                 qx + (right ? -9 : 9), qy + (below ? 20 : -9), right ? "end" : "start", point_names[i], q->dev_mm[c]);
     }
     svg_colour_bar(f, ox + pw + 30, oy, ph, vmax);
@@ -585,19 +598,21 @@ static void write_path_svg(FILE *f, const rch_grind_result *res, const rch_surfa
 {
     char subtitle[160];
     spec_line(subtitle, sizeof subtitle, s);
-    const double pw = 420, ph = fmax(120.0, fmin(420.0, 420.0 * s->h / s->w)), W = 2 * pw + 360, H = ph + 150;
+    const double pw = 420, ph = fmax(120.0, fmin(420.0, 420.0 * s->h / s->w)), gap = 100,
+                 W = 90 + 2 * (pw + 30 + SVG_BAR_W) + gap, H = ph + 165;
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
                "font-family=\"sans-serif\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
             W, H, W, H);
-    fprintf(f, "<text x=\"%.1f\" y=\"22\" font-size=\"16\" text-anchor=\"middle\">Grinding path, top view: deviation of "
-               "the true flange path from the programmed one</text>\n",
+    fprintf(f, "<text x=\"%.1f\" y=\"22\" font-size=\"16\" text-anchor=\"middle\">Grinding path seen from above: "
+               "distance of the true flange position from the programmed one (mm)</text>\n",
             W / 2);
     fprintf(f, "<text x=\"%.1f\" y=\"40\" font-size=\"12\" text-anchor=\"middle\" fill=\"#555\">", W / 2);
     rch_plot_xml_text(f, subtitle);
     fprintf(f, "</text>\n");
-    svg_panel(f, res, RCH_GRIND_UNCOMP, s, 90, 95, pw, ph, "uncompensated");
-    svg_panel(f, res, RCH_GRIND_COMP_CAL, s, 90 + pw + 180, 95, pw, ph, "compensated (calibrated model)");
+    svg_panel(f, res, RCH_GRIND_UNCOMP, s, 90, 110, pw, ph, "uncompensated");
+    svg_panel(f, res, RCH_GRIND_COMP_CAL, s, 90 + pw + 30 + SVG_BAR_W + gap, 110, pw, ph,
+              "compensated (calibrated model)");
     fprintf(f, "</svg>\n");
 }
 
@@ -607,7 +622,10 @@ static rch_plot *plot_deviation(const rch_grind_result *res)
     double *x = malloc((n ? n : 1) * sizeof *x), *y = malloc((n ? n : 1) * sizeof *y);
     rch_plot *pl = NULL;
     if (x && y) {
-        pl = rch_plot_new("Deviation along the grinding path", "path point", "deviation (mm)");
+        pl = rch_plot_new("Distance of the true flange position from the programmed one along the grinding path",
+                          "path point (number, in path order)", "deviation (mm)");
+        rch_plot_subtitle(pl, "deviations below 1e-7 mm (the compensation's numerical floor) are drawn at 1e-7 mm");
+        rch_plot_size(pl, 900, 500);
         rch_plot_logy(pl, 1);
         for (int c = 0; c < RCH_GRIND_CASES; ++c) {
             for (size_t k = 0; k < n; ++k) {
@@ -634,6 +652,35 @@ static void write_points_csv(FILE *f, const rch_grind_result *res)
     }
 }
 
+/* The data of grind_path.svg: one row per drawn point of each panel. */
+static int save_path_csv(const rch_grind_result *res, const rch_plot_dir *pd, rch_diag *d)
+{
+    static const char *const head[] = {"panel", "path point (number)", "x (mm)", "y (mm)", "deviation (mm)"};
+    static const int cases[2] = {RCH_GRIND_UNCOMP, RCH_GRIND_COMP_CAL};
+    const size_t n = res->n;
+    const char **text = malloc((2 * n + 1) * sizeof *text);
+    double *num = malloc((2 * n + 1) * 4 * sizeof *num);
+    int rc;
+    if (!text || !num) {
+        rc = rch_plot_save_csv(NULL, pd, "grind_path.svg", d);
+    } else {
+        for (size_t j = 0; j < 2; ++j)
+            for (size_t k = 0; k < n; ++k) {
+                const size_t r = j * n + k;
+                text[r] = case_names[cases[j]];
+                num[4 * r] = (double)k;
+                num[4 * r + 1] = res->pts[k].p_mm[0];
+                num[4 * r + 2] = res->pts[k].p_mm[1];
+                num[4 * r + 3] = res->pts[k].dev_mm[cases[j]];
+            }
+        const rch_plot_table t = {head, 1, 4, 2 * n, text, num};
+        rc = rch_plot_save_csv(&t, pd, "grind_path.svg", d);
+    }
+    free(text);
+    free(num);
+    return rc;
+}
+
 int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, const rch_plot_dir *pd, rch_diag *d)
 {
     rch_out o;
@@ -644,7 +691,7 @@ int rch_grind_plots(const rch_grind_result *res, const rch_grind_config *cfg, co
     if (rch_plot_open(&o, pd, "grind_path.svg", d) != 0)
         return -1;
     write_path_svg(o.f, res, &cfg->surface);
-    if (rch_plot_close(&o, pd, 0, d) != 0 || rch_plot_save(plot_deviation(res), pd, "grind_deviation.svg", d) != 0 ||
+    if (rch_plot_close(&o, pd, 0, d) != 0 || save_path_csv(res, pd, d) != 0 || rch_plot_save(plot_deviation(res), pd, "grind_deviation.svg", d) != 0 ||
         rch_plot_open(&o, pd, "grind_points.csv", d) != 0)
         return -1;
     write_points_csv(o.f, res);

@@ -25,10 +25,14 @@ struct rch_plot {
     plot_series *series; /* (n_series) */
     size_t n_series;
     size_t cap_series;
+    char *subtitle;
     char **bar_labels; /* (n_bars) */
     double *bar_val;   /* (n_bars) */
     double *bar_err;   /* (n_bars) or NULL */
     size_t n_bars;
+    unsigned *bar_cat;    /* (n_bars) category of each bar, or NULL: one colour */
+    char *cat_names[4];   /* (n_cat) */
+    size_t n_cat;
     int logy;
     int failed;
     unsigned width, height;
@@ -40,6 +44,9 @@ static const char *const plot_colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC
                                            "#E69F00", "#56B4E9", "#000000", "#F0E442",
                                            "#7F3C8D", "#8C564B", "#17BECF", "#BCBD22"};
 #define PLOT_NCOL (sizeof plot_colours / sizeof plot_colours[0])
+/* Bars: one colour, or one per category (lighter than the line colours so
+ * reference lines over bars stay visible). */
+static const char *const bar_colours[4] = {"#56B4E9", "#E69F00", "#CC79A7", "#F0E442"};
 
 static char *plot_strdup(const char *s)
 {
@@ -137,9 +144,14 @@ static void plot_free_bars(rch_plot *p)
     free(p->bar_labels);
     free(p->bar_val);
     free(p->bar_err);
+    free(p->bar_cat);
+    for (i = 0; i < p->n_cat; i++)
+        free(p->cat_names[i]);
     p->bar_labels = NULL;
     p->bar_val = NULL;
     p->bar_err = NULL;
+    p->bar_cat = NULL;
+    p->n_cat = 0;
     p->n_bars = 0;
 }
 
@@ -170,6 +182,40 @@ void rch_plot_bars(rch_plot *p, const char *const *labels, const double *values,
         if (!p->bar_labels[i])
             p->failed = 1;
     }
+}
+
+void rch_plot_bar_categories(rch_plot *p, const unsigned *cat, const char *const *names, size_t n_cat)
+{
+    size_t i;
+    if (!p || p->n_bars == 0)
+        return;
+    if (!cat || !names || n_cat == 0 || n_cat > 4 || p->bar_cat) {
+        p->failed = 1;
+        return;
+    }
+    p->bar_cat = malloc(p->n_bars * sizeof *p->bar_cat);
+    if (!p->bar_cat) {
+        p->failed = 1;
+        return;
+    }
+    for (i = 0; i < p->n_bars; i++)
+        p->bar_cat[i] = cat[i] < n_cat ? cat[i] : 0;
+    for (i = 0; i < n_cat; i++) {
+        p->cat_names[i] = plot_strdup(names[i]);
+        if (!p->cat_names[i])
+            p->failed = 1;
+        p->n_cat = i + 1;
+    }
+}
+
+void rch_plot_subtitle(rch_plot *p, const char *subtitle)
+{
+    if (!p)
+        return;
+    free(p->subtitle);
+    p->subtitle = plot_strdup(subtitle);
+    if (!p->subtitle)
+        p->failed = 1;
 }
 
 void rch_plot_logy(rch_plot *p, int on)
@@ -215,6 +261,7 @@ void rch_plot_free(rch_plot *p)
     free(p->series);
     plot_free_bars(p);
     free(p->title);
+    free(p->subtitle);
     free(p->xlabel);
     free(p->ylabel);
     free(p);
@@ -407,6 +454,8 @@ static void plot_layout(plot_frame *fr, const rch_plot *p)
     fr->rot_labels = 0;
     fr->W = (double)p->width;
     fr->H = (double)p->height;
+    if (p->subtitle && p->subtitle[0])
+        fr->T += 16.0;
     plot_ranges(p, &fr->ax, &fr->ay);
     /* legend: one entry per labelled series */
     for (size_t i = 0; i < p->n_series; i++) {
@@ -417,8 +466,14 @@ static void plot_layout(plot_frame *fr, const rch_plot *p)
                 maxlab = l;
         }
     }
+    for (size_t i = 0; i < p->n_cat; i++) {
+        size_t l = strlen(p->cat_names[i]);
+        fr->nleg++;
+        if (l > maxlab)
+            maxlab = l;
+    }
     if (fr->nleg > 0) {
-        fr->legw = 40.0 + 7.2 * (double)(maxlab > 40 ? 40 : maxlab);
+        fr->legw = 40.0 + 7.2 * (double)(maxlab > 48 ? 48 : maxlab);
         fr->R += fr->legw + 10.0;
     }
     if (p->n_bars > 0) {
@@ -510,7 +565,7 @@ static void plot_bar(FILE *f, const rch_plot *p, const plot_frame *fr, size_t k)
     const plot_axis *ay = &fr->ay;
     const double bw = 0.6 * fr->xs, v = p->bar_val[k], cx = plot_px(fr, (double)k);
     const double base = ay->log ? ay->lo : (ay->lo > 0.0 ? ay->lo : (ay->hi < 0.0 ? ay->hi : 0.0));
-    const char *col = plot_colours[k % PLOT_NCOL];
+    const char *col = bar_colours[p->bar_cat ? p->bar_cat[k] : 0];
     if (plot_ok(ay, v)) {
         double tv = plot_tr(ay, v), top, bot;
         char buf[64];
@@ -557,7 +612,12 @@ static void plot_series_all(FILE *f, const rch_plot *p, const plot_frame *fr)
     for (size_t i = 0; i < p->n_series; i++) {
         const plot_series *s = &p->series[i];
         const char *col = plot_colours[i % PLOT_NCOL];
-        if (s->kind == PLOT_LINE) {
+        fprintf(f, "<g class=\"series\">\n");
+        if (s->kind == PLOT_LINE && s->n == 1) {
+            /* one point: a marker, not an invisible line */
+            if (isfinite(s->x[0]) && plot_ok(ay, s->y[0]))
+                plot_marker(f, 0, plot_px(fr, s->x[0]), plot_py(fr, plot_tr(ay, s->y[0])), col);
+        } else if (s->kind == PLOT_LINE) {
             int pen = 0;
             fprintf(f, "<path fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\" d=\"", col);
             for (size_t k = 0; k < s->n; k++) {
@@ -569,13 +629,12 @@ static void plot_series_all(FILE *f, const rch_plot *p, const plot_frame *fr)
                 pen = 1;
             }
             fprintf(f, "\"/>\n");
-            if (s->n == 1 && isfinite(s->x[0]) && plot_ok(ay, s->y[0]))
-                plot_marker(f, 0, plot_px(fr, s->x[0]), plot_py(fr, plot_tr(ay, s->y[0])), col);
         } else {
             for (size_t k = 0; k < s->n; k++)
                 if (isfinite(s->x[k]) && plot_ok(ay, s->y[k]))
                     plot_marker(f, (int)i, plot_px(fr, s->x[k]), plot_py(fr, plot_tr(ay, s->y[k])), col);
         }
+        fprintf(f, "</g>\n");
     }
     fprintf(f, "</g>\n");
 }
@@ -614,6 +673,15 @@ static void plot_frame_legend(FILE *f, const rch_plot *p, const plot_frame *fr)
         fprintf(f, "</text>\n");
         ly += 18.0;
     }
+    for (size_t c = 0; c < p->n_cat; c++) {
+        const double yy = ly + 16.0;
+        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"14\" height=\"10\" fill=\"%s\" fill-opacity=\"0.85\"/>\n",
+                lx + 9, yy - 9, bar_colours[c]);
+        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">", lx + 30, yy);
+        plot_esc(f, p->cat_names[c]);
+        fprintf(f, "</text>\n");
+        ly += 18.0;
+    }
 }
 
 int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
@@ -634,11 +702,20 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
     fprintf(f, "<text x=\"%.1f\" y=\"24\" text-anchor=\"middle\" font-size=\"16\" font-weight=\"bold\">", fr.W / 2.0);
     plot_esc(f, p->title);
     fprintf(f, "</text>\n");
+    if (p->subtitle && p->subtitle[0]) {
+        fprintf(f, "<text x=\"%.1f\" y=\"42\" text-anchor=\"middle\" font-size=\"12\" fill=\"#555555\">", fr.W / 2.0);
+        plot_esc(f, p->subtitle);
+        fprintf(f, "</text>\n");
+    }
     plot_yticks(f, &fr);
     if (p->n_bars == 0)
         plot_xticks(f, &fr); /* numeric x axis unless this is a pure bar chart */
+    if (p->n_bars > 0)
+        fprintf(f, "<g class=\"bars\">\n");
     for (size_t k = 0; k < p->n_bars; k++)
         plot_bar(f, p, &fr, k);
+    if (p->n_bars > 0)
+        fprintf(f, "</g>\n");
     plot_series_all(f, p, &fr);
     plot_frame_legend(f, p, &fr);
     fprintf(f, "</svg>\n");
@@ -663,6 +740,157 @@ int rch_plot_write_svg(const rch_plot *p, const char *path)
 }
 
 void rch_plot_xml_text(FILE *f, const char *s) { plot_esc(f, s); }
+
+/* ---- data as CSV -------------------------------------------------------- */
+
+/* RFC 4180 field: quoted when it holds a comma, quote or line break. */
+static void csv_field(FILE *f, const char *s)
+{
+    if (!s)
+        s = "";
+    if (strpbrk(s, ",\"\r\n") == NULL) {
+        fputs(s, f);
+        return;
+    }
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"')
+            fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+int rch_plot_table_write(FILE *f, const rch_plot_table *t)
+{
+    const size_t nc = t ? t->n_text + t->n_num : 0;
+    if (!f || !t || nc == 0 || !t->head || (t->n_rows > 0 && ((t->n_text > 0 && !t->text) || (t->n_num > 0 && !t->num)))) {
+        errno = EINVAL;
+        return -1;
+    }
+    for (size_t c = 0; c < nc; c++) {
+        if (c)
+            fputc(',', f);
+        csv_field(f, t->head[c]);
+    }
+    fputc('\n', f);
+    for (size_t r = 0; r < t->n_rows; r++) {
+        for (size_t c = 0; c < t->n_text; c++) {
+            if (c)
+                fputc(',', f);
+            csv_field(f, t->text[r * t->n_text + c]);
+        }
+        for (size_t c = 0; c < t->n_num; c++) {
+            const double v = t->num[r * t->n_num + c];
+            if (c || t->n_text)
+                fputc(',', f);
+            if (isnan(v))
+                fputs("nan", f);
+            else if (isinf(v))
+                fputs(v > 0 ? "inf" : "-inf", f);
+            else
+                fprintf(f, "%.9g", v);
+        }
+        fputc('\n', f);
+    }
+    return ferror(f) ? -1 : 0;
+}
+
+/* The chart as a table (see rch_plot_write_csv_stream); heap arrays in t
+ * and the column names in head (4 + 1 slots, err_head holds the error
+ * column's name). 0, or -1 on allocation failure (t freed). */
+typedef struct plot_csv {
+    rch_plot_table t;
+    const char *head[5];
+    char err_head[300];
+    const char **text;
+    double *num;
+} plot_csv;
+
+static void plot_csv_free(plot_csv *c)
+{
+    free(c->text);
+    free(c->num);
+    c->text = NULL;
+    c->num = NULL;
+}
+
+static int plot_csv_make(plot_csv *c, const rch_plot *p)
+{
+    size_t rows = p->n_bars, k = 0, h = 0;
+    const int bars = p->n_bars > 0, errs = bars && p->bar_err;
+    for (size_t i = 0; i < p->n_series; i++)
+        rows += p->series[i].n;
+    memset(c, 0, sizeof *c);
+    c->head[h++] = "series";
+    if (bars)
+        c->head[h++] = "category";
+    c->head[h++] = p->xlabel[0] ? p->xlabel : "x";
+    c->head[h++] = p->ylabel[0] ? p->ylabel : "y";
+    if (errs) {
+        snprintf(c->err_head, sizeof c->err_head, "+- %s (error bar half-length)", p->ylabel[0] ? p->ylabel : "y");
+        c->head[h++] = c->err_head;
+    }
+    c->t.head = c->head;
+    c->t.n_text = bars ? 2 : 1;
+    c->t.n_num = errs ? 3 : 2;
+    c->t.n_rows = rows;
+    c->text = malloc((rows ? rows : 1) * c->t.n_text * sizeof *c->text);
+    c->num = malloc((rows ? rows : 1) * c->t.n_num * sizeof *c->num);
+    if (!c->text || !c->num) {
+        plot_csv_free(c);
+        return -1;
+    }
+    for (size_t b = 0; b < p->n_bars; b++, k++) {
+        c->text[k * c->t.n_text] = p->ylabel[0] ? p->ylabel : "bars";
+        c->text[k * c->t.n_text + 1] = p->bar_labels[b];
+        c->num[k * c->t.n_num] = (double)b;
+        c->num[k * c->t.n_num + 1] = p->bar_val[b];
+        if (errs)
+            c->num[k * c->t.n_num + 2] = p->bar_err[b];
+    }
+    for (size_t i = 0; i < p->n_series; i++) {
+        const plot_series *s = &p->series[i];
+        for (size_t j = 0; j < s->n; j++, k++) {
+            c->text[k * c->t.n_text] = s->label;
+            if (bars)
+                c->text[k * c->t.n_text + 1] = "";
+            c->num[k * c->t.n_num] = s->x[j];
+            c->num[k * c->t.n_num + 1] = s->y[j];
+            if (errs)
+                c->num[k * c->t.n_num + 2] = NAN;
+        }
+    }
+    c->t.text = c->text;
+    c->t.num = c->num;
+    return 0;
+}
+
+int rch_plot_write_csv_stream(const rch_plot *p, FILE *f)
+{
+    plot_csv c;
+    int rc;
+    if (!p || !f || p->failed || plot_csv_make(&c, p) != 0) {
+        errno = p && p->failed ? ENOMEM : EINVAL;
+        return -1;
+    }
+    rc = rch_plot_table_write(f, &c.t);
+    plot_csv_free(&c);
+    return rc;
+}
+
+const char *rch_plot_fmt_p(char *out, size_t len, double p)
+{
+    if (!out || len == 0)
+        return out;
+    if (!isfinite(p))
+        snprintf(out, len, "-");
+    else if (p < 1e-300)
+        snprintf(out, len, "< 1e-300");
+    else
+        snprintf(out, len, "%.1e", p);
+    return out;
+}
 
 int rch_plot_mkdir(const char *dir)
 {
@@ -716,14 +944,63 @@ int rch_plot_close(rch_out *o, const rch_plot_dir *pd, int failed, rch_diag *d)
     return 0;
 }
 
+/* NAME with .svg (when it ends so) replaced by .csv. 0, or -1 with d set. */
+static int plot_csv_name(char *csv, size_t len, const rch_plot_dir *pd, const char *name, rch_diag *d)
+{
+    if (!name)
+        name = "";
+    size_t n = strlen(name);
+    if (n >= 4 && strcmp(name + n - 4, ".svg") == 0)
+        n -= 4;
+    if (n + 5 > len || n > 4096) {
+        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: name too long", pd->dir, name);
+        return -1;
+    }
+    snprintf(csv, len, "%.*s.csv", (int)n, name);
+    return 0;
+}
+
+int rch_plot_save_csv(const rch_plot_table *t, const rch_plot_dir *pd, const char *name, rch_diag *d)
+{
+    char csv[512];
+    rch_out o;
+    if (plot_csv_name(csv, sizeof csv, pd, name, d) != 0)
+        return -1;
+    if (!t) {
+        rch_diag_set(d, "", 0, 0, "cannot write %s/%s: out of memory", pd->dir, csv);
+        return -1;
+    }
+    if (rch_plot_open(&o, pd, csv, d) != 0)
+        return -1;
+    return rch_plot_close(&o, pd, rch_plot_table_write(o.f, t) != 0, d);
+}
+
 int rch_plot_save(rch_plot *p, const rch_plot_dir *pd, const char *name, rch_diag *d)
 {
     rch_out o;
+    plot_csv c;
+    char csv[512];
     int rc = -1;
     if (!p || p->failed)
         rch_diag_set(d, "", 0, 0, "cannot write %s/%s: out of memory", pd->dir, name);
-    else if (rch_plot_open(&o, pd, name, d) == 0)
-        rc = rch_plot_close(&o, pd, rch_plot_write_svg_stream(p, o.f) != 0, d);
+    else if (plot_csv_name(csv, sizeof csv, pd, name, d) == 0 && rch_plot_open(&o, pd, name, d) == 0) {
+        /* both names are checked against the inputs before either file is written */
+        rch_out oc;
+        if (rch_plot_open(&oc, pd, csv, d) != 0) {
+            rch_out_abort(&o);
+        } else if (plot_csv_make(&c, p) != 0) {
+            rch_out_abort(&o);
+            rch_out_abort(&oc);
+            rch_diag_set(d, "", 0, 0, "cannot write %s/%s: out of memory", pd->dir, csv);
+        } else {
+            const int svg_failed = rch_plot_write_svg_stream(p, o.f) != 0, csv_failed = rch_plot_table_write(oc.f, &c.t) != 0;
+            plot_csv_free(&c);
+            if (rch_plot_close(&o, pd, svg_failed, d) != 0)
+                rch_out_abort(&oc);
+            else
+                rc = rch_plot_close(&oc, pd, csv_failed, d);
+        }
+    }
     rch_plot_free(p);
     return rc;
 }

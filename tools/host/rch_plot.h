@@ -50,6 +50,15 @@ void rch_plot_scatter(rch_plot *p, const char *label, const double *x, const dou
 void rch_plot_bars(rch_plot *p, const char *const *labels, const double *values,
                    const double *errs, size_t n);
 
+/* Colour the bars by category (call after rch_plot_bars): cat (n_bars)
+ * indexes names (n_cat, at most 4); each category gets its own colour and a
+ * legend entry. Without it every bar has the same colour (a colour that
+ * means nothing is not drawn). */
+void rch_plot_bar_categories(rch_plot *p, const unsigned *cat, const char *const *names, size_t n_cat);
+
+/* A second, smaller title line (e.g. the paper figure this corresponds to). */
+void rch_plot_subtitle(rch_plot *p, const char *subtitle);
+
 /* Logarithmic y axis (on != 0). Default linear. */
 void rch_plot_logy(rch_plot *p, int on);
 
@@ -60,9 +69,18 @@ void rch_plot_size(rch_plot *p, unsigned width_px, unsigned height_px);
 void rch_plot_xrange(rch_plot *p, double lo, double hi);
 void rch_plot_yrange(rch_plot *p, double lo, double hi);
 
-/* Write the chart to a file path, or to an open stream. 0 or -1. */
+/* Write the chart to a file path, or to an open stream. 0 or -1.
+ * Each series is drawn inside <g class="series"> (line vertices or one
+ * marker per drawable point), the bars inside <g class="bars"> (one <rect>
+ * per drawable bar), so a reader can count what is drawn. */
 int rch_plot_write_svg(const rch_plot *p, const char *path);
 int rch_plot_write_svg_stream(const rch_plot *p, FILE *f);
+
+/* The chart's data as CSV (rch_plot_table_write of its table): one row per
+ * point, columns "series", then "category" when there are bars, the x and y
+ * axis labels (with their units) and the error-bar half-length when given.
+ * Bar rows: series = the y label, x = the bar's index. 0 or -1. */
+int rch_plot_write_csv_stream(const rch_plot *p, FILE *f);
 
 void rch_plot_free(rch_plot *p);
 
@@ -88,9 +106,34 @@ int rch_plot_open(rch_out *o, const rch_plot_dir *pd, const char *name, rch_diag
  * write error) and log it. 0, or -1 with d set. */
 int rch_plot_close(rch_out *o, const rch_plot_dir *pd, int failed, rch_diag *d);
 
-/* Write p as DIR/NAME and free it (also on failure; p NULL counts as an
- * allocation failure). 0, or -1 with d set ("cannot write DIR/NAME: ..."). */
+/* Write p as DIR/NAME and its data as DIR/BASE.csv beside it (NAME =
+ * BASE.svg; rch_plot_save_csv), then free it (also on failure; p NULL counts
+ * as an allocation failure). 0, or -1 with d set ("cannot write DIR/NAME: ..."). */
 int rch_plot_save(rch_plot *p, const rch_plot_dir *pd, const char *name, rch_diag *d);
+
+/* The data of one plot as a table: n_rows rows of n_text text cells, then
+ * n_num numbers. Column names say what and the unit: "deviation (mm)". */
+typedef struct rch_plot_table {
+    const char *const *head; /* (n_text + n_num) column names */
+    size_t n_text, n_num, n_rows;
+    const char *const *text; /* (n_rows x n_text) row-major; NULL when n_text == 0 */
+    const double *num;       /* (n_rows x n_num) row-major */
+} rch_plot_table;
+
+/* Write t as CSV (RFC 4180 quoting, numbers %.9g, non-finite as nan, inf,
+ * -inf). 0 or -1. */
+int rch_plot_table_write(FILE *f, const rch_plot_table *t);
+
+/* The one writer of a plot's CSV: t as DIR/BASE.csv for the plot file
+ * DIR/NAME (NAME = BASE.svg, or any NAME without .svg: NAME.csv), through
+ * rch_plot_open / rch_plot_close. t NULL: an allocation failure. 0, or -1
+ * with d set. */
+int rch_plot_save_csv(const rch_plot_table *t, const rch_plot_dir *pd, const char *name, rch_diag *d);
+
+/* A p-value as text that never reads "0": "< 1e-300" below 1e-300 (an
+ * underflow to 0 included), else %.1e ("3.0e-17"); "-" when not finite.
+ * Returns out. */
+const char *rch_plot_fmt_p(char *out, size_t len, double p);
 
 /* A perceptually ordered colour map (viridis, 5 stops) at t in [0, 1]
  * (clamped): "#rrggbb" into out. */

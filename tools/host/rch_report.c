@@ -432,7 +432,7 @@ static void chart_svg(rep *r, const chart *c)
         maxl = strlen(c->label[i]) > maxl ? strlen(c->label[i]) : maxl;
     if (maxl > 30)
         maxl = 30;
-    const double W = c->width_px, L = 14.0 + 6.6 * (double)maxl, R = 28.0;
+    const double W = c->width_px, L = 14.0 + 7.2 * (double)maxl, R = 28.0; /* 0.6 em a character: long labels stay on the page */
     const double T = 30.0 + (c->n_leg ? 20.0 : 0.0) + (c->n_ref ? 16.0 : 0.0);
     const double sub_h = 16.0, row_h = sub_h * (double)c->n_sub + 6.0;
     const double pw = W - L - R, ph = row_h * (double)c->n_rows, H = T + ph + 44.0;
@@ -1441,7 +1441,7 @@ static void accuracy_chart(rep *r, const arow *a, size_t n)
     chart c;
     memset(&c, 0, sizeof c);
     c.title = "Flange-position accuracy over the workspace";
-    c.xlabel = "flange position (mm)";
+    c.xlabel = "predicted 95 % flange-position uncertainty (mm)";
     c.n_rows = n;
     c.n_sub = 1;
     c.label = labels;
