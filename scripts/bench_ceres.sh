@@ -43,9 +43,9 @@ for DATA in data/sim_irb120.csv ../shared/data/robotcali.csv; do
     done
     mr=$(median < "$TMP/r"); mc=$(median < "$TMP/c")
     "$RCAL" calibrate --data "$DATA" --test-fraction 0 --json > "$TMP/r.json"
-    r0=$(sed -n 's/.*"train_before": {[^}]*"rmse_mm": \([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
-    r1=$(sed -n 's/.*"train_after": {[^}]*"rmse_mm": \([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
-    it=$(sed -n 's/.*"iterations": \([0-9]*\).*/\1/p' "$TMP/r.json")
+    r0=$(sed -n 's/.*"train_before": *{[^}]*"rmse_mm": *\([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
+    r1=$(sed -n 's/.*"train_after": *{[^}]*"rmse_mm": *\([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
+    it=$(sed -n 's/.*"iterations": *\([0-9]*\).*/\1/p' "$TMP/r.json")
     echo "$DATA: $RUNS runs each, whole process, alternating"
     echo "  rcal calibrate --test-fraction 0   median $mr ms   $it iterations, train RMS $r0 -> $r1 mm"
     echo "  ceres_fit (autodiff, LM, dense QR) median $mc ms   $("$CB/ceres_fit" "$TMP/start.json" "$DATA" --target-rms "$r1")"

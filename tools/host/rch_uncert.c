@@ -504,6 +504,17 @@ static void pack_cov(cov_pack *p, double *buf, const double *cov, size_t ld, con
             buf[(size_t)a * p->nn + b] = cov[(size_t)p->idx[a] * ld + p->idx[b]];
 }
 
+/* t0 += x * a0, t1 += x * a1, t2 += x * a2 over n entries (vectorises). */
+static void axpy3(double *restrict t0, double *restrict t1, double *restrict t2, const double *restrict x, double a0,
+                  double a1, double a2, unsigned n)
+{
+    for (unsigned i = 0; i < n; ++i) {
+        t0[i] += x[i] * a0;
+        t1[i] += x[i] * a1;
+        t2[i] += x[i] * a2;
+    }
+}
+
 /* Longest semi-axis of the 95 % ellipsoid of J Cov J^T, J (3 x n, the
  * columns p->idx read), Cov packed in p: T = Cov J^T, then J T (upper
  * triangle) and its largest eigenvalue in closed form. */
@@ -512,20 +523,14 @@ static double ellipsoid95(double J[3][RC_MAX_PARAMS], const cov_pack *p)
     const unsigned nn = p->nn;
     double jc[3][RC_MAX_PARAMS], T[3][RC_MAX_PARAMS], C[9] = {0};
     for (int i = 0; i < 3; ++i)
-        for (unsigned a = 0; a < nn; ++a)
+        for (unsigned a = 0; a < nn; ++a) {
             jc[i][a] = J[i][p->idx[a]];
-    for (unsigned a = 0; a < nn; ++a) {
-        const double *row = p->c + (size_t)a * nn;
-        double t0 = 0.0, t1 = 0.0, t2 = 0.0;
-        for (unsigned b = 0; b < nn; ++b) {
-            t0 += row[b] * jc[0][b];
-            t1 += row[b] * jc[1][b];
-            t2 += row[b] * jc[2][b];
+            T[i][a] = 0.0;
         }
-        T[0][a] = t0;
-        T[1][a] = t1;
-        T[2][a] = t2;
-    }
+    /* T[i][a] = sum_b Cov[a][b] J[i][b], Cov symmetric: row b of Cov times
+     * J[i][b] added to T[i] */
+    for (unsigned b = 0; b < nn; ++b)
+        axpy3(T[0], T[1], T[2], p->c + (size_t)b * nn, jc[0][b], jc[1][b], jc[2][b], nn);
     for (int i = 0; i < 3; ++i)
         for (int j = i; j < 3; ++j) {
             double v = 0.0;
