@@ -575,11 +575,19 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     unsigned rank = 0;
     double gnorm = 0.0;
     int have_eig = 0; /* the decomposition at m is already in w (LTLM kept x1) */
+    /* A trial point is evaluated with its normal equations (one pass gives
+     * the cost, the Jacobian and J^T J, the cost to the last bit as
+     * cost_tab's: same samples, same order, same sum), so an accepted step
+     * leaves in A, w->g the normal equations the next iteration needs and
+     * its pass is saved; a rejected one costs the Jacobian for nothing
+     * (rare: damping is tuned for acceptance). A and w->g are free during
+     * the trials: the step comes from w->ev, w->c and V. */
+    int have_ne = 1; /* A, w->g hold the normal equations at m */
 
     res->exit = RC_EXIT_MAX_ITER;
     for (unsigned it = 0; it < max_iter; ++it) {
         if (!have_eig) {
-            if (it > 0) {
+            if (!have_ne) {
                 st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
                 ++res->cost_evals;
                 if (st != RC_OK)
@@ -589,7 +597,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
             if (st != RC_OK)
                 return st;
         }
-        have_eig = 0;
+        have_eig = have_ne = 0;
         const double lmax = w->ev[0];
         res->rank = rank;
         res->cond = sqrt(lmax / w->ev[rank - 1]);
@@ -611,7 +619,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
             apply_step(&w->trial, m, w, nf, w->dx);
             double cnew;
             ++res->cost_evals;
-            st = cost_tab(&cnew, &w->trial, samples, tab, n);
+            st = normal_eq_tab(A, w->g, &cnew, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
             const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
             if (rho > 0.0) {
                 accepted = 1;
@@ -624,11 +632,8 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
                      * own next step from x1 (new normal equations, the
                      * updated damping, the same truncation), so both
                      * segments lie in subspaces the robust LM steps in. */
-                    double c1, cbest;
-                    st = normal_eq_tab(A, w->g, &c1, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
-                    ++res->cost_evals;
-                    if (st == RC_OK)
-                        st = lm_subspace(&rank, &gnorm, w, A, V, nf, c1, n, rcond, snr_min);
+                    double c1 = cnew, cbest; /* A, w->g: the normal equations at x1 */
+                    st = lm_subspace(&rank, &gnorm, w, A, V, nf, c1, n, rcond, snr_min);
                     if (st == RC_OK) {
                         if (gnorm > 0.0)
                             (void)lm_subspace_step(w->lt_x2, w, V, nf, rank, mu);
@@ -647,6 +652,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
                         }
                     }
                 }
+                have_ne = !ltlm; /* LTLM: A is decomposed (x1 kept: have_eig) or m is a candidate */
                 const double rel = (cost - cnew) / (cost + 1e-300);
                 *m = w->trial;
                 cost = cnew;
