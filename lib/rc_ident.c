@@ -70,7 +70,8 @@ static rc_status classify(rc_ident *out, const double *vals, int eig, const doub
         const double sk = sv_of(vals, eig, k);
         out->sv_rel[k] = smax > 0.0 ? sk / smax : 0.0;
         /* from eigenvalues, the test the solvers use (the same expression) */
-        const int null = eig ? rc_ident_eig_is_null(vals[k], vals[0]) : !(smax > 0.0 && out->sv_rel[k] >= RC_IDENT_NULL_REL);
+        const int null =
+            eig ? rc_ident_eig_is_null(vals[k], vals[0]) : !(smax > 0.0 && out->sv_rel[k] >= RC_IDENT_NULL_REL);
         if (!null) {
             ++out->rank;
             logsum += log(sk);

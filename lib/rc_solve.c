@@ -415,8 +415,9 @@ static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w
 /* Robust LM, the subspace: scale the normal equations at the current point
  * (A, w->g unscaled, cost) by D, take the eigen-decomposition (w->ev,
  * V) and keep the directions rc_ident does not call null (rcond > 0: the
- * eigenvalues above rcond * largest; *rank of them) whose Gauss-Newton step is significant: w->c[k] =
- * v_k^T g_s for those, 0 for the others; *gnorm = sum of the kept c^2. */
+ * eigenvalues above rcond * largest; *rank of them) whose Gauss-Newton step
+ * is significant: w->c[k] = v_k^T g_s for those, 0 for the others; *gnorm =
+ * sum of the kept c^2. */
 static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_work *w, double *A, double *V,
                              unsigned nf, double cost, size_t n, double rcond, double snr_min)
 {

@@ -199,7 +199,8 @@ static void test_dh_sensitivity(void **state)
             rc_fk(pm, Rm, &mm, s.q_rad);
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j)
-                    D[3 * i + j] = Rp[3 * i] * Rm[3 * j] + Rp[3 * i + 1] * Rm[3 * j + 1] + Rp[3 * i + 2] * Rm[3 * j + 2];
+                    D[3 * i + j] =
+                        Rp[3 * i] * Rm[3 * j] + Rp[3 * i + 1] * Rm[3 * j + 1] + Rp[3 * i + 2] * Rm[3 * j + 2];
             w[0] = 0.5 * (D[7] - D[5]) / (2.0 * h);
             w[1] = 0.5 * (D[2] - D[6]) / (2.0 * h);
             w[2] = 0.5 * (D[3] - D[1]) / (2.0 * h);
