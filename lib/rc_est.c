@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "rc_ident.h"
 #include "rc_linalg.h"
 #include "rc_rand.h"
 
@@ -37,8 +38,8 @@ rc_status rc_est_subset(uint8_t *fixed_out, unsigned *n_kept, rc_est_work *w, co
     *n_kept = 0;
     if (samples == NULL || n == 0 || m->n_params > RC_MAX_PARAMS)
         return RC_ERR_ARG;
-    if (!(tol > 0.0))
-        tol = 1e-8;
+    if (!(tol > 0.0)) /* rc_ident's null bound on a relative singular value, squared (see below) */
+        tol = RC_IDENT_NULL_REL * RC_IDENT_NULL_REL;
     for (unsigned k = 0; k < m->n_params; ++k) {
         fixed_out[k] = 1;
         if (fixed_in == NULL || fixed_in[k] == 0)
@@ -49,17 +50,19 @@ rc_status rc_est_subset(uint8_t *fixed_out, unsigned *n_kept, rc_est_work *w, co
     rc_status st = rc_normal_eq(w->P, w->g, &cost, w->jrow, m, w->idx, nf, samples, n);
     if (st != RC_OK)
         return st;
-    /* correlation matrix C = D^-1 A D^-1; zero columns stay zero */
-    /* a column below 1e-12 of the largest in norm (e.g. alpha6, theta6:
-     * rounding-level values) counts as zero: never identifiable */
-    double amax = 0.0;
-    for (unsigned i = 0; i < nf; ++i)
-        if (w->P[(size_t)i * nf + i] > amax)
-            amax = w->P[(size_t)i * nf + i];
-    for (unsigned i = 0; i < nf; ++i) {
-        const double a = w->P[(size_t)i * nf + i];
-        w->D[i] = a > 1e-24 * amax && a > 0.0 ? sqrt(a) : 0.0;
-    }
+    /* correlation matrix C = D^-1 A D^-1; zero columns stay zero. D is
+     * rc_ident's column scale: a column at most RC_IDENT_ZERO_COL of the
+     * largest in norm (e.g. alpha6, theta6: rounding-level values) counts as
+     * zero, never identifiable. The pivot cut below is rc_ident's null
+     * bound: a column whose residual diagonal (its squared distance, as a
+     * unit column, from the span of those kept) is below tol =
+     * RC_IDENT_NULL_REL^2 would add a direction of relative singular value
+     * below RC_IDENT_NULL_REL (s_min <= sqrt(residual), s_max >= 1), which
+     * rc_ident calls not identifiable: a dropped parameter is always a
+     * null one. The converse is looser: the residual is not divided by
+     * s_max^2 (>= 1), so a pair down to about half the bound in s_rel is
+     * still kept (tests/core/test_solve.c, test_solve_cut_is_rc_ident). */
+    rc_ident_scale(w->D, w->P, nf, (size_t)nf + 1);
     for (unsigned i = 0; i < nf; ++i)
         for (unsigned k = 0; k < nf; ++k) {
             const double d = w->D[i] * w->D[k];

@@ -132,7 +132,7 @@ typedef struct rc_est_config {
     double qibas_d0;        /* QIBAS initial antenna length (normalised); 0: 0.2 */
     double sslm_mu;         /* SSLM fixed damping, scaled variables; 0: 1e-2 */
     double tol_cost;        /* relative cost decrease to stop (EKF, SSLM); 0: 1e-10 */
-    double subset_tol;      /* identifiable-subset threshold; 0: 1e-8 */
+    double subset_tol;      /* identifiable-subset threshold; 0: RC_IDENT_NULL_REL^2 (1e-12, rc_ident) */
     int keep_all;           /* nonzero: no subset selection, every free parameter moves */
     uint64_t seed;
     const uint8_t *fixed;   /* (n_params) nonzero: held fixed; NULL: none */
@@ -178,7 +178,8 @@ const char *rc_est_method_name(rc_est_method method);
 /* The identifiable subset at model m on samples (n): fixed_out (m->n_params)
  * receives 1 for every parameter to hold (fixed_in's and the unidentifiable
  * ones), 0 for the kept ones; *n_kept their number. fixed_in may be NULL;
- * tol 0 means 1e-8. Uses w->P, w->T, w->jrow, w->idx. */
+ * tol 0 means rc_ident's null bound RC_IDENT_NULL_REL^2 (1e-12). Uses w->P,
+ * w->T, w->jrow, w->idx. */
 rc_status rc_est_subset(uint8_t *fixed_out, unsigned *n_kept, rc_est_work *w, const rc_model *m,
                         const uint8_t *fixed_in, double tol, const rc_sample *samples, size_t n);
 

@@ -46,6 +46,14 @@ static double sv_of(const double *vals, int eig, unsigned k)
     return eig ? (vals[k] > 0.0 ? sqrt(vals[k]) : 0.0) : vals[k];
 }
 
+int rc_ident_eig_is_null(double ev, double ev_max)
+{
+    if (!(ev_max > 0.0))
+        return 1;
+    const double sk = ev > 0.0 ? sqrt(ev) : 0.0;
+    return !(sk / sqrt(ev_max) >= RC_IDENT_NULL_REL);
+}
+
 static rc_status classify(rc_ident *out, const double *vals, int eig, const double *V, unsigned n, size_t n_rows)
 {
     RC_ASSERT(out != NULL && vals != NULL && V != NULL);
@@ -61,7 +69,10 @@ static rc_status classify(rc_ident *out, const double *vals, int eig, const doub
     for (unsigned k = 0; k < n; ++k) {
         const double sk = sv_of(vals, eig, k);
         out->sv_rel[k] = smax > 0.0 ? sk / smax : 0.0;
-        if (smax > 0.0 && out->sv_rel[k] >= RC_IDENT_NULL_REL) {
+        /* from eigenvalues, the test the solvers use (the same expression) */
+        const int null =
+            eig ? rc_ident_eig_is_null(vals[k], vals[0]) : !(smax > 0.0 && out->sv_rel[k] >= RC_IDENT_NULL_REL);
+        if (!null) {
             ++out->rank;
             logsum += log(sk);
             out->cond = smax / sk;

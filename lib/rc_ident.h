@@ -102,6 +102,15 @@ rc_status rc_ident_classify(rc_ident *out, const double *sv, const double *V, un
  * RC_ERR_NUMERIC for a non-finite eigenvalue. */
 rc_status rc_ident_classify_eig(rc_ident *out, const double *ev, const double *V, unsigned n, size_t n_rows);
 
+/* The null test of the rule on one eigenvalue ev of the column-scaled
+ * normal matrix beside its largest ev_max: 1 when sqrt(ev) / sqrt(ev_max) <
+ * RC_IDENT_NULL_REL (the relative singular value; in eigenvalues the bound
+ * is RC_IDENT_NULL_REL^2 = 1e-12 of the largest), or when ev_max is not
+ * positive. A negative rounding-level ev counts as 0. rc_ident_classify_eig
+ * decides with this test, and so does every solver that truncates to the
+ * identifiable subspace (rc_solve's LM), so the two can never disagree. */
+int rc_ident_eig_is_null(double ev, double ev_max);
+
 /* Analyse a normal matrix: AtA (n x n) = J^T J of n parameters over n_rows
  * rows, unscaled. Scales it by its diagonal (zero columns as documented
  * above), decomposes it (rcu_eig_sym), and classifies. Outputs: out, V (n x n)

@@ -175,6 +175,44 @@ void rc_kin_fk_jac(rc_real pos_mm[3], rc_real rot[9], rc_real jac[36], rc_kin_da
         memcpy(rot, d->R[RC_NJ], 9 * sizeof rot[0]);
 }
 
+void rc_kin_fk_dh_jac(rc_real pos_mm[3], rc_real rot[9], rc_real *jp, rc_real *jr, rc_kin_data *d, const rc_kin *k,
+                      const rc_real q_rad[RC_NJ])
+{
+    rc_real p[3];
+    RC_ASSERT(pos_mm != NULL && d != NULL && k != NULL && q_rad != NULL);
+    kin_model_chain(p, d, k, q_rad);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const rc_real z[3] = {d->R[i][2], d->R[i][5], d->R[i][8]};
+        const rc_real x1[3] = {d->R[i + 1][0], d->R[i + 1][3], d->R[i + 1][6]};
+        rc_real v[3], wt[3], wa[3];
+        for (int r = 0; r < 3; ++r)
+            v[r] = p[r] - d->o[i][r];
+        cross3(wt, z, v);
+        for (int r = 0; r < 3; ++r)
+            v[r] = p[r] - d->o[i + 1][r];
+        cross3(wa, x1, v);
+        for (unsigned r = 0; r < 3; ++r) {
+            rc_real *P = jp != NULL ? jp + r * RC_N_DH + RC_DH_PER_JOINT * i : NULL;
+            rc_real *W = jr != NULL ? jr + r * RC_N_DH + RC_DH_PER_JOINT * i : NULL;
+            if (P != NULL) { /* a, d, alpha, theta */
+                P[0] = x1[r];
+                P[1] = z[r];
+                P[2] = wa[r];
+                P[3] = wt[r];
+            }
+            if (W != NULL) {
+                W[0] = RC_REAL_C(0.0);
+                W[1] = RC_REAL_C(0.0);
+                W[2] = x1[r];
+                W[3] = z[r];
+            }
+        }
+    }
+    memcpy(pos_mm, p, 3 * sizeof pos_mm[0]);
+    if (rot != NULL)
+        memcpy(rot, d->R[RC_NJ], 9 * sizeof rot[0]);
+}
+
 rc_status rc_kin_chol6(rc_real A[36], rc_real b[RC_NJ])
 {
     const unsigned n = RC_NJ;

@@ -145,6 +145,25 @@ void rc_kin_fk(rc_real pos_mm[3], rc_real rot[9], rc_kin_data *d, const rc_kin *
 void rc_kin_fk_jac(rc_real pos_mm[3], rc_real rot[9], rc_real jac[36], rc_kin_data *d, const rc_kin *k,
                    const rc_real q_rad[RC_NJ]);
 
+/* Forward kinematics and its sensitivity to the 24 DH parameters (order
+ * a, d, alpha, theta per joint, as rc_model's RC_P_A .. RC_P_THETA), from
+ * the chain in closed form: with z_i the axis of joint i at origin o_i,
+ * x_{i+1} the x axis of frame i+1 at o_{i+1} and p the FK point,
+ *   d p / d theta_i = z_i x (p - o_i)           d w / d theta_i = z_i
+ *   d p / d d_i     = z_i                       d w / d d_i     = 0
+ *   d p / d a_i     = x_{i+1}                   d w / d a_i     = 0
+ *   d p / d alpha_i = x_{i+1} x (p - o_{i+1})   d w / d alpha_i = x_{i+1}
+ * where w is the small-rotation vector of the flange in the base frame.
+ * A theta offset enters the joint angle with slope 1 whatever the
+ * joint-side effects add, so they change the chain, not these formulas.
+ * (The encoder and the length-side effects do not move the flange; the
+ * tool offset and joint-side effect parameters are not DH columns.)
+ * pos_mm (3), rot (3 x 3, or NULL) as rc_kin_fk; jp, jr: (3 x RC_N_DH)
+ * row-major, either may be NULL. One chain evaluation: what 48 central
+ * differences of rc_kin_fk give, up to their truncation and rounding. */
+void rc_kin_fk_dh_jac(rc_real pos_mm[3], rc_real rot[9], rc_real *jp, rc_real *jr, rc_kin_data *d, const rc_kin *k,
+                      const rc_real q_rad[RC_NJ]);
+
 /* Solve (A) x = b for a symmetric positive definite 6x6 A by Cholesky, in
  * rc_real. A: (6 x 6) row-major, overwritten by its factor; b: (6), replaced
  * by x. RC_ERR_NUMERIC when A is not positive definite (or not finite). The

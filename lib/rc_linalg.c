@@ -282,3 +282,24 @@ rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned m
     sort_desc(eval, V, n);
     return st;
 }
+
+double rcu_sym3_eig_max(const double A[9])
+{
+    const double a00 = A[0], a01 = A[1], a02 = A[2], a11 = A[4], a12 = A[5], a22 = A[8];
+    const double p1 = a01 * a01 + a02 * a02 + a12 * a12;
+    if (p1 == 0.0) { /* diagonal */
+        double mx = a00 > a11 ? a00 : a11;
+        mx = mx > a22 ? mx : a22;
+        return isfinite(a00 + a11 + a22) ? mx : (double)NAN;
+    }
+    const double q = (a00 + a11 + a22) / 3.0;
+    const double b00 = a00 - q, b11 = a11 - q, b22 = a22 - q;
+    const double p = sqrt((b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * p1) / 6.0);
+    if (!isfinite(p))
+        return (double)NAN;
+    /* det(B) / 2 with B = (A - q I) / p */
+    const double det = b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02) + a02 * (a01 * a12 - b11 * a02);
+    double r = det / (2.0 * p * p * p);
+    r = r < -1.0 ? -1.0 : r > 1.0 ? 1.0 : r;
+    return q + 2.0 * p * cos(acos(r) / 3.0);
+}

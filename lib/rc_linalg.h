@@ -26,4 +26,14 @@ rc_status rcu_eig_sym(double *eval, double *V, double *A, unsigned n, unsigned m
  * max_sweeps 0 means 60. */
 rc_status rcu_eig_sym_jacobi(double *eval, double *V, double *A, unsigned n, unsigned max_sweeps);
 
+/* Largest eigenvalue of a symmetric 3 x 3 matrix A (row-major, the upper
+ * triangle is read) in closed form (O. K. Smith, CACM 4(4), 1961: the
+ * eigenvalues of B = (A - q I) / p are 2 cos(phi + 2 pi k / 3) with
+ * cos(3 phi) = det(B) / 2): no iteration. Accurate to about 1e-12 of the
+ * largest magnitude, and to about 1e-8 when the two largest eigenvalues
+ * coincide (acos near -1 halves the digits): enough for a 95 % ellipsoid's
+ * longest semi-axis, not for eigenvectors. NaN for a matrix that is not
+ * finite. */
+double rcu_sym3_eig_max(const double A[9]);
+
 #endif /* RC_LINALG_H */

@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "rc_ident.h"
 #include "rc_linalg.h"
 #include "rc_rand.h"
 
@@ -413,9 +414,10 @@ static rc_status solve_paper(rc_model *m, rc_solve_result *res, rc_solve_work *w
 
 /* Robust LM, the subspace: scale the normal equations at the current point
  * (A, w->g unscaled, cost) by D, take the eigen-decomposition (w->ev,
- * V) and keep the identifiable directions (eigenvalue above rcond *
- * largest: *rank of them) whose Gauss-Newton step is significant: w->c[k] =
- * v_k^T g_s for those, 0 for the others; *gnorm = sum of the kept c^2. */
+ * V) and keep the directions rc_ident does not call null (rcond > 0: the
+ * eigenvalues above rcond * largest; *rank of them) whose Gauss-Newton step
+ * is significant: w->c[k] = v_k^T g_s for those, 0 for the others; *gnorm =
+ * sum of the kept c^2. */
 static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_work *w, double *A, double *V,
                              unsigned nf, double cost, size_t n, double rcond, double snr_min)
 {
@@ -434,7 +436,14 @@ static rc_status lm_subspace(unsigned *rank_out, double *gnorm_out, rc_solve_wor
     unsigned rank = 0;
     double gnorm = 0.0, gn_gain = 0.0;
     for (unsigned k = 0; k < nf; ++k) {
-        if (w->ev[k] <= rcond * lmax)
+        /* The identifiable subspace is rc_ident's: a direction is null when
+         * its relative singular value s_k / s_max is below RC_IDENT_NULL_REL;
+         * the eigenvalues of the scaled J^T J are the squared singular
+         * values, so in them the cut is lambda_k / lambda_max <
+         * RC_IDENT_NULL_REL^2 (1e-12), decided by rc_ident_eig_is_null as
+         * rc_ident_classify_eig decides it. rcond > 0 (a caller's own cut,
+         * on the eigenvalues) replaces it. */
+        if (rcond > 0.0 ? w->ev[k] <= rcond * lmax : rc_ident_eig_is_null(w->ev[k], lmax))
             break;
         ++rank;
         double c = 0.0;
@@ -516,7 +525,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     const double tau = cfg->mu0 > 0.0 ? cfg->mu0 : 1e-3;
     const double tol_step = cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9;
     const double tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-4;
-    const double rcond = cfg->rcond > 0.0 ? cfg->rcond : 1e-9;
+    const double rcond = cfg->rcond > 0.0 ? cfg->rcond : 0.0; /* 0: rc_ident's rule */
     const double snr_min = cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 1.0);
     const int ltlm = cfg->method == RC_METHOD_LTLM;
     double cost, mu = 0.0, nu = 2.0;
@@ -535,6 +544,8 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
         if (a > dmax)
             dmax = a;
     }
+    /* rc_ident's zero column: squared norm at most RC_IDENT_ZERO_COL^2 of the largest */
+    const double zero_col = RC_IDENT_ZERO_COL * RC_IDENT_ZERO_COL * dmax;
     /* alpha6 turns the flange about x6 after the last translation: it can
      * never move the cable length, so it is dropped from the free set and
      * keeps its value exactly. (theta6 also has a zero column while a6 = 0,
@@ -543,7 +554,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     {
         unsigned keep = 0;
         for (unsigned i = 0; i < nf; ++i) {
-            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || A[(size_t)i * nf + i] > 1e-24 * dmax)
+            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || A[(size_t)i * nf + i] > zero_col)
                 w->D[keep++] = (double)i;
         }
         if (keep == 0)
@@ -559,17 +570,25 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     }
     for (unsigned i = 0; i < nf; ++i) {
         const double a = A[(size_t)i * nf + i];
-        w->D[i] = a > 1e-24 * dmax ? sqrt(a) : 1.0;
+        w->D[i] = a > zero_col ? sqrt(a) : 1.0;
     }
     double chaos_n = ltlm ? ltlm_n0(cfg) : 0.0;
     unsigned rank = 0;
     double gnorm = 0.0;
     int have_eig = 0; /* the decomposition at m is already in w (LTLM kept x1) */
+    /* A trial point is evaluated with its normal equations (one pass gives
+     * the cost, the Jacobian and J^T J, the cost to the last bit as
+     * cost_tab's: same samples, same order, same sum), so an accepted step
+     * leaves in A, w->g the normal equations the next iteration needs and
+     * its pass is saved; a rejected one costs the Jacobian for nothing
+     * (rare: damping is tuned for acceptance). A and w->g are free during
+     * the trials: the step comes from w->ev, w->c and V. */
+    int have_ne = 1; /* A, w->g hold the normal equations at m */
 
     res->exit = RC_EXIT_MAX_ITER;
     for (unsigned it = 0; it < max_iter; ++it) {
         if (!have_eig) {
-            if (it > 0) {
+            if (!have_ne) {
                 st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
                 ++res->cost_evals;
                 if (st != RC_OK)
@@ -579,7 +598,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
             if (st != RC_OK)
                 return st;
         }
-        have_eig = 0;
+        have_eig = have_ne = 0;
         const double lmax = w->ev[0];
         res->rank = rank;
         res->cond = sqrt(lmax / w->ev[rank - 1]);
@@ -601,7 +620,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
             apply_step(&w->trial, m, w, nf, w->dx);
             double cnew;
             ++res->cost_evals;
-            st = cost_tab(&cnew, &w->trial, samples, tab, n);
+            st = normal_eq_tab(A, w->g, &cnew, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
             const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
             if (rho > 0.0) {
                 accepted = 1;
@@ -614,11 +633,8 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
                      * own next step from x1 (new normal equations, the
                      * updated damping, the same truncation), so both
                      * segments lie in subspaces the robust LM steps in. */
-                    double c1, cbest;
-                    st = normal_eq_tab(A, w->g, &c1, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
-                    ++res->cost_evals;
-                    if (st == RC_OK)
-                        st = lm_subspace(&rank, &gnorm, w, A, V, nf, c1, n, rcond, snr_min);
+                    double c1 = cnew, cbest; /* A, w->g: the normal equations at x1 */
+                    st = lm_subspace(&rank, &gnorm, w, A, V, nf, c1, n, rcond, snr_min);
                     if (st == RC_OK) {
                         if (gnorm > 0.0)
                             (void)lm_subspace_step(w->lt_x2, w, V, nf, rank, mu);
@@ -637,6 +653,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
                         }
                     }
                 }
+                have_ne = !ltlm; /* LTLM: A is decomposed (x1 kept: have_eig) or m is a candidate */
                 const double rel = (cost - cnew) / (cost + 1e-300);
                 *m = w->trial;
                 cost = cnew;

@@ -11,7 +11,8 @@
  *    (each free parameter divided by its Jacobian column norm at the start, so
  *    mm and rad are comparable), step acceptance by gain ratio with Nielsen's
  *    damping update, and the step restricted to the identifiable subspace:
- *    eigen-directions of the scaled J^T J below rcond * largest are left
+ *    eigen-directions of the scaled J^T J that rc_ident calls not
+ *    identifiable (relative singular value below RC_IDENT_NULL_REL) are left
  *    untouched, so the solver never wanders along what the data cannot see;
  *    and a direction is moved only while its step is significant against the
  *    residual noise (snr_min), which ends the slow creep along weakly
@@ -106,7 +107,9 @@ typedef struct rc_solve_config {
                                 scaled eigenvalue, 0: 1e-3; paper: absolute mu, 0: 5 */
     double tol_step;         /* 0: 1e-9 (relative, scaled) */
     double tol_cost;         /* 0: 1e-4 (relative decrease of the cost in one iteration) */
-    double rcond;            /* 0: 1e-9: eigenvalue cut-off relative to the largest */
+    double rcond;            /* 0: rc_ident's rule (null below a relative singular value of
+                                RC_IDENT_NULL_REL, an eigenvalue 1e-12 of the largest);
+                                > 0: own eigenvalue cut-off relative to the largest */
     double snr_min;          /* 0: 1: an eigen-direction is stepped along only when its
                                 Gauss-Newton step is at least snr_min standard errors
                                 (sigma from the current residual); negative: off */

@@ -8,7 +8,8 @@
 # ../shared/data/robotcali.csv (when present) times `rcal calibrate
 # --test-fraction 0` and ceres_fit alternately and prints medians, the ratio,
 # both final RMS and where Ceres first reached rcal's final RMS (the stopping
-# rules differ: Ceres runs to its function tolerance or 100 iterations).
+# rules differ: Ceres runs to its function tolerance or 100 iterations),
+# and last the floor of this way of timing (an empty process, rcal --version).
 # Not part of the default build or the test run.
 set -eu
 cd "$(dirname "$0")/.."
@@ -43,11 +44,22 @@ for DATA in data/sim_irb120.csv ../shared/data/robotcali.csv; do
     done
     mr=$(median < "$TMP/r"); mc=$(median < "$TMP/c")
     "$RCAL" calibrate --data "$DATA" --test-fraction 0 --json > "$TMP/r.json"
-    r0=$(sed -n 's/.*"train_before": {[^}]*"rmse_mm": \([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
-    r1=$(sed -n 's/.*"train_after": {[^}]*"rmse_mm": \([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
-    it=$(sed -n 's/.*"iterations": \([0-9]*\).*/\1/p' "$TMP/r.json")
+    r0=$(sed -n 's/.*"train_before": *{[^}]*"rmse_mm": *\([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
+    r1=$(sed -n 's/.*"train_after": *{[^}]*"rmse_mm": *\([0-9.eE+-]*\).*/\1/p' "$TMP/r.json")
+    it=$(sed -n 's/.*"iterations": *\([0-9]*\).*/\1/p' "$TMP/r.json")
     echo "$DATA: $RUNS runs each, whole process, alternating"
     echo "  rcal calibrate --test-fraction 0   median $mr ms   $it iterations, train RMS $r0 -> $r1 mm"
     echo "  ceres_fit (autodiff, LM, dense QR) median $mc ms   $("$CB/ceres_fit" "$TMP/start.json" "$DATA" --target-rms "$r1")"
     awk -v r="$mr" -v c="$mc" 'BEGIN {printf "  ratio ceres / rcal: %.1fx\n", c / r}'
 done
+# What this way of timing costs by itself: an empty process (/bin/true) and
+# rcal doing nothing (--version), timed like the runs above. A ratio above
+# ceres / floor cannot be measured here.
+: > "$TMP/t"; : > "$TMP/v"
+i=0
+while [ $i -lt "$RUNS" ]; do
+    t0=$(now_us); /bin/true; t1=$(now_us); "$RCAL" --version >/dev/null; t2=$(now_us)
+    echo $((t1 - t0)) >> "$TMP/t"; echo $((t2 - t1)) >> "$TMP/v"
+    i=$((i + 1))
+done
+echo "timing floor: empty process (/bin/true) median $(median < "$TMP/t") ms, rcal --version median $(median < "$TMP/v") ms"

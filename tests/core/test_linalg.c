@@ -86,12 +86,58 @@ static void test_cholesky(void **state)
     assert_int_equal(rcu_chol_solve(S, c, 2), RC_ERR_NUMERIC);
 }
 
+/* rcu_sym3_eig_max: the closed form against the QL solver on random
+ * symmetric 3 x 3 matrices (definite, semi-definite, indefinite, with
+ * repeated eigenvalues), diagonal ones, and NaN. */
+static void test_sym3_eig_max(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 9);
+    for (int trial = 0; trial < 2000; ++trial) {
+        double A[9], A1[9], V[9], ev[3];
+        const unsigned kind = (unsigned)trial % 4;
+        if (kind == 0) {
+            random_sym(A, 3, &g, 1 + (unsigned)trial % 3); /* B B^T, rank 1..3 */
+        } else {
+            for (int i = 0; i < 3; ++i)
+                for (int j = i; j < 3; ++j)
+                    A[3 * i + j] = A[3 * j + i] = kind == 3 && i != j ? 0.0 : rc_rng_normal(&g);
+        }
+        if (kind == 2) { /* a repeated eigenvalue: Q diag(a, a, b) Q^T from an eigenbasis */
+            memcpy(A1, A, sizeof A1);
+            assert_int_equal(rcu_eig_sym(ev, V, A1, 3, 0), RC_OK);
+            const double lam[3] = {1.5, 1.5, -0.5};
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) {
+                    double sum = 0.0;
+                    for (int k = 0; k < 3; ++k)
+                        sum += V[3 * i + k] * lam[k] * V[3 * j + k];
+                    A[3 * i + j] = sum;
+                }
+        }
+        memcpy(A1, A, sizeof A1);
+        assert_int_equal(rcu_eig_sym(ev, V, A1, 3, 0), RC_OK);
+        const double scale = fabs(ev[0]) > fabs(ev[2]) ? fabs(ev[0]) : fabs(ev[2]);
+        /* a double largest eigenvalue costs half the digits (acos near -1) */
+        const double tol = kind == 2 ? 1e-7 : 1e-12;
+        if (!(fabs(rcu_sym3_eig_max(A) - ev[0]) <= tol * (scale + 1e-300)))
+            print_error("trial %d kind %u: %.17g vs %.17g\n", trial, kind, rcu_sym3_eig_max(A), ev[0]);
+        assert_true(fabs(rcu_sym3_eig_max(A) - ev[0]) <= tol * (scale + 1e-300));
+    }
+    const double Z[9] = {0};
+    assert_true(rcu_sym3_eig_max(Z) == 0.0);
+    const double Q[9] = {1, NAN, 0, NAN, 1, 0, 0, 0, 1};
+    assert_true(isnan(rcu_sym3_eig_max(Q)));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_eig_matches_definition_and_jacobi),
         cmocka_unit_test(test_eig_nonfinite),
         cmocka_unit_test(test_cholesky),
+        cmocka_unit_test(test_sym3_eig_max),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "rc_kin.h"
 #include "rc_model.h"
 #include "rc_rand.h"
 #include "rct_irb120.h"
@@ -160,6 +161,65 @@ static void test_joint_jacobian(void **state)
     }
 }
 
+/* rc_kin_fk_dh_jac: the closed-form sensitivity of the flange point and
+ * orientation to the 24 DH parameters against central differences of rc_fk
+ * (point and small-rotation vector of R+ R-^T), with a tool offset and a
+ * joint-side effect in the model (the formulas must hold through both). */
+static void test_dh_sensitivity(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 11);
+    rc_model m = nominal();
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        m.x[k] += (rc_param_unit(&m, k) == 1 ? 0.01 : 2.0) * (2.0 * rc_rng_u01(&g) - 1.0);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 1, 0), RC_OK);
+    for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
+        m.x[k] = 3e-3;
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
+    m.x[m.n_params - 3] = 10.0;
+    m.x[m.n_params - 2] = -20.0;
+    m.x[m.n_params - 1] = 40.0;
+    rc_kin kin;
+    rc_kin_data kd;
+    assert_int_equal(rc_kin_compile(&kin, &m), RC_OK);
+    for (int trial = 0; trial < 30; ++trial) {
+        rc_sample s;
+        random_pose(&s, &g);
+        double p[3], R[9], p0[3], jp[3 * RC_N_DH], jr[3 * RC_N_DH];
+        rc_kin_fk_dh_jac(p, R, jp, jr, &kd, &kin, s.q_rad);
+        rc_fk(p0, NULL, &m, s.q_rad);
+        for (int r = 0; r < 3; ++r)
+            assert_true(p[r] == p0[r]); /* the same chain as rc_kin_fk, bit for bit */
+        for (unsigned k = 0; k < RC_N_DH; ++k) {
+            const double h = rc_param_unit(&m, k) == 1 ? 1e-7 : 1e-5;
+            rc_model mp = m, mm = m;
+            mp.x[k] += h;
+            mm.x[k] -= h;
+            double pp[3], pm[3], Rp[9], Rm[9], D[9], w[3];
+            rc_fk(pp, Rp, &mp, s.q_rad);
+            rc_fk(pm, Rm, &mm, s.q_rad);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    D[3 * i + j] =
+                        Rp[3 * i] * Rm[3 * j] + Rp[3 * i + 1] * Rm[3 * j + 1] + Rp[3 * i + 2] * Rm[3 * j + 2];
+            w[0] = 0.5 * (D[7] - D[5]) / (2.0 * h);
+            w[1] = 0.5 * (D[2] - D[6]) / (2.0 * h);
+            w[2] = 0.5 * (D[3] - D[1]) / (2.0 * h);
+            for (int r = 0; r < 3; ++r) {
+                const double fd = (pp[r] - pm[r]) / (2.0 * h);
+                if (fabs(fd - jp[r * RC_N_DH + (int)k]) > 1e-5 * (1.0 + fabs(fd)) ||
+                    fabs(w[r] - jr[r * RC_N_DH + (int)k]) > 1e-6) {
+                    char name[64];
+                    print_error("param %s row %d: dp %.9g vs %.9g, dw %.9g vs %.9g\n", rc_param_name(name, 64, &m, k),
+                                r, jp[r * RC_N_DH + (int)k], fd, jr[r * RC_N_DH + (int)k], w[r]);
+                    fail();
+                }
+            }
+        }
+    }
+}
+
 static void test_fk_zero_pose(void **state)
 {
     (void)state;
@@ -293,7 +353,7 @@ int main(void)
         cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
         cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
         cmocka_unit_test(test_prepared_base),       cmocka_unit_test(test_prepared_effects),
-        cmocka_unit_test(test_wrap_leaves_huge_angles),
+        cmocka_unit_test(test_wrap_leaves_huge_angles), cmocka_unit_test(test_dh_sensitivity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

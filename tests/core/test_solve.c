@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rc_est.h"
+#include "rc_ident.h"
 #include "rc_solve.h"
 #include "rch_calib.h"
 #include "rch_data.h"
@@ -243,6 +245,100 @@ static void sim_set(rc_model *start, rc_model *truth, rc_sample *s, size_t n, un
     memcpy(&start->x[RC_P_ENC], enc, sizeof enc);
 }
 
+/* One identifiability rule: rc_solve's subspace cut and rc_ident's
+ * classification on a problem with a direction of known relative singular
+ * value. Free: a length offset (column 1) and a linear time drift (column
+ * t); the times t_i = T + delta z_i (z = +1, -1, ..., sum 0) make the two
+ * scaled columns nearly parallel: their cosine is rho = T / sqrt(T^2 +
+ * delta^2), the scaled normal matrix [[1, rho], [rho, 1]] has eigenvalues
+ * 1 +- rho, so the smaller direction has s_rel = sqrt((1 - rho) / (1 + rho)).
+ * delta is solved for s_rel = s_target (closed form below). Returns the rank
+ * the solver kept (res.rank) and rc_ident's rank on the same data. */
+static void ident_cut_case(double s_target, unsigned *rank_solve, unsigned *rank_ident, unsigned *n_subset)
+{
+    static rc_est_work EW;
+    enum { NS = 200 };
+    static rc_sample s[NS];
+    rch_robot r = load_robot();
+    rc_model m = r.model;
+    const double enc[3] = {250.0, -460.0, 10.0};
+    memcpy(&m.x[RC_P_ENC], enc, sizeof enc);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_OFFSET, 0, 1), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TIME_DRIFT, 0, 1), RC_OK);
+    const unsigned k_off = m.effects[0].first, k_drift = m.effects[1].first;
+    /* s^2 = (1 - rho) / (1 + rho)  =>  rho = (1 - s^2) / (1 + s^2), and
+     * delta = T sqrt(1 / rho^2 - 1) */
+    const double T = 0.5, s2 = s_target * s_target, rho = (1.0 - s2) / (1.0 + s2);
+    const double delta = T * sqrt((1.0 - rho) * (1.0 + rho)) / rho;
+    rc_rng g;
+    rc_rng_seed(&g, 77);
+    for (size_t i = 0; i < NS; ++i) {
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            s[i].q_rad[j] = 0.8 * (m.q_min_rad[j] + (m.q_max_rad[j] - m.q_min_rad[j]) * rc_rng_u01(&g));
+        s[i].t = T + (i % 2 ? -delta : delta);
+        s[i].group = 0;
+        double l;
+        assert_int_equal(rc_meas(&l, NULL, &m, &s[i]), RC_OK);
+        s[i].len_mm = l + 0.01 * rc_rng_normal(&g) + 0.3;
+    }
+    uint8_t fixed[RC_MAX_PARAMS];
+    memset(fixed, 1, sizeof fixed);
+    fixed[k_off] = fixed[k_drift] = 0;
+    /* rc_ident on the normal matrix of the two free parameters at the start */
+    const uint16_t idx[2] = {(uint16_t)k_off, (uint16_t)k_drift};
+    double A[4], gr[2], cost, jrow[RC_MAX_PARAMS], V[4], work[6];
+    assert_int_equal(rc_normal_eq(A, gr, &cost, jrow, &m, idx, 2, s, NS), RC_OK);
+    rc_ident id;
+    assert_int_equal(rc_ident_normal(&id, V, work, A, 2, NS), RC_OK);
+    print_message("s_target %.3g: rc_ident s_rel %.4g, rank %u\n", s_target, id.sv_rel[1], id.rank);
+    /* the construction is what it claims to be (within 2 %) */
+    assert_true(fabs(id.sv_rel[1] / s_target - 1.0) < 0.02);
+    rc_solve_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.fixed = fixed;
+    rc_solve_result res;
+    assert_int_equal(rc_solve(&m, &res, &W, &cfg, s, NS), RC_OK);
+    assert_int_equal(res.n_free, 2);
+    *rank_solve = res.rank;
+    *rank_ident = id.rank;
+    /* rc_est_subset's pivot cut is the same bound on the same start */
+    uint8_t sub[RC_MAX_PARAMS];
+    rc_model m0 = m;
+    memcpy(m0.x, r.model.x, RC_N_DH * sizeof m0.x[0]);
+    m0.x[k_off] = m0.x[k_drift] = 0.0;
+    assert_int_equal(rc_est_subset(sub, n_subset, &EW, &m0, fixed, 0.0, s, NS), RC_OK);
+}
+
+static void test_solve_cut_is_rc_ident(void **state)
+{
+    (void)state;
+    unsigned rs, ri, ns;
+    /* just above the null bound: weak, kept by all three */
+    ident_cut_case(1.1 * RC_IDENT_NULL_REL, &rs, &ri, &ns);
+    assert_int_equal(ri, 2);
+    assert_int_equal(rs, ri);
+    assert_int_equal(ns, ri);
+    /* just below: not identifiable, truncated by the solver as rc_ident
+     * classifies. rc_est_subset's greedy pivot compares the residual of a
+     * unit column (here 1 - rho^2 = s_rel^2 (1 + rho)^2, about 4 s_rel^2)
+     * with the same bound, so it still keeps the pair here... */
+    ident_cut_case(0.9 * RC_IDENT_NULL_REL, &rs, &ri, &ns);
+    assert_int_equal(ri, 1);
+    assert_int_equal(rs, ri);
+    assert_int_equal(ns, 2);
+    /* ...and drops it once the residual is below the bound too */
+    ident_cut_case(0.45 * RC_IDENT_NULL_REL, &rs, &ri, &ns);
+    assert_int_equal(ri, 1);
+    assert_int_equal(rs, ri);
+    assert_int_equal(ns, ri);
+    /* well inside the weak band (where the old eigenvalue cut of 1e-9, a
+     * relative singular value of 3.2e-5, truncated): kept by all three */
+    ident_cut_case(1e-5, &rs, &ri, &ns);
+    assert_int_equal(ri, 2);
+    assert_int_equal(rs, ri);
+    assert_int_equal(ns, ri);
+}
+
 /* rc_solve_work_size: the prefix of rc_solve_work up to A, two n_params^2
  * matrices and 12 doubles a sample; 0 outside 27..RC_MAX_PARAMS. */
 static void test_work_size(void **state)
@@ -395,7 +491,7 @@ int main(void)
         cmocka_unit_test(test_encoder_guess),   cmocka_unit_test(test_real_data),
         cmocka_unit_test(test_work_size),       cmocka_unit_test(test_solve_buf_same),
         cmocka_unit_test(test_solve_buf_refuses), cmocka_unit_test(test_normal_eq_rows),
-        cmocka_unit_test(test_blocks_equal_rows),
+        cmocka_unit_test(test_blocks_equal_rows), cmocka_unit_test(test_solve_cut_is_rc_ident),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

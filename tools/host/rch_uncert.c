@@ -11,6 +11,8 @@
 #include <string.h>
 
 #include "rc_ident.h"
+#include "rc_kin.h"
+#include "rc_linalg.h"
 #include "rc_rand.h"
 
 /* chi-square quantile with 3 degrees of freedom at 0.95 */
@@ -417,13 +419,23 @@ void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *n
             out->x[k] = nominal->x[k];
 }
 
-/* Central differences of the flange position (Jp, may be NULL) and of its
- * small-rotation vector (Jr, may be NULL) with respect to the parameters k
- * < n with use[k] set; the others' columns are zero. */
+/* Sensitivity of the flange position (Jp, may be NULL) and of its
+ * small-rotation vector (Jr, may be NULL) to the parameters k < n with
+ * use[k] set; the others' columns are zero. The DH columns in closed form
+ * from one chain (rc_kin_fk_dh_jac on kin, the model compiled by
+ * sens_compile); the encoder's are zero (it does not move the flange); the
+ * effects' by central differences of rc_fk (none in a default fit). kin
+ * NULL (a model rc_kin cannot hold): central differences for all. */
 static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARAMS], const uint8_t *use, unsigned n,
-                           const rc_model *m, const double q_rad[RC_NJ])
+                           const rc_model *m, const rc_kin *kin, const double q_rad[RC_NJ])
 {
     rc_model t = *m;
+    double jp[3 * RC_N_DH], jr[3 * RC_N_DH];
+    if (kin != NULL) {
+        rc_kin_data kd;
+        double pos[3];
+        rc_kin_fk_dh_jac(pos, NULL, Jp ? jp : NULL, Jr ? jr : NULL, &kd, kin, q_rad);
+    }
     for (unsigned k = 0; k < n; ++k) {
         for (int i = 0; i < 3; ++i) {
             if (Jp)
@@ -431,8 +443,17 @@ static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARA
             if (Jr)
                 Jr[i][k] = 0.0;
         }
-        if (!use[k])
+        if (!use[k] || (kin != NULL && k >= RC_N_DH && k < RC_N_BASE))
             continue;
+        if (kin != NULL && k < RC_N_DH) {
+            for (int i = 0; i < 3; ++i) {
+                if (Jp)
+                    Jp[i][k] = jp[i * RC_N_DH + (int)k];
+                if (Jr)
+                    Jr[i][k] = jr[i * RC_N_DH + (int)k];
+            }
+            continue;
+        }
         const double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5;
         double pp[3], pm[3], Rp[9], Rm[9];
         t.x[k] = m->x[k] + h;
@@ -454,38 +475,112 @@ static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARA
     }
 }
 
-/* Longest semi-axis of the 95 % ellipsoid of J Cov J^T, J (3 x n), Cov
- * (n x n, leading dimension ld). */
-static double ellipsoid95(double J[3][RC_MAX_PARAMS], const double *cov, size_t ld, unsigned n)
+/* The kinematics of m compiled for fk_sensitivity into kin: kin, or NULL
+ * when rc_kin cannot hold m (central differences then). */
+static const rc_kin *sens_compile(rc_kin *kin, const rc_model *m)
 {
-    double C[9] = {0};
+    return rc_kin_compile(kin, m) == RC_OK ? kin : NULL;
+}
+
+/* The part of a covariance an ellipsoid reads: the parameters k < n with
+ * use[k] set whose FK sensitivity can be nonzero (not the encoder's), idx
+ * (nn) in order, and their covariance c (nn x nn, contiguous, the caller's
+ * buffer of n * n doubles). */
+typedef struct {
+    unsigned nn;
+    unsigned idx[RC_MAX_PARAMS];
+    double *c;
+} cov_pack;
+
+static void pack_cov(cov_pack *p, double *buf, const double *cov, size_t ld, const uint8_t *use, unsigned n)
+{
+    p->nn = 0;
+    p->c = buf;
+    for (unsigned k = 0; k < n; ++k)
+        if (use[k] && !(k >= RC_N_DH && k < RC_N_BASE))
+            p->idx[p->nn++] = k;
+    for (unsigned a = 0; a < p->nn; ++a)
+        for (unsigned b = 0; b < p->nn; ++b)
+            buf[(size_t)a * p->nn + b] = cov[(size_t)p->idx[a] * ld + p->idx[b]];
+}
+
+/* t0 += x * a0, t1 += x * a1, t2 += x * a2 over n entries (vectorises). */
+static void axpy3(double *restrict t0, double *restrict t1, double *restrict t2, const double *restrict x, double a0,
+                  double a1, double a2, unsigned n)
+{
+    for (unsigned i = 0; i < n; ++i) {
+        t0[i] += x[i] * a0;
+        t1[i] += x[i] * a1;
+        t2[i] += x[i] * a2;
+    }
+}
+
+/* Longest semi-axis of the 95 % ellipsoid of J Cov J^T, J (3 x n, the
+ * columns p->idx read), Cov packed in p: T = Cov J^T, then J T (upper
+ * triangle) and its largest eigenvalue in closed form. */
+static double ellipsoid95(double J[3][RC_MAX_PARAMS], const cov_pack *p)
+{
+    const unsigned nn = p->nn;
+    double jc[3][RC_MAX_PARAMS], T[3][RC_MAX_PARAMS], C[9] = {0};
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            for (unsigned k = 0; k < n; ++k)
-                for (unsigned l = 0; J[i][k] != 0.0 && l < n; ++l)
-                    C[i * 3 + j] += J[i][k] * cov[(size_t)k * ld + l] * J[j][l];
-    double ev[3];
-    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, C, 3, ev) != 0)
-        return NAN;
-    return sqrt(CHI2_3_95 * fmax(ev[2], 0.0));
+        for (unsigned a = 0; a < nn; ++a) {
+            jc[i][a] = J[i][p->idx[a]];
+            T[i][a] = 0.0;
+        }
+    /* T[i][a] = sum_b Cov[a][b] J[i][b], Cov symmetric: row b of Cov times
+     * J[i][b] added to T[i] */
+    for (unsigned b = 0; b < nn; ++b)
+        axpy3(T[0], T[1], T[2], p->c + (size_t)b * nn, jc[0][b], jc[1][b], jc[2][b], nn);
+    for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j) {
+            double v = 0.0;
+            for (unsigned a = 0; a < nn; ++a)
+                v += jc[i][a] * T[j][a];
+            C[i * 3 + j] = v;
+        }
+    return sqrt(CHI2_3_95 * fmax(rcu_sym3_eig_max(C), 0.0));
 }
 
 /* 95 % position semi-axis at q from a covariance cov (n x n, leading
  * dimension ld) over the parameters k < n with use[k] set. */
 static double pos95_cov(const double *cov, size_t ld, const uint8_t *use, unsigned n, const rc_model *m,
-                        const double q_rad[RC_NJ])
+                        const rc_kin *kin, const double q_rad[RC_NJ])
 {
     double Jp[3][RC_MAX_PARAMS];
-    fk_sensitivity(Jp, NULL, use, n, m, q_rad);
-    return ellipsoid95(Jp, cov, ld, n);
+    cov_pack p;
+    double *buf = malloc((size_t)n * n * sizeof *buf + 1);
+    if (!buf)
+        return NAN;
+    pack_cov(&p, buf, cov, ld, use, n);
+    fk_sensitivity(Jp, NULL, use, n, m, kin, q_rad);
+    const double r = ellipsoid95(Jp, &p);
+    free(buf);
+    return r;
+}
+
+/* Parameters of the position uncertainty: identifiable and weak ones. */
+static void use_pos(uint8_t *use, const rch_uncert *u)
+{
+    for (unsigned k = 0; k < u->n_params; ++k)
+        use[k] = u->cls[k] == RCH_PARAM_IDENTIFIABLE || u->cls[k] == RCH_PARAM_WEAK;
+}
+
+/* Parameters of the orientation uncertainty: all but fixed and
+ * not-identifiable ones, and with determined_only not those compensation
+ * keeps nominal. */
+static void use_rot(uint8_t *use, const rch_uncert *u, int determined_only)
+{
+    for (unsigned k = 0; k < u->n_params; ++k)
+        use[k] = !(u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE ||
+                   (determined_only && u->comp_nominal[k]));
 }
 
 double rch_uncert_pos95_mm(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
 {
     uint8_t use[RC_MAX_PARAMS];
-    for (unsigned k = 0; k < u->n_params; ++k)
-        use[k] = u->cls[k] == RCH_PARAM_IDENTIFIABLE || u->cls[k] == RCH_PARAM_WEAK;
-    return pos95_cov(u->cov, u->n_params, use, u->n_params, m, q_rad);
+    rc_kin kin;
+    use_pos(use, u);
+    return pos95_cov(u->cov, u->n_params, use, u->n_params, m, sens_compile(&kin, m), q_rad);
 }
 
 void rch_model_unc_from(rch_model_unc *out, const rch_uncert *u)
@@ -510,7 +605,8 @@ double rch_model_unc_pos95_mm(const rch_model_unc *u, const rc_model *m, const d
     uint8_t use[RC_N_DH];
     for (unsigned k = 0; k < RC_N_DH; ++k)
         use[k] = u->cls[k] != RCH_PARAM_FIXED && !u->comp_nominal[k] && isfinite(u->se[k]);
-    return pos95_cov(u->cov_dh, RC_N_DH, use, RC_N_DH, m, q_rad);
+    rc_kin kin;
+    return pos95_cov(u->cov_dh, RC_N_DH, use, RC_N_DH, m, sens_compile(&kin, m), q_rad);
 }
 
 double rch_model_unc_tool95_mm(const rch_model_unc *u, const rc_model *det, const rc_model *fit,
@@ -520,7 +616,8 @@ double rch_model_unc_tool95_mm(const rch_model_unc *u, const rc_model *det, cons
     for (unsigned k = 0; k < RC_N_DH; ++k)
         use[k] = u->cls[k] != RCH_PARAM_FIXED && isfinite(u->se[k]);
     double Jp[3][RC_MAX_PARAMS], Jr[3][RC_MAX_PARAMS], p[3], R[9], t[3], shift[3] = {0, 0, 0};
-    fk_sensitivity(Jp, Jr, use, RC_N_DH, det, q_rad);
+    rc_kin kin;
+    fk_sensitivity(Jp, Jr, use, RC_N_DH, det, sens_compile(&kin, det), q_rad);
     rc_fk(p, R, det, q_rad);
     for (int i = 0; i < 3; ++i)
         t[i] = R[i * 3] * tool_mm[0] + R[i * 3 + 1] * tool_mm[1] + R[i * 3 + 2] * tool_mm[2];
@@ -533,12 +630,10 @@ double rch_model_unc_tool95_mm(const rch_model_unc *u, const rc_model *det, cons
             for (int i = 0; i < 3; ++i)
                 shift[i] += Jp[i][k] * (fit->x[k] - det->x[k]);
     }
-    double cov[RC_N_DH * RC_N_DH];
-    for (unsigned k = 0; k < RC_N_DH; ++k)
-        for (unsigned l = 0; l < RC_N_DH; ++l)
-            cov[k * RC_N_DH + l] = use[k] && use[l] ? u->cov_dh[k * RC_N_DH + l] : 0.0;
-    return sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) +
-           ellipsoid95(Jp, cov, RC_N_DH, RC_N_DH);
+    double buf[RC_N_DH * RC_N_DH];
+    cov_pack cp;
+    pack_cov(&cp, buf, u->cov_dh, RC_N_DH, use, RC_N_DH);
+    return sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) + ellipsoid95(Jp, &cp);
 }
 
 void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_model_unc *u)
@@ -562,22 +657,67 @@ static void med_max(double *med, double *mx, double *v, size_t n)
     *mx = n ? v[n - 1] : NAN;
 }
 
+/* What the map evaluates at every pose: the covariance packed for the
+ * position (pos), the orientation with every parameter (rot) and with those
+ * compensation uses (det), and the parameters any of them reads (all). */
+typedef struct {
+    cov_pack pos, rot, det;
+    uint8_t all[RC_MAX_PARAMS];
+    double *buf; /* 3 x (n_params x n_params) behind the packs */
+} map_ctx;
+
+static int map_ctx_init(map_ctx *c, const rch_uncert *u)
+{
+    const unsigned np = u->n_params;
+    uint8_t up[RC_MAX_PARAMS] = {0}, ur[RC_MAX_PARAMS] = {0}, ud[RC_MAX_PARAMS] = {0};
+    c->buf = malloc(3 * (size_t)np * np * sizeof *c->buf + 1);
+    if (!c->buf)
+        return -1;
+    use_pos(up, u);
+    use_rot(ur, u, 0);
+    use_rot(ud, u, 1);
+    for (unsigned k = 0; k < np; ++k)
+        c->all[k] = up[k] || ur[k];
+    pack_cov(&c->pos, c->buf, u->cov, np, up, np);
+    pack_cov(&c->rot, c->buf + (size_t)np * np, u->cov, np, ur, np);
+    pack_cov(&c->det, c->buf + 2 * (size_t)np * np, u->cov, np, ud, np);
+    return 0;
+}
+
+/* The three figures of the map at one pose from one sensitivity: the 95 %
+ * position semi-axis, the orientation one with every parameter and with
+ * those compensation uses (rot and rot_det NULL: position only). */
+static void map_pose(double *pos, double *rot, double *rot_det, const rch_uncert *u, const map_ctx *c,
+                     const rc_model *m, const rc_kin *kin, const double q_rad[RC_NJ])
+{
+    double Jp[3][RC_MAX_PARAMS], Jr[3][RC_MAX_PARAMS];
+    fk_sensitivity(Jp, rot ? Jr : NULL, c->all, u->n_params, m, kin, q_rad);
+    *pos = ellipsoid95(Jp, &c->pos);
+    if (rot == NULL)
+        return;
+    *rot = ellipsoid95(Jr, &c->rot) * 57.29577951308232;
+    *rot_det = ellipsoid95(Jr, &c->det) * 57.29577951308232;
+}
+
 int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
                            size_t n_random, uint64_t seed)
 {
     memset(out, 0, sizeof *out);
-    double *v = malloc((n > n_random ? n : n_random) * sizeof *v + 1);
-    if (!v)
+    const size_t nv = n > n_random ? n : n_random;
+    map_ctx c;
+    double *v = malloc(3 * nv * sizeof *v + 1);
+    if (!v || map_ctx_init(&c, u) != 0) {
+        free(v);
         return -1;
+    }
+    double *vr = v + nv, *vd = vr + nv;
+    rc_kin kin;
+    const rc_kin *k = sens_compile(&kin, m);
     for (size_t i = 0; i < n; ++i)
-        v[i] = rch_uncert_pos95_mm(u, m, s[i].q_rad);
+        map_pose(&v[i], &vr[i], &vd[i], u, &c, m, k, s[i].q_rad);
     med_max(&out->data_median_mm, &out->data_max_mm, v, n);
-    for (size_t i = 0; i < n; ++i)
-        v[i] = rch_uncert_rot95_deg(u, m, s[i].q_rad);
-    med_max(&out->rot_data_median_deg, &out->rot_data_max_deg, v, n);
-    for (size_t i = 0; i < n; ++i)
-        v[i] = rch_uncert_rot95_det_deg(u, m, s[i].q_rad);
-    med_max(&out->rot_det_median_deg, &out->rot_det_max_deg, v, n);
+    med_max(&out->rot_data_median_deg, &out->rot_data_max_deg, vr, n);
+    med_max(&out->rot_det_median_deg, &out->rot_det_max_deg, vd, n);
     out->n_data = n;
     rc_rng g;
     rc_rng_seed(&g, seed);
@@ -585,34 +725,34 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
         double q[RC_NJ];
         for (int j = 0; j < RC_NJ; ++j)
             q[j] = m->q_min_rad[j] + (m->q_max_rad[j] - m->q_min_rad[j]) * rc_rng_u01(&g);
-        v[i] = rch_uncert_pos95_mm(u, m, q);
+        map_pose(&v[i], NULL, NULL, u, &c, m, k, q);
     }
     med_max(&out->work_median_mm, &out->work_max_mm, v, n_random);
     out->n_work = n_random;
+    free(c.buf);
     free(v);
     return 0;
 }
 
-static double rot95(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ], int determined_only);
+/* One orientation figure at q (det: with the parameters compensation uses). */
+static double rot95_one(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ], int det)
+{
+    double pos, rot, rdet;
+    rc_kin kin;
+    map_ctx c;
+    if (map_ctx_init(&c, u) != 0)
+        return NAN;
+    map_pose(&pos, &rot, &rdet, u, &c, m, sens_compile(&kin, m), q_rad);
+    free(c.buf);
+    return det ? rdet : rot;
+}
 
 double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
 {
-    return rot95(u, m, q_rad, 0);
+    return rot95_one(u, m, q_rad, 0);
 }
 
 double rch_uncert_rot95_det_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
 {
-    return rot95(u, m, q_rad, 1);
-}
-
-static double rot95(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ], int determined_only)
-{
-    unsigned np = u->n_params;
-    uint8_t use[RC_MAX_PARAMS];
-    double Jr[3][RC_MAX_PARAMS];
-    for (unsigned k = 0; k < np; ++k)
-        use[k] = !(u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE ||
-                   (determined_only && u->comp_nominal[k]));
-    fk_sensitivity(NULL, Jr, use, np, m, q_rad);
-    return ellipsoid95(Jr, u->cov, np, np) * 57.29577951308232;
+    return rot95_one(u, m, q_rad, 1);
 }
