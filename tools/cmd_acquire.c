@@ -69,9 +69,7 @@ static int report_json(const rch_acq_result *r, const rch_acq_config *c, const c
                        char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-acquire/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-acquire/1", argc, argv);
     rch_jw_str(&w, "out", c->out_path);
     rch_jw_str(&w, "poses_file", c->poses_path);
     rch_jw_str(&w, "port", c->port_path);

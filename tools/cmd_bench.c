@@ -30,9 +30,7 @@ static void report_text(const rch_bench_result *r, const char *data_path)
 static int report_json(const rch_bench_result *r, const char *data_path, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-bench/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-bench/1", argc, argv);
     rch_jw_str(&w, "data", data_path);
     rch_jw_uint(&w, "samples", r->n_samples);
     rch_jw_uint(&w, "runs", r->runs);

@@ -78,9 +78,7 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
                         char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-compensate/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
     rch_jw_str(&w, "model", job->model_path);
     rch_jw_str(&w, "nominal", job->nominal_path);
     rch_jw_str(&w, "in", job->in_path);

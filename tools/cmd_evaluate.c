@@ -16,9 +16,7 @@
 static int report_json(const rch_evaluate_result *r, const char *model, const char *data, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 1);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-evaluate/1", argc, argv);
+    rch_jw_begin(&w, stdout, 1, "rcal-evaluate/1", argc, argv);
     rch_jw_str(&w, "model", model);
     rch_jw_str(&w, "data", data);
     rch_jw_uint(&w, "n", r->m.n);

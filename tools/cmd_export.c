@@ -16,9 +16,7 @@ static int report_json(const rch_export_result *res, const char *model, const ch
 {
     const int urdf = strcmp(format, "urdf") == 0;
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-export/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-export/1", argc, argv);
     rch_jw_str(&w, "model", model);
     rch_jw_str(&w, "export_format", format);
     rch_jw_str(&w, "out", out_path);

@@ -17,9 +17,7 @@ static const char details[] = "A row further than T mm is a fault unless a joint
 static int report_json(const rch_fkcheck_result *r, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-fkcheck/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-fkcheck/1", argc, argv);
     rch_jw_uint(&w, "rows", r->rows);
     rch_jw_uint(&w, "faults", r->faults);
     rch_jw_uint(&w, "explained_by_rounding", r->rounding);

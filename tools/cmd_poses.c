@@ -33,9 +33,7 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
                        char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-poses/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-poses/1", argc, argv);
     rch_jw_str(&w, "out", out_path);
     rch_jw_uint(&w, "poses", res->n);
     rch_jw_uint(&w, "candidates", res->n_candidates);

@@ -57,9 +57,7 @@ int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, 
 static int report_json(const rch_report_result *res, const rch_report_cfg *cfg, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-report/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-report/1", argc, argv);
     rch_jw_str(&w, "calibration", cfg->cal_path);
     rch_jw_str(&w, "diagnosis", cfg->diag_path);
     rch_jw_str(&w, "model", cfg->model_path);

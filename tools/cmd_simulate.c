@@ -16,9 +16,7 @@ static int report_json(int argc, char **argv, unsigned long n, const char *out_p
                        const rch_sim_job *job)
 {
     rch_jw w;
-    rch_jw_init(&w, stdout, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-simulate/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-simulate/1", argc, argv);
     rch_jw_uint(&w, "samples", n);
     rch_jw_str(&w, "data", out_path);
     rch_jw_str(&w, "truth", truth_out);

@@ -1057,9 +1057,7 @@ static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
 int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, f, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-calibrate/1", argc, argv);
+    rch_jw_begin(&w, f, 0, "rcal-calibrate/1", argc, argv);
     rch_jw_str(&w, "method", rc_method_name(r->cfg.method));
     rch_jw_str(&w, "data", r->cfg.data_path);
     rch_jw_uint(&w, "n_train", r->n_train);

@@ -162,9 +162,7 @@ int rch_chaos_json(FILE *f, const rch_chaos_result *res, const rch_chaos_config 
 {
     const size_t b = res->best;
     rch_jw w;
-    rch_jw_init(&w, f, 1);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-chaos/1", argc, argv);
+    rch_jw_begin(&w, f, 1, "rcal-chaos/1", argc, argv);
     rch_jw_uint(&w, "points", cfg->points);
     rch_jw_uint(&w, "bins", cfg->bins);
     rch_jw_uint(&w, "starts", cfg->starts);

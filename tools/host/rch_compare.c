@@ -538,9 +538,7 @@ int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_c
                      int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, f, 1);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-compare/1", argc, argv);
+    rch_jw_begin(&w, f, 1, "rcal-compare/1", argc, argv);
     rch_jw_str(&w, "data", data_name);
     rch_jw_uint(&w, "rows_in_file", res->rows_in_data);
     rch_jw_uint(&w, "cases", res->cases);

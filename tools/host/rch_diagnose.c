@@ -1557,9 +1557,7 @@ static void json_cands(rch_jw *w, const rch_diagnose_result *r)
 int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, f, 0);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-diagnose/1", argc, argv);
+    rch_jw_begin(&w, f, 0, "rcal-diagnose/1", argc, argv);
     rch_jw_str(&w, "effect", r->effect);
     json_joint(&w, r->joint);
     json_num(&w, "rmse_before_mm", r->rmse_before_mm);

@@ -469,9 +469,7 @@ int rch_grind_json(FILE *f, const rch_grind_result *res, const rch_grind_config 
 {
     static const char *const keys[3] = {"uncompensated", "compensated_calibrated", "compensated_true"};
     rch_jw w;
-    rch_jw_init(&w, f, 1);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-grind/1", argc, argv);
+    rch_jw_begin(&w, f, 1, "rcal-grind/1", argc, argv);
     rch_jw_str(&w, "surface", rch_surface_name(cfg->surface.kind));
     rch_jw_uint(&w, "points", res->n);
     rch_jw_uint(&w, "lines", res->ny);
@@ -813,9 +811,7 @@ void rch_grind_table8_report(FILE *f, const rch_grind_table *t, const rch_grind_
 int rch_grind_table8_json(FILE *f, const rch_grind_table *t, const rch_grind_config *cfg, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_init(&w, f, 1);
-    rch_jw_obj(&w, NULL);
-    rch_jw_header(&w, "rcal-grind-table8/1", argc, argv);
+    rch_jw_begin(&w, f, 1, "rcal-grind-table8/1", argc, argv);
     rch_jw_str(&w, "surface", rch_surface_name(cfg->surface.kind));
     rch_jw_uint(&w, "points", t->n_points);
     rch_jw_bool(&w, "align", cfg->align);

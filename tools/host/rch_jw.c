@@ -281,6 +281,13 @@ const char *rch_jw_escape(const char *s, char *buf, size_t len)
     return buf;
 }
 
+void rch_jw_begin(rch_jw *w, FILE *f, int pretty, const char *format, int argc, char **argv)
+{
+    rch_jw_init(w, f, pretty);
+    rch_jw_obj(w, NULL);
+    rch_jw_header(w, format, argc, argv);
+}
+
 void rch_jw_header(rch_jw *w, const char *format, int argc, char **argv)
 {
     size_t len = 6;

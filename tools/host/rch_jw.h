@@ -51,6 +51,9 @@ int rch_jw_finish(rch_jw *w);
  * "rcal-fkcheck/1"), "tool" ("rcal <version>") and "command" (the command
  * line, argv[0] the command's name, joined with blanks). */
 void rch_jw_header(rch_jw *w, const char *format, int argc, char **argv);
+/* A command's JSON: rch_jw_init on f (pretty as there), the top-level
+ * object opened, and rch_jw_header. */
+void rch_jw_begin(rch_jw *w, FILE *f, int pretty, const char *format, int argc, char **argv);
 
 /* Escape s as a JSON string body into buf (always terminated); returns buf. */
 const char *rch_jw_escape(const char *s, char *buf, size_t len);
