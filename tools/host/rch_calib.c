@@ -77,7 +77,8 @@ int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
         int joint; /* 1: needs ":J" */
     } table[] = {{"length_offset", RC_EFF_LENGTH_OFFSET, 0}, {"length_scale", RC_EFF_LENGTH_SCALE, 0},
                  {"time_drift", RC_EFF_TIME_DRIFT, 0},       {"tool_offset", RC_EFF_TOOL_OFFSET, 0},
-                 {"joint_compliance", RC_EFF_JOINT_COMPLIANCE, 1}, {"joint_periodic", RC_EFF_JOINT_PERIODIC, 1}};
+                 {"joint_compliance", RC_EFF_JOINT_COMPLIANCE, 1}, {"joint_periodic", RC_EFF_JOINT_PERIODIC, 1},
+                 {"cable_sag", RC_EFF_CABLE_SAG, 0},         {"length_nonlinearity", RC_EFF_LENGTH_NONLIN, 0}};
     char buf[512];
     if (strlen(list) >= sizeof buf) {
         rch_diag_set(d, "", 0, 0, "--effects: list longer than %zu characters", sizeof buf - 1);
@@ -97,7 +98,7 @@ int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
         if (k == sizeof table / sizeof table[0]) {
             rch_diag_set(d, "", 0, 0,
                          "--effects: unknown effect '%s' (length_offset, length_scale, time_drift, tool_offset, "
-                         "joint_compliance:J, joint_periodic:J)",
+                         "cable_sag, length_nonlinearity, joint_compliance:J, joint_periodic:J)",
                          tok);
             return -1;
         }

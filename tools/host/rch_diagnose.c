@@ -435,9 +435,10 @@ static const cdef all_cands[] = {
     {RC_EFF_GROUP_OFFSET, 0},     {RC_EFF_JOINT_COMPLIANCE, 1}, {RC_EFF_JOINT_COMPLIANCE, 2},
     {RC_EFF_JOINT_PERIODIC, 0},   {RC_EFF_JOINT_PERIODIC, 1},   {RC_EFF_JOINT_PERIODIC, 2},
     {RC_EFF_JOINT_PERIODIC, 3},   {RC_EFF_JOINT_PERIODIC, 4},   {RC_EFF_JOINT_PERIODIC, 5},
-    {RC_EFF_TOOL_OFFSET, 0},
+    {RC_EFF_TOOL_OFFSET, 0},      {RC_EFF_CABLE_SAG, 0},        {RC_EFF_LENGTH_NONLIN, 0},
 };
 #define N_ALL_CANDS (sizeof all_cands / sizeof all_cands[0])
+RC_STATIC_ASSERT(sizeof all_cands / sizeof all_cands[0] <= RCH_DIAGNOSE_MAX_CAND, candidates_fit_the_step);
 
 static int is_joint_kind(rc_effect_kind k) { return k == RC_EFF_JOINT_COMPLIANCE || k == RC_EFF_JOINT_PERIODIC; }
 
@@ -549,6 +550,10 @@ static void report_params(rch_diagnose_result *r, const rc_model *fold_models, u
             } else if (kind == RC_EFF_LENGTH_SCALE) {
                 scale = 1e6;
                 unit = "ppm";
+            } else if (kind == RC_EFF_CABLE_SAG || (kind == RC_EFF_LENGTH_NONLIN && p == 1)) {
+                unit = "mm/m^3";
+            } else if (kind == RC_EFF_LENGTH_NONLIN) {
+                unit = "mm/m^2";
             }
             for (unsigned f = 0; f < k; ++f)
                 vals[f] = fold_models[f].x[idx] * scale;
