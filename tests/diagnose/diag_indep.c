@@ -188,6 +188,12 @@ static void make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double no
         s[i].len_mm = l0[i] + k * extra[i] + noise * rct_gauss(g);
 }
 
+static int cmp_d(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 static int match(const rch_diagnose_result *r, eff e)
 {
     return strcmp(r->effect, expect[e]) == 0 && (expect_joint[e] == 0 || r->joint == expect_joint[e]);
@@ -211,8 +217,9 @@ int main(int argc, char **argv)
     printf("rcal diagnose on independent data: %u seeds per noise band and cell, %d samples in set-ups of 10,\n"
            "effect RMS = %g x noise, noise drawn in each band and not told; hits / runs per band (mm)\n",
            seeds, N, size);
-    printf("%-22s %-7s %-20s %11s %11s %11s   %s\n", "effect", "robot", "expected", "0.002-0.005", "0.005-0.02",
-           "0.02-0.05", "other verdicts");
+    printf("(vis: median over the runs of the geometry-only held-out RMSE / the noise: what is left to see)\n");
+    printf("%-22s %-7s %-20s %11s %11s %11s %7s  %s\n", "effect", "robot", "expected", "0.002-0.005", "0.005-0.02",
+           "0.02-0.05", "vis", "other verdicts");
     for (unsigned ri = 0; ri < 2; ++ri) {
         rch_robot robot;
         rch_diag d;
@@ -221,7 +228,10 @@ int main(int argc, char **argv)
         for (unsigned e = 0; e < E_COUNT; ++e) {
             if (check && e != E_NONE && e != E_JUMP && e != E_SAG && e != E_NONLIN)
                 continue;
-            unsigned hit[N_BANDS] = {0, 0, 0}, runs[N_BANDS] = {0, 0, 0};
+            if (getenv("DIAG_INDEP_ONLY") && (unsigned)atoi(getenv("DIAG_INDEP_ONLY")) != e)
+                continue; /* one effect (its index in eff), e.g. to look at a miss with DIAG_INDEP_VERBOSE=1 */
+            unsigned hit[N_BANDS] = {0, 0, 0}, runs[N_BANDS] = {0, 0, 0}, n_ratio = 0;
+            double ratio[3 * 1000]; /* geometry's held-out RMSE / the true noise, per run */
             char other[600] = "";
             size_t op = 0;
             rct_rng g = {1000003ull * (ri + 1) + 7919ull * e};
@@ -236,6 +246,7 @@ int main(int argc, char **argv)
                     cfg.folds = 4;
                     cfg.max_steps = 1;
                     cfg.seed = 100u + k;
+                    cfg.verbose = getenv("DIAG_INDEP_VERBOSE") ? atoi(getenv("DIAG_INDEP_VERBOSE")) : 0;
                     runs[b]++;
                     if (rch_diagnose_run(&r, s, N, &robot.nominal, &cfg, &d) != 0) {
                         if (op < sizeof other - 60)
@@ -243,6 +254,8 @@ int main(int argc, char **argv)
                         rch_diagnose_free(&r);
                         continue;
                     }
+                    if (n_ratio < sizeof ratio / sizeof ratio[0])
+                        ratio[n_ratio++] = r.rmse_before_mm / noise;
                     if (match(&r, (eff)e))
                         hit[b]++;
                     else if (op < sizeof other - 40) {
@@ -260,8 +273,9 @@ int main(int argc, char **argv)
                 if (check && e != E_NONE && hit[b] + 1 < runs[b])
                     fail = 1;
             }
-            printf("%-22s %-7s %-20s %11s %11s %11s  %s\n", eff_name[e], ri ? "kr6" : "irb120", expect[e], cell[0],
-                   cell[1], cell[2], other);
+            qsort(ratio, n_ratio, sizeof ratio[0], cmp_d);
+            printf("%-22s %-7s %-20s %11s %11s %11s %7.2f  %s\n", eff_name[e], ri ? "kr6" : "irb120", expect[e],
+                   cell[0], cell[1], cell[2], n_ratio ? ratio[n_ratio / 2] : 0.0, other);
             fflush(stdout);
         }
     }

@@ -42,6 +42,8 @@ static int bands(unsigned seeds, double size_x, int visible, size_t n, unsigned 
     for (unsigned ci = 0; ci < DIAG_N_CASES; ++ci) {
         const diag_case *c = &diag_cases[ci];
         char other[600] = "", label[64], cell[DIAG_N_BANDS][16];
+        if (getenv("DIAG_CASE") && (unsigned)atoi(getenv("DIAG_CASE")) != ci)
+            continue; /* one case only (its index in diag_cases), e.g. with DIAG_VERBOSE=1 */
         size_t op = 0;
         for (unsigned b = 0; b < DIAG_N_BANDS; ++b) {
             unsigned hits = 0;
@@ -54,6 +56,7 @@ static int bands(unsigned seeds, double size_x, int visible, size_t n, unsigned 
                 cfg.folds = folds;
                 cfg.max_steps = 1;
                 cfg.seed = 1000u + k;
+                cfg.verbose = getenv("DIAG_VERBOSE") ? atoi(getenv("DIAG_VERBOSE")) : 0;
                 if (diag_simulate_band(s, n, &nominal, c, 104729ull * (k + 1) + 7919ull * ci + 31ull * b,
                                        diag_band_lo[b], diag_band_hi[b], size_x, visible, &noise) != 0 ||
                     rch_diagnose_run(&r, s, n, &nominal, &cfg, &d) != 0) {

@@ -884,13 +884,16 @@ static int phase_cv_geometry(run_state *S, rch_diag *d)
 
 /* A sharp step inside a set-up: the geometry's residuals of the (up to) 8
  * samples of the same set-up after sample a and before it differ by at
- * least 4 standard errors, the noise taken from the residuals' spread within
- * the two windows, and by the fitted jump size within half of it. A pose-dependent effect read in acquisition order is noise
- * within a set-up and fails; a sensor jump passes. */
+ * least 5 standard errors, the noise taken from the residuals' spread within
+ * the two windows, and by the fitted jump size within 30 % of it; and a step
+ * fits the window clearly better than a straight line through it (the sums
+ * of squares differ by more than 4 noise variances), so that a steep drift,
+ * a ramp, is not taken for a jump. A pose-dependent effect read in
+ * acquisition order is noise within a set-up and fails; a sensor jump passes. */
 static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t a, double size)
 {
-    double sum[2] = {0, 0}, sq[2] = {0, 0};
-    unsigned cnt[2] = {0, 0};
+    double sum[2] = {0, 0}, sq[2] = {0, 0}, r[16], x[16];
+    unsigned cnt[2] = {0, 0}, m = 0;
     for (int side = 0; side < 2; ++side)
         for (size_t k = 0; k < 8; ++k) {
             size_t i = side ? a + k : a - 1 - k;
@@ -899,19 +902,32 @@ static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t 
             double l;
             if (rc_meas(&l, NULL, geo, &s[i]) != RC_OK)
                 return 0;
-            const double r = l - s[i].len_mm;
-            sum[side] += r;
-            sq[side] += r * r;
+            r[m] = l - s[i].len_mm;
+            x[m++] = (double)i - (double)a;
+            sum[side] += r[m - 1];
+            sq[side] += r[m - 1] * r[m - 1];
             cnt[side]++;
         }
     if (cnt[0] < 3 || cnt[1] < 3)
         return 0;
     const double m0 = sum[0] / cnt[0], m1 = sum[1] / cnt[1];
-    const double v = (sq[0] - cnt[0] * m0 * m0 + sq[1] - cnt[1] * m1 * m1) / (double)(cnt[0] + cnt[1] - 2);
+    const double ss_step = sq[0] - cnt[0] * m0 * m0 + sq[1] - cnt[1] * m1 * m1;
+    const double v = ss_step / (double)(cnt[0] + cnt[1] - 2);
     const double se = sqrt(fmax(v, 0.0) * (1.0 / cnt[0] + 1.0 / cnt[1]));
+    double mx = 0.0, mr = 0.0, sxx = 0.0, sxr = 0.0, srr = 0.0;
+    for (unsigned k = 0; k < m; ++k) {
+        mx += x[k] / m;
+        mr += r[k] / m;
+    }
+    for (unsigned k = 0; k < m; ++k) {
+        sxx += (x[k] - mx) * (x[k] - mx);
+        sxr += (x[k] - mx) * (r[k] - mr);
+        srr += (r[k] - mr) * (r[k] - mr);
+    }
+    const double ss_ramp = srr - (sxx > 0.0 ? sxr * sxr / sxx : 0.0);
     /* a step the size of the fitted jump, not a slope that a long fit
      * summarised as one (residual = model - L: a jump up in L moves it down) */
-    return fabs(m1 - m0) > 5.0 * se && fabs((m0 - m1) - size) < 0.3 * fabs(size);
+    return fabs(m1 - m0) > 5.0 * se && fabs((m0 - m1) - size) < 0.3 * fabs(size) && ss_ramp - ss_step > 4.0 * v;
 }
 
 /* 4b. Length jumps in acquisition order: found, removed from the lengths
