@@ -281,9 +281,22 @@ static unsigned structure_tests(rch_diagnose_test *out, const double *r, const r
     for (size_t i = 0; i < n; ++i)
         X[i] = var[i][V_LEV3];
     test_regress(&out[k++], "gravity lever j3", r, X, 1, n, a_each);
-    for (size_t i = 0; i < n; ++i)
-        X[i] = var[i][V_LEN];
-    test_regress(&out[k++], "cable length", r, X, 1, n, a_each);
+    /* cable length: a smooth shape, not only a slope (a sensor's bow, a drum
+     * turn): u, u^2, u^3, sin and cos of 2 pi u, u the length scaled to [0, 1] */
+    double lmin = 1e300, lmax = -1e300;
+    for (size_t i = 0; i < n; ++i) {
+        lmin = var[i][V_LEN] < lmin ? var[i][V_LEN] : lmin;
+        lmax = var[i][V_LEN] > lmax ? var[i][V_LEN] : lmax;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double u = lmax > lmin ? (var[i][V_LEN] - lmin) / (lmax - lmin) : 0.0;
+        X[i * 5 + 0] = u;
+        X[i * 5 + 1] = u * u;
+        X[i * 5 + 2] = u * u * u;
+        X[i * 5 + 3] = sin(2.0 * M_PI * u);
+        X[i * 5 + 4] = cos(2.0 * M_PI * u);
+    }
+    test_regress(&out[k++], "cable length", r, X, 5, n, a_each);
     for (size_t i = 0; i < n; ++i) {
         X[i * 3 + 0] = var[i][V_UX];
         X[i * 3 + 1] = var[i][V_UY];
