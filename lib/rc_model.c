@@ -135,6 +135,7 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     case RC_EFF_TOOL_OFFSET: n = 3; joint = 0; break;
     case RC_EFF_CABLE_SAG: n = 1; joint = 0; break;
     case RC_EFF_LENGTH_NONLIN: n = 2; joint = 0; break;
+    case RC_EFF_LENGTH_PERIODIC: n = 3; joint = 0; break;
     case RC_EFF_TIME_DRIFT: /* polynomial in t without constant, degree 1..4; 0: 3 */
         n = count == 0 ? 3u : count;
         joint = 0;
@@ -203,6 +204,7 @@ const char *rc_effect_name(rc_effect_kind kind)
     case RC_EFF_TOOL_OFFSET: return "tool_offset";
     case RC_EFF_CABLE_SAG: return "cable_sag";
     case RC_EFF_LENGTH_NONLIN: return "length_nonlinearity";
+    case RC_EFF_LENGTH_PERIODIC: return "length_periodic";
     case RC_EFF_NONE: break;
     }
     return "none";
@@ -274,6 +276,7 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
             put_str(buf, buf_len, &pos, j == 0 ? ".x" : j == 1 ? ".y" : ".z");
             break;
         case RC_EFF_LENGTH_NONLIN: put_str(buf, buf_len, &pos, j == 0 ? ".n2" : ".n3"); break;
+        case RC_EFF_LENGTH_PERIODIC: put_str(buf, buf_len, &pos, j == 0 ? ".s" : j == 1 ? ".c" : ".period"); break;
         default: break;
         }
         return buf;
@@ -296,6 +299,7 @@ int rc_param_unit(const rc_model *m, unsigned k)
             case RC_EFF_LENGTH_OFFSET:
             case RC_EFF_TIME_DRIFT:
             case RC_EFF_GROUP_OFFSET:
+            case RC_EFF_LENGTH_PERIODIC:
             case RC_EFF_TOOL_OFFSET: return 0;
             case RC_EFF_JOINT_PERIODIC: return 1;
             default: return 2;
@@ -586,6 +590,16 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
                 gd[r] += dv * u[r];
             break;
         }
+        case RC_EFF_LENGTH_PERIODIC: {
+            if (!(fabs(x[2]) > 1e-9))
+                break;
+            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
+            const double dv = (x[0] * cp - x[1] * sp) * w; /* mm per mm of chord */
+            add += x[0] * sp + x[1] * cp;
+            for (int r = 0; r < 3; ++r)
+                gd[r] += dv * u[r];
+            break;
+        }
         default: break;
         }
     }
@@ -655,6 +669,17 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
             const double v = dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
             J[0] = v * v;
             J[1] = v * v * v;
+            break;
+        }
+        case RC_EFF_LENGTH_PERIODIC: {
+            const double *x = &m->x[ef->first];
+            J[0] = J[1] = J[2] = 0.0;
+            if (!(fabs(x[2]) > 1e-9))
+                break;
+            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
+            J[0] = sp;
+            J[1] = cp;
+            J[2] = (x[0] * cp - x[1] * sp) * (-ph / x[2]); /* d ph / dP = -dist 2 pi / P^2 */
             break;
         }
         case RC_EFF_NONE: break;

@@ -5,8 +5,9 @@
  *   T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i),  theta_i = q_i + theta_off_i,
  * a cable-encoder outlet e in the base frame, and optional model extensions
  * ("effects") for what pure geometry misses. Length-side effects (offset,
- * scale, drift, group offsets, cable sag, length nonlinearity) change the
- * predicted cable length only, never the flange pose (rc_fk, rc_kin). The predicted cable length is
+ * scale, drift, group offsets, cable sag, length nonlinearity and periodic)
+ * change the predicted cable length only, never the flange pose (rc_fk,
+ * rc_kin). The predicted cable length is
  *   l(q) = |p(q) - e| + (length-side effects),
  * p(q) being the translation of T_1...T_6 (the flange point).
  *
@@ -53,12 +54,16 @@ typedef enum rc_effect_kind {
                                    is attached, in the flange frame; 3 params, mm */
     RC_EFF_CABLE_SAG = 8,       /* l += c h^2 L: the extra length of a light cable hanging
                                    between outlet and attachment point; 1 param, mm per m^3 */
-    RC_EFF_LENGTH_NONLIN = 9    /* l += n2 (lam - c)^2 + n3 (lam - c)^3, the length sensor's
+    RC_EFF_LENGTH_NONLIN = 9,   /* l += n2 (lam - c)^2 + n3 (lam - c)^3, the length sensor's
                                    deviation from linear; 2 params, mm per m^2 and mm per m^3 */
+    RC_EFF_LENGTH_PERIODIC = 10 /* l += s sin(2 pi L / P) + c cos(2 pi L / P), L the chord: the
+                                   length sensor's error once per drum turn (an eccentric drum);
+                                   3 params s, c (mm) and the period P (mm, the drum's
+                                   circumference; nonlinear, |P| < 1e-9 mm: no effect) */
 } rc_effect_kind;
 
 /* Last effect kind (for range checks of stored kinds). */
-#define RC_EFF_LAST RC_EFF_LENGTH_NONLIN
+#define RC_EFF_LAST RC_EFF_LENGTH_PERIODIC
 
 /* RC_EFF_CABLE_SAG. A light cable of weight w per length under tension T
  * hangs below its chord; its arc exceeds the chord by about

@@ -8,9 +8,10 @@
  * a sinusoid with a random phase; jumps inside set-ups; the cable hanging as
  * an exact catenary whose tension at the outlet is the encoder spring's (the
  * library uses the small-sag formula with the tension along the chord); a
- * length sensor whose error is a bow between its calibration points plus the
- * eccentricity of its drum (a sine of the drum angle), where the library has
- * a quadratic and a cubic; a cable attached off the flange centre), set-ups
+ * length sensor whose error is a bow between its calibration points plus a
+ * slow wave, where the library has a quadratic and a cubic; an eccentric
+ * (and slightly oval) drum, first and second harmonic of the drum angle,
+ * where the library has the first; a cable attached off the flange centre), set-ups
  * of 10 poses (wrist fixed), contiguous. The noise is drawn at random in
  * three bands (0.002-0.005, 0.005-0.02, 0.02-0.05 mm) and never passed to
  * the workflow; the effect is scaled to an RMS length change of SIZE x the
@@ -23,7 +24,7 @@
  * With --check it runs a short version (3 seeds per band, 10 for the
  * controls) and exits non-zero when a target is missed: controls named
  * anything but none in more than 1 of 10 per band, or a library effect
- * (jumps, sag, nonlinearity) named in fewer than 2 of 3 seeds of a band. */
+ * (jumps, sag, nonlinearity, drum) named in fewer than 2 of 3 seeds of a band. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,15 +40,16 @@
 
 static const double band_lo[N_BANDS] = {0.002, 0.005, 0.02}, band_hi[N_BANDS] = {0.005, 0.02, 0.05};
 
-typedef enum { E_NONE, E_JUMP, E_DRIFT, E_GROUP, E_COMPL2, E_PERIOD3, E_SAG, E_NONLIN, E_ATTACH, E_COUNT } eff;
-static const char *const eff_name[E_COUNT] = {"none",          "length jump",         "warm-up drift (exp)",
-                                              "set-up offsets", "compliance j2",      "periodic j3 (phase)",
-                                              "catenary sag",  "bow + drum sine",     "attachment offset"};
+typedef enum { E_NONE, E_JUMP, E_DRIFT, E_GROUP, E_COMPL2, E_PERIOD3, E_SAG, E_NONLIN, E_DRUM, E_ATTACH, E_COUNT } eff;
+static const char *const eff_name[E_COUNT] = {"none",           "length jump",    "warm-up drift (exp)",
+                                              "set-up offsets", "compliance j2",  "periodic j3 (phase)",
+                                              "catenary sag",   "sensor bow",     "eccentric drum",
+                                              "attachment offset"};
 /* what a correct diagnosis names */
-static const char *const expect[E_COUNT] = {"none",           "length_jump",    "time_drift",
-                                            "group_offset",   "joint_compliance", "joint_periodic",
-                                            "cable_sag",      "length_nonlinearity", "none"};
-static const unsigned expect_joint[E_COUNT] = {0, 0, 0, 0, 2, 3, 0, 0, 0};
+static const char *const expect[E_COUNT] = {"none",         "length_jump",      "time_drift",          "group_offset",
+                                            "joint_compliance", "joint_periodic", "cable_sag",
+                                            "length_nonlinearity", "length_periodic", "none"};
+static const unsigned expect_joint[E_COUNT] = {0, 0, 0, 0, 2, 3, 0, 0, 0, 0};
 
 /* Extra length (mm) of a cable hanging as a catenary from the outlet e to
  * the point p (mm, z up), weight w per length, tension T at the outlet (the
@@ -78,12 +80,21 @@ static double catenary_extra_mm(const double p[3], const double e[3], double w_o
 
 /* The length sensor's error at true length l (mm): a bow that is zero at
  * its calibration points lmin, lmax (a sensor linearised between its range
- * ends) and the eccentricity of its drum, a sine of the drum angle (one
- * turn = circumference c_mm), mixed by wmix in [0, 1]. */
-static double sensor_error_mm(double l, double lmin, double lmax, double c_mm, double phase, double wmix)
+ * ends) and a slow wave over the range (at most half a period: a sine of
+ * the drum angle through a reduction gear), mixed by wmix in [0, 1]. */
+static double sensor_bow_mm(double l, double lmin, double lmax, double turns, double phase, double wmix)
 {
     const double u = (l - lmin) / (lmax - lmin);
-    return (1.0 - wmix) * 4.0 * u * (1.0 - u) + wmix * sin(6.283185307179586 * l / c_mm + phase);
+    return (1.0 - wmix) * 4.0 * u * (1.0 - u) + wmix * sin(6.283185307179586 * turns * u + phase);
+}
+
+/* An eccentric drum: the cable comes off a drum of circumference c_mm whose
+ * axis is off its centre: the error follows the drum angle, its first
+ * harmonic and a quarter as much second (a drum also slightly oval). */
+static double drum_error_mm(double l, double c_mm, double phase)
+{
+    const double a = 6.283185307179586 * l / c_mm;
+    return sin(a + phase) + 0.25 * sin(2.0 * a + 1.7 * phase);
 }
 
 static double rms_centered(const double *x, size_t n, int center)
@@ -109,7 +120,8 @@ static void make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double no
     e0[1] = -0.7 * reach + 50 * rct_gauss(g);
     e0[2] = 50 * rct_gauss(g);
     const double phase = 6.283185307179586 * rct_u01(g), tau = 0.15 + 0.3 * rct_u01(g);
-    const double drum_turns = 0.5 + rct_u01(g), wmix = rct_u01(g); /* drum turns over the range */
+    const double slow_turns = 0.5 * rct_u01(g), wmix = rct_u01(g); /* the bow's slow wave over the range */
+    const double drum_mm = 80.0 + 120.0 * rct_u01(g);               /* drum circumference */
     size_t jump_at = 0;
     double wrist[3] = {0, 0, 0}, setup_off = 0.0;
     do { /* a jump inside a set-up, away from the ends */
@@ -158,6 +170,7 @@ static void make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double no
         case E_ATTACH: x = l - l0[i]; break;
         case E_SAG:
         case E_NONLIN:
+        case E_DRUM:
         case E_COUNT: break; /* below, once the range is known */
         }
         extra[i] = x;
@@ -168,7 +181,7 @@ static void make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double no
         s[i].group = 0;
     }
     const double target = size * noise;
-    const int center = e == E_JUMP || e == E_DRIFT || e == E_SAG || e == E_NONLIN;
+    const int center = e == E_JUMP || e == E_DRIFT || e == E_SAG || e == E_NONLIN || e == E_DRUM;
     if (e == E_SAG) { /* a real catenary: the weight-to-tension ratio found for the target size */
         double wt = 0.05;  /* 1/m */
         for (int it = 0; it < 6; ++it) {
@@ -182,7 +195,10 @@ static void make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double no
     }
     if (e == E_NONLIN)
         for (size_t i = 0; i < N; ++i)
-            extra[i] = sensor_error_mm(l0[i], lmin, lmax, (lmax - lmin) / drum_turns, phase, wmix);
+            extra[i] = sensor_bow_mm(l0[i], lmin, lmax, slow_turns, phase, wmix);
+    if (e == E_DRUM)
+        for (size_t i = 0; i < N; ++i)
+            extra[i] = drum_error_mm(l0[i], drum_mm, phase);
     const double rms = rms_centered(extra, N, center), k = e == E_SAG ? 1.0 : rms > 0 ? target / rms : 0.0;
     for (size_t i = 0; i < N; ++i)
         s[i].len_mm = l0[i] + k * extra[i] + noise * rct_gauss(g);
@@ -226,7 +242,7 @@ int main(int argc, char **argv)
         if (rch_robot_load(&robot, robots[ri], &d) != 0)
             return 2;
         for (unsigned e = 0; e < E_COUNT; ++e) {
-            if (check && e != E_NONE && e != E_JUMP && e != E_SAG && e != E_NONLIN)
+            if (check && e != E_NONE && e != E_JUMP && e != E_SAG && e != E_NONLIN && e != E_DRUM)
                 continue;
             if (getenv("DIAG_INDEP_ONLY") && (unsigned)atoi(getenv("DIAG_INDEP_ONLY")) != e)
                 continue; /* one effect (its index in eff), e.g. to look at a miss with DIAG_INDEP_VERBOSE=1 */

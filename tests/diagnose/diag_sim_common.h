@@ -43,6 +43,7 @@ static const diag_case diag_cases[] = {
     {"joint_periodic", RC_EFF_JOINT_PERIODIC, 2},
     {"cable_sag", RC_EFF_CABLE_SAG, 0},
     {"length_nonlinearity", RC_EFF_LENGTH_NONLIN, 0},
+    {"length_periodic", RC_EFF_LENGTH_PERIODIC, 0},
 };
 #define DIAG_N_CASES (sizeof diag_cases / sizeof diag_cases[0])
 
@@ -90,6 +91,11 @@ static inline int diag_simulate(rc_sample *s, size_t n, const rc_model *nominal,
         case RC_EFF_LENGTH_NONLIN:                                 /* ~0.1-0.2 mm over the range */
             x[0] = sgn * size * 2.0;
             x[1] = size * 3.0 * rc_rng_normal(&g);
+            break;
+        case RC_EFF_LENGTH_PERIODIC: /* an eccentric drum of 100-180 mm circumference, ~0.1 mm */
+            x[0] = sgn * size * 0.08;
+            x[1] = size * 0.04 * rc_rng_normal(&g);
+            x[2] = 100.0 + 80.0 * rc_rng_u01(&g);
             break;
         default: return -1;
         }
@@ -140,6 +146,9 @@ static inline int diag_simulate_band(rc_sample *s, size_t n, const rc_model *nom
         double *x = &truth.x[ef->first];
         for (unsigned k = 0; k < ef->count; ++k)
             x[k] = (k % 2 ? 0.5 : 1.0) * (rc_rng_u01(&g) < 0.5 ? -1.0 : 1.0) * (0.5 + rc_rng_u01(&g));
+        const unsigned n_lin = c->kind == RC_EFF_LENGTH_PERIODIC ? 2u : ef->count; /* the period is not scaled */
+        if (c->kind == RC_EFF_LENGTH_PERIODIC)
+            x[2] = 100.0 + 80.0 * rc_rng_u01(&g);
         if (c->kind == RC_EFF_JOINT_COMPLIANCE || c->kind == RC_EFF_JOINT_PERIODIC)
             for (unsigned k = 0; k < ef->count; ++k)
                 x[k] *= 1e-3; /* stay in the linear range */
@@ -149,7 +158,7 @@ static inline int diag_simulate_band(rc_sample *s, size_t n, const rc_model *nom
             return -1;
         double mean = 0.0, s2 = 0.0;
         const int center = c->kind == RC_EFF_TIME_DRIFT || c->kind == RC_EFF_CABLE_SAG ||
-                           c->kind == RC_EFF_LENGTH_NONLIN;
+                           c->kind == RC_EFF_LENGTH_NONLIN || c->kind == RC_EFF_LENGTH_PERIODIC;
         double *dl = malloc(n * sizeof *dl);
         if (!dl)
             return -1;
@@ -185,7 +194,7 @@ static inline int diag_simulate_band(rc_sample *s, size_t n, const rc_model *nom
         }
         if (!(rms > 0.0))
             return -1;
-        for (unsigned k = 0; k < ef->count; ++k)
+        for (unsigned k = 0; k < n_lin; ++k)
             x[k] *= size_x_noise * *noise_mm / rms;
     }
     /* the same poses (the same generator state, no noise draws between

@@ -102,9 +102,40 @@ static void test_nonlinearity_value(void **state)
     }
 }
 
+static void test_periodic_value(void **state)
+{
+    (void)state;
+    rc_model m;
+    irb(&m);
+    rc_model base = m;
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_PERIODIC, 0, 0), RC_OK);
+    const unsigned f = m.effects[0].first;
+    m.x[f] = 0.08;
+    m.x[f + 1] = -0.03;
+    m.x[f + 2] = 140.0; /* a drum of 140 mm circumference */
+    char name[48];
+    assert_string_equal(rc_param_name(name, sizeof name, &m, f + 2u), "length_periodic.period");
+    for (unsigned k = 0; k < 10; ++k) {
+        rc_sample s;
+        double l, l0;
+        pose(&s, k);
+        assert_int_equal(rc_meas(&l, NULL, &m, &s), RC_OK);
+        assert_int_equal(rc_meas(&l0, NULL, &base, &s), RC_OK);
+        const double turn = l0 / 140.0 * 2.0 * 3.14159265358979323846;
+        assert_true(fabs((l - l0) - (0.08 * sin(turn) - 0.03 * cos(turn))) < 1e-9);
+    }
+    m.x[f + 2] = 0.0; /* no period: no effect, never a division by zero */
+    rc_sample s;
+    double l, l0, jac[RC_MAX_PARAMS];
+    pose(&s, 1);
+    assert_int_equal(rc_meas(&l, jac, &m, &s), RC_OK);
+    assert_int_equal(rc_meas(&l0, NULL, &base, &s), RC_OK);
+    assert_true(l == l0 && jac[f] == 0.0 && jac[f + 2] == 0.0);
+}
+
 /* Every column of the analytic Jacobian against a central difference, with
- * sag, nonlinearity, scale and a tool offset together (the chain rule through
- * the chord). */
+ * sag, nonlinearity, periodic, scale and a tool offset together (the chain
+ * rule through the chord). */
 static void test_jacobian(void **state)
 {
     (void)state;
@@ -114,8 +145,9 @@ static void test_jacobian(void **state)
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_SCALE, 0, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_CABLE_SAG, 0, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_NONLIN, 0, 0), RC_OK);
-    const double vals[] = {12.0, -7.0, 30.0, 2e-3, 40.0, 25.0, -60.0};
-    for (unsigned k = 0; k < 7; ++k)
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_PERIODIC, 0, 0), RC_OK);
+    const double vals[] = {12.0, -7.0, 30.0, 2e-3, 40.0, 25.0, -60.0, 0.3, -0.2, 137.0};
+    for (unsigned k = 0; k < 10; ++k)
         m.x[RC_N_BASE + k] = vals[k];
     for (unsigned k = 0; k < 8; ++k) {
         rc_sample s;
@@ -209,12 +241,26 @@ static void test_model_file_and_effects_list(void **state)
     rc_model m2;
     irb(&m2);
     assert_int_not_equal(rch_calib_effects(&m2, "cable_sagg", &d), 0);
+    /* length_periodic needs its period's start value; a file with a zero period is refused */
+    assert_int_not_equal(rch_calib_effects(&m2, "length_periodic", &d), 0);
+    assert_int_equal(rch_calib_effects(&m2, "length_periodic:137", &d), 0);
+    assert_true(m2.x[m2.effects[m2.n_effects - 1].first + 2] == 137.0);
+    char bad2[2048];
+    const char *cut = strstr(bad, "\"effects\"");
+    assert_non_null(cut);
+    snprintf(bad2, sizeof bad2, "%.*s\"effects\":[{\"kind\":\"length_periodic\",\"params\":[0.1,0,0]}]}",
+             (int)(cut - bad), bad);
+    assert_int_not_equal(rch_robot_parse(&r, bad2, strlen(bad2), "bad2.json", &d), 0);
+    snprintf(bad2, sizeof bad2, "%.*s\"effects\":[{\"kind\":\"length_periodic\",\"params\":[0.1,0,140]}]}",
+             (int)(cut - bad), bad);
+    assert_int_equal(rch_robot_parse(&r, bad2, strlen(bad2), "good.json", &d), 0);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sag_matches_catenary), cmocka_unit_test(test_nonlinearity_value),
+        cmocka_unit_test(test_periodic_value),
         cmocka_unit_test(test_jacobian),             cmocka_unit_test(test_not_in_kinematics),
         cmocka_unit_test(test_model_file_and_effects_list),
     };

@@ -449,6 +449,7 @@ static const cdef all_cands[] = {
     {RC_EFF_JOINT_PERIODIC, 0},   {RC_EFF_JOINT_PERIODIC, 1},   {RC_EFF_JOINT_PERIODIC, 2},
     {RC_EFF_JOINT_PERIODIC, 3},   {RC_EFF_JOINT_PERIODIC, 4},   {RC_EFF_JOINT_PERIODIC, 5},
     {RC_EFF_TOOL_OFFSET, 0},      {RC_EFF_CABLE_SAG, 0},        {RC_EFF_LENGTH_NONLIN, 0},
+    {RC_EFF_LENGTH_PERIODIC, 0},
 };
 #define N_ALL_CANDS (sizeof all_cands / sizeof all_cands[0])
 RC_STATIC_ASSERT(sizeof all_cands / sizeof all_cands[0] <= RCH_DIAGNOSE_MAX_CAND, candidates_fit_the_step);
@@ -563,6 +564,8 @@ static void report_params(rch_diagnose_result *r, const rc_model *fold_models, u
             } else if (kind == RC_EFF_LENGTH_SCALE) {
                 scale = 1e6;
                 unit = "ppm";
+            } else if (kind == RC_EFF_LENGTH_PERIODIC) {
+                unit = "mm";
             } else if (kind == RC_EFF_CABLE_SAG || (kind == RC_EFF_LENGTH_NONLIN && p == 1)) {
                 unit = "mm/m^3";
             } else if (kind == RC_EFF_LENGTH_NONLIN) {
@@ -1029,6 +1032,75 @@ static int cand_applicable(const run_state *S, const cdef *cd, rch_diagnose_cand
     return 1;
 }
 
+/* Start values of a length_periodic effect (the last effect of m, whose
+ * other parameters are those of base): the period of the largest sine in
+ * the lengths' residuals L - l(base), after a straight line in L, over
+ * periods from 20 mm to the range of the lengths (1 % steps; at most 4000
+ * samples, evenly strided), and its two amplitudes. 0, or -1 when the
+ * lengths span less than 40 mm. */
+static int periodic_start(rc_model *m, const rc_model *base, const rc_sample *s, size_t n)
+{
+    const size_t stride = n > 4000 ? n / 4000 + 1 : 1;
+    double lmin = 1e300, lmax = -1e300, ml = 0.0, me = 0.0, sll = 0.0, sle = 0.0, best = -1.0;
+    size_t cnt = 0;
+    double *e = malloc((n / stride + 1) * 2 * sizeof *e), *len = NULL;
+    if (!e)
+        return -1;
+    len = e + n / stride + 1;
+    for (size_t i = 0; i < n; i += stride) {
+        double l;
+        if (rc_meas(&l, NULL, base, &s[i]) != RC_OK)
+            continue;
+        len[cnt] = s[i].len_mm;
+        e[cnt] = s[i].len_mm - l;
+        lmin = len[cnt] < lmin ? len[cnt] : lmin;
+        lmax = len[cnt] > lmax ? len[cnt] : lmax;
+        ml += len[cnt];
+        me += e[cnt];
+        cnt++;
+    }
+    if (cnt < 10 || lmax - lmin < 40.0) {
+        free(e);
+        return -1;
+    }
+    ml /= (double)cnt;
+    me /= (double)cnt;
+    for (size_t i = 0; i < cnt; ++i) {
+        sll += (len[i] - ml) * (len[i] - ml);
+        sle += (len[i] - ml) * (e[i] - me);
+    }
+    for (size_t i = 0; i < cnt; ++i) /* detrended */
+        e[i] -= me + (sll > 0.0 ? sle / sll : 0.0) * (len[i] - ml);
+    const rc_effect *ef = &m->effects[m->n_effects - 1];
+    for (unsigned k = 0;; ++k) {
+        const double per = 20.0 * pow(1.01, (double)k);
+        if (per > lmax - lmin)
+            break;
+        double ss = 0.0, cc = 0.0, sc = 0.0, se = 0.0, ce = 0.0;
+        for (size_t i = 0; i < cnt; ++i) {
+            const double ph = 2.0 * M_PI * len[i] / per, sp = sin(ph), cp = cos(ph);
+            ss += sp * sp;
+            cc += cp * cp;
+            sc += sp * cp;
+            se += sp * e[i];
+            ce += cp * e[i];
+        }
+        const double det = ss * cc - sc * sc;
+        if (!(det > 0.0))
+            continue;
+        const double a = (cc * se - sc * ce) / det, b = (ss * ce - sc * se) / det;
+        const double expl = a * se + b * ce; /* explained sum of squares */
+        if (expl > best) {
+            best = expl;
+            m->x[ef->first] = a;
+            m->x[ef->first + 1] = b;
+            m->x[ef->first + 2] = per;
+        }
+    }
+    free(e);
+    return best > 0.0 ? 0 : -1;
+}
+
 /* Fit candidate ci on all samples (into cand_full[ci]) and count the
  * directions it adds that the data identify. 1 when it is worth
  * cross-validating, else 0 with ca->note set. */
@@ -1043,6 +1115,10 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
         return 0;
     }
     ca->n_params = full->n_params - S->base.n_params;
+    if (cd->kind == RC_EFF_LENGTH_PERIODIC && periodic_start(full, &S->base, out->s, out->n) != 0) {
+        snprintf(ca->note, sizeof ca->note, "not applicable: the lengths span too little for a period");
+        return 0;
+    }
     if (fit(full, res, &S->c, NULL, out->s, out->n) != 0) {
         snprintf(ca->note, sizeof ca->note, "fit failed");
         return 0;
@@ -1059,6 +1135,20 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
     if (ca->n_ident < ca->n_params)
         snprintf(ca->note, sizeof ca->note, "%u of %u parameters identifiable (%s)", ca->n_ident, ca->n_params,
                  known_reason(cd->kind, cd->joint0, &S->base));
+    if (cd->kind == RC_EFF_LENGTH_PERIODIC) { /* a drum turn: 10 mm .. the lengths' range */
+        double lmin = 1e300, lmax = -1e300;
+        for (size_t i = 0; i < out->n; ++i) {
+            lmin = out->s[i].len_mm < lmin ? out->s[i].len_mm : lmin;
+            lmax = out->s[i].len_mm > lmax ? out->s[i].len_mm : lmax;
+        }
+        const double per = fabs(full->x[full->effects[full->n_effects - 1].first + 2]);
+        if (per < 10.0 || per > lmax - lmin) {
+            ca->implausible = 1;
+            snprintf(ca->note, sizeof ca->note,
+                     "implausible: fitted period %.4g mm (a drum turn within 10 mm .. the lengths' range %.4g mm)",
+                     per, lmax - lmin);
+        }
+    }
     const double worst_deg = implausible_deg(full, (const double(*)[V_N])S->var, out->n);
     if (worst_deg > 0.0) {
         ca->implausible = 1;
@@ -1084,6 +1174,9 @@ static int cand_cv(run_state *S, unsigned ci, unsigned count, rch_diagnose_cand 
         if (cd->kind == RC_EFF_JOINT_COMPLIANCE) /* same frozen lever geometry as the full model */
             memcpy(fm[f].effects[fm[f].n_effects - 1].ref_dh, full->effects[full->n_effects - 1].ref_dh,
                    sizeof full->effects[0].ref_dh);
+        if (cd->kind == RC_EFF_LENGTH_PERIODIC) /* a nonlinear period: start where the full fit ended */
+            memcpy(&fm[f].x[fm[f].effects[fm[f].n_effects - 1].first], &full->x[full->effects[full->n_effects - 1].first],
+                   3 * sizeof full->x[0]);
     }
     if (cv_run(fm, rc_, &S->c) != 0) {
         snprintf(ca->note, sizeof ca->note, "a cross-validation fit failed");
