@@ -274,7 +274,9 @@ int main(int argc, char **argv)
                         ratio[n_ratio++] = r.rmse_before_mm / noise;
                     if (match(&r, (eff)e))
                         hit[b]++;
-                    else if (op < sizeof other - 40) {
+                    else if (cfg.verbose && r.n_steps > 0)
+                        fprintf(stderr, "miss: %s\n", r.steps[0].why);
+                    if (!match(&r, (eff)e) && op < sizeof other - 40) {
                         op += (size_t)snprintf(other + op, sizeof other - op, " %s", r.effect);
                         if (r.joint && op < sizeof other - 8)
                             op += (size_t)snprintf(other + op, sizeof other - op, " j%u", r.joint);
