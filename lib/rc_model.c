@@ -552,7 +552,7 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         u[r] /= dist;
 
     /* Length-side effects: l = (1 + scale) * dist + additive terms; those
-     * that depend on the chord d = p - e (sag, nonlinearity) add their
+     * that depend on the chord d = p - e (sag, nonlinearity, periodic) add their
      * gradient with respect to d to gd (3), so that dl/dd = scale u + gd. */
     double scale = 1.0, add = 0.0, gd[3] = {0.0, 0.0, 0.0};
     const double h2 = u[0] * u[0] * dist * dist + u[1] * u[1] * dist * dist; /* horizontal span^2, mm^2 */
