@@ -20,7 +20,7 @@ static void check_model(const rc_model *m)
         FZ_CHECK(isfinite(m->x[k]));
     for (unsigned e = 0; e < m->n_effects; ++e) {
         const rc_effect *ef = &m->effects[e];
-        FZ_CHECK(ef->kind >= RC_EFF_LENGTH_OFFSET && ef->kind <= RC_EFF_LENGTH_SCALE);
+        FZ_CHECK(ef->kind >= RC_EFF_LENGTH_OFFSET && ef->kind <= RC_EFF_LAST);
         FZ_CHECK(ef->first == used);
         FZ_CHECK(ef->joint < RC_NJ);
         used += ef->count;

@@ -133,6 +133,9 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     case RC_EFF_LENGTH_OFFSET: n = 1; joint = 0; break;
     case RC_EFF_LENGTH_SCALE: n = 1; joint = 0; break;
     case RC_EFF_TOOL_OFFSET: n = 3; joint = 0; break;
+    case RC_EFF_CABLE_SAG: n = 1; joint = 0; break;
+    case RC_EFF_LENGTH_NONLIN: n = 2; joint = 0; break;
+    case RC_EFF_LENGTH_PERIODIC: n = 3; joint = 0; break;
     case RC_EFF_TIME_DRIFT: /* polynomial in t without constant, degree 1..4; 0: 3 */
         n = count == 0 ? 3u : count;
         joint = 0;
@@ -199,6 +202,9 @@ const char *rc_effect_name(rc_effect_kind kind)
     case RC_EFF_GROUP_OFFSET: return "group_offset";
     case RC_EFF_LENGTH_SCALE: return "length_scale";
     case RC_EFF_TOOL_OFFSET: return "tool_offset";
+    case RC_EFF_CABLE_SAG: return "cable_sag";
+    case RC_EFF_LENGTH_NONLIN: return "length_nonlinearity";
+    case RC_EFF_LENGTH_PERIODIC: return "length_periodic";
     case RC_EFF_NONE: break;
     }
     return "none";
@@ -269,6 +275,8 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
         case RC_EFF_TOOL_OFFSET:
             put_str(buf, buf_len, &pos, j == 0 ? ".x" : j == 1 ? ".y" : ".z");
             break;
+        case RC_EFF_LENGTH_NONLIN: put_str(buf, buf_len, &pos, j == 0 ? ".n2" : ".n3"); break;
+        case RC_EFF_LENGTH_PERIODIC: put_str(buf, buf_len, &pos, j == 0 ? ".s" : j == 1 ? ".c" : ".period"); break;
         default: break;
         }
         return buf;
@@ -291,6 +299,7 @@ int rc_param_unit(const rc_model *m, unsigned k)
             case RC_EFF_LENGTH_OFFSET:
             case RC_EFF_TIME_DRIFT:
             case RC_EFF_GROUP_OFFSET:
+            case RC_EFF_LENGTH_PERIODIC:
             case RC_EFF_TOOL_OFFSET: return 0;
             case RC_EFF_JOINT_PERIODIC: return 1;
             default: return 2;
@@ -542,8 +551,11 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
     for (int r = 0; r < 3; ++r)
         u[r] /= dist;
 
-    /* Length-side effects: l = (1 + scale) * dist + additive terms. */
-    double scale = 1.0, add = 0.0;
+    /* Length-side effects: l = (1 + scale) * dist + additive terms; those
+     * that depend on the chord d = p - e (sag, nonlinearity, periodic) add their
+     * gradient with respect to d to gd (3), so that dl/dd = scale u + gd. */
+    double scale = 1.0, add = 0.0, gd[3] = {0.0, 0.0, 0.0};
+    const double h2 = u[0] * u[0] * dist * dist + u[1] * u[1] * dist * dist; /* horizontal span^2, mm^2 */
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *ef = &m->effects[i];
         const double *x = &m->x[ef->first];
@@ -562,6 +574,32 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
             if (s->group < ef->count)
                 add += x[s->group];
             break;
+        case RC_EFF_CABLE_SAG: { /* c h^2 L, h and L in m (1e-9 from mm^3) */
+            const double k = x[0] * 1e-9;
+            add += k * h2 * dist;
+            gd[0] += k * (2.0 * dist * u[0] * dist + h2 * u[0]);
+            gd[1] += k * (2.0 * dist * u[1] * dist + h2 * u[1]);
+            gd[2] += k * h2 * u[2];
+            break;
+        }
+        case RC_EFF_LENGTH_NONLIN: {
+            const double v = dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
+            const double dv = (2.0 * x[0] * v + 3.0 * x[1] * v * v) * 1e-3; /* mm per mm of chord */
+            add += x[0] * v * v + x[1] * v * v * v;
+            for (int r = 0; r < 3; ++r)
+                gd[r] += dv * u[r];
+            break;
+        }
+        case RC_EFF_LENGTH_PERIODIC: {
+            if (!(fabs(x[2]) > 1e-9))
+                break;
+            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
+            const double dv = (x[0] * cp - x[1] * sp) * w; /* mm per mm of chord */
+            add += x[0] * sp + x[1] * cp;
+            for (int r = 0; r < 3; ++r)
+                gd[r] += dv * u[r];
+            break;
+        }
         default: break;
         }
     }
@@ -569,6 +607,9 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
     if (jac == NULL)
         return RC_OK;
 
+    double g[3]; /* dl/dp (3): the chord direction, scaled, plus the chord-dependent effects */
+    for (int r = 0; r < 3; ++r)
+        g[r] = scale * u[r] + gd[r];
     for (unsigned i = 0; i < RC_NJ; ++i) {
         const double z[3] = {c->R[i][2], c->R[i][5], c->R[i][8]};
         const double x1[3] = {c->R[i + 1][0], c->R[i + 1][3], c->R[i + 1][6]};
@@ -576,17 +617,17 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         for (int r = 0; r < 3; ++r)
             v[r] = p[r] - c->o[i][r];
         cross3(w, z, v);
-        dl_dtheta[i] = scale * dot3(u, w);
+        dl_dtheta[i] = dot3(g, w);
         for (int r = 0; r < 3; ++r)
             v[r] = p[r] - c->o[i + 1][r];
         cross3(w, x1, v);
-        jac[RC_P_A(i)] = scale * dot3(u, x1);
-        jac[RC_P_D(i)] = scale * dot3(u, z);
-        jac[RC_P_ALPHA(i)] = scale * dot3(u, w);
+        jac[RC_P_A(i)] = dot3(g, x1);
+        jac[RC_P_D(i)] = dot3(g, z);
+        jac[RC_P_ALPHA(i)] = dot3(g, w);
         jac[RC_P_THETA(i)] = dl_dtheta[i];
     }
     for (int r = 0; r < 3; ++r)
-        jac[RC_P_ENC + r] = -scale * u[r];
+        jac[RC_P_ENC + r] = -g[r];
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *ef = &m->effects[i];
         double *J = &jac[ef->first];
@@ -610,17 +651,35 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
             J[0] = dl_dtheta[ef->joint] * rc_gravity_lever_m(ef->ref_dh, ef->joint, s->q_rad);
             break;
         case RC_EFF_JOINT_PERIODIC: {
-            const double g = dl_dtheta[ef->joint];
-            J[0] = g * sin(q);
-            J[1] = g * cos(q);
-            J[2] = g * sin(2.0 * q);
-            J[3] = g * cos(2.0 * q);
+            const double gj = dl_dtheta[ef->joint];
+            J[0] = gj * sin(q);
+            J[1] = gj * cos(q);
+            J[2] = gj * sin(2.0 * q);
+            J[3] = gj * cos(2.0 * q);
             break;
         }
         case RC_EFF_TOOL_OFFSET: { /* dp/dt = R6 */
             const double *R = c->R[RC_NJ];
             for (unsigned k = 0; k < 3; ++k)
-                J[k] = scale * (u[0] * R[k] + u[1] * R[3 + k] + u[2] * R[6 + k]);
+                J[k] = g[0] * R[k] + g[1] * R[3 + k] + g[2] * R[6 + k];
+            break;
+        }
+        case RC_EFF_CABLE_SAG: J[0] = 1e-9 * h2 * dist; break;
+        case RC_EFF_LENGTH_NONLIN: {
+            const double v = dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
+            J[0] = v * v;
+            J[1] = v * v * v;
+            break;
+        }
+        case RC_EFF_LENGTH_PERIODIC: {
+            const double *x = &m->x[ef->first];
+            J[0] = J[1] = J[2] = 0.0;
+            if (!(fabs(x[2]) > 1e-9))
+                break;
+            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
+            J[0] = sp;
+            J[1] = cp;
+            J[2] = (x[0] * cp - x[1] * sp) * (-ph / x[2]); /* d ph / dP = -dist 2 pi / P^2 */
             break;
         }
         case RC_EFF_NONE: break;

@@ -4,7 +4,10 @@
  * What: a six-joint serial arm in standard Denavit-Hartenberg form,
  *   T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i),  theta_i = q_i + theta_off_i,
  * a cable-encoder outlet e in the base frame, and optional model extensions
- * ("effects") for what pure geometry misses. The predicted cable length is
+ * ("effects") for what pure geometry misses. Length-side effects (offset,
+ * scale, drift, group offsets, cable sag, length nonlinearity and periodic)
+ * change the predicted cable length only, never the flange pose (rc_fk,
+ * rc_kin). The predicted cable length is
  *   l(q) = |p(q) - e| + (length-side effects),
  * p(q) being the translation of T_1...T_6 (the flange point).
  *
@@ -47,9 +50,38 @@ typedef enum rc_effect_kind {
                                    count params (1..4; 0: 3), mm */
     RC_EFF_GROUP_OFFSET = 5,    /* l += g_k for samples of group k; count params, mm */
     RC_EFF_LENGTH_SCALE = 6,    /* l *= (1 + s) (encoder scale);   1 param, unitless */
-    RC_EFF_TOOL_OFFSET = 7      /* measured point = flange + R6 (tx, ty, tz): where the cable
+    RC_EFF_TOOL_OFFSET = 7,     /* measured point = flange + R6 (tx, ty, tz): where the cable
                                    is attached, in the flange frame; 3 params, mm */
+    RC_EFF_CABLE_SAG = 8,       /* l += c h^2 L: the extra length of a light cable hanging
+                                   between outlet and attachment point; 1 param, mm per m^3 */
+    RC_EFF_LENGTH_NONLIN = 9,   /* l += n2 (lam - c)^2 + n3 (lam - c)^3, the length sensor's
+                                   deviation from linear; 2 params, mm per m^2 and mm per m^3 */
+    RC_EFF_LENGTH_PERIODIC = 10 /* l += s sin(2 pi L / P) + c cos(2 pi L / P), L the chord: the
+                                   length sensor's error once per drum turn (an eccentric drum);
+                                   3 params s, c (mm) and the period P (mm, the drum's
+                                   circumference; nonlinear, |P| < 1e-9 mm: no effect) */
 } rc_effect_kind;
+
+/* Last effect kind (for range checks of stored kinds). */
+#define RC_EFF_LAST RC_EFF_LENGTH_PERIODIC
+
+/* RC_EFF_CABLE_SAG. A light cable of weight w per length under tension T
+ * hangs below its chord; its arc exceeds the chord by about
+ *   w^2 h^2 L / (24 T^2)
+ * (parabolic approximation of the catenary, small sag), h the horizontal
+ * span and L the chord between outlet e and the measured point p. Gravity
+ * is taken along -z of the robot base frame, so h is the span in the base
+ * x-y plane: h^2 = (px - ex)^2 + (py - ey)^2. The parameter is
+ * c = 1000 w^2 / (24 T^2) in mm of extra length per m^3 of h^2 L (h, L in
+ * metres); the model is linear in c. */
+
+/* RC_EFF_LENGTH_NONLIN. The sensor's reading beyond linear in the cable
+ * length: quadratic and cubic terms in lam = L / 1000 (the chord in metres)
+ * about the fixed centre RC_LENGTH_NONLIN_CENTRE_M; the linear part and the
+ * offset are RC_EFF_LENGTH_SCALE and RC_EFF_LENGTH_OFFSET. The centre only
+ * conditions the parameters: about another centre the same curve differs by
+ * a constant and a linear term. */
+#define RC_LENGTH_NONLIN_CENTRE_M 0.5
 
 typedef struct rc_effect {
     uint8_t kind;     /* rc_effect_kind */

@@ -93,8 +93,9 @@ static rch_opt_status parse(calib_args *a, int argc, char **argv)
          NULL},
         {"--samples", RCH_OPT_UINT, &a->case_samples, 0, 10000000, "M", "rows per case (0: every row)", 0, NULL},
         {"--effects", RCH_OPT_STR, &cfg->effects, 0, 0, "LIST",
-         "effects fitted with the geometry: length_offset, length_scale, time_drift, tool_offset, "
-         "joint_compliance:J, joint_periodic:J (e.g. what rcal diagnose named)",
+         "effects fitted with the geometry: length_offset, length_scale, time_drift, tool_offset, cable_sag, "
+         "length_nonlinearity, length_periodic:P (start period, mm), joint_compliance:J, joint_periodic:J "
+         "(e.g. what rcal diagnose named)",
          0, NULL},
         {"--tool-offset", RCH_OPT_FLAG, &cfg->tool_offset, 0, 0, NULL,
          "also identify where the cable is attached in the flange frame (tx, ty, tz)", 0, NULL},

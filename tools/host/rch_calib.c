@@ -79,7 +79,9 @@ int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
         int joint; /* 1: needs ":J" */
     } table[] = {{"length_offset", RC_EFF_LENGTH_OFFSET, 0}, {"length_scale", RC_EFF_LENGTH_SCALE, 0},
                  {"time_drift", RC_EFF_TIME_DRIFT, 0},       {"tool_offset", RC_EFF_TOOL_OFFSET, 0},
-                 {"joint_compliance", RC_EFF_JOINT_COMPLIANCE, 1}, {"joint_periodic", RC_EFF_JOINT_PERIODIC, 1}};
+                 {"joint_compliance", RC_EFF_JOINT_COMPLIANCE, 1}, {"joint_periodic", RC_EFF_JOINT_PERIODIC, 1},
+                 {"cable_sag", RC_EFF_CABLE_SAG, 0},         {"length_nonlinearity", RC_EFF_LENGTH_NONLIN, 0},
+                 {"length_periodic", RC_EFF_LENGTH_PERIODIC, 2}}; /* 2: needs ":P", the period in mm */
     char buf[512];
     if (strlen(list) >= sizeof buf) {
         rch_diag_set(d, "", 0, 0, "--effects: list longer than %zu characters", sizeof buf - 1);
@@ -99,9 +101,23 @@ int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
         if (k == sizeof table / sizeof table[0]) {
             rch_diag_set(d, "", 0, 0,
                          "--effects: unknown effect '%s' (length_offset, length_scale, time_drift, tool_offset, "
-                         "joint_compliance:J, joint_periodic:J)",
+                         "cable_sag, length_nonlinearity, length_periodic:P, joint_compliance:J, joint_periodic:J)",
                          tok);
             return -1;
+        }
+        if (table[k].joint == 2) { /* the period's start value, mm */
+            double per = 0.0;
+            if (!colon || rch_parse_double(colon, &per) != 0 || !(per >= 1.0 && per <= 1000.0)) {
+                rch_diag_set(d, "", 0, 0, "--effects: %s needs its period in mm (1..1000), e.g. %s:137", tok, tok);
+                return -1;
+            }
+            rc_status st = rc_model_add_effect(m, table[k].kind, 0, 0);
+            if (st != RC_OK) {
+                rch_diag_set(d, "", 0, 0, "--effects: cannot add %s: %s", tok, rc_strerror(st));
+                return -1;
+            }
+            m->x[m->effects[m->n_effects - 1].first + 2] = per;
+            continue;
         }
         unsigned long j = 0;
         if (table[k].joint && (!colon || rch_parse_ulong(colon, &j) != 0 || j < 1 || j > 6)) {

@@ -55,7 +55,9 @@ int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, c
 int rch_method_parse(rc_method *out, const char *name);
 
 /* Add the effects of list to m: comma-separated, "length_offset",
- * "length_scale", "time_drift", "tool_offset", "joint_compliance:J" (J = 2
+ * "length_scale", "time_drift", "tool_offset", "cable_sag",
+ * "length_nonlinearity", "length_periodic:P" (P the period's start value
+ * in mm, 1..1000), "joint_compliance:J" (J = 2
  * or 3), "joint_periodic:J" (J = 1..6). 0, or -1 with d naming the entry. */
 int rch_calib_effects(rc_model *m, const char *list, rch_diag *d);
 

@@ -282,9 +282,22 @@ static unsigned structure_tests(rch_diagnose_test *out, const double *r, const r
     for (size_t i = 0; i < n; ++i)
         X[i] = var[i][V_LEV3];
     test_regress(&out[k++], "gravity lever j3", r, X, 1, n, a_each);
-    for (size_t i = 0; i < n; ++i)
-        X[i] = var[i][V_LEN];
-    test_regress(&out[k++], "cable length", r, X, 1, n, a_each);
+    /* cable length: a smooth shape, not only a slope (a sensor's bow, a drum
+     * turn): u, u^2, u^3, sin and cos of 2 pi u, u the length scaled to [0, 1] */
+    double lmin = 1e300, lmax = -1e300;
+    for (size_t i = 0; i < n; ++i) {
+        lmin = var[i][V_LEN] < lmin ? var[i][V_LEN] : lmin;
+        lmax = var[i][V_LEN] > lmax ? var[i][V_LEN] : lmax;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double u = lmax > lmin ? (var[i][V_LEN] - lmin) / (lmax - lmin) : 0.0;
+        X[i * 5 + 0] = u;
+        X[i * 5 + 1] = u * u;
+        X[i * 5 + 2] = u * u * u;
+        X[i * 5 + 3] = sin(2.0 * M_PI * u);
+        X[i * 5 + 4] = cos(2.0 * M_PI * u);
+    }
+    test_regress(&out[k++], "cable length", r, X, 5, n, a_each);
     for (size_t i = 0; i < n; ++i) {
         X[i * 3 + 0] = var[i][V_UX];
         X[i * 3 + 1] = var[i][V_UY];
@@ -436,9 +449,11 @@ static const cdef all_cands[] = {
     {RC_EFF_GROUP_OFFSET, 0},     {RC_EFF_JOINT_COMPLIANCE, 1}, {RC_EFF_JOINT_COMPLIANCE, 2},
     {RC_EFF_JOINT_PERIODIC, 0},   {RC_EFF_JOINT_PERIODIC, 1},   {RC_EFF_JOINT_PERIODIC, 2},
     {RC_EFF_JOINT_PERIODIC, 3},   {RC_EFF_JOINT_PERIODIC, 4},   {RC_EFF_JOINT_PERIODIC, 5},
-    {RC_EFF_TOOL_OFFSET, 0},
+    {RC_EFF_TOOL_OFFSET, 0},      {RC_EFF_CABLE_SAG, 0},        {RC_EFF_LENGTH_NONLIN, 0},
+    {RC_EFF_LENGTH_PERIODIC, 0},
 };
 #define N_ALL_CANDS (sizeof all_cands / sizeof all_cands[0])
+RC_STATIC_ASSERT(sizeof all_cands / sizeof all_cands[0] <= RCH_DIAGNOSE_MAX_CAND, candidates_fit_the_step);
 
 static int is_joint_kind(rc_effect_kind k) { return k == RC_EFF_JOINT_COMPLIANCE || k == RC_EFF_JOINT_PERIODIC; }
 
@@ -550,6 +565,12 @@ static void report_params(rch_diagnose_result *r, const rc_model *fold_models, u
             } else if (kind == RC_EFF_LENGTH_SCALE) {
                 scale = 1e6;
                 unit = "ppm";
+            } else if (kind == RC_EFF_LENGTH_PERIODIC) {
+                unit = "mm";
+            } else if (kind == RC_EFF_CABLE_SAG || (kind == RC_EFF_LENGTH_NONLIN && p == 1)) {
+                unit = "mm/m^3";
+            } else if (kind == RC_EFF_LENGTH_NONLIN) {
+                unit = "mm/m^2";
             }
             for (unsigned f = 0; f < k; ++f)
                 vals[f] = fold_models[f].x[idx] * scale;
@@ -880,13 +901,16 @@ static int phase_cv_geometry(run_state *S, rch_diag *d)
 
 /* A sharp step inside a set-up: the geometry's residuals of the (up to) 8
  * samples of the same set-up after sample a and before it differ by at
- * least 4 standard errors, the noise taken from the residuals' spread within
- * the two windows, and by the fitted jump size within half of it. A pose-dependent effect read in acquisition order is noise
- * within a set-up and fails; a sensor jump passes. */
+ * least 5 standard errors, the noise taken from the residuals' spread within
+ * the two windows, and by the fitted jump size within 30 % of it; and a step
+ * fits the window clearly better than a straight line through it (the sums
+ * of squares differ by more than 4 noise variances), so that a steep drift,
+ * a ramp, is not taken for a jump. A pose-dependent effect read in
+ * acquisition order is noise within a set-up and fails; a sensor jump passes. */
 static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t a, double size)
 {
-    double sum[2] = {0, 0}, sq[2] = {0, 0};
-    unsigned cnt[2] = {0, 0};
+    double sum[2] = {0, 0}, sq[2] = {0, 0}, r[16], x[16];
+    unsigned cnt[2] = {0, 0}, m = 0;
     for (int side = 0; side < 2; ++side)
         for (size_t k = 0; k < 8; ++k) {
             size_t i = side ? a + k : a - 1 - k;
@@ -895,19 +919,32 @@ static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t 
             double l;
             if (rc_meas(&l, NULL, geo, &s[i]) != RC_OK)
                 return 0;
-            const double r = l - s[i].len_mm;
-            sum[side] += r;
-            sq[side] += r * r;
+            r[m] = l - s[i].len_mm;
+            x[m++] = (double)i - (double)a;
+            sum[side] += r[m - 1];
+            sq[side] += r[m - 1] * r[m - 1];
             cnt[side]++;
         }
     if (cnt[0] < 3 || cnt[1] < 3)
         return 0;
     const double m0 = sum[0] / cnt[0], m1 = sum[1] / cnt[1];
-    const double v = (sq[0] - cnt[0] * m0 * m0 + sq[1] - cnt[1] * m1 * m1) / (double)(cnt[0] + cnt[1] - 2);
+    const double ss_step = sq[0] - cnt[0] * m0 * m0 + sq[1] - cnt[1] * m1 * m1;
+    const double v = ss_step / (double)(cnt[0] + cnt[1] - 2);
     const double se = sqrt(fmax(v, 0.0) * (1.0 / cnt[0] + 1.0 / cnt[1]));
+    double mx = 0.0, mr = 0.0, sxx = 0.0, sxr = 0.0, srr = 0.0;
+    for (unsigned k = 0; k < m; ++k) {
+        mx += x[k] / m;
+        mr += r[k] / m;
+    }
+    for (unsigned k = 0; k < m; ++k) {
+        sxx += (x[k] - mx) * (x[k] - mx);
+        sxr += (x[k] - mx) * (r[k] - mr);
+        srr += (r[k] - mr) * (r[k] - mr);
+    }
+    const double ss_ramp = srr - (sxx > 0.0 ? sxr * sxr / sxx : 0.0);
     /* a step the size of the fitted jump, not a slope that a long fit
      * summarised as one (residual = model - L: a jump up in L moves it down) */
-    return fabs(m1 - m0) > 5.0 * se && fabs((m0 - m1) - size) < 0.3 * fabs(size);
+    return fabs(m1 - m0) > 5.0 * se && fabs((m0 - m1) - size) < 0.3 * fabs(size) && ss_ramp - ss_step > 4.0 * v;
 }
 
 /* 4b. Length jumps in acquisition order: found, removed from the lengths
@@ -996,6 +1033,75 @@ static int cand_applicable(const run_state *S, const cdef *cd, rch_diagnose_cand
     return 1;
 }
 
+/* Start values of a length_periodic effect (the last effect of m, whose
+ * other parameters are those of base): the period of the largest sine in
+ * the lengths' residuals L - l(base), after a straight line in L, over
+ * periods from 20 mm to the range of the lengths (1 % steps; at most 4000
+ * samples, evenly strided), and its two amplitudes. 0, or -1 when the
+ * lengths span less than 40 mm. */
+static int periodic_start(rc_model *m, const rc_model *base, const rc_sample *s, size_t n)
+{
+    const size_t stride = n > 4000 ? n / 4000 + 1 : 1;
+    double lmin = 1e300, lmax = -1e300, ml = 0.0, me = 0.0, sll = 0.0, sle = 0.0, best = -1.0;
+    size_t cnt = 0;
+    double *e = malloc((n / stride + 1) * 2 * sizeof *e), *len = NULL;
+    if (!e)
+        return -1;
+    len = e + n / stride + 1;
+    for (size_t i = 0; i < n; i += stride) {
+        double l;
+        if (rc_meas(&l, NULL, base, &s[i]) != RC_OK)
+            continue;
+        len[cnt] = s[i].len_mm;
+        e[cnt] = s[i].len_mm - l;
+        lmin = len[cnt] < lmin ? len[cnt] : lmin;
+        lmax = len[cnt] > lmax ? len[cnt] : lmax;
+        ml += len[cnt];
+        me += e[cnt];
+        cnt++;
+    }
+    if (cnt < 10 || lmax - lmin < 40.0) {
+        free(e);
+        return -1;
+    }
+    ml /= (double)cnt;
+    me /= (double)cnt;
+    for (size_t i = 0; i < cnt; ++i) {
+        sll += (len[i] - ml) * (len[i] - ml);
+        sle += (len[i] - ml) * (e[i] - me);
+    }
+    for (size_t i = 0; i < cnt; ++i) /* detrended */
+        e[i] -= me + (sll > 0.0 ? sle / sll : 0.0) * (len[i] - ml);
+    const rc_effect *ef = &m->effects[m->n_effects - 1];
+    for (unsigned k = 0;; ++k) {
+        const double per = 20.0 * pow(1.01, (double)k);
+        if (per > lmax - lmin)
+            break;
+        double ss = 0.0, cc = 0.0, sc = 0.0, se = 0.0, ce = 0.0;
+        for (size_t i = 0; i < cnt; ++i) {
+            const double ph = 2.0 * M_PI * len[i] / per, sp = sin(ph), cp = cos(ph);
+            ss += sp * sp;
+            cc += cp * cp;
+            sc += sp * cp;
+            se += sp * e[i];
+            ce += cp * e[i];
+        }
+        const double det = ss * cc - sc * sc;
+        if (!(det > 0.0))
+            continue;
+        const double a = (cc * se - sc * ce) / det, b = (ss * ce - sc * se) / det;
+        const double expl = a * se + b * ce; /* explained sum of squares */
+        if (expl > best) {
+            best = expl;
+            m->x[ef->first] = a;
+            m->x[ef->first + 1] = b;
+            m->x[ef->first + 2] = per;
+        }
+    }
+    free(e);
+    return best > 0.0 ? 0 : -1;
+}
+
 /* Fit candidate ci on all samples (into cand_full[ci]) and count the
  * directions it adds that the data identify. 1 when it is worth
  * cross-validating, else 0 with ca->note set. */
@@ -1010,6 +1116,10 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
         return 0;
     }
     ca->n_params = full->n_params - S->base.n_params;
+    if (cd->kind == RC_EFF_LENGTH_PERIODIC && periodic_start(full, &S->base, out->s, out->n) != 0) {
+        snprintf(ca->note, sizeof ca->note, "not applicable: the lengths span too little for a period");
+        return 0;
+    }
     if (fit(full, res, &S->c, NULL, out->s, out->n) != 0) {
         snprintf(ca->note, sizeof ca->note, "fit failed");
         return 0;
@@ -1026,6 +1136,20 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
     if (ca->n_ident < ca->n_params)
         snprintf(ca->note, sizeof ca->note, "%u of %u parameters identifiable (%s)", ca->n_ident, ca->n_params,
                  known_reason(cd->kind, cd->joint0, &S->base));
+    if (cd->kind == RC_EFF_LENGTH_PERIODIC) { /* a drum turn: 10 mm .. the lengths' range */
+        double lmin = 1e300, lmax = -1e300;
+        for (size_t i = 0; i < out->n; ++i) {
+            lmin = out->s[i].len_mm < lmin ? out->s[i].len_mm : lmin;
+            lmax = out->s[i].len_mm > lmax ? out->s[i].len_mm : lmax;
+        }
+        const double per = fabs(full->x[full->effects[full->n_effects - 1].first + 2]);
+        if (per < 10.0 || per > lmax - lmin) {
+            ca->implausible = 1;
+            snprintf(ca->note, sizeof ca->note,
+                     "implausible: fitted period %.4g mm (a drum turn within 10 mm .. the lengths' range %.4g mm)",
+                     per, lmax - lmin);
+        }
+    }
     const double worst_deg = implausible_deg(full, (const double(*)[V_N])S->var, out->n);
     if (worst_deg > 0.0) {
         ca->implausible = 1;
@@ -1051,6 +1175,9 @@ static int cand_cv(run_state *S, unsigned ci, unsigned count, rch_diagnose_cand 
         if (cd->kind == RC_EFF_JOINT_COMPLIANCE) /* same frozen lever geometry as the full model */
             memcpy(fm[f].effects[fm[f].n_effects - 1].ref_dh, full->effects[full->n_effects - 1].ref_dh,
                    sizeof full->effects[0].ref_dh);
+        if (cd->kind == RC_EFF_LENGTH_PERIODIC) /* a nonlinear period: start where the full fit ended */
+            memcpy(&fm[f].x[fm[f].effects[fm[f].n_effects - 1].first], &full->x[full->effects[full->n_effects - 1].first],
+                   3 * sizeof full->x[0]);
     }
     if (cv_run(fm, rc_, &S->c) != 0) {
         snprintf(ca->note, sizeof ca->note, "a cross-validation fit failed");

@@ -23,7 +23,10 @@
  *     the groups (one-way ANOVA). Bonferroni over the tests.
  *  5. Candidate effects (rc_model effects), each fitted jointly with the
  *     geometry in every fold: length_offset, length_scale, time_drift,
- *     group_offset, joint_compliance j2/j3, joint_periodic j1..j6. A
+ *     group_offset, joint_compliance j2/j3, joint_periodic j1..j6,
+ *     tool_offset, cable_sag, length_nonlinearity, length_periodic (its
+ *     period started from the largest sine in the residuals against the
+ *     length). A
  *     candidate that adds no identifiable direction (rank of the scaled
  *     normal matrix does not grow) is flagged, not tested. Held-out gain:
  *     paired one-sided z test on the per-sample differences of held-out

@@ -75,6 +75,9 @@ static double effect_limit(rc_effect_kind k)
     case RC_EFF_LENGTH_SCALE: return 0.1;   /* 10 % of the length */
     case RC_EFF_JOINT_COMPLIANCE: return 0.1; /* rad per m of lever */
     case RC_EFF_JOINT_PERIODIC: return 0.2;   /* rad (11 deg) */
+    case RC_EFF_CABLE_SAG: return 1000.0;     /* mm per m^3 of h^2 L (1 m of sag length per m^3) */
+    case RC_EFF_LENGTH_NONLIN: return 1000.0; /* mm per m^2, mm per m^3 */
+    case RC_EFF_LENGTH_PERIODIC: return 1000.0; /* mm (amplitudes and the period) */
     case RC_EFF_NONE: break;
     }
     return 0.0;
@@ -86,17 +89,21 @@ static const char *effect_unit(rc_effect_kind k)
     case RC_EFF_LENGTH_SCALE: return "";
     case RC_EFF_JOINT_COMPLIANCE: return "rad/m";
     case RC_EFF_JOINT_PERIODIC: return "rad";
+    case RC_EFF_CABLE_SAG: return "mm/m^3";
+    case RC_EFF_LENGTH_NONLIN: return "mm/m^2, mm/m^3";
     default: return "mm";
     }
 }
 
 static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_diag *d)
 {
-    static const char *const names[] = {"length_offset", "joint_compliance", "joint_periodic",
-                                        "time_drift",    "group_offset",     "length_scale", "tool_offset"};
+    static const char *const names[] = {"length_offset", "joint_compliance", "joint_periodic", "time_drift",
+                                        "group_offset",  "length_scale",     "tool_offset",    "cable_sag",
+                                        "length_nonlinearity", "length_periodic"};
     static const rc_effect_kind kinds[] = {RC_EFF_LENGTH_OFFSET, RC_EFF_JOINT_COMPLIANCE, RC_EFF_JOINT_PERIODIC,
                                            RC_EFF_TIME_DRIFT,    RC_EFF_GROUP_OFFSET,     RC_EFF_LENGTH_SCALE,
-                                           RC_EFF_TOOL_OFFSET};
+                                           RC_EFF_TOOL_OFFSET,   RC_EFF_CABLE_SAG,        RC_EFF_LENGTH_NONLIN,
+                                           RC_EFF_LENGTH_PERIODIC};
     if (arr->type != RCH_JARR) {
         rch_diag_set(d, file, arr->line, arr->col, "\"effects\" must be an array");
         return -1;
@@ -151,6 +158,11 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
                              kind->str, p + 1, m->x[ef->first + p], lim, effect_unit((rc_effect_kind)ef->kind));
                 return -1;
             }
+        }
+        if (ef->kind == RC_EFF_LENGTH_PERIODIC && !(fabs(m->x[ef->first + 2]) >= 1.0)) {
+            rch_diag_set(d, file, params->line, params->col,
+                         "effect length_periodic: the period (third parameter) must be at least 1 mm");
+            return -1;
         }
         if (ref) {
             if (ref->type != RCH_JARR || ref->n != 4) {
