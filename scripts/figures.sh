@@ -24,7 +24,7 @@ plots() {
     cp $O/diagnose.txt docs/diagnose/real_data_output.txt
     run uncertainty_real $R calibrate --data $REAL --plots $F/uncertainty_real
     run uncertainty_real_jumps $R calibrate --data $REAL --jumps --dequantize-joints --plots $F/uncertainty_real_jumps
-    $R calibrate --data $REAL --out $O/real.json > /dev/null
+    $R calibrate --data $REAL --jumps --dequantize-joints --out $O/real.json > /dev/null
     run grind_real_sim $R simulate --truth $O/real.json --out $O/sim_real.csv --samples 1000 --seed 5
     $R calibrate --data $O/sim_real.csv --out $O/cal_real.json > /dev/null
     run grind_real $R grind --model $O/cal_real.json --truth $O/real.json --plots $F/grind_real

@@ -35,6 +35,13 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
     if (!has_encoder) {
         double e[3];
         rc_status st = rc_encoder_guess(e, start, s, n);
+        if (st == RC_ERR_RANGE) {
+            rch_diag_set(d, "", 0, 0,
+                         "cannot place the encoder: the lengths fit no sphere around the nominal flange positions "
+                         "(misfit above 15 %% of the lengths): the length column is not the cable, or the robot "
+                         "is over 100 mm from its nominal model; give the outlet in the robot file (\"encoder_mm\")");
+            return -1;
+        }
         if (st != RC_OK) {
             rch_diag_set(d, "", 0, 0,
                          "cannot place the encoder: %s (the poses must spread in all three directions)",
