@@ -54,7 +54,7 @@ static int bands(unsigned seeds, double size_x, int visible, size_t n, unsigned 
                 double noise;
                 memset(&cfg, 0, sizeof cfg);
                 cfg.folds = folds;
-                cfg.max_steps = 1;
+                cfg.max_steps = 2; /* named: the verdict or the effect added next (diag_named) */
                 cfg.seed = 1000u + k;
                 cfg.verbose = getenv("DIAG_VERBOSE") ? atoi(getenv("DIAG_VERBOSE")) : 0;
                 if (diag_simulate_band(s, n, &nominal, c, 104729ull * (k + 1) + 7919ull * ci + 31ull * b,
@@ -64,7 +64,7 @@ static int bands(unsigned seeds, double size_x, int visible, size_t n, unsigned 
                     free(s);
                     return 1;
                 }
-                const int ok = diag_match(&r, c);
+                const int ok = diag_named(&r, c);
                 hits += (unsigned)ok;
                 if (!ok && op < sizeof other - 40)
                     op += (size_t)snprintf(other + op, sizeof other - op, "%s%s", op ? ", " : "", r.effect);

@@ -230,6 +230,28 @@ static inline int diag_match(const rch_diagnose_result *r, const diag_case *c)
     return 1;
 }
 
+/* Named: the verdict, or the effect the diagnosis adds at a later step
+ * (printed under "Effects added"); "none" only when nothing is added. */
+static inline int diag_named(const rch_diagnose_result *r, const diag_case *c)
+{
+    if (diag_match(r, c))
+        return 1;
+    if (strcmp(c->name, "none") == 0)
+        return 0;
+    const size_t len = strlen(c->name);
+    const int joint_eff = c->kind == RC_EFF_JOINT_COMPLIANCE || c->kind == RC_EFF_JOINT_PERIODIC;
+    for (unsigned k = 0; k < r->n_steps; ++k) {
+        const rch_diagnose_step *st = &r->steps[k];
+        if (st->chosen < 0)
+            continue;
+        const rch_diagnose_cand *cd = &st->cand[st->chosen];
+        if (strncmp(cd->name, c->name, len) == 0 && (cd->name[len] == '\0' || cd->name[len] == ' ') &&
+            (!joint_eff || cd->joint == c->joint0 + 1))
+            return 1;
+    }
+    return 0;
+}
+
 static inline void diag_case_label(char *buf, size_t len, const diag_case *c)
 {
     if (c->kind == RC_EFF_JOINT_COMPLIANCE || c->kind == RC_EFF_JOINT_PERIODIC)
