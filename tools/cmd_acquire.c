@@ -108,6 +108,16 @@ static int report_json(const rch_acq_result *r, const rch_acq_config *c, const c
     return rch_jw_finish(&w);
 }
 
+/* The one-line summary of a complete run. */
+static void report_text(const rch_acq_result *r, const rch_acq_config *c)
+{
+    printf("rcal acquire: %zu poses recorded (%zu new) in %s; %lu readings, %lu timeouts, %lu bad frames, "
+           "%lu format rejects, %lu device errors, %lu out of range, %lu unstable restarts, %lu reconnects, "
+           "%lu follow refusals (worst miss %.2f mm)\n",
+           r->n_before + r->n_new, r->n_new, c->out_path, r->readings, r->timeouts, r->bad_frames, r->shape_rejects,
+           r->device, r->range, r->unstable, r->reconnects, r->follow_refusals, r->worst_follow_mm);
+}
+
 int rcal_cmd_acquire(int argc, char **argv)
 {
     rch_acq_config c;
@@ -185,10 +195,6 @@ int rcal_cmd_acquire(int argc, char **argv)
     if (json)
         return report_json(&r, &c, proto, rc, argc, argv) != 0 && rc == 0 ? 1 : rc;
     if (rc == 0 && r.n_new + r.n_before == r.n_poses && r.n_new)
-        printf("rcal acquire: %zu poses recorded (%zu new) in %s; %lu readings, %lu timeouts, %lu bad frames, "
-               "%lu format rejects, %lu device errors, %lu out of range, %lu unstable restarts, %lu reconnects, "
-               "%lu follow refusals (worst miss %.2f mm)\n",
-               r.n_before + r.n_new, r.n_new, c.out_path, r.readings, r.timeouts, r.bad_frames, r.shape_rejects,
-               r.device, r.range, r.unstable, r.reconnects, r.follow_refusals, r.worst_follow_mm);
+        report_text(&r, &c);
     return rc;
 }

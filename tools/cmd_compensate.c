@@ -122,6 +122,39 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
     return rch_jw_finish(&w);
 }
 
+/* Options that exclude each other; 1 when they fit. */
+static int args_fit(int position_only, int full_pose, int json, const char *out)
+{
+    if (position_only && full_pose) {
+        fprintf(stderr, "rcal compensate: --position-only and --full-pose exclude each other\n");
+        return 0;
+    }
+    if (json && strcmp(out, "-") == 0) {
+        fprintf(stderr, "rcal compensate: --json needs --out FILE (the targets would share stdout)\n");
+        return 0;
+    }
+    return 1;
+}
+
+/* rch_comp_run, its warnings on stderr; with --json they are also read back
+ * into *warn_text (for the JSON; the caller frees it). */
+static int run_job(rch_comp_result *r, const rch_comp_job *job, int json, char **warn_text)
+{
+    rch_diag d;
+    char msg[1024];
+    size_t warn_len = 0;
+    FILE *warn = json ? open_memstream(warn_text, &warn_len) : NULL;
+    const int rc = rch_comp_run(r, job, warn ? warn : stderr, &d);
+    if (warn && fclose(warn) == 0 && *warn_text)
+        fputs(*warn_text, stderr);
+    if (r->no_nominal)
+        fprintf(stderr, "rcal compensate: warning: %s has no \"nominal\" table; only its effects are corrected\n",
+                job->model_path);
+    if (rc < 0)
+        fprintf(stderr, "rcal compensate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+    return rc;
+}
+
 int rcal_cmd_compensate(int argc, char **argv)
 {
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
@@ -170,14 +203,8 @@ int rcal_cmd_compensate(int argc, char **argv)
     const int ps = rch_opt_main(&spec, argc, argv, &seen);
     if (ps >= 0)
         return ps;
-    if (position_only && full_pose) {
-        fprintf(stderr, "rcal compensate: --position-only and --full-pose exclude each other\n");
+    if (!args_fit(position_only, full_pose, json, out))
         return 2;
-    }
-    if (json && strcmp(out, "-") == 0) {
-        fprintf(stderr, "rcal compensate: --json needs --out FILE (the targets would share stdout)\n");
-        return 2;
-    }
 
     const rch_comp_job job = {
         .model_path = model,
@@ -193,19 +220,9 @@ int rcal_cmd_compensate(int argc, char **argv)
     };
     rch_comp_result r;
     memset(&r, 0, sizeof r);
-    rch_diag d;
-    char msg[1024];
-    /* with --json the warnings are also read back for the JSON (then copied to stderr) */
     char *warn_text = NULL;
-    size_t warn_len = 0;
-    FILE *warn = json ? open_memstream(&warn_text, &warn_len) : NULL;
-    const int rc = rch_comp_run(&r, &job, warn ? warn : stderr, &d);
-    if (warn && fclose(warn) == 0 && warn_text)
-        fputs(warn_text, stderr);
-    if (r.no_nominal)
-        fprintf(stderr, "rcal compensate: warning: %s has no \"nominal\" table; only its effects are corrected\n", model);
+    const int rc = run_job(&r, &job, json, &warn_text);
     if (rc < 0) {
-        fprintf(stderr, "rcal compensate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         free(warn_text);
         return 1;
     }
