@@ -186,8 +186,11 @@ int rcal_cmd_calibrate(int argc, char **argv)
         status = 1;
     else if (a.report_path && r->finite) {
         const calib_json_ctx ctx = {r, argc, argv};
-        if (rcal_report_inline(a.report_path, calib_json_cb, &ctx, NULL, NULL, r->finite ? a.out_path : NULL,
-                               a.json) != 0)
+        const char *inputs[RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
+        for (size_t i = 0; i < a.data.n; ++i)
+            inputs[3 + i] = a.data.v[i];
+        if (rcal_report_inline(a.report_path, calib_json_cb, &ctx, NULL, NULL, r->finite ? a.out_path : NULL, inputs,
+                               3 + a.data.n, a.json) != 0)
             status = 1;
     }
     if (a.cfg.residuals_path && !r->finite)

@@ -100,7 +100,8 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
         return 1;
     }
     const json_ctx cx = {c, argc, argv}, dx = {r, argc, argv}; /* both made by this command line */
-    const int rc = rcal_report_inline(html, calib_json_cb, &cx, diag_json_cb, &dx, NULL, quiet);
+    const char *const inputs[2] = {data_path, robot_path};
+    const int rc = rcal_report_inline(html, calib_json_cb, &cx, diag_json_cb, &dx, NULL, inputs, 2, quiet);
     free(c);
     return rc;
 }

@@ -11,6 +11,8 @@
 #include "rch_report.h"
 #include "rch_save.h"
 
+#define RCAL_REPORT_MAX_INPUTS 64 /* input files a run may name (several --data, robot, validate) */
+
 /* path's name without a .html or .htm ending, followed by suffix. */
 static void beside(char *buf, size_t len, const char *path, const char *suffix)
 {
@@ -23,7 +25,8 @@ static void beside(char *buf, size_t len, const char *path, const char *suffix)
 }
 
 int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, rcal_json_fn diag,
-                       const void *diag_ctx, const char *model, int quiet)
+                       const void *diag_ctx, const char *model, const char *const *inputs, size_t n_inputs,
+                       int quiet)
 {
     char cal_path[1100], diag_path[1100], msg[1024];
     rch_diag d;
@@ -35,9 +38,13 @@ int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, 
     }
     beside(cal_path, sizeof cal_path, html, ".calibration.json");
     beside(diag_path, sizeof diag_path, html, ".diagnosis.json");
-    const char *inputs[1] = {model};
-    if (rch_save(cal_path, "--report (its calibration JSON)", inputs, 1, cal, cal_ctx, &d) != 0 ||
-        (diag && rch_save(diag_path, "--report (its diagnosis JSON)", inputs, 1, diag, diag_ctx, &d) != 0)) {
+    const char *ins[RCAL_REPORT_MAX_INPUTS + 1];
+    size_t n_ins = 0;
+    ins[n_ins++] = model;
+    for (size_t i = 0; i < n_inputs && n_ins < RCAL_REPORT_MAX_INPUTS + 1; ++i)
+        ins[n_ins++] = inputs[i];
+    if (rch_save(cal_path, "--report (its calibration JSON)", ins, n_ins, cal, cal_ctx, &d) != 0 ||
+        (diag && rch_save(diag_path, "--report (its diagnosis JSON)", ins, n_ins, diag, diag_ctx, &d) != 0)) {
         fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }

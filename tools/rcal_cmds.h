@@ -30,10 +30,12 @@ int rcal_cmd_report(int argc, char **argv);     /* issue 13 */
  * write the run's JSON as --json prints it; it is kept beside the page as
  * FILE.calibration.json and FILE.diagnosis.json (never over an input), and
  * rch_report_write reads them in this process. model: the model file written
- * by the run, or NULL. quiet: no message on stderr. 0, or 1 with the message
+ * by the run, or NULL. inputs (n_inputs): the run's input files, which no
+ * output of the report may replace. quiet: no message on stderr. 0, or 1 with the message
  * on stderr. */
 typedef int (*rcal_json_fn)(FILE *f, const void *ctx);
 int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, rcal_json_fn diag,
-                       const void *diag_ctx, const char *model, int quiet);
+                       const void *diag_ctx, const char *model, const char *const *inputs, size_t n_inputs,
+                       int quiet);
 
 #endif
