@@ -160,8 +160,8 @@ int rcal_cmd_calibrate(int argc, char **argv)
 {
     calib_args a;
     memset(&a, 0, sizeof a);
+    rch_calib_cfg_init(&a.cfg);
     a.cfg.robot_path = RCAL_DEFAULT_ROBOT;
-    a.cfg.test_fraction = 0.1;
     a.method = "lm";
     a.seed = 1;
     a.cases = 1;

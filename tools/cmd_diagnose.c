@@ -83,13 +83,10 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
                            unsigned long seed, int dequantize, const char *html, int quiet, int argc, char **argv)
 {
     rch_calib_cfg cc;
-    memset(&cc, 0, sizeof cc);
+    rch_calib_cfg_init(&cc);
     cc.data_path = data_path;
     cc.robot_path = robot_path;
-    cc.method = RC_METHOD_LM;
-    cc.test_fraction = 0.1;
     cc.seed = seed;
-    cc.cases = 1;
     cc.dequantize = dequantize;
     rch_calib_result *c = malloc(sizeof *c);
     rch_diag d;

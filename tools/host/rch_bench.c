@@ -77,10 +77,9 @@ static int bench_calibrate(rch_bench_result *r, const rch_bench_cfg *cfg, double
         return -1;
     }
     rch_calib_cfg cc;
-    memset(&cc, 0, sizeof cc);
+    rch_calib_cfg_init(&cc); /* rcal calibrate --test-fraction 0 */
     cc.data_path = cfg->data_path;
     cc.robot_path = cfg->robot_path;
-    cc.method = RC_METHOD_LM;
     cc.test_fraction = 0.0;
     for (unsigned long k = 0; k < cfg->runs; ++k) {
         const double t0 = now_ms();

@@ -67,6 +67,15 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
     return 0;
 }
 
+void rch_calib_cfg_init(rch_calib_cfg *cfg)
+{
+    memset(cfg, 0, sizeof *cfg);
+    cfg->method = RC_METHOD_LM;
+    cfg->test_fraction = 0.1;
+    cfg->seed = 1;
+    cfg->cases = 1;
+}
+
 int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, const rc_sample *train, size_t n,
                     rch_diag *d)
 {

@@ -94,6 +94,10 @@ typedef struct rch_calib_cfg {
     const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
 } rch_calib_cfg;
 
+/* The defaults of `rcal calibrate`: everything zero or NULL but method LM,
+ * test fraction 0.1, seed 1, one case. */
+void rch_calib_cfg_init(rch_calib_cfg *cfg);
+
 typedef struct rch_calib_result {
     rch_calib_cfg cfg;        /* as given (paths point at the caller's strings) */
     rch_robot robot;          /* the robot file; robot.model has the tool offset when asked */

@@ -210,7 +210,7 @@ int rch_ffi_calibrate_file(rch_ffi_calib **out, const char *data_path, const cha
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: NULL argument (data and robot are required)");
     *out = NULL;
     rch_calib_cfg cfg;
-    memset(&cfg, 0, sizeof cfg);
+    rch_calib_cfg_init(&cfg);
     if (rch_method_parse(&cfg.method, method ? method : "lm") != 0)
         return fail(RCH_FFI_ERR_ARG, err, err_len, "unknown method '%s' (lm, ltlm, lm-paper, ltlm-paper)", method);
     if (!(test_fraction >= 0.0 && test_fraction < 1.0))

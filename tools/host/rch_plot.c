@@ -743,8 +743,7 @@ void rch_plot_xml_text(FILE *f, const char *s) { plot_esc(f, s); }
 
 /* ---- data as CSV -------------------------------------------------------- */
 
-/* RFC 4180 field: quoted when it holds a comma, quote or line break. */
-static void csv_field(FILE *f, const char *s)
+void rch_csv_field(FILE *f, const char *s)
 {
     if (!s)
         s = "";
@@ -771,14 +770,14 @@ int rch_plot_table_write(FILE *f, const rch_plot_table *t)
     for (size_t c = 0; c < nc; c++) {
         if (c)
             fputc(',', f);
-        csv_field(f, t->head[c]);
+        rch_csv_field(f, t->head[c]);
     }
     fputc('\n', f);
     for (size_t r = 0; r < t->n_rows; r++) {
         for (size_t c = 0; c < t->n_text; c++) {
             if (c)
                 fputc(',', f);
-            csv_field(f, t->text[r * t->n_text + c]);
+            rch_csv_field(f, t->text[r * t->n_text + c]);
         }
         for (size_t c = 0; c < t->n_num; c++) {
             const double v = t->num[r * t->n_num + c];

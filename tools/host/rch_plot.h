@@ -142,4 +142,9 @@ void rch_plot_viridis(char out[8], double t);
 /* Write s XML-escaped (&, <, >, ", ') to f. */
 void rch_plot_xml_text(FILE *f, const char *s);
 
+/* Write s as one CSV field (RFC 4180: quoted when it holds a comma, quote or
+ * line break; NULL is an empty field). The one CSV field writer of the host
+ * library (plot data, residual tables, the report's CSVs). */
+void rch_csv_field(FILE *f, const char *s);
+
 #endif

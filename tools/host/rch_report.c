@@ -13,6 +13,7 @@
 #include "rc_version.h"
 #include "rch_file.h"
 #include "rch_json.h"
+#include "rch_plot.h"
 #include "rch_sha256.h"
 
 #define NA "<span class=\"na\">not in this run</span>"
@@ -220,24 +221,6 @@ static void put_p(rep *r, double p)
         fputs("&lt; 1e-300", r->f);
     else
         put_num(r, p, "%.3g");
-}
-
-/* RFC 4180 field. */
-static void csv_str(FILE *f, const char *s)
-{
-    if (!s)
-        return;
-    if (!strpbrk(s, ",\"\r\n")) {
-        fputs(s, f);
-        return;
-    }
-    fputc('"', f);
-    for (; *s; ++s) {
-        if (*s == '"')
-            fputc('"', f);
-        fputc(*s, f);
-    }
-    fputc('"', f);
 }
 
 static void csv_num(FILE *f, double v)
@@ -1604,17 +1587,17 @@ static void csv_params(FILE *f, const prow *p, size_t n)
     fputs("name,unit,nominal,calibrated,correction,std_error,ci95_low,ci95_high,class,compensation\n", f);
     for (size_t k = 0; k < n; ++k) {
         const double v[6] = {p[k].nominal, p[k].value, p[k].delta, p[k].se, p[k].ci_lo, p[k].ci_hi};
-        csv_str(f, p[k].name);
+        rch_csv_field(f, p[k].name);
         fputc(',', f);
-        csv_str(f, p[k].unit);
+        rch_csv_field(f, p[k].unit);
         for (size_t i = 0; i < 6; ++i) {
             fputc(',', f);
             csv_num(f, v[i]);
         }
         fputc(',', f);
-        csv_str(f, p[k].cls);
+        rch_csv_field(f, p[k].cls);
         fputc(',', f);
-        csv_str(f, p[k].comp);
+        rch_csv_field(f, p[k].comp);
         fputc('\n', f);
     }
 }
@@ -1623,7 +1606,7 @@ static void csv_accuracy(FILE *f, const arow *a, size_t n)
 {
     fputs("quantity,value_mm\n", f);
     for (size_t k = 0; k < n; ++k) {
-        csv_str(f, a[k].label);
+        rch_csv_field(f, a[k].label);
         fputc(',', f);
         csv_num(f, a[k].v);
         fputc('\n', f);
@@ -1641,7 +1624,7 @@ static void csv_cands(FILE *f, const crow *c, size_t n)
                              c[k].gain + Z95 * c[k].gain_se, c[k].z, c[k].p};
         csv_num(f, v[0]);
         fputc(',', f);
-        csv_str(f, c[k].effect);
+        rch_csv_field(f, c[k].effect);
         for (size_t i = 1; i < 4; ++i) {
             fputc(',', f);
             csv_num(f, v[i]);
@@ -1653,7 +1636,7 @@ static void csv_cands(FILE *f, const crow *c, size_t n)
                 csv_num(f, w[i]);
         }
         fprintf(f, ",%d,%d,", c[k].significant, c[k].chosen);
-        csv_str(f, c[k].note);
+        rch_csv_field(f, c[k].note);
         fputc('\n', f);
     }
 }

@@ -8,6 +8,7 @@
 
 #include "rch_compare.h"
 #include "rch_diagnose.h"
+#include "rch_plot.h"
 #include "rch_save.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
@@ -67,22 +68,6 @@ int rch_resid_add_model(rch_resid_table *t, const rc_model *m, const rc_sample *
     return 0;
 }
 
-/* One CSV field, quoted per RFC 4180 when it holds a comma, quote or line break. */
-static void put_field(FILE *f, const char *s)
-{
-    if (!strpbrk(s, ",\"\r\n")) {
-        fputs(s, f);
-        return;
-    }
-    fputc('"', f);
-    for (; *s; ++s) {
-        if (*s == '"')
-            fputc('"', f);
-        fputc(*s, f);
-    }
-    fputc('"', f);
-}
-
 /* %.17g, or an empty field for a value that is not finite. */
 static void put_num(FILE *f, const char *fmt, double v)
 {
@@ -104,7 +89,7 @@ int rch_resid_write(FILE *f, const rch_resid_table *t)
         fputs(",", f);
         char name[96];
         snprintf(name, sizeof name, "residual_after_%s_mm", t->step[k]);
-        put_field(f, name);
+        rch_csv_field(f, name);
     }
     fputc('\n', f);
     for (size_t i = 0; i < t->n; ++i) {
@@ -112,7 +97,7 @@ int rch_resid_write(FILE *f, const rch_resid_table *t)
         fprintf(f, "%u", r->line);
         if (with_file) {
             fputc(',', f);
-            put_field(f, r->file < t->n_files && t->files[r->file] ? t->files[r->file] : "");
+            rch_csv_field(f, r->file < t->n_files && t->files[r->file] ? t->files[r->file] : "");
         }
         if (t->with_case)
             fprintf(f, ",%u", r->case_no);
