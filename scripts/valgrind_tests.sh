@@ -42,7 +42,7 @@ command -v valgrind >/dev/null || { echo "valgrind: not installed (apt-get insta
 
 echo "== valgrind: building $BUILD_DIR (no sanitizers)"
 mkdir -p "$BUILD_DIR"
-if ! cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRCAL_SANITIZE=OFF \
+if ! cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRCAL_SANITIZE=OFF -DRCAL_STATIC_PROGRAM=OFF \
     >"$BUILD_DIR/valgrind-cfg.log" 2>&1; then
     cat "$BUILD_DIR/valgrind-cfg.log"
     echo "valgrind: configure FAILED"

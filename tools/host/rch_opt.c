@@ -5,8 +5,10 @@
 #include "rch_diag.h"
 
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -50,6 +52,68 @@ int rch_parse_long(const char *s, long *out)
     return 0;
 }
 
+/* Clinger's fast path (1990): a decimal of at most 15 significant digits
+ * M and a power of ten 10^e with |e| <= 22 are both exact doubles, so M * 10^e
+ * or M / 10^-e is one correctly rounded operation: the double strtod gives,
+ * for a fraction of its time. Returns 0 and sets *out, or -1 (strtod then).
+ * Only where double arithmetic is evaluated in double (FLT_EVAL_METHOD 0). */
+static int fast_decimal(const char *s, double *out)
+{
+#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0
+    static const double p10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                   1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    const char *p = s;
+    const int neg = *p == '-';
+    if (*p == '+' || *p == '-')
+        ++p;
+    uint64_t m = 0;
+    int sig = 0, e10 = 0;
+    for (int frac = 0;; ++p) {
+        if (*p == '.' && !frac) {
+            frac = 1;
+            continue;
+        }
+        if (!is_digit(*p))
+            break;
+        if (m == 0 && *p == '0') { /* leading zeros are not significant */
+            e10 -= frac;
+            continue;
+        }
+        if (++sig > 15)
+            return -1;
+        m = m * 10u + (uint64_t)(*p - '0');
+        e10 -= frac;
+    }
+    if (*p == 'e' || *p == 'E') {
+        ++p;
+        const int eneg = *p == '-';
+        if (*p == '+' || *p == '-')
+            ++p;
+        int x = 0;
+        for (; is_digit(*p); ++p) {
+            if (x > 1000)
+                return -1;
+            x = x * 10 + (*p - '0');
+        }
+        e10 += eneg ? -x : x;
+    }
+    if (*p != '\0')
+        return -1;
+    double v = (double)m;
+    if (m != 0) {
+        if (e10 < -22 || e10 > 22)
+            return -1;
+        v = e10 < 0 ? v / p10[-e10] : v * p10[e10];
+    }
+    *out = neg ? -v : v;
+    return 0;
+#else
+    (void)s;
+    (void)out;
+    return -1;
+#endif
+}
+
 int rch_parse_double(const char *s, double *out)
 {
     if (!s || !*s)
@@ -84,6 +148,8 @@ int rch_parse_double(const char *s, double *out)
     }
     if (*p != '\0')
         return -1;
+    if (fast_decimal(s, out) == 0)
+        return 0;
     errno = 0;
     char *end;
     double v = strtod(s, &end);

@@ -3,6 +3,7 @@
 #include "rch_stats.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 void rch_stats_add(rch_stats *s, double e)
@@ -57,4 +58,54 @@ double rch_rms(const double *v, size_t n)
     for (size_t i = 0; i < n; ++i)
         s += v[i] * v[i];
     return n ? sqrt(s / (double)n) : 0.0;
+}
+
+/* v reordered so that v[k] is the k-th smallest, v[i] <= v[k] for i < k and
+ * v[i] >= v[k] for i > k: Wirth's FIND (Hoare), pivot v[k]. */
+static void select_kth(double *v, ptrdiff_t n, ptrdiff_t k)
+{
+    ptrdiff_t l = 0, r = n - 1;
+    while (l < r) {
+        const double x = v[k];
+        ptrdiff_t i = l, j = r;
+        do {
+            while (v[i] < x)
+                ++i;
+            while (x < v[j])
+                --j;
+            if (i <= j) {
+                const double t = v[i];
+                v[i] = v[j];
+                v[j] = t;
+                ++i;
+                --j;
+            }
+        } while (i <= j);
+        if (j < k)
+            l = i;
+        if (k < i)
+            r = j;
+    }
+}
+
+void rch_median_max(double *med, double *max, double *v, size_t n)
+{
+    if (n == 0) {
+        *med = *max = NAN;
+        return;
+    }
+    double mx = v[0];
+    for (size_t i = 1; i < n; ++i)
+        mx = v[i] > mx ? v[i] : mx;
+    *max = mx;
+    const size_t k = n / 2;
+    select_kth(v, (ptrdiff_t)n, (ptrdiff_t)k);
+    if (n % 2) {
+        *med = v[k];
+        return;
+    }
+    double lo = v[0]; /* the (k-1)-th smallest: the largest below k */
+    for (size_t i = 1; i < k; ++i)
+        lo = v[i] > lo ? v[i] : lo;
+    *med = 0.5 * (lo + v[k]);
 }

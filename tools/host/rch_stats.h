@@ -42,4 +42,9 @@ void rch_stats_metrics(rc_metrics *out, const rch_stats *s);
 /* RMS of v (n): sqrt(sum v^2 / n), 0 for n = 0. */
 double rch_rms(const double *v, size_t n);
 
+/* Median (mean of the two middle values for even n) and maximum of v (n
+ * finite values, reordered): an O(n) selection (Hoare's FIND), the very
+ * values a sort gives. Both NaN for n = 0. */
+void rch_median_max(double *med, double *max, double *v, size_t n);
+
 #endif

@@ -3,6 +3,7 @@
  * predicted position uncertainty and the determined part of a model
  * (see rch_uncert.h). */
 #include "rch_uncert.h"
+#include "rch_stats.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -644,19 +645,6 @@ void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model
             out->x[k] = nominal->x[k];
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static void med_max(double *med, double *mx, double *v, size_t n)
-{
-    qsort(v, n, sizeof *v, cmp_double);
-    *med = n ? (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2])) : NAN;
-    *mx = n ? v[n - 1] : NAN;
-}
-
 /* What the map evaluates at every pose: the covariance packed for the
  * position (pos), the orientation with every parameter (rot) and with those
  * compensation uses (det), and the parameters any of them reads (all). */
@@ -715,9 +703,9 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
     const rc_kin *k = sens_compile(&kin, m);
     for (size_t i = 0; i < n; ++i)
         map_pose(&v[i], &vr[i], &vd[i], u, &c, m, k, s[i].q_rad);
-    med_max(&out->data_median_mm, &out->data_max_mm, v, n);
-    med_max(&out->rot_data_median_deg, &out->rot_data_max_deg, vr, n);
-    med_max(&out->rot_det_median_deg, &out->rot_det_max_deg, vd, n);
+    rch_median_max(&out->data_median_mm, &out->data_max_mm, v, n);
+    rch_median_max(&out->rot_data_median_deg, &out->rot_data_max_deg, vr, n);
+    rch_median_max(&out->rot_det_median_deg, &out->rot_det_max_deg, vd, n);
     out->n_data = n;
     rc_rng g;
     rc_rng_seed(&g, seed);
@@ -727,7 +715,7 @@ int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_mo
             q[j] = m->q_min_rad[j] + (m->q_max_rad[j] - m->q_min_rad[j]) * rc_rng_u01(&g);
         map_pose(&v[i], NULL, NULL, u, &c, m, k, q);
     }
-    med_max(&out->work_median_mm, &out->work_max_mm, v, n_random);
+    rch_median_max(&out->work_median_mm, &out->work_max_mm, v, n_random);
     out->n_work = n_random;
     free(c.buf);
     free(v);
