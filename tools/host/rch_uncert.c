@@ -179,6 +179,15 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
                     v += T[a * nf + k] * Ap[k * nf + b];
                 z->Cz[a * nf + b] = c * v;
             }
+        /* Ap M Ap rounds differently in its two triangles (5e-9 relative on
+         * the demo's weak wrist directions); an ellipsoid J Cz J^T cancels
+         * those large terms down to 1e-5 of them, so the two triangles gave
+         * map figures 2e-4 apart. Cz is symmetric: its mean with its transpose. */
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned b = a + 1; b < nf; ++b) {
+                const double v = 0.5 * (z->Cz[a * nf + b] + z->Cz[b * nf + a]);
+                z->Cz[a * nf + b] = z->Cz[b * nf + a] = v;
+            }
         free(T);
         u->kind = RCH_COV_CLUSTER;
         u->n_groups = G;
@@ -486,9 +495,11 @@ static const rc_kin *sens_compile(rc_kin *kin, const rc_model *m)
 /* The part of a covariance an ellipsoid reads: the parameters k < n with
  * use[k] set whose FK sensitivity can be nonzero (not the encoder's), idx
  * (nn) in order, and their covariance c (nn x nn, contiguous, the caller's
- * buffer of n * n doubles). */
+ * buffer of n * n doubles). After factor_cov (r > 0): idx in pivot order
+ * and c holds the factor F (nn x r, row a in c + a * nn, entries c < min(a +
+ * 1, r)) with Cov = F F^T up to what the pivoting dropped, factored set. */
 typedef struct {
-    unsigned nn;
+    unsigned nn, r, factored;
     unsigned idx[RC_MAX_PARAMS];
     double *c;
 } cov_pack;
@@ -496,6 +507,8 @@ typedef struct {
 static void pack_cov(cov_pack *p, double *buf, const double *cov, size_t ld, const uint8_t *use, unsigned n)
 {
     p->nn = 0;
+    p->r = 0;
+    p->factored = 0;
     p->c = buf;
     for (unsigned k = 0; k < n; ++k)
         if (use[k] && !(k >= RC_N_DH && k < RC_N_BASE))
@@ -503,6 +516,66 @@ static void pack_cov(cov_pack *p, double *buf, const double *cov, size_t ld, con
     for (unsigned a = 0; a < p->nn; ++a)
         for (unsigned b = 0; b < p->nn; ++b)
             buf[(size_t)a * p->nn + b] = cov[(size_t)p->idx[a] * ld + p->idx[b]];
+}
+
+/* Pivoted Cholesky of the packed covariance (for an ellipsoid at many
+ * poses: 3 nn r - 3 r^2 / 2 products a pose instead of 3 nn^2), on the
+ * correlation scale so that millimetres and radians weigh alike: a pivot
+ * stops the factor when what is left of every parameter's variance, once the
+ * ones before are known, is below FACTOR_TOL of its variance (a relative
+ * change of at most 1e-12 in any ellipsoid). Parameters with no variance
+ * (held) have no column. */
+#define FACTOR_TOL 1e-12
+static void factor_cov(cov_pack *p)
+{
+    const unsigned nn = p->nn;
+    double *A = p->c, sc[RC_MAX_PARAMS];
+    for (unsigned a = 0; a < nn; ++a) {
+        const double d = A[(size_t)a * nn + a];
+        sc[a] = d > 0.0 ? sqrt(d) : 0.0;
+    }
+    for (unsigned a = 0; a < nn; ++a)
+        for (unsigned b = 0; b < nn; ++b)
+            A[(size_t)a * nn + b] = sc[a] > 0.0 && sc[b] > 0.0 ? A[(size_t)a * nn + b] / (sc[a] * sc[b]) : 0.0;
+    unsigned c = 0;
+    for (; c < nn; ++c) {
+        unsigned q = c;
+        for (unsigned a = c + 1; a < nn; ++a)
+            if (A[(size_t)a * nn + a] > A[(size_t)q * nn + q])
+                q = a;
+        if (!(A[(size_t)q * nn + q] > FACTOR_TOL))
+            break;
+        if (q != c) { /* symmetric swap of rows and columns c, q */
+            for (unsigned b = 0; b < nn; ++b) {
+                const double t = A[(size_t)c * nn + b];
+                A[(size_t)c * nn + b] = A[(size_t)q * nn + b];
+                A[(size_t)q * nn + b] = t;
+            }
+            for (unsigned a = 0; a < nn; ++a) {
+                const double t = A[(size_t)a * nn + c];
+                A[(size_t)a * nn + c] = A[(size_t)a * nn + q];
+                A[(size_t)a * nn + q] = t;
+            }
+            const unsigned ti = p->idx[c];
+            p->idx[c] = p->idx[q];
+            p->idx[q] = ti;
+            const double ts = sc[c];
+            sc[c] = sc[q];
+            sc[q] = ts;
+        }
+        const double l = sqrt(A[(size_t)c * nn + c]);
+        A[(size_t)c * nn + c] = l;
+        for (unsigned a = c + 1; a < nn; ++a)
+            A[(size_t)a * nn + c] /= l;
+        for (unsigned a = c + 1; a < nn; ++a) /* the whole trailing block: a later swap reads both halves */
+            for (unsigned b = c + 1; b < nn; ++b)
+                A[(size_t)a * nn + b] -= A[(size_t)a * nn + c] * A[(size_t)b * nn + c];
+    }
+    p->r = c;
+    p->factored = 1;
+    for (unsigned a = 0; a < nn; ++a) /* back to the covariance's units */
+        for (unsigned k = 0; k < c && k <= a; ++k)
+            A[(size_t)a * nn + k] *= sc[a];
 }
 
 /* t0 += x * a0, t1 += x * a1, t2 += x * a2 over n entries (vectorises). */
@@ -518,7 +591,8 @@ static void axpy3(double *restrict t0, double *restrict t1, double *restrict t2,
 
 /* Longest semi-axis of the 95 % ellipsoid of J Cov J^T, J (3 x n, the
  * columns p->idx read), Cov packed in p: T = Cov J^T, then J T (upper
- * triangle) and its largest eigenvalue in closed form. */
+ * triangle); or, p factored, U = J F and U U^T; then its largest
+ * eigenvalue in closed form. */
 static double ellipsoid95(double J[3][RC_MAX_PARAMS], const cov_pack *p)
 {
     const unsigned nn = p->nn;
@@ -528,6 +602,18 @@ static double ellipsoid95(double J[3][RC_MAX_PARAMS], const cov_pack *p)
             jc[i][a] = J[i][p->idx[a]];
             T[i][a] = 0.0;
         }
+    if (p->factored) { /* T[i] = sum_a J[i][a] F[a] (row a of F: min(a + 1, r) entries) */
+        for (unsigned a = 0; a < nn; ++a)
+            axpy3(T[0], T[1], T[2], p->c + (size_t)a * nn, jc[0][a], jc[1][a], jc[2][a], a < p->r ? a + 1 : p->r);
+        for (int i = 0; i < 3; ++i)
+            for (int j = i; j < 3; ++j) {
+                double v = 0.0;
+                for (unsigned c = 0; c < p->r; ++c)
+                    v += T[i][c] * T[j][c];
+                C[i * 3 + j] = v;
+            }
+        return sqrt(CHI2_3_95 * fmax(rcu_sym3_eig_max(C), 0.0));
+    }
     /* T[i][a] = sum_b Cov[a][b] J[i][b], Cov symmetric: row b of Cov times
      * J[i][b] added to T[i] */
     for (unsigned b = 0; b < nn; ++b)
@@ -669,6 +755,9 @@ static int map_ctx_init(map_ctx *c, const rch_uncert *u)
     pack_cov(&c->pos, c->buf, u->cov, np, up, np);
     pack_cov(&c->rot, c->buf + (size_t)np * np, u->cov, np, ur, np);
     pack_cov(&c->det, c->buf + 2 * (size_t)np * np, u->cov, np, ud, np);
+    factor_cov(&c->pos);
+    factor_cov(&c->rot);
+    factor_cov(&c->det);
     return 0;
 }
 
