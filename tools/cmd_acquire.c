@@ -16,6 +16,7 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 
+static const char summary[] = "record cable lengths from the encoder display, pose by pose";
 static const char details[] =
     "For each pose of POSES.csv (q1..q6 in degrees): show it, write 'INDEX q1..q6' to --announce FILE (for a\n"
     "robot-side program; the simulated display follows it), wait --settle-ms or, with --confirm, for Enter; then\n"
@@ -129,6 +130,7 @@ int rcal_cmd_acquire(int argc, char **argv)
     rch_acq_config_default(&c);
     memset(&r, 0, sizeof r);
     c.robot_path = RCAL_DEFAULT_ROBOT;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--port", RCH_OPT_STR, &c.port_path, 0, 0, "PATH", "serial device", RCH_OPT_REQUIRED, NULL},
         {"--protocol", RCH_OPT_CHOICE, &proto, 0, 0, NULL, "display protocol", RCH_OPT_REQUIRED, "ascii|ascii-poll|stx|modbus"},
@@ -167,9 +169,7 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
          "the run summary as one JSON object on stdout (progress then goes to stderr)", 0, NULL},
     };
-    const rch_cmdspec spec = {"acquire", "record cable lengths from the encoder display, pose by pose", details,
-                              opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
     if (!(c.stable.min_mm < c.stable.max_mm)) {

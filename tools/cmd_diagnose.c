@@ -15,6 +15,7 @@
 #include "rch_opt.h"
 #include "rch_resid.h"
 
+static const char summary[] = "which missing physical effect explains the residuals";
 static const char details[] =
     "Fits the geometric model with K-fold cross-validation (folds random within set-up\n"
     "groups), compares the held-out residuals with the noise floor (length step and the\n"
@@ -129,6 +130,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
     int json = 0, verbose = 0;
     rch_diagnose_cfg cfg;
     memset(&cfg, 0, sizeof cfg);
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements CSV", RCH_OPT_REQUIRED, NULL},
         {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL", "nominal robot model", 0, NULL},
@@ -164,9 +166,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
         {"--verbose", RCH_OPT_FLAG, &verbose, 0, 0, NULL, "progress to stderr", 0, NULL},
         {"--verbosity", RCH_OPT_UINT, &verbosity, 0, 3, "V", "progress level (3: also singular values)", 0, NULL},
     };
-    const rch_cmdspec spec = {"diagnose", "which missing physical effect explains the residuals", details, opts,
-                              sizeof opts / sizeof opts[0]};
-    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    const int ps = rch_opt_cmd(&spec, "diagnose", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (ps >= 0)
         return ps;
     cfg.folds = (unsigned)folds;

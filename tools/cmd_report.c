@@ -13,6 +13,14 @@
 
 #define RCAL_REPORT_MAX_INPUTS 64 /* input files a run may name (several --data, robot, validate) */
 
+static const char summary[] = "an HTML report of a calibration: one self-contained file to hand on";
+static const char details[] =
+    "The page has its CSS inline and every plot as inline SVG: no script, no font, image or link that\n"
+    "leaves the file. Sections: data, split, before/after metrics, the identified parameters with\n"
+    "their standard errors, 95 % intervals and identifiability, the diagnosis, the predicted accuracy\n"
+    "over the workspace, warnings, provenance. Members a run does not carry say \"not in this run\".\n"
+    "The data of every plot is written beside the page as report_<plot>.csv. See docs/report.md.";
+
 /* path's name without a .html or .htm ending, followed by suffix. */
 static void beside(char *buf, size_t len, const char *path, const char *suffix)
 {
@@ -84,6 +92,7 @@ int rcal_cmd_report(int argc, char **argv)
 {
     rch_report_cfg cfg = {NULL, NULL, NULL, NULL, NULL, NULL};
     int json = 0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--calibration", RCH_OPT_STR, &cfg.cal_path, 0, 0, "CAL.json", "the output of rcal calibrate --json",
          RCH_OPT_REQUIRED, NULL},
@@ -97,15 +106,7 @@ int rcal_cmd_report(int argc, char **argv)
          "the HTML page (written whole or not at all, never over an input)", RCH_OPT_REQUIRED, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was written, as one JSON object on stdout", 0, NULL},
     };
-    const rch_cmdspec spec = {
-        "report", "an HTML report of a calibration: one self-contained file to hand on",
-        "The page has its CSS inline and every plot as inline SVG: no script, no font, image or link that\n"
-        "leaves the file. Sections: data, split, before/after metrics, the identified parameters with\n"
-        "their standard errors, 95 % intervals and identifiability, the diagnosis, the predicted accuracy\n"
-        "over the workspace, warnings, provenance. Members a run does not carry say \"not in this run\".\n"
-        "The data of every plot is written beside the page as report_<plot>.csv. See docs/report.md.",
-        opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "report", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
     char args[4000], cmdline[4096];
