@@ -69,12 +69,11 @@ static void unescape(char *dst, size_t cap, const char *src)
 static int report_json(const rch_acq_result *r, const rch_acq_config *c, const char *proto, int rc, int argc,
                        char **argv)
 {
+    const char *const files[] = {"out", c->out_path, "poses_file", c->poses_path, "port", c->port_path,
+                                 "protocol", proto, NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-acquire/1", argc, argv);
-    rch_jw_str(&w, "out", c->out_path);
-    rch_jw_str(&w, "poses_file", c->poses_path);
-    rch_jw_str(&w, "port", c->port_path);
-    rch_jw_str(&w, "protocol", proto);
+    rch_jw_strs(&w, files);
     rch_jw_int(&w, "exit", rc);
     rch_jw_bool(&w, "complete", rc == 0 && r->n_new + r->n_before == r->n_poses);
     rch_jw_bool(&w, "stopped", r->stopped);

@@ -34,19 +34,6 @@ static int write_model(const rch_calib_result *r, const char *out_path, int quie
 static const char summary[] = "identify the DH errors and the encoder position from cable lengths";
 static const char details[] = "mean|e| is what the paper's Eq. 20 calls SD; SD is the true standard deviation.";
 
-/* --report: the run's JSON, as --json prints it. */
-typedef struct {
-    const rch_calib_result *r;
-    int argc;
-    char **argv;
-} calib_json_ctx;
-
-static int calib_json_cb(FILE *f, const void *ctx)
-{
-    const calib_json_ctx *c = ctx;
-    return rch_calib_json(f, c->r, c->argc, c->argv);
-}
-
 /* Options of rcal calibrate into cfg (and out_path, json, data). Returns -1
  * when the command should run, else its exit status (0 for --help, 2 for an
  * error). */
@@ -187,12 +174,11 @@ int rcal_cmd_calibrate(int argc, char **argv)
     else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
         status = 1;
     else if (a.report_path && r->finite) {
-        const calib_json_ctx ctx = {r, argc, argv};
         const char *inputs[RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
         for (size_t i = 0; i < a.data.n; ++i)
             inputs[3 + i] = a.data.v[i];
-        if (rcal_report_inline(a.report_path, calib_json_cb, &ctx, NULL, NULL, r->finite ? a.out_path : NULL, inputs,
-                               3 + a.data.n, a.json) != 0)
+        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs, 3 + a.data.n,
+                               a.json) != 0)
             status = 1;
     }
     if (a.cfg.residuals_path && !r->finite)

@@ -86,13 +86,12 @@ static void json_targets(rch_jw *w, const char *warnings)
 static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int rc, const char *warnings, int argc,
                         char **argv)
 {
+    const char *const files[] = {"model", job->model_path, "nominal", job->nominal_path, "in", job->in_path,
+                                 "out", job->out_path, "input_format", r->format == RCH_COMP_RAPID ? "rapid" : "csv",
+                                 NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
-    rch_jw_str(&w, "model", job->model_path);
-    rch_jw_str(&w, "nominal", job->nominal_path);
-    rch_jw_str(&w, "in", job->in_path);
-    rch_jw_str(&w, "out", job->out_path);
-    rch_jw_str(&w, "input_format", r->format == RCH_COMP_RAPID ? "rapid" : "csv");
+    rch_jw_strs(&w, files);
     rch_jw_int(&w, "exit", rc == 0 ? 0 : 1);
     rch_jw_uint(&w, "targets", r->n + r->n_uncertain + r->n_robtargets);
     rch_jw_uint(&w, "corrected", r->n - r->n_fail);

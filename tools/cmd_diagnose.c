@@ -60,24 +60,6 @@ static int save_residuals(const rch_diagnose_result *r, const char *data_path, c
     return rc;
 }
 
-typedef struct {
-    const void *r; /* rch_diagnose_result or rch_calib_result */
-    int argc;
-    char **argv;
-} json_ctx;
-
-static int diag_json_cb(FILE *f, const void *ctx)
-{
-    const json_ctx *c = ctx;
-    return rch_diagnose_json(f, c->r, c->argc, c->argv);
-}
-
-static int calib_json_cb(FILE *f, const void *ctx)
-{
-    const json_ctx *c = ctx;
-    return rch_calib_json(f, c->r, c->argc, c->argv);
-}
-
 /* --report: the page needs a calibration; it is the one `rcal calibrate
  * --data D --robot R --seed S` makes (with --dequantize-joints when given). */
 static int diagnose_report(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
@@ -97,9 +79,8 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
         free(c);
         return 1;
     }
-    const json_ctx cx = {c, argc, argv}, dx = {r, argc, argv}; /* both made by this command line */
     const char *const inputs[2] = {data_path, robot_path};
-    const int rc = rcal_report_inline(html, calib_json_cb, &cx, diag_json_cb, &dx, NULL, inputs, 2, quiet);
+    const int rc = rcal_report_inline(html, c, r, argc, argv, NULL, inputs, 2, quiet);
     free(c);
     return rc;
 }

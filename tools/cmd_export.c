@@ -23,12 +23,11 @@ static int report_json(const rch_export_result *res, const char *model, const ch
                        const char *nominal, int drop, int argc, char **argv)
 {
     const int urdf = strcmp(format, "urdf") == 0;
+    const char *const files[] = {"model", model, "export_format", format, "out", out_path, "nominal_urdf", nominal,
+                                 NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-export/1", argc, argv);
-    rch_jw_str(&w, "model", model);
-    rch_jw_str(&w, "export_format", format);
-    rch_jw_str(&w, "out", out_path);
-    rch_jw_str(&w, "nominal_urdf", nominal);
+    rch_jw_strs(&w, files);
     if (urdf)
         rch_jw_uint(&w, "joints", res->n_joints);
     else
