@@ -16,6 +16,7 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 
+static const char summary[] = "record cable lengths from the encoder display, pose by pose";
 static const char details[] =
     "For each pose of POSES.csv (q1..q6 in degrees): show it, write 'INDEX q1..q6' to --announce FILE (for a\n"
     "robot-side program; the simulated display follows it), wait --settle-ms or, with --confirm, for Enter; then\n"
@@ -68,12 +69,11 @@ static void unescape(char *dst, size_t cap, const char *src)
 static int report_json(const rch_acq_result *r, const rch_acq_config *c, const char *proto, int rc, int argc,
                        char **argv)
 {
+    const char *const files[] = {"out", c->out_path, "poses_file", c->poses_path, "port", c->port_path,
+                                 "protocol", proto, NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-acquire/1", argc, argv);
-    rch_jw_str(&w, "out", c->out_path);
-    rch_jw_str(&w, "poses_file", c->poses_path);
-    rch_jw_str(&w, "port", c->port_path);
-    rch_jw_str(&w, "protocol", proto);
+    rch_jw_strs(&w, files);
     rch_jw_int(&w, "exit", rc);
     rch_jw_bool(&w, "complete", rc == 0 && r->n_new + r->n_before == r->n_poses);
     rch_jw_bool(&w, "stopped", r->stopped);
@@ -129,6 +129,7 @@ int rcal_cmd_acquire(int argc, char **argv)
     rch_acq_config_default(&c);
     memset(&r, 0, sizeof r);
     c.robot_path = RCAL_DEFAULT_ROBOT;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--port", RCH_OPT_STR, &c.port_path, 0, 0, "PATH", "serial device", RCH_OPT_REQUIRED, NULL},
         {"--protocol", RCH_OPT_CHOICE, &proto, 0, 0, NULL, "display protocol", RCH_OPT_REQUIRED, "ascii|ascii-poll|stx|modbus"},
@@ -167,9 +168,7 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
          "the run summary as one JSON object on stdout (progress then goes to stderr)", 0, NULL},
     };
-    const rch_cmdspec spec = {"acquire", "record cable lengths from the encoder display, pose by pose", details,
-                              opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
     if (!(c.stable.min_mm < c.stable.max_mm)) {

@@ -12,6 +12,11 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 
+static const char summary[] = "calibration speed: median/min/max wall time of full calibrations per method";
+static const char details[] = "'start' = encoder guess + encoder-only fit; 'solve' = the identification itself;\n"
+                              "'calibrate' = the whole calibrate path without printing (rch_calib_run).\n"
+                              "Whole processes against Ceres: scripts/bench_ceres.sh.";
+
 static void report_text(const rch_bench_result *r, const char *data_path)
 {
     printf("rcal bench: %s, %zu samples, %lu runs each, one core\n", data_path, r->n_samples, r->runs);
@@ -62,18 +67,14 @@ int rcal_cmd_bench(int argc, char **argv)
 {
     rch_bench_cfg cfg = {"../shared/data/robotcali.csv", RCAL_DEFAULT_ROBOT, 21};
     int json = 0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STR, &cfg.data_path, 0, 0, "FILE", "measurements (all samples are fitted)", 0, NULL},
         {"--robot", RCH_OPT_STR, &cfg.robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
         {"--runs", RCH_OPT_UINT, &cfg.runs, 1, 10000, "N", "repetitions of each measurement", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
     };
-    const rch_cmdspec spec = {"bench", "calibration speed: median/min/max wall time of full calibrations per method",
-                              "'start' = encoder guess + encoder-only fit; 'solve' = the identification itself;\n"
-                              "'calibrate' = the whole calibrate path without printing (rch_calib_run).\n"
-                              "Whole processes against Ceres: scripts/bench_ceres.sh.",
-                              opts, sizeof opts / sizeof opts[0]};
-    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    const int ps = rch_opt_cmd(&spec, "bench", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (ps >= 0)
         return ps;
     static rch_bench_result r;

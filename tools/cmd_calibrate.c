@@ -31,21 +31,12 @@ static int write_model(const rch_calib_result *r, const char *out_path, int quie
     return 0;
 }
 
-/* --report: the run's JSON, as --json prints it. */
-typedef struct {
-    const rch_calib_result *r;
-    int argc;
-    char **argv;
-} calib_json_ctx;
+static const char summary[] = "identify the DH errors and the encoder position from cable lengths";
+static const char details[] = "mean|e| is what the paper's Eq. 20 calls SD; SD is the true standard deviation.";
 
-static int calib_json_cb(FILE *f, const void *ctx)
-{
-    const calib_json_ctx *c = ctx;
-    return rch_calib_json(f, c->r, c->argc, c->argv);
-}
-
-/* Options of rcal calibrate into cfg (and out_path, json, data). Returns
- * RCH_OPT_OK, or the status to return (0 for --help, 2 for an error). */
+/* Options of rcal calibrate into cfg (and out_path, json, data). Returns -1
+ * when the command should run, else its exit status (0 for --help, 2 for an
+ * error). */
 typedef struct {
     rch_calib_cfg cfg;
     const char *out_path, *method, *report_path;
@@ -54,9 +45,10 @@ typedef struct {
     int json;
 } calib_args;
 
-static rch_opt_status parse(calib_args *a, int argc, char **argv)
+static int parse(calib_args *a, int argc, char **argv)
 {
     rch_calib_cfg *cfg = &a->cfg;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STRS, &a->data, 0, 0, "FILE",
          "measurements: CSV with q1..q6 (deg) and L (mm); several --data are merged (set-up groups never span two files)",
@@ -111,14 +103,11 @@ static rch_opt_status parse(calib_args *a, int argc, char **argv)
          "also the HTML page of rcal report, from this run (its JSON kept beside it as FILE.calibration.json)", 0,
          NULL},
     };
-    const rch_cmdspec spec = {"calibrate", "identify the DH errors and the encoder position from cable lengths",
-                              "mean|e| is what the paper's Eq. 20 calls SD; SD is the true standard deviation.",
-                              opts, sizeof opts / sizeof opts[0]};
-    const rch_opt_status ps = rch_opt_parse(&spec, argc, argv, NULL, stdout, stderr);
-    if (ps != RCH_OPT_OK)
+    const int ps = rch_opt_cmd(&spec, "calibrate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
+    if (ps >= 0)
         return ps;
     if (rch_method_parse(&cfg->method, a->method) != 0)
-        return RCH_OPT_ERROR; /* unreachable: the choice list is the method list */
+        return 2; /* unreachable: the choice list is the method list */
     cfg->seed = a->seed;
     cfg->max_iter = (unsigned)a->max_iter;
     cfg->cases = a->cases;
@@ -126,7 +115,7 @@ static rch_opt_status parse(calib_args *a, int argc, char **argv)
     cfg->data_path = a->data.v[0];
     cfg->data_paths = a->data.v;
     cfg->n_data_paths = a->data.n;
-    return RCH_OPT_OK;
+    return -1;
 }
 
 /* 1 (with the message) when --out, --residuals or --report names one of the inputs. */
@@ -165,9 +154,9 @@ int rcal_cmd_calibrate(int argc, char **argv)
     a.method = "lm";
     a.seed = 1;
     a.cases = 1;
-    const rch_opt_status ps = parse(&a, argc, argv);
-    if (ps != RCH_OPT_OK)
-        return ps == RCH_OPT_HELP ? 0 : 2;
+    const int ps = parse(&a, argc, argv);
+    if (ps >= 0)
+        return ps;
     if (out_is_input(&a))
         return 2;
     rch_calib_result *r = malloc(sizeof *r); /* large: two models, the identifiability report */
@@ -185,12 +174,11 @@ int rcal_cmd_calibrate(int argc, char **argv)
     else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
         status = 1;
     else if (a.report_path && r->finite) {
-        const calib_json_ctx ctx = {r, argc, argv};
         const char *inputs[RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
         for (size_t i = 0; i < a.data.n; ++i)
             inputs[3 + i] = a.data.v[i];
-        if (rcal_report_inline(a.report_path, calib_json_cb, &ctx, NULL, NULL, r->finite ? a.out_path : NULL, inputs,
-                               3 + a.data.n, a.json) != 0)
+        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs, 3 + a.data.n,
+                               a.json) != 0)
             status = 1;
     }
     if (a.cfg.residuals_path && !r->finite)

@@ -10,8 +10,8 @@
 #include "rch_opt.h"
 
 /* the usage text: rch_opt_usage prints the option table between these */
-static const char chaos_summary[] = "uniformity of the logistic-tent map (paper Eq. 11) for r in [0, 4]";
-static const char chaos_details[] =
+static const char summary[] = "uniformity of the logistic-tent map (paper Eq. 11) for r in [0, 4]";
+static const char details[] =
     "The standard deviation of the bin counts of --points iterates in --bins bins (Eq. 12), averaged\n"
     "over --starts initial values; the histogram at --r. The study may take at most 1e9 map iterations\n"
     "((4 / --step + 2) x --starts x --points, about 8 s); larger requests are refused.";
@@ -26,6 +26,7 @@ int rcal_cmd_chaos(int argc, char **argv)
     unsigned long seed = 1;
     int json = 0;
     rch_chaos_defaults(&cfg);
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--r", RCH_OPT_DOUBLE, &cfg.r_hist, 0, 4, "R", "r of the histogram (not given: the minimiser)", 0, NULL},
         {"--points", RCH_OPT_UINT, &cfg.points, 1, 1e7, NULL, "iterates per initial value", 0, NULL},
@@ -36,8 +37,7 @@ int rcal_cmd_chaos(int argc, char **argv)
         {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "chaos_sd.svg and chaos_hist.svg, each with its data as .csv", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
     };
-    const rch_cmdspec spec = {"chaos", chaos_summary, chaos_details, opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "chaos", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st; /* usage printed, or the error named */
     cfg.seed = seed;

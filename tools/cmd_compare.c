@@ -18,8 +18,8 @@
 #include "rch_robot.h"
 
 /* the usage text: rch_opt_usage prints the option table between these */
-static const char compare_summary[] = "the LTLM paper's comparison of seven identification methods on your data";
-static const char compare_details[] =
+static const char summary[] = "the LTLM paper's comparison of seven identification methods on your data";
+static const char details[] =
     "In each case --samples rows are drawn at random, --test-fraction of them held out, every method\n"
     "fitted from the same start (nominal DH + encoder fitted alone) on the rest; the report gives the\n"
     "held-out errors (mean +- std over --cases cases) and times. The paper's other protocol:\n"
@@ -117,6 +117,7 @@ int rcal_cmd_compare(int argc, char **argv)
     unsigned long cases = 10, samples = 300, seed = 1;
     double test_fraction = 0.1;
     int json = 0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements (CSV with q1..q6 in deg and L in mm)",
          RCH_OPT_REQUIRED, NULL},
@@ -142,10 +143,9 @@ int rcal_cmd_compare(int argc, char **argv)
          "case 1's rows (test and train) with the BC residual and one column per method; never over an input", 0,
          NULL},
     };
-    const rch_cmdspec spec = {"compare", compare_summary, compare_details, opts, sizeof opts / sizeof opts[0]};
     rch_compare_config cfg;
     rch_diag d;
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "compare", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st; /* usage printed, or the error named */
     rch_compare_defaults(&cfg);

@@ -12,6 +12,15 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 
+static const char summary[] =
+    "correct joint targets computed with the nominal model so that the calibrated robot reaches the nominal "
+    "flange pose: q' with FK_cal(q') = FK_nom(q)";
+static const char details[] =
+    "Input: csv lines of q1..q6 in degrees, with or without a header (other columns are copied), or ABB RAPID "
+    "jointtarget declarations (other lines are copied). A target that does not converge is written as the "
+    "target plus the last good correction, with a warning naming the cause and its position error; the exit "
+    "status is then 1.";
+
 /* Which parameters the corrections came from (issue 10). */
 static void print_sources(const rch_comp_result *r, const char *model)
 {
@@ -77,13 +86,12 @@ static void json_targets(rch_jw *w, const char *warnings)
 static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int rc, const char *warnings, int argc,
                         char **argv)
 {
+    const char *const files[] = {"model", job->model_path, "nominal", job->nominal_path, "in", job->in_path,
+                                 "out", job->out_path, "input_format", r->format == RCH_COMP_RAPID ? "rapid" : "csv",
+                                 NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
-    rch_jw_str(&w, "model", job->model_path);
-    rch_jw_str(&w, "nominal", job->nominal_path);
-    rch_jw_str(&w, "in", job->in_path);
-    rch_jw_str(&w, "out", job->out_path);
-    rch_jw_str(&w, "input_format", r->format == RCH_COMP_RAPID ? "rapid" : "csv");
+    rch_jw_strs(&w, files);
     rch_jw_int(&w, "exit", rc == 0 ? 0 : 1);
     rch_jw_uint(&w, "targets", r->n + r->n_uncertain + r->n_robtargets);
     rch_jw_uint(&w, "corrected", r->n - r->n_fail);
@@ -159,8 +167,9 @@ int rcal_cmd_compensate(int argc, char **argv)
 {
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
-    int position_only = 0, full_pose = 0, summary = 0, accept_rt = 0, json = 0;
+    int position_only = 0, full_pose = 0, want_summary = 0, accept_rt = 0, json = 0;
     double max_unc_mm = 1.0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/2 or /1, from rcal calibrate --out)",
          RCH_OPT_REQUIRED, NULL},
@@ -185,22 +194,13 @@ int rcal_cmd_compensate(int argc, char **argv)
          "failure",
          0, NULL},
         {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
-        {"--summary", RCH_OPT_FLAG, &summary, 0, 0, NULL, "targets, iterations, largest correction and time on stderr",
+        {"--summary", RCH_OPT_FLAG, &want_summary, 0, 0, NULL, "targets, iterations, largest correction and time on stderr",
          0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
          "the summary as one JSON object on stdout (needs --out FILE: the targets do not share stdout)", 0, NULL},
     };
-    const rch_cmdspec spec = {
-        "compensate",
-        "correct joint targets computed with the nominal model so that the calibrated robot reaches the nominal "
-        "flange pose: q' with FK_cal(q') = FK_nom(q)",
-        "Input: csv lines of q1..q6 in degrees, with or without a header (other columns are copied), or ABB RAPID "
-        "jointtarget declarations (other lines are copied). A target that does not converge is written as the "
-        "target plus the last good correction, with a warning naming the cause and its position error; the exit "
-        "status is then 1.",
-        opts, sizeof opts / sizeof opts[0]};
     unsigned long long seen = 0;
-    const int ps = rch_opt_main(&spec, argc, argv, &seen);
+    const int ps = rch_opt_cmd(&spec, "compensate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (ps >= 0)
         return ps;
     if (!args_fit(position_only, full_pose, json, out))
@@ -226,7 +226,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         free(warn_text);
         return 1;
     }
-    if (summary) {
+    if (want_summary) {
         print_sources(&r, model);
         print_summary(&r);
     }

@@ -15,6 +15,7 @@
 #include "rch_opt.h"
 #include "rch_resid.h"
 
+static const char summary[] = "which missing physical effect explains the residuals";
 static const char details[] =
     "Fits the geometric model with K-fold cross-validation (folds random within set-up\n"
     "groups), compares the held-out residuals with the noise floor (length step and the\n"
@@ -59,24 +60,6 @@ static int save_residuals(const rch_diagnose_result *r, const char *data_path, c
     return rc;
 }
 
-typedef struct {
-    const void *r; /* rch_diagnose_result or rch_calib_result */
-    int argc;
-    char **argv;
-} json_ctx;
-
-static int diag_json_cb(FILE *f, const void *ctx)
-{
-    const json_ctx *c = ctx;
-    return rch_diagnose_json(f, c->r, c->argc, c->argv);
-}
-
-static int calib_json_cb(FILE *f, const void *ctx)
-{
-    const json_ctx *c = ctx;
-    return rch_calib_json(f, c->r, c->argc, c->argv);
-}
-
 /* --report: the page needs a calibration; it is the one `rcal calibrate
  * --data D --robot R --seed S` makes (with --dequantize-joints when given). */
 static int diagnose_report(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
@@ -96,9 +79,8 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
         free(c);
         return 1;
     }
-    const json_ctx cx = {c, argc, argv}, dx = {r, argc, argv}; /* both made by this command line */
     const char *const inputs[2] = {data_path, robot_path};
-    const int rc = rcal_report_inline(html, calib_json_cb, &cx, diag_json_cb, &dx, NULL, inputs, 2, quiet);
+    const int rc = rcal_report_inline(html, c, r, argc, argv, NULL, inputs, 2, quiet);
     free(c);
     return rc;
 }
@@ -129,6 +111,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
     int json = 0, verbose = 0;
     rch_diagnose_cfg cfg;
     memset(&cfg, 0, sizeof cfg);
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements CSV", RCH_OPT_REQUIRED, NULL},
         {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL", "nominal robot model", 0, NULL},
@@ -164,9 +147,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
         {"--verbose", RCH_OPT_FLAG, &verbose, 0, 0, NULL, "progress to stderr", 0, NULL},
         {"--verbosity", RCH_OPT_UINT, &verbosity, 0, 3, "V", "progress level (3: also singular values)", 0, NULL},
     };
-    const rch_cmdspec spec = {"diagnose", "which missing physical effect explains the residuals", details, opts,
-                              sizeof opts / sizeof opts[0]};
-    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    const int ps = rch_opt_cmd(&spec, "diagnose", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (ps >= 0)
         return ps;
     cfg.folds = (unsigned)folds;

@@ -13,6 +13,11 @@
 #include "rch_resid.h"
 #include "rch_robot.h"
 
+static const char summary[] = "a calibrated model on new data, without refitting the robot";
+static const char details[] =
+    "RMSE, mean |e|, SD and MAX of the cable-length residuals, and the ISO 9283 distance\n"
+    "accuracy and repeatability where poses were read more than once.";
+
 static int report_json(const rch_evaluate_result *r, const char *model, const char *data, int argc, char **argv)
 {
     rch_jw w;
@@ -64,6 +69,7 @@ int rcal_cmd_evaluate(int argc, char **argv)
     const char *model_path = NULL, *data_path = NULL, *resid_path = NULL;
     int refit = 0, json = 0;
     double same_deg = 1e-6;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model_path, 0, 0, "MODEL.json", "calibrated model", RCH_OPT_REQUIRED, NULL},
         {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE.csv", "measurements the fit never saw", RCH_OPT_REQUIRED, NULL},
@@ -75,11 +81,7 @@ int rcal_cmd_evaluate(int argc, char **argv)
          "each sample's residual (set validate; with the refitted outlet when --refit-encoder); never over an input",
          0, NULL},
     };
-    const rch_cmdspec spec = {"evaluate", "a calibrated model on new data, without refitting the robot",
-                              "RMSE, mean |e|, SD and MAX of the cable-length residuals, and the ISO 9283 distance\n"
-                              "accuracy and repeatability where poses were read more than once.",
-                              opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "evaluate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
     rch_robot robot;

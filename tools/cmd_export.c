@@ -10,17 +10,24 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 
+static const char summary[] = "export a model as a URDF or as a DH table in CSV";
+static const char details[] =
+    "URDF: joint origins from the model's DH table (lengths in m, angles in rad, %.17g), the joint-zero\n"
+    "offsets folded into the origins' yaw; the robot, joint and link names of --nominal-urdf when given,\n"
+    "else joint_1..joint_6, link_0..link_6, flange. DH CSV: one row per parameter with the nominal,\n"
+    "calibrated and correction values (mm, deg) and the standard error when the model has one.\n"
+    "See docs/export.md.";
+
 /* What was written, as one JSON object on stdout (rcal-export/1). */
 static int report_json(const rch_export_result *res, const char *model, const char *format, const char *out_path,
                        const char *nominal, int drop, int argc, char **argv)
 {
     const int urdf = strcmp(format, "urdf") == 0;
+    const char *const files[] = {"model", model, "export_format", format, "out", out_path, "nominal_urdf", nominal,
+                                 NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-export/1", argc, argv);
-    rch_jw_str(&w, "model", model);
-    rch_jw_str(&w, "export_format", format);
-    rch_jw_str(&w, "out", out_path);
-    rch_jw_str(&w, "nominal_urdf", nominal);
+    rch_jw_strs(&w, files);
     if (urdf)
         rch_jw_uint(&w, "joints", res->n_joints);
     else
@@ -36,6 +43,7 @@ int rcal_cmd_export(int argc, char **argv)
 {
     const char *model = NULL, *format = NULL, *out_path = "-", *nominal = NULL;
     int drop = 0, json = 0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "M.json", "the model to export (rcal calibrate --out, or a robot file)",
          RCH_OPT_REQUIRED, NULL},
@@ -50,15 +58,7 @@ int rcal_cmd_export(int argc, char **argv)
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was written, as one JSON object on stdout (needs --out FILE)",
          0, NULL},
     };
-    const rch_cmdspec spec = {
-        "export", "export a model as a URDF or as a DH table in CSV",
-        "URDF: joint origins from the model's DH table (lengths in m, angles in rad, %.17g), the joint-zero\n"
-        "offsets folded into the origins' yaw; the robot, joint and link names of --nominal-urdf when given,\n"
-        "else joint_1..joint_6, link_0..link_6, flange. DH CSV: one row per parameter with the nominal,\n"
-        "calibrated and correction values (mm, deg) and the standard error when the model has one.\n"
-        "See docs/export.md.",
-        opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "export", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
     const rch_export_format fmt = strcmp(format, "urdf") == 0 ? RCH_EXPORT_URDF : RCH_EXPORT_DH_CSV;

@@ -10,6 +10,7 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 
+static const char summary[] = "compare the nominal FK at each row's joint angles with its x, y, z";
 static const char details[] = "A row further than T mm is a fault unless a joint change within the 0.1 deg\n"
                               "display rounding explains it. Exit status: 0 no fault, 3 faults found (listed),\n"
                               "1 the check could not run, 2 usage.";
@@ -58,6 +59,7 @@ int rcal_cmd_fkcheck(int argc, char **argv)
     const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT;
     double tol_mm = 0.5;
     int json = 0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements with x, y, z columns", RCH_OPT_REQUIRED,
          NULL},
@@ -65,9 +67,7 @@ int rcal_cmd_fkcheck(int argc, char **argv)
         {"--tol-mm", RCH_OPT_DOUBLE, &tol_mm, 0, 1e6, "T", "rows further than T mm are listed", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
     };
-    const rch_cmdspec spec = {"fkcheck", "compare the nominal FK at each row's joint angles with its x, y, z",
-                              details, opts, sizeof opts / sizeof opts[0]};
-    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    const int ps = rch_opt_cmd(&spec, "fkcheck", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (ps >= 0)
         return ps;
     rch_fkcheck_result r;

@@ -19,8 +19,8 @@
 #endif
 
 /* the usage text: rch_opt_usage prints the option table between these */
-static const char grind_summary[] = "the grinding-path experiment (the paper's Table 8) on a simulated true robot";
-static const char grind_details[] =
+static const char summary[] = "the grinding-path experiment (the paper's Table 8) on a simulated true robot";
+static const char details[] =
     "--surface NAME[:key=value,...] (lengths mm, angles deg); NAME one of\n"
     "  plane     z = z0\n"
     "  tilted    z = z0 + tan(ax) (x - cx) + tan(ay) (y - cy)                    ax=15 ay=0\n"
@@ -95,6 +95,7 @@ int rcal_cmd_grind(int argc, char **argv)
     rch_grind_config cfg;
     rch_diag d;
     rch_grind_defaults(&cfg);
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STRS, &model_paths, 0, 0, "MODEL.json",
          "calibrated model used for compensation (rcal calibrate --out); repeat it for the Table 8 form, a row each",
@@ -116,8 +117,7 @@ int rcal_cmd_grind(int argc, char **argv)
          "keep the calibrated model's base heading and height as identified", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the table", 0, NULL},
     };
-    const rch_cmdspec spec = {"grind", grind_summary, grind_details, opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "grind", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st; /* usage printed, or the error named */
     if (rch_surface_parse(&cfg.surface, spec_s, &d) != 0) {

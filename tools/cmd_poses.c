@@ -20,6 +20,7 @@
 #include "rch_poses.h"
 #include "rch_robot.h"
 
+static const char summary[] = "plan an identifiable pose set (D-optimal)";
 static const char details[] =
     "Plans N poses inside the joint limits of MODEL less --margin-deg whose cable length (encoder at the\n"
     "file's encoder_mm, else --encoder) is within [--len-min-mm, --len-max-mm], chosen among M random candidates\n"
@@ -59,6 +60,7 @@ int rcal_cmd_poses(int argc, char **argv)
     double enc[3] = {250.0, -460.0, 10.0};
     rch_poses_config pc = {0, 0, 4, 1, 250, 800, 5};
     int json = 0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--count", RCH_OPT_UINT, &n, 1, RCH_POSES_MAX_COUNT, "N", "poses to plan", RCH_OPT_REQUIRED, NULL},
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "POSES.csv", "the plan", RCH_OPT_REQUIRED, NULL},
@@ -73,15 +75,13 @@ int rcal_cmd_poses(int argc, char **argv)
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was planned and written, as one JSON object on stdout", 0,
          NULL},
     };
-    const rch_cmdspec spec = {"poses", "plan an identifiable pose set (D-optimal)", details, opts,
-                              sizeof opts / sizeof opts[0]};
     rch_poses_result res;
     rch_robot *robot;
     rch_diag dg;
     rch_out out;
     char dbuf[900];
     int rc = 1;
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "poses", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
     pc.count = n;

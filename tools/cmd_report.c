@@ -6,12 +6,22 @@
 #include <string.h>
 
 #include "rcal_cmds.h"
+#include "rch_calib.h"
+#include "rch_diagnose.h"
 #include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_report.h"
 #include "rch_save.h"
 
 #define RCAL_REPORT_MAX_INPUTS 64 /* input files a run may name (several --data, robot, validate) */
+
+static const char summary[] = "an HTML report of a calibration: one self-contained file to hand on";
+static const char details[] =
+    "The page has its CSS inline and every plot as inline SVG: no script, no font, image or link that\n"
+    "leaves the file. Sections: data, split, before/after metrics, the identified parameters with\n"
+    "their standard errors, 95 % intervals and identifiability, the diagnosis, the predicted accuracy\n"
+    "over the workspace, warnings, provenance. Members a run does not carry say \"not in this run\".\n"
+    "The data of every plot is written beside the page as report_<plot>.csv. See docs/report.md.";
 
 /* path's name without a .html or .htm ending, followed by suffix. */
 static void beside(char *buf, size_t len, const char *path, const char *suffix)
@@ -24,10 +34,24 @@ static void beside(char *buf, size_t len, const char *path, const char *suffix)
     snprintf(buf, len, "%.*s%s", (int)n, path, suffix);
 }
 
-int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, rcal_json_fn diag,
-                       const void *diag_ctx, const char *model, const char *const *inputs, size_t n_inputs,
+/* rch_save writers of the run's JSON; ctx is an rch_jw_cmd. */
+static int calib_json_cb(FILE *f, const void *ctx)
+{
+    const rch_jw_cmd *c = ctx;
+    return rch_calib_json(f, c->result, c->argc, c->argv);
+}
+
+static int diag_json_cb(FILE *f, const void *ctx)
+{
+    const rch_jw_cmd *c = ctx;
+    return rch_diagnose_json(f, c->result, c->argc, c->argv);
+}
+
+int rcal_report_inline(const char *html, const struct rch_calib_result *cal, const struct rch_diagnose_result *diag,
+                       int argc, char **argv, const char *model, const char *const *inputs, size_t n_inputs,
                        int quiet)
 {
+    const rch_jw_cmd cal_ctx = {cal, argc, argv}, diag_ctx = {diag, argc, argv}; /* both made by this command line */
     char cal_path[1100], diag_path[1100], msg[1024];
     rch_diag d;
     memset(&d, 0, sizeof d);
@@ -43,8 +67,8 @@ int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, 
     ins[n_ins++] = model;
     for (size_t i = 0; i < n_inputs && n_ins < RCAL_REPORT_MAX_INPUTS + 1; ++i)
         ins[n_ins++] = inputs[i];
-    if (rch_save(cal_path, "--report (its calibration JSON)", ins, n_ins, cal, cal_ctx, &d) != 0 ||
-        (diag && rch_save(diag_path, "--report (its diagnosis JSON)", ins, n_ins, diag, diag_ctx, &d) != 0)) {
+    if (rch_save(cal_path, "--report (its calibration JSON)", ins, n_ins, calib_json_cb, &cal_ctx, &d) != 0 ||
+        (diag && rch_save(diag_path, "--report (its diagnosis JSON)", ins, n_ins, diag_json_cb, &diag_ctx, &d) != 0)) {
         fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
@@ -63,12 +87,11 @@ int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, 
 /* What was written, as one JSON object on stdout (rcal-report/1). */
 static int report_json(const rch_report_result *res, const rch_report_cfg *cfg, int argc, char **argv)
 {
+    const char *const files[] = {"calibration", cfg->cal_path, "diagnosis", cfg->diag_path, "model", cfg->model_path,
+                                 "out", cfg->out_path, NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-report/1", argc, argv);
-    rch_jw_str(&w, "calibration", cfg->cal_path);
-    rch_jw_str(&w, "diagnosis", cfg->diag_path);
-    rch_jw_str(&w, "model", cfg->model_path);
-    rch_jw_str(&w, "out", cfg->out_path);
+    rch_jw_strs(&w, files);
     rch_jw_arr(&w, "plot_data");
     for (unsigned k = 0; k < res->n_csv; ++k)
         rch_jw_str(&w, NULL, res->csv[k]);
@@ -84,6 +107,7 @@ int rcal_cmd_report(int argc, char **argv)
 {
     rch_report_cfg cfg = {NULL, NULL, NULL, NULL, NULL, NULL};
     int json = 0;
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--calibration", RCH_OPT_STR, &cfg.cal_path, 0, 0, "CAL.json", "the output of rcal calibrate --json",
          RCH_OPT_REQUIRED, NULL},
@@ -97,15 +121,7 @@ int rcal_cmd_report(int argc, char **argv)
          "the HTML page (written whole or not at all, never over an input)", RCH_OPT_REQUIRED, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was written, as one JSON object on stdout", 0, NULL},
     };
-    const rch_cmdspec spec = {
-        "report", "an HTML report of a calibration: one self-contained file to hand on",
-        "The page has its CSS inline and every plot as inline SVG: no script, no font, image or link that\n"
-        "leaves the file. Sections: data, split, before/after metrics, the identified parameters with\n"
-        "their standard errors, 95 % intervals and identifiability, the diagnosis, the predicted accuracy\n"
-        "over the workspace, warnings, provenance. Members a run does not carry say \"not in this run\".\n"
-        "The data of every plot is written beside the page as report_<plot>.csv. See docs/report.md.",
-        opts, sizeof opts / sizeof opts[0]};
-    const int st = rch_opt_main(&spec, argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "report", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
     char args[4000], cmdline[4096];

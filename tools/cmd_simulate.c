@@ -12,6 +12,12 @@
 #include "rch_opt.h"
 #include "rch_sim.h"
 
+static const char summary[] = "a data set from a simulated robot with known errors";
+static const char details[] =
+    "The true robot is --truth if given, else the nominal --robot plus random DH errors\n"
+    "and the encoder at --encoder. Lengths get Gaussian noise and the encoder\n"
+    "resolution; joint angles are recorded at the display step.";
+
 static int report_json(int argc, char **argv, unsigned long n, const char *out_path, const char *truth_out,
                        const rch_sim_job *job)
 {
@@ -41,6 +47,7 @@ int rcal_cmd_simulate(int argc, char **argv)
     int json = 0;
     rch_sim_config *c = &job.sim;
     rch_sim_defaults(c); /* the defaults shown; 0 given on the command line means none, never the default */
+    rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--out", RCH_OPT_STR, &out_path, 0, 0, "DATA.csv", "the simulated measurements", RCH_OPT_REQUIRED, NULL},
         {"--truth-out", RCH_OPT_STR, &truth_out, 0, 0, "TRUTH.json", "the true model", 0, NULL},
@@ -67,12 +74,7 @@ int rcal_cmd_simulate(int argc, char **argv)
         {"--repeats", RCH_OPT_UINT, &repeats, 1, 1000, "R",
          "read every pose R times in a row (fresh length noise): repeatability, ISO 9283", 0, NULL},
     };
-    const rch_cmdspec spec = {"simulate", "a data set from a simulated robot with known errors",
-                              "The true robot is --truth if given, else the nominal --robot plus random DH errors\n"
-                              "and the encoder at --encoder. Lengths get Gaussian noise and the encoder\n"
-                              "resolution; joint angles are recorded at the display step.",
-                              opts, sizeof opts / sizeof opts[0]};
-    const int ps = rch_opt_main(&spec, argc, argv, NULL);
+    const int ps = rch_opt_cmd(&spec, "simulate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (ps >= 0)
         return ps;
     job.n = n;

@@ -27,15 +27,17 @@ int rcal_cmd_report(int argc, char **argv);     /* issue 13 */
 
 /* --report FILE.html of calibrate and diagnose (tools/cmd_report.c): the
  * page of `rcal report` from this run. cal (required) and diag (may be NULL)
- * write the run's JSON as --json prints it; it is kept beside the page as
- * FILE.calibration.json and FILE.diagnosis.json (never over an input), and
- * rch_report_write reads them in this process. model: the model file written
- * by the run, or NULL. inputs (n_inputs): the run's input files, which no
- * output of the report may replace. quiet: no message on stderr. 0, or 1 with the message
- * on stderr. */
-typedef int (*rcal_json_fn)(FILE *f, const void *ctx);
-int rcal_report_inline(const char *html, rcal_json_fn cal, const void *cal_ctx, rcal_json_fn diag,
-                       const void *diag_ctx, const char *model, const char *const *inputs, size_t n_inputs,
+ * are the run's results; their JSON, as --json of this command line
+ * (argc, argv) prints it, is kept beside the page as FILE.calibration.json
+ * and FILE.diagnosis.json (never over an input), and rch_report_write reads
+ * them in this process. model: the model file written by the run, or NULL.
+ * inputs (n_inputs): the run's input files, which no output of the report
+ * may replace. quiet: no message on stderr. 0, or 1 with the message on
+ * stderr. */
+struct rch_calib_result;
+struct rch_diagnose_result;
+int rcal_report_inline(const char *html, const struct rch_calib_result *cal, const struct rch_diagnose_result *diag,
+                       int argc, char **argv, const char *model, const char *const *inputs, size_t n_inputs,
                        int quiet);
 
 #endif

@@ -288,6 +288,12 @@ void rch_jw_begin(rch_jw *w, FILE *f, int pretty, const char *format, int argc, 
     rch_jw_header(w, format, argc, argv);
 }
 
+void rch_jw_strs(rch_jw *w, const char *const *kv)
+{
+    for (; kv[0]; kv += 2)
+        rch_jw_str(w, kv[0], kv[1]);
+}
+
 void rch_jw_header(rch_jw *w, const char *format, int argc, char **argv)
 {
     size_t len = 6;

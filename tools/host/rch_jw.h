@@ -55,6 +55,19 @@ void rch_jw_header(rch_jw *w, const char *format, int argc, char **argv);
  * object opened, and rch_jw_header. */
 void rch_jw_begin(rch_jw *w, FILE *f, int pretty, const char *format, int argc, char **argv);
 
+/* Several string members in one call: kv is name, value, name, value, ...,
+ * ended by a NULL name; each pair as rch_jw_str (a NULL value -> null). */
+void rch_jw_strs(rch_jw *w, const char *const *kv);
+
+/* The context of a callback that writes a command's JSON later, e.g. an
+ * rch_save_fn writing it beside a report: the result the JSON reports and
+ * the command line that made it (for rch_jw_header). */
+typedef struct {
+    const void *result;
+    int argc;
+    char **argv;
+} rch_jw_cmd;
+
 /* Escape s as a JSON string body into buf (always terminated); returns buf. */
 const char *rch_jw_escape(const char *s, char *buf, size_t len);
 

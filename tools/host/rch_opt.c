@@ -380,6 +380,17 @@ int rch_opt_main(const rch_cmdspec *spec, int argc, char **argv, unsigned long l
     return st == RCH_OPT_OK ? -1 : st == RCH_OPT_HELP ? 0 : 2;
 }
 
+int rch_opt_cmd(rch_cmdspec *spec, const char *cmd, const char *summary, const char *details, const rch_opt *opts,
+                size_t n, int argc, char **argv, unsigned long long *seen)
+{
+    spec->cmd = cmd;
+    spec->summary = summary;
+    spec->details = details;
+    spec->opts = opts;
+    spec->n = n;
+    return rch_opt_main(spec, argc, argv, seen);
+}
+
 int rch_opt_fail(const rch_cmdspec *spec, const struct rch_diag *d)
 {
     char msg[1024];

@@ -72,6 +72,17 @@ rch_opt_status rch_opt_parse(const rch_cmdspec *spec, int argc, char **argv, uns
  * usage error, already reported). */
 int rch_opt_main(const rch_cmdspec *spec, int argc, char **argv, unsigned long long *seen);
 
+/* The number of entries of an option table (an array, not a pointer). */
+#define RCH_OPT_COUNT(table) (sizeof(table) / sizeof((table)[0]))
+
+/* A command's whole option step in one call: *spec filled with cmd, summary,
+ * details (may be NULL) and opts[n] (kept for rch_opt_fail and
+ * rch_opt_given), then rch_opt_main. Returns -1 when the command should run,
+ * else its exit status (0 after -h/--help, 2 after a usage error, already
+ * reported). `seen` as in rch_opt_parse (may be NULL). */
+int rch_opt_cmd(rch_cmdspec *spec, const char *cmd, const char *summary, const char *details, const rch_opt *opts,
+                size_t n, int argc, char **argv, unsigned long long *seen);
+
 /* The command's failure: "rcal CMD: file:line:col: what" on stderr; returns
  * the exit status 1. */
 struct rch_diag;
