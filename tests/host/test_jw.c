@@ -89,6 +89,31 @@ static void test_numbers(void **state)
     rch_json_free(j);
 }
 
+/* rch_jw_strs: every pair a member, NULL values null, hostile text escaped. */
+static void test_strs(void **state)
+{
+    (void)state;
+    char buf[1024];
+    FILE *f = fmemopen(buf, sizeof buf, "w");
+    assert_non_null(f);
+    rch_jw w;
+    rch_jw_init(&w, f, 0);
+    rch_jw_obj(&w, NULL);
+    static const char *const kv[] = {"a", "x\"y\\z\n", "b", NULL, "c", "", NULL};
+    rch_jw_strs(&w, kv);
+    rch_jw_end(&w);
+    assert_int_equal(rch_jw_finish(&w), 0);
+    fclose(f);
+    rch_diag d;
+    rch_json *j = rch_json_parse(buf, strlen(buf), "mem", &d);
+    if (!j)
+        fail_msg("invalid JSON (%s at %u:%u):\n%s", d.msg, d.line, d.col, buf);
+    assert_string_equal(rch_json_get(j, "a")->str, "x\"y\\z\n");
+    assert_int_equal(rch_json_get(j, "b")->type, RCH_JNULL);
+    assert_string_equal(rch_json_get(j, "c")->str, "");
+    rch_json_free(j);
+}
+
 static void test_misuse_reported(void **state)
 {
     (void)state;
@@ -132,6 +157,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_roundtrip_hostile_strings),
         cmocka_unit_test(test_numbers),
+        cmocka_unit_test(test_strs),
         cmocka_unit_test(test_misuse_reported),
         cmocka_unit_test(test_escape_buffer),
     };

@@ -168,11 +168,30 @@ static void test_given(void **state)
     assert_int_equal(s_i, 2);
 }
 
+/* rch_opt_cmd: the spec filled, -1 to run, 0 after --help, 2 after a usage
+ * error; nothing exits. */
+static void test_cmd(void **state)
+{
+    (void)state;
+    rch_cmdspec cs;
+    char a0[] = "demo", a1[] = "--out=x", a2[] = "--help", a3[] = "--samples", a4[] = "0";
+    char *run[] = {a0, a1}, *help[] = {a0, a2}, *bad[] = {a0, a1, a3, a4};
+    assert_int_equal(rch_opt_cmd(&cs, "demo", "one line", "details", opts, RCH_OPT_COUNT(opts), 2, run, NULL), -1);
+    assert_string_equal(cs.cmd, "demo");
+    assert_int_equal(cs.n, RCH_OPT_COUNT(opts));
+    assert_string_equal(s_out, "x");
+    /* prints the usage text on stdout */
+    assert_int_equal(rch_opt_cmd(&cs, "demo", "one line", NULL, opts, RCH_OPT_COUNT(opts), 2, help, NULL), 0);
+    /* --samples 0 is outside 1..1e6: a usage error on stderr */
+    assert_int_equal(rch_opt_cmd(&cs, "demo", "one line", NULL, opts, RCH_OPT_COUNT(opts), 4, bad, NULL), 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_values), cmocka_unit_test(test_refusals), cmocka_unit_test(test_seed_with_blank),
         cmocka_unit_test(test_help), cmocka_unit_test(test_given),
+        cmocka_unit_test(test_cmd),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
