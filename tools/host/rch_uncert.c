@@ -439,7 +439,8 @@ void rch_uncert_determined(rc_model *out, const rc_model *fit, const rc_model *n
 static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARAMS], const uint8_t *use, unsigned n,
                            const rc_model *m, const rc_kin *kin, const double q_rad[RC_NJ])
 {
-    rc_model t = *m;
+    rc_model t; /* m with one parameter moved: copied when a difference needs it */
+    int have_t = 0;
     double jp[3 * RC_N_DH], jr[3 * RC_N_DH];
     if (kin != NULL) {
         rc_kin_data kd;
@@ -466,6 +467,10 @@ static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARA
         }
         const double h = rc_param_unit(m, k) == 1 ? 1e-7 : 1e-5;
         double pp[3], pm[3], Rp[9], Rm[9];
+        if (!have_t) {
+            t = *m;
+            have_t = 1;
+        }
         t.x[k] = m->x[k] + h;
         rc_fk(pp, Rp, &t, q_rad);
         t.x[k] = m->x[k] - h;
