@@ -73,9 +73,9 @@ int main(int argc, char **argv)
   foreach(c ${cands})
     string(REPLACE "|" ";" blas "${c}")
     set(libs ${RCAL_A_lapacke} ${RCAL_A_lapack} ${blas} ${tail} ${sp} m)
-    try_compile(ok ${CMAKE_BINARY_DIR}/rcal_static_probe SOURCES ${src}
-      LINK_OPTIONS -static LINK_LIBRARIES ${libs} OUTPUT_VARIABLE log)
-    if(ok)
+    try_compile(RCAL_STATIC_PROBE_OK ${CMAKE_BINARY_DIR}/rcal_static_probe SOURCES ${src}
+      LINK_OPTIONS -static LINK_LIBRARIES ${libs})
+    if(RCAL_STATIC_PROBE_OK)
       set(${out} ${RCAL_A_lapack} ${blas} ${tail} PARENT_SCOPE)
       return()
     endif()

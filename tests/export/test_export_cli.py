@@ -28,19 +28,15 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from rct_check import check, failures  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import urdf_fk  # noqa: E402
 
 RCAL, FK_DUMP, SRC, SHARED, WORK = sys.argv[1:6]
 os.makedirs(WORK, exist_ok=True)
-failures = []
-
-
-def check(cond, what):
-    print(("ok    " if cond else "FAIL  ") + what)
-    if not cond:
-        failures.append(what)
 
 
 def run(*args, expect=0):

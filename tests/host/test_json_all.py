@@ -22,20 +22,16 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from rct_check import check, failures  # noqa: E402
+
 RCAL, SIMDISPLAY, SRC, WORK = sys.argv[1:5]
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
 DATA = os.path.join(SRC, "data", "sim_irb120.csv")
 ROBOT = os.path.join(SRC, "data", "irb120.json")
 TRUTH = os.path.join(SRC, "data", "sim_irb120_truth.json")
-failures = []
 skipped = []
-
-
-def check(cond, what):
-    print(("ok    " if cond else "FAIL  ") + what)
-    if not cond:
-        failures.append(what)
 
 
 def w(name):

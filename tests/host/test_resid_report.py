@@ -31,18 +31,14 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from rct_check import check, failures  # noqa: E402
+
 RCAL, SRC, WORK = sys.argv[1:4]
 shutil.rmtree(WORK, ignore_errors=True)
 os.makedirs(WORK)
 DATA = os.path.join(SRC, "data", "sim_irb120.csv")
 ROBOT = os.path.join(SRC, "data", "irb120.json")
-failures = []
-
-
-def check(cond, what):
-    print(("ok    " if cond else "FAIL  ") + what)
-    if not cond:
-        failures.append(what)
 
 
 def w(name):

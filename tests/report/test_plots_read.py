@@ -34,15 +34,10 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from rct_check import check, failures as FAILS  # noqa: E402
+
 SVG = '{http://www.w3.org/2000/svg}'
-FAILS = []
-
-
-def check(cond, what):
-    print(('ok   ' if cond else 'FAIL ') + what)
-    if not cond:
-        FAILS.append(what)
-    return cond
 
 
 def run(cmd, cwd):

@@ -33,18 +33,12 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from rct_check import check, failures as FAILS, passes as PASSES  # noqa: E402
+
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pngread  # noqa: E402
-
-FAILS = []
-PASSES = []
-
-
-def check(cond, what):
-    print(('ok   ' if cond else 'FAIL ') + what)
-    (PASSES if cond else FAILS).append(what)
-    return cond
 
 
 def run(cmd, cwd, stdout=None):

@@ -577,16 +577,16 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
         return fit_jumps(r, w, fixed, train, eval_set, n_eval, d);
     }
     r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
+    int train_ok = r->after_ok;
     if (eval_set == train) { /* nothing held out: the training figures are those */
         r->train_before = r->before_m;
         r->train_after = r->after_m;
-        if (!r->after_ok)
-            memset(&r->train_after, 0, sizeof r->train_after);
     } else {
         rc_eval(&r->train_before, &r->before, train, r->n_train);
-        if (!r->after_ok || rc_eval(&r->train_after, &r->model, train, r->n_train) != RC_OK)
-            memset(&r->train_after, 0, sizeof r->train_after);
+        train_ok = train_ok && rc_eval(&r->train_after, &r->model, train, r->n_train) == RC_OK;
     }
+    if (!train_ok)
+        memset(&r->train_after, 0, sizeof r->train_after);
     return finish(r, fixed, train, &r->model, NULL, d);
 }
 

@@ -52,53 +52,17 @@ int rch_parse_long(const char *s, long *out)
     return 0;
 }
 
-/* Clinger's fast path (1990): a decimal of at most 15 significant digits
- * M and a power of ten 10^e with |e| <= 22 are both exact doubles, so M * 10^e
- * or M / 10^-e is one correctly rounded operation: the double strtod gives,
- * for a fraction of its time. Returns 0 and sets *out, or -1 (strtod then).
- * Only where double arithmetic is evaluated in double (FLT_EVAL_METHOD 0). */
-static int fast_decimal(const char *s, double *out)
+/* Clinger's fast path (1990): a significand m of at most 15 decimal digits
+ * and a power of ten 10^e10 with |e10| <= 22 are both exact doubles, so
+ * m * 10^e10 (or m / 10^-e10) is one correctly rounded operation: the double
+ * strtod gives, for a fraction of its time. Returns 0 and sets *out, or -1
+ * (strtod then). Only where doubles are evaluated in double
+ * (FLT_EVAL_METHOD 0). */
+static int exact_decimal(double *out, uint64_t m, int e10, int neg)
 {
 #if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0
     static const double p10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-    const char *p = s;
-    const int neg = *p == '-';
-    if (*p == '+' || *p == '-')
-        ++p;
-    uint64_t m = 0;
-    int sig = 0, e10 = 0;
-    for (int frac = 0;; ++p) {
-        if (*p == '.' && !frac) {
-            frac = 1;
-            continue;
-        }
-        if (!is_digit(*p))
-            break;
-        if (m == 0 && *p == '0') { /* leading zeros are not significant */
-            e10 -= frac;
-            continue;
-        }
-        if (++sig > 15)
-            return -1;
-        m = m * 10u + (uint64_t)(*p - '0');
-        e10 -= frac;
-    }
-    if (*p == 'e' || *p == 'E') {
-        ++p;
-        const int eneg = *p == '-';
-        if (*p == '+' || *p == '-')
-            ++p;
-        int x = 0;
-        for (; is_digit(*p); ++p) {
-            if (x > 1000)
-                return -1;
-            x = x * 10 + (*p - '0');
-        }
-        e10 += eneg ? -x : x;
-    }
-    if (*p != '\0')
-        return -1;
     double v = (double)m;
     if (m != 0) {
         if (e10 < -22 || e10 > 22)
@@ -108,10 +72,27 @@ static int fast_decimal(const char *s, double *out)
     *out = neg ? -v : v;
     return 0;
 #else
-    (void)s;
     (void)out;
+    (void)m;
+    (void)e10;
+    (void)neg;
     return -1;
 #endif
+}
+
+/* Digit c (after the point: frac 1) into the significand m of sig
+ * significant digits and its power of ten e10; leading zeros count only in
+ * e10, digits past the 15th not at all (the fast path is off then). */
+static void add_digit(uint64_t *m, int *sig, int *e10, char c, int frac)
+{
+    if (*m == 0 && c == '0') {
+        *e10 -= frac;
+        return;
+    }
+    if (++*sig <= 15) {
+        *m = *m * 10u + (uint64_t)(c - '0');
+        *e10 -= frac;
+    }
 }
 
 int rch_parse_double(const char *s, double *out)
@@ -119,36 +100,36 @@ int rch_parse_double(const char *s, double *out)
     if (!s || !*s)
         return -1;
     /* Only a decimal number: sign, digits, one point, exponent. strtod
-     * alone would take blanks, hex floats, "inf" and "nan". */
+     * alone would take blanks, hex floats, "inf" and "nan". The scan also
+     * gathers the significand and power of ten for the fast path. */
     const char *p = s;
+    const int neg = *p == '-';
     if (*p == '+' || *p == '-')
         ++p;
-    int digits = 0;
-    while (is_digit(*p)) {
-        ++p;
-        ++digits;
-    }
-    if (*p == '.') {
-        ++p;
-        while (is_digit(*p)) {
-            ++p;
-            ++digits;
-        }
-    }
+    uint64_t m = 0;
+    int digits = 0, sig = 0, e10 = 0;
+    for (; is_digit(*p); ++p, ++digits)
+        add_digit(&m, &sig, &e10, *p, 0);
+    if (*p == '.')
+        for (++p; is_digit(*p); ++p, ++digits)
+            add_digit(&m, &sig, &e10, *p, 1);
     if (!digits)
         return -1;
     if (*p == 'e' || *p == 'E') {
         ++p;
+        const int eneg = *p == '-';
         if (*p == '+' || *p == '-')
             ++p;
         if (!is_digit(*p))
             return -1;
-        while (is_digit(*p))
-            ++p;
+        int x = 0;
+        for (; is_digit(*p); ++p)
+            x = x < 100000 ? x * 10 + (*p - '0') : x; /* saturates far outside the fast path */
+        e10 += eneg ? -x : x;
     }
     if (*p != '\0')
         return -1;
-    if (fast_decimal(s, out) == 0)
+    if (sig <= 15 && exact_decimal(out, m, e10, neg) == 0)
         return 0;
     errno = 0;
     char *end;

@@ -500,9 +500,9 @@ static const rc_kin *sens_compile(rc_kin *kin, const rc_model *m)
 /* The part of a covariance an ellipsoid reads: the parameters k < n with
  * use[k] set whose FK sensitivity can be nonzero (not the encoder's), idx
  * (nn) in order, and their covariance c (nn x nn, contiguous, the caller's
- * buffer of n * n doubles). After factor_cov (r > 0): idx in pivot order
- * and c holds the factor F (nn x r, row a in c + a * nn, entries c < min(a +
- * 1, r)) with Cov = F F^T up to what the pivoting dropped, factored set. */
+ * buffer of n * n doubles). After factor_cov (factored set): idx in pivot
+ * order and c holds the factor F (nn x r, row a in c + a * nn, entries
+ * k < min(a + 1, r)) with Cov = F F^T up to what the pivoting dropped. */
 typedef struct {
     unsigned nn, r, factored;
     unsigned idx[RC_MAX_PARAMS];
@@ -607,27 +607,25 @@ static double ellipsoid95(double J[3][RC_MAX_PARAMS], const cov_pack *p)
             jc[i][a] = J[i][p->idx[a]];
             T[i][a] = 0.0;
         }
-    if (p->factored) { /* T[i] = sum_a J[i][a] F[a] (row a of F: min(a + 1, r) entries) */
+    /* C = U T^T (upper triangle) over len columns: factored, T = J F and U =
+     * T; else T = Cov J^T (Cov symmetric: row b of Cov times J[i][b] added
+     * to T[i]) and U = J */
+    unsigned len = nn;
+    double(*U)[RC_MAX_PARAMS] = jc;
+    if (p->factored) { /* row a of F: min(a + 1, r) entries */
         for (unsigned a = 0; a < nn; ++a)
             axpy3(T[0], T[1], T[2], p->c + (size_t)a * nn, jc[0][a], jc[1][a], jc[2][a], a < p->r ? a + 1 : p->r);
-        for (int i = 0; i < 3; ++i)
-            for (int j = i; j < 3; ++j) {
-                double v = 0.0;
-                for (unsigned c = 0; c < p->r; ++c)
-                    v += T[i][c] * T[j][c];
-                C[i * 3 + j] = v;
-            }
-        return sqrt(CHI2_3_95 * fmax(rcu_sym3_eig_max(C), 0.0));
+        len = p->r;
+        U = T;
+    } else {
+        for (unsigned b = 0; b < nn; ++b)
+            axpy3(T[0], T[1], T[2], p->c + (size_t)b * nn, jc[0][b], jc[1][b], jc[2][b], nn);
     }
-    /* T[i][a] = sum_b Cov[a][b] J[i][b], Cov symmetric: row b of Cov times
-     * J[i][b] added to T[i] */
-    for (unsigned b = 0; b < nn; ++b)
-        axpy3(T[0], T[1], T[2], p->c + (size_t)b * nn, jc[0][b], jc[1][b], jc[2][b], nn);
     for (int i = 0; i < 3; ++i)
         for (int j = i; j < 3; ++j) {
             double v = 0.0;
-            for (unsigned a = 0; a < nn; ++a)
-                v += jc[i][a] * T[j][a];
+            for (unsigned a = 0; a < len; ++a)
+                v += U[i][a] * T[j][a];
             C[i * 3 + j] = v;
         }
     return sqrt(CHI2_3_95 * fmax(rcu_sym3_eig_max(C), 0.0));
