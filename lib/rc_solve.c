@@ -192,6 +192,59 @@ rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, con
     return normal_eq_tab(A, g, cost_mm2, jrow, m, idx, nf, samples, none, n);
 }
 
+static int method_is_paper(rc_method mt);
+
+/* The weight (noise / sd)^2 of parameter k's prior row, 0 when it has none. */
+static double prior_weight(const rc_solve_config *cfg, unsigned k)
+{
+    if (cfg == NULL || cfg->prior_mean == NULL || cfg->prior_sd == NULL || !(cfg->prior_noise_mm > 0.0))
+        return 0.0;
+    const double sd = cfg->prior_sd[k];
+    if (!(sd > 0.0) || !isfinite(sd))
+        return 0.0;
+    const double r = cfg->prior_noise_mm / sd;
+    return r * r;
+}
+
+static int has_prior(const rc_solve_config *cfg)
+{
+    return cfg != NULL && cfg->prior_mean != NULL && cfg->prior_sd != NULL && cfg->prior_noise_mm > 0.0;
+}
+
+double rc_prior_cost(const rc_model *m, const rc_solve_config *cfg)
+{
+    double c = 0.0;
+    RC_ASSERT(m != NULL);
+    if (!has_prior(cfg))
+        return 0.0;
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        if (cfg->fixed != NULL && cfg->fixed[k] != 0)
+            continue;
+        const double w = prior_weight(cfg, k), r = m->x[k] - cfg->prior_mean[k];
+        if (w > 0.0)
+            c += w * r * r;
+    }
+    return c;
+}
+
+/* The prior rows added to normal equations of the free parameters idx (nf):
+ * A += W, g += W (x - mean), cost += (x - mean)^T W (x - mean). */
+static void prior_ne(double *A, double *g, double *cost, const rc_model *m, const uint16_t *idx, unsigned nf,
+                     const rc_solve_config *cfg)
+{
+    if (!has_prior(cfg))
+        return;
+    for (unsigned i = 0; i < nf; ++i) {
+        const unsigned k = idx[i];
+        const double w = prior_weight(cfg, k), r = m->x[k] - cfg->prior_mean[k];
+        if (w == 0.0)
+            continue;
+        A[(size_t)i * nf + i] += w;
+        g[i] += w * r;
+        *cost += w * r * r;
+    }
+}
+
 rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, size_t n)
 {
     double mean = 0.0, m2 = 0.0, sq = 0.0, abs_sum = 0.0, mx = 0.0;
@@ -312,6 +365,8 @@ static int ltlm_segments(rc_model *best, double *best_cost, const rc_model *xk, 
             double c;
             ++*evals;
             const int ok = rc_cost(&c, t, samples, n) == RC_OK;
+            if (ok && !method_is_paper(cfg->method))
+                c += rc_prior_cost(t, cfg);
             ltlm_report(cfg, iter, side == 0 ? RC_LTLM_XL : RC_LTLM_XR, mi, nm, t, ok ? c : -1.0);
             if (ok && c < *best_cost) { /* Eq. 18 */
                 *best_cost = c;
@@ -526,7 +581,8 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     const double tol_step = cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9;
     const double tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-4;
     const double rcond = cfg->rcond > 0.0 ? cfg->rcond : 0.0; /* 0: rc_ident's rule */
-    const double snr_min = cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 1.0);
+    const double snr_min =
+        has_prior(cfg) ? 0.0 : cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 1.0);
     const int ltlm = cfg->method == RC_METHOD_LTLM;
     double cost, mu = 0.0, nu = 2.0;
 
@@ -534,7 +590,9 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     ++res->cost_evals;
     if (st != RC_OK)
         return st;
-    res->rms_start_mm = res->rms_final_mm = rms_of(cost, n);
+    prior_ne(A, w->g, &cost, m, w->idx, nf, cfg);
+    const double prior0 = rc_prior_cost(m, cfg); /* the figures are the data's RMS, without the prior */
+    res->rms_start_mm = res->rms_final_mm = rms_of(cost - prior0 > 0.0 ? cost - prior0 : 0.0, n);
     /* Fixed scaling from the starting Jacobian: D_i = column norm. A column
      * that is zero (a parameter the data cannot move at all) keeps D = 1 and
      * falls in the null space below. */
@@ -593,6 +651,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
                 ++res->cost_evals;
                 if (st != RC_OK)
                     return st;
+                prior_ne(A, w->g, &cost, m, w->idx, nf, cfg);
             }
             st = lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, rcond, snr_min);
             if (st != RC_OK)
@@ -621,6 +680,8 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
             double cnew;
             ++res->cost_evals;
             st = normal_eq_tab(A, w->g, &cnew, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
+            if (st == RC_OK)
+                prior_ne(A, w->g, &cnew, &w->trial, w->idx, nf, cfg);
             const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
             if (rho > 0.0) {
                 accepted = 1;
@@ -673,7 +734,10 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
             }
         }
         res->iterations = it + 1;
-        res->rms_final_mm = rms_of(cost, n);
+        {
+            const double data_cost = cost - rc_prior_cost(m, cfg);
+            res->rms_final_mm = rms_of(data_cost > 0.0 ? data_cost : 0.0, n);
+        }
         if (cfg->on_iter)
             cfg->on_iter(cfg->cb_ctx, it + 1, res->rms_final_mm, m);
         if (!accepted && !done) {

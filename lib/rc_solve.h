@@ -118,6 +118,19 @@ typedef struct rc_solve_config {
     double chaos_n0;         /* LTLM N_0 in (0, 1); 0: drawn from seed */
     uint64_t seed;           /* LTLM chaotic seed (for N_0) */
     const uint8_t *fixed;    /* (n_params) nonzero: parameter held fixed; NULL: none */
+    /* A Gaussian prior on the parameters (maximum a posteriori estimation;
+     * robust LM and LTLM only, the paper variants ignore it). The cost
+     * becomes sum r_i^2 + sum_k (noise / sd_k)^2 (x_k - mean_k)^2: the
+     * residuals' variance noise^2 against each parameter's prior variance
+     * sd_k^2, so the prior rows weigh as much as the data say they should.
+     * With a prior every direction is determined (by the data or by the
+     * prior), so no direction is truncated as null and the significance
+     * rule (snr_min) is off. prior_mean NULL or prior_noise_mm <= 0: no
+     * prior. */
+    const double *prior_mean; /* (n_params) the prior's mean (nominal geometry) */
+    const double *prior_sd;   /* (n_params) its standard deviation (mm, rad, or the effect's unit);
+                                 <= 0 or not finite: no prior on that parameter */
+    double prior_noise_mm;    /* standard deviation of one residual (mm) the prior is weighed against */
     rc_iter_cb on_iter;
     rc_ltlm_cb on_ltlm;      /* LTLM variants: every point of every iteration; may be NULL */
     void *cb_ctx;            /* passed to on_iter and on_ltlm */
@@ -168,6 +181,11 @@ const char *rc_method_name(rc_method method);
  * for an unknown name (out untouched). */
 rc_status rc_method_from_name(rc_method *out, const char *name);
 const char *rc_exit_str(rc_exit e);
+
+/* The prior's part of the cost at m (mm^2, as rc_solve weighs it): 0
+ * without a prior (cfg NULL, no prior_mean, prior_noise_mm <= 0). Only
+ * parameters not held fixed count. */
+double rc_prior_cost(const rc_model *m, const rc_solve_config *cfg);
 
 /* Sum of squared residuals over samples (n). RC_ERR_NUMERIC on a degenerate
  * sample or a non-finite result. */

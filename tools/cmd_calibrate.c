@@ -90,7 +90,11 @@ static int parse(calib_args *a, int argc, char **argv)
          "(e.g. what rcal diagnose named)",
          0, NULL},
         {"--tool-offset", RCH_OPT_FLAG, &cfg->tool_offset, 0, 0, NULL,
-         "also identify where the cable is attached in the flange frame (tx, ty, tz)", 0, NULL},
+         "identify where the cable is attached in the flange frame (tx, ty, tz); the default with the prior, "
+         "needed with --no-prior", 0, NULL},
+        {"--no-prior", RCH_OPT_FLAG, &cfg->no_prior, 0, 0, NULL,
+         "plain least squares: no physical prior (the robot file's \"prior\", DESIGN.md), no attachment vector "
+         "unless --tool-offset, base heading and height free (to reproduce earlier results)", 0, NULL},
         {"--out", RCH_OPT_STR, &a->out_path, 0, 0, "MODEL.json",
          "write the calibrated model (rcal-model/2) for compensation; never over an input", 0, NULL},
         {"--truth", RCH_OPT_STR, &cfg->truth_path, 0, 0, "TRUTH.json",

@@ -168,7 +168,8 @@ int rcal_cmd_compensate(int argc, char **argv)
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
     int position_only = 0, full_pose = 0, want_summary = 0, accept_rt = 0, json = 0;
-    double max_unc_mm = 1.0;
+    double max_unc_mm = 1.0, tool[3] = {0.0, 0.0, 0.0};
+    const char *unc_out = NULL;
     rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/2 or /1, from rcal calibrate --out)",
@@ -179,6 +180,14 @@ int rcal_cmd_compensate(int argc, char **argv)
         {"--out", RCH_OPT_STR, &out, 0, 0, "FILE|-",
          "result (default standard output, flushed per line); a file is replaced only when complete, and never "
          "when it is the input or a model",
+         0, NULL},
+        {"--tool", RCH_OPT_TRIPLE, tool, -2000.0, 2000.0, "X,Y,Z",
+         "the TCP to place, mm in the flange frame (default: the flange centre; never the cable attachment the "
+         "calibration measured)",
+         0, NULL},
+        {"--uncertainty-out", RCH_OPT_STR, &unc_out, 0, 0, "FILE.csv",
+         "per target (its input line) the predicted 95 % position uncertainty u95_mm of the compensated point, "
+         "from the calibration's posterior covariance (prior-only directions included)",
          0, NULL},
         {"--position-only", RCH_OPT_FLAG, &position_only, 0, 0, NULL, "match the flange position only", 0, NULL},
         {"--full-pose", RCH_OPT_FLAG, &full_pose, 0, 0, NULL,
@@ -217,6 +226,8 @@ int rcal_cmd_compensate(int argc, char **argv)
         .max_unc_mm = max_unc_mm,
         .accept_robtargets = accept_rt,
         .max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0, /* 0: the core's 0.1 rad */
+        .tool_mm = rch_opt_given(&spec, seen, "--tool") ? tool : NULL,
+        .uncertainty_path = unc_out,
     };
     rch_comp_result r;
     memset(&r, 0, sizeof r);

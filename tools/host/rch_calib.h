@@ -92,6 +92,8 @@ typedef struct rch_calib_cfg {
     unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
     size_t case_samples;    /* rows per case (0: every row) */
     const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
+    int no_prior;           /* 1: least squares without the physical prior (rch_prior.h), no cable
+                               attachment vector unless asked, no gauge: the earlier behaviour */
 } rch_calib_cfg;
 
 /* The defaults of `rcal calibrate`: everything zero or NULL but method LM,
@@ -119,7 +121,18 @@ typedef struct rch_calib_result {
     rch_ident ident;          /* at the solution, over the training samples */
     int have_unc;             /* uncertainty computed (model finite, enough samples) */
     rch_model_unc unc;        /* covariance, standard errors, classes, predicted uncertainty */
-    rc_model determined;      /* the model compensation uses (undetermined DH nominal) */
+    rc_model determined;      /* the model compensation uses (the whole estimate) */
+    int prior_on;             /* maximum a posteriori with the physical prior (robust methods, no --no-prior) */
+    double prior_mean[RC_MAX_PARAMS]; /* (RC_MAX_PARAMS) the prior: nominal DH, start attachment */
+    double prior_sd[RC_MAX_PARAMS];   /* (RC_MAX_PARAMS) its sd (mm, rad); 0: none (outlet, nuisance) */
+    double noise_mm;          /* residual sd the prior was weighed against (estimated: SSR / (n - p_eff)) */
+    double p_eff;             /* effective number of parameters the data determined (trace of the hat matrix) */
+    unsigned noise_passes;    /* fits it took for the noise estimate to settle */
+    unsigned n_outside_prior; /* DH parameters more than 3 prior sd from nominal (flagged) */
+    int attach_auto;          /* the cable attachment vector was the default's to decide (not --tool-offset) */
+    int attach_centred;       /* decided: the cable is at the flange centre (no attachment vector) */
+    double attach_dchi2;      /* how much the attachment vector improved the MAP objective (noise units) */
+    double attach_occam;      /* its Occam penalty 2 sum ln(prior sd / posterior sd) */
     unsigned n_groups;        /* set-up groups of the data (file column, else from the wrist) */
     int groups_from_file;
     rch_provenance prov;      /* data file, samples, sha256, date, tool */

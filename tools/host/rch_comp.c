@@ -116,7 +116,10 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
                 c->res->max_held_mm = e;
         }
         if (c->gate->unc && c->gate->unc->present) {
-            double u95 = rch_model_unc_pos95_mm(c->gate->unc, m, qd);
+            double u95 = c->gate->unc->has_prior ? rch_model_unc_radius95_mm(c->gate->unc, m, qd)
+                                                 : rch_model_unc_pos95_mm(c->gate->unc, m, qd);
+            if (c->gate->u95_out)
+                fprintf(c->gate->u95_out, "%u,%.6f\n", line, u95);
             double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm : 1.0;
             if (!(u95 <= lim)) {
                 for (unsigned i = 0; i < RC_NJ; ++i)
@@ -472,6 +475,12 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     res->orientation_determined = unc.present && !res->version1 && unc.orientation_determined;
     res->position_only_used = job->position_only || (!job->full_pose && !res->orientation_determined &&
                                                      (robot.has_nominal || robot.unc.present));
+    /* the point compensation moves: the flange (or the given TCP) of both
+     * models, never the cable attachment the calibration measured */
+    static rc_model nom_pt;
+    rch_comp_point_model(&det, &det, job->tool_mm);
+    rch_comp_point_model(&nom_pt, nom, job->tool_mm);
+    nom = &nom_pt;
     rc_comp_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.max_dev_rad = (rc_real)(job->max_dev_deg * DEG);
@@ -499,8 +508,24 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     }
     if (o.f == stdout)
         setvbuf(stdout, NULL, _IOLBF, 0);
-    const rch_comp_gate gate = {&robot.model, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
-                                job->accept_robtargets};
+    static rc_model fit_pt;
+    rch_comp_point_model(&fit_pt, &robot.model, job->tool_mm);
+    rch_out uo;
+    int have_uo = 0;
+    if (job->uncertainty_path) {
+        const char *const uin[4] = {from_stdin ? NULL : job->in_path, job->model_path, job->nominal_path, job->out_path};
+        if (rch_out_open(&uo, job->uncertainty_path, "--uncertainty-out", uin, 4, d) != 0) {
+            if (in != stdin)
+                fclose(in);
+            if (o.f != stdout)
+                rch_out_abort(&o);
+            return -1;
+        }
+        have_uo = 1;
+        fprintf(uo.f, "line,u95_mm\n");
+    }
+    const rch_comp_gate gate = {&fit_pt, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
+                                job->accept_robtargets, have_uo ? uo.f : NULL};
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);
@@ -509,11 +534,43 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
             rch_out_abort(&o);
         else
             fflush(stdout);
+        if (have_uo)
+            rch_out_abort(&uo);
         return -1;
     }
-    if (rch_out_commit(&o, d) != 0)
+    if (rch_out_commit(&o, d) != 0) {
+        if (have_uo)
+            rch_out_abort(&uo);
+        return -1;
+    }
+    if (have_uo && rch_out_commit(&uo, d) != 0)
         return -1;
     return rc;
+}
+
+void rch_comp_point_model(rc_model *out, const rc_model *m, const double *tool_mm)
+{
+    double dh[RC_NJ][4];
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        for (unsigned k = 0; k < 4; ++k)
+            dh[i][k] = m->x[4 * i + k];
+    rc_model r;
+    rc_model_init(&r, (const double(*)[4])dh, &m->x[RC_P_ENC]);
+    memcpy(r.q_min_rad, m->q_min_rad, sizeof r.q_min_rad);
+    memcpy(r.q_max_rad, m->q_max_rad, sizeof r.q_max_rad);
+    if (tool_mm && rc_model_add_effect(&r, RC_EFF_TOOL_OFFSET, 0, 0) == RC_OK)
+        memcpy(&r.x[r.effects[0].first], tool_mm, 3 * sizeof r.x[0]);
+    for (unsigned e = 0; e < m->n_effects; ++e) {
+        const rc_effect *ef = &m->effects[e];
+        if (ef->kind == RC_EFF_TOOL_OFFSET)
+            continue;
+        if (rc_model_add_effect(&r, (rc_effect_kind)ef->kind, ef->joint, ef->count) != RC_OK)
+            continue;
+        rc_effect *ne = &r.effects[r.n_effects - 1];
+        memcpy(ne->ref_dh, ef->ref_dh, sizeof ne->ref_dh);
+        memcpy(&r.x[ne->first], &m->x[ef->first], ef->count * sizeof r.x[0]);
+    }
+    *out = r;
 }
 
 unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, char *held, size_t held_len,

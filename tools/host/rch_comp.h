@@ -59,7 +59,17 @@ typedef struct rch_comp_job {
                                  uncompensated, with a warning; 0: 1 mm */
     int accept_robtargets;    /* RAPID robtargets are copied uncorrected with a warning each; 1: that is
                                  not a failure (exit 0) */
+    const double *tool_mm;    /* (3) the TCP in the flange frame (mm) that compensation places; NULL: the
+                                 flange centre. Never the cable attachment point the calibration measured */
+    const char *uncertainty_path; /* per target its predicted 95 % position uncertainty (u95_mm, of the point
+                                     compensated) as CSV, or NULL */
 } rch_comp_job;
+
+/* The model whose point compensation moves: m without its cable attachment
+ * (every RC_EFF_TOOL_OFFSET effect removed) and, when tool_mm (3) is not
+ * NULL, with that TCP as its tool offset. The calibration measured the
+ * attachment; the program means the flange (or its TCP). */
+void rch_comp_point_model(rc_model *out, const rc_model *m, const double *tool_mm);
 
 /* What the compensation may act on (issue 10): the determined model is
  * compiled into the stream; these say where it can be trusted. */
@@ -68,6 +78,7 @@ typedef struct rch_comp_gate {
     const rch_model_unc *unc;  /* covariance of the determined DH parameters; NULL: no gate */
     double max_unc_mm;         /* see rch_comp_job */
     int accept_robtargets;     /* see rch_comp_job */
+    FILE *u95_out;             /* one line "line,u95_mm" per target, or NULL */
 } rch_comp_gate;
 
 typedef struct rch_comp_result {

@@ -21,7 +21,7 @@ unsigned rch_jumps_segment(const rch_jumps *j, double t)
 /* Model = start + segment offsets (first held at 0), fitted on s labelled
  * by the change points at[0..m-1] (indices into s). */
 static int fit_segments(rc_model *out, double *ssr, const rc_model *start, const uint8_t *fixed, rc_sample *s,
-                        size_t n, const size_t *at, unsigned m, rc_solve_work *w)
+                        size_t n, const size_t *at, unsigned m, const rc_solve_config *base, rc_solve_work *w)
 {
     rc_model mdl = *start;
     unsigned seg = 0;
@@ -41,6 +41,8 @@ static int fit_segments(rc_model *out, double *ssr, const rc_model *start, const
     }
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
+    if (base)
+        cfg = *base;
     cfg.fixed = fx;
     if (rc_solve(&mdl, NULL, w, &cfg, s, n) != RC_OK)
         return -1;
@@ -155,6 +157,7 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
     size_t min_seg = cfg && cfg->min_seg ? cfg->min_seg : 5;
     unsigned max_j = cfg && cfg->max_jumps ? cfg->max_jumps : (unsigned)(n / 20);
     double factor = cfg && cfg->size_factor > 0 ? cfg->size_factor : 3.0;
+    const rc_solve_config *base = cfg ? cfg->solve : NULL;
     if (max_j > RCH_JUMPS_MAX)
         max_j = RCH_JUMPS_MAX;
     if (n < 2 * min_seg + 30) {
@@ -171,7 +174,7 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
     unsigned m = 0;
     double ssr;
     rc_model cur;
-    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, w) != 0) {
+    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, base, w) != 0) {
         snprintf(err, errlen, "the geometric fit failed");
         free(c);
         return -1;
@@ -190,7 +193,7 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
         qsort(trial, m + 1, sizeof *trial, cmp_size);
         rc_model nm;
         double ssr2;
-        if (fit_segments(&nm, &ssr2, start, fixed, c, n, trial, m + 1, w) != 0)
+        if (fit_segments(&nm, &ssr2, start, fixed, c, n, trial, m + 1, base, w) != 0)
             break;
         if (!((double)n * log(ssr / ssr2) > pen))
             break;
@@ -216,7 +219,7 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
             break;
         memmove(&at[drop], &at[drop + 1], (m - drop - 1) * sizeof *at);
         --m;
-        if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, w) != 0) {
+        if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, base, w) != 0) {
             snprintf(err, errlen, "refit without a jump failed");
             free(c);
             return -1;

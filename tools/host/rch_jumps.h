@@ -41,6 +41,11 @@ typedef struct rch_jumps_config {
     size_t min_seg;       /* rows between change points, 0: 5 */
     unsigned max_jumps;   /* 0: min(RCH_JUMPS_MAX, n / 20) */
     double size_factor;   /* 0: 3 */
+    /* The solver set-up of every fit (method, prior, iteration cap; its
+     * fixed member is replaced by the search's own), NULL: robust LM. A
+     * prior's arrays must cover RC_MAX_PARAMS entries, 0 (no prior) past
+     * the start model's parameters: the segment offsets are added there. */
+    const rc_solve_config *solve;
 } rch_jumps_config;
 
 typedef struct rch_jumps {

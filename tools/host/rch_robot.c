@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "rch_robot.h"
 
+#include <stddef.h>
 #include <math.h>
 #include <string.h>
 
@@ -321,6 +322,48 @@ static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name,
     return 0;
 }
 
+/* "prior": {"length_mm", "twist_deg", "offset_deg", "attachment_mm"}, each
+ * optional, positive and physical; defaults for the rest (rch_prior.h). */
+static int read_prior(rch_prior_cfg *p, const rch_json *pr, const char *name, rch_diag *d)
+{
+    static const struct {
+        const char *key;
+        size_t off;
+        double max;
+    } keys[] = {{"length_mm", offsetof(rch_prior_cfg, length_mm), 100.0},
+                {"twist_deg", offsetof(rch_prior_cfg, twist_deg), 10.0},
+                {"offset_deg", offsetof(rch_prior_cfg, offset_deg), 30.0},
+                {"attachment_mm", offsetof(rch_prior_cfg, attachment_mm), 2000.0}};
+    rch_prior_defaults(p);
+    if (!pr)
+        return 0;
+    if (pr->type != RCH_JOBJ) {
+        rch_diag_set(d, name, pr->line, pr->col, "\"prior\" must be an object of standard deviations");
+        return -1;
+    }
+    for (size_t i = 0; i < pr->n; ++i) {
+        size_t k = 0;
+        while (k < sizeof keys / sizeof keys[0] && strcmp(pr->keys[i], keys[k].key) != 0)
+            ++k;
+        if (k == sizeof keys / sizeof keys[0]) {
+            rch_diag_set(d, name, pr->items[i]->line, pr->items[i]->col,
+                         "unknown prior \"%s\" (length_mm, twist_deg, offset_deg, attachment_mm)", pr->keys[i]);
+            return -1;
+        }
+        double v;
+        if (want_num(&v, pr->items[i], keys[k].key, name, d, pr) != 0)
+            return -1;
+        if (!(v > 0.0 && v <= keys[k].max)) {
+            rch_diag_set(d, name, pr->items[i]->line, pr->items[i]->col,
+                         "prior %s = %g must be a standard deviation in (0, %g]", keys[k].key, v, keys[k].max);
+            return -1;
+        }
+        *(double *)((char *)p + keys[k].off) = v;
+    }
+    p->from_file = 1;
+    return 0;
+}
+
 int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d)
 {
     double dh[RC_NJ][4], enc[3] = {0, 0, 0};
@@ -358,6 +401,8 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
         goto done;
     const rch_json *unc = rch_json_get(root, "uncertainty");
     if (unc && read_uncertainty(out, unc, name, d) != 0)
+        goto done;
+    if (read_prior(&out->prior, rch_json_get(root, "prior"), name, d) != 0)
         goto done;
     rc = 0;
 done:

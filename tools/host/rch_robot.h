@@ -12,6 +12,8 @@
  *   "effects": [ {"kind": "joint_periodic", "joint": 3,       (optional model extensions;
  *                 "params": [...], "ref_dh": [[a, d, alpha, theta] x 4]} ],  joint 1-based,
  *                                                              params in SI: mm, rad, rad/m)
+ *   "prior": {"length_mm": 0.5, "twist_deg": 0.1, "offset_deg": 1.0, "attachment_mm": 100},
+ *                                 (optional: tolerances before the data, rch_prior.h)
  *   "nominal": { "dh": [...] },   (calibrated model: the nominal table it corrects)
  *   "calibration": { ... }        (calibrated model: informational, not read back)
  * }
@@ -25,6 +27,7 @@
 #include "rc_model.h"
 #include "rch_diag.h"
 #include "rch_jw.h"
+#include "rch_prior.h"
 #include "rch_uncert.h"
 
 /* Link lengths (a, d) beyond this are refused as a wrong model file. */
@@ -37,6 +40,7 @@ typedef struct rch_robot {
     int has_encoder;    /* encoder_mm was given */
     int has_nominal;    /* the file is a calibrated model with a nominal table */
     rch_model_unc unc;  /* rcal-model/2 "uncertainty" (unc.present == 0 for version 1) */
+    rch_prior_cfg prior; /* "prior" member: tolerances by parameter type (defaults where absent) */
 } rch_robot;
 
 /* Where a calibration came from (rcal-model/2 "provenance"). */

@@ -4,6 +4,7 @@
  * (see rch_uncert.h). */
 #include "rch_uncert.h"
 #include "rch_stats.h"
+#include "rch_prior.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -108,6 +109,115 @@ static int ident(scaled *z, size_t n_rows)
         z->dir_class[d] = id.dir_class[nf - 1 - d];
     memcpy(z->param_class, id.param_class, nf);
     return 0;
+}
+
+/* The posterior covariance in scaled coordinates of a MAP fit (prior sd
+ * psd of the free parameters, scaled: psd_k D_k; 0 = none) with the
+ * residual sd noise:
+ *   H = A / noise^2 + P,  P = diag(1 / psd^2)
+ *   classical:      Cz = H^-1
+ *   cluster-robust: Cz = H^-1 (c M / noise^4 + P) H^-1, M = sum_g u_g u_g^T
+ * (the data's part of the information replaced by the clustered scores'
+ * outer product, the prior's kept). Every direction is determined (by the
+ * data or by the prior), so nothing is left out. */
+static int covariance_map(scaled *z, rch_uncert *u, const double *A, const double *J, const double *r,
+                          const rc_sample *s, const uint16_t *cl, size_t n, int want_cluster, const double *psd,
+                          double noise)
+{
+    const unsigned nf = z->nf;
+    const double s2 = noise * noise;
+    double *H = calloc((size_t)nf * nf, sizeof *H), *Hi = calloc((size_t)nf * nf, sizeof *Hi);
+    double *M = calloc((size_t)nf * nf, sizeof *M);
+    int rc = -1;
+    if (!H || !Hi || !M)
+        goto done;
+    for (unsigned a = 0; a < nf; ++a) {
+        for (unsigned b = 0; b < nf; ++b)
+            H[a * nf + b] = A[a * nf + b] / s2;
+        if (psd[a] > 0.0)
+            H[a * nf + a] += 1.0 / (psd[a] * psd[a]);
+        else /* no prior: a ridge far below any information the data carry keeps H definite */
+            H[a * nf + a] += 1e-12 * (H[a * nf + a] > 0.0 ? H[a * nf + a] : 1.0);
+        Hi[a * nf + a] = 1.0;
+    }
+    if (LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', (lapack_int)nf, (lapack_int)nf, H, (lapack_int)nf, Hi,
+                      (lapack_int)nf) != 0)
+        goto done;
+    double ssr = 0.0, peff = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        ssr += r[i] * r[i];
+    for (unsigned a = 0; a < nf; ++a)
+        for (unsigned b = 0; b < nf; ++b)
+            peff += Hi[a * nf + b] * A[b * nf + a] / s2;
+    u->rank = 0;
+    u->n_weak = 0;
+    for (unsigned d = 0; d < nf; ++d) {
+        u->rank += z->dir_class[d] != RC_IDENT_NONE;
+        u->n_weak += z->dir_class[d] == RC_IDENT_WEAK;
+    }
+    u->sigma_mm = noise;
+    u->p_eff = peff;
+    (void)ssr;
+    unsigned gmax = 0, G = want_cluster ? count_groups(s, cl, n, &gmax) : 0;
+    if (G) {
+        double *ug = calloc(((size_t)gmax + 1) * nf, sizeof *ug), *T = calloc((size_t)nf * nf, sizeof *T);
+        if (!ug || !T) {
+            free(ug);
+            free(T);
+            goto done;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            double *ui = ug + (size_t)CL(i) * nf;
+            for (unsigned k = 0; k < nf; ++k)
+                ui[k] += J[i * nf + k] * r[i];
+        }
+        for (unsigned g = 0; g <= gmax; ++g) {
+            const double *ua = ug + (size_t)g * nf;
+            for (unsigned a = 0; a < nf; ++a)
+                for (unsigned b = 0; b < nf; ++b)
+                    M[a * nf + b] += ua[a] * ua[b];
+        }
+        const double dof = (double)n - peff;
+        const double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 1.0 ? dof : 1.0));
+        for (unsigned a = 0; a < nf; ++a) {
+            for (unsigned b = 0; b < nf; ++b)
+                M[a * nf + b] *= c / (s2 * s2);
+            if (psd[a] > 0.0)
+                M[a * nf + a] += 1.0 / (psd[a] * psd[a]);
+        }
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned k = 0; k < nf; ++k) {
+                const double h = Hi[a * nf + k];
+                for (unsigned b = 0; b < nf; ++b)
+                    T[a * nf + b] += h * M[k * nf + b];
+            }
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned b = 0; b < nf; ++b) {
+                double v = 0.0;
+                for (unsigned k = 0; k < nf; ++k)
+                    v += T[a * nf + k] * Hi[k * nf + b];
+                z->Cz[a * nf + b] = v;
+            }
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned b = a + 1; b < nf; ++b) {
+                const double v = 0.5 * (z->Cz[a * nf + b] + z->Cz[b * nf + a]);
+                z->Cz[a * nf + b] = z->Cz[b * nf + a] = v;
+            }
+        free(ug);
+        free(T);
+        u->kind = RCH_COV_CLUSTER;
+        u->n_groups = G;
+    } else {
+        memcpy(z->Cz, Hi, (size_t)nf * nf * sizeof *Hi);
+        u->kind = RCH_COV_CLASSICAL;
+        u->n_groups = 0;
+    }
+    rc = 0;
+done:
+    free(H);
+    free(Hi);
+    free(M);
+    return rc;
 }
 
 /* Covariance in scaled coordinates: classical or cluster-robust. */
@@ -332,7 +442,15 @@ static void classify(rch_uncert *u, const scaled *z, const rc_model *m)
         unsigned k = z->idx[a];
         double se = sqrt(fmax(z->Cz[a * nf + a], 0.0)) / z->D[a];
         double tol = rc_param_unit(m, k) == 1 ? RCH_UNCERT_WEAK_RAD : RCH_UNCERT_WEAK_MM;
-        if (z->param_class[a] == RC_IDENT_NONE) {
+        if (u->has_prior) {
+            /* the posterior: every parameter has a standard error; the class
+             * says whether the data or the prior set it */
+            u->se[k] = se;
+            u->prior_cls[k] = (uint8_t)rch_prior_classify(se, u->prior_sd[k]);
+            u->cls[k] = z->param_class[a] == RC_IDENT_NONE
+                            ? RCH_PARAM_NOT_IDENTIFIABLE
+                            : (z->param_class[a] == RC_IDENT_WEAK ? RCH_PARAM_WEAK : RCH_PARAM_IDENTIFIABLE);
+        } else if (z->param_class[a] == RC_IDENT_NONE) {
             u->cls[k] = RCH_PARAM_NOT_IDENTIFIABLE;
             u->se[k] = NAN;
         } else {
@@ -356,7 +474,19 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
 int rch_uncert_compute_cl(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s,
                           const uint16_t *cl, size_t n, int want_cluster, char *err, size_t errlen)
 {
+    return rch_uncert_compute_map(u, m, fixed, s, cl, n, want_cluster, NULL, 0.0, err, errlen);
+}
+
+int rch_uncert_compute_map(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s,
+                           const uint16_t *cl, size_t n, int want_cluster, const double *prior_sd, double noise_mm,
+                           char *err, size_t errlen)
+{
     memset(u, 0, sizeof *u);
+    if (prior_sd && noise_mm > 0.0) {
+        u->has_prior = 1;
+        for (unsigned k = 0; k < m->n_params; ++k)
+            u->prior_sd[k] = prior_sd[k] > 0.0 && isfinite(prior_sd[k]) ? prior_sd[k] : 0.0;
+    }
     u->n_params = m->n_params;
     u->n_samples = n;
     scaled z;
@@ -400,12 +530,22 @@ int rch_uncert_compute_cl(rch_uncert *u, const rc_model *m, const uint8_t *fixed
         snprintf(err, errlen, "the identifiability analysis failed (non-finite normal matrix)");
         goto done;
     }
-    if (covariance(&z, u, J, r, s, cl, n, want_cluster) != 0) {
+    if (u->has_prior) {
+        double psd[RC_MAX_PARAMS];
+        for (unsigned a = 0; a < z.nf; ++a)
+            psd[a] = u->prior_sd[z.idx[a]] * z.D[a];
+        if (covariance_map(&z, u, A, J, r, s, cl, n, want_cluster, psd, noise_mm) != 0) {
+            snprintf(err, errlen, "the posterior covariance failed (out of memory or not positive definite)");
+            goto done;
+        }
+    } else if (covariance(&z, u, J, r, s, cl, n, want_cluster) != 0) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
     classify(u, &z, m);
-    if (comp_nominal(u, &z, m, s, n) != 0) {
+    /* with a prior compensation uses the whole estimate: the posterior
+     * already weighs what the data did not determine toward nominal */
+    if (!u->has_prior && comp_nominal(u, &z, m, s, n) != 0) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
@@ -652,7 +792,8 @@ static double pos95_cov(const double *cov, size_t ld, const uint8_t *use, unsign
 static void use_pos(uint8_t *use, const rch_uncert *u)
 {
     for (unsigned k = 0; k < u->n_params; ++k)
-        use[k] = u->cls[k] == RCH_PARAM_IDENTIFIABLE || u->cls[k] == RCH_PARAM_WEAK;
+        use[k] = u->cls[k] == RCH_PARAM_IDENTIFIABLE || u->cls[k] == RCH_PARAM_WEAK ||
+                 (u->has_prior && u->cls[k] != RCH_PARAM_FIXED);
 }
 
 /* Parameters of the orientation uncertainty: all but fixed and
@@ -661,7 +802,7 @@ static void use_pos(uint8_t *use, const rch_uncert *u)
 static void use_rot(uint8_t *use, const rch_uncert *u, int determined_only)
 {
     for (unsigned k = 0; k < u->n_params; ++k)
-        use[k] = !(u->cls[k] == RCH_PARAM_FIXED || u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE ||
+        use[k] = !(u->cls[k] == RCH_PARAM_FIXED || (u->cls[k] == RCH_PARAM_NOT_IDENTIFIABLE && !u->has_prior) ||
                    (determined_only && u->comp_nominal[k]));
 }
 
@@ -685,6 +826,9 @@ void rch_model_unc_from(rch_model_unc *out, const rch_uncert *u)
     memcpy(out->cls, u->cls, u->n_params);
     memcpy(out->comp_nominal, u->comp_nominal, u->n_params);
     memcpy(out->se, u->se, u->n_params * sizeof *u->se);
+    out->has_prior = u->has_prior;
+    memcpy(out->prior_cls, u->prior_cls, u->n_params);
+    memcpy(out->prior_sd, u->prior_sd, u->n_params * sizeof *u->prior_sd);
     for (unsigned k = 0; k < RC_N_DH && k < u->n_params; ++k)
         for (unsigned l = 0; l < RC_N_DH && l < u->n_params; ++l)
             out->cov_dh[k * RC_N_DH + l] = u->cov[(size_t)k * u->n_params + l];
@@ -835,4 +979,55 @@ double rch_uncert_rot95_deg(const rch_uncert *u, const rc_model *m, const double
 double rch_uncert_rot95_det_deg(const rch_uncert *u, const rc_model *m, const double q_rad[RC_NJ])
 {
     return rot95_one(u, m, q_rad, 1);
+}
+
+/* The 95 % quantile of |e| for e ~ N(0, C), C (3 x 3) with eigenvalues ev:
+ * |e|^2 = sum ev_i z_i^2 taken as c chi2_nu with the same mean and variance
+ * (Welch-Satterthwaite: c = sum ev^2 / sum ev, nu = (sum ev)^2 / sum ev^2),
+ * its quantile by Wilson-Hilferty. Within 3 % of the exact radius from one
+ * dominant axis (nu = 1) to a sphere (nu = 3). */
+static double radius95(const double ev[3])
+{
+    double s1 = 0.0, s2 = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        const double e = ev[i] > 0.0 ? ev[i] : 0.0;
+        s1 += e;
+        s2 += e * e;
+    }
+    if (!(s1 > 0.0))
+        return 0.0;
+    const double c = s2 / s1, nu = s1 * s1 / s2, z = 1.6448536269514722;
+    const double h = 2.0 / (9.0 * nu), t = 1.0 - h + z * sqrt(h);
+    return sqrt(c * nu * t * t * t);
+}
+
+double rch_model_unc_radius95_mm(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ])
+{
+    uint8_t use[RC_N_DH];
+    double Jp[3][RC_MAX_PARAMS], C[9] = {0}, V[9], ev[3];
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        use[k] = u->cls[k] != RCH_PARAM_FIXED && !u->comp_nominal[k] && isfinite(u->se[k]);
+    rc_kin kin;
+    fk_sensitivity(Jp, NULL, use, RC_N_DH, m, sens_compile(&kin, m), q_rad);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double v = 0.0;
+            for (unsigned a = 0; a < RC_N_DH; ++a) {
+                if (!use[a] || Jp[i][a] == 0.0)
+                    continue;
+                double t = 0.0;
+                for (unsigned b = 0; b < RC_N_DH; ++b)
+                    if (use[b])
+                        t += u->cov_dh[a * RC_N_DH + b] * Jp[j][b];
+                v += Jp[i][a] * t;
+            }
+            C[i * 3 + j] = v;
+        }
+    for (int i = 0; i < 3; ++i)
+        for (int j = i + 1; j < 3; ++j)
+            C[i * 3 + j] = C[j * 3 + i] = 0.5 * (C[i * 3 + j] + C[j * 3 + i]);
+    memcpy(V, C, sizeof V);
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, V, 3, ev) != 0)
+        return NAN;
+    return radius95(ev);
 }

@@ -60,6 +60,10 @@ typedef struct rch_uncert {
     uint8_t comp_nominal[RC_MAX_PARAMS]; /* (n_params) 1: compensation keeps it nominal (tied to a weak or
                                             not-identifiable direction that moves the robot, or weak) */
     double *cov;                      /* (n_params x n_params) heap, row-major; rows/cols of fixed params 0 */
+    int has_prior;                    /* the posterior of a MAP fit (rch_uncert_compute_map) */
+    double prior_sd[RC_MAX_PARAMS];   /* (n_params) the prior's sd, 0: none */
+    uint8_t prior_cls[RC_MAX_PARAMS]; /* (n_params) rch_prior_class: what the data did to the prior */
+    double p_eff;                     /* effective parameters the data determined (trace of the hat matrix) */
 } rch_uncert;
 
 /* Compute the covariance at m over the training samples (n). fixed
@@ -73,6 +77,15 @@ int rch_uncert_compute(rch_uncert *u, const rc_model *m, const uint8_t *fixed, c
  * field for something else (segments of length jumps). */
 int rch_uncert_compute_cl(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s,
                           const uint16_t *cl, size_t n, int want_cluster, char *err, size_t errlen);
+/* The posterior of a maximum a posteriori fit: prior_sd (n_params; 0 or
+ * NULL: no prior on that parameter) and noise_mm, the residual sd the
+ * prior was weighed against (rch_calib's estimate). Every free parameter
+ * gets a standard error (the prior's where the data are silent) and a
+ * prior class (determined, partly, prior only); nothing is held for
+ * compensation. prior_sd NULL or noise_mm <= 0: rch_uncert_compute_cl. */
+int rch_uncert_compute_map(rch_uncert *u, const rc_model *m, const uint8_t *fixed, const rc_sample *s,
+                           const uint16_t *cl, size_t n, int want_cluster, const double *prior_sd, double noise_mm,
+                           char *err, size_t errlen);
 void rch_uncert_free(rch_uncert *u);
 
 /* The determined part of a calibration, for compensation: the fit with
@@ -146,6 +159,9 @@ typedef struct rch_model_unc {
     double cov_dh[RC_N_DH * RC_N_DH];   /* (24 x 24) SI units (mm, rad) */
     int orientation_determined;
     rch_uncert_map map;                 /* figures over the data and the workspace */
+    int has_prior;                      /* the posterior of a MAP fit: every se a number, nothing held */
+    uint8_t prior_cls[RC_MAX_PARAMS];   /* (n) rch_prior_class */
+    double prior_sd[RC_MAX_PARAMS];     /* (n) SI units; 0: no prior */
 } rch_model_unc;
 
 /* Fill from a computed rch_uncert (map and orientation_determined are set by
@@ -154,6 +170,13 @@ void rch_model_unc_from(rch_model_unc *out, const rch_uncert *u);
 /* 95 % position uncertainty at q of the determined model (identifiable DH
  * parameters only: the others are held nominal and carry no information). */
 double rch_model_unc_pos95_mm(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ]);
+/* The radius (mm) that holds the error of the point of m at q (the flange,
+ * or the TCP when m carries a tool offset) with 95 % probability under the
+ * posterior covariance of the DH parameters: the 95 % quantile of |e|,
+ * e ~ N(0, Jp Cov Jp^T), every parameter that has a standard error counted
+ * (prior-only directions included). What `rcal compensate
+ * --uncertainty-out` writes per target as u95_mm. */
+double rch_model_unc_radius95_mm(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ]);
 /* 95 % error bound (mm) of a tool point tool_mm (3, in the flange frame)
  * of the robot compensated with the determined model det
  * (rch_model_unc_determined of fit), at q: |what resetting the held

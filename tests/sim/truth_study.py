@@ -1,0 +1,315 @@
+# SPDX-License-Identifier: MIT
+"""truth_study - judge rcal by what the robot does, on robots it never saw.
+
+A generator written apart from rcal (its own kinematics in numpy, its own
+robots, its own error laws) draws a true robot, an outlet, a cable attachment
+and a pose set, makes cable lengths with noise it never tells rcal, and runs
+`rcal calibrate --out` then `rcal compensate` on 500 targets. The compensated
+targets are driven on the TRUE robot and judged by what lengths can see:
+pairwise distances between the landed points against those the program
+meant (a rigid motion about the outlet is invisible to lengths), and per
+target, after the best rigid alignment of landed to meant points, the error
+against the `u95_mm` column of `rcal compensate --uncertainty-out`.
+
+    python3 truth_study.py RCAL [--cases N] [--seed S] [--json OUT] [--quick]
+
+Prints one line per case and a summary; exit 0. The goals are checked by
+the caller (tests/sim/CMakeLists.txt runs a small set with --check).
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+DEG = np.pi / 180.0
+OLD = os.environ.get("TRUTH_STUDY_OLD") == "1"  # the round-start rcal: no --uncertainty-out
+
+# Nominal robots (standard DH rows a, d, alpha, theta offset; mm, deg) and
+# joint limits (deg). The IRB1600-like arm is proportioned from its data
+# sheet, not from rcal's files.
+ROBOTS = {
+    "irb120": {
+        "dh": [(0, 290, -90, 0), (270, 0, 0, -90), (70, 0, -90, 0),
+               (0, 302, 90, 0), (0, 0, -90, 0), (0, 72, 0, 0)],
+        "lim": [(-165, 165), (-110, 110), (-110, 70), (-160, 160), (-120, 120), (-400, 400)],
+        "reach": 580.0,
+    },
+    "irb1600": {
+        "dh": [(150, 486.5, -90, 0), (700, 0, 0, -90), (0, 0, -90, 0),
+               (0, 600, 90, 0), (0, 0, -90, 0), (0, 65, 0, 0)],
+        "lim": [(-180, 180), (-63, 136), (-235, 55), (-200, 200), (-115, 115), (-400, 400)],
+        "reach": 1450.0,
+    },
+}
+
+
+def rot(axis, t):
+    c, s = np.cos(t), np.sin(t)
+    if axis == "x":
+        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    if axis == "y":
+        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+class Robot:
+    """A serial arm as a list of link transforms, each
+    Rot_z(q + off) . Trans(0, 0, d) . Trans(a, 0, 0) . Rot_x(alpha) . Rot_y(beta)
+    (beta: a tilt a DH table cannot hold; 0 unless asked)."""
+
+    def __init__(self, rows, beta=None):
+        self.rows = [tuple(float(v) for v in r) for r in rows]  # a mm, d mm, alpha rad, off rad
+        self.beta = list(beta) if beta is not None else [0.0] * 6
+
+    def frames(self, q):
+        R = np.eye(3)
+        p = np.zeros(3)
+        for i, (a, d, al, off) in enumerate(self.rows):
+            Rz = rot("z", q[i] + off)
+            p = p + R @ (Rz @ np.array([a, 0.0, 0.0]) + np.array([0.0, 0.0, d]))
+            R = R @ Rz @ rot("x", al) @ rot("y", self.beta[i])
+        return R, p
+
+    def point(self, q, tool):
+        R, p = self.frames(q)
+        return p + R @ np.asarray(tool, float)
+
+
+def nominal_robot(name):
+    return Robot([(a, d, al * DEG, th * DEG) for a, d, al, th in ROBOTS[name]["dh"]])
+
+
+def heavy(rng, scale, size=None):
+    """Student-t with 3 degrees of freedom: heavy tails, unlike a Gaussian prior."""
+    return scale * rng.standard_t(3, size=size)
+
+
+def true_robot(rng, name, beta_deg=0.0):
+    rows = []
+    for a, d, al, th in ROBOTS[name]["dh"]:
+        rows.append((a + heavy(rng, 0.25), d + heavy(rng, 0.25), (al + heavy(rng, 0.03)) * DEG,
+                     (th + heavy(rng, 0.15)) * DEG))
+    beta = [0.0] * 6
+    if beta_deg > 0:
+        beta[1] = rng.normal(0, beta_deg) * DEG  # joint 3 axis tilted against joint 2 (parallel pair)
+    return Robot(rows, beta)
+
+
+def draw_q(rng, lim, n):
+    lo = np.array([l for l, _ in lim]) * DEG
+    hi = np.array([h for _, h in lim]) * DEG
+    # keep away from the limits (a compensated target must stay inside) and from the
+    # wrist singularity
+    q = lo + 0.05 * (hi - lo) + 0.9 * (hi - lo) * rng.random((n, 6))
+    return q
+
+
+def poses(rng, rob, lim, outlet, tool, n, fixed_wrist):
+    out = []
+    tries = 0
+    while len(out) < n and tries < 200000:
+        tries += 1
+        if fixed_wrist:
+            if len(out) % 20 == 0:
+                wrist = draw_q(rng, lim, 1)[0][3:]
+            q = draw_q(rng, lim, 1)[0]
+            q[3:] = wrist
+        else:
+            q = draw_q(rng, lim, 1)[0]
+        if abs(np.sin(q[4])) < 0.15:
+            continue
+        p = rob.point(q, tool)
+        L = np.linalg.norm(p - outlet)
+        if p[2] < 80.0 or L < 200.0 or L > 1800.0:
+            continue
+        out.append(q)
+    return np.array(out)
+
+
+def write_robot(path, name):
+    r = ROBOTS[name]
+    doc = {"format": "rcal-model/1", "name": name + " (study nominal)",
+           "dh": [{"a_mm": a, "d_mm": d, "alpha_deg": al, "theta_deg": th} for a, d, al, th in r["dh"]],
+           "joint_limits_deg": [list(l) for l in r["lim"]]}
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+def kabsch(P, Q):
+    """R, t minimising |R P + t - Q| (rows are points)."""
+    cp, cq = P.mean(0), Q.mean(0)
+    H = (P - cp).T @ (Q - cq)
+    U, _, Vt = np.linalg.svd(H)
+    D = np.diag([1, 1, np.sign(np.linalg.det(Vt.T @ U.T))])
+    R = Vt.T @ D @ U.T
+    return R, cq - R @ cp
+
+
+def pair_err(landed, meant, rng, n_pairs=20000):
+    i = rng.integers(0, len(meant), n_pairs)
+    j = rng.integers(0, len(meant), n_pairs)
+    keep = i != j
+    i, j = i[keep], j[keep]
+    dl = np.linalg.norm(landed[i] - landed[j], axis=1)
+    dm = np.linalg.norm(meant[i] - meant[j], axis=1)
+    return np.abs(dl - dm)
+
+
+def run(cmd):
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    return r.returncode, r.stdout, r.stderr
+
+
+def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), beta_deg=0.0, n_poses=300):
+    lim = ROBOTS[name]["lim"]
+    reach = ROBOTS[name]["reach"]
+    truth = true_robot(rng, name, beta_deg)
+    nom = nominal_robot(name)
+    ang = rng.uniform(0, 2 * np.pi)
+    rad = reach * rng.uniform(0.7, 1.2)
+    outlet = np.array([rad * np.cos(ang), rad * np.sin(ang), rng.uniform(-50, 150)])
+    if attach_mm > 0:
+        v = rng.normal(size=3)
+        v /= np.linalg.norm(v)
+        attach = v * attach_mm
+    else:
+        attach = np.zeros(3)
+    Q = poses(rng, truth, lim, outlet, attach, n_poses, fixed_wrist)
+    sigma = rng.uniform(0.005, 0.04)
+    L = np.array([np.linalg.norm(truth.point(q, attach) - outlet) for q in Q])
+    L = L + sigma * rng.standard_normal(len(L))
+    L = np.round(L, 3)
+    qdeg = np.round(Q / DEG, 3)  # what a controller display shows
+    robot_path = os.path.join(tmp, "robot.json")
+    write_robot(robot_path, name)
+    data_path = os.path.join(tmp, "data.csv")
+    with open(data_path, "w") as f:
+        f.write("q1,q2,q3,q4,q5,q6,L\n")
+        for q, l in zip(qdeg, L):
+            f.write(",".join("%.3f" % v for v in q) + ",%.3f\n" % l)
+    model = os.path.join(tmp, "model.json")
+    if os.path.exists(model):
+        os.remove(model)
+    rc, out, err = run([rcal, "calibrate", "--data", data_path, "--robot", robot_path, "--out", model,
+                        "--test-fraction", "0"] + list(extra))
+    if not os.path.exists(model):
+        return {"case": k, "error": "calibrate rc %d: %s" % (rc, err.strip()[:300])}
+    # 500 targets over the workspace
+    T = []
+    while len(T) < 500:
+        q = draw_q(rng, lim, 1)[0]
+        if abs(np.sin(q[4])) < 0.15:
+            continue
+        if nom.point(q, tcp)[2] < 50:
+            continue
+        T.append(q)
+    T = np.array(T)
+    tin = os.path.join(tmp, "targets.csv")
+    with open(tin, "w") as f:
+        f.write("q1,q2,q3,q4,q5,q6\n")
+        for q in T:
+            f.write(",".join("%.6f" % (v / DEG) for v in q) + "\n")
+    tout = os.path.join(tmp, "comp.csv")
+    uout = os.path.join(tmp, "u95.csv")
+    for p in (tout, uout):
+        if os.path.exists(p):
+            os.remove(p)
+    cmd = [rcal, "compensate", "--model", model, "--in", tin, "--out", tout, "--position-only",
+           "--max-uncertainty-mm", "1000"]
+    if not OLD:
+        cmd += ["--uncertainty-out", uout]
+    if any(tcp):
+        cmd += ["--tool", ",".join("%g" % v for v in tcp)]
+    rc, out, err = run(cmd)
+    if not os.path.exists(tout):
+        return {"case": k, "error": "compensate rc %d: %s" % (rc, err.strip()[:300])}
+    C = np.loadtxt(tout, delimiter=",", skiprows=1, usecols=range(6)) * DEG
+    u95 = None
+    if os.path.exists(uout):
+        with open(uout) as f:
+            hdr = f.readline().strip().split(",")
+        if "u95_mm" in hdr:
+            u95 = np.loadtxt(uout, delimiter=",", skiprows=1, usecols=[hdr.index("u95_mm")], ndmin=1)
+    meant = np.array([nom.point(q, tcp) for q in T])
+    landed = np.array([truth.point(q, tcp) for q in C])
+    uncomp = np.array([truth.point(q, tcp) for q in T])
+    prng = np.random.default_rng(k)
+    pe_c = pair_err(landed, meant, prng)
+    pe_u = pair_err(uncomp, meant, np.random.default_rng(k))
+    R, t = kabsch(landed, meant)
+    e_c = np.linalg.norm(landed @ R.T + t - meant, axis=1)
+    R, t = kabsch(uncomp, meant)
+    e_u = np.linalg.norm(uncomp @ R.T + t - meant, axis=1)
+    res = {"case": k, "robot": name, "attach_mm": attach_mm, "wrist": "fixed" if fixed_wrist else "random",
+           "tcp": list(tcp), "noise_mm": sigma, "n": len(Q),
+           "pair_med_comp": float(np.median(pe_c)), "pair_med_uncomp": float(np.median(pe_u)),
+           "pair_p95_comp": float(np.percentile(pe_c, 95)), "pair_max_comp": float(pe_c.max()),
+           "worse_share": float(np.mean(e_c > e_u)),
+           "err_med_comp": float(np.median(e_c)), "err_med_uncomp": float(np.median(e_u))}
+    if u95 is not None and len(u95) == len(e_c):
+        res["u95_cover"] = float(np.mean(e_c <= u95))
+        res["u95_med"] = float(np.median(u95))
+    return res
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("rcal")
+    ap.add_argument("--cases", type=int, default=32)
+    ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument("--json")
+    ap.add_argument("--attach", choices=["centre", "off", "both"], default="both")
+    ap.add_argument("--tcp", default="0,0,0")
+    ap.add_argument("--beta-deg", type=float, default=0.0)
+    ap.add_argument("--extra", default="", help="extra calibrate options, space separated")
+    a = ap.parse_args()
+    rng = np.random.default_rng(a.seed)
+    tcp = [float(v) for v in a.tcp.split(",")]
+    extra = a.extra.split() if a.extra else []
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(a.cases):
+            name = "irb120" if k % 2 == 0 else "irb1600"
+            fixed = (k // 2) % 2 == 1
+            if a.attach == "centre":
+                att = 0.0
+            elif a.attach == "off":
+                att = float(rng.uniform(5, 60))
+            else:
+                att = 0.0 if (k // 4) % 2 == 0 else float(rng.uniform(5, 60))
+            r = one_case(a.rcal, k, rng, name, att, fixed, tcp, tmp, extra, a.beta_deg)
+            out.append(r)
+            if "error" in r:
+                print("case %2d ERROR %s" % (k, r["error"]), flush=True)
+                continue
+            print("case %2d %-7s attach %5.1f %-6s pair median %.4f (uncomp %.3f) p95 %.4f max %.3f "
+                  "worse %.3f u95 cover %s" % (k, r["robot"], r["attach_mm"], r["wrist"], r["pair_med_comp"],
+                                                r["pair_med_uncomp"], r["pair_p95_comp"], r["pair_max_comp"],
+                                                r["worse_share"], "%.3f" % r["u95_cover"] if "u95_cover" in r
+                                                else "-"), flush=True)
+    ok = [r for r in out if "error" not in r]
+    if ok:
+        for label, sel in (("centred", [r for r in ok if r["attach_mm"] == 0]),
+                           ("off-centre", [r for r in ok if r["attach_mm"] > 0]), ("all", ok)):
+            if not sel:
+                continue
+            med = np.median([r["pair_med_comp"] for r in sel])
+            worse_cases = sum(r["pair_med_comp"] > r["pair_med_uncomp"] for r in sel)
+            wshare = np.median([r["worse_share"] for r in sel])
+            cov = [r["u95_cover"] for r in sel if "u95_cover" in r]
+            print("%-10s cases %2d  median of pairwise medians %.4f mm (uncompensated %.3f)  cases worse %d  "
+                  "median share of targets worse %.4f  u95 coverage median %s" % (
+                      label, len(sel), med, np.median([r["pair_med_uncomp"] for r in sel]), worse_cases, wshare,
+                      "%.3f" % np.median(cov) if cov else "-"))
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(out, f, indent=1)
+    print("errors: %d" % (len(out) - len(ok)))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,70 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_prior.c - the physical prior of a calibration (see rch_prior.h). */
+#include "rch_prior.h"
+
+#include <math.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+void rch_prior_defaults(rch_prior_cfg *p)
+{
+    memset(p, 0, sizeof *p);
+    p->length_mm = RCH_PRIOR_LENGTH_MM;
+    p->twist_deg = RCH_PRIOR_TWIST_DEG;
+    p->offset_deg = RCH_PRIOR_OFFSET_DEG;
+    p->attachment_mm = RCH_PRIOR_ATTACHMENT_MM;
+}
+
+void rch_prior_fill(double *mean, double *sd, const rc_model *m, const rc_model *nominal, const rch_prior_cfg *p)
+{
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        mean[k] = m->x[k];
+        sd[k] = 0.0;
+    }
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        mean[RC_P_A(i)] = nominal->x[RC_P_A(i)];
+        mean[RC_P_D(i)] = nominal->x[RC_P_D(i)];
+        mean[RC_P_ALPHA(i)] = nominal->x[RC_P_ALPHA(i)];
+        mean[RC_P_THETA(i)] = nominal->x[RC_P_THETA(i)];
+        sd[RC_P_A(i)] = sd[RC_P_D(i)] = p->length_mm;
+        sd[RC_P_ALPHA(i)] = p->twist_deg * DEG;
+        sd[RC_P_THETA(i)] = p->offset_deg * DEG;
+    }
+    for (unsigned e = 0; e < m->n_effects; ++e) {
+        const rc_effect *ef = &m->effects[e];
+        if (ef->kind != RC_EFF_TOOL_OFFSET)
+            continue;
+        for (unsigned k = 0; k < ef->count; ++k)
+            sd[ef->first + k] = p->attachment_mm;
+    }
+}
+
+void rch_prior_gauge(uint8_t *fixed)
+{
+    fixed[RC_P_THETA(0)] = 1;
+    fixed[RC_P_D(0)] = 1;
+}
+
+rch_prior_class rch_prior_classify(double post_sd, double prior_sd)
+{
+    if (!(prior_sd > 0.0) || !isfinite(prior_sd) || !isfinite(post_sd))
+        return RCH_PRIOR_CLASS_NONE;
+    const double r = post_sd / prior_sd;
+    return r < RCH_PRIOR_DETERMINED ? RCH_PRIOR_CLASS_DETERMINED
+                                    : r < RCH_PRIOR_ONLY ? RCH_PRIOR_CLASS_PARTLY : RCH_PRIOR_CLASS_PRIOR_ONLY;
+}
+
+const char *rch_prior_class_name(rch_prior_class c)
+{
+    switch (c) {
+    case RCH_PRIOR_CLASS_NONE: return "no prior";
+    case RCH_PRIOR_CLASS_DETERMINED: return "determined";
+    case RCH_PRIOR_CLASS_PARTLY: return "partly";
+    case RCH_PRIOR_CLASS_PRIOR_ONLY: return "prior only";
+    }
+    return "?";
+}
