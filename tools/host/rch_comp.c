@@ -604,6 +604,10 @@ unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, c
             rch_uncert_free(&u);
         }
         memset(unc->cov_dh, 0, sizeof unc->cov_dh);
+        /* compensation uses the whole estimate: nothing is held because it
+         * shares a weak combination (a fit's weak directions stay where its
+         * solver or prior left them) */
+        memset(unc->comp_nominal, 0, sizeof unc->comp_nominal);
         *version1 = 1;
     }
     rch_model_unc_determined(det, &robot->model, nominal, unc);
