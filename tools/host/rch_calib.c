@@ -1159,7 +1159,23 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         fprintf(f, "uncertainty (classical covariance: the samples carry no usable set-up groups; residual sigma "
                    "%.4f mm):\n",
                 u->sigma_mm);
-    fprintf(f, "  parameter        value   1 std.error  class\n");
+    if (u->has_prior)
+        fprintf(f, "  maximum a posteriori with the physical prior (sd: lengths %.3g mm, twists %.3g deg, joint zeros "
+                   "%.3g deg, cable attachment %.3g mm%s); noise %.4f mm estimated from the residuals "
+                   "(%u fits, %.1f effective parameters)\n",
+                r->robot.prior.length_mm, r->robot.prior.twist_deg, r->robot.prior.offset_deg,
+                r->robot.prior.attachment_mm, r->robot.prior.from_file ? ", from the robot file" : ", defaults",
+                r->noise_mm, r->noise_passes, r->p_eff);
+    if (u->has_prior)
+        fprintf(f, "  theta1 and d1 held (gauge): one outlet's lengths cannot see the robot's heading and height "
+                   "against the outlet; a cell sets its base frame anyway\n");
+    if (r->attach_auto)
+        fprintf(f, "  cable attachment: %s (an attachment vector improves the fit by %.1f against its Occam "
+                   "penalty %.1f)\n",
+                r->attach_centred ? "at the flange centre" : "estimated in the flange frame (the flange centre "
+                                                             "relative to it is known only from the prior of a6, d6)",
+                r->attach_dchi2, r->attach_occam);
+    fprintf(f, "  parameter        value   1 std.error  class%s\n", u->has_prior ? "              data vs prior" : "");
     unsigned held = 0;
     char list[512] = "";
     for (unsigned k = 0; k < m->n_params; ++k) {
@@ -1171,8 +1187,15 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         else
             snprintf(se, sizeof se, "%11s", "-");
         rc_param_name(nm, sizeof nm, m, k);
-        fprintf(f, "  %-10s %12.5f %s %-3s %s\n", nm, m->x[k] * sc, se, unit == 0 ? "mm" : unit == 1 ? "deg" : "",
-                rch_param_class_name((rch_param_class)u->cls[k]));
+        char pc[96] = "";
+        if (u->has_prior && u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED) {
+            const double dev = fabs(m->x[k] - r->prior_mean[k]) / u->prior_sd[k];
+            snprintf(pc, sizeof pc, "  %-10s (se %.0f %% of prior)%s",
+                     rch_prior_class_name((rch_prior_class)u->prior_cls[k]), 100.0 * u->se[k] / u->prior_sd[k],
+                     dev > 3.0 ? "  OUTSIDE the prior's plausible range (> 3 sd from nominal)" : "");
+        }
+        fprintf(f, "  %-10s %12.5f %s %-3s %-16s%s\n", nm, m->x[k] * sc, se,
+                unit == 0 ? "mm" : unit == 1 ? "deg" : "", rch_param_class_name((rch_param_class)u->cls[k]), pc);
         if (k < RC_N_DH && u->comp_nominal[k]) {
             size_t len = strlen(list);
             snprintf(list + len, sizeof list - len, "%s%s", held ? " " : "", nm);
