@@ -92,6 +92,9 @@ static int parse(calib_args *a, int argc, char **argv)
         {"--tool-offset", RCH_OPT_FLAG, &cfg->tool_offset, 0, 0, NULL,
          "identify where the cable is attached in the flange frame (tx, ty, tz); the default with the prior, "
          "needed with --no-prior", 0, NULL},
+        {"--no-jump-check", RCH_OPT_FLAG, &cfg->no_jump_check, 0, 0, NULL,
+         "do not look for length jumps in the default run (a model fitted across jumps it found is not written: "
+         "use --jumps)", 0, NULL},
         {"--no-prior", RCH_OPT_FLAG, &cfg->no_prior, 0, 0, NULL,
          "plain least squares: no physical prior (the robot file's \"prior\", DESIGN.md), no attachment vector "
          "unless --tool-offset, base heading and height free (to reproduce earlier results)", 0, NULL},

@@ -34,7 +34,7 @@ export_urdf truth "$SRC/data/sim_irb120_truth.json"
 "$RCAL" calibrate --data "$SRC/data/sim_irb120.csv" --tool-offset --out "$WORK/cal_tool.json" >/dev/null || fail=1
 export_urdf calibrated-sim-tool "$WORK/cal_tool.json"
 if [ -f "$SHARED" ]; then
-    "$RCAL" calibrate --data "$SHARED" --out "$WORK/cal_real.json" >/dev/null || fail=1
+    "$RCAL" calibrate --data "$SHARED" --jumps --dequantize-joints --out "$WORK/cal_real.json" >/dev/null || fail=1
     export_urdf calibrated-real "$WORK/cal_real.json"
 else
     echo "      (no real data at $SHARED: that model is left out)"

@@ -115,7 +115,7 @@ models.append(("calibrated-sim", w("cal_sim.json")))
 run("calibrate", "--data", sim, "--tool-offset", "--out", w("cal_sim_tool.json"))
 models.append(("calibrated-sim-tool", w("cal_sim_tool.json")))
 if os.path.exists(SHARED):
-    run("calibrate", "--data", SHARED, "--out", w("cal_real.json"))
+    run("calibrate", "--data", SHARED, "--jumps", "--dequantize-joints", "--out", w("cal_real.json"))
     models.append(("calibrated-real", w("cal_real.json")))
 else:
     print("      (no real data at %s: that model is left out)" % SHARED)

@@ -756,6 +756,43 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
     return RC_OK;
 }
 
+/* The default run looks for length jumps as diagnose does: a model fitted
+ * across a jump it does not know is wrong, so rch_calib_save_model refuses it
+ * and names --jumps. r->jumps_found, r->jump_check_max_mm. */
+static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rc_solve_config *cfg,
+                       const rc_sample *train)
+{
+    rc_sample *tr = malloc(r->n_train * sizeof *tr);
+    rch_jumps *j = malloc(sizeof *j);
+    rc_model keep_model = r->model;
+    if (tr && j) {
+        memcpy(tr, train, r->n_train * sizeof *tr);
+        qsort(tr, r->n_train, sizeof *tr, cmp_t);
+        rch_jumps_config jc;
+        char err[128];
+        memset(&jc, 0, sizeof jc);
+        jc.solve = cfg;
+        if (rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0) {
+            /* A step at a set-up change is confounded with whatever depends on
+             * the set-up (a joint effect the geometry lacks): as in diagnose,
+             * a jump counts as a sensor event when it lies inside a set-up,
+             * or when it is far above what is left (20 x the RMS residual). */
+            for (unsigned k = 0; k < j->n_jumps; ++k) {
+                const size_t a = j->at[k];
+                const int inside = a > 0 && tr[a - 1].group == tr[a].group;
+                if (!(inside || fabs(j->size_mm[k]) > 20.0 * j->rms_after_mm))
+                    continue;
+                r->jumps_found++;
+                if (fabs(j->size_mm[k]) > r->jump_check_max_mm)
+                    r->jump_check_max_mm = fabs(j->size_mm[k]);
+            }
+        }
+    }
+    r->model = keep_model;
+    free(tr);
+    free(j);
+}
+
 /* Identification and the figures, once the split is made. */
 static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
                           rch_diag *d)
@@ -806,6 +843,8 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     if (r->cfg.jumps) {
         return fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
     }
+    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40)
+        jump_check(r, w, fixed, &cfg, train);
     r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
     int train_ok = r->after_ok;
     if (eval_set == train) { /* nothing held out: the training figures are those */
@@ -1245,6 +1284,11 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 r->robot.name, method);
     fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
             r->cfg.test_fraction, r->cfg.seed);
+    if (r->jumps_found && !r->cfg.jumps)
+        fprintf(f, "WARNING: the lengths jump %u time(s) in acquisition order (largest %.3f mm) and this fit does "
+                   "not model them: its geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s "
+                   "--jumps (and --dequantize-joints when the file's joints are rounded; rcal diagnose tells)\n\n",
+                r->jumps_found, r->jump_check_max_mm, r->cfg.data_path);
     fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
             r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
     print_metrics_row(f, "before (nominal DH, fitted encoder)", &r->before_m);
@@ -1463,6 +1507,14 @@ static int write_model_fn(FILE *f, const void *ctx)
 
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
 {
+    if (r->jumps_found && !r->cfg.jumps) {
+        rch_diag_set(d, path, 0, 0,
+                     "not written: the lengths jump %u time(s) in acquisition order (largest %.3f mm), which this "
+                     "fit does not model, so its geometry is wrong; run again with --jumps (or --no-jump-check "
+                     "to write it anyway)",
+                     r->jumps_found, r->jump_check_max_mm);
+        return -1;
+    }
     const char *inputs[RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
     size_t n = 3;
     for (size_t f = 0; f < n_files(&r->cfg); ++f)

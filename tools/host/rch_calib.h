@@ -92,6 +92,8 @@ typedef struct rch_calib_cfg {
     unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
     size_t case_samples;    /* rows per case (0: every row) */
     const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
+    int no_jump_check;      /* 1: the default run does not look for length jumps (rch_calib_save_model
+                               refuses a model fitted across jumps it found) */
     int no_prior;           /* 1: least squares without the physical prior (rch_prior.h), no cable
                                attachment vector unless asked, no gauge: the earlier behaviour */
 } rch_calib_cfg;
@@ -129,6 +131,8 @@ typedef struct rch_calib_result {
     double p_eff;             /* effective number of parameters the data determined (trace of the hat matrix) */
     unsigned noise_passes;    /* fits it took for the noise estimate to settle */
     unsigned n_outside_prior; /* DH parameters more than 3 prior sd from nominal (flagged) */
+    unsigned jumps_found;     /* the default run's jump check: jumps the fit does not model (0: none) */
+    double jump_check_max_mm; /* the largest of them */
     int attach_auto;          /* the cable attachment vector was the default's to decide (not --tool-offset) */
     int attach_centred;       /* decided: the cable is at the flange centre (no attachment vector) */
     double attach_dchi2;      /* how much the attachment vector improved the MAP objective (noise units) */
