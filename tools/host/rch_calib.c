@@ -844,8 +844,16 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     if (r->cfg.jumps) {
         return fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
     }
-    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40)
+    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40) {
         jump_check(r, w, fixed, &cfg, train);
+        if (r->jumps_found && !r->cfg.residuals_path) {
+            /* fit them as nuisance, as --jumps does: the default run never
+             * hands on a geometry fitted across jumps */
+            r->cfg.jumps = 1;
+            r->jumps_auto = 1;
+            return fit_and_report(r, w, train, test, d);
+        }
+    }
     r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
     int train_ok = r->after_ok;
     if (eval_set == train) { /* nothing held out: the training figures are those */
@@ -1290,6 +1298,12 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                    "not model them: its geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s "
                    "--jumps (and --dequantize-joints when the file's joints are rounded; rcal diagnose tells)\n\n",
                 r->jumps_found, r->jump_check_max_mm, r->cfg.data_path);
+    if (r->jumps_auto)
+        fprintf(f, "note: the lengths jump in acquisition order (%u jump(s) far above the residual, largest %.3f mm): "
+                   "fitted as nuisance, as --jumps does (--no-jump-check: not looked for)%s\n\n",
+                r->jumps_found, r->jump_check_max_mm,
+                r->cfg.dequantize ? "" : "; if the file's joint angles are rounded, add --dequantize-joints "
+                                         "(rcal fkcheck tells)");
     fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
             r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
     print_metrics_row(f, "before (nominal DH, fitted encoder)", &r->before_m);

@@ -133,6 +133,7 @@ typedef struct rch_calib_result {
     unsigned n_outside_prior; /* DH parameters more than 3 prior sd from nominal (flagged) */
     unsigned jumps_found;     /* the default run's jump check: jumps the fit does not model (0: none) */
     double jump_check_max_mm; /* the largest of them */
+    int jumps_auto;           /* they were then fitted as nuisance (cfg.jumps set by the run) */
     int attach_auto;          /* the cable attachment vector was the default's to decide (not --tool-offset) */
     int attach_centred;       /* decided: the cable is at the flange centre (no attachment vector) */
     double attach_dchi2;      /* how much the attachment vector improved the MAP objective (noise units) */
