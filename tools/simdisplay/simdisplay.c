@@ -66,6 +66,7 @@
 #include "rch_data.h"
 #include "rch_opt.h"
 #include "rch_robot.h"
+#include "rch_stdio.h"
 
 /* longest delay an option may ask for: one day */
 #define SIM_MAX_MS 86400000UL
@@ -630,7 +631,7 @@ static int serve(sim *s, unsigned long reply_delay_ms)
     }
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     sim s;
     sim_args g = {"ascii", NULL, NULL, NULL, "zero", "mm", "int32", "abcd", NULL, 3, 0, 0, 0, 0, 1, -1};
@@ -658,4 +659,12 @@ int main(int argc, char **argv)
     free(s.script);
     free(s.pose_len);
     return rc;
+}
+
+/* Closed standard descriptors opened on /dev/null first; standard output and
+ * standard error checked at the end (tools/host/rch_stdio.h). */
+int main(int argc, char **argv)
+{
+    rch_stdio_begin("simdisplay");
+    return rch_stdio_end(run(argc, argv));
 }
