@@ -118,20 +118,42 @@ static int parse(calib_args *a, int argc, char **argv)
     return -1;
 }
 
-/* 1 (with the message) when --out, --residuals or --report names one of the inputs. */
+/* 1 (with the message) when --out, --residuals, --report (or a file beside
+ * the page) or a plot name each other or one of the inputs; --data given
+ * twice (the same file by inode, whatever the spelling) or --validate equal
+ * to a --data file. */
 static int out_is_input(const calib_args *a)
 {
     const char *inputs[RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
-    const char *outs[3] = {a->out_path, a->cfg.residuals_path, a->report_path};
-    static const char *const what[3] = {"--out", "--residuals", "--report"};
     for (size_t i = 0; i < a->data.n; ++i)
         inputs[3 + i] = a->data.v[i];
-    for (size_t o = 0; o < 3; ++o)
-        for (size_t i = 0; outs[o] && i < 3 + a->data.n; ++i)
-            if (inputs[i] && rch_same_file(outs[o], inputs[i])) {
-                fprintf(stderr, "rcal calibrate: %s %s is also the input %s\n", what[o], outs[o], inputs[i]);
+    for (size_t i = 0; i < a->data.n; ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (rch_same_file(a->data.v[i], a->data.v[j]) || strcmp(a->data.v[i], a->data.v[j]) == 0) {
+                fprintf(stderr, "rcal calibrate: --data %s is the same file as --data %s: refused (each file once; "
+                                "merging a file with itself counts every sample twice)\n",
+                        a->data.v[i], a->data.v[j]);
                 return 1;
             }
+    for (size_t i = 0; a->cfg.validate_path && i < a->data.n; ++i)
+        if (rch_same_file(a->cfg.validate_path, a->data.v[i]) || strcmp(a->cfg.validate_path, a->data.v[i]) == 0) {
+            fprintf(stderr, "rcal calibrate: --validate %s is the same file as --data %s: refused (validation data "
+                            "must be samples the fit never saw; give a file of other measurements)\n",
+                    a->cfg.validate_path, a->data.v[i]);
+            return 1;
+        }
+    char svg[1100], csv[1100];
+    const char *plot_svg = NULL, *plot_csv = NULL;
+    if (a->cfg.plots_dir) {
+        snprintf(svg, sizeof svg, "%s/uncertainty_position.svg", a->cfg.plots_dir);
+        snprintf(csv, sizeof csv, "%s/uncertainty_position.csv", a->cfg.plots_dir);
+        plot_svg = svg;
+        plot_csv = csv;
+    }
+    const char *outs[5] = {a->out_path, a->cfg.residuals_path, a->report_path, plot_svg, plot_csv};
+    static const char *const what[5] = {"--out", "--residuals", "--report", "--plots", "--plots"};
+    if (rcal_outputs_check("calibrate", outs, what, 5, a->report_path, inputs, 3 + a->data.n) != 0)
+        return 1;
     if (a->cfg.residuals_path && (a->cases > 1 || a->cfg.jumps)) {
         fprintf(stderr, "rcal calibrate: --residuals is for one calibration without --jumps (not with --cases or "
                         "--jumps)\n");

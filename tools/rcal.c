@@ -9,6 +9,7 @@
 
 #include "rc_config.h"
 #include "rcal_cmds.h"
+#include "rch_file.h"
 #include "rch_paths.h"
 #include "rch_stdio.h"
 
@@ -92,5 +93,6 @@ static int run(int argc, char **argv)
 int main(int argc, char **argv)
 {
     rch_stdio_begin("rcal");
+    rch_out_one_command(); /* its outputs never name each other (tools/host/rch_file.h) */
     return rch_stdio_end(run(argc, argv));
 }

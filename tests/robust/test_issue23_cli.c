@@ -45,6 +45,17 @@ static void path_in(char *p, size_t n, const char *name)
     snprintf(p, n, "%s/%s", g_dir, name);
 }
 
+static void write_text(const char *name, const char *text)
+{
+    char p[512];
+    FILE *f;
+    path_in(p, sizeof p, name);
+    f = fopen(p, "wb");
+    assert_non_null(f);
+    assert_int_equal(fputs(text, f) >= 0, 1);
+    assert_int_equal(fclose(f), 0);
+}
+
 static int exists(const char *name)
 {
     char p[512];
@@ -84,6 +95,26 @@ static size_t slurp(char *buf, size_t cap, const char *name)
     }
     buf[n] = '\0';
     return n;
+}
+
+static void assert_unchanged(const char *name, const char *before)
+{
+    char h[65];
+    hash(h, name);
+    if (strcmp(h, before) != 0)
+        fail_msg("%s changed", name);
+}
+
+
+/* Leftover temporaries ("NAME.tmpXXXXXX") of any output in the directory. */
+static int temporaries(void)
+{
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "ls -a '%s' | grep -c '\\.tmp' > '%s/tmp.count'", g_dir, g_dir);
+    (void)system(cmd);
+    char b[32];
+    slurp(b, sizeof b, "tmp.count");
+    return atoi(b);
 }
 
 /* "cd DIR && ( CMD )", its stdout and stderr to files unless CMD redirects
@@ -249,12 +280,150 @@ static void test_stream_stops(void **state)
     assert_non_null(strstr(d.msg, "write failed"));
 }
 
+/* ---- class 3: one command's outputs never name each other ---- */
+static void test_outputs_distinct(void **state)
+{
+    char before[65];
+    (void)state;
+    RUN(2, NEED("--residuals X.json names the same file as --out X.json"),
+        R " calibrate --data d.csv --robot r.json --out X.json --residuals X.json");
+    assert_false(exists("X.json"));
+    write_text("keep.json", "{\"precious\": 1}\n");
+    hash(before, "keep.json");
+    RUN(2, NEED("same file as --out"), R " calibrate --data d.csv --robot r.json --out keep.json --residuals ./keep.json");
+    assert_unchanged("keep.json", before);
+    RUN(2, NEED("--report (a file beside the page) p.calibration.json", "same file as --out"),
+        R " calibrate --data d.csv --robot r.json --out p.calibration.json --report p.html");
+    assert_false(exists("p.html"));
+    RUN(2, NEED("--residuals keep.json names the same file as --out keep.json"),
+        R " diagnose --data d.csv --robot r.json --out keep.json --residuals keep.json");
+    RUN(2, NEED("--report keep.json names the same file as --out keep.json"),
+        R " diagnose --data d.csv --robot r.json --out keep.json --report keep.json");
+    assert_unchanged("keep.json", before);
+    /* an output inside --plots: the rule of the shared output helper */
+    RUN(1, NEED("same file as plot file"), R " diagnose --data d.csv --robot r.json --plots . --out residuals_order.csv");
+    /* rcal report: the CSVs are named from the page, a user's file is never replaced */
+    write_text("report_params.csv", "a user's own file\n");
+    hash(before, "report_params.csv");
+    RUN(0, NEED("x_params.csv"), R " report --calibration cal.json --out x.html");
+    assert_true(exists("x_metrics.csv") && exists("x_params.csv"));
+    char hx[65];
+    hash(hx, "x_params.csv");
+    RUN(0, NEED("y_params.csv"), R " report --calibration cal.json --out y.html");
+    assert_unchanged("x_params.csv", hx); /* a second report keeps the first one's data */
+    assert_unchanged("report_params.csv", before);
+    /* whole or not at all: one CSV cannot be written, the page is not there either */
+    RUN(0, NULL, "mkdir z_params.csv");
+    RUN(1, NEED("z_params.csv", "not a regular file"), R " report --calibration cal.json --out z.html");
+    assert_false(exists("z.html"));
+    assert_false(exists("z_metrics.csv"));
+    assert_int_equal(temporaries(), 0);
+}
+
+/* ---- class 4: links, modes, read-only files, signals ---- */
+static int wait_for_temporary(void)
+{
+    for (int i = 0; i < 500; ++i) {
+        if (temporaries() > 0)
+            return 0;
+        const struct timespec ts = {0, 10000000};
+        nanosleep(&ts, NULL);
+    }
+    return -1;
+}
+
+/* rcal ARGS in the directory, stdin a pipe kept open (so it waits), killed
+ * with sig once its temporary output exists; returns the wait status. */
+static int killed_run(int sig, const char *const *args)
+{
+    int fds[2];
+    assert_int_equal(pipe(fds), 0);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        dup2(fds[0], 0);
+        close(fds[0]);
+        close(fds[1]);
+        if (chdir(g_dir) != 0)
+            _exit(126);
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        execv(RCAL, (char *const *)args);
+        _exit(127);
+    }
+    close(fds[0]);
+    if (wait_for_temporary() != 0) {
+        kill(pid, SIGKILL);
+        fail_msg("%s %s: no temporary output appeared", args[1], args[2]);
+    }
+    kill(pid, sig);
+    int st = 0;
+    waitpid(pid, &st, 0);
+    close(fds[1]);
+    return st;
+}
+
+static void test_links_modes_signals(void **state)
+{
+    struct stat st;
+    char before[65];
+    (void)state;
+    /* through a symbolic link: the target is replaced, the link stays */
+    write_text("real.csv", "old\n");
+    RUN(0, NULL, "ln -s real.csv link.csv");
+    RUN(0, NULL, R " compensate --model m.json --in t.csv --out link.csv 2>/dev/null");
+    {
+        char p[512];
+        path_in(p, sizeof p, "link.csv");
+        assert_int_equal(lstat(p, &st), 0);
+        assert_true(S_ISLNK(st.st_mode));
+    }
+    assert_same_file("real.csv", "t_ref.csv");
+    /* the mode of the existing file is kept */
+    write_text("six.csv", "old\n");
+    RUN(0, NULL, "chmod 0600 six.csv && " R " compensate --model m.json --in t.csv --out six.csv 2>/dev/null");
+    {
+        char p[512];
+        path_in(p, sizeof p, "six.csv");
+        assert_int_equal(stat(p, &st), 0);
+        assert_int_equal(st.st_mode & 07777, 0600);
+    }
+    assert_same_file("six.csv", "t_ref.csv");
+    /* a read-only file is refused (also for root) and stays */
+    write_text("ro.csv", "keep\n");
+    hash(before, "ro.csv");
+    RUN(1, NEED("read-only (mode 0444)", "chmod u+w"),
+        "chmod 0444 ro.csv && " R " compensate --model m.json --in t.csv --out ro.csv");
+    assert_unchanged("ro.csv", before);
+    RUN(1, NEED("read-only"), R " poses --robot r.json --count 4 --out ro.csv");
+    assert_unchanged("ro.csv", before);
+    /* SIGINT during compensate --out, SIGTERM during poses --out: no
+     * temporary is left, no output appears, the signal is what ended it */
+    {
+        static const char *const comp[] = {"rcal", "compensate", "--model", "m.json", "--out", "sig.csv", NULL};
+        const int w = killed_run(SIGINT, comp);
+        assert_true(WIFSIGNALED(w) && WTERMSIG(w) == SIGINT);
+        assert_int_equal(temporaries(), 0);
+        assert_false(exists("sig.csv"));
+    }
+    {
+        static const char *const poses[] = {"rcal", "poses", "--robot", "r.json", "--count", "1000", "--candidates",
+                                            "200000", "--out", "big.csv", NULL};
+        const int w = killed_run(SIGTERM, poses);
+        assert_true(WIFSIGNALED(w) && WTERMSIG(w) == SIGTERM);
+        assert_int_equal(temporaries(), 0);
+        assert_false(exists("big.csv"));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_closed_descriptors),
         cmocka_unit_test(test_stdout_checked),
         cmocka_unit_test(test_stream_stops),
+        cmocka_unit_test(test_outputs_distinct),
+        cmocka_unit_test(test_links_modes_signals),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1709,6 +1709,17 @@ static int job_load(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
     return 0;
 }
 
+int rch_report_csv_path(char *buf, size_t cap, const char *page, const char *name)
+{
+    size_t n = strlen(page);
+    if (n > 5 && strcmp(page + n - 5, ".html") == 0)
+        n -= 5;
+    else if (n > 4 && strcmp(page + n - 4, ".htm") == 0)
+        n -= 4;
+    const int w = snprintf(buf, cap, "%.*s_%s.csv", (int)n, page, name);
+    return w >= 0 && (size_t)w < cap ? 0 : -1;
+}
+
 /* Open the HTML and the CSVs beside it (temporary files until committed). */
 static int job_open(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
 {
@@ -1728,12 +1739,13 @@ static int job_open(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
         names[n++] = "accuracy";
     if (j->n_c)
         names[n++] = "candidates";
-    const char *slash = strrchr(cfg->out_path, '/');
-    const int dir_len = slash ? (int)(slash - cfg->out_path + 1) : 0;
     for (unsigned k = 0; k < n; ++k) {
         char *path = r->res->csv[k];
-        snprintf(path, sizeof r->res->csv[k], "%.*sreport_%s.csv", dir_len, cfg->out_path, names[k]);
-        if (strcmp(path, cfg->out_path) == 0) {
+        if (rch_report_csv_path(path, sizeof r->res->csv[k], cfg->out_path, names[k]) != 0) {
+            rch_diag_set(d, cfg->out_path, 0, 0, "--out: path too long for the plot data beside it");
+            return -1;
+        }
+        if (rch_path_same(path, cfg->out_path)) {
             rch_diag_set(d, path, 0, 0, "--out: the page would be overwritten by its own plot data; name it "
                                         "otherwise");
             return -1;
@@ -1810,9 +1822,9 @@ int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag
             rch_diag_set(d, j.out[k].path, 0, 0, "write error");
             goto done;
         }
-    for (unsigned k = 0; k < j.n_out; ++k)
-        if (rch_out_commit(&j.out[k], d) != 0)
-            goto done; /* the outputs not yet committed are removed by job_free */
+    /* whole or not at all: every file written and synced before any is renamed */
+    if (rch_out_commit_all(j.out, j.n_out, d) != 0)
+        goto done;
     j.n_out = 0;
     rc = 0;
 done:

@@ -15,9 +15,10 @@
  * working while the JSON grows. The members read, and where each is looked
  * for, are listed in docs/report.md.
  *
- * The data of every plot is written beside the HTML as report_<plot>.csv
- * (metrics, params, accuracy when the run has accuracy figures, candidates
- * when a diagnosis is given), in the HTML's directory.
+ * The data of every plot is written beside the HTML, named from it: page
+ * x.html gives x_<plot>.csv (metrics, params, accuracy when the run has
+ * accuracy figures, candidates when a diagnosis is given). The page and its
+ * CSVs are one bundle, written whole or not at all (rch_out_commit_all).
  *
  * Every string that comes from a JSON file is HTML-escaped (& < > " ' and
  * control characters; bytes that are not UTF-8 become U+FFFD), also inside
@@ -63,6 +64,11 @@ typedef struct {
  * 0, or -1 with d set (unreadable or malformed input, an input that is not
  * what its option says, an output that names an input, a write failure). */
 int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag *d);
+
+/* The plot-data file `name` of page: the page's path without .html/.htm,
+ * then "_<name>.csv" (x.html, "params" -> x_params.csv). 0, or -1 when it
+ * does not fit in cap. */
+int rch_report_csv_path(char *buf, size_t cap, const char *page, const char *name);
 
 /* s HTML-escaped into buf (always NUL-terminated; truncated only between
  * whole characters or entities). Returns buf. */
