@@ -416,6 +416,34 @@ static void test_links_modes_signals(void **state)
     }
 }
 
+/* ---- class 5: names inside a file are read only when regular and bounded ---- */
+static void test_unasked_reads(void **state)
+{
+    static char cal[1 << 16], page[1 << 18];
+    (void)state;
+    const size_t n = slurp(cal, sizeof cal, "cal.json");
+    const char *at = strstr(cal, "\"file\":\"d.csv\"");
+    assert_non_null(at);
+    RUN(0, NULL, "mkfifo fifo && truncate -s 300M sparse.bin");
+    static const char *const names[][2] = {{"/dev/zero", "a character device, not a regular file"},
+                                           {"/dev/urandom", "a character device, not a regular file"},
+                                           {"fifo", "a FIFO, not a regular file"},
+                                           {"sparse.bin", "larger than the limit of 256 MiB"}};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k) {
+        char edited[sizeof cal + 64];
+        snprintf(edited, sizeof edited, "%.*s\"file\":\"%s\"%s", (int)(at - cal), cal, names[k][0],
+                 at + strlen("\"file\":\"d.csv\""));
+        assert_true(strlen(edited) + 8 > n); /* the whole file, one name replaced */
+        write_text("cal_x.json", edited);
+        /* timeout 60 would end a read that never ends: exit 124 */
+        RUN(0, NULL, R " report --calibration cal_x.json --out prov.html");
+        slurp(page, sizeof page, "prov.html");
+        if (!strstr(page, names[k][1]))
+            fail_msg("%s: the page does not say '%s'", names[k][0], names[k][1]);
+        assert_non_null(strstr(page, "was not read"));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -424,6 +452,7 @@ int main(void)
         cmocka_unit_test(test_stream_stops),
         cmocka_unit_test(test_outputs_distinct),
         cmocka_unit_test(test_links_modes_signals),
+        cmocka_unit_test(test_unasked_reads),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

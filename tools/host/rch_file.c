@@ -520,6 +520,40 @@ void rch_out_abort(rch_out *o)
     remove_tmp(o);
 }
 
+static const char *file_kind(mode_t m)
+{
+    return S_ISFIFO(m) ? "a FIFO" : S_ISCHR(m) ? "a character device" : S_ISBLK(m) ? "a block device"
+           : S_ISDIR(m) ? "a directory" : S_ISSOCK(m) ? "a socket" : "something else";
+}
+
+FILE *rch_open_regular(const char *path, size_t max_bytes, char *why, size_t why_len)
+{
+    /* O_NONBLOCK: opening a FIFO with no writer must not wait */
+    const int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
+    struct stat st;
+    if (fd < 0) {
+        snprintf(why, why_len, "%s", strerror(errno));
+        return NULL;
+    }
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        snprintf(why, why_len, "%s, not a regular file", file_kind(st.st_mode));
+        close(fd);
+        return NULL;
+    }
+    if ((unsigned long long)st.st_size > (unsigned long long)max_bytes) {
+        snprintf(why, why_len, "larger than the limit of %zu MiB", max_bytes >> 20);
+        close(fd);
+        return NULL;
+    }
+    const int fl = fcntl(fd, F_GETFL);
+    FILE *f = fl < 0 || fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) != 0 ? NULL : fdopen(fd, "rb");
+    if (!f) {
+        snprintf(why, why_len, "%s", strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
 int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, rch_diag *d)
 {
     *text = NULL;

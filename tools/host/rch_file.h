@@ -76,6 +76,16 @@ int rch_outs_distinct(const char *const *paths, const char *const *whats, size_t
 int rch_tmp_register(const char *path);
 void rch_tmp_forget(const char *path);
 
+/* A path the user did not give (a file name found inside a file: the
+ * provenance of a calibration, a reference in a model): opened only when it
+ * is a regular file of at most max_bytes, never a FIFO, a device (/dev/zero)
+ * or a directory, and without blocking on the open. The stream, or NULL with
+ * why set ("not a regular file (a FIFO)", "larger than the limit ...", the
+ * system's reason). A reader still stops after max_bytes (the file may
+ * grow). */
+#define RCH_UNASKED_MAX_BYTES ((size_t)256 << 20)
+FILE *rch_open_regular(const char *path, size_t max_bytes, char *why, size_t why_len);
+
 /* Read a whole file into a NUL-terminated heap buffer, refusing files larger
  * than max_bytes (named in the message). 0, or -1 with d set. */
 int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, rch_diag *d);

@@ -622,6 +622,7 @@ typedef struct {
     const char *file, *sha_rec; /* as recorded; sha_rec NULL when not recorded */
     double samples;
     char sha_now[65];           /* "" when the file cannot be read from here */
+    char why[96];               /* why not (a FIFO, a device, too large, ...) */
 } dfile;
 
 static size_t data_files(const rep *r, dfile out[MAX_DFILES])
@@ -643,8 +644,11 @@ static size_t data_files(const rep *r, dfile out[MAX_DFILES])
         out[0].samples = jnum(r->cal, "n_train") + jnum(r->cal, "n_test");
         n = 1;
     }
+    /* names found in the file, not given by the user: a regular file below
+     * the size limit only (never a FIFO or /dev/zero, which never end) */
     for (size_t i = 0; i < n; ++i)
-        if (rch_sha256_file(out[i].sha_now, out[i].file) != 0)
+        if (rch_sha256_file_unasked(out[i].sha_now, out[i].file, RCH_UNASKED_MAX_BYTES, out[i].why,
+                                    sizeof out[i].why) != 0)
             out[i].sha_now[0] = '\0';
     return n;
 }
@@ -740,7 +744,7 @@ static void warn_inputs(rep *r, const dfile *df, size_t n_df)
             warnf(r, "The data file %s changed since the calibration (its SHA-256 differs from the one recorded).",
                   df[i].file);
         if (!df[i].sha_now[0])
-            warnf(r, "The data file %s cannot be read from here: its content cannot be checked.", df[i].file);
+            warnf(r, "The data file %s was not read (%s): its content cannot be checked.", df[i].file, df[i].why);
     }
     if (!r->prov && !jstr(r->cal, "tool"))
         warnf(r, "No provenance in this run (tool version, command line, data hash, date): the result cannot be "
@@ -863,7 +867,13 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
         fputs("<br>recorded: <span class=\"mono\">", f);
         put_str(r, df[i].sha_rec);
         fputs("</span><br>now: <span class=\"mono\">", f);
-        fputs(df[i].sha_now[0] ? df[i].sha_now : "<span class=\"na\">cannot be read from here</span>", f);
+        if (df[i].sha_now[0]) {
+            fputs(df[i].sha_now, f);
+        } else {
+            fputs("<span class=\"na\">not read: ", f);
+            put_esc(f, df[i].why);
+            fputs("</span>", f);
+        }
         fputs(df[i].sha_rec && df[i].sha_now[0] ? (strcmp(df[i].sha_rec, df[i].sha_now) ? " (DIFFERS)" : " (same)")
                                                  : "",
               f);
