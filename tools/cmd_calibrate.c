@@ -10,8 +10,10 @@
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
+#include "rch_data.h"
 #include "rch_file.h"
 #include "rch_opt.h"
+#include "rch_robot.h"
 
 /* Write the calibrated model to out_path (never over an input), after the fit. */
 static int write_model(const rch_calib_result *r, const char *out_path, int quiet)
@@ -145,8 +147,11 @@ static int out_is_input(const calib_args *a)
     char svg[1100], csv[1100];
     const char *plot_svg = NULL, *plot_csv = NULL;
     if (a->cfg.plots_dir) {
-        snprintf(svg, sizeof svg, "%s/uncertainty_position.svg", a->cfg.plots_dir);
-        snprintf(csv, sizeof csv, "%s/uncertainty_position.csv", a->cfg.plots_dir);
+        if ((size_t)snprintf(svg, sizeof svg, "%s/uncertainty_position.svg", a->cfg.plots_dir) >= sizeof svg ||
+            (size_t)snprintf(csv, sizeof csv, "%s/uncertainty_position.csv", a->cfg.plots_dir) >= sizeof csv) {
+            fprintf(stderr, "rcal calibrate: --plots %s: path too long: refused\n", a->cfg.plots_dir);
+            return 1;
+        }
         plot_svg = svg;
         plot_csv = csv;
     }
@@ -167,6 +172,30 @@ static int out_is_input(const calib_args *a)
     return 0;
 }
 
+/* Every --data and --validate file against the robot's joint limits, before
+ * the fit (rch_calib_run loads them again; its loader is not this file's):
+ * 1 with the message (file:line:column) when a reading is beyond them. */
+static int data_in_limits(const calib_args *a)
+{
+    static rch_robot robot;
+    rch_diag d;
+    char msg[1024];
+    if (rch_robot_load(&robot, a->cfg.robot_path, &d) != 0)
+        return 0; /* rch_calib_run reports it */
+    for (size_t i = 0; i <= a->data.n; ++i) {
+        const char *path = i < a->data.n ? a->data.v[i] : a->cfg.validate_path;
+        rch_data data;
+        if (!path)
+            continue;
+        if (rch_data_load_limited(&data, path, 0, &robot.model, &d) != 0) {
+            fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+            return 1;
+        }
+        rch_data_free(&data);
+    }
+    return 0;
+}
+
 int rcal_cmd_calibrate(int argc, char **argv)
 {
     calib_args a;
@@ -181,6 +210,8 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return ps;
     if (out_is_input(&a))
         return 2;
+    if (data_in_limits(&a))
+        return 1;
     rch_calib_result *r = malloc(sizeof *r); /* large: two models, the identifiability report */
     rch_diag d;
     char msg[1024];

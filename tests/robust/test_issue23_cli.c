@@ -444,6 +444,49 @@ static void test_unasked_reads(void **state)
     }
 }
 
+/* d.csv with field `col` (1-based) of line `line` replaced by v, as name */
+static void data_with(const char *name, unsigned line, unsigned col, const char *v)
+{
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "awk -F, -v v='%s' 'NR==%u{$%u=v}1' OFS=, d.csv > '%s'", v, line, col, name);
+    assert_int_equal(sh("%s", cmd), 0);
+}
+
+/* ---- class 6: data no sensor produces ---- */
+static void test_impossible_data(void **state)
+{
+    (void)state;
+    /* d.csv: x,y,z,q1..q6,L; line 5's L starts at column 81, line 7's q1 at 29 */
+    static const char *const lengths[] = {"0.001", "1e-300", "0", "0.5", "nan", "-3"};
+    for (size_t k = 0; k < sizeof lengths / sizeof lengths[0]; ++k) {
+        data_with("bad_l.csv", 5, 10, lengths[k]);
+        RUN(1, NEED("bad_l.csv:5:81: field 'L'"), R " calibrate --data bad_l.csv --robot r.json");
+    }
+    data_with("bad_l.csv", 5, 10, "0.5");
+    RUN(1, NEED("bad_l.csv:5:81", "metres? rcal reads millimetres"), R " diagnose --data bad_l.csv --robot r.json");
+    /* a joint beyond the robot's limits (+-165 deg for q1), in every command that has a robot */
+    data_with("bad_q.csv", 7, 4, "175");
+    static const char *const need_q[] = {"bad_q.csv:7:29: field 'q1': 175 deg is outside joint 1's limits [-165, 165]",
+                                         "check --robot", NULL};
+    RUN(1, need_q, R " calibrate --data bad_q.csv --robot r.json");
+    RUN(1, need_q, R " calibrate --data d.csv --validate bad_q.csv --robot r.json");
+    RUN(1, need_q, R " diagnose --data bad_q.csv --robot r.json");
+    RUN(1, need_q, R " evaluate --model m.json --data bad_q.csv");
+    RUN(1, need_q, R " compare --data bad_q.csv --robot r.json --cases 1");
+    /* the file's rounding is not a fault: 165.04 passes, 165.06 does not */
+    data_with("edge_q.csv", 7, 4, "165.04");
+    RUN(0, NULL, R " calibrate --data edge_q.csv --robot r.json > /dev/null");
+    data_with("edge_q.csv", 7, 4, "-165.06");
+    RUN(1, NEED("-165.06 deg is outside"), R " calibrate --data edge_q.csv --robot r.json");
+    /* one file twice, by any name; validation data that is training data */
+    RUN(0, NULL, "ln d.csv d_hard.csv");
+    RUN(2, NEED("--data ./d.csv is the same file as --data d.csv"),
+        R " calibrate --data d.csv --data ./d.csv --robot r.json");
+    RUN(2, NEED("same file as --data d.csv"), R " calibrate --data d.csv --data d_hard.csv --robot r.json");
+    RUN(2, NEED("--validate d_hard.csv is the same file as --data d.csv", "never saw"),
+        R " calibrate --data d.csv --validate d_hard.csv --robot r.json");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -453,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_outputs_distinct),
         cmocka_unit_test(test_links_modes_signals),
         cmocka_unit_test(test_unasked_reads),
+        cmocka_unit_test(test_impossible_data),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
