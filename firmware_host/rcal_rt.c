@@ -464,8 +464,12 @@ static int emit_c(const char *path, const char *nominal_path, int position_only)
         fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
-    snprintf(cmd, sizeof cmd, "rcal-rt --emit-c %s%s%s%s", path, nominal_path ? " --nominal " : "",
-             nominal_path ? nominal_path : "", position_only ? " --position-only" : "");
+    if ((size_t)snprintf(cmd, sizeof cmd, "rcal-rt --emit-c %s%s%s%s", path, nominal_path ? " --nominal " : "",
+                         nominal_path ? nominal_path : "", position_only ? " --position-only" : "") >= sizeof cmd) {
+        fprintf(stderr, "rcal-rt: --emit-c: the model paths are too long for the header's provenance line (%zu "
+                        "bytes): refused, not cut\n", sizeof cmd);
+        return 2;
+    }
     /* the firmware compensates with what the data determined, as rcal compensate does (issue 10) */
     static rc_model det;
     int pos_only = determined(&det, &robot) || position_only;

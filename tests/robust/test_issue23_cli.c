@@ -26,6 +26,7 @@
 
 #include "rc_comp.h"
 #include "rch_comp.h"
+#include "rch_report.h"
 #include "rch_robot.h"
 #include "rch_sha256.h"
 
@@ -487,6 +488,36 @@ static void test_impossible_data(void **state)
         R " calibrate --data d.csv --validate d_hard.csv --robot r.json");
 }
 
+/* ---- class 7: options are never silently cut ---- */
+static void test_options_not_cut(void **state)
+{
+    (void)state;
+#define ACQ R " acquire --backend posix --protocol ascii-poll --reconnect-s 0 --quiet --port no-such-tty " \
+            "--poses plan.csv --out acq.csv"
+    RUN(2, NEED("--poll-cmd 'ABCDEFGHIJKLMNOP' is longer than the 15 bytes", "not cut"),
+        ACQ " --poll-cmd ABCDEFGHIJKLMNOP");
+    assert_false(exists("acq.csv"));
+    /* 15 bytes, or 14 and an escaped CR: accepted (then the missing port fails) */
+    RUN(1, NEED("no-such-tty"), ACQ " --poll-cmd ABCDEFGHIJKLMNO");
+    assert_null(strstr(g_err, "not cut"));
+    RUN(1, NEED("no-such-tty"), ACQ " --poll-cmd 'ABCDEFGHIJKLMN\\r'");
+    RUN(2, NEED("not cut"), ACQ " --poll-cmd 'ABCDEFGHIJKLMNO\\r'");
+#undef ACQ
+    if (access(SIMDISPLAY_EXE, X_OK) == 0)
+        RUN(2, NEED("--poll-cmd is longer than 15 bytes", "not cut"),
+            "timeout 10 '" SIMDISPLAY_EXE "' --poll-cmd ABCDEFGHIJKLMNOPQRSTUVWXYZ");
+    /* the command line in a report's provenance says when it was cut */
+    {
+        char buf[64];
+        char a0[] = "calibrate", a1[] = "--data",
+             a2[] = "a-very-long-file-name-of-measurements-from-the-robot-cell-number-seven.csv";
+        char *argv[] = {a0, a1, a2};
+        rch_report_cmdline(buf, sizeof buf, 3, argv);
+        assert_non_null(strstr(buf, " ... (cut)"));
+        assert_int_equal(strlen(buf), sizeof buf - 16 + strlen(" ... (cut)"));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -497,6 +528,7 @@ int main(void)
         cmocka_unit_test(test_links_modes_signals),
         cmocka_unit_test(test_unasked_reads),
         cmocka_unit_test(test_impossible_data),
+        cmocka_unit_test(test_options_not_cut),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

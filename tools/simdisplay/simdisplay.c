@@ -152,7 +152,11 @@ static int open_pty(sim *s)
     fcntl(s->master, F_SETFL, fcntl(s->master, F_GETFL) | O_NONBLOCK);
     if (s->link) {
         char tmp[600];
-        snprintf(tmp, sizeof tmp, "%s.tmp%ld", s->link, (long)getpid());
+        if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp%ld", s->link, (long)getpid()) >= sizeof tmp) {
+            fprintf(stderr, "simdisplay: --link %s: longer than %zu bytes: refused, not cut\n", s->link,
+                    sizeof tmp - 32);
+            return -1;
+        }
         unlink(tmp);
         if (symlink(s->path, tmp) != 0 || rename(tmp, s->link) != 0) {
             fprintf(stderr, "simdisplay: cannot link %s: %s\n", s->link, strerror(errno));
@@ -500,9 +504,14 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
     s->pc.mb_reg = (uint16_t)g->mb_reg;
     s->pc.mb_decimals = (uint8_t)g->mb_decimals;
     s->reconnect_ms = g->reconnect_ms;
-    if (g->poll_cmd) { /* C escapes \r and \n are understood */
+    if (g->poll_cmd) { /* C escapes \r and \n are understood; never cut */
         size_t k = 0;
-        for (const char *p = g->poll_cmd; *p && k + 1 < sizeof s->pc.poll_cmd; ++p) {
+        for (const char *p = g->poll_cmd; *p; ++p) {
+            if (k + 1 >= sizeof s->pc.poll_cmd) {
+                fprintf(stderr, "simdisplay: --poll-cmd is longer than %zu bytes: refused, not cut\n",
+                        sizeof s->pc.poll_cmd - 1);
+                return 2;
+            }
             if (p[0] == '\\' && (p[1] == 'r' || p[1] == 'n')) {
                 s->pc.poll_cmd[k++] = p[1] == 'r' ? '\r' : '\n';
                 ++p;
