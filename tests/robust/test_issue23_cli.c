@@ -147,6 +147,8 @@ static void expect(int got, int rc, const char *cmd, const char *const *needles)
     for (size_t k = 0; needles && needles[k]; ++k)
         if (!strstr(g_err, needles[k]))
             fail_msg("%s: stderr does not say '%s': %s", cmd, needles[k], g_err);
+    if (strstr(g_err, "Sanitizer")) /* the sanitizer build: a report is a failure whatever the status */
+        fail_msg("%s: %s", cmd, g_err);
 }
 
 #define NEED(...) ((const char *const[]){__VA_ARGS__, NULL})

@@ -15,6 +15,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "rch_stdio.h"
+
 #define RCH_TMP_MAX 64    /* temporaries alive at once */
 #define RCH_CLAIM_MAX 256 /* outputs remembered for one command */
 #define RCH_KEY_MAX 4096
@@ -366,12 +368,14 @@ int rch_out_open(rch_out *o, const char *path, const char *what, const char *con
                      what, (unsigned)(st.st_mode & 07777));
         return -1;
     }
-    if (strlen(final) + 16 >= sizeof o->tmp) {
-        rch_diag_set(d, "", 0, 0, "%s: path too long (%zu bytes)", what, strlen(final));
+    const size_t fl = strlen(final);
+    if (fl + 16 >= sizeof o->tmp) {
+        rch_diag_set(d, "", 0, 0, "%s: path too long (%zu bytes)", what, fl);
         return -1;
     }
-    snprintf(o->path, sizeof o->path, "%s", final);
-    snprintf(o->tmp, sizeof o->tmp, "%s.tmpXXXXXX", final);
+    memcpy(o->path, final, fl + 1);
+    memcpy(o->tmp, final, fl);
+    memcpy(o->tmp + fl, ".tmpXXXXXX", sizeof ".tmpXXXXXX");
     sigset_t saved;
     block_signals(1, &saved);
     int fd = mkstemp(o->tmp), full = 0;
@@ -471,7 +475,8 @@ static int stdout_done(rch_out *o, rch_diag *d)
 {
     o->f = NULL;
     if (fflush(stdout) != 0 || ferror(stdout)) {
-        rch_diag_set(d, "", 0, 0, "standard output: %s", strerror(errno));
+        rch_diag_set(d, "", 0, 0, "standard output: write failed (%s): the output is incomplete",
+                     strerror(rch_stdio_errno(stdout)));
         return -1;
     }
     return 0;
