@@ -31,6 +31,7 @@
 #include "rch_emit.h"
 #include "rch_opt.h"
 #include "rch_robot.h"
+#include "rch_stdio.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -463,15 +464,25 @@ static int emit_c(const char *path, const char *nominal_path, int position_only)
         fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
-    snprintf(cmd, sizeof cmd, "rcal-rt --emit-c %s%s%s%s", path, nominal_path ? " --nominal " : "",
-             nominal_path ? nominal_path : "", position_only ? " --position-only" : "");
+    if ((size_t)snprintf(cmd, sizeof cmd, "rcal-rt --emit-c %s%s%s%s", path, nominal_path ? " --nominal " : "",
+                         nominal_path ? nominal_path : "", position_only ? " --position-only" : "") >= sizeof cmd) {
+        fprintf(stderr, "rcal-rt: --emit-c: the model paths are too long for the header's provenance line (%zu "
+                        "bytes): refused, not cut\n", sizeof cmd);
+        return 2;
+    }
     /* the firmware compensates with what the data determined, as rcal compensate does (issue 10) */
     static rc_model det;
     int pos_only = determined(&det, &robot) || position_only;
     const rch_emit_src src = {robot.name, cmd, pos_only ? (unsigned)RC_COMP_FLAG_POSITION_ONLY : 0u};
-    if (rch_emit_c(stdout, &src, &det, nominal_path ? &nominal.model : &robot.nominal, &d) != 0 ||
-        fflush(stdout) != 0) {
-        fprintf(stderr, "rcal-rt: %s: %s\n", path, d.msg);
+    memset(&d, 0, sizeof d);
+    const int bad = rch_emit_c(stdout, &src, &det, nominal_path ? &nominal.model : &robot.nominal, &d) != 0;
+    if (bad && !ferror(stdout)) {
+        fprintf(stderr, "rcal-rt: %s: %s\n", path, rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    if (bad || fflush(stdout) != 0) { /* d.msg is not the reason: the stream's is */
+        fprintf(stderr, "rcal-rt: --emit-c %s: writing the C tables to standard output failed: %s\n", path,
+                strerror(rch_stdio_errno(stdout)));
         return 1;
     }
     return 0;
@@ -499,7 +510,7 @@ static int opt_ulong(const char *name, const char *v, unsigned long *out)
     return 0;
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     const char *model_path = NULL, *nominal_path = NULL, *in_path = NULL, *emit = NULL;
     double rate_hz = 1000.0, seconds = 10.0;
@@ -652,4 +663,12 @@ int main(int argc, char **argv)
                    : run_loop(cal, nom, &cfg, &t, rate_hz, seconds, json);
     free(t.q);
     return rc;
+}
+
+/* Closed standard descriptors opened on /dev/null first; standard output and
+ * standard error checked at the end (tools/host/rch_stdio.h). */
+int main(int argc, char **argv)
+{
+    rch_stdio_begin("rcal-rt");
+    return rch_stdio_end(run(argc, argv));
 }

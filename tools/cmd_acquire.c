@@ -49,11 +49,14 @@ static int pick(const char *v, const char *choices)
     return 0; /* rch_opt checked the choice */
 }
 
-/* "\r" and "\n" in --poll-cmd become CR and LF. */
-static void unescape(char *dst, size_t cap, const char *src)
+/* "\r" and "\n" in --poll-cmd become CR and LF. 0, or -1 (nothing cut,
+ * the caller refuses) when the command does not fit in cap - 1 bytes. */
+static int unescape(char *dst, size_t cap, const char *src)
 {
     size_t k = 0;
-    for (const char *p = src; *p && k + 1 < cap; ++p) {
+    for (const char *p = src; *p; ++p) {
+        if (k + 1 >= cap)
+            return -1;
         if (p[0] == '\\' && (p[1] == 'r' || p[1] == 'n')) {
             dst[k++] = p[1] == 'r' ? '\r' : '\n';
             ++p;
@@ -62,6 +65,7 @@ static void unescape(char *dst, size_t cap, const char *src)
         }
     }
     dst[k] = '\0';
+    return 0;
 }
 
 /* The run summary as one JSON object on stdout (rcal-acquire/1), also when
@@ -181,8 +185,12 @@ int rcal_cmd_acquire(int argc, char **argv)
     c.ser.stop_bits = (unsigned)stop;
     c.ser.parity = (rcd_parity)pick(parity, "none|odd|even|mark|space");
     c.ser.flow = (rcd_flow)pick(flow, "none|xonxoff|rtscts|dtrdsr");
-    if (poll)
-        unescape(c.proto.poll_cmd, sizeof c.proto.poll_cmd, poll);
+    if (poll && unescape(c.proto.poll_cmd, sizeof c.proto.poll_cmd, poll) != 0) {
+        fprintf(stderr, "rcal acquire: --poll-cmd '%s' is longer than the %zu bytes a poll command may have (\\r and "
+                        "\\n count one each): refused, not cut\n",
+                poll, sizeof c.proto.poll_cmd - 1);
+        return 2;
+    }
     c.proto.mb_addr = (uint8_t)mb_addr;
     c.proto.mb_reg = (uint16_t)mb_reg;
     c.proto.mb_decimals = (uint8_t)mb_dec;

@@ -10,8 +10,10 @@
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
+#include "rch_data.h"
 #include "rch_file.h"
 #include "rch_opt.h"
+#include "rch_robot.h"
 
 /* Write the calibrated model to out_path (never over an input), after the fit. */
 static int write_model(const rch_calib_result *r, const char *out_path, int quiet)
@@ -125,20 +127,45 @@ static int parse(calib_args *a, int argc, char **argv)
     return -1;
 }
 
-/* 1 (with the message) when --out, --residuals or --report names one of the inputs. */
+/* 1 (with the message) when --out, --residuals, --report (or a file beside
+ * the page) or a plot name each other or one of the inputs; --data given
+ * twice (the same file by inode, whatever the spelling) or --validate equal
+ * to a --data file. */
 static int out_is_input(const calib_args *a)
 {
     const char *inputs[RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
-    const char *outs[3] = {a->out_path, a->cfg.residuals_path, a->report_path};
-    static const char *const what[3] = {"--out", "--residuals", "--report"};
     for (size_t i = 0; i < a->data.n; ++i)
         inputs[3 + i] = a->data.v[i];
-    for (size_t o = 0; o < 3; ++o)
-        for (size_t i = 0; outs[o] && i < 3 + a->data.n; ++i)
-            if (inputs[i] && rch_same_file(outs[o], inputs[i])) {
-                fprintf(stderr, "rcal calibrate: %s %s is also the input %s\n", what[o], outs[o], inputs[i]);
+    for (size_t i = 0; i < a->data.n; ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (rch_same_file(a->data.v[i], a->data.v[j]) || strcmp(a->data.v[i], a->data.v[j]) == 0) {
+                fprintf(stderr, "rcal calibrate: --data %s is the same file as --data %s: refused (each file once; "
+                                "merging a file with itself counts every sample twice)\n",
+                        a->data.v[i], a->data.v[j]);
                 return 1;
             }
+    for (size_t i = 0; a->cfg.validate_path && i < a->data.n; ++i)
+        if (rch_same_file(a->cfg.validate_path, a->data.v[i]) || strcmp(a->cfg.validate_path, a->data.v[i]) == 0) {
+            fprintf(stderr, "rcal calibrate: --validate %s is the same file as --data %s: refused (validation data "
+                            "must be samples the fit never saw; give a file of other measurements)\n",
+                    a->cfg.validate_path, a->data.v[i]);
+            return 1;
+        }
+    char svg[1100], csv[1100];
+    const char *plot_svg = NULL, *plot_csv = NULL;
+    if (a->cfg.plots_dir) {
+        if ((size_t)snprintf(svg, sizeof svg, "%s/uncertainty_position.svg", a->cfg.plots_dir) >= sizeof svg ||
+            (size_t)snprintf(csv, sizeof csv, "%s/uncertainty_position.csv", a->cfg.plots_dir) >= sizeof csv) {
+            fprintf(stderr, "rcal calibrate: --plots %s: path too long: refused\n", a->cfg.plots_dir);
+            return 1;
+        }
+        plot_svg = svg;
+        plot_csv = csv;
+    }
+    const char *outs[5] = {a->out_path, a->cfg.residuals_path, a->report_path, plot_svg, plot_csv};
+    static const char *const what[5] = {"--out", "--residuals", "--report", "--plots", "--plots"};
+    if (rcal_outputs_check("calibrate", outs, what, 5, a->report_path, inputs, 3 + a->data.n) != 0)
+        return 1;
     if (a->cfg.residuals_path && (a->cases > 1 || a->cfg.jumps)) {
         fprintf(stderr, "rcal calibrate: --residuals is for one calibration without --jumps (not with --cases or "
                         "--jumps)\n");
@@ -148,6 +175,30 @@ static int out_is_input(const calib_args *a)
     if (a->out_path && strcmp(a->out_path, "-") != 0 && stat(a->out_path, &st) == 0 && !S_ISREG(st.st_mode)) {
         fprintf(stderr, "rcal calibrate: --out %s is not a regular file: refused before the fit\n", a->out_path);
         return 1;
+    }
+    return 0;
+}
+
+/* Every --data and --validate file against the robot's joint limits, before
+ * the fit (rch_calib_run loads them again; its loader is not this file's):
+ * 1 with the message (file:line:column) when a reading is beyond them. */
+static int data_in_limits(const calib_args *a)
+{
+    static rch_robot robot;
+    rch_diag d;
+    char msg[1024];
+    if (rch_robot_load(&robot, a->cfg.robot_path, &d) != 0)
+        return 0; /* rch_calib_run reports it */
+    for (size_t i = 0; i <= a->data.n; ++i) {
+        const char *path = i < a->data.n ? a->data.v[i] : a->cfg.validate_path;
+        rch_data data;
+        if (!path)
+            continue;
+        if (rch_data_load_limited(&data, path, 0, &robot.model, &d) != 0) {
+            fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+            return 1;
+        }
+        rch_data_free(&data);
     }
     return 0;
 }
@@ -166,6 +217,8 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return ps;
     if (out_is_input(&a))
         return 2;
+    if (data_in_limits(&a))
+        return 1;
     rch_calib_result *r = malloc(sizeof *r); /* large: two models, the identifiability report */
     rch_diag d;
     char msg[1024];

@@ -59,7 +59,8 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
         fprintf(stderr, "rcal compare: cannot use %s as a plot directory: %s\n", o->plots, strerror(errno));
         return 1;
     }
-    if (rch_robot_load(&robot, robot_path, &d) != 0 || rch_data_load(&data, data_path, 0, &d) != 0) {
+    if (rch_robot_load(&robot, robot_path, &d) != 0 ||
+        rch_data_load_limited(&data, data_path, 0, &robot.model, &d) != 0) {
         fprintf(stderr, "rcal compare: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }

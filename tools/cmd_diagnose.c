@@ -156,6 +156,12 @@ int rcal_cmd_diagnose(int argc, char **argv)
     cfg.max_iter = (unsigned)max_iter;
     cfg.verbose = verbosity > 0 ? (int)verbosity : verbose;
 
+    {   /* outputs that name each other or an input: refused before the work */
+        const char *const outs[3] = {out_path, resid, report_path}, *const ins[2] = {data_path, robot_path};
+        static const char *const what[3] = {"--out", "--residuals", "--report"};
+        if (rcal_outputs_check("diagnose", outs, what, 3, report_path, ins, 2) != 0)
+            return 2;
+    }
     rch_diagnose_result r;
     rch_diag d;
     char msg[1024];

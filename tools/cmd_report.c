@@ -8,6 +8,7 @@
 #include "rcal_cmds.h"
 #include "rch_calib.h"
 #include "rch_diagnose.h"
+#include "rch_file.h"
 #include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_report.h"
@@ -21,7 +22,8 @@ static const char details[] =
     "leaves the file. Sections: data, split, before/after metrics, the identified parameters with\n"
     "their standard errors, 95 % intervals and identifiability, the diagnosis, the predicted accuracy\n"
     "over the workspace, warnings, provenance. Members a run does not carry say \"not in this run\".\n"
-    "The data of every plot is written beside the page as report_<plot>.csv. See docs/report.md.";
+    "The data of every plot is written beside the page, named from it (x.html: x_metrics.csv, x_params.csv,\n"
+    "...); the page and its CSVs are written whole or not at all. See docs/report.md.";
 
 /* path's name without a .html or .htm ending, followed by suffix. */
 static void beside(char *buf, size_t len, const char *path, const char *suffix)
@@ -32,6 +34,51 @@ static void beside(char *buf, size_t len, const char *path, const char *suffix)
     else if (n > 4 && strcmp(path + n - 4, ".htm") == 0)
         n -= 4;
     snprintf(buf, len, "%.*s%s", (int)n, path, suffix);
+}
+
+size_t rcal_report_bundle(char names[RCAL_REPORT_BUNDLE][RCAL_REPORT_NAME], const char *html)
+{
+    static const char *const csv[4] = {"metrics", "params", "accuracy", "candidates"};
+    size_t n = 0;
+    if (!html || strlen(html) >= 1024)
+        return 0;
+    beside(names[n++], RCAL_REPORT_NAME, html, ".calibration.json");
+    beside(names[n++], RCAL_REPORT_NAME, html, ".diagnosis.json");
+    for (size_t k = 0; k < 4; ++k)
+        if (rch_report_csv_path(names[n], RCAL_REPORT_NAME, html, csv[k]) == 0)
+            ++n;
+    return n;
+}
+
+int rcal_outputs_check(const char *cmd, const char *const *outs, const char *const *whats, size_t n,
+                       const char *html, const char *const *inputs, size_t n_inputs)
+{
+    enum { MAX_OUTS = 16 };
+    char bundle[RCAL_REPORT_BUNDLE][RCAL_REPORT_NAME], msg[1024];
+    const char *all[MAX_OUTS + RCAL_REPORT_BUNDLE], *all_what[MAX_OUTS + RCAL_REPORT_BUNDLE];
+    size_t m = 0;
+    for (size_t k = 0; k < n && m < MAX_OUTS; ++k) {
+        all[m] = outs[k];
+        all_what[m++] = whats[k];
+    }
+    const size_t nb = rcal_report_bundle(bundle, html);
+    for (size_t k = 0; k < nb; ++k) {
+        all[m] = bundle[k];
+        all_what[m++] = "--report (a file beside the page)";
+    }
+    rch_diag d;
+    if (rch_outs_distinct(all, all_what, m, &d) != 0) {
+        fprintf(stderr, "rcal %s: %s\n", cmd, rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    for (size_t k = 0; k < m; ++k)
+        for (size_t i = 0; all[k] && strcmp(all[k], "-") != 0 && i < n_inputs; ++i)
+            if (inputs[i] && rch_path_same(all[k], inputs[i])) {
+                fprintf(stderr, "rcal %s: %s %s is also the input %s: refused, nothing written\n", cmd, all_what[k],
+                        all[k], inputs[i]);
+                return 1;
+            }
+    return 0;
 }
 
 /* rch_save writers of the run's JSON; ctx is an rch_jw_cmd. */

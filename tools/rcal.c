@@ -9,7 +9,9 @@
 
 #include "rc_config.h"
 #include "rcal_cmds.h"
+#include "rch_file.h"
 #include "rch_paths.h"
+#include "rch_stdio.h"
 
 typedef struct {
     const char *name;
@@ -55,7 +57,7 @@ static int version(void)
     return 0;
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
 #if defined(__GLIBC__)
     /* A calibration allocates and frees a few matrices of 100-250 KB (the
@@ -83,4 +85,14 @@ int main(int argc, char **argv)
     fprintf(stderr, "rcal: unknown command '%s'\n", argv[1]);
     usage(stderr);
     return 2;
+}
+
+/* Closed standard descriptors are opened on /dev/null before anything else
+ * (no file ever takes them); every write to standard output and standard
+ * error is checked at the end (tools/host/rch_stdio.h). */
+int main(int argc, char **argv)
+{
+    rch_stdio_begin("rcal");
+    rch_out_one_command(); /* its outputs never name each other (tools/host/rch_file.h) */
+    return rch_stdio_end(run(argc, argv));
 }

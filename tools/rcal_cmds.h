@@ -40,4 +40,19 @@ int rcal_report_inline(const char *html, const struct rch_calib_result *cal, con
                        int argc, char **argv, const char *model, const char *const *inputs, size_t n_inputs,
                        int quiet);
 
+/* Every file --report HTML writes besides the page (its JSON, the plot data),
+ * for the check that a command's outputs never name each other before the
+ * work: names[k] (k < RCAL_REPORT_BUNDLE), what[k] the option that makes it.
+ * Returns the count. */
+#define RCAL_REPORT_BUNDLE 6
+#define RCAL_REPORT_NAME 1100
+size_t rcal_report_bundle(char names[RCAL_REPORT_BUNDLE][RCAL_REPORT_NAME], const char *html);
+
+/* The shared rule for a command's outputs, before any work: outs[n] (NULL
+ * skipped) never name each other (nor, with html, the files of its report)
+ * nor any of inputs[n_inputs]. 0, or 1 with the message on stderr
+ * ("rcal CMD: ..."). */
+int rcal_outputs_check(const char *cmd, const char *const *outs, const char *const *whats, size_t n,
+                       const char *html, const char *const *inputs, size_t n_inputs);
+
 #endif

@@ -196,6 +196,129 @@ static void test_read_file_limit(void **state)
     assert_int_equal(rch_read_file(&t, &n, "/nonexistent/x", 9, &d), -1);
 }
 
+/* Child: a page and its CSV as one bundle, the CSV larger than the file-size
+ * limit: 0 when the bundle was committed, 1 when refused. */
+static int child_bundle(const char *page, const char *csv, long limit)
+{
+    signal(SIGXFSZ, SIG_IGN);
+    struct rlimit r = {(rlim_t)limit, (rlim_t)limit};
+    if (setrlimit(RLIMIT_FSIZE, &r) != 0)
+        return 3;
+    rch_out o[2];
+    rch_diag d;
+    if (rch_out_open(&o[0], page, "--out", NULL, 0, &d) != 0)
+        return 2;
+    if (rch_out_open(&o[1], csv, "--out (plot data)", NULL, 0, &d) != 0) {
+        rch_out_abort(&o[0]);
+        return 2;
+    }
+    fputs("<html>new page</html>\n", o[0].f);
+    for (int i = 0; i < 20; ++i)
+        fputs("a,b,c,d,e,f,g,h\n", o[1].f);
+    return rch_out_commit_all(o, 2, &d) == 0 ? 0 : 1;
+}
+
+/* Issue 23: a report and its CSVs are written whole or not at all (the
+ * page is not renamed into place before every CSV was written). */
+static void test_bundle_whole_or_nothing(void **state)
+{
+    (void)state;
+    char page[300], csv[300];
+    path_in(page, sizeof page, "x.html");
+    path_in(csv, sizeof csv, "x_params.csv");
+    put(page, "old page");
+    for (long limit = 100; limit <= 1000; limit += 900) {
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0)
+            _exit(child_bundle(page, csv, limit));
+        int st = 0;
+        waitpid(pid, &st, 0);
+        assert_true(WIFEXITED(st));
+        if (limit == 100) { /* the CSV does not fit: nothing of the bundle is in place */
+            assert_int_equal(WEXITSTATUS(st), 1);
+            assert_string_equal(get(page), "old page");
+            assert_null(get(csv));
+            assert_int_equal(count_entries(), 1); /* no temporary left */
+        } else {
+            assert_int_equal(WEXITSTATUS(st), 0);
+            assert_string_equal(get(page), "<html>new page</html>\n");
+            assert_non_null(get(csv));
+            assert_int_equal(count_entries(), 2);
+        }
+    }
+}
+
+/* Issue 23: one command's outputs never name each other: by inode when the
+ * file exists, by normalised path when it does not; links resolved. */
+static void test_outputs_distinct(void **state)
+{
+    (void)state;
+    char a[300], a2[300], b[300], l[300], sub[300];
+    path_in(a, sizeof a, "new.json");
+    path_in(a2, sizeof a2, "sub/../new.json");
+    path_in(b, sizeof b, "other.json");
+    path_in(l, sizeof l, "link.json");
+    path_in(sub, sizeof sub, "sub");
+    assert_int_equal(mkdir(sub, 0700), 0);
+    assert_int_equal(symlink("new.json", l), 0); /* dangling until new.json exists */
+    assert_int_equal(rch_path_same(a, a2), 1);
+    assert_int_equal(rch_path_same(a, l), 1);
+    assert_int_equal(rch_path_same(a, b), 0);
+    const char *const outs[3] = {a, b, a2}, *const whats[3] = {"--out", "--residuals", "--report"};
+    rch_diag d;
+    assert_int_equal(rch_outs_distinct(outs, whats, 2, &d), 0);
+    assert_int_equal(rch_outs_distinct(outs, whats, 3, &d), -1);
+    assert_non_null(strstr(d.msg, "--report"));
+    assert_non_null(strstr(d.msg, "same file as --out"));
+    /* the same rule inside rch_out_open, for every output of the command */
+    rch_out_one_command();
+    rch_out o1, o2;
+    assert_int_equal(rch_out_open(&o1, a, "--out", NULL, 0, &d), 0);
+    assert_int_equal(rch_out_open(&o2, l, "--residuals", NULL, 0, &d), -1);
+    assert_non_null(strstr(d.msg, "same file as --out"));
+    fputs("model", o1.f);
+    assert_int_equal(rch_out_commit(&o1, &d), 0);
+    assert_int_equal(rch_out_open(&o2, a2, "--report", NULL, 0, &d), -1); /* now by inode */
+    assert_int_equal(rch_out_open(&o2, b, "--residuals", NULL, 0, &d), 0);
+    rch_out_abort(&o2);
+    rch_out_one_command(); /* a new command: nothing remembered */
+    assert_int_equal(rch_out_open(&o2, a, "--out", NULL, 0, &d), 0);
+    rch_out_abort(&o2);
+    assert_string_equal(get(a), "model");
+}
+
+/* Issue 23: through a link the target is replaced (the link stays), the
+ * mode is kept, a read-only file is refused. */
+static void test_link_mode_readonly(void **state)
+{
+    (void)state;
+    char t[300], l[300], ro[300];
+    path_in(t, sizeof t, "target.csv");
+    path_in(l, sizeof l, "link.csv");
+    path_in(ro, sizeof ro, "ro.csv");
+    put(t, "old");
+    assert_int_equal(chmod(t, 0640), 0);
+    assert_int_equal(symlink("target.csv", l), 0);
+    rch_out o;
+    rch_diag d;
+    assert_int_equal(rch_out_open(&o, l, "--out", NULL, 0, &d), 0);
+    fputs("new", o.f);
+    assert_int_equal(rch_out_commit(&o, &d), 0);
+    struct stat st;
+    assert_int_equal(lstat(l, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    assert_string_equal(get(t), "new");
+    assert_int_equal(stat(t, &st), 0);
+    assert_int_equal(st.st_mode & 07777, 0640);
+    put(ro, "keep");
+    assert_int_equal(chmod(ro, 0444), 0);
+    assert_int_equal(rch_out_open(&o, ro, "--out", NULL, 0, &d), -1);
+    assert_non_null(strstr(d.msg, "read-only (mode 0444)"));
+    assert_string_equal(get(ro), "keep");
+    assert_int_equal(count_entries(), 3);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -203,6 +326,9 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_atomic_replace_and_abort, setup, teardown),
         cmocka_unit_test_setup_teardown(test_fault_after_every_byte, setup, teardown),
         cmocka_unit_test_setup_teardown(test_read_file_limit, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_bundle_whole_or_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_outputs_distinct, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_link_mode_readonly, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -186,14 +186,14 @@ check(beside == printed, "calibrate --report: the JSON beside the page is what -
 run("calibrate", "--data", DATA, "--robot", ROBOT, "--report", DATA, expect=2)
 check(open(DATA, "rb").read() == before, "calibrate --report over --data refused, data unchanged")
 # the JSON kept beside the page never replaces an input either (a data file
-# that happens to carry its name)
+# that happens to carry its name); since issue 23 refused before the work (exit 2)
 shutil.copyfile(DATA, w("named.calibration.json"))
 named_before = open(w("named.calibration.json"), "rb").read()
-run("calibrate", "--data", w("named.calibration.json"), "--robot", ROBOT, "--report", w("named.html"), expect=1)
+run("calibrate", "--data", w("named.calibration.json"), "--robot", ROBOT, "--report", w("named.html"), expect=2)
 check(open(w("named.calibration.json"), "rb").read() == named_before,
       "calibrate --report: the data file named like its JSON is refused and unchanged")
 run("diagnose", "--data", w("named.calibration.json"), "--robot", ROBOT, "--folds", "2", "--steps", "1",
-    "--report", w("named.html"), expect=1)
+    "--report", w("named.html"), expect=2)
 check(open(w("named.calibration.json"), "rb").read() == named_before,
       "diagnose --report: the data file named like its JSON is refused and unchanged")
 run("diagnose", "--data", DATA, "--robot", ROBOT, "--folds", "2", "--steps", "1", "--report", w("dg.html"))

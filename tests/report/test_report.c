@@ -243,17 +243,17 @@ static void test_full_run_escaped(void **state)
     assert_int_equal(res.n_csv, 4);
     free(h);
     /* the CSV quotes what needs quoting */
-    char *c = get_file("report_params.csv");
+    char *c = get_file("r_params.csv");
     assert_non_null(c);
     assert_non_null(strstr(c, "\n\"a\"\"1,x<i>\",mm,270,270.1,0.1,0.5,"));
     assert_non_null(strstr(c, ",weak,\n"));
     assert_non_null(strstr(c, ",not identifiable,nominal\n"));
     free(c);
-    c = get_file("report_candidates.csv");
+    c = get_file("r_candidates.csv");
     assert_non_null(c);
     assert_non_null(strstr(c, "\"</td><script>x</script>, \"\"q\"\"\""));
     free(c);
-    c = get_file("report_accuracy.csv");
+    c = get_file("r_accuracy.csv");
     assert_non_null(c);
     assert_non_null(strstr(c, "\"95 % whole workspace, max\",2.5\n"));
     free(c);
@@ -265,7 +265,7 @@ static void test_minimal_run(void **state)
     (void)state;
     put_file("min.json", cal_min);
     char p[256];
-    path_in(p, sizeof p, "report_accuracy.csv");
+    path_in(p, sizeof p, "m_accuracy.csv");
     unlink(p);
     rch_report_result res;
     rch_diag d;
@@ -279,7 +279,7 @@ static void test_minimal_run(void **state)
     assert_non_null(strstr(h, "no diagnosis was given"));
     assert_non_null(strstr(h, "No provenance in this run"));
     assert_int_equal(res.n_csv, 2); /* metrics, params */
-    assert_null(get_file("report_accuracy.csv"));
+    assert_null(get_file("m_accuracy.csv"));
     assert_int_equal(count(h, "<svg"), res.n_plots);
     free(h);
 }

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "rch_acqfile.h"
 #include "rch_data.h"
@@ -252,17 +253,22 @@ static int announce(const char *path, size_t pose, const double q_deg[RC_NJ])
 {
     char tmp[1100];
     FILE *f;
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    f = fopen(tmp, "w");
-    if (!f)
+    if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", path) >= sizeof tmp || rch_tmp_register(tmp) != 0)
         return -1;
+    f = fopen(tmp, "w"); /* removed on SIGINT / SIGTERM while registered */
+    if (!f) {
+        rch_tmp_forget(tmp);
+        return -1;
+    }
     fprintf(f, "%zu", pose);
     for (int j = 0; j < RC_NJ; ++j)
         fprintf(f, " %.4f", q_deg[j]);
     fprintf(f, "\n");
-    if (fclose(f) != 0)
-        return -1;
-    return rename(tmp, path);
+    int rc = fclose(f) != 0 ? -1 : rename(tmp, path);
+    if (rc != 0)
+        unlink(tmp);
+    rch_tmp_forget(tmp);
+    return rc;
 }
 
 /* Measure pose i until its sample follows the move (or give up). */

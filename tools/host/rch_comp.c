@@ -16,6 +16,7 @@
 #include "rch_file.h"
 #include "rch_opt.h"
 #include "rch_robot.h"
+#include "rch_stdio.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -375,6 +376,18 @@ static long read_line(char **line, size_t *cap, FILE *in)
     return (long)n;
 }
 
+/* A write of the output failed (full disk, closed pipe or descriptor): 1
+ * with d set, the stream stops there; no line is ever lost silently. */
+static int out_failed(const comp_ctx *c, unsigned lineno, rch_diag *d)
+{
+    if (!ferror(c->out))
+        return 0;
+    rch_diag_set(d, c->out == stdout ? "<stdout>" : "", 0, 0,
+                 "write failed at input line %u (%s): stopped there, the output is incomplete", lineno,
+                 strerror(rch_stdio_errno(c->out)));
+    return 1;
+}
+
 int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
                    const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d)
 {
@@ -411,6 +424,10 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         if (c.format != 2 && is_comment_or_blank(line, n)) {
             fwrite(line, 1, n, c.out);
             fputc('\n', c.out);
+            if (out_failed(&c, lineno, d)) {
+                rc = -1;
+                break;
+            }
             continue;
         }
         int r;
@@ -423,7 +440,7 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                 double v;
                 c.format = 1;
                 if (split_csv(line, n, st, ln) > 0 && parse_num(&v, line + st[0], ln[0]) != 0) {
-                    if (do_header(&c, line, n, lineno, d) < 0) {
+                    if (do_header(&c, line, n, lineno, d) < 0 || out_failed(&c, lineno, d)) {
                         rc = -1;
                         break;
                     }
@@ -438,6 +455,10 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         }
         if (r > 0)
             rc = 1;
+        if (out_failed(&c, lineno, d)) {
+            rc = -1;
+            break;
+        }
     }
     free(line);
     res->format = (rch_comp_format)c.format;

@@ -116,6 +116,7 @@ typedef struct parse_ctx {
     int col_of[C_N]; /* field index of each known column, -1 absent */
     size_t cap;      /* allocated rows */
     unsigned line_no;
+    const rc_model *lim; /* joint limits of the robot, or NULL */
 } parse_ctx;
 
 /* The header line: find the known columns. 0 or -1 with d set. */
@@ -195,17 +196,37 @@ static int grow(rch_data *out, parse_ctx *pc)
     return 0;
 }
 
+/* Joint j's reading v (degrees, as written) beyond the robot's limits by
+ * more than the file's rounding. */
+static int out_of_limits(const rc_model *m, int j, double v)
+{
+    const double lo = m->q_min_rad[j] * (180.0 / M_PI) - RCH_DATA_LIMIT_TOL_DEG,
+                 hi = m->q_max_rad[j] * (180.0 / M_PI) + RCH_DATA_LIMIT_TOL_DEG;
+    return v < lo || v > hi;
+}
+
 /* Range of one field's value v of column k: 0, or -1 with d set. */
 static int check_value(const parse_ctx *pc, int k, double v, const field *f)
 {
     const char *nm = col_names[k];
     const unsigned ln = pc->line_no, col = f->col;
     if (!isfinite(v))
-        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %s is not finite", nm, isnan(v) ? "NaN" : "infinity");
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %s is not finite (no sensor reads it: fix or remove the row)",
+                     nm, isnan(v) ? "NaN" : "infinity");
     else if (k < C_L && fabs(v) > 720.0)
         rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g degrees is outside -720..720", nm, v);
-    else if (k == C_L && !(v > 0.0 && v <= 20000.0))
-        rch_diag_set(pc->d, pc->name, ln, col, "field 'L': %g mm is not a cable length (0 < L <= 20000)", v);
+    else if (k == C_L && !(v >= RCH_DATA_MIN_LEN_MM && v <= 20000.0))
+        rch_diag_set(pc->d, pc->name, ln, col,
+                     "field 'L': %g mm is not a cable length a draw-wire encoder reads (%g <= L <= 20000 mm): %s",
+                     v, RCH_DATA_MIN_LEN_MM,
+                     v > 0.0 && v < 1.0 && v >= 0.01 ? "metres? rcal reads millimetres (multiply by 1000)"
+                                                     : "check the column's unit and the display, or remove the row");
+    else if (k < C_L && pc->lim && out_of_limits(pc->lim, k - C_Q1, v))
+        rch_diag_set(pc->d, pc->name, ln, col,
+                     "field '%s': %.10g deg is outside joint %d's limits [%g, %g] deg of the robot model (%g deg "
+                     "allowed for rounding): no reading of this robot; check --robot and the column order",
+                     nm, v, k - C_Q1 + 1, pc->lim->q_min_rad[k - C_Q1] * (180.0 / M_PI),
+                     pc->lim->q_max_rad[k - C_Q1] * (180.0 / M_PI), RCH_DATA_LIMIT_TOL_DEG);
     else if ((k == C_X || k == C_Y || k == C_Z) && fabs(v) > 1e5)
         rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g mm is absurd", nm, v);
     else if (k == C_T && fabs(v) > 1e300) /* t_max - t_min must stay finite when scaling */
@@ -294,8 +315,8 @@ static int nul_check(const parse_ctx *pc, const char *line, size_t ll, const cha
     return -1;
 }
 
-int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
-                   rch_diag *d)
+static int parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                 const rc_model *lim, rch_diag *d)
 {
     field fields[256];
     size_t pos = 0;
@@ -306,6 +327,7 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
     pc.name = name;
     pc.flags = flags;
     pc.d = d;
+    pc.lim = lim;
     for (int k = 0; k < C_N; ++k)
         pc.col_of[k] = -1;
     if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
@@ -357,16 +379,27 @@ fail:
     return -1;
 }
 
-int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d)
+int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                   rch_diag *d)
+{
+    return parse(out, text, len, name, flags, NULL, d);
+}
+
+int rch_data_load_limited(rch_data *out, const char *path, unsigned flags, const rc_model *limits, rch_diag *d)
 {
     char *buf = NULL;
     size_t len = 0;
     memset(out, 0, sizeof *out);
     if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
         return -1;
-    int rc = rch_data_parse(out, buf, len, path, flags, d);
+    int rc = parse(out, buf, len, path, flags, limits, d);
     free(buf);
     return rc;
+}
+
+int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d)
+{
+    return rch_data_load_limited(out, path, flags, NULL, d);
 }
 
 void rch_data_free(rch_data *data)
@@ -466,5 +499,5 @@ int rch_load_model_and_data(struct rch_robot *robot, const char *model_path, rch
 {
     if (rch_robot_load(robot, model_path, d) != 0)
         return -1;
-    return rch_data_load(data, data_path, 0, d) != 0 ? -1 : 0;
+    return rch_data_load_limited(data, data_path, 0, &robot->model, d) != 0 ? -1 : 0;
 }

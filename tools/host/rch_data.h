@@ -8,8 +8,10 @@
  * group, integer >= 0). Every other column is ignored. Blank lines and lines
  * starting with '#' are skipped.
  * A bad field is refused with file, line and column: missing fields, text
- * that is not a number, NaN, infinity, and absurd values (|q| > 720 deg,
- * L <= 0 or L > 20000 mm), hexadecimal floats. Nothing is silently used.
+ * that is not a number, NaN, infinity, and values no sensor produces
+ * (|q| > 720 deg, L < 1 mm or L > 20000 mm; with a robot model, a joint
+ * beyond its limits by more than RCH_DATA_LIMIT_TOL_DEG), hexadecimal floats.
+ * Nothing is silently used.
  * Memory: the loader allocates; rch_data_free releases.
  */
 #ifndef RCH_DATA_H
@@ -42,8 +44,19 @@ typedef struct rch_data {
  * calibration; 2 million take about 1.1 GB and 45 s */
 #define RCH_DATA_MAX_ROWS ((size_t)2000000)
 
+/* Shortest cable length a draw-wire encoder reads (mm): below it a value is
+ * a unit or display error (0.001, 1e-300), never a measurement. */
+#define RCH_DATA_MIN_LEN_MM 1.0
+/* Joint readings beyond the robot's limits by more than this (degrees: the
+ * rounding of a file written with 0.1 deg) are refused. */
+#define RCH_DATA_LIMIT_TOL_DEG 0.05
+
 /* Load a file (at most RCH_DATA_MAX_BYTES); on failure returns non-zero with d filled in. */
 int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d);
+/* The same, also refusing joint readings outside the limits of limits
+ * (q_min_rad..q_max_rad, with RCH_DATA_LIMIT_TOL_DEG) with file:line:column;
+ * limits NULL: no such check. */
+int rch_data_load_limited(rch_data *out, const char *path, unsigned flags, const rc_model *limits, rch_diag *d);
 /* The same from memory (name is used in the diagnostics). */
 int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
                    rch_diag *d);
@@ -55,7 +68,8 @@ void rch_data_free(rch_data *data);
 int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d);
 
 /* A command's two inputs: the robot (or calibrated) model file and a data
- * file. 0, or -1 with d set (nothing left allocated). */
+ * file, its joints inside the model's limits. 0, or -1 with d set (nothing
+ * left allocated). */
 struct rch_robot;
 int rch_load_model_and_data(struct rch_robot *robot, const char *model_path, rch_data *data, const char *data_path,
                             rch_diag *d);

@@ -1462,7 +1462,7 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
     memset(out, 0, sizeof *out);
     rch_robot robot;
     rch_data data;
-    if (rch_robot_load(&robot, robot_path, d) != 0 || rch_data_load(&data, data_path, 0, d) != 0)
+    if (rch_robot_load(&robot, robot_path, d) != 0 || rch_data_load_limited(&data, data_path, 0, &robot.model, d) != 0)
         return -1;
     rch_diagnose_cfg c = *cfg;
     c.groups_given = data.has_group;

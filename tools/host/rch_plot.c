@@ -931,12 +931,12 @@ int rch_plot_open(rch_out *o, const rch_plot_dir *pd, const char *name, rch_diag
 
 int rch_plot_close(rch_out *o, const rch_plot_dir *pd, int failed, rch_diag *d)
 {
-    if (failed || ferror(o->f)) {
-        rch_diag_set(d, "", 0, 0, "cannot write %s: %s", o->path, failed ? "out of memory" : "write error");
+    if (failed && !ferror(o->f)) { /* the writer failed, not the stream */
+        rch_diag_set(d, "", 0, 0, "cannot write %s: out of memory", o->path);
         rch_out_abort(o);
         return -1;
     }
-    if (rch_out_commit(o, d) != 0)
+    if (rch_out_commit(o, d) != 0) /* a write error with its reason (a full disk is not memory) */
         return -1;
     if (pd->log)
         fprintf(pd->log, "  wrote %s\n", o->path);

@@ -229,11 +229,13 @@ static void csv_num(FILE *f, double v)
         fprintf(f, "%.9g", v);
 }
 
-static void cl_put(char *buf, size_t len, size_t *k, const char *s)
+/* Appends s; returns 1 when it did not fit. */
+static int cl_put(char *buf, size_t len, size_t *k, const char *s)
 {
     while (*s && *k + 1 < len)
         buf[(*k)++] = *s++;
     buf[*k] = '\0';
+    return *s != '\0';
 }
 
 const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *argv)
@@ -242,17 +244,20 @@ const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *arg
     if (len == 0)
         return buf;
     buf[0] = '\0';
+    int cut = 0;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         const int quote = !*a || strpbrk(a, " \t\n'\"\\$`&|;<>()*?[]{}~!#") != NULL;
-        cl_put(buf, len, &k, i ? " " : "");
-        cl_put(buf, len, &k, quote ? "'" : "");
+        cut |= cl_put(buf, len, &k, i ? " " : "");
+        cut |= cl_put(buf, len, &k, quote ? "'" : "");
         for (; *a; ++a) {
             const char c[2] = {*a, '\0'};
-            cl_put(buf, len, &k, quote && *a == '\'' ? "'\\''" : c);
+            cut |= cl_put(buf, len, &k, quote && *a == '\'' ? "'\\''" : c);
         }
-        cl_put(buf, len, &k, quote ? "'" : "");
+        cut |= cl_put(buf, len, &k, quote ? "'" : "");
     }
+    if (cut && len > 16) /* never cut silently: the end says so */
+        snprintf(buf + len - 16, 16, " ... (cut)");
     return buf;
 }
 
@@ -622,6 +627,7 @@ typedef struct {
     const char *file, *sha_rec; /* as recorded; sha_rec NULL when not recorded */
     double samples;
     char sha_now[65];           /* "" when the file cannot be read from here */
+    char why[96];               /* why not (a FIFO, a device, too large, ...) */
 } dfile;
 
 static size_t data_files(const rep *r, dfile out[MAX_DFILES])
@@ -643,8 +649,11 @@ static size_t data_files(const rep *r, dfile out[MAX_DFILES])
         out[0].samples = jnum(r->cal, "n_train") + jnum(r->cal, "n_test");
         n = 1;
     }
+    /* names found in the file, not given by the user: a regular file below
+     * the size limit only (never a FIFO or /dev/zero, which never end) */
     for (size_t i = 0; i < n; ++i)
-        if (rch_sha256_file(out[i].sha_now, out[i].file) != 0)
+        if (rch_sha256_file_unasked(out[i].sha_now, out[i].file, RCH_UNASKED_MAX_BYTES, out[i].why,
+                                    sizeof out[i].why) != 0)
             out[i].sha_now[0] = '\0';
     return n;
 }
@@ -740,7 +749,7 @@ static void warn_inputs(rep *r, const dfile *df, size_t n_df)
             warnf(r, "The data file %s changed since the calibration (its SHA-256 differs from the one recorded).",
                   df[i].file);
         if (!df[i].sha_now[0])
-            warnf(r, "The data file %s cannot be read from here: its content cannot be checked.", df[i].file);
+            warnf(r, "The data file %s was not read (%s): its content cannot be checked.", df[i].file, df[i].why);
     }
     if (!r->prov && !jstr(r->cal, "tool"))
         warnf(r, "No provenance in this run (tool version, command line, data hash, date): the result cannot be "
@@ -863,7 +872,13 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
         fputs("<br>recorded: <span class=\"mono\">", f);
         put_str(r, df[i].sha_rec);
         fputs("</span><br>now: <span class=\"mono\">", f);
-        fputs(df[i].sha_now[0] ? df[i].sha_now : "<span class=\"na\">cannot be read from here</span>", f);
+        if (df[i].sha_now[0]) {
+            fputs(df[i].sha_now, f);
+        } else {
+            fputs("<span class=\"na\">not read: ", f);
+            put_esc(f, df[i].why);
+            fputs("</span>", f);
+        }
         fputs(df[i].sha_rec && df[i].sha_now[0] ? (strcmp(df[i].sha_rec, df[i].sha_now) ? " (DIFFERS)" : " (same)")
                                                  : "",
               f);
@@ -1709,6 +1724,17 @@ static int job_load(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
     return 0;
 }
 
+int rch_report_csv_path(char *buf, size_t cap, const char *page, const char *name)
+{
+    size_t n = strlen(page);
+    if (n > 5 && strcmp(page + n - 5, ".html") == 0)
+        n -= 5;
+    else if (n > 4 && strcmp(page + n - 4, ".htm") == 0)
+        n -= 4;
+    const int w = snprintf(buf, cap, "%.*s_%s.csv", (int)n, page, name);
+    return w >= 0 && (size_t)w < cap ? 0 : -1;
+}
+
 /* Open the HTML and the CSVs beside it (temporary files until committed). */
 static int job_open(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
 {
@@ -1728,12 +1754,13 @@ static int job_open(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
         names[n++] = "accuracy";
     if (j->n_c)
         names[n++] = "candidates";
-    const char *slash = strrchr(cfg->out_path, '/');
-    const int dir_len = slash ? (int)(slash - cfg->out_path + 1) : 0;
     for (unsigned k = 0; k < n; ++k) {
         char *path = r->res->csv[k];
-        snprintf(path, sizeof r->res->csv[k], "%.*sreport_%s.csv", dir_len, cfg->out_path, names[k]);
-        if (strcmp(path, cfg->out_path) == 0) {
+        if (rch_report_csv_path(path, sizeof r->res->csv[k], cfg->out_path, names[k]) != 0) {
+            rch_diag_set(d, cfg->out_path, 0, 0, "--out: path too long for the plot data beside it");
+            return -1;
+        }
+        if (rch_path_same(path, cfg->out_path)) {
             rch_diag_set(d, path, 0, 0, "--out: the page would be overwritten by its own plot data; name it "
                                         "otherwise");
             return -1;
@@ -1810,9 +1837,9 @@ int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag
             rch_diag_set(d, j.out[k].path, 0, 0, "write error");
             goto done;
         }
-    for (unsigned k = 0; k < j.n_out; ++k)
-        if (rch_out_commit(&j.out[k], d) != 0)
-            goto done; /* the outputs not yet committed are removed by job_free */
+    /* whole or not at all: every file written and synced before any is renamed */
+    if (rch_out_commit_all(j.out, j.n_out, d) != 0)
+        goto done;
     j.n_out = 0;
     rc = 0;
 done:

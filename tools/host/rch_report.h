@@ -15,9 +15,10 @@
  * working while the JSON grows. The members read, and where each is looked
  * for, are listed in docs/report.md.
  *
- * The data of every plot is written beside the HTML as report_<plot>.csv
- * (metrics, params, accuracy when the run has accuracy figures, candidates
- * when a diagnosis is given), in the HTML's directory.
+ * The data of every plot is written beside the HTML, named from it: page
+ * x.html gives x_<plot>.csv (metrics, params, accuracy when the run has
+ * accuracy figures, candidates when a diagnosis is given). The page and its
+ * CSVs are one bundle, written whole or not at all (rch_out_commit_all).
  *
  * Every string that comes from a JSON file is HTML-escaped (& < > " ' and
  * control characters; bytes that are not UTF-8 become U+FFFD), also inside
@@ -64,12 +65,19 @@ typedef struct {
  * what its option says, an output that names an input, a write failure). */
 int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag *d);
 
+/* The plot-data file `name` of page: the page's path without .html/.htm,
+ * then "_<name>.csv" (x.html, "params" -> x_params.csv). 0, or -1 when it
+ * does not fit in cap. */
+int rch_report_csv_path(char *buf, size_t cap, const char *page, const char *name);
+
 /* s HTML-escaped into buf (always NUL-terminated; truncated only between
  * whole characters or entities). Returns buf. */
 const char *rch_report_escape(char *buf, size_t len, const char *s);
 
 /* argv joined by blanks into buf, each argument that holds a blank, a quote
- * or a shell character single-quoted, as a user would type it. Returns buf. */
+ * or a shell character single-quoted, as a user would type it; a command
+ * line that does not fit ends in " ... (cut)", never cut silently. Returns
+ * buf. */
 const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *argv);
 
 #endif

@@ -2,6 +2,8 @@
 /* rch_sha256.c - SHA-256 after FIPS 180-4 (see rch_sha256.h). */
 #include "rch_sha256.h"
 
+#include "rch_file.h"
+
 #include <stdio.h>
 #include <string.h>
 
@@ -95,6 +97,29 @@ int rch_sha256_file(char hex[65], const char *path)
     fclose(f);
     if (bad)
         return -1;
+    rch_sha256_final(&c, hex);
+    return 0;
+}
+
+int rch_sha256_file_unasked(char hex[65], const char *path, size_t max_bytes, char *why, size_t why_len)
+{
+    FILE *f = rch_open_regular(path, max_bytes, why, why_len);
+    if (!f)
+        return -1;
+    rch_sha256 c;
+    unsigned char buf[8192];
+    size_t n, total = 0;
+    rch_sha256_init(&c);
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0 && total <= max_bytes) {
+        rch_sha256_update(&c, buf, n);
+        total += n;
+    }
+    const int bad = ferror(f);
+    fclose(f);
+    if (bad || total > max_bytes) {
+        snprintf(why, why_len, "%s", bad ? "read error" : "grew beyond the size limit while read");
+        return -1;
+    }
     rch_sha256_final(&c, hex);
     return 0;
 }

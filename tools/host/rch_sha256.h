@@ -21,5 +21,9 @@ void rch_sha256_update(rch_sha256 *c, const void *data, size_t len);
 void rch_sha256_final(rch_sha256 *c, char hex[65]);
 /* Digest of a whole file; 0, or -1 when it cannot be read. */
 int rch_sha256_file(char hex[65], const char *path);
+/* The same for a path the user did not give (a name inside a file): only a
+ * regular file of at most max_bytes (rch_open_regular); 0, or -1 with why
+ * set. */
+int rch_sha256_file_unasked(char hex[65], const char *path, size_t max_bytes, char *why, size_t why_len);
 
 #endif

@@ -23,6 +23,7 @@
 
 #include "rcd_display.h"
 #include "rch_opt.h"
+#include "rch_stdio.h"
 
 static double now_s(void)
 {
@@ -179,7 +180,7 @@ static double port_rate(rcd_protocol proto, unsigned baud, double seconds)
     return (double)got / (t - t0);
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     unsigned baud = 115200;
     double seconds = 1.0, v[32] = {0};
@@ -222,4 +223,12 @@ int main(int argc, char **argv)
         v[r] = port_rate(RCD_PROTO_MODBUS, 0, seconds);
     printf("  modbus polled %8.0f readings/s\n", median(v, runs));
     return 0;
+}
+
+/* Closed standard descriptors opened on /dev/null first; standard output and
+ * standard error checked at the end (tools/host/rch_stdio.h). */
+int main(int argc, char **argv)
+{
+    rch_stdio_begin("serial_bench");
+    return rch_stdio_end(run(argc, argv));
 }

@@ -66,6 +66,7 @@
 #include "rch_data.h"
 #include "rch_opt.h"
 #include "rch_robot.h"
+#include "rch_stdio.h"
 
 /* longest delay an option may ask for: one day */
 #define SIM_MAX_MS 86400000UL
@@ -151,7 +152,11 @@ static int open_pty(sim *s)
     fcntl(s->master, F_SETFL, fcntl(s->master, F_GETFL) | O_NONBLOCK);
     if (s->link) {
         char tmp[600];
-        snprintf(tmp, sizeof tmp, "%s.tmp%ld", s->link, (long)getpid());
+        if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp%ld", s->link, (long)getpid()) >= sizeof tmp) {
+            fprintf(stderr, "simdisplay: --link %s: longer than %zu bytes: refused, not cut\n", s->link,
+                    sizeof tmp - 32);
+            return -1;
+        }
         unlink(tmp);
         if (symlink(s->path, tmp) != 0 || rename(tmp, s->link) != 0) {
             fprintf(stderr, "simdisplay: cannot link %s: %s\n", s->link, strerror(errno));
@@ -499,9 +504,14 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
     s->pc.mb_reg = (uint16_t)g->mb_reg;
     s->pc.mb_decimals = (uint8_t)g->mb_decimals;
     s->reconnect_ms = g->reconnect_ms;
-    if (g->poll_cmd) { /* C escapes \r and \n are understood */
+    if (g->poll_cmd) { /* C escapes \r and \n are understood; never cut */
         size_t k = 0;
-        for (const char *p = g->poll_cmd; *p && k + 1 < sizeof s->pc.poll_cmd; ++p) {
+        for (const char *p = g->poll_cmd; *p; ++p) {
+            if (k + 1 >= sizeof s->pc.poll_cmd) {
+                fprintf(stderr, "simdisplay: --poll-cmd is longer than %zu bytes: refused, not cut\n",
+                        sizeof s->pc.poll_cmd - 1);
+                return 2;
+            }
             if (p[0] == '\\' && (p[1] == 'r' || p[1] == 'n')) {
                 s->pc.poll_cmd[k++] = p[1] == 'r' ? '\r' : '\n';
                 ++p;
@@ -630,7 +640,7 @@ static int serve(sim *s, unsigned long reply_delay_ms)
     }
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     sim s;
     sim_args g = {"ascii", NULL, NULL, NULL, "zero", "mm", "int32", "abcd", NULL, 3, 0, 0, 0, 0, 1, -1};
@@ -658,4 +668,12 @@ int main(int argc, char **argv)
     free(s.script);
     free(s.pose_len);
     return rc;
+}
+
+/* Closed standard descriptors opened on /dev/null first; standard output and
+ * standard error checked at the end (tools/host/rch_stdio.h). */
+int main(int argc, char **argv)
+{
+    rch_stdio_begin("simdisplay");
+    return rch_stdio_end(run(argc, argv));
 }
