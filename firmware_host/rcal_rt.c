@@ -449,6 +449,8 @@ static int determined(rc_model *det, const rch_robot *robot)
     int v1 = 0;
     char held[256];
     unsigned n = rch_comp_determined(det, &unc, &v1, held, sizeof held, robot, &robot->nominal);
+    /* the flange, never the cable attachment point the calibration measured */
+    rch_comp_point_model(det, det, NULL);
     fprintf(stderr, "rcal-rt: compensating with %u of 24 DH parameters as fitted; held nominal: %s\n", 24u - n,
             n ? held : "none");
     return v1 || !unc.orientation_determined;

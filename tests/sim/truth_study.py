@@ -259,6 +259,7 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
            "err_med_comp": float(np.median(e_c)), "err_med_uncomp": float(np.median(e_u))}
     if u95 is not None and len(u95) == len(e_c):
         res["u95_cover"] = float(np.mean(e_c <= u95))
+        res["u95_ratio_p95"] = float(np.percentile(e_c / np.maximum(u95, 1e-12), 95))
         res["u95_med"] = float(np.median(u95))
     return res
 
