@@ -125,34 +125,73 @@ rc_status rc_model_init(rc_model *m, const double dh[RC_NJ][4], const double enc
     return RC_OK;
 }
 
+/* The table of effects, indexed by kind (rc_model.h, rc_effect_desc). */
+static const rc_effect_desc effect_table[] = {
+    {RC_EFF_NONE, "none", 0, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 0, "", 0.0, "", "", 0},
+    {RC_EFF_LENGTH_OFFSET, "length_offset", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 0, 0, 1, "mm", 1000.0, "", "", 0},
+    {RC_EFF_JOINT_COMPLIANCE, "joint_compliance", 1, RC_SIDE_JOINT, RC_EFF_ARG_JOINT, 2, 0, 1, "rad/m", 0.1, "",
+     "", 0},
+    {RC_EFF_JOINT_PERIODIC, "joint_periodic", 4, RC_SIDE_JOINT, RC_EFF_ARG_JOINT, 1, 0, 1, "rad", 0.2,
+     "s1|c1|s2|c2", "", 0},
+    {RC_EFF_TIME_DRIFT, "time_drift", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 1, 1, "mm", 1000.0, "", "d", 1},
+    {RC_EFF_GROUP_OFFSET, "group_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 1, 0, "mm", 1000.0, "", "g", 0},
+    {RC_EFF_LENGTH_SCALE, "length_scale", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "", 0.1, "", "", 0},
+    {RC_EFF_TOOL_OFFSET, "tool_offset", 3, RC_SIDE_POINT, RC_EFF_ARG_NONE, 0, 0, 1, "mm", 1000.0, "x|y|z", "", 0},
+    {RC_EFF_CABLE_SAG, "cable_sag", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "mm/m^3", 1000.0, "", "", 0},
+    {RC_EFF_LENGTH_NONLIN, "length_nonlinearity", 2, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "mm/m^2, mm/m^3",
+     1000.0, "n2|n3", "", 0},
+    {RC_EFF_LENGTH_PERIODIC, "length_periodic", 3, RC_SIDE_LENGTH, RC_EFF_ARG_PERIOD, 0, 0, 1, "mm", 1000.0,
+     "s|c|period", "", 0},
+    {RC_EFF_OUTLET, "outlet", 3, RC_SIDE_OUTLET, RC_EFF_ARG_OUTLET, 0, 0, 0, "mm", 1e5, "x|y|z", "", 0},
+};
+RC_STATIC_ASSERT(sizeof effect_table / sizeof effect_table[0] == RC_EFF_LAST + 1, effect_table_covers_every_kind);
+
+const rc_effect_desc *rc_effect_describe(unsigned kind)
+{
+    if (kind == RC_EFF_NONE || kind > RC_EFF_LAST)
+        return NULL;
+    RC_ASSERT(effect_table[kind].kind == kind);
+    return &effect_table[kind];
+}
+
+int rc_effect_by_name(const char *name)
+{
+    if (name == NULL)
+        return -1;
+    for (unsigned k = 1; k <= RC_EFF_LAST; ++k)
+        if (strcmp(effect_table[k].name, name) == 0)
+            return (int)k;
+    return -1;
+}
+
 rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, unsigned count)
 {
     RC_ASSERT(m != NULL);
-    unsigned n;
-    switch (kind) {
-    case RC_EFF_LENGTH_OFFSET: n = 1; joint = 0; break;
-    case RC_EFF_LENGTH_SCALE: n = 1; joint = 0; break;
-    case RC_EFF_TOOL_OFFSET: n = 3; joint = 0; break;
-    case RC_EFF_CABLE_SAG: n = 1; joint = 0; break;
-    case RC_EFF_LENGTH_NONLIN: n = 2; joint = 0; break;
-    case RC_EFF_LENGTH_PERIODIC: n = 3; joint = 0; break;
-    case RC_EFF_TIME_DRIFT: /* polynomial in t without constant, degree 1..4; 0: 3 */
-        n = count == 0 ? 3u : count;
+    const rc_effect_desc *ds = rc_effect_describe((unsigned)kind);
+    if (ds == NULL)
+        return RC_ERR_ARG;
+    unsigned n = ds->count;
+    if (ds->arg == RC_EFF_ARG_COUNT)
+        n = count;
+    if (ds->arg != RC_EFF_ARG_JOINT && ds->arg != RC_EFF_ARG_OUTLET)
         joint = 0;
+    if (kind == RC_EFF_TIME_DRIFT) { /* polynomial in t without constant, degree 1..4; 0: 3 */
+        n = count == 0 ? 3u : count;
         if (n > 4)
             return RC_ERR_ARG;
-        break;
-    case RC_EFF_GROUP_OFFSET: n = count; joint = 0; break;
-    case RC_EFF_JOINT_PERIODIC: n = 4; break;
-    case RC_EFF_JOINT_COMPLIANCE:
-        n = 1;
-        if (joint != 1 && joint != 2)
-            return RC_ERR_ARG; /* gravity lever defined for joints 2 and 3 */
-        break;
-    case RC_EFF_NONE:
-    default: return RC_ERR_ARG;
     }
-    if (joint >= RC_NJ || n == 0)
+    if (kind == RC_EFF_JOINT_COMPLIANCE && joint != 1 && joint != 2)
+        return RC_ERR_ARG; /* gravity lever defined for joints 2 and 3 */
+    if (ds->arg == RC_EFF_ARG_OUTLET) {
+        if (joint < 1 || joint >= RC_MAX_OUTLETS)
+            return RC_ERR_ARG;
+        for (unsigned i = 0; i < m->n_effects; ++i)
+            if (m->effects[i].kind == RC_EFF_OUTLET && m->effects[i].joint == joint)
+                return RC_ERR_ARG; /* one effect per outlet */
+    } else if (joint >= RC_NJ) {
+        return RC_ERR_ARG;
+    }
+    if (n == 0)
         return RC_ERR_ARG;
     if (m->n_effects >= RC_MAX_EFFECTS || (unsigned)m->n_params + n > RC_MAX_PARAMS)
         return RC_ERR_CAPACITY;
@@ -194,20 +233,8 @@ void rc_model_wrap_angles(rc_model *m)
 
 const char *rc_effect_name(rc_effect_kind kind)
 {
-    switch (kind) {
-    case RC_EFF_LENGTH_OFFSET: return "length_offset";
-    case RC_EFF_JOINT_COMPLIANCE: return "joint_compliance";
-    case RC_EFF_JOINT_PERIODIC: return "joint_periodic";
-    case RC_EFF_TIME_DRIFT: return "time_drift";
-    case RC_EFF_GROUP_OFFSET: return "group_offset";
-    case RC_EFF_LENGTH_SCALE: return "length_scale";
-    case RC_EFF_TOOL_OFFSET: return "tool_offset";
-    case RC_EFF_CABLE_SAG: return "cable_sag";
-    case RC_EFF_LENGTH_NONLIN: return "length_nonlinearity";
-    case RC_EFF_LENGTH_PERIODIC: return "length_periodic";
-    case RC_EFF_NONE: break;
-    }
-    return "none";
+    const rc_effect_desc *ds = rc_effect_describe((unsigned)kind);
+    return ds ? ds->name : "none";
 }
 
 /* Small bounded formatter: copies s into buf at *pos. */
@@ -235,7 +262,6 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
 {
     static const char *const dh_names[4] = {"a", "d", "alpha", "theta"};
     static const char *const enc_names[3] = {"ex", "ey", "ez"};
-    static const char *const per_names[4] = {".s1", ".c1", ".s2", ".c2"};
     size_t pos = 0;
     RC_ASSERT(buf != NULL && buf_len > 0 && m != NULL);
     buf[0] = '\0';
@@ -253,31 +279,29 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
         if (k < e->first || k >= (unsigned)e->first + e->count)
             continue;
         unsigned j = k - e->first;
-        put_str(buf, buf_len, &pos, rc_effect_name((rc_effect_kind)e->kind));
-        switch ((rc_effect_kind)e->kind) {
-        case RC_EFF_JOINT_COMPLIANCE:
+        const rc_effect_desc *ds = rc_effect_describe(e->kind);
+        if (ds == NULL)
+            break;
+        put_str(buf, buf_len, &pos, ds->name);
+        if (ds->arg == RC_EFF_ARG_JOINT) {
             put_str(buf, buf_len, &pos, ".j");
             put_uint(buf, buf_len, &pos, e->joint + 1u);
-            break;
-        case RC_EFF_JOINT_PERIODIC:
-            put_str(buf, buf_len, &pos, ".j");
-            put_uint(buf, buf_len, &pos, e->joint + 1u);
-            put_str(buf, buf_len, &pos, per_names[j & 3u]);
-            break;
-        case RC_EFF_TIME_DRIFT:
-            put_str(buf, buf_len, &pos, ".d");
-            put_uint(buf, buf_len, &pos, j + 1u);
-            break;
-        case RC_EFF_GROUP_OFFSET:
-            put_str(buf, buf_len, &pos, ".g");
-            put_uint(buf, buf_len, &pos, j);
-            break;
-        case RC_EFF_TOOL_OFFSET:
-            put_str(buf, buf_len, &pos, j == 0 ? ".x" : j == 1 ? ".y" : ".z");
-            break;
-        case RC_EFF_LENGTH_NONLIN: put_str(buf, buf_len, &pos, j == 0 ? ".n2" : ".n3"); break;
-        case RC_EFF_LENGTH_PERIODIC: put_str(buf, buf_len, &pos, j == 0 ? ".s" : j == 1 ? ".c" : ".period"); break;
-        default: break;
+        } else if (ds->arg == RC_EFF_ARG_OUTLET) {
+            put_str(buf, buf_len, &pos, ".");
+            put_uint(buf, buf_len, &pos, e->joint);
+        }
+        if (ds->suffixes[0] != '\0') { /* the j-th of "a|b|c" */
+            const char *sfx = ds->suffixes;
+            for (unsigned t = 0; t < j && *sfx != '\0'; ++sfx)
+                t += *sfx == '|';
+            put_str(buf, buf_len, &pos, ".");
+            while (*sfx != '\0' && *sfx != '|' && pos + 1 < buf_len)
+                buf[pos++] = *sfx++;
+            buf[pos] = '\0';
+        } else if (e->count > 1 || ds->index_prefix[0] != '\0') {
+            put_str(buf, buf_len, &pos, ".");
+            put_str(buf, buf_len, &pos, ds->index_prefix);
+            put_uint(buf, buf_len, &pos, j + ds->index_base);
         }
         return buf;
     }
@@ -295,15 +319,8 @@ int rc_param_unit(const rc_model *m, unsigned k)
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *e = &m->effects[i];
         if (k >= e->first && k < (unsigned)e->first + e->count) {
-            switch ((rc_effect_kind)e->kind) {
-            case RC_EFF_LENGTH_OFFSET:
-            case RC_EFF_TIME_DRIFT:
-            case RC_EFF_GROUP_OFFSET:
-            case RC_EFF_LENGTH_PERIODIC:
-            case RC_EFF_TOOL_OFFSET: return 0;
-            case RC_EFF_JOINT_PERIODIC: return 1;
-            default: return 2;
-            }
+            const rc_effect_desc *ds = rc_effect_describe(e->kind);
+            return ds ? ds->unit : 2;
         }
     }
     return 2;
@@ -543,6 +560,15 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
 {
     double u[3], dl_dtheta[RC_NJ];
     const double *e = &m->x[RC_P_ENC];
+    int outlet_first = -1; /* the outlet effect's first parameter, -1: e */
+    if (s->outlet != 0) {
+        for (unsigned i = 0; i < m->n_effects && outlet_first < 0; ++i)
+            if (m->effects[i].kind == RC_EFF_OUTLET && m->effects[i].joint == s->outlet)
+                outlet_first = m->effects[i].first;
+        if (outlet_first < 0)
+            return RC_ERR_ARG; /* a sample from an outlet the model does not have */
+        e = &m->x[outlet_first];
+    }
     for (int r = 0; r < 3; ++r)
         u[r] = p[r] - e[r];
     const double dist = sqrt(dot3(u, u));
@@ -627,12 +653,16 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         jac[RC_P_THETA(i)] = dl_dtheta[i];
     }
     for (int r = 0; r < 3; ++r)
-        jac[RC_P_ENC + r] = -g[r];
+        jac[RC_P_ENC + r] = outlet_first < 0 ? -g[r] : 0.0;
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *ef = &m->effects[i];
         double *J = &jac[ef->first];
-        const double q = s->q_rad[ef->joint];
+        const double q = ef->joint < RC_NJ ? s->q_rad[ef->joint] : 0.0;
         switch ((rc_effect_kind)ef->kind) {
+        case RC_EFF_OUTLET:
+            for (unsigned k = 0; k < 3; ++k)
+                J[k] = (int)ef->first == outlet_first ? -g[k] : 0.0;
+            break;
         case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
         case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
         case RC_EFF_TIME_DRIFT: {

@@ -56,14 +56,60 @@ typedef enum rc_effect_kind {
                                    between outlet and attachment point; 1 param, mm per m^3 */
     RC_EFF_LENGTH_NONLIN = 9,   /* l += n2 (lam - c)^2 + n3 (lam - c)^3, the length sensor's
                                    deviation from linear; 2 params, mm per m^2 and mm per m^3 */
-    RC_EFF_LENGTH_PERIODIC = 10 /* l += s sin(2 pi L / P) + c cos(2 pi L / P), L the chord: the
+    RC_EFF_LENGTH_PERIODIC = 10, /* l += s sin(2 pi L / P) + c cos(2 pi L / P), L the chord: the
                                    length sensor's error once per drum turn (an eccentric drum);
                                    3 params s, c (mm) and the period P (mm, the drum's
                                    circumference; nonlinear, |P| < 1e-9 mm: no effect) */
+    RC_EFF_OUTLET = 11          /* another place of the encoder: samples with rc_sample.outlet == k
+                                   (the effect's `joint` field, 1..RC_MAX_OUTLETS-1) are measured from
+                                   this outlet instead of e; 3 params (x, y, z) mm in the base frame */
 } rc_effect_kind;
 
 /* Last effect kind (for range checks of stored kinds). */
-#define RC_EFF_LAST RC_EFF_LENGTH_PERIODIC
+#define RC_EFF_LAST RC_EFF_OUTLET
+
+/* Outlets a data set may use (outlet 0 is e, the others RC_EFF_OUTLET). */
+#define RC_MAX_OUTLETS 16
+
+/* The one description of every effect kind: what sizes, names, units and
+ * limits are expanded from (rc_effect_describe), so that an effect is
+ * defined once: its row here, its formula in rc_meas (length, outlet and
+ * point side) or rc_model_theta (joint side), nothing else. */
+typedef enum {
+    RC_EFF_ARG_NONE = 0,   /* added with no argument */
+    RC_EFF_ARG_JOINT = 1,  /* the joint it acts on (0..5; the file's "joint" 1..6) */
+    RC_EFF_ARG_COUNT = 2,  /* its parameter count (drift degree, number of groups) */
+    RC_EFF_ARG_PERIOD = 3, /* a start value for its period, set by the caller */
+    RC_EFF_ARG_OUTLET = 4  /* the outlet number (1.., the file's "outlet") */
+} rc_effect_arg;
+
+typedef enum {
+    RC_SIDE_LENGTH = 0, /* adds to the predicted length; never moves the flange */
+    RC_SIDE_JOINT = 1,  /* changes a joint angle the geometry sees: moves the flange */
+    RC_SIDE_POINT = 2,  /* moves the measured point in the flange frame (not the flange) */
+    RC_SIDE_OUTLET = 3  /* where a sample's length is measured from */
+} rc_effect_side;
+
+typedef struct rc_effect_desc {
+    uint8_t kind;             /* rc_effect_kind */
+    const char *name;         /* machine name: the model file's "kind" and --effects' */
+    uint8_t count;            /* parameters; 0: given when added (RC_EFF_ARG_COUNT) */
+    uint8_t side;             /* rc_effect_side */
+    uint8_t arg;              /* rc_effect_arg */
+    uint8_t unit;             /* unit class of its parameters, as rc_param_unit: 0 mm, 1 rad, 2 other */
+    uint8_t nuisance;         /* 1: describes one acquisition, not the robot: predicts nothing at a new pose */
+    uint8_t user;             /* 1: may be named in `rcal calibrate --effects` */
+    const char *unit_text;    /* the units in words, for messages */
+    double limit;             /* largest plausible |parameter| (the file's SI units): beyond, a typo */
+    const char *suffixes;     /* parameter name suffixes, '|'-separated ("x|y|z"), or "" */
+    const char *index_prefix; /* with no suffixes and count > 1: name.<prefix><index + index_base> */
+    uint8_t index_base;
+} rc_effect_desc;
+
+/* The description of kind, NULL when kind is not an effect kind. */
+const rc_effect_desc *rc_effect_describe(unsigned kind);
+/* The kind named name (rc_effect_desc.name), or -1. */
+int rc_effect_by_name(const char *name);
 
 /* RC_EFF_CABLE_SAG. A light cable of weight w per length under tension T
  * hangs below its chord; its arc exceeds the chord by about
@@ -85,7 +131,7 @@ typedef enum rc_effect_kind {
 
 typedef struct rc_effect {
     uint8_t kind;     /* rc_effect_kind */
-    uint8_t joint;    /* 0..5 for joint-side effects, else 0 */
+    uint8_t joint;    /* 0..5 for joint-side effects, the outlet number for RC_EFF_OUTLET, else 0 */
     uint16_t first;   /* index of its first parameter in x */
     uint16_t count;   /* number of parameters */
     /* Frozen reference geometry (DH rows of joints 1..4: a, d, alpha, theta)
@@ -109,6 +155,8 @@ typedef struct rc_sample {
     double len_mm;       /* measured cable length */
     double t;            /* acquisition order scaled to [0, 1] */
     uint16_t group;      /* set-up group (consecutive samples sharing a set-up) */
+    uint8_t outlet;      /* the encoder outlet it was measured from: 0 = e, k = the RC_EFF_OUTLET effect
+                            with joint k (a sample whose outlet the model lacks has no length: RC_ERR_ARG) */
 } rc_sample;
 
 /* Initialise a model from a DH table and an encoder position.

@@ -37,6 +37,7 @@ static void random_pose(rc_sample *s, rc_rng *g)
         s->q_rad[j] = (2.0 * rc_rng_u01(g) - 1.0) * 2.5;
     s->t = rc_rng_u01(g);
     s->group = (uint16_t)rc_rng_below(g, 3);
+    s->outlet = 0;
 }
 
 /* d l / d x_k: central differences against rc_meas's analytic gradient, for
@@ -45,6 +46,7 @@ static void check_param_jacobian(rc_model *m, rc_rng *g)
 {
     for (int trial = 0; trial < 50; ++trial) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         random_pose(&s, g);
         double l, jac[RC_MAX_PARAMS];
         assert_int_equal(rc_meas(&l, jac, m, &s), RC_OK);
@@ -131,6 +133,7 @@ static void test_joint_jacobian(void **state)
     m.x[m.n_params - 1] = 30.0;
     for (int trial = 0; trial < 50; ++trial) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         random_pose(&s, &g);
         double p[3], R[9], J[36];
         rc_fk_jac(p, R, J, &m, s.q_rad);
@@ -185,6 +188,7 @@ static void test_dh_sensitivity(void **state)
     assert_int_equal(rc_kin_compile(&kin, &m), RC_OK);
     for (int trial = 0; trial < 30; ++trial) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         random_pose(&s, &g);
         double p[3], R[9], p0[3], jp[3 * RC_N_DH], jr[3 * RC_N_DH];
         rc_kin_fk_dh_jac(p, R, jp, jr, &kd, &kin, s.q_rad);
@@ -249,6 +253,7 @@ static void test_wrap_angles(void **state)
     }
     for (int trial = 0; trial < 20; ++trial) { /* same lengths */
         rc_sample s;
+        memset(&s, 0, sizeof s);
         random_pose(&s, &g);
         double l1, l2;
         assert_int_equal(rc_meas(&l1, NULL, &m, &s), RC_OK);
@@ -282,6 +287,7 @@ static void check_prepared(const rc_model *m, rc_rng *g)
     rc_meas_prepare(&p, m);
     for (int trial = 0; trial < 200; ++trial) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         random_pose(&s, g);
         double sq[RC_NJ], cq[RC_NJ], l0, l1, l2, j0[RC_MAX_PARAMS], j1[RC_MAX_PARAMS], j2[RC_MAX_PARAMS];
         rc_qtrig_fill(sq, cq, &s, 1);

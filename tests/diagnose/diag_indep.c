@@ -186,6 +186,7 @@ static void make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double no
             s[i].q_rad[j] = 0.001 * DEGR * round(s[i].q_rad[j] / (0.001 * DEGR));
         s[i].t = t;
         s[i].group = 0;
+        s[i].outlet = 0;
     }
     const double target = size * noise;
     const int center = e == E_JUMP || e == E_DRIFT || e == E_SAG || e == E_NONLIN || e == E_DRUM;

@@ -59,6 +59,7 @@ static void test_sim_csv_json(void **state)
     (void)state;
     rc_model nominal;
     rc_sample s[300];
+    memset(s, 0, sizeof s);
     char csv[] = "/tmp/rcal_diag_sim_XXXXXX", plots[] = "/tmp/rcal_diag_plots_XXXXXX", args[1024];
     assert_int_equal(diag_load_nominal(&nominal), 0);
     /* diag_cases[1]: length_offset, 0.5 mm */

@@ -64,6 +64,7 @@ static void test_sag_matches_catenary(void **state)
     m.x[m.effects[0].first] = 1000.0 * w * w / (24.0 * T * T);
     for (unsigned k = 0; k < 20; ++k) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         double l, l0, p[3];
         pose(&s, k);
         assert_int_equal(rc_meas(&l, NULL, &m, &s), RC_OK);
@@ -93,6 +94,7 @@ static void test_nonlinearity_value(void **state)
     assert_string_equal(rc_param_name(name, sizeof name, &m, m.effects[0].first + 1u), "length_nonlinearity.n3");
     for (unsigned k = 0; k < 10; ++k) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         double l, l0;
         pose(&s, k);
         assert_int_equal(rc_meas(&l, NULL, &m, &s), RC_OK);
@@ -117,6 +119,7 @@ static void test_periodic_value(void **state)
     assert_string_equal(rc_param_name(name, sizeof name, &m, f + 2u), "length_periodic.period");
     for (unsigned k = 0; k < 10; ++k) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         double l, l0;
         pose(&s, k);
         assert_int_equal(rc_meas(&l, NULL, &m, &s), RC_OK);
@@ -126,6 +129,7 @@ static void test_periodic_value(void **state)
     }
     m.x[f + 2] = 0.0; /* no period: no effect, never a division by zero */
     rc_sample s;
+    memset(&s, 0, sizeof s);
     double l, l0, jac[RC_MAX_PARAMS];
     pose(&s, 1);
     assert_int_equal(rc_meas(&l, jac, &m, &s), RC_OK);
@@ -151,6 +155,7 @@ static void test_jacobian(void **state)
         m.x[RC_N_BASE + k] = vals[k];
     for (unsigned k = 0; k < 8; ++k) {
         rc_sample s;
+        memset(&s, 0, sizeof s);
         double l, jac[RC_MAX_PARAMS];
         pose(&s, k);
         assert_int_equal(rc_meas(&l, jac, &m, &s), RC_OK);
@@ -188,6 +193,7 @@ static void test_not_in_kinematics(void **state)
     assert_int_equal(kin.n_jeff, 0);
     assert_int_equal(kin.has_tool, 0);
     rc_sample s;
+    memset(&s, 0, sizeof s);
     double p[3], p0[3];
     pose(&s, 3);
     rc_fk(p, NULL, &m, s.q_rad);

@@ -176,6 +176,7 @@ static int setup(void **state)
     for (int i = 0; i < NP; ++i) {
         rc_sample s;
         memset(&s, 0, sizeof s);
+        memset(&s, 0, sizeof s);
         n += (size_t)snprintf(text + n, sizeof text - n, "%d", i);
         for (int j = 0; j < RC_NJ; ++j) {
             s.q_rad[j] = plan_deg[i][j] * 3.14159265358979323846 / 180.0;

@@ -78,6 +78,7 @@ static void one(tally *t, const rch_robot *nom, rct_rng *g, int grouped, rc_solv
         s[i].len_mm = rct_dist(p, e) + noise * rct_gauss(g);
         s[i].t = (double)i / (N - 1);
         s[i].group = (uint16_t)(i / 20);
+        s[i].outlet = 0;
     }
     static rch_robot cal;
     rch_diag d;

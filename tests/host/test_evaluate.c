@@ -31,6 +31,7 @@ static void test_iso9283_and_refit(void **state)
     /* 40 poses, each read 5 times with noise; true lengths from our FK */
     enum { P = 40, R = 5 };
     rc_sample s[P * R];
+    memset(s, 0, sizeof s);
     double ad_max = 0, rd_max = 0, ad_sum = 0, rd_sum = 0;
     for (int p = 0; p < P; ++p) {
         double q[6], pos[3];
@@ -44,6 +45,7 @@ static void test_iso9283_and_refit(void **state)
             x->len_mm = truth + bias + 0.01 * rct_gauss(&g);
             x->t = 0;
             x->group = 0;
+            x->outlet = 0;
             mean += x->len_mm;
         }
         mean /= R;

@@ -72,6 +72,7 @@ static void make(rc_sample *s, size_t n, rct_rng *g, double noise, unsigned n_ju
                 s[i].len_mm += size[k];
         s[i].t = (double)i / (double)(n - 1);
         s[i].group = 0;
+        s[i].outlet = 0;
     }
 }
 

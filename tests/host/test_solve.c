@@ -277,6 +277,7 @@ static void ident_cut_case(double s_target, unsigned *rank_solve, unsigned *rank
             s[i].q_rad[j] = 0.8 * (m.q_min_rad[j] + (m.q_max_rad[j] - m.q_min_rad[j]) * rc_rng_u01(&g));
         s[i].t = T + (i % 2 ? -delta : delta);
         s[i].group = 0;
+        s[i].outlet = 0;
         double l;
         assert_int_equal(rc_meas(&l, NULL, &m, &s[i]), RC_OK);
         s[i].len_mm = l + 0.01 * rc_rng_normal(&g) + 0.3;

@@ -54,6 +54,7 @@ static void one_robot(tally *t, const rch_robot *nom, double noise_mm, size_t n,
                            (p[2] - enc[2]) * (p[2] - enc[2])) +
                       noise_mm * gauss();
         s[i].group = grouped ? (uint16_t)(i / 10) : 0;
+        s[i].outlet = 0;
         s[i].t = (double)i / (double)(n - 1);
     }
     rc_model start, fit;

@@ -90,18 +90,24 @@ int rch_method_parse(rc_method *out, const char *name)
     return rc_method_from_name(out, name) == RC_OK ? 0 : -1;
 }
 
+/* The effects --effects may name, from the one table (rc_effect_desc.user),
+ * for messages: "length_offset, ..., joint_periodic:J". */
+static void effect_list(char *buf, size_t len)
+{
+    size_t pos = 0;
+    buf[0] = '\0';
+    for (unsigned k = 1; k <= RC_EFF_LAST && pos < len; ++k) {
+        const rc_effect_desc *ds = rc_effect_describe(k);
+        if (!ds || !ds->user)
+            continue;
+        pos += (size_t)snprintf(buf + pos, len - pos, "%s%s%s", pos ? ", " : "", ds->name,
+                                ds->arg == RC_EFF_ARG_JOINT ? ":J" : ds->arg == RC_EFF_ARG_PERIOD ? ":P" : "");
+    }
+}
+
 int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
 {
-    static const struct {
-        const char *name;
-        rc_effect_kind kind;
-        int joint; /* 1: needs ":J" */
-    } table[] = {{"length_offset", RC_EFF_LENGTH_OFFSET, 0}, {"length_scale", RC_EFF_LENGTH_SCALE, 0},
-                 {"time_drift", RC_EFF_TIME_DRIFT, 0},       {"tool_offset", RC_EFF_TOOL_OFFSET, 0},
-                 {"joint_compliance", RC_EFF_JOINT_COMPLIANCE, 1}, {"joint_periodic", RC_EFF_JOINT_PERIODIC, 1},
-                 {"cable_sag", RC_EFF_CABLE_SAG, 0},         {"length_nonlinearity", RC_EFF_LENGTH_NONLIN, 0},
-                 {"length_periodic", RC_EFF_LENGTH_PERIODIC, 2}}; /* 2: needs ":P", the period in mm */
-    char buf[512];
+    char buf[512], names[512];
     if (strlen(list) >= sizeof buf) {
         rch_diag_set(d, "", 0, 0, "--effects: list longer than %zu characters", sizeof buf - 1);
         return -1;
@@ -114,23 +120,20 @@ int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
         char *colon = strchr(tok, ':');
         if (colon)
             *colon++ = '\0';
-        size_t k = 0;
-        while (k < sizeof table / sizeof table[0] && strcmp(tok, table[k].name) != 0)
-            ++k;
-        if (k == sizeof table / sizeof table[0]) {
-            rch_diag_set(d, "", 0, 0,
-                         "--effects: unknown effect '%s' (length_offset, length_scale, time_drift, tool_offset, "
-                         "cable_sag, length_nonlinearity, length_periodic:P, joint_compliance:J, joint_periodic:J)",
-                         tok);
+        const int kind = rc_effect_by_name(tok);
+        const rc_effect_desc *ds = kind > 0 ? rc_effect_describe((unsigned)kind) : NULL;
+        if (!ds || !ds->user) {
+            effect_list(names, sizeof names);
+            rch_diag_set(d, "", 0, 0, "--effects: unknown effect '%s' (%s)", tok, names);
             return -1;
         }
-        if (table[k].joint == 2) { /* the period's start value, mm */
+        if (ds->arg == RC_EFF_ARG_PERIOD) { /* the period's start value, mm */
             double per = 0.0;
             if (!colon || rch_parse_double(colon, &per) != 0 || !(per >= 1.0 && per <= 1000.0)) {
                 rch_diag_set(d, "", 0, 0, "--effects: %s needs its period in mm (1..1000), e.g. %s:137", tok, tok);
                 return -1;
             }
-            rc_status st = rc_model_add_effect(m, table[k].kind, 0, 0);
+            rc_status st = rc_model_add_effect(m, (rc_effect_kind)kind, 0, 0);
             if (st != RC_OK) {
                 rch_diag_set(d, "", 0, 0, "--effects: cannot add %s: %s", tok, rc_strerror(st));
                 return -1;
@@ -139,11 +142,12 @@ int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
             continue;
         }
         unsigned long j = 0;
-        if (table[k].joint && (!colon || rch_parse_ulong(colon, &j) != 0 || j < 1 || j > 6)) {
+        const int needs_joint = ds->arg == RC_EFF_ARG_JOINT;
+        if (needs_joint && (!colon || rch_parse_ulong(colon, &j) != 0 || j < 1 || j > 6)) {
             rch_diag_set(d, "", 0, 0, "--effects: %s needs the joint, e.g. %s:2", tok, tok);
             return -1;
         }
-        rc_status st = rc_model_add_effect(m, table[k].kind, table[k].joint ? (unsigned)j - 1u : 0u, 0);
+        rc_status st = rc_model_add_effect(m, (rc_effect_kind)kind, needs_joint ? (unsigned)j - 1u : 0u, 0);
         if (st != RC_OK) {
             rch_diag_set(d, "", 0, 0, "--effects: cannot add %s%s%s: %s", tok, colon ? ":" : "", colon ? colon : "",
                          rc_strerror(st));
@@ -165,7 +169,8 @@ void rch_model_strip_nuisance(rc_model *out, const rc_model *m)
     memcpy(r.q_max_rad, m->q_max_rad, sizeof r.q_max_rad);
     for (unsigned e = 0; e < m->n_effects; ++e) {
         const rc_effect *ef = &m->effects[e];
-        if (ef->kind == RC_EFF_GROUP_OFFSET || ef->kind == RC_EFF_TIME_DRIFT)
+        const rc_effect_desc *ds = rc_effect_describe(ef->kind);
+        if (ds && ds->nuisance)
             continue;
         if (rc_model_add_effect(&r, (rc_effect_kind)ef->kind, ef->joint, ef->count) != RC_OK)
             continue;

@@ -64,47 +64,8 @@ static int read_dh(double dh[RC_NJ][4], const rch_json *arr, const char *file, r
     return 0;
 }
 
-/* Largest plausible magnitude of an effect parameter (SI as in the file):
- * beyond it the effect is not a small physical correction but a typo. */
-static double effect_limit(rc_effect_kind k)
-{
-    switch (k) {
-    case RC_EFF_LENGTH_OFFSET:
-    case RC_EFF_TIME_DRIFT:
-    case RC_EFF_GROUP_OFFSET:
-    case RC_EFF_TOOL_OFFSET: return 1000.0; /* mm */
-    case RC_EFF_LENGTH_SCALE: return 0.1;   /* 10 % of the length */
-    case RC_EFF_JOINT_COMPLIANCE: return 0.1; /* rad per m of lever */
-    case RC_EFF_JOINT_PERIODIC: return 0.2;   /* rad (11 deg) */
-    case RC_EFF_CABLE_SAG: return 1000.0;     /* mm per m^3 of h^2 L (1 m of sag length per m^3) */
-    case RC_EFF_LENGTH_NONLIN: return 1000.0; /* mm per m^2, mm per m^3 */
-    case RC_EFF_LENGTH_PERIODIC: return 1000.0; /* mm (amplitudes and the period) */
-    case RC_EFF_NONE: break;
-    }
-    return 0.0;
-}
-
-static const char *effect_unit(rc_effect_kind k)
-{
-    switch (k) {
-    case RC_EFF_LENGTH_SCALE: return "";
-    case RC_EFF_JOINT_COMPLIANCE: return "rad/m";
-    case RC_EFF_JOINT_PERIODIC: return "rad";
-    case RC_EFF_CABLE_SAG: return "mm/m^3";
-    case RC_EFF_LENGTH_NONLIN: return "mm/m^2, mm/m^3";
-    default: return "mm";
-    }
-}
-
 static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_diag *d)
 {
-    static const char *const names[] = {"length_offset", "joint_compliance", "joint_periodic", "time_drift",
-                                        "group_offset",  "length_scale",     "tool_offset",    "cable_sag",
-                                        "length_nonlinearity", "length_periodic"};
-    static const rc_effect_kind kinds[] = {RC_EFF_LENGTH_OFFSET, RC_EFF_JOINT_COMPLIANCE, RC_EFF_JOINT_PERIODIC,
-                                           RC_EFF_TIME_DRIFT,    RC_EFF_GROUP_OFFSET,     RC_EFF_LENGTH_SCALE,
-                                           RC_EFF_TOOL_OFFSET,   RC_EFF_CABLE_SAG,        RC_EFF_LENGTH_NONLIN,
-                                           RC_EFF_LENGTH_PERIODIC};
     if (arr->type != RCH_JARR) {
         rch_diag_set(d, file, arr->line, arr->col, "\"effects\" must be an array");
         return -1;
@@ -112,21 +73,28 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
     for (size_t i = 0; i < arr->n; ++i) {
         const rch_json *e = arr->items[i];
         const rch_json *kind = rch_json_get(e, "kind"), *joint = rch_json_get(e, "joint"),
-                       *params = rch_json_get(e, "params"), *ref = rch_json_get(e, "ref_dh");
+                       *outlet = rch_json_get(e, "outlet"), *params = rch_json_get(e, "params"),
+                       *ref = rch_json_get(e, "ref_dh");
         if (e->type != RCH_JOBJ || !kind || kind->type != RCH_JSTR) {
             rch_diag_set(d, file, e->line, e->col, "effect %zu needs a \"kind\" string", i + 1);
             return -1;
         }
-        int k = -1;
-        for (int t = 0; t < (int)(sizeof kinds / sizeof kinds[0]); ++t)
-            if (strcmp(kind->str, names[t]) == 0)
-                k = t;
-        if (k < 0) {
+        const int k = rc_effect_by_name(kind->str);
+        const rc_effect_desc *ds = k > 0 ? rc_effect_describe((unsigned)k) : NULL;
+        if (ds == NULL) {
             rch_diag_set(d, file, kind->line, kind->col, "unknown effect kind \"%s\"", kind->str);
             return -1;
         }
         unsigned j = 0;
-        if (joint) {
+        if (ds->arg == RC_EFF_ARG_OUTLET) {
+            if (!outlet || outlet->type != RCH_JNUM || outlet->num < 1 || outlet->num >= RC_MAX_OUTLETS ||
+                outlet->num != floor(outlet->num)) {
+                rch_diag_set(d, file, outlet ? outlet->line : e->line, outlet ? outlet->col : e->col,
+                             "effect outlet needs \"outlet\": 1..%d", RC_MAX_OUTLETS - 1);
+                return -1;
+            }
+            j = (unsigned)outlet->num;
+        } else if (joint) {
             if (joint->type != RCH_JNUM || joint->num < 1 || joint->num > 6 || joint->num != floor(joint->num)) {
                 rch_diag_set(d, file, joint->line, joint->col, "effect joint must be 1..6");
                 return -1;
@@ -137,7 +105,7 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
             rch_diag_set(d, file, e->line, e->col, "effect %zu needs a non-empty \"params\" array", i + 1);
             return -1;
         }
-        rc_status st = rc_model_add_effect(m, kinds[k], j, (unsigned)params->n);
+        rc_status st = rc_model_add_effect(m, (rc_effect_kind)k, j, (unsigned)params->n);
         if (st != RC_OK) {
             rch_diag_set(d, file, e->line, e->col, "effect %zu (%s): %s", i + 1, kind->str, rc_strerror(st));
             return -1;
@@ -151,12 +119,12 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
         for (size_t p = 0; p < params->n; ++p) {
             if (want_num(&m->x[ef->first + p], params->items[p], "effect parameter", file, d, params) != 0)
                 return -1;
-            const double lim = effect_limit((rc_effect_kind)ef->kind);
+            const double lim = ds->limit;
             if (fabs(m->x[ef->first + p]) > lim) {
                 rch_diag_set(d, file, params->items[p]->line, params->items[p]->col,
                              "effect %s: parameter %zu = %g is implausible (|value| at most %g %s): check the model "
                              "file",
-                             kind->str, p + 1, m->x[ef->first + p], lim, effect_unit((rc_effect_kind)ef->kind));
+                             kind->str, p + 1, m->x[ef->first + p], lim, ds->unit_text);
                 return -1;
             }
         }
@@ -546,7 +514,11 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
             const rc_effect *e = &m->effects[i];
             rch_jw_obj(&w, NULL);
             rch_jw_str(&w, "kind", rc_effect_name((rc_effect_kind)e->kind));
-            rch_jw_uint(&w, "joint", e->joint + 1u);
+            const rc_effect_desc *ds = rc_effect_describe(e->kind);
+            if (ds && ds->arg == RC_EFF_ARG_OUTLET)
+                rch_jw_uint(&w, "outlet", e->joint);
+            else
+                rch_jw_uint(&w, "joint", e->joint + 1u);
             write_numsf(&w, "params", &m->x[e->first], e->count, "%.12g");
             rch_jw_arr(&w, "ref_dh");
             for (unsigned r = 0; r < 4; ++r) {
