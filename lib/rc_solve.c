@@ -542,6 +542,56 @@ static double lm_subspace_step(double *dx, const rc_solve_work *w, const double 
     return pred;
 }
 
+/* With a prior, the directions the data do not see are held only by the
+ * prior rows, whose eigenvalues can be 1e-8 of the largest: LM's damping
+ * (relative to the largest) all but freezes them, and the cost test ends the
+ * iterations long before they reach the posterior mode (the cable
+ * attachment shared half and half with a6 instead of staying in the
+ * attachment). Undamped Gauss-Newton steps on the whole posterior (it is
+ * positive definite) finish them: each accepted only when the MAP cost falls
+ * (halved up to RC_MAP_POLISH_HALVINGS times), at most RC_MAP_POLISH_ITER. */
+#define RC_MAP_POLISH_ITER 60
+#define RC_MAP_POLISH_HALVINGS 12
+static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, passbuf tab,
+                       const rc_solve_config *cfg, unsigned nf, const rc_sample *samples, size_t n)
+{
+    for (unsigned k = 0; k < RC_MAP_POLISH_ITER; ++k) {
+        double cost, gnorm = 0.0, cnew;
+        unsigned rank = 0;
+        ++res->cost_evals;
+        if (normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n) != RC_OK)
+            return;
+        prior_ne(A, w->g, &cost, m, w->idx, nf, cfg);
+        /* every direction with a positive eigenvalue: the prior determines
+         * what the data do not (no null truncation, no significance rule) */
+        if (lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, 1e-300, 0.0) != RC_OK || gnorm == 0.0)
+            return;
+        (void)lm_subspace_step(w->dx, w, V, nf, rank, 0.0);
+        /* the near-null directions are rotations of the last frames traded
+         * against the attachment: far from linear over tens of mm, so the
+         * step is halved until the cost falls */
+        int ok = 0;
+        for (unsigned h = 0; h < RC_MAP_POLISH_HALVINGS && !ok; ++h) {
+            if (h > 0)
+                for (unsigned i = 0; i < nf; ++i)
+                    w->dx[i] *= 0.5;
+            apply_step(&w->trial, m, w, nf, w->dx);
+            ++res->cost_evals;
+            if (cost_tab(&cnew, &w->trial, samples, tab, n) != RC_OK)
+                continue;
+            cnew += rc_prior_cost(&w->trial, cfg);
+            ok = cnew < cost;
+        }
+        if (!ok)
+            return;
+        *m = w->trial;
+        const double data_cost = cnew - rc_prior_cost(m, cfg);
+        res->rms_final_mm = rms_of(data_cost > 0.0 ? data_cost : 0.0, n);
+        if (cost - cnew <= 1e-12 * cost)
+            return;
+    }
+}
+
 /* rc_solve on w's small fields and the matrices A, V ((nf x nf) each, n_params^2
  * entries of room) and the sample tables t. */
 static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, passbuf tab,
@@ -747,6 +797,8 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
         if (done)
             break;
     }
+    if (has_prior(cfg))
+        map_polish(m, res, w, A, V, tab, cfg, nf, samples, n);
     rc_model_wrap_angles(m);
     return RC_OK;
 }

@@ -173,14 +173,20 @@ def run(cmd):
     return r.returncode, r.stdout, r.stderr
 
 
-def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), beta_deg=0.0, n_poses=300):
+def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), beta_deg=0.0, n_poses=300, outlets=1,
+             split=False):
     lim = ROBOTS[name]["lim"]
     reach = ROBOTS[name]["reach"]
     truth = true_robot(rng, name, beta_deg)
     nom = nominal_robot(name)
-    ang = rng.uniform(0, 2 * np.pi)
-    rad = reach * rng.uniform(0.7, 1.2)
-    outlet = np.array([rad * np.cos(ang), rad * np.sin(ang), rng.uniform(-50, 150)])
+    orng = np.random.default_rng([k, 99, outlets])  # the outlets' places: apart from the robot's draws
+    ang0 = orng.uniform(0, 2 * np.pi)
+    outs = []
+    for o in range(outlets):  # spread around the robot, floor or stand height
+        ang = ang0 + 2 * np.pi * o / max(outlets, 1) + orng.uniform(-0.4, 0.4)
+        rad = reach * orng.uniform(0.7, 1.2)
+        outs.append(np.array([rad * np.cos(ang), rad * np.sin(ang), orng.uniform(-50, 150) + (o % 2) * 300.0]))
+    outlet = outs[0]
     if attach_mm > 0:
         v = rng.normal(size=3)
         v /= np.linalg.norm(v)
@@ -189,7 +195,16 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
         attach = np.zeros(3)
     Q = poses(rng, truth, lim, outlet, attach, n_poses, fixed_wrist)
     sigma = rng.uniform(0.005, 0.04)
-    L = np.array([np.linalg.norm(truth.point(q, attach) - outlet) for q in Q])
+    rows_q, rows_o = [], []
+    for i, q in enumerate(Q):
+        for o in range(outlets):
+            if split and i % outlets != o:
+                continue
+            rows_q.append(q)
+            rows_o.append(o)
+    Q = np.array(rows_q)
+    O = np.array(rows_o)
+    L = np.array([np.linalg.norm(truth.point(q, attach) - outs[o]) for q, o in zip(Q, O)])
     L = L + sigma * rng.standard_normal(len(L))
     L = np.round(L, 3)
     qdeg = np.round(Q / DEG, 3)  # what a controller display shows
@@ -197,9 +212,17 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     write_robot(robot_path, name)
     data_path = os.path.join(tmp, "data.csv")
     with open(data_path, "w") as f:
-        f.write("q1,q2,q3,q4,q5,q6,L\n")
-        for q, l in zip(qdeg, L):
-            f.write(",".join("%.3f" % v for v in q) + ",%.3f\n" % l)
+        f.write("q1,q2,q3,q4,q5,q6,L" + (",outlet" if outlets > 1 else "") + "\n")
+        for q, l, o in zip(qdeg, L, O):
+            f.write(",".join("%.3f" % v for v in q) + ",%.3f" % l + (",%d" % (o + 1) if outlets > 1 else "") + "\n")
+    if os.environ.get("TRUTH_STUDY_KEEP"):  # keep each case's data and robot for a look by hand
+        import shutil
+        keep = os.path.join(os.environ["TRUTH_STUDY_KEEP"], "case%02d" % k)
+        os.makedirs(keep, exist_ok=True)
+        shutil.copy(data_path, keep)
+        shutil.copy(robot_path, keep)
+        with open(os.path.join(keep, "truth.txt"), "w") as f:
+            f.write("attach %s\noutlets %s\n" % (attach.tolist(), [o.tolist() for o in outs]))
     model = os.path.join(tmp, "model.json")
     if os.path.exists(model):
         os.remove(model)
@@ -251,7 +274,9 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     pe_u = pair_err(uncomp, meant, np.random.default_rng(k))
     e_c = np.linalg.norm(gauge_align(landed, meant) - meant, axis=1)
     e_u = np.linalg.norm(gauge_align(uncomp, meant) - meant, axis=1)
-    res = {"case": k, "robot": name, "attach_mm": attach_mm, "wrist": "fixed" if fixed_wrist else "random",
+    e3 = np.linalg.norm(gauge_align(landed, meant) - meant, axis=1)
+    res = {"case": k, "robot": name, "attach_mm": attach_mm, "outlets": outlets, "split": split,
+           "err3d_rms": float(np.sqrt(np.mean(e3 ** 2))), "wrist": "fixed" if fixed_wrist else "random",
            "tcp": list(tcp), "noise_mm": sigma, "n": len(Q),
            "pair_med_comp": float(np.median(pe_c)), "pair_med_uncomp": float(np.median(pe_u)),
            "pair_p95_comp": float(np.percentile(pe_c, 95)), "pair_max_comp": float(pe_c.max()),
@@ -273,6 +298,9 @@ def main():
     ap.add_argument("--attach", choices=["centre", "off", "both"], default="both")
     ap.add_argument("--tcp", default="0,0,0")
     ap.add_argument("--beta-deg", type=float, default=0.0)
+    ap.add_argument("--outlets", type=int, default=1, help="encoder places (column outlet when > 1)")
+    ap.add_argument("--split", action="store_true", help="the pose set split among the outlets (else every pose "
+                                                         "from each)")
     ap.add_argument("--extra", default="", help="extra calibrate options, space separated")
     ap.add_argument("--check", action="store_true",
                     help="check the goals (flange: centred <= 0.02 mm, off-centre <= 0.7 mm median; TCP <= 0.45 mm; "
@@ -293,7 +321,9 @@ def main():
                 att = float(rng.uniform(5, 60))
             else:
                 att = 0.0 if (k // 4) % 2 == 0 else float(rng.uniform(5, 60))
-            r = one_case(a.rcal, k, rng, name, att, fixed, tcp, tmp, extra, a.beta_deg)
+            crng = np.random.default_rng([a.seed, k])  # one case's robot, poses and noise: the same for every design
+            r = one_case(a.rcal, k, crng, name, att, fixed, tcp, tmp, extra, a.beta_deg, outlets=a.outlets,
+                         split=a.split)
             out.append(r)
             if "error" in r:
                 print("case %2d ERROR %s" % (k, r["error"]), flush=True)
@@ -313,6 +343,8 @@ def main():
             worse_cases = sum(r["pair_med_comp"] > r["pair_med_uncomp"] for r in sel)
             wshare = np.median([r["worse_share"] for r in sel])
             cov = [r["u95_cover"] for r in sel if "u95_cover" in r]
+            print("%-10s 3-D error after compensation (gauge aligned), RMS over targets: median over cases "
+                  "%.4f mm" % (label, np.median([r["err3d_rms"] for r in sel])))
             print("%-10s cases %2d  median of pairwise medians %.4f mm (uncompensated %.3f)  cases worse %d  "
                   "median share of targets worse %.4f  u95 coverage median %s" % (
                       label, len(sel), med, np.median([r["pair_med_uncomp"] for r in sel]), worse_cases, wshare,

@@ -31,31 +31,64 @@
 #endif
 #define DEG (M_PI / 180.0)
 
+/* The first guess of outlet k's position (k = 0: e) from its samples. */
+static int guess_outlet(double e[3], const rc_model *m, unsigned k, const rc_sample *s, size_t n, rch_diag *d)
+{
+    rc_sample *sub = malloc((n ? n : 1) * sizeof *sub);
+    size_t ns = 0;
+    if (!sub) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (s[i].outlet == k)
+            sub[ns++] = s[i];
+    rc_status st = rc_encoder_guess(e, m, sub, ns);
+    free(sub);
+    char which[48] = "";
+    if (k > 0)
+        snprintf(which, sizeof which, " of outlet %u", k);
+    if (st == RC_ERR_RANGE) {
+        rch_diag_set(d, "", 0, 0,
+                     "cannot place the encoder%s: the lengths fit no sphere around the nominal flange positions "
+                     "(misfit above 15 %% of the lengths): the length column is not the cable, or the robot "
+                     "is over 100 mm from its nominal model; give the outlet in the robot file (\"encoder_mm\")",
+                     which);
+        return -1;
+    }
+    if (st != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "cannot place the encoder%s: %s (the poses must spread in all three directions)",
+                     which, rc_strerror(st));
+        return -1;
+    }
+    return 0;
+}
+
 int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int has_encoder, const rc_sample *s,
                  size_t n, rch_diag *d)
 {
     *start = *nominal;
     if (!has_encoder) {
         double e[3];
-        rc_status st = rc_encoder_guess(e, start, s, n);
-        if (st == RC_ERR_RANGE) {
-            rch_diag_set(d, "", 0, 0,
-                         "cannot place the encoder: the lengths fit no sphere around the nominal flange positions "
-                         "(misfit above 15 %% of the lengths): the length column is not the cable, or the robot "
-                         "is over 100 mm from its nominal model; give the outlet in the robot file (\"encoder_mm\")");
+        if (guess_outlet(e, start, 0, s, n, d) != 0)
             return -1;
-        }
-        if (st != RC_OK) {
-            rch_diag_set(d, "", 0, 0,
-                         "cannot place the encoder: %s (the poses must spread in all three directions)",
-                         rc_strerror(st));
-            return -1;
-        }
         memcpy(&start->x[RC_P_ENC], e, sizeof e);
+    }
+    for (unsigned i = 0; i < start->n_effects; ++i) {
+        const rc_effect *ef = &start->effects[i];
+        if (ef->kind != RC_EFF_OUTLET)
+            continue;
+        double e[3];
+        if (guess_outlet(e, start, ef->joint, s, n, d) != 0)
+            return -1;
+        memcpy(&start->x[ef->first], e, sizeof e);
     }
     uint8_t fixed[RC_MAX_PARAMS];
     memset(fixed, 1, sizeof fixed);
     fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 0;
+    for (unsigned i = 0; i < start->n_effects; ++i)
+        if (start->effects[i].kind == RC_EFF_OUTLET)
+            memset(&fixed[start->effects[i].first], 0, 3);
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.method = RC_METHOD_LM;
@@ -1080,6 +1113,20 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
         fprintf(stderr, "rcal calibrate: %zu samples: the fit takes about %.0f s\n", data.n, 2e-5 * (double)data.n);
     groups(r, &data, counts);
     provenance(r, counts);
+    {
+        const int no = rch_data_outlets(r->outlet_label, data.s, data.n, d);
+        if (no < 0) {
+            rch_data_free(&data);
+            return -1;
+        }
+        r->n_outlets = (unsigned)no;
+        for (unsigned k = 1; k < r->n_outlets; ++k)
+            if (rc_model_add_effect(&r->robot.model, RC_EFF_OUTLET, k, 0) != RC_OK) {
+                rch_diag_set(d, "", 0, 0, "cannot add outlet %u (RC_MAX_PARAMS or RC_MAX_EFFECTS)", k);
+                rch_data_free(&data);
+                return -1;
+            }
+    }
     int rc = -1;
     rc_solve_work *w = malloc(sizeof *w);
     unsigned *file_of = cfg->residuals_path ? malloc((data.n ? data.n : 1) * sizeof *file_of) : NULL;

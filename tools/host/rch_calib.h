@@ -131,6 +131,8 @@ typedef struct rch_calib_result {
     double p_eff;             /* effective number of parameters the data determined (trace of the hat matrix) */
     unsigned noise_passes;    /* fits it took for the noise estimate to settle */
     unsigned n_outside_prior; /* DH parameters more than 3 prior sd from nominal (flagged) */
+    unsigned n_outlets;       /* encoder places in the data (column outlet; 1 without it) */
+    uint8_t outlet_label[RC_MAX_OUTLETS]; /* (n_outlets) the file's label of outlet k (k = 0: e) */
     unsigned jumps_found;     /* the default run's jump check: jumps the fit does not model (0: none) */
     double jump_check_max_mm; /* the largest of them */
     int jumps_auto;           /* they were then fitted as nuisance (cfg.jumps set by the run) */

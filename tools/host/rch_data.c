@@ -17,9 +17,9 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_P = 12, C_N = 13 };
+enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_P = 12, C_O = 13, C_N = 14 };
 static const char *const col_names[C_N] = {"q1", "q2", "q3", "q4", "q5", "q6", "L",
-                                           "x",  "y",  "z",  "t",  "group", "pose"};
+                                           "x",  "y",  "z",  "t",  "group", "pose", "outlet"};
 
 typedef struct {
     const char *p; /* field start */
@@ -235,6 +235,10 @@ static int check_value(const parse_ctx *pc, int k, double v, const field *f)
         rch_diag_set(pc->d, pc->name, ln, col, "field 'pose': %g is not an integer in 0..1000000000", v);
     else if (k == C_G && (v < 0.0 || v > 65535.0 || v != floor(v)))
         rch_diag_set(pc->d, pc->name, ln, col, "field 'group': %g is not an integer in 0..65535", v);
+    else if (k == C_O && (v < 0.0 || v > 255.0 || v != floor(v)))
+        rch_diag_set(pc->d, pc->name, ln, col,
+                     "field 'outlet': %g is not an outlet number (an integer 0..255 naming where the encoder stood)",
+                     v);
     else
         return 0;
     return -1;
@@ -272,6 +276,7 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
     s->len_mm = v[C_L];
     s->t = v[C_T];
     s->group = (uint16_t)v[C_G];
+    s->outlet = (uint8_t)v[C_O]; /* the file's label: rch_data_outlets numbers them 0.. */
     if (out->xyz) {
         out->xyz[out->n][0] = v[C_X];
         out->xyz[out->n][1] = v[C_Y];
@@ -372,6 +377,7 @@ static int parse(rch_data *out, const char *text, size_t len, const char *name, 
     }
     out->has_t = pc.col_of[C_T] >= 0;
     out->has_group = pc.col_of[C_G] >= 0;
+    out->has_outlet = pc.col_of[C_O] >= 0;
     scale_t(out);
     return 0;
 fail:
@@ -500,4 +506,25 @@ int rch_load_model_and_data(struct rch_robot *robot, const char *model_path, rch
     if (rch_robot_load(robot, model_path, d) != 0)
         return -1;
     return rch_data_load_limited(data, data_path, 0, &robot->model, d) != 0 ? -1 : 0;
+}
+
+int rch_data_outlets(uint8_t label[RC_MAX_OUTLETS], rc_sample *s, size_t n, rch_diag *d)
+{
+    unsigned k = 0;
+    int of[256];
+    for (unsigned i = 0; i < 256; ++i)
+        of[i] = -1;
+    for (size_t i = 0; i < n; ++i) {
+        const unsigned v = s[i].outlet;
+        if (of[v] < 0) {
+            if (k >= RC_MAX_OUTLETS) {
+                rch_diag_set(d, "", 0, 0, "more than %d outlets in the data (column 'outlet')", RC_MAX_OUTLETS);
+                return -1;
+            }
+            label[k] = (uint8_t)v;
+            of[v] = (int)k++;
+        }
+        s[i].outlet = (uint8_t)of[v];
+    }
+    return (int)k;
 }

@@ -37,7 +37,14 @@ typedef struct rch_data {
     unsigned long *pose; /* (n) pose column (RCH_DATA_POSE), else NULL */
     int has_t;          /* a t column was present */
     int has_group;      /* a group column was present */
+    int has_outlet;     /* an outlet column was present (rc_sample.outlet holds the file's label) */
 } rch_data;
+
+/* Number the outlets of samples s (n) 0, 1, ... in the order their labels
+ * (rc_sample.outlet as read) first appear, so that the first outlet is the
+ * model's e; label (RC_MAX_OUTLETS) receives each number's label. Returns
+ * the number of outlets, or -1 with d set (more than RC_MAX_OUTLETS). */
+int rch_data_outlets(uint8_t label[RC_MAX_OUTLETS], rc_sample *s, size_t n, rch_diag *d);
 
 #define RCH_DATA_MAX_BYTES ((size_t)1 << 30) /* largest file loaded (1 GiB) */
 /* most rows loaded: 1 GiB of short rows is 60 million, about 35 GB for a
