@@ -5,12 +5,16 @@
  * parses options, loads the robot and the data, and reports.
  */
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rcal_cmds.h"
 #include "rch_compare.h"
+#include "rch_calib.h" /* rch_calib_effects */
 #include "rch_data.h"
+#include "rch_dequant.h"
 #include "rch_opt.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_plot.h"
@@ -38,7 +42,9 @@ static const char *sub_dir(char *buf, size_t len, const char *dir, int both, rch
 /* What the command writes besides the report. */
 typedef struct compare_out {
     const char *plots, *models, *resid; /* directories / file, or NULL */
+    const char *effects;                /* --effects LIST, or NULL */
     int json, both;                     /* --json; --params both */
+    int dequantize;                     /* --dequantize-joints */
     int argc;                           /* the command line, for the JSON header */
     char **argv;
 } compare_out;
@@ -60,9 +66,37 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
         return 1;
     }
     if (rch_robot_load(&robot, robot_path, &d) != 0 ||
-        rch_data_load_limited(&data, data_path, 0, &robot.model, &d) != 0) {
+        rch_data_load_limited(&data, data_path, 0, &robot.model, &d) != 0 ||
+        (o->effects && rch_calib_effects(&robot.model, o->effects, &d) != 0)) {
         fprintf(stderr, "rcal compare: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
+    }
+    if (o->dequantize) { /* the joint angles from x, y, z (rch_dequant); inconsistent rows dropped */
+        if (!data.xyz) {
+            fprintf(stderr, "rcal compare: --dequantize-joints needs the x, y, z columns of %s\n", data_path);
+            rch_data_free(&data);
+            return 1;
+        }
+        uint8_t *bad = calloc(data.n + 1, 1);
+        rch_dequant_result q;
+        size_t k = 0;
+        if (!bad) {
+            rch_data_free(&data);
+            return 1;
+        }
+        rch_dequant(&q, bad, data.s, data.n, (const double(*)[3])data.xyz, &robot.nominal, 0.0);
+        for (size_t i = 0; i < data.n; ++i)
+            if (!bad[i]) {
+                data.s[k] = data.s[i];
+                data.line[k] = data.line[i];
+                memcpy(data.xyz[k], data.xyz[i], sizeof data.xyz[k]);
+                ++k;
+            }
+        data.n = k;
+        free(bad);
+        if (!o->json)
+            printf("joints dequantized from x, y, z: %zu rows corrected (RMS %.4f deg), %zu refused and dropped\n",
+                   q.n_corrected, q.dq_rms_deg, q.n_refused);
     }
     if (cfg->samples > data.n) {
         fprintf(stderr, "rcal compare: --samples %zu but %s has %zu rows\n", cfg->samples, data_path, data.n);
@@ -114,7 +148,8 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
 int rcal_cmd_compare(int argc, char **argv)
 {
     const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *methods = NULL, *models = NULL;
-    const char *params = "paper", *resid = NULL;
+    const char *params = "paper", *resid = NULL, *effects = NULL;
+    int literal = 0, jumps = 0, prior = 0, dequantize = 0, tool_offset = 0;
     unsigned long cases = 10, samples = 300, seed = 1;
     double test_fraction = 0.1;
     int json = 0;
@@ -130,7 +165,8 @@ int rcal_cmd_compare(int argc, char **argv)
          NULL},
         {"--seed", RCH_OPT_UINT, &seed, 0, 4294967295.0, NULL, "case c draws with seed * 1000003 + c", 0, NULL},
         {"--methods", RCH_OPT_STR, &methods, 0, 0, "LIST",
-         "comma list of LM,EKF,PF,SCA,QIBAS,SSLM,LTLM (or M1..M7); default all", 0, NULL},
+         "comma list of LM,EKF,PF,SCA,QIBAS,SSLM,LTLM (or M1..M7), LM-paper, LM-paper-deg, LTLM-paper, "
+         "LTLM-paper-deg; default the seven", 0, NULL},
         {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "SVG charts (each with its data as .csv): convergence, bars, times, per-sample errors", 0,
          NULL},
         {"--params", RCH_OPT_CHOICE, &params, 0, 0, "SET",
@@ -139,6 +175,22 @@ int rcal_cmd_compare(int argc, char **argv)
          0, "paper|common|both"},
         {"--models", RCH_OPT_STR, &models, 0, 0, "DIR",
          "write case 1's model of every row (BC.json, M1-LM.json .. M7-LTLM.json) for rcal grind --models", 0, NULL},
+        {"--literal", RCH_OPT_FLAG, &literal, 0, 0, NULL,
+         "also the paper's own M1 and M7: LM-paper (Eq. 10, mu = 5, no acceptance) and LTLM-paper (Algorithm I), "
+         "angles in rad and in deg (-deg), beside the robust rows",
+         0, NULL},
+        {"--jumps", RCH_OPT_FLAG, &jumps, 0, 0, NULL,
+         "fit length jumps at change points in acquisition order with every method (nuisance; rch_jumps)", 0, NULL},
+        {"--dequantize-joints", RCH_OPT_FLAG, &dequantize, 0, 0, NULL,
+         "recover the joint angles rounded in the file from its x, y, z (rows that cannot be are dropped)", 0, NULL},
+        {"--effects", RCH_OPT_STR, &effects, 0, 0, "LIST",
+         "model effects every method fits (rcal calibrate --effects names: tool_offset, length_offset, ...)", 0,
+         NULL},
+        {"--tool-offset", RCH_OPT_FLAG, &tool_offset, 0, 0, NULL, "the cable attachment off the flange centre "
+         "(the tool_offset effect)", 0, NULL},
+        {"--prior", RCH_OPT_FLAG, &prior, 0, 0, NULL,
+         "LM and LTLM maximum a posteriori with the robot's physical prior (as rcal calibrate; the others ignore it)",
+         0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout instead of the report", 0, NULL},
         {"--residuals", RCH_OPT_STR, &resid, 0, 0, "FILE.csv",
          "case 1's rows (test and train) with the BC residual and one column per method; never over an input", 0,
@@ -166,6 +218,14 @@ int rcal_cmd_compare(int argc, char **argv)
         return 2;
     }
     cfg.params = strcmp(params, "common") == 0 ? RCH_PARAMS_COMMON : RCH_PARAMS_PAPER;
-    const compare_out o = {plots, models, resid, json, both, argc, argv};
+    if (literal)
+        cfg.run[RCH_EST_LM_PAPER] = cfg.run[RCH_EST_LM_PAPER_DEG] = cfg.run[RCH_EST_LTLM_PAPER] =
+            cfg.run[RCH_EST_LTLM_PAPER_DEG] = 1;
+    cfg.jumps = jumps;
+    cfg.prior = prior;
+    char eff[512];
+    if (tool_offset)
+        snprintf(eff, sizeof eff, "%s%s%s", effects ? effects : "", effects ? "," : "", "tool_offset");
+    const compare_out o = {plots, models, resid, tool_offset ? eff : effects, json, both, dequantize, argc, argv};
     return compare_run(&cfg, data_path, robot_path, &o);
 }

@@ -15,7 +15,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_calib.h"
 #include "rch_chaos.h"
+#include "rch_eval.h"
 #include "rch_compare.h"
 #include "rch_json.h"
 #include "rch_robot.h"
@@ -47,11 +49,11 @@ static int setup(void **state)
 
 static void test_methods_list(void **state)
 {
-    int run[RCH_EST_COUNT];
+    int run[RCH_EST_ALL];
     rch_diag d;
     (void)state;
     assert_int_equal(rch_compare_methods(run, "lm,M7", &d), 0);
-    for (int i = 0; i < RCH_EST_COUNT; ++i)
+    for (int i = 0; i < RCH_EST_ALL; ++i)
         assert_int_equal(run[i], i == RCH_EST_LM || i == RCH_EST_LTLM);
     static const char *const bad[] = {"", ",", "lm,", "lm,,ekf", "foo", "lm,foo"};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
@@ -196,6 +198,135 @@ static void test_common_set_and_models(void **state)
     assert_int_equal(system(cmd), 0);
 }
 
+
+/* --literal: the paper's rows are rc_solve's paper variants run from the
+ * case's BC start with the case's seed (LTLM-paper's model of case 1 is
+ * Algorithm I's, bit for bit), each row labelled with the paper's method
+ * number; the JSON carries the paper's Table 6 as published. */
+static void test_literal_rows(void **state)
+{
+    rch_compare_config cfg;
+    rch_compare_result a;
+    rch_diag d;
+    (void)state;
+    rch_compare_defaults(&cfg);
+    cfg.cases = 1;
+    cfg.samples = 70;
+    cfg.test_fraction = 0.2;
+    cfg.seed = 3;
+    for (int i = 0; i < RCH_EST_ALL; ++i)
+        cfg.run[i] = i == RCH_EST_LM || i == RCH_EST_LTLM || i >= RCH_EST_COUNT;
+    assert_int_equal(rch_compare_run(&a, &cfg, &g_robot, g_s, NS, NULL, &d), 0);
+    assert_false(rch_compare_any_failed(&a));
+    assert_string_equal(rch_compare_row_name(RCH_EST_LTLM_PAPER + 1), "LTLM-paper");
+    assert_int_equal(rch_est_paper_row(RCH_EST_LTLM_PAPER_DEG), 7);
+    assert_int_equal(rch_est_paper_row(RCH_EST_LM_PAPER), 1);
+    /* the same fit by hand: BC start of the case, Algorithm I, the case's seed */
+    {
+        size_t idx[NS];
+        rch_holdout h;
+        rc_model start, m;
+        rc_solve_config sc;
+        rc_solve_work *w = malloc(sizeof *w);
+        assert_non_null(w);
+        assert_int_equal(rch_holdout_draw(&h, idx, g_s, NS, 70, 14, cfg.seed * 1000003ull), 0);
+        assert_int_equal(rch_calib_start(&start, w, &g_robot, h.train, h.n_train, &d), 0);
+        static const rc_method mt[4] = {RC_METHOD_LM_PAPER, RC_METHOD_LM_PAPER_DEG, RC_METHOD_LTLM_PAPER,
+                                        RC_METHOD_LTLM_PAPER_DEG};
+        for (int k = 0; k < 4; ++k) {
+            memset(&sc, 0, sizeof sc);
+            sc.method = mt[k];
+            sc.seed = cfg.seed * 1000003ull;
+            m = start;
+            assert_int_equal(rc_solve(&m, NULL, w, &sc, h.train, h.n_train), RC_OK);
+            const rc_model *cm = &a.model_case1[RCH_EST_LM_PAPER + k + 1];
+            for (unsigned p = 0; p < m.n_params; ++p)
+                if (m.x[p] != cm->x[p])
+                    fail_msg("%s parameter %u: compare %.17g, rc_solve %.17g", rch_compare_row_name(RCH_EST_LM_PAPER + k + 1),
+                             p, cm->x[p], m.x[p]);
+            assert_int_equal(a.cell[RCH_EST_LM_PAPER + k + 1].iterations, 50u); /* K = 50, no early exit here */
+        }
+        /* and differs from the robust row (the literal mode is not a relabelling) */
+        unsigned differ = 0;
+        for (unsigned p = 0; p < m.n_params; ++p)
+            differ += fabs(a.model_case1[RCH_EST_LTLM + 1].x[p] - m.x[p]) > 1e-6;
+        assert_true(differ > 3);
+        rch_holdout_free(&h);
+        free(w);
+    }
+    {
+        char *buf = NULL;
+        size_t len = 0;
+        FILE *f = open_memstream(&buf, &len);
+        assert_non_null(f);
+        assert_int_equal(rch_compare_json(f, &a, &cfg, "sim", 0, NULL), 0);
+        fclose(f);
+        rch_json *j = rch_json_parse(buf, len, "compare", &d);
+        if (!j)
+            fail_msg("not JSON: %s\n%s", d.msg, buf);
+        const rch_json *t6 = rch_json_get(j, "paper_table6");
+        assert_non_null(t6);
+        assert_int_equal(t6->n, 8);
+        assert_string_equal(rch_json_get(t6->items[7], "name")->str, "M7 LTLM");
+        assert_true(fabs(rch_json_get(t6->items[7], "rmse_mm")->num - 0.32) < 1e-12);
+        assert_true(fabs(rch_json_get(t6->items[1], "max_mm")->num - 0.91) < 1e-12);
+        const rch_json *ms = rch_json_get(j, "methods");
+        assert_int_equal(ms->n, 7); /* BC, LM, LTLM and the four paper variants */
+        assert_string_equal(rch_json_get(ms->items[6], "name")->str, "LTLM-paper-deg");
+        assert_int_equal((int)rch_json_get(ms->items[6], "paper_row")->num, 7);
+        rch_json_free(j);
+        free(buf);
+    }
+    rch_compare_free(&a);
+}
+
+/* --jumps with every method: a 4 mm jump put into the simulated lengths
+ * half way through the acquisition is found by every rc_solve method's own
+ * search (the method is honoured: LM and LTLM-paper-deg end at different
+ * models) and given to EKF and SSLM, and every row predicts the held-out
+ * rows far better than without --jumps. */
+static void test_jumps_every_method(void **state)
+{
+    rch_compare_config cfg;
+    rch_compare_result a, b;
+    rch_diag d;
+    rc_sample s[NS];
+    (void)state;
+    memcpy(s, g_s, sizeof s);
+    for (size_t i = NS / 2; i < NS; ++i)
+        s[i].len_mm += 4.0; /* t ascends with i */
+    rch_compare_defaults(&cfg);
+    cfg.cases = 1;
+    cfg.samples = NS;
+    cfg.test_fraction = 0.2;
+    cfg.seed = 5;
+    for (int i = 0; i < RCH_EST_ALL; ++i)
+        cfg.run[i] = i == RCH_EST_LM || i == RCH_EST_EKF || i == RCH_EST_SSLM || i == RCH_EST_LTLM ||
+                     i == RCH_EST_LTLM_PAPER_DEG;
+    assert_int_equal(rch_compare_run(&b, &cfg, &g_robot, s, NS, NULL, &d), 0); /* without */
+    cfg.jumps = 1;
+    if (rch_compare_run(&a, &cfg, &g_robot, s, NS, NULL, &d) != 0)
+        fail_msg("%s", d.msg);
+    assert_int_equal(a.jumps, 1);
+    for (int id = 0; id < RCH_EST_ALL; ++id) {
+        if (!cfg.run[id])
+            continue;
+        const rch_compare_cell *e = &a.cell[id + 1], *e0 = &b.cell[id + 1];
+        assert_true(e->ok && e0->ok);
+        if (e->n_jumps != 1)
+            fail_msg("%s: %u jumps", rch_est_name((rch_est_id)id), e->n_jumps);
+        if (!(e->held_out.rmse_mm < 0.5 * e0->held_out.rmse_mm))
+            fail_msg("%s: held-out %.4f with --jumps, %.4f without", rch_est_name((rch_est_id)id),
+                     e->held_out.rmse_mm, e0->held_out.rmse_mm);
+    }
+    unsigned differ = 0;
+    for (unsigned p = 0; p < RC_N_DH; ++p)
+        differ += fabs(a.model_case1[RCH_EST_LM + 1].x[p] - a.model_case1[RCH_EST_LTLM_PAPER_DEG + 1].x[p]) > 1e-9;
+    assert_true(differ > 3);
+    rch_compare_free(&a);
+    rch_compare_free(&b);
+}
+
 static void test_compare_refused(void **state)
 {
     rch_compare_config cfg;
@@ -271,6 +402,8 @@ int main(void)
         cmocka_unit_test(test_methods_list),
         cmocka_unit_test(test_compare_run),
         cmocka_unit_test(test_common_set_and_models),
+        cmocka_unit_test(test_literal_rows),
+        cmocka_unit_test(test_jumps_every_method),
         cmocka_unit_test(test_compare_refused),
         cmocka_unit_test(test_chaos),
     };

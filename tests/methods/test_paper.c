@@ -222,13 +222,13 @@ static void show(const char *what, const double lib[NP], double lib_cost, const 
 /* Algorithm I, K iterations by hand from the start, compared with the
  * library's trace point by point. Returns the number of iterations where a
  * candidate beat x1. */
-static unsigned check_algorithm1(int deg, int print)
+static unsigned check_algorithm1_from(const rc_model *start, unsigned K, int deg, int print, unsigned *rises)
 {
     const double mu = 5.0, n0 = 0.3, r = 0.5;
     trace *t = calloc(1, sizeof *t);
     rc_solve_config cfg;
     rc_solve_result res;
-    rc_model m = g_start;
+    rc_model m = *start;
     uint8_t fixed[RC_MAX_PARAMS];
     double u[NP], n = n0;
     unsigned wins = 0;
@@ -238,7 +238,7 @@ static unsigned check_algorithm1(int deg, int print)
         fixed[g_idx[i]] = 0;
     memset(&cfg, 0, sizeof cfg);
     cfg.method = deg ? RC_METHOD_LTLM_PAPER_DEG : RC_METHOD_LTLM_PAPER;
-    cfg.max_iter = KITER;
+    cfg.max_iter = K;
     cfg.n_candidates = MCAND;
     cfg.chaos_n0 = n0;
     cfg.fixed = fixed;
@@ -246,10 +246,12 @@ static unsigned check_algorithm1(int deg, int print)
     cfg.cb_ctx = t;
     t->deg = deg;
     assert_int_equal(rc_solve(&m, &res, &W, &cfg, g_s, NS), RC_OK);
-    assert_int_equal(res.iterations, KITER);
+    assert_int_equal(res.iterations, K);
 
-    from_model(u, &g_start, deg);
-    for (unsigned k = 1; k <= KITER; ++k) {
+    from_model(u, start, deg);
+    if (rises)
+        *rises = 0;
+    for (unsigned k = 1; k <= K; ++k) {
         double x1[NP], x2[NP], a[NP], b[NP], best[NP], cl[MCAND], cr[MCAND];
         double xl[MCAND][NP], xr[MCAND][NP], nm[MCAND];
         hand_lm(x1, u, mu, deg);                     /* Eq. 13 */
@@ -282,6 +284,8 @@ static unsigned check_algorithm1(int deg, int print)
             }
         }
         wins += (unsigned)picked;
+        if (rises && bc > hand_cost(u, deg))
+            ++*rises; /* Algorithm I has no acceptance test: x_{k+1} may cost more than x_k */
 
         check_point(find(t, k, RC_LTLM_X1, 0), x1, c1, "x1");
         check_point(find(t, k, RC_LTLM_X2, 0), x2, -1.0, "x2");
@@ -297,7 +301,7 @@ static unsigned check_algorithm1(int deg, int print)
 
         if (print && k == 1) {
             double uk[NP];
-            from_model(uk, &g_start, deg);
+            from_model(uk, start, deg);
             print_message("ltlm-paper%s, iteration 1, mu = 5, M = %d, N_0 = %.1f, r = 0.5; point (a2 mm, theta2 %s, "
                           "ez mm) cost mm^2\n",
                           deg ? "-deg" : "", MCAND, n0, deg ? "deg" : "rad");
@@ -329,6 +333,8 @@ static unsigned check_algorithm1(int deg, int print)
     free(t);
     return wins;
 }
+
+static unsigned check_algorithm1(int deg, int print) { return check_algorithm1_from(&g_start, KITER, deg, print, NULL); }
 
 static void test_algorithm1_rad(void **state)
 {
@@ -380,12 +386,53 @@ static void test_eq10(void **state)
  * candidate lies on its segment with the reported N_m, the N_m follow Eq. 11
  * as one scalar sequence, the chosen point is the cheapest of {x1,
  * candidates} and never costs more than x_k; and candidates win sometimes. */
+/* x2 is the robust LM's step from x1 with the normal equations AT x1: in
+ * the solver's column scaling D (the start's column norms, D_i^2 = A0_ii)
+ * the step d = x2 - x1 solves (A1 + mu D^2) d = -g1 for one damping mu > 0
+ * (every direction kept: three identifiable parameters, snr_min off). A
+ * step from the old normal equations (x_k's) solves another system and
+ * leaves a residual. Returns 1 when x2 was checked (a step was taken and
+ * the gradient at x1 is above 1e-6 of the start's: past that, roundoff). */
+static int check_x2(const double A0[NP * NP], double g0_norm, const ev *x1, const ev *x2)
+{
+    double A1[NP * NP], g1[NP], dv[NP], r[NP], q[NP], num = 0.0, den = 0.0, rn = 0.0, gn = 0.0, dn = 0.0;
+    (void)hand_normal(A1, g1, x1->u, 0);
+    for (unsigned i = 0; i < NP; ++i) {
+        dv[i] = x2->u[i] - x1->u[i];
+        dn += dv[i] * dv[i];
+    }
+    if (!(sqrt(dn) > 1e-10))
+        return 0;
+    for (unsigned i = 0; i < NP; ++i) {
+        r[i] = g1[i];
+        for (unsigned k = 0; k < NP; ++k)
+            r[i] += A1[i * NP + k] * dv[k];
+        q[i] = A0[i * NP + i] * dv[i];
+        num -= q[i] * r[i];
+        den += q[i] * q[i];
+        gn += g1[i] * g1[i];
+    }
+    if (sqrt(gn) < 1e-6 * g0_norm)
+        return 0; /* converged: the equation holds to roundoff only */
+    const double mu = num / den;
+    for (unsigned i = 0; i < NP; ++i)
+        rn += (r[i] + mu * q[i]) * (r[i] + mu * q[i]);
+    if (!(mu > 0.0) || !(sqrt(rn) <= 1e-4 * sqrt(gn))) { /* roundoff near convergence: ~1e-6 */
+        print_error("x2 is not the LM step at x1: mu %.6g, |(A1 + mu D^2) d + g1| = %.3g against |g1| = %.3g\n", mu,
+                    sqrt(rn), sqrt(gn));
+        fail();
+    }
+    return 1;
+}
+
 static void robust_trace_check(const trace *t, const rc_model *start, double n0, unsigned *wins)
 {
-    double uk[NP], ck;
+    double uk[NP], ck, A0[NP * NP], g0[NP];
     double n = n0;
+    unsigned x2_checked = 0;
     from_model(uk, start, 0);
     ck = hand_cost(uk, 0);
+    (void)hand_normal(A0, g0, uk, 0); /* the solver's column scaling: D_i^2 = A0_ii at the start */
     for (unsigned k = 1;; ++k) {
         const ev *x1 = find(t, k, RC_LTLM_X1, 0), *x2 = find(t, k, RC_LTLM_X2, 0);
         const ev *a = find(t, k, RC_LTLM_A, 0), *b = find(t, k, RC_LTLM_B, 0);
@@ -396,6 +443,7 @@ static void robust_trace_check(const trace *t, const rc_model *start, double n0,
         assert_non_null(a);
         assert_non_null(b);
         assert_non_null(ch);
+        x2_checked += (unsigned)check_x2(A0, sqrt(g0[0] * g0[0] + g0[1] * g0[1] + g0[2] * g0[2]), x1, x2);
         double best = x1->cost;
         for (unsigned i = 0; i < NP; ++i) {
             assert_true(fabs(a->u[i] - 0.5 * (uk[i] + x1->u[i])) < 1e-12 * (1.0 + fabs(uk[i])));
@@ -428,6 +476,76 @@ static void robust_trace_check(const trace *t, const rc_model *start, double n0,
         memcpy(uk, ch->u, sizeof uk);
         ck = ch->cost;
     }
+    assert_true(x2_checked >= 2);
+}
+
+
+/* Algorithm I has no acceptance test (x_k is not a candidate), so the cost
+ * may rise from one iteration to the next: on the real file the rad reading
+ * rises in about 25 of 50 iterations (the cost of the model after each
+ * iteration, through on_iter, against the one before). A library that added an
+ * acceptance test (kept x_k when the chosen point costs more) fails this. */
+typedef struct rise_trace {
+    double prev, worst_rise;
+    unsigned iters, rises;
+} rise_trace;
+
+static const rch_data *g_rise_data;
+
+/* after each iteration: the cost of the model the solver carries on with */
+static void on_iterate(void *ctx, unsigned iter, double rms, const rc_model *m)
+{
+    rise_trace *r = ctx;
+    double c;
+    (void)iter;
+    (void)rms;
+    assert_int_equal(rc_cost(&c, m, g_rise_data->s, g_rise_data->n), RC_OK);
+    if (c > r->prev) {
+        ++r->rises;
+        if (c - r->prev > r->worst_rise)
+            r->worst_rise = c - r->prev;
+    }
+    r->prev = c;
+    ++r->iters;
+}
+
+static void test_algorithm1_cost_rises(void **state)
+{
+    rch_robot robot;
+    rch_data data;
+    rch_diag d;
+    (void)state;
+    assert_int_equal(rch_robot_load(&robot, RCAL_SOURCE_DIR "/data/irb120.json", &d), 0);
+    /* the real file: a large-residual problem (length jumps, an attachment
+     * off the flange centre) where the rad reading of Eq. 10 overshoots; on
+     * the simulated robot (with jumps or an attachment put in) no
+     * iteration's cost rose */
+    if (rch_data_load(&data, RCAL_SHARED_DATA, 0, &d) != 0) {
+        print_message("SKIP: %s is absent; the cost-rise check not run\n", RCAL_SHARED_DATA);
+        skip();
+    }
+    rc_model start;
+    assert_int_equal(rch_calib_start(&start, &W, &robot, data.s, data.n, &d), 0);
+    for (int deg = 0; deg <= 1; ++deg) {
+        rc_solve_config cfg;
+        rise_trace r;
+        rc_model m = start;
+        memset(&cfg, 0, sizeof cfg);
+        memset(&r, 0, sizeof r);
+        assert_int_equal(rc_cost(&r.prev, &start, data.s, data.n), RC_OK);
+        cfg.method = deg ? RC_METHOD_LTLM_PAPER_DEG : RC_METHOD_LTLM_PAPER;
+        cfg.chaos_n0 = 0.3;
+        cfg.on_iter = on_iterate;
+        cfg.cb_ctx = &r;
+        g_rise_data = &data;
+        assert_int_equal(rc_solve(&m, NULL, &W, &cfg, data.s, data.n), RC_OK);
+        print_message("ltlm-paper%s on the real file (27 free): the cost rose in %u of %u iterations (largest "
+                      "rise %.4g mm^2)\n", deg ? "-deg" : "", r.rises, r.iters, r.worst_rise);
+        assert_int_equal(r.iters, 50);
+        if (!deg)
+            assert_true(r.rises > 0); /* an acceptance test would never let the cost rise */
+    }
+    rch_data_free(&data);
 }
 
 static void test_robust_ltlm(void **state)
@@ -615,6 +733,7 @@ int main(void)
         cmocka_unit_test(test_algorithm1_rad),
         cmocka_unit_test(test_algorithm1_deg),
         cmocka_unit_test(test_eq10),
+        cmocka_unit_test(test_algorithm1_cost_rises),
         cmocka_unit_test(test_robust_ltlm),
         cmocka_unit_test(test_robust_ltlm_null_direction),
         cmocka_unit_test(test_ekf_real),

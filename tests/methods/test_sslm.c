@@ -54,7 +54,13 @@ static double cost_at(const rc_model *base, const uint16_t idx[2], const double 
     return c;
 }
 
-static void test_step_sizes(void **state)
+/* One run from truth + (dth_deg on theta2, da_mm on a3) with damping mu,
+ * recomputed iteration by iteration. *carry: iterations where the step size
+ * carried over mattered: eta_prev < 0.5 and a longer step than
+ * 2 eta_prev (1, 1/2, ...) would also have lowered the cost, so a rule that
+ * restarts at 1 each iteration takes another point. Returns 1 when the
+ * run converged to the truth's two values. */
+static int check_rule(double dth_deg, double da_mm, double mu, unsigned *shortened_out, unsigned *carry)
 {
     static rch_robot robot;
     static rc_est_work w;
@@ -68,7 +74,6 @@ static void test_step_sizes(void **state)
     trace t;
     rc_est_config cfg;
     rc_est_result res;
-    (void)state;
     assert_int_equal(rch_robot_load(&robot, RCAL_SOURCE_DIR "/data/irb120.json", &d), 0);
     memset(&c, 0, sizeof c);
     c.q_step_deg = -1.0;
@@ -85,15 +90,15 @@ static void test_step_sizes(void **state)
         fixed[k] = 1;
     fixed[t.idx[0]] = fixed[t.idx[1]] = 0;
     start = truth;
-    start.x[t.idx[0]] += 70.0 * 3.14159265358979 / 180.0;
-    start.x[t.idx[1]] += 150.0;
+    start.x[t.idx[0]] += dth_deg * 3.14159265358979 / 180.0;
+    start.x[t.idx[1]] += da_mm;
 
     memset(&cfg, 0, sizeof cfg);
     cfg.method = RC_EST_SSLM;
     cfg.keep_all = 1;
     cfg.fixed = fixed;
     cfg.max_iter = MAXIT;
-    cfg.sslm_mu = 1e-3;
+    cfg.sslm_mu = mu;
     cfg.on_iter = on_iter;
     cfg.cb_ctx = &t;
     rc_model m = start;
@@ -132,6 +137,17 @@ static void test_step_sizes(void **state)
         assert_true(ok);
         if (a < 1.0)
             ++shortened;
+        if (eta < 0.5) { /* would a restart at 1 have taken a longer step? */
+            double a1 = 1.0, xr[2];
+            for (int h = 0; h <= 40 && a1 > 2.0 * eta * 1.000001; ++h, a1 *= 0.5) {
+                xr[0] = x[0] + a1 * delta[0] / D[0];
+                xr[1] = x[1] + a1 * delta[1] / D[1];
+                if (cost_at(&start, t.idx, xr, s) < cost) {
+                    ++*carry;
+                    break;
+                }
+            }
+        }
         /* the library's point after iteration k + 1 */
         assert_true(fabs(t.x[k][0] - xn[0]) <= 1e-9 * (1.0 + fabs(xn[0])));
         assert_true(fabs(t.x[k][1] - xn[1]) <= 1e-9 * (1.0 + fabs(xn[1])));
@@ -139,17 +155,44 @@ static void test_step_sizes(void **state)
         x[1] = t.x[k][1];
         eta = a;
     }
-    /* the problem exercises the rule: some steps were shortened */
+    *shortened_out = shortened;
+    return fabs(m.x[t.idx[0]] - truth.x[t.idx[0]]) < 1e-3 && fabs(m.x[t.idx[1]] - truth.x[t.idx[1]]) < 0.1;
+}
+
+static void test_step_sizes(void **state)
+{
+    unsigned shortened = 0, carry = 0;
+    (void)state;
+    /* started 70 deg / 150 mm off (a curved problem): some steps shortened, converged */
+    assert_true(check_rule(70.0, 150.0, 1e-3, &shortened, &carry));
     assert_true(shortened >= 1);
-    /* and it converged to the truth's two values (noise-level data) */
-    assert_true(fabs(m.x[t.idx[0]] - truth.x[t.idx[0]]) < 1e-3);
-    assert_true(fabs(m.x[t.idx[1]] - truth.x[t.idx[1]]) < 0.1);
+}
+
+/* The step size carried over: runs where eta_prev < 0.5 occurs and a
+ * restart at eta = 1 would have been accepted at a longer step, so that
+ * carrying eta over (first try min(1, 2 eta_prev)) decides the point; a
+ * rule that does not carry it over fails the recomputation. */
+static void test_step_size_carried(void **state)
+{
+    static const double runs[][3] = {{70.0, 150.0, 1e-3}, {120.0, 300.0, 1e-3}, {150.0, -200.0, 1e-4},
+                                     {100.0, 250.0, 1e-5}, {160.0, 400.0, 1e-5}};
+    unsigned carry = 0;
+    (void)state;
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; ++k) {
+        unsigned sh = 0, c = 0;
+        (void)check_rule(runs[k][0], runs[k][1], runs[k][2], &sh, &c);
+        print_message("start off by %g deg / %g mm, mu %g: %u steps shortened, %u where the carried step size "
+                      "mattered\n", runs[k][0], runs[k][1], runs[k][2], sh, c);
+        carry += c;
+    }
+    assert_true(carry >= 1);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_step_sizes),
+        cmocka_unit_test(test_step_size_carried),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -6,9 +6,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "rch_calib.h"
 #include "rch_eval.h"
+#include "rch_jumps.h"
+#include "rch_prior.h"
 #include "rch_jw.h"
 #include "rch_plot.h"
 #include "rch_save.h"
@@ -24,10 +27,14 @@ void rch_compare_defaults(rch_compare_config *cfg)
     const rch_compare_config def = {.cases = 10, .samples = 300, .test_fraction = 0.1, .seed = 1};
     *cfg = def;
     for (int i = 0; i < RCH_EST_COUNT; ++i)
-        cfg->run[i] = 1;
+        cfg->run[i] = 1; /* the seven; the paper variants with --literal */
 }
 
-int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d)
+const double rch_compare_table6[8][3] = {{2.18, 2.01, 3.42}, {0.36, 0.30, 0.91}, {0.63, 0.51, 1.52},
+                                         {0.73, 0.61, 1.77}, {0.82, 0.66, 1.96}, {0.50, 0.40, 1.31},
+                                         {0.34, 0.28, 0.85}, {0.32, 0.26, 0.83}};
+
+int rch_compare_methods(int run[RCH_EST_ALL], const char *list, rch_diag *d)
 {
     char buf[256];
     size_t n_sel = 0;
@@ -35,7 +42,7 @@ int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d)
         rch_diag_set(d, "", 0, 0, "--methods: list longer than %zu characters", sizeof buf - 1);
         return -1;
     }
-    for (int i = 0; i < RCH_EST_COUNT; ++i)
+    for (int i = 0; i < RCH_EST_ALL; ++i)
         run[i] = 0;
     memcpy(buf, list, strlen(list) + 1);
     for (char *tok = buf, *next; tok; tok = next) {
@@ -45,7 +52,9 @@ int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d)
             *next++ = '\0';
         id = rch_est_parse(tok);
         if (id < 0) {
-            rch_diag_set(d, "", 0, 0, "--methods: %s '%s' (LM, EKF, PF, SCA, QIBAS, SSLM, LTLM or M1..M7)",
+            rch_diag_set(d, "", 0, 0,
+                         "--methods: %s '%s' (LM, EKF, PF, SCA, QIBAS, SSLM, LTLM or M1..M7, LM-paper, "
+                         "LM-paper-deg, LTLM-paper, LTLM-paper-deg)",
                          *tok ? "unknown method" : "empty method name in", *tok ? tok : list);
             return -1;
         }
@@ -62,7 +71,7 @@ void rch_compare_model_file(char *buf, size_t len, int row)
     if (row <= 0)
         snprintf(buf, len, "BC.json");
     else
-        snprintf(buf, len, "M%d-%s.json", row, rch_est_name((rch_est_id)(row - 1)));
+        snprintf(buf, len, "M%d-%s.json", rch_est_paper_row((rch_est_id)(row - 1)), rch_est_name((rch_est_id)(row - 1)));
 }
 
 size_t rch_compare_model_list(char (*paths)[RCH_COMPARE_PATH_MAX], char (*names)[32], const char *dir)
@@ -76,7 +85,7 @@ size_t rch_compare_model_list(char (*paths)[RCH_COMPARE_PATH_MAX], char (*names)
         if (!f)
             continue; /* a method compare did not run */
         fclose(f);
-        snprintf(names[n], 32, "M%d %s", r, rch_est_name((rch_est_id)(r - 1)));
+        snprintf(names[n], 32, "M%d %s", rch_est_paper_row((rch_est_id)(r - 1)), rch_est_name((rch_est_id)(r - 1)));
         ++n;
     }
     return n;
@@ -100,7 +109,7 @@ int rch_compare_any_failed(const rch_compare_result *res)
 
 void rch_compare_free(rch_compare_result *res)
 {
-    for (int id = 0; id < RCH_EST_COUNT; ++id)
+    for (int id = 0; id < RCH_EST_ALL; ++id)
         rch_curve_free(&res->curve[id]);
     free(res->cell);
     free(res->err_case1_mm);
@@ -143,6 +152,9 @@ static void summarise(rch_compare_result *res)
             rch_stats_add(&row->iterations, (double)e->iterations);
             rch_stats_add(&row->cost_evals, (double)e->cost_evals);
             rch_stats_add(&row->n_moved, (double)e->n_moved);
+            rch_stats_add(&row->dlen_max_mm, e->dlen_max_mm);
+            rch_stats_add(&row->dang_max_deg, e->dang_max_deg);
+            rch_stats_add(&row->n_jumps, (double)e->n_jumps);
         }
     }
 }
@@ -224,9 +236,179 @@ static int save_row_model(const rch_compare_config *cfg, const rch_robot *robot,
     return rch_save(path, "--models", cfg->inputs, cfg->n_inputs, model_write_fn, &job, d);
 }
 
+/* The largest |a, d - nominal| (mm) and |alpha, theta - nominal| (deg) of m. */
+static void param_deltas(rch_compare_cell *e, const rc_model *m, const rc_model *nominal)
+{
+    e->dlen_max_mm = e->dang_max_deg = 0.0;
+    for (unsigned k = 0; k < RC_N_DH; ++k) {
+        double dv = m->x[k] - nominal->x[k];
+        if (k % 4 >= 2) {
+            dv = remainder(dv, 2.0 * M_PI) / DEG;
+            if (fabs(dv) > e->dang_max_deg)
+                e->dang_max_deg = fabs(dv);
+        } else if (fabs(dv) > e->dlen_max_mm) {
+            e->dlen_max_mm = fabs(dv);
+        }
+    }
+}
+
+static int cmp_t(const void *a, const void *b)
+{
+    const double x = ((const rc_sample *)a)->t, y = ((const rc_sample *)b)->t;
+    return (x > y) - (x < y);
+}
+
+/* What a case shares between its methods. */
+typedef struct case_ctx {
+    rc_sample *sorted;  /* (n_train) training rows in acquisition order (--jumps) */
+    rc_sample *lab;     /* (n_train) training rows, labelled by the reference segments */
+    rc_sample *test;    /* (n_test) held-out rows, relabelled per model */
+    rch_jumps ref;      /* --jumps: the robust LM's search (change points of the rc_est methods) */
+    double mean[RC_MAX_PARAMS], sd[RC_MAX_PARAMS]; /* --prior */
+    uint8_t fixed_prior[RC_MAX_PARAMS];            /* --prior: the set's fixed plus the gauge */
+} case_ctx;
+
+/* Held-out rows placed in the segments of j (acquisition time); no jumps: as drawn. */
+static void label_test(case_ctx *cx, const rch_holdout *h, const rch_jumps *j)
+{
+    memcpy(cx->test, h->test, h->n_test * sizeof *cx->test);
+    for (size_t i = 0; j && i < h->n_test; ++i)
+        cx->test[i].group = (uint16_t)rch_jumps_segment(j, cx->test[i].t);
+}
+
+/* Method id from start on the case's training rows, honouring --jumps:
+ * m = the fitted model (with the segment offsets), *jused = its change
+ * points (NULL without jumps). */
+static rc_status run_method(rc_model *m, rch_est_out *out, rch_jumps *jm, const rch_jumps **jused, rch_curve *curve,
+                            rch_est_ws *ws, rch_est_id id, uint64_t seed, const rch_est_opts *eo,
+                            const rch_compare_config *cfg, case_ctx *cx, const rch_holdout *h)
+{
+    *jused = NULL;
+    if (!cfg->jumps)
+        return rch_est_run(m, out, curve, ws, id, seed, eo, h->train, h->n_train);
+    if (rch_est_is_solve(id)) { /* the method runs the jump search itself */
+        rc_solve_config sc;
+        rch_jumps_config jc;
+        char err[256];
+        struct timespec t0, t1;
+        rch_est_solve_config(&sc, id, seed, eo);
+        memset(&jc, 0, sizeof jc);
+        jc.solve = &sc;
+        memset(out, 0, sizeof *out);
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        const int jr = rch_jumps_find(jm, m, eo->fixed, cx->sorted, h->n_train, &jc, &ws->solve, err, sizeof err);
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        if (jr != 0)
+            return RC_ERR_NUMERIC;
+        out->time_ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) / 1e6;
+        out->rms_start_mm = jm->rms_before_mm;
+        out->rms_final_mm = jm->rms_after_mm;
+        *m = jm->model;
+        *jused = jm;
+        return RC_OK;
+    }
+    /* the rc_est methods: the reference change points, offsets fitted by the method */
+    uint8_t fx[RC_MAX_PARAMS];
+    rch_est_opts o = *eo;
+    memset(fx, 0, sizeof fx);
+    if (eo->fixed)
+        memcpy(fx, eo->fixed, m->n_params);
+    if (cx->ref.n_jumps) {
+        if (rc_model_add_effect(m, RC_EFF_GROUP_OFFSET, 0, cx->ref.n_jumps + 1) != RC_OK)
+            return RC_ERR_CAPACITY;
+        const rc_effect *ef = &m->effects[m->n_effects - 1];
+        for (unsigned k = ef->first; k < ef->first + ef->count; ++k)
+            fx[k] = k == ef->first; /* the first segment is the reference */
+    }
+    o.fixed = fx;
+    *jused = &cx->ref;
+    return rch_est_run(m, out, curve, ws, id, seed, &o, cx->lab, h->n_train);
+}
+
+/* --jumps and --prior set-up of a case: the sorted and labelled training
+ * rows, the prior, its noise (robust LM fits) and the reference change
+ * points. 0 or -1 with d set. */
+static int case_setup(case_ctx *cx, rch_compare_result *res, const rch_compare_config *cfg, rch_est_ws *ws,
+                      const rch_robot *robot, const rc_model *start, rch_est_opts *eo, const rch_holdout *h,
+                      rch_diag *d)
+{
+    char err[256];
+    memset(&cx->ref, 0, sizeof cx->ref);
+    memcpy(cx->sorted, h->train, h->n_train * sizeof *cx->sorted);
+    qsort(cx->sorted, h->n_train, sizeof *cx->sorted, cmp_t);
+    rch_est_opts po = *eo;
+    if (cfg->prior) {
+        memset(cx->mean, 0, sizeof cx->mean);
+        memset(cx->sd, 0, sizeof cx->sd);
+        memset(cx->fixed_prior, 0, sizeof cx->fixed_prior);
+        rch_prior_fill(cx->mean, cx->sd, start, &robot->nominal, &robot->prior);
+        if (eo->fixed)
+            memcpy(cx->fixed_prior, eo->fixed, start->n_params);
+        rch_prior_gauge(cx->fixed_prior);
+        rc_metrics m0;
+        double noise = rc_eval(&m0, start, h->train, h->n_train) == RC_OK && m0.rmse_mm > 0.0 ? m0.rmse_mm : 1.0;
+        po.fixed = cx->fixed_prior;
+        po.prior_mean = cx->mean;
+        po.prior_sd = cx->sd;
+        for (unsigned pass = 0; pass < 4; ++pass) {
+            rc_solve_config sc;
+            rc_model m = *start;
+            double ssr;
+            po.prior_noise_mm = noise;
+            rch_est_solve_config(&sc, RCH_EST_LM, 0, &po);
+            unsigned p = 0;
+            if (cfg->jumps) {
+                rch_jumps_config jc;
+                memset(&jc, 0, sizeof jc);
+                jc.solve = &sc;
+                if (rch_jumps_find(&cx->ref, start, po.fixed, cx->sorted, h->n_train, &jc, &ws->solve, err,
+                                   sizeof err) != 0) {
+                    rch_diag_set(d, "", 0, 0, "length jumps: %s", err);
+                    return -1;
+                }
+                m = cx->ref.model;
+                for (size_t i = 0; i < h->n_train; ++i)
+                    cx->sorted[i].group = (uint16_t)rch_jumps_segment(&cx->ref, cx->sorted[i].t);
+                p = cx->ref.n_jumps;
+            } else if (rc_solve(&m, NULL, &ws->solve, &sc, h->train, h->n_train) != RC_OK) {
+                rch_diag_set(d, "", 0, 0, "the prior's noise cannot be estimated: the robust LM fails");
+                return -1;
+            }
+            if (rc_cost(&ssr, &m, cfg->jumps ? cx->sorted : h->train, h->n_train) != RC_OK)
+                return -1;
+            for (unsigned k = 0; k < start->n_params; ++k)
+                p += !po.fixed[k];
+            const double dof = (double)h->n_train - (double)p;
+            const double next = dof > 1.0 ? sqrt(ssr / dof) : noise;
+            const int settled = fabs(next - noise) <= 0.02 * noise;
+            noise = next > 1e-6 ? next : 1e-6;
+            if (settled)
+                break;
+        }
+        po.prior_noise_mm = noise;
+        rch_stats_add(&res->noise_mm, noise);
+    }
+    if (cfg->jumps) {
+        rc_solve_config sc;
+        rch_jumps_config jc;
+        rch_est_solve_config(&sc, RCH_EST_LM, 0, &po);
+        memset(&jc, 0, sizeof jc);
+        jc.solve = &sc;
+        if (rch_jumps_find(&cx->ref, start, po.fixed, cx->sorted, h->n_train, &jc, &ws->solve, err, sizeof err) != 0) {
+            rch_diag_set(d, "", 0, 0, "length jumps: %s", err);
+            return -1;
+        }
+        memcpy(cx->lab, h->train, h->n_train * sizeof *cx->lab);
+        for (size_t i = 0; i < h->n_train; ++i)
+            cx->lab[i].group = (uint16_t)rch_jumps_segment(&cx->ref, cx->lab[i].t);
+    }
+    *eo = po; /* the prior (if any) rides along; only the robust LM and LTLM read it */
+    return 0;
+}
+
 /* Case c: BC from the training part, then every selected method from it;
  * one cell per row. */
-static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_est_ws *ws,
+static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_est_ws *ws, case_ctx *cx,
                     const rch_robot *robot, const rch_holdout *h, unsigned long c, FILE *progress, rch_diag *d)
 {
     const unsigned long long cseed = cfg->seed * 1000003ull + c;
@@ -236,7 +418,7 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
     rc_model start;
     rc_metrics trm;
     uint8_t common[RC_MAX_PARAMS];
-    rch_est_opts eo;
+    rch_est_opts eo, eo_prior;
     memset(&eo, 0, sizeof eo);
     if (rch_calib_start(&start, &ws->solve, robot, h->train, h->n_train, d) != 0)
         return -1;
@@ -257,12 +439,16 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
         eo.bound_enc_mm = RCH_COMPARE_COMMON_BOX_MM;
         eo.bound_other = 0.0;
     }
+    eo_prior = eo;
+    if ((cfg->jumps || cfg->prior) && case_setup(cx, res, cfg, ws, robot, &start, &eo_prior, h, d) != 0)
+        return -1;
     if (rc_eval(&cell[0].held_out, &start, h->test, h->n_test) != RC_OK) {
         rch_diag_set(d, "", 0, 0, "the start model cannot be evaluated on the held-out samples");
         return -1;
     }
     cell[0].ok = 1;
     cell[0].train_rmse_mm = rc_eval(&trm, &start, h->train, h->n_train) == RC_OK ? trm.rmse_mm : NAN;
+    param_deltas(&cell[0], &start, &robot->nominal);
     if (first)
         sample_errors(res->err_case1_mm, &start, h->test, h->n_test);
     if (c == 0) {
@@ -271,15 +457,21 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
     }
     if (save && save_row_model(cfg, robot, &start, 0, eo.fixed, h, &cell[0], d) != 0)
         return -1;
-    for (int id = 0; id < RCH_EST_COUNT; ++id) {
+    for (int id = 0; id < RCH_EST_ALL; ++id) {
         rch_compare_cell *e = &cell[id + 1];
-        rc_model m = start;
+        rc_model m = start, geo;
         rch_est_out out;
+        rch_jumps jm;
+        const rch_jumps *jused = NULL;
         if (!cfg->run[id])
             continue;
-        rc_status st = rch_est_run(&m, &out, first ? &res->curve[id] : NULL, ws, (rch_est_id)id, cseed, &eo,
-                                   h->train, h->n_train);
-        if (st != RC_OK || rc_eval(&e->held_out, &m, h->test, h->n_test) != RC_OK) {
+        /* the prior's rows: the robust LM and LTLM (the others ignore the prior, not the gauge: see rch_compare.h) */
+        const rch_est_opts *o = cfg->prior && (id == RCH_EST_LM || id == RCH_EST_LTLM) ? &eo_prior : &eo;
+        rc_status st = run_method(&m, &out, &jm, &jused, first ? &res->curve[id] : NULL, ws, (rch_est_id)id, cseed,
+                                  o, cfg, cx, h);
+        if (st == RC_OK && cfg->jumps)
+            label_test(cx, h, jused);
+        if (st != RC_OK || rc_eval(&e->held_out, &m, cfg->jumps ? cx->test : h->test, h->n_test) != RC_OK) {
             if (progress)
                 fprintf(progress, "rcal compare: case %lu: %s failed: %s\n", c + 1, rch_est_name((rch_est_id)id),
                         rc_strerror(st));
@@ -291,15 +483,20 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
         e->iterations = out.iterations;
         e->cost_evals = out.cost_evals;
         e->n_moved = out.n_moved;
+        e->n_jumps = jused ? jused->n_jumps : 0;
+        param_deltas(e, &m, &robot->nominal);
         if (id == RCH_EST_LTLM)
             add_ltlm(res, &m);
         if (first)
-            sample_errors(res->err_case1_mm + (size_t)(id + 1) * h->n_test, &m, h->test, h->n_test);
+            sample_errors(res->err_case1_mm + (size_t)(id + 1) * h->n_test, &m, cfg->jumps ? cx->test : h->test,
+                          h->n_test);
+        /* the models kept: the geometry (the segment offsets describe this acquisition only) */
+        rch_model_strip_nuisance(&geo, &m);
         if (c == 0) {
-            res->model_case1[id + 1] = m;
+            res->model_case1[id + 1] = geo;
             res->ok_case1[id + 1] = 1;
         }
-        if (save && save_row_model(cfg, robot, &m, id + 1, eo.fixed, h, e, d) != 0)
+        if (save && save_row_model(cfg, robot, &geo, id + 1, eo.fixed, h, e, d) != 0)
             return -1;
     }
     return 0;
@@ -309,7 +506,7 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
 static int case_sizes(rch_compare_result *res, const rch_compare_config *cfg, size_t n, rch_diag *d)
 {
     size_t sel = 0;
-    for (int i = 0; i < RCH_EST_COUNT; ++i)
+    for (int i = 0; i < RCH_EST_ALL; ++i)
         sel += cfg->run[i] != 0;
     if (sel == 0 || cfg->cases < 1 || cfg->cases > RCH_COMPARE_MAX_CASES ||
         !(cfg->test_fraction > 0.0 && cfg->test_fraction < 1.0)) {
@@ -353,16 +550,23 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
     res->rows_in_data = n;
     res->cases = cfg->cases;
     res->params = cfg->params;
+    res->jumps = cfg->jumps;
     if (case_sizes(res, cfg, n, d) != 0)
         return -1;
     int rc = -1;
     size_t *idx = malloc((n ? n : 1) * sizeof *idx);
     rch_est_ws *ws = rch_est_ws_new();
+    case_ctx *cx = calloc(1, sizeof *cx);
+    if (cx) {
+        cx->sorted = malloc((res->n_train ? res->n_train : 1) * sizeof *cx->sorted);
+        cx->lab = malloc((res->n_train ? res->n_train : 1) * sizeof *cx->lab);
+        cx->test = malloc((res->n_test ? res->n_test : 1) * sizeof *cx->test);
+    }
     res->cell = calloc(cfg->cases * RCH_COMPARE_ROWS, sizeof *res->cell);
     res->err_case1_mm = malloc(RCH_COMPARE_ROWS * res->n_test * sizeof(double));
     res->idx_case1 = malloc((res->n_draw ? res->n_draw : 1) * sizeof *res->idx_case1);
     res->model_case1 = malloc(RCH_COMPARE_ROWS * sizeof *res->model_case1);
-    if (!idx || !ws || !res->cell || !res->err_case1_mm || !res->idx_case1 || !res->model_case1) {
+    if (!idx || !ws || !cx || !cx->sorted || !cx->lab || !cx->test || !res->cell || !res->err_case1_mm || !res->idx_case1 || !res->model_case1) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
@@ -371,7 +575,7 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
         goto done;
     }
     res->row[0].used = 1;
-    for (int id = 0; id < RCH_EST_COUNT; ++id)
+    for (int id = 0; id < RCH_EST_ALL; ++id)
         res->row[id + 1].used = cfg->run[id] != 0;
     for (size_t k = 0; k < RCH_COMPARE_ROWS * res->n_test; ++k)
         res->err_case1_mm[k] = NAN;
@@ -384,7 +588,7 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
         }
         if (c == 0)
             memcpy(res->idx_case1, idx, res->n_draw * sizeof *idx);
-        const int st = run_case(res, cfg, ws, robot, &h, c, progress, d);
+        const int st = run_case(res, cfg, ws, cx, robot, &h, c, progress, d);
         rch_holdout_free(&h);
         if (st != 0) {
             char msg[600];
@@ -398,6 +602,12 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
     summarise(res);
     rc = 0;
 done:
+    if (cx) {
+        free(cx->sorted);
+        free(cx->lab);
+        free(cx->test);
+        free(cx);
+    }
     rch_est_ws_free(ws);
     free(idx);
     return rc;
@@ -405,12 +615,16 @@ done:
 
 /* ---- reports ----------------------------------------------------------- */
 
+/* 1 when the rows were fitted with length jumps (some cell used change points, or --jumps ran). */
+static int jumps_any(const rch_compare_result *res) { return res->jumps; }
+
 static void report_rows(FILE *f, const rch_compare_result *res)
 {
     const double lm_time = rch_compare_lm_time_ms(res);
     fprintf(f, "Held-out errors, mean +- std over cases (mm); time of the identification alone (ms, one core)\n");
-    fprintf(f, "  %-6s %-17s %-17s %-17s %-19s %8s %10s %9s %6s\n", "method", "RMSE", "mean|e| (\"SD\")", "MAX",
-            "time (ms)", "x LM", "train RMS", "iters", "moved");
+    fprintf(f, "  %-14s %-17s %-17s %-17s %-19s %8s %10s %9s %6s %9s %9s%s\n", "method", "RMSE", "mean|e| (\"SD\")",
+            "MAX", "time (ms)", "x LM", "train RMS", "iters", "moved", "|dlen|mm", "|dang|deg",
+            jumps_any(res) ? "  jumps" : "");
     for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
         const rch_compare_row *s = &res->row[r];
         char tbuf[64], rbuf[32];
@@ -423,26 +637,30 @@ static void report_rows(FILE *f, const rch_compare_result *res)
             if (isfinite(lm_time) && lm_time > 0)
                 snprintf(rbuf, sizeof rbuf, "%.2f", s->time_ms.mean / lm_time);
         }
-        fprintf(f, "  %-6s %6.4f +- %-7.4f %6.4f +- %-7.4f %6.4f +- %-7.4f %-19s %8s %10.4f %9.0f %6.1f%s\n",
+        char jbuf[32] = "";
+        if (jumps_any(res) && r > 0)
+            snprintf(jbuf, sizeof jbuf, "  %5.1f", s->n_jumps.mean);
+        fprintf(f, "  %-14s %6.4f +- %-7.4f %6.4f +- %-7.4f %6.4f +- %-7.4f %-19s %8s %10.4f %9.0f %6.1f %9.2f %9.2f%s%s\n",
                 rch_compare_row_name(r), s->rmse_mm.mean, rch_stats_sd(&s->rmse_mm), s->mean_abs_mm.mean,
                 rch_stats_sd(&s->mean_abs_mm), s->max_mm.mean, rch_stats_sd(&s->max_mm), tbuf, rbuf,
                 s->train_rmse_mm.mean, r == 0 ? 0.0 : s->iterations.mean, r == 0 ? 0.0 : s->n_moved.mean,
-                s->failed ? "  (failed in some cases)" : "");
+                s->dlen_max_mm.mean, s->dang_max_deg.mean, jbuf, s->failed ? "  (failed in some cases)" : "");
     }
     fprintf(f, "  (BC: nominal DH with the encoder fitted alone; mean|e| is what the paper's Eq. 20 calls SD;\n"
-               "   moved: parameters the method moved, for LM/LTLM the rank they found among those they may move)\n");
+               "   moved: parameters the method moved, for LM/LTLM the rank they found among those they may move;\n"
+               "   |dlen|, |dang|: the largest change of a DH length / angle from nominal, mean over the cases (the\n"
+               "   paper's Table 7 size); *-paper: the paper's Eq. 10 (mu = 5, no acceptance) and Algorithm I on it,\n"
+               "   -deg with the angles in degrees inside Eq. 10; jumps: change points the fit used, mean)\n");
     /* The paper's Table 6 (Liu et al. 2024), as published, beside ours. */
-    static const double paper[RCH_COMPARE_ROWS][3] = {{2.18, 2.01, 3.42}, {0.36, 0.30, 0.91}, {0.63, 0.51, 1.52},
-                                                      {0.73, 0.61, 1.77}, {0.82, 0.66, 1.96}, {0.50, 0.40, 1.31},
-                                                      {0.34, 0.28, 0.85}, {0.32, 0.26, 0.83}};
     fprintf(f, "\nThe paper's Table 6 beside ours (mm; the paper's SD is its Eq. 20, our mean|e|):\n");
-    fprintf(f, "  %-6s %22s %22s %22s\n", "method", "RMSE paper / ours", "SD paper / ours", "MAX paper / ours");
+    fprintf(f, "  %-14s %22s %22s %22s\n", "method", "RMSE paper / ours", "SD paper / ours", "MAX paper / ours");
     for (int r = 0; r < RCH_COMPARE_ROWS; ++r) {
         const rch_compare_row *s = &res->row[r];
         if (!s->used)
             continue;
-        fprintf(f, "  %-6s %12.2f / %-7.3f %12.2f / %-7.3f %12.2f / %-7.3f\n", rch_compare_row_name(r), paper[r][0],
-                s->rmse_mm.mean, paper[r][1], s->mean_abs_mm.mean, paper[r][2], s->max_mm.mean);
+        const double *paper = rch_compare_table6[r == 0 ? 0 : rch_est_paper_row((rch_est_id)(r - 1))];
+        fprintf(f, "  %-14s %12.2f / %-7.3f %12.2f / %-7.3f %12.2f / %-7.3f\n", rch_compare_row_name(r), paper[0],
+                s->rmse_mm.mean, paper[1], s->mean_abs_mm.mean, paper[2], s->max_mm.mean);
     }
 }
 
@@ -478,6 +696,14 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
         fprintf(f, "parameter set: paper -- LM and LTLM move all %u parameters (own truncation), the other five\n"
                    "  an identifiable subset; the population methods search +-2 mm / +-0.2 deg / encoder +-5 mm\n",
                 res->n_params);
+    if (cfg->jumps || cfg->prior)
+        fprintf(f, "nuisance and prior:%s%s\n",
+                cfg->jumps ? " length jumps fitted with every method (rc_solve methods: their own jump search; "
+                             "EKF..SSLM: the robust LM's change points, offsets their own);" : "",
+                cfg->prior ? " LM and LTLM maximum a posteriori with the physical prior (gauge theta1, d1 held)" : "");
+    if (cfg->prior)
+        fprintf(f, "  prior weighed against a residual sd of %.4f +- %.4f mm (over the cases)\n", res->noise_mm.mean,
+                rch_stats_sd(&res->noise_mm));
     report_rows(f, res);
     if (res->n_ltlm > 0)
         report_ltlm(f, res);
@@ -506,7 +732,12 @@ static void json_row(rch_jw *w, const rch_compare_result *res, int r)
         rch_jw_numf(w, "iterations", s->iterations.mean, "%.1f");
         rch_jw_numf(w, "cost_evals", s->cost_evals.mean, "%.0f");
         rch_jw_uint(w, "cases_failed", s->failed);
+        rch_jw_int(w, "paper_row", rch_est_paper_row((rch_est_id)(r - 1)));
+        if (res->jumps)
+            rch_jw_numf(w, "jumps", s->n_jumps.mean, "%.2f");
     }
+    rch_jw_numf(w, "max_dlen_mm", s->dlen_max_mm.mean, "%.5f");
+    rch_jw_numf(w, "max_dang_deg", s->dang_max_deg.mean, "%.5f");
     rch_jw_end(w);
 }
 
@@ -548,6 +779,22 @@ int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_c
     rch_jw_numf(&w, "test_fraction", cfg->test_fraction, "%.6g");
     rch_jw_uint(&w, "seed", cfg->seed);
     rch_jw_str(&w, "params", rch_compare_params_name(res->params));
+    rch_jw_bool(&w, "jumps", cfg->jumps != 0);
+    rch_jw_bool(&w, "prior", cfg->prior != 0);
+    if (cfg->prior)
+        rch_jw_numf(&w, "prior_noise_mm", res->noise_mm.mean, "%.6f");
+    /* the paper's Table 6 as published: BC and M1..M7 */
+    rch_jw_arr(&w, "paper_table6");
+    for (int r = 0; r < 8; ++r) {
+        static const char *const names[8] = {"BC", "M1 LM", "M2 EKF", "M3 PF", "M4 SCA", "M5 QIBAS", "M6 SSLM", "M7 LTLM"};
+        rch_jw_obj(&w, NULL);
+        rch_jw_str(&w, "name", names[r]);
+        rch_jw_numf(&w, "rmse_mm", rch_compare_table6[r][0], "%.2f");
+        rch_jw_numf(&w, "sd_mm", rch_compare_table6[r][1], "%.2f");
+        rch_jw_numf(&w, "max_mm", rch_compare_table6[r][2], "%.2f");
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
     rch_jw_arr(&w, "methods");
     for (int r = 0; r < RCH_COMPARE_ROWS; ++r)
         if (res->row[r].used)
@@ -577,7 +824,7 @@ int rch_compare_json(FILE *f, const rch_compare_result *res, const rch_compare_c
 static int write_curves_csv(FILE *f, const rch_compare_result *res, const rch_compare_config *cfg)
 {
     fprintf(f, "method,iteration,train_rmse_mm\n");
-    for (int id = 0; id < RCH_EST_COUNT; ++id)
+    for (int id = 0; id < RCH_EST_ALL; ++id)
         if (cfg->run[id])
             for (size_t k = 0; k < res->curve[id].n; ++k)
                 fprintf(f, "%s,%zu,%.9g\n", rch_est_name((rch_est_id)id), k, res->curve[id].rms_mm[k]);
@@ -612,7 +859,7 @@ static rch_plot *plot_convergence(const rch_compare_result *res, const rch_compa
     rch_plot *p = rch_plot_new(zoom ? "Training RMS length error per iteration, first 60 iterations (case 1)"
                                     : "Training RMS length error per iteration of each method (case 1)",
                                "iteration (count)", "training RMS length error (mm)");
-    for (int id = 0; id < RCH_EST_COUNT; ++id)
+    for (int id = 0; id < RCH_EST_ALL; ++id)
         if (cfg->run[id] && res->curve[id].n > 0)
             plot_indexed(p, rch_est_name((rch_est_id)id), res->curve[id].rms_mm, res->curve[id].n, 0.0);
     rch_plot_logy(p, 1);

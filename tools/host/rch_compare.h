@@ -61,7 +61,11 @@ typedef enum rch_compare_params { RCH_PARAMS_PAPER = 0, RCH_PARAMS_COMMON = 1 } 
 const char *rch_compare_params_name(rch_compare_params p);
 
 /* Rows of the result: 0 = BC (the start model), id + 1 = method id. */
-enum { RCH_COMPARE_ROWS = RCH_EST_COUNT + 1 };
+enum { RCH_COMPARE_ROWS = RCH_EST_ALL + 1 };
+
+/* The paper's Table 6 (Liu et al. 2024) as published: RMSE, "SD" (its Eq. 20,
+ * our mean|e|) and MAX in mm of BC (row 0) and M1..M7 (rows 1..7). */
+extern const double rch_compare_table6[8][3];
 
 #define RCH_COMPARE_MAX_CASES 10000ul
 /* cases x rows drawn x methods at most (the cost of a comparison) */
@@ -72,17 +76,35 @@ typedef struct rch_compare_config {
     size_t samples;           /* rows drawn per case, <= rows in the data; 0: every row */
     double test_fraction;     /* share held out, in (0, 1) */
     unsigned long long seed;  /* case c uses seed * 1000003 + c */
-    int run[RCH_EST_COUNT];   /* 1: run method id; at least one */
+    int run[RCH_EST_ALL];     /* 1: run method id; at least one (the paper variants: --literal) */
     int curves;               /* 1: keep case 1's convergence curves and per-sample errors (plots) */
     rch_compare_params params; /* the methods' parameter set (above) */
     const char *models_dir;   /* non-NULL: case 1's model of every row written here (rch_compare_model_file
                                  names), rcal-model/2 through rch_robot_write, never over one of inputs */
     const char *const *inputs; /* (n_inputs) the command's input files (NULL entries skipped) */
     size_t n_inputs;
+    /* Nuisance, with every method (rcal compare --jumps). 1: length jumps
+     * at change points in acquisition order are fitted on each case's
+     * training rows: an rc_solve method (LM, LTLM and the paper variants)
+     * runs the jump search itself with its own configuration
+     * (rch_jumps_config.solve); the rc_est methods (EKF .. SSLM), which
+     * cannot run the search, get the change points the robust LM's search
+     * found in that case and fit the segment offsets themselves with the
+     * geometry (start 0, the first segment the reference). Held-out rows are
+     * placed in their segment by acquisition time; the geometry alone is
+     * what the models (--models, --residuals) keep. */
+    int jumps;
+    /* 1: the robust LM and LTLM are maximum a posteriori with the robot's
+     * physical prior (rch_prior_fill, gauge theta1 and d1 held: rch_prior_gauge),
+     * noise re-estimated per case from the robust LM's fit, SSR / (n - p),
+     * until it settles (2 %, at most 4 fits). The paper variants and the
+     * rc_est methods ignore it. */
+    int prior;
 } rch_compare_config;
 
 /* File name of row r's model in models_dir: "BC.json", "M1-LM.json", ...,
- * "M7-LTLM.json" (the order rcal grind --models reads them in). */
+ * "M7-LTLM.json", then "M1-LM-paper.json" .. "M7-LTLM-paper-deg.json" (the
+ * order rcal grind --models reads them in). */
 void rch_compare_model_file(char *buf, size_t len, int row);
 /* The model files of M1..M7 (not BC) that exist in dir, in row order:
  * paths[k] the file, names[k] its row label ("M1 LM"). Returns how many. */
@@ -94,7 +116,7 @@ void rch_compare_defaults(rch_compare_config *cfg);
 
 /* "LM,EKF,m7" (rch_est_parse names, comma separated) into run[]. An empty
  * list, an empty name or an unknown name is refused: -1 with d set. */
-int rch_compare_methods(int run[RCH_EST_COUNT], const char *list, rch_diag *d);
+int rch_compare_methods(int run[RCH_EST_ALL], const char *list, rch_diag *d);
 
 /* One row (BC or a method) in one case. */
 typedef struct rch_compare_cell {
@@ -104,6 +126,9 @@ typedef struct rch_compare_cell {
     double time_ms;           /* the identification alone (methods only) */
     unsigned iterations, cost_evals; /* methods only */
     unsigned n_moved;         /* parameters the method moved (LM/LTLM: the rank it found among them) */
+    double dlen_max_mm;       /* largest |a_i, d_i - nominal| of the model (the paper's Table 7 size) */
+    double dang_max_deg;      /* largest |alpha_i, theta_i - nominal| (theta1, whose nominal is the gauge, included) */
+    unsigned n_jumps;         /* --jumps: the change points the model was fitted with */
 } rch_compare_cell;
 
 /* Statistics of one row over the cases where it succeeded. */
@@ -114,6 +139,8 @@ typedef struct rch_compare_row {
     rch_stats train_rmse_mm;                /* training RMS at the end */
     rch_stats time_ms, iterations, cost_evals; /* methods only (BC: empty) */
     rch_stats n_moved;                         /* parameters moved (LM/LTLM: rank) */
+    rch_stats dlen_max_mm, dang_max_deg;       /* the cells' largest parameter changes (BC: 0) */
+    rch_stats n_jumps;                         /* --jumps */
 } rch_compare_row;
 
 typedef struct rch_compare_result {
@@ -121,6 +148,7 @@ typedef struct rch_compare_result {
     unsigned long cases;
     size_t n_draw, n_train, n_test;
     rch_compare_params params;
+    int jumps;              /* cfg.jumps */
     rch_stats n_common;     /* COMMON: size of the common set over the cases */
     unsigned n_params;      /* parameters of the model */
     rch_compare_row row[RCH_COMPARE_ROWS];
@@ -131,7 +159,8 @@ typedef struct rch_compare_result {
     rch_stats ltlm_dh[RC_NJ][4];
     rch_stats ltlm_enc_mm[3];
     /* with cfg.curves: case 1 only */
-    rch_curve curve[RCH_EST_COUNT];  /* training RMS per iteration of each method run */
+    rch_curve curve[RCH_EST_ALL];    /* training RMS per iteration of each method run */
+    rch_stats noise_mm;              /* --prior: the noise the prior was weighed against, over the cases */
     double *err_case1_mm;            /* (RCH_COMPARE_ROWS x n_test) model - measured length; NaN where absent */
     /* always, for --residuals (rch_resid.h): case 1's data rows and models */
     size_t *idx_case1;               /* (n_draw) indices into s: the n_test held out first, then training */
@@ -146,7 +175,7 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
                     const rc_sample *s, size_t n, FILE *progress, rch_diag *d);
 void rch_compare_free(rch_compare_result *res);
 
-/* "BC", "LM", ..., "LTLM". */
+/* "BC", "LM", ..., "LTLM", "LM-paper", ..., "LTLM-paper-deg". */
 const char *rch_compare_row_name(int row);
 /* Mean identification time of LM (NaN when LM was not run or has no time). */
 double rch_compare_lm_time_ms(const rch_compare_result *res);

@@ -10,12 +10,46 @@
 #include <string.h>
 #include <time.h>
 
-static const char *const est_names[RCH_EST_COUNT] = {"LM",    "EKF",  "PF",  "SCA",
-                                                     "QIBAS", "SSLM", "LTLM"};
+static const char *const est_names[RCH_EST_ALL] = {"LM",       "EKF",          "PF",         "SCA",
+                                                   "QIBAS",    "SSLM",         "LTLM",       "LM-paper",
+                                                   "LM-paper-deg", "LTLM-paper", "LTLM-paper-deg"};
 
 const char *rch_est_name(rch_est_id id)
 {
-    return (unsigned)id < RCH_EST_COUNT ? est_names[id] : "unknown";
+    return (unsigned)id < RCH_EST_ALL ? est_names[id] : "unknown";
+}
+
+int rch_est_paper_row(rch_est_id id)
+{
+    if ((unsigned)id < RCH_EST_COUNT)
+        return (int)id + 1;
+    return id == RCH_EST_LM_PAPER || id == RCH_EST_LM_PAPER_DEG ? 1 : 7;
+}
+
+int rch_est_is_solve(rch_est_id id)
+{
+    return id == RCH_EST_LM || id == RCH_EST_LTLM || ((unsigned)id >= RCH_EST_COUNT && (unsigned)id < RCH_EST_ALL);
+}
+
+void rch_est_solve_config(rc_solve_config *cfg, rch_est_id id, uint64_t seed, const rch_est_opts *opts)
+{
+    static const rc_method mt[RCH_EST_ALL] = {RC_METHOD_LM,         RC_METHOD_LM,           RC_METHOD_LM,
+                                              RC_METHOD_LM,         RC_METHOD_LM,           RC_METHOD_LM,
+                                              RC_METHOD_LTLM,       RC_METHOD_LM_PAPER,     RC_METHOD_LM_PAPER_DEG,
+                                              RC_METHOD_LTLM_PAPER, RC_METHOD_LTLM_PAPER_DEG};
+    static const rch_est_opts defaults;
+    if (!opts)
+        opts = &defaults;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->method = (unsigned)id < RCH_EST_ALL ? mt[id] : RC_METHOD_LM;
+    cfg->max_iter = opts->max_iter;
+    cfg->seed = seed;
+    cfg->fixed = opts->fixed;
+    if (id == RCH_EST_LM || id == RCH_EST_LTLM) { /* the paper variants ignore a prior */
+        cfg->prior_mean = opts->prior_mean;
+        cfg->prior_sd = opts->prior_sd;
+        cfg->prior_noise_mm = opts->prior_noise_mm;
+    }
 }
 
 static int ieq(const char *a, const char *b)
@@ -30,9 +64,9 @@ int rch_est_parse(const char *name)
 {
     if (!name)
         return -1;
-    for (int i = 0; i < RCH_EST_COUNT; ++i) {
+    for (int i = 0; i < RCH_EST_ALL; ++i) {
         char m[4] = {'m', (char)('1' + i), 0, 0};
-        if (ieq(name, est_names[i]) || ieq(name, m))
+        if (ieq(name, est_names[i]) || (i < RCH_EST_COUNT && ieq(name, m)))
             return i;
     }
     return -1;
@@ -97,14 +131,10 @@ rc_status rch_est_run(rc_model *m, rch_est_out *out, rch_curve *curve, rch_est_w
         if (rc_cost(&c0, m, train, n) == RC_OK && n > 0)
             curve_push(curve, sqrt(c0 / (double)n));
     }
-    if (id == RCH_EST_LM || id == RCH_EST_LTLM) {
+    if (rch_est_is_solve(id)) {
         rc_solve_config cfg;
         rc_solve_result res;
-        memset(&cfg, 0, sizeof cfg);
-        cfg.method = id == RCH_EST_LM ? RC_METHOD_LM : RC_METHOD_LTLM;
-        cfg.max_iter = opts->max_iter;
-        cfg.seed = seed;
-        cfg.fixed = opts->fixed;
+        rch_est_solve_config(&cfg, id, seed, opts);
         cfg.on_iter = curve ? curve_cb : NULL;
         cfg.cb_ctx = curve;
         t0 = now_ms();
@@ -114,7 +144,7 @@ rc_status rch_est_run(rc_model *m, rch_est_out *out, rch_curve *curve, rch_est_w
         out->cost_evals = res.cost_evals;
         out->rms_start_mm = res.rms_start_mm;
         out->rms_final_mm = res.rms_final_mm;
-        out->n_moved = res.rank;
+        out->n_moved = res.rank ? res.rank : res.n_free; /* the paper variants move every free parameter */
         return st;
     }
     {

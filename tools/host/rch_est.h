@@ -33,13 +33,26 @@ typedef enum rch_est_id {
     RCH_EST_QIBAS = 4,
     RCH_EST_SSLM = 5,
     RCH_EST_LTLM = 6,
-    RCH_EST_COUNT = 7
+    RCH_EST_COUNT = 7,
+    /* The paper's own M1 and M7 (rc_solve's paper variants: Eq. 10 with
+     * mu = 5 and no acceptance; Algorithm I on it), angles in rad or in deg
+     * inside Eq. 10 (rcal compare --literal). */
+    RCH_EST_LM_PAPER = 7,
+    RCH_EST_LM_PAPER_DEG = 8,
+    RCH_EST_LTLM_PAPER = 9,
+    RCH_EST_LTLM_PAPER_DEG = 10,
+    RCH_EST_ALL = 11
 } rch_est_id;
 
-/* "LM", "EKF", "PF", "SCA", "QIBAS", "SSLM", "LTLM" (the paper's names). */
+/* "LM", "EKF", "PF", "SCA", "QIBAS", "SSLM", "LTLM" (the paper's names),
+ * "LM-paper", "LM-paper-deg", "LTLM-paper", "LTLM-paper-deg". */
 const char *rch_est_name(rch_est_id id);
-/* Case-insensitive name (or "m1".."m7") to id; -1 when unknown. */
+/* Case-insensitive name (or "m1".."m7" for the seven) to id; -1 when unknown. */
 int rch_est_parse(const char *name);
+/* The paper's method number of id: 1..7 (the paper variants: 1 for LM, 7 for LTLM). */
+int rch_est_paper_row(rch_est_id id);
+/* 1: id is one of rc_solve's methods (LM, LTLM and the paper variants). */
+int rch_est_is_solve(rch_est_id id);
 
 /* Training RMS per iteration; rms_mm[0] is the start. */
 typedef struct rch_curve {
@@ -70,7 +83,17 @@ typedef struct rch_est_opts {
      * their own), so that all seven methods work on one set. */
     const uint8_t *fixed;
     int same_set;
+    /* A Gaussian prior for the robust LM and LTLM (rc_solve_config's
+     * prior_mean, prior_sd, prior_noise_mm; the arrays cover the model's
+     * parameters): maximum a posteriori. NULL: least squares. The paper
+     * variants and the rc_est methods ignore it. */
+    const double *prior_mean, *prior_sd;
+    double prior_noise_mm;
 } rch_est_opts;
+
+/* The rc_solve configuration rch_est_run uses for an rc_solve method id
+ * (rch_est_is_solve), without callbacks: for the jump search (rch_jumps). */
+void rch_est_solve_config(rc_solve_config *cfg, rch_est_id id, uint64_t seed, const rch_est_opts *opts);
 
 typedef struct rch_est_out {
     double time_ms;        /* wall time of the identification alone (CLOCK_MONOTONIC) */
