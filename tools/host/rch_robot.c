@@ -285,6 +285,12 @@ static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name,
     }
     out->unc.orientation_determined = od && od->type == RCH_JBOOL && od->num != 0.0;
     out->unc.sigma_mm = sg && sg->type == RCH_JNUM ? sg->num : NAN;
+    const rch_json *po = rch_json_get(u, "posterior");
+    if (po && po->type != RCH_JBOOL) {
+        rch_diag_set(d, name, po->line, po->col, "\"posterior\" must be true or false");
+        return -1;
+    }
+    out->unc.has_prior = po && po->num != 0.0;
     out->unc.n = out->model.n_params;
     out->unc.present = 1;
     return 0;
@@ -448,6 +454,10 @@ void rch_robot_write_unc_params(rch_jw *w, const rc_model *m, const rch_model_un
         rch_jw_numf(w, "std_error", u->se[k] * sc, "%.6g"); /* NaN -> null */
         rch_jw_str(w, "class", rch_param_class_name((rch_param_class)u->cls[k]));
         rch_jw_str(w, "compensation", k < RC_N_DH ? (u->comp_nominal[k] ? "nominal" : "fitted") : "not used");
+        if (u->has_prior && u->prior_sd[k] > 0.0) {
+            rch_jw_numf(w, "prior_sd", u->prior_sd[k] * sc, "%.6g");
+            rch_jw_str(w, "data_vs_prior", rch_prior_class_name((rch_prior_class)u->prior_cls[k]));
+        }
         rch_jw_end(w);
     }
     rch_jw_end(w);
@@ -460,6 +470,7 @@ static void write_uncertainty(rch_jw *w, const rc_model *m, const rch_model_unc 
     rch_jw_uint(w, "groups", u->n_groups);
     rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
     rch_jw_uint(w, "rank", u->rank);
+    rch_jw_bool(w, "posterior", u->has_prior); /* the covariance of a MAP fit: prior-only directions included */
     rch_robot_write_unc_params(w, m, u, "%.12g");
     rch_jw_arr(w, "covariance_dh");
     for (unsigned k = 0; k < RC_N_DH * RC_N_DH; ++k)
