@@ -168,7 +168,7 @@ int rcal_cmd_compensate(int argc, char **argv)
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
     int position_only = 0, full_pose = 0, want_summary = 0, accept_rt = 0, json = 0;
-    double max_unc_mm = 1.0, tool[3] = {0.0, 0.0, 0.0};
+    double max_unc_mm = 0.0, tool[3] = {0.0, 0.0, 0.0};
     const char *unc_out = NULL;
     rch_cmdspec spec;
     const rch_opt opts[] = {
@@ -194,9 +194,10 @@ int rcal_cmd_compensate(int argc, char **argv)
          "match position and orientation even when the model file says the data did not determine the "
          "orientation (default: full pose only when it did)",
          0, NULL},
-        {"--max-uncertainty-mm", RCH_OPT_DOUBLE, &max_unc_mm, 0.001, 1000.0, "MM",
-         "leave a target uncompensated (with a warning) where the model's 95 % position uncertainty is larger", 0,
-         NULL},
+        {"--max-uncertainty-mm", RCH_OPT_DOUBLE, &max_unc_mm, 0.0, 1000.0, "MM",
+         "leave a target uncompensated (with a warning) where the model's 95 % position uncertainty is larger "
+         "(0: no limit for a model with a posterior, whose compensation never widens the error; 1 mm for one "
+         "without)", 0, NULL},
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
          "RAPID robtargets (Cartesian) are copied uncorrected, each with a warning; with this flag that is not a "

@@ -173,7 +173,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
     const char *inputs[2] = {data_path, robot_path};
     int rc = report(&r, plots, inputs, json, argc, argv);
     if (rc == 0 && out_path) {
-        if (rch_diagnose_save_model(&r, robot_path, out_path, inputs, 2, &d) != 0) {
+        if (rch_diagnose_save_model(&r, data_path, robot_path, out_path, inputs, 2, &d) != 0) {
             fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
             rc = 1;
         } else if (!json) {

@@ -121,7 +121,12 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
                                                  : rch_model_unc_pos95_mm(c->gate->unc, m, qd);
             if (c->gate->u95_out)
                 fprintf(c->gate->u95_out, "%u,%.6f\n", line, u95);
-            double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm : 1.0;
+            /* A posterior (MAP) model: compensation never makes the expected
+             * error larger than the uncompensated target's (the posterior is
+             * never wider than the prior the nominal model stands for), so
+             * there is no limit unless the user sets one. A model without
+             * (least squares): 1 mm, its covariance leaves out what it held. */
+            double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm : c->gate->unc->has_prior ? INFINITY : 1.0;
             if (!(u95 <= lim)) {
                 for (unsigned i = 0; i < RC_NJ; ++i)
                     out_deg[i] = in_deg[i];

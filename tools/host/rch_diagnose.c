@@ -1741,27 +1741,42 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
     return rch_jw_finish(&w);
 }
 
-typedef struct {
-    const rc_model *m, *nominal;
-    const char *name;
-} save_ctx;
-
-static int save_fn(FILE *f, const void *arg)
+int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
+                            const char *path, const char *const *inputs, size_t n_inputs, rch_diag *d)
 {
-    const save_ctx *c = arg;
-    return rch_robot_write(f, c->name, c->m, c->nominal, NULL);
-}
-
-int rch_diagnose_save_model(const rch_diagnose_result *r, const char *robot_path, const char *path,
-                            const char *const *inputs, size_t n_inputs, rch_diag *d)
-{
-    static rch_robot robot;
-    if (rch_robot_load(&robot, robot_path, d) != 0)
+    (void)inputs;
+    (void)n_inputs; /* rch_calib_save_model refuses the data and the robot file itself */
+    /* the chosen effects as --effects names them */
+    char list[512] = "";
+    size_t pos = 0;
+    for (unsigned e = 0; e < r->final.n_effects && pos < sizeof list; ++e) {
+        const rc_effect *ef = &r->final.effects[e];
+        const rc_effect_desc *ds = rc_effect_describe(ef->kind);
+        if (!ds || ds->nuisance || !ds->user || ef->kind == RC_EFF_TOOL_OFFSET)
+            continue;
+        if (ds->arg == RC_EFF_ARG_JOINT)
+            pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s:%u", pos ? "," : "", ds->name, ef->joint + 1u);
+        else if (ds->arg == RC_EFF_ARG_PERIOD)
+            pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s:%.6g", pos ? "," : "", ds->name,
+                                    fabs(r->final.x[ef->first + 2]));
+        else
+            pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s", pos ? "," : "", ds->name);
+    }
+    static rch_calib_result cr;
+    rch_calib_cfg cfg;
+    rch_calib_cfg_init(&cfg);
+    cfg.data_path = data_path;
+    cfg.robot_path = robot_path;
+    cfg.test_fraction = 0.0;
+    cfg.effects = list[0] ? list : NULL;
+    cfg.jumps = strcmp(r->effect, "length_jump") == 0;
+    const int rc = rch_calib_run(&cr, &cfg, d);
+    if (rc != 0)
         return -1;
-    rc_model m;
-    rch_model_strip_nuisance(&m, &r->final);
-    memcpy(m.q_min_rad, robot.model.q_min_rad, sizeof m.q_min_rad);
-    memcpy(m.q_max_rad, robot.model.q_max_rad, sizeof m.q_max_rad);
-    const save_ctx c = {&m, &robot.nominal, robot.name};
-    return rch_save(path, "--out", inputs, n_inputs, save_fn, &c, d);
+    if (!cr.after_ok) {
+        rch_diag_set(d, path, 0, 0, "the model with the diagnosed effects (%s) did not fit: not written",
+                     list[0] ? list : "none");
+        return -1;
+    }
+    return rch_calib_save_model(&cr, path, d);
 }

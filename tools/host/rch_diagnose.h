@@ -200,12 +200,15 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
 
 void rch_diagnose_free(rch_diagnose_result *r);
 
-/* The calibrated model with the effects the diagnosis chose (r->final), its
- * nuisance effects (group offsets, time drift; length jumps are never in it)
- * left out, as a model file at path (rch_save: whole or not at all, never
- * over one of inputs). robot_path: the nominal robot (its name and nominal
- * table). 0, or -1 with d set. */
-int rch_diagnose_save_model(const rch_diagnose_result *r, const char *robot_path, const char *path,
+/* The calibrated model with the effects the diagnosis chose, fitted as
+ * `rcal calibrate --effects LIST` fits it (the one pipeline: maximum a
+ * posteriori with the physical prior, the attachment decided by the data,
+ * length jumps fitted as nuisance when the verdict is length_jump or the
+ * default jump check finds them, every sample used), as a model file at path
+ * with its posterior (rch_save: whole or not at all, never over one of
+ * inputs). data_path: the diagnosed data; robot_path: the nominal robot.
+ * 0, or -1 with d set. */
+int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path, const char *path,
                             const char *const *inputs, size_t n_inputs, rch_diag *d);
 
 /* Human report and one JSON object. 0 or -1 on a write error. */

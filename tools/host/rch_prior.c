@@ -36,10 +36,17 @@ void rch_prior_fill(double *mean, double *sd, const rc_model *m, const rc_model 
     }
     for (unsigned e = 0; e < m->n_effects; ++e) {
         const rc_effect *ef = &m->effects[e];
-        if (ef->kind != RC_EFF_TOOL_OFFSET)
-            continue;
-        for (unsigned k = 0; k < ef->count; ++k)
-            sd[ef->first + k] = p->attachment_mm;
+        const rc_effect_desc *ds = rc_effect_describe(ef->kind);
+        if (ef->kind == RC_EFF_TOOL_OFFSET) {
+            for (unsigned k = 0; k < ef->count; ++k)
+                sd[ef->first + k] = p->attachment_mm;
+        } else if (ds && !ds->nuisance && ds->side != RC_SIDE_OUTLET) {
+            /* a physical effect: its plausible range (the table's limit) as
+             * 3 sd about its start value, so that a fit cannot trade it into
+             * something no sensor or joint does (a 31 m "drum period") */
+            for (unsigned k = 0; k < ef->count; ++k)
+                sd[ef->first + k] = ds->limit / 3.0;
+        }
     }
 }
 

@@ -23,8 +23,10 @@
  *   attachment_mm  100   the cable attachment point in the flange frame (the
  *                         measured point): a fixture of the user's, known only
  *                         roughly; centred on the start value (0 or the robot file's)
- * The encoder outlet and the nuisance effects (length jumps, offsets, drift)
- * have no prior: the data place them.
+ * Every other physical effect (length scale, sag, joint compliance, ...):
+ * its plausible range from the effect table (rc_effect_desc.limit) as 3 sd
+ * about its start value. The encoder outlets and the nuisance effects
+ * (length jumps, group offsets, drift) have no prior: the data place them.
  *
  * Gauge. Lengths from one outlet cannot see a rigid motion of the robot
  * about the outlet; in the robot's frame that is the base heading theta1 and
