@@ -1,7 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include "rch_robot.h"
 
-#include <stddef.h>
 #include <math.h>
 #include <string.h>
 
@@ -300,15 +299,15 @@ static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name,
  * optional, positive and physical; defaults for the rest (rch_prior.h). */
 static int read_prior(rch_prior_cfg *p, const rch_json *pr, const char *name, rch_diag *d)
 {
-    static const struct {
-        const char *key;
-        size_t off;
-        double max;
-    } keys[] = {{"length_mm", offsetof(rch_prior_cfg, length_mm), 100.0},
-                {"twist_deg", offsetof(rch_prior_cfg, twist_deg), 10.0},
-                {"offset_deg", offsetof(rch_prior_cfg, offset_deg), 30.0},
-                {"attachment_mm", offsetof(rch_prior_cfg, attachment_mm), 2000.0}};
     rch_prior_defaults(p);
+    const struct {
+        const char *key;
+        double *dst;
+        double max;
+    } keys[] = {{"length_mm", &p->length_mm, 100.0},
+                {"twist_deg", &p->twist_deg, 10.0},
+                {"offset_deg", &p->offset_deg, 30.0},
+                {"attachment_mm", &p->attachment_mm, 2000.0}};
     if (!pr)
         return 0;
     if (pr->type != RCH_JOBJ) {
@@ -332,7 +331,7 @@ static int read_prior(rch_prior_cfg *p, const rch_json *pr, const char *name, rc
                          "prior %s = %g must be a standard deviation in (0, %g]", keys[k].key, v, keys[k].max);
             return -1;
         }
-        *(double *)((char *)p + keys[k].off) = v;
+        *keys[k].dst = v;
     }
     p->from_file = 1;
     return 0;
