@@ -528,7 +528,8 @@ static double effective_params(const rc_model *m, const rc_solve_config *cfg, co
     for (unsigned k = 0; k < m->n_params; ++k)
         if (!cfg->fixed || !cfg->fixed[k])
             idx[nf++] = (uint16_t)k;
-    double *A = malloc((size_t)nf * nf * sizeof *A), *H = malloc((size_t)nf * nf * sizeof *H);
+    const size_t nn = nf ? (size_t)nf * nf : 1u;
+    double *A = malloc(nn * sizeof *A), *H = malloc(nn * sizeof *H);
     double g[RC_MAX_PARAMS], jrow[RC_MAX_PARAMS], cost, pe = (double)nf;
     if (A && H && rc_normal_eq(A, g, &cost, jrow, m, idx, nf, s, n) == RC_OK) {
         memcpy(H, A, (size_t)nf * nf * sizeof *H);

@@ -563,7 +563,7 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
         cx->test = malloc((res->n_test ? res->n_test : 1) * sizeof *cx->test);
     }
     res->cell = calloc(cfg->cases * RCH_COMPARE_ROWS, sizeof *res->cell);
-    res->err_case1_mm = malloc(RCH_COMPARE_ROWS * res->n_test * sizeof(double));
+    res->err_case1_mm = malloc(RCH_COMPARE_ROWS * (res->n_test ? res->n_test : 1) * sizeof(double));
     res->idx_case1 = malloc((res->n_draw ? res->n_draw : 1) * sizeof *res->idx_case1);
     res->model_case1 = malloc(RCH_COMPARE_ROWS * sizeof *res->model_case1);
     if (!idx || !ws || !cx || !cx->sorted || !cx->lab || !cx->test || !res->cell || !res->err_case1_mm || !res->idx_case1 || !res->model_case1) {

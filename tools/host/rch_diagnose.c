@@ -259,7 +259,7 @@ static unsigned structure_tests(rch_diagnose_test *out, const double *r, const r
 {
     const unsigned n_tests = 12 + groups_usable(n_groups, n);
     const double a_each = alpha / n_tests;
-    double *X = malloc(n * MAXREG * sizeof *X);
+    double *X = malloc((n ? n : 1) * MAXREG * sizeof *X);
     unsigned k = 0;
     if (!X)
         return 0;

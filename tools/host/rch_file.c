@@ -123,15 +123,17 @@ void rch_tmp_forget(const char *path)
 static int resolve_links(char *out, size_t cap, const char *path)
 {
     char cur[RCH_KEY_MAX], link[RCH_KEY_MAX];
-    if (strlen(path) >= sizeof cur)
+    const size_t pl = strlen(path);
+    if (pl >= sizeof cur)
         return -1;
-    strcpy(cur, path);
+    memcpy(cur, path, pl + 1);
     for (int hop = 0; hop < 40; ++hop) {
         struct stat st;
         if (lstat(cur, &st) != 0 || !S_ISLNK(st.st_mode)) {
-            if (strlen(cur) >= cap)
+            const size_t cl = strlen(cur);
+            if (cl >= cap)
                 return -1;
-            strcpy(out, cur);
+            memcpy(out, cur, cl + 1);
             return 0;
         }
         const ssize_t n = readlink(cur, link, sizeof link - 1);
@@ -139,7 +141,7 @@ static int resolve_links(char *out, size_t cap, const char *path)
             return -1;
         link[n] = '\0';
         if (link[0] == '/') {
-            strcpy(cur, link);
+            memcpy(cur, link, (size_t)n + 1); /* n < sizeof link - 1 <= sizeof cur - 1 */
         } else { /* relative to the link's directory */
             char *slash = strrchr(cur, '/');
             const size_t dl = slash ? (size_t)(slash - cur + 1) : 0;
@@ -161,10 +163,11 @@ static int lexical(char *out, size_t cap, const char *path)
             return -1;
         n = strlen(buf);
     }
-    if (n + 1 + strlen(path) >= sizeof buf)
+    const size_t pl = strlen(path);
+    if (n + 1 + pl >= sizeof buf)
         return -1;
     buf[n++] = '/';
-    strcpy(buf + n, path);
+    memcpy(buf + n, path, pl + 1);
     size_t k = 0; /* out: "/a/b" */
     for (char *p = buf; *p;) {
         while (*p == '/')
@@ -209,9 +212,10 @@ static int path_key(char *key, size_t cap, const char *path)
         return w >= 0 && (size_t)w < cap ? 0 : -1;
     }
     *slash = '/';
-    if (strlen(norm) >= cap)
+    const size_t nl = strlen(norm);
+    if (nl >= cap)
         return -1;
-    strcpy(key, norm);
+    memcpy(key, norm, nl + 1);
     return 0;
 }
 
