@@ -250,8 +250,7 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     for p in (tout, uout):
         if os.path.exists(p):
             os.remove(p)
-    cmd = [rcal, "compensate", "--model", model, "--in", tin, "--out", tout, "--position-only",
-           "--max-uncertainty-mm", "1000"]
+    cmd = [rcal, "compensate", "--model", model, "--in", tin, "--out", tout, "--position-only"]
     if not OLD:
         cmd += ["--uncertainty-out", uout]
     if any(tcp):
