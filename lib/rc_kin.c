@@ -29,6 +29,13 @@ static void kin_chain(rc_real (*o)[3], rc_real (*R)[9], const rc_kin_link *lk, c
                 N[3 * r + k] = P[3 * r] * L[k] + P[3 * r + 1] * L[3 + k] + P[3 * r + 2] * L[6 + k];
             o[i + 1][r] = o[i][r] + P[3 * r] * t[0] + P[3 * r + 1] * t[1] + P[3 * r + 2] * t[2];
         }
+        const rc_real cm1 = lk[i].tilt_cm1_rad, sb = lk[i].tilt_sin;
+        if (cm1 != RC_REAL_C(0.0) || sb != RC_REAL_C(0.0)) /* Ry(beta), as rc_model.c's tilt_rows */
+            for (int r = 0; r < 3; ++r) {
+                const rc_real x = N[3 * r], z = N[3 * r + 2];
+                N[3 * r] = x + cm1 * x - sb * z;
+                N[3 * r + 2] = z + sb * x + cm1 * z;
+            }
     }
 }
 
@@ -183,8 +190,12 @@ void rc_kin_fk_dh_jac(rc_real pos_mm[3], rc_real rot[9], rc_real *jp, rc_real *j
     kin_model_chain(p, d, k, q_rad);
     for (unsigned i = 0; i < RC_NJ; ++i) {
         const rc_real z[3] = {d->R[i][2], d->R[i][5], d->R[i][8]};
-        const rc_real x1[3] = {d->R[i + 1][0], d->R[i + 1][3], d->R[i + 1][6]};
+        rc_real x1[3] = {d->R[i + 1][0], d->R[i + 1][3], d->R[i + 1][6]};
         rc_real v[3], wt[3], wa[3];
+        const rc_real cm1 = k->link[i].tilt_cm1_rad, sb = k->link[i].tilt_sin;
+        if (cm1 != RC_REAL_C(0.0) || sb != RC_REAL_C(0.0)) /* a, alpha act along x before the tilt */
+            for (int r = 0; r < 3; ++r)
+                x1[r] = x1[r] + cm1 * x1[r] + sb * d->R[i + 1][3 * r + 2];
         for (int r = 0; r < 3; ++r)
             v[r] = p[r] - d->o[i][r];
         cross3(wt, z, v);

@@ -60,6 +60,8 @@ typedef struct rc_kin_link {
     rc_real cos_alpha;
     rc_real sin_alpha;
     rc_real theta_off_rad;
+    rc_real tilt_cm1_rad; /* Hayati's beta of the row (RC_EFF_AXIS_TILT): cos(beta) - 1 ... */
+    rc_real tilt_sin;     /* ... and sin(beta); both 0 (a table without them): no tilt */
 } rc_kin_link;
 
 /* Kinds of rc_kin_jeffect.kind (the values of rc_effect_kind). */

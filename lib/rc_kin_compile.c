@@ -50,6 +50,14 @@ rc_status rc_kin_compile(rc_kin *out, const rc_model *m)
             if (!isfinite(p[k]))
                 return fail(out, RC_ERR_RANGE);
         switch ((rc_effect_kind)e->kind) {
+        case RC_EFF_AXIS_TILT: {
+            if (e->joint >= RC_NJ)
+                return fail(out, RC_ERR_RANGE);
+            const double h = sin(0.5 * p[0]);
+            out->link[e->joint].tilt_cm1_rad = (rc_real)(-2.0 * h * h); /* as rc_model.c's model_tilts */
+            out->link[e->joint].tilt_sin = (rc_real)sin(p[0]);
+            break;
+        }
         case RC_EFF_TOOL_OFFSET:
             if (out->has_tool)
                 break; /* rc_fk uses the first tool offset */

@@ -20,8 +20,21 @@ typedef struct {
 
 /* The chain from the DH lengths (dh[i][0] a, dh[i][1] d) and the cosines and
  * sines of the joint angles (ct, st) and of the alphas (ca, sa), (nj) each. */
+/* Row i's axis tilt (Hayati's beta, RC_EFF_AXIS_TILT) turns R[i+1] about
+ * its y axis: x' = x + (cos b - 1) x - sin b z, z' = z + sin b x + (cos b - 1) z
+ * (written with cos b - 1 so that a zero tilt is the identity to the bit);
+ * cm1, s: (nj) or NULL for none. */
+static void tilt_rows(double *N, double cm1, double s)
+{
+    for (int r = 0; r < 3; ++r) {
+        const double x = N[3 * r], z = N[3 * r + 2];
+        N[3 * r] = x + cm1 * x - s * z;
+        N[3 * r + 2] = z + s * x + cm1 * z;
+    }
+}
+
 static void chain_trig(chain *c, const double dh[][4], const double ct[], const double st[], const double ca[],
-                       const double sa[], unsigned nj)
+                       const double sa[], unsigned nj, const double *cm1, const double *ts)
 {
     static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     memcpy(c->R[0], eye, sizeof eye);
@@ -38,6 +51,8 @@ static void chain_trig(chain *c, const double dh[][4], const double ct[], const 
                 N[3 * r + k] = P[3 * r] * L[k] + P[3 * r + 1] * L[3 + k] + P[3 * r + 2] * L[6 + k];
             c->o[i + 1][r] = c->o[i][r] + P[3 * r] * t[0] + P[3 * r + 1] * t[1] + P[3 * r + 2] * t[2];
         }
+        if (cm1 != NULL && (cm1[i] != 0.0 || ts[i] != 0.0))
+            tilt_rows(N, cm1[i], ts[i]);
     }
 }
 
@@ -50,7 +65,7 @@ static void chain_trig(chain *c, const double dh[][4], const double ct[], const 
  * left out (a length without Jacobian or tool offset needs o6 only).
  * Equal to chain_trig up to rounding. */
 static void chain_axes(chain *c, const rc_model *m, const double ct[RC_NJ], const double st[RC_NJ],
-                       const double ca[RC_NJ], const double sa[RC_NJ], int full)
+                       const double ca[RC_NJ], const double sa[RC_NJ], int full, const rc_meas_prep *pr)
 {
     static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     const double a0 = m->x[RC_P_A(0)], d0 = m->x[RC_P_D(0)];
@@ -79,6 +94,8 @@ static void chain_axes(chain *c, const rc_model *m, const double ct[RC_NJ], cons
             N[3 * r + 2] = zr * ca[i] - v * sa[i];
             c->o[i + 1][r] = c->o[i][r] + a * nx + d * zr;
         }
+        if (pr != NULL && pr->tilt_at[i] >= 0)
+            tilt_rows(N, pr->tilt_cm1[i], pr->tilt_s[i]);
     }
 }
 
@@ -91,7 +108,29 @@ static void chain_compute(chain *c, const double dh[][4], const double theta_rad
         ca[i] = cos(dh[i][2]);
         sa[i] = sin(dh[i][2]);
     }
-    chain_trig(c, dh, ct, st, ca, sa, nj);
+    chain_trig(c, dh, ct, st, ca, sa, nj, NULL, NULL);
+}
+
+/* The axis tilts of m: cm1, ts (6) cos(beta) - 1 and sin(beta), at (6) the
+ * index of each row's beta in x or -1. Returns 1 when any row is tilted. */
+static int model_tilts(double cm1[RC_NJ], double ts[RC_NJ], int16_t at[RC_NJ], const rc_model *m)
+{
+    int any = 0;
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        cm1[i] = ts[i] = 0.0;
+        at[i] = -1;
+    }
+    for (unsigned e = 0; e < m->n_effects; ++e) {
+        const rc_effect *ef = &m->effects[e];
+        if (ef->kind != RC_EFF_AXIS_TILT || ef->joint >= RC_NJ || at[ef->joint] >= 0)
+            continue;
+        const double b = m->x[ef->first], h = sin(0.5 * b);
+        cm1[ef->joint] = -2.0 * h * h; /* cos b - 1 without cancellation */
+        ts[ef->joint] = sin(b);
+        at[ef->joint] = (int16_t)ef->first;
+        any = 1;
+    }
+    return any;
 }
 
 static void cross3(double out[3], const double a[3], const double b[3])
@@ -143,6 +182,7 @@ static const rc_effect_desc effect_table[] = {
     {RC_EFF_LENGTH_PERIODIC, "length_periodic", 3, RC_SIDE_LENGTH, RC_EFF_ARG_PERIOD, 0, 0, 1, "mm", 1000.0,
      "s|c|period", "", 0},
     {RC_EFF_OUTLET, "outlet", 3, RC_SIDE_OUTLET, RC_EFF_ARG_OUTLET, 0, 0, 0, "mm", 1e5, "x|y|z", "", 0},
+    {RC_EFF_AXIS_TILT, "axis_tilt", 1, RC_SIDE_GEOMETRY, RC_EFF_ARG_JOINT, 1, 0, 1, "rad", 0.1, "", "", 0},
 };
 RC_STATIC_ASSERT(sizeof effect_table / sizeof effect_table[0] == RC_EFF_LAST + 1, effect_table_covers_every_kind);
 
@@ -415,9 +455,21 @@ static void chain_tool(double tool[3], const chain *c, const rc_model *m, int ti
 /* Chain of the model at q; tool (3) receives the measured point. */
 static void model_chain(chain *c, double tool[3], const rc_model *m, const double q_rad[RC_NJ])
 {
-    double th[RC_NJ];
+    double th[RC_NJ], cm1[RC_NJ], ts[RC_NJ];
+    int16_t at[RC_NJ];
     rc_model_theta(th, m, q_rad);
-    chain_compute(c, (const double(*)[4])m->x, th, RC_NJ);
+    if (model_tilts(cm1, ts, at, m)) {
+        double ct[RC_NJ], st[RC_NJ], ca[RC_NJ], sa[RC_NJ];
+        for (unsigned i = 0; i < RC_NJ; ++i) {
+            ct[i] = cos(th[i]);
+            st[i] = sin(th[i]);
+            ca[i] = cos(m->x[RC_P_ALPHA(i)]);
+            sa[i] = sin(m->x[RC_P_ALPHA(i)]);
+        }
+        chain_trig(c, (const double(*)[4])m->x, ct, st, ca, sa, RC_NJ, cm1, ts);
+    } else {
+        chain_compute(c, (const double(*)[4])m->x, th, RC_NJ);
+    }
     chain_tool(tool, c, m, tool_index(m));
 }
 
@@ -486,6 +538,7 @@ void rc_meas_prepare(rc_meas_prep *p, const rc_model *m)
         p->sin_alpha[i] = sin(al);
     }
     p->tool = (int16_t)tool_index(m);
+    p->has_tilt = (uint8_t)model_tilts(p->tilt_cm1, p->tilt_s, p->tilt_at, m);
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *e = &m->effects[i];
         if (e->kind == RC_EFF_JOINT_COMPLIANCE || e->kind == RC_EFF_JOINT_PERIODIC) {
@@ -531,7 +584,8 @@ static void chain_prepared(chain *c, double p[3], const rc_model *m, const rc_me
                 st[i] = sin(th[i]);
             }
     }
-    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || pr->tool >= 0);
+    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || pr->tool >= 0 || pr->has_tilt,
+               pr->has_tilt ? pr : NULL);
     chain_tool(p, c, m, pr->tool);
 }
 
@@ -636,10 +690,18 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
     double g[3]; /* dl/dp (3): the chord direction, scaled, plus the chord-dependent effects */
     for (int r = 0; r < 3; ++r)
         g[r] = scale * u[r] + gd[r];
+    double cm1[RC_NJ], ts[RC_NJ];
+    int16_t tat[RC_NJ];
+    const int tilted = model_tilts(cm1, ts, tat, m);
     for (unsigned i = 0; i < RC_NJ; ++i) {
         const double z[3] = {c->R[i][2], c->R[i][5], c->R[i][8]};
-        const double x1[3] = {c->R[i + 1][0], c->R[i + 1][3], c->R[i + 1][6]};
+        double x1[3] = {c->R[i + 1][0], c->R[i + 1][3], c->R[i + 1][6]};
         double v[3], w[3];
+        if (tilted && tat[i] >= 0) { /* a and alpha act along x before the tilt: x = cos b x' + sin b z' */
+            const double z1[3] = {c->R[i + 1][2], c->R[i + 1][5], c->R[i + 1][8]};
+            for (int r = 0; r < 3; ++r)
+                x1[r] = x1[r] + cm1[i] * x1[r] + ts[i] * z1[r];
+        }
         for (int r = 0; r < 3; ++r)
             v[r] = p[r] - c->o[i][r];
         cross3(w, z, v);
@@ -663,6 +725,16 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
             for (unsigned k = 0; k < 3; ++k)
                 J[k] = (int)ef->first == outlet_first ? -g[k] : 0.0;
             break;
+        case RC_EFF_AXIS_TILT: { /* a turn about y of frame j+1 at its origin */
+            const unsigned j = ef->joint < RC_NJ ? ef->joint : 0u;
+            const double y1[3] = {c->R[j + 1][1], c->R[j + 1][4], c->R[j + 1][7]};
+            double v[3], w[3];
+            for (int r = 0; r < 3; ++r)
+                v[r] = p[r] - c->o[j + 1][r];
+            cross3(w, y1, v);
+            J[0] = tat[j] == (int16_t)ef->first ? dot3(g, w) : 0.0;
+            break;
+        }
         case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
         case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
         case RC_EFF_TIME_DRIFT: {

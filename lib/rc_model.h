@@ -60,13 +60,17 @@ typedef enum rc_effect_kind {
                                    length sensor's error once per drum turn (an eccentric drum);
                                    3 params s, c (mm) and the period P (mm, the drum's
                                    circumference; nonlinear, |P| < 1e-9 mm: no effect) */
-    RC_EFF_OUTLET = 11          /* another place of the encoder: samples with rc_sample.outlet == k
+    RC_EFF_OUTLET = 11,         /* another place of the encoder: samples with rc_sample.outlet == k
                                    (the effect's `joint` field, 1..RC_MAX_OUTLETS-1) are measured from
                                    this outlet instead of e; 3 params (x, y, z) mm in the base frame */
+    RC_EFF_AXIS_TILT = 12       /* Hayati's beta of DH row j (joint): frame j+1 turned about its own y
+                                   axis after Rx(alpha): T_j = Rz(theta) Tz(d) Tx(a) Rx(alpha) Ry(beta).
+                                   The tilt of a joint axis against a nominally parallel previous one,
+                                   which standard DH can only express with d of metres; 1 param, rad */
 } rc_effect_kind;
 
 /* Last effect kind (for range checks of stored kinds). */
-#define RC_EFF_LAST RC_EFF_OUTLET
+#define RC_EFF_LAST RC_EFF_AXIS_TILT
 
 /* Outlets a data set may use (outlet 0 is e, the others RC_EFF_OUTLET). */
 #define RC_MAX_OUTLETS 16
@@ -87,7 +91,8 @@ typedef enum {
     RC_SIDE_LENGTH = 0, /* adds to the predicted length; never moves the flange */
     RC_SIDE_JOINT = 1,  /* changes a joint angle the geometry sees: moves the flange */
     RC_SIDE_POINT = 2,  /* moves the measured point in the flange frame (not the flange) */
-    RC_SIDE_OUTLET = 3  /* where a sample's length is measured from */
+    RC_SIDE_OUTLET = 3, /* where a sample's length is measured from */
+    RC_SIDE_GEOMETRY = 4 /* part of the chain's geometry (a DH row's extra parameter): moves the flange */
 } rc_effect_side;
 
 typedef struct rc_effect_desc {
@@ -233,6 +238,9 @@ typedef struct rc_meas_prep {
     uint8_t joint_effect[RC_NJ];               /* nonzero: joint i has a joint-side effect */
     uint8_t has_joint_effect;                  /* any of joint_effect */
     int16_t tool;                              /* index of the tool offset in x, -1: none */
+    double tilt_cm1[RC_NJ], tilt_s[RC_NJ];     /* (6) cos(beta) - 1 and sin(beta) of each row's axis tilt */
+    int16_t tilt_at[RC_NJ];                    /* (6) index of row i's tilt in x, -1: none */
+    uint8_t has_tilt;                          /* any row tilted */
 } rc_meas_prep;
 
 void rc_meas_prepare(rc_meas_prep *p, const rc_model *m);

@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: MIT
 """FK and cable length against an independent pure-Python DH implementation
-(standard DH, T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), read straight
-from the model file's JSON) at random poses, to 1e-9 mm."""
+(standard DH, T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), with Hayati's
+axis tilt Ry(beta) where the file has an axis_tilt effect and the measured
+point at the file's tool_offset, read straight from the model file's JSON)
+at random poses, to 1e-9 mm."""
 import json
 import math
 import random
@@ -25,13 +27,25 @@ def matmul(A, B):
     return [[sum(A[i][k] * B[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
 
 
-def reference_fk(dh_rows, q_deg):
-    """dh_rows: the file's rows (a_mm, d_mm, alpha_deg, theta_deg)."""
+def ry_matrix(b):
+    cb, sb = math.cos(b), math.sin(b)
+    return [[cb, 0.0, sb, 0.0], [0.0, 1.0, 0.0, 0.0], [-sb, 0.0, cb, 0.0], [0.0, 0.0, 0.0, 1.0]]
+
+
+def reference_fk(dh_rows, q_deg, effects=()):
+    """dh_rows: the file's rows (a_mm, d_mm, alpha_deg, theta_deg); effects:
+    the file's "effects" (axis_tilt: Ry(beta) after its row, joint 1-based;
+    tool_offset: the point in the flange frame)."""
+    tilt = {e["joint"] - 1: e["params"][0] for e in effects if e["kind"] == "axis_tilt"}
+    tool = next((e["params"] for e in effects if e["kind"] == "tool_offset"), [0.0, 0.0, 0.0])
     T = [[1.0 if i == j else 0.0 for j in range(4)] for i in range(4)]
-    for row, q in zip(dh_rows, q_deg):
+    for i, (row, q) in enumerate(zip(dh_rows, q_deg)):
         T = matmul(T, dh_matrix(row["a_mm"], row["d_mm"], math.radians(row["alpha_deg"]),
                                 math.radians(q + row["theta_deg"])))
-    return [T[0][3], T[1][3], T[2][3]], [T[i][j] for i in range(3) for j in range(3)]
+        if i in tilt:
+            T = matmul(T, ry_matrix(tilt[i]))
+    p = [T[r][3] + sum(T[r][c] * tool[c] for c in range(3)) for r in range(3)]
+    return p, [T[i][j] for i in range(3) for j in range(3)]
 
 
 def random_poses(limits, n, seed):
@@ -51,7 +65,8 @@ def test_fk_and_cable_length_against_reference(which, calibrated_file):
     path = {"nominal": "data/irb120.json", "truth": "data/sim_irb120_truth.json",
             "calibrated": str(calibrated_file)}[which]
     doc = json.load(open(path))
-    assert "effects" not in doc  # the reference is pure DH
+    effects = doc.get("effects", [])
+    assert all(e["kind"] in ("axis_tilt", "tool_offset") for e in effects)  # what the reference models
     m = rcal.Model.load(path)
     for mine, theirs in zip(m.joint_limits_deg, doc["joint_limits_deg"]):
         assert abs(mine[0] - theirs[0]) < 1e-9 and abs(mine[1] - theirs[1]) < 1e-9
@@ -60,7 +75,7 @@ def test_fk_and_cable_length_against_reference(which, calibrated_file):
     lengths = m.cable_length(poses) if "encoder_mm" in doc else None
     worst = 0.0
     for k, q in enumerate(poses):
-        p_ref, R_ref = reference_fk(doc["dh"], q)
+        p_ref, R_ref = reference_fk(doc["dh"], q, effects)
         worst = max(worst, max(abs(a - b) for a, b in zip(pos[k], p_ref)))
         assert max(abs(a - b) for a, b in zip(rot[k], R_ref)) < 1e-12
         if lengths is not None:

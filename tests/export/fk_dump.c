@@ -12,6 +12,7 @@
 #include "rc_model.h"
 #include "rc_rand.h"
 #include "rch_robot.h"
+#include "rch_comp.h"
 
 int main(int argc, char **argv)
 {
@@ -26,6 +27,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "fk_dump: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
+    static rc_model pm; /* the flange: the URDF carries the robot, not the cable attachment */
+    rch_comp_point_model(&pm, &r.model, NULL);
     const long n = strtol(argv[2], NULL, 10);
     rc_rng g;
     rc_rng_seed(&g, (uint64_t)strtoull(argv[3], NULL, 10));
@@ -33,7 +36,7 @@ int main(int argc, char **argv)
         double q[RC_NJ], p[3];
         for (unsigned i = 0; i < RC_NJ; ++i)
             q[i] = r.model.q_min_rad[i] + (r.model.q_max_rad[i] - r.model.q_min_rad[i]) * rc_rng_u01(&g);
-        rc_fk(p, NULL, &r.model, q);
+        rc_fk(p, NULL, &pm, q);
         for (unsigned i = 0; i < RC_NJ; ++i)
             printf("%.17g,", q[i]);
         printf("%.17g,%.17g,%.17g\n", p[0], p[1], p[2]);

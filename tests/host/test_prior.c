@@ -15,6 +15,7 @@
 
 #include <cmocka.h>
 
+#include "rc_kin.h"
 #include "rc_model.h"
 #include "rc_solve.h"
 #include "rch_calib.h"
@@ -400,12 +401,104 @@ static void test_radius95(void **state)
     assert_true(fabs(r3 / 2.795483 - 1.0) < 0.03);
 }
 
+/* Row 2 tilted by beta (Hayati): rc_meas and rc_fk against a chain written
+ * here (Rz Tz Tx Rx Ry), the derivatives by differences, and the compiled
+ * kinematics (rc_kin) equal to the model's. */
+static void test_axis_tilt(void **state)
+{
+    (void)state;
+    double dh[6][4];
+    for (int i = 0; i < 6; ++i)
+        for (int k = 0; k < 4; ++k)
+            dh[i][k] = k < 2 ? NOM[i][k] : NOM[i][k] * DEGR;
+    const double e[3] = {500, -300, 0}, beta = 0.3 * DEGR;
+    rc_model m;
+    assert_int_equal(rc_model_init(&m, (const double(*)[4])dh, e), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_AXIS_TILT, 1, 0), RC_OK);
+    const unsigned kb = m.effects[0].first;
+    m.x[kb] = beta;
+    const double q[6] = {0.3, -0.2, 0.1, 0.4, 0.7, -0.5};
+    /* the chain written here */
+    double T[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+    for (int i = 0; i < 6; ++i) {
+        const double th = q[i] + dh[i][3], ct = cos(th), st = sin(th), ca = cos(dh[i][2]), sa = sin(dh[i][2]);
+        const double b = i == 1 ? beta : 0.0, cb = cos(b), sb = sin(b);
+        /* Rz Tz Tx Rx: the DH block, then Ry(b) on the right */
+        double A[4][4] = {{ct, -st * ca, st * sa, dh[i][0] * ct}, {st, ct * ca, -ct * sa, dh[i][0] * st},
+                          {0, sa, ca, dh[i][1]}, {0, 0, 0, 1}};
+        const double Ry[4][4] = {{cb, 0, sb, 0}, {0, 1, 0, 0}, {-sb, 0, cb, 0}, {0, 0, 0, 1}};
+        double B[4][4], X[4][4];
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+                B[r][c] = A[r][0] * Ry[0][c] + A[r][1] * Ry[1][c] + A[r][2] * Ry[2][c] + A[r][3] * Ry[3][c];
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+                X[r][c] = T[r][0] * B[0][c] + T[r][1] * B[1][c] + T[r][2] * B[2][c] + T[r][3] * B[3][c];
+        memcpy(T, X, sizeof T);
+    }
+    double p[3], Rm[9];
+    rc_fk(p, Rm, &m, q);
+    for (int r = 0; r < 3; ++r) {
+        assert_true(fabs(p[r] - T[r][3]) < 1e-9);
+        for (int c = 0; c < 3; ++c)
+            assert_true(fabs(Rm[3 * r + c] - T[r][c]) < 1e-12);
+    }
+    rc_sample s;
+    memset(&s, 0, sizeof s);
+    memcpy(s.q_rad, q, sizeof q);
+    double l, jac[RC_MAX_PARAMS], lp[1];
+    assert_int_equal(rc_meas(&l, jac, &m, &s), RC_OK);
+    const double pt[3] = {T[0][3], T[1][3], T[2][3]};
+    assert_true(fabs(l - rct_dist(pt, e)) < 1e-9);
+    /* the prepared path (the solver's) gives the same length and Jacobian */
+    rc_meas_prep pr;
+    rc_meas_prepare(&pr, &m);
+    double jac2[RC_MAX_PARAMS];
+    assert_int_equal(rc_meas_prepared(lp, jac2, &m, &pr, &s, NULL, NULL), RC_OK);
+    assert_true(fabs(lp[0] - l) < 1e-9);
+    const unsigned ks[5] = {RC_P_A(1), RC_P_ALPHA(1), RC_P_A(3), RC_P_THETA(2), kb};
+    for (int t = 0; t < 5; ++t) {
+        rc_model a = m, b = m;
+        const double h = ks[t] == RC_P_A(1) || ks[t] == RC_P_A(3) ? 1e-4 : 1e-7;
+        double la, lb;
+        a.x[ks[t]] += h;
+        b.x[ks[t]] -= h;
+        assert_int_equal(rc_meas(&la, NULL, &a, &s), RC_OK);
+        assert_int_equal(rc_meas(&lb, NULL, &b, &s), RC_OK);
+        const double fd = (la - lb) / (2 * h);
+        print_message("d l / d %u: analytic %.9f, differences %.9f\n", ks[t], jac[ks[t]], fd);
+        assert_true(fabs(fd - jac[ks[t]]) < 1e-5 * (1.0 + fabs(fd)));
+        assert_true(fabs(jac2[ks[t]] - jac[ks[t]]) < 1e-9 * (1.0 + fabs(fd)));
+    }
+    /* the compiled kinematics: the same point and DH columns */
+    rc_kin kin;
+    rc_kin_data kd;
+    assert_int_equal(rc_kin_compile(&kin, &m), RC_OK);
+    rc_real pk[3], qr[6], jp[3 * RC_N_DH];
+    for (int j = 0; j < 6; ++j)
+        qr[j] = (rc_real)q[j];
+    rc_kin_fk_dh_jac(pk, NULL, jp, NULL, &kd, &kin, qr);
+    for (int r = 0; r < 3; ++r)
+        assert_true(fabs((double)pk[r] - p[r]) < 1e-9);
+    for (int t = 0; t < 2; ++t) { /* a2 and alpha2 of the tilted row, by differences of rc_fk */
+        rc_model a = m, b = m;
+        const double h = t == 0 ? 1e-4 : 1e-7;
+        double pa[3], pb[3];
+        a.x[ks[t]] += h;
+        b.x[ks[t]] -= h;
+        rc_fk(pa, NULL, &a, q);
+        rc_fk(pb, NULL, &b, q);
+        for (int r = 0; r < 3; ++r)
+            assert_true(fabs((pa[r] - pb[r]) / (2 * h) - (double)jp[r * RC_N_DH + ks[t]]) < 1e-4);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_effect_table), cmocka_unit_test(test_outlet_meas), cmocka_unit_test(test_prior_fill),
         cmocka_unit_test(test_centred),      cmocka_unit_test(test_off_centre),  cmocka_unit_test(test_outlets),
-        cmocka_unit_test(test_radius95),
+        cmocka_unit_test(test_radius95),     cmocka_unit_test(test_axis_tilt),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

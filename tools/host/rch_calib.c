@@ -1147,6 +1147,21 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     const int want_tool = cfg->tool_offset || (!cfg->no_prior && (cfg->method == RC_METHOD_LM ||
                                                                    cfg->method == RC_METHOD_LTLM));
     r->attach_auto = want_tool && !has_tool && !cfg->tool_offset;
+    /* Hayati's beta where a joint axis is nominally parallel to the previous
+     * one (alpha = 0 or 180 deg, rows 2..5): standard DH can tilt that axis
+     * only with a d of metres, which the prior forbids, so the tilt gets its
+     * own parameter (with the twists' prior) */
+    if (want_tool && !cfg->tool_offset)
+        for (unsigned i = 1; i + 1 < RC_NJ; ++i) {
+            int have = 0;
+            for (unsigned e = 0; e < r->robot.model.n_effects; ++e)
+                have |= r->robot.model.effects[e].kind == RC_EFF_AXIS_TILT && r->robot.model.effects[e].joint == i;
+            if (!have && fabs(sin(r->robot.nominal.x[RC_P_ALPHA(i)])) < 1e-6 &&
+                rc_model_add_effect(&r->robot.model, RC_EFF_AXIS_TILT, i, 0) != RC_OK) {
+                rch_diag_set(d, "", 0, 0, "cannot add the axis tilt of row %u (RC_MAX_PARAMS or RC_MAX_EFFECTS)", i + 1);
+                goto done;
+            }
+        }
     if (want_tool && !has_tool && rc_model_add_effect(&r->robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
         rch_diag_set(d, "", 0, 0, "cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
         goto done;

@@ -54,8 +54,11 @@ static void reals(FILE *f, const rc_real *v, unsigned n)
 
 static void link_row(FILE *f, const rc_kin_link *l)
 {
-    const rc_real v[5] = {l->a_mm, l->d_mm, l->cos_alpha, l->sin_alpha, l->theta_off_rad};
-    reals(f, v, 5);
+    const rc_real v[7] = {l->a_mm, l->d_mm, l->cos_alpha, l->sin_alpha, l->theta_off_rad, l->tilt_cm1_rad,
+                          l->tilt_sin};
+    /* the tilt (Hayati's beta) only where a row has one: an untilted row's
+     * two zeros are the initializer's default */
+    reals(f, v, l->tilt_cm1_rad != RC_REAL_C(0.0) || l->tilt_sin != RC_REAL_C(0.0) ? 7 : 5);
 }
 
 static void emit_kin(FILE *f, const char *name, const rc_kin *k)
