@@ -98,6 +98,9 @@ static int report(rch_diagnose_result *r, const char *plots, const char *const i
         return rch_diagnose_json(stdout, r, argc, argv) == 0 ? 0 : 1;
     if (rch_diagnose_print(stdout, r) != 0)
         return 1;
+    char next[1200];
+    if (rch_diagnose_next(next, sizeof next, r, inputs[0]) == 0)
+        printf("\nNext: %s\n", next);
     if (plots)
         printf("\nPlots:\n%s", paths);
     return 0;

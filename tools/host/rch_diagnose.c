@@ -1741,27 +1741,43 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
     return rch_jw_finish(&w);
 }
 
-int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
-                            const char *path, const char *const *inputs, size_t n_inputs, rch_diag *d)
+/* The chosen effects as `rcal calibrate --effects` names them, into list. */
+static void chosen_effects(char *list, size_t len, const rch_diagnose_result *r)
 {
-    (void)inputs;
-    (void)n_inputs; /* rch_calib_save_model refuses the data and the robot file itself */
-    /* the chosen effects as --effects names them */
-    char list[512] = "";
     size_t pos = 0;
-    for (unsigned e = 0; e < r->final.n_effects && pos < sizeof list; ++e) {
+    list[0] = '\0';
+    for (unsigned e = 0; e < r->final.n_effects && pos < len; ++e) {
         const rc_effect *ef = &r->final.effects[e];
         const rc_effect_desc *ds = rc_effect_describe(ef->kind);
         if (!ds || ds->nuisance || !ds->user || ef->kind == RC_EFF_TOOL_OFFSET)
             continue;
         if (ds->arg == RC_EFF_ARG_JOINT)
-            pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s:%u", pos ? "," : "", ds->name, ef->joint + 1u);
+            pos += (size_t)snprintf(list + pos, len - pos, "%s%s:%u", pos ? "," : "", ds->name, ef->joint + 1u);
         else if (ds->arg == RC_EFF_ARG_PERIOD)
-            pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s:%.6g", pos ? "," : "", ds->name,
+            pos += (size_t)snprintf(list + pos, len - pos, "%s%s:%.6g", pos ? "," : "", ds->name,
                                     fabs(r->final.x[ef->first + 2]));
         else
-            pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s", pos ? "," : "", ds->name);
+            pos += (size_t)snprintf(list + pos, len - pos, "%s%s", pos ? "," : "", ds->name);
     }
+}
+
+int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path)
+{
+    char list[512];
+    chosen_effects(list, sizeof list, r);
+    const int w = snprintf(buf, len, "rcal calibrate --data %s%s%s%s%s --out model.json", data_path,
+                           strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps ? " --jumps" : "",
+                           r->dequant_corrected ? " --dequantize-joints" : "", list[0] ? " --effects " : "", list);
+    return w >= 0 && (size_t)w < len ? 0 : -1;
+}
+
+int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
+                            const char *path, const char *const *inputs, size_t n_inputs, rch_diag *d)
+{
+    (void)inputs;
+    (void)n_inputs; /* rch_calib_save_model refuses the data and the robot file itself */
+    char list[512];
+    chosen_effects(list, sizeof list, r);
     static rch_calib_result cr;
     rch_calib_cfg cfg;
     rch_calib_cfg_init(&cfg);
@@ -1769,7 +1785,8 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path,
     cfg.robot_path = robot_path;
     cfg.test_fraction = 0.0;
     cfg.effects = list[0] ? list : NULL;
-    cfg.jumps = strcmp(r->effect, "length_jump") == 0;
+    cfg.jumps = strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps > 0;
+    cfg.dequantize = r->dequant_corrected > 0;
     const int rc = rch_calib_run(&cr, &cfg, d);
     if (rc != 0)
         return -1;
