@@ -559,6 +559,28 @@ static int cmp_t(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The jump fit of one pass: the first search finds the change points
+ * (rch_jumps_find), every later fit of the same training set refits at them
+ * (rch_jumps_refit): the noise passes, the attachment comparison and the
+ * final fit move the change points' sizes, not where they are. */
+static int jumps_fit(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rch_jumps_config *jc,
+                     const rc_sample *sorted, char *err, size_t errlen)
+{
+    if (r->have_jump_at) {
+        const int rc = rch_jumps_refit(&r->jumps, &r->before, fixed, sorted, r->n_train, r->jump_at, r->n_jump_at,
+                                       jc, w, err, errlen);
+        r->jumps.rms_before_mm = r->jump_rms_before_mm; /* the geometry alone, from the search */
+        return rc;
+    }
+    if (rch_jumps_find(&r->jumps, &r->before, fixed, sorted, r->n_train, jc, w, err, errlen) != 0)
+        return -1;
+    r->jump_rms_before_mm = r->jumps.rms_before_mm;
+    r->n_jump_at = r->jumps.n_jumps;
+    memcpy(r->jump_at, r->jumps.at, r->jumps.n_jumps * sizeof r->jump_at[0]);
+    r->have_jump_at = 1;
+    return 0;
+}
+
 /* Length jumps (nuisance): detected on the training samples in acquisition
  * order and fitted with the geometry; r->model becomes the geometry alone
  * (what predicts a new pose). Held-out samples are labelled with their
@@ -588,7 +610,7 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     rch_jumps_config jc;
     memset(&jc, 0, sizeof jc);
     jc.solve = scfg;
-    if (rch_jumps_find(&r->jumps, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) != 0) {
+    if (jumps_fit(r, w, fixed, &jc, tr, err, sizeof err) != 0) {
         rch_diag_set(d, "", 0, 0, "length jumps: %s", err);
         goto done;
     }
@@ -666,7 +688,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 char err[256];
                 memset(&jc, 0, sizeof jc);
                 jc.solve = &cfg;
-                if (rch_jumps_find(&r->jumps, &r->before, fixed, sorted, r->n_train, &jc, w, err, sizeof err) != 0)
+                if (jumps_fit(r, w, fixed, &jc, sorted, err, sizeof err) != 0)
                     break; /* fit_jumps reports it */
                 fitm = &r->jumps.model;
                 fs = sorted;
@@ -812,6 +834,9 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
         memset(&jc, 0, sizeof jc);
         jc.solve = cfg;
         if (rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0) {
+            r->n_jump_at = j->n_jumps; /* every change point found: the nuisance fit starts from them */
+            r->jump_rms_before_mm = j->rms_before_mm;
+            memcpy(r->jump_at, j->at, j->n_jumps * sizeof r->jump_at[0]);
             /* A step can also describe an effect the geometry lacks (a joint
              * compliance leaves steps of a few times the residual, inside
              * set-ups too): a jump counts as a sensor event when it is far
@@ -837,6 +862,8 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
 static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
                           rch_diag *d)
 {
+    if (!r->keep_jump_at)
+        r->have_jump_at = 0; /* a new training set: its change points are searched */
     if (rch_calib_start(&r->before, w, &r->robot, train, r->n_train, d) != 0)
         return -1;
     r->model = r->before;
@@ -890,7 +917,11 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
              * hands on a geometry fitted across jumps */
             r->cfg.jumps = 1;
             r->jumps_auto = 1;
-            return fit_and_report(r, w, train, test, d);
+            r->have_jump_at = 1; /* at the change points the check found */
+            r->keep_jump_at = 1;
+            const int rc = fit_and_report(r, w, train, test, d);
+            r->keep_jump_at = 0;
+            return rc;
         }
     }
     r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
@@ -1335,7 +1366,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
             RC_N_DH - held, held ? list : "none");
 }
 
-static void print_ident(FILE *f, const rch_ident *id)
+static void print_ident(FILE *f, const rch_ident *id, int prior)
 {
     fprintf(f,
             "identifiability (%u parameters, at the solution): rank %u, %u not identifiable, %u weakly "
@@ -1347,7 +1378,9 @@ static void print_ident(FILE *f, const rch_ident *id)
         if (id->dirs[k].why[0])
             fprintf(f, "      %s\n", id->dirs[k].why);
     }
-    fprintf(f, "  The solver leaves directions it cannot identify where they started (nominal).\n\n");
+    fprintf(f, prior ? "  With the prior, what the data cannot identify stays where the drawing puts it (the prior's mean), "
+                       "with the prior's uncertainty (the parameters' classes above).\n\n"
+                     : "  The solver leaves directions it cannot identify where they started (nominal).\n\n");
 }
 
 void rch_calib_print(FILE *f, const rch_calib_result *r)
@@ -1392,7 +1425,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     if (r->have_unc)
         print_uncertainty(f, r);
     if (r->have_ident)
-        print_ident(f, &r->ident);
+        print_ident(f, &r->ident, r->prior_on);
     if (r->have_validate) {
         const rch_evaluate_result *v = &r->validate;
         fprintf(f,

@@ -136,6 +136,10 @@ typedef struct rch_calib_result {
     unsigned jumps_found;     /* the default run's jump check: jumps the fit does not model (0: none) */
     double jump_check_max_mm; /* the largest of them */
     int jumps_auto;           /* they were then fitted as nuisance (cfg.jumps set by the run) */
+    int have_jump_at, keep_jump_at; /* the change points of this training set are known (searched once) */
+    unsigned n_jump_at;
+    double jump_rms_before_mm; /* training RMS of the geometry alone (the search's) */
+    size_t jump_at[RCH_JUMPS_MAX];    /* (n_jump_at) first training sample (in t order) after each jump */
     int attach_auto;          /* the cable attachment vector was the default's to decide (not --tool-offset) */
     int attach_centred;       /* decided: the cable is at the flange centre (no attachment vector) */
     double attach_dchi2;      /* how much the attachment vector improved the MAP objective (noise units) */

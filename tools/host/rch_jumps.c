@@ -244,3 +244,50 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
     free(c);
     return 0;
 }
+
+int rch_jumps_refit(rch_jumps *out, const rc_model *start, const uint8_t *fixed, const rc_sample *s, size_t n,
+                    const size_t *at, unsigned m, const rch_jumps_config *cfg, rc_solve_work *w, char *err,
+                    size_t errlen)
+{
+    const rc_solve_config *base = cfg ? cfg->solve : NULL;
+    if (m > RCH_JUMPS_MAX) {
+        snprintf(err, errlen, "more than %d jumps", RCH_JUMPS_MAX);
+        return -1;
+    }
+    for (unsigned k = 0; k < m; ++k)
+        if (at[k] == 0 || at[k] >= n || (k > 0 && at[k] <= at[k - 1])) {
+            snprintf(err, errlen, "change points must be ascending inside the samples");
+            return -1;
+        }
+    rc_sample *c = malloc((n ? n : 1) * sizeof *c);
+    if (!c) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    memcpy(c, s, n * sizeof *c);
+    memset(out, 0, sizeof *out);
+    double ssr;
+    rc_model cur;
+    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, base, w) != 0) {
+        snprintf(err, errlen, "the fit at the given change points failed");
+        free(c);
+        return -1;
+    }
+    out->n_jumps = m;
+    out->model = cur;
+    out->rms_after_mm = out->rms_before_mm = sqrt(ssr / (double)n);
+    for (unsigned k = 0; k < m; ++k) {
+        out->at[k] = at[k];
+        out->at_t[k] = s[at[k]].t;
+    }
+    out->geometry = cur;
+    if (m > 0) {
+        out->geometry.n_effects--;
+        out->geometry.n_params = (uint16_t)cur.effects[cur.n_effects - 1].first;
+    }
+    for (size_t i = 0; i < n; ++i)
+        c[i].group = (uint16_t)rch_jumps_segment(out, c[i].t);
+    jump_sizes(out, c, n);
+    free(c);
+    return 0;
+}

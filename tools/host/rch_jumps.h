@@ -72,4 +72,13 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
  * j->model on rows the detection did not see. */
 unsigned rch_jumps_segment(const rch_jumps *j, double t);
 
+/* The fit of rch_jumps_find at given change points at (m, ascending
+ * indices into s, each inside 1..n-1): geometry and segment offsets, the
+ * sizes and standard errors; no search (rms_before_mm is the fit's). For
+ * refits where the change points are known (the noise passes of a MAP fit,
+ * the second model of a comparison). 0, or -1 with err set. */
+int rch_jumps_refit(rch_jumps *out, const rc_model *start, const uint8_t *fixed, const rc_sample *s, size_t n,
+                    const size_t *at, unsigned m, const rch_jumps_config *cfg, rc_solve_work *w, char *err,
+                    size_t errlen);
+
 #endif
