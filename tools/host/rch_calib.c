@@ -688,6 +688,9 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 char err[256];
                 memset(&jc, 0, sizeof jc);
                 jc.solve = &cfg;
+                if (pass <= 1 && !r->attach_m0)
+                    r->have_jump_at = 0; /* the change points depend on the prior's weight: searched again
+                                            until the noise is near its final value (pass 1), refitted after */
                 if (jumps_fit(r, w, fixed, &jc, sorted, err, sizeof err) != 0)
                     break; /* fit_jumps reports it */
                 fitm = &r->jumps.model;
@@ -791,7 +794,9 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
     rc_solve_config c0 = *cfg;
     c0.prior_mean = r->prior_mean;
     c0.prior_sd = r->prior_sd;
+    r->attach_m0 = 1; /* at the attachment model's change points */
     rc_status st = map_fit(r, w, &c0, fixed, train, &chi2_0);
+    r->attach_m0 = 0;
     /* both objectives in units of the attachment model's noise */
     const double chi2_0n = st == RC_OK ? chi2_0 * (r->noise_mm * r->noise_mm) / (noise1 * noise1) : INFINITY;
     r->attach_dchi2 = chi2_0n - chi2_1;

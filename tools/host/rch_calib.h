@@ -137,6 +137,7 @@ typedef struct rch_calib_result {
     double jump_check_max_mm; /* the largest of them */
     int jumps_auto;           /* they were then fitted as nuisance (cfg.jumps set by the run) */
     int have_jump_at, keep_jump_at; /* the change points of this training set are known (searched once) */
+    int attach_m0;                  /* fitting the no-attachment model: refit at the attachment model's points */
     unsigned n_jump_at;
     double jump_rms_before_mm; /* training RMS of the geometry alone (the search's) */
     size_t jump_at[RCH_JUMPS_MAX];    /* (n_jump_at) first training sample (in t order) after each jump */
