@@ -493,12 +493,66 @@ static void test_axis_tilt(void **state)
     }
 }
 
+/* Model files are data from outside: a covariance that is not one, or an
+ * enumeration spelt otherwise, is refused with its place (issue 23). */
+static void test_model_file_checked(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rcal_prior_XXXXXX", path[256], bad[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/m.json", dir);
+    snprintf(bad, sizeof bad, "%s/bad.json", dir);
+    calibrate(RCAL_SOURCE_DIR "/data/sim_irb120.csv");
+    rch_diag d;
+    assert_int_equal(rch_calib_save_model(&res, path, &d), 0);
+    rch_robot rb;
+    assert_int_equal(rch_robot_load(&rb, path, &d), 0);
+    assert_true(rb.unc.present && rb.unc.has_prior);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    static char text[1 << 16];
+    const size_t len = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[len] = '\0';
+    /* each edit: the first match of what in the file replaced by with */
+    const struct {
+        const char *what, *with, *msg;
+    } edits[] = {{"\"compensation\": \"fitted\"", "\"compensation\": \"Fitted\"", "compensation"},
+                 {"\"compensation\": \"fitted\"", "\"compensation\": \"held\"", "compensation"},
+                 {"\"covariance_dh\": [", "\"covariance_dh\": [-1, ", "variance"},
+                 {"\"covariance_dh\": [", "\"covariance_dh\": [1e200, ", "variance"},
+                 {"\"posterior\": true", "\"posterior\": 1", "posterior"}};
+    for (size_t e = 0; e < sizeof edits / sizeof edits[0]; ++e) {
+        const char *at = strstr(text, edits[e].what);
+        assert_non_null(at);
+        /* for the covariance edits the first number is dropped so the count stays 576 */
+        const char *rest = at + strlen(edits[e].what);
+        if (strstr(edits[e].with, "covariance_dh")) {
+            const char *comma = strchr(rest, ',');
+            assert_non_null(comma);
+            rest = comma + 1;
+        }
+        f = fopen(bad, "w");
+        assert_non_null(f);
+        fprintf(f, "%.*s%s%s", (int)(at - text), text, edits[e].with, rest);
+        fclose(f);
+        memset(&d, 0, sizeof d);
+        assert_int_not_equal(rch_robot_load(&rb, bad, &d), 0);
+        print_message("%s -> %s:%u:%u: %s\n", edits[e].with, d.file, d.line, d.col, d.msg);
+        assert_non_null(strstr(d.msg, edits[e].msg));
+        assert_true(d.line > 0);
+    }
+    unlink(bad);
+    unlink(path);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_effect_table), cmocka_unit_test(test_outlet_meas), cmocka_unit_test(test_prior_fill),
         cmocka_unit_test(test_centred),      cmocka_unit_test(test_off_centre),  cmocka_unit_test(test_outlets),
-        cmocka_unit_test(test_radius95),     cmocka_unit_test(test_axis_tilt),
+        cmocka_unit_test(test_radius95),     cmocka_unit_test(test_axis_tilt),   cmocka_unit_test(test_model_file_checked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "rc_linalg.h"
 #include "rch_json.h"
 #include "rch_jw.h"
 
@@ -244,6 +245,13 @@ static int read_unc_param(rch_robot *out, unsigned k, const rch_json *p, const c
     }
     out->unc.cls[k] = (uint8_t)c;
     const rch_json *cp = rch_json_get(p, "compensation");
+    if (cp && (cp->type != RCH_JSTR || (strcmp(cp->str, "nominal") != 0 && strcmp(cp->str, "fitted") != 0 &&
+                                        strcmp(cp->str, "not used") != 0))) {
+        rch_diag_set(d, name, cp->line, cp->col,
+                     "uncertainty parameter %u: \"compensation\" must be exactly \"fitted\", \"nominal\" or "
+                     "\"not used\"", k + 1);
+        return -1;
+    }
     /* version-2 files before this member: weak and not identifiable held nominal */
     out->unc.comp_nominal[k] = cp && cp->type == RCH_JSTR ? strcmp(cp->str, "nominal") == 0 : (c == 2 || c == 3);
     out->unc.se[k] = NAN;
@@ -253,6 +261,54 @@ static int read_unc_param(rch_robot *out, unsigned k, const rch_json *p, const c
             return -1;
         }
         out->unc.se[k] = se->num * (rc_param_unit(&out->model, k) == 1 ? DEG : 1.0);
+    }
+    return 0;
+}
+
+/* A covariance read from outside is checked as data (issue 23): symmetric,
+ * of physical size (a standard error below 1 m or 1 rad: beyond, no
+ * calibration determined anything and every uncertainty figure would be
+ * meaningless) and positive semi-definite (its smallest eigenvalue not below
+ * -1e-9 of its largest); otherwise it would turn the safety checks of
+ * compensation into noise (a -1 diagonal printed "0.0000 mm"). */
+static int check_cov(const double *c, const rch_json *arr, const char *name, rch_diag *d)
+{
+    const unsigned n = RC_N_DH;
+    for (unsigned i = 0; i < n; ++i) {
+        const double v = c[i * n + i], lim = (i % 4 == 0 || i % 4 == 1) ? 1e6 : 1.0;
+        if (!(v >= 0.0) || v > lim) {
+            const rch_json *it = arr->items[i * n + i];
+            rch_diag_set(d, name, it->line, it->col,
+                         "covariance_dh[%u][%u] = %g is not a variance of a calibrated parameter (0 to %g %s^2)", i, i,
+                         v, lim, lim > 1.0 ? "mm" : "rad");
+            return -1;
+        }
+        for (unsigned j = 0; j < i; ++j) {
+            const double a = c[i * n + j], b = c[j * n + i];
+            if (fabs(a - b) > 1e-9 * sqrt(c[i * n + i] * c[j * n + j]) + 1e-300) {
+                const rch_json *it = arr->items[i * n + j];
+                rch_diag_set(d, name, it->line, it->col, "covariance_dh is not symmetric at [%u][%u] (%g against %g)",
+                             i, j, a, b);
+                return -1;
+            }
+        }
+    }
+    double A[RC_N_DH * RC_N_DH], V[RC_N_DH * RC_N_DH], ev[RC_N_DH];
+    memcpy(A, c, sizeof A);
+    if (rcu_eig_sym(ev, V, A, n, 0) != RC_OK) {
+        rch_diag_set(d, name, arr->line, arr->col, "covariance_dh: its eigenvalues cannot be computed");
+        return -1;
+    }
+    double mx = 0.0, mn = 0.0;
+    for (unsigned i = 0; i < n; ++i) {
+        mx = ev[i] > mx ? ev[i] : mx;
+        mn = ev[i] < mn ? ev[i] : mn;
+    }
+    if (mn < -1e-9 * mx - 1e-300) {
+        rch_diag_set(d, name, arr->line, arr->col,
+                     "covariance_dh is not positive semi-definite (eigenvalue %g against a largest of %g): not the "
+                     "covariance of any calibration", mn, mx);
+        return -1;
     }
     return 0;
 }
@@ -282,6 +338,8 @@ static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name,
         }
         out->unc.cov_dh[k] = cov->items[k]->num;
     }
+    if (check_cov(out->unc.cov_dh, cov, name, d) != 0)
+        return -1;
     out->unc.orientation_determined = od && od->type == RCH_JBOOL && od->num != 0.0;
     out->unc.sigma_mm = sg && sg->type == RCH_JNUM ? sg->num : NAN;
     const rch_json *po = rch_json_get(u, "posterior");
