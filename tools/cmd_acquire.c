@@ -128,7 +128,7 @@ int rcal_cmd_acquire(int argc, char **argv)
     rch_acq_result r;
     const char *proto = NULL, *parity = "none", *flow = "none", *mbf = "int32", *mbo = "abcd", *poll = NULL,
                *joints = "plan";
-    unsigned long baud = 9600, bits = 8, stop = 1, mb_addr = 1, mb_reg = 0, mb_dec = 0, n = 5, pose_s = 60;
+    unsigned long baud = 9600, bits = 8, stop = 1, mb_addr = 1, mb_reg = 0, mb_dec = 0, n = 5, pose_s = 60, outlet = 0;
     int rc, json = 0;
     rch_acq_config_default(&c);
     memset(&r, 0, sizeof r);
@@ -139,6 +139,10 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--protocol", RCH_OPT_CHOICE, &proto, 0, 0, NULL, "display protocol", RCH_OPT_REQUIRED, "ascii|ascii-poll|stx|modbus"},
         {"--poses", RCH_OPT_STR, &c.poses_path, 0, 0, "POSES.csv", "pose plan (rcal poses)", RCH_OPT_REQUIRED, NULL},
         {"--out", RCH_OPT_STR, &c.out_path, 0, 0, "DATA.csv", "acquisition file (appended)", RCH_OPT_REQUIRED, NULL},
+        {"--outlet", RCH_OPT_UINT, &outlet, 0, 255, "N",
+         "the encoder place this run measures from (a label 0..255, written as the file's outlet column): "
+         "the same plan run again from another place appends to the same file; give --encoder as this "
+         "place's position for the follow check", 0, NULL},
         {"--robot", RCH_OPT_STR, &c.robot_path, 0, 0, "MODEL.json", "nominal model: limits, follow check", 0, NULL},
         {"--encoder", RCH_OPT_TRIPLE, c.encoder_mm, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none", 0, NULL},
         {"--backend", RCH_OPT_CHOICE, &c.backend, 0, 0, NULL, "port backend", 0, "serialport|posix"},
@@ -172,9 +176,11 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
          "the run summary as one JSON object on stdout (progress then goes to stderr)", 0, NULL},
     };
-    const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
+    unsigned long long seen = 0;
+    const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (st >= 0)
         return st;
+    c.outlet_p1 = rch_opt_given(&spec, seen, "--outlet") ? (int)outlet + 1 : 0;
     if (!(c.stable.min_mm < c.stable.max_mm)) {
         fprintf(stderr, "rcal acquire: need --min-mm < --max-mm\n");
         return 2;

@@ -18,7 +18,9 @@
 #include "rc_kin.h"
 #include "rc_model.h"
 #include "rc_solve.h"
+#include "rch_acqfile.h"
 #include "rch_calib.h"
+#include "rch_data.h"
 #include "rch_comp.h"
 #include "rch_prior.h"
 #include "rch_robot.h"
@@ -547,12 +549,69 @@ static void test_model_file_checked(void **state)
     rmdir(dir);
 }
 
+/* The acquisition file of several encoder places: the same plan from a
+ * second place appends, poses are done per place, a file's header decides,
+ * and the calibration reads the places back (issue 20). */
+static void test_acqfile_outlets(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rcal_prior_XXXXXX", path[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/acq.csv", dir);
+    const double plan[2][RC_NJ] = {{0, 10, 20, 0, 30, 0}, {5, 15, 25, 0, 35, 0}};
+    unsigned char done[2];
+    rch_acqfile a;
+    rch_acqfile_state st;
+    rch_diag d;
+    rc_stable_result r;
+    memset(&r, 0, sizeof r);
+    r.mean_mm = 500.0;
+    r.count = 5;
+    for (int place = 3; place <= 4; ++place) { /* labels 3 and 4 */
+        assert_int_equal(rch_acqfile_open_outlet(&a, &st, done, path, plan, 2, place + 1, &d), 0);
+        assert_int_equal(st.n_done, 0); /* nothing yet from this place */
+        for (size_t i = 0; i < 2; ++i) {
+            r.mean_mm = 500.0 + 10.0 * place + (double)i;
+            assert_int_equal(rch_acqfile_append(&a, i, plan[i], &r, 1000, &d), 0);
+        }
+        assert_int_equal(rch_acqfile_close(&a, &d), 0);
+        assert_int_equal(rch_acqfile_open_outlet(&a, &st, done, path, plan, 2, place + 1, &d), 0);
+        assert_int_equal(st.n_done, 2);
+        assert_true(st.has_last && fabs(st.last_len_mm - (501.0 + 10.0 * place)) < 1e-9);
+        assert_int_equal(rch_acqfile_close(&a, &d), 0);
+    }
+    /* a run without --outlet on a file of places is refused, nothing changed */
+    assert_int_not_equal(rch_acqfile_open(&a, &st, done, path, plan, 2, &d), 0);
+    assert_non_null(strstr(d.msg, "--outlet"));
+    rch_data data;
+    assert_int_equal(rch_data_load(&data, path, RCH_DATA_POSE, &d), 0);
+    assert_int_equal(data.n, 4);
+    assert_true(data.has_outlet);
+    uint8_t label[RC_MAX_OUTLETS];
+    assert_int_equal(rch_data_outlets(label, data.s, data.n, &d), 2);
+    assert_int_equal(label[0], 3);
+    assert_int_equal(label[1], 4);
+    assert_int_equal(data.s[0].outlet, 0);
+    assert_int_equal(data.s[3].outlet, 1);
+    rch_data_free(&data);
+    /* a file of one place refuses --outlet */
+    char one[256];
+    snprintf(one, sizeof one, "%s/one.csv", dir);
+    assert_int_equal(rch_acqfile_open(&a, &st, done, one, plan, 2, &d), 0);
+    assert_int_equal(rch_acqfile_close(&a, &d), 0);
+    assert_int_not_equal(rch_acqfile_open_outlet(&a, &st, done, one, plan, 2, 1, &d), 0);
+    unlink(one);
+    unlink(path);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_effect_table), cmocka_unit_test(test_outlet_meas), cmocka_unit_test(test_prior_fill),
         cmocka_unit_test(test_centred),      cmocka_unit_test(test_off_centre),  cmocka_unit_test(test_outlets),
         cmocka_unit_test(test_radius95),     cmocka_unit_test(test_axis_tilt),   cmocka_unit_test(test_model_file_checked),
+        cmocka_unit_test(test_acqfile_outlets),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

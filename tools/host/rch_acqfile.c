@@ -112,8 +112,9 @@ static long good_prefix(const char *text, size_t len, const char *path, rch_diag
 }
 
 static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state *st,
-                      const double (*plan_deg)[RC_NJ], size_t n_poses, const char *path, rch_diag *d)
+                      const double (*plan_deg)[RC_NJ], size_t n_poses, const char *path, int outlet_p1, rch_diag *d)
 {
+    size_t last = f->n;
     for (size_t i = 0; i < f->n; ++i) {
         const unsigned long pose = f->pose[i];
         if (pose >= n_poses) {
@@ -129,21 +130,30 @@ static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state 
                 return -1;
             }
         }
+        if (outlet_p1 && f->s[i].outlet != (unsigned)(outlet_p1 - 1))
+            continue; /* measured from another place: not done from this one */
         if (!done[pose])
             st->n_done++;
         done[pose] = 1;
+        last = i;
     }
-    if (f->n > 0) {
+    if (last < f->n) { /* the last sample from this place */
         st->has_last = 1;
-        st->last_pose = (size_t)f->pose[f->n - 1];
-        st->last_len_mm = f->s[f->n - 1].len_mm;
+        st->last_pose = (size_t)f->pose[last];
+        st->last_len_mm = f->s[last].len_mm;
     }
     return 0;
 }
 
 /* Read the file (bounded), drop an unfinished tail, check the rest. */
+static int has_header(const char *text, size_t len, const char *h)
+{
+    const size_t n = strlen(h);
+    return len > n && strncmp(text, h, n) == 0 && (text[n] == '\n' || (text[n] == '\r' && len > n + 1 && text[n + 1] == '\n'));
+}
+
 static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *path,
-                const double (*plan_deg)[RC_NJ], size_t n_poses, rch_diag *d)
+                const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, rch_diag *d)
 {
     struct stat sb;
     char *text;
@@ -180,17 +190,28 @@ static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *
     good = good_prefix(text, len, path, d);
     if (good < 0)
         goto out;
-    if (good > 0 && strncmp(text, RCH_ACQ_HEADER "\n", strlen(RCH_ACQ_HEADER) + 1) != 0 &&
-        strncmp(text, RCH_ACQ_HEADER "\r\n", strlen(RCH_ACQ_HEADER) + 2) != 0) {
+    const int plain = good > 0 && has_header(text, (size_t)good, RCH_ACQ_HEADER);
+    const int with_outlet = good > 0 && has_header(text, (size_t)good, RCH_ACQ_HEADER_OUTLET);
+    if (good > 0 && !plain && !with_outlet) {
         rch_diag_set(d, path, 1, 1, "exists but is not an acquisition file (header '%s' expected); choose "
-                     "another --out (nothing was changed)", RCH_ACQ_HEADER);
+                     "another --out (nothing was changed)", outlet_p1 ? RCH_ACQ_HEADER_OUTLET : RCH_ACQ_HEADER);
+        goto out;
+    }
+    if (plain && outlet_p1) {
+        rch_diag_set(d, path, 1, 1, "holds samples of one encoder place (no outlet column): a run with --outlet "
+                     "needs a file of its own, or leave --outlet out (nothing was changed)");
+        goto out;
+    }
+    if (with_outlet && !outlet_p1) {
+        rch_diag_set(d, path, 1, 1, "records several encoder places (column outlet): say which one this run "
+                     "measures from with --outlet N (nothing was changed)");
         goto out;
     }
     if (good > 0) {
         rch_data f;
         if (rch_data_parse(&f, text, (size_t)good, path, RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY, d) != 0)
             goto out;
-        rc = check_plan(&f, done, st, plan_deg, n_poses, path, d);
+        rc = check_plan(&f, done, st, plan_deg, n_poses, path, outlet_p1, d);
         rch_data_free(&f);
         if (rc != 0)
             goto out;
@@ -205,7 +226,8 @@ static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *
         }
         st->dropped_bytes = len - (size_t)good;
     }
-    if (good == 0 && write_all(fd, RCH_ACQ_HEADER "\n", strlen(RCH_ACQ_HEADER) + 1) != 0) {
+    const char *header = outlet_p1 ? RCH_ACQ_HEADER_OUTLET "\n" : RCH_ACQ_HEADER "\n";
+    if (good == 0 && write_all(fd, header, strlen(header)) != 0) {
         rch_diag_set(d, path, 0, 0, "cannot write the header: %s", strerror(errno));
         goto out;
     }
@@ -222,9 +244,16 @@ out:
 int rch_acqfile_open(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
                      const double (*plan_deg)[RC_NJ], size_t n_poses, rch_diag *d)
 {
+    return rch_acqfile_open_outlet(a, st, done, path, plan_deg, n_poses, 0, d);
+}
+
+int rch_acqfile_open_outlet(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
+                            const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, rch_diag *d)
+{
     memset(st, 0, sizeof *st);
     memset(done, 0, n_poses);
     a->fd = -1;
+    a->outlet_p1 = outlet_p1 > 0 && outlet_p1 <= 256 ? outlet_p1 : 0;
     if (strlen(path) >= sizeof a->path) {
         rch_diag_set(d, path, 0, 0, "path too long");
         return -1;
@@ -235,7 +264,7 @@ int rch_acqfile_open(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done,
         rch_diag_set(d, path, 0, 0, "cannot open for appending: %s", strerror(errno));
         return -1;
     }
-    if (lock_file(a->fd, path, d) != 0 || scan(st, done, a->fd, path, plan_deg, n_poses, d) != 0) {
+    if (lock_file(a->fd, path, d) != 0 || scan(st, done, a->fd, path, plan_deg, n_poses, a->outlet_p1, d) != 0) {
         close(a->fd);
         a->fd = -1;
         return -1;
@@ -250,8 +279,11 @@ int rch_acqfile_append(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], c
     int n = snprintf(line, sizeof line, "%zu", pose);
     for (int j = 0; j < RC_NJ; ++j)
         n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f", q_deg[j]);
-    n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f,%.4f,%u,%lld\n", r->mean_mm, r->spread_mm, r->count,
+    n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f,%.4f,%u,%lld", r->mean_mm, r->spread_mm, r->count,
                   t_unix_ms);
+    if (a->outlet_p1)
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%d", a->outlet_p1 - 1);
+    n += snprintf(line + n, sizeof line - (size_t)n, "\n");
     if (n <= 0 || (size_t)n >= sizeof line) {
         rch_diag_set(d, a->path, 0, 0, "sample line too long");
         return -1;

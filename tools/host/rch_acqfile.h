@@ -7,6 +7,11 @@
  * one line per sample: plan index, joint angles (deg, %.4f), the sample's
  * mean length and spread (mm, %.4f), the readings it averages and the wall
  * clock (ms). Each line is written with one write(2) and fsync'ed at once.
+ * A file of several encoder places (issue 20) has a last column, outlet (the
+ * place's label, 0..255: RCH_ACQ_HEADER_OUTLET): the same plan run again from
+ * another place appends to the same file, and a pose counts as done only for
+ * the place it was measured from. A file's header decides: an outlet is
+ * given exactly when the file has the column.
  *
  * rch_acqfile_open() takes an exclusive lock on the file (fcntl F_SETLK,
  * held until rch_acqfile_close): a second acquisition on the same file is
@@ -31,12 +36,14 @@
 #include "rch_diag.h"
 
 #define RCH_ACQ_HEADER "pose,q1,q2,q3,q4,q5,q6,L,spread_mm,n_readings,t_unix_ms"
+#define RCH_ACQ_HEADER_OUTLET RCH_ACQ_HEADER ",outlet"
 #define RCH_ACQ_MAX_LINE 4096u                  /* longest line accepted when resuming */
 #define RCH_ACQ_MAX_BYTES (256u * 1024u * 1024u) /* largest file resumed (about 2.5 M samples) */
 
 typedef struct rch_acqfile {
     int fd;              /* -1 when closed */
     char path[1024];
+    int outlet_p1;       /* 0 no outlet column, k + 1 the outlet label k recorded (rch_acqfile_open_outlet) */
 } rch_acqfile;
 
 /* What the file held when it was opened. */
@@ -56,6 +63,11 @@ typedef struct rch_acqfile_state {
  * plan"). 0, or -1 with d set (and the file closed, unlocked, unchanged). */
 int rch_acqfile_open(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
                      const double (*plan_deg)[RC_NJ], size_t n_poses, rch_diag *d);
+
+/* rch_acqfile_open for the encoder place outlet_p1 - 1 (0: a file of one
+ * place, no outlet column): poses count as done only when measured from it. */
+int rch_acqfile_open_outlet(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
+                            const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, rch_diag *d);
 
 /* Append one sample line and fsync. 0, or -1 with d set. */
 int rch_acqfile_append(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], const rc_stable_result *r,

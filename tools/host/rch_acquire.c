@@ -475,7 +475,8 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     if (check_paths(&a) != 0 || load_inputs(&a) != 0)
         goto out;
     res->n_poses = a.n;
-    if (rch_acqfile_open(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n, &dg) != 0) {
+    if (rch_acqfile_open_outlet(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n,
+                                c->outlet_p1, &dg) != 0) {
         WARN(&a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
         goto out;
     }

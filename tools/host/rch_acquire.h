@@ -85,6 +85,8 @@ typedef struct rch_acq_config {
      * plan). Raise it when the outlet position is only roughly known. */
     double follow_tol_mm;       /* > 0 */
     int no_follow_check;        /* 1: skip it (a plan of tiny moves) */
+    int outlet_p1;              /* 0: one encoder place; k + 1: this run measures from outlet k (the file's
+                                   outlet column; give --encoder as this place's position for the follow check) */
     int confirm, quiet;
 } rch_acq_config;
 
