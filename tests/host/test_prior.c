@@ -21,6 +21,7 @@
 #include "rch_acqfile.h"
 #include "rch_calib.h"
 #include "rch_data.h"
+#include "rch_diagnose.h"
 #include "rch_comp.h"
 #include "rch_prior.h"
 #include "rch_robot.h"
@@ -605,13 +606,62 @@ static void test_acqfile_outlets(void **state)
     rmdir(dir);
 }
 
+/* A 5 mm length jump in the middle of independent poses (the ordinary
+ * plan, no set-ups): diagnose names it and calibrate fits it by default
+ * (issue 23's missed cause: it was read as time drift). */
+static void test_jump_independent(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rcal_prior_XXXXXX", path[256], jpath[256];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/i.csv", dir);
+    snprintf(jpath, sizeof jpath, "%s/j.csv", dir);
+    rct_rng g = {5150};
+    double dh[6][4];
+    draw_truth(dh, &g);
+    const double e[1][3] = {{480, -350, 30}}, tool[3] = {0, 0, 0};
+    write_data(path, dh, tool, e, 1, 300, 0.01, &g);
+    /* the same rows, every length from the middle on 5 mm longer */
+    FILE *in = fopen(path, "r"), *out = fopen(jpath, "w");
+    assert_true(in && out);
+    char line[512];
+    int k = 0;
+    while (fgets(line, sizeof line, in)) {
+        char *last = strrchr(line, ',');
+        if (k++ > 150 && last) {
+            const double l = atof(last + 1) + 5.0;
+            snprintf(last, sizeof line - (size_t)(last - line), ",%.4f\n", l);
+        }
+        fputs(line, out);
+    }
+    fclose(in);
+    fclose(out);
+    static rch_diagnose_result dr;
+    rch_diagnose_cfg dc;
+    memset(&dc, 0, sizeof dc);
+    rch_diag d;
+    assert_int_equal(rch_diagnose_file(&dr, jpath, RCAL_SOURCE_DIR "/data/irb120.json", &dc, &d), 0);
+    print_message("verdict %s, %u jump(s)\n", dr.effect, dr.jumps.n_jumps);
+    assert_string_equal(dr.effect, "length_jump");
+    assert_int_equal(dr.jumps.n_jumps, 1);
+    assert_true(fabs(dr.jumps.size_mm[0] - 5.0) < 0.05);
+    rch_diagnose_free(&dr);
+    calibrate(jpath);
+    assert_true(res.jumps_auto && res.have_jumps && res.jumps.n_jumps == 1);
+    assert_true(fabs(res.jumps.size_mm[0] - 5.0) < 0.05);
+    assert_true(res.after_m.rmse_mm < 0.03);
+    unlink(path);
+    unlink(jpath);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_effect_table), cmocka_unit_test(test_outlet_meas), cmocka_unit_test(test_prior_fill),
         cmocka_unit_test(test_centred),      cmocka_unit_test(test_off_centre),  cmocka_unit_test(test_outlets),
         cmocka_unit_test(test_radius95),     cmocka_unit_test(test_axis_tilt),   cmocka_unit_test(test_model_file_checked),
-        cmocka_unit_test(test_acqfile_outlets),
+        cmocka_unit_test(test_acqfile_outlets), cmocka_unit_test(test_jump_independent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

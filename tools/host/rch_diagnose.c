@@ -972,11 +972,19 @@ static int phase_jumps(run_state *S, rch_diag *d)
     unsigned inside = 0;
     for (unsigned k = 0; k < out->jumps.n_jumps; ++k) {
         size_t a = out->jumps.at[k];
-        int near = 0;
+        int near = 0, single = 1;
         for (size_t i = a >= 2 ? a - 2 : 1; i <= a + 1 && i < n; ++i)
             near |= out->s[i].group != out->s[i - 1].group;
-        inside += !near && sharp_step(&out->jumps.geometry, out->s, n, a, out->jumps.size_mm[k]);
-        out->jumps_at_setup_change += (unsigned)near;
+        /* Independent poses (no set-ups: every sample its own group around
+         * the step) leave nothing set-up dependent to confound a step with:
+         * there a jump far above the residual (8 x, rcal calibrate's rule)
+         * is a sensor event (issue 23: a 5 mm jump on the ordinary plan was
+         * read as time drift). */
+        for (size_t i = a >= 3 ? a - 3 : 1; i <= a + 2 && i < n; ++i)
+            single &= out->s[i].group != out->s[i - 1].group;
+        const int big_alone = near && single && fabs(out->jumps.size_mm[k]) > 8.0 * out->jumps.rms_after_mm;
+        inside += big_alone || (!near && sharp_step(&out->jumps.geometry, out->s, n, a, out->jumps.size_mm[k]));
+        out->jumps_at_setup_change += (unsigned)(near && !big_alone);
     }
     if (inside == 0) {
         out->jumps_confounded = out->jumps.n_jumps;
