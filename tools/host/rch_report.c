@@ -1544,7 +1544,8 @@ static void sec_provenance(rep *r, const dfile *df, size_t n_df, const char *dat
     kv_end(r);
     kv(r, "command line");
     fputs("<span class=\"mono\">", f);
-    put_str(r, prov_str(r, "command_line"));
+    /* calibrate's JSON names it "command" (rch_jw_header); older files "command_line" */
+    put_str(r, prov_str(r, "command") ? prov_str(r, "command") : prov_str(r, "command_line"));
     fputs("</span>", f);
     kv_end(r);
     kv(r, "date (UTC)");
