@@ -1513,6 +1513,7 @@ static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
     rch_jw_str(w, "groups_from", r->groups_from_file ? "file" : "wrist joints");
     rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
     rch_jw_uint(w, "rank", u->rank);
+    rch_jw_bool(w, "posterior", u->has_prior);
     rch_robot_write_unc_params(w, &r->model, u, "%.9g");
     rch_robot_write_unc_map(w, &u->map);
     rch_jw_bool(w, "orientation_determined", u->orientation_determined);
@@ -1539,6 +1540,24 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
     rch_jw_uint(&w, "cost_evals", r->solve.cost_evals);
     rch_jw_numf(&w, "time_ms", r->time_ms, "%.3f");
     json_params(&w, r);
+    rch_jw_obj(&w, "estimation");
+    rch_jw_bool(&w, "prior", r->prior_on);
+    if (r->prior_on) {
+        rch_jw_num(&w, "prior_length_mm", r->robot.prior.length_mm);
+        rch_jw_num(&w, "prior_twist_deg", r->robot.prior.twist_deg);
+        rch_jw_num(&w, "prior_offset_deg", r->robot.prior.offset_deg);
+        rch_jw_num(&w, "prior_attachment_mm", r->robot.prior.attachment_mm);
+        rch_jw_numf(&w, "noise_mm", r->noise_mm, "%.6g");
+        rch_jw_numf(&w, "effective_params", r->p_eff, "%.4g");
+    }
+    rch_jw_uint(&w, "outlets", r->n_outlets ? r->n_outlets : 1u);
+    if (r->attach_auto) {
+        rch_jw_str(&w, "attachment", r->attach_centred ? "flange centre" : "estimated");
+        rch_jw_numf(&w, "attachment_dchi2", r->attach_dchi2, "%.6g");
+        rch_jw_numf(&w, "attachment_occam", r->attach_occam, "%.6g");
+    }
+    rch_jw_bool(&w, "jumps_found_by_default", r->jumps_auto);
+    rch_jw_end(&w);
     if (r->cfg.truth_path) {
         rch_jw_obj(&w, "truth_flange");
         rch_jw_numf(&w, "before_rms_mm", r->truth_before_rms_mm, "%.6f");
