@@ -24,6 +24,13 @@
 #                      pkg_limits_link_refused run the compiler and pass on
 #                      the error it prints (ctest's PASS_REGULAR_EXPRESSION),
 #                      which this script cannot judge; no project code runs.
+#                      diag_indep (the independent generator's 100 diagnoses,
+#                      each now a MAP calibration with jump search: 509 s under
+#                      memcheck, the same paths as diag_cli and host_prior) and
+#                      robust_issue23 (it closes stdout with >&- and checks the
+#                      exit status: memcheck's own descriptors change what a
+#                      closed stdout is; its sanitizer run is the check) run
+#                      under ASan+UBSan+LSan only.
 #                      Set it to '' to run everything.
 #   VALGRIND_TIMEOUT   seconds per test (default 900)
 #   VALGRIND_CHILDREN  1: trace child processes (default), 0: only the test
@@ -32,7 +39,7 @@ set -u -o pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-$ROOT/build-valgrind}
-EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|drv_e2e|pkg_limits_define_refused|pkg_limits_link_refused)\$}
+EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|drv_e2e|robust_issue23|pkg_limits_define_refused|pkg_limits_link_refused)\$}
 TMO=${VALGRIND_TIMEOUT:-900}
 CHILDREN=${VALGRIND_CHILDREN:-1}
 JOBS=${JOBS:-1}
