@@ -24,9 +24,9 @@
 #                      pkg_limits_link_refused run the compiler and pass on
 #                      the error it prints (ctest's PASS_REGULAR_EXPRESSION),
 #                      which this script cannot judge; no project code runs.
-#                      diag_indep (the independent generator's 100 diagnoses,
-#                      each now a MAP calibration with jump search: 509 s under
-#                      memcheck, the same paths as diag_cli and host_prior) and
+#                      diag_indep (the independent generator's 100 diagnoses:
+#                      509 s under memcheck, a third of the whole valgrind run;
+#                      the same paths as diag_cli and host_prior) and
 #                      robust_issue23 (it closes stdout with >&- and checks the
 #                      exit status: memcheck's own descriptors change what a
 #                      closed stdout is; its sanitizer run is the check) run
