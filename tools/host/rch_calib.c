@@ -192,26 +192,7 @@ int rch_calib_effects(rc_model *m, const char *list, rch_diag *d)
 
 void rch_model_strip_nuisance(rc_model *out, const rc_model *m)
 {
-    double dh[RC_NJ][4];
-    for (unsigned i = 0; i < RC_NJ; ++i)
-        for (unsigned k = 0; k < 4; ++k)
-            dh[i][k] = m->x[4 * i + k];
-    rc_model r;
-    rc_model_init(&r, (const double(*)[4])dh, &m->x[RC_P_ENC]);
-    memcpy(r.q_min_rad, m->q_min_rad, sizeof r.q_min_rad);
-    memcpy(r.q_max_rad, m->q_max_rad, sizeof r.q_max_rad);
-    for (unsigned e = 0; e < m->n_effects; ++e) {
-        const rc_effect *ef = &m->effects[e];
-        const rc_effect_desc *ds = rc_effect_describe(ef->kind);
-        if (ds && ds->nuisance)
-            continue;
-        if (rc_model_add_effect(&r, (rc_effect_kind)ef->kind, ef->joint, ef->count) != RC_OK)
-            continue;
-        rc_effect *ne = &r.effects[r.n_effects - 1];
-        memcpy(ne->ref_dh, ef->ref_dh, sizeof ne->ref_dh);
-        memcpy(&r.x[ne->first], &m->x[ef->first], ef->count * sizeof r.x[0]);
-    }
-    *out = r;
+    rch_model_rebuild(out, m, 1, 0, NULL);
 }
 
 int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d)

@@ -574,7 +574,7 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     return rc;
 }
 
-void rch_comp_point_model(rc_model *out, const rc_model *m, const double *tool_mm)
+void rch_model_rebuild(rc_model *out, const rc_model *m, int drop_nuisance, int drop_point, const double *tool_mm)
 {
     double dh[RC_NJ][4];
     for (unsigned i = 0; i < RC_NJ; ++i)
@@ -588,7 +588,8 @@ void rch_comp_point_model(rc_model *out, const rc_model *m, const double *tool_m
         memcpy(&r.x[r.effects[0].first], tool_mm, 3 * sizeof r.x[0]);
     for (unsigned e = 0; e < m->n_effects; ++e) {
         const rc_effect *ef = &m->effects[e];
-        if (ef->kind == RC_EFF_TOOL_OFFSET)
+        const rc_effect_desc *ds = rc_effect_describe(ef->kind);
+        if ((drop_point && ef->kind == RC_EFF_TOOL_OFFSET) || (drop_nuisance && ds && ds->nuisance))
             continue;
         if (rc_model_add_effect(&r, (rc_effect_kind)ef->kind, ef->joint, ef->count) != RC_OK)
             continue;
@@ -597,6 +598,11 @@ void rch_comp_point_model(rc_model *out, const rc_model *m, const double *tool_m
         memcpy(&r.x[ne->first], &m->x[ef->first], ef->count * sizeof r.x[0]);
     }
     *out = r;
+}
+
+void rch_comp_point_model(rc_model *out, const rc_model *m, const double *tool_mm)
+{
+    rch_model_rebuild(out, m, 0, 1, tool_mm);
 }
 
 unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, char *held, size_t held_len,

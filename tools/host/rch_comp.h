@@ -71,6 +71,12 @@ typedef struct rch_comp_job {
  * attachment; the program means the flange (or its TCP). */
 void rch_comp_point_model(rc_model *out, const rc_model *m, const double *tool_mm);
 
+/* m rebuilt with some of its effects left out: the nuisance ones
+ * (rc_effect_desc.nuisance) with drop_nuisance, the measured point's offset
+ * (RC_EFF_TOOL_OFFSET) with drop_point; with tool_mm (3, may be NULL) a tool
+ * offset of that value first. The one place a model loses effects. */
+void rch_model_rebuild(rc_model *out, const rc_model *m, int drop_nuisance, int drop_point, const double *tool_mm);
+
 /* What the compensation may act on (issue 10): the determined model is
  * compiled into the stream; these say where it can be trusted. */
 typedef struct rch_comp_gate {

@@ -150,6 +150,29 @@ static void jump_sizes(rch_jumps *j, const rc_sample *s, size_t n)
         rch_uncert_free(&u);
 }
 
+/* The result of a fit cur (SSR ssr) at the change points at (m): the model,
+ * the points, the geometry without the nuisance offsets, and the sizes with
+ * their standard errors (c: the samples' copy, relabelled here). */
+static void finish(rch_jumps *out, const rc_model *cur, double ssr, const rc_sample *s, rc_sample *c, size_t n,
+                   const size_t *at, unsigned m)
+{
+    out->n_jumps = m;
+    out->model = *cur;
+    out->rms_after_mm = sqrt(ssr / (double)n);
+    for (unsigned k = 0; k < m; ++k) {
+        out->at[k] = at[k];
+        out->at_t[k] = s[at[k]].t;
+    }
+    out->geometry = *cur;
+    if (m > 0) {
+        out->geometry.n_effects--;
+        out->geometry.n_params = (uint16_t)cur->effects[cur->n_effects - 1].first;
+    }
+    for (size_t i = 0; i < n; ++i)
+        c[i].group = (uint16_t)rch_jumps_segment(out, c[i].t);
+    jump_sizes(out, c, n);
+}
+
 int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, const rc_sample *s, size_t n,
                    const rch_jumps_config *cfg, rc_solve_work *w, char *err, size_t errlen)
 {
@@ -225,22 +248,7 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
             return -1;
         }
     }
-    out->n_jumps = m;
-    out->model = cur;
-    out->rms_after_mm = sqrt(ssr / (double)n);
-    for (unsigned k = 0; k < m; ++k) {
-        out->at[k] = at[k];
-        out->at_t[k] = s[at[k]].t;
-    }
-    /* the geometry of the final fit, without the nuisance offsets */
-    out->geometry = cur;
-    if (m > 0) {
-        out->geometry.n_effects--;
-        out->geometry.n_params = (uint16_t)cur.effects[cur.n_effects - 1].first;
-    }
-    for (size_t i = 0; i < n; ++i)
-        c[i].group = (uint16_t)rch_jumps_segment(out, c[i].t);
-    jump_sizes(out, c, n);
+    finish(out, &cur, ssr, s, c, n, at, m);
     free(c);
     return 0;
 }
@@ -273,21 +281,8 @@ int rch_jumps_refit(rch_jumps *out, const rc_model *start, const uint8_t *fixed,
         free(c);
         return -1;
     }
-    out->n_jumps = m;
-    out->model = cur;
-    out->rms_after_mm = out->rms_before_mm = sqrt(ssr / (double)n);
-    for (unsigned k = 0; k < m; ++k) {
-        out->at[k] = at[k];
-        out->at_t[k] = s[at[k]].t;
-    }
-    out->geometry = cur;
-    if (m > 0) {
-        out->geometry.n_effects--;
-        out->geometry.n_params = (uint16_t)cur.effects[cur.n_effects - 1].first;
-    }
-    for (size_t i = 0; i < n; ++i)
-        c[i].group = (uint16_t)rch_jumps_segment(out, c[i].t);
-    jump_sizes(out, c, n);
+    finish(out, &cur, ssr, s, c, n, at, m);
+    out->rms_before_mm = out->rms_after_mm;
     free(c);
     return 0;
 }
