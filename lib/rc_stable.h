@@ -13,7 +13,7 @@
  *
  * This is the second step of the data path: serial byte -> reading
  * (drivers/rcd_proto, rcd_display) -> sample (this rule) -> acquisition file
- * (tools/host/rch_acqfile) -> fit.
+ * (tools/host/files/rch_acqfile) -> fit.
  *
  * Depends on: rc_status.h only. No heap, no stdio, no clock: the caller
  * passes the time of each reading (any monotonic millisecond counter; a

@@ -7,7 +7,8 @@
 #     static analysis, fuzzing (bounded time), valgrind, the package
 #     (fresh-tree install, static and shared, consumer built with find_package
 #     and with pkg-config: scripts/install_check.sh, about 30 s) and the SPDX
-#     licence line of every source file (scripts/spdx_check.sh).
+#     licence line of every source file (scripts/spdx_check.sh), and the host
+#     library's layers (scripts/layers.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -27,7 +28,7 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
   ctest --test-dir build-asan --output-on-failure -j"$JOBS" || status=1
 
 for extra in firmware_host/cross_build.sh scripts/static_analysis.sh fuzz/run.sh scripts/valgrind_tests.sh \
-  scripts/install_check.sh scripts/spdx_check.sh; do
+  scripts/install_check.sh scripts/spdx_check.sh scripts/layers.sh; do
   if [ -x "$extra" ]; then
     echo "== $extra"
     "$extra" || status=1

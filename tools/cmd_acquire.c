@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_acquire.c - rcal acquire: record cable lengths from the encoder display.
  *
- * Parses the options and runs rch_acquire_run (tools/host/rch_acquire.h: the
+ * Parses the options and runs rch_acquire_run (tools/host/studies/rch_acquire.h: the
  * state machine, the follow check; lib/rc_stable.h: the stability rule;
- * tools/host/rch_acqfile.h: the locked, append-only, resumable file).
+ * tools/host/files/rch_acqfile.h: the locked, append-only, resumable file).
  */
 #include <math.h>
 #include <stdio.h>

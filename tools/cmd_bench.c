@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_bench.c - rcal bench: calibration speed, medians of repeated runs in
- * one process (rch_bench_run, tools/host/rch_bench.h). Times are wall-clock
+ * one process (rch_bench_run, tools/host/studies/rch_bench.h). Times are wall-clock
  * on one core; these machines are shared, so quote the medians and the
  * ratios measured in the same run. The comparison with Ceres (whole
  * processes) is scripts/bench_ceres.sh. */

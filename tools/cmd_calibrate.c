@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_calibrate.c - rcal calibrate: identify the DH errors and the encoder
  * position from cable lengths, with a held-out before/after report. The work
- * is rch_calib_run (tools/host/rch_calib.h). */
+ * is rch_calib_run (tools/host/fit/rch_calib.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

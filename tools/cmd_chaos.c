@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_chaos.c - rcal chaos: the LTLM paper's uniformity study of its
  * logistic-tent map (its Figs. 2-3 and Eq. 12). The study is rch_chaos_run
- * (tools/host/rch_chaos.h); this file parses options and reports.
+ * (tools/host/studies/rch_chaos.h); this file parses options and reports.
  */
 #include <stdio.h>
 

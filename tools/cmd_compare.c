@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_compare.c - rcal compare: the LTLM paper's comparison of seven
  * identification methods (its Table 6, Fig. 6d, Figs. 7-8) on your data.
- * The protocol is rch_compare_run (tools/host/rch_compare.h); this file
+ * The protocol is rch_compare_run (tools/host/studies/rch_compare.h); this file
  * parses options, loads the robot and the data, and reports.
  */
 #include <errno.h>
@@ -127,7 +127,7 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
         if (rc == 0 && o->resid) { /* case 1, every method */
             rch_resid_table t;
             rch_resid_init(&t, inputs, 1);
-            if (rch_resid_from_compare(&t, &res, data.s, data.line) != 0) {
+            if (rch_compare_resid(&t, &res, data.s, data.line) != 0) {
                 rch_diag_set(&d, "", 0, 0, "out of memory");
                 rc = 1;
             } else {

@@ -2,7 +2,7 @@
 /* cmd_diagnose.c - rcal diagnose: where model and measurement disagree,
  * which missing physical effect explains it, and how much the held-out gap
  * shrinks when it is added (issue 6). The work is rch_diagnose_file
- * (tools/host/rch_diagnose.h). */
+ * (tools/host/studies/rch_diagnose.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,7 +47,7 @@ static int save_residuals(const rch_diagnose_result *r, const char *data_path, c
     } else {
         rch_resid_table t;
         rch_resid_init(&t, inputs, 1);
-        if (rch_resid_from_diagnose(&t, r, data.line) != 0) {
+        if (rch_diagnose_resid(&t, r, data.line) != 0) {
             fprintf(stderr, "rcal diagnose: out of memory\n");
             rc = 1;
         } else if (rch_resid_save(path, inputs, 2, &t, &d) != 0) {

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_export.c - rcal export: a model as a URDF or as a DH table in CSV
- * (tools/host/rch_export.h, docs/export.md). */
+ * (tools/host/outputs/rch_export.h, docs/export.md). */
 #include <stdio.h>
 #include <string.h>
 

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_fkcheck.c - rcal fkcheck: does our forward kinematics reproduce the
  * controller's nominal x, y, z columns? Reports every row that does not. The
- * work is rch_fkcheck_run (tools/host/rch_calib.h). */
+ * work is rch_fkcheck_run (tools/host/fit/rch_calib.h). */
 #include <stdio.h>
 
 #include "rcal_cmds.h"

@@ -2,7 +2,7 @@
 /* cmd_grind.c - rcal grind: the grinding-path experiment (the paper's
  * Table 8). The experiment (surface, path, nominal IK, base alignment,
  * compensation, deviations, SVG) is rch_grind_run and rch_grind_plots
- * (tools/host/rch_grind.h); this file parses options, loads the models and
+ * (tools/host/studies/rch_grind.h); this file parses options, loads the models and
  * reports.
  */
 #include <math.h>

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_poses.c - rcal poses: plan an identifiable pose set.
  *
- * Parses the options, runs rch_poses_plan (tools/host/rch_poses.h: the
+ * Parses the options, runs rch_poses_plan (tools/host/studies/rch_poses.h: the
  * D-optimal design) and writes the plan with rch_data_write_plan through a
  * temporary file renamed into place (rch_file.h), refusing an --out that
  * names the --robot file.

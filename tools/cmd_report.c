@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_report.c - rcal report: one self-contained HTML page of a calibration
  * (with its diagnosis and model file when given) and the data of its plots as
- * CSV beside it. The work is in tools/host/rch_report.h; see docs/report.md. */
+ * CSV beside it. The work is in tools/host/outputs/rch_report.h; see docs/report.md. */
 #include <stdio.h>
 #include <string.h>
 

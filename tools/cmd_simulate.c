@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_simulate.c - rcal simulate: a data set from a simulated robot with
  * known DH errors and encoder position, in the same CSV format as real data.
- * The work is rch_sim_make (tools/host/rch_sim.h). */
+ * The work is rch_sim_make (tools/host/fit/rch_sim.h). */
 #include <stdio.h>
 #include <string.h>
 

@@ -89,10 +89,10 @@ static int run(int argc, char **argv)
 
 /* Closed standard descriptors are opened on /dev/null before anything else
  * (no file ever takes them); every write to standard output and standard
- * error is checked at the end (tools/host/rch_stdio.h). */
+ * error is checked at the end (tools/host/files/rch_stdio.h). */
 int main(int argc, char **argv)
 {
     rch_stdio_begin("rcal");
-    rch_out_one_command(); /* its outputs never name each other (tools/host/rch_file.h) */
+    rch_out_one_command(); /* its outputs never name each other (tools/host/files/rch_file.h) */
     return rch_stdio_end(run(argc, argv));
 }

@@ -2,7 +2,7 @@
 """rcal: robot calibration with a cable encoder, from Python.
 
 A thin ctypes layer over the C libraries of this repository (the flat API of
-tools/host/rch_ffi.h in librcal_ffi.so), so every figure is the one the
+tools/host/outputs/rch_ffi.h in librcal_ffi.so), so every figure is the one the
 command-line tool prints: the calibration runs the same host function as
 `rcal calibrate`, the compensation the same stream as `rcal compensate`.
 

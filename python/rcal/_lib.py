@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Loading of the shared library rcal_ffi and its ctypes signatures.
 
-The library is tools/host/rch_ffi.h compiled by python/CMakeLists.txt. It is
+The library is tools/host/outputs/rch_ffi.h compiled by python/CMakeLists.txt. It is
 found, in order, at the path in the environment variable RCAL_FFI_LIB, then
 in the build trees next to the package (build/python/librcal_ffi.so under the
 repository root, or any <root>/build*/python/).

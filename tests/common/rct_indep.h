@@ -2,7 +2,7 @@
 /* rct_indep.h - an independent data generator for tests: its own random
  * numbers (splitmix64 + Box-Muller) and its own forward kinematics
  * (standard DH with 4 x 4 homogeneous matrices), written apart from the
- * code under test (lib/rc_model.c, tools/host/rch_sim.c). Tests draw the
+ * code under test (lib/rc_model.c, tools/host/fit/rch_sim.c). Tests draw the
  * truth, the poses and the noise here and never pass the noise level, the
  * effect or its location to the code under test. */
 #ifndef RCT_INDEP_H

@@ -9,6 +9,7 @@
 #include <math.h>
 
 #include "rch_diagnose.h"
+#include "rch_dequant.h"
 
 /* Upper tail of F against tabulated 5 % and 1 % critical values. */
 static void test_f_tail(void **state)
@@ -28,15 +29,15 @@ static void test_detect_step(void **state)
 {
     (void)state;
     const double q[] = {33.9, -30.8, 0.0, 80.5, -59.7, 12.3};
-    assert_true(fabs(rch_diagnose_detect_step(q, 6) - 0.1) < 1e-12);
+    assert_true(fabs(rch_dequant_detect_step(q, 6) - 0.1) < 1e-12);
     const double l[] = {509.19, 498.04, 487.45, 495.14};
-    assert_true(fabs(rch_diagnose_detect_step(l, 4) - 0.01) < 1e-12);
+    assert_true(fabs(rch_dequant_detect_step(l, 4) - 0.01) < 1e-12);
     const double r[] = {500.004, 500.008, 499.996};
-    assert_true(fabs(rch_diagnose_detect_step(r, 3) - 0.004) < 1e-12);
+    assert_true(fabs(rch_dequant_detect_step(r, 3) - 0.004) < 1e-12);
     const double h[] = {1.0, 2.5, 3.0};
-    assert_true(fabs(rch_diagnose_detect_step(h, 3) - 0.5) < 1e-12);
+    assert_true(fabs(rch_dequant_detect_step(h, 3) - 0.5) < 1e-12);
     const double none[] = {0.123456789, 1.0};
-    assert_true(rch_diagnose_detect_step(none, 2) == 0.0);
+    assert_true(rch_dequant_detect_step(none, 2) == 0.0);
 }
 
 int main(void)

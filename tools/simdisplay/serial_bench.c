@@ -226,7 +226,7 @@ static int run(int argc, char **argv)
 }
 
 /* Closed standard descriptors opened on /dev/null first; standard output and
- * standard error checked at the end (tools/host/rch_stdio.h). */
+ * standard error checked at the end (tools/host/files/rch_stdio.h). */
 int main(int argc, char **argv)
 {
     rch_stdio_begin("serial_bench");

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "rc_linalg.h"
+#include "rch_data.h"
 #include "rch_json.h"
 #include "rch_jw.h"
 
@@ -615,4 +616,12 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
         rch_robot_write_provenance(&w, info->prov);
     rch_jw_end(&w);
     return rch_jw_finish(&w) == 0 && !ferror(f) ? 0 : -1;
+}
+
+int rch_load_model_and_data(struct rch_robot *robot, const char *model_path, rch_data *data, const char *data_path,
+                            rch_diag *d)
+{
+    if (rch_robot_load(robot, model_path, d) != 0)
+        return -1;
+    return rch_data_load_limited(data, data_path, 0, &robot->model, d) != 0 ? -1 : 0;
 }

@@ -38,4 +38,8 @@ typedef struct rch_dequant_result {
 int rch_dequant(rch_dequant_result *res, uint8_t *refused, rc_sample *s, size_t n, const double (*xyz)[3],
                 const rc_model *nominal, double max_dq_rad);
 
+/* Coarsest display step of a fixed list (1, 0.5, 0.2, 0.1, ... 1e-4) that
+ * every value sits on (within 1e-6 of a step); 0 when none fits. values: (n). */
+double rch_dequant_detect_step(const double *values, size_t n);
+
 #endif

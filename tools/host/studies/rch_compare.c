@@ -14,6 +14,7 @@
 #include "rch_prior.h"
 #include "rch_jw.h"
 #include "rch_plot.h"
+#include "rch_resid.h"
 #include "rch_save.h"
 #include "rch_uncert.h"
 
@@ -931,5 +932,39 @@ int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *c
         rch_plot_save(plot_per_sample(res, cfg), pd, "per_sample.svg", d) != 0 ||
         rch_compare_curves_csv(res, cfg, pd, d) != 0)
         return -1;
+    return 0;
+}
+
+int rch_compare_resid(rch_resid_table *t, const rch_compare_result *res, const rc_sample *s, const unsigned *line)
+{
+    int col[RCH_COMPARE_ROWS];
+    t->with_case = 1;
+    for (int r = 1; r < RCH_COMPARE_ROWS; ++r) {
+        col[r] = -1;
+        if (res->row[r].used && t->n_steps < RCH_RESID_MAX_STEPS) {
+            col[r] = (int)t->n_steps;
+            (void)rch_resid_add_step(t, rch_compare_row_name(r));
+        }
+    }
+    for (size_t i = 0; i < res->n_draw; ++i) {
+        const size_t k = res->idx_case1[i];
+        rch_resid_row row;
+        memset(&row, 0, sizeof row);
+        row.line = line[k];
+        row.case_no = 1;
+        row.set = i < res->n_test ? RCH_RESID_TEST : RCH_RESID_TRAIN;
+        row.s = s[k];
+        if (!res->ok_case1[0] || rc_meas(&row.predicted_mm, NULL, &res->model_case1[0], &s[k]) != RC_OK)
+            row.predicted_mm = NAN;
+        for (unsigned c = 0; c < RCH_RESID_MAX_STEPS; ++c)
+            row.after_mm[c] = NAN;
+        for (int r = 1; r < RCH_COMPARE_ROWS; ++r) {
+            double l;
+            if (col[r] >= 0 && res->ok_case1[r] && rc_meas(&l, NULL, &res->model_case1[r], &s[k]) == RC_OK)
+                row.after_mm[col[r]] = s[k].len_mm - l;
+        }
+        if (rch_resid_add(t, &row) != 0)
+            return -1;
+    }
     return 0;
 }

@@ -62,6 +62,7 @@
 #include "rc_solve.h"
 #include "rch_diag.h"
 #include "rch_jumps.h"
+#include "rch_resid.h"
 
 #define RCH_DIAGNOSE_MAX_CAND 16
 #define RCH_DIAGNOSE_MAX_STEPS 4
@@ -232,8 +233,13 @@ int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, const char
 /* Statistics helpers (exposed for tests). */
 /* Upper tail P(F > f) of the F(d1, d2) distribution. */
 double rch_diagnose_f_sf(double f, double d1, double d2);
-/* Coarsest display step of a fixed list (1, 0.5, 0.2, 0.1, ... 1e-4) that
- * every value sits on (within 1e-6 of a step); 0 when none fits. values: (n). */
-double rch_diagnose_detect_step(const double *values, size_t n);
+
+/* The table of `rcal diagnose --residuals`: every sample as the diagnosis
+ * used it (line (r->n): their data lines), predicted by the final model (the
+ * geometry with the chosen effects, fitted on all samples: set train), and
+ * the cross-validated held-out residuals of the geometry alone
+ * (residual_after_geometry_cv_mm) and with the chosen effects
+ * (residual_after_<effect>+..._cv_mm, when one was chosen). 0, or -1. */
+int rch_diagnose_resid(rch_resid_table *t, const rch_diagnose_result *r, const unsigned *line);
 
 #endif

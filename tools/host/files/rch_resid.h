@@ -68,21 +68,10 @@ int rch_resid_write(FILE *f, const rch_resid_table *t);
  * one of inputs (n_inputs). 0, or -1 with d set. */
 int rch_resid_save(const char *path, const char *const *inputs, size_t n_inputs, const rch_resid_table *t,
                    rch_diag *d);
-/* The table of `rcal compare --residuals`: case 1's drawn rows of s (line:
- * their data lines), set test (held out) or train, predicted by case 1's
- * start (BC) model, one residual_after_<method>_mm column per method run
- * (empty where it failed). 0, or -1 out of memory. */
-struct rch_compare_result;
-int rch_resid_from_compare(rch_resid_table *t, const struct rch_compare_result *res, const rc_sample *s,
-                           const unsigned *line);
-/* The table of `rcal diagnose --residuals`: every sample as the diagnosis
- * used it (line (r->n): their data lines), predicted by the final model (the
- * geometry with the chosen effects, fitted on all samples: set train), and
- * the cross-validated held-out residuals of the geometry alone
- * (residual_after_geometry_cv_mm) and with the chosen effects
- * (residual_after_<effect>+..._cv_mm, when one was chosen). 0, or -1. */
-struct rch_diagnose_result;
-int rch_resid_from_diagnose(rch_resid_table *t, const struct rch_diagnose_result *r, const unsigned *line);
+/* Adds a residual column named residual_after_<name>_mm (blanks become '_';
+ * cut to the column buffer). 0, or -1 when the table has its
+ * RCH_RESID_MAX_STEPS columns. */
+int rch_resid_add_step(rch_resid_table *t, const char *name);
 void rch_resid_free(rch_resid_table *t);
 
 const char *rch_resid_set_name(rch_resid_set set);

@@ -27,6 +27,7 @@
 #include "rc_model.h"
 #include "rch_diag.h"
 #include "rch_jw.h"
+#include "rch_data.h"
 #include "rch_prior.h"
 #include "rch_uncert.h"
 
@@ -81,5 +82,11 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
 void rch_robot_write_unc_params(rch_jw *w, const rc_model *m, const rch_model_unc *u, const char *value_fmt);
 void rch_robot_write_unc_map(rch_jw *w, const rch_uncert_map *mp);
 void rch_robot_write_provenance(rch_jw *w, const rch_provenance *p);
+
+/* A command's two inputs: the robot (or calibrated) model file and a data
+ * file, its joints inside the model's limits. 0, or -1 with d set (nothing
+ * left allocated). */
+int rch_load_model_and_data(rch_robot *robot, const char *model_path, rch_data *data, const char *data_path,
+                            rch_diag *d);
 
 #endif

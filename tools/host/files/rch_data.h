@@ -74,12 +74,6 @@ void rch_data_free(rch_data *data);
  * with a message naming the likely unit (file name in d). 0 or -1. */
 int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d);
 
-/* A command's two inputs: the robot (or calibrated) model file and a data
- * file, its joints inside the model's limits. 0, or -1 with d set (nothing
- * left allocated). */
-struct rch_robot;
-int rch_load_model_and_data(struct rch_robot *robot, const char *model_path, rch_data *data, const char *data_path,
-                            rch_diag *d);
 
 /* Copy of the samples selected by idx (k). Returns NULL on allocation failure. */
 rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k);

@@ -118,3 +118,21 @@ int rch_dequant(rch_dequant_result *res, uint8_t *refused, rc_sample *s, size_t 
     }
     return 0;
 }
+
+double rch_dequant_detect_step(const double *values, size_t n)
+{
+    static const double steps[] = {1.0,  0.5,   0.2,   0.1,    0.05,  0.02, 0.01,
+                                   0.005, 0.004, 0.002, 0.001, 0.0005, 0.0001};
+    if (n == 0)
+        return 0.0;
+    for (size_t k = 0; k < sizeof steps / sizeof steps[0]; ++k) {
+        int ok = 1;
+        for (size_t i = 0; i < n && ok; ++i) {
+            const double u = values[i] / steps[k];
+            ok = fabs(u - floor(u + 0.5)) < 1e-6;
+        }
+        if (ok)
+            return steps[k];
+    }
+    return 0.0;
+}

@@ -6,8 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rch_compare.h"
-#include "rch_diagnose.h"
 #include "rch_plot.h"
 #include "rch_save.h"
 
@@ -127,84 +125,16 @@ int rch_resid_save(const char *path, const char *const *inputs, size_t n_inputs,
     return rch_save(path, "--residuals", inputs, n_inputs, write_cb, t, d);
 }
 
-/* name into a column-name part (len > 0; cut at len - 1 bytes): blanks become '_'. */
-static void step_name(char *dst, size_t len, const char *name)
+int rch_resid_add_step(rch_resid_table *t, const char *name)
 {
+    char *dst;
     size_t k = 0;
-    for (; name[k] && k + 1 < len; ++k) {
-        dst[k] = name[k];
-        if (dst[k] == ' ')
-            dst[k] = '_';
-    }
+    if (t->n_steps >= RCH_RESID_MAX_STEPS)
+        return -1;
+    dst = t->step[t->n_steps++];
+    for (; name[k] && k + 1 < sizeof t->step[0]; ++k)
+        dst[k] = name[k] == ' ' ? '_' : name[k];
     dst[k] = '\0';
-}
-
-int rch_resid_from_compare(rch_resid_table *t, const rch_compare_result *res, const rc_sample *s,
-                           const unsigned *line)
-{
-    int col[RCH_COMPARE_ROWS];
-    t->with_case = 1;
-    for (int r = 1; r < RCH_COMPARE_ROWS; ++r) {
-        col[r] = -1;
-        if (res->row[r].used && t->n_steps < RCH_RESID_MAX_STEPS) {
-            col[r] = (int)t->n_steps;
-            step_name(t->step[t->n_steps++], sizeof t->step[0], rch_compare_row_name(r));
-        }
-    }
-    for (size_t i = 0; i < res->n_draw; ++i) {
-        const size_t k = res->idx_case1[i];
-        rch_resid_row row;
-        memset(&row, 0, sizeof row);
-        row.line = line[k];
-        row.case_no = 1;
-        row.set = i < res->n_test ? RCH_RESID_TEST : RCH_RESID_TRAIN;
-        row.s = s[k];
-        if (!res->ok_case1[0] || rc_meas(&row.predicted_mm, NULL, &res->model_case1[0], &s[k]) != RC_OK)
-            row.predicted_mm = NAN;
-        for (unsigned c = 0; c < RCH_RESID_MAX_STEPS; ++c)
-            row.after_mm[c] = NAN;
-        for (int r = 1; r < RCH_COMPARE_ROWS; ++r) {
-            double l;
-            if (col[r] >= 0 && res->ok_case1[r] && rc_meas(&l, NULL, &res->model_case1[r], &s[k]) == RC_OK)
-                row.after_mm[col[r]] = s[k].len_mm - l;
-        }
-        if (rch_resid_add(t, &row) != 0)
-            return -1;
-    }
-    return 0;
-}
-
-int rch_resid_from_diagnose(rch_resid_table *t, const rch_diagnose_result *r, const unsigned *line)
-{
-    char chain[48] = "";
-    size_t len = 0;
-    for (unsigned k = 0; k < r->n_steps; ++k) {
-        const int c = r->steps[k].chosen;
-        if (c >= 0 && len < sizeof chain)
-            len += (size_t)snprintf(chain + len, sizeof chain - len, "%s%s", len ? "+" : "", r->steps[k].cand[c].name);
-    }
-    step_name(t->step[t->n_steps++], sizeof t->step[0], "geometry_cv");
-    if (r->n_chosen > 0) {
-        char name[64];
-        snprintf(name, sizeof name, "%s_cv", chain);
-        step_name(t->step[t->n_steps++], sizeof t->step[0], name);
-    }
-    for (size_t i = 0; i < r->n; ++i) {
-        rch_resid_row row;
-        memset(&row, 0, sizeof row);
-        row.line = line[i];
-        row.set = RCH_RESID_TRAIN;
-        row.s = r->s[i];
-        if (rc_meas(&row.predicted_mm, NULL, &r->final, &r->s[i]) != RC_OK)
-            row.predicted_mm = NAN;
-        for (unsigned c = 0; c < RCH_RESID_MAX_STEPS; ++c)
-            row.after_mm[c] = NAN;
-        row.after_mm[0] = r->res_before_mm ? -r->res_before_mm[i] : NAN; /* they are model - measured */
-        if (r->n_chosen > 0)
-            row.after_mm[1] = r->res_after_mm ? -r->res_after_mm[i] : NAN;
-        if (rch_resid_add(t, &row) != 0)
-            return -1;
-    }
     return 0;
 }
 

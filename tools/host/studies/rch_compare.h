@@ -38,6 +38,7 @@
 #include "rch_stats.h"
 #include "rch_plot.h"
 #include "rch_robot.h"
+#include "rch_resid.h"
 
 /* The parameter set the methods work on (rcal compare --params).
  *  PAPER  (the set-up the paper describes, and this project's before issue
@@ -205,5 +206,11 @@ int rch_compare_plots(const rch_compare_result *res, const rch_compare_config *c
  * beetle move (3 cost evaluations). 0, or -1 with d set. */
 int rch_compare_curves_csv(const rch_compare_result *res, const rch_compare_config *cfg, const rch_plot_dir *pd,
                            rch_diag *d);
+
+/* The table of `rcal compare --residuals`: case 1's drawn rows of s (line:
+ * their data lines), set test (held out) or train, predicted by case 1's
+ * start (BC) model, one residual_after_<method>_mm column per method run
+ * (empty where it failed). 0, or -1 out of memory. */
+int rch_compare_resid(rch_resid_table *t, const rch_compare_result *res, const rc_sample *s, const unsigned *line);
 
 #endif

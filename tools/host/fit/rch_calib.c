@@ -12,7 +12,7 @@
 
 #include "rc_version.h"
 #include "rch_data.h"
-#include "rch_diagnose.h"
+#include "rch_dequant.h"
 #include "rch_groups.h"
 #include "rch_opt.h"
 #include "rch_plot.h"
@@ -466,7 +466,7 @@ static void groups(rch_calib_result *r, rch_data *data, const size_t *counts)
         for (size_t i = 0; i < data->n; ++i)
             for (unsigned j = 0; j < 3; ++j)
                 q[i * 3 + j] = data->s[i].q_rad[3 + j] / DEG;
-        step = rch_diagnose_detect_step(q, data->n * 3);
+        step = rch_dequant_detect_step(q, data->n * 3);
         free(q);
     }
     r->n_groups = 0;

@@ -11,7 +11,6 @@
 #include "rc_rand.h"
 #include "rch_file.h"
 #include "rch_opt.h"
-#include "rch_robot.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -498,14 +497,6 @@ int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d)
         return -1;
     }
     return 0;
-}
-
-int rch_load_model_and_data(struct rch_robot *robot, const char *model_path, rch_data *data, const char *data_path,
-                            rch_diag *d)
-{
-    if (rch_robot_load(robot, model_path, d) != 0)
-        return -1;
-    return rch_data_load_limited(data, data_path, 0, &robot->model, d) != 0 ? -1 : 0;
 }
 
 int rch_data_outlets(uint8_t label[RC_MAX_OUTLETS], rc_sample *s, size_t n, rch_diag *d)

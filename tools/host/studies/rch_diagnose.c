@@ -17,6 +17,7 @@
 #include "rch_data.h"
 #include "rch_jw.h"
 #include "rch_plot.h"
+#include "rch_resid.h"
 #include "rch_robot.h"
 #include "rch_stats.h"
 
@@ -84,24 +85,6 @@ double rch_diagnose_f_sf(double f, double d1, double d2)
     if (!isfinite(f))
         return 0.0;
     return incbeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
-}
-
-double rch_diagnose_detect_step(const double *values, size_t n)
-{
-    static const double steps[] = {1.0,  0.5,   0.2,   0.1,    0.05,  0.02, 0.01,
-                                   0.005, 0.004, 0.002, 0.001, 0.0005, 0.0001};
-    if (n == 0)
-        return 0.0;
-    for (size_t k = 0; k < sizeof steps / sizeof steps[0]; ++k) {
-        int ok = 1;
-        for (size_t i = 0; i < n && ok; ++i) {
-            const double u = values[i] / steps[k];
-            ok = fabs(u - floor(u + 0.5)) < 1e-6;
-        }
-        if (ok)
-            return steps[k];
-    }
-    return 0.0;
 }
 
 static double now_ms(void)
@@ -725,12 +708,12 @@ static void phase_steps(run_state *S)
             S->tmp[i * RC_NJ + j] = out->s[i].q_rad[j] / DEG;
     out->q_step_deg = S->cfg.q_step_deg > 0.0   ? S->cfg.q_step_deg
                       : S->cfg.q_step_deg < 0.0 ? 0.0
-                                                : rch_diagnose_detect_step(S->tmp, n * RC_NJ);
+                                                : rch_dequant_detect_step(S->tmp, n * RC_NJ);
     for (size_t i = 0; i < n; ++i)
         S->tmp[i] = out->s[i].len_mm;
     out->len_step_mm = S->cfg.len_step_mm > 0.0   ? S->cfg.len_step_mm
                        : S->cfg.len_step_mm < 0.0 ? 0.0
-                                                  : rch_diagnose_detect_step(S->tmp, n);
+                                                  : rch_dequant_detect_step(S->tmp, n);
     out->len_noise_mm = S->cfg.len_noise_mm > 0.0 ? S->cfg.len_noise_mm : 0.0;
     if (!S->cfg.groups_given)
         out->n_groups = rch_groups_by_wrist(out->s, n, out->q_step_deg, &out->n_flicker);
@@ -1486,7 +1469,7 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
                 for (unsigned j = 0; j < 3; ++j)
                     q[i * 3 + j] = data.s[i].q_rad[3 + j] / DEG;
             if (q)
-                step = rch_diagnose_detect_step(q, data.n * 3);
+                step = rch_dequant_detect_step(q, data.n * 3);
             free(q);
             rch_groups_by_wrist(data.s, data.n, step, NULL);
             c.groups_given = 1;
@@ -1804,4 +1787,38 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path,
         return -1;
     }
     return rch_calib_save_model(&cr, path, d);
+}
+
+int rch_diagnose_resid(rch_resid_table *t, const rch_diagnose_result *r, const unsigned *line)
+{
+    char chain[48] = "";
+    size_t len = 0;
+    for (unsigned k = 0; k < r->n_steps; ++k) {
+        const int c = r->steps[k].chosen;
+        if (c >= 0 && len < sizeof chain)
+            len += (size_t)snprintf(chain + len, sizeof chain - len, "%s%s", len ? "+" : "", r->steps[k].cand[c].name);
+    }
+    (void)rch_resid_add_step(t, "geometry_cv");
+    if (r->n_chosen > 0) {
+        char name[64];
+        snprintf(name, sizeof name, "%s_cv", chain);
+        (void)rch_resid_add_step(t, name);
+    }
+    for (size_t i = 0; i < r->n; ++i) {
+        rch_resid_row row;
+        memset(&row, 0, sizeof row);
+        row.line = line[i];
+        row.set = RCH_RESID_TRAIN;
+        row.s = r->s[i];
+        if (rc_meas(&row.predicted_mm, NULL, &r->final, &r->s[i]) != RC_OK)
+            row.predicted_mm = NAN;
+        for (unsigned c = 0; c < RCH_RESID_MAX_STEPS; ++c)
+            row.after_mm[c] = NAN;
+        row.after_mm[0] = r->res_before_mm ? -r->res_before_mm[i] : NAN; /* they are model - measured */
+        if (r->n_chosen > 0)
+            row.after_mm[1] = r->res_after_mm ? -r->res_after_mm[i] : NAN;
+        if (rch_resid_add(t, &row) != 0)
+            return -1;
+    }
+    return 0;
 }
