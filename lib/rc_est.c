@@ -116,8 +116,20 @@ typedef struct est_ctx {
     size_t n;
     unsigned nf;
     rc_est_result *res;
-    double best_cost; /* cost of w->ubest (normalised methods) */
+    double best_cost;   /* objective of w->ubest (normalised methods) */
+    rc_solve_config pc; /* the prior (rc_prior_cost, rc_prior_normal_eq); no prior: all zero */
+    int prior;
 } est_ctx;
+
+/* The objective every method minimises: the squared residuals, plus the
+ * prior's rows when there is a prior (the MAP objective, as rc_solve's). */
+static rc_status objective(double *f, const est_ctx *c, const rc_model *m)
+{
+    const rc_status st = rc_cost(f, m, c->s, c->n);
+    if (st == RC_OK && c->prior)
+        *f += rc_prior_cost(m, &c->pc);
+    return st;
+}
 
 static double rms_of(double cost, size_t n) { return sqrt(cost / (double)n); }
 
@@ -147,7 +159,7 @@ static double cost_u(est_ctx *c, const double *u)
     double cost;
     model_at(&c->w->trial, c, u);
     ++c->res->cost_evals;
-    if (rc_cost(&cost, &c->w->trial, c->s, c->n) != RC_OK || !isfinite(cost))
+    if (objective(&cost, c, &c->w->trial) != RC_OK || !isfinite(cost))
         return HUGE_VAL;
     return cost;
 }
@@ -161,12 +173,22 @@ static void offer(est_ctx *c, const double *u, double cost)
     }
 }
 
+/* The training RMS a curve shows at m whose objective is f: the data's
+ * residuals only (with a prior the objective also holds the prior's rows). */
+static double curve_rms(const est_ctx *c, const rc_model *m, double f)
+{
+    double ssr;
+    if (c->prior && rc_cost(&ssr, m, c->s, c->n) == RC_OK)
+        return rms_of(ssr, c->n);
+    return rms_of(f, c->n);
+}
+
 static void report(est_ctx *c, unsigned it)
 {
     c->res->iterations = it;
     if (c->cfg->on_iter) {
         model_at(&c->w->best, c, c->w->ubest);
-        c->cfg->on_iter(c->cfg->cb_ctx, it, rms_of(c->best_cost, c->n), &c->w->best);
+        c->cfg->on_iter(c->cfg->cb_ctx, it, curve_rms(c, &c->w->best, c->best_cost), &c->w->best);
     }
 }
 
@@ -477,6 +499,101 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
     return RC_OK;
 }
 
+/* M2 with a prior: the iterated EKF (Bell & Cathey 1993). Each pass filters
+ * the samples from the prior (mean: the prior's for parameters that have one,
+ * the start's for the others; covariance diag(sd^2), (10 box)^2 for the
+ * others) with every measurement linearised at the previous pass's estimate
+ * x_lin: predicted l(x_lin) + h (x - x_lin). R is the prior's noise^2, fixed
+ * (the weight the prior is given against the data), no process noise. A pass
+ * is one Gauss-Newton step on the MAP objective, so the fixed point is the
+ * MAP estimate; the pass that lowers the objective least ends it, the best
+ * pass is returned. */
+static rc_status run_iekf(est_ctx *c, rc_model *m)
+{
+    rc_est_work *w = c->w;
+    const rc_est_config *cfg = c->cfg;
+    const unsigned T = cfg->max_iter ? cfg->max_iter : 10u;
+    const unsigned nf = c->nf;
+    const double tol = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-10;
+    const double R = cfg->prior_noise_mm * cfg->prior_noise_mm;
+    double *h = w->g, *Ph = w->dx, *K = w->v, *Mh = w->D;
+    double *xl = w->pop; /* (nf) the linearisation point, x_lin - start */
+    double prev = c->best_cost;
+    rc_model *x = &w->trial; /* the filter state */
+    rc_model *lin = &w->best;
+    *lin = *m;
+    for (unsigned pass = 0; pass < T; ++pass) {
+        *x = *m;
+        memset(w->P, 0, (size_t)nf * nf * sizeof(double));
+        for (unsigned j = 0; j < nf; ++j) {
+            const unsigned k = w->idx[j];
+            const double sd = cfg->prior_sd[k];
+            const int has = sd > 0.0 && isfinite(sd);
+            x->x[k] = has ? cfg->prior_mean[k] : m->x[k];
+            w->P[(size_t)j * nf + j] = has ? sd * sd : 100.0 * w->bound[j] * w->bound[j];
+            xl[j] = lin->x[k];
+        }
+        for (size_t s = 0; s < c->n; ++s) {
+            double l, hph = 0.0, pred;
+            if (rc_meas(&l, w->jrow, lin, &c->s[s]) != RC_OK)
+                continue; /* degenerate sample: no information */
+            pred = l;
+            for (unsigned j = 0; j < nf; ++j) {
+                h[j] = w->jrow[w->idx[j]];
+                pred += h[j] * (x->x[w->idx[j]] - xl[j]);
+            }
+            const double innov = c->s[s].len_mm - pred;
+            for (unsigned i = 0; i < nf; ++i) {
+                double acc = 0.0;
+                for (unsigned k = 0; k < nf; ++k)
+                    acc += w->P[(size_t)i * nf + k] * h[k];
+                Ph[i] = acc;
+                hph += h[i] * acc;
+            }
+            const double S = hph + R;
+            if (!(S > 0.0) || !isfinite(S))
+                return RC_ERR_NUMERIC;
+            for (unsigned i = 0; i < nf; ++i) {
+                K[i] = Ph[i] / S;
+                x->x[w->idx[i]] += K[i] * innov;
+            }
+            /* Joseph form, as run_ekf */
+            for (unsigned i = 0; i < nf; ++i)
+                for (unsigned k = 0; k < nf; ++k)
+                    w->T[(size_t)i * nf + k] = w->P[(size_t)i * nf + k] - K[i] * Ph[k];
+            for (unsigned i = 0; i < nf; ++i) {
+                double acc = 0.0;
+                for (unsigned k = 0; k < nf; ++k)
+                    acc += w->T[(size_t)i * nf + k] * h[k];
+                Mh[i] = acc;
+            }
+            for (unsigned i = 0; i < nf; ++i)
+                for (unsigned k = i; k < nf; ++k) {
+                    const double a = w->T[(size_t)i * nf + k] - Mh[i] * K[k] + R * K[i] * K[k];
+                    const double b = w->T[(size_t)k * nf + i] - Mh[k] * K[i] + R * K[k] * K[i];
+                    w->P[(size_t)i * nf + k] = w->P[(size_t)k * nf + i] = 0.5 * (a + b);
+                }
+        }
+        double cost;
+        ++c->res->cost_evals;
+        const rc_status st = objective(&cost, c, x);
+        c->res->iterations = pass + 1;
+        if (st != RC_OK || !(cost < prev)) { /* no better than the last pass: it is the estimate */
+            if (cfg->on_iter)
+                cfg->on_iter(cfg->cb_ctx, pass + 1, curve_rms(c, lin, c->best_cost), lin);
+            break;
+        }
+        c->best_cost = cost;
+        *lin = *x; /* the next pass linearises here; w->best is the estimate */
+        if (cfg->on_iter)
+            cfg->on_iter(cfg->cb_ctx, pass + 1, curve_rms(c, lin, c->best_cost), lin);
+        if (prev - cost < tol * prev)
+            break;
+        prev = cost;
+    }
+    return RC_OK;
+}
+
 /* ---- M6 SSLM ----------------------------------------------------------- */
 
 /* Variable step-size LM (our reading of the paper's ref. 19; rc_est.h):
@@ -498,6 +615,8 @@ static rc_status run_sslm(est_ctx *c, rc_model *m)
         ++c->res->cost_evals;
         if (st != RC_OK)
             return st;
+        if (c->prior)
+            rc_prior_normal_eq(w->P, w->g, &cost, x, w->idx, nf, &c->pc);
         if (it == 0) /* the scaling of the start, kept (scaled variables u = D x) */
             for (unsigned i = 0; i < nf; ++i) {
                 const double a = w->P[(size_t)i * nf + i];
@@ -519,7 +638,7 @@ static rc_status run_sslm(est_ctx *c, rc_model *m)
             for (unsigned i = 0; i < nf; ++i)
                 w->trial.x[w->idx[i]] += a * w->dx[i] / w->D[i];
             ++c->res->cost_evals;
-            if (rc_cost(&ct, &w->trial, c->s, c->n) == RC_OK && ct < cost) {
+            if (objective(&ct, c, &w->trial) == RC_OK && ct < cost) {
                 accepted = 1;
                 newcost = ct;
                 break;
@@ -532,7 +651,7 @@ static rc_status run_sslm(est_ctx *c, rc_model *m)
         c->best_cost = newcost;
         c->res->iterations = it + 1;
         if (cfg->on_iter)
-            cfg->on_iter(cfg->cb_ctx, it + 1, rms_of(c->best_cost, c->n), x);
+            cfg->on_iter(cfg->cb_ctx, it + 1, curve_rms(c, x, c->best_cost), x);
         if (cost - newcost < tol * cost)
             break;
     }
@@ -584,7 +703,15 @@ rc_status rc_est_solve(rc_model *m, rc_est_result *res, rc_est_work *w, const rc
     res->n_free = nf;
     if (nf == 0)
         return RC_ERR_RANK;
-    if (!cfg->keep_all) {
+    memset(&c.pc, 0, sizeof c.pc);
+    c.prior = cfg->prior_mean != NULL && cfg->prior_sd != NULL && cfg->prior_noise_mm > 0.0;
+    if (c.prior) {
+        c.pc.prior_mean = cfg->prior_mean;
+        c.pc.prior_sd = cfg->prior_sd;
+        c.pc.prior_noise_mm = cfg->prior_noise_mm;
+        c.pc.fixed = cfg->fixed;
+    }
+    if (!cfg->keep_all && !c.prior) { /* with a prior every direction is determined: all move */
         uint8_t sub[RC_MAX_PARAMS];
         unsigned kept;
         st = rc_est_subset(sub, &kept, w, m, cfg->fixed, cfg->subset_tol, samples, n);
@@ -604,6 +731,8 @@ rc_status rc_est_solve(rc_model *m, rc_est_result *res, rc_est_work *w, const rc
     for (unsigned j = 0; j < nf; ++j) {
         w->x0[j] = m->x[w->idx[j]];
         w->bound[j] = bound_of(m, w->idx[j], cfg);
+        if (c.prior && cfg->prior_sd[w->idx[j]] > 0.0 && isfinite(cfg->prior_sd[w->idx[j]]))
+            w->bound[j] = 3.0 * cfg->prior_sd[w->idx[j]]; /* the box: the prior's 3 sd */
         w->ubest[j] = 0.0;
     }
 
@@ -615,16 +744,22 @@ rc_status rc_est_solve(rc_model *m, rc_est_result *res, rc_est_work *w, const rc
     c.nf = nf;
     c.res = res;
     ++res->cost_evals;
-    st = rc_cost(&c.best_cost, m, samples, n);
+    st = objective(&c.best_cost, &c, m);
     if (st != RC_OK)
         return st;
-    res->rms_start_mm = rms_of(c.best_cost, n);
+    {
+        double data_cost;
+        st = rc_cost(&data_cost, m, samples, n);
+        if (st != RC_OK)
+            return st;
+        res->rms_start_mm = rms_of(data_cost, n);
+    }
     rc_rng_seed(&g, cfg->seed ^ ((uint64_t)cfg->method + 1u) * 0x9E3779B97F4A7C15ull);
 
     switch (cfg->method) {
     case RC_EST_EKF:
         w->best = *m;
-        st = run_ekf(&c, m);
+        st = c.prior ? run_iekf(&c, m) : run_ekf(&c, m);
         if (st == RC_OK)
             *m = w->best;
         break;

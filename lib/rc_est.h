@@ -136,6 +136,18 @@ typedef struct rc_est_config {
     int keep_all;           /* nonzero: no subset selection, every free parameter moves */
     uint64_t seed;
     const uint8_t *fixed;   /* (n_params) nonzero: held fixed; NULL: none */
+    /* A Gaussian prior, as rc_solve_config's (prior_mean NULL or
+     * prior_noise_mm <= 0: none). With it every method minimises the MAP
+     * objective SSR + sum ((noise / sd_k) (x_k - mean_k))^2: no subset
+     * (every free parameter moves), the population box is 3 prior sd wide
+     * per side where a parameter has a prior, SSLM adds the prior rows
+     * (rc_prior_normal_eq), and EKF becomes the iterated EKF from the prior
+     * (run_iekf: R = noise^2 fixed, no process noise; its fixed point is the
+     * MAP estimate). The figures (rms_*, the curves) stay the data's
+     * residuals. */
+    const double *prior_mean; /* (n_params) */
+    const double *prior_sd;   /* (n_params) mm, rad or the effect's unit; <= 0: no prior on it */
+    double prior_noise_mm;
     rc_iter_cb on_iter;     /* after each iteration: best training RMS so far */
     void *cb_ctx;
 } rc_est_config;

@@ -1,13 +1,17 @@
 /* SPDX-License-Identifier: MIT */
 /* rc_kin.c - forward kinematics and joint Jacobian of the compiled model, in rc_real.
  *
- * The arithmetic follows rc_model.c's chain (same operations in the same
- * order), so that a double build gives the solver model's numbers bit for
- * bit; only the cosines and sines of the link twists are taken from the
- * table instead of being recomputed. */
+ * The link transform is rc_chain.h's, the one rc_model.c's chain expands
+ * too, so that a double build gives the solver model's numbers bit for bit;
+ * only the cosines and sines of the link twists are taken from the table
+ * instead of being recomputed. */
 #include "rc_kin.h"
 
 #include <string.h>
+
+#define RC_CHAIN_T rc_real
+#define RC_CHAIN_LINK kin_link
+#include "rc_chain.h" /* the one link transform (also rc_model.c's) */
 
 /* Chain of nj links: o[k], R[k] frame k (o[0], R[0] the base). */
 static void kin_chain(rc_real (*o)[3], rc_real (*R)[9], const rc_kin_link *lk, const rc_real *theta_rad,
@@ -16,27 +20,9 @@ static void kin_chain(rc_real (*o)[3], rc_real (*R)[9], const rc_kin_link *lk, c
     static const rc_real eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     memcpy(R[0], eye, sizeof eye);
     o[0][0] = o[0][1] = o[0][2] = RC_REAL_C(0.0);
-    for (unsigned i = 0; i < nj; ++i) {
-        const rc_real a = lk[i].a_mm, d = lk[i].d_mm;
-        const rc_real ct = rc_rcos(theta_rad[i]), st = rc_rsin(theta_rad[i]);
-        const rc_real ca = lk[i].cos_alpha, sa = lk[i].sin_alpha;
-        const rc_real L[9] = {ct, -st * ca, st * sa, st, ct * ca, -ct * sa, RC_REAL_C(0.0), sa, ca};
-        const rc_real t[3] = {a * ct, a * st, d};
-        const rc_real *P = R[i];
-        rc_real *N = R[i + 1];
-        for (int r = 0; r < 3; ++r) {
-            for (int k = 0; k < 3; ++k)
-                N[3 * r + k] = P[3 * r] * L[k] + P[3 * r + 1] * L[3 + k] + P[3 * r + 2] * L[6 + k];
-            o[i + 1][r] = o[i][r] + P[3 * r] * t[0] + P[3 * r + 1] * t[1] + P[3 * r + 2] * t[2];
-        }
-        const rc_real cm1 = lk[i].tilt_cm1_rad, sb = lk[i].tilt_sin;
-        if (cm1 != RC_REAL_C(0.0) || sb != RC_REAL_C(0.0)) /* Ry(beta), as rc_model.c's tilt_rows */
-            for (int r = 0; r < 3; ++r) {
-                const rc_real x = N[3 * r], z = N[3 * r + 2];
-                N[3 * r] = x + cm1 * x - sb * z;
-                N[3 * r + 2] = z + sb * x + cm1 * z;
-            }
-    }
+    for (unsigned i = 0; i < nj; ++i)
+        kin_link(R[i + 1], o[i + 1], R[i], o[i], lk[i].a_mm, lk[i].d_mm, rc_rcos(theta_rad[i]), rc_rsin(theta_rad[i]),
+                 lk[i].cos_alpha, lk[i].sin_alpha, lk[i].tilt_cm1_rad, lk[i].tilt_sin, 1);
 }
 
 static void cross3(rc_real out[3], const rc_real a[3], const rc_real b[3])

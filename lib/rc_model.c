@@ -18,84 +18,39 @@ typedef struct {
     double R[RC_NJ + 1][9];
 } chain;
 
-/* The chain from the DH lengths (dh[i][0] a, dh[i][1] d) and the cosines and
- * sines of the joint angles (ct, st) and of the alphas (ca, sa), (nj) each. */
-/* Row i's axis tilt (Hayati's beta, RC_EFF_AXIS_TILT) turns R[i+1] about
- * its y axis: x' = x + (cos b - 1) x - sin b z, z' = z + sin b x + (cos b - 1) z
- * (written with cos b - 1 so that a zero tilt is the identity to the bit);
- * cm1, s: (nj) or NULL for none. */
-static void tilt_rows(double *N, double cm1, double s)
-{
-    for (int r = 0; r < 3; ++r) {
-        const double x = N[3 * r], z = N[3 * r + 2];
-        N[3 * r] = x + cm1 * x - s * z;
-        N[3 * r + 2] = z + s * x + cm1 * z;
-    }
-}
+#define RC_CHAIN_T double
+#define RC_CHAIN_LINK chain_link
+#include "rc_chain.h" /* the one link transform (also rc_kin.c's) */
 
+static const double chain_eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+/* The chain from the DH lengths (dh[i][0] a, dh[i][1] d) and the cosines and
+ * sines of the joint angles (ct, st) and of the alphas (ca, sa), (nj) each;
+ * row i's axis tilt (Hayati's beta) from cm1[i] = cos b - 1, ts[i] = sin b
+ * (NULL: none). */
 static void chain_trig(chain *c, const double dh[][4], const double ct[], const double st[], const double ca[],
                        const double sa[], unsigned nj, const double *cm1, const double *ts)
 {
-    static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    memcpy(c->R[0], eye, sizeof eye);
+    memcpy(c->R[0], chain_eye, sizeof chain_eye);
     c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
-    for (unsigned i = 0; i < nj; ++i) {
-        const double a = dh[i][0], d = dh[i][1];
-        const double L[9] = {ct[i], -st[i] * ca[i], st[i] * sa[i], st[i], ct[i] * ca[i], -ct[i] * sa[i],
-                             0.0,   sa[i],          ca[i]};
-        const double t[3] = {a * ct[i], a * st[i], d};
-        const double *P = c->R[i];
-        double *N = c->R[i + 1];
-        for (int r = 0; r < 3; ++r) {
-            for (int k = 0; k < 3; ++k)
-                N[3 * r + k] = P[3 * r] * L[k] + P[3 * r + 1] * L[3 + k] + P[3 * r + 2] * L[6 + k];
-            c->o[i + 1][r] = c->o[i][r] + P[3 * r] * t[0] + P[3 * r + 1] * t[1] + P[3 * r + 2] * t[2];
-        }
-        if (cm1 != NULL && (cm1[i] != 0.0 || ts[i] != 0.0))
-            tilt_rows(N, cm1[i], ts[i]);
-    }
+    for (unsigned i = 0; i < nj; ++i)
+        chain_link(c->R[i + 1], c->o[i + 1], c->R[i], c->o[i], dh[i][0], dh[i][1], ct[i], st[i], ca[i], sa[i],
+                   cm1 ? cm1[i] : 0.0, ts ? ts[i] : 0.0, 1);
 }
 
-/* chain_trig for the six joints of a model, with fewer operations (the
- * solver's passes): R' = R Rz(theta) Rx(alpha) written on the columns x, y, z
- * of R, o' = o + R (a ct, a st, d):
- *   x' = x ct + y st,  v = y ct - x st,  y' = v ca + z sa,  z' = z ca - v sa,
- *   o' = o + a x' + d z.
- * Joint 1 starts from the base (R = I). With full = 0 the last rotation R6 is
- * left out (a length without Jacobian or tool offset needs o6 only).
- * Equal to chain_trig up to rounding. */
+/* chain_trig for the six joints of a model in the solver's passes: the
+ * tilts from the prepared model pr (or none); with full = 0 the last
+ * rotation R6 is left out (a length without Jacobian or tool offset needs o6
+ * only). */
 static void chain_axes(chain *c, const rc_model *m, const double ct[RC_NJ], const double st[RC_NJ],
                        const double ca[RC_NJ], const double sa[RC_NJ], int full, const rc_meas_prep *pr)
 {
-    static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    const double a0 = m->x[RC_P_A(0)], d0 = m->x[RC_P_D(0)];
-    const double R1[9] = {ct[0], -st[0] * ca[0], st[0] * sa[0], st[0], ct[0] * ca[0], -ct[0] * sa[0],
-                          0.0,   sa[0],          ca[0]};
-    memcpy(c->R[0], eye, sizeof eye);
-    memcpy(c->R[1], R1, sizeof R1);
+    memcpy(c->R[0], chain_eye, sizeof chain_eye);
     c->o[0][0] = c->o[0][1] = c->o[0][2] = 0.0;
-    c->o[1][0] = a0 * ct[0];
-    c->o[1][1] = a0 * st[0];
-    c->o[1][2] = d0;
-    for (unsigned i = 1; i < RC_NJ; ++i) {
-        const double a = m->x[RC_P_A(i)], d = m->x[RC_P_D(i)];
-        const double *P = c->R[i];
-        double *N = c->R[i + 1];
-        if (i == RC_NJ - 1 && !full) {
-            for (unsigned r = 0; r < 3; ++r)
-                c->o[i + 1][r] = c->o[i][r] + a * (P[3 * r] * ct[i] + P[3 * r + 1] * st[i]) + d * P[3 * r + 2];
-            break;
-        }
-        for (unsigned r = 0; r < 3; ++r) {
-            const double xr = P[3 * r], yr = P[3 * r + 1], zr = P[3 * r + 2];
-            const double nx = xr * ct[i] + yr * st[i], v = yr * ct[i] - xr * st[i];
-            N[3 * r] = nx;
-            N[3 * r + 1] = v * ca[i] + zr * sa[i];
-            N[3 * r + 2] = zr * ca[i] - v * sa[i];
-            c->o[i + 1][r] = c->o[i][r] + a * nx + d * zr;
-        }
-        if (pr != NULL && pr->tilt_at[i] >= 0)
-            tilt_rows(N, pr->tilt_cm1[i], pr->tilt_s[i]);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const int tilt = pr != NULL && pr->tilt_at[i] >= 0;
+        chain_link(c->R[i + 1], c->o[i + 1], c->R[i], c->o[i], m->x[RC_P_A(i)], m->x[RC_P_D(i)], ct[i], st[i],
+                   ca[i], sa[i], tilt ? pr->tilt_cm1[i] : 0.0, tilt ? pr->tilt_s[i] : 0.0, full || i + 1 < RC_NJ);
     }
 }
 

@@ -227,10 +227,8 @@ double rc_prior_cost(const rc_model *m, const rc_solve_config *cfg)
     return c;
 }
 
-/* The prior rows added to normal equations of the free parameters idx (nf):
- * A += W, g += W (x - mean), cost += (x - mean)^T W (x - mean). */
-static void prior_ne(double *A, double *g, double *cost, const rc_model *m, const uint16_t *idx, unsigned nf,
-                     const rc_solve_config *cfg)
+void rc_prior_normal_eq(double *A, double *g, double *cost, const rc_model *m, const uint16_t *idx, unsigned nf,
+                        const rc_solve_config *cfg)
 {
     if (!has_prior(cfg))
         return;
@@ -561,7 +559,7 @@ static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, doub
         ++res->cost_evals;
         if (normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n) != RC_OK)
             return;
-        prior_ne(A, w->g, &cost, m, w->idx, nf, cfg);
+        rc_prior_normal_eq(A, w->g, &cost, m, w->idx, nf, cfg);
         /* every direction with a positive eigenvalue: the prior determines
          * what the data do not (no null truncation, no significance rule) */
         if (lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, 1e-300, 0.0) != RC_OK || gnorm == 0.0)
@@ -640,7 +638,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     ++res->cost_evals;
     if (st != RC_OK)
         return st;
-    prior_ne(A, w->g, &cost, m, w->idx, nf, cfg);
+    rc_prior_normal_eq(A, w->g, &cost, m, w->idx, nf, cfg);
     const double prior0 = rc_prior_cost(m, cfg); /* the figures are the data's RMS, without the prior */
     res->rms_start_mm = res->rms_final_mm = rms_of(cost - prior0 > 0.0 ? cost - prior0 : 0.0, n);
     /* Fixed scaling from the starting Jacobian: D_i = column norm. A column
@@ -701,7 +699,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
                 ++res->cost_evals;
                 if (st != RC_OK)
                     return st;
-                prior_ne(A, w->g, &cost, m, w->idx, nf, cfg);
+                rc_prior_normal_eq(A, w->g, &cost, m, w->idx, nf, cfg);
             }
             st = lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, rcond, snr_min);
             if (st != RC_OK)
@@ -731,7 +729,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
             ++res->cost_evals;
             st = normal_eq_tab(A, w->g, &cnew, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
             if (st == RC_OK)
-                prior_ne(A, w->g, &cnew, &w->trial, w->idx, nf, cfg);
+                rc_prior_normal_eq(A, w->g, &cnew, &w->trial, w->idx, nf, cfg);
             const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
             if (rho > 0.0) {
                 accepted = 1;

@@ -186,6 +186,12 @@ const char *rc_exit_str(rc_exit e);
  * without a prior (cfg NULL, no prior_mean, prior_noise_mm <= 0). Only
  * parameters not held fixed count. */
 double rc_prior_cost(const rc_model *m, const rc_solve_config *cfg);
+/* The prior rows added to the normal equations of the free parameters idx
+ * (nf): A (nf x nf) += W, g (nf) += W (x - mean), *cost += (x - mean)^T W
+ * (x - mean), W = diag((noise / sd_k)^2). Nothing without a prior. The one
+ * definition every solver with a prior uses (rc_solve, rc_est's SSLM). */
+void rc_prior_normal_eq(double *A, double *g, double *cost, const rc_model *m, const uint16_t *idx, unsigned nf,
+                        const rc_solve_config *cfg);
 
 /* Sum of squared residuals over samples (n). RC_ERR_NUMERIC on a degenerate
  * sample or a non-finite result. */

@@ -165,6 +165,9 @@ rc_status rch_est_run(rc_model *m, rch_est_out *out, rch_curve *curve, rch_est_w
         cfg.bound_other = opts->bound_other;
         cfg.fixed = opts->fixed;
         cfg.keep_all = opts->same_set;
+        cfg.prior_mean = opts->prior_mean; /* every method takes the prior (rc_est.h) */
+        cfg.prior_sd = opts->prior_sd;
+        cfg.prior_noise_mm = opts->prior_noise_mm;
         cfg.seed = seed;
         cfg.on_iter = curve ? curve_cb : NULL;
         cfg.cb_ctx = curve;

@@ -83,10 +83,10 @@ typedef struct rch_est_opts {
      * their own), so that all seven methods work on one set. */
     const uint8_t *fixed;
     int same_set;
-    /* A Gaussian prior for the robust LM and LTLM (rc_solve_config's
-     * prior_mean, prior_sd, prior_noise_mm; the arrays cover the model's
-     * parameters): maximum a posteriori. NULL: least squares. The paper
-     * variants and the rc_est methods ignore it. */
+    /* A Gaussian prior (rc_solve_config's prior_mean, prior_sd,
+     * prior_noise_mm; the arrays cover the model's parameters): maximum a
+     * posteriori for LM, LTLM and the five rc_est methods (rc_est.h). NULL:
+     * least squares. The paper variants ignore it. */
     const double *prior_mean, *prior_sd;
     double prior_noise_mm;
 } rch_est_opts;

@@ -403,7 +403,7 @@ static int case_setup(case_ctx *cx, rch_compare_result *res, const rch_compare_c
         for (size_t i = 0; i < h->n_train; ++i)
             cx->lab[i].group = (uint16_t)rch_jumps_segment(&cx->ref, cx->lab[i].t);
     }
-    *eo = po; /* the prior (if any) rides along; only the robust LM and LTLM read it */
+    *eo = po; /* the prior (if any) rides along; every method but the paper-literal ones reads it */
     return 0;
 }
 
@@ -466,8 +466,10 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
         const rch_jumps *jused = NULL;
         if (!cfg->run[id])
             continue;
-        /* the prior's rows: the robust LM and LTLM (the others ignore the prior, not the gauge: see rch_compare.h) */
-        const rch_est_opts *o = cfg->prior && (id == RCH_EST_LM || id == RCH_EST_LTLM) ? &eo_prior : &eo;
+        /* the prior: every method but the paper's literal LM and LTLM (see rch_compare.h) */
+        const int literal = id == RCH_EST_LM_PAPER || id == RCH_EST_LM_PAPER_DEG || id == RCH_EST_LTLM_PAPER ||
+                            id == RCH_EST_LTLM_PAPER_DEG;
+        const rch_est_opts *o = cfg->prior && !literal ? &eo_prior : &eo;
         rc_status st = run_method(&m, &out, &jm, &jused, first ? &res->curve[id] : NULL, ws, (rch_est_id)id, cseed,
                                   o, cfg, cx, h);
         if (st == RC_OK && cfg->jumps)
@@ -693,6 +695,10 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
                    "start (EKF prior sd the same)\n",
                 res->n_common.mean, rch_stats_sd(&res->n_common), res->n_params, RCH_COMPARE_COMMON_BOX_MM,
                 RCH_COMPARE_COMMON_BOX_DEG);
+    else if (cfg->prior)
+        fprintf(f, "parameter set: paper with the prior -- every method moves all %u parameters (the prior\n"
+                   "  determines what the data do not); the population methods search 3 prior sd around the start\n",
+                res->n_params);
     else
         fprintf(f, "parameter set: paper -- LM and LTLM move all %u parameters (own truncation), the other five\n"
                    "  an identifiable subset; the population methods search +-2 mm / +-0.2 deg / encoder +-5 mm\n",
@@ -701,7 +707,8 @@ void rch_compare_report(FILE *f, const rch_compare_result *res, const rch_compar
         fprintf(f, "nuisance and prior:%s%s\n",
                 cfg->jumps ? " length jumps fitted with every method (rc_solve methods: their own jump search; "
                              "EKF..SSLM: the robust LM's change points, offsets their own);" : "",
-                cfg->prior ? " LM and LTLM maximum a posteriori with the physical prior (gauge theta1, d1 held)" : "");
+                cfg->prior ? " every method but the paper-literal ones maximum a posteriori with the physical prior "
+                             "(gauge theta1, d1 held; EKF iterated from the prior)" : "");
     if (cfg->prior)
         fprintf(f, "  prior weighed against a residual sd of %.4f +- %.4f mm (over the cases)\n", res->noise_mm.mean,
                 rch_stats_sd(&res->noise_mm));

@@ -98,8 +98,9 @@ typedef struct rch_compare_config {
     /* 1: the robust LM and LTLM are maximum a posteriori with the robot's
      * physical prior (rch_prior_fill, gauge theta1 and d1 held: rch_prior_gauge),
      * noise re-estimated per case from the robust LM's fit, SSR / (n - p),
-     * until it settles (2 %, at most 4 fits). The paper variants and the
-     * rc_est methods ignore it. */
+     * until it settles (2 %, at most 4 fits). The five rc_est methods take
+     * it too (rc_est.h: the MAP objective, no subset, the box 3 prior sd,
+     * EKF iterated from the prior); the paper-literal variants ignore it. */
     int prior;
 } rch_compare_config;
 
