@@ -68,8 +68,10 @@ static int bench_method(rch_bench_row *row, rc_method method, unsigned long runs
 }
 
 /* The whole calibrate path (rch_calib_run, every sample in training),
- * runs times; t (runs) scratch. */
-static int bench_calibrate(rch_bench_result *r, const rch_bench_cfg *cfg, double *t, rch_diag *d)
+ * runs times, by default or (least_squares) with --no-prior --no-jump-check;
+ * t (runs) scratch; med, lo, hi: the median and range. */
+static int bench_calibrate(double *med, double *lo, double *hi, const rch_bench_cfg *cfg, int least_squares,
+                           double *t, rch_diag *d)
 {
     rch_calib_result *cr = malloc(sizeof *cr);
     if (!cr) {
@@ -81,6 +83,7 @@ static int bench_calibrate(rch_bench_result *r, const rch_bench_cfg *cfg, double
     cc.data_path = cfg->data_path;
     cc.robot_path = cfg->robot_path;
     cc.test_fraction = 0.0;
+    cc.no_prior = cc.no_jump_check = least_squares;
     for (unsigned long k = 0; k < cfg->runs; ++k) {
         const double t0 = now_ms();
         const int rc = rch_calib_run(cr, &cc, d);
@@ -91,7 +94,7 @@ static int bench_calibrate(rch_bench_result *r, const rch_bench_cfg *cfg, double
         }
     }
     free(cr);
-    med_range(&r->calib_ms, &r->calib_min_ms, &r->calib_max_ms, t, cfg->runs);
+    med_range(med, lo, hi, t, cfg->runs);
     return 0;
 }
 
@@ -127,7 +130,9 @@ int rch_bench_run(rch_bench_result *r, const rch_bench_cfg *cfg, rch_diag *d)
     for (size_t k = 0; k < RCH_BENCH_N_METHODS && rc == 0; ++k)
         rc = bench_method(&r->rows[k], k_methods[k], cfg->runs, w, &robot, &data, t_start, t_solve, d);
     if (rc == 0)
-        rc = bench_calibrate(r, cfg, t_solve, d);
+        rc = bench_calibrate(&r->calib_ms, &r->calib_min_ms, &r->calib_max_ms, cfg, 0, t_solve, d);
+    if (rc == 0)
+        rc = bench_calibrate(&r->calib_ls_ms, &r->calib_ls_min_ms, &r->calib_ls_max_ms, cfg, 1, t_solve, d);
     free(w);
     free(t_start);
     free(t_solve);

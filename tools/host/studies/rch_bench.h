@@ -12,7 +12,10 @@
  *    reading the robot and data files, the fit, identifiability, the
  *    uncertainty and its workspace map), the figure to set beside the
  *    whole-process times of scripts/bench_ceres.sh (which adds process
- *    start-up and printing).
+ *    start-up and printing); and the same with --no-prior --no-jump-check
+ *    (least squares without the jump check: the work the calibrate path did
+ *    before the prior, the attachment test and the jump check existed, so
+ *    that a version comparison compares the same work).
  * These machines are shared: quote medians and ratios measured in one run.
  * Memory: heap (the solver workspace, the timings); errors: 0 or -1 with
  * the diagnostic in d.
@@ -48,6 +51,7 @@ typedef struct rch_bench_result {
     unsigned long runs;
     rch_bench_row rows[RCH_BENCH_N_METHODS];     /* lm first: the reference of the ratios */
     double calib_ms, calib_min_ms, calib_max_ms; /* rch_calib_run, --test-fraction 0, default method */
+    double calib_ls_ms, calib_ls_min_ms, calib_ls_max_ms; /* the same with --no-prior --no-jump-check */
 } rch_bench_result;
 
 /* Run the benchmark. -2 (d set) when the work (runs x samples x methods)
