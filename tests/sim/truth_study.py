@@ -348,6 +348,12 @@ def main():
                   "median share of targets worse %.4f  u95 coverage median %s" % (
                       label, len(sel), med, np.median([r["pair_med_uncomp"] for r in sel]), worse_cases, wshare,
                       "%.3f" % np.median(cov) if cov else "-"))
+            if cov:
+                # every case has 500 targets: the mean over cases is the share of all targets
+                print("%-10s u95 coverage over all %d targets %.3f; median u95 %.4f mm against a median error "
+                      "%.4f mm" % (label, 500 * len(cov), np.mean(cov),
+                                   np.median([r["u95_med"] for r in sel if "u95_med" in r]),
+                                   np.median([r["err_med_comp"] for r in sel])))
     if a.json:
         with open(a.json, "w") as f:
             json.dump(out, f, indent=1)
