@@ -514,11 +514,10 @@ static double effective_params(const rc_model *m, const rc_solve_config *cfg, co
     double g[RC_MAX_PARAMS], jrow[RC_MAX_PARAMS], cost, pe = (double)nf;
     if (A && H && rc_normal_eq(A, g, &cost, jrow, m, idx, nf, s, n) == RC_OK) {
         memcpy(H, A, (size_t)nf * nf * sizeof *H);
+        rc_prior_normal_eq(H, g, &cost, m, idx, nf, cfg); /* H = A + W, the solver's prior rows */
         for (unsigned i = 0; i < nf; ++i) {
             const double sd = cfg->prior_sd ? cfg->prior_sd[idx[i]] : 0.0;
-            if (sd > 0.0 && isfinite(sd))
-                H[(size_t)i * nf + i] += (cfg->prior_noise_mm / sd) * (cfg->prior_noise_mm / sd);
-            else
+            if (!(sd > 0.0 && isfinite(sd)))
                 H[(size_t)i * nf + i] += 1e-12 * (H[(size_t)i * nf + i] + 1e-300); /* a free direction */
         }
         /* H X = A, trace X */

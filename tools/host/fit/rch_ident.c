@@ -2,6 +2,7 @@
 #include "rch_ident.h"
 
 #include "rc_ident.h"
+#include "rch_jac.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -60,18 +61,15 @@ static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
 static int scaled_svd(double *sv, double *vt, const rc_model *m, const rc_sample *s, size_t n)
 {
     const unsigned np = m->n_params;
-    double *J = malloc(n * np * sizeof *J), *norm = calloc(np, sizeof *norm), *sup = malloc(np * sizeof *sup);
+    rch_jac jac;
+    char err[160];
+    double *J, *sup = malloc(np * sizeof *sup);
     int rc = -1;
-    if (!J || !norm || !sup)
+    memset(&jac, 0, sizeof jac);
+    if (!sup || rch_jac_eval(&jac, m, NULL, np, s, n, err, sizeof err) != 0) /* the Jacobian at the solution */
         goto done;
-    for (size_t i = 0; i < n; ++i) {
-        double l;
-        if (rc_meas(&l, &J[i * np], m, &s[i]) != RC_OK)
-            goto done;
-        for (unsigned k = 0; k < np; ++k)
-            norm[k] += J[i * np + k] * J[i * np + k];
-    }
-    rc_ident_scale(sup, norm, np, 1); /* the one column-scaling rule */
+    J = jac.J;
+    rc_ident_scale(sup, jac.norm2, np, 1); /* the one column-scaling rule */
     for (unsigned k = 0; k < np; ++k)
         for (size_t i = 0; i < n; ++i)
             J[i * np + k] = sup[k] > 0.0 ? J[i * np + k] / sup[k] : 0.0;
@@ -82,8 +80,7 @@ static int scaled_svd(double *sv, double *vt, const rc_model *m, const rc_sample
         sv[k] = 0.0;
     rc = 0;
 done:
-    free(J);
-    free(norm);
+    rch_jac_free(&jac);
     free(sup);
     return rc;
 }

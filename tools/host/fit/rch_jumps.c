@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_jac.h"
 #include "rch_uncert.h"
 
 unsigned rch_jumps_segment(const rch_jumps *j, double t)
@@ -64,19 +65,16 @@ static size_t best_candidate(const rc_model *mdl, const uint8_t *fixed, const rc
             idx[p++] = (uint16_t)k;
     if (p == 0 || n <= p)
         return 0;
-    double *Q = malloc(n * p * sizeof *Q), *r = malloc(n * sizeof *r), *tau = malloc(p * sizeof *tau);
-    double *a = calloc(p, sizeof *a), jrow[RC_MAX_PARAMS];
+    rch_jac jac;
+    char err[160];
+    double *Q = NULL, *r = NULL, *tau = malloc(p * sizeof *tau);
+    double *a = calloc(p, sizeof *a);
     size_t best = 0;
-    if (!Q || !r || !tau || !a)
+    memset(&jac, 0, sizeof jac);
+    if (!tau || !a || rch_jac_eval(&jac, mdl, idx, p, s, n, err, sizeof err) != 0) /* the Jacobian at the fit */
         goto done;
-    for (size_t i = 0; i < n; ++i) {
-        double l;
-        if (rc_meas(&l, jrow, mdl, &s[i]) != RC_OK)
-            goto done;
-        r[i] = l - s[i].len_mm;
-        for (unsigned k = 0; k < p; ++k)
-            Q[i * p + k] = jrow[idx[k]];
-    }
+    Q = jac.J;
+    r = jac.r;
     if (LAPACKE_dgeqrf(LAPACK_ROW_MAJOR, (lapack_int)n, (lapack_int)p, Q, (lapack_int)p, tau) != 0 ||
         LAPACKE_dorgqr(LAPACK_ROW_MAJOR, (lapack_int)n, (lapack_int)p, (lapack_int)p, Q, (lapack_int)p, tau) != 0)
         goto done;
@@ -111,8 +109,7 @@ static size_t best_candidate(const rc_model *mdl, const uint8_t *fixed, const rc
         }
     }
 done:
-    free(Q);
-    free(r);
+    rch_jac_free(&jac);
     free(tau);
     free(a);
     return best;

@@ -3,8 +3,9 @@
  * predicted position uncertainty and the determined part of a model
  * (see rch_uncert.h). */
 #include "rch_uncert.h"
-#include "rch_stats.h"
+#include "rch_jac.h"
 #include "rch_prior.h"
+#include "rch_stats.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -24,32 +25,6 @@ void rch_uncert_free(rch_uncert *u)
 {
     free(u->cov);
     u->cov = NULL;
-}
-
-/* Scaled Jacobian (n x nf, row-major), residuals (n), column norms (nf). */
-static int jacobian(double *J, double *r, double *D, const rc_model *m, const unsigned *idx, unsigned nf,
-                    const rc_sample *s, size_t n)
-{
-    double jrow[RC_MAX_PARAMS];
-    memset(D, 0, nf * sizeof *D);
-    for (size_t i = 0; i < n; ++i) {
-        double l;
-        if (rc_meas(&l, jrow, m, &s[i]) != RC_OK || !isfinite(l))
-            return -1;
-        r[i] = l - s[i].len_mm;
-        for (unsigned k = 0; k < nf; ++k) {
-            J[i * nf + k] = jrow[idx[k]];
-            D[k] += jrow[idx[k]] * jrow[idx[k]];
-        }
-    }
-    for (unsigned k = 0; k < nf; ++k) {
-        D[k] = sqrt(D[k]);
-        if (!(D[k] > 0.0))
-            D[k] = 1.0; /* a column of zeros: the parameter has no effect at all */
-        for (size_t i = 0; i < n; ++i)
-            J[i * nf + k] /= D[k];
-    }
-    return 0;
 }
 
 /* Groups usable as clusters: at least 5 groups with >= 2 samples each. */
@@ -500,19 +475,27 @@ int rch_uncert_compute_map(rch_uncert *u, const rc_model *m, const uint8_t *fixe
         return -1;
     }
     size_t np = m->n_params, nf = z.nf;
-    double *J = calloc(n * nf, sizeof *J), *r = calloc(n, sizeof *r), *A = calloc(nf * nf, sizeof *A);
+    rch_jac jac;
+    double *J = NULL, *r = NULL, *A = calloc(nf * nf, sizeof *A);
     double *V = calloc(nf * nf, sizeof *V), *Cz = calloc(nf * nf, sizeof *Cz);
     z.V = V;
     z.Cz = Cz;
     u->cov = calloc(np * np, sizeof *u->cov);
     int rc = -1;
-    if (!J || !r || !A || !V || !Cz || !u->cov) {
+    memset(&jac, 0, sizeof jac);
+    if (!A || !V || !Cz || !u->cov) {
         snprintf(err, errlen, "out of memory");
         goto done;
     }
-    if (jacobian(J, r, z.D, m, z.idx, z.nf, s, n) != 0) {
-        snprintf(err, errlen, "a sample has no defined length derivative (flange on the outlet?)");
-        goto done;
+    {
+        uint16_t cols[RC_MAX_PARAMS];
+        for (unsigned k = 0; k < z.nf; ++k)
+            cols[k] = (uint16_t)z.idx[k];
+        if (rch_jac_eval(&jac, m, cols, z.nf, s, n, err, errlen) != 0) /* the Jacobian at the solution */
+            goto done;
+        rch_jac_scale_columns(&jac, z.D);
+        J = jac.J;
+        r = jac.r;
     }
     for (size_t i = 0; i < n; ++i)
         for (size_t a = 0; a < nf; ++a)
@@ -551,8 +534,7 @@ int rch_uncert_compute_map(rch_uncert *u, const rc_model *m, const uint8_t *fixe
     }
     rc = 0;
 done:
-    free(J);
-    free(r);
+    rch_jac_free(&jac);
     free(A);
     free(V);
     free(Cz);
