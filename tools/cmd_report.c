@@ -19,7 +19,9 @@
 static const char summary[] = "an HTML report of a calibration: one self-contained file to hand on";
 static const char details[] =
     "The page has its CSS inline and every plot as inline SVG: no script, no font, image or link that\n"
-    "leaves the file. Sections: data, split, before/after metrics, the identified parameters with\n"
+    "leaves the file. First the verdict: the predicted 95 % accuracy after compensation over the data's\n"
+    "poses and the workspace (pass or fail with --tolerance-mm), the held-out figures and what they rest on.\n"
+    "Sections: data (with every nuisance fitted), split, before/after metrics, the identified parameters with\n"
     "their standard errors, 95 % intervals and identifiability, the diagnosis, the predicted accuracy\n"
     "over the workspace, warnings, provenance. Members a run does not carry say \"not in this run\".\n"
     "The data of every plot is written beside the page, named from it (x.html: x_metrics.csv, x_params.csv,\n"
@@ -119,7 +121,7 @@ int rcal_report_inline(const char *html, const struct rch_calib_result *cal, con
         fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
-    rch_report_cfg cfg = {cal_path, diag ? diag_path : NULL, model, html, NULL, NULL};
+    rch_report_cfg cfg = {cal_path, diag ? diag_path : NULL, model, html, NULL, NULL, 0.0};
     rch_report_result res;
     if (rch_report_write(&res, &cfg, &d) != 0) {
         fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
@@ -152,7 +154,7 @@ static int report_json(const rch_report_result *res, const rch_report_cfg *cfg, 
 
 int rcal_cmd_report(int argc, char **argv)
 {
-    rch_report_cfg cfg = {NULL, NULL, NULL, NULL, NULL, NULL};
+    rch_report_cfg cfg = {NULL, NULL, NULL, NULL, NULL, NULL, 0.0};
     int json = 0;
     rch_cmdspec spec;
     const rch_opt opts[] = {
@@ -166,6 +168,10 @@ int rcal_cmd_report(int argc, char **argv)
          0, NULL},
         {"--out", RCH_OPT_STR, &cfg.out_path, 0, 0, "report.html",
          "the HTML page (written whole or not at all, never over an input)", RCH_OPT_REQUIRED, NULL},
+        {"--tolerance-mm", RCH_OPT_DOUBLE, &cfg.tolerance_mm, 0.001, 1000.0, "MM",
+         "the verdict: pass when the compensated robot's 95 % position radius stays within MM over the data's poses "
+         "(the largest), fail otherwise",
+         0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was written, as one JSON object on stdout", 0, NULL},
     };
     const int st = rch_opt_cmd(&spec, "report", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);

@@ -149,14 +149,21 @@ static const char cal_min[] =
     " \"after\": {\"n\": 1, \"rmse_mm\": 0.1, \"mean_abs_mm\": 0.1, \"sd_mm\": 0, \"mean_mm\": 0.1, \"max_mm\": 0.1},"
     " \"params\": [{\"name\": \"a1\", \"unit\": \"mm\", \"value\": 0.2, \"delta\": 0.2}]}\n";
 
-static int report(rch_report_result *res, const char *cal, const char *diag, const char *out, rch_diag *d)
+static int report_tol(rch_report_result *res, const char *cal, const char *diag, const char *out, double tol_mm,
+                      rch_diag *d)
 {
     char pc[256], pd[256], po[256];
     path_in(pc, sizeof pc, cal);
     path_in(pd, sizeof pd, diag ? diag : "");
     path_in(po, sizeof po, out);
-    const rch_report_cfg cfg = {pc, diag ? pd : NULL, NULL, po, "rcal report --out <x>", "2026-11-29T17:00:00Z"};
+    const rch_report_cfg cfg = {pc, diag ? pd : NULL, NULL, po, "rcal report --out <x>", "2026-11-29T17:00:00Z",
+                                tol_mm};
     return rch_report_write(res, &cfg, d);
+}
+
+static int report(rch_report_result *res, const char *cal, const char *diag, const char *out, rch_diag *d)
+{
+    return report_tol(res, cal, diag, out, 0.0, d);
 }
 
 static void test_escape(void **state)
@@ -260,6 +267,40 @@ static void test_full_run_escaped(void **state)
 }
 
 /* Today's output: what it lacks says so, nothing breaks. */
+/* The first screen: the verdict against the tolerance from the largest
+ * 95 % radius over the data's poses (0.09 mm in cal_full), the held-out
+ * figures, what it rests on; without a tolerance no pass or fail. */
+static void test_verdict(void **state)
+{
+    (void)state;
+    put_file("cal.json", cal_full);
+    rch_report_result res;
+    rch_diag d;
+    char msg[1024];
+    static const struct {
+        double tol;
+        const char *want, *not;
+    } cases[] = {{0.1, "<b>PASS</b> against the tolerance of 0.1 mm", "FAIL"},
+                 {0.08, "<b>FAIL</b> against the tolerance of 0.08 mm", "PASS"},
+                 {0.0, "no tolerance given", "against the tolerance"}};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        if (report_tol(&res, "cal.json", NULL, "v.html", cases[k].tol, &d) != 0)
+            fail_msg("%s", rch_diag_str(&d, msg, sizeof msg));
+        char *h = get_file("v.html");
+        assert_non_null(h);
+        const char *v = strstr(h, "id=\"verdict\"");
+        assert_non_null(v);
+        assert_non_null(strstr(v, cases[k].want));
+        const char *end = strstr(v, "</div>");
+        assert_non_null(end);
+        const char *no = strstr(v, cases[k].not);
+        assert_true(no == NULL || no > end);
+        assert_non_null(strstr(v, "Measured on samples the fit never saw"));
+        assert_true(strstr(v, "It rests on:") != NULL && strstr(v, "It rests on:") < end);
+        free(h);
+    }
+}
+
 static void test_minimal_run(void **state)
 {
     (void)state;
@@ -348,7 +389,7 @@ static void test_refusals(void **state)
         assert_null(strstr(e->d_name, ".tmp"));
     closedir(dd);
     /* standard output cannot carry the CSVs beside it */
-    const rch_report_cfg cfg = {"x.json", NULL, NULL, "-", NULL, NULL};
+    const rch_report_cfg cfg = {"x.json", NULL, NULL, "-", NULL, NULL, 0.0};
     assert_int_equal(rch_report_write(&res, &cfg, &d), -1);
     assert_non_null(strstr(rch_diag_str(&d, msg, sizeof msg), "needs a file"));
     /* a directory that does not exist: nothing written */
@@ -361,6 +402,7 @@ int main(void)
         cmocka_unit_test(test_escape),
         cmocka_unit_test(test_cmdline),
         cmocka_unit_test(test_full_run_escaped),
+        cmocka_unit_test(test_verdict),
         cmocka_unit_test(test_minimal_run),
         cmocka_unit_test(test_wrong_types),
         cmocka_unit_test(test_refusals),

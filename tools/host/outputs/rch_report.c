@@ -474,6 +474,7 @@ static const metric_def metric_defs[] = {
 typedef struct {
     char name[64], unit[16], cls[24], comp[24]; /* comp: "fitted", "nominal", "not used" or "" */
     double nominal, value, delta, se, ci_lo, ci_hi; /* NaN when absent */
+    double prior_sd;                                /* the prior's sd (the parameter's unit), NaN or 0: none */
 } prow;
 
 typedef struct {
@@ -491,11 +492,11 @@ typedef struct {
 
 static unsigned char class_colour(const char *cls)
 {
-    if (strcmp(cls, "identifiable") == 0)
+    if (strcmp(cls, "identifiable") == 0 || strcmp(cls, "determined") == 0)
         return C_IDENT;
-    if (strcmp(cls, "weak") == 0)
+    if (strcmp(cls, "weak") == 0 || strcmp(cls, "partly") == 0)
         return C_WEAK;
-    if (strcmp(cls, "not identifiable") == 0)
+    if (strcmp(cls, "not identifiable") == 0 || strcmp(cls, "prior only") == 0)
         return C_NOTID;
     if (strcmp(cls, "fixed") == 0)
         return C_FIXED;
@@ -507,6 +508,7 @@ static unsigned char class_colour(const char *cls)
 static void param_unc(const rep *r, const rch_json *pk, prow *p)
 {
     const char *cls = jstr(pk, "class"), *comp = jstr(pk, "compensation");
+    p->prior_sd = NAN;
     p->se = jnum(pk, "std_error");
     if (!isfinite(p->se))
         p->se = jnum(pk, "se");
@@ -517,8 +519,12 @@ static void param_unc(const rep *r, const rch_json *pk, prow *p)
             continue;
         if (!isfinite(p->se))
             p->se = jnum(list->items[i], "std_error");
-        if (!cls)
+        const char *post = jstr(list->items[i], "data_vs_prior"); /* a MAP fit: what the data did to the prior */
+        if (post && strcmp(post, "no prior") != 0)
+            cls = post;
+        else if (!cls)
             cls = jstr(list->items[i], "class");
+        p->prior_sd = jnum(list->items[i], "prior_sd");
         if (!comp)
             comp = jstr(list->items[i], "compensation");
         break;
@@ -678,11 +684,16 @@ static void warn_fit(rep *r)
                  "%.4f mm).", after, before);
     const double rank = jnum(r->cal, "identifiability.rank"), np = jnum(r->cal, "identifiability.params"),
                  weak = jnum(r->cal, "identifiability.weak");
+    const int prior = jbool(jpath(r->cal, "estimation"), "prior") == 1;
     if (isfinite(rank) && isfinite(np) && rank < np)
-        warnf(r, "%.0f of %.0f parameter directions are not identifiable from these data; the solver left them at "
-                 "their starting values (see the identifiability table).", np - rank, np);
+        warnf(r, "%.0f of %.0f parameter directions are not seen by these data; %s (see the identifiability table).",
+              np - rank, np,
+              prior ? "the physical prior holds them near nominal and their uncertainty is counted at the prior's "
+                      "width"
+                    : "the solver left them at their starting values");
     if (isfinite(weak) && weak > 0)
-        warnf(r, "%.0f direction(s) are only weakly identifiable: their values carry little information.", weak);
+        warnf(r, "%.0f direction(s) are only weakly seen by the data: %s.", weak,
+              prior ? "the prior shares in their values" : "their values carry little information");
     const double tb = jnum(r->cal, "truth_flange.before_rms_mm"), ta = jnum(r->cal, "truth_flange.after_rms_mm");
     if (isfinite(tb) && isfinite(ta) && ta > tb)
         warnf(r, "Against the simulated truth the calibrated flange positions are worse than the nominal ones "
@@ -691,16 +702,31 @@ static void warn_fit(rep *r)
 
 static void warn_params(rep *r, const prow *p, size_t n)
 {
-    char weak[512] = "", notid[512] = "";
+    char weak[512] = "", notid[512] = "", far[512] = "";
+    int posterior = 0;
     for (size_t k = 0; k < n; ++k) {
-        char *dst = strcmp(p[k].cls, "weak") == 0 ? weak : strcmp(p[k].cls, "not identifiable") == 0 ? notid : NULL;
+        const int po = strcmp(p[k].cls, "prior only") == 0, pa = strcmp(p[k].cls, "partly") == 0;
+        posterior |= po || pa || strcmp(p[k].cls, "determined") == 0;
+        char *dst = strcmp(p[k].cls, "weak") == 0 || pa   ? weak
+                    : strcmp(p[k].cls, "not identifiable") == 0 || po ? notid
+                                                                      : NULL;
         if (dst && strlen(dst) + strlen(p[k].name) + 3 < sizeof weak)
             snprintf(dst + strlen(dst), sizeof weak - strlen(dst), "%s%s", dst[0] ? ", " : "", p[k].name);
+        if (p[k].prior_sd > 0.0 && fabs(p[k].delta) > 3.0 * p[k].prior_sd && strlen(far) + strlen(p[k].name) + 3 < sizeof far)
+            snprintf(far + strlen(far), sizeof far - strlen(far), "%s%s", far[0] ? ", " : "", p[k].name);
     }
     if (notid[0])
-        warnf(r, "Not identifiable (their values mean nothing alone; compensation keeps them nominal): %s.", notid);
+        warnf(r, posterior ? "Determined by the prior only (the data did not narrow them; they stay within their "
+                             "prior, and compensation uses them as they are): %s."
+                           : "Not identifiable (their values mean nothing alone; compensation keeps them nominal): %s.",
+              notid);
     if (weak[0])
-        warnf(r, "Weakly identified (large standard error): %s.", weak);
+        warnf(r, posterior ? "Partly determined by the data (the prior shares in their values): %s."
+                           : "Weakly identified (large standard error): %s.",
+              weak);
+    if (far[0])
+        warnf(r, "More than 3 prior standard deviations from nominal (a real deviation, or an effect these "
+                 "parameters stand in for: run rcal diagnose): %s.", far);
     if (jbool(r->unc, "orientation_determined") == 0)
         warnf(r, "The data do not determine the flange orientation: compensate position only.");
     const double in = jnum(r->unc, "position95_mm.data_max"), ws = jnum(r->unc, "position95_mm.workspace_max");
@@ -727,11 +753,20 @@ static void warn_diag(rep *r)
         if (isfinite(a) && isfinite(b))
             snprintf(fig, sizeof fig, " (held-out RMSE %.4g mm with the geometry alone, %.4g mm with %s)", b, a,
                      q && q->n > 1 ? "them" : "it");
-        warnf(r, "The diagnosis finds what the geometric model misses: %s%s. The calibration above does not model "
-                 "it.", seq[0] ? seq : effect, fig);
+        const rch_json *cj = jarr(r->cal, "length_jumps");
+        if (strcmp(effect, "length_jump") == 0 && cj && cj->n)
+            ; /* the calibration fitted them: nothing the model misses */
+        else
+            warnf(r, "The diagnosis finds what the geometric model misses: %s%s. The calibration above does not "
+                     "model it: %s.",
+                  seq[0] ? seq : effect, fig,
+                  strcmp(effect, "length_jump") == 0 ? "calibrate again with --jumps"
+                                                     : "calibrate again with --effects naming it (the diagnosis' "
+                                                       "Next line gives the command)");
     }
     const double nd = jnum(r->diag, "n"), nc = jnum(r->cal, "n_train") + jnum(r->cal, "n_test");
-    if (isfinite(nd) && isfinite(nc) && nd != nc)
+    const double dropped = jnum(r->cal, "dequantized.refused");
+    if (isfinite(nd) && isfinite(nc) && nd != nc && !(isfinite(dropped) && nd == nc + dropped))
         warnf(r, "The diagnosis ran on %.0f samples, the calibration on %.0f: are they from the same data?", nd, nc);
     const double flick = jnum(r->diag, "wrist_flicker_samples");
     if (isfinite(flick) && flick > 0)
@@ -769,6 +804,9 @@ static const char css[] =
     "header{padding:6px 0}h1{font-size:22px;margin:6px 0 2px}"
     ".sub{color:#445;margin:0}"
     ".glance{margin:8px 0 0;padding:8px 12px;background:#fff;border-left:5px solid #0072B2;border-radius:4px}"
+    ".flag{color:#b34700;font-size:12px}.glance p{margin:4px 0}.glance .big{font-size:16px}"
+    ".glance.pass{border-left-color:#009E73}.glance.fail{border-left-color:#D55E00}"
+    ".glance.pass b:first-child{color:#007a5a}.glance.fail b:first-child{color:#b34700}.rests{color:#334;font-size:13px}"
     "section{background:#fff;border:1px solid #d6dae0;border-radius:6px;padding:8px 16px 12px;margin:12px 0}"
     "h2{font-size:17px;margin:2px 0 8px;padding-bottom:3px;border-bottom:1px solid #e4e7eb}"
     "h3{font-size:14px;margin:10px 0 4px}"
@@ -793,6 +831,96 @@ static const char css[] =
 static void kv(rep *r, const char *key) { fprintf(r->f, "<tr><th>%s</th><td>", key); }
 static void kv_end(rep *r) { fputs("</td></tr>\n", r->f); }
 
+/* The first screen: the verdict (the accuracy of the compensated robot, 95 %,
+ * over the data's poses and the workspace; pass or fail against the user's
+ * tolerance), the held-out measurements it is checked on, and what it rests
+ * on (the prior, the outlets, every nuisance fitted). */
+static void verdict(rep *r, size_t n_warn)
+{
+    FILE *f = r->f;
+    const double in = jnum(r->unc, "position95_mm.data_median"), in_max = jnum(r->unc, "position95_mm.data_max"),
+                 ws = jnum(r->unc, "position95_mm.workspace_median");
+    const double tol = r->cfg->tolerance_mm;
+    const int have = isfinite(in) && isfinite(in_max);
+    const int pass = have && tol > 0.0 && in_max <= tol;
+    fprintf(f, "<div class=\"glance %s\" id=\"verdict\"><p class=\"big\">",
+            !have || !(tol > 0.0) ? "" : pass ? "pass" : "fail");
+    if (have && tol > 0.0)
+        fprintf(f, "<b>%s</b> against the tolerance of %.4g mm: ", pass ? "PASS" : "FAIL", tol);
+    if (have) {
+        fputs("predicted from the fit, after compensation the robot lands within &plusmn;<b>", f);
+        put_sig(r, in, " mm");
+        fputs("</b> (95 %) over the measured region (the median over the data's poses; the largest &plusmn;", f);
+        put_sig(r, in_max, " mm");
+        fputs("), &plusmn;", f);
+        put_sig(r, ws, " mm");
+        fputs(" over the whole workspace.", f);
+        if (!(tol > 0.0))
+            fputs(" <span class=\"note\">(no tolerance given: <code>rcal report --tolerance-mm MM</code> gives a "
+                  "pass or fail)</span>",
+                  f);
+    } else {
+        fputs("No predicted accuracy in this run: the calibration output carries no uncertainty (pass the model "
+              "file of the run with <code>--model</code>, or calibrate again with <code>rcal calibrate --json</code>).",
+              f);
+        r->res->n_missing++;
+    }
+    const double b = jnum(r->cal, "before.rmse_mm"), a = jnum(r->cal, "after.rmse_mm");
+    const double nt = jnum(r->cal, "after.n");
+    fprintf(f, "</p>\n<p>%s: cable-length RMSE <b>",
+            jbool(r->cal, "held_out") == 0 ? "Measured on the training samples (none held out)"
+                                           : "Measured on samples the fit never saw");
+    put_num(r, b, "%.4f");
+    fputs(" mm &rarr; ", f);
+    put_num(r, a, "%.4f");
+    fputs(" mm</b>", f);
+    if (isfinite(nt))
+        fprintf(f, " (%.0f samples)", nt);
+    if (isfinite(a) && isfinite(b) && b > 0)
+        fprintf(f, ", %+.1f %%", 100.0 * (a - b) / b);
+    fputs(".</p>\n<p class=\"rests\">It rests on: ", f);
+    const rch_json *est = jpath(r->cal, "estimation");
+    if (jbool(est, "prior") == 1) {
+        fputs("the posterior of a fit with the physical prior (link lengths &plusmn;", f);
+        put_sig(r, jnum(est, "prior_length_mm"), " mm");
+        fputs(", twists &plusmn;", f);
+        put_sig(r, jnum(est, "prior_twist_deg"), "&deg;");
+        fputs(", joint zeros &plusmn;", f);
+        put_sig(r, jnum(est, "prior_offset_deg"), "&deg;");
+        fputs(": what the data did not determine counts at the prior's width), the noise estimated from the data (",
+              f);
+        put_sig(r, jnum(est, "noise_mm"), " mm");
+        fputs(")", f);
+    } else if (est) {
+        fputs("the covariance of a least-squares fit (no prior: directions the data did not determine are held "
+              "nominal and not counted)",
+              f);
+    } else {
+        put_str(r, NULL);
+    }
+    const double outlets = jnum(est, "outlets");
+    if (isfinite(outlets))
+        fprintf(f, "; %.0f cable outlet%s%s", outlets, outlets == 1 ? "" : "s",
+                outlets < 3 ? " (lengths from fewer than three outlets cannot see every rigid motion of the robot "
+                              "about them: the figures hold for positions relative to each other)"
+                            : "");
+    const char *att = jstr(est, "attachment");
+    if (att)
+        fprintf(f, "; the cable attachment %s",
+                strcmp(att, "estimated") == 0 ? "estimated (a vector in the flange frame)" : "at the flange centre");
+    const rch_json *jumps = jarr(r->cal, "length_jumps");
+    if (jumps && jumps->n)
+        fprintf(f, "; %zu length jump%s fitted as nuisance", jumps->n, jumps->n == 1 ? "" : "s");
+    const double dq = jnum(r->cal, "dequantized.corrected"), dqr = jnum(r->cal, "dequantized.refused");
+    if (isfinite(dq))
+        fprintf(f, "; joint angles recovered from x, y, z for %.0f rows (%.0f refused)", dq,
+                isfinite(dqr) ? dqr : 0.0);
+    const double g = jnum(r->unc, "groups");
+    if (isfinite(g) && g > 0)
+        fprintf(f, "; %.0f set-up groups (cluster-robust covariance)", g);
+    fprintf(f, ".</p>\n<p><a href=\"#warnings\">%zu warning%s</a></p></div>\n", n_warn, n_warn == 1 ? "" : "s");
+}
+
 static void page_head(rep *r, size_t n_warn)
 {
     FILE *f = r->f;
@@ -810,26 +938,9 @@ static void page_head(rep *r, size_t n_warn)
     put_str(r, jstr(r->cal, "method"));
     fputs("</b> &middot; calibrated ", f);
     put_str(r, prov_str(r, "date"));
-    fputs("</p>\n<div class=\"glance\">", f);
-    const double b = jnum(r->cal, "before.rmse_mm"), a = jnum(r->cal, "after.rmse_mm");
-    fprintf(f, "%s RMSE of the cable length: <b>", jbool(r->cal, "held_out") == 0 ? "Training" : "Held-out");
-    put_num(r, b, "%.4f");
-    fputs(" mm &rarr; ", f);
-    put_num(r, a, "%.4f");
-    fputs(" mm</b>", f);
-    if (isfinite(a) && isfinite(b) && b > 0)
-        fprintf(f, " (%+.1f %%)", 100.0 * (a - b) / b);
-    const double in = jnum(r->unc, "position95_mm.data_median"), ws = jnum(r->unc, "position95_mm.workspace_median");
-    fputs(" &middot; predicted position uncertainty (95 %): ", f);
-    if (isfinite(in) || isfinite(ws)) {
-        fputs("inside the data &plusmn;", f);
-        put_sig(r, in, " mm");
-        fputs(", whole workspace &plusmn;", f);
-        put_sig(r, ws, " mm");
-    } else {
-        put_num(r, NAN, "");
-    }
-    fprintf(f, " &middot; <a href=\"#warnings\">%zu warning%s</a></div>\n</header>\n", n_warn, n_warn == 1 ? "" : "s");
+    fputs("</p>\n", f);
+    verdict(r, n_warn);
+    fputs("</header>\n", f);
 }
 
 static void sec_data(rep *r, const dfile *df, size_t n_df)
@@ -843,8 +954,34 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
     put_num(r, jnum(r->cal, "n_train") + jnum(r->cal, "n_test"), "%.0f");
     kv_end(r);
     kv(r, "set-up groups");
-    put_num(r, jnum(r->diag, "groups"), "%.0f");
-    fputs(r->diag ? " (from the diagnosis)" : "", f);
+    if (isfinite(jnum(r->unc, "groups")) && jnum(r->unc, "groups") > 0) {
+        put_num(r, jnum(r->unc, "groups"), "%.0f");
+        fputs(" (the covariance's clusters, from the ", f);
+        put_str(r, jstr(r->unc, "groups_from"));
+        fputs(")", f);
+    } else {
+        put_num(r, jnum(r->diag, "groups"), "%.0f");
+        fputs(r->diag ? " (from the diagnosis)" : "", f);
+    }
+    kv_end(r);
+    /* the nuisance the calibration fitted: every one shown */
+    const rch_json *jumps = jarr(r->cal, "length_jumps");
+    kv(r, "length jumps (nuisance)");
+    if (!jumps)
+        fputs("none fitted", f);
+    for (size_t k = 0; jumps && k < jumps->n; ++k) {
+        const rch_json *jk = jumps->items[k];
+        fprintf(f, "%sline %.0f: %+.3f &plusmn; %.3f mm", k ? "<br>" : "", jnum(jk, "line"), jnum(jk, "size_mm"),
+                jnum(jk, "se_mm"));
+    }
+    kv_end(r);
+    kv(r, "joint angles");
+    if (isfinite(jnum(r->cal, "dequantized.corrected")))
+        fprintf(f, "recovered from the file's x, y, z: %.0f rows corrected (RMS %.4f&deg;), %.0f refused and dropped",
+                jnum(r->cal, "dequantized.corrected"), jnum(r->cal, "dequantized.dq_rms_deg"),
+                jnum(r->cal, "dequantized.refused"));
+    else
+        fputs("as read (not recovered from x, y, z)", f);
     kv_end(r);
     kv(r, "display resolution");
     fputs("joints ", f);
@@ -1042,6 +1179,10 @@ static void params_table(rep *r, const prow *p, size_t n)
         put_num(r, p[k].value, "%.6g");
         fputs("</td><td>", f);
         put_num(r, p[k].delta, "%+.4g");
+        if (p[k].prior_sd > 0.0 && isfinite(p[k].delta) && fabs(p[k].delta) > 3.0 * p[k].prior_sd)
+            fprintf(f, " <span class=\"flag\" title=\"more than 3 prior sd (%.3g) from nominal\">&#9888; &gt; 3 "
+                       "prior sd</span>",
+                    p[k].prior_sd);
         if (have_se) {
             /* no standard error by design for a parameter the data cannot determine or that was fixed */
             const int none = !isfinite(p[k].se) && (strcmp(p[k].cls, "not identifiable") == 0 ||
@@ -1181,11 +1322,19 @@ static void sec_params(rep *r, const prow *p, size_t n)
     fputs("<section id=\"params\"><h2>4. Identified parameters</h2>\n<p>solver ", f);
     put_str(r, jstr(r->cal, "method"));
     fputs(": ", f);
-    put_num(r, jnum(r->cal, "iterations"), "%.0f iterations");
-    fputs(", ", f);
-    put_num(r, jnum(r->cal, "cost_evals"), "%.0f passes over the data");
-    fputs(", exit: ", f);
-    put_str(r, jstr(r->cal, "exit"));
+    const rch_json *jumps = jarr(r->cal, "length_jumps");
+    if (jumps && jnum(r->cal, "iterations") == 0.0) {
+        fprintf(f, "fitted with %zu length jump%s (a change-point search, each candidate a fit)", jumps->n,
+                jumps->n == 1 ? "" : "s");
+    } else {
+        put_num(r, jnum(r->cal, "iterations"), "%.0f iterations");
+        fputs(", ", f);
+        put_num(r, jnum(r->cal, "cost_evals"), "%.0f passes over the data");
+        fputs(", exit: ", f);
+        put_str(r, jstr(r->cal, "exit"));
+    }
+    if (jbool(jpath(r->cal, "estimation"), "prior") == 1)
+        fputs(", maximum a posteriori with the physical prior", f);
     fputs(", ", f);
     put_num(r, jnum(r->cal, "time_ms"), "%.1f ms");
     fputs(".<br>standard errors: ", f);
@@ -1354,8 +1503,9 @@ static void sec_diag(rep *r, const crow *c, size_t n)
     fputs("</b>", f);
     const char *why = jstr(r->diag, "remaining_why");
     if (why && *why) {
-        fputs(" &mdash; ", f);
+        fputs("<br><span class=\"note\">what is left after it: ", f);
         put_esc(f, why);
+        fputs("</span>", f);
     }
     fputs("</p>\n<table class=\"kv\">\n", f);
     kv(r, "after the chosen effects");

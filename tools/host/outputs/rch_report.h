@@ -50,6 +50,8 @@ typedef struct {
     const char *out_path;     /* the HTML page (required; not "-": the CSVs go beside it) */
     const char *command_line; /* the report's own command line, shown in the provenance; may be NULL */
     const char *date_utc;     /* "2026-11-29T17:00:00Z" shown as the report's date; NULL: now */
+    double tolerance_mm;      /* > 0: the verdict is pass or fail against it (the largest 95 % position
+                                 radius after compensation over the data's poses); 0: no verdict */
 } rch_report_cfg;
 
 typedef struct {
