@@ -142,9 +142,10 @@ static void test_real_data(void **state)
         skip();
     }
     fclose(f);
-    char args[1024];
-    snprintf(args, sizeof args, "--data %s --robot %s/data/irb120.json --folds 3 --steps 1 --max-iter 40 --json", RCAL_SHARED_DATA,
-             RCAL_SOURCE_DIR);
+    char args[1024], plots[] = "/tmp/rcal_diag_real_XXXXXX";
+    assert_non_null(mkdtemp(plots));
+    snprintf(args, sizeof args, "--data %s --robot %s/data/irb120.json --folds 3 --steps 1 --max-iter 40 --json --plots %s",
+             RCAL_SHARED_DATA, RCAL_SOURCE_DIR, plots);
     int status;
     rch_json *j = run_json(args, &status);
     assert_int_equal(status, 0);
@@ -168,6 +169,25 @@ static void test_real_data(void **state)
     assert_true(after < 0.5 * before);
     assert_true(after < 1.5 * floor_mm);
     assert_true(fabs(jnum(j, "q_step_deg") - 0.1) < 1e-12);
+    /* the plot of the residuals in acquisition order marks every jump found */
+    char path[600], line[4096];
+    snprintf(path, sizeof path, "%s/residuals_order.svg", plots);
+    FILE *svg = fopen(path, "r");
+    assert_non_null(svg);
+    size_t marks = 0;
+    while (fgets(line, sizeof line, svg))
+        for (const char *q = line; (q = strstr(q, "length jump ")) != NULL; ++q)
+            ++marks;
+    fclose(svg);
+    print_message("residuals_order.svg: %zu length-jump marks for %zu jumps\n", marks, jl->n);
+    assert_true(marks >= jl->n);
+    const char *files[] = {"residuals_order.svg", "residuals_order.csv", "group_means.svg", "group_means.csv",
+                           "candidates.svg", "candidates.csv", "residuals_structure.svg", "residuals_structure.csv"};
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; ++k) {
+        snprintf(path, sizeof path, "%s/%s", plots, files[k]);
+        unlink(path);
+    }
+    rmdir(plots);
     rch_json_free(j);
 }
 

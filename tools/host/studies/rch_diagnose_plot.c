@@ -95,6 +95,21 @@ static int plot_order(const rch_diagnose_result *r, const plot_out *o, double *x
                  fl[2] = {-r->noise_floor_mm, -r->noise_floor_mm};
     rch_plot_line(p, "+ noise floor", ends, fh, 2); /* level lines: their two ends */
     rch_plot_line(p, "- noise floor", ends, fl, 2);
+    /* the nuisance found: each length jump a vertical line between the last
+     * sample before it and the first after (acquisition order) */
+    if (r->jumps.n_jumps > 0 && n > 0) {
+        double lo = r->res_before_mm[0], hi = r->res_before_mm[0];
+        for (size_t i = 1; i < n; ++i) {
+            lo = r->res_before_mm[i] < lo ? r->res_before_mm[i] : lo;
+            hi = r->res_before_mm[i] > hi ? r->res_before_mm[i] : hi;
+        }
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+            char lab[96];
+            const double xv[2] = {(double)r->jumps.at[k] - 0.5, (double)r->jumps.at[k] - 0.5}, yv[2] = {lo, hi};
+            snprintf(lab, sizeof lab, "length jump %u: %+.3f mm", k + 1, r->jumps.size_mm[k]);
+            rch_plot_line(p, lab, xv, yv, 2);
+        }
+    }
     rch_plot_size(p, 1000, 500);
     return save(p, o, "residuals_order.svg", d);
 }
