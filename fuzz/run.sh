@@ -48,13 +48,14 @@ dict_for() {
     fuzz_csv | fuzz_plan) echo "$ROOT/fuzz/dict/csv.dict" ;;
     fuzz_json | fuzz_robot) echo "$ROOT/fuzz/dict/json.dict" ;;
     fuzz_ascii | fuzz_stx | fuzz_display) echo "$ROOT/fuzz/dict/ascii.dict" ;;
+    fuzz_urdf) echo "$ROOT/fuzz/dict/xml.dict" ;;
     *) echo "" ;;
     esac
 }
 
 maxlen_for() {
     case "$1" in
-    fuzz_csv | fuzz_plan | fuzz_json | fuzz_robot) echo 16384 ;;
+    fuzz_csv | fuzz_plan | fuzz_json | fuzz_robot | fuzz_urdf) echo 16384 ;;
     *) echo 1024 ;;
     esac
 }

@@ -291,7 +291,7 @@ static void test_csv_categories(void **state)
     rch_plot_scatter(p, "b", x, y, 3);
     rch_plot_line(p, "one", x + 2, y + 2, 1);
     char *svg = render(p);
-    assert_non_null(strstr(svg, ">the paper&apos;s Fig. 9</text>"));
+    assert_non_null(strstr(svg, ">the paper&#39;s Fig. 9</text>"));
     assert_int_equal(drawn_points(svg), 7 + 3 + 1);
     assert_int_equal(count(svg, "<g class=\"series\">"), 3);
     free(svg);

@@ -3,6 +3,7 @@
 #include "rch_jw.h"
 
 #include "rc_version.h"
+#include "rch_text.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -30,34 +31,6 @@ static void indent(rch_jw *w)
         put(w, "  ");
 }
 
-/* Length of the well-formed UTF-8 sequence at p (1..4), or 0 when the
- * bytes there are not one (overlong forms, surrogates and code points above
- * U+10FFFF are not well-formed). */
-static size_t utf8_len(const unsigned char *p)
-{
-    unsigned char c = p[0];
-    size_t n;
-    unsigned cp;
-    if (c < 0x80)
-        return 1;
-    if (c >= 0xc2 && c <= 0xdf)
-        n = 2, cp = c & 0x1fu;
-    else if (c >= 0xe0 && c <= 0xef)
-        n = 3, cp = c & 0x0fu;
-    else if (c >= 0xf0 && c <= 0xf4)
-        n = 4, cp = c & 0x07u;
-    else
-        return 0;
-    for (size_t i = 1; i < n; ++i) {
-        if ((p[i] & 0xc0) != 0x80)
-            return 0;
-        cp = cp << 6 | (p[i] & 0x3fu);
-    }
-    if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10ffff)) || (cp >= 0xd800 && cp <= 0xdfff))
-        return 0;
-    return n;
-}
-
 static void write_string(rch_jw *w, const char *s)
 {
     char buf[8];
@@ -80,7 +53,7 @@ static void write_string(rch_jw *w, const char *s)
         } else if (c >= 0x80) {
             /* Well-formed UTF-8 is copied; any other byte becomes U+FFFD,
              * so the output is valid UTF-8 whatever the input path holds. */
-            size_t n = utf8_len(p);
+            size_t n = rch_utf8_len(p);
             if (n) {
                 memcpy(buf, p, n);
                 buf[n] = '\0';
@@ -259,7 +232,7 @@ const char *rch_jw_escape(const char *s, char *buf, size_t len)
         } else if (c < 0x20) {
             snprintf(tmp, sizeof tmp, "\\u%04x", (unsigned)c);
         } else if (c >= 0x80) {
-            size_t k = utf8_len(p);
+            size_t k = rch_utf8_len(p);
             if (k) {
                 memcpy(tmp, p, k);
                 tmp[k] = '\0';

@@ -8,6 +8,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rch_text.h"
+
 enum { PLOT_LINE = 0, PLOT_SCATTER = 1 };
 
 typedef struct plot_series {
@@ -269,24 +271,7 @@ void rch_plot_free(rch_plot *p)
 
 /* ---- writing ---------------------------------------------------------- */
 
-static void plot_esc(FILE *f, const char *s)
-{
-    for (; s && *s; s++) {
-        switch (*s) {
-        case '&': fputs("&amp;", f); break;
-        case '<': fputs("&lt;", f); break;
-        case '>': fputs("&gt;", f); break;
-        case '"': fputs("&quot;", f); break;
-        case '\'': fputs("&apos;", f); break;
-        default:
-            /* control characters are not allowed in XML 1.0 text */
-            if ((unsigned char)*s < 0x20 && *s != '\t' && *s != '\n')
-                fputc(' ', f);
-            else
-                fputc(*s, f);
-        }
-    }
-}
+static void plot_esc(FILE *f, const char *s) { rch_xml_put(f, s, 0); }
 
 /* 1-2-5 step for about `want` intervals over span. */
 static double plot_nice_step(double span, int want)

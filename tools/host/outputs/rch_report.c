@@ -12,6 +12,7 @@
 
 #include "rc_version.h"
 #include "rch_file.h"
+#include "rch_text.h"
 #include "rch_json.h"
 #include "rch_plot.h"
 #include "rch_sha256.h"
@@ -94,89 +95,9 @@ static const rch_json *jarr(const rch_json *o, const char *path)
 
 /* ---- escaping */
 
-/* Length of the valid UTF-8 sequence at s (1..4), or 0. */
-static size_t utf8_len(const unsigned char *s)
-{
-    size_t n;
-    unsigned long cp, min;
-    if (s[0] < 0x80)
-        return 1;
-    if ((s[0] & 0xE0) == 0xC0) {
-        n = 2;
-        min = 0x80;
-    } else if ((s[0] & 0xF0) == 0xE0) {
-        n = 3;
-        min = 0x800;
-    } else if ((s[0] & 0xF8) == 0xF0) {
-        n = 4;
-        min = 0x10000;
-    } else {
-        return 0;
-    }
-    cp = s[0] & (0x7Fu >> n);
-    for (size_t i = 1; i < n; ++i) {
-        if ((s[i] & 0xC0) != 0x80)
-            return 0;
-        cp = (cp << 6) | (s[i] & 0x3Fu);
-    }
-    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
-        return 0;
-    return n;
-}
+const char *rch_report_escape(char *buf, size_t len, const char *s) { return rch_xml_escape(buf, len, s, 0); }
 
-/* The HTML text for the character at s into out; *used gets the bytes read. */
-static const char *esc_piece(char out[8], const char *s, size_t *used)
-{
-    const unsigned char c = (unsigned char)*s;
-    *used = 1;
-    switch (c) {
-    case '&': return "&amp;";
-    case '<': return "&lt;";
-    case '>': return "&gt;";
-    case '"': return "&quot;";
-    case '\'': return "&#39;";
-    default: break;
-    }
-    if ((c < 0x20 && c != '\t' && c != '\n') || c == 0x7F)
-        return "&#xFFFD;";
-    const size_t n = utf8_len((const unsigned char *)s);
-    if (n == 0)
-        return "&#xFFFD;";
-    memcpy(out, s, n);
-    out[n] = '\0';
-    *used = n;
-    return out;
-}
-
-const char *rch_report_escape(char *buf, size_t len, const char *s)
-{
-    size_t k = 0;
-    if (len == 0)
-        return buf;
-    buf[0] = '\0';
-    while (s && *s) {
-        char tmp[8];
-        size_t used;
-        const char *p = esc_piece(tmp, s, &used);
-        const size_t n = strlen(p);
-        if (k + n >= len)
-            break;
-        memcpy(buf + k, p, n + 1);
-        k += n;
-        s += used;
-    }
-    return buf;
-}
-
-static void put_esc(FILE *f, const char *s)
-{
-    while (s && *s) {
-        char tmp[8];
-        size_t used;
-        fputs(esc_piece(tmp, s, &used), f);
-        s += used;
-    }
-}
+static void put_esc(FILE *f, const char *s) { rch_xml_put(f, s, 0); }
 
 /* A JSON string escaped, or "not in this run". */
 static void put_str(rep *r, const char *s)
