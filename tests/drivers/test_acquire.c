@@ -435,19 +435,34 @@ static void test_plan_limits(void **state)
 {
     rch_robot rb;
     rch_diag dg;
-    rch_poses_config pc = {12, 0, 4, 3, 250, 800, 20};
+    rch_poses_config pc;
     rch_poses_result res;
     rch_data back;
     char p[512];
     FILE *f;
     (void)state;
+    memset(&pc, 0, sizeof pc);
+    pc.count = 12;
+    pc.passes = 4;
+    pc.seed = 3;
+    pc.len_min_mm = 250;
+    pc.len_max_mm = 800;
+    pc.margin_deg = 20;
     assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
     rb.model.x[RC_P_ENC] = 250.0;
     rb.model.x[RC_P_ENC + 1] = -460.0;
     rb.model.x[RC_P_ENC + 2] = 10.0;
+    pc.criterion = RCH_POSES_LENGTH; /* the length plan: O1 above random */
     assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
     assert_int_equal(res.n, 12);
     assert_true(res.o1_plan > res.o1_random);
+    rch_poses_free(&res);
+    pc.criterion = RCH_POSES_POSITION; /* the 3-D plan: predicted accuracy above random */
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
+    assert_int_equal(res.n, 12);
+    print_message("12 poses: predicted 95 %% radius median %.4f mm (random %.4f), p95 %.4f (random %.4f)\n",
+                  res.plan.median_mm, res.random.median_mm, res.plan.p95_mm, res.random.p95_mm);
+    assert_true(res.plan.phi_mm2 < res.random.phi_mm2);
     path_in(p, sizeof p, "plan12.csv");
     f = fopen(p, "w");
     assert_non_null(f);
