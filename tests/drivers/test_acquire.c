@@ -492,6 +492,66 @@ static void test_plan_limits(void **state)
     assert_null(res.poses);
 }
 
+/* a plan for two places of the encoder (rcal poses --outlet A --outlet B:
+ * the poses repeated per outlet, column outlet): a run records the rows of
+ * its outlet only, the run from the other outlet appends to the same file,
+ * and a run that names no outlet is refused */
+static void test_plan_outlets(void **state)
+{
+    char text[2048], p[512];
+    size_t n = 0;
+    double v[NP];
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    rch_data back;
+    rch_diag dg;
+    (void)state;
+    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6,outlet\n");
+    for (int k = 0; k < 2; ++k)
+        for (int i = 0; i < NP; ++i) {
+            n += (size_t)snprintf(text + n, sizeof text - n, "%d", k * NP + i);
+            for (int j = 0; j < RC_NJ; ++j)
+                n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
+            n += (size_t)snprintf(text + n, sizeof text - n, ",%d\n", k);
+        }
+    write_text("plan_outlets.csv", text);
+    char saved[512];
+    snprintf(saved, sizeof saved, "%s", g_plan);
+    path_in(g_plan, sizeof g_plan, "plan_outlets.csv");
+    for (int i = 0; i < NP; ++i)
+        v[i] = nominal_mm[i] + 0.5;
+    /* no --outlet: refused, nothing written */
+    tio_init(&t);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+    config(&c, "outlets.csv");
+    c.stable.n = 5;
+    assert_int_not_equal(run(&r, &c, &t), 0);
+    assert_non_null(strstr(g_err, "--outlet"));
+    assert_true(fsize("outlets.csv") <= 0);
+    /* outlet 0, then outlet 1 into the same file */
+    for (int k = 0; k < 2; ++k) {
+        tio_init(&t);
+        t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+        c.outlet_p1 = k + 1;
+        assert_int_equal(run(&r, &c, &t), 0);
+        assert_int_equal(r.n_poses, NP);
+        assert_int_equal(r.n_new, NP);
+        assert_int_equal(r.n_before, 0);
+    }
+    tio_init(&t);
+    assert_int_equal(run(&r, &c, &t), 0); /* outlet 1 again: nothing to do */
+    assert_int_equal(r.n_new, 0);
+    path_in(p, sizeof p, "outlets.csv");
+    assert_int_equal(rch_data_load(&back, p, 0, &dg), 0);
+    assert_int_equal(back.n, 2 * NP);
+    assert_true(back.has_outlet);
+    for (size_t i = 0; i < back.n; ++i)
+        assert_int_equal(back.s[i].outlet, i < NP ? 0 : 1);
+    rch_data_free(&back);
+    snprintf(g_plan, sizeof g_plan, "%s", saved);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -504,6 +564,7 @@ int main(void)
         cmocka_unit_test(test_scan_bounded),
         cmocka_unit_test(test_nul_last_line_dropped),
         cmocka_unit_test(test_plan_limits),
+        cmocka_unit_test(test_plan_outlets),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
