@@ -127,12 +127,9 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
         rch_jw_arr(&w, "combinations");
         for (size_t i = 0; i < ch->n_combos; ++i) {
             const rch_poses_combo *cb = &ch->combos[i];
-            unsigned size = 0;
-            for (unsigned j = 0; j < ch->k; ++j)
-                size += j == 0 || cb->idx[j] != 0 || (ch->exhaustive);
             rch_jw_obj(&w, NULL);
             rch_jw_arr(&w, "candidates");
-            for (unsigned j = 0; j < (ch->exhaustive ? ch->k : size); ++j)
+            for (unsigned j = 0; j < cb->k; ++j)
                 rch_jw_uint(&w, NULL, cb->idx[j]);
             rch_jw_end(&w);
             rch_jw_num(&w, "median_mm", cb->acc.median_mm);
@@ -155,10 +152,10 @@ static void print_choice(const rch_poses_choice *ch, const double (*cand)[3])
     for (size_t i = 0; i < ch->n_combos; ++i) {
         const rch_poses_combo *cb = &ch->combos[i];
         printf("  %s", i == ch->best ? "*" : " ");
-        for (unsigned j = 0; j < ch->k; ++j)
+        for (unsigned j = 0; j < cb->k; ++j)
             printf(" %u", cb->idx[j]);
         printf("  (");
-        for (unsigned j = 0; j < ch->k; ++j)
+        for (unsigned j = 0; j < cb->k; ++j)
             printf("%s%.0f,%.0f,%.0f", j ? "; " : "", cand[cb->idx[j]][0], cand[cb->idx[j]][1], cand[cb->idx[j]][2]);
         printf(")  predicted 95 %% radius median %.4f mm, p95 %.4f mm  [%s]\n", cb->acc.median_mm, cb->acc.p95_mm,
                cb->span == 1 ? "one point" : cb->span == 2 ? "on a line" : "a plane");
@@ -180,11 +177,15 @@ static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, 
            res->n_distinct, res->n_candidates, res->n_outlets,
            res->n_outlets < 2 ? "" : pc->split ? ", each pose from one outlet (--split)" : ", every pose from each",
            res->n, res->n_ident);
-    for (unsigned k = 0; k < res->n_outlets; ++k)
-        printf("  outlet %u at (%.1f, %.1f, %.1f) mm: %zu rows; record them with: rcal acquire --poses %s%s --outlet "
-               "%u --encoder %g,%g,%g ...\n",
+    for (unsigned k = 0; k < res->n_outlets; ++k) {
+        char opt[32] = "";
+        if (res->n_outlets > 1)
+            snprintf(opt, sizeof opt, " --outlet %u", k);
+        printf("  outlet %u at (%.1f, %.1f, %.1f) mm: %zu rows; record them with: rcal acquire --poses %s%s "
+               "--encoder %g,%g,%g ...\n",
                k, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2], res->rows_per_outlet[k], out_path,
-               "", k, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2]);
+               opt, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2]);
+    }
     printf("  predicted 3-D accuracy of the %s after calibration (95 %% position radius over %s random workspace "
            "poses, length noise %g mm):\n",
            pc->has_tool ? "tool point" : "flange", "1000", pc->noise_mm > 0 ? pc->noise_mm : RCH_POSES_NOISE_MM);

@@ -784,11 +784,11 @@ static int pos_design(pos_work *w, const rch_poses_config *c, FILE *progress)
         if (best >= w->n_cand)
             return -1;
         pos_take(w, t, best, 1);
-        progress_line(w->n >= 100 ? progress : NULL, "greedy design, pose", t, w->n);
+        progress_line(w->n >= 200 ? progress : NULL, "greedy design, pose", t, w->n);
     }
     for (unsigned long pass = 0; pass < c->passes; ++pass) {
         unsigned swaps = 0;
-        if (progress && w->n >= 100)
+        if (progress && w->n >= 200)
             fprintf(progress, "rcal poses: exchange pass %lu/%lu\n", pass + 1, c->passes);
         for (size_t t = 0; t < w->n; ++t) {
             const size_t cur = w->design[t];
@@ -1028,6 +1028,7 @@ static int combo_eval(rch_poses_combo *cb, const rc_model *m, const rch_poses_co
     double pos[RC_MAX_OUTLETS][3];
     cc.n_outlets = k;
     cc.passes = 0;
+    cb->k = k;
     if (k < 2)
         cc.split = 0;
     for (unsigned j = 0; j < k; ++j) {

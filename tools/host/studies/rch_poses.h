@@ -122,6 +122,7 @@ int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_pose
 #define RCH_POSES_MAX_CANDIDATE_PLACES 16u
 #define RCH_POSES_MAX_COMBOS 64u
 typedef struct rch_poses_combo {
+    unsigned k;                   /* places in it (fewer than the choice's k on the greedy path's way) */
     unsigned idx[RC_MAX_OUTLETS]; /* (k) candidate indices */
     rch_poses_accuracy acc;
     int span;                     /* rch_prior_outlet_span */
