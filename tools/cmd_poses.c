@@ -197,6 +197,60 @@ static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, 
            res->o1_random, res->o1_random > 0 ? res->o1_plan / res->o1_random : 0.0);
 }
 
+/* The plan into f: CSV (an outlet column with several outlets) or RAPID. 0 or -1. */
+static int write_out(FILE *f, const rch_poses_result *res, const rch_poses_config *pc, const char *format,
+                     double settle_s)
+{
+    if (strcmp(format, "rapid") != 0)
+        return res->n_outlets > 1 ? rch_data_write_plan_outlets(f, res->poses, res->n)
+                                  : rch_data_write_plan(f, res->poses, res->n);
+    unsigned char *lab = malloc(res->n ? res->n : 1);
+    char comment[200];
+    snprintf(comment, sizeof comment, "rcal poses --count %zu --seed %llu: %u outlet(s)%s", res->n_distinct,
+             pc->seed, res->n_outlets, res->n_outlets > 1 ? (pc->split ? ", split" : ", every pose from each") : "");
+    for (size_t i = 0; lab && i < res->n; ++i)
+        lab[i] = res->poses[i].outlet;
+    const int wr = lab ? rch_poses_write_rapid(f, res->poses, lab, res->n, settle_s, comment) : -1;
+    free(lab);
+    return wr;
+}
+
+/* --outlet, --candidate and --choose-outlets together. 0 or -1 (reported). */
+static int check_places(unsigned long choose, unsigned n_places, unsigned n_c, int split)
+{
+    if (split && n_places < 2 && choose < 2) {
+        fprintf(stderr, "rcal poses: --split needs at least two --outlet places (or --choose-outlets K >= 2)\n");
+        return -1;
+    }
+    if (choose && (n_places || n_c < choose)) {
+        fprintf(stderr, "rcal poses: --choose-outlets %lu needs at least %lu --candidate places and no --outlet\n",
+                choose, choose);
+        return -1;
+    }
+    if (!choose && n_c) {
+        fprintf(stderr, "rcal poses: --candidate is for --choose-outlets K\n");
+        return -1;
+    }
+    return 0;
+}
+
+/* --choose-outlets: the best K of the candidates into pc's outlets. 0 or -1 (reported). */
+static int choose_places(rch_poses_choice *ch, rch_poses_config *pc, const rc_model *m, const double (*cand)[3],
+                         unsigned n_c, unsigned k, int json)
+{
+    rch_diag dg;
+    if (rch_poses_choose_outlets(ch, m, pc, cand, n_c, k, &dg) != 0) {
+        fprintf(stderr, "rcal poses: %s\n", dg.msg);
+        return -1;
+    }
+    pc->n_outlets = k;
+    for (unsigned j = 0; j < k; ++j)
+        memcpy(pc->outlet_mm[j], cand[ch->combos[ch->best].idx[j]], sizeof pc->outlet_mm[j]);
+    if (!json)
+        print_choice(ch, cand);
+    return 0;
+}
+
 int rcal_cmd_poses(int argc, char **argv)
 {
     const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL, *criterion = "position", *format = "csv";
@@ -257,17 +311,8 @@ int rcal_cmd_poses(int argc, char **argv)
     if (st >= 0)
         return st;
     if (parse_places(pc.outlet_mm, &n_places, &outlets, "--outlet") != 0 ||
-        parse_places(cand, &n_c, &cands, "--candidate") != 0)
+        parse_places(cand, &n_c, &cands, "--candidate") != 0 || check_places(choose, n_places, n_c, split) != 0)
         return 2;
-    if (choose && (n_places || n_c < choose)) {
-        fprintf(stderr, "rcal poses: --choose-outlets %lu needs at least %lu --candidate places and no --outlet\n",
-                choose, choose);
-        return 2;
-    }
-    if (!choose && n_c) {
-        fprintf(stderr, "rcal poses: --candidate is for --choose-outlets K\n");
-        return 2;
-    }
     pc.count = n;
     pc.candidates = n_cand;
     pc.passes = passes;
@@ -299,21 +344,14 @@ int rcal_cmd_poses(int argc, char **argv)
         free(robot);
         return 1;
     }
-    if (choose) {
-        ch = malloc(sizeof *ch);
-        if (!ch || rch_poses_choose_outlets(ch, &robot->model, &pc, (const double(*)[3])cand, n_c, (unsigned)choose,
-                                            &dg) != 0) {
-            rch_out_abort(&out);
-            fprintf(stderr, "rcal poses: %s\n", ch ? dg.msg : "out of memory");
-            free(ch);
-            free(robot);
-            return 1;
-        }
-        pc.n_outlets = (unsigned)choose;
-        for (unsigned j = 0; j < pc.n_outlets; ++j)
-            memcpy(pc.outlet_mm[j], cand[ch->combos[ch->best].idx[j]], sizeof pc.outlet_mm[j]);
-        if (!json)
-            print_choice(ch, (const double(*)[3])cand);
+    if (choose && (!(ch = malloc(sizeof *ch)) ||
+                   choose_places(ch, &pc, &robot->model, (const double(*)[3])cand, n_c, (unsigned)choose, json) != 0)) {
+        if (!ch)
+            fprintf(stderr, "rcal poses: out of memory\n");
+        rch_out_abort(&out);
+        free(ch);
+        free(robot);
+        return 1;
     }
     if (rch_poses_plan(&res, &robot->model, &pc, stderr, &dg) != 0) {
         rch_out_abort(&out);
@@ -324,20 +362,7 @@ int rcal_cmd_poses(int argc, char **argv)
     }
     if (!json)
         print_plan(&res, &pc, out_path);
-    int wr;
-    if (strcmp(format, "rapid") == 0) {
-        unsigned char *lab = malloc(res.n ? res.n : 1);
-        char comment[200];
-        snprintf(comment, sizeof comment, "rcal poses --count %zu --seed %lu: %u outlet(s)%s", res.n_distinct, seed,
-                 res.n_outlets, res.n_outlets > 1 ? (pc.split ? ", split" : ", every pose from each") : "");
-        for (size_t i = 0; lab && i < res.n; ++i)
-            lab[i] = res.poses[i].outlet;
-        wr = lab ? rch_poses_write_rapid(out.f, res.poses, lab, res.n, settle_s, comment) : -1;
-        free(lab);
-    } else {
-        wr = res.n_outlets > 1 ? rch_data_write_plan_outlets(out.f, res.poses, res.n)
-                                 : rch_data_write_plan(out.f, res.poses, res.n);
-    }
+    const int wr = write_out(out.f, &res, &pc, format, settle_s);
     if (wr != 0) {
         rch_out_abort(&out);
         fprintf(stderr, "rcal poses: writing %s failed; nothing was replaced\n", out_path);
