@@ -92,6 +92,8 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
     for (unsigned k = 0; k < res->n_outlets; ++k)
         rch_jw_uint(&w, NULL, res->rows_per_outlet[k]);
     rch_jw_end(&w);
+    if (pc->criterion != RCH_POSES_LENGTH)
+        rch_jw_uint(&w, "rows_advised", res->rows_advised);
     rch_jw_uint(&w, "candidates", res->n_candidates);
     rch_jw_uint(&w, "seed", pc->seed);
     rch_jw_uint(&w, "identifiable_directions", res->n_ident);
@@ -195,6 +197,12 @@ static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, 
            res->random.p95_mm);
     printf("  observability O1 of the lengths (rch_ident): planned %.5g, random %.5g, ratio %.2f\n", res->o1_plan,
            res->o1_random, res->o1_random > 0 ? res->o1_plan / res->o1_random : 0.0);
+    if (res->n < res->rows_advised)
+        printf("  WARNING: %zu rows for about %zu parameters calibrate fits: it estimates the noise from the "
+               "residuals and needs at least %zu rows, else the fit follows the noise and the predicted accuracy is "
+               "not reached; next: raise --count%s\n",
+               res->n, res->rows_advised - RCH_POSES_ROWS_SPARE, res->rows_advised,
+               pc->split ? " (or measure every pose from each outlet: leave out --split)" : "");
 }
 
 /* The plan into f: CSV (an outlet column with several outlets) or RAPID. 0 or -1. */

@@ -19,6 +19,7 @@ base heading and height (the gauge rcal holds). Checks:
   - --format rapid: a module that `rcal compensate` reads, with every pose.
 
     python3 plan_study.py RCAL WORKDIR [--cases N]
+    python3 plan_study.py RCAL WORKDIR --table [--cases N]   (not a test: the table by outlets and design)
 """
 import json
 import os
@@ -75,7 +76,7 @@ def random_design(rng, nom, lim, outs, n):
     return q, o
 
 
-def judge(rcal, tmp, truth, nom, robot_path, q, o, outs_true, rng, name):
+def judge(rcal, tmp, truth, nom, robot_path, q, o, outs_true, rng, name, robot_name="irb120"):
     L = np.array([np.linalg.norm(truth.point(qq, [0, 0, 0]) - outs_true[k]) for qq, k in zip(q, o)])
     L = np.round(L + NOISE * rng.standard_normal(len(L)), 4)
     data = os.path.join(tmp, name + ".csv")
@@ -89,7 +90,7 @@ def judge(rcal, tmp, truth, nom, robot_path, q, o, outs_true, rng, name):
     run([rcal, "calibrate", "--data", data, "--robot", robot_path, "--out", model, "--test-fraction", "0"])
     if not os.path.exists(model):
         return None, None
-    lim = ts.ROBOTS["irb120"]["lim"]
+    lim = ts.ROBOTS[robot_name]["lim"]
     T = []
     while len(T) < 300:
         qq = ts.draw_q(rng, lim, 1)[0]
@@ -121,8 +122,58 @@ def poses_cmd(rcal, robot, out, outs, extra=()):
     return json.loads(r.stdout) if r.returncode == 0 else None
 
 
+OUTS4 = [np.array([500.0, -250.0, 50.0]), np.array([-400.0, -400.0, 350.0]), np.array([-100.0, 550.0, 0.0]),
+         np.array([450.0, 400.0, 300.0])]
+
+
+def table(rcal, work, cases):
+    """The 3-D compensated error by outlets (1-4) and design, beside rcal poses' prediction, two robots."""
+    print("robot    K design  | predicted 95 %% radius median / p95 | measured 3-D error p95 / RMS (median over "
+          "%d cases)" % cases)
+    for name in ("irb120", "irb1600"):
+        sc = ts.ROBOTS[name]["reach"] / ts.ROBOTS["irb120"]["reach"]
+        robot = os.path.join(work, name + ".json")
+        ts.write_robot(robot, name)
+        nom = ts.nominal_robot(name)
+        for K in (1, 2, 3, 4):
+            for split, count in (((False, COUNT),) if K == 1 else
+                                 ((False, COUNT), (True, COUNT), (True, COUNT * K))):
+                outs = [o * sc for o in OUTS4[:K]]
+                pr, me = [], []
+                for k in range(cases):
+                    rng = np.random.default_rng([2028, K, k, split, count])
+                    truth = ts.true_robot(rng, name, 0.03)
+                    outs_true = [o + rng.normal(0, 20.0 / np.sqrt(3), 3) for o in outs]
+                    plan = os.path.join(work, "t.csv")
+                    cmd = [rcal, "poses", "--robot", robot, "--count", str(count), "--len-min-mm", "250",
+                           "--len-max-mm", "%g" % (LEN[1] * sc), "--candidates", "1500", "--seed", str(k + 1),
+                           "--json", "--out", plan] + (["--split"] if split else [])
+                    for o in outs:
+                        cmd += ["--outlet", ",".join("%g" % v for v in o)]
+                    r = run(cmd)
+                    if r.returncode != 0:
+                        continue
+                    d = json.loads(r.stdout)["predicted_position95_mm"]["plan"]
+                    qp, op = read_plan(plan)
+                    e, _ = judge(rcal, work, truth, nom, robot, qp, op, outs_true, rng, "t", name)
+                    if e is None:
+                        continue
+                    pr.append((d["median_mm"], d["p95_mm"]))
+                    me.append((np.percentile(e, 95), np.sqrt(np.mean(e ** 2))))
+                if pr:
+                    p_, m_ = np.median(np.array(pr), 0), np.median(np.array(me), 0)
+                    print("%-8s %d %-7s %3d poses %3d rows | %.4f / %.4f mm | %.4f / %.4f mm" % (
+                        name, K, "split" if split else "all", count, count if split else count * K, p_[0], p_[1],
+                        m_[0], m_[1]), flush=True)
+    return 0
+
+
 def main():
     rcal, work = sys.argv[1], sys.argv[2]
+    if "--table" in sys.argv:
+        shutil.rmtree(work, ignore_errors=True)
+        os.makedirs(work)
+        return table(rcal, work, int(sys.argv[sys.argv.index("--cases") + 1]) if "--cases" in sys.argv else 3)
     cases = int(sys.argv[sys.argv.index("--cases") + 1]) if "--cases" in sys.argv else 3
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)

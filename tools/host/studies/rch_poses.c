@@ -17,24 +17,16 @@
 
 #define PI_ 3.14159265358979323846
 
-/* Cholesky of the r x r matrix A (row-major) into L; log det or -inf. */
+/* Cholesky of the r x r matrix A (row-major) into L (LAPACK; the lower
+ * triangle and the diagonal are read); log det or -inf. */
 static double chol(double *L, const double *A, unsigned r)
 {
     double ld = 0;
+    memcpy(L, A, (size_t)r * r * sizeof *L);
+    if (LAPACKE_dpotrf(LAPACK_ROW_MAJOR, 'L', (lapack_int)r, L, (lapack_int)r) != 0)
+        return -INFINITY;
     for (unsigned i = 0; i < r; ++i)
-        for (unsigned j = 0; j <= i; ++j) {
-            double s = A[i * r + j];
-            for (unsigned k = 0; k < j; ++k)
-                s -= L[i * r + k] * L[j * r + k];
-            if (i == j) {
-                if (!(s > 0))
-                    return -INFINITY;
-                L[i * r + i] = sqrt(s);
-                ld += 2.0 * log(L[i * r + i]);
-            } else {
-                L[i * r + j] = s / L[j * r + j];
-            }
-        }
+        ld += 2.0 * log(L[i * r + i]);
     return ld;
 }
 
@@ -924,6 +916,7 @@ static int plan_position(rch_poses_result *res, const rc_model *m, const rch_pos
     res->n_ident = w->nf;
     res->n_outlets = w->K;
     res->n_distinct = w->n;
+    res->rows_advised = w->nf + 3u + RCH_POSES_ROWS_SPARE;
     {   /* O1 (rch_ident) of the plan's rows and of the random ones, as for the length criterion */
         rc_sample *rs = malloc(w->n * w->rows_per * sizeof *rs);
         rch_ident *id = calloc(1, sizeof *id);

@@ -99,7 +99,15 @@ typedef struct rch_poses_result {
     size_t n_distinct;         /* distinct poses (n = K n_distinct, or n_distinct with split) */
     rch_poses_accuracy plan, random; /* predicted 3-D accuracy of the plan and of random poses */
     size_t rows_per_outlet[RC_MAX_OUTLETS];
+    size_t rows_advised;       /* fewest rows advised: calibrate's parameters (the free ones + the cable
+                                  attachment it tries) + RCH_POSES_ROWS_SPARE */
 } rch_poses_result;
+/* `rcal calibrate` estimates the noise from its residuals (SSR / (n - p_eff)):
+ * with about as many rows as parameters the estimate collapses, the prior
+ * loses its weight and the fit follows the noise (measured, plan_study.py
+ * --table: 30 rows for 32 parameters, 3-D error 0.33-0.69 mm against a
+ * predicted 0.05-0.07 mm; 60 rows and more as predicted). */
+#define RCH_POSES_ROWS_SPARE 10u
 
 /* Plan poses for model m (with its encoder position set). progress: a
  * stream for progress lines when the plan takes more than a few seconds
