@@ -552,6 +552,70 @@ static void test_plan_outlets(void **state)
     snprintf(g_plan, sizeof g_plan, "%s", saved);
 }
 
+/* the position criterion with several outlets: a balanced split, the
+ * prediction of the plan's own rows (rch_poses_predict) equal to the plan's,
+ * the choice of 2 of 3 places, the RAPID module with every row */
+static void test_plan_split_choose(void **state)
+{
+    rch_robot rb;
+    rch_diag dg;
+    rch_poses_config pc;
+    rch_poses_result res;
+    rch_poses_accuracy acc;
+    static rch_poses_choice ch;
+    static const double cand[3][3] = {{500, -250, 50}, {-400, -400, 350}, {-100, 550, 0}};
+    (void)state;
+    assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
+    memset(&pc, 0, sizeof pc);
+    pc.count = 9;
+    pc.candidates = 150;
+    pc.passes = 1;
+    pc.seed = 4;
+    pc.len_min_mm = 250;
+    pc.len_max_mm = 1200;
+    pc.margin_deg = 5;
+    pc.n_outlets = 3;
+    memcpy(pc.outlet_mm, cand, sizeof cand);
+    pc.split = 1;
+    pc.n_eval = 200;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
+    assert_int_equal(res.n, 9);
+    for (unsigned k = 0; k < 3; ++k)
+        assert_int_equal(res.rows_per_outlet[k], 3);
+    assert_true(res.n < res.rows_advised); /* 9 rows: calibrate needs more */
+    assert_int_equal(rch_poses_predict(&acc, &rb.model, &pc, res.poses, res.n, &dg), 0);
+    assert_true(fabs(acc.median_mm - res.plan.median_mm) <= 1e-9 * res.plan.median_mm);
+    assert_true(res.plan.phi_mm2 < res.random.phi_mm2);
+    {
+        char buf[1 << 14];
+        FILE *f = fmemopen(buf, sizeof buf, "w");
+        unsigned char lab[9];
+        for (size_t i = 0; i < res.n; ++i)
+            lab[i] = res.poses[i].outlet;
+        assert_non_null(f);
+        assert_int_equal(rch_poses_write_rapid(f, res.poses, lab, res.n, 2.0, "test"), 0);
+        fclose(f);
+        size_t n_jt = 0, n_mv = 0;
+        for (const char *p = buf; (p = strstr(p, "CONST jointtarget rcal_p")) != NULL; ++p)
+            ++n_jt;
+        for (const char *p = buf; (p = strstr(p, "MoveAbsJ rcal_p")) != NULL; ++p)
+            ++n_mv;
+        assert_int_equal(n_jt, 9);
+        assert_int_equal(n_mv, 9);
+        assert_non_null(strstr(buf, "PROC rcal_outlet2()"));
+        assert_non_null(strstr(buf, "TPReadNum"));
+    }
+    rch_poses_free(&res);
+    pc.split = 0;
+    pc.n_outlets = 0;
+    assert_int_equal(rch_poses_choose_outlets(&ch, &rb.model, &pc, cand, 3, 2, &dg), 0);
+    assert_int_equal(ch.n_combos, 3);
+    assert_true(ch.exhaustive);
+    for (size_t i = 0; i < ch.n_combos; ++i)
+        assert_true(ch.combos[ch.best].acc.median_mm <= ch.combos[i].acc.median_mm);
+    assert_int_equal(rch_poses_choose_outlets(&ch, &rb.model, &pc, cand, 3, 4, &dg), -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -565,6 +629,7 @@ int main(void)
         cmocka_unit_test(test_nul_last_line_dropped),
         cmocka_unit_test(test_plan_limits),
         cmocka_unit_test(test_plan_outlets),
+        cmocka_unit_test(test_plan_split_choose),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
