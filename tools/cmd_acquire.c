@@ -141,7 +141,8 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--out", RCH_OPT_STR, &c.out_path, 0, 0, "DATA.csv", "acquisition file (appended)", RCH_OPT_REQUIRED, NULL},
         {"--outlet", RCH_OPT_UINT, &outlet, 0, 255, "N",
          "the encoder place this run measures from (a label 0..255, written as the file's outlet column): "
-         "the same plan run again from another place appends to the same file; give --encoder as this "
+         "the same plan run again from another place appends to the same file; a plan with an outlet "
+         "column (rcal poses --outlet ...) has its rows of outlet N recorded; give --encoder as this "
          "place's position for the follow check", 0, NULL},
         {"--robot", RCH_OPT_STR, &c.robot_path, 0, 0, "MODEL.json", "nominal model: limits, follow check", 0, NULL},
         {"--encoder", RCH_OPT_TRIPLE, c.encoder_mm, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none", 0, NULL},

@@ -1,10 +1,11 @@
 /* SPDX-License-Identifier: MIT */
-/* cmd_poses.c - rcal poses: plan an identifiable pose set.
+/* cmd_poses.c - rcal poses: plan a pose set.
  *
- * Parses the options, runs rch_poses_plan (tools/host/studies/rch_poses.h: the
- * D-optimal design) and writes the plan with rch_data_write_plan through a
- * temporary file renamed into place (rch_file.h), refusing an --out that
- * names the --robot file.
+ * Parses the options, runs rch_poses_plan (tools/host/studies/rch_poses.h:
+ * the 3-D position criterion for K outlets, or the D-optimal length plan)
+ * or rch_poses_choose_outlets, and writes the plan (CSV with
+ * rch_data_write_plan, or a RAPID module) through a temporary file renamed
+ * into place (rch_file.h), refusing an --out that names the --robot file.
  */
 #include <math.h>
 #include <stdio.h>
@@ -20,27 +21,96 @@
 #include "rch_poses.h"
 #include "rch_robot.h"
 
-static const char summary[] = "plan an identifiable pose set (D-optimal)";
+static const char summary[] = "plan a pose set for the best predicted 3-D accuracy (one or several outlets)";
 static const char details[] =
-    "Plans N poses inside the joint limits of MODEL less --margin-deg whose cable length (encoder at the\n"
-    "file's encoder_mm, else --encoder) is within [--len-min-mm, --len-max-mm], chosen among M random candidates\n"
-    "(default max(2000, 40 N)) to maximise det(J^T J) over the identifiable directions (rc_ident; greedy +\n"
-    "exchange).\n"
-    "Writes pose,q1..q6 (degrees, 0.01 deg steps); prints the observability index O1 beside that of a random\n"
-    "plan of the same size. The design cost grows as N^2 (1000 poses: about 25 s; progress on stderr).";
+    "Plans N poses inside the joint limits of MODEL less --margin-deg whose cable length from the outlet(s) is\n"
+    "within [--len-min-mm, --len-max-mm], chosen among M random candidates (default max(2000, 40 N)).\n"
+    "--criterion position (default): the outlets at --outlet X,Y,Z (repeatable, mm in the base frame; none:\n"
+    "the file's encoder_mm, else --encoder), every pose measured from every outlet (the plan repeats the poses\n"
+    "per outlet) or with --split each from one; the plan minimises the predicted mean squared 3-D error of the\n"
+    "flange (or --tool) over the workspace (I-optimal, the physical prior as prior information) and reports\n"
+    "the predicted 95 % position radius over random workspace poses (median, 95th percentile) at --noise-mm,\n"
+    "beside random poses. --criterion length: the earlier D-optimal plan on the lengths (one outlet; O1).\n"
+    "--choose-outlets K --candidate X,Y,Z ...: which K of the candidate places give the best predicted\n"
+    "accuracy (every combination up to 64, else greedily); the plan is then made for them.\n"
+    "Writes pose,q1..q6 (degrees, 0.01 deg steps) and, with several outlets, outlet (0..K-1); --format rapid\n"
+    "writes an ABB RAPID module that moves through the same plan (the same options and seed give the same\n"
+    "plan). The design cost grows as N^2 (progress on stderr).";
 
-/* What was planned and written, as one JSON object on stdout (rcal-poses/1). */
-static int report_json(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path, int argc,
-                       char **argv)
+static int parse_places(double (*out)[3], unsigned *n, const rch_opt_strs *v, const char *name)
+{
+    *n = 0;
+    for (size_t i = 0; i < v->n; ++i) {
+        if (rch_parse_triple(v->v[i], out[i]) != 0 || fabs(out[i][0]) > 1e5 || fabs(out[i][1]) > 1e5 ||
+            fabs(out[i][2]) > 1e5) {
+            fprintf(stderr, "rcal poses: %s '%s': expected X,Y,Z in mm (three finite numbers within 1e5)\n", name,
+                    v->v[i]);
+            return -1;
+        }
+        ++*n;
+    }
+    return 0;
+}
+
+static void json_acc(rch_jw *w, const char *key, const rch_poses_accuracy *a)
+{
+    rch_jw_obj(w, key);
+    rch_jw_num(w, "median_mm", a->median_mm);
+    rch_jw_num(w, "p95_mm", a->p95_mm);
+    rch_jw_num(w, "mean_sq_mm2", a->phi_mm2);
+    rch_jw_end(w);
+}
+
+static void json_places(rch_jw *w, const double (*p)[3], const unsigned *idx, unsigned n)
+{
+    for (unsigned j = 0; j < n; ++j) {
+        const double *x = p[idx ? idx[j] : j];
+        rch_jw_arr(w, NULL);
+        for (int c = 0; c < 3; ++c)
+            rch_jw_numf(w, NULL, x[c], "%.6g");
+        rch_jw_end(w);
+    }
+}
+
+/* What was planned and written, as one JSON object on stdout (rcal-poses/2). */
+static int report_json(const rch_poses_result *res, const rch_poses_config *pc, const rch_poses_choice *ch,
+                       const double (*cand)[3], const char *out_path, const char *format, int argc, char **argv)
 {
     rch_jw w;
-    rch_jw_begin(&w, stdout, 0, "rcal-poses/1", argc, argv);
+    rch_jw_begin(&w, stdout, 0, "rcal-poses/2", argc, argv);
     rch_jw_str(&w, "out", out_path);
-    rch_jw_uint(&w, "poses", res->n);
+    rch_jw_str(&w, "out_format", format);
+    rch_jw_str(&w, "criterion", pc->criterion == RCH_POSES_LENGTH ? "length" : "position");
+    rch_jw_uint(&w, "poses", res->n_distinct);
+    rch_jw_uint(&w, "rows", res->n);
+    rch_jw_uint(&w, "outlets", res->n_outlets);
+    rch_jw_bool(&w, "split", pc->split);
+    rch_jw_arr(&w, "outlet_mm");
+    json_places(&w, (const double(*)[3])pc->outlet_mm, NULL, pc->n_outlets);
+    rch_jw_end(&w);
+    rch_jw_arr(&w, "rows_per_outlet");
+    for (unsigned k = 0; k < res->n_outlets; ++k)
+        rch_jw_uint(&w, NULL, res->rows_per_outlet[k]);
+    rch_jw_end(&w);
+    if (pc->criterion != RCH_POSES_LENGTH)
+        rch_jw_uint(&w, "rows_advised", res->rows_advised);
     rch_jw_uint(&w, "candidates", res->n_candidates);
     rch_jw_uint(&w, "seed", pc->seed);
     rch_jw_uint(&w, "identifiable_directions", res->n_ident);
     rch_jw_uint(&w, "params", res->n_params);
+    if (pc->criterion != RCH_POSES_LENGTH) {
+        rch_jw_numf(&w, "noise_mm", pc->noise_mm, "%.6g");
+        if (pc->has_tool) {
+            rch_jw_arr(&w, "tool_mm");
+            for (int c = 0; c < 3; ++c)
+                rch_jw_numf(&w, NULL, pc->tool_mm[c], "%.6g");
+            rch_jw_end(&w);
+        }
+        rch_jw_obj(&w, "predicted_position95_mm");
+        json_acc(&w, "plan", &res->plan);
+        json_acc(&w, "random", &res->random);
+        rch_jw_end(&w);
+    }
     rch_jw_num(&w, "o1_plan", res->o1_plan);
     rch_jw_uint(&w, "rank_plan", res->rank_plan);
     rch_jw_num(&w, "o1_random", res->o1_random);
@@ -49,24 +119,185 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
     rch_jw_numf(&w, "len_min_mm", pc->len_min_mm, "%.6g");
     rch_jw_numf(&w, "len_max_mm", pc->len_max_mm, "%.6g");
     rch_jw_numf(&w, "margin_deg", pc->margin_deg, "%.6g");
+    if (ch) {
+        rch_jw_obj(&w, "choose_outlets");
+        rch_jw_uint(&w, "k", ch->k);
+        rch_jw_str(&w, "search", ch->exhaustive ? "every combination" : "greedy");
+        rch_jw_arr(&w, "candidate_mm");
+        json_places(&w, cand, NULL, ch->n_cand);
+        rch_jw_end(&w);
+        rch_jw_arr(&w, "combinations");
+        for (size_t i = 0; i < ch->n_combos; ++i) {
+            const rch_poses_combo *cb = &ch->combos[i];
+            rch_jw_obj(&w, NULL);
+            rch_jw_arr(&w, "candidates");
+            for (unsigned j = 0; j < cb->k; ++j)
+                rch_jw_uint(&w, NULL, cb->idx[j]);
+            rch_jw_end(&w);
+            rch_jw_num(&w, "median_mm", cb->acc.median_mm);
+            rch_jw_num(&w, "p95_mm", cb->acc.p95_mm);
+            rch_jw_str(&w, "span", cb->span == 1 ? "point" : cb->span == 2 ? "line" : "plane");
+            rch_jw_bool(&w, "chosen", i == ch->best);
+            rch_jw_end(&w);
+        }
+        rch_jw_end(&w);
+        rch_jw_end(&w);
+    }
     rch_jw_end(&w);
     return rch_jw_finish(&w);
 }
 
+static void print_choice(const rch_poses_choice *ch, const double (*cand)[3])
+{
+    printf("rcal poses: which %u of %u candidate outlet places (%s; a greedy plan of the same count each):\n", ch->k,
+           ch->n_cand, ch->exhaustive ? "every combination" : "greedily, one place at a time");
+    for (size_t i = 0; i < ch->n_combos; ++i) {
+        const rch_poses_combo *cb = &ch->combos[i];
+        printf("  %s", i == ch->best ? "*" : " ");
+        for (unsigned j = 0; j < cb->k; ++j)
+            printf(" %u", cb->idx[j]);
+        printf("  (");
+        for (unsigned j = 0; j < cb->k; ++j)
+            printf("%s%.0f,%.0f,%.0f", j ? "; " : "", cand[cb->idx[j]][0], cand[cb->idx[j]][1], cand[cb->idx[j]][2]);
+        printf(")  predicted 95 %% radius median %.4f mm, p95 %.4f mm  [%s]\n", cb->acc.median_mm, cb->acc.p95_mm,
+               cb->span == 1 ? "one point" : cb->span == 2 ? "on a line" : "a plane");
+    }
+}
+
+static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
+{
+    if (pc->criterion == RCH_POSES_LENGTH) {
+        printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
+               res->n, res->n_candidates, res->n_ident, res->n_params);
+        printf("  observability O1 (rch_ident): planned %.5g (rank %u), random %.5g (rank %u), ratio %.2f\n",
+               res->o1_plan, res->rank_plan, res->o1_random, res->rank_random,
+               res->o1_random > 0 ? res->o1_plan / res->o1_random : 0.0);
+        return;
+    }
+    printf("rcal poses: %zu poses from %zu candidates, %u outlet(s)%s: %zu rows; %u free parameters (the prior's "
+           "information included; theta1, d1 held)\n",
+           res->n_distinct, res->n_candidates, res->n_outlets,
+           res->n_outlets < 2 ? "" : pc->split ? ", each pose from one outlet (--split)" : ", every pose from each",
+           res->n, res->n_ident);
+    for (unsigned k = 0; k < res->n_outlets; ++k) {
+        char opt[32] = "";
+        if (res->n_outlets > 1)
+            snprintf(opt, sizeof opt, " --outlet %u", k);
+        printf("  outlet %u at (%.1f, %.1f, %.1f) mm: %zu rows; record them with: rcal acquire --poses %s%s "
+               "--encoder %g,%g,%g ...\n",
+               k, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2], res->rows_per_outlet[k], out_path,
+               opt, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2]);
+    }
+    printf("  predicted 3-D accuracy of the %s after calibration (95 %% position radius over %s random workspace "
+           "poses, length noise %g mm):\n",
+           pc->has_tool ? "tool point" : "flange", "1000", pc->noise_mm > 0 ? pc->noise_mm : RCH_POSES_NOISE_MM);
+    printf("    this plan:         median %.4f mm, 95th percentile %.4f mm\n", res->plan.median_mm,
+           res->plan.p95_mm);
+    printf("    random, same count: median %.4f mm, 95th percentile %.4f mm\n", res->random.median_mm,
+           res->random.p95_mm);
+    printf("  observability O1 of the lengths (rch_ident): planned %.5g, random %.5g, ratio %.2f\n", res->o1_plan,
+           res->o1_random, res->o1_random > 0 ? res->o1_plan / res->o1_random : 0.0);
+    if (res->n < res->rows_advised)
+        printf("  WARNING: %zu rows for about %zu parameters calibrate fits: it estimates the noise from the "
+               "residuals and needs at least %zu rows, else the fit follows the noise and the predicted accuracy is "
+               "not reached; next: raise --count%s\n",
+               res->n, res->rows_advised - RCH_POSES_ROWS_SPARE, res->rows_advised,
+               pc->split ? " (or measure every pose from each outlet: leave out --split)" : "");
+}
+
+/* The plan into f: CSV (an outlet column with several outlets) or RAPID. 0 or -1. */
+static int write_out(FILE *f, const rch_poses_result *res, const rch_poses_config *pc, const char *format,
+                     double settle_s)
+{
+    if (strcmp(format, "rapid") != 0)
+        return res->n_outlets > 1 ? rch_data_write_plan_outlets(f, res->poses, res->n)
+                                  : rch_data_write_plan(f, res->poses, res->n);
+    unsigned char *lab = malloc(res->n ? res->n : 1);
+    char comment[200];
+    snprintf(comment, sizeof comment, "rcal poses --count %zu --seed %llu: %u outlet(s)%s", res->n_distinct,
+             pc->seed, res->n_outlets, res->n_outlets > 1 ? (pc->split ? ", split" : ", every pose from each") : "");
+    for (size_t i = 0; lab && i < res->n; ++i)
+        lab[i] = res->poses[i].outlet;
+    const int wr = lab ? rch_poses_write_rapid(f, res->poses, lab, res->n, settle_s, comment) : -1;
+    free(lab);
+    return wr;
+}
+
+/* --outlet, --candidate and --choose-outlets together. 0 or -1 (reported). */
+static int check_places(unsigned long choose, unsigned n_places, unsigned n_c, int split)
+{
+    if (split && n_places < 2 && choose < 2) {
+        fprintf(stderr, "rcal poses: --split needs at least two --outlet places (or --choose-outlets K >= 2)\n");
+        return -1;
+    }
+    if (choose && (n_places || n_c < choose)) {
+        fprintf(stderr, "rcal poses: --choose-outlets %lu needs at least %lu --candidate places and no --outlet\n",
+                choose, choose);
+        return -1;
+    }
+    if (!choose && n_c) {
+        fprintf(stderr, "rcal poses: --candidate is for --choose-outlets K\n");
+        return -1;
+    }
+    return 0;
+}
+
+/* --choose-outlets: the best K of the candidates into pc's outlets. 0 or -1 (reported). */
+static int choose_places(rch_poses_choice *ch, rch_poses_config *pc, const rc_model *m, const double (*cand)[3],
+                         unsigned n_c, unsigned k, int json)
+{
+    rch_diag dg;
+    if (rch_poses_choose_outlets(ch, m, pc, cand, n_c, k, &dg) != 0) {
+        fprintf(stderr, "rcal poses: %s\n", dg.msg);
+        return -1;
+    }
+    pc->n_outlets = k;
+    for (unsigned j = 0; j < k; ++j)
+        memcpy(pc->outlet_mm[j], cand[ch->combos[ch->best].idx[j]], sizeof pc->outlet_mm[j]);
+    if (!json)
+        print_choice(ch, cand);
+    return 0;
+}
+
 int rcal_cmd_poses(int argc, char **argv)
 {
-    const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL;
-    unsigned long n = 0, seed = 1, n_cand = 0, passes = 4;
-    double enc[3] = {250.0, -460.0, 10.0};
-    rch_poses_config pc = {0, 0, 4, 1, 250, 800, 5};
-    int json = 0;
+    const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL, *criterion = "position", *format = "csv";
+    unsigned long n = 0, seed = 1, n_cand = 0, passes = 4, choose = 0;
+    double enc[3] = {250.0, -460.0, 10.0}, tool[3] = {0, 0, 0}, settle_s = 5.0;
+    rch_poses_config pc;
+    rch_opt_strs outlets = {{0}, 0}, cands = {{0}, 0};
+    int json = 0, split = 0;
     rch_cmdspec spec;
+    unsigned long long seen = 0;
+    memset(&pc, 0, sizeof pc);
+    pc.len_min_mm = 250;
+    pc.len_max_mm = 800;
+    pc.margin_deg = 5;
+    pc.noise_mm = RCH_POSES_NOISE_MM;
     const rch_opt opts[] = {
         {"--count", RCH_OPT_UINT, &n, 1, RCH_POSES_MAX_COUNT, "N", "poses to plan", RCH_OPT_REQUIRED, NULL},
-        {"--out", RCH_OPT_STR, &out_path, 0, 0, "POSES.csv", "the plan", RCH_OPT_REQUIRED, NULL},
+        {"--out", RCH_OPT_STR, &out_path, 0, 0, "FILE", "the plan (CSV, or RAPID with --format rapid)",
+         RCH_OPT_REQUIRED, NULL},
         {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL.json", "nominal model", 0, NULL},
         {"--seed", RCH_OPT_UINT, &seed, 0, 4294967295.0, "S", NULL, 0, NULL},
-        {"--encoder", RCH_OPT_TRIPLE, enc, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none", 0, NULL},
+        {"--encoder", RCH_OPT_TRIPLE, enc, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none and no --outlet",
+         0, NULL},
+        {"--outlet", RCH_OPT_STRS, &outlets, 0, 0, "X,Y,Z",
+         "an outlet's approximate place (mm, base frame); repeatable: outlets 0, 1, ...", 0, NULL},
+        {"--split", RCH_OPT_FLAG, &split, 0, 0, NULL, "each pose from one outlet (default: every pose from each)", 0,
+         NULL},
+        {"--criterion", RCH_OPT_CHOICE, &criterion, 0, 0, NULL, "3-D position accuracy, or the lengths' D-optimum",
+         0, "position|length"},
+        {"--noise-mm", RCH_OPT_DOUBLE, &pc.noise_mm, 1e-6, 100, "MM", "length noise of the predicted accuracy", 0,
+         NULL},
+        {"--tool", RCH_OPT_TRIPLE, tool, -2000.0, 2000.0, "X,Y,Z", "plan for this tool point (flange frame, mm)", 0,
+         NULL},
+        {"--choose-outlets", RCH_OPT_UINT, &choose, 1, RC_MAX_OUTLETS, "K",
+         "choose the best K of the --candidate places", 0, NULL},
+        {"--candidate", RCH_OPT_STRS, &cands, 0, 0, "X,Y,Z", "a candidate outlet place (repeatable)", 0, NULL},
+        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "what --out holds", 0, "csv|rapid"},
+        {"--settle-s", RCH_OPT_DOUBLE, &settle_s, 0, 600, "S", "RAPID: WaitTime at each pose (settle and read)", 0,
+         NULL},
         {"--len-min-mm", RCH_OPT_DOUBLE, &pc.len_min_mm, 0, 20000, "A", "shortest cable length", 0, NULL},
         {"--len-max-mm", RCH_OPT_DOUBLE, &pc.len_max_mm, 0, 20000, "B", "longest cable length", 0, NULL},
         {"--candidates", RCH_OPT_UINT, &n_cand, 0, RCH_POSES_MAX_CANDIDATES, "M", "0: max(2000, 40 N)", 0, NULL},
@@ -76,18 +307,33 @@ int rcal_cmd_poses(int argc, char **argv)
          NULL},
     };
     rch_poses_result res;
+    rch_poses_choice *ch = NULL;
+    double cand[RCH_OPT_MAX_STRS][3];
+    unsigned n_places = 0, n_c = 0;
     rch_robot *robot;
     rch_diag dg;
     rch_out out;
     char dbuf[900];
     int rc = 1;
-    const int st = rch_opt_cmd(&spec, "poses", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
+    const int st = rch_opt_cmd(&spec, "poses", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (st >= 0)
         return st;
+    if (parse_places(pc.outlet_mm, &n_places, &outlets, "--outlet") != 0 ||
+        parse_places(cand, &n_c, &cands, "--candidate") != 0 || check_places(choose, n_places, n_c, split) != 0)
+        return 2;
     pc.count = n;
     pc.candidates = n_cand;
     pc.passes = passes;
     pc.seed = seed;
+    pc.n_outlets = n_places;
+    pc.split = split;
+    pc.criterion = strcmp(criterion, "length") == 0 ? RCH_POSES_LENGTH : RCH_POSES_POSITION;
+    pc.has_tool = rch_opt_given(&spec, seen, "--tool");
+    memcpy(pc.tool_mm, tool, sizeof tool);
+    if (pc.criterion == RCH_POSES_LENGTH && (choose || pc.has_tool)) {
+        fprintf(stderr, "rcal poses: --choose-outlets and --tool need --criterion position\n");
+        return 2;
+    }
     robot = calloc(1, sizeof *robot);
     if (!robot || rch_robot_load(robot, robot_path, &dg) != 0) {
         fprintf(stderr, "rcal poses: %s\n", robot ? rch_diag_str(&dg, dbuf, sizeof dbuf) : "out of memory");
@@ -96,36 +342,48 @@ int rcal_cmd_poses(int argc, char **argv)
     }
     if (!robot->has_encoder)
         memcpy(&robot->model.x[RC_P_ENC], enc, sizeof enc);
+    pc.prior = &robot->prior;
+    if (!n_places && !choose) { /* one outlet: the model's encoder */
+        pc.n_outlets = 1;
+        memcpy(pc.outlet_mm[0], &robot->model.x[RC_P_ENC], sizeof pc.outlet_mm[0]);
+    }
     if (rch_out_open(&out, out_path, "--out", &robot_path, 1, &dg) != 0) { /* before the work */
         fprintf(stderr, "rcal poses: %s\n", rch_diag_str(&dg, dbuf, sizeof dbuf));
+        free(robot);
+        return 1;
+    }
+    if (choose && (!(ch = malloc(sizeof *ch)) ||
+                   choose_places(ch, &pc, &robot->model, (const double(*)[3])cand, n_c, (unsigned)choose, json) != 0)) {
+        if (!ch)
+            fprintf(stderr, "rcal poses: out of memory\n");
+        rch_out_abort(&out);
+        free(ch);
         free(robot);
         return 1;
     }
     if (rch_poses_plan(&res, &robot->model, &pc, stderr, &dg) != 0) {
         rch_out_abort(&out);
         fprintf(stderr, "rcal poses: %s\n", dg.msg);
+        free(ch);
         free(robot);
         return 1;
     }
-    if (!json) {
-        printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
-               res.n, res.n_candidates, res.n_ident, res.n_params);
-        printf("  observability O1 (rch_ident): planned %.5g (rank %u), random %.5g (rank %u), ratio %.2f\n",
-               res.o1_plan, res.rank_plan, res.o1_random, res.rank_random,
-               res.o1_random > 0 ? res.o1_plan / res.o1_random : 0.0);
-    }
-    if (rch_data_write_plan(out.f, res.poses, res.n) != 0) {
+    if (!json)
+        print_plan(&res, &pc, out_path);
+    const int wr = write_out(out.f, &res, &pc, format, settle_s);
+    if (wr != 0) {
         rch_out_abort(&out);
         fprintf(stderr, "rcal poses: writing %s failed; nothing was replaced\n", out_path);
     } else if (rch_out_commit(&out, &dg) != 0) {
         fprintf(stderr, "rcal poses: %s\n", rch_diag_str(&dg, dbuf, sizeof dbuf));
     } else if (json) {
-        rc = report_json(&res, &pc, out_path, argc, argv) != 0;
+        rc = report_json(&res, &pc, ch, (const double(*)[3])cand, out_path, format, argc, argv) != 0;
     } else {
-        printf("  written to %s\n", out_path);
+        printf("  written to %s%s\n", out_path, strcmp(format, "rapid") == 0 ? " (RAPID module)" : "");
         rc = 0;
     }
     rch_poses_free(&res);
+    free(ch);
     free(robot);
     return rc;
 }

@@ -435,19 +435,34 @@ static void test_plan_limits(void **state)
 {
     rch_robot rb;
     rch_diag dg;
-    rch_poses_config pc = {12, 0, 4, 3, 250, 800, 20};
+    rch_poses_config pc;
     rch_poses_result res;
     rch_data back;
     char p[512];
     FILE *f;
     (void)state;
+    memset(&pc, 0, sizeof pc);
+    pc.count = 12;
+    pc.passes = 4;
+    pc.seed = 3;
+    pc.len_min_mm = 250;
+    pc.len_max_mm = 800;
+    pc.margin_deg = 20;
     assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
     rb.model.x[RC_P_ENC] = 250.0;
     rb.model.x[RC_P_ENC + 1] = -460.0;
     rb.model.x[RC_P_ENC + 2] = 10.0;
+    pc.criterion = RCH_POSES_LENGTH; /* the length plan: O1 above random */
     assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
     assert_int_equal(res.n, 12);
     assert_true(res.o1_plan > res.o1_random);
+    rch_poses_free(&res);
+    pc.criterion = RCH_POSES_POSITION; /* the 3-D plan: predicted accuracy above random */
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
+    assert_int_equal(res.n, 12);
+    print_message("12 poses: predicted 95 %% radius median %.4f mm (random %.4f), p95 %.4f (random %.4f)\n",
+                  res.plan.median_mm, res.random.median_mm, res.plan.p95_mm, res.random.p95_mm);
+    assert_true(res.plan.phi_mm2 < res.random.phi_mm2);
     path_in(p, sizeof p, "plan12.csv");
     f = fopen(p, "w");
     assert_non_null(f);
@@ -477,6 +492,130 @@ static void test_plan_limits(void **state)
     assert_null(res.poses);
 }
 
+/* a plan for two places of the encoder (rcal poses --outlet A --outlet B:
+ * the poses repeated per outlet, column outlet): a run records the rows of
+ * its outlet only, the run from the other outlet appends to the same file,
+ * and a run that names no outlet is refused */
+static void test_plan_outlets(void **state)
+{
+    char text[2048], p[512];
+    size_t n = 0;
+    double v[NP];
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    rch_data back;
+    rch_diag dg;
+    (void)state;
+    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6,outlet\n");
+    for (int k = 0; k < 2; ++k)
+        for (int i = 0; i < NP; ++i) {
+            n += (size_t)snprintf(text + n, sizeof text - n, "%d", k * NP + i);
+            for (int j = 0; j < RC_NJ; ++j)
+                n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
+            n += (size_t)snprintf(text + n, sizeof text - n, ",%d\n", k);
+        }
+    write_text("plan_outlets.csv", text);
+    char saved[512];
+    snprintf(saved, sizeof saved, "%s", g_plan);
+    path_in(g_plan, sizeof g_plan, "plan_outlets.csv");
+    for (int i = 0; i < NP; ++i)
+        v[i] = nominal_mm[i] + 0.5;
+    /* no --outlet: refused, nothing written */
+    tio_init(&t);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+    config(&c, "outlets.csv");
+    c.stable.n = 5;
+    assert_int_not_equal(run(&r, &c, &t), 0);
+    assert_non_null(strstr(g_err, "--outlet"));
+    assert_true(fsize("outlets.csv") <= 0);
+    /* outlet 0, then outlet 1 into the same file */
+    for (int k = 0; k < 2; ++k) {
+        tio_init(&t);
+        t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+        c.outlet_p1 = k + 1;
+        assert_int_equal(run(&r, &c, &t), 0);
+        assert_int_equal(r.n_poses, NP);
+        assert_int_equal(r.n_new, NP);
+        assert_int_equal(r.n_before, 0);
+    }
+    tio_init(&t);
+    assert_int_equal(run(&r, &c, &t), 0); /* outlet 1 again: nothing to do */
+    assert_int_equal(r.n_new, 0);
+    path_in(p, sizeof p, "outlets.csv");
+    assert_int_equal(rch_data_load(&back, p, 0, &dg), 0);
+    assert_int_equal(back.n, 2 * NP);
+    assert_true(back.has_outlet);
+    for (size_t i = 0; i < back.n; ++i)
+        assert_int_equal(back.s[i].outlet, i < NP ? 0 : 1);
+    rch_data_free(&back);
+    snprintf(g_plan, sizeof g_plan, "%s", saved);
+}
+
+/* the position criterion with several outlets: a balanced split, the
+ * prediction of the plan's own rows (rch_poses_predict) equal to the plan's,
+ * the choice of 2 of 3 places, the RAPID module with every row */
+static void test_plan_split_choose(void **state)
+{
+    rch_robot rb;
+    rch_diag dg;
+    rch_poses_config pc;
+    rch_poses_result res;
+    rch_poses_accuracy acc;
+    static rch_poses_choice ch;
+    static const double cand[3][3] = {{500, -250, 50}, {-400, -400, 350}, {-100, 550, 0}};
+    (void)state;
+    assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
+    memset(&pc, 0, sizeof pc);
+    pc.count = 9;
+    pc.candidates = 150;
+    pc.passes = 1;
+    pc.seed = 4;
+    pc.len_min_mm = 250;
+    pc.len_max_mm = 1200;
+    pc.margin_deg = 5;
+    pc.n_outlets = 3;
+    memcpy(pc.outlet_mm, cand, sizeof cand);
+    pc.split = 1;
+    pc.n_eval = 200;
+    assert_int_equal(rch_poses_plan(&res, &rb.model, &pc, NULL, &dg), 0);
+    assert_int_equal(res.n, 9);
+    for (unsigned k = 0; k < 3; ++k)
+        assert_int_equal(res.rows_per_outlet[k], 3);
+    assert_true(res.n < res.rows_advised); /* 9 rows: calibrate needs more */
+    assert_int_equal(rch_poses_predict(&acc, &rb.model, &pc, res.poses, res.n, &dg), 0);
+    assert_true(fabs(acc.median_mm - res.plan.median_mm) <= 1e-9 * res.plan.median_mm);
+    assert_true(res.plan.phi_mm2 < res.random.phi_mm2);
+    {
+        char buf[1 << 14];
+        FILE *f = fmemopen(buf, sizeof buf, "w");
+        unsigned char lab[9];
+        for (size_t i = 0; i < res.n; ++i)
+            lab[i] = res.poses[i].outlet;
+        assert_non_null(f);
+        assert_int_equal(rch_poses_write_rapid(f, res.poses, lab, res.n, 2.0, "test"), 0);
+        fclose(f);
+        size_t n_jt = 0, n_mv = 0;
+        for (const char *p = buf; (p = strstr(p, "CONST jointtarget rcal_p")) != NULL; ++p)
+            ++n_jt;
+        for (const char *p = buf; (p = strstr(p, "MoveAbsJ rcal_p")) != NULL; ++p)
+            ++n_mv;
+        assert_int_equal(n_jt, 9);
+        assert_int_equal(n_mv, 9);
+        assert_non_null(strstr(buf, "PROC rcal_outlet2()"));
+        assert_non_null(strstr(buf, "TPReadNum"));
+    }
+    rch_poses_free(&res);
+    pc.split = 0;
+    pc.n_outlets = 0;
+    assert_int_equal(rch_poses_choose_outlets(&ch, &rb.model, &pc, cand, 3, 2, &dg), 0);
+    assert_int_equal(ch.n_combos, 3);
+    assert_true(ch.exhaustive);
+    for (size_t i = 0; i < ch.n_combos; ++i)
+        assert_true(ch.combos[ch.best].acc.median_mm <= ch.combos[i].acc.median_mm);
+    assert_int_equal(rch_poses_choose_outlets(&ch, &rb.model, &pc, cand, 3, 4, &dg), -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -489,6 +628,8 @@ int main(void)
         cmocka_unit_test(test_scan_bounded),
         cmocka_unit_test(test_nul_last_line_dropped),
         cmocka_unit_test(test_plan_limits),
+        cmocka_unit_test(test_plan_outlets),
+        cmocka_unit_test(test_plan_split_choose),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -444,18 +444,30 @@ int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nomina
     return fflush(f) == 0 ? 0 : -1;
 }
 
-int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n)
+static int write_plan(FILE *f, const rc_sample *s, size_t n, int with_outlet)
 {
-    if (fprintf(f, "pose,q1,q2,q3,q4,q5,q6\n") < 0)
+    if (fprintf(f, "pose,q1,q2,q3,q4,q5,q6%s\n", with_outlet ? ",outlet" : "") < 0)
         return -1;
     for (size_t t = 0; t < n; ++t) {
         fprintf(f, "%zu", t);
         for (int j = 0; j < RC_NJ; ++j)
             fprintf(f, ",%.4f", s[t].q_rad[j] * 180.0 / M_PI);
+        if (with_outlet)
+            fprintf(f, ",%u", (unsigned)s[t].outlet);
         if (fprintf(f, "\n") < 0)
             return -1;
     }
     return fflush(f) == 0 && !ferror(f) ? 0 : -1;
+}
+
+int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n)
+{
+    return write_plan(f, s, n, 0);
+}
+
+int rch_data_write_plan_outlets(FILE *f, const rc_sample *s, size_t n)
+{
+    return write_plan(f, s, n, 1);
 }
 
 void rch_split(size_t *idx, size_t n, unsigned long long seed)

@@ -85,6 +85,9 @@ int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nomina
 /* Write a pose plan: "pose,q1,..,q6" then one line per sample, q in degrees
  * (%.4f). Read back with rch_data_load(..., RCH_DATA_NO_LEN). 0 or -1. */
 int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n);
+/* The same with a last column outlet (rc_sample.outlet): a plan for several
+ * places of the encoder (`rcal acquire --outlet N` records its rows). */
+int rch_data_write_plan_outlets(FILE *f, const rc_sample *s, size_t n);
 
 /* Random train/test split: a permutation of 0..n-1 from seed; the first
  * n_test indices go to test. idx: (n) output. */

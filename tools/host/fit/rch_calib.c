@@ -1280,6 +1280,22 @@ static void print_effects(FILE *f, const rch_calib_result *r)
         fprintf(f, "\n");
 }
 
+/* What the outlets add: the rigid motion their places fix (rch_prior_outlet_span). */
+static void print_outlets(FILE *f, const rc_model *m)
+{
+    double pos[RC_MAX_OUTLETS][3], off = 0.0;
+    unsigned n = 1;
+    memcpy(pos[0], &m->x[RC_P_ENC], sizeof pos[0]);
+    for (unsigned e = 0; e < m->n_effects && n < RC_MAX_OUTLETS; ++e)
+        if (m->effects[e].kind == RC_EFF_OUTLET)
+            memcpy(pos[n++], &m->x[m->effects[e].first], sizeof pos[0]);
+    const int span = rch_prior_outlet_span(&off, (const double(*)[3])pos, n);
+    fprintf(f, "  outlets: %u place%s", n, n == 1 ? "" : "s");
+    if (n > 2)
+        fprintf(f, " (largest distance from the line through the two farthest apart: %.0f mm)", off);
+    fprintf(f, "; %s\n", rch_prior_outlet_span_text(span));
+}
+
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {
     const rch_model_unc *u = &r->unc;
@@ -1299,8 +1315,9 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                 r->robot.prior.attachment_mm, r->robot.prior.from_file ? ", from the robot file" : ", defaults",
                 r->noise_mm, r->noise_passes, r->p_eff);
     if (u->has_prior)
-        fprintf(f, "  theta1 and d1 held (gauge): one outlet's lengths cannot see the robot's heading and height "
-                   "against the outlet; a cell sets its base frame anyway\n");
+        fprintf(f, "  theta1 and d1 held (gauge): lengths from outlets whose places are estimated cannot see the "
+                   "robot's heading and height against them; a cell sets its base frame anyway\n");
+    print_outlets(f, m);
     if (r->attach_auto)
         fprintf(f, "  cable attachment: %s (an attachment vector improves the fit by %.1f against its Occam "
                    "penalty %.1f)\n",
@@ -1335,8 +1352,9 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         }
     }
     fprintf(f,
-            "predicted flange-position uncertainty (95 %%, longest semi-axis): inside the data: +-%.4f mm "
-            "(median; max %.4f), whole workspace: +-%.4f mm (median over %d random poses; max %.4f)\n",
+            "predicted 3-D accuracy after compensation (95 %%, longest semi-axis of the flange-position "
+            "ellipsoid): over the sampled region +-%.4f mm (median over the data's poses; max %.4f), whole "
+            "workspace +-%.4f mm (median over %d random poses; max %.4f)\n",
             u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
             u->map.work_max_mm);
     fprintf(f,

@@ -77,3 +77,52 @@ const char *rch_prior_class_name(rch_prior_class c)
     }
     return "?";
 }
+
+int rch_prior_outlet_span(double *off_line_mm, const double (*pos_mm)[3], unsigned n)
+{
+    unsigned a = 0, b = 0;
+    double span = 0.0, off = 0.0;
+    for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = i + 1; j < n; ++j) {
+            const double dx = pos_mm[j][0] - pos_mm[i][0], dy = pos_mm[j][1] - pos_mm[i][1],
+                         dz = pos_mm[j][2] - pos_mm[i][2], dd = sqrt(dx * dx + dy * dy + dz * dz);
+            if (dd > span) {
+                span = dd;
+                a = i;
+                b = j;
+            }
+        }
+    if (off_line_mm)
+        *off_line_mm = 0.0;
+    if (n <= 1 || !(span > 1e-9))
+        return 1;
+    double u[3];
+    for (int c = 0; c < 3; ++c)
+        u[c] = (pos_mm[b][c] - pos_mm[a][c]) / span;
+    for (unsigned i = 0; i < n; ++i) {
+        double v[3], t = 0.0, d2 = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            v[c] = pos_mm[i][c] - pos_mm[a][c];
+            t += v[c] * u[c];
+        }
+        for (int c = 0; c < 3; ++c)
+            d2 += (v[c] - t * u[c]) * (v[c] - t * u[c]);
+        if (sqrt(d2) > off)
+            off = sqrt(d2);
+    }
+    if (off_line_mm)
+        *off_line_mm = off;
+    return off > RCH_OUTLET_LINE_SHARE * span ? 3 : 2;
+}
+
+const char *rch_prior_outlet_span_text(int span)
+{
+    switch (span) {
+    case 1: return "one outlet: the rotation of the whole robot about the outlet is not observable, so the robot's "
+                   "placement in the cell is not known from the lengths; compensation is judged on pairwise distances";
+    case 2: return "the outlets lie on a line: the rotation of the whole robot about that line is not observable; "
+                   "compensation is judged on pairwise distances";
+    default: return "three or more outlets not on a line: the robot is fixed in the outlets' frame (their estimated "
+                    "positions place it in the cell)";
+    }
+}

@@ -67,6 +67,19 @@ void rch_prior_fill(double *mean, double *sd, const rc_model *m, const rc_model 
 /* Mark the gauge parameters (theta1, d1) in fixed (n_params). */
 void rch_prior_gauge(uint8_t *fixed);
 
+/* What the places of the encoder fix of the robot's placement among them
+ * (the rigid motion lengths cannot see otherwise): 1 one place (a point: the
+ * rotation of the whole robot about it is not observable), 2 the places lie
+ * on a line (the rotation about that line is not), 3 they span a plane (the
+ * robot is fixed in the outlets' frame). Places within RCH_OUTLET_LINE_SHARE
+ * of their longest span from the line through the two farthest apart count
+ * as on it. pos_mm: (n x 3); off_line_mm (may be NULL): the largest distance
+ * from that line. */
+#define RCH_OUTLET_LINE_SHARE 0.05
+int rch_prior_outlet_span(double *off_line_mm, const double (*pos_mm)[3], unsigned n);
+/* One sentence saying what rch_prior_outlet_span's answer means. */
+const char *rch_prior_outlet_span_text(int span);
+
 /* How much the data narrowed a parameter's prior: posterior sd / prior sd.
  * Below RCH_PRIOR_DETERMINED the data determined it, above
  * RCH_PRIOR_ONLY only the prior did ("partly" between). */

@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 
 void rch_stats_add(rch_stats *s, double e)
@@ -108,4 +109,21 @@ void rch_median_max(double *med, double *max, double *v, size_t n)
     for (size_t i = 1; i < k; ++i)
         lo = v[i] > lo ? v[i] : lo;
     *med = 0.5 * (lo + v[k]);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y ? 1 : 0;
+}
+
+double rch_quantile(double *v, size_t n, double p)
+{
+    if (n == 0)
+        return NAN;
+    qsort(v, n, sizeof *v, cmp_double);
+    const double h = (double)(n - 1) * (p < 0 ? 0 : p > 1 ? 1 : p);
+    const size_t lo = (size_t)floor(h);
+    const size_t hi = lo + 1 < n ? lo + 1 : lo;
+    return v[lo] + (h - (double)lo) * (v[hi] - v[lo]);
 }

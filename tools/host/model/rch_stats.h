@@ -47,4 +47,8 @@ double rch_rms(const double *v, size_t n);
  * values a sort gives. Both NaN for n = 0. */
 void rch_median_max(double *med, double *max, double *v, size_t n);
 
+/* The p quantile (0..1) of v (n finite values, sorted in place), linear
+ * between order statistics (numpy's default): NaN for n = 0. */
+double rch_quantile(double *v, size_t n, double p);
+
 #endif

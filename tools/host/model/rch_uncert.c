@@ -1013,3 +1013,25 @@ double rch_model_unc_radius95_mm(const rch_model_unc *u, const rc_model *m, cons
         return NAN;
     return radius95(ev);
 }
+
+double rch_uncert_radius95(const double C[9])
+{
+    double V[9], ev[3];
+    for (int i = 0; i < 9; ++i)
+        if (!isfinite(C[i]))
+            return NAN;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            V[i * 3 + j] = 0.5 * (C[i * 3 + j] + C[j * 3 + i]);
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', 3, V, 3, ev) != 0)
+        return NAN;
+    return radius95(ev);
+}
+
+void rch_uncert_point_sens(double Jp[3][RC_MAX_PARAMS], const rc_model *m, const double q_rad[RC_NJ])
+{
+    uint8_t use[RC_MAX_PARAMS];
+    rc_kin kin;
+    memset(use, 1, sizeof use);
+    fk_sensitivity(Jp, NULL, use, m->n_params, m, sens_compile(&kin, m), q_rad);
+}

@@ -125,6 +125,17 @@ typedef struct rch_uncert_map {
 int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
                            size_t n_random, uint64_t seed);
 
+/* Sensitivity of the point of m at q (the flange, or the tool point when m
+ * carries a tool offset) to every parameter: Jp (3 x m->n_params), the DH
+ * columns in closed form (rc_kin), the effects' by central differences of
+ * rc_fk, the outlets' zero. The one definition the uncertainty figures use
+ * (rch_poses plans with it). */
+void rch_uncert_point_sens(double Jp[3][RC_MAX_PARAMS], const rc_model *m, const double q_rad[RC_NJ]);
+/* The 95 % quantile of |e| for e ~ N(0, C), C (3 x 3, row-major,
+ * symmetric): the radius rch_model_unc_radius95_mm gives (mm when C is in
+ * mm^2). NaN when C is not finite. */
+double rch_uncert_radius95(const double C[9]);
+
 /* The words of a class ("identifiable", "weak", "not identifiable",
  * "fixed"). Inline so that the model-file reader needs no LAPACKE. */
 static inline const char *rch_param_class_name(rch_param_class c)

@@ -116,6 +116,9 @@ typedef struct acq {
     double (*plan_deg)[RC_NJ]; /* (n x 6) */
     double *pred_mm;          /* (n) nominal length, NaN when unknown */
     unsigned char *done;      /* (n) */
+    unsigned char *other;     /* (n) 1: a row of another outlet of the plan (its outlet column): not this run's */
+    size_t n_mine;            /* rows this run measures */
+    int outlet_p1;            /* this run's outlet + 1 (--outlet, or the plan's only outlet), 0: one place */
     rch_acqfile file;
     int has_ref;              /* a recorded sample to check the next against */
     size_t ref_pose;
@@ -334,9 +337,36 @@ static int load_inputs(acq *a)
     a->plan_deg = calloc(plan.n, sizeof *a->plan_deg);
     a->pred_mm = calloc(plan.n, sizeof *a->pred_mm);
     a->done = calloc(plan.n, 1);
-    if (!a->plan_deg || !a->pred_mm || !a->done) {
+    a->other = calloc(plan.n ? plan.n : 1, 1);
+    if (!a->plan_deg || !a->pred_mm || !a->done || !a->other) {
         WARN(a, "out of memory\n");
         goto out;
+    }
+    /* a plan for several places (rcal poses --outlet ...): this run records
+     * the rows of its outlet (--outlet N, or the plan's only one) */
+    a->outlet_p1 = c->outlet_p1;
+    a->n_mine = plan.n;
+    if (plan.has_outlet && plan.n) {
+        unsigned char seen[256] = {0};
+        unsigned n_lab = 0;
+        for (size_t i = 0; i < plan.n; ++i)
+            n_lab += !seen[plan.s[i].outlet]++;
+        if (!a->outlet_p1 && n_lab == 1)
+            a->outlet_p1 = plan.s[0].outlet + 1;
+        if (!a->outlet_p1) {
+            WARN(a, "%s plans %u places of the encoder (column outlet): say which one this run measures from with "
+                    "--outlet N; nothing was recorded\n", c->poses_path, n_lab);
+            goto out;
+        }
+        if (a->outlet_p1 > 256 || !seen[a->outlet_p1 - 1]) {
+            WARN(a, "%s has no rows for outlet %d; nothing was recorded\n", c->poses_path, a->outlet_p1 - 1);
+            goto out;
+        }
+        a->n_mine = 0;
+        for (size_t i = 0; i < plan.n; ++i) {
+            a->other[i] = plan.s[i].outlet != (unsigned)(a->outlet_p1 - 1);
+            a->n_mine += !a->other[i];
+        }
     }
     for (size_t i = 0; i < plan.n; ++i) {
         rc_sample s = plan.s[i];
@@ -393,7 +423,7 @@ static int run_poses(acq *a)
         rc_stable_result r;
         double q_deg[RC_NJ];
         rc_status st;
-        if (a->done[i])
+        if (a->done[i] || a->other[i])
             continue;
         SAY(a, "pose %zu/%zu: q =", i + 1, a->n);
         for (int j = 0; j < RC_NJ; ++j)
@@ -420,7 +450,7 @@ static int run_poses(acq *a)
             a->res->stopped = 1;
             a->res->stopped_at = i;
             WARN(a, "stopped at pose %zu; %zu of %zu poses recorded in %s; rerun the same command to resume\n", i,
-                 a->res->n_before + a->res->n_new, a->n, c->out_path);
+                 a->res->n_before + a->res->n_new, a->n_mine, c->out_path);
             return 1;
         }
         if (rch_acqfile_append(&a->file, i, q_deg, &r, a->io->wall_ms(a->io->ctx), &dg) != 0) {
@@ -474,13 +504,20 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     a.io = io;
     if (check_paths(&a) != 0 || load_inputs(&a) != 0)
         goto out;
-    res->n_poses = a.n;
+    res->n_poses = a.n_mine;
     if (rch_acqfile_open_outlet(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n,
-                                c->outlet_p1, &dg) != 0) {
+                                a.outlet_p1, &dg) != 0) {
         WARN(&a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
         goto out;
     }
     file_open = 1;
+    for (size_t i = 0; i < a.n; ++i)
+        if (a.done[i] && a.other[i]) {
+            WARN(&a, "%s: pose %zu was recorded from outlet %d, but the plan %s gives it to another outlet: the file "
+                     "belongs to another plan (nothing was changed)\n",
+                 c->out_path, i, a.outlet_p1 - 1, c->poses_path);
+            goto out;
+        }
     res->n_before = fst.n_done;
     res->dropped_bytes = fst.dropped_bytes;
     if (fst.dropped_bytes)
@@ -489,13 +526,13 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     a.has_ref = fst.has_last;
     a.ref_pose = fst.last_pose;
     a.ref_len_mm = fst.last_len_mm;
-    if (fst.n_done == a.n) {
-        SAY(&a, "rcal acquire: %s already holds all %zu poses; nothing to do\n", c->out_path, a.n);
+    if (fst.n_done == a.n_mine) {
+        SAY(&a, "rcal acquire: %s already holds all %zu poses; nothing to do\n", c->out_path, a.n_mine);
         rc = 0;
         goto out;
     }
     if (fst.n_done)
-        SAY(&a, "rcal acquire: resuming: %zu of %zu poses already in %s\n", fst.n_done, a.n, c->out_path);
+        SAY(&a, "rcal acquire: resuming: %zu of %zu poses already in %s\n", fst.n_done, a.n_mine, c->out_path);
     st = io->open(io->ctx, &a.port, c->port_path, &c->ser);
     if (st != RC_OK) {
         WARN(&a, "cannot open %s (%s backend): %s: %s\n", c->port_path, c->backend ? c->backend : "given",
@@ -520,5 +557,6 @@ out:
     free(a.plan_deg);
     free(a.pred_mm);
     free(a.done);
+    free(a.other);
     return rc;
 }

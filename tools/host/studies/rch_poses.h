@@ -1,28 +1,45 @@
 /* SPDX-License-Identifier: MIT */
-/* rch_poses.h - planning an identifiable pose set (`rcal poses`).
+/* rch_poses.h - planning a pose set (`rcal poses`).
  *
- * Method (D-optimal design, greedy start + Fedorov exchange):
- *  1. draw `candidates` random poses uniformly inside the joint limits (less
- *     margin_deg, at 0.01 deg steps) whose nominal cable length lies in
- *     [len_min_mm, len_max_mm], the range the encoder reaches;
- *  2. one row per candidate of the identification Jacobian d l / d x (rc_meas,
- *     nominal model with the encoder position), each column scaled by its
- *     RMS over the candidates so that mm and rad compare;
- *  3. keep what the candidates can identify (lib/rc_ident, the project's one
- *     definition): the eigen-directions of the column-scaled information
- *     matrix that are not null (rank r; alpha6, the base heading/height vs
- *     the encoder, d2 vs d3 ... drop out); each candidate's scaled row is
- *     expressed in those r directions;
- *  4. maximise log det(X_S^T X_S) over N poses (X: the rows of step 3): greedy additions (each adds the
- *     candidate with the largest x^T A^-1 x), then exchange passes that swap a
- *     chosen pose for a candidate while the determinant grows.
- * The plan is reported with the observability index O1 of rch_ident beside
- * that of N random poses from the same candidates. Collisions of the cable
- * with the arm are not modelled: review the plan before running it.
+ * Two criteria, one candidate set: `candidates` random poses uniformly
+ * inside the joint limits (less margin_deg, at 0.01 deg steps) whose
+ * nominal cable length from the outlet(s) lies in [len_min_mm, len_max_mm].
  *
- * Cost: grows as N^2 (one core: 100 poses 0.2 s, 300 poses 2 s, 1000 poses
- * 25 s), memory
- * candidates x n_params doubles; hence the limits below, named in the error.
+ * RCH_POSES_POSITION (the default; issue 20): the 3-D accuracy of the
+ * calibrated robot. K outlets at given approximate places (outlet 0 is the
+ * model's encoder when none are given); every pose is measured from every
+ * outlet (K rows per pose), or with `split` each pose from one outlet (N / K
+ * poses each, slot t of the design belonging to outlet t mod K). The
+ * model is the one `rcal calibrate` fits: the nominal DH, Hayati's tilt of
+ * every nominally parallel axis, one outlet effect per place, theta1 and d1
+ * held (the gauge). The information of a design is
+ *   M = P + sum over its rows g g^T / noise^2,
+ * g = d l / d x (rc_meas), P the physical prior's diag(1 / sd^2)
+ * (rch_prior_fill: directions the prior fixes need no poses); the outlets,
+ * which have no prior, are given 100 mm about their approximate places so
+ * that M is invertible before the first pose (the data then place them to
+ * a few hundredths of a mm). The criterion is I-optimality, the classical
+ * "average prediction variance": minimise
+ *   phi = mean over W workspace poses w of trace(Jp_w M^-1 Jp_w^T),
+ * the expected squared 3-D error of the point (flange or tool) over the
+ * workspace (W = 300 poses uniform in the joint limits; Jp = d p / d x,
+ * rch_uncert_point_sens). A candidate of rows X lowers it by
+ * trace((I + X^T C X)^-1 X^T C Q C X), C = M^-1, Q = mean Jp^T Jp:
+ * greedy additions, then exchange passes (a pose swapped for the candidate
+ * that lowers phi most while it falls). The plan is reported by its
+ * predicted 3-D accuracy: the 95 % radius of the position error
+ * (rch_uncert_radius95 of Jp C Jp^T) at n_eval other workspace poses, median
+ * and 95th percentile, beside N random candidates of the same design.
+ *
+ * RCH_POSES_LENGTH (the earlier plan, one outlet): D-optimal on the lengths:
+ * maximise log det(X^T X) over the directions rc_ident calls identifiable
+ * (columns scaled by their RMS), greedy + Fedorov exchange, reported by the
+ * observability index O1 (rch_ident) beside N random poses.
+ *
+ * Collisions of the cable with the arm are not modelled: review the plan
+ * before running it. Cost of the position criterion: about candidates x K x
+ * P^2 x N x (passes + 1) products (P ~ 26 + 3 K); 50 poses from 3 outlets
+ * of 2000 candidates about 2 s on one core.
  * Host side (prefix rch_): heap; progress lines on a caller-given stream.
  */
 #ifndef RCH_POSES_H
@@ -33,6 +50,7 @@
 
 #include "rc_model.h"
 #include "rch_diag.h"
+#include "rch_prior.h"
 
 #define RCH_POSES_MAX_COUNT 1000u        /* poses per plan */
 #define RCH_POSES_MAX_CANDIDATES 200000u /* candidate poses */
@@ -44,7 +62,29 @@ typedef struct rch_poses_config {
     unsigned long long seed;
     double len_min_mm, len_max_mm; /* cable length range, min < max */
     double margin_deg;             /* kept from every joint limit, >= 0 */
+    /* the position criterion (zero-initialised: the default) */
+    int criterion;                 /* rch_poses_criterion */
+    unsigned n_outlets;            /* K places of the encoder, 0: the model's encoder alone */
+    double outlet_mm[RC_MAX_OUTLETS][3]; /* (K x 3) their approximate places, base frame */
+    int split;                     /* 1: each pose measured from one outlet; 0: from every outlet */
+    double noise_mm;               /* length noise the prediction is for; 0: RCH_POSES_NOISE_MM */
+    int has_tool;                  /* 1: plan for the tool point tool_mm (flange frame), else the flange */
+    double tool_mm[3];
+    const rch_prior_cfg *prior;    /* NULL: rch_prior_defaults */
+    size_t n_work;                 /* workspace poses of the criterion, 0: 300 */
+    size_t n_eval;                 /* workspace poses of the reported accuracy, 0: 1000 */
 } rch_poses_config;
+
+typedef enum { RCH_POSES_POSITION = 0, RCH_POSES_LENGTH = 1 } rch_poses_criterion;
+#define RCH_POSES_NOISE_MM 0.02
+#define RCH_POSES_OUTLET_SD_MM 100.0 /* the planner's prior on the outlets' approximate places */
+
+/* Predicted 3-D accuracy of a design: the 95 % radius of the point's
+ * position error over workspace poses. */
+typedef struct rch_poses_accuracy {
+    double median_mm, p95_mm;      /* over the n_eval workspace poses */
+    double phi_mm2;                /* the criterion: mean trace of the position covariance over them */
+} rch_poses_accuracy;
 
 typedef struct rch_poses_result {
     rc_sample *poses;          /* (n) the plan, q at 0.01 deg steps; rch_poses_free */
@@ -54,7 +94,20 @@ typedef struct rch_poses_result {
     unsigned n_params;
     double o1_plan, o1_random; /* observability O1 (rch_ident) of the plan and of N random candidates */
     unsigned rank_plan, rank_random;
+    /* the position criterion */
+    unsigned n_outlets;        /* K */
+    size_t n_distinct;         /* distinct poses (n = K n_distinct, or n_distinct with split) */
+    rch_poses_accuracy plan, random; /* predicted 3-D accuracy of the plan and of random poses */
+    size_t rows_per_outlet[RC_MAX_OUTLETS];
+    size_t rows_advised;       /* fewest rows advised: calibrate's parameters (the free ones + the cable
+                                  attachment it tries) + RCH_POSES_ROWS_SPARE */
 } rch_poses_result;
+/* `rcal calibrate` estimates the noise from its residuals (SSR / (n - p_eff)):
+ * with about as many rows as parameters the estimate collapses, the prior
+ * loses its weight and the fit follows the noise (measured, plan_study.py
+ * --table: 30 rows for 32 parameters, 3-D error 0.33-0.69 mm against a
+ * predicted 0.05-0.07 mm; 60 rows and more as predicted). */
+#define RCH_POSES_ROWS_SPARE 10u
 
 /* Plan poses for model m (with its encoder position set). progress: a
  * stream for progress lines when the plan takes more than a few seconds
@@ -63,5 +116,42 @@ typedef struct rch_poses_result {
 int rch_poses_plan(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, FILE *progress,
                    rch_diag *d);
 void rch_poses_free(rch_poses_result *res);
+
+/* The predicted 3-D accuracy of given rows (n; q_rad and outlet 0..K-1 read)
+ * for the outlets and options of c (criterion ignored). 0, or -1 with d. */
+int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_poses_config *c, const rc_sample *rows,
+                      size_t n, rch_diag *d);
+
+/* Which k of the n candidate places (cand_mm, n x 3) give the best predicted
+ * 3-D accuracy (median 95 % radius over the workspace) for a plan of
+ * c->count poses (a greedy plan per combination, c's other options): every
+ * combination when there are at most RCH_POSES_MAX_COMBOS, else greedily
+ * (the best place, then the one that improves it most, ...). */
+#define RCH_POSES_MAX_CANDIDATE_PLACES 16u
+#define RCH_POSES_MAX_COMBOS 64u
+typedef struct rch_poses_combo {
+    unsigned k;                   /* places in it (fewer than the choice's k on the greedy path's way) */
+    unsigned idx[RC_MAX_OUTLETS]; /* (k) candidate indices */
+    rch_poses_accuracy acc;
+    int span;                     /* rch_prior_outlet_span */
+} rch_poses_combo;
+typedef struct rch_poses_choice {
+    unsigned k, n_cand;
+    int exhaustive;
+    size_t n_combos;
+    rch_poses_combo combos[RCH_POSES_MAX_COMBOS + RCH_POSES_MAX_CANDIDATE_PLACES * RC_MAX_OUTLETS];
+    size_t best;                  /* index into combos */
+} rch_poses_choice;
+int rch_poses_choose_outlets(rch_poses_choice *out, const rc_model *m, const rch_poses_config *c,
+                             const double (*cand_mm)[3], unsigned n, unsigned k, rch_diag *d);
+
+/* The plan as an ABB RAPID module: one CONST jointtarget per row (robax in
+ * degrees, extax 9E9), one PROC per outlet moving through its rows (MoveAbsJ
+ * ... fine, tool0), writing "rcal pose I outlet K" on the pendant (TPWrite)
+ * and waiting settle_s (WaitTime) while `rcal acquire` reads, and main (it
+ * asks the outlet when there are several). outlet_label: (n) the rows'
+ * outlet column, NULL: all 0. 0, or -1 (a write failed). */
+int rch_poses_write_rapid(FILE *f, const rc_sample *rows, const unsigned char *outlet_label, size_t n,
+                          double settle_s, const char *comment);
 
 #endif
