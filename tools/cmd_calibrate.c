@@ -42,7 +42,7 @@ static const char details[] = "mean|e| is what the paper's Eq. 20 calls SD; SD i
 typedef struct {
     rch_calib_cfg cfg;
     const char *out_path, *method, *report_path;
-    rch_opt_strs data;
+    rch_opt_strs data, positions;
     unsigned long seed, max_iter, cases, case_samples;
     int json;
 } calib_args;
@@ -54,7 +54,11 @@ static int parse(calib_args *a, int argc, char **argv)
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STRS, &a->data, 0, 0, "FILE",
          "measurements: CSV with q1..q6 (deg) and L (mm); several --data are merged (set-up groups never span two files)",
-         RCH_OPT_REQUIRED, NULL},
+         0, NULL},
+        {"--positions", RCH_OPT_STRS, &a->positions, 0, 0, "FILE",
+         "laser-tracker positions: CSV with q1..q6 (deg), x, y, z (mm, tracker frame), optional target, pose, sigma_mm "
+         "(docs/positions.md); repeatable, mixable with --data; the tracker frame and targets are estimated",
+         0, NULL},
         {"--validate", RCH_OPT_STR, &cfg->validate_path, 0, 0, "FILE",
          "data the fit never sees: the model evaluated on it with no refit (RMSE, ISO 9283 from repeated poses)", 0,
          NULL},
@@ -121,9 +125,15 @@ static int parse(calib_args *a, int argc, char **argv)
     cfg->max_iter = (unsigned)a->max_iter;
     cfg->cases = a->cases;
     cfg->case_samples = a->case_samples;
-    cfg->data_path = a->data.v[0];
-    cfg->data_paths = a->data.v;
+    if (a->data.n == 0 && a->positions.n == 0) {
+        fprintf(stderr, "rcal calibrate: --data or --positions is required (rcal calibrate --help)\n");
+        return 2;
+    }
+    cfg->data_path = a->data.n ? a->data.v[0] : NULL;
+    cfg->data_paths = a->data.n ? a->data.v : NULL;
     cfg->n_data_paths = a->data.n;
+    cfg->positions_paths = a->positions.v;
+    cfg->n_positions_paths = a->positions.n;
     return -1;
 }
 
@@ -133,9 +143,22 @@ static int parse(calib_args *a, int argc, char **argv)
  * to a --data file. */
 static int out_is_input(const calib_args *a)
 {
-    const char *inputs[RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
+    const char *inputs[2 * RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
     for (size_t i = 0; i < a->data.n; ++i)
         inputs[3 + i] = a->data.v[i];
+    for (size_t i = 0; i < a->positions.n; ++i)
+        inputs[3 + a->data.n + i] = a->positions.v[i];
+    for (size_t i = 0; i < a->positions.n; ++i)
+        for (size_t j = 0; j < 3 + a->data.n + i; ++j)
+            if (inputs[j] && (rch_same_file(a->positions.v[i], inputs[j]) || strcmp(a->positions.v[i], inputs[j]) == 0)) {
+                fprintf(stderr, "rcal calibrate: --positions %s is given twice or is another input: refused\n",
+                        a->positions.v[i]);
+                return 1;
+            }
+    if (a->report_path && a->positions.n) {
+        fprintf(stderr, "rcal calibrate: --report does not show tracker positions yet: run without --report\n");
+        return 1;
+    }
     for (size_t i = 0; i < a->data.n; ++i)
         for (size_t j = 0; j < i; ++j)
             if (rch_same_file(a->data.v[i], a->data.v[j]) || strcmp(a->data.v[i], a->data.v[j]) == 0) {
@@ -164,7 +187,7 @@ static int out_is_input(const calib_args *a)
     }
     const char *outs[5] = {a->out_path, a->cfg.residuals_path, a->report_path, plot_svg, plot_csv};
     static const char *const what[5] = {"--out", "--residuals", "--report", "--plots", "--plots"};
-    if (rcal_outputs_check("calibrate", outs, what, 5, a->report_path, inputs, 3 + a->data.n) != 0)
+    if (rcal_outputs_check("calibrate", outs, what, 5, a->report_path, inputs, 3 + a->data.n + a->positions.n) != 0)
         return 1;
     if (a->cfg.residuals_path && (a->cases > 1 || a->cfg.jumps)) {
         fprintf(stderr, "rcal calibrate: --residuals is for one calibration without --jumps (not with --cases or "
