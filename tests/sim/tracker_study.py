@@ -112,6 +112,32 @@ def main():
     ev_test = json.loads(run([a.rcal, "evaluate", "--model", model, "--positions", test, "--json"]))
     ev_nom = json.loads(run([a.rcal, "evaluate", "--model", nominal, "--positions", truth, "--json"]))
     noise3 = a.noise * np.sqrt(3.0)
+    # identified against the truth: the DH parameters the positions determine, and the tracker frame up
+    # to the gauge (theta1, d1 held at nominal: the fitted frame holds the truth's heading and height)
+    doc = json.load(open(model))
+    dev = []
+    for i, row in enumerate(doc["dh"]):
+        ta, td, tal, tth = rob.rows[i]
+        if i < 5:
+            dev += [("a%d" % (i + 1), row["a_mm"] - ta, "mm"), ("alpha%d" % (i + 1), row["alpha_deg"] - tal / DEG, "deg")]
+        if 0 < i < 5:
+            dev.append(("theta%d" % (i + 1), row["theta_deg"] - tth / DEG, "deg"))
+        if i in (3, 4):
+            dev.append(("d%d" % (i + 1), row["d_mm"] - td, "mm"))
+    eff = {e["kind"]: e["params"] for e in doc["effects"]}
+    nom = ts.nominal_robot(name).rows
+    Rg = R @ ts.rot("z", rob.rows[0][3] - nom[0][3])
+    Tg = T + R @ np.array([0.0, 0.0, rob.rows[0][1] - nom[0][1]])
+    Rf = rotvec(np.array(eff["tracker_rotation"]))
+    frame_deg = np.degrees(np.arccos(np.clip((np.trace(Rf.T @ Rg) - 1) / 2, -1, 1)))
+    frame_mm = np.linalg.norm(np.array(eff["tracker_position"]) - Tg)
+    worst_mm = max(abs(d) for n, d, u in dev if u == "mm")
+    worst_deg = max(abs(d) for n, d, u in dev if u == "deg")
+    print("identified - true: %s" % ", ".join("%s %+.4f" % (n, d) for n, d, u in dev))
+    print("  largest: %.4f mm, %.5f deg; tracker frame vs the truth's (gauge applied): %.5f deg, %.4f mm "
+          "(the frame is %.0f mm and %.1f deg from the base)" % (worst_mm, worst_deg, frame_deg, frame_mm,
+                                                                 np.linalg.norm(T),
+                                                                 np.degrees(np.arccos((np.trace(R) - 1) / 2))))
     t, h, nm = ev_truth["position_error_mm"], ev_test["position_error_mm"], ev_nom["position_error_mm"]
     print("calibrate: held-out 3-D RMS %.4f mm (%d positions), %s" % (
         cal["positions"]["position_error_mm"]["rms"], cal["positions"]["position_error_mm"]["points"],
@@ -128,6 +154,7 @@ def main():
         ok &= t["rms"] < 3.0 * noise3 and t["rms"] < 0.2 * nm["rms"]
         ok &= abs(h["rms"] - noise3) < 0.5 * noise3 + t["rms"]
         ok &= h["repeated"] == 90
+        ok &= worst_mm < 0.05 and worst_deg < 0.01 and frame_deg < 0.01 and frame_mm < 0.2
         print("check:", "ok" if ok else "FAILED")
         return 0 if ok else 1
     return 0
