@@ -45,6 +45,7 @@ typedef struct {
     rch_opt_strs data, positions;
     unsigned long seed, max_iter, cases, case_samples;
     int json;
+    double tracker_pos[3], tracker_rot[3];
 } calib_args;
 
 static int parse(calib_args *a, int argc, char **argv)
@@ -59,6 +60,11 @@ static int parse(calib_args *a, int argc, char **argv)
          "laser-tracker positions: CSV with q1..q6 (deg), x, y, z (mm, tracker frame), optional target, pose, sigma_mm "
          "(docs/positions.md); repeatable, mixable with --data; the tracker frame and targets are estimated",
          0, NULL},
+        {"--tracker-position", RCH_OPT_TRIPLE, a->tracker_pos, -1e5, 1e5, "X,Y,Z",
+         "with --positions: start of the tracker frame's translation (the base origin in the tracker's frame, mm; "
+         "default: a closed-form fit)", 0, NULL},
+        {"--tracker-rotation", RCH_OPT_TRIPLE, a->tracker_rot, -360.0, 360.0, "RX,RY,RZ",
+         "with --positions: start of its rotation (rotation vector, deg)", 0, NULL},
         {"--validate", RCH_OPT_STR, &cfg->validate_path, 0, 0, "FILE",
          "data the fit never sees: the model evaluated on it with no refit (RMSE, ISO 9283 from repeated poses)", 0,
          NULL},
@@ -116,7 +122,8 @@ static int parse(calib_args *a, int argc, char **argv)
          "also the HTML page of rcal report, from this run (its JSON kept beside it as FILE.calibration.json)", 0,
          NULL},
     };
-    const int ps = rch_opt_cmd(&spec, "calibrate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
+    unsigned long long seen = 0;
+    const int ps = rch_opt_cmd(&spec, "calibrate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (ps >= 0)
         return ps;
     if (rch_method_parse(&cfg->method, a->method) != 0)
@@ -134,6 +141,16 @@ static int parse(calib_args *a, int argc, char **argv)
     cfg->n_data_paths = a->data.n;
     cfg->positions_paths = a->positions.v;
     cfg->n_positions_paths = a->positions.n;
+    cfg->have_tracker_start = rch_opt_given(&spec, seen, "--tracker-position") ||
+                              rch_opt_given(&spec, seen, "--tracker-rotation");
+    for (int k = 0; k < 3; ++k) { /* the one not given: 0 */
+        cfg->tracker_start[k] = a->tracker_pos[k];
+        cfg->tracker_start[3 + k] = a->tracker_rot[k] * (3.14159265358979323846 / 180.0);
+    }
+    if (cfg->have_tracker_start && a->positions.n == 0) {
+        fprintf(stderr, "rcal calibrate: --tracker-position and --tracker-rotation need --positions\n");
+        return 2;
+    }
     return -1;
 }
 

@@ -70,7 +70,7 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
     *start = *nominal;
     const size_t n_len = rch_pos_count_lengths(s, n);
     if (n_len < n && rch_pos_effect_at(start, RC_EFF_TRACKER_ROTATION, NULL) >= 0 &&
-        rch_pos_start(start, s, n) != 0) { /* the tracker frame and targets: closed form, then with e below */
+        rch_pos_start(start, s, n, rch_pos_frame_given(start)) != 0) { /* closed form, then with e below */
         rch_diag_set(d, "", 0, 0, "cannot place the tracker: the positions do not spread in three directions");
         return -1;
     }
@@ -447,7 +447,8 @@ static int append_positions(rch_calib_result *r, rch_data *data, rch_diag *d)
     unsigned *ln = s ? realloc(data->line, (data->n + p.n) * sizeof *ln) : NULL;
     if (ln)
         data->line = ln;
-    if (!ln || rch_pos_add_effects(&r->robot.model, p.n_targets) != 0) {
+    if (!ln || rch_pos_add_effects(&r->robot.model, p.n_targets) != 0 ||
+        (cfg->have_tracker_start && rch_pos_set_frame(&r->robot.model, cfg->tracker_start) != 0)) {
         rch_diag_set(d, "", 0, 0, ln ? "no room for the tracker frame and %u targets (RC_MAX_EFFECTS, RC_MAX_PARAMS)"
                                      : "out of memory", p.n_targets);
         rch_pos_free(&p);
@@ -1321,8 +1322,11 @@ static void print_model(FILE *f, const rch_calib_result *r)
         fprintf(f, "  %5u %10.4f %10.4f %12.5f %12.5f | %9.4f %10.4f %12.5f %12.5f\n", j + 1, x[0], x[1],
                 x[2] / DEG, x[3] / DEG, x[0] - x0[0], x[1] - x0[1], (x[2] - x0[2]) / DEG, (x[3] - x0[3]) / DEG);
     }
-    fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
-            m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
+    if (r->n_pos_rows && r->n_data == 3 * r->n_pos_rows)
+        fprintf(f, "  encoder e: no cable lengths (tracker positions only), held\n\n");
+    else
+        fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
+                m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
 }
 
 /* Dequantized joints, length jumps, the protocol over cases. */
@@ -1390,7 +1394,10 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                 r->robot.prior.length_mm, r->robot.prior.twist_deg, r->robot.prior.offset_deg,
                 r->robot.prior.attachment_mm, r->robot.prior.from_file ? ", from the robot file" : ", defaults",
                 r->noise_mm, r->noise_passes, r->p_eff);
-    if (u->has_prior)
+    if (u->has_prior && r->n_pos_rows)
+        fprintf(f, "  theta1 and d1 held (gauge): the tracker's frame absorbs the robot's heading and height, as "
+                   "an outlet does for lengths; a cell sets its base frame anyway\n");
+    else if (u->has_prior)
         fprintf(f, "  theta1 and d1 held (gauge): one outlet's lengths cannot see the robot's heading and height "
                    "against the outlet; a cell sets its base frame anyway\n");
     if (r->attach_auto)

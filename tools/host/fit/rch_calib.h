@@ -101,6 +101,8 @@ typedef struct rch_calib_cfg {
                                            (rch_positions.h), merged after the data; data_path may
                                            then be NULL */
     size_t n_positions_paths;
+    int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
+    double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
 } rch_calib_cfg;
 
 /* The defaults of `rcal calibrate`: everything zero or NULL but method LM,

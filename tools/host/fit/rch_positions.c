@@ -210,7 +210,26 @@ static int kabsch(double R[9], double T[3], const double (*a)[3], const double (
     return 0;
 }
 
-int rch_pos_start(rc_model *m, const rc_sample *s, size_t n)
+int rch_pos_set_frame(rc_model *m, const double frame[6])
+{
+    const int tf = rch_pos_effect_at(m, RC_EFF_TRACKER_POSITION, NULL), rf = rch_pos_effect_at(m, RC_EFF_TRACKER_ROTATION, NULL);
+    if (tf < 0 || rf < 0)
+        return -1;
+    memcpy(&m->x[tf], frame, 3 * sizeof frame[0]);
+    memcpy(&m->x[rf], frame + 3, 3 * sizeof frame[0]);
+    return 0;
+}
+
+int rch_pos_frame_given(const rc_model *m)
+{
+    const int tf = rch_pos_effect_at(m, RC_EFF_TRACKER_POSITION, NULL), rf = rch_pos_effect_at(m, RC_EFF_TRACKER_ROTATION, NULL);
+    int given = 0;
+    for (int k = 0; k < 3; ++k)
+        given |= (tf >= 0 && m->x[tf + k] != 0.0) || (rf >= 0 && m->x[rf + k] != 0.0);
+    return given;
+}
+
+int rch_pos_start(rc_model *m, const rc_sample *s, size_t n, int keep_frame)
 {
     unsigned nt = 0;
     const int tf = rch_pos_effect_at(m, RC_EFF_TRACKER_POSITION, NULL), rf = rch_pos_effect_at(m, RC_EFF_TRACKER_ROTATION, NULL),
@@ -241,13 +260,15 @@ int rch_pos_start(rc_model *m, const rc_sample *s, size_t n)
         }
     double *t = &m->x[kf], R[9], T[3];
     memset(t, 0, 3 * nt * sizeof *t);
-    for (int it = 0; it < 8; ++it) {
+    rc_rotvec_matrix(R, &m->x[rf]);
+    memcpy(T, &m->x[tf], sizeof T);
+    for (int it = 0; it < (keep_frame ? 1 : 8); ++it) {
         for (size_t i = 0; i < k; ++i) { /* the targets' points at the current targets */
             const double *tt = &t[3 * tg[i]], *Q = R6[i];
             for (int r = 0; r < 3; ++r)
                 a[i][r] = o[i][r] + Q[3 * r] * tt[0] + Q[3 * r + 1] * tt[1] + Q[3 * r + 2] * tt[2];
         }
-        if (kabsch(R, T, (const double(*)[3])a, (const double(*)[3])y, k) != 0)
+        if (!keep_frame && kabsch(R, T, (const double(*)[3])a, (const double(*)[3])y, k) != 0)
             goto done;
         /* each target: the mean of R6^T (R^T (y - T) - o) over its points */
         memset(t, 0, 3 * nt * sizeof *t);
@@ -492,7 +513,7 @@ int rch_pos_evaluate(rch_pos_eval *out, const rc_model *m, const rch_pos *p, int
               rf = rch_pos_effect_at(&use, RC_EFF_TRACKER_ROTATION, NULL),
               kf = rch_pos_effect_at(&use, RC_EFF_TRACKER_TARGETS, &nt);
     if (out->frame_fitted) {
-        if (rch_pos_start(&use, p->s, p->n) != 0) {
+        if (rch_pos_start(&use, p->s, p->n, 0) != 0) {
             snprintf(err, errlen, "cannot place the tracker: the positions do not spread in three directions");
             return -1;
         }
@@ -503,7 +524,7 @@ int rch_pos_evaluate(rch_pos_eval *out, const rc_model *m, const rch_pos *p, int
         memset(&fixed[kf + 3 * (int)j], 0, 3);
     if (!out->frame_fitted && out->targets_fitted) { /* start of the unknown targets at the model's frame */
         rc_model tmp = use;
-        if (rch_pos_start(&tmp, p->s, p->n) == 0)
+        if (rch_pos_start(&tmp, p->s, p->n, 1) == 0)
             for (unsigned j = out->targets_known; j < nt / 3u; ++j)
                 memcpy(&use.x[kf + 3 * (int)j], &tmp.x[kf + 3 * (int)j], 3 * sizeof use.x[0]);
     }

@@ -57,8 +57,14 @@ int rch_pos_add_effects(rc_model *m, unsigned n_targets);
 int rch_pos_effect_at(const rc_model *m, unsigned kind, unsigned *count);
 
 /* Closed-form start of the tracker frame and targets of m from the tracker
- * samples of s (n) at m's geometry. 0, or -1 (fewer than 3 points apart). */
-int rch_pos_start(rc_model *m, const rc_sample *s, size_t n);
+ * samples of s (n) at m's geometry; keep_frame: m's frame is kept (given as
+ * a start) and only the targets are placed. 0, or -1 (fewer than 3 points
+ * apart). */
+int rch_pos_start(rc_model *m, const rc_sample *s, size_t n, int keep_frame);
+/* Set m's tracker frame to frame (6: T mm, rotation vector rad). 0, or -1 (none). */
+int rch_pos_set_frame(rc_model *m, const double frame[6]);
+/* 1 when m's tracker frame is not all zero (given: a robot file, an option). */
+int rch_pos_frame_given(const rc_model *m);
 
 /* What only a sensor absent from s (n) sees is held in fixed (m->n_params):
  * without lengths the outlets, e and the length-side and attachment
