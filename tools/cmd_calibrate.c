@@ -172,10 +172,6 @@ static int out_is_input(const calib_args *a)
                         a->positions.v[i]);
                 return 1;
             }
-    if (a->report_path && a->positions.n) {
-        fprintf(stderr, "rcal calibrate: --report does not show tracker positions yet: run without --report\n");
-        return 1;
-    }
     for (size_t i = 0; i < a->data.n; ++i)
         for (size_t j = 0; j < i; ++j)
             if (rch_same_file(a->data.v[i], a->data.v[j]) || strcmp(a->data.v[i], a->data.v[j]) == 0) {
@@ -274,11 +270,13 @@ int rcal_cmd_calibrate(int argc, char **argv)
     else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
         status = 1;
     else if (a.report_path && r->finite) {
-        const char *inputs[RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
+        const char *inputs[2 * RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
         for (size_t i = 0; i < a.data.n; ++i)
             inputs[3 + i] = a.data.v[i];
-        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs, 3 + a.data.n,
-                               a.json) != 0)
+        for (size_t i = 0; i < a.positions.n; ++i)
+            inputs[3 + a.data.n + i] = a.positions.v[i];
+        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs,
+                               3 + a.data.n + a.positions.n, a.json) != 0)
             status = 1;
     }
     if (a.cfg.residuals_path && !r->finite)
