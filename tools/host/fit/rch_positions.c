@@ -262,7 +262,10 @@ int rch_pos_start(rc_model *m, const rc_sample *s, size_t n, int keep_frame)
     memset(t, 0, 3 * nt * sizeof *t);
     rc_rotvec_matrix(R, &m->x[rf]);
     memcpy(T, &m->x[tf], sizeof T);
-    for (int it = 0; it < (keep_frame ? 1 : 8); ++it) {
+    double moved = INFINITY;
+    for (int it = 0; it < (keep_frame ? 1 : 100) && moved > 1e-9; ++it) { /* alternated until the targets settle */
+        double before[3 * RC_MAX_TARGETS];
+        memcpy(before, t, 3 * nt * sizeof *t);
         for (size_t i = 0; i < k; ++i) { /* the targets' points at the current targets */
             const double *tt = &t[3 * tg[i]], *Q = R6[i];
             for (int r = 0; r < 3; ++r)
@@ -283,9 +286,12 @@ int rch_pos_start(rc_model *m, const rc_sample *s, size_t n, int keep_frame)
                 t[3 * tg[i] + r] += R6[i][r] * u[0] + R6[i][3 + r] * u[1] + R6[i][6 + r] * u[2];
             cnt[tg[i]]++;
         }
+        moved = 0.0;
         for (unsigned j = 0; j < nt; ++j)
-            for (int r = 0; r < 3; ++r)
+            for (int r = 0; r < 3; ++r) {
                 t[3 * j + r] = cnt[j] ? t[3 * j + r] / cnt[j] : 0.0;
+                moved = fmax(moved, fabs(t[3 * j + r] - before[3 * j + r]));
+            }
     }
     memcpy(&m->x[tf], T, sizeof T);
     rc_rotvec_from_matrix(&m->x[rf], R);
