@@ -511,7 +511,11 @@ int rch_pos_evaluate(rch_pos_eval *out, const rc_model *m, const rch_pos *p, int
     }
     out->frame_fitted = refit_frame || !had_frame;
     out->targets_known = out->frame_fitted ? 0u : (had < p->n_targets ? had : p->n_targets);
-    out->targets_fitted = p->n_targets - out->targets_known;
+    uint8_t seen[RC_MAX_TARGETS] = {0};
+    for (size_t i = 0; i < p->n; ++i)
+        seen[p->s[i].target < RC_MAX_TARGETS ? p->s[i].target : 0] = 1;
+    for (unsigned j = out->targets_known; j < p->n_targets; ++j)
+        out->targets_fitted += seen[j]; /* those the data show */
     uint8_t fixed[RC_MAX_PARAMS];
     memset(fixed, 1, sizeof fixed);
     unsigned nt = 0;
