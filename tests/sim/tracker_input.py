@@ -58,6 +58,10 @@ bad = list(good_rows)
 bad[3] = bad[3].replace(",10,-20,", ",10,95,")  # joint 3 beyond the IRB120's +70 deg
 badq = write("badq.csv", head + "\n".join(bad) + "\n")
 expect("joint limits", ["calibrate", "--robot", ROBOT, "--positions", badq], 1, "badq.csv:5:")
+rad = write("rad.csv", head + "\n".join(",".join([r.split(",")[0]] + ["%.6f" % (float(v) * 3.141592653589793 / 180.0)
+                                                                     for v in r.split(",")[1:7]] + r.split(",")[7:])
+                                        for r in good_rows) + "\n")
+expect("radians", ["calibrate", "--robot", ROBOT, "--positions", rad], 1, "look like radians")
 good = write("good.csv", head + "\n".join(good_rows) + "\n")
 expect("both --data and --positions to evaluate", ["evaluate", "--model", ROBOT, "--positions", good, "--data", good],
        2, "one of --data and --positions")

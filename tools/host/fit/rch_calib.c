@@ -74,7 +74,7 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
         rch_diag_set(d, "", 0, 0, "cannot place the tracker: the positions do not spread in three directions");
         return -1;
     }
-    if (!has_encoder && n_len > 0) {
+    if (!has_encoder && (n_len > 0 || n == 0)) { /* no lengths at all: e is held (rch_pos_fix_unseen) */
         double e[3];
         if (guess_outlet(e, start, 0, s, n, d) != 0)
             return -1;

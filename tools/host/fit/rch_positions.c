@@ -73,6 +73,32 @@ static int append_file(rch_pos *out, const rch_data *dt, unsigned f, double *nex
     return 0;
 }
 
+/* Units, as rch_data_check_units for lengths: joints all within +-7 (as
+ * read) look like radians, coordinates all within +-5 like metres. */
+static int check_units(const rch_data *dt, const char *path, rch_diag *d)
+{
+    double qmax = 0.0, pmax = 0.0;
+    if (dt->n < 5)
+        return 0;
+    for (size_t i = 0; i < dt->n; ++i) {
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            qmax = fmax(qmax, fabs(dt->s[i].q_rad[j]));
+        for (unsigned c = 0; c < 3; ++c)
+            pmax = fmax(pmax, fabs(dt->xyz[i][c]));
+    }
+    if (qmax > 0.0 && qmax < 7.0 * 3.14159265358979323846 / 180.0) {
+        rch_diag_set(d, path, 0, 0, "every joint angle is within +-7: the q columns look like radians, rcal reads "
+                                    "degrees (multiply by 180/pi, or scripts/positions_convert.py --joints-unit rad)");
+        return -1;
+    }
+    if (pmax < 5.0) {
+        rch_diag_set(d, path, 0, 0, "every coordinate is within +-5: x, y, z look like metres, rcal reads "
+                                    "millimetres (multiply by 1000, or scripts/positions_convert.py --positions-unit m)");
+        return -1;
+    }
+    return 0;
+}
+
 int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0, const rc_model *limits,
                  rch_diag *d)
 {
@@ -82,6 +108,12 @@ int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0,
     for (size_t f = 0; f < k; ++f) {
         rch_data dt;
         if (rch_data_load_limited(&dt, paths[f], RCH_DATA_POSITIONS | RCH_DATA_NO_LEN, limits, d) != 0) {
+            rch_pos_free(out);
+            free(sig);
+            return -1;
+        }
+        if (check_units(&dt, paths[f], d) != 0) {
+            rch_data_free(&dt);
             rch_pos_free(out);
             free(sig);
             return -1;
