@@ -1662,6 +1662,22 @@ static void json_pos_err(rch_jw *w, const char *name, const rch_pos_err *e)
     rch_jw_end(w);
 }
 
+/* With --positions: the "positions" member (docs/json-formats.md). */
+static void json_positions(rch_jw *w, const rch_calib_result *r)
+{
+    rch_jw_obj(w, "positions");
+    rch_jw_uint(w, "rows", r->n_pos_rows);
+    rch_jw_uint(w, "poses", r->n_pos_poses);
+    rch_jw_uint(w, "targets", r->n_targets);
+    rch_jw_num(w, "sigma_mm", r->pos_has_sigma ? r->pos_sigma_mm : NAN);
+    if (r->have_pos) {
+        json_pos_err(w, "position_error_mm", &r->pos_after);
+        json_pos_err(w, "before_mm", &r->pos_before);
+        json_pos_err(w, "train_after_mm", &r->pos_train_after);
+    }
+    rch_jw_end(w);
+}
+
 int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
 {
     rch_jw w;
@@ -1700,19 +1716,8 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
     }
     rch_jw_bool(&w, "jumps_found_by_default", r->jumps_auto);
     rch_jw_end(&w);
-    if (r->n_pos_rows) {
-        rch_jw_obj(&w, "positions");
-        rch_jw_uint(&w, "rows", r->n_pos_rows);
-        rch_jw_uint(&w, "poses", r->n_pos_poses);
-        rch_jw_uint(&w, "targets", r->n_targets);
-        rch_jw_num(&w, "sigma_mm", r->pos_has_sigma ? r->pos_sigma_mm : NAN);
-        if (r->have_pos) {
-            json_pos_err(&w, "position_error_mm", &r->pos_after);
-            json_pos_err(&w, "before_mm", &r->pos_before);
-            json_pos_err(&w, "train_after_mm", &r->pos_train_after);
-        }
-        rch_jw_end(&w);
-    }
+    if (r->n_pos_rows)
+        json_positions(&w, r);
     if (r->cfg.truth_path) {
         rch_jw_obj(&w, "truth_flange");
         rch_jw_numf(&w, "before_rms_mm", r->truth_before_rms_mm, "%.6f");
