@@ -234,8 +234,9 @@ void rc_fk(double pos_mm[3], double rot[9], const rc_model *m, const double q_ra
 void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *m,
                const double q_rad[RC_NJ]);
 
-/* Predicted cable length of one sample and, when jac is not NULL, its
- * analytic derivative with respect to every model parameter.
+/* Predicted value of one sample (its cable length, or for a tracker sample,
+ * rc_sample.sensor, its coordinate: lib/rc_sensor.h) and, when jac is not
+ * NULL, its analytic derivative with respect to every model parameter.
  * jac: (m->n_params). Returns RC_ERR_NUMERIC when the flange point
  * coincides with the encoder outlet (length derivative undefined).
  * Same as rc_meas_prepare + rc_meas_prepared(no tables): bit for bit what a

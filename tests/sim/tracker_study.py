@@ -11,7 +11,8 @@ from them (`--positions`, optionally mixed with cable lengths `--data`), and:
     random poses gives the 3-D error of the calibrated model against the truth,
   - on noisy held-out positions it gives an RMS that should be near the noise.
 
-    python3 tracker_study.py RCAL [--seed S] [--poses N] [--noise MM] [--mixed] [--check] [--dir D]
+    python3 tracker_study.py RCAL [--seed S] [--poses N] [--noise MM] [--mixed] [--robot irb120|irb1600]
+                             [--check] [--dir D]
 """
 import argparse
 import json
@@ -80,9 +81,10 @@ def main():
     ap.add_argument("--mixed", action="store_true", help="also 300 cable lengths from one outlet (--data)")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--dir")
+    ap.add_argument("--robot", choices=sorted(ts.ROBOTS), default="irb120")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
-    name = "irb120"
+    name = a.robot
     lim = ts.ROBOTS[name]["lim"]
     rob = ts.true_robot(rng, name, beta_deg=0.03)
     axis = rng.normal(size=3)
