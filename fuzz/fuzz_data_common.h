@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* fuzz_data_common.h - one fuzz body for the CSV reader (rch_data_parse),
  * used with flags 0 (measurement files), RCH_DATA_NO_LEN (pose plans) and
- * RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY (acquisition files, as rch_acqfile reads them). */
+ * RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY (acquisition files, as rch_acqfile reads them) and
+ * RCH_DATA_POSITIONS | RCH_DATA_NO_LEN (tracker positions, as rch_pos_load reads them). */
 #ifndef FUZZ_DATA_COMMON_H
 #define FUZZ_DATA_COMMON_H
 
@@ -24,7 +25,7 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
     if (rc != 0) {
         /* refused: a message, nothing left allocated */
         FZ_CHECK(diag.msg[0] != '\0');
-        FZ_CHECK(d.s == NULL && d.xyz == NULL && d.line == NULL && d.pose == NULL && d.n == 0);
+        FZ_CHECK(d.s == NULL && d.xyz == NULL && d.line == NULL && d.pose == NULL && d.sigma_mm == NULL && d.n == 0);
         return;
     }
     if (d.n == 0) { /* only with RCH_DATA_ALLOW_EMPTY (an acquisition file holding its header) */
@@ -33,7 +34,10 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
         return;
     }
     FZ_CHECK(d.s != NULL && d.line != NULL);
-    FZ_CHECK(((flags & RCH_DATA_POSE) != 0) == (d.pose != NULL));
+    if (flags & RCH_DATA_POSITIONS)
+        FZ_CHECK(d.xyz != NULL); /* required; pose and sigma_mm when present */
+    else
+        FZ_CHECK(((flags & RCH_DATA_POSE) != 0) == (d.pose != NULL) && d.sigma_mm == NULL);
     for (size_t i = 0; i < d.n; ++i) {
         const rc_sample *s = &d.s[i];
         for (int j = 0; j < RC_NJ; ++j)
@@ -49,6 +53,9 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
             FZ_CHECK(d.line[i] > d.line[i - 1]);
         if (d.pose)
             FZ_CHECK(d.pose[i] <= 1000000000ul);
+        FZ_CHECK(s->target < RC_MAX_TARGETS && s->sensor == RC_SENSOR_LENGTH);
+        if (d.sigma_mm)
+            FZ_CHECK(d.sigma_mm[i] > 0.0 && d.sigma_mm[i] <= 100.0);
         if (d.xyz)
             for (int k = 0; k < 3; ++k)
                 FZ_CHECK(isfinite(d.xyz[i][k]));

@@ -2,6 +2,8 @@
 /* rc_model.c - kinematics and the cable-length measurement model. */
 #include "rc_model.h"
 
+#include "rc_sensor.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -138,6 +140,12 @@ static const rc_effect_desc effect_table[] = {
      "s|c|period", "", 0},
     {RC_EFF_OUTLET, "outlet", 3, RC_SIDE_OUTLET, RC_EFF_ARG_OUTLET, 0, 0, 0, "mm", 1e5, "x|y|z", "", 0},
     {RC_EFF_AXIS_TILT, "axis_tilt", 1, RC_SIDE_GEOMETRY, RC_EFF_ARG_JOINT, 1, 0, 1, "rad", 0.1, "", "", 0},
+    {RC_EFF_TRACKER_POSITION, "tracker_position", 3, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 0, 0, 0, "mm", 1e5, "x|y|z",
+     "", 0},
+    {RC_EFF_TRACKER_ROTATION, "tracker_rotation", 3, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 1, 0, 0, "rad", 7.0, "x|y|z",
+     "", 0},
+    {RC_EFF_TRACKER_TARGETS, "tracker_targets", 0, RC_SIDE_SENSOR, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z",
+     "", 0},
 };
 RC_STATIC_ASSERT(sizeof effect_table / sizeof effect_table[0] == RC_EFF_LAST + 1, effect_table_covers_every_kind);
 
@@ -186,6 +194,12 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     } else if (joint >= RC_NJ) {
         return RC_ERR_ARG;
     }
+    if (kind == RC_EFF_TRACKER_TARGETS && (n % 3 != 0 || n > 3 * RC_MAX_TARGETS))
+        return RC_ERR_ARG; /* three per target */
+    if (ds->side == RC_SIDE_SENSOR)
+        for (unsigned i = 0; i < m->n_effects; ++i)
+            if (m->effects[i].kind == (uint8_t)kind)
+                return RC_ERR_ARG; /* one tracker frame, one set of targets */
     if (n == 0)
         return RC_ERR_ARG;
     if (m->n_effects >= RC_MAX_EFFECTS || (unsigned)m->n_params + n > RC_MAX_PARAMS)
@@ -286,6 +300,15 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
             put_uint(buf, buf_len, &pos, e->joint);
         }
         if (ds->suffixes[0] != '\0') { /* the j-th of "a|b|c" */
+            unsigned ns = 1;
+            for (const char *c = ds->suffixes; *c != '\0'; ++c)
+                ns += *c == '|';
+            if (e->count > ns) { /* repeated: name.<prefix><repeat>.<suffix> */
+                put_str(buf, buf_len, &pos, ".");
+                put_str(buf, buf_len, &pos, ds->index_prefix);
+                put_uint(buf, buf_len, &pos, j / ns + ds->index_base);
+                j %= ns;
+            }
             const char *sfx = ds->suffixes;
             for (unsigned t = 0; t < j && *sfx != '\0'; ++sfx)
                 t += *sfx == '|';
@@ -344,7 +367,7 @@ void rc_model_theta(double theta_rad[RC_NJ], const rc_model *m, const double q_r
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *e = &m->effects[i];
         const double *p = &m->x[e->first];
-        const double q = q_rad[e->joint];
+        const double q = e->joint < RC_NJ ? q_rad[e->joint] : 0.0; /* outlets and targets: no joint */
         if (e->kind == RC_EFF_JOINT_COMPLIANCE)
             theta_rad[e->joint] += p[0] * rc_gravity_lever_m(e->ref_dh, e->joint, q_rad);
         else if (e->kind == RC_EFF_JOINT_PERIODIC)
@@ -362,7 +385,7 @@ static void theta_dq(double D[36], const rc_model *m, const double q_rad[RC_NJ])
         const rc_effect *e = &m->effects[i];
         const double *p = &m->x[e->first];
         const unsigned j = e->joint;
-        const double q = q_rad[j];
+        const double q = j < RC_NJ ? q_rad[j] : 0.0;
         if (e->kind == RC_EFF_JOINT_PERIODIC) {
             D[7 * j] += p[0] * cos(q) - p[1] * sin(q) + 2.0 * p[2] * cos(2.0 * q) - 2.0 * p[3] * sin(2.0 * q);
         } else if (e->kind == RC_EFF_JOINT_COMPLIANCE && p[0] != 0.0) {
@@ -539,7 +562,7 @@ static void chain_prepared(chain *c, double p[3], const rc_model *m, const rc_me
                 st[i] = sin(th[i]);
             }
     }
-    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || pr->tool >= 0 || pr->has_tilt,
+    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || pr->tool >= 0 || pr->has_tilt || s->sensor != 0,
                pr->has_tilt ? pr : NULL);
     chain_tool(p, c, m, pr->tool);
 }
@@ -562,12 +585,86 @@ rc_status rc_meas_prepared(double *len_mm, double *jac, const rc_model *m, const
     return meas_chain(len_mm, jac, m, s, &c, p);
 }
 
+/* The chain's part of a measurement's Jacobian row: g (3) = d value / d p at
+ * the point p (3) moved rigidly with the flange, into jac's DH rows, axis
+ * tilts and joint-side effects; dl_dtheta (6) receives d value / d theta_i.
+ * The one chain rule of every sensor (lengths, tracker positions). */
+static void point_jac(double *jac, double dl_dtheta[RC_NJ], const rc_model *m, const rc_sample *s, const chain *c,
+                      const double p[3], const double g[3])
+{
+    double cm1[RC_NJ], ts[RC_NJ];
+    int16_t tat[RC_NJ];
+    const int tilted = model_tilts(cm1, ts, tat, m);
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        const double z[3] = {c->R[i][2], c->R[i][5], c->R[i][8]};
+        double x1[3] = {c->R[i + 1][0], c->R[i + 1][3], c->R[i + 1][6]};
+        double v[3], w[3];
+        if (tilted && tat[i] >= 0) { /* a and alpha act along x before the tilt: x = cos b x' + sin b z' */
+            const double z1[3] = {c->R[i + 1][2], c->R[i + 1][5], c->R[i + 1][8]};
+            for (int r = 0; r < 3; ++r)
+                x1[r] = x1[r] + cm1[i] * x1[r] + ts[i] * z1[r];
+        }
+        for (int r = 0; r < 3; ++r)
+            v[r] = p[r] - c->o[i][r];
+        cross3(w, z, v);
+        dl_dtheta[i] = dot3(g, w);
+        for (int r = 0; r < 3; ++r)
+            v[r] = p[r] - c->o[i + 1][r];
+        cross3(w, x1, v);
+        jac[RC_P_A(i)] = dot3(g, x1);
+        jac[RC_P_D(i)] = dot3(g, z);
+        jac[RC_P_ALPHA(i)] = dot3(g, w);
+        jac[RC_P_THETA(i)] = dl_dtheta[i];
+    }
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *ef = &m->effects[i];
+        double *J = &jac[ef->first];
+        const double q = ef->joint < RC_NJ ? s->q_rad[ef->joint] : 0.0;
+        switch ((rc_effect_kind)ef->kind) {
+        case RC_EFF_AXIS_TILT: { /* a turn about y of frame j+1 at its origin */
+            const unsigned j = ef->joint < RC_NJ ? ef->joint : 0u;
+            const double y1[3] = {c->R[j + 1][1], c->R[j + 1][4], c->R[j + 1][7]};
+            double v[3], w[3];
+            for (int r = 0; r < 3; ++r)
+                v[r] = p[r] - c->o[j + 1][r];
+            cross3(w, y1, v);
+            J[0] = tat[j] == (int16_t)ef->first ? dot3(g, w) : 0.0;
+            break;
+        }
+        case RC_EFF_JOINT_COMPLIANCE:
+            J[0] = dl_dtheta[ef->joint] * rc_gravity_lever_m(ef->ref_dh, ef->joint, s->q_rad);
+            break;
+        case RC_EFF_JOINT_PERIODIC: {
+            const double gj = dl_dtheta[ef->joint];
+            J[0] = gj * sin(q);
+            J[1] = gj * cos(q);
+            J[2] = gj * sin(2.0 * q);
+            J[3] = gj * cos(2.0 * q);
+            break;
+        }
+        default: break;
+        }
+    }
+}
+
+/* A tracker sample (rc_sensor.h): its component and Jacobian row. */
+static rc_status sensor_chain(double *value, double *jac, const rc_model *m, const rc_sample *s, const chain *c)
+{
+    double pt[3], g[3], dl_dtheta[RC_NJ];
+    const rc_status st = rc_sensor_tracker(value, pt, g, jac, m, s, c->o[RC_NJ], c->R[RC_NJ]);
+    if (st == RC_OK && jac != NULL)
+        point_jac(jac, dl_dtheta, m, s, c, pt, g);
+    return st;
+}
+
 /* Length (and its Jacobian) of sample s from the model's chain c at s and
- * the measured point p. */
+ * the measured point p; other sensors through sensor_chain. */
 static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, const rc_sample *s, const chain *c,
                             const double p[3])
 {
     double u[3], dl_dtheta[RC_NJ];
+    if (s->sensor != RC_SENSOR_LENGTH)
+        return sensor_chain(len_mm, jac, m, s, c);
     const double *e = &m->x[RC_P_ENC];
     int outlet_first = -1; /* the outlet effect's first parameter, -1: e */
     if (s->outlet != 0) {
@@ -645,51 +742,26 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
     double g[3]; /* dl/dp (3): the chord direction, scaled, plus the chord-dependent effects */
     for (int r = 0; r < 3; ++r)
         g[r] = scale * u[r] + gd[r];
-    double cm1[RC_NJ], ts[RC_NJ];
-    int16_t tat[RC_NJ];
-    const int tilted = model_tilts(cm1, ts, tat, m);
-    for (unsigned i = 0; i < RC_NJ; ++i) {
-        const double z[3] = {c->R[i][2], c->R[i][5], c->R[i][8]};
-        double x1[3] = {c->R[i + 1][0], c->R[i + 1][3], c->R[i + 1][6]};
-        double v[3], w[3];
-        if (tilted && tat[i] >= 0) { /* a and alpha act along x before the tilt: x = cos b x' + sin b z' */
-            const double z1[3] = {c->R[i + 1][2], c->R[i + 1][5], c->R[i + 1][8]};
-            for (int r = 0; r < 3; ++r)
-                x1[r] = x1[r] + cm1[i] * x1[r] + ts[i] * z1[r];
-        }
-        for (int r = 0; r < 3; ++r)
-            v[r] = p[r] - c->o[i][r];
-        cross3(w, z, v);
-        dl_dtheta[i] = dot3(g, w);
-        for (int r = 0; r < 3; ++r)
-            v[r] = p[r] - c->o[i + 1][r];
-        cross3(w, x1, v);
-        jac[RC_P_A(i)] = dot3(g, x1);
-        jac[RC_P_D(i)] = dot3(g, z);
-        jac[RC_P_ALPHA(i)] = dot3(g, w);
-        jac[RC_P_THETA(i)] = dl_dtheta[i];
-    }
+    point_jac(jac, dl_dtheta, m, s, c, p, g);
     for (int r = 0; r < 3; ++r)
         jac[RC_P_ENC + r] = outlet_first < 0 ? -g[r] : 0.0;
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *ef = &m->effects[i];
         double *J = &jac[ef->first];
-        const double q = ef->joint < RC_NJ ? s->q_rad[ef->joint] : 0.0;
         switch ((rc_effect_kind)ef->kind) {
         case RC_EFF_OUTLET:
             for (unsigned k = 0; k < 3; ++k)
                 J[k] = (int)ef->first == outlet_first ? -g[k] : 0.0;
             break;
-        case RC_EFF_AXIS_TILT: { /* a turn about y of frame j+1 at its origin */
-            const unsigned j = ef->joint < RC_NJ ? ef->joint : 0u;
-            const double y1[3] = {c->R[j + 1][1], c->R[j + 1][4], c->R[j + 1][7]};
-            double v[3], w[3];
-            for (int r = 0; r < 3; ++r)
-                v[r] = p[r] - c->o[j + 1][r];
-            cross3(w, y1, v);
-            J[0] = tat[j] == (int16_t)ef->first ? dot3(g, w) : 0.0;
+        case RC_EFF_AXIS_TILT: /* the chain's (point_jac) */
+        case RC_EFF_JOINT_COMPLIANCE:
+        case RC_EFF_JOINT_PERIODIC: break;
+        case RC_EFF_TRACKER_POSITION: /* another sensor's: no part in a length */
+        case RC_EFF_TRACKER_ROTATION:
+        case RC_EFF_TRACKER_TARGETS:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = 0.0;
             break;
-        }
         case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
         case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
         case RC_EFF_TIME_DRIFT: {
@@ -704,17 +776,6 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
             for (unsigned k = 0; k < ef->count; ++k)
                 J[k] = (k == s->group) ? 1.0 : 0.0;
             break;
-        case RC_EFF_JOINT_COMPLIANCE:
-            J[0] = dl_dtheta[ef->joint] * rc_gravity_lever_m(ef->ref_dh, ef->joint, s->q_rad);
-            break;
-        case RC_EFF_JOINT_PERIODIC: {
-            const double gj = dl_dtheta[ef->joint];
-            J[0] = gj * sin(q);
-            J[1] = gj * cos(q);
-            J[2] = gj * sin(2.0 * q);
-            J[3] = gj * cos(2.0 * q);
-            break;
-        }
         case RC_EFF_TOOL_OFFSET: { /* dp/dt = R6 */
             const double *R = c->R[RC_NJ];
             for (unsigned k = 0; k < 3; ++k)

@@ -63,14 +63,23 @@ typedef enum rc_effect_kind {
     RC_EFF_OUTLET = 11,         /* another place of the encoder: samples with rc_sample.outlet == k
                                    (the effect's `joint` field, 1..RC_MAX_OUTLETS-1) are measured from
                                    this outlet instead of e; 3 params (x, y, z) mm in the base frame */
-    RC_EFF_AXIS_TILT = 12       /* Hayati's beta of DH row j (joint): frame j+1 turned about its own y
+    RC_EFF_AXIS_TILT = 12,      /* Hayati's beta of DH row j (joint): frame j+1 turned about its own y
                                    axis after Rx(alpha): T_j = Rz(theta) Tz(d) Tx(a) Rx(alpha) Ry(beta).
                                    The tilt of a joint axis against a nominally parallel previous one,
                                    which standard DH can only express with d of metres; 1 param, rad */
+    RC_EFF_TRACKER_POSITION = 13, /* a position sensor's frame (laser tracker): the translation T of
+                                   p_tracker = R p_base + T; 3 params (x, y, z) mm (lib/rc_sensor.h) */
+    RC_EFF_TRACKER_ROTATION = 14, /* its rotation R = exp([w]x), w the rotation vector; 3 params, rad */
+    RC_EFF_TRACKER_TARGETS = 15 /* the targets the tracker sees on the tool: a sample with rc_sample.target
+                                   == k sees flange + R6 (x_k, y_k, z_k); 3 params per target (count =
+                                   3 x targets, at most RC_MAX_TARGETS), mm in the flange frame */
 } rc_effect_kind;
 
 /* Last effect kind (for range checks of stored kinds). */
-#define RC_EFF_LAST RC_EFF_AXIS_TILT
+#define RC_EFF_LAST RC_EFF_TRACKER_TARGETS
+
+/* Targets a position data set may use (rc_sample.target, RC_EFF_TRACKER_TARGETS). */
+#define RC_MAX_TARGETS 16
 
 /* Outlets a data set may use (outlet 0 is e, the others RC_EFF_OUTLET). */
 #define RC_MAX_OUTLETS 16
@@ -92,7 +101,9 @@ typedef enum {
     RC_SIDE_JOINT = 1,  /* changes a joint angle the geometry sees: moves the flange */
     RC_SIDE_POINT = 2,  /* moves the measured point in the flange frame (not the flange) */
     RC_SIDE_OUTLET = 3, /* where a sample's length is measured from */
-    RC_SIDE_GEOMETRY = 4 /* part of the chain's geometry (a DH row's extra parameter): moves the flange */
+    RC_SIDE_GEOMETRY = 4, /* part of the chain's geometry (a DH row's extra parameter): moves the flange */
+    RC_SIDE_SENSOR = 5   /* where a non-length sensor sees the robot from (tracker frame, targets):
+                            moves nothing, no prior */
 } rc_effect_side;
 
 typedef struct rc_effect_desc {
@@ -107,7 +118,8 @@ typedef struct rc_effect_desc {
     const char *unit_text;    /* the units in words, for messages */
     double limit;             /* largest plausible |parameter| (the file's SI units): beyond, a typo */
     const char *suffixes;     /* parameter name suffixes, '|'-separated ("x|y|z"), or "" */
-    const char *index_prefix; /* with no suffixes and count > 1: name.<prefix><index + index_base> */
+    const char *index_prefix; /* with no suffixes and count > 1: name.<prefix><index + index_base>; with
+                                 suffixes and count above their number: name.<prefix><repeat>.<suffix> */
     uint8_t index_base;
 } rc_effect_desc;
 
@@ -154,14 +166,26 @@ typedef struct rc_model {
     double q_max_rad[RC_NJ];
 } rc_model;
 
+/* What a sample measured (rc_sample.sensor): one scalar residual row each.
+ * A tracker position is three samples, its x, y and z components in the
+ * tracker's frame (lib/rc_sensor.h). */
+typedef enum rc_sensor_kind {
+    RC_SENSOR_LENGTH = 0,    /* cable length from an outlet (the default of a zeroed sample) */
+    RC_SENSOR_TRACKER_X = 1, /* x of a target in the tracker frame (mm) */
+    RC_SENSOR_TRACKER_Y = 2,
+    RC_SENSOR_TRACKER_Z = 3
+} rc_sensor_kind;
+
 /* One measurement: joint readings, cable length and its context. */
 typedef struct rc_sample {
     double q_rad[RC_NJ]; /* (6) joint readings */
-    double len_mm;       /* measured cable length */
+    double len_mm;       /* the measured value (mm): cable length, or the tracker coordinate */
     double t;            /* acquisition order scaled to [0, 1] */
     uint16_t group;      /* set-up group (consecutive samples sharing a set-up) */
     uint8_t outlet;      /* the encoder outlet it was measured from: 0 = e, k = the RC_EFF_OUTLET effect
                             with joint k (a sample whose outlet the model lacks has no length: RC_ERR_ARG) */
+    uint8_t sensor;      /* rc_sensor_kind: what len_mm is */
+    uint8_t target;      /* tracker samples: the target seen (its three parameters in RC_EFF_TRACKER_TARGETS) */
 } rc_sample;
 
 /* Initialise a model from a DH table and an encoder position.
@@ -210,8 +234,9 @@ void rc_fk(double pos_mm[3], double rot[9], const rc_model *m, const double q_ra
 void rc_fk_jac(double pos_mm[3], double rot[9], double jac[36], const rc_model *m,
                const double q_rad[RC_NJ]);
 
-/* Predicted cable length of one sample and, when jac is not NULL, its
- * analytic derivative with respect to every model parameter.
+/* Predicted value of one sample (its cable length, or for a tracker sample,
+ * rc_sample.sensor, its coordinate: lib/rc_sensor.h) and, when jac is not
+ * NULL, its analytic derivative with respect to every model parameter.
  * jac: (m->n_params). Returns RC_ERR_NUMERIC when the flange point
  * coincides with the encoder outlet (length derivative undefined).
  * Same as rc_meas_prepare + rc_meas_prepared(no tables): bit for bit what a

@@ -42,9 +42,10 @@ static const char details[] = "mean|e| is what the paper's Eq. 20 calls SD; SD i
 typedef struct {
     rch_calib_cfg cfg;
     const char *out_path, *method, *report_path;
-    rch_opt_strs data;
+    rch_opt_strs data, positions;
     unsigned long seed, max_iter, cases, case_samples;
     int json;
+    double tracker_pos[3], tracker_rot[3];
 } calib_args;
 
 static int parse(calib_args *a, int argc, char **argv)
@@ -54,7 +55,16 @@ static int parse(calib_args *a, int argc, char **argv)
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STRS, &a->data, 0, 0, "FILE",
          "measurements: CSV with q1..q6 (deg) and L (mm); several --data are merged (set-up groups never span two files)",
-         RCH_OPT_REQUIRED, NULL},
+         0, NULL},
+        {"--positions", RCH_OPT_STRS, &a->positions, 0, 0, "FILE",
+         "laser-tracker positions: CSV with q1..q6 (deg), x, y, z (mm, tracker frame), optional target, pose, sigma_mm "
+         "(docs/positions.md); repeatable, mixable with --data; the tracker frame and targets are estimated",
+         0, NULL},
+        {"--tracker-position", RCH_OPT_TRIPLE, a->tracker_pos, -1e5, 1e5, "X,Y,Z",
+         "with --positions: start of the tracker frame's translation (the base origin in the tracker's frame, mm; "
+         "default: a closed-form fit)", 0, NULL},
+        {"--tracker-rotation", RCH_OPT_TRIPLE, a->tracker_rot, -360.0, 360.0, "RX,RY,RZ",
+         "with --positions: start of its rotation (rotation vector, deg)", 0, NULL},
         {"--validate", RCH_OPT_STR, &cfg->validate_path, 0, 0, "FILE",
          "data the fit never sees: the model evaluated on it with no refit (RMSE, ISO 9283 from repeated poses)", 0,
          NULL},
@@ -112,7 +122,8 @@ static int parse(calib_args *a, int argc, char **argv)
          "also the HTML page of rcal report, from this run (its JSON kept beside it as FILE.calibration.json)", 0,
          NULL},
     };
-    const int ps = rch_opt_cmd(&spec, "calibrate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
+    unsigned long long seen = 0;
+    const int ps = rch_opt_cmd(&spec, "calibrate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (ps >= 0)
         return ps;
     if (rch_method_parse(&cfg->method, a->method) != 0)
@@ -121,9 +132,25 @@ static int parse(calib_args *a, int argc, char **argv)
     cfg->max_iter = (unsigned)a->max_iter;
     cfg->cases = a->cases;
     cfg->case_samples = a->case_samples;
-    cfg->data_path = a->data.v[0];
-    cfg->data_paths = a->data.v;
+    if (a->data.n == 0 && a->positions.n == 0) {
+        fprintf(stderr, "rcal calibrate: --data or --positions is required (rcal calibrate --help)\n");
+        return 2;
+    }
+    cfg->data_path = a->data.n ? a->data.v[0] : NULL;
+    cfg->data_paths = a->data.n ? a->data.v : NULL;
     cfg->n_data_paths = a->data.n;
+    cfg->positions_paths = a->positions.v;
+    cfg->n_positions_paths = a->positions.n;
+    cfg->have_tracker_start = rch_opt_given(&spec, seen, "--tracker-position") ||
+                              rch_opt_given(&spec, seen, "--tracker-rotation");
+    for (int k = 0; k < 3; ++k) { /* the one not given: 0 */
+        cfg->tracker_start[k] = a->tracker_pos[k];
+        cfg->tracker_start[3 + k] = a->tracker_rot[k] * (3.14159265358979323846 / 180.0);
+    }
+    if (cfg->have_tracker_start && a->positions.n == 0) {
+        fprintf(stderr, "rcal calibrate: --tracker-position and --tracker-rotation need --positions\n");
+        return 2;
+    }
     return -1;
 }
 
@@ -133,9 +160,18 @@ static int parse(calib_args *a, int argc, char **argv)
  * to a --data file. */
 static int out_is_input(const calib_args *a)
 {
-    const char *inputs[RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
+    const char *inputs[2 * RCH_OPT_MAX_STRS + 3] = {a->cfg.robot_path, a->cfg.truth_path, a->cfg.validate_path};
     for (size_t i = 0; i < a->data.n; ++i)
         inputs[3 + i] = a->data.v[i];
+    for (size_t i = 0; i < a->positions.n; ++i)
+        inputs[3 + a->data.n + i] = a->positions.v[i];
+    for (size_t i = 0; i < a->positions.n; ++i)
+        for (size_t j = 0; j < 3 + a->data.n + i; ++j)
+            if (inputs[j] && (rch_same_file(a->positions.v[i], inputs[j]) || strcmp(a->positions.v[i], inputs[j]) == 0)) {
+                fprintf(stderr, "rcal calibrate: --positions %s is given twice or is another input: refused\n",
+                        a->positions.v[i]);
+                return 1;
+            }
     for (size_t i = 0; i < a->data.n; ++i)
         for (size_t j = 0; j < i; ++j)
             if (rch_same_file(a->data.v[i], a->data.v[j]) || strcmp(a->data.v[i], a->data.v[j]) == 0) {
@@ -164,7 +200,7 @@ static int out_is_input(const calib_args *a)
     }
     const char *outs[5] = {a->out_path, a->cfg.residuals_path, a->report_path, plot_svg, plot_csv};
     static const char *const what[5] = {"--out", "--residuals", "--report", "--plots", "--plots"};
-    if (rcal_outputs_check("calibrate", outs, what, 5, a->report_path, inputs, 3 + a->data.n) != 0)
+    if (rcal_outputs_check("calibrate", outs, what, 5, a->report_path, inputs, 3 + a->data.n + a->positions.n) != 0)
         return 1;
     if (a->cfg.residuals_path && (a->cases > 1 || a->cfg.jumps)) {
         fprintf(stderr, "rcal calibrate: --residuals is for one calibration without --jumps (not with --cases or "
@@ -234,11 +270,13 @@ int rcal_cmd_calibrate(int argc, char **argv)
     else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
         status = 1;
     else if (a.report_path && r->finite) {
-        const char *inputs[RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
+        const char *inputs[2 * RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
         for (size_t i = 0; i < a.data.n; ++i)
             inputs[3 + i] = a.data.v[i];
-        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs, 3 + a.data.n,
-                               a.json) != 0)
+        for (size_t i = 0; i < a.positions.n; ++i)
+            inputs[3 + a.data.n + i] = a.positions.v[i];
+        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs,
+                               3 + a.data.n + a.positions.n, a.json) != 0)
             status = 1;
     }
     if (a.cfg.residuals_path && !r->finite)

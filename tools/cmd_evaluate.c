@@ -10,13 +10,94 @@
 #include "rch_evaluate.h"
 #include "rch_jw.h"
 #include "rch_opt.h"
+#include "rch_positions.h"
 #include "rch_resid.h"
 #include "rch_robot.h"
 
 static const char summary[] = "a calibrated model on new data, without refitting the robot";
 static const char details[] =
     "RMSE, mean |e|, SD and MAX of the cable-length residuals, and the ISO 9283 distance\n"
-    "accuracy and repeatability where poses were read more than once.";
+    "accuracy and repeatability where poses were read more than once. With --positions (laser-tracker\n"
+    "positions, docs/positions.md): the 3-D error |p_model - p_measured| (RMS, mean, MAX) and ISO 9283 AP and\n"
+    "RP where a pose was measured more than once; nothing of the robot is refitted: the model's tracker frame\n"
+    "is kept when it has one (calibrated from that tracker) and only the targets it lacks are fitted, else\n"
+    "the tracker frame and every target are fitted (--refit-tracker: always).";
+
+/* rcal evaluate --positions: the report of rch_pos_evaluate. */
+static void pos_err_json(rch_jw *w, const char *name, const rch_pos_err *e)
+{
+    rch_jw_obj(w, name);
+    rch_jw_uint(w, "points", e->points);
+    rch_jw_numf(w, "rms", e->rms_mm, "%.6f");
+    rch_jw_numf(w, "mean", e->mean_mm, "%.6f");
+    rch_jw_numf(w, "max", e->max_mm, "%.6f");
+    rch_jw_uint(w, "repeated", e->repeated);
+    rch_jw_numf(w, "ap_max", e->ap_max_mm, "%.6f");
+    rch_jw_numf(w, "rp_max", e->rp_max_mm, "%.6f");
+    rch_jw_end(w);
+}
+
+static int positions_report(const rch_pos_eval *r, const rch_pos *p, const char *model, const char *data, int json,
+                            int argc, char **argv)
+{
+    const char *how = r->frame_fitted ? "fitted" : "kept";
+    if (json) {
+        rch_jw w;
+        rch_jw_begin(&w, stdout, 1, "rcal-evaluate/1", argc, argv);
+        rch_jw_str(&w, "model", model);
+        rch_jw_str(&w, "positions", data);
+        rch_jw_uint(&w, "n", p->n);
+        rch_jw_uint(&w, "rows", p->rows);
+        rch_jw_str(&w, "tracker_frame", how);
+        rch_jw_nums(&w, "tracker_frame_params", r->frame, 6);
+        rch_jw_uint(&w, "targets_known", r->targets_known);
+        rch_jw_uint(&w, "targets_fitted", r->targets_fitted);
+        rch_jw_numf(&w, "component_rms_mm", r->rms_component_mm, "%.6f");
+        pos_err_json(&w, "position_error_mm", &r->err);
+        rch_jw_end(&w);
+        return rch_jw_finish(&w);
+    }
+    printf("model %s on the tracker positions %s: %zu positions (%zu poses), no refit of the robot\n", model, data,
+           r->err.points, p->poses);
+    if (r->frame_fitted)
+        printf("  tracker frame fitted here (the model has none from this tracker, or --refit-tracker), and %u "
+               "target(s)\n", r->targets_fitted);
+    else
+        printf("  tracker frame kept from the model (calibrated from this tracker); %u target(s) known, %u fitted "
+               "here\n", r->targets_known, r->targets_fitted);
+    printf("  3-D position error |p_model - p_measured|: RMS %.4f mm, mean %.4f mm, MAX %.4f mm\n", r->err.rms_mm,
+           r->err.mean_mm, r->err.max_mm);
+    if (r->err.repeated)
+        printf("  ISO 9283 over %zu repeated pose-targets: positioning accuracy AP max %.4f mm, repeatability RP max "
+               "%.4f mm\n", r->err.repeated, r->err.ap_max_mm, r->err.rp_max_mm);
+    else
+        printf("  ISO 9283 AP and RP: no pose was measured twice\n");
+    return 0;
+}
+
+static int evaluate_positions(const char *model_path, const char *pos_path, int refit, int json, int argc,
+                              char **argv)
+{
+    rch_robot robot;
+    rch_pos p;
+    rch_diag d;
+    char msg[1024];
+    if (rch_robot_load(&robot, model_path, &d) != 0 || rch_pos_load(&p, &pos_path, 1, 0.0, &robot.model, &d) != 0) {
+        fprintf(stderr, "rcal evaluate: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        return 1;
+    }
+    rch_pos_eval *r = malloc(sizeof *r);
+    rc_solve_work *w = malloc(sizeof *w);
+    int rc = r && w ? rch_pos_evaluate(r, &robot.model, &p, refit, w, msg, sizeof msg) : -1;
+    if (rc != 0)
+        fprintf(stderr, "rcal evaluate: %s: %s\n", pos_path, r && w ? msg : "out of memory");
+    else
+        rc = positions_report(r, &p, model_path, pos_path, json, argc, argv) != 0;
+    free(r);
+    free(w);
+    rch_pos_free(&p);
+    return rc != 0;
+}
 
 static int report_json(const rch_evaluate_result *r, const char *model, const char *data, int argc, char **argv)
 {
@@ -66,13 +147,18 @@ static void report_text(const rch_evaluate_result *r, const char *model, const c
 
 int rcal_cmd_evaluate(int argc, char **argv)
 {
-    const char *model_path = NULL, *data_path = NULL, *resid_path = NULL;
-    int refit = 0, json = 0;
+    const char *model_path = NULL, *data_path = NULL, *resid_path = NULL, *pos_path = NULL;
+    int refit = 0, json = 0, refit_tracker = 0;
     double same_deg = 1e-6;
     rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model_path, 0, 0, "MODEL.json", "calibrated model", RCH_OPT_REQUIRED, NULL},
-        {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE.csv", "measurements the fit never saw", RCH_OPT_REQUIRED, NULL},
+        {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE.csv", "measurements the fit never saw (or --positions)", 0,
+         NULL},
+        {"--positions", RCH_OPT_STR, &pos_path, 0, 0, "FILE.csv",
+         "laser-tracker positions (docs/positions.md): the 3-D error of the model", 0, NULL},
+        {"--refit-tracker", RCH_OPT_FLAG, &refit_tracker, 0, 0, NULL,
+         "with --positions: fit the tracker frame even when the model has one", 0, NULL},
         {"--refit-encoder", RCH_OPT_FLAG, &refit, 0, 0, NULL, "refit the encoder outlet alone first", 0, NULL},
         {"--same-pose-deg", RCH_OPT_DOUBLE, &same_deg, 1e-9, 1.0, "DEG", "rows this close in every joint are one pose",
          0, NULL},
@@ -84,6 +170,17 @@ int rcal_cmd_evaluate(int argc, char **argv)
     const int st = rch_opt_cmd(&spec, "evaluate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (st >= 0)
         return st;
+    if ((data_path != NULL) == (pos_path != NULL)) {
+        fprintf(stderr, "rcal evaluate: give one of --data and --positions (rcal evaluate --help)\n");
+        return 2;
+    }
+    if (pos_path) {
+        if (refit || resid_path) {
+            fprintf(stderr, "rcal evaluate: --refit-encoder and --residuals are for --data\n");
+            return 2;
+        }
+        return evaluate_positions(model_path, pos_path, refit_tracker, json, argc, argv);
+    }
     rch_robot robot;
     rch_data data;
     rch_diag d;

@@ -42,12 +42,16 @@ static void random_pose(rc_sample *s, rc_rng *g)
 
 /* d l / d x_k: central differences against rc_meas's analytic gradient, for
  * the base model and a model with every effect kind. */
-static void check_param_jacobian(rc_model *m, rc_rng *g)
+static void check_param_jacobian_sensor(rc_model *m, rc_rng *g, int tracker)
 {
     for (int trial = 0; trial < 50; ++trial) {
         rc_sample s;
         memset(&s, 0, sizeof s);
         random_pose(&s, g);
+        if (tracker) {
+            s.sensor = (uint8_t)(RC_SENSOR_TRACKER_X + trial % 3);
+            s.target = (uint8_t)(trial % 2);
+        }
         double l, jac[RC_MAX_PARAMS];
         assert_int_equal(rc_meas(&l, jac, m, &s), RC_OK);
         for (unsigned k = 0; k < m->n_params; ++k) {
@@ -68,6 +72,8 @@ static void check_param_jacobian(rc_model *m, rc_rng *g)
         }
     }
 }
+
+static void check_param_jacobian(rc_model *m, rc_rng *g) { check_param_jacobian_sensor(m, g, 0); }
 
 static void test_param_jacobian_base(void **state)
 {
@@ -105,6 +111,93 @@ static void test_param_jacobian_effects(void **state)
     rc_rng_seed(&g, 2);
     rc_model m = model_with_effects(&g);
     check_param_jacobian(&m, &g);
+}
+
+/* A laser tracker's position (rc_sensor.h): every derivative of each
+ * component by differences (a model with every effect, axis tilts and a
+ * tracker turned by about 1 rad), lengths blind to the tracker's parameters,
+ * the prepared path equal, and the value against one written here:
+ * R (o6 + R6 t) + T with R from the axis and angle. */
+static void add_tracker(rc_model *m, rc_rng *g)
+{
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_AXIS_TILT, 2, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_TRACKER_POSITION, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_TRACKER_ROTATION, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_TRACKER_ROTATION, 0, 0), RC_ERR_ARG); /* one frame */
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_TRACKER_TARGETS, 0, 4), RC_ERR_ARG); /* 3 per target */
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_TRACKER_TARGETS, 0, 3 * RC_MAX_TARGETS + 3), RC_ERR_ARG);
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_TRACKER_TARGETS, 0, 6), RC_OK); /* targets 0, 1 */
+    assert_int_equal(rc_model_add_effect(m, RC_EFF_TRACKER_TARGETS, 0, 6), RC_ERR_ARG); /* one set */
+    const unsigned n = m->n_params;
+    m->x[n - 13] = 1e-3;                       /* tilt */
+    m->x[n - 12] = 1200.0 + rc_rng_normal(g); /* T */
+    m->x[n - 11] = -800.0;
+    m->x[n - 10] = 300.0;
+    m->x[n - 9] = 0.3;                         /* w: about 1 rad */
+    m->x[n - 8] = -0.5;
+    m->x[n - 7] = 0.8;
+    for (unsigned k = n - 6; k < n; ++k)
+        m->x[k] = 40.0 * rc_rng_normal(g);
+}
+
+static void test_tracker_jacobian(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 31);
+    rc_model m = nominal(); /* joint-side, point and length effects beside the tracker (RC_MAX_EFFECTS 8) */
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 1, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 3, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_SCALE, 0, 0), RC_OK);
+    for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
+        m.x[k] = 1e-3 * rc_rng_normal(&g);
+    add_tracker(&m, &g);
+    char name[64];
+    assert_string_equal(rc_param_name(name, sizeof name, &m, m.n_params - 1), "tracker_targets.1.z");
+    check_param_jacobian_sensor(&m, &g, 1);
+    check_param_jacobian_sensor(&m, &g, 0); /* lengths: zero derivative for the tracker's */
+    rc_meas_prep p;
+    rc_meas_prepare(&p, &m);
+    rc_model plain = nominal(); /* no tool offset: rc_fk gives the flange */
+    add_tracker(&plain, &g);
+    const double *w = &plain.x[plain.n_params - 9], *T = &plain.x[plain.n_params - 12];
+    const double th = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    const double a[3] = {w[0] / th, w[1] / th, w[2] / th}, c = cos(th), sn = sin(th);
+    const double R[9] = {c + a[0] * a[0] * (1 - c),        a[0] * a[1] * (1 - c) - a[2] * sn,
+                         a[0] * a[2] * (1 - c) + a[1] * sn, a[1] * a[0] * (1 - c) + a[2] * sn,
+                         c + a[1] * a[1] * (1 - c),        a[1] * a[2] * (1 - c) - a[0] * sn,
+                         a[2] * a[0] * (1 - c) - a[1] * sn, a[2] * a[1] * (1 - c) + a[0] * sn,
+                         c + a[2] * a[2] * (1 - c)};
+    for (int trial = 0; trial < 20; ++trial) {
+        rc_sample s;
+        random_pose(&s, &g);
+        s.sensor = (uint8_t)(RC_SENSOR_TRACKER_X + trial % 3);
+        s.target = (uint8_t)(trial % 2);
+        double v0, v1, j0[RC_MAX_PARAMS], j1[RC_MAX_PARAMS];
+        assert_int_equal(rc_meas(&v0, j0, &m, &s), RC_OK);
+        assert_int_equal(rc_meas_prepared(&v1, j1, &m, &p, &s, NULL, NULL), RC_OK);
+        assert_true(fabs(v0 - v1) < 1e-9 * (1.0 + fabs(v0)));
+        assert_int_equal(rc_meas_prepared(&v1, NULL, &m, &p, &s, NULL, NULL), RC_OK);
+        assert_true(fabs(v0 - v1) < 1e-9 * (1.0 + fabs(v0)));
+        for (unsigned k = 0; k < m.n_params; ++k)
+            assert_true(fabs(j1[k] - j0[k]) < 1e-9 * (1.0 + fabs(j0[k])));
+        double o6[3], R6[9], pt[3], want = 0.0;
+        rc_fk(o6, R6, &plain, s.q_rad);
+        const double *t = &plain.x[plain.n_params - (s.target == 1 ? 3 : 6)];
+        for (int r = 0; r < 3; ++r)
+            pt[r] = o6[r] + R6[3 * r] * t[0] + R6[3 * r + 1] * t[1] + R6[3 * r + 2] * t[2];
+        const int cc = s.sensor - RC_SENSOR_TRACKER_X;
+        want = R[3 * cc] * pt[0] + R[3 * cc + 1] * pt[1] + R[3 * cc + 2] * pt[2] + T[cc];
+        assert_int_equal(rc_meas(&v0, NULL, &plain, &s), RC_OK);
+        assert_true(fabs(v0 - want) < 1e-9 * (1.0 + fabs(want)));
+    }
+    rc_sample s;
+    random_pose(&s, &g);
+    s.sensor = RC_SENSOR_TRACKER_Y;
+    s.target = 2; /* a target the model lacks */
+    double v;
+    assert_int_equal(rc_meas(&v, NULL, &m, &s), RC_ERR_ARG);
 }
 
 static void test_effect_capacity(void **state)
@@ -359,7 +452,7 @@ int main(void)
         cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
         cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
         cmocka_unit_test(test_prepared_base),       cmocka_unit_test(test_prepared_effects),
-        cmocka_unit_test(test_wrap_leaves_huge_angles), cmocka_unit_test(test_dh_sensitivity),
+        cmocka_unit_test(test_wrap_leaves_huge_angles), cmocka_unit_test(test_dh_sensitivity), cmocka_unit_test(test_tracker_jacobian),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

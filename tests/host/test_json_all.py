@@ -145,6 +145,16 @@ def diagnose():
 def evaluate():
     d = doc_of("evaluate", run("evaluate", "--model", w("cal.json"), "--data", w("sim.csv"), "--json"))
     check(d.get("n") == 40, "evaluate: 40 samples")
+    pos = w("positions.csv")  # tracker positions (docs/positions.md): the frame and target fitted here
+    with open(pos, "w") as f:
+        f.write("q1,q2,q3,q4,q5,q6,x,y,z\n")
+        for i in range(8):
+            f.write("%d,%d,-20,30,40,50,%.3f,%.3f,%.3f\n" % (10 * i - 40, 3 * i, 1000 + 7 * i, -500 + 3 * i * i, 200 + i))
+    d = doc_of("evaluate", run("evaluate", "--model", w("cal.json"), "--positions", pos, "--json"))
+    pe = d.get("position_error_mm", {})
+    check(d.get("rows") == 8 and d.get("n") == 24 and d.get("tracker_frame") == "fitted" and
+          pe.get("points") == 8 and all(isinstance(pe.get(k), float) for k in ("rms", "mean", "max")),
+          "evaluate --positions: 8 positions, frame fitted, position_error_mm rms/mean/max (%s)" % pe)
 
 
 def bench():

@@ -16,9 +16,10 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_P = 12, C_O = 13, C_N = 14 };
-static const char *const col_names[C_N] = {"q1", "q2", "q3", "q4", "q5", "q6", "L",
-                                           "x",  "y",  "z",  "t",  "group", "pose", "outlet"};
+enum { C_Q1 = 0, C_L = 6, C_X = 7, C_Y = 8, C_Z = 9, C_T = 10, C_G = 11, C_P = 12, C_O = 13, C_TG = 14, C_SG = 15,
+       C_N = 16 };
+static const char *const col_names[C_N] = {"q1", "q2", "q3",    "q4",   "q5",     "q6",     "L",      "x",
+                                           "y",  "z",  "t",     "group", "pose", "outlet", "target", "sigma_mm"};
 
 typedef struct {
     const char *p; /* field start */
@@ -148,8 +149,19 @@ static int parse_header(parse_ctx *pc, field *fields, size_t nf, const char *lin
             return -1;
         }
     }
+    if (flags & RCH_DATA_POSITIONS)
+        for (int k = C_X; k <= C_Z; ++k)
+            if (pc->col_of[k] < 0) {
+                rch_diag_set(pc->d, pc->name, pc->line_no, 1,
+                             "header has no '%s' column (a positions file needs q1..q6 in degrees and x, y, z in mm "
+                             "in the tracker's frame)%s",
+                             col_names[k], header_hint(line, ll));
+                return -1;
+            }
     if ((pc->col_of[C_X] >= 0) != (pc->col_of[C_Y] >= 0) || (pc->col_of[C_X] >= 0) != (pc->col_of[C_Z] >= 0))
         pc->col_of[C_X] = pc->col_of[C_Y] = pc->col_of[C_Z] = -1; /* use x,y,z only as a triple */
+    if (!(flags & RCH_DATA_POSITIONS))
+        pc->col_of[C_TG] = pc->col_of[C_SG] = -1; /* a positions file's columns only */
     return 0;
 }
 
@@ -175,7 +187,13 @@ static int grow(rch_data *out, parse_ctx *pc)
     unsigned *ln = s ? realloc(out->line, nc * sizeof *ln) : NULL;
     if (ln)
         out->line = ln;
-    if (s && ln && pc->col_of[C_P] >= 0 && (pc->flags & RCH_DATA_POSE)) {
+    if (s && ln && pc->col_of[C_SG] >= 0) {
+        double *sg = realloc(out->sigma_mm, nc * sizeof *sg);
+        if (sg)
+            out->sigma_mm = sg;
+        s = sg ? s : NULL;
+    }
+    if (s && ln && pc->col_of[C_P] >= 0 && (pc->flags & (RCH_DATA_POSE | RCH_DATA_POSITIONS))) {
         unsigned long *pz = realloc(out->pose, nc * sizeof *pz);
         if (pz)
             out->pose = pz;
@@ -234,6 +252,12 @@ static int check_value(const parse_ctx *pc, int k, double v, const field *f)
         rch_diag_set(pc->d, pc->name, ln, col, "field 'pose': %g is not an integer in 0..1000000000", v);
     else if (k == C_G && (v < 0.0 || v > 65535.0 || v != floor(v)))
         rch_diag_set(pc->d, pc->name, ln, col, "field 'group': %g is not an integer in 0..65535", v);
+    else if (k == C_TG && (v < 0.0 || v >= RC_MAX_TARGETS || v != floor(v)))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'target': %g is not a target number (an integer 0..%d)", v,
+                     RC_MAX_TARGETS - 1);
+    else if (k == C_SG && !(v > 0.0 && v <= 100.0))
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'sigma_mm': %g is not a tracker's standard deviation (0 < sigma "
+                     "<= 100 mm)", v);
     else if (k == C_O && (v < 0.0 || v > 255.0 || v != floor(v)))
         rch_diag_set(pc->d, pc->name, ln, col,
                      "field 'outlet': %g is not an outlet number (an integer 0..255 naming where the encoder stood)",
@@ -251,7 +275,7 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
     if (grow(out, pc) != 0)
         return -1;
     for (int k = 0; k < C_N; ++k) {
-        if (pc->col_of[k] < 0 || (k == C_P && !(pc->flags & RCH_DATA_POSE)))
+        if (pc->col_of[k] < 0 || (k == C_P && !(pc->flags & (RCH_DATA_POSE | RCH_DATA_POSITIONS))))
             continue;
         const size_t c = (size_t)pc->col_of[k];
         if (c >= nf) {
@@ -276,6 +300,9 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
     s->t = v[C_T];
     s->group = (uint16_t)v[C_G];
     s->outlet = (uint8_t)v[C_O]; /* the file's label: rch_data_outlets numbers them 0.. */
+    s->target = (uint8_t)v[C_TG];
+    if (out->sigma_mm)
+        out->sigma_mm[out->n] = v[C_SG];
     if (out->xyz) {
         out->xyz[out->n][0] = v[C_X];
         out->xyz[out->n][1] = v[C_Y];
@@ -377,6 +404,7 @@ static int parse(rch_data *out, const char *text, size_t len, const char *name, 
     out->has_t = pc.col_of[C_T] >= 0;
     out->has_group = pc.col_of[C_G] >= 0;
     out->has_outlet = pc.col_of[C_O] >= 0;
+    out->has_target = pc.col_of[C_TG] >= 0;
     scale_t(out);
     return 0;
 fail:
@@ -413,6 +441,7 @@ void rch_data_free(rch_data *data)
     free(data->xyz);
     free(data->line);
     free(data->pose);
+    free(data->sigma_mm);
     memset(data, 0, sizeof *data);
 }
 

@@ -26,7 +26,11 @@
 enum {
     RCH_DATA_NO_LEN = 1u,      /* pose plan: L is not required (len_mm = 0) */
     RCH_DATA_POSE = 2u,        /* a 'pose' column (index 0..1e9) is required: pose[] */
-    RCH_DATA_ALLOW_EMPTY = 4u  /* a header without rows is not an error */
+    RCH_DATA_ALLOW_EMPTY = 4u, /* a header without rows is not an error */
+    RCH_DATA_POSITIONS = 8u    /* a tracker's positions file: x, y, z (mm, tracker frame) required, L not;
+                                  optional target (0..RC_MAX_TARGETS-1, rc_sample.target), pose (pose[]),
+                                  sigma_mm (sigma_mm[]); docs/positions.md. Rows stay rows: rch_pos_load
+                                  (tools/host/fit/rch_positions.h) makes the three samples of each */
 };
 
 typedef struct rch_data {
@@ -38,6 +42,8 @@ typedef struct rch_data {
     int has_t;          /* a t column was present */
     int has_group;      /* a group column was present */
     int has_outlet;     /* an outlet column was present (rc_sample.outlet holds the file's label) */
+    int has_target;     /* RCH_DATA_POSITIONS: a target column was present */
+    double *sigma_mm;   /* (n) RCH_DATA_POSITIONS: the sigma_mm column, or NULL when absent */
 } rch_data;
 
 /* Number the outlets of samples s (n) 0, 1, ... in the order their labels

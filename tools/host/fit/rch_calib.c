@@ -41,7 +41,7 @@ static int guess_outlet(double e[3], const rc_model *m, unsigned k, const rc_sam
         return -1;
     }
     for (size_t i = 0; i < n; ++i)
-        if (s[i].outlet == k)
+        if (s[i].outlet == k && s[i].sensor == RC_SENSOR_LENGTH) /* a tracker's samples have no outlet */
             sub[ns++] = s[i];
     rc_status st = rc_encoder_guess(e, m, sub, ns);
     free(sub);
@@ -68,7 +68,13 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
                  size_t n, rch_diag *d)
 {
     *start = *nominal;
-    if (!has_encoder) {
+    const size_t n_len = rch_pos_count_lengths(s, n);
+    if (n_len < n && rch_pos_effect_at(start, RC_EFF_TRACKER_ROTATION, NULL) >= 0 &&
+        rch_pos_start(start, s, n, rch_pos_frame_given(start)) != 0) { /* closed form, then with e below */
+        rch_diag_set(d, "", 0, 0, "cannot place the tracker: the positions do not spread in three directions");
+        return -1;
+    }
+    if (!has_encoder && (n_len > 0 || n == 0)) { /* no lengths at all: e is held (rch_pos_fix_unseen) */
         double e[3];
         if (guess_outlet(e, start, 0, s, n, d) != 0)
             return -1;
@@ -86,9 +92,12 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
     uint8_t fixed[RC_MAX_PARAMS];
     memset(fixed, 1, sizeof fixed);
     fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 0;
-    for (unsigned i = 0; i < start->n_effects; ++i)
-        if (start->effects[i].kind == RC_EFF_OUTLET)
-            memset(&fixed[start->effects[i].first], 0, 3);
+    for (unsigned i = 0; i < start->n_effects; ++i) {
+        const rc_effect_desc *ds = rc_effect_describe(start->effects[i].kind);
+        if (start->effects[i].kind == RC_EFF_OUTLET || (ds && ds->side == RC_SIDE_SENSOR))
+            memset(&fixed[start->effects[i].first], 0, start->effects[i].count);
+    }
+    rch_pos_fix_unseen(fixed, start, s, n);
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.method = RC_METHOD_LM;
@@ -263,7 +272,7 @@ static int uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_s
     rch_plot *p = rch_plot_new("Predicted 95 % flange-position uncertainty of the calibrated model",
                                "horizontal reach of the flange from the base axis (mm)",
                                "predicted 95 % position uncertainty (mm)");
-    const char *inputs[RCH_CALIB_MAX_FILES + 4];
+    const char *inputs[2 * RCH_CALIB_MAX_FILES + 4];
     size_t n_in = 0;
     int rc = -1;
     if (!x || !y || !p) {
@@ -292,6 +301,8 @@ static int uncertainty_plot(rch_calib_result *r, const rch_uncert *u, const rc_s
     const int several = r->cfg.data_paths && r->cfg.n_data_paths;
     for (size_t k = 0; k < (several ? r->cfg.n_data_paths : 1u) && n_in < RCH_CALIB_MAX_FILES; ++k)
         inputs[n_in++] = several ? r->cfg.data_paths[k] : r->cfg.data_path;
+    for (size_t k = 0; k < r->cfg.n_positions_paths && k < RCH_CALIB_MAX_FILES; ++k)
+        inputs[n_in++] = r->cfg.positions_paths[k];
     inputs[n_in++] = r->cfg.validate_path;
     inputs[n_in++] = r->cfg.robot_path;
     inputs[n_in++] = r->cfg.truth_path;
@@ -337,7 +348,7 @@ static int uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sampl
 
 static size_t n_files(const rch_calib_cfg *cfg)
 {
-    return cfg->data_paths && cfg->n_data_paths ? cfg->n_data_paths : 1;
+    return cfg->data_paths && cfg->n_data_paths ? cfg->n_data_paths : cfg->data_path ? 1 : 0; /* 0: positions only */
 }
 
 static const char *file_at(const rch_calib_cfg *cfg, size_t i)
@@ -358,6 +369,8 @@ static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch
         rch_diag_set(d, "", 0, 0, "at most %d data files", RCH_CALIB_MAX_FILES);
         return -1;
     }
+    if (nf == 0)
+        return 0; /* tracker positions only (append_positions) */
     if (nf == 1) {
         int rc = rch_data_load(out, file_at(cfg, 0), 0, d);
         counts[0] = out->n;
@@ -411,6 +424,63 @@ static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
+    return 0;
+}
+
+/* The tracker positions files (cfg.positions_paths) appended to data: three
+ * samples a row (rch_positions.h), one set-up group a file, the tracker
+ * frame and targets added to the model. 0, or -1 with d set. */
+static int append_positions(rch_calib_result *r, rch_data *data, rch_diag *d)
+{
+    const rch_calib_cfg *cfg = &r->cfg;
+    if (cfg->cases > 1 || cfg->residuals_path || cfg->dequantize || cfg->jumps) {
+        rch_diag_set(d, "", 0, 0,
+                     "--positions is not yet combined with --cases, --residuals, --dequantize-joints or --jumps");
+        return -1;
+    }
+    rch_pos p;
+    if (rch_pos_load(&p, cfg->positions_paths, cfg->n_positions_paths, 0.0, &r->robot.model, d) != 0)
+        return -1;
+    rc_sample *s = realloc(data->s, (data->n + p.n) * sizeof *s);
+    if (s)
+        data->s = s;
+    unsigned *ln = s ? realloc(data->line, (data->n + p.n) * sizeof *ln) : NULL;
+    if (ln)
+        data->line = ln;
+    if (!ln || rch_pos_add_effects(&r->robot.model, p.n_targets) != 0 ||
+        (cfg->have_tracker_start && rch_pos_set_frame(&r->robot.model, cfg->tracker_start) != 0)) {
+        rch_diag_set(d, "", 0, 0, ln ? "no room for the tracker frame and %u targets (RC_MAX_EFFECTS, RC_MAX_PARAMS)"
+                                     : "out of memory", p.n_targets);
+        rch_pos_free(&p);
+        return -1;
+    }
+    for (size_t i = 0; i < p.n; ++i) {
+        data->s[data->n + i] = p.s[i];
+        data->s[data->n + i].group = (uint16_t)(r->n_groups + p.file[i]);
+        data->line[data->n + i] = p.line[i];
+    }
+    data->n += p.n;
+    free(data->xyz); /* the length files' x, y, z (only --dequantize-joints reads them) */
+    data->xyz = NULL;
+    r->n_groups += (unsigned)cfg->n_positions_paths;
+    r->n_data = data->n;
+    r->n_pos_rows = p.rows;
+    r->n_pos_poses = p.poses;
+    r->n_targets = p.n_targets;
+    r->pos_has_sigma = p.has_sigma;
+    r->pos_sigma_mm = p.sigma_mm;
+    rch_provenance *pv = &r->prov;
+    for (size_t f = 0; f < cfg->n_positions_paths && pv->n_files < RCH_PROV_MAX_FILES; ++f) {
+        size_t c = 0;
+        for (size_t i = 0; i < p.n; ++i)
+            c += p.file[i] == f;
+        pv->file[pv->n_files] = cfg->positions_paths[f];
+        pv->samples[pv->n_files] = c;
+        if (rch_sha256_file(pv->sha256[pv->n_files], cfg->positions_paths[f]) != 0)
+            snprintf(pv->sha256[pv->n_files], sizeof pv->sha256[0], "unreadable");
+        pv->n_files++;
+    }
+    rch_pos_free(&p);
     return 0;
 }
 
@@ -856,6 +926,7 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     memset(fixed, 0, sizeof fixed);
     if (r->cfg.fix && rch_calib_fix(fixed, &r->model, r->cfg.fix, d) != 0)
         return -2;
+    rch_pos_fix_unseen(fixed, &r->model, train, r->n_train); /* what only an absent sensor sees */
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.method = r->cfg.method;
@@ -895,7 +966,7 @@ static int fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample
     if (r->cfg.jumps) {
         return fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
     }
-    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40) {
+    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40 && !r->n_pos_rows) { /* jumps: a cable's */
         jump_check(r, w, fixed, &cfg, train);
         if (r->jumps_found && !r->cfg.residuals_path) {
             /* fit them as nuisance, as --jumps does: the default run never
@@ -964,6 +1035,8 @@ static size_t split(size_t *idx, const rc_sample *s, size_t n, double fraction, 
 {
     size_t want = (size_t)floor(fraction * (double)n + 0.5);
     rch_split(idx, n, seed);
+    if (rch_pos_count_tracker(s, n) > 0 && want > 0)
+        return rch_pos_split(idx, s, n, want); /* a tracker pose whole on one side (not by set-up group) */
     if (!by_group || want == 0)
         return want;
     size_t *tmp = n ? malloc(n * sizeof *tmp) : NULL, k = 0;
@@ -994,6 +1067,17 @@ static size_t split(size_t *idx, const rc_sample *s, size_t n, double fraction, 
     return nt;
 }
 
+/* The 3-D errors of the tracker positions, before and after, held out (or
+ * training when none is) and training. */
+static void position_figures(rch_calib_result *r, const rc_sample *train, const rc_sample *test)
+{
+    const rc_sample *ev = r->n_test ? test : train;
+    const size_t ne = r->n_test ? r->n_test : r->n_train;
+    r->have_pos = r->after_ok && rch_pos_errors(&r->pos_before, &r->before, ev, ne) == 0 &&
+                  rch_pos_errors(&r->pos_after, &r->model, ev, ne) == 0 &&
+                  rch_pos_errors(&r->pos_train_after, &r->model, train, r->n_train) == 0;
+}
+
 /* One calibration on the rows sub (m) of data; held (m, or NULL) set to 1
  * for the held-out rows. */
 static int run_once(rch_calib_result *r, rc_solve_work *w, const rc_sample *s, size_t m, unsigned long long seed,
@@ -1022,6 +1106,8 @@ static int run_once(rch_calib_result *r, rc_solve_work *w, const rc_sample *s, s
         goto done;
     }
     rc = fit_and_report(r, w, train, test, d);
+    if (rc == 0 && r->n_pos_rows)
+        position_figures(r, train, test);
 done:
     free(idx);
     free(train);
@@ -1144,6 +1230,11 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
                 return -1;
             }
     }
+    if (cfg->n_positions_paths && append_positions(r, &data, d) != 0) {
+        rch_data_free(&data);
+        return -1;
+    }
+    const size_t n_len = rch_pos_count_lengths(data.s, data.n);
     int rc = -1;
     rc_solve_work *w = malloc(sizeof *w);
     unsigned *file_of = cfg->residuals_path ? malloc((data.n ? data.n : 1) * sizeof *file_of) : NULL;
@@ -1162,7 +1253,7 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
      * (with its prior): the flange centre is where compensation aims */
     const int want_tool = cfg->tool_offset || (!cfg->no_prior && (cfg->method == RC_METHOD_LM ||
                                                                    cfg->method == RC_METHOD_LTLM));
-    r->attach_auto = want_tool && !has_tool && !cfg->tool_offset;
+    r->attach_auto = want_tool && !has_tool && !cfg->tool_offset && n_len > 0;
     /* Hayati's beta where a joint axis is nominally parallel to the previous
      * one (alpha = 0 or 180 deg, rows 2..5): standard DH can tilt that axis
      * only with a d of metres, which the prior forbids, so the tilt gets its
@@ -1178,7 +1269,8 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
                 goto done;
             }
         }
-    if (want_tool && !has_tool && rc_model_add_effect(&r->robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
+    if (want_tool && !has_tool && (n_len > 0 || cfg->tool_offset) &&
+        rc_model_add_effect(&r->robot.model, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
         rch_diag_set(d, "", 0, 0, "cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
         goto done;
     }
@@ -1229,8 +1321,11 @@ static void print_model(FILE *f, const rch_calib_result *r)
         fprintf(f, "  %5u %10.4f %10.4f %12.5f %12.5f | %9.4f %10.4f %12.5f %12.5f\n", j + 1, x[0], x[1],
                 x[2] / DEG, x[3] / DEG, x[0] - x0[0], x[1] - x0[1], (x[2] - x0[2]) / DEG, (x[3] - x0[3]) / DEG);
     }
-    fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
-            m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
+    if (r->n_pos_rows && r->n_data == 3 * r->n_pos_rows)
+        fprintf(f, "  encoder e: no cable lengths (tracker positions only), held\n\n");
+    else
+        fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
+                m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
 }
 
 /* Dequantized joints, length jumps, the protocol over cases. */
@@ -1314,7 +1409,10 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                 r->robot.prior.length_mm, r->robot.prior.twist_deg, r->robot.prior.offset_deg,
                 r->robot.prior.attachment_mm, r->robot.prior.from_file ? ", from the robot file" : ", defaults",
                 r->noise_mm, r->noise_passes, r->p_eff);
-    if (u->has_prior)
+    if (u->has_prior && r->n_pos_rows)
+        fprintf(f, "  theta1 and d1 held (gauge): the tracker's frame absorbs the robot's heading and height, as "
+                   "an outlet does for lengths; a cell sets its base frame anyway\n");
+    else if (u->has_prior)
         fprintf(f, "  theta1 and d1 held (gauge): lengths from outlets whose places are estimated cannot see the "
                    "robot's heading and height against them; a cell sets its base frame anyway\n");
     print_outlets(f, m);
@@ -1386,6 +1484,55 @@ static void print_ident(FILE *f, const rch_ident *id, int prior)
                      : "  The solver leaves directions it cannot identify where they started (nominal).\n\n");
 }
 
+static void print_pos_err(FILE *f, const char *label, const rch_pos_err *e)
+{
+    fprintf(f, "  %-36s %8.4f %8.4f %8.4f", label, e->rms_mm, e->mean_mm, e->max_mm);
+    if (e->repeated)
+        fprintf(f, "   AP %.4f  RP %.4f (%zu repeated)", e->ap_max_mm, e->rp_max_mm, e->repeated);
+    fprintf(f, "\n");
+}
+
+/* The tracker positions in 3-D: |p_model - p_measured| (rch_positions.h). */
+static void print_positions(FILE *f, const rch_calib_result *r)
+{
+    if (!r->n_pos_rows)
+        return;
+    fprintf(f, "tracker positions: %zu rows (%zu poses, %u target(s)), %zu cable lengths; every row weighs the "
+               "same%s\n",
+            r->n_pos_rows, r->n_pos_poses, r->n_targets, r->n_data - 3 * r->n_pos_rows,
+            r->pos_has_sigma ? " (the files' sigma_mm is reported, not used as a weight)" : "");
+    fprintf(f, "  (the table above counts every row: a length or one coordinate of a position)\n");
+    if (!r->have_pos) {
+        fprintf(f, "  3-D errors: none (the fit did not converge)\n\n");
+        return;
+    }
+    fprintf(f, "3-D position error, %s (%zu positions, mm)   RMS     mean      MAX   ISO 9283 (worst pose)\n",
+            r->n_test ? "held-out" : "training", r->pos_after.points);
+    print_pos_err(f, "before (nominal DH, fitted tracker)", &r->pos_before);
+    print_pos_err(f, "after", &r->pos_after);
+    fprintf(f, "training 3-D RMS after: %.4f mm over %zu positions\n", r->pos_train_after.rms_mm,
+            r->pos_train_after.points);
+    unsigned nt = 0;
+    const int tf = rch_pos_effect_at(&r->model, RC_EFF_TRACKER_POSITION, NULL),
+              rf = rch_pos_effect_at(&r->model, RC_EFF_TRACKER_ROTATION, NULL),
+              kf = rch_pos_effect_at(&r->model, RC_EFF_TRACKER_TARGETS, &nt);
+    if (tf >= 0 && rf >= 0) {
+        const double *w = &r->model.x[rf];
+        fprintf(f, "tracker frame (base in the tracker's): T %.3f %.3f %.3f mm, rotation vector %.4f %.4f %.4f deg "
+                   "(it absorbs the base: theta1 and d1 stay held, the gauge)\n",
+                r->model.x[tf], r->model.x[tf + 1], r->model.x[tf + 2], w[0] / DEG, w[1] / DEG, w[2] / DEG);
+    }
+    for (unsigned j = 0; kf >= 0 && j < nt / 3; ++j)
+        fprintf(f, "  target %u in the flange frame: %.4f %.4f %.4f mm\n", j, r->model.x[kf + 3 * (int)j],
+                r->model.x[kf + 3 * (int)j + 1], r->model.x[kf + 3 * (int)j + 2]);
+    fprintf(f, "\n");
+}
+
+static const char *data_name(const rch_calib_result *r)
+{
+    return r->cfg.data_path ? r->cfg.data_path : r->cfg.n_positions_paths ? r->cfg.positions_paths[0] : "";
+}
+
 void rch_calib_print(FILE *f, const rch_calib_result *r)
 {
     const char *method = rc_method_name(r->cfg.method);
@@ -1393,7 +1540,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
         fprintf(f, "rcal calibrate: %u files merged (%zu samples), robot \"%s\", method %s\n", r->prov.n_files,
                 r->n_data, r->robot.name, method);
     else
-        fprintf(f, "rcal calibrate: %s (%zu samples), robot \"%s\", method %s\n", r->cfg.data_path, r->n_data,
+        fprintf(f, "rcal calibrate: %s (%zu samples), robot \"%s\", method %s\n", data_name(r), r->n_data,
                 r->robot.name, method);
     fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
             r->cfg.test_fraction, r->cfg.seed);
@@ -1417,6 +1564,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
         fprintf(f, "  after: the solver diverged (non-finite model or cable length): no figures\n");
     fprintf(f, "  (mean|e| is what the paper's Eq. 20 calls SD; SD here is the true standard deviation)\n");
     fprintf(f, "training RMSE: before %.4f mm, after %.4f mm\n\n", r->train_before.rmse_mm, r->train_after.rmse_mm);
+    print_positions(f, r);
     if (r->have_truth)
         fprintf(f,
                 "flange position against the truth (%d random poses, base heading/height aligned):\n"
@@ -1518,12 +1666,41 @@ static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
     rch_jw_end(w);
 }
 
+static void json_pos_err(rch_jw *w, const char *name, const rch_pos_err *e)
+{
+    rch_jw_obj(w, name);
+    rch_jw_uint(w, "points", e->points);
+    rch_jw_numf(w, "rms", e->rms_mm, "%.6f");
+    rch_jw_numf(w, "mean", e->mean_mm, "%.6f");
+    rch_jw_numf(w, "max", e->max_mm, "%.6f");
+    rch_jw_uint(w, "repeated", e->repeated);
+    rch_jw_numf(w, "ap_max", e->ap_max_mm, "%.6f"); /* null without repeats */
+    rch_jw_numf(w, "rp_max", e->rp_max_mm, "%.6f");
+    rch_jw_end(w);
+}
+
+/* With --positions: the "positions" member (docs/json-formats.md). */
+static void json_positions(rch_jw *w, const rch_calib_result *r)
+{
+    rch_jw_obj(w, "positions");
+    rch_jw_uint(w, "rows", r->n_pos_rows);
+    rch_jw_uint(w, "poses", r->n_pos_poses);
+    rch_jw_uint(w, "targets", r->n_targets);
+    rch_jw_num(w, "sigma_mm", r->pos_has_sigma ? r->pos_sigma_mm : NAN);
+    if (r->have_pos) {
+        json_pos_err(w, "position_error_mm", &r->pos_after);
+        json_pos_err(w, "before_mm", &r->pos_before);
+        json_pos_err(w, "train_after_mm", &r->pos_train_after);
+    }
+    rch_jw_end(w);
+}
+
 int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
 {
     rch_jw w;
     rch_jw_begin(&w, f, 0, "rcal-calibrate/1", argc, argv);
     rch_jw_str(&w, "method", rc_method_name(r->cfg.method));
-    rch_jw_str(&w, "data", r->cfg.data_path);
+    rch_jw_str(&w, "data", data_name(r));
     rch_jw_uint(&w, "n_train", r->n_train);
     rch_jw_uint(&w, "n_test", r->n_test);
     rch_jw_uint(&w, "seed", r->cfg.seed);
@@ -1556,6 +1733,8 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
     }
     rch_jw_bool(&w, "jumps_found_by_default", r->jumps_auto);
     rch_jw_end(&w);
+    if (r->n_pos_rows)
+        json_positions(&w, r);
     if (r->cfg.truth_path) {
         rch_jw_obj(&w, "truth_flange");
         rch_jw_numf(&w, "before_rms_mm", r->truth_before_rms_mm, "%.6f");
@@ -1621,7 +1800,7 @@ static void calib_info(rch_jw *w, const void *ctx)
 {
     const rch_calib_result *r = ctx;
     rch_jw_str(w, "method", rc_method_name(r->cfg.method));
-    rch_jw_str(w, "data", r->cfg.data_path);
+    rch_jw_str(w, "data", data_name(r));
     rch_jw_uint(w, "n_train", r->n_train);
     rch_jw_uint(w, "n_test", r->n_test);
     rch_jw_uint(w, "seed", r->cfg.seed);
@@ -1653,10 +1832,12 @@ int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *
                      r->jumps_found, r->jump_check_max_mm);
         return -1;
     }
-    const char *inputs[RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
+    const char *inputs[2 * RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
     size_t n = 3;
     for (size_t f = 0; f < n_files(&r->cfg); ++f)
         inputs[n++] = file_at(&r->cfg, f);
+    for (size_t f = 0; f < r->cfg.n_positions_paths && f < RCH_CALIB_MAX_FILES; ++f)
+        inputs[n++] = r->cfg.positions_paths[f];
     return rch_save(path, "--out", inputs, n, write_model_fn, r, d);
 }
 

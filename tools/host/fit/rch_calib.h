@@ -30,6 +30,7 @@
 #include "rch_dequant.h"
 #include "rch_evaluate.h"
 #include "rch_jumps.h"
+#include "rch_positions.h"
 #include "rch_stats.h"
 #include "rch_uncert.h"
 
@@ -96,6 +97,12 @@ typedef struct rch_calib_cfg {
                                refuses a model fitted across jumps it found) */
     int no_prior;           /* 1: least squares without the physical prior (rch_prior.h), no cable
                                attachment vector unless asked, no gauge: the earlier behaviour */
+    const char *const *positions_paths; /* (n_positions_paths) laser-tracker positions files
+                                           (rch_positions.h), merged after the data; data_path may
+                                           then be NULL */
+    size_t n_positions_paths;
+    int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
+    double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
 } rch_calib_cfg;
 
 /* The defaults of `rcal calibrate`: everything zero or NULL but method LM,
@@ -163,6 +170,15 @@ typedef struct rch_calib_result {
     int have_validate;
     rch_evaluate_result validate; /* on cfg.validate_path */
     char plot_paths[2400];    /* files written into plots_dir, "\n"-separated */
+    /* with cfg.positions_paths: */
+    size_t n_pos_rows;        /* position rows read (three samples each) */
+    size_t n_pos_poses;
+    unsigned n_targets;
+    int pos_has_sigma;
+    double pos_sigma_mm;      /* the files' median sigma_mm (rows are weighed equally) */
+    int have_pos;             /* the 3-D figures below are set */
+    rch_pos_err pos_before, pos_after; /* held-out positions (the training ones when none is held out) */
+    rch_pos_err pos_train_after;
 } rch_calib_result;
 
 /* The whole calibration. Returns 0 (the solver ran; r->after_ok says whether

@@ -25,15 +25,18 @@
  *                         roughly; centred on the start value (0 or the robot file's)
  * Every other physical effect (length scale, sag, joint compliance, ...):
  * its plausible range from the effect table (rc_effect_desc.limit) as 3 sd
- * about its start value. The encoder outlets and the nuisance effects
- * (length jumps, group offsets, drift) have no prior: the data place them.
+ * about its start value. The encoder outlets, the nuisance effects
+ * (length jumps, group offsets, drift) and a tracker's frame and targets
+ * (RC_SIDE_SENSOR) have no prior: the data place them.
  *
  * Gauge. Lengths from one outlet cannot see a rigid motion of the robot
  * about the outlet; in the robot's frame that is the base heading theta1 and
  * height d1 traded against the outlet position. They are held at nominal
  * (rch_prior_gauge) and reported as such: they do not change what the robot
  * does relative to itself (pairwise distances), and a cell sets its robot's
- * base frame anyway.
+ * base frame anyway. A laser tracker does not lift the gauge: its positions
+ * are in its own frame, whose six parameters absorb the same rigid motion
+ * (a turn about and a shift along joint 1's axis), so theta1 and d1 stay held.
  *
  * Depends on: rc_model. Memory: none. Thread safety: reentrant.
  */
