@@ -147,3 +147,30 @@ def test_refusals_as_the_cli(run_cli, halves):
     assert p.returncode != 0 and e.value.message in p.stderr
     with pytest.raises(ValueError):
         rcal.export(DATA, "x.urdf", format="sdf")
+
+
+def test_cases_residuals_and_plots(run_cli, tmp_path):
+    c = cli_json(run_cli, "calibrate", "--data", DATA, "--cases", "3", "--samples", "200", "--json")
+    r = rcal.calibrate(DATA, cases=3, samples=200)
+    assert r.figure("cases_done") == c["protocol"]["cases"] == 3
+    assert float("%.6f" % r.figure("cases_after_rmse_mean_mm")) == c["protocol"]["after_rmse_mean_mm"]
+    mine, theirs = tmp_path / "py_res.csv", tmp_path / "cli_res.csv"
+    rcal.calibrate(DATA, residuals=str(mine), plots=str(tmp_path / "py_plots"))
+    run_cli("calibrate", "--data", DATA, "--residuals", str(theirs))
+    assert mine.read_bytes() == theirs.read_bytes()
+    assert (tmp_path / "py_plots" / "uncertainty_position.svg").exists()
+    with pytest.raises(rcal.RcalError):
+        rcal.calibrate(DATA, residuals=str(tmp_path / "x.csv"), jumps=True)  # as the CLI: not with jumps
+
+
+def test_arrays_with_groups_equal_the_file(tmp_path):
+    import csv
+    rows = list(csv.DictReader(open(DATA)))
+    q = [[float(r["q%d" % j]) for j in range(1, 7)] for r in rows]
+    L = [float(r["L"]) for r in rows]
+    group = [i // 20 for i in range(len(rows))]
+    f = tmp_path / "g.csv"
+    f.write_text("q1,q2,q3,q4,q5,q6,L,group\n" + "".join(
+        ",".join(r["q%d" % j] for j in range(1, 7)) + ",%s,%d\n" % (r["L"], g) for r, g in zip(rows, group)))
+    a, b = rcal.calibrate(q_deg=q, L_mm=L, group=group), rcal.calibrate(str(f))
+    assert a.after == b.after and a.figure("groups") == b.figure("groups") == 30

@@ -196,22 +196,30 @@ int rch_ffi_fk(const rch_ffi_model *m, int nominal, double *pos_mm, double *rot,
 {
     if (!m || !pos_mm || (!q_deg && n > 0))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "fk: NULL argument");
-    static rc_model det; /* only for nominal == 2 */
+    rc_model *det = NULL; /* only for nominal == 2: on the heap (no static state, too large for a stack) */
     const rc_model *model = nominal == 1 ? &m->robot.nominal : &m->robot.model;
     if (nominal == 2) {
-        rch_model_unc unc;
+        rch_model_unc *unc = malloc(sizeof *unc);
+        det = malloc(sizeof *det);
+        if (!det || !unc) {
+            free(det);
+            free(unc);
+            return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
+        }
         int v1;
         char held[8];
-        det = m->robot.model;
+        *det = m->robot.model;
         if (m->robot.has_nominal || m->robot.unc.present)
-            rch_comp_determined(&det, &unc, &v1, held, sizeof held, &m->robot, &m->robot.nominal);
-        model = &det;
+            rch_comp_determined(det, unc, &v1, held, sizeof held, &m->robot, &m->robot.nominal);
+        free(unc);
+        model = det;
     }
     for (size_t i = 0; i < n; ++i) {
         rc_sample s;
         to_sample(&s, &q_deg[RC_NJ * i]);
         rc_fk(&pos_mm[3 * i], rot ? &rot[9 * i] : NULL, model, s.q_rad);
     }
+    free(det);
     return RCH_FFI_OK;
 }
 
