@@ -2,7 +2,7 @@
 """The package installed as a user installs it, then used (ctest
 python_venv_install).
 
-    python3 venv_install.py RCAL_BIN SOURCE_ROOT
+    python3 venv_install.py RCAL_BIN SOURCE_ROOT [--demo-only]
 
 1. a clean virtual environment (`python3 -m venv --system-site-packages`,
    so that the system's numpy, setuptools and wheel are there: the machine
@@ -16,7 +16,9 @@ python_venv_install).
 3. from outside the source tree, the installed package must load its own
    library, report __version__, and pass session_check.py (calibrate,
    diagnose, compensate equal to the CLI).
-Exit 77 (ctest: skipped) with the reason when venv or pip is unavailable.
+--demo-only (the sanitizer build, whose CLI is 20 times slower) checks the
+demo data only. Exit 77 (ctest: skipped) with the reason when venv or pip
+is unavailable.
 """
 import os
 import shutil
@@ -77,7 +79,7 @@ def main(argv):
             print("python_venv_install: FAILED: the installed package does not use its own library and data")
             return 1
         p = subprocess.run([py, os.path.join(root, "python", "tests", "session_check.py"), rcal_bin, root,
-                            os.path.join(tmp, "work")], cwd=tmp, env=env, capture_output=True, text=True)
+                            os.path.join(tmp, "work")] + argv[3:], cwd=tmp, env=env, capture_output=True, text=True)
         print(p.stdout + p.stderr)
         print("python_venv_install: %s in %.1f s" % ("passed" if p.returncode == 0 else "FAILED", time.time() - t0))
         return p.returncode
