@@ -12,11 +12,14 @@
  * HTML report. Each calls the host function the command calls.
  *
  * The interface a foreign caller sees is deliberately plain:
- *  - handles are opaque pointers (rch_ffi_model, rch_ffi_calib) created by
- *    rch_ffi_*_load / rch_ffi_calibrate_* and released by the matching
- *    *_free (NULL is accepted there). No struct layout crosses the API, so
+ *  - handles are opaque pointers (rch_ffi_model, rch_ffi_calib,
+ *    rch_ffi_diag) created by rch_ffi_model_load, rch_ffi_calibrate*,
+ *    rch_ffi_diagnose and released by the matching *_free (NULL is accepted
+ *    there). No struct layout crosses the API, so
  *    compile-time limits such as RC_MAX_PARAMS never leak to the caller.
- *  - numbers are double, counts size_t or unsigned, flags int; arrays are
+ *  - numbers are double, counts size_t or unsigned, flags int or unsigned
+ *    (OR of RCH_FFI_CAL_* / RCH_FFI_DIAG_*), lists of names a string
+ *    ("a1,theta6"), figures of a result by name; arrays are
  *    plain row-major double arrays whose shape is given in the comment of
  *    each parameter ("(n x 6)"). Angles at this interface are DEGREES,
  *    lengths MILLIMETRES (as in the CSV files and the command line).
@@ -86,9 +89,8 @@ int rch_ffi_model_param(const rch_ffi_model *m, unsigned k, int nominal, char *n
 
 /* Forward kinematics at n poses. pos_mm: (n x 3) flange point (the tool
  * point when the model has a tool offset); rot: (n x 9) row-major flange
- * rotation, or NULL; q_deg: (n x 6). nominal: 1 to use the nominal table. */
-/* nominal: 0 the model, 1 its nominal table, 2 its determined part (what
- * compensation uses). */
+ * rotation, or NULL; q_deg: (n x 6). nominal: 0 the model, 1 its nominal
+ * table, 2 its determined part (rch_comp_determined). */
 int rch_ffi_fk(const rch_ffi_model *m, int nominal, double *pos_mm, double *rot, const double *q_deg, size_t n,
                char *err, size_t err_len);
 /* Predicted cable length at n poses (rc_meas; samples with t = 0 and group
