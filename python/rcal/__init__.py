@@ -2,9 +2,12 @@
 """rcal: robot calibration with a cable encoder, from Python.
 
 A thin ctypes layer over the C libraries of this repository (the flat API of
-tools/host/outputs/rch_ffi.h in librcal_ffi.so), so every figure is the one the
-command-line tool prints: the calibration runs the same host function as
-`rcal calibrate`, the compensation the same stream as `rcal compensate`.
+tools/host/outputs/rch_ffi.h in librcal_ffi.so, shipped inside the package
+by `pip install ./python`), so every figure is the one the command-line tool
+prints: each function calls the host function the command calls
+(calibrate: rch_calib_run, diagnose: rch_diagnose_file, evaluate:
+rch_evaluate, compensate: the set-up of rch_comp_run and its stream,
+export: rch_export_file, report: rch_report_write).
 
 Units: joint angles in DEGREES, lengths in MILLIMETRES, everywhere.
 Arrays: a pose is 6 numbers (q1..q6); a batch is n poses, as a list of lists
@@ -12,39 +15,70 @@ or an (n, 6) numpy array. Results come back as tuples and lists, or as numpy
 arrays when the input was a numpy array (numpy is optional).
 
     import rcal
-    m = rcal.Model.load("data/irb120.json")
-    x, y, z = m.fk([0, 0, 0, 0, 30, 0])                       # mm
-    r = rcal.calibrate(data_csv="data/sim_irb120.csv")        # data/irb120.json by default
-    print(r.before.rmse_mm, r.after.rmse_mm)
+    r = rcal.calibrate("data/sim_irb120.csv")                 # rcal calibrate --data ...
+    print(r.before.rmse_mm, r.after.rmse_mm, r.param("a2").std_error)
     r.write("cal.json")
-    q_new = rcal.compensate(rcal.Model.load("cal.json"), [[10, 20, 30, 0, 40, 0]])
+    g = rcal.diagnose("data/sim_irb120.csv")                  # rcal diagnose --data ...
+    print(g.effect, g.next_command)
+    q_new = rcal.compensate("cal.json", [[10, 20, 30, 0, 40, 0]], tool_mm=(0, 0, 100))
 
 Errors raise RcalError with the C library's message ("file:line:col: ...").
 """
 
 import collections
 import ctypes
+import math
 import os
+import shutil
+import tempfile
 
 from . import _lib
 
-__all__ = ["RcalError", "Model", "Metrics", "Param", "Result", "calibrate", "compensate", "default_robot"]
+__all__ = ["RcalError", "Model", "Metrics", "Param", "Jump", "Result", "Diagnosis", "Evaluation", "Compensation",
+           "calibrate", "diagnose", "evaluate", "compensate", "export", "report", "default_robot", "data_file",
+           "library_path"]
 
 try:  # optional
     import numpy as _np
 except ImportError:  # pragma: no cover - depends on the machine
     _np = None
 
-_ERR_LEN = 1024
+_ERR_LEN = 2048
+
+
+def __getattr__(name):
+    """rcal.__version__: the C library's version (rc_version()), read when
+    first asked (so that `import rcal` itself never fails)."""
+    if name == "__version__":
+        return _lib.lib().rch_ffi_version().decode()
+    raise AttributeError("module 'rcal' has no attribute %r" % name)
+
+
+def library_path():
+    """Path of the librcal_ffi.so in use (RCAL_FFI_LIB, the package's own,
+    or a build tree's)."""
+    return _lib.lib().rcal_path
+
 
 Metrics = collections.namedtuple("Metrics", "n rmse_mm mean_abs_mm sd_mm mean_mm max_mm")
 Metrics.__doc__ = """Cable-length error over a sample set, mm (n: number of samples; mean_abs_mm is
 what the paper's Eq. 20 calls SD, sd_mm the true standard deviation)."""
 
-Param = collections.namedtuple("Param", "name unit value delta")
+Param = collections.namedtuple("Param", "name unit value delta std_error identifiability data_vs_prior prior_sd "
+                                        "compensation")
 Param.__doc__ = """One identified parameter as `rcal calibrate --json` lists it: unit "mm", "deg"
 or "-"; value and delta against nominal in that unit (the encoder's delta is
-against the before-calibration fit)."""
+against the before-calibration fit); std_error in that unit (NaN: none);
+identifiability "identifiable", "weak", "not identifiable" or "fixed";
+data_vs_prior "determined", "partly", "prior only" (None: no prior on it);
+prior_sd (0: none); compensation "fitted", "nominal" (held nominal by
+compensation) or "not used" (encoder, effects). The uncertainty fields are
+None when the run has no uncertainty."""
+
+Jump = collections.namedtuple("Jump", "line size_mm se_mm")
+Jump.__doc__ = """A length jump fitted in acquisition order: the data-file line of the first
+sample after it (0 when several files were merged), its size and standard
+error, mm."""
 
 _UNITS = {0: "mm", 1: "deg", 2: "-"}
 
@@ -74,12 +108,53 @@ def _opt_path(p):
     return None if p is None else _path(p)
 
 
-def default_robot():
-    """Path of the nominal robot model `rcal` uses by default (data/irb120.json:
-    $RCAL_DATA_DIR/irb120.json when that variable is set, else the
-    repository's data/)."""
+def _opt_str(v):
+    if v is None:
+        return None
+    if not isinstance(v, str):
+        v = ",".join(v)
+    return v.encode()
+
+
+def _data_dir():
     d = os.environ.get("RCAL_DATA_DIR")
-    return os.path.join(d if d else os.path.join(_lib.repo_root(), "data"), "irb120.json")
+    if d:
+        return d
+    shipped = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+    if os.path.isdir(shipped):
+        return shipped
+    return os.path.join(_lib.repo_root(), "data")
+
+
+def data_file(name):
+    """Path of a data file shipped with rcal ("irb120.json", "kr6.json",
+    "sim_irb120.csv", "sim_irb120_truth.json"): in $RCAL_DATA_DIR when set,
+    else the package's own copy (an installed package), else the
+    repository's data/."""
+    return os.path.join(_data_dir(), name)
+
+
+def default_robot():
+    """Path of the nominal robot model `rcal` uses by default: irb120.json
+    by data_file()."""
+    return data_file("irb120.json")
+
+
+def _text(fn, h):
+    needed = ctypes.c_size_t()
+    fn(h, None, 0, ctypes.byref(needed))
+    buf = ctypes.create_string_buffer(needed.value)
+    _check(fn(h, buf, needed.value, None))
+    return buf.value.decode()
+
+
+def _ints(values, n, what):
+    if values is None:
+        return None
+    vals = [int(v) for v in (values.tolist() if _np is not None and isinstance(values, _np.ndarray) else values)]
+    if len(vals) != n:
+        raise ValueError("%s: %d values for %d samples" % (what, len(vals), n))
+    return (ctypes.c_int * max(n, 1))(*vals)
 
 
 def _doubles(values, width, what):
@@ -136,9 +211,10 @@ class Model:
     nominal table it corrects. Load with Model.load(path); a calibration's
     identified model is Result.model."""
 
-    def __init__(self, handle):
+    def __init__(self, handle, path=None):
         self._h = ctypes.c_void_p(handle)
         self._free = _lib.lib().rch_ffi_model_free
+        self.path = None if path is None else os.fspath(path)  # the file it was loaded from, if any
 
     @classmethod
     def load(cls, path):
@@ -148,7 +224,7 @@ class Model:
         h = ctypes.c_void_p()
         err = ctypes.create_string_buffer(_ERR_LEN)
         _check(lib.rch_ffi_model_load(ctypes.byref(h), _path(path), err, _ERR_LEN), err)
-        return cls(h.value)
+        return cls(h.value, path)
 
     def __del__(self):
         if getattr(self, "_h", None) and self._h.value:
@@ -229,15 +305,25 @@ class Result:
     before, after:             Metrics on the held-out samples (the training
                                samples when none is held out), mm
     train_before, train_after: Metrics on the training samples, mm
-    params:                    list of Param (value, delta in mm or deg)
+    after_unambiguous:         with jumps: held-out Metrics without the samples
+                               between a jump and its training rows, else None
+    validation:                Metrics on the validate= file (no refit), else None
+    params:                    list of Param (value, delta, std_error, classes)
     encoder_mm:                (ex, ey, ez) identified encoder outlet, mm
-    n_train, n_test, converged, exit, iterations, cost_evals, method, seed
+    predicted:                 the predicted 95 % uncertainty (dict: position
+                               over the data and the workspace, mm; orientation,
+                               deg; orientation_determined), None without one
+    jumps:                     list of Jump fitted (empty without)
+    outlets:                   the data's encoder-place labels (place 0 is e)
+    n_data, n_train, n_test, converged, exit, iterations, cost_evals, method, seed
     truth_flange:              with truth=: flange errors against the truth
                                (before/after RMS and max, mm), else None
+    figure(name):              any figure of rch_ffi_calib_get ("noise_mm", ...)
     json(), json_text():       the report as `rcal calibrate --json` prints it
     model:                     the identified Model (full precision)
     write(path):               the calibrated model file (`--out`), never
                                over one of the inputs
+    report(directory, ...):    the HTML report into a directory
     """
 
     def __init__(self, handle, method, data, seed):
@@ -246,11 +332,13 @@ class Result:
         self._free = lib.rch_ffi_calib_free
         self.method, self.data, self.seed = method, data, seed
         ms = []
-        for which in range(4):
+        for which in range(6):
             out = (ctypes.c_double * 6)()
-            _check(lib.rch_ffi_calib_metrics(self._h, which, out))
-            ms.append(Metrics(int(out[0]), *out[1:6]))
-        self.before, self.after, self.train_before, self.train_after = ms
+            if lib.rch_ffi_calib_metrics(self._h, which, out) != 0:
+                ms.append(None)
+            else:
+                ms.append(Metrics(int(out[0]), *out[1:6]))
+        self.before, self.after, self.train_before, self.train_after, self.after_unambiguous, self.validation = ms
         n_train, n_test = ctypes.c_size_t(), ctypes.c_size_t()
         conv, it, ev = ctypes.c_int(), ctypes.c_uint(), ctypes.c_uint()
         ex = ctypes.create_string_buffer(128)
@@ -259,29 +347,58 @@ class Result:
         self.n_train, self.n_test = n_train.value, n_test.value
         self.converged, self.iterations, self.cost_evals = bool(conv.value), it.value, ev.value
         self.exit = ex.value.decode()
+        self.n_data = int(self.figure("n_data"))
         self.params = []
         for k in range(lib.rch_ffi_calib_n_params(self._h)):
             name = ctypes.create_string_buffer(64)
             v, dv, u = ctypes.c_double(), ctypes.c_double(), ctypes.c_int()
             _check(lib.rch_ffi_calib_param(self._h, k, name, 64, ctypes.byref(v), ctypes.byref(dv),
                                            ctypes.byref(u)))
-            self.params.append(Param(name.value.decode(), _UNITS[u.value], v.value, dv.value))
+            se, psd, held = ctypes.c_double(), ctypes.c_double(), ctypes.c_int()
+            cls, pcls = ctypes.create_string_buffer(32), ctypes.create_string_buffer(32)
+            unc = None
+            if lib.rch_ffi_calib_param_unc(self._h, k, ctypes.byref(se), ctypes.byref(psd), cls, 32, pcls, 32,
+                                           ctypes.byref(held)) == 0:
+                unc = (se.value, cls.value.decode(), pcls.value.decode() or None, psd.value,
+                       ("nominal" if held.value else "fitted") if k < 24 else "not used")
+            self.params.append(Param(name.value.decode(), _UNITS[u.value], v.value, dv.value,
+                                     *(unc if unc else (None,) * 5)))
         self.encoder_mm = tuple(p.value for p in self.params[24:27])
         truth = (ctypes.c_double * 4)()
         self.truth_flange = None
         if lib.rch_ffi_calib_truth(self._h, truth) == 0:
             self.truth_flange = dict(zip(("before_rms_mm", "before_max_mm", "after_rms_mm", "after_max_mm"),
                                          truth[:4]))
+        self.predicted = None
+        if self.figure("position95_data_median_mm") is not None:
+            keys = ("position95_data_median_mm", "position95_data_max_mm", "position95_workspace_median_mm",
+                    "position95_workspace_max_mm", "orientation95_data_median_deg", "orientation95_data_max_deg")
+            self.predicted = {k: self.figure(k) for k in keys}
+            self.predicted["orientation_determined"] = bool(self.figure("orientation_determined"))
+        n = ctypes.c_uint()
+        _check(lib.rch_ffi_calib_jumps(self._h, ctypes.byref(n), None, None, None, 0))
+        line, size, sej = (ctypes.c_uint * max(n.value, 1))(), (ctypes.c_double * max(n.value, 1))(), \
+            (ctypes.c_double * max(n.value, 1))()
+        _check(lib.rch_ffi_calib_jumps(self._h, ctypes.byref(n), line, size, sej, n.value))
+        self.jumps = [Jump(line[k], size[k], sej[k]) for k in range(n.value)]
+        labels = (ctypes.c_int * 64)()
+        _check(lib.rch_ffi_calib_outlets(self._h, ctypes.byref(n), labels, 64))
+        self.outlets = list(labels[:min(n.value, 64)])
+
+    def figure(self, name):
+        """A figure of the run by name (rch_ffi_calib_get in rch_ffi.h:
+        "noise_mm", "effective_params", "prior", "groups", "jumps_fitted",
+        "dequant_corrected", "validate_ad_mean_mm", ...), or None when
+        this run has none."""
+        v = ctypes.c_double()
+        if _lib.lib().rch_ffi_calib_get(self._h, name.encode(), ctypes.byref(v)) != 0:
+            return None
+        return v.value
 
     def json_text(self):
         """The report exactly as `rcal calibrate --json` prints it (the same
         writer; time_ms is this run's)."""
-        lib = _lib.lib()
-        needed = ctypes.c_size_t()
-        lib.rch_ffi_calib_json(self._h, None, 0, ctypes.byref(needed))
-        buf = ctypes.create_string_buffer(needed.value)
-        _check(lib.rch_ffi_calib_json(self._h, buf, needed.value, None))
-        return buf.value.decode()
+        return _text(_lib.lib().rch_ffi_calib_json, self._h)
 
     def json(self):
         """json_text() parsed: a dict."""
@@ -311,46 +428,81 @@ class Result:
 
     def write(self, path):
         """Write the calibrated model file, as `rcal calibrate --out path`
-        writes it (rcal-model/1 JSON, for `rcal compensate` and Model.load)."""
+        writes it (rcal-model/2 JSON, for `rcal compensate` and Model.load)."""
         err = ctypes.create_string_buffer(_ERR_LEN)
         _check(_lib.lib().rch_ffi_calib_write(self._h, _path(path), err, _ERR_LEN), err)
+
+    def report(self, directory, diagnosis=None, name="report", model=None):
+        """The HTML report: see rcal.report()."""
+        return report(self, directory, diagnosis=diagnosis, name=name, model=model)
 
     def __repr__(self):
         return "<rcal.Result %s: %d train / %d test, RMSE %.4f -> %.4f mm>" % (
             self.method, self.n_train, self.n_test, self.before.rmse_mm, self.after.rmse_mm)
 
 
-def calibrate(data_csv=None, q_deg=None, L_mm=None, robot=None, method="lm", test_fraction=0.1, seed=1,
-              max_iter=0, fix=None, tool_offset=False, truth=None):
+_CAL_FLAGS = {"tool_offset": 1, "jumps": 2, "dequantize": 4, "no_prior": 8, "holdout_groups": 16,
+              "no_jump_check": 32}
+
+
+def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=None, robot=None, method="lm",
+              test_fraction=0.1, seed=1, max_iter=0, fix=None, effects=None, jumps=False, dequantize=False,
+              prior=True, tool_offset=False, holdout_groups=False, jump_check=True, validate=None, truth=None,
+              cases=1, samples=0, plots=None, residuals=None, data_csv=None):
     """Identify the DH errors and the encoder outlet from cable lengths, as
     `rcal calibrate` does (the same host function: identical figures).
+    Each argument is the CLI option of the same meaning.
 
-    data_csv:      measurements CSV (q1..q6 in degrees, L in mm), or
-    q_deg, L_mm:   the samples as arrays: (n x 6) joint readings in degrees
-                   and (n) cable lengths in mm, in acquisition order
-    robot:         nominal robot model file (default: default_robot())
-    method:        "lm" (default), "ltlm", "lm-paper" or "ltlm-paper"
-    test_fraction: share of the samples held out for the before/after figures
-    seed:          split (and LTLM) seed
-    max_iter:      iteration cap, 0 for the method's default
-    fix:           parameters held at nominal: "a1,theta6" or a list of names
-    tool_offset:   also identify where the cable is attached on the flange
-    truth:         a simulated truth model file: Result.truth_flange
+    data:           measurements CSV (q1..q6 deg, L mm; optional x, y, z, t,
+                    group, outlet columns), or a list of them (several --data,
+                    merged); data_csv= is the same
+    q_deg, L_mm:    or the samples as arrays: (n x 6) joint readings in degrees
+                    and (n) cable lengths in mm, in acquisition order, with
+                    optional xyz_mm (n x 3, for dequantize), group (n) and
+                    outlet (n) labels
+    robot:          nominal robot model file (--robot; default: default_robot())
+    method:         "lm" (default), "ltlm", "lm-paper", "ltlm-paper",
+                    "lm-paper-deg", "ltlm-paper-deg"
+    test_fraction:  share of the samples held out (--test-fraction)
+    seed:           split (and LTLM) seed; max_iter: iteration cap (0: default)
+    fix:            parameters held at nominal: "a1,theta6" or a list of names
+    effects:        effects fitted with the geometry (--effects): "cable_sag,
+                    joint_periodic:2" or a list, e.g. Diagnosis.effects
+    jumps:          fit length jumps (--jumps); dequantize: --dequantize-joints
+    prior:          False for --no-prior (plain least squares)
+    tool_offset:    --tool-offset; holdout_groups: --holdout-groups;
+    jump_check:     False for --no-jump-check
+    validate:       a file the fit never sees (--validate): Result.validation
+    truth:          a simulated truth model file: Result.truth_flange
+    cases, samples: --cases, --samples (the paper's protocol)
+    plots, residuals: --plots DIR, --residuals FILE.csv
     Returns a Result. Raises RcalError (bad file with file:line:col, too few
-    samples, unknown method) or ValueError (bad arguments)."""
-    if (data_csv is None) == (q_deg is None):
-        raise ValueError("calibrate: give either data_csv or q_deg and L_mm")
+    samples, unknown method or effect) or ValueError (bad arguments)."""
+    if data is None:
+        data = data_csv
+    elif data_csv is not None:
+        raise ValueError("calibrate: give data or data_csv, not both")
+    if (data is None) == (q_deg is None):
+        raise ValueError("calibrate: give either data (a file or a list of files) or q_deg and L_mm")
     lib = _lib.lib()
     robot = default_robot() if robot is None else robot
-    if fix is not None and not isinstance(fix, str):
-        fix = ",".join(fix)
+    flags = 0
+    for name, on in (("tool_offset", tool_offset), ("jumps", jumps), ("dequantize", dequantize),
+                     ("no_prior", not prior), ("holdout_groups", holdout_groups), ("no_jump_check", not jump_check)):
+        if on:
+            flags |= _CAL_FLAGS[name]
     h = ctypes.c_void_p()
     err = ctypes.create_string_buffer(_ERR_LEN)
-    common = (method.encode(), float(test_fraction), int(seed), int(max_iter),
-              None if fix is None else fix.encode(), 1 if tool_offset else 0, _opt_path(truth), err, _ERR_LEN)
-    if data_csv is not None:
-        st = lib.rch_ffi_calibrate_file(ctypes.byref(h), _path(data_csv), _path(robot), *common)
-        data = os.fspath(data_csv)
+    common = (_path(robot), method.encode(), float(test_fraction), int(seed), int(max_iter), _opt_str(fix),
+              _opt_str(effects), flags, _opt_path(validate), _opt_path(truth), int(cases), int(samples),
+              _opt_path(plots), _opt_path(residuals), err, _ERR_LEN)
+    if data is not None:
+        files = [data] if isinstance(data, (str, bytes, os.PathLike)) else list(data)
+        if not files:
+            raise ValueError("calibrate: no data file")
+        arr = (ctypes.c_char_p * len(files))(*[_path(f) for f in files])
+        st = lib.rch_ffi_calibrate(ctypes.byref(h), arr, len(files), *common)
+        label = os.fspath(files[0]) if len(files) == 1 else [os.fspath(f) for f in files]
     else:
         if L_mm is None:
             raise ValueError("calibrate: q_deg needs L_mm")
@@ -358,45 +510,279 @@ def calibrate(data_csv=None, q_deg=None, L_mm=None, robot=None, method="lm", tes
         L, nl, _, _ = _doubles(L_mm, 1, "L_mm")
         if n != nl:
             raise ValueError("calibrate: %d poses but %d lengths" % (n, nl))
-        st = lib.rch_ffi_calibrate_arrays(ctypes.byref(h), q, L, n, _path(robot), *common)
-        data = None
+        xyz = None
+        if xyz_mm is not None:
+            xyz, nx, _, _ = _doubles(xyz_mm, 3, "xyz_mm")
+            if nx != n:
+                raise ValueError("calibrate: %d poses but %d xyz rows" % (n, nx))
+        st = lib.rch_ffi_calibrate_arrays(ctypes.byref(h), q, L, xyz, _ints(group, n, "group"),
+                                          _ints(outlet, n, "outlet"), n, *common)
+        label = None
     _check(st, err)
-    return Result(h.value, method, data, int(seed))
+    return Result(h.value, method, label, int(seed))
 
 
-def compensate(model, targets_deg, nominal=None, position_only=None, max_dev_deg=0.0, return_status=False):
-    """Correct joint targets made with the nominal model so that the
-    calibrated robot reaches the nominal flange pose: q' with
-    FK_cal(q') = FK_nom(q), target by target in order with one stream, as
-    `rcal compensate` does line by line.
+Chosen = collections.namedtuple("Chosen", "name rmse_cv_mm gain_mm2 p_value")
+DiagParam = collections.namedtuple("DiagParam", "name value se unit")
 
-    model:         the calibrated Model (e.g. Model.load("cal.json"))
-    targets_deg:   one target (6 joint angles, degrees) or a batch (n x 6)
-    nominal:       the Model the targets were made with (default: the
-                   calibrated model's nominal table)
-    position_only: True position only, False position and orientation,
-                   None (default) as the model file says, like `rcal
-                   compensate` (position only unless the data determined
-                   the orientation). The model used is the determined part
-                   of the calibration (parameters the data did not
-                   determine held nominal).
-    max_dev_deg:   largest correction per joint, degrees (0: 0.1 rad)
-    Returns the corrected targets in degrees, shaped like the input; with
-    return_status=True also a list of per-target codes: 0 converged, 1
-    position matched with the orientation best effort, 2 not converged
-    (target plus the last good correction), 3 left uncompensated (the
-    model's 95 % position uncertainty there is above 1 mm). A target outside the joint limits
-    raises RcalError."""
+
+class Diagnosis:
+    """The result of diagnose(): what `rcal diagnose` reports.
+
+    effect:          the verdict ("length_jump", "cable_sag", "joint_periodic",
+                     ..., "none", "unexplained"); joint: its joint (0: none)
+    remaining, remaining_why: what is left after the chosen effects
+    chosen:          list of Chosen(name, rmse_cv_mm, gain_mm2, p_value), the
+                     effects added one after the other
+    effects:         the --effects list the Next command passes (names as
+                     calibrate(effects=...) takes them), jumps, dequantize
+    params:          list of DiagParam(name, value, se, unit) fitted
+    next_command:    the command that acts on the verdict (`Next:` of the CLI)
+    noise_floor_mm, rmse_before_mm, rmse_after_mm, noise_est_mm, n, n_groups,
+    n_jumps, ...:    figure(name) for any figure of rch_ffi_diag_get
+    residuals():     (before, after, floor) per sample, mm (numpy when present)
+    json(), write(path): `rcal diagnose --json`, `--out path`
+    """
+
+    _FIGURES = ("n", "n_groups", "folds", "noise_floor_mm", "floor_joints_mm", "floor_len_mm", "train_rmse_geo_mm",
+                "rmse_before_mm", "rmse_after_mm", "noise_est_mm", "n_jumps", "rmse_jumps_mm", "dequant_corrected",
+                "dequant_refused", "effect_rms_mm", "q_step_deg", "len_step_mm", "time_ms")
+
+    def __init__(self, handle, data):
+        lib = _lib.lib()
+        self._h = ctypes.c_void_p(handle)
+        self._free = lib.rch_ffi_diag_free
+        self.data = data
+        eff, rem, why = (ctypes.create_string_buffer(64), ctypes.create_string_buffer(64),
+                         ctypes.create_string_buffer(512))
+        joint = ctypes.c_uint()
+        _check(lib.rch_ffi_diag_verdict(self._h, eff, 64, ctypes.byref(joint), rem, 64, why, 512))
+        self.effect, self.joint = eff.value.decode(), joint.value
+        self.remaining, self.remaining_why = rem.value.decode(), why.value.decode()
+        for k in self._FIGURES:
+            v = self.figure(k)
+            setattr(self, k, int(v) if k in ("n", "n_groups", "folds", "n_jumps", "dequant_corrected",
+                                             "dequant_refused") else v)
+        self.chosen = []
+        for k in range(int(self.figure("n_chosen"))):
+            name = ctypes.create_string_buffer(64)
+            a, b, c = ctypes.c_double(), ctypes.c_double(), ctypes.c_double()
+            _check(lib.rch_ffi_diag_chosen(self._h, k, name, 64, ctypes.byref(a), ctypes.byref(b), ctypes.byref(c)))
+            self.chosen.append(Chosen(name.value.decode(), a.value, b.value, c.value))
+        self.params = []
+        for k in range(int(self.figure("n_params"))):
+            name, unit = ctypes.create_string_buffer(64), ctypes.create_string_buffer(16)
+            v, se = ctypes.c_double(), ctypes.c_double()
+            _check(lib.rch_ffi_diag_param(self._h, k, name, 64, ctypes.byref(v), ctypes.byref(se), unit, 16))
+            self.params.append(DiagParam(name.value.decode(), v.value, se.value, unit.value.decode()))
+        buf = ctypes.create_string_buffer(4096)
+        self.next_command = buf.value.decode() if lib.rch_ffi_diag_next(self._h, buf, 4096) == 0 else None
+        args = self.next_command.split() if self.next_command else []
+        self.jumps = "--jumps" in args
+        self.dequantize = "--dequantize-joints" in args
+        self.effects = args[args.index("--effects") + 1].split(",") if "--effects" in args else []
+
+    def figure(self, name):
+        """A figure by name (rch_ffi_diag_get), or None when unknown."""
+        v = ctypes.c_double()
+        if _lib.lib().rch_ffi_diag_get(self._h, name.encode(), ctypes.byref(v)) != 0:
+            return None
+        return v.value
+
+    def residuals(self):
+        """(before, after, floor): per sample as the diagnosis used them, the
+        cross-validated held-out residual of the geometry, of the final model,
+        and the noise-floor sigma, mm (numpy arrays when numpy is present)."""
+        n = self.n
+        bufs = [(ctypes.c_double * max(n, 1))() for _ in range(3)]
+        _check(_lib.lib().rch_ffi_diag_residuals(self._h, *bufs))
+        return tuple(_rows(b, n, 1, False, _np is not None) for b in bufs)
+
+    def json_text(self):
+        """The report exactly as `rcal diagnose --json` prints it."""
+        return _text(_lib.lib().rch_ffi_diag_json, self._h)
+
+    def json(self):
+        import json
+        return json.loads(self.json_text())
+
+    def write(self, path):
+        """The calibrated model with the effects found, what `rcal diagnose
+        --out path` writes (never over the data or the robot file)."""
+        err = ctypes.create_string_buffer(_ERR_LEN)
+        _check(_lib.lib().rch_ffi_diag_write(self._h, _path(path), err, _ERR_LEN), err)
+
+    def __del__(self):
+        if getattr(self, "_h", None) and self._h.value:
+            self._free(self._h)
+            self._h = ctypes.c_void_p()
+
+    def __repr__(self):
+        return "<rcal.Diagnosis %s: held-out %.4f -> %.4f mm, floor %.4f mm>" % (
+            self.effect, self.rmse_before_mm, self.rmse_after_mm, self.noise_floor_mm)
+
+
+def diagnose(data, robot=None, seed=1, folds=5, steps=3, jumps=True, dequantize=False, q_step_deg=0.0,
+             len_step_mm=0.0, len_noise_mm=0.0, alpha=0.0, max_iter=0):
+    """Which missing physical effect explains the residuals, as `rcal
+    diagnose` finds it (rch_diagnose_file): --data, --robot, --seed,
+    --folds, --steps, jumps=False for --no-jumps, --dequantize-joints,
+    --q-step-deg, --len-step-mm (0: detected, < 0: none), --len-noise-mm,
+    --alpha (0: 0.01), --max-iter (0: 100). Returns a Diagnosis."""
     lib = _lib.lib()
+    robot = default_robot() if robot is None else robot
+    h = ctypes.c_void_p()
+    err = ctypes.create_string_buffer(_ERR_LEN)
+    flags = (0 if jumps else 1) | (2 if dequantize else 0)
+    _check(lib.rch_ffi_diagnose(ctypes.byref(h), _path(data), _path(robot), int(seed), int(folds), int(steps), flags,
+                                float(q_step_deg), float(len_step_mm), float(len_noise_mm), float(alpha),
+                                int(max_iter), err, _ERR_LEN), err)
+    return Diagnosis(h.value, os.fspath(data))
+
+
+Evaluation = collections.namedtuple("Evaluation", "metrics encoder_refitted encoder_mm encoder_shift_mm poses "
+                                                  "repeated_poses ad_mean_mm ad_max_mm rd_mean_mm rd_max_mm")
+Evaluation.__doc__ = """A model on new data (`rcal evaluate --json`): metrics (Metrics of the
+residuals, mm), the encoder outlet used (refitted alone when asked) and its
+shift, the ISO 9283 distance accuracy AD and repeatability RD over the
+repeated poses (NaN without repeated poses)."""
+
+
+def _model(model):
+    return model if isinstance(model, Model) else Model.load(model)
+
+
+def evaluate(model, data, refit_encoder=False, same_pose_deg=1e-6):
+    """A calibrated model (a Model or a model file) on data the fit never
+    saw, as `rcal evaluate --model M --data D` (rch_evaluate: no refit of
+    the robot; refit_encoder: --refit-encoder; same_pose_deg:
+    --same-pose-deg). Returns an Evaluation."""
+    m = _model(model)
+    out = (ctypes.c_double * 17)()
+    err = ctypes.create_string_buffer(_ERR_LEN)
+    _check(_lib.lib().rch_ffi_evaluate(out, m._h, _path(data), 1 if refit_encoder else 0, float(same_pose_deg), err,
+                                       _ERR_LEN), err)
+    v = list(out)
+    return Evaluation(Metrics(int(v[0]), *v[1:6]), bool(v[6]), tuple(v[7:10]), v[10], int(v[11]), int(v[12]),
+                      *v[13:17])
+
+
+Compensation = collections.namedtuple("Compensation", "q_deg status u95_mm")
+Compensation.__doc__ = """compensate(..., details=True): the corrected targets (deg, shaped like the
+input), a status per target (0 converged, 1 position matched with the
+orientation best effort, 2 not converged: target plus the last good
+correction, 3 left uncompensated: uncertainty above the limit) and u95_mm,
+the predicted 95 % position uncertainty of the compensated point per target
+(what --uncertainty-out writes; NaN when the model has no uncertainty)."""
+
+
+def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=None, max_dev_deg=0.0,
+               max_uncertainty_mm=0.0, return_status=False, details=False):
+    """Correct joint targets made with the nominal model so that the
+    calibrated robot reaches the nominal pose: q' with FK_cal(q') =
+    FK_nom(q) for the tool point, target by target in order with one
+    stream, with the model set-up of `rcal compensate` (its determined part,
+    the cable attachment removed).
+
+    model:         the calibrated Model or model file (--model)
+    targets_deg:   one target (6 joint angles, degrees) or a batch (n x 6)
+    nominal:       the Model or file the targets were made with (--nominal;
+                   default: the calibrated model's nominal table)
+    tool_mm:       the TCP in the flange frame, mm (--tool X,Y,Z; default the
+                   flange centre)
+    position_only: True --position-only, False --full-pose, None (default)
+                   as the model file says (position only unless the data
+                   determined the orientation)
+    max_dev_deg:   largest correction per joint (--max-dev-deg; 0: 0.1 rad)
+    max_uncertainty_mm: --max-uncertainty-mm (0: none for a model with a
+                   posterior, 1 mm for one without)
+    Returns the corrected targets in degrees, shaped like the input (numpy in,
+    numpy out); return_status=True: (targets, status codes); details=True: a
+    Compensation (targets, status, u95_mm). A target outside the joint
+    limits raises RcalError."""
+    lib = _lib.lib()
+    cal = _model(model)
+    nom = None if nominal is None else _model(nominal)
     q, n, single, numpy = _doubles(targets_deg, 6, "targets_deg")
     out = (ctypes.c_double * max(6 * n, 1))()
     status = (ctypes.c_int * max(n, 1))()
+    u95 = (ctypes.c_double * max(n, 1))()
+    tool = None
+    if tool_mm is not None:
+        t = [float(v) for v in tool_mm]
+        if len(t) != 3:
+            raise ValueError("tool_mm: expected 3 numbers (x, y, z in the flange frame, mm)")
+        tool = (ctypes.c_double * 3)(*t)
     err = ctypes.create_string_buffer(_ERR_LEN)
-    _check(lib.rch_ffi_compensate(model._h, nominal._h if nominal is not None else None, out, status, q, n,
+    _check(lib.rch_ffi_compensate(cal._h, nom._h if nom is not None else None, out, status, u95, q, n,
                                   0 if position_only is None else (1 if position_only else 2),
-                                  float(max_dev_deg), err, _ERR_LEN), err)
+                                  float(max_dev_deg), float(max_uncertainty_mm), tool, err, _ERR_LEN), err)
     corrected = _rows(out, n, 6, single, numpy)
+    codes = list(status[:n])
+    if details:
+        u = _rows(u95, n, 1, single, numpy)
+        return Compensation(corrected, codes[0] if single else codes, u)
     if return_status:
-        codes = list(status[:n])
         return corrected, (codes[0] if single else codes)
     return corrected
+
+
+_FORMATS = {"urdf": 0, "dh-csv": 1}
+
+
+def export(model, out_path, format="urdf", nominal_urdf=None, drop_joint_effects=False):
+    """The model as a URDF or its DH table as CSV, as `rcal export --model M
+    --format F --out PATH` writes it (whole or not at all, never over an
+    input). model: a model file, a Model loaded from one, or a Result (its
+    model file is written to a temporary directory first); format "urdf" or
+    "dh-csv"; nominal_urdf: take the names from this URDF; drop_joint_effects:
+    --drop-joint-effects. Returns {"written": joints or rows,
+    "effects_not_carried": n}."""
+    if format not in _FORMATS:
+        raise ValueError("export: format must be 'urdf' or 'dh-csv'")
+    tmp = None
+    try:
+        if isinstance(model, Result):
+            tmp = tempfile.mkdtemp(prefix="rcal-export-")
+            path = os.path.join(tmp, "model.json")
+            model.write(path)
+        elif isinstance(model, Model):
+            if model.path is None:
+                raise ValueError("export: this Model has no file; pass the model file or the Result")
+            path = model.path
+        else:
+            path = model
+        written, left = ctypes.c_uint(), ctypes.c_uint()
+        err = ctypes.create_string_buffer(_ERR_LEN)
+        _check(_lib.lib().rch_ffi_export(_path(path), _path(out_path), _FORMATS[format], _opt_path(nominal_urdf),
+                                         1 if drop_joint_effects else 0, ctypes.byref(written), ctypes.byref(left),
+                                         err, _ERR_LEN), err)
+        return {"written": written.value, "effects_not_carried": left.value}
+    finally:
+        if tmp:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def report(result, directory, diagnosis=None, name="report", model=None):
+    """The HTML report of a calibration (and a diagnosis) into directory
+    (created when missing), as `rcal calibrate --report` makes it:
+    <name>.html with its plot data (<name>_*.csv), the calibration's JSON
+    (<name>.calibration.json) and the diagnosis's (<name>.diagnosis.json)
+    beside it. model: the model file of the run; None writes the result's
+    model as <name>.model.json into the directory (when it is finite) and
+    uses that. Returns the paths written."""
+    if not isinstance(result, Result):
+        raise ValueError("report: result must be an rcal.Result")
+    os.makedirs(directory, exist_ok=True)
+    html = os.path.join(os.fspath(directory), name + ".html")
+    written = []
+    if model is None and result.figure("n_data") is not None and all(
+            math.isfinite(p.value) for p in result.params):
+        model = os.path.join(os.fspath(directory), name + ".model.json")
+        result.write(model)
+        written.append(model)
+    paths = ctypes.create_string_buffer(16384)
+    err = ctypes.create_string_buffer(_ERR_LEN)
+    _check(_lib.lib().rch_ffi_report(result._h, diagnosis._h if diagnosis is not None else None, _path(html),
+                                     _opt_path(model), paths, 16384, err, _ERR_LEN), err)
+    return [p for p in paths.value.decode().split("\n") if p] + written

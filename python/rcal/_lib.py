@@ -1,17 +1,20 @@
 # SPDX-License-Identifier: MIT
 """Loading of the shared library rcal_ffi and its ctypes signatures.
 
-The library is tools/host/outputs/rch_ffi.h compiled by python/CMakeLists.txt. It is
-found, in order, at the path in the environment variable RCAL_FFI_LIB, then
-in the build trees next to the package (build/python/librcal_ffi.so under the
-repository root, or any <root>/build*/python/).
+The library is tools/host/outputs/rch_ffi.h compiled by python/CMakeLists.txt
+(`pip install ./python` builds it with CMake and ships it inside the
+package). It is found, in order, at the path in the environment variable
+RCAL_FFI_LIB (an override), then next to this file (the installed package),
+then in the build trees of the repository the package sits in
+(build/python/librcal_ffi.so under the repository root, or any
+<root>/build*/python/), for use from a source tree with PYTHONPATH=python.
 """
 
 import ctypes
 import glob
 import os
 
-ABI = 1  # RCH_FFI_ABI this package is written for
+ABI = 2  # RCH_FFI_ABI this package is written for
 LIB_NAME = "librcal_ffi.so"
 
 _c_double_p = ctypes.POINTER(ctypes.c_double)
@@ -32,7 +35,8 @@ def _candidates():
     if env:
         return [env]
     root = repo_root()
-    found = [os.path.join(root, "build", "python", LIB_NAME)]
+    found = [os.path.join(os.path.dirname(os.path.abspath(__file__)), LIB_NAME)]
+    found += [os.path.join(root, "build", "python", LIB_NAME)]
     found += sorted(glob.glob(os.path.join(root, "build*", "python", LIB_NAME)))
     return found
 
@@ -42,6 +46,7 @@ def _declare(lib):
     vp, cp, sz, d, i, u, ul = (ctypes.c_void_p, ctypes.c_char_p, ctypes.c_size_t, ctypes.c_double,
                               ctypes.c_int, ctypes.c_uint, ctypes.c_ulong)
     pvp = ctypes.POINTER(ctypes.c_void_p)
+    ppc = ctypes.POINTER(ctypes.c_char_p)
     sigs = {
         "rch_ffi_abi": (i, []),
         "rch_ffi_strerror": (cp, [i]),
@@ -54,8 +59,27 @@ def _declare(lib):
         "rch_ffi_model_param": (i, [vp, u, i, cp, sz, _c_double_p, _c_int_p]),
         "rch_ffi_fk": (i, [vp, i, _c_double_p, _c_double_p, _c_double_p, sz, cp, sz]),
         "rch_ffi_cable_length": (i, [vp, _c_double_p, _c_double_p, sz, cp, sz]),
-        "rch_ffi_calibrate_file": (i, [pvp, cp, cp, cp, d, ul, u, cp, i, cp, cp, sz]),
-        "rch_ffi_calibrate_arrays": (i, [pvp, _c_double_p, _c_double_p, sz, cp, cp, d, ul, u, cp, i, cp, cp, sz]),
+        "rch_ffi_version": (cp, []),
+        "rch_ffi_calibrate": (i, [pvp, ppc, sz, cp, cp, d, ul, u, cp, cp, u, cp, cp, ul, sz, cp, cp, cp, sz]),
+        "rch_ffi_calibrate_arrays": (i, [pvp, _c_double_p, _c_double_p, _c_double_p, _c_int_p, _c_int_p, sz, cp, cp,
+                                         d, ul, u, cp, cp, u, cp, cp, ul, sz, cp, cp, cp, sz]),
+        "rch_ffi_calib_param_unc": (i, [vp, u, _c_double_p, _c_double_p, cp, sz, cp, sz, _c_int_p]),
+        "rch_ffi_calib_get": (i, [vp, cp, _c_double_p]),
+        "rch_ffi_calib_jumps": (i, [vp, _c_uint_p, _c_uint_p, _c_double_p, _c_double_p, u]),
+        "rch_ffi_calib_outlets": (i, [vp, _c_uint_p, _c_int_p, u]),
+        "rch_ffi_diagnose": (i, [pvp, cp, cp, ul, u, u, u, d, d, d, d, u, cp, sz]),
+        "rch_ffi_diag_free": (None, [vp]),
+        "rch_ffi_diag_verdict": (i, [vp, cp, sz, _c_uint_p, cp, sz, cp, sz]),
+        "rch_ffi_diag_chosen": (i, [vp, u, cp, sz, _c_double_p, _c_double_p, _c_double_p]),
+        "rch_ffi_diag_param": (i, [vp, u, cp, sz, _c_double_p, _c_double_p, cp, sz]),
+        "rch_ffi_diag_get": (i, [vp, cp, _c_double_p]),
+        "rch_ffi_diag_next": (i, [vp, cp, sz]),
+        "rch_ffi_diag_residuals": (i, [vp, _c_double_p, _c_double_p, _c_double_p]),
+        "rch_ffi_diag_json": (i, [vp, cp, sz, _c_size_p]),
+        "rch_ffi_diag_write": (i, [vp, cp, cp, sz]),
+        "rch_ffi_evaluate": (i, [_c_double_p, vp, cp, i, d, cp, sz]),
+        "rch_ffi_export": (i, [cp, cp, i, cp, i, _c_uint_p, _c_uint_p, cp, sz]),
+        "rch_ffi_report": (i, [vp, vp, cp, cp, cp, sz, cp, sz]),
         "rch_ffi_calib_free": (None, [vp]),
         "rch_ffi_calib_metrics": (i, [vp, i, _c_double_p]),
         "rch_ffi_calib_info": (i, [vp, _c_size_p, _c_size_p, _c_int_p, _c_uint_p, _c_uint_p, cp, sz]),
@@ -65,7 +89,8 @@ def _declare(lib):
         "rch_ffi_calib_write": (i, [vp, cp, cp, sz]),
         "rch_ffi_calib_truth": (i, [vp, _c_double_p]),
         "rch_ffi_calib_json": (i, [vp, cp, sz, _c_size_p]),
-        "rch_ffi_compensate": (i, [vp, vp, _c_double_p, _c_int_p, _c_double_p, sz, i, d, cp, sz]),
+        "rch_ffi_compensate": (i, [vp, vp, _c_double_p, _c_int_p, _c_double_p, _c_double_p, sz, i, d, d,
+                                   _c_double_p, cp, sz]),
     }
     for name, (res, args) in sigs.items():
         fn = getattr(lib, name)
@@ -85,11 +110,15 @@ def lib():
             tried.append(path)
             continue
         handle = ctypes.CDLL(path)
-        _declare(handle)
+        handle.rch_ffi_abi.restype = ctypes.c_int
+        handle.rch_ffi_abi.argtypes = []
         abi = handle.rch_ffi_abi()
         if abi != ABI:
-            raise OSError("%s has rch_ffi ABI %d, this package needs %d: rebuild" % (path, abi, ABI))
+            raise OSError("%s has rch_ffi ABI %d, this package needs %d: rebuild it (or reinstall the package)"
+                          % (path, abi, ABI))
+        _declare(handle)
+        handle.rcal_path = path
         _lib = handle
         return _lib
-    raise OSError("librcal_ffi.so not found (set RCAL_FFI_LIB to its path, or build it: cmake --build build); "
-                  "tried: " + ", ".join(tried))
+    raise OSError("librcal_ffi.so not found (install the package: pip install --no-build-isolation ./python; "
+                  "or build it, cmake --build build, or set RCAL_FFI_LIB to its path); tried: " + ", ".join(tried))

@@ -1,0 +1,91 @@
+# SPDX-License-Identifier: MIT
+"""The package installed as a user installs it, then used (ctest
+python_venv_install).
+
+    python3 venv_install.py RCAL_BIN SOURCE_ROOT [--demo-only]
+
+1. a clean virtual environment (`python3 -m venv --system-site-packages`,
+   so that the system's numpy, setuptools and wheel are there: the machine
+   may be offline);
+2. `pip install --no-build-isolation <copy of python/>` with RCAL_SOURCE_DIR
+   set to the repository (a copy, so the test writes nothing into the source
+   tree; `pip install ./python` from a clone finds the root by itself),
+   with no RCAL_FFI_LIB in the environment: pip's build runs CMake on the
+   repository for the rcal_ffi target and ships librcal_ffi.so inside the
+   package;
+3. from outside the source tree, the installed package must load its own
+   library, report __version__, and pass session_check.py (calibrate,
+   diagnose, compensate equal to the CLI).
+--demo-only (the sanitizer build, whose CLI is 20 times slower) checks the
+demo data only. Exit 77 (ctest: skipped) with the reason when venv or pip
+is unavailable.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def skip(why):
+    print("python_venv_install: SKIPPED: " + why)
+    sys.exit(77)
+
+
+def main(argv):
+    rcal_bin, root = os.path.abspath(argv[1]), os.path.abspath(argv[2])
+    try:
+        import venv  # noqa: F401
+        import ensurepip  # noqa: F401
+    except ImportError as e:
+        skip("%s has no venv/ensurepip (%s; Debian: apt-get install python3-venv)" % (sys.executable, e))
+    tmp = tempfile.mkdtemp(prefix="rcal-venv-")
+    env = {k: v for k, v in os.environ.items() if k not in ("RCAL_FFI_LIB", "PYTHONPATH", "LD_PRELOAD")}
+    try:
+        t0 = time.time()
+        env_dir = os.path.join(tmp, "venv")
+        p = subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", env_dir], capture_output=True,
+                           text=True)
+        if p.returncode != 0:
+            skip("python3 -m venv failed (%s)" % p.stderr.strip().splitlines()[-1:])
+        py = os.path.join(env_dir, "bin", "python")
+        if subprocess.run([py, "-m", "pip", "--version"], capture_output=True).returncode != 0:
+            skip("pip is not available in the virtual environment (Debian: apt-get install python3-pip)")
+        missing = subprocess.run([py, "-c", "import setuptools, wheel"], capture_output=True).returncode != 0
+        if missing:
+            skip("setuptools or wheel is missing (Debian: python3-setuptools, python3-wheel); offline, pip cannot "
+                 "fetch them")
+        src = os.path.join(tmp, "python")
+        shutil.copytree(os.path.join(root, "python"), src,
+                        ignore=shutil.ignore_patterns("build", "*.egg-info", "dist", "__pycache__"))
+        env["RCAL_SOURCE_DIR"] = root
+        t1 = time.time()
+        p = subprocess.run([py, "-m", "pip", "install", "--no-build-isolation", "--no-deps", "--no-index", src],
+                           cwd=tmp, env=env, capture_output=True, text=True)
+        t2 = time.time()
+        if p.returncode != 0:
+            print(p.stdout[-4000:], p.stderr[-4000:])
+            print("python_venv_install: FAILED: pip install --no-build-isolation ./python")
+            return 1
+        print("venv %.1f s, pip install --no-build-isolation ./python %.1f s (CMake build of librcal_ffi.so "
+              "included)" % (t1 - t0, t2 - t1))
+        probe = ("import os, rcal, sys; p = rcal.library_path(); print(rcal.__version__, p, rcal.default_robot()); "
+                 "sys.exit(0 if p.startswith(sys.prefix) and os.path.dirname(p) == os.path.dirname(rcal.__file__) "
+                 "and rcal.default_robot().startswith(sys.prefix) else 1)")
+        p = subprocess.run([py, "-c", probe], cwd=tmp, env=env, capture_output=True, text=True)
+        print("installed: " + (p.stdout.strip() or p.stderr.strip()))
+        if p.returncode != 0:
+            print("python_venv_install: FAILED: the installed package does not use its own library and data")
+            return 1
+        p = subprocess.run([py, os.path.join(root, "python", "tests", "session_check.py"), rcal_bin, root,
+                            os.path.join(tmp, "work")] + argv[3:], cwd=tmp, env=env, capture_output=True, text=True)
+        print(p.stdout + p.stderr)
+        print("python_venv_install: %s in %.1f s" % ("passed" if p.returncode == 0 else "FAILED", time.time() - t0))
+        return p.returncode
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
