@@ -1,0 +1,575 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_rapid.c - the RAPID reader (rch_rapid.h): tokens, declarations, and
+ * every joint target and robtarget literal with its numbers' bytes. */
+#include "rch_rapid.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "rch_opt.h"
+
+typedef enum { T_IDENT, T_NUM, T_STR, T_ASSIGN, T_PUNCT } tok_type;
+
+typedef struct {
+    tok_type type;
+    char ch; /* T_PUNCT: the character */
+    size_t off, len;
+    unsigned line, col;
+} tok;
+
+typedef struct {
+    tok *t;
+    size_t n, cap;
+} toks;
+
+/* a name declared in the module with a target type */
+typedef struct {
+    char name[48];
+    int kind;  /* rch_rapid_kind, 0: another type, -1: declared with two types */
+    int array; /* declared with {dims} */
+} decl;
+
+typedef struct {
+    const char *text;
+    size_t len;
+    const char *name;
+    toks tk;
+    decl *dc;
+    size_t ndc, capdc;
+    rch_rapid_targets *out;
+    rch_diag *d;
+} scan;
+
+static int push_tok(scan *s, tok_type ty, char ch, size_t off, size_t len, unsigned line, unsigned col)
+{
+    if (s->tk.n == s->tk.cap) {
+        const size_t nc = s->tk.cap ? 2 * s->tk.cap : 256;
+        tok *nt = realloc(s->tk.t, nc * sizeof *nt);
+        if (!nt) {
+            rch_diag_set(s->d, s->name, line, col, "out of memory");
+            return -1;
+        }
+        s->tk.t = nt;
+        s->tk.cap = nc;
+    }
+    s->tk.t[s->tk.n++] = (tok){ty, ch, off, len, line, col};
+    return 0;
+}
+
+static int is_id(int c) { return isalnum(c) || c == '_'; }
+
+/* text -> tokens (comments dropped). 0 or -1. */
+static int tokenize(scan *s)
+{
+    const char *p = s->text;
+    size_t i = 0;
+    unsigned line = 1, col = 1;
+#define ADV(k)                                                                                                     \
+    do {                                                                                                           \
+        for (size_t a_ = 0; a_ < (k); ++a_, ++i) {                                                                 \
+            if (p[i] == '\n') {                                                                                    \
+                ++line;                                                                                            \
+                col = 1;                                                                                           \
+            } else                                                                                                 \
+                ++col;                                                                                             \
+        }                                                                                                          \
+    } while (0)
+    while (i < s->len) {
+        const unsigned char c = (unsigned char)p[i];
+        const size_t b = i;
+        const unsigned bl = line, bc = col;
+        if (c == '\0') {
+            rch_diag_set(s->d, s->name, line, col, "NUL byte in a RAPID module");
+            return -1;
+        }
+        if (isspace(c)) {
+            ADV(1);
+        } else if (c == '!') { /* comment to the end of the line */
+            while (i < s->len && p[i] != '\n') {
+                if (p[i] == '\0') {
+                    rch_diag_set(s->d, s->name, line, col, "NUL byte in a RAPID module");
+                    return -1;
+                }
+                ADV(1);
+            }
+        } else if (c == '"') {
+            ADV(1);
+            for (;;) {
+                if (i >= s->len || p[i] == '\n' || p[i] == '\0') {
+                    rch_diag_set(s->d, s->name, bl, bc, "string not closed on its line");
+                    return -1;
+                }
+                if (p[i] == '"') {
+                    if (i + 1 < s->len && p[i + 1] == '"') {
+                        ADV(2);
+                        continue;
+                    }
+                    ADV(1);
+                    break;
+                }
+                ADV(1);
+            }
+            if (push_tok(s, T_STR, 0, b, i - b, bl, bc) != 0)
+                return -1;
+        } else if (isdigit(c) || (c == '.' && i + 1 < s->len && isdigit((unsigned char)p[i + 1]))) {
+            while (i < s->len) {
+                const unsigned char e = (unsigned char)p[i];
+                if (is_id(e) || e == '.')
+                    ADV(1);
+                else if ((e == '+' || e == '-') && (p[i - 1] == 'e' || p[i - 1] == 'E') && isdigit((unsigned char)p[b]))
+                    ADV(1);
+                else
+                    break;
+            }
+            if (push_tok(s, T_NUM, 0, b, i - b, bl, bc) != 0)
+                return -1;
+        } else if (is_id(c)) {
+            while (i < s->len && is_id((unsigned char)p[i]))
+                ADV(1);
+            if (push_tok(s, T_IDENT, 0, b, i - b, bl, bc) != 0)
+                return -1;
+        } else if (c == ':' && i + 1 < s->len && p[i + 1] == '=') {
+            ADV(2);
+            if (push_tok(s, T_ASSIGN, 0, b, 2, bl, bc) != 0)
+                return -1;
+        } else {
+            ADV(1);
+            if (push_tok(s, T_PUNCT, (char)c, b, 1, bl, bc) != 0)
+                return -1;
+        }
+    }
+#undef ADV
+    return 0;
+}
+
+static int tok_is(const scan *s, size_t i, const char *w)
+{
+    const tok *t = &s->tk.t[i];
+    return t->type == T_IDENT && t->len == strlen(w) && strncasecmp(s->text + t->off, w, t->len) == 0;
+}
+
+static int punct(const scan *s, size_t i, char ch)
+{
+    return i < s->tk.n && s->tk.t[i].type == T_PUNCT && s->tk.t[i].ch == ch;
+}
+
+static void tok_name(char *buf, size_t n, const scan *s, size_t i)
+{
+    const tok *t = &s->tk.t[i];
+    const size_t k = t->len < n - 1 ? t->len : n - 1;
+    memcpy(buf, s->text + t->off, k);
+    buf[k] = '\0';
+}
+
+/* Index of the bracket closing the one at i ('[', '(' or '{'), or s->tk.n. */
+static size_t close_of(const scan *s, size_t i)
+{
+    size_t depth = 0;
+    for (size_t j = i; j < s->tk.n; ++j) {
+        const tok *t = &s->tk.t[j];
+        if (t->type != T_PUNCT)
+            continue;
+        if (t->ch == '[' || t->ch == '(' || t->ch == '{')
+            ++depth;
+        else if (t->ch == ']' || t->ch == ')' || t->ch == '}') {
+            if (--depth == 0)
+                return j;
+        }
+    }
+    return s->tk.n;
+}
+
+static int target_type(const scan *s, size_t i)
+{
+    if (tok_is(s, i, "jointtarget"))
+        return RCH_RAPID_JOINTTARGET;
+    if (tok_is(s, i, "robtarget"))
+        return RCH_RAPID_ROBTARGET;
+    return 0;
+}
+
+static const decl *find_decl(const scan *s, size_t i)
+{
+    for (size_t k = 0; k < s->ndc; ++k) {
+        const tok *t = &s->tk.t[i];
+        if (strlen(s->dc[k].name) == t->len && strncasecmp(s->dc[k].name, s->text + t->off, t->len) == 0)
+            return &s->dc[k];
+    }
+    return NULL;
+}
+
+/* Declarations: VAR|PERS|CONST TYPE NAME. Names of target types are kept. */
+static int collect_decls(scan *s)
+{
+    for (size_t i = 0; i + 2 < s->tk.n; ++i) {
+        if (!(tok_is(s, i, "VAR") || tok_is(s, i, "PERS") || tok_is(s, i, "CONST")))
+            continue;
+        if (s->tk.t[i + 1].type != T_IDENT || s->tk.t[i + 2].type != T_IDENT)
+            continue;
+        const int kind = target_type(s, i + 1);
+        char nm[48];
+        tok_name(nm, sizeof nm, s, i + 2);
+        decl *old = NULL;
+        for (size_t k = 0; k < s->ndc; ++k)
+            if (strcasecmp(s->dc[k].name, nm) == 0)
+                old = &s->dc[k];
+        const int array = punct(s, i + 3, '{');
+        if (old) {
+            if (old->kind != kind || old->array != array)
+                old->kind = -1; /* two meanings in one module: its assignments are not guessed */
+            continue;
+        }
+        if (s->ndc == s->capdc) {
+            const size_t nc = s->capdc ? 2 * s->capdc : 32;
+            decl *nd = realloc(s->dc, nc * sizeof *nd);
+            if (!nd) {
+                rch_diag_set(s->d, s->name, s->tk.t[i].line, s->tk.t[i].col, "out of memory");
+                return -1;
+            }
+            s->dc = nd;
+            s->capdc = nc;
+        }
+        decl *dn = &s->dc[s->ndc++];
+        memset(dn, 0, sizeof *dn);
+        memcpy(dn->name, nm, sizeof dn->name);
+        dn->kind = kind;
+        dn->array = array;
+    }
+    return 0;
+}
+
+/* The shape of an aggregate of aggregates of leaves, [[a,b],[c,d,e],...]. */
+#define MAXG 6
+#define MAXL 8
+typedef struct {
+    int ng;            /* groups; -1: not an aggregate of aggregates of leaves */
+    int nl[MAXG];      /* leaves per group (counted past MAXL) */
+    size_t lb[MAXG][MAXL], le[MAXG][MAXL]; /* leaf token range [lb, le) */
+} shape;
+
+/* Shape of the aggregate at token i (a '['), closing at c. */
+static void shape_of(shape *sh, const scan *s, size_t i, size_t c)
+{
+    memset(sh, 0, sizeof *sh);
+    size_t j = i + 1;
+    if (j == c)
+        return; /* [] */
+    for (;;) {
+        if (!punct(s, j, '[') || sh->ng >= MAXG) {
+            sh->ng = -1;
+            return;
+        }
+        const size_t gc = close_of(s, j);
+        if (gc >= c) {
+            sh->ng = -1;
+            return;
+        }
+        const int g = sh->ng++;
+        size_t k = j + 1;
+        while (k < gc) {
+            const size_t b = k;
+            while (k < gc && !punct(s, k, ',')) {
+                if (punct(s, k, '[')) { /* nested deeper: not a target */
+                    sh->ng = -1;
+                    return;
+                }
+                if (punct(s, k, '(') || punct(s, k, '{')) {
+                    const size_t cc = close_of(s, k);
+                    if (cc >= gc) { /* not closed inside the group */
+                        sh->ng = -1;
+                        return;
+                    }
+                    k = cc;
+                }
+                ++k;
+            }
+            if (sh->nl[g] < MAXL) {
+                sh->lb[g][sh->nl[g]] = b;
+                sh->le[g][sh->nl[g]] = k;
+            }
+            sh->nl[g]++;
+            if (k < gc)
+                ++k; /* ',' */
+        }
+        j = gc + 1;
+        if (j >= c)
+            return;
+        if (!punct(s, j, ',')) {
+            sh->ng = -1;
+            return;
+        }
+        ++j;
+    }
+}
+
+static int shape_is(const shape *sh, rch_rapid_kind k)
+{
+    if (k == RCH_RAPID_JOINTTARGET)
+        return sh->ng == 2 && sh->nl[0] == 6 && sh->nl[1] == 6;
+    return sh->ng == 4 && sh->nl[0] == 3 && sh->nl[1] == 4 && sh->nl[2] == 4 && sh->nl[3] == 6;
+}
+
+static void shape_text(char *buf, size_t n, const shape *sh)
+{
+    if (sh->ng < 0) {
+        snprintf(buf, n, "another form");
+        return;
+    }
+    size_t k = (size_t)snprintf(buf, n, "[");
+    for (int g = 0; g < sh->ng && k < n; ++g)
+        k += (size_t)snprintf(buf + k, n - k, "%s[%d]", g ? "," : "", sh->nl[g]);
+    if (k < n)
+        snprintf(buf + k, n - k, "]");
+}
+
+static rch_rapid_target *new_target(scan *s, size_t i, size_t c, rch_rapid_kind kind, rch_rapid_context ctx,
+                                    const char *name)
+{
+    rch_rapid_targets *o = s->out;
+    if (o->n == o->cap) {
+        const size_t nc = o->cap ? 2 * o->cap : 32;
+        rch_rapid_target *nt = realloc(o->t, nc * sizeof *nt);
+        if (!nt) {
+            rch_diag_set(s->d, s->name, s->tk.t[i].line, s->tk.t[i].col, "out of memory");
+            return NULL;
+        }
+        o->t = nt;
+        o->cap = nc;
+    }
+    rch_rapid_target *t = &o->t[o->n++];
+    memset(t, 0, sizeof *t);
+    t->kind = kind;
+    t->context = ctx;
+    t->line = s->tk.t[i].line;
+    t->col = s->tk.t[i].col;
+    t->off = s->tk.t[i].off;
+    t->end = s->tk.t[c].off + 1;
+    snprintf(t->name, sizeof t->name, "%s", name ? name : "");
+    return t;
+}
+
+static const char *const jt_names[] = {"axis 1", "axis 2", "axis 3", "axis 4", "axis 5", "axis 6"};
+static const char *const rt_names[] = {"x", "y", "z", "q1", "q2", "q3", "q4", "cf1", "cf4", "cf6", "cfx"};
+
+/* A target literal of kind at tokens [i, c]: its numbers, or its error. */
+static int add_target(scan *s, size_t i, size_t c, rch_rapid_kind kind, rch_rapid_context ctx, const char *name)
+{
+    shape sh;
+    shape_of(&sh, s, i, c);
+    rch_rapid_target *t = new_target(s, i, c, kind, ctx, name);
+    if (!t)
+        return -1;
+    if (!shape_is(&sh, kind)) {
+        char got[64];
+        shape_text(got, sizeof got, &sh);
+        snprintf(t->error, sizeof t->error, "a %s is %s; this aggregate is %s", rch_rapid_kind_name(kind),
+                 kind == RCH_RAPID_JOINTTARGET ? "[[6 robot axes],[6 external axes]]"
+                                               : "[[x,y,z],[q1,q2,q3,q4],[cf1,cf4,cf6,cfx],[6 external axes]]",
+                 got);
+        return 0;
+    }
+    const int ng = kind == RCH_RAPID_JOINTTARGET ? 1 : 3; /* groups whose numbers may change */
+    unsigned k = 0;
+    for (int g = 0; g < ng; ++g)
+        for (int l = 0; l < sh.nl[g]; ++l, ++k) {
+            size_t b = sh.lb[g][l];
+            const size_t e = sh.le[g][l];
+            const tok *tb = &s->tk.t[b];
+            const char *nm = kind == RCH_RAPID_JOINTTARGET ? jt_names[k] : rt_names[k];
+            size_t nb = b;
+            if (e - b == 2 && (punct(s, b, '-') || punct(s, b, '+')))
+                nb = b + 1;
+            char buf[64];
+            const tok *tn = &s->tk.t[nb];
+            double v;
+            int ok = e > b && nb + 1 == e && tn->type == T_NUM && tn->len < sizeof buf;
+            if (ok) {
+                memcpy(buf, s->text + tn->off, tn->len);
+                buf[tn->len] = '\0';
+                ok = rch_parse_double(buf, &v) == 0;
+                if (ok && nb > b && punct(s, b, '-'))
+                    v = -v;
+            }
+            if (!ok) {
+                const size_t from = tb->off, to = e > b ? s->tk.t[e - 1].off + s->tk.t[e - 1].len : from;
+                const size_t w = to - from > 40 ? 40 : to - from;
+                snprintf(t->error, sizeof t->error, "%s (line %u, column %u): '%.*s' is not a literal number", nm,
+                         tb->line, tb->col, (int)w, s->text + from);
+                t->n = 0;
+                return 0;
+            }
+            t->num_off[k] = tb->off;
+            t->num_len[k] = tn->off + tn->len - tb->off;
+            t->num_line[k] = tb->line;
+            t->num_col[k] = tb->col;
+            t->val[k] = v;
+        }
+    t->n = k;
+    return 0;
+}
+
+/* The value of a declaration or assignment of a target kind at tokens [i, c]:
+ * one target, or, for an array, each element (nested arrays too). */
+static int add_value(scan *s, size_t i, size_t c, rch_rapid_kind kind, int array, rch_rapid_context ctx,
+                     const char *name)
+{
+    if (!array)
+        return add_target(s, i, c, kind, ctx, name);
+    size_t j = i + 1;
+    while (j < c) {
+        if (!punct(s, j, '[')) {
+            rch_rapid_target *t = new_target(s, i, c, kind, ctx, name);
+            if (!t)
+                return -1;
+            snprintf(t->error, sizeof t->error, "an array of %ss must list aggregates", rch_rapid_kind_name(kind));
+            return 0;
+        }
+        const size_t e = close_of(s, j);
+        if (e >= c) {
+            rch_rapid_target *t = new_target(s, i, c, kind, ctx, name);
+            if (!t)
+                return -1;
+            snprintf(t->error, sizeof t->error, "brackets of another kind cross this aggregate");
+            return 0;
+        }
+        shape sh;
+        shape_of(&sh, s, j, e);
+        /* an element of a 2-D array is itself an array of targets */
+        const int deeper = sh.ng < 0 && j + 1 < e && punct(s, j + 1, '[') && punct(s, j + 2, '[');
+        if (add_value(s, j, e, kind, deeper, ctx, name) != 0)
+            return -1;
+        j = e + 1;
+        if (j < c && punct(s, j, ','))
+            ++j;
+    }
+    return 0;
+}
+
+/* The target the aggregate at token i (closing at c) stands for, from what
+ * precedes it. */
+static int classify(scan *s, size_t i, size_t c)
+{
+    char nm[48] = "";
+    if (i >= 2 && s->tk.t[i - 1].type == T_ASSIGN) {
+        size_t k = i - 2; /* the assigned name, past {dims} or {index} */
+        int indexed = 0;
+        if (punct(s, k, '}')) {
+            size_t depth = 0;
+            for (;; --k) {
+                if (punct(s, k, '}'))
+                    ++depth;
+                else if (punct(s, k, '{') && --depth == 0)
+                    break;
+                if (k == 0)
+                    break;
+            }
+            if (k == 0)
+                return 0;
+            --k;
+            indexed = 1;
+        }
+        if (s->tk.t[k].type == T_IDENT) {
+            tok_name(nm, sizeof nm, s, k);
+            /* a declaration: [VAR|PERS|CONST] TYPE NAME */
+            if (k >= 2 && s->tk.t[k - 1].type == T_IDENT &&
+                (tok_is(s, k - 2, "VAR") || tok_is(s, k - 2, "PERS") || tok_is(s, k - 2, "CONST"))) {
+                const int kind = target_type(s, k - 1);
+                if (kind == 0)
+                    return 0; /* another type: not a target */
+                return add_value(s, i, c, (rch_rapid_kind)kind, indexed, RCH_RAPID_DECLARATION, nm);
+            }
+            const int field = k > 0 && punct(s, k - 1, '.');
+            const int optarg = k > 0 && punct(s, k - 1, '\\');
+            if (!field && !optarg) {
+                const decl *dc = find_decl(s, k);
+                if (dc && dc->kind > 0)
+                    return add_value(s, i, c, (rch_rapid_kind)dc->kind, dc->array && !indexed, RCH_RAPID_ASSIGNMENT,
+                                     nm);
+                shape sh;
+                shape_of(&sh, s, i, c);
+                if (dc && dc->kind == 0)
+                    return 0; /* declared here with another type */
+                if (shape_is(&sh, RCH_RAPID_JOINTTARGET) || shape_is(&sh, RCH_RAPID_ROBTARGET)) {
+                    rch_rapid_target *t =
+                        new_target(s, i, c, shape_is(&sh, RCH_RAPID_JOINTTARGET) ? RCH_RAPID_JOINTTARGET
+                                                                                 : RCH_RAPID_ROBTARGET,
+                                   RCH_RAPID_ASSIGNMENT, nm);
+                    if (!t)
+                        return -1;
+                    snprintf(t->error, sizeof t->error,
+                             "'%s' has the form of a %s but %s in this module, so its type cannot be told", nm,
+                             rch_rapid_kind_name(t->kind), dc ? "is declared with two types" : "is not declared");
+                }
+                return 0;
+            }
+        }
+    }
+    /* inline: the shape decides */
+    shape sh;
+    shape_of(&sh, s, i, c);
+    if (shape_is(&sh, RCH_RAPID_JOINTTARGET))
+        return add_target(s, i, c, RCH_RAPID_JOINTTARGET, RCH_RAPID_INLINE, nm);
+    if (shape_is(&sh, RCH_RAPID_ROBTARGET))
+        return add_target(s, i, c, RCH_RAPID_ROBTARGET, RCH_RAPID_INLINE, nm);
+    return 0;
+}
+
+int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const char *name, rch_diag *d)
+{
+    if (len > RCH_RAPID_MAX_BYTES) {
+        rch_diag_set(d, name, 0, 0, "a RAPID module of more than %u bytes is refused", RCH_RAPID_MAX_BYTES);
+        return -1;
+    }
+    scan s;
+    memset(&s, 0, sizeof s);
+    s.text = text;
+    s.len = len;
+    s.name = name;
+    s.out = out;
+    s.d = d;
+    int rc = tokenize(&s) == 0 && collect_decls(&s) == 0 ? 0 : -1;
+    for (size_t i = 0; rc == 0 && i < s.tk.n; ++i) {
+        if (!punct(&s, i, '['))
+            continue;
+        const size_t c = close_of(&s, i);
+        if (c >= s.tk.n) {
+            rch_diag_set(d, name, s.tk.t[i].line, s.tk.t[i].col, "'[' not closed");
+            rc = -1;
+            break;
+        }
+        if (classify(&s, i, c) != 0)
+            rc = -1;
+        i = c; /* an aggregate's inside is its own */
+    }
+    /* a closing bracket with no opening one */
+    for (size_t i = 0, depth = 0; rc == 0 && i < s.tk.n; ++i) {
+        if (punct(&s, i, '['))
+            ++depth;
+        else if (punct(&s, i, ']') && depth-- == 0) {
+            rch_diag_set(d, name, s.tk.t[i].line, s.tk.t[i].col, "']' with no '[' before it");
+            rc = -1;
+        }
+    }
+    free(s.tk.t);
+    free(s.dc);
+    return rc;
+}
+
+void rch_rapid_free(rch_rapid_targets *ts)
+{
+    free(ts->t);
+    memset(ts, 0, sizeof *ts);
+}
+
+const char *rch_rapid_kind_name(rch_rapid_kind k)
+{
+    return k == RCH_RAPID_JOINTTARGET ? "jointtarget" : "robtarget";
+}
+
+const char *rch_rapid_context_name(rch_rapid_context c)
+{
+    return c == RCH_RAPID_DECLARATION ? "declaration" : c == RCH_RAPID_ASSIGNMENT ? "assignment" : "inline";
+}
