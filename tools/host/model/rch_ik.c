@@ -112,8 +112,8 @@ int rch_ik_supported(const rc_model *m, char *why, size_t why_len)
         bad = "axes 1 and 2 are parallel (alpha1 = 0)";
     else if (fabs(r[3].a) > 1e-9 || fabs(r[4].a) > 1e-9 || fabs(r[4].d) > 1e-9 || fabs(r[5].a) > 1e-9)
         bad = "the wrist is not spherical (a4, a5, d5 and a6 must be 0)";
-    else if (fabs(r[3].sa * r[4].sa) < 1e-6)
-        bad = "wrist axes 4, 5, 6 are not at right angles (alpha4, alpha5)";
+    else if (fabs(r[3].ca) > 1e-12 || fabs(r[4].ca) > 1e-12)
+        bad = "wrist axes 4, 5, 6 are not at right angles (alpha4, alpha5 must be +-90 deg)";
     else if (fabs(r[1].a) < 1e-9)
         bad = "a2 is 0";
     if (bad) {
@@ -290,20 +290,20 @@ static int solve_all(double out[8][RC_NJ], int *singular, const rc_model *m, con
             rot_x(Ra6, -atan2(r[5].sa, r[5].ca));
             tmul3(M, R03, R6);
             mul3(M, M, Ra6); /* M = Rz(th4) Rx(al4) Rz(th5) Rx(al5) Rz(th6) */
-            double c5 = (r[3].ca * r[4].ca - M[8]) / (r[3].sa * r[4].sa);
-            c5 = c5 > 1.0 ? 1.0 : c5 < -1.0 ? -1.0 : c5;
-            const double a5 = acos(c5);
+            /* alpha4, alpha5 = +-90 deg: M[8] = -sa4 sa5 cos th5 and
+             * (M[2], M[5]) = Rz(th4) (sa5 sin th5, 0), so |sin th5| is
+             * their length: th5 by atan2, well conditioned at 0 as well */
+            const double c5 = -M[8] / (r[3].sa * r[4].sa), s5 = hypot(M[2], M[5]);
             for (int i5 = 0; i5 < 2; ++i5) {
-                const double th5 = i5 == 0 ? a5 : -a5;
-                const double a = r[4].sa * sin(th5), b = -r[3].ca * r[4].sa * cos(th5) - r[3].sa * r[4].ca;
+                const double th5 = i5 == 0 ? atan2(s5, c5) : -atan2(s5, c5);
                 double th4;
-                if (hypot(a, b) < 1e-9 || hypot(M[2], M[5]) < 1e-9) {
+                if (s5 < 1e-12) {
                     *singular = 1;
                     if (i5 == 1)
                         continue; /* one solution family: q4 from the hint */
                     th4 = q4_hint + r[3].off;
                 } else
-                    th4 = atan2(M[5], M[2]) - atan2(b, a);
+                    th4 = atan2(M[5], M[2]) - atan2(0.0, r[4].sa * sin(th5));
                 /* Rz(th6) = Rx(-al5) Rz(-th5) Rx(-al4) Rz(-th4) M */
                 double N[9], T[9];
                 rot_z(T, -th4);

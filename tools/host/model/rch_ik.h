@@ -4,7 +4,7 @@
  *
  * The class: standard DH rows (rc_model.h) with alpha2 = 0 (axes 2 and 3
  * parallel), sin(alpha1) != 0, a4 = a5 = d5 = a6 = 0 (axes 4, 5, 6 meet at
- * the wrist centre), sin(alpha4) sin(alpha5) != 0; a1, d2, d3, alpha3,
+ * the wrist centre), alpha4 and alpha5 +-90 deg; a1, d2, d3, alpha3,
  * alpha6 and every joint zero are free. The IRB120's and the KR6's robot
  * files are of it. The model must have no effect that moves the flange
  * (joint-side, geometry or point side): the IK is of the pure DH table.
