@@ -309,9 +309,12 @@ static void test_refused(void **state)
         "bad_targets.mod:6:26: error: robtarget pConf (declaration) cannot be corrected: the solution with cfx = 0 "
         "has axis 1 outside the quadrant cf1 = 2",
         "bad_targets.mod:7:29: error: jointtarget jLimit (declaration) cannot be corrected: q3 = 100 deg is outside",
-        "bad_targets.mod:9:15: error: jointtarget jUnknown (assignment) cannot be corrected: 'jUnknown' has the form "
+        "bad_targets.mod:8:26: error: robtarget pWobj (declaration) cannot be corrected: used in work object wobjTable "
+        "(line 11)",
+        "bad_targets.mod:12:11: error: robtarget (inline) cannot be corrected: used with tool tPen (line 12)",
+        "bad_targets.mod:10:15: error: jointtarget jUnknown (assignment) cannot be corrected: 'jUnknown' has the form "
         "of a jointtarget but is not declared in this module",
-        "(and 5 more targets; nothing written)",
+        "(and 7 more targets; nothing written)",
     };
     for (size_t k = 0; k < sizeof want / sizeof want[0]; ++k)
         if (!strstr(msg, want[k]))

@@ -5,7 +5,10 @@ MODULE BadTargets
   CONST jointtarget jShort:=[[10,20,30,40,50],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST robtarget pConf:=[[438.426,100.804,511.163],[0.174033,0.432048,0.808673,0.359297],[2,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST jointtarget jLimit:=[[10,20,100,40,50,60],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  CONST robtarget pWobj:=[[438.426,100.804,511.163],[0.174033,0.432048,0.808673,0.359297],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   PROC main()
     jUnknown:=[[1,2,3,4,5,6],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    MoveL pWobj, v100, fine, tool0 \WObj:=wobjTable;
+    MoveL [[438.426,100.804,511.163],[0.174033,0.432048,0.808673,0.359297],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tPen;
   ENDPROC
 ENDMODULE

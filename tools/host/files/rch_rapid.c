@@ -164,17 +164,25 @@ static void tok_name(char *buf, size_t n, const scan *s, size_t i)
     buf[k] = '\0';
 }
 
-/* Index of the bracket closing the one at i ('[', '(' or '{'), or s->tk.n. */
+/* Index of the bracket closing the one at i ('[', '(' or '{'), or s->tk.n
+ * when it is not closed, a bracket of another kind closes first, or the
+ * nesting is deeper than 64. */
 static size_t close_of(const scan *s, size_t i)
 {
+    char open[64];
     size_t depth = 0;
     for (size_t j = i; j < s->tk.n; ++j) {
         const tok *t = &s->tk.t[j];
         if (t->type != T_PUNCT)
             continue;
-        if (t->ch == '[' || t->ch == '(' || t->ch == '{')
-            ++depth;
-        else if (t->ch == ']' || t->ch == ')' || t->ch == '}') {
+        if (t->ch == '[' || t->ch == '(' || t->ch == '{') {
+            if (depth == sizeof open)
+                return s->tk.n;
+            open[depth++] = t->ch;
+        } else if (t->ch == ']' || t->ch == ')' || t->ch == '}') {
+            const char want = t->ch == ']' ? '[' : t->ch == ')' ? '(' : '{';
+            if (depth == 0 || open[depth - 1] != want)
+                return s->tk.n;
             if (--depth == 0)
                 return j;
         }
@@ -517,6 +525,110 @@ static int classify(scan *s, size_t i, size_t c)
     return 0;
 }
 
+static int is_default(const char *tool, const char *wobj)
+{
+    return (tool[0] == '\0' || strcasecmp(tool, "tool0") == 0) && (wobj[0] == '\0' || strcasecmp(wobj, "wobj0") == 0);
+}
+
+static void note_use(rch_rapid_target *t, const char *tool, const char *wobj, unsigned line)
+{
+    if (t->use_line == 0 || (is_default(t->tool, t->wobj) && !is_default(tool, wobj))) {
+        snprintf(t->tool, sizeof t->tool, "%s", tool);
+        snprintf(t->wobj, sizeof t->wobj, "%s", wobj);
+        t->use_line = line;
+    }
+}
+
+static unsigned hash_ci(const char *p, size_t n)
+{
+    unsigned h = 2166136261u;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ (unsigned)tolower((unsigned char)p[i])) * 16777619u;
+    return h;
+}
+
+/* The Move* instructions: each one's tool (its last positional argument)
+ * and work object (\WObj:=) onto the targets it names or holds. */
+static int note_uses(scan *s)
+{
+    rch_rapid_targets *o = s->out;
+    enum { NB = 1024 };
+    size_t head[NB];
+    size_t *next = o->n ? malloc(o->n * sizeof *next) : NULL;
+    if (o->n && !next) {
+        rch_diag_set(s->d, s->name, 0, 0, "out of memory");
+        return -1;
+    }
+    for (size_t b = 0; b < NB; ++b)
+        head[b] = (size_t)-1;
+    for (size_t k = 0; k < o->n; ++k) {
+        const size_t nl = strlen(o->t[k].name);
+        next[k] = (size_t)-1;
+        if (nl == 0 || o->t[k].context == RCH_RAPID_INLINE)
+            continue;
+        const unsigned b = hash_ci(o->t[k].name, nl) % NB;
+        next[k] = head[b];
+        head[b] = k;
+    }
+    size_t ti = 0; /* the first target not before the statement */
+    for (size_t i = 0; i < s->tk.n;) {
+        /* a statement: up to ';' at depth 0 */
+        size_t e = i, depth = 0;
+        while (e < s->tk.n && !(depth == 0 && punct(s, e, ';'))) {
+            if (punct(s, e, '[') || punct(s, e, '(') || punct(s, e, '{'))
+                ++depth;
+            else if ((punct(s, e, ']') || punct(s, e, ')') || punct(s, e, '}')) && depth > 0)
+                --depth;
+            ++e;
+        }
+        size_t mv = i;
+        while (mv < e && !(s->tk.t[mv].type == T_IDENT && s->tk.t[mv].len > 4 &&
+                           strncasecmp(s->text + s->tk.t[mv].off, "Move", 4) == 0))
+            ++mv;
+        if (mv < e) {
+            char tool[48] = "", wobj[48] = "";
+            /* arguments: pieces between commas at depth 0 */
+            size_t b = mv + 1;
+            while (b < e) {
+                size_t c = b;
+                depth = 0;
+                while (c < e && !(depth == 0 && punct(s, c, ','))) {
+                    if (punct(s, c, '[') || punct(s, c, '(') || punct(s, c, '{'))
+                        ++depth;
+                    else if ((punct(s, c, ']') || punct(s, c, ')') || punct(s, c, '}')) && depth > 0)
+                        --depth;
+                    if (depth == 0 && punct(s, c, '\\') && c + 3 <= e && c + 2 < s->tk.n && tok_is(s, c + 1, "WObj") &&
+                        s->tk.t[c + 2].type == T_ASSIGN && c + 3 < e && s->tk.t[c + 3].type == T_IDENT)
+                        tok_name(wobj, sizeof wobj, s, c + 3);
+                    ++c;
+                }
+                if (!punct(s, b, '\\') && s->tk.t[b].type == T_IDENT && (b + 1 == c || punct(s, b + 1, '\\')))
+                    tok_name(tool, sizeof tool, s, b); /* the last such positional argument */
+                else if (!punct(s, b, '\\'))
+                    tool[0] = '\0';
+                b = c + 1;
+            }
+            const unsigned line = s->tk.t[mv].line;
+            const size_t from = s->tk.t[mv].off, to = e < s->tk.n ? s->tk.t[e].off : s->len;
+            while (ti < o->n && o->t[ti].off < from)
+                ++ti;
+            for (size_t k = ti; k < o->n && o->t[k].end <= to; ++k)
+                note_use(&o->t[k], tool, wobj, line);
+            for (size_t k = mv + 1; k < e; ++k) {
+                if (s->tk.t[k].type != T_IDENT)
+                    continue;
+                const tok *t = &s->tk.t[k];
+                for (size_t h = head[hash_ci(s->text + t->off, t->len) % NB]; h != (size_t)-1; h = next[h])
+                    if (strlen(o->t[h].name) == t->len && strncasecmp(o->t[h].name, s->text + t->off, t->len) == 0)
+                        note_use(&o->t[h], tool, wobj, line);
+            }
+        }
+        i = e + 1;
+    }
+    free(next);
+    return 0;
+}
+
 int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const char *name, rch_diag *d)
 {
     if (len > RCH_RAPID_MAX_BYTES) {
@@ -536,7 +648,8 @@ int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const c
             continue;
         const size_t c = close_of(&s, i);
         if (c >= s.tk.n) {
-            rch_diag_set(d, name, s.tk.t[i].line, s.tk.t[i].col, "'[' not closed");
+            rch_diag_set(d, name, s.tk.t[i].line, s.tk.t[i].col,
+                         "'[' not closed (or a bracket of another kind closes first, or nested deeper than 64)");
             rc = -1;
             break;
         }
@@ -544,6 +657,8 @@ int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const c
             rc = -1;
         i = c; /* an aggregate's inside is its own */
     }
+    if (rc == 0 && note_uses(&s) != 0)
+        rc = -1;
     /* a closing bracket with no opening one */
     for (size_t i = 0, depth = 0; rc == 0 && i < s.tk.n; ++i) {
         if (punct(&s, i, '['))

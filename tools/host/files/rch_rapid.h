@@ -15,6 +15,8 @@
  *  - anywhere else (an instruction's argument, MoveAbsJ [[...]], MoveL
  *    [[...]], \ToPoint:=[...]): the shape decides, [[6],[6]] a jointtarget,
  *    [[3],[4],[4],[6]] a robtarget.
+ * Each target also gets the tool and work object of a Move* instruction that
+ * uses it (its last positional argument, its \WObj:=), inline or by name.
  * A target literal whose shape is wrong or whose numbers are not literal
  * numbers is listed with its error (the caller names it and refuses).
  * Nothing here computes; the caller rewrites the numbers' bytes
@@ -54,6 +56,10 @@ typedef struct rch_rapid_target {
     double val[RCH_RAPID_NUMS];    /* robax (deg) | x, y, z (mm), q1..q4, cf1, cf4, cf6, cfx */
     unsigned num_line[RCH_RAPID_NUMS], num_col[RCH_RAPID_NUMS];
     char name[48];                 /* the declared or assigned name; "" inline */
+    char tool[48], wobj[48];       /* of the Move instruction that uses it (inline: its own; named: a use
+                                      with another tool than tool0 or another work object than wobj0 if
+                                      there is one, else the first); "" when no Move instruction names it */
+    unsigned use_line;             /* that instruction's line */
     char error[200];               /* not empty: the literal cannot be read (shape, not a number) */
 } rch_rapid_target;
 

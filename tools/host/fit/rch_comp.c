@@ -343,6 +343,22 @@ static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_ra
         snprintf(why, why_len, "no nominal model to invert");
         return -1;
     }
+    const double *tool = c->gate->tool_mm;
+    if (t->wobj[0] && strcasecmp(t->wobj, "wobj0") != 0) {
+        snprintf(why, why_len, "used in work object %s (line %u): rcal corrects robtargets in the base frame (wobj0)",
+                 t->wobj, base + t->use_line);
+        return -1;
+    }
+    if (t->tool[0] && !tool && strcasecmp(t->tool, "tool0") != 0) {
+        snprintf(why, why_len, "used with tool %s (line %u): a robtarget is the pose of that tool's TCP; give "
+                 "--tool X,Y,Z (its TCP in the flange frame) or use tool0", t->tool, base + t->use_line);
+        return -1;
+    }
+    if (t->tool[0] && tool && strcasecmp(t->tool, "tool0") == 0) {
+        snprintf(why, why_len, "used with tool0 (line %u) while --tool gives a TCP: it would be read as that TCP's "
+                 "pose", base + t->use_line);
+        return -1;
+    }
     int cf[4];
     for (int k = 0; k < 4; ++k) {
         const double v = t->val[7 + k];
