@@ -426,32 +426,37 @@ static int add_value(scan *s, size_t i, size_t c, rch_rapid_kind kind, int array
 {
     if (!array)
         return add_target(s, i, c, kind, ctx, name);
+    const size_t n0 = s->out->n;
+    const char *bad = NULL;
     size_t j = i + 1;
-    while (j < c) {
+    while (j < c && !bad) {
         if (!punct(s, j, '[')) {
-            rch_rapid_target *t = new_target(s, i, c, kind, ctx, name);
-            if (!t)
-                return -1;
-            snprintf(t->error, sizeof t->error, "an array of %ss must list aggregates", rch_rapid_kind_name(kind));
-            return 0;
+            bad = "an array of targets must list aggregates";
+            break;
         }
         const size_t e = close_of(s, j);
         if (e >= c) {
-            rch_rapid_target *t = new_target(s, i, c, kind, ctx, name);
-            if (!t)
-                return -1;
-            snprintf(t->error, sizeof t->error, "brackets of another kind cross this aggregate");
-            return 0;
+            bad = "brackets of another kind cross this aggregate";
+            break;
         }
         shape sh;
         shape_of(&sh, s, j, e);
         /* an element of a 2-D array is itself an array of targets */
-        const int deeper = sh.ng < 0 && j + 1 < e && punct(s, j + 1, '[') && punct(s, j + 2, '[');
+        const int deeper = sh.ng < 0 && j + 2 < e && punct(s, j + 1, '[') && punct(s, j + 2, '[');
         if (add_value(s, j, e, kind, deeper, ctx, name) != 0)
             return -1;
         j = e + 1;
         if (j < c && punct(s, j, ','))
             ++j;
+        else if (j < c)
+            bad = "the elements of an array of targets must be separated by commas";
+    }
+    if (bad) { /* the whole array, named once */
+        s->out->n = n0;
+        rch_rapid_target *t = new_target(s, i, c, kind, ctx, name);
+        if (!t)
+            return -1;
+        snprintf(t->error, sizeof t->error, "%s", bad);
     }
     return 0;
 }

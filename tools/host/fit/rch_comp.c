@@ -606,7 +606,8 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         int r;
         if (!decided) {
             decided = 1;
-            if (starts_with_ci(line, n, "MODULE") || starts_with_ci(line, n, "%%%") || find_ci(line, n, "jointtarget") ||
+            if (starts_with_ci(line, n, "MODULE") || starts_with_ci(line, n, "%%%") || starts_with_ci(line, n, "!") ||
+                find_ci(line, n, "jointtarget") ||
                 find_ci(line, n, "robtarget")) {
                 c.format = 2;
             } else {
