@@ -675,6 +675,8 @@ int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const c
     }
     free(s.tk.t);
     free(s.dc);
+    if (rc != 0)
+        rch_rapid_free(out); /* nothing half read is left */
     return rc;
 }
 

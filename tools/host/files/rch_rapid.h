@@ -69,7 +69,8 @@ typedef struct rch_rapid_targets {
 } rch_rapid_targets;
 
 /* Every target literal of text[0..len) (named name in messages) into *out
- * (zero it first; rch_rapid_free after). 0, or -1 with d set. */
+ * (zero it first; rch_rapid_free after). 0, or -1 with d set and *out
+ * empty. */
 int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const char *name, rch_diag *d);
 void rch_rapid_free(rch_rapid_targets *ts);
 
