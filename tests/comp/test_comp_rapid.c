@@ -339,12 +339,71 @@ static void test_refused(void **state)
     free(msg);
 }
 
+/* A tool the module declares: without --tool the message gives the --tool
+ * its tooldata means; with it the robtarget is that TCP's pose, and the real
+ * robot's TCP lands on it. */
+static void test_declared_tool(void **state)
+{
+    (void)state;
+    char in[128], out[128], err[128], cmd[768];
+    snprintf(in, sizeof in, "%s/pen.mod", dir);
+    snprintf(out, sizeof out, "%s/pen_comp.mod", dir);
+    snprintf(err, sizeof err, "%s/pen.err", dir);
+    FILE *f = fopen(in, "w");
+    assert_non_null(f);
+    fputs("MODULE m\n  PERS tooldata tPen:=[TRUE,[[10,-5,150],[1,0,0,0]],[0.5,[0,0,50],[1,0,0,0],0,0,0]];\n"
+          "  PROC main()\n    MoveL [[438.426,100.804,511.163],[0.174033,0.432048,0.808673,0.359297],[0,0,0,0],"
+          "[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tPen;\n  ENDPROC\nENDMODULE\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --in '%s' --out '%s' 2> '%s'", RCAL,
+             model_path, in, out, err);
+    assert_int_equal(run(cmd), 1);
+    size_t n;
+    char *msg = slurp(err, &n);
+    if (!strstr(msg, "pen.mod:4:11: error: robtarget (inline) cannot be corrected: used with tool tPen (line 4), "
+                     "whose TCP is [10,-5,150] in tool0's frame: give --tool -10,5,150 (the flange frame)"))
+        fail_msg("%s", msg);
+    free(msg);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --tool=-10,5,150 --in '%s' --out '%s'", RCAL,
+             model_path, in, out);
+    assert_int_equal(run(cmd), 0);
+    char *txt = slurp(out, &n);
+    rch_rapid_targets to;
+    memset(&to, 0, sizeof to);
+    rch_diag d;
+    assert_int_equal(rch_rapid_scan(&to, txt, n, "out", &d), 0);
+    assert_int_equal(to.n, 1);
+    const rch_rapid_target *b = &to.t[0];
+    const double tool[3] = {-10, 5, 150}, want[3] = {438.426, 100.804, 511.163};
+    int cf[4] = {(int)b->val[7], (int)b->val[8], (int)b->val[9], (int)b->val[10]};
+    double q[RC_NJ], p[3];
+    char why[256];
+    assert_int_equal(rch_ik_solve(q, &robot.nominal, &b->val[0], &b->val[3], cf, tool, why, sizeof why), 0);
+    rc_model det, det_tcp;
+    rch_model_unc unc;
+    int v1;
+    char held[256];
+    rch_comp_determined(&det, &unc, &v1, held, sizeof held, &robot, &robot.nominal);
+    rch_comp_point_model(&det_tcp, &det, tool);
+    rc_fk(p, NULL, &det_tcp, q);
+    const double e = sqrt((p[0] - want[0]) * (p[0] - want[0]) + (p[1] - want[1]) * (p[1] - want[1]) +
+                          (p[2] - want[2]) * (p[2] - want[2]));
+    printf("declared tool: the real TCP at the controller's IK of the written robtarget is %.5f mm from the "
+           "intended point (written trans [%.4f,%.4f,%.4f])\n", e, b->val[0], b->val[1], b->val[2]);
+    assert_true(e < 2e-3);
+    assert_true(fabs(b->val[0] - want[0]) > 0.01); /* it was corrected */
+    rch_rapid_free(&to);
+    free(txt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ik_round_trip),
         cmocka_unit_test(test_every_form),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_declared_tool),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -41,6 +41,12 @@ typedef struct {
     size_t ndc, capdc;
     rch_rapid_targets *out;
     rch_diag *d;
+    struct {
+        char name[48];
+        int robhold;    /* 1 TRUE, 0 FALSE */
+        double tf[7];   /* tframe: trans (mm, tool0 frame), rot (quaternion) */
+    } tools[32];
+    size_t ntools;
 } scan;
 
 static int push_tok(scan *s, tok_type ty, char ch, size_t off, size_t len, unsigned line, unsigned col)
@@ -461,6 +467,46 @@ static int add_value(scan *s, size_t i, size_t c, rch_rapid_kind kind, int array
     return 0;
 }
 
+/* A tooldata literal [robhold, [[x,y,z],[q1..q4]], load]: its frame. */
+static void note_tooldata(scan *s, size_t i, size_t c, const char *name)
+{
+    if (s->ntools == sizeof s->tools / sizeof s->tools[0] || !punct(s, i + 2, ',') || !punct(s, i + 3, '['))
+        return;
+    const int hold = tok_is(s, i + 1, "TRUE") ? 1 : tok_is(s, i + 1, "FALSE") ? 0 : -1;
+    const size_t e = close_of(s, i + 3);
+    if (hold < 0 || e >= c)
+        return;
+    shape sh;
+    shape_of(&sh, s, i + 3, e);
+    if (!(sh.ng == 2 && sh.nl[0] == 3 && sh.nl[1] == 4))
+        return;
+    double v[7];
+    for (int g = 0, k = 0; g < 2; ++g)
+        for (int l = 0; l < sh.nl[g]; ++l, ++k) {
+            size_t b = sh.lb[g][l];
+            const size_t en = sh.le[g][l];
+            int neg = 0;
+            if (en - b == 2 && (punct(s, b, '-') || punct(s, b, '+'))) {
+                neg = punct(s, b, '-');
+                ++b;
+            }
+            const tok *t = &s->tk.t[b];
+            char buf[64];
+            if (!(en == b + 1 && t->type == T_NUM && t->len < sizeof buf))
+                return;
+            memcpy(buf, s->text + t->off, t->len);
+            buf[t->len] = '\0';
+            if (rch_parse_double(buf, &v[k]) != 0)
+                return;
+            if (neg)
+                v[k] = -v[k];
+        }
+    snprintf(s->tools[s->ntools].name, sizeof s->tools[0].name, "%s", name);
+    s->tools[s->ntools].robhold = hold;
+    memcpy(s->tools[s->ntools].tf, v, sizeof v);
+    s->ntools++;
+}
+
 /* The target the aggregate at token i (closing at c) stands for, from what
  * precedes it. */
 static int classify(scan *s, size_t i, size_t c)
@@ -490,6 +536,8 @@ static int classify(scan *s, size_t i, size_t c)
             if (k >= 2 && s->tk.t[k - 1].type == T_IDENT &&
                 (tok_is(s, k - 2, "VAR") || tok_is(s, k - 2, "PERS") || tok_is(s, k - 2, "CONST"))) {
                 const int kind = target_type(s, k - 1);
+                if (kind == 0 && tok_is(s, k - 1, "tooldata") && !indexed)
+                    note_tooldata(s, i, c, nm);
                 if (kind == 0)
                     return 0; /* another type: not a target */
                 return add_value(s, i, c, (rch_rapid_kind)kind, indexed, RCH_RAPID_DECLARATION, nm);
@@ -664,6 +712,13 @@ int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const c
     }
     if (rc == 0 && note_uses(&s) != 0)
         rc = -1;
+    for (size_t k = 0; rc == 0 && k < out->n; ++k)
+        for (size_t j = 0; j < s.ntools; ++j)
+            if (strcasecmp(out->t[k].tool, s.tools[j].name) == 0) {
+                out->t[k].tool_declared = 1;
+                out->t[k].tool_robhold = s.tools[j].robhold;
+                memcpy(out->t[k].tool_frame, s.tools[j].tf, sizeof out->t[k].tool_frame);
+            }
     /* a closing bracket with no opening one */
     for (size_t i = 0, depth = 0; rc == 0 && i < s.tk.n; ++i) {
         if (punct(&s, i, '['))

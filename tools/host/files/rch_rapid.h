@@ -16,7 +16,8 @@
  *    [[...]], \ToPoint:=[...]): the shape decides, [[6],[6]] a jointtarget,
  *    [[3],[4],[4],[6]] a robtarget.
  * Each target also gets the tool and work object of a Move* instruction that
- * uses it (its last positional argument, its \WObj:=), inline or by name.
+ * uses it (its last positional argument, its \WObj:=), inline or by name,
+ * and that tool's frame when the module declares it with a literal tooldata.
  * A target literal whose shape is wrong or whose numbers are not literal
  * numbers is listed with its error (the caller names it and refuses).
  * Nothing here computes; the caller rewrites the numbers' bytes
@@ -60,6 +61,9 @@ typedef struct rch_rapid_target {
                                       with another tool than tool0 or another work object than wobj0 if
                                       there is one, else the first); "" when no Move instruction names it */
     unsigned use_line;             /* that instruction's line */
+    int tool_declared;             /* that tool is declared in the module with a literal tooldata: */
+    int tool_robhold;              /*   its robhold (1 TRUE: held by the robot) */
+    double tool_frame[7];          /*   its tframe: trans (mm, in tool0's frame), rot (q1..q4) */
     char error[200];               /* not empty: the literal cannot be read (shape, not a number) */
 } rch_rapid_target;
 

@@ -349,7 +349,30 @@ static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_ra
                  t->wobj, base + t->use_line);
         return -1;
     }
-    if (t->tool[0] && !tool && strcasecmp(t->tool, "tool0") != 0) {
+    if (t->tool_declared) {
+        /* the module's own tooldata: its TCP in the flange frame is tool0's
+         * vector turned by RCH_IK_TOOL0_RZ_DEG about z */
+        const double *f = t->tool_frame, c0 = cos(RCH_IK_TOOL0_RZ_DEG * DEG), s0 = sin(RCH_IK_TOOL0_RZ_DEG * DEG);
+        const double fl[3] = {c0 * f[0] - s0 * f[1], s0 * f[0] + c0 * f[1], f[2]};
+        const double qn = sqrt(f[3] * f[3] + f[4] * f[4] + f[5] * f[5] + f[6] * f[6]);
+        if (!t->tool_robhold) {
+            snprintf(why, why_len, "used with tool %s (line %u), a stationary tool (robhold FALSE): its robtargets "
+                     "are not TCP poses", t->tool, base + t->use_line);
+            return -1;
+        }
+        if (!(qn > 0) || fabs(fabs(f[3]) / qn - 1.0) > 1e-9) {
+            snprintf(why, why_len, "used with tool %s (line %u), whose frame is turned against tool0 (rot [%g,%g,%g,%g]): "
+                     "rcal reads robtargets of a TCP with tool0's orientation", t->tool, base + t->use_line, f[3],
+                     f[4], f[5], f[6]);
+            return -1;
+        }
+        if (!tool || fabs(tool[0] - fl[0]) > 1e-6 || fabs(tool[1] - fl[1]) > 1e-6 || fabs(tool[2] - fl[2]) > 1e-6) {
+            snprintf(why, why_len, "used with tool %s (line %u), whose TCP is [%g,%g,%g] in tool0's frame: give "
+                     "--tool %g,%g,%g (the flange frame)%s", t->tool, base + t->use_line, f[0], f[1], f[2],
+                     fl[0] + 0.0, fl[1] + 0.0, fl[2] + 0.0, tool ? ", not the --tool given" : "");
+            return -1;
+        }
+    } else if (t->tool[0] && !tool && strcasecmp(t->tool, "tool0") != 0) {
         snprintf(why, why_len, "used with tool %s (line %u): a robtarget is the pose of that tool's TCP; give "
                  "--tool X,Y,Z (its TCP in the flange frame) or use tool0", t->tool, base + t->use_line);
         return -1;
