@@ -181,12 +181,13 @@ int rcal_cmd_compensate(int argc, char **argv)
          "nominal model the targets were made with (default: the model file's \"nominal\" table)", 0, NULL},
         {"--in", RCH_OPT_STR, &in, 0, 0, "FILE|-", "targets (default standard input)", 0, NULL},
         {"--out", RCH_OPT_STR, &out, 0, 0, "FILE|-",
-         "result (default standard output, flushed per line); a file is replaced only when complete, and never "
+         "result (default standard output, flushed per line; a RAPID module at the end, whole); a file is replaced only when complete, and never "
          "when it is the input or a model",
          0, NULL},
         {"--tool", RCH_OPT_TRIPLE, tool, -2000.0, 2000.0, "X,Y,Z",
          "the TCP to place, mm in the flange frame (default: the flange centre; never the cable attachment the "
-         "calibration measured)",
+         "calibration measured); RAPID robtargets are then poses of this TCP with tool0's orientation (an ABB "
+         "tooldata trans [x,y,z] is -x,-y,z here)",
          0, NULL},
         {"--uncertainty-out", RCH_OPT_STR, &unc_out, 0, 0, "FILE.csv",
          "per target (its input line) the predicted 95 % position uncertainty u95_mm of the compensated point, "
