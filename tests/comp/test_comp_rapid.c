@@ -161,6 +161,58 @@ static void ik_round_trip(const rc_model *m, const char *name)
     assert_true(worst_q < 1e-9);
 }
 
+typedef struct {
+    double rt_mm, rt_rot, land_mm, land_rot;
+} worst;
+
+/* One robtarget of the module: b (after) is FK_nom of the stream's output qc
+ * for the IK joints of a (before), and the controller's IK of b puts the
+ * real robot (det) on a's pose. */
+static void check_robtarget(worst *w, const rch_rapid_target *a, const rch_rapid_target *b, const rc_real qc[RC_NJ],
+                            const rc_model *det, int exit_kind)
+{
+    char why[256];
+    double qcd[RC_NJ], p[3], qt[4];
+    int cf[4];
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        qcd[j] = (double)qc[j];
+    rch_ik_fk(p, qt, cf, &robot.nominal, qcd, NULL);
+    for (int j = 0; j < 3; ++j)
+        w->rt_mm = fmax(w->rt_mm, fabs(b->val[j] - p[j]));
+    w->rt_rot = fmax(w->rt_rot, rot_gap(&b->val[3], qt));
+    for (int j = 0; j < 4; ++j)
+        assert_int_equal((int)b->val[7 + j], cf[j]);
+    /* what the controller then does: its nominal IK of the written
+     * target, on the real (calibrated) robot, lands on the intended pose */
+    int cfo[4] = {(int)b->val[7], (int)b->val[8], (int)b->val[9], (int)b->val[10]};
+    double qr[RC_NJ], pr[3], Rr[9], Rz[9], Ra[9];
+    assert_int_equal(rch_ik_solve(qr, &robot.nominal, &b->val[0], &b->val[3], cfo, NULL, why, sizeof why), 0);
+    rc_fk(pr, Rr, det, qr);
+    rch_ik_quat_to_rot(Ra, &a->val[3]);
+    const double Rz180[9] = {-1, 0, 0, 0, -1, 0, 0, 0, 1};
+    memcpy(Rz, Rz180, sizeof Rz);
+    double Rt[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            Rt[3 * i + j] = Rr[3 * i] * Rz[j] + Rr[3 * i + 1] * Rz[3 + j] + Rr[3 * i + 2] * Rz[6 + j];
+    double tr = 0;
+    for (int i = 0; i < 9; ++i)
+        tr += Rt[i] * Ra[i];
+    const double ang = acos(fmin(1.0, fmax(-1.0, (tr - 1.0) / 2.0)));
+    const double e = sqrt((pr[0] - a->val[0]) * (pr[0] - a->val[0]) + (pr[1] - a->val[1]) * (pr[1] - a->val[1]) +
+                          (pr[2] - a->val[2]) * (pr[2] - a->val[2]));
+    w->land_mm = fmax(w->land_mm, e);
+    if (exit_kind != RC_COMP_POSITION_ONLY)
+        w->land_rot = fmax(w->land_rot, ang);
+    printf("line %3u %-11s %-9s before [%g,%g,%g] [%g,%g,%g,%g] [%g,%g,%g,%g] after [%.4f,%.4f,%.4f] "
+           "[%.7f,%.7f,%.7f,%.7f] [%g,%g,%g,%g]; the real robot at the controller's IK of it: %.5f mm, %.2g rad "
+           "from the intended pose\n",
+           a->line, "robtarget", a->name[0] ? a->name : "(inline)", a->val[0], a->val[1], a->val[2], a->val[3],
+           a->val[4], a->val[5], a->val[6], a->val[7], a->val[8], a->val[9], a->val[10], b->val[0], b->val[1],
+           b->val[2], b->val[3], b->val[4], b->val[5], b->val[6], b->val[7], b->val[8], b->val[9], b->val[10], e,
+           ang);
+}
+
 /* The module with every target form: each output target is the stream's
  * correction of the same joints (a robtarget: the nominal pose of the
  * corrected IK joints), and the bytes between the numbers are unchanged. */
@@ -223,7 +275,8 @@ static void test_every_form(void **state)
     memset(&cfg, 0, sizeof cfg);
     static rc_comp_stream s;
     assert_int_equal(rc_comp_stream_init(&s, &det, &nom_pt, &cfg), RC_OK);
-    double worst_jt = 0, worst_rt_mm = 0, worst_rt_rot = 0, worst_land_mm = 0, worst_land_rot = 0;
+    double worst_jt = 0;
+    worst w = {0, 0, 0, 0};
     for (size_t k = 0; k < ti.n; ++k) {
         const rch_rapid_target *a = &ti.t[k], *b = &to.t[k];
         assert_int_equal(a->kind, b->kind);
@@ -250,54 +303,16 @@ static void test_every_form(void **state)
                    b->val[5]);
             continue;
         }
-        double qcd[RC_NJ], p[3], qt[4];
-        int cf[4];
-        for (unsigned j = 0; j < RC_NJ; ++j)
-            qcd[j] = (double)qc[j];
-        rch_ik_fk(p, qt, cf, &robot.nominal, qcd, NULL);
-        for (int j = 0; j < 3; ++j)
-            worst_rt_mm = fmax(worst_rt_mm, fabs(b->val[j] - p[j]));
-        worst_rt_rot = fmax(worst_rt_rot, rot_gap(&b->val[3], qt));
-        for (int j = 0; j < 4; ++j)
-            assert_int_equal((int)b->val[7 + j], cf[j]);
-        /* what the controller then does: its nominal IK of the written
-         * target, on the real (calibrated) robot, lands on the intended pose */
-        int cfo[4] = {(int)b->val[7], (int)b->val[8], (int)b->val[9], (int)b->val[10]};
-        double qr[RC_NJ], pr[3], Rr[9], Rz[9], Ra[9];
-        assert_int_equal(rch_ik_solve(qr, &robot.nominal, &b->val[0], &b->val[3], cfo, NULL, why, sizeof why), 0);
-        rc_fk(pr, Rr, &det, qr);
-        rch_ik_quat_to_rot(Ra, &a->val[3]);
-        const double Rz180[9] = {-1, 0, 0, 0, -1, 0, 0, 0, 1};
-        memcpy(Rz, Rz180, sizeof Rz);
-        double Rt[9];
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                Rt[3 * i + j] = Rr[3 * i] * Rz[j] + Rr[3 * i + 1] * Rz[3 + j] + Rr[3 * i + 2] * Rz[6 + j];
-        double tr = 0;
-        for (int i = 0; i < 9; ++i)
-            tr += Rt[i] * Ra[i];
-        const double ang = acos(fmin(1.0, fmax(-1.0, (tr - 1.0) / 2.0)));
-        const double e = sqrt((pr[0] - a->val[0]) * (pr[0] - a->val[0]) + (pr[1] - a->val[1]) * (pr[1] - a->val[1]) +
-                              (pr[2] - a->val[2]) * (pr[2] - a->val[2]));
-        worst_land_mm = fmax(worst_land_mm, e);
-        if (res.exit != RC_COMP_POSITION_ONLY)
-            worst_land_rot = fmax(worst_land_rot, ang);
-        printf("line %3u %-11s %-9s before [%g,%g,%g] [%g,%g,%g,%g] [%g,%g,%g,%g] after [%.4f,%.4f,%.4f] "
-               "[%.7f,%.7f,%.7f,%.7f] [%g,%g,%g,%g]; the real robot at the controller's IK of it: %.5f mm, %.2g rad "
-               "from the intended pose\n",
-               a->line, "robtarget", a->name[0] ? a->name : "(inline)", a->val[0], a->val[1], a->val[2], a->val[3],
-               a->val[4], a->val[5], a->val[6], a->val[7], a->val[8], a->val[9], a->val[10], b->val[0], b->val[1],
-               b->val[2], b->val[3], b->val[4], b->val[5], b->val[6], b->val[7], b->val[8], b->val[9], b->val[10], e,
-               ang);
+        check_robtarget(&w, a, b, qc, &det, res.exit);
     }
     printf("every form: jointtargets within %.2g deg of the stream, robtargets within %.2g mm and 1-|q.q'| %.2g of "
            "FK_nom(stream(IK_nom)); the real robot lands within %.4f mm and %.2g rad\n",
-           worst_jt, worst_rt_mm, worst_rt_rot, worst_land_mm, worst_land_rot);
+           worst_jt, w.rt_mm, w.rt_rot, w.land_mm, w.land_rot);
     assert_true(worst_jt <= 0.5e-4 + 1e-9);   /* %.4f */
-    assert_true(worst_rt_mm <= 0.5e-4 + 1e-9); /* %.4f */
-    assert_true(worst_rt_rot < 1e-12);
-    assert_true(worst_land_mm < 2e-3);
-    assert_true(worst_land_rot < 1e-5);
+    assert_true(w.rt_mm <= 0.5e-4 + 1e-9); /* %.4f */
+    assert_true(w.rt_rot < 1e-12);
+    assert_true(w.land_mm < 2e-3);
+    assert_true(w.land_rot < 1e-5);
     rch_rapid_free(&ti);
     rch_rapid_free(&to);
     free(in);

@@ -331,19 +331,11 @@ static void rapid_refuse(comp_ctx *c, unsigned long *n_bad, rch_diag *d, const r
     ++*n_bad;
 }
 
-/* One robtarget: the nominal IK with its confdata gives the joints, the
- * compensation corrects them, the nominal pose of the corrected joints (its
- * confdata recomputed) is written. 0 ok, 1 flagged, 2 left as it was,
- * -1 refused (why set). */
-static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_rapid_target *t, unsigned base,
-                           char *why, size_t why_len)
+/* The tool and work object of the instruction that uses robtarget t fit
+ * what the command was given (tool0, or the --tool TCP; wobj0): 0, or -1
+ * with why set. */
+static int robtarget_frame(const rch_rapid_target *t, const double *tool, unsigned base, char *why, size_t why_len)
 {
-    const rc_model *nom = c->gate ? c->gate->nominal : NULL;
-    if (nom == NULL) {
-        snprintf(why, why_len, "no nominal model to invert");
-        return -1;
-    }
-    const double *tool = c->gate->tool_mm;
     if (t->wobj[0] && strcasecmp(t->wobj, "wobj0") != 0) {
         snprintf(why, why_len, "used in work object %s (line %u): rcal corrects robtargets in the base frame (wobj0)",
                  t->wobj, base + t->use_line);
@@ -382,6 +374,24 @@ static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_ra
                  "pose", base + t->use_line);
         return -1;
     }
+    return 0;
+}
+
+/* One robtarget: the nominal IK with its confdata gives the joints, the
+ * compensation corrects them, the nominal pose of the corrected joints (its
+ * confdata recomputed) is written. 0 ok, 1 flagged, 2 left as it was,
+ * -1 refused (why set). */
+static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_rapid_target *t, unsigned base,
+                           char *why, size_t why_len)
+{
+    const rc_model *nom = c->gate ? c->gate->nominal : NULL;
+    if (nom == NULL) {
+        snprintf(why, why_len, "no nominal model to invert");
+        return -1;
+    }
+    const double *tool = c->gate->tool_mm;
+    if (robtarget_frame(t, tool, base, why, why_len) != 0)
+        return -1;
     int cf[4];
     for (int k = 0; k < 4; ++k) {
         const double v = t->val[7 + k];
