@@ -346,7 +346,9 @@ static void test_refused(void **state)
         "bad_targets.mod:12:11: error: robtarget (inline) cannot be corrected: used with tool tPen (line 12)",
         "bad_targets.mod:10:15: error: jointtarget jUnknown (assignment) cannot be corrected: 'jUnknown' has the form "
         "of a jointtarget but is not declared in this module",
-        "(and 7 more targets; nothing written)",
+        "bad_targets.mod:14:26: error: robtarget pSing (declaration) cannot be corrected: singular: the wrist centre "
+        "is on axis 1 (shoulder singularity)",
+        "(and 8 more targets; nothing written)",
     };
     for (size_t k = 0; k < sizeof want / sizeof want[0]; ++k)
         if (!strstr(msg, want[k]))

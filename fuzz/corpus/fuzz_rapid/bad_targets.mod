@@ -11,4 +11,5 @@ MODULE BadTargets
     MoveL pWobj, v100, fine, tool0 \WObj:=wobjTable;
     MoveL [[438.426,100.804,511.163],[0.174033,0.432048,0.808673,0.359297],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tPen;
   ENDPROC
+  CONST robtarget pSing:=[[0,0,800],[0,0,0,1],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
 ENDMODULE

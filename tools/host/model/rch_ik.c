@@ -262,8 +262,12 @@ static int solve_all(double out[8][RC_NJ], int *singular, const rc_model *m, con
     const double h = r[1].d + r[2].d + r[2].ca * r[3].d;
     const double rho = hypot(W[0], W[1]);
     const double C = (h - r[0].ca * (W[2] - r[0].d)) / r[0].sa;
-    if (rho < 1e-9 || fabs(C) > rho)
-        return 0; /* on axis 1, or out of reach of axis 1's offset */
+    if (rho < 1e-9) {
+        *singular = 2; /* the wrist centre on axis 1: axis 1 is not determined */
+        return 0;
+    }
+    if (fabs(C) > rho)
+        return 0; /* out of reach of axis 1's offset */
     const double psi = atan2(W[1], W[0]), as = asin(C / rho);
     const double b3 = -r[2].sa * r[3].d, L3 = hypot(r[2].a, b3), phi = atan2(b3, r[2].a);
     int n = 0;
@@ -373,7 +377,9 @@ int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3],
         int sing;
         const int n = solve_all(sol, &sing, m, pos_mm, quat, tool_mm, wrap(hint));
         if (n == 0) {
-            snprintf(why, why_len, "out of reach: no joint solution reaches this pose");
+            snprintf(why, why_len, sing == 2 ? "singular: the wrist centre is on axis 1 (shoulder singularity), "
+                                               "axis 1 is not determined"
+                                             : "out of reach: no joint solution reaches this pose");
             return -1;
         }
         for (int k = 0; k < n; ++k) {
@@ -408,7 +414,7 @@ int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3],
             memcpy(q_rad, q, sizeof q);
             return 0;
         }
-        if (!sing)
+        if (sing != 1)
             break;
     }
     if (n_cfx == 0)
