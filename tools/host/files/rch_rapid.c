@@ -39,6 +39,8 @@ typedef struct {
     toks tk;
     decl *dc;
     size_t ndc, capdc;
+    size_t *dnext;           /* (capdc) the next declaration in the same hash bucket */
+    size_t dhead[1024];      /* first declaration of each bucket, or (size_t)-1 */
     rch_rapid_targets *out;
     rch_diag *d;
     struct {
@@ -205,32 +207,38 @@ static int target_type(const scan *s, size_t i)
     return 0;
 }
 
+static unsigned hash_ci(const char *p, size_t n)
+{
+    unsigned h = 2166136261u;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ (unsigned)tolower((unsigned char)p[i])) * 16777619u;
+    return h;
+}
+
 static const decl *find_decl(const scan *s, size_t i)
 {
-    for (size_t k = 0; k < s->ndc; ++k) {
-        const tok *t = &s->tk.t[i];
+    const tok *t = &s->tk.t[i];
+    const size_t nb = sizeof s->dhead / sizeof s->dhead[0];
+    for (size_t k = s->dhead[hash_ci(s->text + t->off, t->len) % nb]; k != (size_t)-1; k = s->dnext[k])
         if (strlen(s->dc[k].name) == t->len && strncasecmp(s->dc[k].name, s->text + t->off, t->len) == 0)
             return &s->dc[k];
-    }
     return NULL;
 }
 
 /* Declarations: VAR|PERS|CONST TYPE NAME. Names of target types are kept. */
 static int collect_decls(scan *s)
 {
+    const size_t nb = sizeof s->dhead / sizeof s->dhead[0];
+    for (size_t b = 0; b < nb; ++b)
+        s->dhead[b] = (size_t)-1;
     for (size_t i = 0; i + 2 < s->tk.n; ++i) {
         if (!(tok_is(s, i, "VAR") || tok_is(s, i, "PERS") || tok_is(s, i, "CONST")))
             continue;
         if (s->tk.t[i + 1].type != T_IDENT || s->tk.t[i + 2].type != T_IDENT)
             continue;
         const int kind = target_type(s, i + 1);
-        char nm[48];
-        tok_name(nm, sizeof nm, s, i + 2);
-        decl *old = NULL;
-        for (size_t k = 0; k < s->ndc; ++k)
-            if (strcasecmp(s->dc[k].name, nm) == 0)
-                old = &s->dc[k];
         const int array = punct(s, i + 3, '{');
+        decl *old = (decl *)find_decl(s, i + 2);
         if (old) {
             if (old->kind != kind || old->array != array)
                 old->kind = -1; /* two meanings in one module: its assignments are not guessed */
@@ -239,18 +247,24 @@ static int collect_decls(scan *s)
         if (s->ndc == s->capdc) {
             const size_t nc = s->capdc ? 2 * s->capdc : 32;
             decl *nd = realloc(s->dc, nc * sizeof *nd);
-            if (!nd) {
+            if (nd)
+                s->dc = nd;
+            size_t *nn = nd ? realloc(s->dnext, nc * sizeof *nn) : NULL;
+            if (!nd || !nn) {
                 rch_diag_set(s->d, s->name, s->tk.t[i].line, s->tk.t[i].col, "out of memory");
                 return -1;
             }
-            s->dc = nd;
+            s->dnext = nn;
             s->capdc = nc;
         }
-        decl *dn = &s->dc[s->ndc++];
+        decl *dn = &s->dc[s->ndc];
         memset(dn, 0, sizeof *dn);
-        memcpy(dn->name, nm, sizeof dn->name);
+        tok_name(dn->name, sizeof dn->name, s, i + 2);
         dn->kind = kind;
         dn->array = array;
+        const unsigned h = hash_ci(dn->name, strlen(dn->name)) % nb;
+        s->dnext[s->ndc] = s->dhead[h];
+        s->dhead[h] = s->ndc++;
     }
     return 0;
 }
@@ -592,14 +606,6 @@ static void note_use(rch_rapid_target *t, const char *tool, const char *wobj, un
     }
 }
 
-static unsigned hash_ci(const char *p, size_t n)
-{
-    unsigned h = 2166136261u;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ (unsigned)tolower((unsigned char)p[i])) * 16777619u;
-    return h;
-}
-
 /* The Move* instructions: each one's tool (its last positional argument)
  * and work object (\WObj:=) onto the targets it names or holds. */
 static int note_uses(scan *s)
@@ -730,6 +736,7 @@ int rch_rapid_scan(rch_rapid_targets *out, const char *text, size_t len, const c
     }
     free(s.tk.t);
     free(s.dc);
+    free(s.dnext);
     if (rc != 0)
         rch_rapid_free(out); /* nothing half read is left */
     return rc;
