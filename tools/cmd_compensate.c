@@ -16,8 +16,11 @@ static const char summary[] =
     "correct joint targets computed with the nominal model so that the calibrated robot reaches the nominal "
     "flange pose: q' with FK_cal(q') = FK_nom(q)";
 static const char details[] =
-    "Input: csv lines of q1..q6 in degrees, with or without a header (other columns are copied), or ABB RAPID "
-    "jointtarget declarations (other lines are copied). A target that does not converge is written as the "
+    "Input: csv lines of q1..q6 in degrees, with or without a header (other columns are copied), or an ABB RAPID "
+    "module: every jointtarget and robtarget literal (declarations, inline in instructions, assignments) is "
+    "corrected, every other byte copied; a robtarget through the nominal IK with its confdata, written as the "
+    "nominal pose of the corrected joints (tool0, or the --tool TCP; base frame). A RAPID target that cannot be "
+    "corrected is named with line, column and reason and nothing is written. A target that does not converge is written as the "
     "target plus the last good correction, with a warning naming the cause and its position error; the exit "
     "status is then 1.";
 
@@ -69,8 +72,7 @@ static void json_targets(rch_jw *w, const char *warnings)
             if (num < tag && num > p && num[-1] == ':') {
                 rch_jw_obj(w, NULL);
                 rch_jw_uint(w, "line", strtoull(num, NULL, 10));
-                rch_jw_str(w, "exit", strstr(msg, "robtarget")          ? "robtarget_copied"
-                                      : strstr(msg, "left uncompensated") ? "left_uncertain"
+                rch_jw_str(w, "exit", strstr(msg, "left uncompensated") ? "left_uncertain"
                                       : strstr(msg, "not compensated")    ? "not_converged"
                                                                           : "warning");
                 rch_jw_str(w, "message", msg);
@@ -93,13 +95,14 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
     rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
     rch_jw_strs(&w, files);
     rch_jw_int(&w, "exit", rc == 0 ? 0 : 1);
-    rch_jw_uint(&w, "targets", r->n + r->n_uncertain + r->n_robtargets);
+    rch_jw_uint(&w, "targets", r->n + r->n_uncertain);
     rch_jw_uint(&w, "corrected", r->n - r->n_fail);
     rch_jw_uint(&w, "not_converged", r->n_fail);
     rch_jw_uint(&w, "not_converged_joint_limit", r->n_joint_limit);
     rch_jw_uint(&w, "orientation_best_effort", r->n_pos_only);
     rch_jw_uint(&w, "left_uncertain", r->n_uncertain);
-    rch_jw_uint(&w, "left_robtargets", r->n_robtargets);
+    rch_jw_uint(&w, "robtargets", r->n_robtargets);
+    rch_jw_uint(&w, "left_robtargets", 0); /* kept for readers of rcal-compensate/1: robtargets are corrected */
     rch_jw_num(&w, "largest_correction_deg", r->max_corr_deg);
     rch_jw_num(&w, "largest_fail_error_mm", r->n_fail ? r->max_fail_err_mm : NAN);
     rch_jw_num(&w, "iterations_per_target", r->n ? (double)r->iters / (double)r->n : NAN);
@@ -178,12 +181,13 @@ int rcal_cmd_compensate(int argc, char **argv)
          "nominal model the targets were made with (default: the model file's \"nominal\" table)", 0, NULL},
         {"--in", RCH_OPT_STR, &in, 0, 0, "FILE|-", "targets (default standard input)", 0, NULL},
         {"--out", RCH_OPT_STR, &out, 0, 0, "FILE|-",
-         "result (default standard output, flushed per line); a file is replaced only when complete, and never "
+         "result (default standard output, flushed per line; a RAPID module at the end, whole); a file is replaced only when complete, and never "
          "when it is the input or a model",
          0, NULL},
         {"--tool", RCH_OPT_TRIPLE, tool, -2000.0, 2000.0, "X,Y,Z",
          "the TCP to place, mm in the flange frame (default: the flange centre; never the cable attachment the "
-         "calibration measured)",
+         "calibration measured); RAPID robtargets are then poses of this TCP with tool0's orientation (an ABB "
+         "tooldata trans [x,y,z] is -x,-y,z here)",
          0, NULL},
         {"--uncertainty-out", RCH_OPT_STR, &unc_out, 0, 0, "FILE.csv",
          "per target (its input line) the predicted 95 % position uncertainty u95_mm of the compensated point, "
@@ -200,9 +204,7 @@ int rcal_cmd_compensate(int argc, char **argv)
          "without)", 0, NULL},
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
-         "RAPID robtargets (Cartesian) are copied uncorrected, each with a warning; with this flag that is not a "
-         "failure",
-         0, NULL},
+         "deprecated, no effect: RAPID robtargets are corrected (through the nominal inverse kinematics)", 0, NULL},
         {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
         {"--summary", RCH_OPT_FLAG, &want_summary, 0, 0, NULL, "targets, iterations, largest correction and time on stderr",
          0, NULL},
@@ -215,6 +217,9 @@ int rcal_cmd_compensate(int argc, char **argv)
         return ps;
     if (!args_fit(position_only, full_pose, json, out))
         return 2;
+    if (accept_rt)
+        fprintf(stderr, "rcal compensate: note: --accept-robtargets is deprecated and has no effect: robtargets are "
+                        "corrected now\n");
 
     const rch_comp_job job = {
         .model_path = model,

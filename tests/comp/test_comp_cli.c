@@ -402,8 +402,9 @@ static void test_rt_bad_numbers(void **state)
     }
 }
 
-/* A RAPID robtarget is copied uncorrected: never silently (issue 13). */
-static void test_robtargets_not_silent(void **state)
+/* A RAPID robtarget is corrected (issue 21; it was copied with a warning,
+ * issue 13); --accept-robtargets is still accepted, with a note. */
+static void test_robtargets_corrected(void **state)
 {
     (void)state;
     char in[128], out[128], err[128], cmd[640];
@@ -412,20 +413,20 @@ static void test_robtargets_not_silent(void **state)
     snprintf(err, sizeof err, "%s/mixed.err", dir);
     write_file(in, "MODULE m\n"
                    "  CONST jointtarget j1 := [[10,20,30,40,50,60],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
-                   "  CONST robtarget p1 := [[500,0,400],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                   "  CONST robtarget p1 := [[438.426,100.804,511.163],[0.174033,0.432048,0.808673,0.359297],"
+                   "[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
                    "ENDMODULE\n");
     snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' 2> '%s'", RCAL, model_path, in, out,
              err);
-    assert_int_equal(run(cmd), 1);
-    const char *msg = read_file(err);
-    assert_non_null(strstr(msg, "mixed.mod:3: warning: robtarget copied uncorrected"));
+    assert_int_equal(run(cmd), 0);
     const char *txt = read_file(out);
-    assert_non_null(strstr(txt, "CONST robtarget p1 := [[500,0,400]"));
-    assert_null(strstr(txt, "[[10,20,30,40,50,60]")); /* the jointtarget was corrected */
+    assert_non_null(strstr(txt, "CONST robtarget p1 := [["));
+    assert_null(strstr(txt, "[[438.426,100.804,511.163]")); /* the robtarget was corrected */
+    assert_null(strstr(txt, "[[10,20,30,40,50,60]"));       /* the jointtarget was corrected */
     snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' --accept-robtargets 2> '%s'", RCAL,
              model_path, in, out, err);
     assert_int_equal(run(cmd), 0);
-    assert_non_null(strstr(read_file(err), "robtarget copied uncorrected"));
+    assert_non_null(strstr(read_file(err), "--accept-robtargets is deprecated"));
 }
 
 int main(void)
@@ -439,7 +440,7 @@ int main(void)
         cmocka_unit_test(test_output_never_destroys),
         cmocka_unit_test(test_failure_reported_truthfully),
         cmocka_unit_test(test_lines_in_process),
-        cmocka_unit_test(test_robtargets_not_silent),
+        cmocka_unit_test(test_robtargets_corrected),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

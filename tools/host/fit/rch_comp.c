@@ -14,7 +14,9 @@
 #include <time.h>
 
 #include "rch_file.h"
+#include "rch_ik.h"
 #include "rch_opt.h"
+#include "rch_rapid.h"
 #include "rch_robot.h"
 #include "rch_stdio.h"
 
@@ -31,7 +33,6 @@ typedef struct {
     rc_comp_stream *stream;
     const rc_model *cal;
     const rch_comp_gate *gate;
-    int accept_robtargets;
     rch_comp_result *res;
     FILE *out, *warn;
     const char *in_name;
@@ -292,66 +293,266 @@ static int do_header(comp_ctx *c, const char *line, size_t n, unsigned lineno, r
     return 0;
 }
 
-/* RAPID: rewrite the robax of a jointtarget declaration; other lines copied. */
-static int do_rapid(comp_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d)
+/* One replacement of the rewritten module: text[off..off+len) -> rep. */
+typedef struct {
+    size_t off, len;
+    char rep[40];
+} edit;
+
+static int add_edit(edit **e, size_t *n, size_t *cap, size_t off, size_t len, const char *fmt, double v)
 {
-    const char *jt = find_ci(line, n, "jointtarget");
-    const char *as = jt ? find_ci(jt, n - (size_t)(jt - line), ":=") : NULL;
-    if (as == NULL) { /* not a declaration with a value: copy */
-        const char *rt = find_ci(line, n, "robtarget");
-        int uncorrected = rt && find_ci(rt, n - (size_t)(rt - line), ":=") != NULL;
-        fwrite(line, 1, n, c->out);
-        fputc('\n', c->out);
-        if (uncorrected) {
-            /* a Cartesian target: the controller's own inverse kinematics
-             * picks its joints, so a joint correction cannot be written here */
-            c->res->n_robtargets++;
-            if (c->warn)
-                fprintf(c->warn,
-                        "%s:%u: warning: robtarget copied uncorrected (rcal corrects jointtargets; convert it to a "
-                        "jointtarget, or pass --accept-robtargets)\n",
-                        c->in_name, lineno);
-            return c->accept_robtargets ? 0 : 1;
-        }
-        return 0;
+    if (*n == *cap) {
+        const size_t nc = *cap ? 2 * *cap : 64;
+        edit *ne = realloc(*e, nc * sizeof *ne);
+        if (!ne)
+            return -1;
+        *e = ne;
+        *cap = nc;
     }
-    const char *p = as + 2, *end = line + n;
-    while (p < end && (*p == ' ' || *p == '\t'))
-        ++p;
-    if (end - p < 2 || p[0] != '[' || p[1] != '[') {
-        rch_diag_set(d, c->in_name, lineno, (unsigned)(p - line) + 1, "expected [[q1,...,q6],[...]] after :=");
+    edit *x = &(*e)[(*n)++];
+    x->off = off;
+    x->len = len;
+    snprintf(x->rep, sizeof x->rep, fmt, v);
+    return 0;
+}
+
+/* A target rcal cannot correct: named with its line, column and reason. */
+static void rapid_refuse(comp_ctx *c, unsigned long *n_bad, rch_diag *d, const rch_rapid_target *t, unsigned base,
+                         const char *why)
+{
+    char what[96];
+    snprintf(what, sizeof what, "%s%s%s", rch_rapid_kind_name(t->kind), t->name[0] ? " " : "", t->name);
+    if (*n_bad == 0)
+        rch_diag_set(d, c->in_name, base + t->line, t->col, "%s (%s): %s", what, rch_rapid_context_name(t->context),
+                     why);
+    if (c->warn)
+        fprintf(c->warn, "%s:%u:%u: error: %s (%s) cannot be corrected: %s\n", c->in_name, base + t->line, t->col,
+                what, rch_rapid_context_name(t->context), why);
+    ++*n_bad;
+}
+
+/* The tool and work object of the instruction that uses robtarget t fit
+ * what the command was given (tool0, or the --tool TCP; wobj0): 0, or -1
+ * with why set. */
+static int robtarget_frame(const rch_rapid_target *t, const double *tool, unsigned base, char *why, size_t why_len)
+{
+    if (t->wobj[0] && strcasecmp(t->wobj, "wobj0") != 0) {
+        snprintf(why, why_len, "used in work object %s (line %u): rcal corrects robtargets in the base frame (wobj0)",
+                 t->wobj, base + t->use_line);
         return -1;
     }
-    const char *body = p + 2;
-    const char *close = memchr(body, ']', (size_t)(end - body));
-    if (close == NULL) {
-        rch_diag_set(d, c->in_name, lineno, (unsigned)(body - line) + 1, "missing ']' after the robot axes");
-        return -1;
-    }
-    size_t st[MAX_FIELDS], ln[MAX_FIELDS];
-    const int nf = split_csv(body, (size_t)(close - body), st, ln);
-    if (nf != RC_NJ) {
-        rch_diag_set(d, c->in_name, lineno, (unsigned)(body - line) + 1, "expected 6 robot axes, found %d", nf);
-        return -1;
-    }
-    double qd[RC_NJ], qo[RC_NJ];
-    unsigned cols[RC_NJ];
-    for (int i = 0; i < RC_NJ; ++i) {
-        cols[i] = (unsigned)(body - line) + (unsigned)st[i] + 1;
-        if (parse_num(&qd[i], body + st[i], ln[i]) != 0) {
-            rch_diag_set(d, c->in_name, lineno, cols[i], "axis %d: '%.*s' is not a finite number", i + 1,
-                         (int)(ln[i] > 40 ? 40 : ln[i]), body + st[i]);
+    if (t->tool_declared) {
+        /* the module's own tooldata: its TCP in the flange frame is tool0's
+         * vector turned by RCH_IK_TOOL0_RZ_DEG about z */
+        const double *f = t->tool_frame, c0 = cos(RCH_IK_TOOL0_RZ_DEG * DEG), s0 = sin(RCH_IK_TOOL0_RZ_DEG * DEG);
+        const double fl[3] = {c0 * f[0] - s0 * f[1], s0 * f[0] + c0 * f[1], f[2]};
+        const double qn = sqrt(f[3] * f[3] + f[4] * f[4] + f[5] * f[5] + f[6] * f[6]);
+        if (!t->tool_robhold) {
+            snprintf(why, why_len, "used with tool %s (line %u), a stationary tool (robhold FALSE): its robtargets "
+                     "are not TCP poses", t->tool, base + t->use_line);
             return -1;
         }
+        if (!(qn > 0) || fabs(fabs(f[3]) / qn - 1.0) > 1e-9) {
+            snprintf(why, why_len, "used with tool %s (line %u), whose frame is turned against tool0 (rot [%g,%g,%g,%g]): "
+                     "rcal reads robtargets of a TCP with tool0's orientation", t->tool, base + t->use_line, f[3],
+                     f[4], f[5], f[6]);
+            return -1;
+        }
+        if (!tool || fabs(tool[0] - fl[0]) > 1e-6 || fabs(tool[1] - fl[1]) > 1e-6 || fabs(tool[2] - fl[2]) > 1e-6) {
+            snprintf(why, why_len, "used with tool %s (line %u), whose TCP is [%g,%g,%g] in tool0's frame: give "
+                     "--tool %g,%g,%g (the flange frame)%s", t->tool, base + t->use_line, f[0], f[1], f[2],
+                     fl[0] + 0.0, fl[1] + 0.0, fl[2] + 0.0, tool ? ", not the --tool given" : "");
+            return -1;
+        }
+    } else if (t->tool[0] && !tool && strcasecmp(t->tool, "tool0") != 0) {
+        snprintf(why, why_len, "used with tool %s (line %u): a robtarget is the pose of that tool's TCP; give "
+                 "--tool X,Y,Z (its TCP in the flange frame) or use tool0", t->tool, base + t->use_line);
+        return -1;
     }
-    const int r = compensate(c, qo, qd, lineno, cols, d);
-    if (r < 0)
-        return r;
-    fwrite(line, 1, (size_t)(body - line), c->out);
-    fprintf(c->out, "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f", qo[0], qo[1], qo[2], qo[3], qo[4], qo[5]);
-    fwrite(close, 1, (size_t)(end - close), c->out);
-    fputc('\n', c->out);
+    if (t->tool[0] && tool && strcasecmp(t->tool, "tool0") == 0) {
+        snprintf(why, why_len, "used with tool0 (line %u) while --tool gives a TCP: it would be read as that TCP's "
+                 "pose", base + t->use_line);
+        return -1;
+    }
+    return 0;
+}
+
+/* One robtarget: the nominal IK with its confdata gives the joints, the
+ * compensation corrects them, the nominal pose of the corrected joints (its
+ * confdata recomputed) is written. 0 ok, 1 flagged, 2 left as it was,
+ * -1 refused (why set). */
+static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_rapid_target *t, unsigned base,
+                           char *why, size_t why_len)
+{
+    const rc_model *nom = c->gate ? c->gate->nominal : NULL;
+    if (nom == NULL) {
+        snprintf(why, why_len, "no nominal model to invert");
+        return -1;
+    }
+    const double *tool = c->gate->tool_mm;
+    if (robtarget_frame(t, tool, base, why, why_len) != 0)
+        return -1;
+    int cf[4];
+    for (int k = 0; k < 4; ++k) {
+        const double v = t->val[7 + k];
+        if (!(v == floor(v)) || fabs(v) > 1000) {
+            snprintf(why, why_len, "confdata value %g is not an integer", v);
+            return -1;
+        }
+        cf[k] = (int)v;
+    }
+    double q[RC_NJ], qd[RC_NJ], qo[RC_NJ];
+    if (rch_ik_solve(q, nom, &t->val[0], &t->val[3], cf, c->gate->tool_mm, why, why_len) != 0)
+        return -1;
+    unsigned cols[RC_NJ];
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        qd[i] = q[i] / DEG;
+        cols[i] = t->col;
+    }
+    rch_diag dd;
+    const unsigned long before_unc = c->res->n_uncertain;
+    const int r = compensate(c, qo, qd, base + t->line, cols, &dd);
+    if (r < 0) {
+        snprintf(why, why_len, "%.300s", dd.msg);
+        return -1;
+    }
+    if (c->res->n_uncertain != before_unc)
+        return 2; /* left uncompensated: copied as it was */
+    c->res->n_robtargets++;
+    double qr[RC_NJ], pos[3], quat[4];
+    int cfo[4];
+    for (unsigned i = 0; i < RC_NJ; ++i)
+        qr[i] = qo[i] * DEG;
+    rch_ik_fk(pos, quat, cfo, nom, qr, c->gate->tool_mm);
+    /* the quaternion's sign as written */
+    const double dot = quat[0] * t->val[3] + quat[1] * t->val[4] + quat[2] * t->val[5] + quat[3] * t->val[6];
+    for (int k = 0; k < 3; ++k)
+        out[k] = pos[k];
+    for (int k = 0; k < 4; ++k)
+        out[3 + k] = dot < 0 ? -quat[k] : quat[k];
+    for (int k = 0; k < 4; ++k)
+        out[7 + k] = cfo[k];
     return r;
+}
+
+/* A whole RAPID module text[0..len), its first line being line base + 1:
+ * every joint target and robtarget corrected, every other byte copied. All
+ * or nothing: a target that cannot be corrected is named (line, column,
+ * reason) and nothing is written. 0, 1 (some flagged), -1. */
+static int do_rapid_text(comp_ctx *c, const char *text, size_t len, unsigned base, rch_diag *d)
+{
+    rch_rapid_targets ts;
+    memset(&ts, 0, sizeof ts);
+    if (rch_rapid_scan(&ts, text, len, c->in_name, d) != 0) {
+        d->line += d->line ? base : 0;
+        return -1;
+    }
+    edit *ed = NULL;
+    size_t ne = 0, cap = 0;
+    unsigned long n_bad = 0;
+    int rc = 0;
+    for (size_t i = 0; i < ts.n; ++i) {
+        const rch_rapid_target *t = &ts.t[i];
+        if (t->error[0]) {
+            rapid_refuse(c, &n_bad, d, t, base, t->error);
+            continue;
+        }
+        char why[320];
+        double out[RCH_RAPID_NUMS];
+        int r;
+        if (t->kind == RCH_RAPID_JOINTTARGET) {
+            unsigned cols[RC_NJ];
+            for (unsigned k = 0; k < RC_NJ; ++k)
+                cols[k] = t->num_col[k];
+            rch_diag dd;
+            r = compensate(c, out, t->val, base + t->line, cols, &dd);
+            if (r < 0) {
+                rapid_refuse(c, &n_bad, d, t, base, dd.msg);
+                continue;
+            }
+        } else {
+            r = rapid_robtarget(c, out, t, base, why, sizeof why);
+            if (r < 0) {
+                rapid_refuse(c, &n_bad, d, t, base, why);
+                continue;
+            }
+            if (r == 2) {
+                rc = 1;
+                continue;
+            }
+        }
+        if (r > 0)
+            rc = 1;
+        for (unsigned k = 0; k < t->n; ++k) {
+            const char *fmt = t->kind == RCH_RAPID_JOINTTARGET ? "%.4f" : k < 3 ? "%.4f" : k < 7 ? "%.7f" : "%.0f";
+            if (add_edit(&ed, &ne, &cap, t->num_off[k], t->num_len[k], fmt, out[k]) != 0) {
+                rch_diag_set(d, c->in_name, 0, 0, "out of memory");
+                free(ed);
+                rch_rapid_free(&ts);
+                return -1;
+            }
+        }
+    }
+    if (n_bad > 0) {
+        if (n_bad > 1) {
+            char more[80];
+            snprintf(more, sizeof more, " (and %lu more targets; nothing written)", n_bad - 1);
+            strncat(d->msg, more, sizeof d->msg - strlen(d->msg) - 1);
+        } else
+            strncat(d->msg, " (nothing written)", sizeof d->msg - strlen(d->msg) - 1);
+        rc = -1;
+    } else {
+        size_t at = 0;
+        for (size_t k = 0; k < ne; ++k) {
+            fwrite(text + at, 1, ed[k].off - at, c->out);
+            fputs(ed[k].rep, c->out);
+            at = ed[k].off + ed[k].len;
+        }
+        fwrite(text + at, 1, len - at, c->out);
+        if (len > 0 && text[len - 1] != '\n')
+            fputc('\n', c->out);
+    }
+    free(ed);
+    rch_rapid_free(&ts);
+    return rc;
+}
+
+/* The rest of a RAPID input: the line already read (raw, got bytes) and
+ * everything after it, at most RCH_RAPID_MAX_BYTES. */
+static int do_rapid(comp_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d)
+{
+    size_t cap = got + 65536, n = got;
+    char *buf = malloc(cap);
+    if (!buf) {
+        rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
+        return -1;
+    }
+    memcpy(buf, line, got);
+    for (;;) {
+        if (n == cap) {
+            if (cap > RCH_RAPID_MAX_BYTES) {
+                free(buf);
+                rch_diag_set(d, c->in_name, 0, 0, "a RAPID module of more than %u bytes is refused",
+                             RCH_RAPID_MAX_BYTES);
+                return -1;
+            }
+            char *nb = realloc(buf, 2 * cap);
+            if (!nb) {
+                free(buf);
+                rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
+                return -1;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        const size_t k = fread(buf + n, 1, cap - n, in);
+        n += k;
+        if (k == 0)
+            break;
+    }
+    const int rc = do_rapid_text(c, buf, n, lineno - 1, d);
+    free(buf);
+    return rc;
 }
 
 /* One line of at most MAX_LINE bytes into *line (grown as needed, '\n'
@@ -404,7 +605,7 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                          rch_diag *d)
 {
     comp_ctx c = {.stream = s, .cal = cal, .gate = gate, .res = res, .out = out, .warn = warn, .in_name = in_name,
-                  .format = (int)format, .accept_robtargets = gate ? gate->accept_robtargets : 0};
+                  .format = (int)format};
     char *line = NULL;
     size_t cap = 0;
     long got;
@@ -438,7 +639,9 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         int r;
         if (!decided) {
             decided = 1;
-            if (starts_with_ci(line, n, "MODULE") || starts_with_ci(line, n, "%%%") || find_ci(line, n, "jointtarget")) {
+            if (starts_with_ci(line, n, "MODULE") || starts_with_ci(line, n, "%%%") || starts_with_ci(line, n, "!") ||
+                find_ci(line, n, "jointtarget") ||
+                find_ci(line, n, "robtarget")) {
                 c.format = 2;
             } else {
                 size_t st[MAX_FIELDS], ln[MAX_FIELDS];
@@ -453,7 +656,13 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                 }
             }
         }
-        r = c.format == 2 ? do_rapid(&c, line, n, lineno, d) : do_csv(&c, line, n, lineno, d);
+        if (c.format == 2) { /* a module is read whole: all or nothing */
+            rc = do_rapid(&c, line, (size_t)got, in, lineno, d);
+            if (rc >= 0 && out_failed(&c, lineno, d))
+                rc = -1;
+            break;
+        }
+        r = do_csv(&c, line, n, lineno, d);
         if (r < 0) {
             rc = -1;
             break;
@@ -490,6 +699,7 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
         (job->nominal_path && rch_robot_load(&nominal_robot, job->nominal_path, d) != 0))
         return -1;
     const rc_model *nom = job->nominal_path ? &nominal_robot.model : &robot.nominal;
+    const rc_model *nom_raw = nom; /* what the program was made with: the robtargets' IK */
     res->no_nominal = !job->nominal_path && !robot.has_nominal;
     static rc_model det;
     static rch_model_unc unc;
@@ -551,7 +761,7 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
         fprintf(uo.f, "line,u95_mm\n");
     }
     const rch_comp_gate gate = {&fit_pt, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
-                                job->accept_robtargets, have_uo ? uo.f : NULL};
+                                job->accept_robtargets, have_uo ? uo.f : NULL, nom_raw, job->tool_mm};
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);

@@ -11,8 +11,17 @@
  *    j1..j6), any case, are corrected; every other column is copied, so a
  *    whole target list (names, speeds, ...) goes through. The header is copied.
  *  - ABB RAPID (a line starting with MODULE or %%%, or holding
- *    "jointtarget"): every "jointtarget NAME := [[q1,...,q6], [...]]" has its
- *    six robot axes corrected ("%.4f"); every other line is copied.
+ *    "jointtarget" or "robtarget"): the module is read whole (rch_rapid.h
+ *    finds every target literal: declarations, inline arguments,
+ *    assignments, several per line, over several lines). A joint target's
+ *    six robot axes are corrected ("%.4f"); a robtarget goes through the
+ *    nominal IK with its confdata (rch_ik.h), its joints are corrected, and
+ *    the nominal pose of the corrected joints is written (trans "%.4f", rot
+ *    "%.7f", confdata recomputed). Every other byte is copied. All or
+ *    nothing: a target that cannot be corrected (out of reach, singular, a
+ *    confdata with no solution, not a literal number, a wrong shape, a
+ *    joint limit) is named with line, column and reason, and nothing is
+ *    written.
  * Blank lines and lines starting with '#' are copied. A malformed line or a
  * target outside the joint limits is an error with file:line:col. A target
  * that does not converge is written as the target plus the last good
@@ -57,8 +66,7 @@ typedef struct rch_comp_job {
     double max_dev_deg;       /* largest correction per joint; 0: the default 0.1 rad */
     double max_unc_mm;        /* a target where the model's 95 % position uncertainty exceeds this is left
                                  uncompensated, with a warning; 0: 1 mm */
-    int accept_robtargets;    /* RAPID robtargets are copied uncorrected with a warning each; 1: that is
-                                 not a failure (exit 0) */
+    int accept_robtargets;    /* accepted for old command lines: robtargets are corrected now */
     const double *tool_mm;    /* (3) the TCP in the flange frame (mm) that compensation places; NULL: the
                                  flange centre. Never the cable attachment point the calibration measured */
     const char *uncertainty_path; /* per target its predicted 95 % position uncertainty (u95_mm, of the point
@@ -83,8 +91,11 @@ typedef struct rch_comp_gate {
     const rc_model *fit;       /* the full fit (for the size of what the held parameters would have moved) */
     const rch_model_unc *unc;  /* covariance of the determined DH parameters; NULL: no gate */
     double max_unc_mm;         /* see rch_comp_job */
-    int accept_robtargets;     /* see rch_comp_job */
+    int accept_robtargets;     /* unused (robtargets are corrected) */
     FILE *u95_out;             /* one line "line,u95_mm" per target, or NULL */
+    const rc_model *nominal;   /* the nominal model the program was made with (pure DH): the robtargets'
+                                  inverse kinematics; NULL: a robtarget is refused */
+    const double *tool_mm;     /* (3) the TCP the robtargets are poses of, in the flange frame; NULL: tool0 */
 } rch_comp_gate;
 
 typedef struct rch_comp_result {
@@ -107,7 +118,7 @@ typedef struct rch_comp_result {
     double max_held_mm;           /* largest flange move the held parameters' fitted values would have made */
     unsigned long n_uncertain;    /* targets left uncompensated: uncertainty above max_unc_mm */
     double max_pos95_mm;          /* largest 95 % position uncertainty at a compensated target */
-    unsigned long n_robtargets;   /* RAPID robtargets copied uncorrected (each warned with its line) */
+    unsigned long n_robtargets;   /* of n: RAPID robtargets corrected (through the nominal IK) */
 } rch_comp_result;
 
 /* Compensate lines of `in` (named in_name in messages) to `out` with the

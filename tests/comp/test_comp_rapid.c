@@ -1,0 +1,426 @@
+/* SPDX-License-Identifier: MIT */
+/* test_comp_rapid.c - whole RAPID programs (issue 21): the nominal IK
+ * against forward kinematics (every configuration of random poses), the
+ * committed module with every target form compensated and each target's
+ * before/after checked against the stream's result for the same joints,
+ * every byte outside the corrected numbers kept, and a module of targets
+ * that cannot be corrected refused with each one's line, column and reason. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "rc_rand.h"
+#include "rch_comp.h"
+#include "rch_ik.h"
+#include "rch_rapid.h"
+#include "rch_robot.h"
+
+#define DEG (3.14159265358979323846 / 180.0)
+#define RCAL RCAL_BINARY_DIR "/tools/rcal"
+#define MODULE_IN RCAL_SOURCE_DIR "/tests/comp/data/every_form.mod"
+#define MODULE_BAD RCAL_SOURCE_DIR "/tests/comp/data/bad_targets.mod"
+
+static char dir[64], model_path[128];
+static rch_robot nominal, robot;
+
+static char *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char *b = malloc(1 << 20);
+    assert_non_null(b);
+    *len = fread(b, 1, (1 << 20) - 1, f);
+    b[*len] = '\0';
+    fclose(f);
+    return b;
+}
+
+static int run(const char *cmd)
+{
+    const int st = system(cmd);
+    assert_true(st != -1);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    strcpy(dir, "/tmp/rcal_comp_rapid_XXXXXX");
+    assert_non_null(mkdtemp(dir));
+    snprintf(model_path, sizeof model_path, "%s/model.json", dir);
+    rch_diag d;
+    assert_int_equal(rch_robot_load(&nominal, RCAL_SOURCE_DIR "/data/irb120.json", &d), 0);
+    rc_model cal = nominal.model; /* "calibrated": nominal + known errors */
+    rc_rng g;
+    rc_rng_seed(&g, 21);
+    for (int k = 0; k < RC_N_DH; ++k)
+        cal.x[k] += (k % 4 < 2 ? 0.5 : 0.1 * DEG) * rc_rng_normal(&g);
+    cal.x[RC_P_ALPHA(5)] = nominal.model.x[RC_P_ALPHA(5)];
+    FILE *f = fopen(model_path, "w");
+    assert_non_null(f);
+    assert_int_equal(rch_robot_write(f, "test calibrated", &cal, &nominal.model, NULL), 0);
+    fclose(f);
+    assert_int_equal(rch_robot_load(&robot, model_path, &d), 0);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static double rot_gap(const double a[4], const double b[4])
+{
+    const double na = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] + a[3] * a[3]);
+    const double nb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
+    return 1.0 - fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]) / (na * nb);
+}
+
+/* FK(IK(pose)) = pose for every closed-form solution of random poses; the
+ * confdata of each solution selects it back. */
+static void ik_round_trip(const rc_model *m, const char *name);
+
+static void test_ik_round_trip(void **state)
+{
+    (void)state;
+    ik_round_trip(&nominal.model, "irb120");
+    static rch_robot kr6;
+    rch_diag d;
+    assert_int_equal(rch_robot_load(&kr6, RCAL_SOURCE_DIR "/data/kr6.json", &d), 0);
+    ik_round_trip(&kr6.model, "kr6 (a1 = 25 mm)");
+}
+
+static void ik_round_trip(const rc_model *m, const char *name)
+{
+    char why[256];
+    assert_int_equal(rch_ik_supported(m, why, sizeof why), 0);
+    /* tool0 at the zero position, as the IRB120's controller reads it */
+    const double q0[RC_NJ] = {0, 0, 0, 0, 0, 0};
+    double p[3], qt[4];
+    int cf[4];
+    rch_ik_fk(p, qt, cf, m, q0, NULL);
+    if (strcmp(name, "irb120") == 0)
+        assert_true(fabs(p[0] - 374) < 1e-9 && fabs(p[1]) < 1e-9 && fabs(p[2] - 630) < 1e-9);
+    if (strcmp(name, "irb120") == 0)
+        assert_true(fabs(qt[0] - sqrt(0.5)) < 1e-12 && fabs(qt[1]) < 1e-12 && fabs(qt[2] - sqrt(0.5)) < 1e-12 &&
+                fabs(qt[3]) < 1e-12);
+    rc_rng g;
+    rc_rng_seed(&g, 2101);
+    double worst_mm = 0, worst_rot = 0, worst_q = 0;
+    int seen[8] = {0}, n_sol = 0;
+    const double tool[3] = {30, -20, 120};
+    for (int t = 0; t < 500; ++t) {
+        double q[RC_NJ];
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            q[j] = m->q_min_rad[j] + (m->q_max_rad[j] - m->q_min_rad[j]) * rc_rng_u01(&g);
+        const double *tl = t % 2 ? tool : NULL;
+        rch_ik_fk(p, qt, cf, m, q, tl);
+        double all[8][RC_NJ];
+        const int n = rch_ik_all(all, m, p, qt, tl);
+        /* eight with no shoulder offset; with a1 != 0 the arm turned over
+         * may not reach (four) */
+        assert_true(n == 8 || (n >= 2 && m->x[RC_P_A(0)] != 0.0));
+        int cfx_mask = 0;
+        for (int k = 0; k < n; ++k) {
+            double p2[3], q2[4];
+            int c2[4];
+            rch_ik_fk(p2, q2, c2, m, all[k], tl);
+            const double e = sqrt((p2[0] - p[0]) * (p2[0] - p[0]) + (p2[1] - p[1]) * (p2[1] - p[1]) +
+                                  (p2[2] - p[2]) * (p2[2] - p[2]));
+            worst_mm = fmax(worst_mm, e);
+            worst_rot = fmax(worst_rot, rot_gap(q2, qt));
+            cfx_mask |= 1 << c2[3];
+            seen[c2[3]]++;
+            ++n_sol;
+        }
+        int bits = 0;
+        for (int b = 0; b < 8; ++b)
+            bits += (cfx_mask >> b) & 1;
+        assert_int_equal(bits, n); /* each solution its own cfx */
+        double qs[RC_NJ];
+        assert_int_equal(rch_ik_solve(qs, m, p, qt, cf, tl, why, sizeof why), 0);
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            worst_q = fmax(worst_q, fabs(qs[j] - q[j]));
+    }
+    printf("IK round trip, %s: %d solutions of 500 poses (%d..%d per cfx), worst |FK(IK) - pose| %.3g mm, "
+           "1 - |q.q'| %.3g, joints recovered from confdata to %.3g rad\n",
+           name, n_sol, seen[0], seen[7], worst_mm, worst_rot, worst_q);
+    assert_true(worst_mm < 1e-9);
+    assert_true(worst_rot < 1e-12);
+    assert_true(worst_q < 1e-9);
+}
+
+typedef struct {
+    double rt_mm, rt_rot, land_mm, land_rot;
+} worst;
+
+/* One robtarget of the module: b (after) is FK_nom of the stream's output qc
+ * for the IK joints of a (before), and the controller's IK of b puts the
+ * real robot (det) on a's pose. */
+static void check_robtarget(worst *w, const rch_rapid_target *a, const rch_rapid_target *b, const rc_real qc[RC_NJ],
+                            const rc_model *det, int exit_kind)
+{
+    char why[256];
+    double qcd[RC_NJ], p[3], qt[4];
+    int cf[4];
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        qcd[j] = (double)qc[j];
+    rch_ik_fk(p, qt, cf, &robot.nominal, qcd, NULL);
+    for (int j = 0; j < 3; ++j)
+        w->rt_mm = fmax(w->rt_mm, fabs(b->val[j] - p[j]));
+    w->rt_rot = fmax(w->rt_rot, rot_gap(&b->val[3], qt));
+    for (int j = 0; j < 4; ++j)
+        assert_int_equal((int)b->val[7 + j], cf[j]);
+    /* what the controller then does: its nominal IK of the written
+     * target, on the real (calibrated) robot, lands on the intended pose */
+    int cfo[4] = {(int)b->val[7], (int)b->val[8], (int)b->val[9], (int)b->val[10]};
+    double qr[RC_NJ], pr[3], Rr[9], Rz[9], Ra[9];
+    assert_int_equal(rch_ik_solve(qr, &robot.nominal, &b->val[0], &b->val[3], cfo, NULL, why, sizeof why), 0);
+    rc_fk(pr, Rr, det, qr);
+    rch_ik_quat_to_rot(Ra, &a->val[3]);
+    const double Rz180[9] = {-1, 0, 0, 0, -1, 0, 0, 0, 1};
+    memcpy(Rz, Rz180, sizeof Rz);
+    double Rt[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            Rt[3 * i + j] = Rr[3 * i] * Rz[j] + Rr[3 * i + 1] * Rz[3 + j] + Rr[3 * i + 2] * Rz[6 + j];
+    double tr = 0;
+    for (int i = 0; i < 9; ++i)
+        tr += Rt[i] * Ra[i];
+    const double ang = acos(fmin(1.0, fmax(-1.0, (tr - 1.0) / 2.0)));
+    const double e = sqrt((pr[0] - a->val[0]) * (pr[0] - a->val[0]) + (pr[1] - a->val[1]) * (pr[1] - a->val[1]) +
+                          (pr[2] - a->val[2]) * (pr[2] - a->val[2]));
+    w->land_mm = fmax(w->land_mm, e);
+    if (exit_kind != RC_COMP_POSITION_ONLY)
+        w->land_rot = fmax(w->land_rot, ang);
+    printf("line %3u %-11s %-9s before [%g,%g,%g] [%g,%g,%g,%g] [%g,%g,%g,%g] after [%.4f,%.4f,%.4f] "
+           "[%.7f,%.7f,%.7f,%.7f] [%g,%g,%g,%g]; the real robot at the controller's IK of it: %.5f mm, %.2g rad "
+           "from the intended pose\n",
+           a->line, "robtarget", a->name[0] ? a->name : "(inline)", a->val[0], a->val[1], a->val[2], a->val[3],
+           a->val[4], a->val[5], a->val[6], a->val[7], a->val[8], a->val[9], a->val[10], b->val[0], b->val[1],
+           b->val[2], b->val[3], b->val[4], b->val[5], b->val[6], b->val[7], b->val[8], b->val[9], b->val[10], e,
+           ang);
+}
+
+/* The module with every target form: each output target is the stream's
+ * correction of the same joints (a robtarget: the nominal pose of the
+ * corrected IK joints), and the bytes between the numbers are unchanged. */
+static void test_every_form(void **state)
+{
+    (void)state;
+    char out[128], cmd[640];
+    snprintf(out, sizeof out, "%s/every_form_comp.mod", dir);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --in '%s' --out '%s'", RCAL, model_path,
+             MODULE_IN, out);
+    assert_int_equal(run(cmd), 0);
+    size_t n_in, n_out;
+    char *in = slurp(MODULE_IN, &n_in), *ou = slurp(out, &n_out);
+    rch_rapid_targets ti, to;
+    memset(&ti, 0, sizeof ti);
+    memset(&to, 0, sizeof to);
+    rch_diag d;
+    assert_int_equal(rch_rapid_scan(&ti, in, n_in, "in", &d), 0);
+    assert_int_equal(rch_rapid_scan(&to, ou, n_out, "out", &d), 0);
+    /* the forms: 6 jointtarget declarations (two on a line, one over four
+     * lines with a comment inside, an array of two), 5 robtarget ones (one
+     * over four lines, an array of two), 2 inline MoveAbsJ, a jointtarget
+     * assignment, 3 inline robtargets (MoveL, MoveC's two), a robtarget
+     * assignment; the comment, the string and the num table are no target */
+    assert_int_equal(ti.n, 18);
+    assert_int_equal(to.n, 18);
+    unsigned n_kind[3] = {0}, n_ctx[4] = {0};
+    for (size_t k = 0; k < ti.n; ++k) {
+        n_kind[ti.t[k].kind]++;
+        n_ctx[ti.t[k].context]++;
+        assert_string_equal(ti.t[k].error, "");
+    }
+    assert_int_equal(n_kind[RCH_RAPID_JOINTTARGET], 9);
+    assert_int_equal(n_kind[RCH_RAPID_ROBTARGET], 9);
+    assert_int_equal(n_ctx[RCH_RAPID_DECLARATION], 11);
+    assert_int_equal(n_ctx[RCH_RAPID_ASSIGNMENT], 2);
+    assert_int_equal(n_ctx[RCH_RAPID_INLINE], 5);
+    /* every byte outside the numbers: the texts without their numbers agree */
+    size_t ai = 0, ao = 0;
+    for (size_t k = 0; k < ti.n; ++k)
+        for (unsigned j = 0; j < ti.t[k].n; ++j) {
+            const size_t li = ti.t[k].num_off[j] - ai, lo = to.t[k].num_off[j] - ao;
+            assert_int_equal(li, lo);
+            assert_memory_equal(in + ai, ou + ao, li);
+            ai = ti.t[k].num_off[j] + ti.t[k].num_len[j];
+            ao = to.t[k].num_off[j] + to.t[k].num_len[j];
+        }
+    assert_int_equal(n_in - ai, n_out - ao);
+    assert_memory_equal(in + ai, ou + ao, n_in - ai);
+
+    /* the stream rcal compensate runs (full pose, flange), fed the same joints in the same order */
+    rc_model det, nom_pt;
+    rch_model_unc unc;
+    int v1;
+    char held[256];
+    rch_comp_determined(&det, &unc, &v1, held, sizeof held, &robot, &robot.nominal);
+    rch_comp_point_model(&det, &det, NULL);
+    rch_comp_point_model(&nom_pt, &robot.nominal, NULL);
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    static rc_comp_stream s;
+    assert_int_equal(rc_comp_stream_init(&s, &det, &nom_pt, &cfg), RC_OK);
+    double worst_jt = 0;
+    worst w = {0, 0, 0, 0};
+    for (size_t k = 0; k < ti.n; ++k) {
+        const rch_rapid_target *a = &ti.t[k], *b = &to.t[k];
+        assert_int_equal(a->kind, b->kind);
+        rc_real q[RC_NJ], qc[RC_NJ];
+        double qd[RC_NJ];
+        char why[256];
+        if (a->kind == RCH_RAPID_JOINTTARGET) {
+            for (unsigned j = 0; j < RC_NJ; ++j)
+                q[j] = (rc_real)(a->val[j] * DEG);
+        } else {
+            int cf[4] = {(int)a->val[7], (int)a->val[8], (int)a->val[9], (int)a->val[10]};
+            assert_int_equal(rch_ik_solve(qd, &robot.nominal, &a->val[0], &a->val[3], cf, NULL, why, sizeof why), 0);
+            for (unsigned j = 0; j < RC_NJ; ++j)
+                q[j] = (rc_real)qd[j];
+        }
+        rc_comp_result res;
+        assert_int_equal(rc_comp_stream_step(&s, qc, &res, q), RC_OK);
+        if (a->kind == RCH_RAPID_JOINTTARGET) {
+            for (unsigned j = 0; j < RC_NJ; ++j)
+                worst_jt = fmax(worst_jt, fabs(b->val[j] - (double)qc[j] / DEG));
+            printf("line %3u %-11s %-9s before [%g,%g,%g,%g,%g,%g] after [%.4f,%.4f,%.4f,%.4f,%.4f,%.4f]\n",
+                   a->line, rch_rapid_kind_name(a->kind), a->name[0] ? a->name : "(inline)", a->val[0], a->val[1],
+                   a->val[2], a->val[3], a->val[4], a->val[5], b->val[0], b->val[1], b->val[2], b->val[3], b->val[4],
+                   b->val[5]);
+            continue;
+        }
+        check_robtarget(&w, a, b, qc, &det, res.exit);
+    }
+    printf("every form: jointtargets within %.2g deg of the stream, robtargets within %.2g mm and 1-|q.q'| %.2g of "
+           "FK_nom(stream(IK_nom)); the real robot lands within %.4f mm and %.2g rad\n",
+           worst_jt, w.rt_mm, w.rt_rot, w.land_mm, w.land_rot);
+    assert_true(worst_jt <= 0.5e-4 + 1e-9);   /* %.4f */
+    assert_true(w.rt_mm <= 0.5e-4 + 1e-9); /* %.4f */
+    assert_true(w.rt_rot < 1e-12);
+    assert_true(w.land_mm < 2e-3);
+    assert_true(w.land_rot < 1e-5);
+    rch_rapid_free(&ti);
+    rch_rapid_free(&to);
+    free(in);
+    free(ou);
+}
+
+/* Targets that cannot be corrected: each named, nothing written, exit 1. */
+static void test_refused(void **state)
+{
+    (void)state;
+    char out[128], err[128], cmd[640];
+    snprintf(out, sizeof out, "%s/bad_comp.mod", dir);
+    snprintf(err, sizeof err, "%s/bad.err", dir);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' 2> '%s'", RCAL, model_path,
+             MODULE_BAD, out, err);
+    assert_int_equal(run(cmd), 1);
+    assert_int_equal(access(out, F_OK), -1); /* nothing written */
+    size_t n;
+    char *msg = slurp(err, &n);
+    static const char *const want[] = {
+        "bad_targets.mod:3:25: error: robtarget pFar (declaration) cannot be corrected: out of reach",
+        "bad_targets.mod:4:28: error: jointtarget jName (declaration) cannot be corrected: axis 3 (line 4, column 36): "
+        "'q3' is not a literal number",
+        "bad_targets.mod:5:29: error: jointtarget jShort (declaration) cannot be corrected: a jointtarget is "
+        "[[6 robot axes],[6 external axes]]; this aggregate is [[5],[6]]",
+        "bad_targets.mod:6:26: error: robtarget pConf (declaration) cannot be corrected: the solution with cfx = 0 "
+        "has axis 1 outside the quadrant cf1 = 2",
+        "bad_targets.mod:7:29: error: jointtarget jLimit (declaration) cannot be corrected: q3 = 100 deg is outside",
+        "bad_targets.mod:8:26: error: robtarget pWobj (declaration) cannot be corrected: used in work object wobjTable "
+        "(line 11)",
+        "bad_targets.mod:12:11: error: robtarget (inline) cannot be corrected: used with tool tPen (line 12)",
+        "bad_targets.mod:10:15: error: jointtarget jUnknown (assignment) cannot be corrected: 'jUnknown' has the form "
+        "of a jointtarget but is not declared in this module",
+        "bad_targets.mod:14:26: error: robtarget pSing (declaration) cannot be corrected: singular: the wrist centre "
+        "is on axis 1 (shoulder singularity)",
+        "(and 8 more targets; nothing written)",
+    };
+    for (size_t k = 0; k < sizeof want / sizeof want[0]; ++k)
+        if (!strstr(msg, want[k]))
+            fail_msg("expected '%s' in:\n%s", want[k], msg);
+    free(msg);
+}
+
+/* A tool the module declares: without --tool the message gives the --tool
+ * its tooldata means; with it the robtarget is that TCP's pose, and the real
+ * robot's TCP lands on it. */
+static void test_declared_tool(void **state)
+{
+    (void)state;
+    char in[128], out[128], err[128], cmd[768];
+    snprintf(in, sizeof in, "%s/pen.mod", dir);
+    snprintf(out, sizeof out, "%s/pen_comp.mod", dir);
+    snprintf(err, sizeof err, "%s/pen.err", dir);
+    FILE *f = fopen(in, "w");
+    assert_non_null(f);
+    fputs("MODULE m\n  PERS tooldata tPen:=[TRUE,[[10,-5,150],[1,0,0,0]],[0.5,[0,0,50],[1,0,0,0],0,0,0]];\n"
+          "  PROC main()\n    MoveL [[438.426,100.804,511.163],[0.174033,0.432048,0.808673,0.359297],[0,0,0,0],"
+          "[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tPen;\n  ENDPROC\nENDMODULE\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --in '%s' --out '%s' 2> '%s'", RCAL,
+             model_path, in, out, err);
+    assert_int_equal(run(cmd), 1);
+    size_t n;
+    char *msg = slurp(err, &n);
+    if (!strstr(msg, "pen.mod:4:11: error: robtarget (inline) cannot be corrected: used with tool tPen (line 4), "
+                     "whose TCP is [10,-5,150] in tool0's frame: give --tool -10,5,150 (the flange frame)"))
+        fail_msg("%s", msg);
+    free(msg);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --tool=-10,5,150 --in '%s' --out '%s'", RCAL,
+             model_path, in, out);
+    assert_int_equal(run(cmd), 0);
+    char *txt = slurp(out, &n);
+    rch_rapid_targets to;
+    memset(&to, 0, sizeof to);
+    rch_diag d;
+    assert_int_equal(rch_rapid_scan(&to, txt, n, "out", &d), 0);
+    assert_int_equal(to.n, 1);
+    const rch_rapid_target *b = &to.t[0];
+    const double tool[3] = {-10, 5, 150}, want[3] = {438.426, 100.804, 511.163};
+    int cf[4] = {(int)b->val[7], (int)b->val[8], (int)b->val[9], (int)b->val[10]};
+    double q[RC_NJ], p[3];
+    char why[256];
+    assert_int_equal(rch_ik_solve(q, &robot.nominal, &b->val[0], &b->val[3], cf, tool, why, sizeof why), 0);
+    rc_model det, det_tcp;
+    rch_model_unc unc;
+    int v1;
+    char held[256];
+    rch_comp_determined(&det, &unc, &v1, held, sizeof held, &robot, &robot.nominal);
+    rch_comp_point_model(&det_tcp, &det, tool);
+    rc_fk(p, NULL, &det_tcp, q);
+    const double e = sqrt((p[0] - want[0]) * (p[0] - want[0]) + (p[1] - want[1]) * (p[1] - want[1]) +
+                          (p[2] - want[2]) * (p[2] - want[2]));
+    printf("declared tool: the real TCP at the controller's IK of the written robtarget is %.5f mm from the "
+           "intended point (written trans [%.4f,%.4f,%.4f])\n", e, b->val[0], b->val[1], b->val[2]);
+    assert_true(e < 2e-3);
+    assert_true(fabs(b->val[0] - want[0]) > 0.01); /* it was corrected */
+    rch_rapid_free(&to);
+    free(txt);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ik_round_trip),
+        cmocka_unit_test(test_every_form),
+        cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_declared_tool),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
