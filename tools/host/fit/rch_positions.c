@@ -27,6 +27,15 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* Append file f's rows (three samples each) to out; pose numbers from *next. */
+/* The same joint readings (value by value: -0 equals 0). */
+static int same_q(const double *a, const double *b)
+{
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        if (a[j] != b[j])
+            return 0;
+    return 1;
+}
+
 static int append_file(rch_pos *out, const rch_data *dt, unsigned f, double *next, double *sig, size_t *nsig)
 {
     rc_sample *s = realloc(out->s, (out->n + 3 * dt->n) * sizeof *s);
@@ -45,7 +54,7 @@ static int append_file(rch_pos *out, const rch_data *dt, unsigned f, double *nex
         double pose;
         if (dt->pose) {
             pose = base + (double)dt->pose[i];
-        } else if (i > 0 && memcmp(dt->s[i].q_rad, dt->s[i - 1].q_rad, sizeof dt->s[i].q_rad) == 0) {
+        } else if (i > 0 && same_q(dt->s[i].q_rad, dt->s[i - 1].q_rad)) {
             pose = top - 1.0; /* the same joint readings as the row before: the same pose */
         } else {
             pose = top;

@@ -487,6 +487,10 @@ static int pos_candidates(pos_work *w, const rch_poses_config *c, rch_diag *d)
     const unsigned nf = w->nf, K = w->K;
     const double mg = c->margin_deg * PI_ / 180.0;
     size_t tries = 0, cap = w->n_pose * (c->split ? K : 1u);
+    if (K == 0 || nf == 0 || cap == 0) {
+        rch_diag_set(d, "", 0, 0, "no outlet, parameter or pose to plan");
+        return -1;
+    }
     double *rows = malloc((size_t)K * nf * sizeof *rows), len[RC_MAX_OUTLETS];
     rc_rng g;
     rc_rng_seed(&g, c->seed);
@@ -592,7 +596,9 @@ static void add_rows(double *M, const double *X, unsigned r, unsigned nf, double
 static double pos_gain(pos_work *w, const double *X, unsigned r)
 {
     const unsigned nf = w->nf;
-    double S[RC_MAX_OUTLETS * RC_MAX_OUTLETS], D[RC_MAX_OUTLETS * RC_MAX_OUTLETS];
+    double S[RC_MAX_OUTLETS * RC_MAX_OUTLETS] = {0}, D[RC_MAX_OUTLETS * RC_MAX_OUTLETS] = {0};
+    if (r == 0 || r > RC_MAX_OUTLETS)
+        return 0.0;
     for (unsigned j = 0; j < r; ++j) {
         const double *x = X + (size_t)j * nf;
         double *u = w->u + (size_t)j * nf, *v = w->v + (size_t)j * nf;
@@ -918,7 +924,7 @@ static int plan_position(rch_poses_result *res, const rc_model *m, const rch_pos
     res->n_distinct = w->n;
     res->rows_advised = w->nf + 3u + RCH_POSES_ROWS_SPARE;
     {   /* O1 (rch_ident) of the plan's rows and of the random ones, as for the length criterion */
-        rc_sample *rs = malloc(w->n * w->rows_per * sizeof *rs);
+        rc_sample *rs = w->n > 0 && w->rows_per > 0 ? malloc(w->n * w->rows_per * sizeof *rs) : NULL;
         rch_ident *id = calloc(1, sizeof *id);
         if (rs && id) {
             for (int pass = 0; pass < 2; ++pass) {
@@ -1085,7 +1091,7 @@ int rch_poses_choose_outlets(rch_poses_choice *out, const rc_model *m, const rch
         }
         return 0;
     }
-    unsigned chosen[RC_MAX_OUTLETS];
+    unsigned chosen[RC_MAX_OUTLETS] = {0};
     for (unsigned size = 1; size <= k; ++size) { /* greedy: add the place that helps most */
         size_t best = (size_t)-1;
         for (unsigned p = 0; p < n; ++p) {
@@ -1118,8 +1124,10 @@ int rch_poses_write_rapid(FILE *f, const rc_sample *rows, const unsigned char *o
     unsigned n_out = 0;
     for (size_t i = 0; i < n; ++i) {
         const unsigned o = outlet_label ? outlet_label[i] : 0u;
-        if (!seen[o]++)
+        if (!seen[o]) { /* a flag, not a count: 256 poses of one outlet must not wrap it */
+            seen[o] = 1;
             ++n_out;
+        }
     }
     fprintf(f, "MODULE rcal_plan\n");
     if (comment)
