@@ -494,7 +494,7 @@ static void note_tooldata(scan *s, size_t i, size_t c, const char *name)
     shape_of(&sh, s, i + 3, e);
     if (!(sh.ng == 2 && sh.nl[0] == 3 && sh.nl[1] == 4))
         return;
-    double v[7];
+    double v[7] = {0};
     for (int g = 0, k = 0; g < 2; ++g)
         for (int l = 0; l < sh.nl[g]; ++l, ++k) {
             size_t b = sh.lb[g][l];
