@@ -46,27 +46,33 @@ void rc_stable_clear_window(rc_stable *s)
     s->h_next = 0u;
 }
 
-/* Learn tau from the ring (see rc_stable.h): thirds, d1/d2 = exp(dt/tau). */
+/* Learn tau from the ring (see rc_stable.h): quarters, d1/d2 = d2/d3 =
+ * exp(dt/tau). */
 static void learn(rc_stable *s)
 {
-    const unsigned k = s->nh / 3u, first = (s->h_next + RC_STABLE_MAX_N - s->nh) % RC_STABLE_MAX_N;
+    const unsigned k = s->nh / 4u, first = (s->h_next + RC_STABLE_MAX_N - s->nh) % RC_STABLE_MAX_N;
     const uint32_t t_ref = s->hist_t[first];
-    double m[3] = {0, 0, 0}, t[3] = {0, 0, 0}, d1, d2, dt, tau;
+    double m[4] = {0, 0, 0, 0}, t[4] = {0, 0, 0, 0}, d[3], l1, l2, dt, tau;
     if (k < 3u)
         return;
-    for (unsigned part = 0; part < 3u; ++part)
+    for (unsigned part = 0; part < 4u; ++part)
         for (unsigned j = 0; j < k; ++j) {
-            /* the last 3k readings, oldest first */
-            const unsigned idx = (first + (s->nh - 3u * k) + part * k + j) % RC_STABLE_MAX_N;
+            /* the last 4k readings, oldest first */
+            const unsigned idx = (first + (s->nh - 4u * k) + part * k + j) % RC_STABLE_MAX_N;
             m[part] += s->hist[idx] / (double)k;
             t[part] += (double)(uint32_t)(s->hist_t[idx] - t_ref) / (double)k;
         }
-    d1 = m[1] - m[0];
-    d2 = m[2] - m[1];
-    dt = 0.5 * (t[2] - t[0]);
-    if (!(d1 * d2 > 0.0) || !(fabs(d2) >= 0.5 * s->cfg.tol_mm) || !(fabs(d1) >= 1.2 * fabs(d2)) || !(dt > 0.0))
+    for (int q = 0; q < 3; ++q)
+        d[q] = m[q + 1] - m[q];
+    dt = (t[3] - t[0]) / 3.0;
+    if (!(d[0] * d[1] > 0.0) || !(d[1] * d[2] > 0.0) || !(fabs(d[2]) >= 0.5 * s->cfg.tol_mm) || !(dt > 0.0))
         return;
-    tau = dt / log(d1 / d2);
+    l1 = log(d[0] / d[1]);
+    l2 = log(d[1] / d[2]);
+    /* an exponential: both ratios above 1.05 and alike (a step or a ramp that stops is not) */
+    if (!(l1 > 0.0488 && l2 > 0.0488) || l1 > 2.0 * l2 || l2 > 2.0 * l1)
+        return;
+    tau = 2.0 * dt / (l1 + l2);
     if (tau > (double)s->cfg.tau_max_ms)
         tau = (double)s->cfg.tau_max_ms;
     if (tau > s->tau_learnt_ms)

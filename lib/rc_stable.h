@@ -22,10 +22,12 @@
  * which for a first-order filter bounds the recorded error by tol_mm. tau is
  * the larger of cfg.tau_ms (set: the display's data sheet) and the one learnt
  * from the readings (cfg.learn_tau): the last RC_STABLE_MAX_N readings of the
- * pose are cut into three equal parts; an exponential approach shows as
- * changes d1, d2 between their means of the same sign with d1/d2 =
- * exp(dt/tau) >= 1.2 and |d2| >= tol_mm/2 (well above the display's noise);
- * then tau = dt / ln(d1/d2), capped at tau_max_ms. The learnt tau is a
+ * pose are cut into four equal parts; an exponential approach shows as
+ * changes d1, d2, d3 between their means of one sign with d1/d2 and d2/d3
+ * alike (their logarithms within a factor of 2), both above 1.05, and
+ * |d3| >= tol_mm/2 (well above the display's noise; a step or a ramp that
+ * stops is not an exponential); then tau = dt / mean(ln(d1/d2), ln(d2/d3)),
+ * capped at tau_max_ms. The learnt tau is a
  * property of the device: it is kept across poses (rc_stable_restart) and
  * only grows. A window that fails the trend test slides by one reading.
  *

@@ -251,6 +251,16 @@ static void test_noise_learns_nothing(void **state)
     for (uint32_t t = 0; t < 64u * 50u; t += 50u)
         (void)rc_stable_push(&s, &res, 500.0 + 0.002 * (double)t / 50.0, t); /* 0.04 mm/s */
     assert_true(s.tau_learnt_ms == 0.0);
+    /* nor a robot that arrives late: a ramp, then still */
+    rc_stable_restart(&s);
+    for (uint32_t t = 0; t < 64u * 50u; t += 50u)
+        (void)rc_stable_push(&s, &res, 500.0 + (t < 1600u ? 0.05 * (double)t / 50.0 : 80 * 0.05 / 2.0), t);
+    assert_true(s.tau_learnt_ms == 0.0);
+    /* nor a step */
+    rc_stable_restart(&s);
+    for (uint32_t t = 0; t < 64u * 50u; t += 50u)
+        (void)rc_stable_push(&s, &res, t < 1200u ? 500.0 : 510.0, t);
+    assert_true(s.tau_learnt_ms == 0.0);
 }
 
 int main(void)
