@@ -46,6 +46,34 @@ void rc_stable_clear_window(rc_stable *s)
     s->h_next = 0u;
 }
 
+/* no libm on the reading path (it is cross-built for a microcontroller) */
+static double absd(double x)
+{
+    return x < 0.0 ? -x : x;
+}
+
+/* natural logarithm of x > 0: x = 2^k y, y in [1, 2), ln y = 2 atanh((y - 1)/(y + 1)) */
+static double ln_pos(double x)
+{
+    double k = 0.0, z, z2, term, sum = 0.0;
+    while (x >= 2.0) {
+        x *= 0.5;
+        k += 1.0;
+    }
+    while (x < 1.0) {
+        x *= 2.0;
+        k -= 1.0;
+    }
+    z = (x - 1.0) / (x + 1.0); /* [0, 1/3) */
+    z2 = z * z;
+    term = z;
+    for (int j = 1; j < 40; j += 2) {
+        sum += term / (double)j;
+        term *= z2;
+    }
+    return k * 0.69314718055994530942 + 2.0 * sum;
+}
+
 /* Learn tau from the ring (see rc_stable.h): quarters, d1/d2 = d2/d3 =
  * exp(dt/tau). */
 static void learn(rc_stable *s)
@@ -65,10 +93,10 @@ static void learn(rc_stable *s)
     for (int q = 0; q < 3; ++q)
         d[q] = m[q + 1] - m[q];
     dt = (t[3] - t[0]) / 3.0;
-    if (!(d[0] * d[1] > 0.0) || !(d[1] * d[2] > 0.0) || !(fabs(d[2]) >= 0.5 * s->cfg.tol_mm) || !(dt > 0.0))
+    if (!(d[0] * d[1] > 0.0) || !(d[1] * d[2] > 0.0) || !(absd(d[2]) >= 0.5 * s->cfg.tol_mm) || !(dt > 0.0))
         return;
-    l1 = log(d[0] / d[1]);
-    l2 = log(d[1] / d[2]);
+    l1 = ln_pos(d[0] / d[1]);
+    l2 = ln_pos(d[1] / d[2]);
     /* an exponential: both ratios above 1.05 and alike (a step or a ramp that stops is not) */
     if (!(l1 > 0.0488 && l2 > 0.0488) || l1 > 2.0 * l2 || l2 > 2.0 * l1)
         return;
@@ -188,9 +216,9 @@ rc_status rc_stable_push(rc_stable *s, rc_stable_result *out, double len_mm, uin
         double dur_ms, tau = rc_stable_tau_ms(s), slope = window_slope(s, &dur_ms); /* mm/ms */
         if (tau > 0.0) { /* the slope over the last tau as well: the larger counts */
             const double ring = ring_slope(s, tau > dur_ms ? tau : dur_ms);
-            slope = fabs(ring) > fabs(slope) ? ring : slope;
+            slope = absd(ring) > absd(slope) ? ring : slope;
         }
-        if (fabs(slope) * (tau + 0.5 * dur_ms) > s->cfg.tol_mm) {
+        if (absd(slope) * (tau + 0.5 * dur_ms) > s->cfg.tol_mm) {
             s->trend_rejects++; /* still creeping: the next reading slides the window */
             return RC_ERR_INCOMPLETE;
         }
