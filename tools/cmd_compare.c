@@ -31,6 +31,27 @@ static const char details[] =
     "--samples 200 --test-fraction 0.2. --params both runs the paper's set-up and the common parameter set\n"
     "(plots and models then go to DIR/paper and DIR/common).";
 
+/* The cost of the whole command before any work (both sets run the
+ * protocol twice): refused above --max-minutes, said above 10 s. 0 or -1. */
+static int check_cost(const rch_compare_config *cfg, size_t n, int both)
+{
+    /* the cost of the whole command before any work: both sets run the protocol twice */
+    const double est_s = (both ? 2.0 : 1.0) * rch_compare_estimate_s(cfg, n);
+    const double lim_min = cfg->max_minutes > 0.0 ? cfg->max_minutes : RCH_COMPARE_MAX_MINUTES;
+    char b1[32];
+    if (est_s > 60.0 * lim_min) {
+        fprintf(stderr, "rcal compare: %lu cases of %zu rows%s would take about %s (measured cost per row on the "
+                        "reference machine, docs/methods.md), above the limit of %.0f min: lower --cases or "
+                        "--samples, or raise --max-minutes\n",
+                cfg->cases, cfg->samples && cfg->samples < n ? cfg->samples : n,
+                both ? ", both parameter sets," : "", rch_cost_human(b1, sizeof b1, est_s), lim_min);
+        return -1;
+    }
+    if (est_s > 10.0)
+        fprintf(stderr, "rcal compare: about %s (progress below)\n", rch_cost_human(b1, sizeof b1, est_s));
+    return 0;
+}
+
 /* DIR, or DIR/paper and DIR/common when both sets run; NULL stays NULL. */
 static const char *sub_dir(char *buf, size_t len, const char *dir, int both, rch_compare_params p)
 {
@@ -106,22 +127,9 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
     }
     cfg->inputs = inputs;
     cfg->n_inputs = 2;
-    {
-        /* the cost of the whole command before any work: both sets run the protocol twice */
-        const double est_s = (o->both ? 2.0 : 1.0) * rch_compare_estimate_s(cfg, data.n);
-        const double lim_min = cfg->max_minutes > 0.0 ? cfg->max_minutes : RCH_COMPARE_MAX_MINUTES;
-        char b1[32];
-        if (est_s > 60.0 * lim_min) {
-            fprintf(stderr, "rcal compare: %lu cases of %zu rows%s would take about %s (measured cost per row on the "
-                            "reference machine, docs/methods.md), above the limit of %.0f min: lower --cases or "
-                            "--samples, or raise --max-minutes\n",
-                    cfg->cases, cfg->samples && cfg->samples < data.n ? cfg->samples : data.n,
-                    o->both ? ", both parameter sets," : "", rch_cost_human(b1, sizeof b1, est_s), lim_min);
-            rch_data_free(&data);
-            return 2;
-        }
-        if (est_s > 10.0)
-            fprintf(stderr, "rcal compare: about %s (progress below)\n", rch_cost_human(b1, sizeof b1, est_s));
+    if (check_cost(cfg, data.n, o->both) != 0) {
+        rch_data_free(&data);
+        return 2;
     }
     int rc = 0;
     for (int k = 0; k < (o->both ? 2 : 1) && rc == 0; ++k) {

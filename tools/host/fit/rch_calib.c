@@ -1155,6 +1155,36 @@ static int save_residuals(const rch_calib_result *r, const rch_data *data, const
     return rc;
 }
 
+/* The cost, before the work: refused above --max-minutes (0, or -1 with d
+ * set), said on stderr above 10 s. */
+static int check_cost(const rch_calib_cfg *cfg, size_t n, rch_diag *d)
+{
+    double bound_s;
+    const double est_s = rch_calib_estimate_s(cfg, n, &bound_s);
+    const double limit_s = 60.0 * (cfg->max_minutes > 0.0 ? cfg->max_minutes : 60.0);
+    char b1[32], b2[32], b3[32];
+    if (est_s > limit_s) {
+        char it[48];
+        if (cfg->max_iter)
+            snprintf(it, sizeof it, "--max-iter %u", cfg->max_iter);
+        else
+            snprintf(it, sizeof it, "the default iteration cap");
+        rch_diag_set(d, "", 0, 0,
+                     "this run would take about %s (%lu case(s) of %zu rows, %s, %s; the measured cost per row "
+                     "on the reference machine, docs/methods.md), above the limit of %s: lower --cases, "
+                     "--samples or --max-iter, or raise --max-minutes",
+                     rch_cost_human(b1, sizeof b1, est_s), cfg->cases > 1 ? cfg->cases : 1ul,
+                     cfg->cases > 1 && cfg->case_samples && cfg->case_samples < n ? cfg->case_samples : n,
+                     rc_method_name(cfg->method), it, rch_cost_human(b3, sizeof b3, limit_s));
+        return -1;
+    }
+    if (est_s > 10.0)
+        fprintf(stderr, "rcal calibrate: %zu samples, %s: about %s (at most %s)\n", n,
+                rc_method_name(cfg->method), rch_cost_human(b1, sizeof b1, est_s),
+                rch_cost_human(b2, sizeof b2, bound_s));
+    return 0;
+}
+
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
 {
     memset(r, 0, sizeof *r);
@@ -1169,33 +1199,9 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || load_all(&data, counts, cfg, d) != 0)
         return -1;
     r->n_data = data.n;
-    {
-        /* the cost, before the work: refused above --max-minutes, said above 10 s */
-        double bound_s;
-        const double est_s = rch_calib_estimate_s(cfg, data.n, &bound_s);
-        const double limit_s = 60.0 * (cfg->max_minutes > 0.0 ? cfg->max_minutes : 60.0);
-        char b1[32], b2[32], b3[32];
-        if (est_s > limit_s) {
-            char it[48];
-            if (cfg->max_iter)
-                snprintf(it, sizeof it, "--max-iter %u", cfg->max_iter);
-            else
-                snprintf(it, sizeof it, "the default iteration cap");
-            rch_diag_set(d, "", 0, 0,
-                         "this run would take about %s (%lu case(s) of %zu rows, %s, %s; the measured cost per row "
-                         "on the reference machine, docs/methods.md), above the limit of %s: lower --cases, "
-                         "--samples or --max-iter, or raise --max-minutes",
-                         rch_cost_human(b1, sizeof b1, est_s), cfg->cases > 1 ? cfg->cases : 1ul,
-                         cfg->cases > 1 && cfg->case_samples && cfg->case_samples < data.n ? cfg->case_samples
-                                                                                           : data.n,
-                         rc_method_name(cfg->method), it, rch_cost_human(b3, sizeof b3, limit_s));
-            rch_data_free(&data);
-            return -2;
-        }
-        if (est_s > 10.0)
-            fprintf(stderr, "rcal calibrate: %zu samples, %s: about %s (at most %s)\n", data.n,
-                    rc_method_name(cfg->method), rch_cost_human(b1, sizeof b1, est_s),
-                    rch_cost_human(b2, sizeof b2, bound_s));
+    if (check_cost(cfg, data.n, d) != 0) {
+        rch_data_free(&data);
+        return -2;
     }
     groups(r, &data, counts);
     provenance(r, counts);
