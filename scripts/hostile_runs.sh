@@ -75,6 +75,9 @@ device_runs() {
     dev jump5 dplan.csv --jump-at-pose 2 --jump-mm 5 -- &
     dev filt2 dplan2.csv --filter-tau-ms 2000 -- &
     dev filt5 dplan2.csv --filter-tau-ms 5000 -- &
+    # controls: the protections turned off, as before issue 23; the judge must call them bad
+    dev ctl_filt2 dplan2.csv --filter-tau-ms 2000 -- --no-learn-tau &
+    dev ctl_jump5 dplan.csv --jump-at-pose 2 --jump-mm 5 -- --jump-mm 9.9 &
     wait
 }
 device_runs > devices.log 2>&1 &
@@ -179,17 +182,23 @@ TEST[deceptive devices]="drv_acquire (test_reconnect_5mm_off, test_jump_mid_run,
 if [ -x "$SD" ]; then
     # L of every recorded pose against the clean run: the largest difference (mm), "none" without samples
     worst() { awk -F, 'BEGIN{m=0} NR==FNR{if(FNR>1)L[$1]=$8; next} FNR>1{d=$8-L[$1]; d=d<0?-d:d; if(d>m)m=d; n++} END{printf "%s", n?m:"none"}' "$2" "$1"; }
-    judge() { # name plan_ref: good = no sample off by more than 0.06 mm; a stop must say why
+    ok_run() { # name ref: no sample off by more than 0.06 mm; a stop must say why
+        local rc w
+        rc=$(cat "$1.rc" 2>/dev/null || echo x)
+        w=$(worst "$1.csv" "$2.csv" 2>/dev/null || echo none)
+        [ "$w" != none ] && awk -v w="$w" 'BEGIN{exit !(w <= 0.06)}' &&
+            { [ "$rc" = 0 ] || grep -q "off\|stopped" "$1.err"; }
+    }
+    judge() { # name plan_ref
         local name=$1 ref=$2 w rc
         rc=$(cat "$name.rc" 2>/dev/null || echo x)
         w=$(worst "$name.csv" "$ref.csv" 2>/dev/null || echo none)
-        if [ "$w" != none ] && awk -v w="$w" 'BEGIN{exit !(w <= 0.06)}' &&
-           { [ "$rc" = 0 ] || grep -q "off\|stopped" "$name.err"; }; then
+        if ok_run "$name" "$ref"; then
             verdict "deceptive devices" 1
         else
             verdict "deceptive devices" 0 "$name: exit $rc, worst sample $w mm off"
         fi
-        printf '  %-6s exit %s, %s samples, worst %s mm off the clean run\n' "$name" "$rc" \
+        printf '  %-9s exit %s, %s samples, worst %s mm off the clean run\n' "$name" "$rc" \
             "$(($(wc -l < "$name.csv" 2>/dev/null || echo 1) - 1))" "$w" >> devices.txt
     }
     [ "$(cat ref.rc)" = 0 ] && [ "$(cat ref2.rc)" = 0 ] || echo "  (the clean runs failed: see $work/ref.err)"
@@ -197,8 +206,16 @@ if [ -x "$SD" ]; then
     judge jump5 ref
     judge filt2 ref2
     judge filt5 ref2
-    grep -q "+5.0.. mm off" off5.err || verdict "deceptive devices" 0 "off5: the 5 mm offset was not named"
-    grep -q "+5.0.. mm off" jump5.err || verdict "deceptive devices" 0 "jump5: the 5 mm jump was not named"
+    # the controls must be judged bad (the judge sees what issue 23 saw)
+    for name in ctl_filt2:ref2 ctl_jump5:ref; do
+        ! ok_run "${name%%:*}" "${name#*:}" && verdict "judge controls" 1 || verdict "judge controls" 0 "${name%%:*} judged good"
+        printf '  %-9s (control) exit %s, worst %s mm off the clean run\n' "${name%%:*}" "$(cat "${name%%:*}.rc")" \
+            "$(worst "${name%%:*}.csv" "${name#*:}.csv")" >> devices.txt
+    done
+    TEST[judge controls]="(this script: protections off, as before issue 23)"
+    for name in off5 jump5; do # the message names the 5 mm
+        grep -q "+5.0.. mm off" $name.err && verdict "deceptive devices" 1 || verdict "deceptive devices" 0 "$name: 5 mm not named"
+    done
 fi
 
 echo
