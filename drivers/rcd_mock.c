@@ -67,6 +67,8 @@ static rc_status mk_read(void *ctx, size_t *n_read, uint8_t *buf, size_t cap, un
     st = mk_read_(m, n_read, buf, cap);
     if (st == RC_ERR_TIMEOUT)
         m->clock_ms += (uint32_t)timeout_ms; /* the wait a real port would have done */
+    else if (st == RC_OK && *n_read > 0)
+        m->clock_ms += m->ms_per_read;
     return st;
 }
 

@@ -148,8 +148,9 @@ uint32_t rcd_posix_now_ms(void *ctx);
  *    RC_ERR_TIMEOUT, or RC_ERR_CLOSED when closed_at_end is set.
  * flush only counts (scripted bytes are the device's future output).
  * Simulated time: the clock (now_ms) starts at clock_ms and advances only
- * when a read times out (by that read's timeout_ms) or when a test moves it;
- * a timeout is reported at once. */
+ * when a read times out (by that read's timeout_ms), by ms_per_read at each
+ * read that delivers bytes (a display's update period), or when a test moves
+ * it; a timeout is reported at once. */
 #define RCD_MOCK_NEVER ((size_t)-1)
 
 typedef struct rcd_mock_ctx {
@@ -167,6 +168,7 @@ typedef struct rcd_mock_ctx {
     int closed_at_end;
     int fail_open;          /* open returns fail_status */
     uint32_t clock_ms;      /* the simulated clock (state; tests may set it) */
+    uint32_t ms_per_read;   /* a read that delivers bytes advances the clock this much (0: not at all) */
     /* polled device: when n_segments > 0, the script is cut into segments
      * (segments: (n_segments) byte counts) and each write releases the next
      * one: a reply only after a request. */

@@ -28,6 +28,12 @@ static const char details[] =
     "model (cable outlet: the file's encoder_mm, else --encoder) predicts, within --follow-tol-mm; a frozen\n"
     "display or another device fails it: the pose is measured again up to --retries times, then the run stops\n"
     "and nothing is recorded. Plan poses must be inside the robot's joint limits.\n"
+    "Jump check: a change more than --jump-mm (3) from the model's, and every reconnect and resume, send the run\n"
+    "back to the last recorded pose (announced; with --confirm you are asked to return there) to read it again:\n"
+    "within --verify-tol-mm (default --stable-mm) the run goes on; off (a slipped cable, a counter reset) it\n"
+    "stops with nothing recorded after that pose, or with --on-jump record reports the jump and goes on.\n"
+    "Trend: a window whose slope says the display still creeps (a filter of time constant --display-tau-ms, or\n"
+    "the one learnt from the readings) is not a sample.\n"
     "Backend: serialport (real adapters, 9600 8N1 unless told) or posix (ptys of rcal_simdisplay).\n"
     "Retry policy: a reading waits --read-timeout-ms; after --retries failures in a row the port is closed and\n"
     "reopened; a disconnect is retried for --reconnect-s seconds; a pose that does not settle within\n"
@@ -95,6 +101,8 @@ static int report_json(const rch_acq_result *r, const rch_acq_config *c, const c
     rch_jw_num(&w, "min_mm", c->stable.min_mm);
     rch_jw_num(&w, "max_mm", c->stable.max_mm);
     rch_jw_uint(&w, "unstable_restarts", r->unstable);
+    rch_jw_uint(&w, "trend_rejects", r->trend_rejects);
+    rch_jw_num(&w, "display_tau_ms", r->tau_ms);
     rch_jw_end(&w);
     rch_jw_obj(&w, "rejected");
     rch_jw_uint(&w, "timeouts", r->timeouts);
@@ -108,6 +116,16 @@ static int report_json(const rch_acq_result *r, const rch_acq_config *c, const c
     rch_jw_uint(&w, "reconnects", r->reconnects);
     rch_jw_bool(&w, "follow_check", !c->no_follow_check);
     rch_jw_num(&w, "worst_follow_mm", r->n_new ? r->worst_follow_mm : NAN);
+    rch_jw_uint(&w, "rechecks", r->verifies);
+    rch_jw_uint(&w, "recheck_failures", r->verify_fails);
+    rch_jw_arr(&w, "jumps");
+    for (size_t k = 0; k < r->n_jumps && k < sizeof r->jumps / sizeof r->jumps[0]; ++k) {
+        rch_jw_obj(&w, NULL);
+        rch_jw_uint(&w, "before_pose", r->jumps[k].pose);
+        rch_jw_num(&w, "jump_mm", r->jumps[k].jump_mm);
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
 }
@@ -117,9 +135,13 @@ static void report_text(const rch_acq_result *r, const rch_acq_config *c)
 {
     printf("rcal acquire: %zu poses recorded (%zu new) in %s; %lu readings, %lu timeouts, %lu bad frames, "
            "%lu format rejects, %lu device errors, %lu out of range, %lu unstable restarts, %lu reconnects, "
-           "%lu follow refusals (worst miss %.2f mm)\n",
+           "%lu follow refusals (worst miss %.2f mm), %lu trend rejects (display tau %.1f s), %lu rechecks\n",
            r->n_before + r->n_new, r->n_new, c->out_path, r->readings, r->timeouts, r->bad_frames, r->shape_rejects,
-           r->device, r->range, r->unstable, r->reconnects, r->follow_refusals, r->worst_follow_mm);
+           r->device, r->range, r->unstable, r->reconnects, r->follow_refusals, r->worst_follow_mm, r->trend_rejects,
+           r->tau_ms / 1000.0, r->verifies);
+    for (size_t k = 0; k < r->n_jumps && k < sizeof r->jumps / sizeof r->jumps[0]; ++k)
+        printf("rcal acquire: JUMP of %+.3f mm before pose %zu recorded past (--on-jump record): fit with calibrate "
+               "--jumps\n", r->jumps[k].jump_mm, r->jumps[k].pose);
 }
 
 int rcal_cmd_acquire(int argc, char **argv)
@@ -127,9 +149,10 @@ int rcal_cmd_acquire(int argc, char **argv)
     rch_acq_config c;
     rch_acq_result r;
     const char *proto = NULL, *parity = "none", *flow = "none", *mbf = "int32", *mbo = "abcd", *poll = NULL,
-               *joints = "plan";
-    unsigned long baud = 9600, bits = 8, stop = 1, mb_addr = 1, mb_reg = 0, mb_dec = 0, n = 5, pose_s = 60, outlet = 0;
-    int rc, json = 0;
+               *joints = "plan", *on_jump = "stop";
+    unsigned long baud = 9600, bits = 8, stop = 1, mb_addr = 1, mb_reg = 0, mb_dec = 0, n = 5, pose_s = 60, outlet = 0,
+                  tau_ms = 0;
+    int rc, json = 0, no_learn = 0;
     rch_acq_config_default(&c);
     memset(&r, 0, sizeof r);
     c.robot_path = RCAL_DEFAULT_ROBOT;
@@ -169,6 +192,16 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--reconnect-s", RCH_OPT_UINT, &c.reconnect_s, 0, 3600, NULL, NULL, 0, NULL},
         {"--poll-interval-ms", RCH_OPT_UINT, &c.poll_interval_ms, 0, 60000, NULL, NULL, 0, NULL},
         {"--follow-tol-mm", RCH_OPT_DOUBLE, &c.follow_tol_mm, 0.001, 1e4, NULL, "follow check tolerance", 0, NULL},
+        {"--jump-mm", RCH_OPT_DOUBLE, &c.jump_mm, 0.001, 1e4, "MM",
+         "a change this far from the model's sends the run back to the last recorded pose", 0, NULL},
+        {"--verify-tol-mm", RCH_OPT_DOUBLE, &c.verify_tol_mm, 0, 1000, "MM",
+         "the last recorded pose read again must agree within this (default --stable-mm)", 0, NULL},
+        {"--on-jump", RCH_OPT_CHOICE, &on_jump, 0, 0, NULL,
+         "a confirmed jump stops the run, or is reported and recorded past", 0, "stop|record"},
+        {"--display-tau-ms", RCH_OPT_UINT, &tau_ms, 0, 600000, "MS",
+         "the display's filter time constant, when known (the trend test)", 0, NULL},
+        {"--no-learn-tau", RCH_OPT_FLAG, &no_learn, 0, 0, NULL,
+         "do not learn the display's time constant from the readings", 0, NULL},
         {"--no-follow-check", RCH_OPT_FLAG, &c.no_follow_check, 0, 0, NULL, "skip the follow check", 0, NULL},
         {"--announce", RCH_OPT_STR, &c.announce_path, 0, 0, "FILE", "pose for the robot side", 0, NULL},
         {"--confirm", RCH_OPT_FLAG, &c.confirm, 0, 0, NULL, "wait for Enter at each pose", 0, NULL},
@@ -205,6 +238,9 @@ int rcal_cmd_acquire(int argc, char **argv)
     c.proto.mb_order = (rcd_word_order)pick(mbo, "abcd|cdab|badc|dcba");
     c.stable.n = (unsigned)n;
     c.stable.timeout_ms = (uint32_t)(pose_s * 1000ul);
+    c.stable.tau_ms = (uint32_t)tau_ms;
+    c.stable.learn_tau = !no_learn;
+    c.on_jump_record = strcmp(on_jump, "record") == 0;
     rc = rch_acquire_run(&r, &c, NULL, json ? stderr : stdout, stderr);
     if (json)
         return report_json(&r, &c, proto, rc, argc, argv) != 0 && rc == 0 ? 1 : rc;

@@ -95,6 +95,8 @@ static int parse(calib_args *a, int argc, char **argv)
          0, NULL},
         {"--cases", RCH_OPT_UINT, &a->cases, 1, 1000, "N", "repeat on N random subsets (the paper's protocol)", 0,
          NULL},
+        {"--max-minutes", RCH_OPT_DOUBLE, &a->cfg.max_minutes, 0.01, 1e7, "MIN",
+         "refuse a run estimated longer than this (default 60; the estimate is printed above 10 s)", 0, NULL},
         {"--samples", RCH_OPT_UINT, &a->case_samples, 0, 10000000, "M", "rows per case (0: every row)", 0, NULL},
         {"--effects", RCH_OPT_STR, &cfg->effects, 0, 0, "LIST",
          "effects fitted with the geometry: length_offset, length_scale, time_drift, tool_offset, cable_sag, "

@@ -12,6 +12,7 @@
 
 #include "rcal_cmds.h"
 #include "rch_compare.h"
+#include "rch_cost.h"
 #include "rch_calib.h" /* rch_calib_effects */
 #include "rch_data.h"
 #include "rch_dequant.h"
@@ -29,6 +30,27 @@ static const char details[] =
     "held-out errors (mean +- std over --cases cases) and times. The paper's other protocol:\n"
     "--samples 200 --test-fraction 0.2. --params both runs the paper's set-up and the common parameter set\n"
     "(plots and models then go to DIR/paper and DIR/common).";
+
+/* The cost of the whole command before any work (both sets run the
+ * protocol twice): refused above --max-minutes, said above 10 s. 0 or -1. */
+static int check_cost(const rch_compare_config *cfg, size_t n, int both)
+{
+    /* the cost of the whole command before any work: both sets run the protocol twice */
+    const double est_s = (both ? 2.0 : 1.0) * rch_compare_estimate_s(cfg, n);
+    const double lim_min = cfg->max_minutes > 0.0 ? cfg->max_minutes : RCH_COMPARE_MAX_MINUTES;
+    char b1[32];
+    if (est_s > 60.0 * lim_min) {
+        fprintf(stderr, "rcal compare: %lu cases of %zu rows%s would take about %s (measured cost per row on the "
+                        "reference machine, docs/methods.md), above the limit of %.0f min: lower --cases or "
+                        "--samples, or raise --max-minutes\n",
+                cfg->cases, cfg->samples && cfg->samples < n ? cfg->samples : n,
+                both ? ", both parameter sets," : "", rch_cost_human(b1, sizeof b1, est_s), lim_min);
+        return -1;
+    }
+    if (est_s > 10.0)
+        fprintf(stderr, "rcal compare: about %s (progress below)\n", rch_cost_human(b1, sizeof b1, est_s));
+    return 0;
+}
 
 /* DIR, or DIR/paper and DIR/common when both sets run; NULL stays NULL. */
 static const char *sub_dir(char *buf, size_t len, const char *dir, int both, rch_compare_params p)
@@ -105,6 +127,10 @@ static int compare_run(const rch_compare_config *cfg_in, const char *data_path, 
     }
     cfg->inputs = inputs;
     cfg->n_inputs = 2;
+    if (check_cost(cfg, data.n, o->both) != 0) {
+        rch_data_free(&data);
+        return 2;
+    }
     int rc = 0;
     for (int k = 0; k < (o->both ? 2 : 1) && rc == 0; ++k) {
         if (o->both)
@@ -151,7 +177,7 @@ int rcal_cmd_compare(int argc, char **argv)
     const char *params = "paper", *resid = NULL, *effects = NULL;
     int literal = 0, jumps = 0, prior = 0, dequantize = 0, tool_offset = 0;
     unsigned long cases = 10, samples = 300, seed = 1;
-    double test_fraction = 0.1;
+    double test_fraction = 0.1, max_minutes = RCH_COMPARE_MAX_MINUTES;
     int json = 0;
     rch_cmdspec spec;
     const rch_opt opts[] = {
@@ -188,6 +214,8 @@ int rcal_cmd_compare(int argc, char **argv)
          NULL},
         {"--tool-offset", RCH_OPT_FLAG, &tool_offset, 0, 0, NULL, "the cable attachment off the flange centre "
          "(the tool_offset effect)", 0, NULL},
+        {"--max-minutes", RCH_OPT_DOUBLE, &max_minutes, 0.01, 1e7, "MIN",
+         "refuse a comparison estimated longer (both sets together); the estimate is printed above 10 s", 0, NULL},
         {"--prior", RCH_OPT_FLAG, &prior, 0, 0, NULL,
          "LM and LTLM maximum a posteriori with the robot's physical prior (as rcal calibrate; the others ignore it)",
          0, NULL},
@@ -223,6 +251,7 @@ int rcal_cmd_compare(int argc, char **argv)
             cfg.run[RCH_EST_LTLM_PAPER_DEG] = 1;
     cfg.jumps = jumps;
     cfg.prior = prior;
+    cfg.max_minutes = max_minutes;
     char eff[512];
     if (tool_offset)
         snprintf(eff, sizeof eff, "%s%s%s", effects ? effects : "", effects ? "," : "", "tool_offset");

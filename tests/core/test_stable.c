@@ -35,6 +35,9 @@ static void test_config_checked(void **state)
     c = cfg(5, NAN);
     assert_int_equal(rc_stable_init(&s, &c), RC_ERR_ARG);
     c = cfg(5, 0.05);
+    c.tau_max_ms = 0;
+    assert_int_equal(rc_stable_init(&s, &c), RC_ERR_ARG);
+    c = cfg(5, 0.05);
     c.min_mm = c.max_mm;
     assert_int_equal(rc_stable_init(&s, &c), RC_ERR_ARG);
     assert_int_equal(rc_stable_init(NULL, &c), RC_ERR_ARG);
@@ -136,12 +139,138 @@ static void test_clear_window(void **state)
     assert_true(res.spread_mm == 0.0);
 }
 
+/* ---- a simulated first-order display filter (issue 23) -------------------
+ * The display shows y(t) = L + (y0 - L) exp(-t / tau), rounded to its 0.01 mm
+ * resolution, read at 20 Hz from settle_ms after the move (the acquisition's
+ * default wait, 2 s). Written apart from the rule: the exact response. */
+static double filt(double L, double y0, double tau_ms, double t_ms)
+{
+    const double y = tau_ms > 0.0 ? L + (y0 - L) * exp(-t_ms / tau_ms) : L;
+    return round(y * 100.0) / 100.0;
+}
+
+/* run one pose: the sample's error (mean - L) and the time it took (ms) */
+static rc_status pose_run(rc_stable *s, rc_stable_result *res, double L, double y0, double tau_ms, double *err_mm,
+                          double *t_ms)
+{
+    rc_status st = RC_ERR_INCOMPLETE;
+    rc_stable_restart(s);
+    for (uint32_t t = 2000u; st == RC_ERR_INCOMPLETE || st == RC_ERR_RANGE; t += 50u) {
+        st = rc_stable_push(s, res, filt(L, y0, tau_ms, (double)t), t);
+        *t_ms = (double)t;
+    }
+    *err_mm = res->mean_mm - L;
+    return st;
+}
+
+/* without the trend test (tau 0, not learnt) a 2 s and a 5 s filter pass
+ * the spread test short of the true length (what issue 23 found) */
+static void test_filter_fools_spread_alone(void **state)
+{
+    const double taus[2] = {2000.0, 5000.0};
+    rc_stable s;
+    rc_stable_result res;
+    rc_stable_config c = cfg(5, 0.05);
+    (void)state;
+    c.learn_tau = 0;
+    assert_int_equal(rc_stable_init(&s, &c), RC_OK);
+    for (int k = 0; k < 2; ++k) {
+        double err, t;
+        assert_int_equal(pose_run(&s, &res, 600.0, 500.0, taus[k], &err, &t), RC_OK);
+        print_message("tau %.0f ms, spread test alone: recorded %.3f mm off after %.1f s\n", taus[k], err, t / 1e3);
+        assert_true(err < -0.15 * taus[k] / 1000.0); /* 0.3 and 0.75 mm short at least */
+    }
+}
+
+/* with tau learnt from the readings: within tol_mm of the true length, both
+ * filters, steps up and down; the learnt tau is within 30 % of the truth */
+static void test_filter_tau_learnt(void **state)
+{
+    const double taus[2] = {2000.0, 5000.0};
+    (void)state;
+    for (int k = 0; k < 2; ++k)
+        for (int dir = -1; dir <= 1; dir += 2) {
+            rc_stable s;
+            rc_stable_result res;
+            rc_stable_config c = cfg(5, 0.05);
+            double err, t;
+            assert_int_equal(rc_stable_init(&s, &c), RC_OK);
+            assert_int_equal(pose_run(&s, &res, 600.0, 600.0 - dir * 100.0, taus[k], &err, &t), RC_OK);
+            print_message("tau %.0f ms, step %+d mm: learnt %.0f ms, recorded %.3f mm off after %.1f s, %lu trend "
+                          "rejects\n", taus[k], dir * 100, s.tau_learnt_ms, err, t / 1e3, s.trend_rejects);
+            assert_true(fabs(err) <= c.tol_mm + 0.005);
+            assert_true(s.tau_learnt_ms > 0.7 * taus[k] && s.tau_learnt_ms < 1.3 * taus[k]);
+            assert_true(s.trend_rejects > 0);
+            assert_true(fabs(res.tau_ms - s.tau_learnt_ms) < 1e-9);
+            /* kept for the next pose: a small step of 2 mm, too small to learn from, is right as well */
+            assert_int_equal(pose_run(&s, &res, 602.0, 600.0, taus[k], &err, &t), RC_OK);
+            assert_true(fabs(err) <= c.tol_mm + 0.005);
+        }
+}
+
+/* with tau set (the data sheet), learning off: within tol_mm as well */
+static void test_filter_tau_set(void **state)
+{
+    rc_stable s;
+    rc_stable_result res;
+    rc_stable_config c = cfg(5, 0.05);
+    double err, t;
+    (void)state;
+    c.learn_tau = 0;
+    c.tau_ms = 5000u;
+    assert_int_equal(rc_stable_init(&s, &c), RC_OK);
+    assert_int_equal(pose_run(&s, &res, 600.0, 700.0, 5000.0, &err, &t), RC_OK);
+    assert_true(fabs(err) <= c.tol_mm + 0.005);
+    assert_true(s.tau_learnt_ms == 0.0);
+    /* a display without a filter is not slowed by much: n readings */
+    assert_int_equal(pose_run(&s, &res, 600.0, 700.0, 0.0, &err, &t), RC_OK);
+    assert_true(fabs(err) < 1e-9 && t <= 2000.0 + 4 * 50.0);
+}
+
+/* a display without a filter, noisy at its resolution (+-0.01 mm): nothing
+ * learnt, a sample after n readings; a robot still creeping linearly is
+ * not learnt as a filter either (the spread test handles it) */
+static void test_noise_learns_nothing(void **state)
+{
+    rc_stable s;
+    rc_stable_result res;
+    rc_stable_config c = cfg(5, 0.05);
+    unsigned seed = 12345u;
+    rc_status st = RC_ERR_INCOMPLETE;
+    (void)state;
+    assert_int_equal(rc_stable_init(&s, &c), RC_OK);
+    for (uint32_t t = 0; t < 200u * 50u; t += 50u) {
+        seed = seed * 1103515245u + 12345u;
+        st = rc_stable_push(&s, &res, 500.0 + 0.01 * (double)((seed >> 16) % 3u) - 0.01, t);
+        if (st == RC_OK)
+            break;
+    }
+    assert_int_equal(st, RC_OK);
+    assert_true(s.tau_learnt_ms == 0.0);
+    rc_stable_restart(&s);
+    for (uint32_t t = 0; t < 64u * 50u; t += 50u)
+        (void)rc_stable_push(&s, &res, 500.0 + 0.002 * (double)t / 50.0, t); /* 0.04 mm/s */
+    assert_true(s.tau_learnt_ms == 0.0);
+    /* nor a robot that arrives late: a ramp, then still */
+    rc_stable_restart(&s);
+    for (uint32_t t = 0; t < 64u * 50u; t += 50u)
+        (void)rc_stable_push(&s, &res, 500.0 + (t < 1600u ? 0.05 * (double)t / 50.0 : 80 * 0.05 / 2.0), t);
+    assert_true(s.tau_learnt_ms == 0.0);
+    /* nor a step */
+    rc_stable_restart(&s);
+    for (uint32_t t = 0; t < 64u * 50u; t += 50u)
+        (void)rc_stable_push(&s, &res, t < 1200u ? 500.0 : 510.0, t);
+    assert_true(s.tau_learnt_ms == 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_config_checked),  cmocka_unit_test(test_steady),
         cmocka_unit_test(test_drift_keeps_agreeing_tail), cmocka_unit_test(test_range),
         cmocka_unit_test(test_timeout_and_wrap), cmocka_unit_test(test_clear_window),
+        cmocka_unit_test(test_filter_fools_spread_alone), cmocka_unit_test(test_filter_tau_learnt),
+        cmocka_unit_test(test_filter_tau_set), cmocka_unit_test(test_noise_learns_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -461,7 +461,7 @@ static void test_unbounded_work(void **state)
     refused(C, "chaos --points 1e8 --starts 1e5", 2, NEED("--points"), NULL, R " chaos --points 1e8 --starts 1e5");
     refused(C, "chaos --points 10000000 --starts 100000", 2, NEED("limit of 1e+09"), NULL,
             R " chaos --points 10000000 --starts 100000");
-    refused(C, "compare --cases 10000 --samples 0", 1, NEED("--cases", "limit of"), KEEP("d.csv"),
+    refused(C, "compare --cases 10000 --samples 0", 2, NEED("--cases", "limit of"), KEEP("d.csv"),
             R " compare --data d.csv --cases 10000 --samples 0");
     refused(C, "bench --runs 10000", 2, NEED("--runs", "limit of"), KEEP("d.csv"), R " bench --data d.csv --runs 10000");
     refused(C, "rcal-rt --bench --targets 1e7 --repeat 1000", 2, NEED("--targets times --repeat", "limit"), NULL,

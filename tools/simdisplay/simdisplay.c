@@ -46,7 +46,13 @@
  *                       (HOLD pressed, firmware hung): `rcal acquire` must
  *                       refuse it (follow check)
  *   --foreign-offset-mm X  the device found after a reconnect is another
- *                       one: it shows the true length + X mm
+ *                       one (or the cable slipped while unplugged): it shows
+ *                       the true length + X mm
+ *   --filter-tau-ms T   the display filters what it shows (first order, time
+ *                       constant T): it creeps towards a new length
+ *   --jump-at-pose P --jump-mm J  when the robot reaches pose P (1 or more)
+ *                       the display jumps by J mm and stays off (a slipped
+ *                       cable, a counter that lost counts)
  *   --seed S            random faults and noise are reproducible
  */
 #include <errno.h>
@@ -104,6 +110,12 @@ typedef struct sim {
     int have_shown;
     unsigned long freeze_after; /* 0: never */
     double foreign_offset_mm;   /* added after a reconnect */
+    double filter_tau_ms;       /* first-order filter of the shown value (0: none) */
+    double filt_mm, filt_t_s;   /* its state */
+    int have_filt;
+    unsigned long jump_at_pose; /* the display jumps by jump_mm when the robot reaches this pose (0: never) */
+    double jump_mm;
+    int jumped;
     int foreign;                /* the reconnected device is another one */
 } sim;
 
@@ -266,6 +278,8 @@ static void follow_pose(sim *s)
     }
     s->from_mm = shown;
     s->cur_pose = idx;
+    if (s->jump_at_pose && (unsigned long)idx == s->jump_at_pose)
+        s->jumped = 1; /* the counter lost counts on the way: every later value is off */
     s->change_ms = t;
 }
 
@@ -278,7 +292,16 @@ static double shown_value(sim *s)
         return s->shown_mm; /* frozen: HOLD pressed or firmware hung */
     if (s->pc.protocol != RCD_PROTO_ASCII && s->rate_hz > 0 && s->have_shown && t < s->next_refresh_s)
         return s->shown_mm;
-    s->shown_mm = true_value(s) + (s->foreign ? s->foreign_offset_mm : 0.0);
+    s->shown_mm = true_value(s) + (s->foreign ? s->foreign_offset_mm : 0.0) + (s->jumped ? s->jump_mm : 0.0);
+    if (s->filter_tau_ms > 0) { /* y += (x - y) (1 - exp(-dt / tau)) */
+        if (s->have_filt)
+            s->filt_mm = s->shown_mm + (s->filt_mm - s->shown_mm) * exp(-(t - s->filt_t_s) * 1000.0 / s->filter_tau_ms);
+        else
+            s->filt_mm = s->shown_mm;
+        s->have_filt = 1;
+        s->filt_t_s = t;
+        s->shown_mm = s->filt_mm;
+    }
     if (s->noise_mm > 0)
         s->shown_mm += s->noise_mm * rc_rng_normal(&s->rng);
     s->have_shown = 1;
@@ -479,6 +502,9 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
         {"--disconnect-after", RCH_OPT_UINT, &s->disconnect_after, 0, 4294967294.0, "N", "frames, then hang up", 0, NULL},
         {"--reconnect-ms", RCH_OPT_INT, &g->reconnect_ms, -1, SIM_MAX_MS, "R", "reopen after R ms (-1: exit)", 0, NULL},
         {"--foreign-offset-mm", RCH_OPT_DOUBLE, &s->foreign_offset_mm, -1e5, 1e5, "X", "another device after a reconnect", 0, NULL},
+        {"--filter-tau-ms", RCH_OPT_DOUBLE, &s->filter_tau_ms, 0, 1e6, "T", "first-order display filter", 0, NULL},
+        {"--jump-at-pose", RCH_OPT_UINT, &s->jump_at_pose, 0, 4294967294.0, "P", "jump when the robot reaches P", 0, NULL},
+        {"--jump-mm", RCH_OPT_DOUBLE, &s->jump_mm, -1e5, 1e5, "J", "the jump (with --jump-at-pose)", 0, NULL},
         {"--freeze-after", RCH_OPT_UINT, &s->freeze_after, 0, 4294967294.0, "N", "frames, then the value freezes", 0, NULL},
         {"--settle-ms", RCH_OPT_UINT, &s->settle_ms, 0, SIM_MAX_MS, "T", "move transient", 0, NULL},
         {"--reply-delay-ms", RCH_OPT_UINT, &g->reply_delay_ms, 0, SIM_MAX_MS, "T", NULL, 0, NULL},

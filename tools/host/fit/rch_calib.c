@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_calib.c - the calibration pipeline and the nominal-FK check (see rch_calib.h). */
 #include "rch_calib.h"
+#include "rch_cost.h"
 
 #include <errno.h>
 #include <math.h>
@@ -1115,6 +1116,44 @@ done:
     return rc;
 }
 
+/* Measured on the reference machine (docs/methods.md, "Cost estimates";
+ * `rcal calibrate` on robotcali.csv, 1,041 rows, and on 10,000 simulated
+ * rows): seconds per case = fixed + per_row * rows (* iterations for the
+ * paper's methods, which run to their cap). */
+double rch_calib_estimate_s(const rch_calib_cfg *cfg, size_t n_rows, double *bound_s)
+{
+    const double m = (double)(cfg->cases > 1 && cfg->case_samples && cfg->case_samples < n_rows ? cfg->case_samples
+                                                                                                : n_rows);
+    const double cases = cfg->cases > 1 ? (double)cfg->cases : 1.0;
+    const int paper = cfg->method == RC_METHOD_LM_PAPER || cfg->method == RC_METHOD_LM_PAPER_DEG ||
+                      cfg->method == RC_METHOD_LTLM_PAPER || cfg->method == RC_METHOD_LTLM_PAPER_DEG;
+    const int chaotic = cfg->method == RC_METHOD_LTLM || cfg->method == RC_METHOD_LTLM_PAPER ||
+                        cfg->method == RC_METHOD_LTLM_PAPER_DEG;
+    double one, bound;
+    if (paper) {
+        const double it = cfg->max_iter ? (double)cfg->max_iter : 50.0;
+        /* per training row and iteration: 2.7-7.8 us (ltlm-paper) and 0.6-1.9 us (lm-paper) measured as the
+         * shared machine's load changed; the geometric middles */
+        one = 0.1 + (chaotic ? 4.5e-6 : 0.9e-6) * m * (1.0 - cfg->test_fraction) * it;
+        bound = one;
+    } else {
+        const double it = cfg->max_iter ? (double)cfg->max_iter : 100.0;
+        one = chaotic ? 0.2 + 174e-6 * m : 0.06 + 53e-6 * m;
+        bound = one + (chaotic ? 4.5e-6 : 0.9e-6) * m * it; /* every iteration to the cap */
+    }
+    if (cfg->jumps || !cfg->no_jump_check) {
+        /* the jump search refits with the robust solver around candidate change points: 0.2x (simulated,
+         * no jump) to 5x (robotcali.csv) the fit itself; 1.5x is the geometric middle. A paper method's run
+         * refits with the robust solver once: small beside its iterations */
+        const double jc = paper ? 0.05 : 1.5 * one;
+        one += jc;
+        bound += jc;
+    }
+    if (bound_s)
+        *bound_s = cases * bound;
+    return cases * one;
+}
+
 /* The paper's protocol: `cases` random subsets of case_samples rows, each
  * split and calibrated; the held-out RMSE before and after over the cases. */
 static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data, rch_diag *d)
@@ -1124,6 +1163,9 @@ static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data
     size_t m = r->cfg.case_samples && r->cfg.case_samples < data->n ? r->cfg.case_samples : data->n;
     rc_sample *sub = NULL;
     int rc = -1;
+    rch_progress pg;
+    rch_progress_start(&pg, stderr, "rcal calibrate: cases", (double)r->cfg.cases,
+                       rch_calib_estimate_s(&r->cfg, data->n, NULL));
     if (!c || !idx) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
@@ -1157,6 +1199,7 @@ static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data
         r->cases_done++;
         fprintf(stderr, "rcal calibrate: case %lu of %lu: held-out RMSE %.4f -> %.4f mm\n", k + 1, r->cfg.cases,
                 into->before_m.rmse_mm, into->after_m.rmse_mm);
+        rch_progress_step(&pg, (double)(k + 1));
     }
     rc = 0;
 done:
@@ -1198,6 +1241,36 @@ static int save_residuals(const rch_calib_result *r, const rch_data *data, const
     return rc;
 }
 
+/* The cost, before the work: refused above --max-minutes (0, or -1 with d
+ * set), said on stderr above 10 s. */
+static int check_cost(const rch_calib_cfg *cfg, size_t n, rch_diag *d)
+{
+    double bound_s;
+    const double est_s = rch_calib_estimate_s(cfg, n, &bound_s);
+    const double limit_s = 60.0 * (cfg->max_minutes > 0.0 ? cfg->max_minutes : 60.0);
+    char b1[32], b2[32], b3[32];
+    if (est_s > limit_s) {
+        char it[48];
+        if (cfg->max_iter)
+            snprintf(it, sizeof it, "--max-iter %u", cfg->max_iter);
+        else
+            snprintf(it, sizeof it, "the default iteration cap");
+        rch_diag_set(d, "", 0, 0,
+                     "this run would take about %s (%lu case(s) of %zu rows, %s, %s; the measured cost per row "
+                     "on the reference machine, docs/methods.md), above the limit of %s: lower --cases, "
+                     "--samples or --max-iter, or raise --max-minutes",
+                     rch_cost_human(b1, sizeof b1, est_s), cfg->cases > 1 ? cfg->cases : 1ul,
+                     cfg->cases > 1 && cfg->case_samples && cfg->case_samples < n ? cfg->case_samples : n,
+                     rc_method_name(cfg->method), it, rch_cost_human(b3, sizeof b3, limit_s));
+        return -1;
+    }
+    if (est_s > 10.0)
+        fprintf(stderr, "rcal calibrate: %zu samples, %s: about %s (at most %s)\n", n,
+                rc_method_name(cfg->method), rch_cost_human(b1, sizeof b1, est_s),
+                rch_cost_human(b2, sizeof b2, bound_s));
+    return 0;
+}
+
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
 {
     memset(r, 0, sizeof *r);
@@ -1212,8 +1285,10 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     if (rch_robot_load(&r->robot, cfg->robot_path, d) != 0 || load_all(&data, counts, cfg, d) != 0)
         return -1;
     r->n_data = data.n;
-    if (data.n > 100000)
-        fprintf(stderr, "rcal calibrate: %zu samples: the fit takes about %.0f s\n", data.n, 2e-5 * (double)data.n);
+    if (check_cost(cfg, data.n, d) != 0) {
+        rch_data_free(&data);
+        return -2;
+    }
     groups(r, &data, counts);
     provenance(r, counts);
     {

@@ -103,7 +103,13 @@ typedef struct rch_calib_cfg {
     size_t n_positions_paths;
     int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
     double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
+    double max_minutes;     /* refuse a run estimated longer (rch_calib_estimate_s); 0: 60 */
 } rch_calib_cfg;
+
+/* The run's cost on the reference machine (docs/methods.md, "Cost
+ * estimates"): seconds for n_rows rows as cfg would run them; *bound_s the
+ * most it can take when nothing converges early (the iteration cap). */
+double rch_calib_estimate_s(const rch_calib_cfg *cfg, size_t n_rows, double *bound_s);
 
 /* The defaults of `rcal calibrate`: everything zero or NULL but method LM,
  * test fraction 0.1, seed 1, one case. */

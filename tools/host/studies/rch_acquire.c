@@ -31,6 +31,7 @@ void rch_acq_config_default(rch_acq_config *c)
     c->reconnect_s = 10;
     c->poll_interval_ms = 100;
     c->follow_tol_mm = 10.0;
+    c->jump_mm = 3.0;
 }
 
 int rch_acq_follows(double *miss_mm, double len_mm, double pred_mm, double ref_len_mm, double ref_pred_mm,
@@ -123,6 +124,10 @@ typedef struct acq {
     int has_ref;              /* a recorded sample to check the next against */
     size_t ref_pose;
     double ref_len_mm;
+    rc_stable st;             /* the stability rule, one for the run (its learnt tau is the display's) */
+    const char *verify_why;   /* non-NULL: go back to ref_pose before the next sample counts */
+    int reconnected;          /* set by reconnect(): the pose's readings so far are void */
+    size_t jump_cleared;      /* pose + 1 whose suspected jump the check at ref_pose cleared; 0 none */
 } acq;
 
 #define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
@@ -147,6 +152,9 @@ static rc_status reconnect(acq *a)
             a->d.port = a->port;
             rcd_display_reset(&a->d); /* the format lock is kept: the device must show the same format */
             WARN(a, "%s reopened\n", a->c->port_path);
+            a->reconnected = 1;
+            if (a->has_ref)
+                a->verify_why = "after the reconnect";
             return RC_OK;
         }
         a->io->sleep_ms(a->io->ctx, a->port, 250);
@@ -208,12 +216,13 @@ static rc_status handle_failure(acq *a, rc_status st, const rcd_reading *r, size
 static rc_status measure(rc_stable_result *out, acq *a, size_t pose)
 {
     const rch_acq_config *c = a->c;
-    rc_stable s;
+    rc_stable *const s = &a->st;
     unsigned long fails = 0, reopens = 0;
     uint32_t last_poll = 0;
     int polled_once = 0;
     rc_status st;
-    rc_stable_init(&s, &c->stable);
+    rc_stable_restart(s);
+    a->reconnected = 0;
     for (;;) {
         rcd_reading r;
         memset(&r, 0, sizeof r);
@@ -227,7 +236,7 @@ static rc_status measure(rc_stable_result *out, acq *a, size_t pose)
         st = rcd_display_read(&a->d, &r, (unsigned)c->read_timeout_ms);
         if (st == RC_OK) {
             fails = 0;
-            st = rc_stable_push(&s, out, r.len_mm, now_ms(a));
+            st = rc_stable_push(s, out, r.len_mm, now_ms(a));
             if (st == RC_OK || st == RC_ERR_TIMEOUT)
                 break;
             if (st == RC_ERR_RANGE)
@@ -235,20 +244,26 @@ static rc_status measure(rc_stable_result *out, acq *a, size_t pose)
                      c->stable.min_mm, c->stable.max_mm);
             continue;
         }
-        st = handle_failure(a, st, &r, pose, &fails, &reopens, &s);
+        st = handle_failure(a, st, &r, pose, &fails, &reopens, s);
         if (st != RC_OK)
             return st;
-        if (s.started && c->stable.timeout_ms && (uint32_t)(now_ms(a) - s.t_start_ms) > c->stable.timeout_ms) {
+        if (a->reconnected && a->verify_why) {
+            st = RC_ERR_INCOMPLETE; /* the device must first read the last recorded pose as it did */
+            break;
+        }
+        if (s->started && c->stable.timeout_ms && (uint32_t)(now_ms(a) - s->t_start_ms) > c->stable.timeout_ms) {
             st = RC_ERR_TIMEOUT;
             break;
         }
     }
-    a->res->range += s.range_rejects;
-    a->res->unstable += s.restarts;
+    a->res->range += s->range_rejects;
+    a->res->unstable += s->restarts;
+    a->res->trend_rejects += s->trend_rejects;
     if (st == RC_ERR_TIMEOUT)
-        WARN(a, "pose %zu: no %u consecutive readings within %g mm in %lu s (robot still moving or vibrating? "
-                "raise --stable-mm or --pose-timeout-s)\n", pose, c->stable.n, c->stable.tol_mm,
-             (unsigned long)(c->stable.timeout_ms / 1000u));
+        WARN(a, "pose %zu: no %u consecutive readings within %g mm and without a trend in %lu s (robot still "
+                "moving or vibrating, or a display filter of time constant %.1f s still settling? %lu windows had a "
+                "trend; raise --stable-mm or --pose-timeout-s)\n", pose, c->stable.n, c->stable.tol_mm,
+             (unsigned long)(c->stable.timeout_ms / 1000u), rc_stable_tau_ms(s) / 1000.0, s->trend_rejects);
     return st;
 }
 
@@ -289,6 +304,16 @@ static rc_status measure_checked(rc_stable_result *r, acq *a, size_t i)
         if (c->no_follow_check || !a->has_ref || !isfinite(a->pred_mm[i]) || !isfinite(a->pred_mm[a->ref_pose]) ||
             rch_acq_follows(&miss, r->mean_mm, a->pred_mm[i], a->ref_len_mm, a->pred_mm[a->ref_pose],
                             c->follow_tol_mm) == 0) {
+            if (a->has_ref && !c->no_follow_check && miss > c->jump_mm && a->jump_cleared != i + 1) {
+                WARN(a, "pose %zu: L = %.4f mm changed by %+.2f mm from pose %zu where the nominal model predicts "
+                        "%+.2f mm (off by %.2f mm, more than --jump-mm %g): a length jump? (a slipped cable, a "
+                        "counter reset) Going back to pose %zu to read it again; nothing recorded yet\n",
+                     i, r->mean_mm, r->mean_mm - a->ref_len_mm, a->ref_pose,
+                     a->pred_mm[i] - a->pred_mm[a->ref_pose], miss, c->jump_mm, a->ref_pose);
+                a->verify_why = "for a suspected length jump";
+                a->jump_cleared = i + 1; /* once cleared at ref_pose, this pose's change is the model's error */
+                return RC_ERR_INCOMPLETE;
+            }
             if (a->has_ref && miss > a->res->worst_follow_mm)
                 a->res->worst_follow_mm = miss;
             return RC_OK;
@@ -414,6 +439,89 @@ static int check_paths(acq *a)
     return 0;
 }
 
+/* Show pose i to the robot side, wait for it. 0, or 1 with a message. */
+static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
+{
+    const rch_acq_config *c = a->c;
+    SAY(a, "%s %zu/%zu: q =", recheck ? "back to pose" : "pose", i + 1, a->n);
+    for (int j = 0; j < RC_NJ; ++j)
+        SAY(a, " %.4f", a->plan_deg[i][j]);
+    SAY(a, recheck ? " deg (the last recorded pose: its length is read again)\n" : " deg\n");
+    if (a->out)
+        fflush(a->out);
+    if (c->announce_path && announce(c->announce_path, i, a->plan_deg[i]) != 0) {
+        WARN(a, "cannot write --announce %s: %s\n", c->announce_path, strerror(errno));
+        return 1;
+    }
+    if (c->confirm && a->io->confirm(a->io->ctx, i) != 0) {
+        WARN(a, "end of input; stopped (rerun to resume)\n");
+        return 1;
+    }
+    a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
+    memcpy(q_deg, a->plan_deg[i], sizeof(double) * RC_NJ); /* default joint source: the plan */
+    if (a->io->joints && a->io->joints(a->io->ctx, q_deg, a->plan_deg[i], i) != 0) {
+        WARN(a, "pose %zu: the joint-angle source failed; stopped (rerun to resume)\n", i);
+        return 1;
+    }
+    return 0;
+}
+
+/* The device must read the last recorded pose as it did before pose i's
+ * sample counts (after a reconnect, on resuming, for a suspected jump).
+ * RC_OK go on (a->ref_len_mm may have moved: on_jump_record), else stop. */
+static rc_status recheck(acq *a, size_t i)
+{
+    const rch_acq_config *c = a->c;
+    const double tol = c->verify_tol_mm > 0.0 ? c->verify_tol_mm : c->stable.tol_mm;
+    const size_t r = a->ref_pose;
+    for (unsigned long attempt = 0; attempt <= c->retries; ++attempt) {
+        const char *why = a->verify_why;
+        rc_stable_result v;
+        double q_deg[RC_NJ], off;
+        rc_status st;
+        a->res->verifies++;
+        if (go_to(a, r, q_deg, 1) != 0)
+            return RC_ERR_IO;
+        rcd_port_flush(a->port);
+        rcd_display_reset(&a->d);
+        st = measure(&v, a, r);
+        if (st == RC_ERR_INCOMPLETE)
+            continue; /* reconnected while re-reading: once more */
+        if (st != RC_OK)
+            return st;
+        off = v.mean_mm - a->ref_len_mm;
+        if (fabs(off) <= tol) {
+            NOTE(a, "pose %zu re-read %s: L = %.4f mm, recorded %.4f mm (%+.3f mm, within %g mm): the device "
+                    "reads as before; going on at pose %zu\n", r, why, v.mean_mm, a->ref_len_mm, off, tol, i);
+            a->verify_why = NULL;
+            return RC_OK;
+        }
+        a->res->verify_fails++;
+        WARN(a, "pose %zu re-read %s: L = %.4f mm where %.4f mm was recorded: the device now reads %+.3f mm off "
+                "(more than %g mm): a slipped or re-hooked cable, an encoder counter that reset, a display "
+                "re-zeroed, or another device on the port. The %zu samples up to pose %zu are kept in %s; %s\n",
+             r, why, v.mean_mm, a->ref_len_mm, off, tol, a->res->n_before + a->res->n_new, r, c->out_path,
+             c->on_jump_record ? "--on-jump record: this jump is recorded past; the run goes on from the length "
+                                 "read now (fit with calibrate --jumps, or calibrate's jump check will stop)"
+                               : "nothing more is recorded. Check the cable hook and the display, then rerun the "
+                                 "same command to resume (it re-reads this pose first); if the offset is real and "
+                                 "should stay, rerun with --on-jump record (and fit with calibrate --jumps) or "
+                                 "start a new file");
+        if (!c->on_jump_record)
+            return RC_ERR_RANGE;
+        if (a->res->n_jumps < sizeof a->res->jumps / sizeof a->res->jumps[0]) {
+            a->res->jumps[a->res->n_jumps].pose = i;
+            a->res->jumps[a->res->n_jumps].jump_mm = off;
+        }
+        a->res->n_jumps++;
+        a->ref_len_mm = v.mean_mm; /* the new offset: what follows is checked against it */
+        a->verify_why = NULL;
+        return RC_OK;
+    }
+    WARN(a, "pose %zu: the device kept disconnecting while pose %zu was re-read\n", i, r);
+    return RC_ERR_IO;
+}
+
 static int run_poses(acq *a)
 {
     const rch_acq_config *c = a->c;
@@ -422,30 +530,21 @@ static int run_poses(acq *a)
     for (size_t i = 0; i < a->n; ++i) {
         rc_stable_result r;
         double q_deg[RC_NJ];
-        rc_status st;
+        rc_status st = RC_ERR_INCOMPLETE;
         if (a->done[i] || a->other[i])
             continue;
-        SAY(a, "pose %zu/%zu: q =", i + 1, a->n);
-        for (int j = 0; j < RC_NJ; ++j)
-            SAY(a, " %.4f", a->plan_deg[i][j]);
-        SAY(a, " deg\n");
-        if (a->out)
-            fflush(a->out);
-        if (c->announce_path && announce(c->announce_path, i, a->plan_deg[i]) != 0) {
-            WARN(a, "cannot write --announce %s: %s\n", c->announce_path, strerror(errno));
-            return 1;
+        for (unsigned long round = 0; st == RC_ERR_INCOMPLETE; ++round) {
+            if (a->verify_why && a->has_ref && (st = recheck(a, i)) != RC_OK)
+                break;
+            if (round > 2 * c->retries + 2) {
+                WARN(a, "pose %zu: the device keeps disconnecting or jumping\n", i);
+                st = RC_ERR_IO;
+                break;
+            }
+            if (go_to(a, i, q_deg, 0) != 0)
+                return 1;
+            st = measure_checked(&r, a, i);
         }
-        if (c->confirm && a->io->confirm(a->io->ctx, i) != 0) {
-            WARN(a, "end of input; stopped (rerun to resume)\n");
-            return 1;
-        }
-        a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
-        memcpy(q_deg, a->plan_deg[i], sizeof q_deg); /* default joint source: the plan */
-        if (a->io->joints && a->io->joints(a->io->ctx, q_deg, a->plan_deg[i], i) != 0) {
-            WARN(a, "pose %zu: the joint-angle source failed; stopped (rerun to resume)\n", i);
-            return 1;
-        }
-        st = measure_checked(&r, a, i);
         if (st != RC_OK) {
             a->res->stopped = 1;
             a->res->stopped_at = i;
@@ -490,7 +589,8 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     a.file.fd = -1;
     if (!c->port_path || !c->poses_path || !c->out_path || !c->robot_path || c->read_timeout_ms < 1 ||
         c->read_timeout_ms > 3600000ul || c->retries < 1 || rc_stable_init(&chk, &c->stable) != RC_OK ||
-        !(c->follow_tol_mm > 0.0) || rcd_display_init(&a.d, &(rcd_port){&rcd_mock_ops, NULL}, &c->proto) != RC_OK) {
+        !(c->follow_tol_mm > 0.0) || !(c->jump_mm > 0.0) || !(c->verify_tol_mm >= 0.0) ||
+        rc_stable_init(&a.st, &c->stable) != RC_OK || rcd_display_init(&a.d, &(rcd_port){&rcd_mock_ops, NULL}, &c->proto) != RC_OK) {
         WARN(&a, "invalid settings\n");
         return 2;
     }
@@ -526,6 +626,8 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     a.has_ref = fst.has_last;
     a.ref_pose = fst.last_pose;
     a.ref_len_mm = fst.last_len_mm;
+    if (a.has_ref)
+        a.verify_why = "on resuming"; /* the device may have been re-hooked or reset since */
     if (fst.n_done == a.n_mine) {
         SAY(&a, "rcal acquire: %s already holds all %zu poses; nothing to do\n", c->out_path, a.n_mine);
         rc = 0;
@@ -544,6 +646,7 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     port_open = 1;
     rcd_display_init(&a.d, a.port, &c->proto);
     rc = run_poses(&a);
+    res->tau_ms = rc_stable_tau_ms(&a.st);
     res->readings = a.d.stats.readings;
     res->bad_frames = a.d.stats.bad_frames;
     res->shape_rejects = a.d.stats.shape_rejects;

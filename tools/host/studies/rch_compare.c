@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "rch_calib.h"
+#include "rch_cost.h"
 #include "rch_eval.h"
 #include "rch_jumps.h"
 #include "rch_prior.h"
@@ -505,6 +506,19 @@ static int run_case(rch_compare_result *res, const rch_compare_config *cfg, rch_
     return 0;
 }
 
+double rch_compare_estimate_s(const rch_compare_config *cfg, size_t n)
+{
+    /* us per drawn row and case, measured with rcal compare --cases 1 --samples 100/300/1000 --methods X on
+     * robotcali.csv (both parameter sets alike); the order of rch_est_id */
+    static const double us_per_row[RCH_EST_ALL] = {25, 25, 1050, 1450, 600, 30, 250, 80, 80, 375, 375};
+    const double rows = (double)(cfg->samples && cfg->samples < n ? cfg->samples : n);
+    double per_row = 20.0; /* the start model, the split, the evaluation */
+    for (int i = 0; i < RCH_EST_ALL; ++i)
+        if (cfg->run[i])
+            per_row += us_per_row[i];
+    return (double)cfg->cases * (0.005 + rows * per_row * 1e-6) * (cfg->jumps ? 1.2 : 1.0);
+}
+
 /* Sizes of a case from the configuration; 0 or -1 with d set. */
 static int case_sizes(rch_compare_result *res, const rch_compare_config *cfg, size_t n, rch_diag *d)
 {
@@ -523,14 +537,16 @@ static int case_sizes(rch_compare_result *res, const rch_compare_config *cfg, si
         return -1;
     }
     {
-        /* the cost: one fit per case, method and drawn row (about 0.5 ms
-         * each on one core): 10 cases x 300 rows x 7 methods is 21000 */
-        const double work = (double)cfg->cases * (double)res->n_draw * (double)sel;
-        if (work > RCH_COMPARE_MAX_WORK) {
+        /* the cost, before the work (rch_compare_estimate_s) */
+        const double est_s = rch_compare_estimate_s(cfg, n);
+        const double lim_min = cfg->max_minutes > 0.0 ? cfg->max_minutes : RCH_COMPARE_MAX_MINUTES;
+        if (est_s > 60.0 * lim_min) {
+            char b1[32];
             rch_diag_set(d, "", 0, 0,
-                         "%lu cases x %zu rows x %zu methods = %.3g row fits, above the limit of %.0e (about 8 "
-                         "min): lower --cases or --samples",
-                         cfg->cases, res->n_draw, sel, work, RCH_COMPARE_MAX_WORK);
+                         "%lu cases x %zu rows x %zu methods would take about %s (measured cost per row on the "
+                         "reference machine, docs/methods.md), above the limit of %.0f min: lower --cases or "
+                         "--samples, or raise --max-minutes",
+                         cfg->cases, res->n_draw, sel, rch_cost_human(b1, sizeof b1, est_s), lim_min);
             return -1;
         }
     }
@@ -582,6 +598,7 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
         res->row[id + 1].used = cfg->run[id] != 0;
     for (size_t k = 0; k < RCH_COMPARE_ROWS * res->n_test; ++k)
         res->err_case1_mm[k] = NAN;
+    const double t0_s = rch_cost_now_s();
     for (unsigned long c = 0; c < cfg->cases; ++c) {
         rch_holdout h;
         /* the case's draw: the first n_test rows of the permutation are held out */
@@ -599,8 +616,13 @@ int rch_compare_run(rch_compare_result *res, const rch_compare_config *cfg, cons
             rch_diag_set(d, "", 0, 0, "case %lu: %s", c + 1, msg);
             goto done;
         }
-        if (progress)
-            fprintf(progress, "case %lu/%lu done\n", c + 1, cfg->cases);
+        if (progress) {
+            char b1[32], b2[32];
+            const double el = rch_cost_now_s() - t0_s;
+            fprintf(progress, "case %lu/%lu done, %s elapsed, about %s left\n", c + 1, cfg->cases,
+                    rch_cost_human(b1, sizeof b1, el),
+                    rch_cost_human(b2, sizeof b2, el * (double)(cfg->cases - c - 1) / (double)(c + 1)));
+        }
     }
     summarise(res);
     rc = 0;

@@ -69,8 +69,8 @@ enum { RCH_COMPARE_ROWS = RCH_EST_ALL + 1 };
 extern const double rch_compare_table6[8][3];
 
 #define RCH_COMPARE_MAX_CASES 10000ul
-/* cases x rows drawn x methods at most (the cost of a comparison) */
-#define RCH_COMPARE_MAX_WORK 1e6
+/* the default limit of one comparison's estimated time (rch_compare_estimate_s) */
+#define RCH_COMPARE_MAX_MINUTES 60.0
 
 typedef struct rch_compare_config {
     unsigned long cases;      /* 1..RCH_COMPARE_MAX_CASES */
@@ -102,7 +102,14 @@ typedef struct rch_compare_config {
      * it too (rc_est.h: the MAP objective, no subset, the box 3 prior sd,
      * EKF iterated from the prior); the paper-literal variants ignore it. */
     int prior;
+    double max_minutes;       /* refuse a run estimated longer; 0: RCH_COMPARE_MAX_MINUTES */
 } rch_compare_config;
+
+/* Seconds one rch_compare_run of cfg on n rows takes on the reference
+ * machine: cases x rows drawn x the sum over the selected methods of their
+ * measured cost per drawn row (docs/methods.md, "Cost estimates"), x 1.2
+ * with jumps. --params both runs it twice. */
+double rch_compare_estimate_s(const rch_compare_config *cfg, size_t n);
 
 /* File name of row r's model in models_dir: "BC.json", "M1-LM.json", ...,
  * "M7-LTLM.json", then "M1-LM-paper.json" .. "M7-LTLM-paper-deg.json" (the
