@@ -188,7 +188,11 @@ static size_t close_of(const scan *s, size_t i)
                 return s->tk.n;
             open[depth++] = t->ch;
         } else if (t->ch == ']' || t->ch == ')' || t->ch == '}') {
-            const char want = t->ch == ']' ? '[' : t->ch == ')' ? '(' : '{';
+            char want = '{';
+            if (t->ch == ']')
+                want = '[';
+            else if (t->ch == ')')
+                want = '(';
             if (depth == 0 || open[depth - 1] != want)
                 return s->tk.n;
             if (--depth == 0)

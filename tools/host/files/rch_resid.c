@@ -133,7 +133,10 @@ int rch_resid_add_step(rch_resid_table *t, const char *name)
         return -1;
     dst = t->step[t->n_steps++];
     for (; name[k] && k + 1 < sizeof t->step[0]; ++k)
-        dst[k] = name[k] == ' ' ? (char)'_' : name[k];
+        if (name[k] == ' ')
+            dst[k] = '_';
+        else
+            dst[k] = name[k];
     dst[k] = '\0';
     return 0;
 }

@@ -1025,6 +1025,7 @@ static int combo_eval(rch_poses_combo *cb, const rc_model *m, const rch_poses_co
     rch_poses_config cc = *c;
     rch_poses_result r;
     double pos[RC_MAX_OUTLETS][3];
+    memset(&r, 0, sizeof r);
     cc.n_outlets = k;
     cc.passes = 0;
     cb->k = k;
