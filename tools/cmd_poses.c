@@ -263,6 +263,7 @@ int rcal_cmd_poses(int argc, char **argv)
 {
     const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL, *criterion = "position", *format = "csv";
     unsigned long n = 0, seed = 1, n_cand = 0, passes = 4, choose = 0;
+    double max_minutes = 60.0;
     double enc[3] = {250.0, -460.0, 10.0}, tool[3] = {0, 0, 0}, settle_s = 5.0;
     rch_poses_config pc;
     rch_opt_strs outlets = {{0}, 0}, cands = {{0}, 0};
@@ -303,6 +304,8 @@ int rcal_cmd_poses(int argc, char **argv)
         {"--candidates", RCH_OPT_UINT, &n_cand, 0, RCH_POSES_MAX_CANDIDATES, "M", "0: max(2000, 40 N)", 0, NULL},
         {"--margin-deg", RCH_OPT_DOUBLE, &pc.margin_deg, 0, 360, "D", "kept from every joint limit", 0, NULL},
         {"--passes", RCH_OPT_UINT, &passes, 0, 100, "P", "exchange passes", 0, NULL},
+        {"--max-minutes", RCH_OPT_DOUBLE, &max_minutes, 0.01, 1e7, "MIN",
+         "refuse a plan estimated longer (the estimate is printed before the work when over 10 s)", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was planned and written, as one JSON object on stdout", 0,
          NULL},
     };
@@ -324,6 +327,7 @@ int rcal_cmd_poses(int argc, char **argv)
     pc.count = n;
     pc.candidates = n_cand;
     pc.passes = passes;
+    pc.max_minutes = max_minutes;
     pc.seed = seed;
     pc.n_outlets = n_places;
     pc.split = split;

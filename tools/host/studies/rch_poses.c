@@ -11,11 +11,45 @@
 
 #include "rc_rand.h"
 #include "rc_ident.h"
+#include "rch_cost.h"
 #include "rch_ident.h"
 #include "rch_stats.h"
 #include "rch_uncert.h"
 
 #define PI_ 3.14159265358979323846
+
+void rch_poses_estimate(double *first_s, double *all_s, size_t n, size_t n_cand, unsigned nf, unsigned long passes,
+                        int length_criterion)
+{
+    const double phase = (double)n * (double)n_cand * (double)nf * (double)nf * (length_criterion ? 0.3e-9 : 0.8e-9);
+    const double fixed = length_criterion ? 20e-6 * (double)n_cand : 0.0;
+    *first_s = fixed + phase * (passes ? 2.0 : 1.0);
+    *all_s = fixed + phase * (1.0 + (double)passes);
+}
+
+/* The estimate printed (over 10 s) and checked against the limit before the
+ * work starts: 0, or -1 with d set (above --max-minutes). */
+static int plan_cost(const rch_poses_config *c, FILE *progress, size_t n, size_t n_cand, unsigned nf, int length,
+                     rch_diag *d)
+{
+    double first, all;
+    char a[32], b[32];
+    const double lim_min = c->max_minutes > 0.0 ? c->max_minutes : 60.0;
+    rch_poses_estimate(&first, &all, n, n_cand, nf, c->passes, length);
+    if (all > 60.0 * lim_min) {
+        rch_diag_set(d, "", 0, 0,
+                     "a plan of %zu poses from %zu candidates with %lu exchange passes would take about %s (at most %s): "
+                     "above the limit of %g min; lower --count, --candidates or --passes, or raise --max-minutes",
+                     n, n_cand, c->passes, rch_cost_human(a, sizeof a, first), rch_cost_human(b, sizeof b, all),
+                     lim_min);
+        return -1;
+    }
+    if (progress && all > 10.0)
+        fprintf(progress, "rcal poses: %zu poses from %zu candidates: about %s with one exchange pass, at most %s "
+                          "with all %lu\n",
+                n, n_cand, rch_cost_human(a, sizeof a, first), rch_cost_human(b, sizeof b, all), c->passes);
+    return 0;
+}
 
 /* Cholesky of the r x r matrix A (row-major) into L (LAPACK; the lower
  * triangle and the diagonal are read); log det or -inf. */
@@ -259,8 +293,8 @@ static unsigned exchange(plan_work *w)
 static int check_config(const rc_model *m, const rch_poses_config *c, size_t *n_cand, rch_diag *d)
 {
     if (c->count < 1 || c->count > RCH_POSES_MAX_COUNT) {
-        rch_diag_set(d, "", 0, 0, "--count %zu: a plan has 1..%u poses (the design cost grows as N^2; "
-                     "1000 poses take about 25 s)", c->count, RCH_POSES_MAX_COUNT);
+        rch_diag_set(d, "", 0, 0, "--count %zu: a plan has 1..%u poses (the cost grows as poses x candidates x "
+                     "passes: rcal poses says its estimate before it starts)", c->count, RCH_POSES_MAX_COUNT);
         return -1;
     }
     *n_cand = c->candidates ? c->candidates : (c->count * 40 > 2000 ? c->count * 40 : 2000);
@@ -305,9 +339,8 @@ static int plan_length(rch_poses_result *res, const rc_model *m, const rch_poses
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
-    if (progress && w.n >= 200)
-        fprintf(progress, "rcal poses: %zu poses from %zu candidates: about %.0f s\n", w.n, w.n_cand,
-                (double)w.n * (double)w.n / 40000.0);
+    if (plan_cost(c, progress, w.n, w.n_cand, w.P < 20u ? w.P : 20u, 1, d) != 0)
+        goto done;
     if (draw_candidates(&w, m, c, d) != 0)
         goto done;
     if (ident_subspace(&w, d) != 0)
@@ -867,10 +900,8 @@ static int plan_position(rch_poses_result *res, const rc_model *m, const rch_pos
         goto done;
     w->n = c->count;
     w->n_pose = n_pose;
-    if (progress && w->n * w->K >= 200)
-        fprintf(progress, "rcal poses: %zu poses from %zu candidates and %u outlet(s): about %.0f s\n", w->n,
-                w->n_pose, w->K,
-                (double)w->n * (double)w->n_pose * w->K * w->nf * w->nf * 2.0 * (double)(c->passes + 1) / 1e9);
+    if (plan_cost(c, progress, w->n, w->n_pose * w->K, w->nf, 0, d) != 0)
+        goto done;
     if (pos_candidates(w, c, d) != 0)
         goto done;
     if (w->n_cand < w->n) {

@@ -59,6 +59,7 @@ typedef struct rch_poses_config {
     size_t count;              /* N, 1..RCH_POSES_MAX_COUNT */
     size_t candidates;         /* 0: max(2000, 40 N); else N..RCH_POSES_MAX_CANDIDATES */
     unsigned long passes;      /* exchange passes (4 in rcal poses) */
+    double max_minutes;        /* refuse a plan estimated longer (rch_poses_estimate); 0: 60 */
     unsigned long long seed;
     double len_min_mm, len_max_mm; /* cable length range, min < max */
     double margin_deg;             /* kept from every joint limit, >= 0 */
@@ -153,5 +154,17 @@ int rch_poses_choose_outlets(rch_poses_choice *out, const rc_model *m, const rch
  * outlet column, NULL: all 0. 0, or -1 (a write failed). */
 int rch_poses_write_rapid(FILE *f, const rc_sample *rows, const unsigned char *outlet_label, size_t n,
                           double settle_s, const char *comment);
+
+/* What a plan costs before it starts, from the exact work count and the
+ * cost of a unit measured on the reference machine (docs/driver.md): the
+ * position criterion about 0.8 ns x poses x candidates x nf^2 per phase (the
+ * greedy design, then each exchange pass), nf the parameters it designs for;
+ * the length criterion 20 us per candidate (its Jacobian row) plus 0.3 ns x
+ * poses x candidates x r^2 per phase, r the identifiable rank. first_s: the
+ * greedy design and one pass; all_s: every --passes pass (exchange stops
+ * early when no swap helps, so all_s is the most it takes). Measured against
+ * real runs in tests/sim/plan_study.py's neighbourhood: within a factor of 2. */
+void rch_poses_estimate(double *first_s, double *all_s, size_t n, size_t n_cand, unsigned nf, unsigned long passes,
+                        int length_criterion);
 
 #endif
