@@ -186,7 +186,7 @@ int rcal_cmd_report(int argc, char **argv)
         return rch_opt_fail(&spec, &d);
     if (json)
         return report_json(&res, &cfg, argc, argv) != 0;
-    fprintf(stderr, "rcal report: %s written (%u plots, %u warnings, %u places not in this run)\n", cfg.out_path,
+    fprintf(stderr, "rcal report: %s written (%u plots, %u warnings, %u place(s) not in this run)\n", cfg.out_path,
             res.n_plots, res.n_warnings, res.n_missing);
     for (unsigned k = 0; k < res.n_csv; ++k)
         fprintf(stderr, "  plot data: %s\n", res.csv[k]);

@@ -104,6 +104,16 @@ def check_csv(model, label):
             good &= enc[k][:3] == ["encoder", "xyz"[k], "mm"] and enc[k][3] == "" and enc[k][5] == ""
             good &= abs(float(enc[k][4]) - m["encoder_mm"][k]) <= 1e-9 * max(1.0, abs(m["encoder_mm"][k]))
     check(good, "%s: the DH CSV parses back to the model file's values" % label)
+    # a model with a posterior (rcal-model/2 "uncertainty"): every DH row carries its standard error
+    unc = {u["name"]: u.get("std_error") for u in m.get("uncertainty", {}).get("parameters", [])}
+    if unc:
+        se_ok = True
+        for i in range(6):
+            for k in range(4):
+                want = unc.get("%s%d" % (names[k], i + 1))
+                got = rows[1 + 4 * i + k][6]
+                se_ok &= (got == "") if want is None else abs(float(got) - want) <= 1e-9 * max(1.0, abs(want))
+        check(se_ok, "%s: the DH CSV's standard errors are the model's posterior ones" % label)
 
 
 # --- 1. models ----------------------------------------------------------

@@ -1626,7 +1626,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 r->jumps_found, r->jump_check_max_mm, r->cfg.data_path);
     if (r->jumps_auto)
         fprintf(f, "note: the lengths jump in acquisition order (%u jump(s) far above the residual, largest %.3f mm): "
-                   "fitted as nuisance, as --jumps does (--no-jump-check: not looked for)%s\n\n",
+                   "every change point is fitted as nuisance, as --jumps does (--no-jump-check: not looked for)%s\n\n",
                 r->jumps_found, r->jump_check_max_mm,
                 r->cfg.dequantize ? "" : "; if the file's joint angles are rounded, add --dequantize-joints "
                                          "(rcal fkcheck tells)");
@@ -1665,8 +1665,12 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     }
     if (r->plot_paths[0])
         fprintf(f, "plots:\n%s\n", r->plot_paths);
-    fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
-            r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
+    if (r->have_jumps && r->solve.iterations == 0)
+        fprintf(f, "solver: %s with %u length jump(s) (a change-point search, each candidate a fit), %.2f ms\n",
+                method, r->jumps.n_jumps, r->time_ms);
+    else
+        fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
+                r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
 }
 
 static void json_metrics(rch_jw *w, const char *name, const rc_metrics *m)

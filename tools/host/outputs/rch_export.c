@@ -128,6 +128,31 @@ int rch_export_se_parse(rch_export_se *se, const char *text, size_t len, const c
             blk = rch_json_get(where[w], "standard_error");
     }
     if (!blk) {
+        /* a model file (rcal-model/2): its posterior's standard errors, by name
+         * (a1..theta6 in mm and deg, ex, ey, ez in mm; null: none) */
+        const rch_json *unc = rch_json_get(root, "uncertainty");
+        const rch_json *ps = unc && unc->type == RCH_JOBJ ? rch_json_get(unc, "parameters") : NULL;
+        static const char *const pre[4] = {"a", "d", "alpha", "theta"};
+        for (size_t i = 0; ps && ps->type == RCH_JARR && i < ps->n; ++i) {
+            const rch_json *pk = ps->items[i];
+            const rch_json *nm = pk->type == RCH_JOBJ ? rch_json_get(pk, "name") : NULL;
+            const rch_json *v = pk->type == RCH_JOBJ ? rch_json_get(pk, "std_error") : NULL;
+            if (!nm || nm->type != RCH_JSTR || !v || v->type != RCH_JNUM)
+                continue;
+            for (unsigned k = 0; k < 4; ++k)
+                for (unsigned j = 0; j < RC_NJ; ++j) {
+                    char want[16];
+                    snprintf(want, sizeof want, "%s%u", pre[k], j + 1);
+                    if (strcmp(nm->str, want) == 0 && se_num(&se->has_dh[j][k], &se->dh[j][k], v, file, d) != 0)
+                        goto done;
+                }
+            for (unsigned k = 0; k < 3; ++k) {
+                const char want[3] = {'e', (char)('x' + k), '\0'};
+                if (strcmp(nm->str, want) == 0 && se_num(&se->has_enc[k], &se->enc_mm[k], v, file, d) != 0)
+                    goto done;
+            }
+            se->has = 1;
+        }
         rc = 0;
         goto done;
     }

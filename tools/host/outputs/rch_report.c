@@ -906,7 +906,10 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
     kv_end(r);
     kv(r, "display resolution");
     fputs("joints ", f);
-    put_num(r, jnum(r->diag, "q_step_deg"), "%.4g&deg;");
+    if (jnum(r->diag, "q_step_deg") == 0.0)
+        fputs("no display step left (recovered from x, y, z, or not rounded)", f);
+    else
+        put_num(r, jnum(r->diag, "q_step_deg"), "%.4g&deg;");
     fputs(", cable length ", f);
     put_num(r, jnum(r->diag, "len_step_mm"), "%.4g mm");
     kv_end(r);
@@ -915,7 +918,7 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
     if (r->diag) {
         fputs(" (joint display step through the Jacobian ", f);
         put_num(r, jnum(r->diag, "noise_floor_joints_mm"), "%.4g mm");
-        fputs(", length step ", f);
+        fputs(", length step / &radic;12 ", f);
         put_num(r, jnum(r->diag, "noise_floor_length_mm"), "%.4g mm");
         fputs(")", f);
     }
