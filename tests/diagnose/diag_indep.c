@@ -248,7 +248,7 @@ int main(int argc, char **argv)
         seeds = (unsigned)atoi(env);
     }
     const char *robots[2] = {RCAL_SOURCE_DIR "/data/irb120.json", RCAL_SOURCE_DIR "/data/kr6.json"};
-    rc_sample *s = malloc(N * sizeof *s);
+    rc_sample *s = calloc(N, sizeof *s); /* every field zero: a cable-length row of outlet 0 (rc_sample.sensor) */
     int fail = 0;
     if (!s || seeds == 0 || seeds > 1000)
         return 2;

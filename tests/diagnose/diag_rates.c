@@ -31,7 +31,7 @@ static double median(double *v, unsigned n)
 static int bands(unsigned seeds, double size_x, int visible, size_t n, unsigned folds)
 {
     rc_model nominal;
-    rc_sample *s = malloc(n * sizeof *s);
+    rc_sample *s = calloc(n, sizeof *s);
     if (!s || diag_load_nominal(&nominal) != 0)
         return 1;
     printf("own simulator (rch_sim, IRB120), %u seeds per noise band and case, n %zu in set-ups of %u, %u folds,\n"
@@ -98,7 +98,7 @@ int main(int argc, char **argv)
     rc_model nominal;
     if (diag_load_nominal(&nominal) != 0 || seeds == 0 || seeds > 1000)
         return 1;
-    rc_sample *s = malloc(n * sizeof *s);
+    rc_sample *s = calloc(n, sizeof *s);
     double *before = malloc(seeds * sizeof *before), *after = malloc(seeds * sizeof *after),
            *floor_ = malloc(seeds * sizeof *floor_);
     if (!s || !before || !after || !floor_)

@@ -24,7 +24,7 @@
 
 static unsigned run_case(const diag_case *c, unsigned ci, const rc_model *nominal, unsigned *shrunk)
 {
-    rc_sample *s = malloc(N_SAMPLES * sizeof *s);
+    rc_sample *s = calloc(N_SAMPLES, sizeof *s);
     unsigned hits = 0;
     char label[64], other[256] = "";
     size_t op = 0;
@@ -95,7 +95,7 @@ static void test_controls_coarse(void **state)
 {
     (void)state;
     rc_model nominal;
-    rc_sample *s = malloc(N_SAMPLES * sizeof *s);
+    rc_sample *s = calloc(N_SAMPLES, sizeof *s);
     assert_non_null(s);
     assert_int_equal(diag_load_nominal(&nominal), 0);
     for (unsigned k = 0; k < 3; ++k) {
@@ -126,7 +126,7 @@ static void test_not_identifiable(void **state)
 {
     (void)state;
     rc_model nominal;
-    rc_sample *s = malloc(N_SAMPLES * sizeof *s);
+    rc_sample *s = calloc(N_SAMPLES, sizeof *s);
     rch_diagnose_cfg cfg;
     rch_diagnose_result r;
     rch_diag d;
@@ -162,7 +162,7 @@ static void test_noise_bands(void **state)
 {
     (void)state;
     rc_model nominal;
-    rc_sample *s = malloc(N_SAMPLES * sizeof *s);
+    rc_sample *s = calloc(N_SAMPLES, sizeof *s);
     assert_non_null(s);
     assert_int_equal(diag_load_nominal(&nominal), 0);
     for (unsigned ci = 0; ci < DIAG_N_CASES; ++ci) {

@@ -398,7 +398,7 @@ static void test_solve_buf_same(void **state)
     /* more samples than the fixed struct's tails hold (1,396 for 27
      * parameters): rc_solve computes the sines per pass, same result */
     enum { NB = 1500 };
-    rc_sample *b = malloc(NB * sizeof *b);
+    rc_sample *b = calloc(NB, sizeof *b);
     assert_non_null(b);
     sim_set(&start, &truth, b, NB, 32);
     solve_three_ways(RC_METHOD_LM, &start, b, NB);
