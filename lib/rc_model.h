@@ -176,7 +176,10 @@ typedef enum rc_sensor_kind {
     RC_SENSOR_TRACKER_Z = 3
 } rc_sensor_kind;
 
-/* One measurement: joint readings, cable length and its context. */
+/* One measurement: joint readings, cable length and its context. Zero-
+ * initialise it (memset, calloc or = {0}) before filling the fields: a zero
+ * sensor, target and outlet is a cable length from the first outlet, and a
+ * sensor kind the model does not know makes rc_meas return RC_ERR_ARG. */
 typedef struct rc_sample {
     double q_rad[RC_NJ]; /* (6) joint readings */
     double len_mm;       /* the measured value (mm): cable length, or the tracker coordinate */
