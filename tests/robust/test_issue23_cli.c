@@ -491,6 +491,11 @@ static void test_impossible_data(void **state)
     RUN(2, NEED("same file as --data d.csv"), R " calibrate --data d.csv --data d_hard.csv --robot r.json");
     RUN(2, NEED("--validate d_hard.csv is the same file as --data d.csv", "never saw"),
         R " calibrate --data d.csv --validate d_hard.csv --robot r.json");
+    /* messages that point the right way: a model path that is a directory, targets without a header */
+    RUN(0, NULL, "mkdir -p model_dir && printf 'nan,0,0,0,0,0\\n' > no_header.csv");
+    RUN(1, NEED("model_dir: is a directory, not a file"), R " compensate --model model_dir --in no_header.csv --out o.csv");
+    RUN(1, NEED("no_header.csv:1:1", "this first line holds numbers", "q1,q2,q3,q4,q5,q6"),
+        R " compensate --model m.json --in no_header.csv --out o.csv");
 }
 
 /* ---- class 7: options are never silently cut ---- */

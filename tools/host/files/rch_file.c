@@ -572,6 +572,12 @@ int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, 
         rch_diag_set(d, path, 0, 0, "cannot open: %s", strerror(errno));
         return -1;
     }
+    struct stat st;
+    if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
+        rch_diag_set(d, path, 0, 0, "is a directory, not a file: name the file in it");
+        fclose(f);
+        return -1;
+    }
     size_t cap = max_bytes < 4096 ? max_bytes : 4096, n = 0;
     char *buf = malloc(cap + 1);
     int oom = buf == NULL;

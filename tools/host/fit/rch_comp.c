@@ -282,7 +282,14 @@ static int do_header(comp_ctx *c, const char *line, size_t n, unsigned lineno, r
             }
         }
         if (c->qcol[i] < 0) {
-            rch_diag_set(d, c->in_name, lineno, 1, "header has no q%d column (need q1..q6, degrees)", i + 1);
+            /* a first line of numbers (or nan, inf) is a target, not a header */
+            char *end = NULL;
+            (void)strtod(line + st[0], &end);
+            const int numeric = nf > 0 && end != line + st[0] && (size_t)(end - line) == st[0] + ln[0];
+            rch_diag_set(d, c->in_name, lineno, 1, "header has no q%d column (need q1..q6, degrees)%s", i + 1,
+                         numeric ? ": this first line holds numbers, a target; put a header line "
+                                   "q1,q2,q3,q4,q5,q6 above the targets"
+                                 : "");
             return -1;
         }
     }

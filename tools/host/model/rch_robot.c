@@ -2,10 +2,12 @@
 #include "rch_robot.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rc_linalg.h"
 #include "rch_data.h"
+#include "rch_file.h"
 #include "rch_json.h"
 #include "rch_jw.h"
 
@@ -444,20 +446,14 @@ done:
 
 int rch_robot_load(rch_robot *out, const char *path, rch_diag *d)
 {
-    FILE *f = fopen(path, "rb");
-    char buf[1 << 16];
-    if (!f) {
-        rch_diag_set(d, path, 0, 0, "cannot open model file");
+    char *text;
+    size_t len;
+    /* the one file reader: a directory, a read error (with its reason) or a file over 64 KiB is refused */
+    if (rch_read_file(&text, &len, path, (size_t)1 << 16, d) != 0)
         return -1;
-    }
-    size_t len = fread(buf, 1, sizeof buf, f);
-    int big = len == sizeof buf;
-    fclose(f);
-    if (big) {
-        rch_diag_set(d, path, 0, 0, "model file larger than 64 KiB");
-        return -1;
-    }
-    return rch_robot_parse(out, buf, len, path, d);
+    const int rc = rch_robot_parse(out, text, len, path, d);
+    free(text);
+    return rc;
 }
 
 static void write_dh(rch_jw *w, const char *key, const rc_model *m)
