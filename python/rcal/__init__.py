@@ -432,9 +432,9 @@ class Result:
         err = ctypes.create_string_buffer(_ERR_LEN)
         _check(_lib.lib().rch_ffi_calib_write(self._h, _path(path), err, _ERR_LEN), err)
 
-    def report(self, directory, diagnosis=None, name="report", model=None):
+    def report(self, directory, diagnosis=None, name="report", model=None, tolerance_mm=None):
         """The HTML report: see rcal.report()."""
-        return report(self, directory, diagnosis=diagnosis, name=name, model=model)
+        return report(self, directory, diagnosis=diagnosis, name=name, model=model, tolerance_mm=tolerance_mm)
 
     def __repr__(self):
         return "<rcal.Result %s: %d train / %d test, RMSE %.4f -> %.4f mm>" % (
@@ -763,14 +763,15 @@ def export(model, out_path, format="urdf", nominal_urdf=None, drop_joint_effects
             shutil.rmtree(tmp, ignore_errors=True)
 
 
-def report(result, directory, diagnosis=None, name="report", model=None):
+def report(result, directory, diagnosis=None, name="report", model=None, tolerance_mm=None):
     """The HTML report of a calibration (and a diagnosis) into directory
     (created when missing), as `rcal calibrate --report` makes it:
     <name>.html with its plot data (<name>_*.csv), the calibration's JSON
     (<name>.calibration.json) and the diagnosis's (<name>.diagnosis.json)
     beside it. model: the model file of the run; None writes the result's
     model as <name>.model.json into the directory (when it is finite) and
-    uses that. Returns the paths written."""
+    uses that. tolerance_mm: the verdict on the first screen passes or fails
+    against it (rcal report --tolerance-mm). Returns the paths written."""
     if not isinstance(result, Result):
         raise ValueError("report: result must be an rcal.Result")
     os.makedirs(directory, exist_ok=True)
@@ -784,5 +785,6 @@ def report(result, directory, diagnosis=None, name="report", model=None):
     paths = ctypes.create_string_buffer(16384)
     err = ctypes.create_string_buffer(_ERR_LEN)
     _check(_lib.lib().rch_ffi_report(result._h, diagnosis._h if diagnosis is not None else None, _path(html),
-                                     _opt_path(model), paths, 16384, err, _ERR_LEN), err)
+                                     _opt_path(model), float(tolerance_mm) if tolerance_mm else 0.0, paths, 16384,
+                                     err, _ERR_LEN), err)
     return [p for p in paths.value.decode().split("\n") if p] + written

@@ -79,7 +79,7 @@ def _declare(lib):
         "rch_ffi_diag_write": (i, [vp, cp, cp, sz]),
         "rch_ffi_evaluate": (i, [_c_double_p, vp, cp, i, d, cp, sz]),
         "rch_ffi_export": (i, [cp, cp, i, cp, i, _c_uint_p, _c_uint_p, cp, sz]),
-        "rch_ffi_report": (i, [vp, vp, cp, cp, cp, sz, cp, sz]),
+        "rch_ffi_report": (i, [vp, vp, cp, cp, d, cp, sz, cp, sz]),
         "rch_ffi_calib_free": (None, [vp]),
         "rch_ffi_calib_metrics": (i, [vp, i, _c_double_p]),
         "rch_ffi_calib_info": (i, [vp, _c_size_p, _c_size_p, _c_int_p, _c_uint_p, _c_uint_p, cp, sz]),

@@ -107,6 +107,11 @@ def test_report_into_a_directory(tmp_path):
     html = (tmp_path / "rep" / "report.html").read_text()
     assert "<html" in html.lower() and "a2" in html
     assert json.loads((tmp_path / "rep" / "report.calibration.json").read_text())["n_train"] == 540
+    # the verdict against a tolerance: the demo's largest 95 % radius over the data is about 0.016 mm
+    r.report(str(tmp_path / "pass"), tolerance_mm=1.0)
+    assert "<b>PASS</b> against the tolerance of 1 mm" in (tmp_path / "pass" / "report.html").read_text()
+    r.report(str(tmp_path / "fail"), tolerance_mm=0.001)
+    assert "<b>FAIL</b> against the tolerance of 0.001 mm" in (tmp_path / "fail" / "report.html").read_text()
 
 
 def test_diagnosis_figures_and_residuals(run_cli):

@@ -1070,7 +1070,7 @@ static void add_path(char *paths, size_t len, const char *p)
 }
 
 int rch_ffi_report(const rch_ffi_calib *c, const rch_ffi_diag *g, const char *html_path, const char *model_path,
-                   char *paths, size_t paths_len, char *err, size_t err_len)
+                   double tolerance_mm, char *paths, size_t paths_len, char *err, size_t err_len)
 {
     if (!c || !html_path || strcmp(html_path, "-") == 0 || strlen(html_path) >= PATH_LEN)
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
@@ -1099,7 +1099,7 @@ int rch_ffi_report(const rch_ffi_calib *c, const rch_ffi_diag *g, const char *ht
         (g && rch_save(diag_path, what[2], ins, n_ins, diag_json, &g->r, &d) != 0))
         return fail_diag(RCH_FFI_ERR_IO, err, err_len, &d);
     rch_report_cfg rc = {.cal_path = cal_path, .diag_path = g ? diag_path : NULL, .model_path = model_path,
-                         .out_path = html_path};
+                         .out_path = html_path, .tolerance_mm = tolerance_mm > 0.0 ? tolerance_mm : 0.0};
     rch_report_result res;
     memset(&res, 0, sizeof res);
     if (rch_report_write(&res, &rc, &d) != 0)

@@ -325,9 +325,11 @@ int rch_ffi_export(const char *model_path, const char *out_path, int format, con
  * html_path, as `rcal calibrate --report` makes it: the calibration's JSON
  * (and the diagnosis's) written beside the page as <page>.calibration.json
  * (<page>.diagnosis.json), then rch_report_write with model_path (a model
- * file, or NULL) and the page's plot-data CSVs. paths (len, may be NULL):
- * every file written, "\n"-separated. Never over an input. */
+ * file, or NULL) and the page's plot-data CSVs; tolerance_mm > 0: the
+ * verdict passes or fails against it (`rcal report --tolerance-mm`), 0: none.
+ * paths (len, may be NULL): every file written, "\n"-separated. Never over
+ * an input. */
 int rch_ffi_report(const rch_ffi_calib *c, const rch_ffi_diag *g, const char *html_path, const char *model_path,
-                   char *paths, size_t paths_len, char *err, size_t err_len);
+                   double tolerance_mm, char *paths, size_t paths_len, char *err, size_t err_len);
 
 #endif /* RCH_FFI_H */
