@@ -1498,7 +1498,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                                                              "relative to it is known only from the prior of a6, d6)",
                 r->attach_dchi2, r->attach_occam);
     fprintf(f, "  parameter        value   1 std.error  class%s\n", u->has_prior ? "              data vs prior" : "");
-    unsigned held = 0;
+    unsigned held = 0, outside = 0;
     char list[512] = "";
     for (unsigned k = 0; k < m->n_params; ++k) {
         char nm[64], se[32];
@@ -1512,6 +1512,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         char pc[96] = "";
         if (u->has_prior && u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED) {
             const double dev = fabs(m->x[k] - r->prior_mean[k]) / u->prior_sd[k];
+            outside += dev > 3.0;
             snprintf(pc, sizeof pc, "  %-10s (se %.0f %% of prior)%s",
                      rch_prior_class_name((rch_prior_class)u->prior_cls[k]), 100.0 * u->se[k] / u->prior_sd[k],
                      dev > 3.0 ? "  OUTSIDE the prior's plausible range (> 3 sd from nominal)" : "");
@@ -1524,12 +1525,21 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
             ++held;
         }
     }
+    if (outside)
+        fprintf(f, "  next: %u parameter(s) OUTSIDE the prior's range are a real deviation (check the drawing) or "
+                   "stand in for an effect the model lacks: rcal diagnose --data %s%s\n",
+                outside, r->cfg.data_path ? r->cfg.data_path : "FILE", r->cfg.dequantize ? " --dequantize-joints" : "");
     fprintf(f,
             "predicted 3-D accuracy after compensation (95 %%, longest semi-axis of the flange-position "
             "ellipsoid): over the sampled region +-%.4f mm (median over the data's poses; max %.4f), whole "
             "workspace +-%.4f mm (median over %d random poses; max %.4f)\n",
             u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
             u->map.work_max_mm);
+    if (r->after_ok && u->map.data_median_mm > 10.0 * r->after_m.rmse_mm && u->map.data_median_mm > 0.1)
+        fprintf(f, "  next: the lengths are predicted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave "
+                   "most of the geometry to the prior; plan poses that move every joint, from more than one outlet: "
+                   "rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv\n",
+                r->after_m.rmse_mm, u->map.data_median_mm, r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json");
     fprintf(f,
             "predicted flange-orientation uncertainty (95 %%) inside the data: +-%.4f deg with every parameter, "
             "+-%.4f deg with those compensation uses: orientation %s\n",
