@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* rc_kin.c - forward kinematics and joint Jacobian of the compiled model, in rc_real.
  *
- * The link transform is rc_chain.h's, the one rc_model.c's chain expands
+ * The link transform is rc_chain.inc's, the one rc_model.c's chain expands
  * too, so that a double build gives the solver model's numbers bit for bit;
  * only the cosines and sines of the link twists are taken from the table
  * instead of being recomputed. */
@@ -11,7 +11,7 @@
 
 #define RC_CHAIN_T rc_real
 #define RC_CHAIN_LINK kin_link
-#include "rc_chain.h" /* the one link transform (also rc_model.c's) */
+#include "rc_chain.inc" /* the one link transform (also rc_model.c's) */
 
 /* Chain of nj links: o[k], R[k] frame k (o[0], R[0] the base). */
 static void kin_chain(rc_real (*o)[3], rc_real (*R)[9], const rc_kin_link *lk, const rc_real *theta_rad,

@@ -22,7 +22,7 @@ typedef struct {
 
 #define RC_CHAIN_T double
 #define RC_CHAIN_LINK chain_link
-#include "rc_chain.h" /* the one link transform (also rc_kin.c's) */
+#include "rc_chain.inc" /* the one link transform (also rc_kin.c's) */
 
 static const double chain_eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 

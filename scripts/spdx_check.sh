@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # scripts/spdx_check.sh - every source file carries its licence: lists each
-# file (*.c *.h *.sh CMakeLists.txt *.cmake *.in *.py, as git sees the tree:
+# file (*.c *.h *.inc *.sh CMakeLists.txt *.cmake *.in *.py, as git sees the tree:
 # tracked and new files, ignored ones left out) without an
 # "SPDX-License-Identifier: MIT" line in its first 3 lines, and fails when
 # there is one. Outside git: every such file under the tree but build*/.
@@ -21,7 +21,7 @@ n=0
 missing=0
 while IFS= read -r f; do
     case "$f" in
-    *.c | *.h | *.sh | *.cmake | *.in | *.py | CMakeLists.txt | */CMakeLists.txt) ;;
+    *.c | *.h | *.inc | *.sh | *.cmake | *.in | *.py | CMakeLists.txt | */CMakeLists.txt) ;;
     *) continue ;;
     esac
     [ -f "$f" ] || continue # deleted in the work tree
