@@ -404,6 +404,51 @@ static void run_pf(est_ctx *c, rc_rng *g)
 
 /* ---- M2 EKF ------------------------------------------------------------ */
 
+/* One scalar measurement of the filters (run_ekf, run_iekf): with h = w->g
+ * (nf) the measurement row, S = h^T P h + R, gain K = P h / S, the state
+ * x_idx += K innov and P by the Joseph form P = (I - K h^T) P (I - K h^T)^T +
+ * R K K^T (as M = P - K (Ph)^T; P' = M - (M h) K^T + R K K^T, symmetrised).
+ * *S and *hph get S and h^T P h before the update. RC_ERR_NUMERIC when S is
+ * not positive. Scratch: w->dx (Ph), w->v (K), w->D (M h), w->T (M). */
+static rc_status kalman_update(double *S_out, double *hph_out, rc_est_work *w, rc_model *x, unsigned nf, double R,
+                               double innov)
+{
+    const double *h = w->g;
+    double *Ph = w->dx, *K = w->v, *Mh = w->D, hph = 0.0;
+    for (unsigned i = 0; i < nf; ++i) {
+        double acc = 0.0;
+        for (unsigned k = 0; k < nf; ++k)
+            acc += w->P[(size_t)i * nf + k] * h[k];
+        Ph[i] = acc;
+        hph += h[i] * acc;
+    }
+    const double S = hph + R;
+    *S_out = S;
+    *hph_out = hph;
+    if (!(S > 0.0) || !isfinite(S))
+        return RC_ERR_NUMERIC;
+    for (unsigned i = 0; i < nf; ++i) {
+        K[i] = Ph[i] / S;
+        x->x[w->idx[i]] += K[i] * innov;
+    }
+    for (unsigned i = 0; i < nf; ++i)
+        for (unsigned k = 0; k < nf; ++k)
+            w->T[(size_t)i * nf + k] = w->P[(size_t)i * nf + k] - K[i] * Ph[k];
+    for (unsigned i = 0; i < nf; ++i) {
+        double acc = 0.0;
+        for (unsigned k = 0; k < nf; ++k)
+            acc += w->T[(size_t)i * nf + k] * h[k];
+        Mh[i] = acc;
+    }
+    for (unsigned i = 0; i < nf; ++i)
+        for (unsigned k = i; k < nf; ++k) {
+            const double a = w->T[(size_t)i * nf + k] - Mh[i] * K[k] + R * K[i] * K[k];
+            const double b = w->T[(size_t)k * nf + i] - Mh[k] * K[i] + R * K[k] * K[i];
+            w->P[(size_t)i * nf + k] = w->P[(size_t)k * nf + i] = 0.5 * (a + b);
+        }
+    return RC_OK;
+}
+
 static rc_status run_ekf(est_ctx *c, rc_model *m)
 {
     rc_est_work *w = c->w;
@@ -415,7 +460,7 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
     const double alpha = cfg->ekf_alpha > 0.0 ? (cfg->ekf_alpha < 1.0 ? cfg->ekf_alpha : 1.0) : 0.3;
     const double q = cfg->ekf_q > 0.0 ? cfg->ekf_q : 1e-9;
     const double tol = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-10;
-    double *h = w->g, *Ph = w->dx, *K = w->v, *Mh = w->D;
+    double *h = w->g;
     double prev = c->best_cost;
     /* R starts at the caller's noise, else at the start's mean squared
      * residual (what the residual-based rule would converge to at x0) */
@@ -437,37 +482,9 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
                 h[j] = w->jrow[w->idx[j]];
                 w->P[(size_t)j * nf + j] += q * w->bound[j] * w->bound[j];
             }
-            for (unsigned i = 0; i < nf; ++i) {
-                double acc = 0.0;
-                for (unsigned k = 0; k < nf; ++k)
-                    acc += w->P[(size_t)i * nf + k] * h[k];
-                Ph[i] = acc;
-                hph += h[i] * acc;
-            }
-            const double S = hph + R;
-            if (!(S > 0.0) || !isfinite(S))
+            double S;
+            if (kalman_update(&S, &hph, w, x, nf, R, innov) != RC_OK)
                 return RC_ERR_NUMERIC;
-            for (unsigned i = 0; i < nf; ++i) {
-                K[i] = Ph[i] / S;
-                x->x[w->idx[i]] += K[i] * innov;
-            }
-            /* Joseph form P = (I - K h^T) P (I - K h^T)^T + R K K^T:
-             * M = P - K (Ph)^T; P' = M - (M h) K^T + R K K^T. */
-            for (unsigned i = 0; i < nf; ++i)
-                for (unsigned k = 0; k < nf; ++k)
-                    w->T[(size_t)i * nf + k] = w->P[(size_t)i * nf + k] - K[i] * Ph[k];
-            for (unsigned i = 0; i < nf; ++i) {
-                double acc = 0.0;
-                for (unsigned k = 0; k < nf; ++k)
-                    acc += w->T[(size_t)i * nf + k] * h[k];
-                Mh[i] = acc;
-            }
-            for (unsigned i = 0; i < nf; ++i)
-                for (unsigned k = i; k < nf; ++k) {
-                    const double a = w->T[(size_t)i * nf + k] - Mh[i] * K[k] + R * K[i] * K[k];
-                    const double b = w->T[(size_t)k * nf + i] - Mh[k] * K[i] + R * K[k] * K[i];
-                    w->P[(size_t)i * nf + k] = w->P[(size_t)k * nf + i] = 0.5 * (a + b);
-                }
             /* Residual-based adaptive measurement noise: the post-update
              * residual eps = innov R / S and h^T P+ h = hph R / S (both exact
              * for the linearised measurement) give
@@ -516,7 +533,7 @@ static rc_status run_iekf(est_ctx *c, rc_model *m)
     const unsigned nf = c->nf;
     const double tol = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-10;
     const double R = cfg->prior_noise_mm * cfg->prior_noise_mm;
-    double *h = w->g, *Ph = w->dx, *K = w->v, *Mh = w->D;
+    double *h = w->g;
     double *xl = w->pop; /* (nf) the linearisation point, x_lin - start */
     double prev = c->best_cost;
     rc_model *x = &w->trial; /* the filter state */
@@ -543,36 +560,9 @@ static rc_status run_iekf(est_ctx *c, rc_model *m)
                 pred += h[j] * (x->x[w->idx[j]] - xl[j]);
             }
             const double innov = c->s[s].len_mm - pred;
-            for (unsigned i = 0; i < nf; ++i) {
-                double acc = 0.0;
-                for (unsigned k = 0; k < nf; ++k)
-                    acc += w->P[(size_t)i * nf + k] * h[k];
-                Ph[i] = acc;
-                hph += h[i] * acc;
-            }
-            const double S = hph + R;
-            if (!(S > 0.0) || !isfinite(S))
+            double S;
+            if (kalman_update(&S, &hph, w, x, nf, R, innov) != RC_OK)
                 return RC_ERR_NUMERIC;
-            for (unsigned i = 0; i < nf; ++i) {
-                K[i] = Ph[i] / S;
-                x->x[w->idx[i]] += K[i] * innov;
-            }
-            /* Joseph form, as run_ekf */
-            for (unsigned i = 0; i < nf; ++i)
-                for (unsigned k = 0; k < nf; ++k)
-                    w->T[(size_t)i * nf + k] = w->P[(size_t)i * nf + k] - K[i] * Ph[k];
-            for (unsigned i = 0; i < nf; ++i) {
-                double acc = 0.0;
-                for (unsigned k = 0; k < nf; ++k)
-                    acc += w->T[(size_t)i * nf + k] * h[k];
-                Mh[i] = acc;
-            }
-            for (unsigned i = 0; i < nf; ++i)
-                for (unsigned k = i; k < nf; ++k) {
-                    const double a = w->T[(size_t)i * nf + k] - Mh[i] * K[k] + R * K[i] * K[k];
-                    const double b = w->T[(size_t)k * nf + i] - Mh[k] * K[i] + R * K[k] * K[i];
-                    w->P[(size_t)i * nf + k] = w->P[(size_t)k * nf + i] = 0.5 * (a + b);
-                }
         }
         double cost;
         ++c->res->cost_evals;
