@@ -23,20 +23,6 @@ static const char details[] =
     "is kept when it has one (calibrated from that tracker) and only the targets it lacks are fitted, else\n"
     "the tracker frame and every target are fitted (--refit-tracker: always).";
 
-/* rcal evaluate --positions: the report of rch_pos_evaluate. */
-static void pos_err_json(rch_jw *w, const char *name, const rch_pos_err *e)
-{
-    rch_jw_obj(w, name);
-    rch_jw_uint(w, "points", e->points);
-    rch_jw_numf(w, "rms", e->rms_mm, "%.6f");
-    rch_jw_numf(w, "mean", e->mean_mm, "%.6f");
-    rch_jw_numf(w, "max", e->max_mm, "%.6f");
-    rch_jw_uint(w, "repeated", e->repeated);
-    rch_jw_numf(w, "ap_max", e->ap_max_mm, "%.6f");
-    rch_jw_numf(w, "rp_max", e->rp_max_mm, "%.6f");
-    rch_jw_end(w);
-}
-
 static int positions_report(const rch_pos_eval *r, const rch_pos *p, const char *model, const char *data, int json,
                             int argc, char **argv)
 {
@@ -53,7 +39,7 @@ static int positions_report(const rch_pos_eval *r, const rch_pos *p, const char 
         rch_jw_uint(&w, "targets_known", r->targets_known);
         rch_jw_uint(&w, "targets_fitted", r->targets_fitted);
         rch_jw_numf(&w, "component_rms_mm", r->rms_component_mm, "%.6f");
-        pos_err_json(&w, "position_error_mm", &r->err);
+        rch_pos_err_json(&w, "position_error_mm", &r->err);
         rch_jw_end(&w);
         return rch_jw_finish(&w);
     }

@@ -1755,19 +1755,6 @@ static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
     rch_jw_end(w);
 }
 
-static void json_pos_err(rch_jw *w, const char *name, const rch_pos_err *e)
-{
-    rch_jw_obj(w, name);
-    rch_jw_uint(w, "points", e->points);
-    rch_jw_numf(w, "rms", e->rms_mm, "%.6f");
-    rch_jw_numf(w, "mean", e->mean_mm, "%.6f");
-    rch_jw_numf(w, "max", e->max_mm, "%.6f");
-    rch_jw_uint(w, "repeated", e->repeated);
-    rch_jw_numf(w, "ap_max", e->ap_max_mm, "%.6f"); /* null without repeats */
-    rch_jw_numf(w, "rp_max", e->rp_max_mm, "%.6f");
-    rch_jw_end(w);
-}
-
 /* With --positions: the "positions" member (docs/json-formats.md). */
 static void json_positions(rch_jw *w, const rch_calib_result *r)
 {
@@ -1777,9 +1764,9 @@ static void json_positions(rch_jw *w, const rch_calib_result *r)
     rch_jw_uint(w, "targets", r->n_targets);
     rch_jw_num(w, "sigma_mm", r->pos_has_sigma ? r->pos_sigma_mm : NAN);
     if (r->have_pos) {
-        json_pos_err(w, "position_error_mm", &r->pos_after);
-        json_pos_err(w, "before_mm", &r->pos_before);
-        json_pos_err(w, "train_after_mm", &r->pos_train_after);
+        rch_pos_err_json(w, "position_error_mm", &r->pos_after);
+        rch_pos_err_json(w, "before_mm", &r->pos_before);
+        rch_pos_err_json(w, "train_after_mm", &r->pos_train_after);
     }
     rch_jw_end(w);
 }

@@ -604,3 +604,16 @@ int rch_pos_evaluate(rch_pos_eval *out, const rc_model *m, const rch_pos *p, int
     out->used = use;
     return 0;
 }
+
+void rch_pos_err_json(rch_jw *w, const char *name, const rch_pos_err *e)
+{
+    rch_jw_obj(w, name);
+    rch_jw_uint(w, "points", e->points);
+    rch_jw_numf(w, "rms", e->rms_mm, "%.6f");
+    rch_jw_numf(w, "mean", e->mean_mm, "%.6f");
+    rch_jw_numf(w, "max", e->max_mm, "%.6f");
+    rch_jw_uint(w, "repeated", e->repeated);
+    rch_jw_numf(w, "ap_max", e->ap_max_mm, "%.6f"); /* null without repeats */
+    rch_jw_numf(w, "rp_max", e->rp_max_mm, "%.6f");
+    rch_jw_end(w);
+}

@@ -26,6 +26,7 @@
 
 #include "rc_solve.h"
 #include "rch_diag.h"
+#include "rch_jw.h"
 
 typedef struct rch_pos {
     rc_sample *s;       /* (n) three per position row: x, y, z (RC_SENSOR_TRACKER_*); t the pose's number */
@@ -86,6 +87,9 @@ typedef struct rch_pos_err {
 /* 3-D errors of model m on the tracker samples of s (n). 0, or -1 (a
  * target the model lacks, out of memory). */
 int rch_pos_errors(rch_pos_err *e, const rc_model *m, const rc_sample *s, size_t n);
+/* e as the JSON object `name` (points, rms, mean, max in mm; repeated,
+ * ap_max, rp_max, null without repeats): what calibrate and evaluate write. */
+void rch_pos_err_json(rch_jw *w, const char *name, const rch_pos_err *e);
 
 /* A model on tracker data: nothing of the robot refitted. When m has a
  * tracker frame (calibrated from that tracker) and !refit_frame it is
