@@ -3,7 +3,8 @@
 # The host library's layers: tools/host/<layer>/, each using only the layers
 # before it (files <- model <- fit <- studies <- outputs). A file including a
 # header of a later layer is a circle in the making: this prints each such
-# include and exits 1. Usage: scripts/layers.sh [SOURCE_DIR]
+# include and exits 1; also any SVG markup written outside files/rch_svg.c
+# (the one SVG writer). Usage: scripts/layers.sh [SOURCE_DIR]
 set -eu
 root=${1:-$(dirname "$0")/..}
 host=$root/tools/host
@@ -34,5 +35,13 @@ for l in $layers; do
     done
   done
 done
-[ $bad -eq 0 ] && echo "layers: $n files, every include from its own or an earlier layer ($layers)"
+# one writer of SVG markup: no string literal outside files/rch_svg.c opens an SVG element
+svg_re='"([^"\\]|\\.)*<(svg|g|rect|circle|line|path|polyline|polygon|clipPath|defs|text)[ >/\\"]'
+for f in $(find "$root/tools" "$root/lib" "$root/drivers" "$root/firmware_host" -name '*.[ch]' ! -name rch_svg.c); do
+  hits=$(grep -nE "$svg_re" "$f" | grep -vE '^[0-9]+:[[:space:]]*(/?\*|//)' || true)
+  if [ -n "$hits" ]; then
+    echo "layers: $f writes SVG markup itself (draw through files/rch_svg.h):"; printf "%s\n" "$hits" | head -3; bad=1
+  fi
+done
+[ $bad -eq 0 ] && echo "layers: $n files, every include from its own or an earlier layer ($layers); SVG markup only in files/rch_svg.c"
 exit $bad

@@ -232,22 +232,6 @@ static void test_dir_helpers(void **state)
     assert_non_null(strstr(d.msg, "r.svg"));
     snprintf(path, sizeof path, "rm -rf '%s'", dir);
     assert_int_equal(system(path), 0);
-    /* colour map ends and clamping */
-    char c[8];
-    rch_plot_viridis(c, 0.0);
-    assert_string_equal(c, "#440154");
-    rch_plot_viridis(c, 1.0);
-    assert_string_equal(c, "#fde725");
-    rch_plot_viridis(c, 7.0);
-    assert_string_equal(c, "#fde725");
-    rch_plot_viridis(c, -1.0);
-    assert_string_equal(c, "#440154");
-    buf = NULL;
-    log = open_memstream(&buf, &len);
-    rch_plot_xml_text(log, "a<b & \"c\"");
-    fclose(log);
-    assert_string_equal(buf, "a&lt;b &amp; &quot;c&quot;");
-    free(buf);
 }
 
 /* Count the points drawn inside each <g class="series">: vertices (M/L)

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rch_svg.h"
 #include "rch_text.h"
 
 enum { PLOT_LINE = 0, PLOT_SCATTER = 1 };
@@ -271,25 +272,6 @@ void rch_plot_free(rch_plot *p)
 
 /* ---- writing ---------------------------------------------------------- */
 
-static void plot_esc(FILE *f, const char *s) { rch_xml_put(f, s, 0); }
-
-/* 1-2-5 step for about `want` intervals over span. */
-static double plot_nice_step(double span, int want)
-{
-    double raw = span / (double)want, mag, f;
-    if (!(raw > 0.0) || !isfinite(raw))
-        return 1.0;
-    mag = pow(10.0, floor(log10(raw)));
-    f = raw / mag;
-    if (f < 1.5)
-        return mag;
-    if (f < 3.5)
-        return 2.0 * mag;
-    if (f < 7.5)
-        return 5.0 * mag;
-    return 10.0 * mag;
-}
-
 typedef struct plot_axis {
     double lo, hi; /* data range (in transformed units for log) */
     int log;
@@ -381,21 +363,23 @@ static void plot_ranges(const rch_plot *p, plot_axis *ax, plot_axis *ay)
 
 static void plot_marker(FILE *f, int shape, double x, double y, const char *col)
 {
+    const rch_svg_paint pt = {.fill = col};
     switch (shape % 4) {
     case 0:
-        fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"3\" fill=\"%s\"/>\n", x, y, col);
+        rch_svg_circle(f, x, y, 3.0, &pt);
         break;
     case 1:
-        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"6\" height=\"6\" fill=\"%s\"/>\n", x - 3,
-                y - 3, col);
+        rch_svg_rect(f, x - 3.0, y - 3.0, 6.0, 6.0, &pt, NULL);
         break;
-    case 2:
-        fprintf(f, "<path d=\"M%.2f %.2fL%.2f %.2fL%.2f %.2fZ\" fill=\"%s\"/>\n", x, y - 4, x + 4,
-                y + 3, x - 4, y + 3, col);
+    case 2: {
+        const double tri[6] = {x, y - 4, x + 4, y + 3, x - 4, y + 3};
+        rch_svg_polygon(f, tri, 3, &pt);
         break;
-    default:
-        fprintf(f, "<path d=\"M%.2f %.2fL%.2f %.2fL%.2f %.2fL%.2f %.2fZ\" fill=\"%s\"/>\n", x,
-                y - 4, x + 4, y, x, y + 4, x - 4, y, col);
+    }
+    default: {
+        const double dia[8] = {x, y - 4, x + 4, y, x, y + 4, x - 4, y};
+        rch_svg_polygon(f, dia, 4, &pt);
+    }
     }
 }
 
@@ -410,9 +394,11 @@ static void plot_fmt(char *buf, size_t len, double v, double step)
  * tick mark, label. */
 static void plot_ytick(FILE *f, double L, double pw, double py, const char *label)
 {
-    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e0e0e0\"/>\n", L, py, L + pw, py);
-    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n", L - 5, py, L, py);
-    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", L - 8, py + 4, label);
+    static const rch_svg_paint grid = {.stroke = "#e0e0e0"}, tick = {.stroke = "black"};
+    static const rch_svg_font ft = {.anchor = RCH_SVG_END};
+    rch_svg_line(f, L, py, L + pw, py, &grid);
+    rch_svg_line(f, L - 5, py, L, py, &tick);
+    rch_svg_text(f, L - 8, py + 4, &ft, label);
 }
 
 /* Page layout of one chart: axes, margins (left L, right R, top T, bottom
@@ -491,7 +477,7 @@ static void plot_yticks(FILE *f, const plot_frame *fr)
     if (ay->log && ay->hi - ay->lo < 0.7) {
         /* less than a decade: linear 1-2-5 ticks placed on the log axis */
         const double vlo = pow(10.0, ay->lo), vhi = pow(10.0, ay->hi);
-        step = plot_nice_step(vhi - vlo, 5);
+        step = rch_svg_nice_step(vhi - vlo, 5.0);
         for (y0 = ceil(vlo / step - 1e-9) * step; y0 <= vhi + 1e-9 * step && guard < 100; y0 += step, guard++) {
             if (y0 <= 0.0)
                 continue;
@@ -518,7 +504,7 @@ static void plot_yticks(FILE *f, const plot_frame *fr)
             }
         }
     } else {
-        step = plot_nice_step(ay->hi - ay->lo, 6);
+        step = rch_svg_nice_step(ay->hi - ay->lo, 6.0);
         for (y0 = ceil(ay->lo / step - 1e-9) * step; y0 <= ay->hi + 1e-9 * step && guard < 100;
              y0 += step, guard++) {
             plot_fmt(buf, sizeof buf, y0, step);
@@ -530,17 +516,18 @@ static void plot_yticks(FILE *f, const plot_frame *fr)
 /* x ticks and grid (numeric x axis). */
 static void plot_xticks(FILE *f, const plot_frame *fr)
 {
-    const double step = plot_nice_step(fr->ax.hi - fr->ax.lo, 8), T = fr->T, ph = fr->ph;
+    const double step = rch_svg_nice_step(fr->ax.hi - fr->ax.lo, 8.0), T = fr->T, ph = fr->ph;
     int guard = 0;
     char buf[64];
     for (double x0 = ceil(fr->ax.lo / step - 1e-9) * step; x0 <= fr->ax.hi + 1e-9 * step && guard < 100;
          x0 += step, guard++) {
-        double px = plot_px(fr, x0);
-        fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e0e0e0\"/>\n", px, T, px, T + ph);
-        fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"black\"/>\n", px, T + ph, px,
-                T + ph + 5);
+        static const rch_svg_paint grid = {.stroke = "#e0e0e0"}, tick = {.stroke = "black"};
+        static const rch_svg_font ft = {.anchor = RCH_SVG_MIDDLE};
+        const double px = plot_px(fr, x0);
+        rch_svg_line(f, px, T, px, T + ph, &grid);
+        rch_svg_line(f, px, T + ph, px, T + ph + 5, &tick);
         plot_fmt(buf, sizeof buf, x0, step);
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">%s</text>\n", px, T + ph + 18, buf);
+        rch_svg_text(f, px, T + ph + 18, &ft, buf);
     }
 }
 
@@ -550,121 +537,116 @@ static void plot_bar(FILE *f, const rch_plot *p, const plot_frame *fr, size_t k)
     const plot_axis *ay = &fr->ay;
     const double bw = 0.6 * fr->xs, v = p->bar_val[k], cx = plot_px(fr, (double)k);
     const double base = ay->log ? ay->lo : (ay->lo > 0.0 ? ay->lo : (ay->hi < 0.0 ? ay->hi : 0.0));
-    const char *col = bar_colours[p->bar_cat ? p->bar_cat[k] : 0];
+    const rch_svg_paint bar = {.fill = bar_colours[p->bar_cat ? p->bar_cat[k] : 0], .fill_opacity = 0.85};
     if (plot_ok(ay, v)) {
         double tv = plot_tr(ay, v), top, bot;
-        char buf[64];
+        char tip[256];
         if (tv > ay->hi) tv = ay->hi;
         if (tv < ay->lo) tv = ay->lo;
         top = plot_py(fr, tv > base ? tv : base);
         bot = plot_py(fr, tv > base ? base : tv);
-        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"%s\" fill-opacity=\"0.85\"><title>",
-                cx - bw / 2.0, top, bw, bot - top, col);
-        plot_esc(f, p->bar_labels[k]);
-        fprintf(f, ": %g</title></rect>\n", v);
+        snprintf(tip, sizeof tip, "%s: %g", p->bar_labels[k], v);
+        rch_svg_rect(f, cx - bw / 2.0, top, bw, bot - top, &bar, tip);
         if (p->bar_err && isfinite(p->bar_err[k]) && p->bar_err[k] != 0.0) {
+            static const rch_svg_paint ebar = {.stroke = "black", .stroke_px = 1.2};
             double e = fabs(p->bar_err[k]), hi = v + e, lo = v - e, yh, yl;
+            rch_svg_pen pn;
             yh = plot_tr(ay, hi);
             yl = (ay->log && lo <= 0.0) ? ay->lo : plot_tr(ay, lo);
             if (yh > ay->hi) yh = ay->hi;
             if (yl < ay->lo) yl = ay->lo;
-            fprintf(f, "<path d=\"M%.2f %.2fV%.2fM%.2f %.2fH%.2fM%.2f %.2fH%.2f\" stroke=\"black\" "
-                       "stroke-width=\"1.2\" fill=\"none\"/>\n",
-                    cx, plot_py(fr, yl), plot_py(fr, yh), cx - bw / 6.0, plot_py(fr, yl), cx + bw / 6.0,
-                    cx - bw / 6.0, plot_py(fr, yh), cx + bw / 6.0);
+            rch_svg_path_begin(&pn, f, &ebar);
+            rch_svg_path_move(&pn, cx, plot_py(fr, yl));
+            rch_svg_path_line(&pn, cx, plot_py(fr, yh));
+            rch_svg_path_move(&pn, cx - bw / 6.0, plot_py(fr, yl));
+            rch_svg_path_line(&pn, cx + bw / 6.0, plot_py(fr, yl));
+            rch_svg_path_move(&pn, cx - bw / 6.0, plot_py(fr, yh));
+            rch_svg_path_line(&pn, cx + bw / 6.0, plot_py(fr, yh));
+            rch_svg_path_end(&pn);
         }
-        snprintf(buf, sizeof buf, "%.3g", v);
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\" font-size=\"10\">%s</text>\n",
-                cx + (p->bar_err ? bw / 4.0 : 0.0), top - 3.0, buf);
+        static const rch_svg_font vf = {.anchor = RCH_SVG_MIDDLE, .size_px = 10};
+        rch_svg_textf(f, cx + (p->bar_err ? bw / 4.0 : 0.0), top - 3.0, &vf, "%.3g", v);
     }
-    if (fr->rot_labels)
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"end\" transform=\"rotate(-45 %.2f %.2f)\">", cx,
-                fr->T + fr->ph + 14, cx, fr->T + fr->ph + 14);
-    else
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", cx, fr->T + fr->ph + 18);
-    plot_esc(f, p->bar_labels[k]);
-    fprintf(f, "</text>\n");
+    if (fr->rot_labels) {
+        static const rch_svg_font rf = {.anchor = RCH_SVG_END, .rotate_deg = -45.0};
+        rch_svg_text(f, cx, fr->T + fr->ph + 14, &rf, p->bar_labels[k]);
+    } else {
+        static const rch_svg_font cf = {.anchor = RCH_SVG_MIDDLE};
+        rch_svg_text(f, cx, fr->T + fr->ph + 18, &cf, p->bar_labels[k]);
+    }
 }
 
 /* Every series, clipped to the plot area. */
 static void plot_series_all(FILE *f, const rch_plot *p, const plot_frame *fr)
 {
     const plot_axis *ay = &fr->ay;
-    fprintf(f,
-            "<defs><clipPath id=\"plotarea\"><rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" "
-            "height=\"%.2f\"/></clipPath></defs>\n<g clip-path=\"url(#plotarea)\">\n",
-            fr->L, fr->T, fr->pw, fr->ph);
+    rch_svg_clip(f, "plotarea", fr->L, fr->T, fr->pw, fr->ph);
     for (size_t i = 0; i < p->n_series; i++) {
         const plot_series *s = &p->series[i];
         const char *col = plot_colours[i % PLOT_NCOL];
-        fprintf(f, "<g class=\"series\">\n");
+        rch_svg_group(f, "series", NULL, NULL);
         if (s->kind == PLOT_LINE && s->n == 1) {
             /* one point: a marker, not an invisible line */
             if (isfinite(s->x[0]) && plot_ok(ay, s->y[0]))
                 plot_marker(f, 0, plot_px(fr, s->x[0]), plot_py(fr, plot_tr(ay, s->y[0])), col);
         } else if (s->kind == PLOT_LINE) {
+            const rch_svg_paint line = {.stroke = col, .stroke_px = 1.8};
+            rch_svg_pen pn;
             int pen = 0;
-            fprintf(f, "<path fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\" d=\"", col);
+            rch_svg_path_begin(&pn, f, &line);
             for (size_t k = 0; k < s->n; k++) {
                 if (!isfinite(s->x[k]) || !plot_ok(ay, s->y[k])) {
                     pen = 0;
                     continue;
                 }
-                fprintf(f, "%s%.2f %.2f", pen ? "L" : "M", plot_px(fr, s->x[k]), plot_py(fr, plot_tr(ay, s->y[k])));
+                (pen ? rch_svg_path_line : rch_svg_path_move)(&pn, plot_px(fr, s->x[k]),
+                                                               plot_py(fr, plot_tr(ay, s->y[k])));
                 pen = 1;
             }
-            fprintf(f, "\"/>\n");
+            rch_svg_path_end(&pn);
         } else {
             for (size_t k = 0; k < s->n; k++)
                 if (isfinite(s->x[k]) && plot_ok(ay, s->y[k]))
                     plot_marker(f, (int)i, plot_px(fr, s->x[k]), plot_py(fr, plot_tr(ay, s->y[k])), col);
         }
-        fprintf(f, "</g>\n");
+        rch_svg_group_end(f);
     }
-    fprintf(f, "</g>\n");
+    rch_svg_group_end(f);
 }
 
 /* Frame, axis labels and the legend. */
 static void plot_frame_legend(FILE *f, const rch_plot *p, const plot_frame *fr)
 {
+    static const rch_svg_paint frame = {.stroke = "black"}, box = {.fill = "white", .stroke = "#999999"};
+    static const rch_svg_font mid = {.anchor = RCH_SVG_MIDDLE}, yl = {.anchor = RCH_SVG_MIDDLE, .rotate_deg = -90.0};
     const double L = fr->L, T = fr->T, pw = fr->pw, ph = fr->ph;
-    fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"none\" stroke=\"black\"/>\n", L, T,
-            pw, ph);
-    fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", L + pw / 2.0, fr->H - 12.0);
-    plot_esc(f, p->xlabel);
-    fprintf(f, "</text>\n");
-    fprintf(f, "<text x=\"16\" y=\"%.2f\" text-anchor=\"middle\" transform=\"rotate(-90 16 %.2f)\">", T + ph / 2.0,
-            T + ph / 2.0);
-    plot_esc(f, p->ylabel);
-    fprintf(f, "</text>\n");
+    rch_svg_rect(f, L, T, pw, ph, &frame, NULL);
+    rch_svg_text(f, L + pw / 2.0, fr->H - 12.0, &mid, p->xlabel);
+    rch_svg_text(f, 16.0, T + ph / 2.0, &yl, p->ylabel);
     if (fr->nleg == 0)
         return;
     double lx = L + pw + 10.0, ly = T;
-    fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"white\" stroke=\"#999999\"/>\n", lx,
-            ly, fr->legw, 8.0 + 18.0 * (double)fr->nleg);
+    rch_svg_rect(f, lx, ly, fr->legw, 8.0 + 18.0 * (double)fr->nleg, &box, NULL);
     for (size_t i = 0; i < p->n_series; i++) {
         const plot_series *s = &p->series[i];
         const char *col = plot_colours[i % PLOT_NCOL];
         const double yy = ly + 16.0;
         if (s->label[0] == '\0')
             continue;
-        if (s->kind == PLOT_LINE)
-            fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" stroke-width=\"2.5\"/>\n",
-                    lx + 6, yy - 4, lx + 26, yy - 4, col);
-        else
+        if (s->kind == PLOT_LINE) {
+            const rch_svg_paint swatch = {.stroke = col, .stroke_px = 2.5};
+            rch_svg_line(f, lx + 6, yy - 4, lx + 26, yy - 4, &swatch);
+        } else {
             plot_marker(f, (int)i, lx + 16, yy - 4, col);
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">", lx + 30, yy);
-        plot_esc(f, s->label);
-        fprintf(f, "</text>\n");
+        }
+        rch_svg_text(f, lx + 30, yy, NULL, s->label);
         ly += 18.0;
     }
     for (size_t c = 0; c < p->n_cat; c++) {
+        const rch_svg_paint swatch = {.fill = bar_colours[c], .fill_opacity = 0.85};
         const double yy = ly + 16.0;
-        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"14\" height=\"10\" fill=\"%s\" fill-opacity=\"0.85\"/>\n",
-                lx + 9, yy - 9, bar_colours[c]);
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\">", lx + 30, yy);
-        plot_esc(f, p->cat_names[c]);
-        fprintf(f, "</text>\n");
+        rch_svg_rect(f, lx + 9, yy - 9, 14, 10, &swatch, NULL);
+        rch_svg_text(f, lx + 30, yy, NULL, p->cat_names[c]);
         ly += 18.0;
     }
 }
@@ -677,33 +659,25 @@ int rch_plot_write_svg_stream(const rch_plot *p, FILE *f)
         return -1;
     }
     plot_layout(&fr, p);
-    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    fprintf(f,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%u\" height=\"%u\" "
-            "viewBox=\"0 0 %u %u\" font-family=\"Helvetica, Arial, sans-serif\" "
-            "font-size=\"12\">\n",
-            p->width, p->height, p->width, p->height);
-    fprintf(f, "<rect x=\"0\" y=\"0\" width=\"%u\" height=\"%u\" fill=\"white\"/>\n", p->width, p->height);
-    fprintf(f, "<text x=\"%.1f\" y=\"24\" text-anchor=\"middle\" font-size=\"16\" font-weight=\"bold\">", fr.W / 2.0);
-    plot_esc(f, p->title);
-    fprintf(f, "</text>\n");
-    if (p->subtitle && p->subtitle[0]) {
-        fprintf(f, "<text x=\"%.1f\" y=\"42\" text-anchor=\"middle\" font-size=\"12\" fill=\"#555555\">", fr.W / 2.0);
-        plot_esc(f, p->subtitle);
-        fprintf(f, "</text>\n");
-    }
+    const rch_svg_doc doc = {.width_px = p->width, .height_px = p->height, .title = p->title};
+    static const rch_svg_font tf = {.anchor = RCH_SVG_MIDDLE, .size_px = 16, .bold = 1},
+                              sf = {.anchor = RCH_SVG_MIDDLE, .size_px = 12, .fill = "#555555"};
+    rch_svg_begin(f, &doc);
+    rch_svg_text(f, fr.W / 2.0, 24.0, &tf, p->title);
+    if (p->subtitle && p->subtitle[0])
+        rch_svg_text(f, fr.W / 2.0, 42.0, &sf, p->subtitle);
     plot_yticks(f, &fr);
     if (p->n_bars == 0)
         plot_xticks(f, &fr); /* numeric x axis unless this is a pure bar chart */
     if (p->n_bars > 0)
-        fprintf(f, "<g class=\"bars\">\n");
+        rch_svg_group(f, "bars", NULL, NULL);
     for (size_t k = 0; k < p->n_bars; k++)
         plot_bar(f, p, &fr, k);
     if (p->n_bars > 0)
-        fprintf(f, "</g>\n");
+        rch_svg_group_end(f);
     plot_series_all(f, p, &fr);
     plot_frame_legend(f, p, &fr);
-    fprintf(f, "</svg>\n");
+    rch_svg_end(f);
     return ferror(f) ? -1 : 0;
 }
 
@@ -723,8 +697,6 @@ int rch_plot_write_svg(const rch_plot *p, const char *path)
         rc = -1;
     return rc;
 }
-
-void rch_plot_xml_text(FILE *f, const char *s) { plot_esc(f, s); }
 
 /* ---- data as CSV -------------------------------------------------------- */
 
@@ -987,20 +959,4 @@ int rch_plot_save(rch_plot *p, const rch_plot_dir *pd, const char *name, rch_dia
     }
     rch_plot_free(p);
     return rc;
-}
-
-void rch_plot_viridis(char out[8], double t)
-{
-    static const double stops[5][3] = {
-        {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
-    t = t < 0 ? 0 : (t > 1 ? 1 : t);
-    const double u = t * 4.0;
-    int i = (int)floor(u);
-    if (i > 3)
-        i = 3;
-    const double f = u - i;
-    int rgb[3];
-    for (int c = 0; c < 3; ++c)
-        rgb[c] = (int)lround(stops[i][c] + f * (stops[i + 1][c] - stops[i][c]));
-    snprintf(out, 8, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
 }

@@ -7,7 +7,8 @@
  * (1-2-5 steps; decades on a log y axis), a grid, and a legend naming every
  * series; series get distinct colours (a colour-blind-safe palette) and
  * distinct markers for scatter. All text is XML-escaped. Output is a single
- * self-contained SVG file that any browser opens.
+ * self-contained SVG file that any browser opens, written through rch_svg
+ * (the one SVG writer).
  *
  * Bars and numeric series in one chart: bars take the categories 0..n-1 as
  * x positions; line/scatter series added to a bar chart are drawn on the same
@@ -16,8 +17,8 @@
  * Non-finite points (NaN, inf) are skipped and break a line; on a log y axis
  * points with y <= 0 are skipped too.
  *
- * Depends on: the C library (stdio, stdlib, string, math); rch_file for
- * the plot-directory helpers. Memory: the chart
+ * Depends on: the C library (stdio, stdlib, string, math); rch_svg for the
+ * markup, rch_file for the plot-directory helpers. Memory: the chart
  * copies every string and array it is given (callers may free theirs at once);
  * rch_plot_free releases it. Thread safety: one object per thread.
  * Errors: rch_plot_new returns NULL on allocation failure; an allocation
@@ -134,13 +135,6 @@ int rch_plot_save_csv(const rch_plot_table *t, const rch_plot_dir *pd, const cha
  * underflow to 0 included), else %.1e ("3.0e-17"); "-" when not finite.
  * Returns out. */
 const char *rch_plot_fmt_p(char *out, size_t len, double p);
-
-/* A perceptually ordered colour map (viridis, 5 stops) at t in [0, 1]
- * (clamped): "#rrggbb" into out. */
-void rch_plot_viridis(char out[8], double t);
-
-/* Write s XML-escaped (&, <, >, ", ') to f. */
-void rch_plot_xml_text(FILE *f, const char *s);
 
 /* Write s as one CSV field (RFC 4180: quoted when it holds a comma, quote or
  * line break; NULL is an empty field). The one CSV field writer of the host

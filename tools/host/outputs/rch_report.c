@@ -16,6 +16,7 @@
 #include "rch_json.h"
 #include "rch_plot.h"
 #include "rch_sha256.h"
+#include "rch_svg.h"
 
 #define NA "<span class=\"na\">not in this run</span>"
 #define Z95 1.959963984540054 /* two-sided 95 % normal quantile */
@@ -214,12 +215,6 @@ typedef struct {
     unsigned width_px;
 } chart;
 
-static double nice_step(double span, double n)
-{
-    const double raw = span / n, p = pow(10.0, floor(log10(raw))), m = raw / p;
-    return (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * p;
-}
-
 static void chart_range(const chart *c, double *lo, double *hi)
 {
     double a = 0.0, b = 0.0;
@@ -250,7 +245,7 @@ static void chart_range(const chart *c, double *lo, double *hi)
         a = -m;
         b = m;
     }
-    const double step = nice_step(b - a, 6.0);
+    const double step = rch_svg_nice_step(b - a, 6.0);
     *lo = floor(a / step + 1e-9) * step;
     *hi = ceil(b / step - 1e-9) * step;
 }
@@ -259,7 +254,10 @@ static double clampd(double x, double a, double b) { return x < a ? a : x > b ? 
 
 static void chart_axes(FILE *f, const chart *c, double L, double T, double pw, double ph, double lo, double hi)
 {
-    const double step = nice_step(hi - lo, 6.0);
+    static const rch_svg_paint zero = {.stroke = "#333"}, grid = {.stroke = "#e4e4e4"},
+                               ref = {.stroke = "#444", .dash = "4 3"}, frame = {.stroke = "#999"};
+    static const rch_svg_font tick = {.anchor = RCH_SVG_MIDDLE, .fill = "#333"}, axis = {.anchor = RCH_SVG_MIDDLE};
+    const double step = rch_svg_nice_step(hi - lo, 6.0);
 #define CX(x) (L + ((x) - lo) / (hi - lo) * pw)
     for (int i = 0; i <= 40; ++i) {
         double t = lo + step * i;
@@ -267,27 +265,19 @@ static void chart_axes(FILE *f, const chart *c, double L, double T, double pw, d
             break;
         if (fabs(t) < 1e-9 * step)
             t = 0.0;
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\"/>", CX(t), T, CX(t), T + ph,
-                t == 0.0 ? "#333" : "#e4e4e4");
-        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" fill=\"#333\">%.6g</text>\n", CX(t),
-                T + ph + 14.0, t);
+        rch_svg_line(f, CX(t), T, CX(t), T + ph, t == 0.0 ? &zero : &grid);
+        rch_svg_textf(f, CX(t), T + ph + 14.0, &tick, "%.6g", t);
     }
     for (size_t k = 0; k < c->n_ref; ++k) {
         if (!isfinite(c->ref[k]))
             continue;
         const double x = CX(clampd(c->ref[k], lo, hi));
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#444\" stroke-dasharray=\"4 3\"/>",
-                x, T - 4.0, x, T + ph);
-        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"%s\" font-size=\"11\" fill=\"#333\">", x, T - 7.0,
-                k ? "start" : "end");
-        put_esc(f, c->ref_label[k]);
-        fprintf(f, "</text>\n");
+        const rch_svg_font rf = {.anchor = k ? RCH_SVG_START : RCH_SVG_END, .size_px = 11, .fill = "#333"};
+        rch_svg_line(f, x, T - 4.0, x, T + ph, &ref);
+        rch_svg_text(f, x, T - 7.0, &rf, c->ref_label[k]);
     }
-    fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#999\"/>\n", L, T,
-            pw, ph);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", L + pw / 2.0, T + ph + 32.0);
-    put_esc(f, c->xlabel);
-    fprintf(f, "</text>\n");
+    rch_svg_rect(f, L, T, pw, ph, &frame, NULL);
+    rch_svg_text(f, L + pw / 2.0, T + ph + 32.0, &axis, c->xlabel);
 #undef CX
 }
 
@@ -298,38 +288,46 @@ static void chart_cell(FILE *f, const chart *c, size_t i, double y, double L, do
     const double a = c->lo ? c->lo[i] : NAN, b = c->hi ? c->hi[i] : NAN;
     const char *col = colour[c->col[i]];
     if (!isfinite(v)) {
-        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" font-style=\"italic\" fill=\"#777\">",
-                CX(clampd(0.0, lo, hi)) + 4.0, y + 4.0);
-        put_esc(f, c->missing ? c->missing[i / c->n_sub] : "not in this run");
-        fprintf(f, "</text>\n");
+        static const rch_svg_font mf = {.size_px = 11, .italic = 1, .fill = "#777"};
+        rch_svg_text(f, CX(clampd(0.0, lo, hi)) + 4.0, y + 4.0, &mf,
+                     c->missing ? c->missing[i / c->n_sub] : "not in this run");
         return;
     }
-    fprintf(f, "<g><title>");
-    put_esc(f, c->label[i / c->n_sub]);
-    fprintf(f, ": %.6g", v);
-    if (isfinite(a) && isfinite(b))
-        fprintf(f, " (95 %% interval %.6g to %.6g)", a, b);
-    fprintf(f, "</title>");
+    char tip[320];
+    int n = snprintf(tip, sizeof tip, "%s: %.6g", c->label[i / c->n_sub], v);
+    if (n >= 0 && (size_t)n < sizeof tip && isfinite(a) && isfinite(b))
+        snprintf(tip + n, sizeof tip - (size_t)n, " (95 %% interval %.6g to %.6g)", a, b);
+    rch_svg_group(f, NULL, NULL, tip);
+    const rch_svg_paint fill = {.fill = col}, stroke = {.stroke = col, .stroke_px = 1.6};
     if (c->bars) {
         const double x0 = CX(clampd(0.0, lo, hi)), x1 = CX(clampd(v, lo, hi));
-        fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"12\" fill=\"%s\"/>", x0 < x1 ? x0 : x1,
-                y - 6.0, fabs(x1 - x0) > 0.5 ? fabs(x1 - x0) : 0.5, col);
-        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\"%s>%.4g</text>", x1 + (v < 0 ? -3.0 : 3.0), y + 4.0,
-                v < 0 ? " text-anchor=\"end\"" : "", v);
+        const rch_svg_font vf = {.size_px = 11, .anchor = v < 0 ? RCH_SVG_END : RCH_SVG_START};
+        rch_svg_rect(f, x0 < x1 ? x0 : x1, y - 6.0, fabs(x1 - x0) > 0.5 ? fabs(x1 - x0) : 0.5, 12.0, &fill, NULL);
+        rch_svg_textf(f, x1 + (v < 0 ? -3.0 : 3.0), y + 4.0, &vf, "%.4g", v);
     }
     if (isfinite(a) && isfinite(b)) {
         const double xa = CX(clampd(a, lo, hi)), xb = CX(clampd(b, lo, hi));
-        fprintf(f, "<path d=\"M%.1f %.1fH%.1f\" stroke=\"%s\" stroke-width=\"1.6\"/>", xa, y, xb, col);
-        fprintf(f, "<path d=\"%s%.1f %.1fv8M%.1f %.1fv8\" stroke=\"%s\" stroke-width=\"1.6\"/>", "M",
-                xa, y - 4.0, xb, y - 4.0, col);
-        if (a < lo)
-            fprintf(f, "<path d=\"M%.1f %.1fl7 -5v10z\" fill=\"%s\"/>", xa - 1.0, y, col);
-        if (b > hi)
-            fprintf(f, "<path d=\"M%.1f %.1fl-7 -5v10z\" fill=\"%s\"/>", xb + 1.0, y, col);
+        rch_svg_pen pn;
+        rch_svg_path_begin(&pn, f, &stroke); /* the interval and its end ticks */
+        rch_svg_path_move(&pn, xa, y);
+        rch_svg_path_line(&pn, xb, y);
+        rch_svg_path_move(&pn, xa, y - 4.0);
+        rch_svg_path_line(&pn, xa, y + 4.0);
+        rch_svg_path_move(&pn, xb, y - 4.0);
+        rch_svg_path_line(&pn, xb, y + 4.0);
+        rch_svg_path_end(&pn);
+        if (a < lo) { /* arrows: the interval goes on beyond the axis */
+            const double t[6] = {xa - 1.0, y, xa + 6.0, y - 5.0, xa + 6.0, y + 5.0};
+            rch_svg_polygon(f, t, 3, &fill);
+        }
+        if (b > hi) {
+            const double t[6] = {xb + 1.0, y, xb - 6.0, y - 5.0, xb - 6.0, y + 5.0};
+            rch_svg_polygon(f, t, 3, &fill);
+        }
     }
     if (!c->bars)
-        fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>", CX(clampd(v, lo, hi)), y, col);
-    fprintf(f, "</g>\n");
+        rch_svg_circle(f, CX(clampd(v, lo, hi)), y, 4.0, &fill);
+    rch_svg_group_end(f);
 #undef CX
 }
 
@@ -345,40 +343,34 @@ static void chart_svg(rep *r, const chart *c)
     const double T = 30.0 + (c->n_leg ? 20.0 : 0.0) + (c->n_ref ? 16.0 : 0.0);
     const double sub_h = 16.0, row_h = sub_h * (double)c->n_sub + 6.0;
     const double pw = W - L - R, ph = row_h * (double)c->n_rows, H = T + ph + 44.0;
+    static const rch_svg_font tf = {.size_px = 14, .bold = 1}, lf = {.size_px = 11.5},
+                              rf = {.anchor = RCH_SVG_END};
+    static const rch_svg_paint band = {.fill = "#f3f5f8"};
     double lo, hi;
     chart_range(c, &lo, &hi);
-    fprintf(f, "<svg class=\"chart\" width=\"%u\" height=\"%.0f\" viewBox=\"0 0 %u %.0f\" role=\"img\" aria-label=\"",
-            c->width_px, H, c->width_px, H);
-    put_esc(f, c->title);
-    fprintf(f, "\" font-family=\"system-ui, Helvetica, Arial, sans-serif\" font-size=\"12\">\n<title>");
-    put_esc(f, c->title);
-    fprintf(f, "</title><rect width=\"%u\" height=\"%.0f\" fill=\"#fff\"/>\n", c->width_px, H);
-    fprintf(f, "<text x=\"%.1f\" y=\"18\" font-size=\"14\" font-weight=\"bold\">", L);
-    put_esc(f, c->title);
-    fprintf(f, "</text>\n");
+    const rch_svg_doc doc = {.width_px = W, .height_px = H, .cls = "chart", .title = c->title, .in_html = 1,
+                             .font_family = "system-ui, Helvetica, Arial, sans-serif"};
+    rch_svg_begin(f, &doc);
+    rch_svg_text(f, L, 18.0, &tf, c->title);
     for (size_t k = 0; k < c->n_leg; ++k) {
         const double x = L + (double)legw;
-        fprintf(f, "<rect x=\"%.1f\" y=\"33\" width=\"11\" height=\"11\" fill=\"%s\"/>", x, colour[c->leg[k]]);
-        fprintf(f, "<text x=\"%.1f\" y=\"43\" font-size=\"11.5\">", x + 15.0);
-        put_esc(f, c->leg_label[k]);
-        fprintf(f, "</text>\n");
+        const rch_svg_paint sw = {.fill = colour[c->leg[k]]};
+        rch_svg_rect(f, x, 33.0, 11.0, 11.0, &sw, NULL);
+        rch_svg_text(f, x + 15.0, 43.0, &lf, c->leg_label[k]);
         legw += 30 + (size_t)(6.3 * (double)strlen(c->leg_label[k]));
     }
     for (size_t i = 0; i < c->n_rows; ++i) {
         const double y0 = T + row_h * (double)i;
         if (i % 2)
-            fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f3f5f8\"/>", L, y0, pw,
-                    row_h);
-        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">", L - 6.0, y0 + row_h / 2.0 + 4.0);
-        put_esc(f, c->label[i]);
-        fprintf(f, "</text>\n");
+            rch_svg_rect(f, L, y0, pw, row_h, &band, NULL);
+        rch_svg_text(f, L - 6.0, y0 + row_h / 2.0 + 4.0, &rf, c->label[i]);
     }
     chart_axes(f, c, L, T, pw, ph, lo, hi);
     for (size_t i = 0; i < c->n_rows; ++i)
         for (size_t k = 0; k < c->n_sub; ++k)
             chart_cell(f, c, i * c->n_sub + k, T + row_h * (double)i + 3.0 + sub_h * ((double)k + 0.5), L, pw, lo,
                        hi);
-    fprintf(f, "</svg>\n");
+    rch_svg_end(f);
     r->res->n_plots++;
 }
 

@@ -12,6 +12,7 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_plot.h"
+#include "rch_svg.h"
 #include "rch_robot.h"
 
 #ifndef M_PI
@@ -519,42 +520,43 @@ static double py(const panel_map *m, double y) { return m->cy - (y - m->s->cy) *
 #define SVG_BAR_W 110.0
 static void svg_colour_bar(FILE *f, double bx, double by, double bh, double vmax)
 {
-    fprintf(f, "<g class=\"colourbar\">\n");
+    static const rch_svg_paint frame = {.stroke = "#333"};
+    static const rch_svg_font tick = {.size_px = 11},
+                              unit = {.size_px = 11, .anchor = RCH_SVG_MIDDLE, .rotate_deg = -90.0};
+    rch_svg_group(f, "colourbar", NULL, NULL);
     for (int i = 0; i < 50; ++i) {
         char col[8];
-        rch_plot_viridis(col, (i + 0.5) / 50.0);
-        fprintf(f, "<rect x=\"%.1f\" y=\"%.2f\" width=\"14\" height=\"%.2f\" fill=\"%s\"/>\n", bx,
-                by + bh - (i + 1) * bh / 50.0, bh / 50.0 + 0.3, col);
+        rch_svg_viridis(col, (i + 0.5) / 50.0);
+        const rch_svg_paint cell = {.fill = col};
+        rch_svg_rect(f, bx, by + bh - (i + 1) * bh / 50.0, 14.0, bh / 50.0 + 0.3, &cell, NULL);
     }
-    fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"14\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", bx, by, bh);
+    rch_svg_rect(f, bx, by, 14.0, bh, &frame, NULL);
     for (int i = 0; i <= 4; ++i)
-        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\">%.3g</text>\n", bx + 18, by + bh - i * bh / 4.0 + 4,
-                vmax * i / 4.0);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"middle\" transform=\"rotate(-90 %.1f %.1f)\">"
-               "deviation (mm)</text>\n",
-            bx + 84, by + bh / 2, bx + 84, by + bh / 2);
-    fprintf(f, "</g>\n");
+        rch_svg_textf(f, bx + 18, by + bh - i * bh / 4.0 + 4, &tick, "%.3g", vmax * i / 4.0);
+    rch_svg_text(f, bx + 84, by + bh / 2, &unit, "deviation (mm)");
+    rch_svg_group_end(f);
 }
 
 /* Axis labels at the patch edges. */
 static void svg_panel_axes(FILE *f, const panel_map *m)
 {
+    static const rch_svg_font xf = {.size_px = 11, .anchor = RCH_SVG_MIDDLE}, yf = {.size_px = 11, .anchor = RCH_SVG_END};
     const rch_surface *s = m->s;
     const double x0 = s->cx - 0.5 * s->w, x1 = s->cx + 0.5 * s->w, y0 = s->cy - 0.5 * s->h, y1 = s->cy + 0.5 * s->h;
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"middle\">x = %.0f</text>\n", px(m, x0),
-            py(m, y0) + 42, x0);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"middle\">x = %.0f mm</text>\n", px(m, x1),
-            py(m, y0) + 42, x1);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"end\">y = %.0f</text>\n", px(m, x0) - 10,
-            py(m, y0) + 4, y0);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" text-anchor=\"end\">y = %.0f</text>\n", px(m, x0) - 10,
-            py(m, y1) + 4, y1);
+    rch_svg_textf(f, px(m, x0), py(m, y0) + 42, &xf, "x = %.0f", x0);
+    rch_svg_textf(f, px(m, x1), py(m, y0) + 42, &xf, "x = %.0f mm", x1);
+    rch_svg_textf(f, px(m, x0) - 10, py(m, y0) + 4, &yf, "y = %.0f", y0);
+    rch_svg_textf(f, px(m, x0) - 10, py(m, y1) + 4, &yf, "y = %.0f", y1);
 }
 
 /* One panel: the path of case c coloured by its deviation, the named points, a colour bar. */
 static void svg_panel(FILE *f, const rch_grind_result *res, int c, const rch_surface *s, double ox, double oy,
                       double pw, double ph, const char *title)
 {
+    static const rch_svg_paint patch = {.fill = "#f4f4f4", .stroke = "#999"},
+                               ring = {.stroke = "#d62728", .stroke_px = 2};
+    static const rch_svg_font tf = {.size_px = 15, .anchor = RCH_SVG_MIDDLE},
+                              sf = {.size_px = 12, .anchor = RCH_SVG_MIDDLE, .fill = "#555"};
     const rch_grind_point *p = res->pts;
     double vmax = 0.0;
     for (size_t k = 0; k < res->n; ++k)
@@ -562,31 +564,26 @@ static void svg_panel(FILE *f, const rch_grind_result *res, int c, const rch_sur
     if (!(vmax > 0.0))
         vmax = 1e-9;
     const panel_map m = {s, fmin(pw / s->w, ph / fmax(s->h, 1e-9)), ox + 0.5 * pw, oy + 0.5 * ph};
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"15\" text-anchor=\"middle\">%s</text>\n", ox + 0.5 * pw,
-            oy - 40, title);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"12\" text-anchor=\"middle\" fill=\"#555\">own colour "
-               "scale: 0 to %.3g mm</text>\n",
-            ox + 0.5 * pw, oy - 24, vmax);
-    fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f4f4f4\" stroke=\"#999\"/>\n",
-            px(&m, s->cx - 0.5 * s->w) - 6, py(&m, s->cy + 0.5 * s->h) - 6, s->w * m.sc + 12, s->h * m.sc + 12);
-    fprintf(f, "<g class=\"series\" data-kind=\"segments\">\n"); /* n points: n - 1 segments */
+    rch_svg_text(f, ox + 0.5 * pw, oy - 40, &tf, title);
+    rch_svg_textf(f, ox + 0.5 * pw, oy - 24, &sf, "own colour scale: 0 to %.3g mm", vmax);
+    rch_svg_rect(f, px(&m, s->cx - 0.5 * s->w) - 6, py(&m, s->cy + 0.5 * s->h) - 6, s->w * m.sc + 12,
+                 s->h * m.sc + 12, &patch, NULL);
+    rch_svg_group(f, "series", "segments", NULL); /* n points: n - 1 segments */
     for (size_t k = 0; k + 1 < res->n; ++k) {
         char col[8];
-        rch_plot_viridis(col, 0.5 * (p[k].dev_mm[c] + p[k + 1].dev_mm[c]) / vmax);
-        fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" stroke-width=\"4\" "
-                   "stroke-linecap=\"round\"/>\n",
-                px(&m, p[k].p_mm[0]), py(&m, p[k].p_mm[1]), px(&m, p[k + 1].p_mm[0]), py(&m, p[k + 1].p_mm[1]), col);
+        rch_svg_viridis(col, 0.5 * (p[k].dev_mm[c] + p[k + 1].dev_mm[c]) / vmax);
+        const rch_svg_paint seg = {.stroke = col, .stroke_px = 4, .round_cap = 1};
+        rch_svg_line(f, px(&m, p[k].p_mm[0]), py(&m, p[k].p_mm[1]), px(&m, p[k + 1].p_mm[0]), py(&m, p[k + 1].p_mm[1]),
+                     &seg);
     }
-    fprintf(f, "</g>\n");
+    rch_svg_group_end(f);
     for (int i = 0; i < 5; ++i) {
         const rch_grind_point *q = &p[res->named[i]];
         const double qx = px(&m, q->p_mm[0]), qy = py(&m, q->p_mm[1]);
         const int right = q->p_mm[0] > s->cx + 1e-9, below = q->p_mm[1] < s->cy - 1e-9;
-        fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"5\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n",
-                qx, qy);
-        fprintf(f, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\" fill=\"#d62728\" text-anchor=\"%s\" "
-                   "font-weight=\"bold\">%s %.3g</text>\n",
-                qx + (right ? -9 : 9), qy + (below ? 20 : -9), right ? "end" : "start", point_names[i], q->dev_mm[c]);
+        const rch_svg_font lf = {.size_px = 12, .fill = "#d62728", .bold = 1, .anchor = right ? RCH_SVG_END : RCH_SVG_START};
+        rch_svg_circle(f, qx, qy, 5.0, &ring);
+        rch_svg_textf(f, qx + (right ? -9 : 9), qy + (below ? 20 : -9), &lf, "%s %.3g", point_names[i], q->dev_mm[c]);
     }
     svg_colour_bar(f, ox + pw + 30, oy, ph, vmax);
     svg_panel_axes(f, &m);
@@ -598,20 +595,18 @@ static void write_path_svg(FILE *f, const rch_grind_result *res, const rch_surfa
     spec_line(subtitle, sizeof subtitle, s);
     const double pw = 420, ph = fmax(120.0, fmin(420.0, 420.0 * s->h / s->w)), gap = 100,
                  W = 90 + 2 * (pw + 30 + SVG_BAR_W) + gap, H = ph + 165;
-    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-               "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
-               "font-family=\"sans-serif\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
-            W, H, W, H);
-    fprintf(f, "<text x=\"%.1f\" y=\"22\" font-size=\"16\" text-anchor=\"middle\">Grinding path seen from above: "
-               "distance of the true flange position from the programmed one (mm)</text>\n",
-            W / 2);
-    fprintf(f, "<text x=\"%.1f\" y=\"40\" font-size=\"12\" text-anchor=\"middle\" fill=\"#555\">", W / 2);
-    rch_plot_xml_text(f, subtitle);
-    fprintf(f, "</text>\n");
+    static const char title[] = "Grinding path seen from above: distance of the true flange position from the "
+                                "programmed one (mm)";
+    const rch_svg_doc doc = {.width_px = W, .height_px = H, .title = title, .font_family = "sans-serif"};
+    static const rch_svg_font tf = {.size_px = 16, .anchor = RCH_SVG_MIDDLE},
+                              sf = {.size_px = 12, .anchor = RCH_SVG_MIDDLE, .fill = "#555"};
+    rch_svg_begin(f, &doc);
+    rch_svg_text(f, W / 2, 22, &tf, title);
+    rch_svg_text(f, W / 2, 40, &sf, subtitle);
     svg_panel(f, res, RCH_GRIND_UNCOMP, s, 90, 110, pw, ph, "uncompensated");
     svg_panel(f, res, RCH_GRIND_COMP_CAL, s, 90 + pw + 30 + SVG_BAR_W + gap, 110, pw, ph,
               "compensated (calibrated model)");
-    fprintf(f, "</svg>\n");
+    rch_svg_end(f);
 }
 
 static rch_plot *plot_deviation(const rch_grind_result *res)
