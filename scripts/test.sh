@@ -12,7 +12,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-JOBS=$(nproc)
+# exported: scripts/valgrind_tests.sh and static_analysis.sh run JOBS at a time
+export JOBS=$(nproc)
 status=0
 
 echo "== build and test (Release)"
