@@ -51,4 +51,21 @@ void rch_median_max(double *med, double *max, double *v, size_t n);
  * between order statistics (numpy's default): NaN for n = 0. */
 double rch_quantile(double *v, size_t n, double p);
 
+/* Upper tail P(F > f) of the F(d1, d2) distribution: 1 for f <= 0 or any
+ * argument NaN or not positive, 0 for f = +inf; never a misleading value
+ * down to 1e-290 (test diag_fdist_gsl: within 1e-9 of GSL, relative). */
+double rch_f_sf(double f, double d1, double d2);
+
+/* The f with P(F(d1, d2) > f) = p (0 < p < 1): rch_f_sf inverted by
+ * bisection in log f (relative 1e-13). NaN for arguments out of range. */
+double rch_f_isf(double p, double d1, double d2);
+
+/* What the 95 % region of a three-dimensional estimate needs when its
+ * covariance is itself estimated with nu degrees of freedom (a
+ * cluster-robust covariance from G groups: nu = G - 1): Hotelling's T^2
+ * quantile 3 nu / (nu - 2) F95(3, nu - 2) over the chi2(3) quantile of a
+ * known covariance. 1 for nu = +inf; 1.563 at nu = 14, 1.127 at 47, 1.018
+ * at 299; INFINITY for nu < 4 (or NaN). */
+double rch_t2_ratio95_3d(double nu);
+
 #endif

@@ -95,6 +95,22 @@ static int ident(scaled *z, size_t n_rows)
  * (the data's part of the information replaced by the clustered scores'
  * outer product, the prior's kept). Every direction is determined (by the
  * data or by the prior), so nothing is left out. */
+/* The cluster-robust covariance is estimated from G groups' scores: G - 1
+ * degrees of freedom. Its 95 % regions in three dimensions (the position
+ * figures: u95_mm, the compensation gate, the map, the report's verdict)
+ * are Hotelling's T^2, not chi2: the data's part of the covariance is
+ * scaled by their ratio (rch_t2_ratio95_3d(G - 1): 1.56 at 15 groups,
+ * 1.13 at 48, 1.01 at 300), so that every 3-D figure drawn from it keeps
+ * its 95 %. One-dimensional intervals (a parameter's +-1.96 se) are then
+ * wider than Student's t would make them (at 15 groups 1.25 against 1.09
+ * times the CR1 width). Truth study, two outlets, fixed-wrist set-ups of 20
+ * poses (seed 5): coverage 0.851 before, 0.924 after. */
+static double cluster_factor(unsigned G)
+{
+    const double f = rch_t2_ratio95_3d((double)G - 1.0);
+    return isfinite(f) ? f : 1.0;
+}
+
 static int covariance_map(scaled *z, rch_uncert *u, const double *A, const double *J, const double *r,
                           const rc_sample *s, const uint16_t *cl, size_t n, int want_cluster, const double *psd,
                           double noise)
@@ -153,7 +169,9 @@ static int covariance_map(scaled *z, rch_uncert *u, const double *A, const doubl
                     M[a * nf + b] += ua[a] * ua[b];
         }
         const double dof = (double)n - peff;
-        const double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 1.0 ? dof : 1.0));
+        /* CR1 (G / (G - 1) (n - 1) / (n - p)), then the few-groups factor
+         * (cluster_factor) */
+        const double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 1.0 ? dof : 1.0)) * cluster_factor(G);
         for (unsigned a = 0; a < nf; ++a) {
             for (unsigned b = 0; b < nf; ++b)
                 M[a * nf + b] *= c / (s2 * s2);
@@ -245,7 +263,7 @@ static int covariance(scaled *z, rch_uncert *u, const double *J, const double *r
                     M[a * nf + b] += ua[a] * ua[b];
         }
         free(ug);
-        double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 0 ? dof : 1.0));
+        const double c = ((double)G / (G - 1.0)) * (((double)n - 1.0) / (dof > 0 ? dof : 1.0)) * cluster_factor(G);
         /* Cz = c Ap M Ap */
         double *T = calloc((size_t)nf * nf, sizeof *T);
         if (!T) {

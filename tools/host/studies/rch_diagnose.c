@@ -28,75 +28,6 @@
 
 /* ------------------------------------------------------------------ stats */
 
-/* Continued fraction of the incomplete beta function (modified Lentz). */
-static double betacf(double a, double b, double x)
-{
-    const double tiny = 1e-300, eps = 1e-15;
-    double qab = a + b, qap = a + 1.0, qam = a - 1.0;
-    double c = 1.0, dd = 1.0 - qab * x / qap;
-    if (fabs(dd) < tiny)
-        dd = tiny;
-    dd = 1.0 / dd;
-    double h = dd;
-    for (int m = 1; m <= 500; ++m) {
-        const double m2 = 2.0 * m;
-        double aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-        dd = 1.0 + aa * dd;
-        if (fabs(dd) < tiny)
-            dd = tiny;
-        c = 1.0 + aa / c;
-        if (fabs(c) < tiny)
-            c = tiny;
-        dd = 1.0 / dd;
-        h *= dd * c;
-        aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-        dd = 1.0 + aa * dd;
-        if (fabs(dd) < tiny)
-            dd = tiny;
-        c = 1.0 + aa / c;
-        if (fabs(c) < tiny)
-            c = tiny;
-        dd = 1.0 / dd;
-        const double del = dd * c;
-        h *= del;
-        if (fabs(del - 1.0) < eps)
-            break;
-    }
-    return h;
-}
-
-/* Own code, on purpose: the Debian libraries with an F/incomplete-beta tail
- * are GSL (GPL-3) and R's libRmath (GPL-2+), and rcal and its binaries are
- * MIT. The test diag_fdist_gsl (test binary only, never shipped) checks
- * rch_diagnose_f_sf against GSL's gsl_cdf_fdist_Q over d1 1..30, d2 1..1e5,
- * p 0.999..1e-250: worst relative error 7.1e-10 (f = 2.71, d1 = 1,
- * d2 = 1e5; the cancellation in lgamma(a + b) - lgamma(a) at a = 5e4).
- *
- * Regularized incomplete beta I_x(a, b); y = 1 - x, given by the caller
- * without cancellation (1.0 - x loses digits when x is near 1). */
-static double incbeta(double a, double b, double x, double y)
-{
-    if (x <= 0.0)
-        return 0.0;
-    if (y <= 0.0)
-        return 1.0;
-    const double lx = x > 0.5 ? log1p(-y) : log(x), ly = y > 0.5 ? log1p(-x) : log(y);
-    const double lbt = lgamma(a + b) - lgamma(a) - lgamma(b) + a * lx + b * ly;
-    if (x < (a + 1.0) / (a + b + 2.0))
-        return exp(lbt) * betacf(a, b, x) / a;
-    return 1.0 - exp(lbt) * betacf(b, a, y) / b;
-}
-
-double rch_diagnose_f_sf(double f, double d1, double d2)
-{
-    if (!(f > 0.0) || !(d1 > 0.0) || !(d2 > 0.0))
-        return 1.0;
-    if (!isfinite(f))
-        return 0.0;
-    const double s = d2 + d1 * f;
-    return incbeta(0.5 * d2, 0.5 * d1, d2 / s, d1 * f / s);
-}
-
 static double now_ms(void)
 {
     struct timespec ts;
@@ -166,7 +97,7 @@ static void test_regress(rch_diagnose_test *t, const char *name, const double *r
     }
     t->r2 = expl / rss0;
     t->f_stat = (expl / dof) / ((rss1 > 0.0 ? rss1 : 1e-300) / t->dof2);
-    t->p_value = rch_diagnose_f_sf(t->f_stat, dof, t->dof2);
+    t->p_value = rch_f_sf(t->f_stat, dof, t->dof2);
     t->significant = t->p_value < alpha_each;
 }
 
@@ -189,7 +120,7 @@ static void test_bias(rch_diagnose_test *t, const double *r, size_t n, double al
     }
     t->r2 = (double)n * m * m / tot;
     t->f_stat = (double)n * m * m / (ss / t->dof2);
-    t->p_value = rch_diagnose_f_sf(t->f_stat, 1.0, t->dof2);
+    t->p_value = rch_f_sf(t->f_stat, 1.0, t->dof2);
     t->significant = t->p_value < alpha_each;
 }
 
@@ -233,7 +164,7 @@ static void test_groups(rch_diagnose_test *t, const double *r, const rc_sample *
     t->dof2 = (unsigned)(n - g_used);
     t->r2 = ssb / (ssb + ssw);
     t->f_stat = (ssb / t->dof1) / (ssw / t->dof2);
-    t->p_value = rch_diagnose_f_sf(t->f_stat, t->dof1, t->dof2);
+    t->p_value = rch_f_sf(t->f_stat, t->dof1, t->dof2);
     t->significant = t->p_value < alpha_each;
 }
 

@@ -230,9 +230,6 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
 int rch_diagnose_plots(const rch_diagnose_result *r, const char *dir, const char *const *inputs, size_t n_inputs,
                        char *paths, size_t paths_len, rch_diag *d);
 
-/* Statistics helpers (exposed for tests). */
-/* Upper tail P(F > f) of the F(d1, d2) distribution. */
-double rch_diagnose_f_sf(double f, double d1, double d2);
 
 /* The table of `rcal diagnose --residuals`: every sample as the diagnosis
  * used it (line (r->n): their data lines), predicted by the final model (the
