@@ -891,6 +891,7 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
         jc.solve = cfg;
         if (rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0) {
             r->n_jump_at = j->n_jumps; /* every change point found: the nuisance fit starts from them */
+            r->jump_check_steps = j->n_jumps;
             r->jump_rms_before_mm = j->rms_before_mm;
             memcpy(r->jump_at, j->at, j->n_jumps * sizeof r->jump_at[0]);
             /* A step can also describe an effect the geometry lacks (a joint
@@ -1629,17 +1630,29 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 r->robot.name, method);
     fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
             r->cfg.test_fraction, r->cfg.seed);
+    /* the check counts the steps far above the residual; the fit then takes
+     * every step the search found, the smaller ones too: both numbers said */
+    const unsigned steps = r->jump_check_steps, fitted = r->have_jumps ? r->jumps.n_jumps : steps;
     if (r->jumps_found && !r->cfg.jumps)
-        fprintf(f, "WARNING: the lengths jump %u time(s) in acquisition order (largest %.3f mm) and this fit does "
-                   "not model them: its geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s "
-                   "--jumps (and --dequantize-joints when the file's joints are rounded; rcal diagnose tells)\n\n",
-                r->jumps_found, r->jump_check_max_mm, r->cfg.data_path);
-    if (r->jumps_auto)
-        fprintf(f, "note: the lengths jump in acquisition order (%u jump(s) far above the residual, largest %.3f mm): "
-                   "every change point is fitted as nuisance, as --jumps does (--no-jump-check: not looked for)%s\n\n",
-                r->jumps_found, r->jump_check_max_mm,
+        fprintf(f, "WARNING: the lengths jump in acquisition order: %u of the %u step%s the change-point search "
+                   "found %s far above the residual (8 x its RMS; largest %.3f mm) and this fit does not model "
+                   "them: its geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --jumps "
+                   "(it fits all %u steps; and --dequantize-joints when the file's joints are rounded; rcal "
+                   "diagnose tells)\n\n",
+                r->jumps_found, steps, steps == 1 ? "" : "s", r->jumps_found == 1 ? "is" : "are",
+                r->jump_check_max_mm, r->cfg.data_path, steps);
+    if (r->jumps_auto) {
+        char also[64] = "";
+        if (fitted != steps)
+            snprintf(also, sizeof also, " (%u after the fit with them)", fitted);
+        fprintf(f, "note: the lengths jump in acquisition order: %u of the %u step%s the change-point search found "
+                   "%s far above the residual (8 x its RMS; largest %.3f mm), so all %u %s fitted as nuisance%s, as "
+                   "--jumps does (--no-jump-check: not looked for)%s\n\n",
+                r->jumps_found, steps, steps == 1 ? "" : "s", r->jumps_found == 1 ? "is" : "are",
+                r->jump_check_max_mm, steps, steps == 1 ? "is" : "are", also,
                 r->cfg.dequantize ? "" : "; if the file's joint angles are rounded, add --dequantize-joints "
                                          "(rcal fkcheck tells)");
+    }
     fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
             r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
     print_metrics_row(f, "before (nominal DH, fitted encoder)", &r->before_m);
@@ -1902,10 +1915,11 @@ int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *
 {
     if (r->jumps_found && !r->cfg.jumps) {
         rch_diag_set(d, path, 0, 0,
-                     "not written: the lengths jump %u time(s) in acquisition order (largest %.3f mm), which this "
-                     "fit does not model, so its geometry is wrong; run again with --jumps (or --no-jump-check "
-                     "to write it anyway)",
-                     r->jumps_found, r->jump_check_max_mm);
+                     "not written: the lengths jump in acquisition order (%u of the %u steps the change-point "
+                     "search found are far above the residual, largest %.3f mm), which this fit does not model, so "
+                     "its geometry is wrong; run again with --jumps, which fits all %u (or --no-jump-check to "
+                     "write it anyway)",
+                     r->jumps_found, r->jump_check_steps, r->jump_check_max_mm, r->jump_check_steps);
         return -1;
     }
     const char *inputs[2 * RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
