@@ -1614,6 +1614,20 @@ static void print_positions(FILE *f, const rch_calib_result *r)
     fprintf(f, "\n");
 }
 
+/* "2 of the 3 steps the change-point search found are far above the
+ * residual (...)", or, when every one is, "the change-point search found 2
+ * steps far above the residual (...)". */
+static void jump_counts(char *buf, size_t len, const rch_calib_result *r)
+{
+    const unsigned found = r->jumps_found, steps = r->jump_check_steps;
+    if (found == steps)
+        snprintf(buf, len, "the change-point search found %u step%s far above the residual (8 x its RMS; largest "
+                 "%.3f mm)", found, found == 1 ? "" : "s", r->jump_check_max_mm);
+    else
+        snprintf(buf, len, "%u of the %u steps the change-point search found %s far above the residual (8 x its "
+                 "RMS; largest %.3f mm)", found, steps, found == 1 ? "is" : "are", r->jump_check_max_mm);
+}
+
 static const char *data_name(const rch_calib_result *r)
 {
     return r->cfg.data_path ? r->cfg.data_path : r->cfg.n_positions_paths ? r->cfg.positions_paths[0] : "";
@@ -1633,23 +1647,22 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     /* the check counts the steps far above the residual; the fit then takes
      * every step the search found, the smaller ones too: both numbers said */
     const unsigned steps = r->jump_check_steps, fitted = r->have_jumps ? r->jumps.n_jumps : steps;
+    char counts[200], all[64];
+    jump_counts(counts, sizeof counts, r);
+    snprintf(all, sizeof all, steps == 1 ? "it is" : r->jumps_found == steps ? "they are" : "all %u are", steps);
     if (r->jumps_found && !r->cfg.jumps)
-        fprintf(f, "WARNING: the lengths jump in acquisition order: %u of the %u step%s the change-point search "
-                   "found %s far above the residual (8 x its RMS; largest %.3f mm) and this fit does not model "
-                   "them: its geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --jumps "
-                   "(it fits all %u steps; and --dequantize-joints when the file's joints are rounded; rcal "
-                   "diagnose tells)\n\n",
-                r->jumps_found, steps, steps == 1 ? "" : "s", r->jumps_found == 1 ? "is" : "are",
-                r->jump_check_max_mm, r->cfg.data_path, steps);
+        fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
+                   "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --jumps (it fits "
+                   "the %u step%s found; and --dequantize-joints when the file's joints are rounded; rcal diagnose "
+                   "tells)\n\n",
+                counts, r->cfg.data_path, steps, steps == 1 ? "" : "s");
     if (r->jumps_auto) {
         char also[64] = "";
         if (fitted != steps)
             snprintf(also, sizeof also, " (%u after the fit with them)", fitted);
-        fprintf(f, "note: the lengths jump in acquisition order: %u of the %u step%s the change-point search found "
-                   "%s far above the residual (8 x its RMS; largest %.3f mm), so all %u %s fitted as nuisance%s, as "
-                   "--jumps does (--no-jump-check: not looked for)%s\n\n",
-                r->jumps_found, steps, steps == 1 ? "" : "s", r->jumps_found == 1 ? "is" : "are",
-                r->jump_check_max_mm, steps, steps == 1 ? "is" : "are", also,
+        fprintf(f, "note: the lengths jump in acquisition order: %s, so %s fitted as nuisance%s, as --jumps does "
+                   "(--no-jump-check: not looked for)%s\n\n",
+                counts, all, also,
                 r->cfg.dequantize ? "" : "; if the file's joint angles are rounded, add --dequantize-joints "
                                          "(rcal fkcheck tells)");
     }
@@ -1914,12 +1927,13 @@ static int write_model_fn(FILE *f, const void *ctx)
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
 {
     if (r->jumps_found && !r->cfg.jumps) {
+        char counts[200];
+        jump_counts(counts, sizeof counts, r);
         rch_diag_set(d, path, 0, 0,
-                     "not written: the lengths jump in acquisition order (%u of the %u steps the change-point "
-                     "search found are far above the residual, largest %.3f mm), which this fit does not model, so "
-                     "its geometry is wrong; run again with --jumps, which fits all %u (or --no-jump-check to "
-                     "write it anyway)",
-                     r->jumps_found, r->jump_check_steps, r->jump_check_max_mm, r->jump_check_steps);
+                     "not written: the lengths jump in acquisition order (%s), which this fit does not model, so "
+                     "its geometry is wrong; run again with --jumps, which fits the %u step%s found (or "
+                     "--no-jump-check to write it anyway)",
+                     counts, r->jump_check_steps, r->jump_check_steps == 1 ? "" : "s");
         return -1;
     }
     const char *inputs[2 * RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
