@@ -1908,6 +1908,18 @@ static void calib_info(rch_jw *w, const void *ctx)
     rch_jw_uint(w, "seed", r->cfg.seed);
     rch_jw_numf(w, "rmse_before_mm", r->before_m.rmse_mm, "%.6f");
     rch_jw_numf(w, "rmse_after_mm", r->after_m.rmse_mm, "%.6f");
+    if (r->have_jumps && r->jumps.n_jumps) { /* read back: rcal evaluate says they are not applied */
+        rch_jw_arr(w, "length_jumps");
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+            rch_jw_obj(w, NULL);
+            rch_jw_uint(w, "line", r->jump_lines[k]);
+            rch_jw_numf(w, "t", r->jumps.at_t[k], "%.6f");
+            rch_jw_numf(w, "size_mm", r->jumps.size_mm[k], "%.6f");
+            rch_jw_numf(w, "se_mm", r->jumps.se_mm[k], "%.6f");
+            rch_jw_end(w);
+        }
+        rch_jw_end(w);
+    }
 }
 
 int rch_calib_write_model(FILE *f, const rch_calib_result *r)
