@@ -1467,6 +1467,26 @@ static void print_outlets(FILE *f, const rc_model *m)
     fprintf(f, "; %s\n", rch_prior_outlet_span_text(span));
 }
 
+/* Parameters more than 3 prior sd from the prior's mean (the "OUTSIDE"
+ * rows of the uncertainty table). */
+static unsigned outside_prior(const rch_calib_result *r)
+{
+    const rch_model_unc *u = &r->unc;
+    unsigned n = 0;
+    for (unsigned k = 0; u->has_prior && k < r->model.n_params; ++k)
+        if (u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED)
+            n += fabs(r->model.x[k] - r->prior_mean[k]) / u->prior_sd[k] > 3.0;
+    return n;
+}
+
+/* The 3-D accuracy is far worse than the lengths: the poses leave the
+ * geometry to the prior. */
+static int accuracy_needs_poses(const rch_calib_result *r)
+{
+    const double a = r->unc.map.data_median_mm;
+    return r->have_unc && r->after_ok && a > 10.0 * r->after_m.rmse_mm && a > 0.1;
+}
+
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {
     const rch_model_unc *u = &r->unc;
@@ -1536,7 +1556,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
             "workspace +-%.4f mm (median over %d random poses; max %.4f)\n",
             u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
             u->map.work_max_mm);
-    if (r->after_ok && u->map.data_median_mm > 10.0 * r->after_m.rmse_mm && u->map.data_median_mm > 0.1)
+    if (accuracy_needs_poses(r))
         fprintf(f, "  next: the lengths are predicted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave "
                    "most of the geometry to the prior; plan poses that move every joint, from more than one outlet: "
                    "rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv\n",
@@ -1633,6 +1653,42 @@ static const char *data_name(const rch_calib_result *r)
     return r->cfg.data_path ? r->cfg.data_path : r->cfg.n_positions_paths ? r->cfg.positions_paths[0] : "";
 }
 
+/* The last lines on the screen: the held-out RMSE before -> after, the
+ * predicted 3-D accuracy after compensation, and the first next step the
+ * report above names (the jumps it does not model, parameters outside the
+ * prior, poses that leave the geometry to the prior). */
+static void print_summary(FILE *f, const rch_calib_result *r)
+{
+    const char *data = r->cfg.data_path ? r->cfg.data_path : "FILE";
+    fputs("\nsummary:\n", f);
+    if (r->after_ok)
+        fprintf(f, "  %s RMSE %.4f mm before -> %.4f mm after calibration (%zu samples%s)\n",
+                r->n_test ? "held-out" : "training", r->before_m.rmse_mm, r->after_m.rmse_mm,
+                r->n_test ? r->n_test : r->n_train, r->n_test ? " the fit never saw" : ", none held out");
+    else
+        fprintf(f, "  %s RMSE %.4f mm before; after: the solver diverged, no figures\n",
+                r->n_test ? "held-out" : "training", r->before_m.rmse_mm);
+    if (r->have_unc)
+        fprintf(f, "  predicted 3-D accuracy after compensation (95 %%): +-%.4f mm over the data's poses (median; "
+                   "max %.4f), +-%.4f mm over the whole workspace (median; max %.4f)\n",
+                r->unc.map.data_median_mm, r->unc.map.data_max_mm, r->unc.map.work_median_mm, r->unc.map.work_max_mm);
+    else
+        fputs("  predicted 3-D accuracy: none in this run (no uncertainty: too few samples or a model that is not "
+              "finite)\n",
+              f);
+    const unsigned outside = r->have_unc ? outside_prior(r) : 0;
+    if (r->jumps_found && !r->cfg.jumps)
+        fprintf(f, "  next: rcal calibrate --data %s --jumps (the lengths jump and this fit does not model them)\n",
+                data);
+    else if (outside)
+        fprintf(f, "  next: rcal diagnose --data %s%s (%u parameter%s outside the prior's range)\n", data,
+                r->cfg.dequantize ? " --dequantize-joints" : "", outside, outside == 1 ? "" : "s");
+    else if (accuracy_needs_poses(r))
+        fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
+                   "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",
+                r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json", r->unc.map.data_median_mm / r->after_m.rmse_mm);
+}
+
 void rch_calib_print(FILE *f, const rch_calib_result *r)
 {
     const char *method = rc_method_name(r->cfg.method);
@@ -1707,6 +1763,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     else
         fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
                 r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
+    print_summary(f, r);
 }
 
 static void json_metrics(rch_jw *w, const char *name, const rc_metrics *m)
