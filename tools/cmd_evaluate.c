@@ -8,6 +8,7 @@
 #include "rcal_cmds.h"
 #include "rch_data.h"
 #include "rch_evaluate.h"
+#include "rch_file.h"
 #include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_positions.h"
@@ -114,6 +115,22 @@ static int report_json(const rch_evaluate_result *r, const char *model, const ch
     return rch_jw_finish(&w);
 }
 
+/* The length jumps the calibration fitted are a nuisance of that
+ * acquisition: never applied to new data, so the figures above hold them
+ * when data is the calibration file. */
+static void jumps_note(const rch_robot *robot, const char *data)
+{
+    if (robot->n_cal_jumps == 0)
+        return;
+    const int same = robot->cal_data[0] && rch_path_same(data, robot->cal_data);
+    printf("  note: the model was calibrated with %u length jump%s fitted as nuisance of that acquisition (largest "
+           "%.3f mm), not applied to new data: %s\n",
+           robot->n_cal_jumps, robot->n_cal_jumps == 1 ? "" : "s", robot->cal_jump_max_mm,
+           same ? "this is the calibration file, so the RMSE above includes its jumps (rcal calibrate's figures "
+                  "take them out)"
+                : "on another file the RMSE holds that file's own jumps, if it has any");
+}
+
 static void report_text(const rch_evaluate_result *r, const char *model, const char *data)
 {
     printf("model %s on %s: %zu samples, no refit of the robot%s\n", model, data, r->m.n,
@@ -202,7 +219,9 @@ int rcal_cmd_evaluate(int argc, char **argv)
         return 1;
     if (json)
         rc = report_json(&r, model_path, data_path, argc, argv) != 0;
-    else
+    else {
         report_text(&r, model_path, data_path);
+        jumps_note(&robot, data_path);
+    }
     return rc;
 }

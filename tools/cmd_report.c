@@ -133,6 +133,27 @@ int rcal_report_inline(const char *html, const struct rch_calib_result *cal, con
     return 0;
 }
 
+/* What the page lacks, one line per way of getting it: "  not in this
+ * run: noise floor, the diagnosis; needs a diagnosis: rcal diagnose ...". */
+static void print_missing(const rch_report_result *res)
+{
+    for (unsigned k = 0; k < res->n_missing_items; ++k) {
+        unsigned seen = 0;
+        for (unsigned i = 0; i < k; ++i)
+            seen |= strcmp(res->missing[i].how, res->missing[k].how) == 0;
+        if (seen)
+            continue;
+        fputs("  not in this run: ", stderr);
+        for (unsigned i = k, n = 0; i < res->n_missing_items; ++i)
+            if (strcmp(res->missing[i].how, res->missing[k].how) == 0)
+                fprintf(stderr, "%s%s", n++ ? ", " : "", res->missing[i].what);
+        if (res->missing[k].how[0])
+            fprintf(stderr, "; needs %s\n", res->missing[k].how);
+        else
+            fputs("; the calibration output has none\n", stderr);
+    }
+}
+
 /* What was written, as one JSON object on stdout (rcal-report/1). */
 static int report_json(const rch_report_result *res, const rch_report_cfg *cfg, int argc, char **argv)
 {
@@ -148,6 +169,14 @@ static int report_json(const rch_report_result *res, const rch_report_cfg *cfg, 
     rch_jw_uint(&w, "plots", res->n_plots);
     rch_jw_uint(&w, "warnings", res->n_warnings);
     rch_jw_uint(&w, "not_in_this_run", res->n_missing);
+    rch_jw_arr(&w, "not_in_this_run_items"); /* each distinct one and how a run gets it ("": it cannot) */
+    for (unsigned k = 0; k < res->n_missing_items; ++k) {
+        rch_jw_obj(&w, NULL);
+        rch_jw_str(&w, "what", res->missing[k].what);
+        rch_jw_str(&w, "how", res->missing[k].how);
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
 }
@@ -186,8 +215,10 @@ int rcal_cmd_report(int argc, char **argv)
         return rch_opt_fail(&spec, &d);
     if (json)
         return report_json(&res, &cfg, argc, argv) != 0;
-    fprintf(stderr, "rcal report: %s written (%u plots, %u warnings, %u place(s) not in this run)\n", cfg.out_path,
-            res.n_plots, res.n_warnings, res.n_missing);
+    fprintf(stderr, "rcal report: %s written (%u plots, %u warnings, %u place%s saying \"not in this run\"%s)\n",
+            cfg.out_path, res.n_plots, res.n_warnings, res.n_missing, res.n_missing == 1 ? "" : "s",
+            res.n_missing ? ", below" : "");
+    print_missing(&res);
     for (unsigned k = 0; k < res.n_csv; ++k)
         fprintf(stderr, "  plot data: %s\n", res.csv[k]);
     return 0;

@@ -648,16 +648,35 @@ shift, the ISO 9283 distance accuracy AD and repeatability RD over the
 repeated poses (NaN without repeated poses)."""
 
 
-def _model(model):
-    return model if isinstance(model, Model) else Model.load(model)
+def _model(model, what="model"):
+    """A Model from a Model, a Result of calibrate() (its model file, as
+    Result.write writes it for `rcal calibrate --out`, read back: the
+    posterior included) or a model file path; what names the argument in
+    the error for anything else."""
+    if isinstance(model, Model):
+        return model
+    if isinstance(model, Result):
+        tmp = tempfile.mkdtemp(prefix="rcal-model-")
+        try:
+            path = os.path.join(tmp, "model.json")
+            model.write(path)
+            m = Model.load(path)
+            m.path = None  # the temporary file is gone
+            return m
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+    if isinstance(model, (str, bytes, os.PathLike)):
+        return Model.load(model)
+    raise TypeError("%s: expected an rcal.Model, an rcal.Result (from rcal.calibrate) or the path of a model file, "
+                    "not %s" % (what, type(model).__name__))
 
 
 def evaluate(model, data, refit_encoder=False, same_pose_deg=1e-6):
-    """A calibrated model (a Model or a model file) on data the fit never
-    saw, as `rcal evaluate --model M --data D` (rch_evaluate: no refit of
-    the robot; refit_encoder: --refit-encoder; same_pose_deg:
-    --same-pose-deg). Returns an Evaluation."""
-    m = _model(model)
+    """A calibrated model (a Model, a Result of calibrate() or a model file)
+    on data the fit never saw, as `rcal evaluate --model M --data D`
+    (rch_evaluate: no refit of the robot; refit_encoder: --refit-encoder;
+    same_pose_deg: --same-pose-deg). Returns an Evaluation."""
+    m = _model(model, "evaluate: model")
     out = (ctypes.c_double * 17)()
     err = ctypes.create_string_buffer(_ERR_LEN)
     _check(_lib.lib().rch_ffi_evaluate(out, m._h, _path(data), 1 if refit_encoder else 0, float(same_pose_deg), err,
@@ -684,7 +703,9 @@ def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=Non
     stream, with the model set-up of `rcal compensate` (its determined part,
     the cable attachment removed).
 
-    model:         the calibrated Model or model file (--model)
+    model:         the calibrated Model, the Result of calibrate() (its
+                   model file, as Result.write writes it) or a model file
+                   (--model)
     targets_deg:   one target (6 joint angles, degrees) or a batch (n x 6)
     nominal:       the Model or file the targets were made with (--nominal;
                    default: the calibrated model's nominal table)
@@ -701,8 +722,8 @@ def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=Non
     Compensation (targets, status, u95_mm). A target outside the joint
     limits raises RcalError."""
     lib = _lib.lib()
-    cal = _model(model)
-    nom = None if nominal is None else _model(nominal)
+    cal = _model(model, "compensate: model")
+    nom = None if nominal is None else _model(nominal, "compensate: nominal")
     q, n, single, numpy = _doubles(targets_deg, 6, "targets_deg")
     out = (ctypes.c_double * max(6 * n, 1))()
     status = (ctypes.c_int * max(n, 1))()

@@ -75,3 +75,21 @@ def test_single_target_and_numpy(cal_file):
     a = rcal.compensate(model, np.array(rows))
     assert isinstance(a, np.ndarray) and a.shape == (4, 6)
     assert np.array_equal(a, np.array(batch))
+
+
+def test_result_as_model(cal_file, tmp_path):
+    """compensate takes the Result of calibrate() as export and report do:
+    its model file, so the targets equal those of the file it writes; a
+    wrong type is named."""
+    r = rcal.calibrate("data/sim_irb120.csv")
+    path = tmp_path / "r.json"
+    r.write(path)
+    model = rcal.Model.load(path)
+    rows = [[float(v) for v in t] for t in targets(model, 5, 3)]
+    assert rcal.compensate(r, rows) == rcal.compensate(model, rows)
+    assert rcal.compensate(r, rows, nominal=r) == rcal.compensate(model, rows, nominal=model)
+    assert rcal.evaluate(r, "data/sim_irb120.csv").metrics == rcal.evaluate(model, "data/sim_irb120.csv").metrics
+    with pytest.raises(TypeError, match=r"compensate: model: expected an rcal\.Model, an rcal\.Result .* not int"):
+        rcal.compensate(42, rows)
+    with pytest.raises(TypeError, match=r"compensate: nominal: .* not list"):
+        rcal.compensate(r, rows, nominal=[1, 2])

@@ -339,7 +339,8 @@ static void test_refused(void **state)
         "bad_targets.mod:5:29: error: jointtarget jShort (declaration) cannot be corrected: a jointtarget is "
         "[[6 robot axes],[6 external axes]]; this aggregate is [[5],[6]]",
         "bad_targets.mod:6:26: error: robtarget pConf (declaration) cannot be corrected: the solution with cfx = 0 "
-        "has axis 1 outside the quadrant cf1 = 2",
+        "has axis 1 outside the quadrant cf1 = 2 (axis 1 at 10.0000 deg: cf1 = 0); solutions exist with "
+        "[cf1,cf4,cf6,cfx] = [0,0,0,0], [0,-2,-2,1] (write one of them as the robtarget's confdata)",
         "bad_targets.mod:7:29: error: jointtarget jLimit (declaration) cannot be corrected: q3 = 100 deg is outside",
         "bad_targets.mod:8:26: error: robtarget pWobj (declaration) cannot be corrected: used in work object wobjTable "
         "(line 11)",
@@ -348,12 +349,55 @@ static void test_refused(void **state)
         "of a jointtarget but is not declared in this module",
         "bad_targets.mod:14:26: error: robtarget pSing (declaration) cannot be corrected: singular: the wrist centre "
         "is on axis 1 (shoulder singularity)",
-        "(and 8 more targets; nothing written)",
+        "rcal compensate: " RCAL_SOURCE_DIR "/tests/comp/data/bad_targets.mod: 9 targets cannot be corrected (each "
+        "named above with its line, column and reason); nothing written",
     };
     for (size_t k = 0; k < sizeof want / sizeof want[0]; ++k)
         if (!strstr(msg, want[k]))
             fail_msg("expected '%s' in:\n%s", want[k], msg);
     free(msg);
+}
+
+/* A confdata with no solution (the user's report: cf6 = 0 where axis 6 is
+ * at -8 deg): the one error is printed once and names the confdata that
+ * exist; the module with the first of them is then corrected. */
+static void test_refused_names_confdata(void **state)
+{
+    (void)state;
+    char in[128], out[128], err[128], cmd[768];
+    snprintf(in, sizeof in, "%s/conf.mod", dir);
+    snprintf(out, sizeof out, "%s/conf_comp.mod", dir);
+    snprintf(err, sizeof err, "%s/conf.err", dir);
+    static const char mod[] = "MODULE m\n  PROC main()\n    MoveL [[350,-50,450],[0,0,1,0],[%s],"
+                              "[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tool0;\n  ENDPROC\nENDMODULE\n";
+    FILE *f = fopen(in, "w");
+    assert_non_null(f);
+    fprintf(f, mod, "-1,0,0,0");
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' 2> '%s'", RCAL, model_path, in, out,
+             err);
+    assert_int_equal(run(cmd), 1);
+    assert_int_equal(access(out, F_OK), -1);
+    size_t n;
+    char *msg = slurp(err, &n);
+    const char *want = "conf.mod:3:11: error: robtarget (inline) cannot be corrected: the solution with cfx = 0 has "
+                       "axis 6 outside the quadrant cf6 = 0 (axis 6 at -8.1301 deg: cf6 = -1); solutions exist with "
+                       "[cf1,cf4,cf6,cfx] = [-1,0,-1,0]";
+    const char *at = strstr(msg, want);
+    if (!at)
+        fail_msg("expected '%s' in:\n%s", want, msg);
+    if (strstr(at + strlen(want), "outside the quadrant"))
+        fail_msg("the reason is printed more than once:\n%s", msg);
+    if (!strstr(msg, "conf.mod: 1 target cannot be corrected (each named above with its line, column and reason); "
+                     "nothing written"))
+        fail_msg("no closing line in:\n%s", msg);
+    free(msg);
+    f = fopen(in, "w");
+    assert_non_null(f);
+    fprintf(f, mod, "-1,0,-1,0");
+    fclose(f);
+    assert_int_equal(run(cmd), 0);
+    assert_int_equal(access(out, F_OK), 0);
 }
 
 /* A tool the module declares: without --tool the message gives the --tool
@@ -420,6 +464,7 @@ int main(void)
         cmocka_unit_test(test_ik_round_trip),
         cmocka_unit_test(test_every_form),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_refused_names_confdata),
         cmocka_unit_test(test_declared_tool),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

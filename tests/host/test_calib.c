@@ -149,6 +149,92 @@ static void test_ident_routes(void **state)
         print_message("skipped the real data: %s is absent\n", RCAL_SHARED_DATA);
 }
 
+/* The default run's text on the real file, which jumps. */
+static char *real_text(rch_calib_result *r)
+{
+    rch_calib_cfg cfg = demo_cfg();
+    cfg.data_path = RCAL_SHARED_DATA;
+    rch_diag d;
+    assert_int_equal(rch_calib_run(r, &cfg, &d), 0);
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    assert_non_null(f);
+    rch_calib_print(f, r);
+    assert_int_equal(fclose(f), 0);
+    return text;
+}
+
+/* The jump check counts the steps far above the residual, the fit takes
+ * every step the search found: the note says both, and the number it says
+ * are fitted is the "N found" of the jumps' own line (the real file: 2 of
+ * 3, then 3). */
+static void test_real_jump_counts(void **state)
+{
+    (void)state;
+    if (access(RCAL_SHARED_DATA, R_OK) != 0) {
+        print_message("skipped the real data: %s is absent\n", RCAL_SHARED_DATA);
+        return;
+    }
+    static rch_calib_result r;
+    char *text = real_text(&r);
+    assert_true(r.jumps_auto && r.have_jumps);
+    assert_true(r.jumps_found >= 1 && r.jumps_found < r.jump_check_steps);
+    assert_int_equal(r.jumps.n_jumps, r.jump_check_steps);
+    char note[256], found[160];
+    snprintf(note, sizeof note, "note: the lengths jump in acquisition order: %u of the %u steps the change-point "
+             "search found are far above the residual (8 x its RMS; largest %.3f mm), so all %u are fitted as "
+             "nuisance", r.jumps_found, r.jump_check_steps, r.jump_check_max_mm, r.jump_check_steps);
+    snprintf(found, sizeof found, "length jumps in acquisition order (nuisance, not used at a new pose): %u found;",
+             r.jumps.n_jumps);
+    if (!strstr(text, note) || !strstr(text, found))
+        fail_msg("expected '%s' and '%s' in:\n%s", note, found, text);
+    print_message("real file: %u of %u steps far above the residual, %u fitted\n", r.jumps_found,
+                  r.jump_check_steps, r.jumps.n_jumps);
+    free(text);
+}
+
+/* The text report ends with the summary: held-out RMSE before -> after and
+ * the predicted 3-D accuracy (the figures of the run, as the lines above
+ * print them), then the next step when the report names one (the real
+ * file: plan poses). */
+static void test_summary_last(void **state)
+{
+    (void)state;
+    static rch_calib_result r;
+    rch_diag d;
+    const rch_calib_cfg cfg = demo_cfg();
+    assert_int_equal(rch_calib_run(&r, &cfg, &d), 0);
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    assert_non_null(f);
+    rch_calib_print(f, &r);
+    assert_int_equal(fclose(f), 0);
+    char want[1024];
+    snprintf(want, sizeof want,
+             "\nsummary:\n  held-out RMSE %.4f mm before -> %.4f mm after calibration (%zu samples the fit never "
+             "saw)\n  predicted 3-D accuracy after compensation (95 %%): +-%.4f mm over the data's poses (median; max "
+             "%.4f), +-%.4f mm over the whole workspace (median; max %.4f)\n",
+             r.before_m.rmse_mm, r.after_m.rmse_mm, r.n_test, r.unc.map.data_median_mm, r.unc.map.data_max_mm,
+             r.unc.map.work_median_mm, r.unc.map.work_max_mm);
+    const size_t n = strlen(want);
+    if (len < n || strcmp(text + len - n, want) != 0) /* the very end: no next step on the demo */
+        fail_msg("expected the report to end with:\n%s\ngot:\n%s", want, len > 600 ? text + len - 600 : text);
+    free(text);
+    if (access(RCAL_SHARED_DATA, R_OK) != 0)
+        return;
+    text = real_text(&r);
+    len = strlen(text);
+    const char *sum = strstr(text, "\nsummary:\n");
+    assert_non_null(sum);
+    const char *next = strstr(sum, "  next: rcal poses --robot ");
+    if (!next || !strstr(next, "the poses leave most of the geometry to the prior)\n") ||
+        strchr(next, '\n') != text + len - 1)
+        fail_msg("the real file's report should end with the next step:\n%s", sum);
+    free(text);
+}
+
 /* --fix holds the named parameters at nominal; an unknown name is a request
  * error (-2), not a failure of the work. */
 static void test_fix(void **state)
@@ -367,6 +453,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_run_demo),
         cmocka_unit_test(test_ident_routes),
+        cmocka_unit_test(test_real_jump_counts),
+        cmocka_unit_test(test_summary_last),
         cmocka_unit_test(test_fix),
         cmocka_unit_test(test_random_poses),
         cmocka_unit_test(test_stats),

@@ -317,6 +317,26 @@ static void test_minimal_run(void **state)
     assert_non_null(h);
     assert_true(res.n_missing >= 10);
     assert_true(count(h, "not in this run") >= res.n_missing);
+    /* each distinct thing missing is named once, with how a run gets it */
+    static const struct {
+        const char *what, *how;
+    } want[] = {{"the predicted accuracy", "rcal report --model MODEL.json"},
+                {"the diagnosis", "rcal diagnose --data FILE --json > DIAG.json, then rcal report --diagnosis"},
+                {"the comparison against a simulated truth", "rcal calibrate --truth TRUTH.json"},
+                {"standard errors and 95 % intervals of the parameters", "rcal report --model MODEL.json"},
+                {"noise floor", "rcal diagnose"}};
+    assert_true(res.n_missing_items >= sizeof want / sizeof want[0] && res.n_missing_items <= res.n_missing);
+    for (size_t k = 0; k < sizeof want / sizeof want[0]; ++k) {
+        unsigned found = 0;
+        for (unsigned i = 0; i < res.n_missing_items; ++i)
+            found += strcmp(res.missing[i].what, want[k].what) == 0 && strstr(res.missing[i].how, want[k].how);
+        if (found != 1)
+            fail_msg("'%s' (%s) named %u times", want[k].what, want[k].how, found);
+    }
+    for (unsigned i = 0; i < res.n_missing_items; ++i)
+        for (unsigned k = 0; k < i; ++k)
+            assert_false(strcmp(res.missing[i].what, res.missing[k].what) == 0 &&
+                         strcmp(res.missing[i].how, res.missing[k].how) == 0);
     assert_non_null(strstr(h, "no diagnosis was given"));
     assert_non_null(strstr(h, "No provenance in this run"));
     assert_int_equal(res.n_csv, 2); /* metrics, params */

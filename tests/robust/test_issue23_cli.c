@@ -311,7 +311,13 @@ static void test_outputs_distinct(void **state)
     /* rcal report: the CSVs are named from the page, a user's file is never replaced */
     write_text("report_params.csv", "a user's own file\n");
     hash(before, "report_params.csv");
-    RUN(0, NEED("x_params.csv"), R " report --calibration cal.json --out x.html");
+    /* what the page lacks is named with how to get it, not only counted */
+    RUN(0, NEED("x_params.csv", "saying \"not in this run\", below)",
+                "  not in this run: the comparison against a simulated truth; needs a simulated truth: rcal calibrate "
+                "--truth TRUTH.json",
+                "the diagnosis; needs a diagnosis: rcal diagnose --data FILE --json > DIAG.json, then rcal report "
+                "--diagnosis DIAG.json"),
+        R " report --calibration cal.json --out x.html");
     assert_true(exists("x_metrics.csv") && exists("x_params.csv"));
     char hx[65];
     hash(hx, "x_params.csv");

@@ -891,6 +891,7 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
         jc.solve = cfg;
         if (rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0) {
             r->n_jump_at = j->n_jumps; /* every change point found: the nuisance fit starts from them */
+            r->jump_check_steps = j->n_jumps;
             r->jump_rms_before_mm = j->rms_before_mm;
             memcpy(r->jump_at, j->at, j->n_jumps * sizeof r->jump_at[0]);
             /* A step can also describe an effect the geometry lacks (a joint
@@ -1466,6 +1467,26 @@ static void print_outlets(FILE *f, const rc_model *m)
     fprintf(f, "; %s\n", rch_prior_outlet_span_text(span));
 }
 
+/* Parameters more than 3 prior sd from the prior's mean (the "OUTSIDE"
+ * rows of the uncertainty table). */
+static unsigned outside_prior(const rch_calib_result *r)
+{
+    const rch_model_unc *u = &r->unc;
+    unsigned n = 0;
+    for (unsigned k = 0; u->has_prior && k < r->model.n_params; ++k)
+        if (u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED)
+            n += fabs(r->model.x[k] - r->prior_mean[k]) / u->prior_sd[k] > 3.0;
+    return n;
+}
+
+/* The 3-D accuracy is far worse than the lengths: the poses leave the
+ * geometry to the prior. */
+static int accuracy_needs_poses(const rch_calib_result *r)
+{
+    const double a = r->unc.map.data_median_mm;
+    return r->have_unc && r->after_ok && a > 10.0 * r->after_m.rmse_mm && a > 0.1;
+}
+
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {
     const rch_model_unc *u = &r->unc;
@@ -1535,7 +1556,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
             "workspace +-%.4f mm (median over %d random poses; max %.4f)\n",
             u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
             u->map.work_max_mm);
-    if (r->after_ok && u->map.data_median_mm > 10.0 * r->after_m.rmse_mm && u->map.data_median_mm > 0.1)
+    if (accuracy_needs_poses(r))
         fprintf(f, "  next: the lengths are predicted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave "
                    "most of the geometry to the prior; plan poses that move every joint, from more than one outlet: "
                    "rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv\n",
@@ -1613,9 +1634,59 @@ static void print_positions(FILE *f, const rch_calib_result *r)
     fprintf(f, "\n");
 }
 
+/* "2 of the 3 steps the change-point search found are far above the
+ * residual (...)", or, when every one is, "the change-point search found 2
+ * steps far above the residual (...)". */
+static void jump_counts(char *buf, size_t len, const rch_calib_result *r)
+{
+    const unsigned found = r->jumps_found, steps = r->jump_check_steps;
+    if (found == steps)
+        snprintf(buf, len, "the change-point search found %u step%s far above the residual (8 x its RMS; largest "
+                 "%.3f mm)", found, found == 1 ? "" : "s", r->jump_check_max_mm);
+    else
+        snprintf(buf, len, "%u of the %u steps the change-point search found %s far above the residual (8 x its "
+                 "RMS; largest %.3f mm)", found, steps, found == 1 ? "is" : "are", r->jump_check_max_mm);
+}
+
 static const char *data_name(const rch_calib_result *r)
 {
     return r->cfg.data_path ? r->cfg.data_path : r->cfg.n_positions_paths ? r->cfg.positions_paths[0] : "";
+}
+
+/* The last lines on the screen: the held-out RMSE before -> after, the
+ * predicted 3-D accuracy after compensation, and the first next step the
+ * report above names (the jumps it does not model, parameters outside the
+ * prior, poses that leave the geometry to the prior). */
+static void print_summary(FILE *f, const rch_calib_result *r)
+{
+    const char *data = r->cfg.data_path ? r->cfg.data_path : "FILE";
+    fputs("\nsummary:\n", f);
+    if (r->after_ok)
+        fprintf(f, "  %s RMSE %.4f mm before -> %.4f mm after calibration (%zu samples%s)\n",
+                r->n_test ? "held-out" : "training", r->before_m.rmse_mm, r->after_m.rmse_mm,
+                r->n_test ? r->n_test : r->n_train, r->n_test ? " the fit never saw" : ", none held out");
+    else
+        fprintf(f, "  %s RMSE %.4f mm before; after: the solver diverged, no figures\n",
+                r->n_test ? "held-out" : "training", r->before_m.rmse_mm);
+    if (r->have_unc)
+        fprintf(f, "  predicted 3-D accuracy after compensation (95 %%): +-%.4f mm over the data's poses (median; "
+                   "max %.4f), +-%.4f mm over the whole workspace (median; max %.4f)\n",
+                r->unc.map.data_median_mm, r->unc.map.data_max_mm, r->unc.map.work_median_mm, r->unc.map.work_max_mm);
+    else
+        fputs("  predicted 3-D accuracy: none in this run (no uncertainty: too few samples or a model that is not "
+              "finite)\n",
+              f);
+    const unsigned outside = r->have_unc ? outside_prior(r) : 0;
+    if (r->jumps_found && !r->cfg.jumps)
+        fprintf(f, "  next: rcal calibrate --data %s --jumps (the lengths jump and this fit does not model them)\n",
+                data);
+    else if (outside)
+        fprintf(f, "  next: rcal diagnose --data %s%s (%u parameter%s outside the prior's range)\n", data,
+                r->cfg.dequantize ? " --dequantize-joints" : "", outside, outside == 1 ? "" : "s");
+    else if (accuracy_needs_poses(r))
+        fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
+                   "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",
+                r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json", r->unc.map.data_median_mm / r->after_m.rmse_mm);
 }
 
 void rch_calib_print(FILE *f, const rch_calib_result *r)
@@ -1629,17 +1700,28 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 r->robot.name, method);
     fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
             r->cfg.test_fraction, r->cfg.seed);
+    /* the check counts the steps far above the residual; the fit then takes
+     * every step the search found, the smaller ones too: both numbers said */
+    const unsigned steps = r->jump_check_steps, fitted = r->have_jumps ? r->jumps.n_jumps : steps;
+    char counts[200], all[64];
+    jump_counts(counts, sizeof counts, r);
+    snprintf(all, sizeof all, steps == 1 ? "it is" : r->jumps_found == steps ? "they are" : "all %u are", steps);
     if (r->jumps_found && !r->cfg.jumps)
-        fprintf(f, "WARNING: the lengths jump %u time(s) in acquisition order (largest %.3f mm) and this fit does "
-                   "not model them: its geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s "
-                   "--jumps (and --dequantize-joints when the file's joints are rounded; rcal diagnose tells)\n\n",
-                r->jumps_found, r->jump_check_max_mm, r->cfg.data_path);
-    if (r->jumps_auto)
-        fprintf(f, "note: the lengths jump in acquisition order (%u jump(s) far above the residual, largest %.3f mm): "
-                   "every change point is fitted as nuisance, as --jumps does (--no-jump-check: not looked for)%s\n\n",
-                r->jumps_found, r->jump_check_max_mm,
+        fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
+                   "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --jumps (it fits "
+                   "the %u step%s found; and --dequantize-joints when the file's joints are rounded; rcal diagnose "
+                   "tells)\n\n",
+                counts, r->cfg.data_path, steps, steps == 1 ? "" : "s");
+    if (r->jumps_auto) {
+        char also[64] = "";
+        if (fitted != steps)
+            snprintf(also, sizeof also, " (%u after the fit with them)", fitted);
+        fprintf(f, "note: the lengths jump in acquisition order: %s, so %s fitted as nuisance%s, as --jumps does "
+                   "(--no-jump-check: not looked for)%s\n\n",
+                counts, all, also,
                 r->cfg.dequantize ? "" : "; if the file's joint angles are rounded, add --dequantize-joints "
                                          "(rcal fkcheck tells)");
+    }
     fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
             r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
     print_metrics_row(f, "before (nominal DH, fitted encoder)", &r->before_m);
@@ -1681,6 +1763,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     else
         fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
                 r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
+    print_summary(f, r);
 }
 
 static void json_metrics(rch_jw *w, const char *name, const rc_metrics *m)
@@ -1882,6 +1965,18 @@ static void calib_info(rch_jw *w, const void *ctx)
     rch_jw_uint(w, "seed", r->cfg.seed);
     rch_jw_numf(w, "rmse_before_mm", r->before_m.rmse_mm, "%.6f");
     rch_jw_numf(w, "rmse_after_mm", r->after_m.rmse_mm, "%.6f");
+    if (r->have_jumps && r->jumps.n_jumps) { /* read back: rcal evaluate says they are not applied */
+        rch_jw_arr(w, "length_jumps");
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+            rch_jw_obj(w, NULL);
+            rch_jw_uint(w, "line", r->jump_lines[k]);
+            rch_jw_numf(w, "t", r->jumps.at_t[k], "%.6f");
+            rch_jw_numf(w, "size_mm", r->jumps.size_mm[k], "%.6f");
+            rch_jw_numf(w, "se_mm", r->jumps.se_mm[k], "%.6f");
+            rch_jw_end(w);
+        }
+        rch_jw_end(w);
+    }
 }
 
 int rch_calib_write_model(FILE *f, const rch_calib_result *r)
@@ -1901,11 +1996,13 @@ static int write_model_fn(FILE *f, const void *ctx)
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
 {
     if (r->jumps_found && !r->cfg.jumps) {
+        char counts[200];
+        jump_counts(counts, sizeof counts, r);
         rch_diag_set(d, path, 0, 0,
-                     "not written: the lengths jump %u time(s) in acquisition order (largest %.3f mm), which this "
-                     "fit does not model, so its geometry is wrong; run again with --jumps (or --no-jump-check "
-                     "to write it anyway)",
-                     r->jumps_found, r->jump_check_max_mm);
+                     "not written: the lengths jump in acquisition order (%s), which this fit does not model, so "
+                     "its geometry is wrong; run again with --jumps, which fits the %u step%s found (or "
+                     "--no-jump-check to write it anyway)",
+                     counts, r->jump_check_steps, r->jump_check_steps == 1 ? "" : "s");
         return -1;
     }
     const char *inputs[2 * RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};

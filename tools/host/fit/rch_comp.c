@@ -500,7 +500,12 @@ static int do_rapid_text(comp_ctx *c, const char *text, size_t len, unsigned bas
             }
         }
     }
-    if (n_bad > 0) {
+    if (n_bad > 0 && c->warn) {
+        /* each target is named above; the error says how many, once */
+        rch_diag_set(d, c->in_name, 0, 0, "%lu target%s cannot be corrected (each named above with its line, column "
+                     "and reason); nothing written", n_bad, n_bad == 1 ? "" : "s");
+        rc = -1;
+    } else if (n_bad > 0) {
         if (n_bad > 1) {
             char more[80];
             snprintf(more, sizeof more, " (and %lu more targets; nothing written)", n_bad - 1);

@@ -353,6 +353,44 @@ static int to_quadrant(double *q, int cf)
     return 0;
 }
 
+/* Appends to why the confdata [cf1,cf4,cf6,cfx] of the pose's solutions
+ * within m's joint limits (each axis in (-180, 180] deg), those with cfx
+ * first, so that a refused target names what would be accepted. */
+static void append_solutions(char *why, size_t why_len, const rc_model *m, const double pos_mm[3],
+                             const double quat[4], const double *tool_mm, int cfx)
+{
+    double sol[8][RC_NJ];
+    const int n = rch_ik_all(sol, m, pos_mm, quat, tool_mm);
+    int got[8][4], n_got = 0;
+    for (int pass = 0; pass < 2; ++pass)
+        for (int k = 0; k < n; ++k) {
+            int c[4], j, dup = 0;
+            rch_ik_confdata(c, m, sol[k]);
+            if ((c[3] == cfx) != (pass == 0))
+                continue;
+            for (j = 0; j < RC_NJ; ++j)
+                if (sol[k][j] < m->q_min_rad[j] - 1e-12 || sol[k][j] > m->q_max_rad[j] + 1e-12)
+                    break;
+            for (int i = 0; i < n_got; ++i)
+                dup |= memcmp(got[i], c, sizeof c) == 0;
+            if (j == RC_NJ && !dup)
+                memcpy(got[n_got++], c, sizeof c);
+        }
+    size_t at = strlen(why);
+    if (at + 1 >= why_len)
+        return;
+    if (n_got == 0) {
+        snprintf(why + at, why_len - at, "; no solution of this pose is within the joint limits");
+        return;
+    }
+    at += (size_t)snprintf(why + at, why_len - at, "; solutions exist with [cf1,cf4,cf6,cfx] =");
+    for (int i = 0; i < n_got && at + 1 < why_len; ++i)
+        at += (size_t)snprintf(why + at, why_len - at, "%s [%d,%d,%d,%d]", i ? "," : "", got[i][0], got[i][1],
+                               got[i][2], got[i][3]);
+    if (at + 1 < why_len)
+        snprintf(why + at, why_len - at, " (write one of them as the robtarget's confdata)");
+}
+
 int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3], const double quat[4],
                  const int cf[4], const double *tool_mm, char *why, size_t why_len)
 {
@@ -371,6 +409,7 @@ int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3],
      * tried across its quadrant until q6 meets its own */
     const double q4_lo = cf[1] >= 0 ? 90.0 * cf[1] : 90.0 * (cf[1] + 1);
     int n_cfx = 0, last_bad = -1;
+    double bad_deg = 0.0;
     for (int step = 0; step <= 90; ++step) {
         const double hint = (cf[1] >= 0 ? q4_lo + step : q4_lo - step) * DEG;
         double sol[8][RC_NJ];
@@ -390,16 +429,14 @@ int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3],
             ++n_cfx;
             double q[RC_NJ];
             memcpy(q, sol[k], sizeof q);
-            if (to_quadrant(&q[0], cf[0]) != 0) {
-                last_bad = 0;
-                continue;
-            }
-            if (to_quadrant(&q[3], cf[1]) != 0) {
-                last_bad = 3;
-                continue;
-            }
-            if (to_quadrant(&q[5], cf[2]) != 0) {
-                last_bad = 5;
+            static const int axis[3] = {0, 3, 5};
+            int a;
+            for (a = 0; a < 3; ++a)
+                if (to_quadrant(&q[axis[a]], cf[a]) != 0)
+                    break;
+            if (a < 3) {
+                last_bad = axis[a];
+                bad_deg = q[axis[a]] / DEG;
                 continue;
             }
             int j;
@@ -409,6 +446,7 @@ int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3],
             if (j < RC_NJ) {
                 snprintf(why, why_len, "the solution with this confdata has axis %d = %.4f deg, outside its limits "
                          "[%g, %g] deg", j + 1, q[j] / DEG, m->q_min_rad[j] / DEG, m->q_max_rad[j] / DEG);
+                append_solutions(why, why_len, m, pos_mm, quat, tool_mm, cf[3]);
                 return -1;
             }
             memcpy(q_rad, q, sizeof q);
@@ -420,7 +458,10 @@ int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3],
     if (n_cfx == 0)
         snprintf(why, why_len, "no solution with cfx = %d reaches this pose (a singular or boundary pose)", cf[3]);
     else
-        snprintf(why, why_len, "the solution with cfx = %d has axis %d outside the quadrant cf%d = %d", cf[3],
-                 last_bad + 1, last_bad + 1, cf[last_bad == 0 ? 0 : last_bad == 3 ? 1 : 2]);
+        snprintf(why, why_len, "the solution with cfx = %d has axis %d outside the quadrant cf%d = %d (axis %d at "
+                 "%.4f deg: cf%d = %d)", cf[3], last_bad + 1, last_bad + 1,
+                 cf[last_bad == 0 ? 0 : last_bad == 3 ? 1 : 2], last_bad + 1, bad_deg, last_bad + 1,
+                 quadrant(bad_deg * DEG));
+    append_solutions(why, why_len, m, pos_mm, quat, tool_mm, cf[3]);
     return -1;
 }

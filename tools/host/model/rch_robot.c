@@ -316,6 +316,38 @@ static int check_cov(const double *c, const rch_json *arr, const char *name, rch
     return 0;
 }
 
+/* What the informational "calibration" member says of the fit: the file
+ * and the length jumps fitted as nuisance ("length_jumps": [{"line", "t",
+ * "size_mm", "se_mm"}], written since the jumps are said by rcal evaluate).
+ * Older files have neither: 0. */
+static int read_calibration(rch_robot *out, const rch_json *c, const char *name, rch_diag *d)
+{
+    if (!c || c->type != RCH_JOBJ)
+        return 0;
+    const rch_json *data = rch_json_get(c, "data"), *jumps = rch_json_get(c, "length_jumps");
+    if (data && data->type == RCH_JSTR)
+        snprintf(out->cal_data, sizeof out->cal_data, "%s", data->str);
+    if (!jumps)
+        return 0;
+    if (jumps->type != RCH_JARR) {
+        rch_diag_set(d, name, jumps->line, jumps->col, "\"calibration\": \"length_jumps\" must be an array of "
+                     "{\"size_mm\": number, ...}");
+        return -1;
+    }
+    for (size_t k = 0; k < jumps->n; ++k) {
+        const rch_json *sz = rch_json_get(jumps->items[k], "size_mm");
+        if (!sz || sz->type != RCH_JNUM || !isfinite(sz->num)) {
+            rch_diag_set(d, name, jumps->items[k]->line, jumps->items[k]->col,
+                         "\"calibration\": length jump %zu needs \"size_mm\", a finite number", k + 1);
+            return -1;
+        }
+        if (fabs(sz->num) > out->cal_jump_max_mm)
+            out->cal_jump_max_mm = fabs(sz->num);
+    }
+    out->n_cal_jumps = (unsigned)jumps->n;
+    return 0;
+}
+
 /* "uncertainty" of an rcal-model/2 file. */
 static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name, rch_diag *d)
 {
@@ -437,6 +469,8 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     if (unc && read_uncertainty(out, unc, name, d) != 0)
         goto done;
     if (read_prior(&out->prior, rch_json_get(root, "prior"), name, d) != 0)
+        goto done;
+    if (read_calibration(out, rch_json_get(root, "calibration"), name, d) != 0)
         goto done;
     rc = 0;
 done:

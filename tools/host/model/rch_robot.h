@@ -42,6 +42,11 @@ typedef struct rch_robot {
     int has_nominal;    /* the file is a calibrated model with a nominal table */
     rch_model_unc unc;  /* rcal-model/2 "uncertainty" (unc.present == 0 for version 1) */
     rch_prior_cfg prior; /* "prior" member: tolerances by parameter type (defaults where absent) */
+    /* from the informational "calibration" member (absent: 0, ""): */
+    unsigned n_cal_jumps;   /* "length_jumps": steps of the cable length fitted as nuisance of that acquisition,
+                               never applied to new data */
+    double cal_jump_max_mm; /* the largest |size_mm| of them */
+    char cal_data[512];     /* "data": the file the model was calibrated on */
 } rch_robot;
 
 /* Where a calibration came from (rcal-model/2 "provenance"). */

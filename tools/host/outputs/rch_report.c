@@ -49,7 +49,41 @@ typedef struct {
     rch_report_result *res;
     char warn[RCH_REPORT_MAX_WARN][640];
     unsigned n_warn;
+    const char *section, *where, *how; /* what a "not in this run" here stands for, and how to get it */
 } rep;
+
+/* How a run gets what the diagnosis, the model file or a truth holds. */
+#define HOW_DIAG "a diagnosis: rcal diagnose --data FILE --json > DIAG.json, then rcal report --diagnosis DIAG.json"
+#define HOW_MODEL "the run's model file: rcal report --model MODEL.json (rcal calibrate --out MODEL.json)"
+#define HOW_TRUTH "a simulated truth: rcal calibrate --truth TRUTH.json (only a simulation has one: rcal simulate --truth-out)"
+
+/* One place that says "not in this run": counted, and what it stands for
+ * recorded once (with how to get it) for the command's summary. */
+static void missing(rep *r, const char *what, const char *how)
+{
+    rch_report_result *res = r->res;
+    res->n_missing++;
+    if (!what)
+        what = "a figure";
+    if (!how)
+        how = "";
+    for (unsigned k = 0; k < res->n_missing_items; ++k)
+        if (strcmp(res->missing[k].what, what) == 0 && strcmp(res->missing[k].how, how) == 0)
+            return;
+    if (res->n_missing_items == RCH_REPORT_MAX_MISSING)
+        return;
+    snprintf(res->missing[res->n_missing_items].what, sizeof res->missing[0].what, "%s", what);
+    snprintf(res->missing[res->n_missing_items].how, sizeof res->missing[0].how, "%s", how);
+    res->n_missing_items++;
+}
+
+/* The section (or page part) the next places are in: a missing value there
+ * is named by it unless a row (kv) names it. */
+static void section(rep *r, const char *name, const char *how)
+{
+    r->section = r->where = name;
+    r->how = how;
+}
 
 /* ---- JSON access by dotted path ("uncertainty.position95_mm.data_max") */
 
@@ -107,7 +141,7 @@ static void put_str(rep *r, const char *s)
         put_esc(r->f, s);
     } else {
         fputs(NA, r->f);
-        r->res->n_missing++;
+        missing(r, r->where, r->how);
     }
 }
 
@@ -118,7 +152,7 @@ static void put_num(rep *r, double v, const char *fmt)
         fprintf(r->f, fmt, v);
     } else {
         fputs(NA, r->f);
-        r->res->n_missing++;
+        missing(r, r->where, r->how);
     }
 }
 
@@ -741,8 +775,17 @@ static const char css[] =
     "details summary{cursor:pointer;color:#234}"
     "@media print{body{background:#fff}main{max-width:none;padding:0}section{break-inside:avoid;border:none}}";
 
-static void kv(rep *r, const char *key) { fprintf(r->f, "<tr><th>%s</th><td>", key); }
-static void kv_end(rep *r) { fputs("</td></tr>\n", r->f); }
+static void kv(rep *r, const char *key)
+{
+    fprintf(r->f, "<tr><th>%s</th><td>", key);
+    r->where = key;
+}
+
+static void kv_end(rep *r)
+{
+    fputs("</td></tr>\n", r->f);
+    r->where = r->section;
+}
 
 /* The first screen: the verdict (the accuracy of the compensated robot, 95 %,
  * over the data's poses and the workspace; pass or fail against the user's
@@ -756,6 +799,7 @@ static void verdict(rep *r, size_t n_warn)
     const double tol = r->cfg->tolerance_mm;
     const int have = isfinite(in) && isfinite(in_max);
     const int pass = have && tol > 0.0 && in_max <= tol;
+    section(r, "the verdict (first screen)", NULL);
     fprintf(f, "<div class=\"glance %s\" id=\"verdict\"><p class=\"big\">",
             !have || !(tol > 0.0) ? "" : pass ? "pass" : "fail");
     if (have && tol > 0.0)
@@ -776,7 +820,7 @@ static void verdict(rep *r, size_t n_warn)
         fputs("No predicted accuracy in this run: the calibration output carries no uncertainty (pass the model "
               "file of the run with <code>--model</code>, or calibrate again with <code>rcal calibrate --json</code>).",
               f);
-        r->res->n_missing++;
+        missing(r, "the predicted accuracy", HOW_MODEL);
     }
     const double b = jnum(r->cal, "before.rmse_mm"), a = jnum(r->cal, "after.rmse_mm");
     const double nt = jnum(r->cal, "after.n");
@@ -844,7 +888,9 @@ static void page_head(rep *r, size_t n_warn)
     put_esc(f, data ? data : "?");
     fprintf(f, "</title>\n<style>%s</style>\n</head>\n<body>\n<main>\n<header>\n<h1>Calibration report</h1>\n", css);
     fputs("<p class=\"sub\">robot <b>", f);
+    section(r, "the robot's name", HOW_MODEL);
     put_str(r, robot ? robot : jstr(r->cal, "robot"));
+    section(r, "the page's head", NULL);
     fputs("</b> &middot; data <b>", f);
     put_str(r, data);
     fputs("</b> &middot; method <b>", f);
@@ -859,6 +905,7 @@ static void page_head(rep *r, size_t n_warn)
 static void sec_data(rep *r, const dfile *df, size_t n_df)
 {
     FILE *f = r->f;
+    section(r, "section 1 (data)", NULL);
     fputs("<div class=\"two\"><section id=\"data\"><h2>1. Data</h2>\n<table class=\"kv\">\n", f);
     kv(r, "data file");
     put_str(r, jstr(r->cal, "data"));
@@ -867,6 +914,7 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
     put_num(r, jnum(r->cal, "n_train") + jnum(r->cal, "n_test"), "%.0f");
     kv_end(r);
     kv(r, "set-up groups");
+    r->how = HOW_DIAG; /* the rows up to the files come from a diagnosis when the calibration has none */
     if (isfinite(jnum(r->unc, "groups")) && jnum(r->unc, "groups") > 0) {
         put_num(r, jnum(r->unc, "groups"), "%.0f");
         fputs(" (the covariance's clusters, from the ", f);
@@ -915,6 +963,7 @@ static void sec_data(rep *r, const dfile *df, size_t n_df)
         fputs(")", f);
     }
     kv_end(r);
+    r->how = NULL;
     for (size_t i = 0; i < n_df; ++i) {
         kv(r, "file, SHA-256");
         fputs("<span class=\"mono\">", f);
@@ -945,6 +994,7 @@ static void sec_split(rep *r)
 {
     FILE *f = r->f;
     const double ntr = jnum(r->cal, "n_train"), nte = jnum(r->cal, "n_test");
+    section(r, "section 2 (split)", NULL);
     fputs("<section id=\"split\"><h2>2. Split</h2>\n<table class=\"kv\">\n", f);
     kv(r, "training samples");
     put_num(r, ntr, "%.0f");
@@ -988,6 +1038,7 @@ static void sec_metrics(rep *r)
 {
     FILE *f = r->f;
     const int held = jbool(r->cal, "held_out") != 0;
+    section(r, "section 3 (before and after)", NULL);
     fputs("<section id=\"metrics\"><h2>3. Before and after calibration</h2>\n<div class=\"row\"><div style=\"flex:1 1 500px\">\n"
           "<table><tr><th class=\"l\">cable-length residual (mm)</th><th>samples</th><th>RMSE</th>"
           "<th>mean |e|</th><th>SD</th><th>mean</th><th>MAX</th></tr>\n",
@@ -1131,7 +1182,8 @@ static void params_table(rep *r, const prow *p, size_t n)
     if (!have_se || !have_cls) {
         fprintf(f, "<p class=\"note\" style=\"max-width:520px\">%s%s%s: " NA ".</p>\n", have_se ? "" : "standard errors and 95 % intervals",
                 !have_se && !have_cls ? ", " : "", have_cls ? "" : "identifiability class of each parameter");
-        r->res->n_missing++;
+        missing(r, !have_se ? "standard errors and 95 % intervals of the parameters"
+                            : "the identifiability class of each parameter", HOW_MODEL);
     }
 }
 
@@ -1235,6 +1287,7 @@ static void ident_block(rep *r)
 static void sec_params(rep *r, const prow *p, size_t n)
 {
     FILE *f = r->f;
+    section(r, "section 4 (parameters)", NULL);
     fputs("<section id=\"params\"><h2>4. Identified parameters</h2>\n<p>solver ", f);
     put_str(r, jstr(r->cal, "method"));
     fputs(": ", f);
@@ -1402,8 +1455,10 @@ static void structure_table(rep *r)
 static void sec_diag(rep *r, const crow *c, size_t n)
 {
     FILE *f = r->f;
+    section(r, "section 5 (diagnosis)", NULL);
     fputs("<section id=\"diagnosis\"><h2>5. Diagnosis: what the model misses</h2>\n", f);
     if (!r->diag) {
+        section(r, "the diagnosis", HOW_DIAG);
         fputs("<p>", f);
         put_str(r, NULL);
         fputs(": no diagnosis was given (run <code>rcal diagnose --data FILE --json</code> and pass its output "
@@ -1522,6 +1577,7 @@ static void accuracy_chart(rep *r, const arow *a, size_t n)
 static void sec_accuracy(rep *r, const arow *a, size_t n)
 {
     FILE *f = r->f;
+    section(r, "section 6 (predicted accuracy)", NULL);
     fputs("<section id=\"accuracy\"><h2>6. Predicted accuracy over the workspace</h2>\n<table class=\"kv\">\n", f);
     kv(r, "flange position, 95 %");
     fputs("inside the data &plusmn;", f);
@@ -1558,7 +1614,7 @@ static void sec_accuracy(rep *r, const arow *a, size_t n)
         put_num(r, jnum(t, "after_max_mm"), "%.4f mm");
     } else {
         fputs(NA " (only a simulation has a truth: <code>rcal calibrate --truth</code>)", f);
-        r->res->n_missing++;
+        missing(r, "the comparison against a simulated truth", HOW_TRUTH);
     }
     kv_end(r);
     fputs("</table>\n", f);
@@ -1604,6 +1660,7 @@ static void input_row(rep *r, const char *what, const char *path, const rch_json
 static void sec_provenance(rep *r, const dfile *df, size_t n_df, const char *date)
 {
     FILE *f = r->f;
+    section(r, "section 8 (provenance)", NULL);
     fputs("<section id=\"provenance\"><h2>8. Provenance</h2>\n<table class=\"kv\">\n", f);
     kv(r, "tool version");
     put_str(r, prov_str(r, "tool"));

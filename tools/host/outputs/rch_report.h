@@ -42,6 +42,7 @@
 
 #define RCH_REPORT_MAX_CSV 4
 #define RCH_REPORT_MAX_WARN 32
+#define RCH_REPORT_MAX_MISSING 24
 
 typedef struct {
     const char *cal_path;     /* output of rcal calibrate --json (required) */
@@ -60,6 +61,11 @@ typedef struct {
     unsigned n_plots;                   /* inline SVG charts in the page */
     unsigned n_warnings;                /* entries in the warnings section */
     unsigned n_missing;                 /* places that say "not in this run" */
+    struct {
+        char what[96]; /* what is missing ("noise floor", "the comparison against a simulated truth") */
+        char how[160]; /* how a run gets it ("a diagnosis: ..."), "" when the calibration output has none */
+    } missing[RCH_REPORT_MAX_MISSING]; /* each distinct one, in page order */
+    unsigned n_missing_items;
 } rch_report_result;
 
 /* Read the inputs named in cfg, write the HTML page and its CSV files.
