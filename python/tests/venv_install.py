@@ -15,7 +15,10 @@ python_venv_install).
    package;
 3. from outside the source tree, the installed package must load its own
    library, report __version__, and pass session_check.py (calibrate,
-   diagnose, compensate equal to the CLI).
+   diagnose, compensate equal to the CLI);
+4. the wheel of the same source installed into a virtual environment with
+   nothing in it (no system site packages: no numpy, setuptools, wheel), and
+   session_check.py --demo-only there.
 --demo-only (the sanitizer build, whose CLI is 20 times slower) checks the
 demo data only. Exit 77 (ctest: skipped) with the reason when venv or pip
 is unavailable.
@@ -31,6 +34,43 @@ import time
 def skip(why):
     print("python_venv_install: SKIPPED: " + why)
     sys.exit(77)
+
+
+def clean_wheel(py, src, tmp, env, rcal_bin, root):
+    """4. The wheel (pip wheel, as the python_wheel target builds it) into a
+    virtual environment with nothing in it: no system site packages, so no
+    numpy, setuptools or wheel; the demo session must still equal the CLI."""
+    dist = os.path.join(tmp, "dist")
+    t0 = time.time()
+    p = subprocess.run([py, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps", "--no-index", "-w", dist, src],
+                       cwd=tmp, env=env, capture_output=True, text=True)
+    wheels = [f for f in os.listdir(dist) if f.endswith(".whl")] if os.path.isdir(dist) else []
+    if p.returncode != 0 or len(wheels) != 1:
+        print(p.stdout[-4000:], p.stderr[-4000:])
+        print("python_venv_install: FAILED: pip wheel ./python")
+        return 1
+    clean = os.path.join(tmp, "clean")
+    p = subprocess.run([sys.executable, "-m", "venv", clean], capture_output=True, text=True)
+    if p.returncode != 0:
+        print("python_venv_install: FAILED: python3 -m venv (no system site packages): " + p.stderr.strip())
+        return 1
+    cpy = os.path.join(clean, "bin", "python")
+    bare = subprocess.run([cpy, "-c", "import importlib.util as u; print([m for m in ('numpy', 'wheel') "
+                                      "if u.find_spec(m)])"], capture_output=True, text=True).stdout.strip()
+    p = subprocess.run([cpy, "-m", "pip", "install", "--no-deps", "--no-index", os.path.join(dist, wheels[0])],
+                       cwd=tmp, env=env, capture_output=True, text=True)
+    t1 = time.time()
+    if p.returncode != 0:
+        print(p.stdout[-4000:], p.stderr[-4000:])
+        print("python_venv_install: FAILED: pip install of the wheel into a clean environment")
+        return 1
+    print("clean environment (importable of numpy, wheel: %s): %s installed in %.1f s (wheel build included)" % (
+        bare, wheels[0], t1 - t0))
+    p = subprocess.run([cpy, os.path.join(root, "python", "tests", "session_check.py"), rcal_bin, root,
+                        os.path.join(tmp, "work_clean"), "--demo-only"], cwd=tmp, env=env, capture_output=True,
+                       text=True)
+    print(p.stdout + p.stderr)
+    return p.returncode
 
 
 def main(argv):
@@ -81,8 +121,12 @@ def main(argv):
         p = subprocess.run([py, os.path.join(root, "python", "tests", "session_check.py"), rcal_bin, root,
                             os.path.join(tmp, "work")] + argv[3:], cwd=tmp, env=env, capture_output=True, text=True)
         print(p.stdout + p.stderr)
-        print("python_venv_install: %s in %.1f s" % ("passed" if p.returncode == 0 else "FAILED", time.time() - t0))
-        return p.returncode
+        if p.returncode != 0:
+            print("python_venv_install: FAILED in %.1f s" % (time.time() - t0))
+            return p.returncode
+        rc = clean_wheel(py, src, tmp, env, rcal_bin, root)
+        print("python_venv_install: %s in %.1f s" % ("passed" if rc == 0 else "FAILED", time.time() - t0))
+        return rc
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
