@@ -323,6 +323,52 @@ static void test_failure_reported_truthfully(void **state)
         fail_msg("warning says %.4f mm, the written target is %.4f mm off", said, gap);
 }
 
+/* u95_mm of a target whose compensation did not converge is what the robot
+ * then misses by: the posterior's radius plus the distance the warning names
+ * (not the radius alone, as if it had been compensated). The demo model
+ * (a posterior) with --max-dev-deg 0.001: every target stops short. */
+static void test_u95_of_unconverged(void **state)
+{
+    (void)state;
+    char mp[160], in[160], out[160], u_ok[160], u_bad[160], err[160], cmd[1200];
+    snprintf(mp, sizeof mp, "%s/demo_model.json", dir);
+    snprintf(in, sizeof in, "%s/u95_targets.csv", dir);
+    snprintf(out, sizeof out, "%s/u95_out.csv", dir);
+    snprintf(u_ok, sizeof u_ok, "%s/u95_ok.csv", dir);
+    snprintf(u_bad, sizeof u_bad, "%s/u95_bad.csv", dir);
+    snprintf(err, sizeof err, "%s/u95_err.txt", dir);
+    snprintf(cmd, sizeof cmd, "'%s' calibrate --data '%s/data/sim_irb120.csv' --out '%s' > /dev/null", RCAL,
+             RCAL_SOURCE_DIR, mp);
+    assert_int_equal(run(cmd), 0);
+    write_file(in, "10,20,30,40,50,50\n-30,40,10,20,-50,90\n");
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' --uncertainty-out '%s'", RCAL, mp, in,
+             out, u_ok);
+    assert_int_equal(run(cmd), 0);
+    snprintf(cmd, sizeof cmd,
+             "'%s' compensate --model '%s' --in '%s' --out '%s' --uncertainty-out '%s' --max-dev-deg 0.001 2> '%s'",
+             RCAL, mp, in, out, u_bad, err);
+    assert_int_equal(run(cmd), 1);
+    double ok[2], bad[2], miss[2];
+    unsigned ln;
+    FILE *f = fopen(u_ok, "r"), *g = fopen(u_bad, "r");
+    assert_non_null(f);
+    assert_non_null(g);
+    assert_int_equal(fscanf(f, "line,u95_mm %u,%lf %u,%lf", &ln, &ok[0], &ln, &ok[1]), 4);
+    assert_int_equal(fscanf(g, "line,u95_mm %u,%lf %u,%lf", &ln, &bad[0], &ln, &bad[1]), 4);
+    fclose(f);
+    fclose(g);
+    const char *msg = read_file(err), *at = msg;
+    for (int k = 0; k < 2; ++k) {
+        at = strstr(at, "correction, ");
+        assert_non_null(at);
+        assert_int_equal(sscanf(at, "correction, %lf mm", &miss[k]), 1);
+        at += 12;
+        assert_true(ok[k] > 0.0 && ok[k] < 0.05 && miss[k] > 0.1);
+        if (fabs(bad[k] - (ok[k] + miss[k])) > 1e-4)
+            fail_msg("target %d: u95 %.6f mm, expected %.6f + %.4f", k + 1, bad[k], ok[k], miss[k]);
+    }
+}
+
 /* The host library in-process: rch_comp_lines on a CSV with a header. */
 static void test_lines_in_process(void **state)
 {
@@ -441,6 +487,7 @@ int main(void)
         cmocka_unit_test(test_failure_reported_truthfully),
         cmocka_unit_test(test_lines_in_process),
         cmocka_unit_test(test_robtargets_corrected),
+        cmocka_unit_test(test_u95_of_unconverged),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

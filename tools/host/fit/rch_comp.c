@@ -89,6 +89,22 @@ static int parse_num(double *v, const char *text, size_t len)
     return rch_parse_double(buf, v);
 }
 
+double rch_comp_u95_written(double u95_mm, int status, double miss_mm)
+{
+    if (status == 3)
+        return NAN;
+    if (status == 2)
+        return u95_mm + (miss_mm > 0.0 ? miss_mm : 0.0);
+    return u95_mm;
+}
+
+/* One line of --uncertainty-out (when asked for and the model has a posterior). */
+static void u95_line(const comp_ctx *c, unsigned line, double u95_mm)
+{
+    if (c->gate && c->gate->u95_out && c->gate->unc && c->gate->unc->present)
+        fprintf(c->gate->u95_out, "%u,%.6f\n", line, u95_mm);
+}
+
 /* Compensate one target (degrees in, degrees out). 0 ok, 1 not converged
  * (output still written), -1 range error (d set). cols: (6) columns of the
  * fields for diagnostics. */
@@ -105,6 +121,7 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
             return -1;
         }
     }
+    double u95_at = NAN; /* the posterior's radius at the target, when the model has one */
     if (c->gate) {
         double qd[RC_NJ], pf[3], pd[3];
         for (unsigned i = 0; i < RC_NJ; ++i)
@@ -120,8 +137,7 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
         if (c->gate->unc && c->gate->unc->present) {
             double u95 = c->gate->unc->has_prior ? rch_model_unc_radius95_mm(c->gate->unc, m, qd)
                                                  : rch_model_unc_pos95_mm(c->gate->unc, m, qd);
-            if (c->gate->u95_out)
-                fprintf(c->gate->u95_out, "%u,%.6f\n", line, u95);
+            u95_at = u95;
             /* A posterior (MAP) model: compensation never makes the expected
              * error larger than the uncompensated target's (the posterior is
              * never wider than the prior the nominal model stands for), so
@@ -131,6 +147,7 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
             if (!(u95 <= lim)) {
                 for (unsigned i = 0; i < RC_NJ; ++i)
                     out_deg[i] = in_deg[i];
+                u95_line(c, line, rch_comp_u95_written(u95, 3, 0.0));
                 c->res->n_uncertain++;
                 if (c->warn)
                     fprintf(c->warn,
@@ -157,8 +174,10 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
     if (st == RC_OK) {
         if (res.exit == RC_COMP_POSITION_ONLY)
             r->n_pos_only++;
+        u95_line(c, line, rch_comp_u95_written(u95_at, res.exit == RC_COMP_POSITION_ONLY, 0.0));
         return 0;
     }
+    u95_line(c, line, rch_comp_u95_written(u95_at, 2, (double)res.pos_err_mm));
     r->n_fail++;
     if ((double)res.pos_err_mm > r->max_fail_err_mm)
         r->max_fail_err_mm = (double)res.pos_err_mm;

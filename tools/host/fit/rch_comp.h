@@ -98,6 +98,17 @@ typedef struct rch_comp_gate {
     const double *tool_mm;     /* (3) the TCP the robtargets are poses of, in the flange frame; NULL: tool0 */
 } rch_comp_gate;
 
+/* What u95_mm says of one target, by how its compensation ended (status: 0
+ * converged, 1 position matched with the orientation best effort, 2 not
+ * converged, 3 left uncompensated for its uncertainty): the posterior's 95 %
+ * radius u95_mm at the target where its position was matched; for 2, u95_mm
+ * plus miss_mm, the distance by which the written joints miss the intended
+ * point on the calibrated model (what the robot then misses by, to 95 %);
+ * for 3 NaN (the robot goes to the program's own joints: the calibrated
+ * model's radius there says nothing of that error). The one rule of the
+ * command's --uncertainty-out and of the Python package. */
+double rch_comp_u95_written(double u95_mm, int status, double miss_mm);
+
 typedef struct rch_comp_result {
     rch_comp_format format;       /* the form read (detected or forced) */
     unsigned long n;              /* targets compensated */

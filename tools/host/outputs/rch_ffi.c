@@ -1000,21 +1000,24 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
         const double u95 = !gate ? NAN
                            : gate->has_prior ? rch_model_unc_radius95_mm(gate, m, qd)
                                              : rch_model_unc_pos95_mm(gate, m, qd);
-        if (u95_mm)
-            u95_mm[i] = u95;
         if (gate && !(u95 <= lim)) {
             for (unsigned j = 0; j < RC_NJ; ++j)
                 out_deg[RC_NJ * i + j] = in[j]; /* left uncompensated: uncertainty above the limit */
             if (status)
                 status[i] = 3;
+            if (u95_mm)
+                u95_mm[i] = rch_comp_u95_written(u95, 3, 0.0);
             continue;
         }
         rc_comp_result res;
         const rc_status st = rc_comp_stream_step(&cs->s, qc, &res, q);
         for (unsigned j = 0; j < RC_NJ; ++j)
             out_deg[RC_NJ * i + j] = (double)qc[j] / DEG;
+        const int how = st != RC_OK ? 2 : res.exit == RC_COMP_POSITION_ONLY ? 1 : 0;
         if (status)
-            status[i] = st != RC_OK ? 2 : res.exit == RC_COMP_POSITION_ONLY ? 1 : 0;
+            status[i] = how;
+        if (u95_mm)
+            u95_mm[i] = rch_comp_u95_written(u95, how, (double)res.pos_err_mm);
     }
     free(cs);
     return rc;
