@@ -152,10 +152,19 @@ def kabsch(P, Q):
 
 def gauge_align(P, Q):
     """Rz(phi) P + (0, 0, tz) closest to Q: the base heading and height, which
-    lengths from one outlet cannot see (rcal holds them nominal)."""
-    tz = np.mean(Q[:, 2] - P[:, 2])
-    phi = np.arctan2(np.sum(P[:, 0] * Q[:, 1] - P[:, 1] * Q[:, 0]), np.sum(P[:, 0] * Q[:, 0] + P[:, 1] * Q[:, 1]))
-    return P @ rot("z", phi).T + np.array([0.0, 0.0, tz])
+    lengths from one outlet cannot see (rcal holds them nominal). Fitted on
+    all points, then again without those more than 10 times the median
+    distance off (a target compensate could not correct, 28 mm off, would
+    otherwise tilt the gauge for all the others); every point is returned."""
+    keep = np.ones(len(P), dtype=bool)
+    for _ in range(2):
+        A, B = P[keep], Q[keep]
+        tz = np.mean(B[:, 2] - A[:, 2])
+        phi = np.arctan2(np.sum(A[:, 0] * B[:, 1] - A[:, 1] * B[:, 0]), np.sum(A[:, 0] * B[:, 0] + A[:, 1] * B[:, 1]))
+        R = P @ rot("z", phi).T + np.array([0.0, 0.0, tz])
+        d = np.linalg.norm(R - Q, axis=1)
+        keep = d <= 10.0 * max(np.median(d), 1e-9)
+    return R
 
 
 def pair_err(landed, meant, rng, n_pairs=20000):
