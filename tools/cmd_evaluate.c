@@ -86,7 +86,8 @@ static int evaluate_positions(const char *model_path, const char *pos_path, int 
     return rc != 0;
 }
 
-static int report_json(const rch_evaluate_result *r, const char *model, const char *data, int argc, char **argv)
+static int report_json(const rch_evaluate_result *r, const rch_robot *robot, const char *model, const char *data,
+                       int argc, char **argv)
 {
     rch_jw w;
     rch_jw_begin(&w, stdout, 1, "rcal-evaluate/1", argc, argv);
@@ -110,6 +111,17 @@ static int report_json(const rch_evaluate_result *r, const char *model, const ch
     rch_jw_num(&w, "ad_max_mm", r->ad_max_mm);
     rch_jw_num(&w, "rd_mean_mm", r->rd_mean_mm);
     rch_jw_num(&w, "rd_max_mm", r->rd_max_mm);
+    rch_jw_end(&w);
+    /* the text's jumps note: fitted as nuisance of the calibration's
+     * acquisition, never applied here */
+    rch_jw_obj(&w, "calibration_jumps");
+    rch_jw_uint(&w, "n", robot->n_cal_jumps);
+    if (robot->n_cal_jumps)
+        rch_jw_num(&w, "max_mm", robot->cal_jump_max_mm);
+    else
+        rch_jw_null(&w, "max_mm");
+    rch_jw_bool(&w, "applied", 0);
+    rch_jw_bool(&w, "data_is_calibration_file", robot->cal_data[0] && rch_path_same(data, robot->cal_data));
     rch_jw_end(&w);
     rch_jw_end(&w);
     return rch_jw_finish(&w);
@@ -218,7 +230,7 @@ int rcal_cmd_evaluate(int argc, char **argv)
     if (rc != 0)
         return 1;
     if (json)
-        rc = report_json(&r, model_path, data_path, argc, argv) != 0;
+        rc = report_json(&r, &robot, model_path, data_path, argc, argv) != 0;
     else {
         report_text(&r, model_path, data_path);
         jumps_note(&robot, data_path);

@@ -148,6 +148,13 @@ static void test_jumps_said(void **state)
     if (!strstr(text, note) || !strstr(text, "on another file the RMSE holds that file's own jumps"))
         fail_msg("%s", text);
     free(text);
+    snprintf(cmd, sizeof cmd, "'%s' evaluate --model '%s' --data '%s' --json", RCAL, model, jump);
+    text = run_out(cmd);
+    const char *cj = strstr(text, "\"calibration_jumps\"");
+    if (!cj || !strstr(cj, "\"n\": 1") || !strstr(cj, "\"applied\": false") ||
+        !strstr(cj, "\"data_is_calibration_file\": true") || !strstr(cj, "\"max_mm\": 4.99"))
+        fail_msg("%s", text);
+    free(text);
     /* a model without jumps says nothing of them */
     snprintf(cmd, sizeof cmd, "'%s' evaluate --model '%s' --data '%s'", RCAL, RCAL_SOURCE_DIR "/data/irb120.json",
              jump);
