@@ -340,7 +340,8 @@ static void test_refused(void **state)
         "[[6 robot axes],[6 external axes]]; this aggregate is [[5],[6]]",
         "bad_targets.mod:6:26: error: robtarget pConf (declaration) cannot be corrected: the solution with cfx = 0 "
         "has axis 1 outside the quadrant cf1 = 2 (axis 1 at 10.0000 deg: cf1 = 0); solutions exist with "
-        "[cf1,cf4,cf6,cfx] = [0,0,0,0], [0,-2,-2,1] (write one of them as the robtarget's confdata)",
+        "[cf1,cf4,cf6,cfx] = [0,0,0,0], [0,-2,-2,1], [0,0,-4,0], [0,-2,2,1] (write one of them as the robtarget's "
+        "confdata)", /* axis 6 spans +-400 deg: 60 deg is also -300 (cf6 = -4), -120 also 240 (cf6 = 2) */
         "bad_targets.mod:7:29: error: jointtarget jLimit (declaration) cannot be corrected: q3 = 100 deg is outside",
         "bad_targets.mod:8:26: error: robtarget pWobj (declaration) cannot be corrected: used in work object wobjTable "
         "(line 11)",
@@ -382,7 +383,7 @@ static void test_refused_names_confdata(void **state)
     char *msg = slurp(err, &n);
     const char *want = "conf.mod:3:11: error: robtarget (inline) cannot be corrected: the solution with cfx = 0 has "
                        "axis 6 outside the quadrant cf6 = 0 (axis 6 at -8.1301 deg: cf6 = -1); solutions exist with "
-                       "[cf1,cf4,cf6,cfx] = [-1,0,-1,0]";
+                       "[cf1,cf4,cf6,cfx] = [-1,0,-1,0], [-1,0,-5,0], [-1,0,3,0] (write";
     const char *at = strstr(msg, want);
     if (!at)
         fail_msg("expected '%s' in:\n%s", want, msg);
@@ -398,6 +399,22 @@ static void test_refused_names_confdata(void **state)
     fclose(f);
     assert_int_equal(run(cmd), 0);
     assert_int_equal(access(out, F_OK), 0);
+    /* the whole turns of axis 6 it names are accepted too */
+    static const char *const turned[] = {"-1,0,-5,0", "-1,0,3,0"}, *const kept[] = {",-5,0],[9E9", ",3,0],[9E9"};
+    for (size_t k = 0; k < 2; ++k) {
+        assert_int_equal(remove(out), 0);
+        f = fopen(in, "w");
+        assert_non_null(f);
+        fprintf(f, mod, turned[k]);
+        fclose(f);
+        assert_int_equal(run(cmd), 0);
+        char *w = slurp(out, &n);
+        /* axis 4 is near 0 here: the corrected joints' cf4 may differ,
+         * the turn of axis 6 may not */
+        if (!strstr(w, kept[k]))
+            fail_msg("confdata [%s]: axis 6's turn not kept in:\n%s", turned[k], w);
+        free(w);
+    }
 }
 
 /* A tool the module declares: without --tool the message gives the --tool

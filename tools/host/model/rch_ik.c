@@ -354,28 +354,41 @@ static int to_quadrant(double *q, int cf)
 }
 
 /* Appends to why the confdata [cf1,cf4,cf6,cfx] of the pose's solutions
- * within m's joint limits (each axis in (-180, 180] deg), those with cfx
+ * within m's joint limits, whole turns of axes 1, 4 and 6 included (an
+ * IRB120's axis 6 spans +-400 deg: cf6 = 2 or -3 are real), those with cfx
  * first, so that a refused target names what would be accepted. */
 static void append_solutions(char *why, size_t why_len, const rc_model *m, const double pos_mm[3],
                              const double quat[4], const double *tool_mm, int cfx)
 {
+    enum { MAX_LISTED = 16 };
+    static const int turned[3] = {0, 3, 5};
     double sol[8][RC_NJ];
     const int n = rch_ik_all(sol, m, pos_mm, quat, tool_mm);
-    int got[8][4], n_got = 0;
-    for (int pass = 0; pass < 2; ++pass)
-        for (int k = 0; k < n; ++k) {
-            int c[4], j, dup = 0;
-            rch_ik_confdata(c, m, sol[k]);
-            if ((c[3] == cfx) != (pass == 0))
-                continue;
-            for (j = 0; j < RC_NJ; ++j)
-                if (sol[k][j] < m->q_min_rad[j] - 1e-12 || sol[k][j] > m->q_max_rad[j] + 1e-12)
-                    break;
-            for (int i = 0; i < n_got; ++i)
-                dup |= memcmp(got[i], c, sizeof c) == 0;
-            if (j == RC_NJ && !dup)
-                memcpy(got[n_got++], c, sizeof c);
-        }
+    int got[MAX_LISTED][4], n_got = 0;
+    static const int turns[5] = {0, -1, 1, -2, 2};
+    /* the solutions as solved first (axes in (-180, 180] deg), then their
+     * whole turns; within each, those with cfx first */
+    for (int pass = 0; pass < 4; ++pass)
+        for (int k = 0; k < n; ++k)
+            for (int t = pass < 2 ? 0 : 1; t < (pass < 2 ? 1 : 125) && n_got < MAX_LISTED; ++t) {
+                double q[RC_NJ];
+                int c[4], j, dup = 0;
+                memcpy(q, sol[k], sizeof q);
+                for (int a = 0, rest = t; a < 3; ++a, rest /= 5)
+                    q[turned[a]] += 2.0 * M_PI * (double)turns[rest % 5];
+                for (j = 0; j < RC_NJ; ++j)
+                    if (q[j] < m->q_min_rad[j] - 1e-12 || q[j] > m->q_max_rad[j] + 1e-12)
+                        break;
+                if (j < RC_NJ)
+                    continue;
+                rch_ik_confdata(c, m, q);
+                if ((c[3] == cfx) != (pass % 2 == 0))
+                    continue;
+                for (int i = 0; i < n_got; ++i)
+                    dup |= memcmp(got[i], c, sizeof c) == 0;
+                if (!dup)
+                    memcpy(got[n_got++], c, sizeof c);
+            }
     size_t at = strlen(why);
     if (at + 1 >= why_len)
         return;
