@@ -85,8 +85,10 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
     return rc;
 }
 
-static int report(rch_diagnose_result *r, const char *plots, const char *const inputs[2], int json, int argc,
-                  char **argv)
+/* inputs: the data and the robot file; robot_given: --robot was on the
+ * command line (then the next step names it) */
+static int report(rch_diagnose_result *r, const char *plots, const char *const inputs[2], int robot_given, int json,
+                  int argc, char **argv)
 {
     rch_diag d;
     char msg[1024], paths[4096] = "";
@@ -99,7 +101,7 @@ static int report(rch_diagnose_result *r, const char *plots, const char *const i
     if (rch_diagnose_print(stdout, r) != 0)
         return 1;
     char next[1200];
-    if (rch_diagnose_next(next, sizeof next, r, inputs[0]) == 0)
+    if (rch_diagnose_next(next, sizeof next, r, inputs[0], robot_given ? inputs[1] : NULL) == 0)
         printf("\nNext: %s\n", next);
     if (plots)
         printf("\nPlots:\n%s", paths);
@@ -108,8 +110,9 @@ static int report(rch_diagnose_result *r, const char *plots, const char *const i
 
 int rcal_cmd_diagnose(int argc, char **argv)
 {
-    const char *data_path = NULL, *robot_path = RCAL_DEFAULT_ROBOT, *plots = NULL, *out_path = NULL,
-               *resid = NULL, *report_path = NULL;
+    const char *const default_robot = RCAL_DEFAULT_ROBOT;
+    const char *data_path = NULL, *robot_path = default_robot, *plots = NULL, *out_path = NULL, *resid = NULL,
+               *report_path = NULL;
     unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0, verbosity = 0;
     int json = 0, verbose = 0;
     rch_diagnose_cfg cfg;
@@ -174,7 +177,7 @@ int rcal_cmd_diagnose(int argc, char **argv)
         return 1;
     }
     const char *inputs[2] = {data_path, robot_path};
-    int rc = report(&r, plots, inputs, json, argc, argv);
+    int rc = report(&r, plots, inputs, robot_path != default_robot, json, argc, argv);
     if (rc == 0 && out_path) {
         if (rch_diagnose_save_model(&r, data_path, robot_path, out_path, inputs, 2, &d) != 0) {
             fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));

@@ -13,6 +13,7 @@
 #include "rch_opt.h"
 #include "rch_report.h"
 #include "rch_save.h"
+#include "rch_text.h"
 
 #define RCAL_REPORT_MAX_INPUTS 64 /* input files a run may name (several --data, robot, validate) */
 
@@ -207,7 +208,7 @@ int rcal_cmd_report(int argc, char **argv)
     if (st >= 0)
         return st;
     char args[4000], cmdline[4096];
-    snprintf(cmdline, sizeof cmdline, "rcal %s", rch_report_cmdline(args, sizeof args, argc, argv));
+    snprintf(cmdline, sizeof cmdline, "rcal %s", rch_shell_join(args, sizeof args, argc, (const char *const *)argv));
     cfg.command_line = cmdline;
     rch_report_result res;
     rch_diag d;

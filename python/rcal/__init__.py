@@ -548,7 +548,7 @@ class Diagnosis:
                 "rmse_before_mm", "rmse_after_mm", "noise_est_mm", "n_jumps", "rmse_jumps_mm", "dequant_corrected",
                 "dequant_refused", "effect_rms_mm", "q_step_deg", "len_step_mm", "time_ms")
 
-    def __init__(self, handle, data):
+    def __init__(self, handle, data, robot_given=False):
         lib = _lib.lib()
         self._h = ctypes.c_void_p(handle)
         self._free = lib.rch_ffi_diag_free
@@ -576,7 +576,8 @@ class Diagnosis:
             _check(lib.rch_ffi_diag_param(self._h, k, name, 64, ctypes.byref(v), ctypes.byref(se), unit, 16))
             self.params.append(DiagParam(name.value.decode(), v.value, se.value, unit.value.decode()))
         buf = ctypes.create_string_buffer(4096)
-        self.next_command = buf.value.decode() if lib.rch_ffi_diag_next(self._h, buf, 4096) == 0 else None
+        self.next_command = (buf.value.decode() if lib.rch_ffi_diag_next(self._h, 1 if robot_given else 0, buf, 4096)
+                             == 0 else None)
         args = self.next_command.split() if self.next_command else []
         self.jumps = "--jumps" in args
         self.dequantize = "--dequantize-joints" in args
@@ -630,6 +631,7 @@ def diagnose(data, robot=None, seed=1, folds=5, steps=3, jumps=True, dequantize=
     --q-step-deg, --len-step-mm (0: detected, < 0: none), --len-noise-mm,
     --alpha (0: 0.01), --max-iter (0: 100). Returns a Diagnosis."""
     lib = _lib.lib()
+    robot_given = robot is not None
     robot = default_robot() if robot is None else robot
     h = ctypes.c_void_p()
     err = ctypes.create_string_buffer(_ERR_LEN)
@@ -637,7 +639,7 @@ def diagnose(data, robot=None, seed=1, folds=5, steps=3, jumps=True, dequantize=
     _check(lib.rch_ffi_diagnose(ctypes.byref(h), _path(data), _path(robot), int(seed), int(folds), int(steps), flags,
                                 float(q_step_deg), float(len_step_mm), float(len_noise_mm), float(alpha),
                                 int(max_iter), err, _ERR_LEN), err)
-    return Diagnosis(h.value, os.fspath(data))
+    return Diagnosis(h.value, os.fspath(data), robot_given)
 
 
 Evaluation = collections.namedtuple("Evaluation", "metrics encoder_refitted encoder_mm encoder_shift_mm poses "

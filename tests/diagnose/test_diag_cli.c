@@ -130,6 +130,54 @@ static void test_usage_errors(void **state)
     assert_true(WIFEXITED(st) && WEXITSTATUS(st) == 1);
 }
 
+/* The next step names the user's robot file (--robot given), quoted for
+ * the shell, and runs as printed: the demo file against a copy of the
+ * nominal robot under a name with a blank. */
+static void test_next_names_robot(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/rcal_diag_next_XXXXXX", robot[128], out[160], cmd[2048];
+    assert_non_null(mkdtemp(dir));
+    snprintf(robot, sizeof robot, "%s/my robot.json", dir);
+    snprintf(out, sizeof out, "%s/next.txt", dir);
+    snprintf(cmd, sizeof cmd, "cp '%s/data/irb120.json' '%s'", RCAL_SOURCE_DIR, robot);
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "cd '%s' && %s diagnose --data '%s/data/sim_irb120.csv' --robot 'my robot.json' "
+             "--folds 3 --steps 1 > next.txt", dir, RCAL, RCAL_SOURCE_DIR);
+    assert_int_equal(system(cmd), 0);
+    FILE *f = fopen(out, "r");
+    assert_non_null(f);
+    char line[1024], next[1024] = "";
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, "Next: rcal ", 11) == 0)
+            snprintf(next, sizeof next, "%s", line + 11);
+    fclose(f);
+    char want[512];
+    snprintf(want, sizeof want, "calibrate --data %s/data/sim_irb120.csv --robot 'my robot.json'", RCAL_SOURCE_DIR);
+    if (strncmp(next, want, strlen(want)) != 0)
+        fail_msg("Next: rcal %s\nexpected it to begin: rcal %s", next, want);
+    /* run as printed (the shell quoting included) */
+    next[strcspn(next, "\n")] = '\0';
+    snprintf(cmd, sizeof cmd, "cd '%s' && %s %s > /dev/null", dir, RCAL, next);
+    assert_int_equal(system(cmd), 0);
+    snprintf(line, sizeof line, "%s/model.json", dir);
+    assert_int_equal(access(line, F_OK), 0);
+    /* without --robot the default robot is not named */
+    snprintf(cmd, sizeof cmd, "%s diagnose --data '%s/data/sim_irb120.csv' --folds 3 --steps 1 > '%s'", RCAL,
+             RCAL_SOURCE_DIR, out);
+    assert_int_equal(system(cmd), 0);
+    f = fopen(out, "r");
+    assert_non_null(f);
+    int named = -1;
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, "Next: rcal ", 11) == 0)
+            named = strstr(line, "--robot") != NULL;
+    fclose(f);
+    assert_int_equal(named, 0);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 /* The real data: geometry leaves a held-out gap of several times the floor,
  * with strong group structure; the workflow must name group_offset and the
  * gap must close to near the floor. One step and 3 folds to keep it short. */
@@ -196,6 +244,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_usage_errors),
         cmocka_unit_test(test_sim_csv_json),
+        cmocka_unit_test(test_next_names_robot),
         cmocka_unit_test(test_real_data),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "rch_report.h"
+#include "rch_text.h"
 
 static char dir[64];
 
@@ -188,11 +189,10 @@ static void test_cmdline(void **state)
 {
     (void)state;
     char a0[] = "report", a1[] = "--out", a2[] = "my file.html", a3[] = "it's", a4[] = "a<b", a5[] = "";
-    char *argv[] = {a0, a1, a2, a3, a4, a5};
+    const char *const argv[] = {a0, a1, a2, a3, a4, a5};
     char buf[256];
-    assert_string_equal(rch_report_cmdline(buf, sizeof buf, 6, argv),
-                        "report --out 'my file.html' 'it'\\''s' 'a<b' ''");
-    assert_string_equal(rch_report_cmdline(buf, 4, 2, argv), "rep");
+    assert_string_equal(rch_shell_join(buf, sizeof buf, 6, argv), "report --out 'my file.html' 'it'\\''s' 'a<b' ''");
+    assert_string_equal(rch_shell_join(buf, 4, 2, argv), "rep");
 }
 
 /* Every string from the JSON escaped; the members of issue 10 rendered. */

@@ -32,6 +32,7 @@
 #include "rch_report.h"
 #include "rch_robot.h"
 #include "rch_sha256.h"
+#include "rch_text.h"
 
 #define RCAL RCAL_BINARY_DIR "/tools/rcal"
 #define RCAL_RT RCAL_BINARY_DIR "/firmware_host/rcal-rt"
@@ -527,8 +528,8 @@ static void test_options_not_cut(void **state)
         char buf[64];
         char a0[] = "calibrate", a1[] = "--data",
              a2[] = "a-very-long-file-name-of-measurements-from-the-robot-cell-number-seven.csv";
-        char *argv[] = {a0, a1, a2};
-        rch_report_cmdline(buf, sizeof buf, 3, argv);
+        const char *const argv[] = {a0, a1, a2};
+        rch_shell_join(buf, sizeof buf, 3, argv);
         assert_non_null(strstr(buf, " ... (cut)"));
         assert_int_equal(strlen(buf), sizeof buf - 16 + strlen(" ... (cut)"));
     }

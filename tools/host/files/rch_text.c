@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* rch_text.c - UTF-8 check and XML escaping (see rch_text.h). */
+/* rch_text.c - UTF-8 check, XML escaping and shell quoting (see rch_text.h). */
 #include "rch_text.h"
 
+#include <stdio.h>
 #include <string.h>
 
 size_t rch_utf8_len(const unsigned char *s)
@@ -87,5 +88,37 @@ const char *rch_xml_escape(char *buf, size_t len, const char *s, unsigned flags)
         k += n;
         s += used;
     }
+    return buf;
+}
+
+/* Appends s; returns 1 when it did not fit. */
+static int cl_put(char *buf, size_t len, size_t *k, const char *s)
+{
+    while (*s && *k + 1 < len)
+        buf[(*k)++] = *s++;
+    buf[*k] = '\0';
+    return *s != '\0';
+}
+
+const char *rch_shell_join(char *buf, size_t len, int argc, const char *const *argv)
+{
+    size_t k = 0;
+    if (len == 0)
+        return buf;
+    buf[0] = '\0';
+    int cut = 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        const int quote = !*a || strpbrk(a, " \t\n'\"\\$`&|;<>()*?[]{}~!#") != NULL;
+        cut |= cl_put(buf, len, &k, i ? " " : "");
+        cut |= cl_put(buf, len, &k, quote ? "'" : "");
+        for (; *a; ++a) {
+            const char c[2] = {*a, '\0'};
+            cut |= cl_put(buf, len, &k, quote && *a == '\'' ? "'\\''" : c);
+        }
+        cut |= cl_put(buf, len, &k, quote ? "'" : "");
+    }
+    if (cut && len > 16) /* never cut silently: the end says so */
+        snprintf(buf + len - 16, 16, " ... (cut)");
     return buf;
 }

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* rch_text.h - the one UTF-8 check and the one XML/HTML escaper of the host
- * library: the JSON writer (rch_jw), the SVG charts (rch_plot), the report
- * (rch_report) and the URDF export (rch_export) all write text through these.
+/* rch_text.h - the one UTF-8 check, the one XML/HTML escaper and the one
+ * shell quoting of the host library: the JSON writer (rch_jw), the SVG
+ * charts (rch_plot), the report (rch_report), the URDF export (rch_export)
+ * and the next steps commands print all write text through these.
  *
  * Host side (prefix rch_). */
 #ifndef RCH_TEXT_H
@@ -34,5 +35,12 @@ void rch_xml_put(FILE *f, const char *s, unsigned flags);
 /* s escaped into buf (len > 0; always NUL-terminated, cut only between whole
  * characters or references). Returns buf. */
 const char *rch_xml_escape(char *buf, size_t len, const char *s, unsigned flags);
+
+/* The one shell quoting: argv (argc words) joined by blanks into buf, each
+ * word that holds a blank, a quote or a shell character single-quoted, as
+ * a user would type it (the report's command line, the next step a command
+ * prints); a line that does not fit ends in " ... (cut)", never cut
+ * silently. Returns buf. */
+const char *rch_shell_join(char *buf, size_t len, int argc, const char *const *argv);
 
 #endif

@@ -1548,8 +1548,9 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
     }
     if (outside)
         fprintf(f, "  next: %u parameter(s) OUTSIDE the prior's range are a real deviation (check the drawing) or "
-                   "stand in for an effect the model lacks: rcal diagnose --data %s%s\n",
-                outside, r->cfg.data_path ? r->cfg.data_path : "FILE", r->cfg.dequantize ? " --dequantize-joints" : "");
+                   "stand in for an effect the model lacks: rcal diagnose --data %s --robot %s%s\n",
+                outside, r->cfg.data_path ? r->cfg.data_path : "FILE", r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json",
+                r->cfg.dequantize ? " --dequantize-joints" : "");
     fprintf(f,
             "predicted 3-D accuracy after compensation (95 %%, longest semi-axis of the flange-position "
             "ellipsoid): over the sampled region +-%.4f mm (median over the data's poses; max %.4f), whole "
@@ -1678,11 +1679,13 @@ static void print_summary(FILE *f, const rch_calib_result *r)
               f);
     const unsigned outside = r->have_unc ? outside_prior(r) : 0;
     if (r->jumps_found && !r->cfg.jumps)
-        fprintf(f, "  next: rcal calibrate --data %s --jumps (the lengths jump and this fit does not model them)\n",
-                data);
+        fprintf(f, "  next: rcal calibrate --data %s --robot %s --jumps (the lengths jump and this fit does not model "
+                   "them)\n",
+                data, r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json");
     else if (outside)
-        fprintf(f, "  next: rcal diagnose --data %s%s (%u parameter%s outside the prior's range)\n", data,
-                r->cfg.dequantize ? " --dequantize-joints" : "", outside, outside == 1 ? "" : "s");
+        fprintf(f, "  next: rcal diagnose --data %s --robot %s%s (%u parameter%s outside the prior's range)\n", data,
+                r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json", r->cfg.dequantize ? " --dequantize-joints" : "",
+                outside, outside == 1 ? "" : "s");
     else if (accuracy_needs_poses(r))
         fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
                    "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",
@@ -1708,10 +1711,11 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     snprintf(all, sizeof all, steps == 1 ? "it is" : r->jumps_found == steps ? "they are" : "all %u are", steps);
     if (r->jumps_found && !r->cfg.jumps)
         fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
-                   "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --jumps (it fits "
-                   "the %u step%s found; and --dequantize-joints when the file's joints are rounded; rcal diagnose "
-                   "tells)\n\n",
-                counts, r->cfg.data_path, steps, steps == 1 ? "" : "s");
+                   "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --robot %s --jumps (it "
+                   "fits the %u step%s found; and --dequantize-joints when the file's joints are rounded; rcal "
+                   "diagnose tells)\n\n",
+                counts, r->cfg.data_path, r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json", steps,
+                steps == 1 ? "" : "s");
     if (r->jumps_auto) {
         char also[64] = "";
         if (fitted != steps)

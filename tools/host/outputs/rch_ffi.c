@@ -857,11 +857,13 @@ int rch_ffi_diag_get(const rch_ffi_diag *g, const char *name, double *value)
     return RCH_FFI_ERR_ARG;
 }
 
-int rch_ffi_diag_next(const rch_ffi_diag *g, char *buf, size_t len)
+int rch_ffi_diag_next(const rch_ffi_diag *g, int name_robot, char *buf, size_t len)
 {
     if (!g || !buf || len == 0)
         return RCH_FFI_ERR_ARG;
-    return rch_diagnose_next(buf, len, &g->r, g->data_path) == 0 ? RCH_FFI_OK : RCH_FFI_ERR_ARG;
+    return rch_diagnose_next(buf, len, &g->r, g->data_path, name_robot ? g->robot_path : NULL) == 0
+               ? RCH_FFI_OK
+               : RCH_FFI_ERR_ARG;
 }
 
 int rch_ffi_diag_residuals(const rch_ffi_diag *g, double *before_mm, double *after_mm, double *floor_mm)

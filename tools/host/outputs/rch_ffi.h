@@ -263,8 +263,10 @@ int rch_ffi_diag_param(const rch_ffi_diag *g, unsigned k, char *name, size_t len
 int rch_ffi_diag_get(const rch_ffi_diag *g, const char *name, double *value);
 /* The command that acts on the verdict ("rcal calibrate --data ... --jumps
  * --effects ... --out model.json"), what `rcal diagnose` prints after
- * "Next: " (rch_diagnose_next). */
-int rch_ffi_diag_next(const rch_ffi_diag *g, char *buf, size_t len);
+ * "Next: " (rch_diagnose_next); name_robot: 1 when the robot was the
+ * caller's (then --robot names it, as the CLI does after --robot), 0 for
+ * the default robot. */
+int rch_ffi_diag_next(const rch_ffi_diag *g, int name_robot, char *buf, size_t len);
 /* Per sample (the file's rows as used): the cross-validated held-out
  * residuals of the geometry (before) and with the chosen effects (after),
  * and the noise floor sigma, mm. Each (n) array may be NULL. */

@@ -185,38 +185,6 @@ static void csv_num(FILE *f, double v)
         fprintf(f, "%.9g", v);
 }
 
-/* Appends s; returns 1 when it did not fit. */
-static int cl_put(char *buf, size_t len, size_t *k, const char *s)
-{
-    while (*s && *k + 1 < len)
-        buf[(*k)++] = *s++;
-    buf[*k] = '\0';
-    return *s != '\0';
-}
-
-const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *argv)
-{
-    size_t k = 0;
-    if (len == 0)
-        return buf;
-    buf[0] = '\0';
-    int cut = 0;
-    for (int i = 0; i < argc; ++i) {
-        const char *a = argv[i];
-        const int quote = !*a || strpbrk(a, " \t\n'\"\\$`&|;<>()*?[]{}~!#") != NULL;
-        cut |= cl_put(buf, len, &k, i ? " " : "");
-        cut |= cl_put(buf, len, &k, quote ? "'" : "");
-        for (; *a; ++a) {
-            const char c[2] = {*a, '\0'};
-            cut |= cl_put(buf, len, &k, quote && *a == '\'' ? "'\\''" : c);
-        }
-        cut |= cl_put(buf, len, &k, quote ? "'" : "");
-    }
-    if (cut && len > 16) /* never cut silently: the end says so */
-        snprintf(buf + len - 16, 16, " ... (cut)");
-    return buf;
-}
-
 static void warnf(rep *r, const char *fmt, ...) RCH_PRINTF(2, 3);
 static void warnf(rep *r, const char *fmt, ...)
 {

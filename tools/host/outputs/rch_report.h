@@ -82,10 +82,5 @@ int rch_report_csv_path(char *buf, size_t cap, const char *page, const char *nam
  * whole characters or entities). Returns buf. */
 const char *rch_report_escape(char *buf, size_t len, const char *s);
 
-/* argv joined by blanks into buf, each argument that holds a blank, a quote
- * or a shell character single-quoted, as a user would type it; a command
- * line that does not fit ends in " ... (cut)", never cut silently. Returns
- * buf. */
-const char *rch_report_cmdline(char *buf, size_t len, int argc, char *const *argv);
 
 #endif

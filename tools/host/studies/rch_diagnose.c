@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_diagnose.c - the `rcal diagnose` workflow; see rch_diagnose.h. */
 #include "rch_diagnose.h"
+#include "rch_text.h"
 #include "rch_dequant.h"
 #include "rch_groups.h"
 #include "rch_save.h"
@@ -1693,14 +1694,33 @@ static void chosen_effects(char *list, size_t len, const rch_diagnose_result *r)
     }
 }
 
-int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path)
+int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path,
+                      const char *robot_path)
 {
     char list[512];
     chosen_effects(list, sizeof list, r);
-    const int w = snprintf(buf, len, "rcal calibrate --data %s%s%s%s%s --out model.json", data_path,
-                           strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps ? " --jumps" : "",
-                           r->dequant_corrected ? " --dequantize-joints" : "", list[0] ? " --effects " : "", list);
-    return w >= 0 && (size_t)w < len ? 0 : -1;
+    const char *argv[12];
+    int n = 0;
+    argv[n++] = "rcal";
+    argv[n++] = "calibrate";
+    argv[n++] = "--data";
+    argv[n++] = data_path;
+    if (robot_path) {
+        argv[n++] = "--robot";
+        argv[n++] = robot_path;
+    }
+    if (strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps)
+        argv[n++] = "--jumps";
+    if (r->dequant_corrected)
+        argv[n++] = "--dequantize-joints";
+    if (list[0]) {
+        argv[n++] = "--effects";
+        argv[n++] = list;
+    }
+    argv[n++] = "--out";
+    argv[n++] = "model.json";
+    rch_shell_join(buf, len, n, argv);
+    return strstr(buf, " ... (cut)") ? -1 : 0;
 }
 
 int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path,

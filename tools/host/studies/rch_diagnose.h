@@ -210,9 +210,11 @@ void rch_diagnose_free(rch_diagnose_result *r);
  * inputs). data_path: the diagnosed data; robot_path: the nominal robot.
  * 0, or -1 with d set. */
 /* The command that acts on the verdict: `rcal calibrate --data DATA` with
- * --jumps, --dequantize-joints and --effects as the diagnosis found, into
- * buf (len). 0, or -1 when it does not fit. */
-int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path);
+ * --robot ROBOT (robot_path NULL: the default robot, not named), --jumps,
+ * --dequantize-joints and --effects as the diagnosis found, into buf (len).
+ * 0, or -1 when it does not fit. */
+int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path,
+                      const char *robot_path);
 
 int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path, const char *path,
                             const char *const *inputs, size_t n_inputs, rch_diag *d);
