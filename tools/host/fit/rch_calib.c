@@ -26,6 +26,7 @@
 #include "rch_save.h"
 #include "rch_sim.h"
 #include "rch_stats.h"
+#include "rch_text.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -1486,6 +1487,19 @@ static int accuracy_needs_poses(const rch_calib_result *r)
     const double a = r->unc.map.data_median_mm;
     return r->have_unc && r->after_ok && a > 10.0 * r->after_m.rmse_mm && a > 0.1;
 }
+/* The data file and the robot file as a next-step command names them,
+ * quoted for the shell (rch_shell_join). */
+typedef struct {
+    char data[1100], robot[1100];
+} hint_paths;
+
+static void hint_paths_of(hint_paths *h, const rch_calib_result *r)
+{
+    const char *d = r->cfg.data_path ? r->cfg.data_path : "FILE", *b = r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json";
+    rch_shell_join(h->data, sizeof h->data, 1, &d);
+    rch_shell_join(h->robot, sizeof h->robot, 1, &b);
+}
+
 
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {
@@ -1546,11 +1560,12 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
             ++held;
         }
     }
+    hint_paths hp;
+    hint_paths_of(&hp, r);
     if (outside)
         fprintf(f, "  next: %u parameter(s) OUTSIDE the prior's range are a real deviation (check the drawing) or "
                    "stand in for an effect the model lacks: rcal diagnose --data %s --robot %s%s\n",
-                outside, r->cfg.data_path ? r->cfg.data_path : "FILE", r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json",
-                r->cfg.dequantize ? " --dequantize-joints" : "");
+                outside, hp.data, hp.robot, r->cfg.dequantize ? " --dequantize-joints" : "");
     fprintf(f,
             "predicted 3-D accuracy after compensation (95 %%, longest semi-axis of the flange-position "
             "ellipsoid): over the sampled region +-%.4f mm (median over the data's poses; max %.4f), whole "
@@ -1561,7 +1576,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         fprintf(f, "  next: the lengths are predicted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave "
                    "most of the geometry to the prior; plan poses that move every joint, from more than one outlet: "
                    "rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv\n",
-                r->after_m.rmse_mm, u->map.data_median_mm, r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json");
+                r->after_m.rmse_mm, u->map.data_median_mm, hp.robot);
     fprintf(f,
             "predicted flange-orientation uncertainty (95 %%) inside the data: +-%.4f deg with every parameter, "
             "+-%.4f deg with those compensation uses: orientation %s\n",
@@ -1660,7 +1675,8 @@ static const char *data_name(const rch_calib_result *r)
  * prior, poses that leave the geometry to the prior). */
 static void print_summary(FILE *f, const rch_calib_result *r)
 {
-    const char *data = r->cfg.data_path ? r->cfg.data_path : "FILE";
+    hint_paths hp;
+    hint_paths_of(&hp, r);
     fputs("\nsummary:\n", f);
     if (r->after_ok)
         fprintf(f, "  %s RMSE %.4f mm before -> %.4f mm after calibration (%zu samples%s)\n",
@@ -1681,15 +1697,14 @@ static void print_summary(FILE *f, const rch_calib_result *r)
     if (r->jumps_found && !r->cfg.jumps)
         fprintf(f, "  next: rcal calibrate --data %s --robot %s --jumps (the lengths jump and this fit does not model "
                    "them)\n",
-                data, r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json");
+                hp.data, hp.robot);
     else if (outside)
-        fprintf(f, "  next: rcal diagnose --data %s --robot %s%s (%u parameter%s outside the prior's range)\n", data,
-                r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json", r->cfg.dequantize ? " --dequantize-joints" : "",
-                outside, outside == 1 ? "" : "s");
+        fprintf(f, "  next: rcal diagnose --data %s --robot %s%s (%u parameter%s outside the prior's range)\n",
+                hp.data, hp.robot, r->cfg.dequantize ? " --dequantize-joints" : "", outside, outside == 1 ? "" : "s");
     else if (accuracy_needs_poses(r))
         fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
                    "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",
-                r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json", r->unc.map.data_median_mm / r->after_m.rmse_mm);
+                hp.robot, r->unc.map.data_median_mm / r->after_m.rmse_mm);
 }
 
 void rch_calib_print(FILE *f, const rch_calib_result *r)
@@ -1709,13 +1724,14 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     char counts[200], all[64];
     jump_counts(counts, sizeof counts, r);
     snprintf(all, sizeof all, steps == 1 ? "it is" : r->jumps_found == steps ? "they are" : "all %u are", steps);
+    hint_paths hp;
+    hint_paths_of(&hp, r);
     if (r->jumps_found && !r->cfg.jumps)
         fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
                    "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --robot %s --jumps (it "
                    "fits the %u step%s found; and --dequantize-joints when the file's joints are rounded; rcal "
                    "diagnose tells)\n\n",
-                counts, r->cfg.data_path, r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json", steps,
-                steps == 1 ? "" : "s");
+                counts, hp.data, hp.robot, steps, steps == 1 ? "" : "s");
     if (r->jumps_auto) {
         char also[64] = "";
         if (fitted != steps)
