@@ -213,6 +213,8 @@ static void test_real_data(void **state)
     for (unsigned k = 0; k < 3; ++k) {
         assert_true(fabs(rch_json_get(jl->items[k], "sample")->num - want_at[k]) <= 1.0);
         assert_true(fabs(rch_json_get(jl->items[k], "size_mm")->num - want_mm[k]) < 0.3);
+        /* named by the file's line, as rcal calibrate names them */
+        assert_true(fabs(rch_json_get(jl->items[k], "line")->num - (want_at[k] + 2.0)) <= 1.0);
     }
     assert_true(after < 0.5 * before);
     assert_true(after < 1.5 * floor_mm);

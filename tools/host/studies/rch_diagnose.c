@@ -1425,8 +1425,10 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
         rch_dequant(&dq, bad, data.s, data.n, (const double(*)[3])data.xyz, &robot.nominal, 0.0);
         size_t k = 0;
         for (size_t i = 0; i < data.n; ++i)
-            if (!bad[i])
+            if (!bad[i]) {
+                data.line[k] = data.line[i];
                 data.s[k++] = data.s[i];
+            }
         data.n = k;
         free(bad);
         if (c.q_step_deg == 0.0)
@@ -1437,6 +1439,12 @@ int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const cha
     const int rc = rch_diagnose_run(out, data.s, data.n, &robot.nominal, &c, d);
     out->dequant_corrected = dq.n_corrected;
     out->dequant_refused = dq.n_refused;
+    for (unsigned k = 0; rc == 0 && k < out->jumps.n_jumps; ++k)
+        for (size_t i = 0; i < data.n; ++i)
+            if (data.s[i].t == out->jumps.at_t[k]) {
+                out->jump_line[k] = data.line[i];
+                break;
+            }
     rch_data_free(&data);
     return rc;
 }
@@ -1514,8 +1522,13 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
                 "Length jumps in acquisition order (the lengths shift at a row and stay shifted: a display "
                 "re-zeroed or counts lost; removed as a nuisance before the search below):\n");
         for (unsigned k = 0; k < r->jumps.n_jumps; ++k)
-            fprintf(f, "  before sample %zu (1-based, in file order; t %.4f): %+.4f +- %.4f mm\n", r->jumps.at[k] + 1,
-                    r->jumps.at_t[k], r->jumps.size_mm[k], r->jumps.se_mm[k]);
+        {
+            char where[48] = "";
+            if (r->jump_line[k])
+                snprintf(where, sizeof where, "line %u, ", r->jump_line[k]);
+            fprintf(f, "  at %ssample %zu (1-based, in file order; t %.4f): %+.4f +- %.4f mm\n", where,
+                    r->jumps.at[k] + 1, r->jumps.at_t[k], r->jumps.size_mm[k], r->jumps.se_mm[k]);
+        }
         fprintf(f, "  geometry held-out RMSE %.4f mm with the jumps in the data, %.4f mm with them removed\n",
                 r->rmse_before_mm, r->rmse_jumps_mm);
         if (r->jumps_at_setup_change)
@@ -1639,6 +1652,10 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
     for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
         rch_jw_obj(&w, NULL);
         rch_jw_uint(&w, "sample", r->jumps.at[k]);
+        if (r->jump_line[k])
+            rch_jw_uint(&w, "line", r->jump_line[k]);
+        else
+            rch_jw_null(&w, "line");
         json_num(&w, "t", r->jumps.at_t[k]);
         json_num(&w, "size_mm", r->jumps.size_mm[k]);
         json_num(&w, "se_mm", r->jumps.se_mm[k]);

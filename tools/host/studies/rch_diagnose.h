@@ -152,6 +152,8 @@ typedef struct rch_diagnose_result {
     double rmse_after_mm;      /* held-out, with the chosen effects */
     double noise_est_mm;       /* the held-out RMS when no structure remains: the noise, estimated */
     rch_jumps jumps;           /* length jumps in acquisition order (n_jumps 0: none found) */
+    unsigned jump_line[RCH_JUMPS_MAX]; /* (jumps.n_jumps) the data file's line of the first sample after each
+                                          jump, as rcal calibrate names it (0: not from a file) */
     double rmse_jumps_mm;      /* held-out, geometry on the lengths with the jumps removed */
     unsigned jumps_at_setup_change; /* of the jumps found, at a set-up change (confounded) */
     unsigned jumps_confounded; /* steps found only at set-up changes: not taken as jumps */
