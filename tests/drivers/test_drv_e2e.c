@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -347,6 +348,8 @@ static void test_frozen_and_foreign_refused(void **state)
                              "--pose-timeout-s 20 --reconnect-s 3 --retries 3 --stable-mm 0.03 --quiet "
                              ">>%s/acquire.log 2>&1", RCAL_EXE, link, g_dir, g_dir, g_dir, g_dir), 1);
         sim_stop(&s);
+        struct stat ls;
+        assert_int_equal(lstat(link, &ls), -1); /* stopped by SIGTERM, the display removed its link */
     }
     n = count_samples("foreign.csv");
     print_message("foreign device after a reconnect: %d of %d poses recorded before, then refused\n", n, NPOSES);

@@ -54,12 +54,16 @@
  *                       the display jumps by J mm and stays off (a slipped
  *                       cable, a counter that lost counts)
  *   --seed S            random faults and noise are reproducible
+ *
+ * On SIGTERM, SIGINT or SIGHUP it stops and removes --link (when the link
+ * still points at its pty), so `kill PID` leaves nothing behind.
  */
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <poll.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -73,6 +77,15 @@
 #include "rch_opt.h"
 #include "rch_robot.h"
 #include "rch_stdio.h"
+
+/* set by SIGTERM, SIGINT, SIGHUP: the serving loop ends */
+static volatile sig_atomic_t stop_requested;
+
+static void on_stop(int sig)
+{
+    (void)sig;
+    stop_requested = 1;
+}
 
 /* longest delay an option may ask for: one day */
 #define SIM_MAX_MS 86400000UL
@@ -620,7 +633,7 @@ static int serve(sim *s, unsigned long reply_delay_ms)
         struct pollfd pfd;
         int timeout_ms = 20;
         double t = now_s();
-        if (t - t_start > s->max_seconds || (s->exit_after && s->frames >= s->exit_after))
+        if (stop_requested || t - t_start > s->max_seconds || (s->exit_after && s->frames >= s->exit_after))
             return 0;
         if (s->disconnected) {
             if (s->reconnect_ms < 0)
@@ -688,8 +701,24 @@ static int run(int argc, char **argv)
     } else {
         s.src = SRC_CONST;
     }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGHUP, &sa, NULL);
     if (rc == 0)
         rc = open_pty(&s) != 0 ? 1 : serve(&s, g.reply_delay_ms);
+    if (s.link && s.path[0]) { /* the link goes with the pty, unless another display took it over */
+        char to[sizeof s.path];
+        const ssize_t n = readlink(s.link, to, sizeof to - 1);
+        if (n > 0 && (size_t)n < sizeof to) {
+            to[n] = '\0';
+            if (strcmp(to, s.path) == 0)
+                unlink(s.link);
+        }
+    }
     close_pty(&s);
     free(s.script);
     free(s.pose_len);
