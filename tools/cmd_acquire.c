@@ -206,7 +206,8 @@ int rcal_cmd_acquire(int argc, char **argv)
         {"--announce", RCH_OPT_STR, &c.announce_path, 0, 0, "FILE", "pose for the robot side", 0, NULL},
         {"--confirm", RCH_OPT_FLAG, &c.confirm, 0, 0, NULL, "wait for Enter at each pose", 0, NULL},
         {"--joints", RCH_OPT_CHOICE, &joints, 0, 0, NULL, "source of q1..q6", 0, "plan"},
-        {"--quiet", RCH_OPT_FLAG, &c.quiet, 0, 0, NULL, "fewer messages", 0, NULL},
+        {"--quiet", RCH_OPT_FLAG, &c.quiet, 0, 0, NULL,
+         "no per-pose lines (kept with --confirm) and fewer notes; the closing summary and every warning stay", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
          "the run summary as one JSON object on stdout (progress then goes to stderr)", 0, NULL},
     };

@@ -133,6 +133,8 @@ typedef struct acq {
 #define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
 #define WARN(a, ...) ((a)->err ? (void)fprintf((a)->err, "rcal acquire: " __VA_ARGS__) : (void)0)
 #define NOTE(a, ...) (!(a)->c->quiet ? WARN(a, __VA_ARGS__) : (void)0)
+/* a pose's progress line: kept with --confirm (the user is asked at the pose) */
+#define PROGRESS(a, ...) (!(a)->c->quiet || (a)->c->confirm ? SAY(a, __VA_ARGS__) : (void)0)
 
 static uint32_t now_ms(const acq *a)
 {
@@ -443,10 +445,10 @@ static int check_paths(acq *a)
 static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
 {
     const rch_acq_config *c = a->c;
-    SAY(a, "%s %zu/%zu: q =", recheck ? "back to pose" : "pose", i + 1, a->n);
+    PROGRESS(a, "%s %zu/%zu: q =", recheck ? "back to pose" : "pose", i + 1, a->n);
     for (int j = 0; j < RC_NJ; ++j)
-        SAY(a, " %.4f", a->plan_deg[i][j]);
-    SAY(a, recheck ? " deg (the last recorded pose: its length is read again)\n" : " deg\n");
+        PROGRESS(a, " %.4f", a->plan_deg[i][j]);
+    PROGRESS(a, recheck ? " deg (the last recorded pose: its length is read again)\n" : " deg\n");
     if (a->out)
         fflush(a->out);
     if (c->announce_path && announce(c->announce_path, i, a->plan_deg[i]) != 0) {
@@ -560,7 +562,7 @@ static int run_poses(acq *a)
         a->ref_pose = i;
         a->ref_len_mm = r.mean_mm;
         a->res->n_new++;
-        SAY(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
+        PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
         if (a->out)
             fflush(a->out);
     }

@@ -111,7 +111,7 @@ typedef struct rch_acq_config {
     int no_follow_check;        /* 1: skip it (a plan of tiny moves) */
     int outlet_p1;              /* 0: one encoder place; k + 1: this run measures from outlet k (the file's
                                    outlet column; give --encoder as this place's position for the follow check) */
-    int confirm, quiet;
+    int confirm, quiet; /* quiet: no per-pose progress lines (kept with confirm), no notes */
 } rch_acq_config;
 
 /* Defaults as `rcal acquire` documents them (paths NULL, ASCII, posix off). */
