@@ -153,6 +153,45 @@ static void test_identifiability(void **state)
         saw_alpha6 |= strstr(id.dirs[k].why, "alpha6") != NULL;
     }
     assert_true(saw_base && saw_alpha6);
+
+    /* The dependent sets it names hold physically: each move below changes
+     * no length (the model's own rc_meas), and each is named. With the
+     * encoder at enc (the nominal file has none). */
+    rc_model m = r.model;
+    for (unsigned k = 0; k < 3; ++k)
+        m.x[RC_P_ENC + k] = enc[k];
+    assert_int_equal(rch_ident_compute(&id, &m, s, 300), 0);
+    for (unsigned k = 0; k < id.n_combos; ++k)
+        print_message("  set %s: %s %.1e\n", id.combos[k].params, id.combos[k].weak ? "weak" : "null",
+                      id.combos[k].sv_rel);
+    static const char *const want[] = {"d1 ez", "d2 d3", "theta1 ex ey"};
+    for (unsigned w = 0; w < 3; ++w) {
+        int found = 0;
+        for (unsigned k = 0; k < id.n_combos; ++k)
+            found |= strcmp(id.combos[k].params, want[w]) == 0 && !id.combos[k].weak;
+        if (!found)
+            fail_msg("dependent set '%s' not named", want[w]);
+    }
+    const double dl = 3.0, dth = 0.02;
+    rc_model up = m, par = m, turn = m;
+    up.x[RC_P_D(0)] += dl; /* the base 3 mm up, the encoder with it */
+    up.x[RC_P_ENC + 2] += dl;
+    par.x[RC_P_D(1)] += dl; /* along the parallel axes 2 and 3 */
+    par.x[RC_P_D(2)] -= dl;
+    turn.x[RC_P_THETA(0)] += dth; /* the robot and the encoder turned together about the base axis */
+    turn.x[RC_P_ENC] = cos(dth) * enc[0] - sin(dth) * enc[1];
+    turn.x[RC_P_ENC + 1] = sin(dth) * enc[0] + cos(dth) * enc[1];
+    double worst = 0.0;
+    for (size_t i = 0; i < 300; ++i) {
+        double l0, l1, l2, l3;
+        assert_int_equal(rc_meas(&l0, NULL, &m, &s[i]), RC_OK);
+        assert_int_equal(rc_meas(&l1, NULL, &up, &s[i]), RC_OK);
+        assert_int_equal(rc_meas(&l2, NULL, &par, &s[i]), RC_OK);
+        assert_int_equal(rc_meas(&l3, NULL, &turn, &s[i]), RC_OK);
+        worst = fmax(worst, fmax(fabs(l1 - l0), fmax(fabs(l2 - l0), fabs(l3 - l0))));
+    }
+    print_message("  the three moves change lengths by at most %.2e mm\n", worst);
+    assert_true(worst < 1e-9);
 }
 
 static void test_encoder_guess(void **state)

@@ -1601,6 +1601,11 @@ static void print_ident(FILE *f, const rch_ident *id, int prior)
         if (id->dirs[k].why[0])
             fprintf(f, "      %s\n", id->dirs[k].why);
     }
+    if (id->n_combos)
+        fprintf(f, "  what these directions hold (known sets of parameters whose columns are dependent):\n");
+    for (unsigned k = 0; k < id->n_combos; ++k)
+        fprintf(f, "    %s %s (%.1e): %s\n", id->combos[k].params, id->combos[k].weak ? "weak" : "NOT identifiable",
+                id->combos[k].sv_rel, id->combos[k].why);
     fprintf(f, prior ? "  With the prior, what the data cannot identify stays where the drawing puts it (the prior's mean), "
                        "with the prior's uncertainty (the parameters' classes above).\n\n"
                      : "  The solver leaves directions it cannot identify where they started (nominal).\n\n");
@@ -1836,6 +1841,16 @@ static void json_ident(rch_jw *w, const rch_ident *id)
         rch_jw_numf(w, "sv_rel", id->dirs[k].sv_rel, "%.3g");
         rch_jw_str(w, "identifiable", id->dirs[k].weak ? "weakly" : "no");
         rch_jw_str(w, "combo", id->dirs[k].combo);
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_arr(w, "dependent_sets");
+    for (unsigned k = 0; k < id->n_combos; ++k) {
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "params", id->combos[k].params);
+        rch_jw_str(w, "identifiable", id->combos[k].weak ? "weakly" : "no");
+        rch_jw_numf(w, "sv_rel", id->combos[k].sv_rel, "%.3g");
+        rch_jw_str(w, "why", id->combos[k].why);
         rch_jw_end(w);
     }
     rch_jw_end(w);

@@ -20,45 +20,60 @@ static double comp(const double *v, const rc_model *m, const char *name)
     return 0.0;
 }
 
-static int has(const double *v, const rc_model *m, const char *name, double thr)
+/* Share of the unit direction v on the parameters named in the
+ * NULL-terminated list: the sum of their squared components (0..1). */
+static double share(const double *v, const rc_model *m, const char *const *names)
 {
-    return fabs(comp(v, m, name)) >= thr;
+    double s2 = 0.0;
+    for (; *names; ++names) {
+        const double c = comp(v, m, *names);
+        s2 += c * c;
+    }
+    return s2;
 }
 
+/* The plain-words reason of a direction, only when the direction lies in
+ * the reason's parameters (RCH_IDENT_WHY_SHARE of its squared length): where
+ * several null directions share one singular value the SVD mixes them, and
+ * a mix is given no reason rather than a wrong one. */
 static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
 {
-    const double t = 0.15;
+    static const char *const flange_turns[] = {"alpha6", "theta6", NULL}, *const a6_only[] = {"alpha6", NULL},
+                             *const t6_only[] = {"theta6", NULL}, *const base_z[] = {"d1", "ez", NULL},
+                             *const heading[] = {"theta1", "ex", "ey", NULL}, *const d23[] = {"d2", "d3", NULL},
+                             *const scale[] = {"length_scale", NULL}, *const offset[] = {"length_offset", NULL};
+    const double t = RCH_IDENT_WHY_SHARE;
     const char *why = "";
-    const double a6 = comp(v, m, "alpha6"), t6 = comp(v, m, "theta6");
-    if (fabs(a6) >= t && fabs(t6) >= t && a6 * a6 + t6 * t6 > 0.98)
+    if (share(v, m, flange_turns) > 0.98 && fabs(comp(v, m, "alpha6")) >= 0.15 && fabs(comp(v, m, "theta6")) >= 0.15)
         why = "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 "
               "is zero (both columns are zero, so any mix of them is null): cable lengths cannot see them";
-    else if (has(v, m, "alpha6", t) && !has(v, m, "theta6", t) && !has(v, m, "d6", t))
+    else if (share(v, m, a6_only) >= t)
         why = "alpha6 turns the flange about its own x axis after the last translation: it never moves the "
               "flange point, so cable lengths cannot see it";
-    else if (has(v, m, "theta6", t) && !has(v, m, "a6", 0.5))
+    else if (share(v, m, t6_only) >= t)
         why = "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about "
               "axis 6 is invisible to a point measurement";
-    else if (has(v, m, "d1", t) && has(v, m, "ez", t))
+    else if (share(v, m, base_z) >= t)
         why = "moving the robot base up is the same as moving the encoder down: only their difference is "
               "measured";
-    else if (has(v, m, "theta1", t) && (has(v, m, "ex", t) || has(v, m, "ey", t)))
+    else if (share(v, m, heading) >= t && fabs(comp(v, m, "theta1")) >= 0.15)
         why = "turning the whole robot about its base axis is the same as turning the encoder around it: "
               "lengths do not fix the base heading";
-    else if (has(v, m, "d2", t) && has(v, m, "d3", t))
+    else if (share(v, m, d23) >= t)
         why = "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum "
               "counts";
-    else if (has(v, m, "length_scale", t))
+    else if (share(v, m, scale) >= 0.5)
         why = "an encoder scale error looks like a uniformly larger robot: separate them with one reference "
               "length (a gauge bar or a laser tracker distance)";
-    else if (has(v, m, "length_offset", t))
+    else if (share(v, m, offset) >= 0.5)
         why = "a constant cable offset trades against the encoder position and the link lengths";
     snprintf(d->why, sizeof d->why, "%s", why);
 }
 
 /* SVD of the column-scaled identification Jacobian of m over the samples (n):
- * sv (np) descending (zero beyond n), vt (np x np) row k = direction k. */
-static int scaled_svd(double *sv, double *vt, const rc_model *m, const rc_sample *s, size_t n)
+ * sv (np) descending (zero beyond n), vt (np x np) row k = direction k;
+ * Js (n x np, row-major), when not NULL, gets the scaled Jacobian. */
+static int scaled_svd(double *sv, double *vt, double *Js, const rc_model *m, const rc_sample *s, size_t n)
 {
     const unsigned np = m->n_params;
     rch_jac jac;
@@ -73,6 +88,8 @@ static int scaled_svd(double *sv, double *vt, const rc_model *m, const rc_sample
     for (unsigned k = 0; k < np; ++k)
         for (size_t i = 0; i < n; ++i)
             J[i * np + k] = sup[k] > 0.0 ? J[i * np + k] / sup[k] : 0.0;
+    if (Js)
+        memcpy(Js, J, n * np * sizeof *J);
     if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'A', (lapack_int)n, (lapack_int)np, J, (lapack_int)np, sv, NULL, 1, vt,
                        (lapack_int)np, sup) != 0)
         goto done;
@@ -114,6 +131,97 @@ static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
     explain(d, v, m);
 }
 
+/* The known dependent sets, smallest first (a set holding one found before
+ * is not listed). */
+static const struct {
+    const char *params[5];
+    const char *why;
+} known_sets[] = {
+    {{"alpha6"}, "alpha6 turns the flange about its own x axis after the last translation: it never moves the "
+                 "flange point, so cable lengths cannot see it"},
+    {{"theta6"}, "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about "
+                 "axis 6 is invisible to a point measurement"},
+    {{"d1", "ez"}, "moving the robot base up is the same as moving the encoder down: only their difference is "
+                   "measured"},
+    {{"d2", "d3"}, "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum "
+                   "counts"},
+    {{"d6", "tool_offset.z"}, "d6 and the cable attachment's z both move the measured point along the flange "
+                              "axis: only their sum is seen"},
+    {{"a6", "tool_offset.x"}, "a6 and the cable attachment's x both move the measured point along the flange's "
+                              "x axis: only their sum is seen"},
+    {{"alpha6", "theta6"}, "alpha6 and theta6 turn the flange about its own axes without moving the flange point "
+                           "while a6 is zero: cable lengths cannot see them"},
+    {{"theta1", "ex", "ey"}, "turning the whole robot about its base axis is the same as turning the encoder "
+                             "around it: lengths do not fix the base heading"},
+    {{"alpha6", "tool_offset.y", "tool_offset.z"}, "turning the flange about its x axis moves the cable attachment "
+                                                   "as a change of its y and z does"},
+    {{"theta6", "tool_offset.x", "tool_offset.y"}, "turning the flange about its axis moves the cable attachment "
+                                                   "as a change of its x and y does"},
+};
+
+static int param_index(const rc_model *m, const char *name)
+{
+    char buf[64];
+    for (unsigned k = 0; k < m->n_params; ++k)
+        if (strcmp(rc_param_name(buf, sizeof buf, m, k), name) == 0)
+            return (int)k;
+    return -1;
+}
+
+/* out->combos from the scaled Jacobian Js (n x np) and its largest singular
+ * value s_max. */
+static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max, const rc_model *m)
+{
+    const unsigned np = m->n_params;
+    unsigned found[sizeof known_sets / sizeof known_sets[0]];
+    unsigned n_found = 0;
+    double *A = malloc(n * 5 * sizeof *A);
+    if (!A || s_max <= 0.0 || n < 5)
+        goto done;
+    for (unsigned p = 0; p < sizeof known_sets / sizeof known_sets[0]; ++p) {
+        int idx[5];
+        unsigned k = 0, all = 1;
+        for (; k < 5 && known_sets[p].params[k]; ++k)
+            all &= (idx[k] = param_index(m, known_sets[p].params[k])) >= 0;
+        if (!all || out->n_combos >= RCH_IDENT_MAX_COMBOS)
+            continue;
+        int holds = 0; /* a smaller set found already inside this one */
+        for (unsigned f = 0; f < n_found && !holds; ++f) {
+            unsigned in = 1;
+            for (unsigned a = 0; a < 5 && known_sets[found[f]].params[a]; ++a) {
+                unsigned hit = 0;
+                for (unsigned b = 0; b < k; ++b)
+                    hit |= strcmp(known_sets[found[f]].params[a], known_sets[p].params[b]) == 0;
+                in &= hit;
+            }
+            holds = (int)in;
+        }
+        if (holds)
+            continue;
+        for (size_t i = 0; i < n; ++i)
+            for (unsigned b = 0; b < k; ++b)
+                A[i * k + b] = Js[i * np + (unsigned)idx[b]];
+        double sv[5], super[5];
+        if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'N', (lapack_int)n, (lapack_int)k, A, (lapack_int)k, sv, NULL, 1,
+                           NULL, 1, super) != 0)
+            continue;
+        const double rel = sv[k - 1] / s_max;
+        if (!(rel < RC_IDENT_WEAK_REL))
+            continue;
+        rch_ident_combo *c = &out->combos[out->n_combos++];
+        size_t pos = 0;
+        for (unsigned b = 0; b < k; ++b)
+            pos += (size_t)snprintf(c->params + pos, sizeof c->params - pos, "%s%s", b ? " " : "",
+                                    known_sets[p].params[b]);
+        c->weak = rel >= RC_IDENT_NULL_REL;
+        c->sv_rel = rel;
+        snprintf(c->why, sizeof c->why, "%s", known_sets[p].why);
+        found[n_found++] = p;
+    }
+done:
+    free(A);
+}
+
 int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, size_t n)
 {
     const unsigned np = m->n_params;
@@ -122,10 +230,11 @@ int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, siz
     if (n == 0 || np == 0 || np > RC_MAX_PARAMS)
         return -1;
     double *sv = malloc(np * sizeof *sv), *vt = malloc((size_t)np * np * sizeof *vt);
-    double *V = malloc((size_t)np * np * sizeof *V);
+    double *V = malloc((size_t)np * np * sizeof *V), *Js = malloc(n * np * sizeof *Js);
     int rc = -1;
-    if (!sv || !vt || !V || scaled_svd(sv, vt, m, s, n) != 0)
+    if (!sv || !vt || !V || !Js || scaled_svd(sv, vt, Js, m, s, n) != 0)
         goto done;
+    find_combos(out, Js, n, sv[0], m);
     for (unsigned k = 0; k < np; ++k) /* V: direction k in column k */
         for (unsigned i = 0; i < np; ++i)
             V[(size_t)i * np + k] = vt[(size_t)k * np + i];
@@ -152,5 +261,6 @@ done:
     free(sv);
     free(vt);
     free(V);
+    free(Js);
     return rc;
 }

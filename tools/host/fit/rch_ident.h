@@ -20,6 +20,10 @@
 #include "rc_model.h"
 
 #define RCH_IDENT_MAX_DIRS 24
+/* a direction gets a known reason only when this share of its squared
+ * length lies on the reason's parameters (a mix of null directions gets
+ * none rather than a wrong one) */
+#define RCH_IDENT_WHY_SHARE 0.8
 
 typedef struct rch_ident_dir {
     double sv_rel;       /* singular value relative to the largest */
@@ -27,6 +31,19 @@ typedef struct rch_ident_dir {
     char combo[256];     /* e.g. "+0.71 d1 -0.71 ez" */
     char why[256];       /* plain-words explanation, "" when no known pattern */
 } rch_ident_dir;
+
+#define RCH_IDENT_MAX_COMBOS 12
+
+/* A known set of parameters whose (scaled) Jacobian columns are dependent:
+ * some combination of them alone is not (or weakly) identifiable. Where
+ * several null directions share one singular value the SVD's directions mix
+ * these; the sets say what the null space holds. */
+typedef struct rch_ident_combo {
+    char params[96];     /* "d1 ez" */
+    int weak;            /* 0: not identifiable, 1: weakly */
+    double sv_rel;       /* smallest singular value of their columns, relative to the Jacobian's largest */
+    char why[256];       /* plain words */
+} rch_ident_combo;
 
 typedef struct rch_ident {
     unsigned n_params;
@@ -37,6 +54,9 @@ typedef struct rch_ident {
     double observability;         /* O1 = (prod s_i)^(1/r) / sqrt(n), identifiable part */
     unsigned n_dirs;
     rch_ident_dir dirs[RCH_IDENT_MAX_DIRS];
+    unsigned n_combos;
+    rch_ident_combo combos[RCH_IDENT_MAX_COMBOS]; /* the known dependent sets found, smallest first; a set
+                                                     holding one already found is not listed */
     rc_ident core;                /* rc_ident's classes per direction and per parameter, log det */
 } rch_ident;
 

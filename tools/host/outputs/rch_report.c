@@ -1250,6 +1250,17 @@ static void ident_block(rep *r)
                                 {"relative singular value", "sv_rel", 'n', "%.2g"},
                                 {"identifiable", "identifiable", 's', NULL}};
     json_table(r, dirs, cols, sizeof cols / sizeof cols[0]);
+    const rch_json *sets = jarr(id, "dependent_sets"); /* absent from calibrations written before them */
+    if (!sets || sets->n == 0)
+        return;
+    fputs("<p>What these directions hold: known sets of parameters whose columns are dependent (where several "
+          "directions share one singular value the directions above mix them).</p>\n",
+          f);
+    static const jcol scols[] = {{"parameters", "params", 's', NULL},
+                                 {"identifiable", "identifiable", 's', NULL},
+                                 {"relative singular value", "sv_rel", 'n', "%.2g"},
+                                 {"why", "why", 's', NULL}};
+    json_table(r, sets, scols, sizeof scols / sizeof scols[0]);
 }
 
 static void sec_params(rep *r, const prow *p, size_t n)
