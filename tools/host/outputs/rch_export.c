@@ -208,10 +208,26 @@ static void xml_attr(FILE *f, const char *key, const char *v)
     fputc('"', f);
 }
 
+/* v with the fewest significant digits that read back as exactly v
+ * (0.174452183, not 0.17445218300000001): a reader gets the same double. */
+static const char *num(char buf[32], double v)
+{
+    /* at least the integer digits, so that 290 is not written 2.9e+02 */
+    const double a = fabs(v);
+    int p = a >= 1.0 && a < 1e17 ? (int)floor(log10(a)) + 1 : 1;
+    for (p = p < 17 ? p : 17; p <= 17; ++p) {
+        snprintf(buf, 32, "%.*g", p, v);
+        if (strtod(buf, NULL) == v)
+            break;
+    }
+    return buf;
+}
+
 static void write_origin(FILE *f, const rch_urdf_origin *o)
 {
-    fprintf(f, "    <origin xyz=\"%.17g %.17g %.17g\" rpy=\"%.17g %.17g %.17g\"/>\n", o->xyz_m[0], o->xyz_m[1],
-            o->xyz_m[2], o->rpy_rad[0], o->rpy_rad[1], o->rpy_rad[2]);
+    char b[6][32];
+    fprintf(f, "    <origin xyz=\"%s %s %s\" rpy=\"%s %s %s\"/>\n", num(b[0], o->xyz_m[0]), num(b[1], o->xyz_m[1]),
+            num(b[2], o->xyz_m[2]), num(b[3], o->rpy_rad[0]), num(b[4], o->rpy_rad[1]), num(b[5], o->rpy_rad[2]));
 }
 
 static void write_link(FILE *f, const char *name)
@@ -308,9 +324,11 @@ static void write_urdf(FILE *f, const rch_export_cfg *cfg, const rch_robot *r, c
             fputs("    <axis xyz=\"0 0 1\"/>\n", f);
             if (n->continuous[i])
                 fputs("    <limit effort=\"0\" velocity=\"0\"/>\n", f);
-            else
-                fprintf(f, "    <limit lower=\"%.17g\" upper=\"%.17g\" effort=\"0\" velocity=\"0\"/>\n",
-                        r->model.q_min_rad[i], r->model.q_max_rad[i]);
+            else {
+                char lo[32], hi[32];
+                fprintf(f, "    <limit lower=\"%s\" upper=\"%s\" effort=\"0\" velocity=\"0\"/>\n",
+                        num(lo, r->model.q_min_rad[i]), num(hi, r->model.q_max_rad[i]));
+            }
         }
         fputs("  </joint>\n", f);
         write_link(f, flange ? n->flange_link : n->link[i]);
@@ -323,9 +341,10 @@ static void write_urdf(FILE *f, const rch_export_cfg *cfg, const rch_robot *r, c
 
 static void csv_num(FILE *f, int has, double v)
 {
+    char b[32];
     fputc(',', f);
     if (has)
-        fprintf(f, "%.17g", v);
+        fputs(num(b, v), f);
 }
 
 static void write_csv(FILE *f, const rch_export_cfg *cfg, const rch_robot *r, rch_export_result *res)
