@@ -48,9 +48,9 @@ static void print_summary(const rch_comp_result *rp)
         snprintf(fails, sizeof fails, " (%lu at a joint limit; largest position error written %.4f mm)",
                  r.n_joint_limit, r.max_fail_err_mm);
     fprintf(stderr,
-            "rcal compensate: %lu targets, %lu not converged%s, %lu with the orientation best effort (position "
+            "rcal compensate: %lu target%s, %lu not converged%s, %lu with the orientation best effort (position "
             "matched), %.2f iterations/target, largest correction %.4f deg, %.2f us/target\n",
-            r.n, r.n_fail, fails, r.n_pos_only, r.n ? (double)r.iters / (double)r.n : 0.0, r.max_corr_deg,
+            r.n, r.n == 1 ? "" : "s", r.n_fail, fails, r.n_pos_only, r.n ? (double)r.iters / (double)r.n : 0.0, r.max_corr_deg,
             r.n ? r.t_ns / (double)r.n / 1e3 : 0.0);
 }
 

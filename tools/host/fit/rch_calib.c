@@ -663,7 +663,12 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     memset(&jc, 0, sizeof jc);
     jc.solve = scfg;
     if (jumps_fit(r, w, fixed, &jc, tr, err, sizeof err) != 0) {
-        rch_diag_set(d, "", 0, 0, "length jumps: %s", err);
+        if (r->n_test)
+            rch_diag_set(d, "", 0, 0, "length jumps: %s: the training samples, %zu of the %zu rows after %zu held "
+                         "out (--test-fraction 0 fits them all; or record more poses)", err, r->n_train,
+                         r->n_train + r->n_test, r->n_test);
+        else
+            rch_diag_set(d, "", 0, 0, "length jumps: %s", err);
         goto done;
     }
     r->have_jumps = 1;
