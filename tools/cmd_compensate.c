@@ -50,8 +50,8 @@ static void print_summary(const rch_comp_result *rp)
     fprintf(stderr,
             "rcal compensate: %lu target%s, %lu not converged%s, %lu with the orientation best effort (position "
             "matched), %.2f iterations/target, largest correction %.4f deg, %.2f us/target\n",
-            r.n, r.n == 1 ? "" : "s", r.n_fail, fails, r.n_pos_only, r.n ? (double)r.iters / (double)r.n : 0.0, r.max_corr_deg,
-            r.n ? r.t_ns / (double)r.n / 1e3 : 0.0);
+            r.n, r.n == 1 ? "" : "s", r.n_fail, fails, r.n_pos_only, r.n ? (double)r.iters / (double)r.n : 0.0,
+            r.max_corr_deg, r.n ? r.t_ns / (double)r.n / 1e3 : 0.0);
 }
 
 /* The targets the warnings name ("IN:LINE: warning: TEXT" lines of

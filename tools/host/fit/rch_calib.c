@@ -1492,6 +1492,7 @@ static int accuracy_needs_poses(const rch_calib_result *r)
     const double a = r->unc.map.data_median_mm;
     return r->have_unc && r->after_ok && a > 10.0 * r->after_m.rmse_mm && a > 0.1;
 }
+
 /* The data file and the robot file as a next-step command names them,
  * quoted for the shell (rch_shell_join). */
 typedef struct {
@@ -1500,11 +1501,11 @@ typedef struct {
 
 static void hint_paths_of(hint_paths *h, const rch_calib_result *r)
 {
-    const char *d = r->cfg.data_path ? r->cfg.data_path : "FILE", *b = r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json";
+    const char *d = r->cfg.data_path ? r->cfg.data_path : "FILE";
+    const char *b = r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json";
     rch_shell_join(h->data, sizeof h->data, 1, &d);
     rch_shell_join(h->robot, sizeof h->robot, 1, &b);
 }
-
 
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {

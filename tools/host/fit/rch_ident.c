@@ -10,64 +10,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Component of v (n_params) on the parameter called name; 0 when none is. */
-static double comp(const double *v, const rc_model *m, const char *name)
+static int param_index(const rc_model *m, const char *name)
 {
     char buf[64];
     for (unsigned k = 0; k < m->n_params; ++k)
         if (strcmp(rc_param_name(buf, sizeof buf, m, k), name) == 0)
-            return v[k];
-    return 0.0;
+            return (int)k;
+    return -1;
 }
 
-/* Share of the unit direction v on the parameters named in the
- * NULL-terminated list: the sum of their squared components (0..1). */
-static double share(const double *v, const rc_model *m, const char *const *names)
+/* Component of v (n_params) on the parameter called name; 0 when none is. */
+static double comp(const double *v, const rc_model *m, const char *name)
 {
-    double s2 = 0.0;
-    for (; *names; ++names) {
-        const double c = comp(v, m, *names);
-        s2 += c * c;
-    }
-    return s2;
-}
-
-/* The plain-words reason of a direction, only when the direction lies in
- * the reason's parameters (RCH_IDENT_WHY_SHARE of its squared length): where
- * several null directions share one singular value the SVD mixes them, and
- * a mix is given no reason rather than a wrong one. */
-static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
-{
-    static const char *const flange_turns[] = {"alpha6", "theta6", NULL}, *const a6_only[] = {"alpha6", NULL},
-                             *const t6_only[] = {"theta6", NULL}, *const base_z[] = {"d1", "ez", NULL},
-                             *const heading[] = {"theta1", "ex", "ey", NULL}, *const d23[] = {"d2", "d3", NULL},
-                             *const scale[] = {"length_scale", NULL}, *const offset[] = {"length_offset", NULL};
-    const double t = RCH_IDENT_WHY_SHARE;
-    const char *why = "";
-    if (share(v, m, flange_turns) > 0.98 && fabs(comp(v, m, "alpha6")) >= 0.15 && fabs(comp(v, m, "theta6")) >= 0.15)
-        why = "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 "
-              "is zero (both columns are zero, so any mix of them is null): cable lengths cannot see them";
-    else if (share(v, m, a6_only) >= t)
-        why = "alpha6 turns the flange about its own x axis after the last translation: it never moves the "
-              "flange point, so cable lengths cannot see it";
-    else if (share(v, m, t6_only) >= t)
-        why = "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about "
-              "axis 6 is invisible to a point measurement";
-    else if (share(v, m, base_z) >= t)
-        why = "moving the robot base up is the same as moving the encoder down: only their difference is "
-              "measured";
-    else if (share(v, m, heading) >= t && fabs(comp(v, m, "theta1")) >= 0.15)
-        why = "turning the whole robot about its base axis is the same as turning the encoder around it: "
-              "lengths do not fix the base heading";
-    else if (share(v, m, d23) >= t)
-        why = "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum "
-              "counts";
-    else if (share(v, m, scale) >= 0.5)
-        why = "an encoder scale error looks like a uniformly larger robot: separate them with one reference "
-              "length (a gauge bar or a laser tracker distance)";
-    else if (share(v, m, offset) >= 0.5)
-        why = "a constant cable offset trades against the encoder position and the link lengths";
-    snprintf(d->why, sizeof d->why, "%s", why);
+    const int k = param_index(m, name);
+    return k >= 0 ? v[k] : 0.0;
 }
 
 /* SVD of the column-scaled identification Jacobian of m over the samples (n):
@@ -102,6 +58,67 @@ done:
     return rc;
 }
 
+/* The known causes of unseen directions, in one table: each a set of
+ * parameters and why lengths cannot separate them. A direction of the SVD
+ * gets the first reason it lies on (dir_share of its squared length: where
+ * several null directions share one singular value the SVD mixes them, and
+ * a mix gets no reason rather than a wrong one); the sets with is_set are
+ * also tested on their own columns (find_combos), smallest first. */
+static const struct {
+    const char *params[5];
+    double dir_share;
+    int is_set;
+    const char *why;
+} known_sets[] = {
+    {{"alpha6"}, RCH_IDENT_WHY_SHARE, 1,
+     "alpha6 turns the flange about its own x axis after the last translation: it never moves the flange point, so "
+     "cable lengths cannot see it"},
+    {{"theta6"}, RCH_IDENT_WHY_SHARE, 1,
+     "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about axis 6 is "
+     "invisible to a point measurement"},
+    {{"d1", "ez"}, RCH_IDENT_WHY_SHARE, 1,
+     "moving the robot base up is the same as moving the encoder down: only their difference is measured"},
+    {{"d2", "d3"}, RCH_IDENT_WHY_SHARE, 1,
+     "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum counts"},
+    {{"d6", "tool_offset.z"}, RCH_IDENT_WHY_SHARE, 1,
+     "d6 and the cable attachment's z both move the measured point along the flange axis: only their sum is seen"},
+    {{"a6", "tool_offset.x"}, RCH_IDENT_WHY_SHARE, 1,
+     "a6 and the cable attachment's x both move the measured point along the flange's x axis: only their sum is "
+     "seen"},
+    {{"alpha6", "theta6"}, RCH_IDENT_WHY_SHARE, 1,
+     "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 is zero: cable "
+     "lengths cannot see them"},
+    {{"theta1", "ex", "ey"}, RCH_IDENT_WHY_SHARE, 1,
+     "turning the whole robot about its base axis is the same as turning the encoder around it: lengths do not fix "
+     "the base heading"},
+    {{"alpha6", "tool_offset.y", "tool_offset.z"}, RCH_IDENT_WHY_SHARE, 1,
+     "turning the flange about its x axis moves the cable attachment as a change of its y and z does"},
+    {{"theta6", "tool_offset.x", "tool_offset.y"}, RCH_IDENT_WHY_SHARE, 1,
+     "turning the flange about its axis moves the cable attachment as a change of its x and y does"},
+    /* these trade against many parameters at once: named when they lead a direction */
+    {{"length_scale"}, 0.5, 0,
+     "an encoder scale error looks like a uniformly larger robot: separate them with one reference length (a gauge "
+     "bar or a laser tracker distance)"},
+    {{"length_offset"}, 0.5, 0, "a constant cable offset trades against the encoder position and the link lengths"},
+};
+#define N_KNOWN (sizeof known_sets / sizeof known_sets[0])
+
+static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
+{
+    d->why[0] = '\0';
+    for (unsigned p = 0; p < N_KNOWN; ++p) {
+        double s2 = 0.0; /* the squared length of v on the set's parameters */
+        for (unsigned k = 0; k < 5 && known_sets[p].params[k]; ++k) {
+            const double c = comp(v, m, known_sets[p].params[k]);
+            s2 += c * c;
+        }
+        if (s2 >= known_sets[p].dir_share) {
+            snprintf(d->why, sizeof d->why, "%s", known_sets[p].why);
+            return;
+        }
+    }
+}
+
 /* "+0.71 d2 -0.71 d3": the (at most five) components of v (np) of at least
  * 0.1, largest first, then the plain-words reason. */
 static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
@@ -131,54 +148,19 @@ static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
     explain(d, v, m);
 }
 
-/* The known dependent sets, smallest first (a set holding one found before
- * is not listed). */
-static const struct {
-    const char *params[5];
-    const char *why;
-} known_sets[] = {
-    {{"alpha6"}, "alpha6 turns the flange about its own x axis after the last translation: it never moves the "
-                 "flange point, so cable lengths cannot see it"},
-    {{"theta6"}, "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about "
-                 "axis 6 is invisible to a point measurement"},
-    {{"d1", "ez"}, "moving the robot base up is the same as moving the encoder down: only their difference is "
-                   "measured"},
-    {{"d2", "d3"}, "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum "
-                   "counts"},
-    {{"d6", "tool_offset.z"}, "d6 and the cable attachment's z both move the measured point along the flange "
-                              "axis: only their sum is seen"},
-    {{"a6", "tool_offset.x"}, "a6 and the cable attachment's x both move the measured point along the flange's "
-                              "x axis: only their sum is seen"},
-    {{"alpha6", "theta6"}, "alpha6 and theta6 turn the flange about its own axes without moving the flange point "
-                           "while a6 is zero: cable lengths cannot see them"},
-    {{"theta1", "ex", "ey"}, "turning the whole robot about its base axis is the same as turning the encoder "
-                             "around it: lengths do not fix the base heading"},
-    {{"alpha6", "tool_offset.y", "tool_offset.z"}, "turning the flange about its x axis moves the cable attachment "
-                                                   "as a change of its y and z does"},
-    {{"theta6", "tool_offset.x", "tool_offset.y"}, "turning the flange about its axis moves the cable attachment "
-                                                   "as a change of its x and y does"},
-};
-
-static int param_index(const rc_model *m, const char *name)
-{
-    char buf[64];
-    for (unsigned k = 0; k < m->n_params; ++k)
-        if (strcmp(rc_param_name(buf, sizeof buf, m, k), name) == 0)
-            return (int)k;
-    return -1;
-}
-
 /* out->combos from the scaled Jacobian Js (n x np) and its largest singular
  * value s_max. */
 static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max, const rc_model *m)
 {
     const unsigned np = m->n_params;
-    unsigned found[sizeof known_sets / sizeof known_sets[0]];
+    unsigned found[N_KNOWN];
     unsigned n_found = 0;
     double *A = malloc(n * 5 * sizeof *A);
     if (!A || s_max <= 0.0 || n < 5)
         goto done;
-    for (unsigned p = 0; p < sizeof known_sets / sizeof known_sets[0]; ++p) {
+    for (unsigned p = 0; p < N_KNOWN; ++p) {
+        if (!known_sets[p].is_set)
+            continue;
         int idx[5];
         unsigned k = 0, all = 1;
         for (; k < 5 && known_sets[p].params[k]; ++k)
