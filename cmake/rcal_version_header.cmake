@@ -14,7 +14,7 @@
 #         -P cmake/rcal_version_header.cmake             (builds without CMake:
 #         firmware_host/cross_build.sh, scripts/stack_usage.sh, ...)
 set(RCAL_DEFAULT_MAX_PARAMS 96)
-set(RCAL_DEFAULT_MAX_EFFECTS 8)
+set(RCAL_DEFAULT_MAX_EFFECTS 24)
 set(_rcal_version_header_dir "${CMAKE_CURRENT_LIST_DIR}")
 
 function(rcal_write_version_header dir)

@@ -146,6 +146,9 @@ static const rc_effect_desc effect_table[] = {
      "", 0},
     {RC_EFF_TRACKER_TARGETS, "tracker_targets", 0, RC_SIDE_SENSOR, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z",
      "", 0},
+    {RC_EFF_OUTLET_OFFSET, "outlet_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 0, 1, "mm", 1000.0, "", "o", 0},
+    {RC_EFF_OUTLET_SCALE, "outlet_scale", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 2, 0, 1, "", 0.1, "", "o", 0},
+    {RC_EFF_TRACKER_SCALE, "tracker_scale", 1, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 2, 0, 1, "", 0.01, "", "", 0},
 };
 RC_STATIC_ASSERT(sizeof effect_table / sizeof effect_table[0] == RC_EFF_LAST + 1, effect_table_covers_every_kind);
 
@@ -182,6 +185,12 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
         n = count == 0 ? 3u : count;
         if (n > 4)
             return RC_ERR_ARG;
+    }
+    if ((kind == RC_EFF_OUTLET_OFFSET || kind == RC_EFF_OUTLET_SCALE) && n == 0) {
+        n = 1; /* one per outlet: e and every RC_EFF_OUTLET */
+        for (unsigned i = 0; i < m->n_effects; ++i)
+            if (m->effects[i].kind == RC_EFF_OUTLET && m->effects[i].joint + 1u > n)
+                n = m->effects[i].joint + 1u;
     }
     if (kind == RC_EFF_JOINT_COMPLIANCE && joint != 1 && joint != 2)
         return RC_ERR_ARG; /* gravity lever defined for joints 2 and 3 */
@@ -694,6 +703,14 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         switch ((rc_effect_kind)ef->kind) {
         case RC_EFF_LENGTH_OFFSET: add += x[0]; break;
         case RC_EFF_LENGTH_SCALE: scale += x[0]; break;
+        case RC_EFF_OUTLET_OFFSET:
+            if (s->outlet < ef->count)
+                add += x[s->outlet];
+            break;
+        case RC_EFF_OUTLET_SCALE:
+            if (s->outlet < ef->count)
+                scale += x[s->outlet];
+            break;
         case RC_EFF_TIME_DRIFT: {
             double tp = s->t;
             for (unsigned k = 0; k < ef->count; ++k) {
@@ -759,8 +776,17 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
         case RC_EFF_TRACKER_POSITION: /* another sensor's: no part in a length */
         case RC_EFF_TRACKER_ROTATION:
         case RC_EFF_TRACKER_TARGETS:
+        case RC_EFF_TRACKER_SCALE:
             for (unsigned k = 0; k < ef->count; ++k)
                 J[k] = 0.0;
+            break;
+        case RC_EFF_OUTLET_OFFSET:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = k == s->outlet ? 1.0 : 0.0;
+            break;
+        case RC_EFF_OUTLET_SCALE:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = k == s->outlet ? dist : 0.0;
             break;
         case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
         case RC_EFF_LENGTH_SCALE: J[0] = dist; break;

@@ -70,13 +70,20 @@ typedef enum rc_effect_kind {
     RC_EFF_TRACKER_POSITION = 13, /* a position sensor's frame (laser tracker): the translation T of
                                    p_tracker = R p_base + T; 3 params (x, y, z) mm (lib/rc_sensor.h) */
     RC_EFF_TRACKER_ROTATION = 14, /* its rotation R = exp([w]x), w the rotation vector; 3 params, rad */
-    RC_EFF_TRACKER_TARGETS = 15 /* the targets the tracker sees on the tool: a sample with rc_sample.target
+    RC_EFF_TRACKER_TARGETS = 15, /* the targets the tracker sees on the tool: a sample with rc_sample.target
                                    == k sees flange + R6 (x_k, y_k, z_k); 3 params per target (count =
                                    3 x targets, at most RC_MAX_TARGETS), mm in the flange frame */
+    RC_EFF_OUTLET_OFFSET = 16,  /* l += b_k for samples with rc_sample.outlet == k: each outlet's own zero
+                                   (a display re-zeroed at one outlet, a different cable hook); count
+                                   params, one per outlet (0: 1 + the largest RC_EFF_OUTLET number), mm */
+    RC_EFF_OUTLET_SCALE = 17,   /* l *= 1 + s_k for samples from outlet k (each encoder's own scale, or
+                                   one cable stretched differently); count params as OUTLET_OFFSET */
+    RC_EFF_TRACKER_SCALE = 18   /* the tracker's length scale: p_tracker = (1 + s) (R p_base + T), e.g.
+                                   a wrong air temperature in its refractive index; 1 param, unitless */
 } rc_effect_kind;
 
 /* Last effect kind (for range checks of stored kinds). */
-#define RC_EFF_LAST RC_EFF_TRACKER_TARGETS
+#define RC_EFF_LAST RC_EFF_TRACKER_SCALE
 
 /* Targets a position data set may use (rc_sample.target, RC_EFF_TRACKER_TARGETS). */
 #define RC_MAX_TARGETS 16

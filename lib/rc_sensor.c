@@ -94,7 +94,7 @@ void rc_rotvec_from_matrix(double w[3], const double R[9])
 rc_status rc_sensor_tracker(double *value, double pt[3], double g[3], double *jac, const rc_model *m,
                             const rc_sample *s, const double o6[3], const double R6[9])
 {
-    int tf = -1, rf = -1, kf = -1; /* first parameters of translation, rotation, target */
+    int tf = -1, rf = -1, kf = -1, sf = -1; /* first parameters of translation, rotation, target, scale */
     RC_ASSERT(value != NULL && pt != NULL && g != NULL && m != NULL && s != NULL && o6 != NULL && R6 != NULL);
     if (s->sensor < RC_SENSOR_TRACKER_X || s->sensor > RC_SENSOR_TRACKER_Z)
         return RC_ERR_ARG;
@@ -107,7 +107,10 @@ rc_status rc_sensor_tracker(double *value, double pt[3], double g[3], double *ja
             rf = e->first;
         else if (e->kind == RC_EFF_TRACKER_TARGETS && kf < 0 && 3u * s->target + 3u <= e->count)
             kf = e->first + 3 * s->target;
+        else if (e->kind == RC_EFF_TRACKER_SCALE && sf < 0)
+            sf = e->first;
     }
+    const double k = 1.0 + (sf >= 0 ? m->x[sf] : 0.0); /* the tracker's scale about its origin */
     if (kf < 0)
         return RC_ERR_ARG; /* a target the model does not have */
     const double *t = &m->x[kf];
@@ -117,32 +120,37 @@ rc_status rc_sensor_tracker(double *value, double pt[3], double g[3], double *ja
     if (rf >= 0)
         rc_rotvec_matrix(R, &m->x[rf]);
     double v = 0.0;
-    for (int k = 0; k < 3; ++k) {
-        g[k] = R[3 * c + k];
-        v += g[k] * pt[k];
+    for (int i = 0; i < 3; ++i) {
+        g[i] = R[3 * c + i];
+        v += g[i] * pt[i];
     }
-    *value = v + (tf >= 0 ? m->x[tf + c] : 0.0);
+    const double unscaled = v + (tf >= 0 ? m->x[tf + c] : 0.0);
+    *value = k * unscaled;
+    for (int i = 0; i < 3; ++i)
+        g[i] *= k;
     if (!isfinite(*value))
         return RC_ERR_NUMERIC;
     if (jac == NULL)
         return RC_OK;
     memset(jac, 0, m->n_params * sizeof jac[0]);
+    if (sf >= 0)
+        jac[sf] = unscaled;
     if (tf >= 0)
-        jac[tf + c] = 1.0;
+        jac[tf + c] = k;
     if (rf >= 0) { /* -e_c^T [R pt]x J_l */
         double Rp[3], S[9], J[9];
         for (int r = 0; r < 3; ++r)
             Rp[r] = R[3 * r] * pt[0] + R[3 * r + 1] * pt[1] + R[3 * r + 2] * pt[2];
         skew(S, Rp);
         rc_rotvec_jl(J, &m->x[rf]);
-        for (int k = 0; k < 3; ++k) {
+        for (int j = 0; j < 3; ++j) {
             double sum = 0.0;
             for (int i = 0; i < 3; ++i)
-                sum += S[3 * c + i] * J[3 * i + k];
-            jac[rf + k] = -sum;
+                sum += S[3 * c + i] * J[3 * i + j];
+            jac[rf + j] = -k * sum;
         }
     }
-    for (int k = 0; k < 3; ++k) /* g^T R6 */
-        jac[kf + k] = g[0] * R6[k] + g[1] * R6[3 + k] + g[2] * R6[6 + k];
+    for (int j = 0; j < 3; ++j) /* g^T R6 (g scaled) */
+        jac[kf + j] = g[0] * R6[j] + g[1] * R6[3 + j] + g[2] * R6[6 + j];
     return RC_OK;
 }

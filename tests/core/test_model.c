@@ -140,12 +140,70 @@ static void add_tracker(rc_model *m, rc_rng *g)
         m->x[k] = 40.0 * rc_rng_normal(g);
 }
 
+/* The sensor-side scale effects (issue 31): the tracker's scale about its
+ * origin and each outlet's own offset and scale, against finite differences
+ * and against their formulas. */
+static void test_sensor_scales(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 37);
+    rc_model m = nominal();
+    add_tracker(&m, &g);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TRACKER_SCALE, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TRACKER_SCALE, 0, 0), RC_ERR_ARG); /* one per tracker */
+    m.x[m.n_params - 1] = 40e-6;
+    check_param_jacobian_sensor(&m, &g, 1);
+    rc_model plain = m; /* the scale about the tracker's origin: value = (1 + s) value_unscaled */
+    plain.x[plain.n_params - 1] = 0.0;
+    for (int trial = 0; trial < 10; ++trial) {
+        rc_sample s;
+        memset(&s, 0, sizeof s);
+        random_pose(&s, &g);
+        s.sensor = (uint8_t)(RC_SENSOR_TRACKER_X + trial % 3);
+        double a, b;
+        assert_int_equal(rc_meas(&a, NULL, &m, &s), RC_OK);
+        assert_int_equal(rc_meas(&b, NULL, &plain, &s), RC_OK);
+        assert_true(fabs(a - (1.0 + 40e-6) * b) < 1e-9 * (1.0 + fabs(b)));
+    }
+    rc_model c = nominal(); /* two outlets: e and outlet 2 (numbered as a file may number them) */
+    assert_int_equal(rc_model_add_effect(&c, RC_EFF_OUTLET, 2, 0), RC_OK);
+    c.x[c.n_params - 3] = 900.0;
+    c.x[c.n_params - 2] = -300.0;
+    c.x[c.n_params - 1] = 200.0;
+    assert_int_equal(rc_model_add_effect(&c, RC_EFF_OUTLET_OFFSET, 0, 0), RC_OK);
+    assert_int_equal(c.effects[c.n_effects - 1].count, 3); /* outlets 0..2 */
+    assert_int_equal(rc_model_add_effect(&c, RC_EFF_OUTLET_SCALE, 0, 0), RC_OK);
+    const unsigned off = c.effects[c.n_effects - 2].first, sc = c.effects[c.n_effects - 1].first;
+    for (unsigned k = 0; k < 3; ++k) {
+        c.x[off + k] = 0.1 * (k + 1);
+        c.x[sc + k] = 1e-4 * (k + 1);
+    }
+    rc_model c0 = c;
+    memset(&c0.x[off], 0, 6 * sizeof c0.x[0]);
+    for (int trial = 0; trial < 20; ++trial) {
+        rc_sample s;
+        memset(&s, 0, sizeof s);
+        random_pose(&s, &g);
+        s.outlet = (uint8_t)(trial % 2 ? 2 : 0);
+        double l, l0, jac[RC_MAX_PARAMS];
+        assert_int_equal(rc_meas(&l, jac, &c, &s), RC_OK);
+        assert_int_equal(rc_meas(&l0, NULL, &c0, &s), RC_OK);
+        const unsigned o = s.outlet;
+        assert_true(fabs(l - ((1.0 + c.x[sc + o]) * l0 + c.x[off + o])) < 1e-9 * l0);
+        for (unsigned k = 0; k < 3; ++k) {
+            assert_true(fabs(jac[off + k] - (k == o ? 1.0 : 0.0)) < 1e-12);
+            assert_true(fabs(jac[sc + k] - (k == o ? l0 : 0.0)) < 1e-9 * l0);
+        }
+    }
+}
+
 static void test_tracker_jacobian(void **state)
 {
     (void)state;
     rc_rng g;
     rc_rng_seed(&g, 31);
-    rc_model m = nominal(); /* joint-side, point and length effects beside the tracker (RC_MAX_EFFECTS 8) */
+    rc_model m = nominal(); /* joint-side, point and length effects beside the tracker */
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_COMPLIANCE, 1, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 3, 0), RC_OK);
     assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
@@ -452,7 +510,7 @@ int main(void)
         cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
         cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
         cmocka_unit_test(test_prepared_base),       cmocka_unit_test(test_prepared_effects),
-        cmocka_unit_test(test_wrap_leaves_huge_angles), cmocka_unit_test(test_dh_sensitivity), cmocka_unit_test(test_tracker_jacobian),
+        cmocka_unit_test(test_wrap_leaves_huge_angles), cmocka_unit_test(test_dh_sensitivity), cmocka_unit_test(test_tracker_jacobian), cmocka_unit_test(test_sensor_scales),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
