@@ -1,0 +1,206 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_diagnose_tests.c - the structure tests of `rcal diagnose`: F tests of
+ * held-out residuals against explanatory variables (intercept included),
+ * the groups' one-way ANOVA, Bonferroni over the tests. See rch_diagnose.h. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rch_diagnose_int.h"
+#include "rch_stats.h"
+
+/* ------------------------------------------------------- structure tests */
+
+#define MAXREG 6
+
+/* F test of r (n) against regressors X (n x p, row-major), intercept
+ * included. Nearly collinear regressors are dropped (dof counts the rest). */
+static void test_regress(rch_diagnose_test *t, const char *name, const double *r, const double *X,
+                         unsigned p, size_t n, double alpha_each)
+{
+    double xm[MAXREG] = {0}, rm = 0.0, A[MAXREG * MAXREG] = {0}, b[MAXREG] = {0}, rss0 = 0.0;
+    memset(t, 0, sizeof *t);
+    snprintf(t->name, sizeof t->name, "%s", name);
+    for (size_t i = 0; i < n; ++i) {
+        rm += r[i];
+        for (unsigned k = 0; k < p; ++k)
+            xm[k] += X[i * p + k];
+    }
+    rm /= (double)n;
+    for (unsigned k = 0; k < p; ++k)
+        xm[k] /= (double)n;
+    for (size_t i = 0; i < n; ++i) {
+        const double ri = r[i] - rm;
+        rss0 += ri * ri;
+        for (unsigned k = 0; k < p; ++k) {
+            const double xk = X[i * p + k] - xm[k];
+            b[k] += xk * ri;
+            for (unsigned l = 0; l < p; ++l)
+                A[k * p + l] += xk * (X[i * p + l] - xm[l]);
+        }
+    }
+    /* Cholesky-like elimination with pivot dropping. */
+    unsigned used[MAXREG] = {0}, dof = 0;
+    double amax = 0.0;
+    for (unsigned k = 0; k < p; ++k)
+        if (A[k * p + k] > amax)
+            amax = A[k * p + k];
+    double expl = 0.0;
+    for (unsigned k = 0; k < p; ++k) {
+        const double piv = A[k * p + k];
+        if (!(piv > 1e-10 * amax) || !(piv > 0.0))
+            continue;
+        used[k] = 1;
+        ++dof;
+        expl += b[k] * b[k] / piv;
+        for (unsigned i = k + 1; i < p; ++i) {
+            const double f = A[i * p + k] / piv;
+            b[i] -= f * b[k];
+            for (unsigned l = k + 1; l < p; ++l)
+                A[i * p + l] -= f * A[k * p + l];
+        }
+    }
+    (void)used;
+    const double rss1 = rss0 - expl;
+    t->dof1 = dof;
+    t->dof2 = n > (size_t)dof + 1 ? (unsigned)(n - dof - 1) : 0;
+    if (dof == 0 || t->dof2 == 0 || !(rss0 > 0.0)) {
+        t->p_value = 1.0;
+        return;
+    }
+    t->r2 = expl / rss0;
+    t->f_stat = (expl / dof) / ((rss1 > 0.0 ? rss1 : 1e-300) / t->dof2);
+    t->p_value = rch_f_sf(t->f_stat, dof, t->dof2);
+    t->significant = t->p_value < alpha_each;
+}
+
+static void test_bias(rch_diagnose_test *t, const double *r, size_t n, double alpha_each)
+{
+    double m = 0.0, ss = 0.0;
+    memset(t, 0, sizeof *t);
+    snprintf(t->name, sizeof t->name, "bias (mean residual)");
+    for (size_t i = 0; i < n; ++i)
+        m += r[i];
+    m /= (double)n;
+    for (size_t i = 0; i < n; ++i)
+        ss += (r[i] - m) * (r[i] - m);
+    t->dof1 = 1;
+    t->dof2 = n > 1 ? (unsigned)(n - 1) : 0;
+    const double tot = ss + (double)n * m * m;
+    if (t->dof2 == 0 || !(ss > 0.0)) {
+        t->p_value = 1.0;
+        return;
+    }
+    t->r2 = (double)n * m * m / tot;
+    t->f_stat = (double)n * m * m / (ss / t->dof2);
+    t->p_value = rch_f_sf(t->f_stat, 1.0, t->dof2);
+    t->significant = t->p_value < alpha_each;
+}
+
+static void test_groups(rch_diagnose_test *t, const double *r, const rc_sample *s, size_t n,
+                        unsigned n_groups, double alpha_each)
+{
+    double *sum = calloc(n_groups, sizeof *sum);
+    size_t *cnt = calloc(n_groups, sizeof *cnt);
+    memset(t, 0, sizeof *t);
+    snprintf(t->name, sizeof t->name, "groups (ANOVA)");
+    t->p_value = 1.0;
+    if (!sum || !cnt) {
+        free(sum);
+        free(cnt);
+        return;
+    }
+    double m = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        sum[s[i].group] += r[i];
+        cnt[s[i].group]++;
+        m += r[i];
+    }
+    m /= (double)n;
+    unsigned g_used = 0;
+    double ssb = 0.0, ssw = 0.0;
+    for (unsigned g = 0; g < n_groups; ++g)
+        if (cnt[g]) {
+            ++g_used;
+            const double gm = sum[g] / (double)cnt[g];
+            ssb += (double)cnt[g] * (gm - m) * (gm - m);
+        }
+    for (size_t i = 0; i < n; ++i) {
+        const double gm = sum[s[i].group] / (double)cnt[s[i].group];
+        ssw += (r[i] - gm) * (r[i] - gm);
+    }
+    free(sum);
+    free(cnt);
+    if (g_used < 2 || n <= g_used || !(ssw > 0.0))
+        return;
+    t->dof1 = g_used - 1;
+    t->dof2 = (unsigned)(n - g_used);
+    t->r2 = ssb / (ssb + ssw);
+    t->f_stat = (ssb / t->dof1) / (ssw / t->dof2);
+    t->p_value = rch_f_sf(t->f_stat, t->dof1, t->dof2);
+    t->significant = t->p_value < alpha_each;
+}
+
+unsigned rch_dg_groups_usable(unsigned n_groups, size_t n) { return n_groups >= 2 && (size_t)n_groups * 3 <= n; }
+
+/* All structure tests of residuals r (n). Returns the number of tests. */
+unsigned rch_dg_structure_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
+                                const double (*var)[V_N], unsigned n_groups, double alpha)
+{
+    const unsigned n_tests = 12 + rch_dg_groups_usable(n_groups, n);
+    const double a_each = alpha / n_tests;
+    double *X = malloc((n ? n : 1) * MAXREG * sizeof *X);
+    unsigned k = 0;
+    if (!X)
+        return 0;
+    test_bias(&out[k++], r, n, a_each);
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        char name[40];
+        for (size_t i = 0; i < n; ++i) {
+            const double q = s[i].q_rad[j];
+            X[i * 4 + 0] = sin(q);
+            X[i * 4 + 1] = cos(q);
+            X[i * 4 + 2] = sin(2.0 * q);
+            X[i * 4 + 3] = cos(2.0 * q);
+        }
+        snprintf(name, sizeof name, "q%u harmonics (1st, 2nd)", j + 1);
+        test_regress(&out[k++], name, r, X, 4, n, a_each);
+    }
+    for (size_t i = 0; i < n; ++i)
+        X[i] = var[i][V_LEV2];
+    test_regress(&out[k++], "gravity lever j2", r, X, 1, n, a_each);
+    for (size_t i = 0; i < n; ++i)
+        X[i] = var[i][V_LEV3];
+    test_regress(&out[k++], "gravity lever j3", r, X, 1, n, a_each);
+    /* cable length: a smooth shape, not only a slope (a sensor's bow, a drum
+     * turn): u, u^2, u^3, sin and cos of 2 pi u, u the length scaled to [0, 1] */
+    double lmin = 1e300, lmax = -1e300;
+    for (size_t i = 0; i < n; ++i) {
+        lmin = var[i][V_LEN] < lmin ? var[i][V_LEN] : lmin;
+        lmax = var[i][V_LEN] > lmax ? var[i][V_LEN] : lmax;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double u = lmax > lmin ? (var[i][V_LEN] - lmin) / (lmax - lmin) : 0.0;
+        X[i * 5 + 0] = u;
+        X[i * 5 + 1] = u * u;
+        X[i * 5 + 2] = u * u * u;
+        X[i * 5 + 3] = sin(2.0 * M_PI * u);
+        X[i * 5 + 4] = cos(2.0 * M_PI * u);
+    }
+    test_regress(&out[k++], "cable length", r, X, 5, n, a_each);
+    for (size_t i = 0; i < n; ++i) {
+        X[i * 3 + 0] = var[i][V_UX];
+        X[i * 3 + 1] = var[i][V_UY];
+        X[i * 3 + 2] = var[i][V_UZ];
+    }
+    test_regress(&out[k++], "cable direction", r, X, 3, n, a_each);
+    for (size_t i = 0; i < n; ++i) {
+        X[i * 2 + 0] = var[i][V_T];
+        X[i * 2 + 1] = var[i][V_T] * var[i][V_T];
+    }
+    test_regress(&out[k++], "acquisition order (t, t^2)", r, X, 2, n, a_each);
+    if (rch_dg_groups_usable(n_groups, n))
+        test_groups(&out[k++], r, s, n, n_groups, a_each);
+    free(X);
+    return k;
+}
