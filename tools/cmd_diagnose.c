@@ -111,15 +111,28 @@ static int report(rch_diagnose_result *r, const char *plots, const char *const i
 int rcal_cmd_diagnose(int argc, char **argv)
 {
     const char *const default_robot = RCAL_DEFAULT_ROBOT;
-    const char *data_path = NULL, *robot_path = default_robot, *plots = NULL, *out_path = NULL, *resid = NULL,
-               *report_path = NULL;
+    const char *robot_path = default_robot, *plots = NULL, *out_path = NULL, *resid = NULL, *report_path = NULL,
+               *effects = NULL;
+    rch_opt_strs data, positions;
+    memset(&data, 0, sizeof data);
+    memset(&positions, 0, sizeof positions);
     unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0, verbosity = 0;
     int json = 0, verbose = 0;
     rch_diagnose_cfg cfg;
     memset(&cfg, 0, sizeof cfg);
     rch_cmdspec spec;
     const rch_opt opts[] = {
-        {"--data", RCH_OPT_STR, &data_path, 0, 0, "FILE", "measurements CSV", RCH_OPT_REQUIRED, NULL},
+        {"--data", RCH_OPT_STRS, &data, 0, 0, "FILE",
+         "cable lengths: CSV with q1..q6 (deg) and L (mm), optional outlet; several --data are merged", 0, NULL},
+        {"--positions", RCH_OPT_STRS, &positions, 0, 0, "FILE",
+         "laser-tracker positions: CSV with q1..q6 (deg), x, y, z (mm, tracker frame), optional target, pose; "
+         "several are merged, mixable with --data",
+         0, NULL},
+        {"--effects", RCH_OPT_STR, &effects, 0, 0, "LIST",
+         "effects already known (as rcal calibrate --effects names them): fitted from the start, never offered again",
+         0, NULL},
+        {"--jumps", RCH_OPT_FLAG, &cfg.jumps, 0, 0, NULL,
+         "length jumps found are removed as nuisance even at a set-up change (rcal calibrate --jumps)", 0, NULL},
         {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL", "nominal robot model", 0, NULL},
         {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "fold assignment seed", 0, NULL},
         {"--folds", RCH_OPT_UINT, &folds, 2, RCH_DIAGNOSE_MAX_FOLDS, "K", "cross-validation folds", 0, NULL},
@@ -162,24 +175,51 @@ int rcal_cmd_diagnose(int argc, char **argv)
     cfg.max_iter = (unsigned)max_iter;
     cfg.verbose = verbosity > 0 ? (int)verbosity : verbose;
 
+    const char *ins[2 * RCH_OPT_MAX_STRS + 1];
+    size_t n_ins = 0;
+    for (size_t k = 0; k < data.n; ++k)
+        ins[n_ins++] = data.v[k];
+    for (size_t k = 0; k < positions.n; ++k)
+        ins[n_ins++] = positions.v[k];
+    ins[n_ins++] = robot_path;
+    if (data.n + positions.n == 0) {
+        fprintf(stderr, "rcal diagnose: give --data FILE (cable lengths) or --positions FILE (tracker), or both\n");
+        return 2;
+    }
+    const int one_file = data.n == 1 && positions.n == 0; /* --residuals and --report read it again */
+    if (!one_file && (resid || report_path)) {
+        fprintf(stderr, "rcal diagnose: --residuals and --report take one --data file (no --positions) for now; "
+                        "the diagnosis itself takes them all\n");
+        return 2;
+    }
     {   /* outputs that name each other or an input: refused before the work */
-        const char *const outs[3] = {out_path, resid, report_path}, *const ins[2] = {data_path, robot_path};
+        const char *const outs[3] = {out_path, resid, report_path};
         static const char *const what[3] = {"--out", "--residuals", "--report"};
-        if (rcal_outputs_check("diagnose", outs, what, 3, report_path, ins, 2) != 0)
+        if (rcal_outputs_check("diagnose", outs, what, 3, report_path, ins, n_ins) != 0)
             return 2;
     }
+    rch_diagnose_in in;
+    memset(&in, 0, sizeof in);
+    in.data_paths = data.v;
+    in.n_data = data.n;
+    in.positions_paths = positions.v;
+    in.n_positions = positions.n;
+    in.robot_path = robot_path;
+    in.robot_given = robot_path != default_robot;
+    in.effects = effects;
     rch_diagnose_result r;
     rch_diag d;
     char msg[1024];
-    if (rch_diagnose_file(&r, data_path, robot_path, &cfg, &d) != 0) {
+    if (rch_diagnose_inputs(&r, &in, &cfg, &d) != 0) {
         fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
         rch_diagnose_free(&r);
         return 1;
     }
-    const char *inputs[2] = {data_path, robot_path};
+    const char *data_path = data.n ? data.v[0] : NULL;
+    const char *inputs[2] = {data_path ? data_path : positions.v[0], robot_path};
     int rc = report(&r, plots, inputs, robot_path != default_robot, json, argc, argv);
     if (rc == 0 && out_path) {
-        if (rch_diagnose_save_model(&r, data_path, robot_path, out_path, inputs, 2, &d) != 0) {
+        if (rch_diagnose_save_model(&r, data_path, robot_path, out_path, ins, n_ins, &d) != 0) {
             fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
             rc = 1;
         } else if (!json) {

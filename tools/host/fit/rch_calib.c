@@ -1043,6 +1043,11 @@ static size_t split(size_t *idx, const rc_sample *s, size_t n, double fraction, 
 {
     size_t want = (size_t)floor(fraction * (double)n + 0.5);
     rch_split(idx, n, seed);
+    if (rch_pos_count_tracker(s, n) > 0 && want == 0) { /* all rows train: in file order (a row's x, y, z together) */
+        for (size_t i = 0; i < n; ++i)
+            idx[i] = i;
+        return 0;
+    }
     if (rch_pos_count_tracker(s, n) > 0 && want > 0)
         return rch_pos_split(idx, s, n, want); /* a tracker pose whole on one side (not by set-up group) */
     if (!by_group || want == 0)

@@ -48,7 +48,7 @@ int rch_dg_fit(rc_model *m, rc_solve_result *res, ctx *c, const uint8_t *fixed, 
     memset(&cfg, 0, sizeof cfg);
     cfg.method = RC_METHOD_LM;
     cfg.max_iter = fixed || s == c->s ? 200u : c->max_iter; /* cold starts converge fully */
-    cfg.fixed = fixed;
+    cfg.fixed = fixed ? fixed : c->have_fixed ? c->fixed0 : NULL;
     return rc_solve(m, res ? res : &tmp, c->w, &cfg, s, n) == RC_OK ? 0 : -1;
 }
 
@@ -171,6 +171,9 @@ static void report_params(rch_diagnose_result *r, const rc_model *fold_models, u
     for (unsigned e = 0; e < m->n_effects; ++e) {
         const rc_effect *ef = &m->effects[e];
         const rc_effect_kind kind = (rc_effect_kind)ef->kind;
+        const rc_effect_desc *ds = rc_effect_describe(kind);
+        if (ds && (ds->side == RC_SIDE_OUTLET || ds->side == RC_SIDE_SENSOR) && kind != RC_EFF_TRACKER_SCALE)
+            continue; /* where the sensors stand: not an effect found */
         if (kind == RC_EFF_GROUP_OFFSET) {
             /* summarise: common level (trades with the geometry) and the
              * spread between set-ups (what the groups really differ by) */
@@ -195,7 +198,7 @@ static void report_params(rch_diagnose_result *r, const rc_model *fold_models, u
             } else if (kind == RC_EFF_JOINT_COMPLIANCE) {
                 scale = 1e3 / DEG;
                 unit = "mdeg/m";
-            } else if (kind == RC_EFF_LENGTH_SCALE) {
+            } else if (kind == RC_EFF_LENGTH_SCALE || kind == RC_EFF_OUTLET_SCALE || kind == RC_EFF_TRACKER_SCALE) {
                 scale = 1e6;
                 unit = "ppm";
             } else if (kind == RC_EFF_LENGTH_PERIODIC) {
@@ -259,6 +262,8 @@ static void run_free(run_state *S)
     free(S->tmp);
     free(S->var);
     free(S->order);
+    free(S->cls);
+    free(S->c.pose);
     free(S->base_folds);
     free(S->cand_folds);
     free(S->cand_full);
@@ -286,9 +291,9 @@ static int phase_setup(run_state *S, rch_diagnose_result *out, const rc_sample *
         rch_diag_set(d, "", 0, 0, "folds must be within 2..%d", RCH_DIAGNOSE_MAX_FOLDS);
         return -1;
     }
-    if (n < 10u * cfg->folds || n < 60) {
-        rch_diag_set(d, "", 0, 0, "%zu samples are too few to diagnose (need at least %u)", n,
-                     10u * cfg->folds > 60 ? 10u * cfg->folds : 60u);
+    if (n < 10u * cfg->folds) {
+        rch_diag_set(d, "", 0, 0, "%zu residual rows are too few to diagnose with %u folds (need at least %u)", n,
+                     cfg->folds, 10u * cfg->folds);
         return -1;
     }
     out->n = n;
@@ -303,12 +308,14 @@ static int phase_setup(run_state *S, rch_diagnose_result *out, const rc_sample *
     S->tmp = calloc(n * RC_NJ, sizeof *S->tmp);
     S->var = calloc(n, sizeof *S->var);
     S->order = calloc(n, sizeof *S->order);
+    S->cls = calloc(n, 1);
+    S->c.pose = calloc(n, sizeof *S->c.pose);
     S->base_folds = calloc(cfg->folds, sizeof *S->base_folds);
     S->cand_folds = calloc((size_t)RCH_DG_N_CANDS * cfg->folds, sizeof *S->cand_folds);
     S->cand_full = calloc(RCH_DG_N_CANDS, sizeof *S->cand_full);
     S->cand_res = calloc(RCH_DG_N_CANDS * n, sizeof *S->cand_res);
     if (!out->s || !out->res_before_mm || !out->res_after_mm || !out->floor_mm || !S->c.w || !S->c.fold ||
-        !S->r0 || !S->tmp || !S->var || !S->order || !S->base_folds || !S->cand_folds || !S->cand_full ||
+        !S->r0 || !S->tmp || !S->var || !S->order || !S->cls || !S->c.pose || !S->base_folds || !S->cand_folds || !S->cand_full ||
         !S->cand_res) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
@@ -319,6 +326,82 @@ static int phase_setup(run_state *S, rch_diagnose_result *out, const rc_sample *
     S->c.k = cfg->folds;
     S->c.max_iter = cfg->max_iter ? cfg->max_iter : 100u;
     S->c.verbose = cfg->verbose;
+    return 0;
+}
+
+typedef struct {
+    const rc_sample *s;
+    size_t i;
+} pose_key;
+
+static int cmp_pose(const void *a, const void *b)
+{
+    const pose_key *x = a, *y = b;
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        if (x->s->q_rad[j] != y->s->q_rad[j])
+            return x->s->q_rad[j] < y->s->q_rad[j] ? -1 : 1;
+    return (x->i > y->i) - (x->i < y->i);
+}
+
+/* The poses (samples with the same joint readings: the outlets and targets
+ * of one pose, numbered by first appearance) and each sample's sensor: the
+ * tracker, or the cable outlet it was measured from. 0 or -1 (memory). */
+static int phase_sensors(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    const size_t n = out->n;
+    pose_key *k = malloc((n ? n : 1) * sizeof *k);
+    size_t *first = malloc((n ? n : 1) * sizeof *first);
+    if (!k || !first) {
+        free(k);
+        free(first);
+        return -1;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        k[i].s = &out->s[i];
+        k[i].i = i;
+    }
+    qsort(k, n, sizeof *k, cmp_pose);
+    for (size_t a = 0, b; a < n; a = b) { /* a run of equal joints: its first sample in file order */
+        for (b = a + 1; b < n && memcmp(k[b].s->q_rad, k[a].s->q_rad, sizeof k[a].s->q_rad) == 0; ++b)
+            ;
+        for (size_t j = a; j < b; ++j)
+            first[k[j].i] = k[a].i;
+    }
+    size_t next = 0;
+    for (size_t i = 0; i < n; ++i)
+        S->c.pose[i] = first[i] == i ? (unsigned)next++ : S->c.pose[first[i]];
+    S->c.n_poses = out->n_poses = next;
+    free(k);
+    free(first);
+    int slot[RC_MAX_OUTLETS + 1];
+    for (unsigned j = 0; j <= RC_MAX_OUTLETS; ++j)
+        slot[j] = -1;
+    for (size_t i = 0; i < n; ++i) {
+        const int tr = out->s[i].sensor != RC_SENSOR_LENGTH;
+        const unsigned key = tr ? RC_MAX_OUTLETS : out->s[i].outlet % RC_MAX_OUTLETS;
+        if (slot[key] < 0 && out->n_sensors < RCH_DIAGNOSE_MAX_SENSORS) {
+            rch_diagnose_sensor *z = &out->sensors[out->n_sensors];
+            z->tracker = tr;
+            z->label = tr ? 0u : key;
+            slot[key] = (int)out->n_sensors++;
+        }
+        S->cls[i] = (uint8_t)(slot[key] < 0 ? 0 : slot[key]);
+        out->sensors[S->cls[i]].rows++;
+        out->n_tracker += (size_t)tr;
+        out->n_cable += (size_t)!tr;
+    }
+    for (unsigned j = 0; j < out->n_sensors; ++j) {
+        rch_diagnose_sensor *z = &out->sensors[j];
+        if (z->tracker) {
+            z->rows /= 3;
+            snprintf(z->name, sizeof z->name, "tracker");
+        } else if (out->n_sensors - (out->n_tracker > 0) > 1) {
+            snprintf(z->name, sizeof z->name, "cable outlet %u", z->label);
+        } else {
+            snprintf(z->name, sizeof z->name, "cable");
+        }
+    }
     return 0;
 }
 
@@ -339,11 +422,13 @@ static void phase_steps(run_state *S)
     out->q_step_deg = S->cfg.q_step_deg > 0.0   ? S->cfg.q_step_deg
                       : S->cfg.q_step_deg < 0.0 ? 0.0
                                                 : rch_dequant_detect_step(S->tmp, n * RC_NJ);
+    size_t nl = 0; /* the lengths' step (a tracker's coordinates have none) */
     for (size_t i = 0; i < n; ++i)
-        S->tmp[i] = out->s[i].len_mm;
+        if (out->s[i].sensor == RC_SENSOR_LENGTH)
+            S->tmp[nl++] = out->s[i].len_mm;
     out->len_step_mm = S->cfg.len_step_mm > 0.0   ? S->cfg.len_step_mm
-                       : S->cfg.len_step_mm < 0.0 ? 0.0
-                                                  : rch_dequant_detect_step(S->tmp, n);
+                       : S->cfg.len_step_mm < 0.0 || nl == 0 ? 0.0
+                                                             : rch_dequant_detect_step(S->tmp, nl);
     out->len_noise_mm = S->cfg.len_noise_mm > 0.0 ? S->cfg.len_noise_mm : 0.0;
     if (!S->cfg.groups_given)
         out->n_groups = rch_groups_by_wrist(out->s, n, out->q_step_deg, &out->n_flicker);
@@ -356,10 +441,32 @@ static int phase_geometry(run_state *S, const rc_model *nominal, rch_diag *d)
     rch_diagnose_result *out = S->out;
     rc_model geometry = *nominal;
     rc_solve_result res;
-    geometry.n_effects = 0;
-    geometry.n_params = RC_N_BASE;
+    if (!S->cfg.keep_effects) {
+        geometry.n_effects = 0;
+        geometry.n_params = RC_N_BASE;
+    }
+    for (unsigned e = 0; e < geometry.n_effects; ++e) {
+        const rc_effect_desc *ds = rc_effect_describe(geometry.effects[e].kind);
+        if (ds && ds->side != RC_SIDE_OUTLET && ds->side != RC_SIDE_SENSOR)
+            out->n_known++;
+    }
     if (rch_calib_bc(&out->geo, S->c.w, &geometry, S->cfg.have_encoder, out->s, out->n, d) != 0)
         return -1;
+    memset(S->c.fixed0, 0, sizeof S->c.fixed0); /* what no sample sees: an encoder without lengths, a target unseen */
+    rch_pos_fix_unseen(S->c.fixed0, &out->geo, out->s, out->n);
+    unsigned n_free = 0;
+    for (unsigned k = 0; k < out->geo.n_params; ++k) {
+        S->c.have_fixed |= S->c.fixed0[k];
+        n_free += !S->c.fixed0[k];
+    }
+    const size_t need = 2u * n_free + 6u > 10u * S->cfg.folds ? 2u * n_free + 6u : 10u * S->cfg.folds;
+    if (out->n < need || out->n_poses < 2u * S->cfg.folds) {
+        rch_diag_set(d, "", 0, 0,
+                     "%zu residual rows of %zu poses are too few to diagnose %u free parameters with %u folds (need at "
+                     "least %zu rows, twice the parameters and 6 more, and %u poses)",
+                     out->n, out->n_poses, n_free, S->cfg.folds, need, 2u * S->cfg.folds);
+        return -1;
+    }
     if (rch_dg_fit(&out->geo, &res, &S->c, NULL, out->s, out->n) != 0) {
         rch_diag_set(d, "", 0, 0, "the geometric fit failed");
         return -1;
@@ -384,24 +491,38 @@ static int phase_floor(run_state *S, rch_diag *d)
     for (size_t i = 0; i < n; ++i) {
         double l, p[3], u[3], nu = 0.0, sq = 0.0;
         if (rc_meas(&l, jac, g, &out->s[i]) != RC_OK) {
-            rch_diag_set(d, "", 0, 0, "sample %zu: the flange meets the encoder outlet", i + 1);
+            rch_diag_set(d, "", 0, 0, "sample %zu: the model cannot predict it (the flange at an outlet)", i + 1);
             return -1;
         }
         for (unsigned j = 0; j < RC_NJ; ++j)
             sq += jac[RC_P_THETA(j)] * jac[RC_P_THETA(j)];
-        const double viq = sq * qs * qs / 12.0, vil = ls * ls / 12.0 + ln * ln;
+        const int tracker = out->s[i].sensor != RC_SENSOR_LENGTH;
+        const double viq = sq * qs * qs / 12.0, vil = tracker ? 0.0 : ls * ls / 12.0 + ln * ln;
         out->floor_mm[i] = sqrt(viq + vil);
         vq += viq;
         vl += vil;
-        rc_fk(p, NULL, g, out->s[i].q_rad);
-        for (unsigned k = 0; k < 3; ++k) {
-            u[k] = p[k] - g->x[RC_P_ENC + k];
-            nu += u[k] * u[k];
+        if (tracker) { /* the position in the tracker's frame: its distance and direction from the tracker */
+            for (unsigned k = 0; k < 3; ++k) {
+                rc_sample c = out->s[i];
+                c.sensor = (uint8_t)(RC_SENSOR_TRACKER_X + k);
+                if (rc_meas(&u[k], NULL, g, &c) != RC_OK)
+                    u[k] = 0.0;
+            }
+        } else {
+            const double *e = &g->x[RC_P_ENC];
+            for (unsigned k = 0; out->s[i].outlet && k < g->n_effects; ++k)
+                if (g->effects[k].kind == RC_EFF_OUTLET && g->effects[k].joint == out->s[i].outlet)
+                    e = &g->x[g->effects[k].first];
+            rc_fk(p, NULL, g, out->s[i].q_rad);
+            for (unsigned k = 0; k < 3; ++k)
+                u[k] = p[k] - e[k];
         }
-        nu = sqrt(nu);
+        for (unsigned k = 0; k < 3; ++k)
+            nu += u[k] * u[k];
+        nu = nu > 0.0 ? sqrt(nu) : 1.0;
         S->var[i][V_LEV2] = rc_gravity_lever_m((const double(*)[4])ref, 1, out->s[i].q_rad);
         S->var[i][V_LEV3] = rc_gravity_lever_m((const double(*)[4])ref, 2, out->s[i].q_rad);
-        S->var[i][V_LEN] = out->s[i].len_mm;
+        S->var[i][V_LEN] = tracker ? nu : out->s[i].len_mm;
         S->var[i][V_UX] = u[0] / nu;
         S->var[i][V_UY] = u[1] / nu;
         S->var[i][V_UZ] = u[2] / nu;
@@ -424,43 +545,51 @@ static void shuffle(unsigned *v, size_t n, rc_rng *rng)
     }
 }
 
-/* Fold of every sample: the groups in shuffled order, within each group the
- * samples in shuffled order, dealt round-robin (the counter runs on across
- * groups). 0 or -1 (out of memory). */
+/* Fold of every sample: the groups in shuffled order, within each group its
+ * poses in shuffled order, dealt round-robin (the counter runs on across
+ * groups); every sample of a pose (its outlets, its targets' coordinates) in
+ * its pose's fold. 0 or -1 (out of memory). */
 static int assign_folds(run_state *S)
 {
     const rch_diagnose_result *out = S->out;
-    const size_t n = out->n;
+    const size_t n = out->n, np = S->c.n_poses;
     const unsigned ng = out->n_groups;
     rc_rng rng;
     rc_rng_seed(&rng, S->cfg.seed ^ 0x6469616700000000ull);
-    for (size_t i = 0; i < n; ++i)
-        S->order[i] = (unsigned)i;
-    shuffle(S->order, n, &rng);
-    unsigned *gorder = calloc(ng ? ng : 1, sizeof *gorder), *byg = calloc(n ? n : 1, sizeof *byg);
+    for (size_t p = 0; p < np; ++p)
+        S->order[p] = (unsigned)p;
+    shuffle(S->order, np, &rng);
+    unsigned *gorder = calloc(ng ? ng : 1, sizeof *gorder), *byg = calloc(np ? np : 1, sizeof *byg);
+    unsigned *pgroup = calloc(np ? np : 1, sizeof *pgroup), *pfold = calloc(np ? np : 1, sizeof *pfold);
     size_t *start = calloc((size_t)ng + 1, sizeof *start), *pos = calloc(ng ? ng : 1, sizeof *pos);
     int rc = -1;
-    if (!gorder || !byg || !start || !pos)
+    if (!gorder || !byg || !pgroup || !pfold || !start || !pos)
         goto done;
+    for (size_t i = n; i-- > 0;) /* a pose's group: its first sample's */
+        pgroup[S->c.pose[i]] = out->s[i].group < ng ? out->s[i].group : 0u;
     for (unsigned g = 0; g < ng; ++g)
         gorder[g] = g;
     shuffle(gorder, ng, &rng);
-    for (size_t i = 0; i < n; ++i) /* bucket the samples by group, in shuffled order */
-        start[out->s[i].group + 1]++;
+    for (size_t p = 0; p < np; ++p) /* bucket the poses by group, in shuffled order */
+        start[pgroup[p] + 1]++;
     for (unsigned g = 0; g < ng; ++g)
         start[g + 1] += start[g];
-    for (size_t i = 0; i < n; ++i) {
-        const unsigned s = S->order[i], g = out->s[s].group;
-        byg[start[g] + pos[g]++] = s;
+    for (size_t p = 0; p < np; ++p) {
+        const unsigned q = S->order[p], g = pgroup[q];
+        byg[start[g] + pos[g]++] = q;
     }
     unsigned counter = 0;
     for (unsigned gi = 0; gi < ng; ++gi)
         for (size_t p = start[gorder[gi]]; p < start[gorder[gi] + 1]; ++p)
-            S->c.fold[byg[p]] = counter++ % S->c.k;
+            pfold[byg[p]] = counter++ % S->c.k;
+    for (size_t i = 0; i < n; ++i) /* every sample of a pose in its pose's fold */
+        S->c.fold[i] = pfold[S->c.pose[i]];
     rc = 0;
 done:
     free(gorder);
     free(byg);
+    free(pgroup);
+    free(pfold);
     free(start);
     free(pos);
     return rc;
@@ -504,7 +633,7 @@ static int phase_cv_geometry(run_state *S, rch_diag *d)
     }
     memcpy(out->res_before_mm, S->r0, n * sizeof *S->r0);
     out->rmse_before_mm = rch_rms(S->r0, n);
-    out->n_tests = rch_dg_structure_tests(out->before, S->r0, out->s, n, (const double(*)[V_N])S->var, out->n_groups,
+    out->n_tests = rch_dg_sensor_tests(out->before, S->r0, out->s, n, (const double(*)[V_N])S->var, out->n_groups,
                                    S->cfg.alpha);
     if (S->cfg.verbose)
         fprintf(stderr, "diagnose: geometry held-out RMSE %.4f mm, floor %.4f mm\n", out->rmse_before_mm,
@@ -568,8 +697,8 @@ static int phase_jumps(run_state *S, rch_diag *d)
     rch_diagnose_result *out = S->out;
     const size_t n = out->n;
     char err[256];
-    if (S->cfg.no_jumps)
-        return 0;
+    if (S->cfg.no_jumps || out->n_tracker > 0)
+        return 0; /* a tracker's coordinates do not jump like a display's count */
     for (size_t i = 1; i < n; ++i)
         if (out->s[i].t < out->s[i - 1].t)
             return 0; /* not in acquisition order: no change points to look for */
@@ -596,8 +725,8 @@ static int phase_jumps(run_state *S, rch_diag *d)
         for (size_t i = a >= 3 ? a - 3 : 1; i <= a + 2 && i < n; ++i)
             single &= out->s[i].group != out->s[i - 1].group;
         const int big_alone = near && single && fabs(out->jumps.size_mm[k]) > 8.0 * out->jumps.rms_after_mm;
-        inside += big_alone || (!near && sharp_step(&out->jumps.geometry, out->s, n, a, out->jumps.size_mm[k]));
-        out->jumps_at_setup_change += (unsigned)(near && !big_alone);
+        inside += S->cfg.jumps || big_alone || (!near && sharp_step(&out->jumps.geometry, out->s, n, a, out->jumps.size_mm[k]));
+        out->jumps_at_setup_change += (unsigned)(near && !big_alone && !S->cfg.jumps);
     }
     if (inside == 0) {
         out->jumps_confounded = out->jumps.n_jumps;
@@ -634,7 +763,7 @@ static void phase_after(run_state *S)
     int unexpl = 0;
     memcpy(out->res_after_mm, S->r0, out->n * sizeof *S->r0);
     out->rmse_after_mm = rch_rms(S->r0, out->n);
-    rch_dg_structure_tests(out->after, S->r0, out->s, out->n, (const double(*)[V_N])S->var, out->n_groups, S->cfg.alpha);
+    rch_dg_sensor_tests(out->after, S->r0, out->s, out->n, (const double(*)[V_N])S->var, out->n_groups, S->cfg.alpha);
     out->remaining_why[0] = '\0';
     /* Structure decides, not the size of the residual: residuals with no
      * significant structure against any explanatory variable are noise,
@@ -665,6 +794,27 @@ static void phase_after(run_state *S)
     }
 }
 
+/* Per sensor: held-out RMS before and after and the floor (3-D for the
+ * tracker: the root of the mean squared distance over its position rows). */
+static void sensor_figures(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    double b[RCH_DIAGNOSE_MAX_SENSORS] = {0}, a[RCH_DIAGNOSE_MAX_SENSORS] = {0}, f[RCH_DIAGNOSE_MAX_SENSORS] = {0};
+    for (size_t i = 0; i < out->n; ++i) {
+        const unsigned k = S->cls[i];
+        b[k] += out->res_before_mm[i] * out->res_before_mm[i];
+        a[k] += out->res_after_mm[i] * out->res_after_mm[i];
+        f[k] += out->floor_mm[i] * out->floor_mm[i];
+    }
+    for (unsigned k = 0; k < out->n_sensors; ++k) {
+        rch_diagnose_sensor *z = &out->sensors[k];
+        const double rows = z->rows ? (double)z->rows : 1.0;
+        z->before_mm = sqrt(b[k] / rows);
+        z->after_mm = sqrt(a[k] / rows);
+        z->floor_mm = sqrt(f[k] / rows);
+    }
+}
+
 /* 7. Effect parameters (fold jackknife), the effects' size, and the notes on
  * what cable lengths cannot identify. */
 static void phase_report(run_state *S)
@@ -682,7 +832,8 @@ static void phase_report(run_state *S)
             s2 += (la - lb) * (la - lb);
     }
     out->effect_rms_mm = sqrt(s2 / (double)out->n);
-    scale_note(out);
+    if (out->n_tracker == 0 && out->n_sensors == 1)
+        scale_note(out); /* one outlet: the encoder scale against the robot's size */
     for (unsigned st = 0; st < out->n_steps; ++st)
         for (unsigned k = 0; k < out->steps[st].n_cand; ++k) {
             const rch_diagnose_cand *ca = &out->steps[st].cand[k];
@@ -704,6 +855,10 @@ int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t 
     memset(out, 0, sizeof *out);
     memset(&S, 0, sizeof S);
     int rc = phase_setup(&S, out, samples, n, cfg, d);
+    if (rc == 0 && phase_sensors(&S) != 0) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        rc = -1;
+    }
     if (rc == 0) {
         phase_steps(&S);
         rc = phase_geometry(&S, nominal, d);
@@ -719,70 +874,11 @@ int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t 
     if (rc == 0) {
         rch_dg_phase_search(&S);
         phase_after(&S);
+        sensor_figures(&S);
         phase_report(&S);
     }
     out->time_ms = now_ms() - t0;
     run_free(&S);
-    return rc;
-}
-
-int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const char *robot_path,
-                      const rch_diagnose_cfg *cfg, rch_diag *d)
-{
-    memset(out, 0, sizeof *out);
-    rch_robot robot;
-    rch_data data;
-    if (rch_robot_load(&robot, robot_path, d) != 0 || rch_data_load_limited(&data, data_path, 0, &robot.model, d) != 0)
-        return -1;
-    rch_diagnose_cfg c = *cfg;
-    c.groups_given = data.has_group;
-    c.have_encoder = robot.has_encoder;
-    rch_dequant_result dq;
-    memset(&dq, 0, sizeof dq);
-    if (cfg->dequantize) {
-        /* set-ups from the wrist angles as recorded (on the display grid), before they are recovered */
-        if (!c.groups_given) {
-            double *q = calloc(data.n * 3 + 1, sizeof *q);
-            double step = 0.0;
-            for (size_t i = 0; q && i < data.n; ++i)
-                for (unsigned j = 0; j < 3; ++j)
-                    q[i * 3 + j] = data.s[i].q_rad[3 + j] / DEG;
-            if (q)
-                step = rch_dequant_detect_step(q, data.n * 3);
-            free(q);
-            rch_groups_by_wrist(data.s, data.n, step, NULL);
-            c.groups_given = 1;
-        }
-        uint8_t *bad = data.xyz ? calloc(data.n + 1, 1) : NULL;
-        if (!bad) {
-            rch_diag_set(d, data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
-            rch_data_free(&data);
-            return -1;
-        }
-        rch_dequant(&dq, bad, data.s, data.n, (const double(*)[3])data.xyz, &robot.nominal, 0.0);
-        size_t k = 0;
-        for (size_t i = 0; i < data.n; ++i)
-            if (!bad[i]) {
-                data.line[k] = data.line[i];
-                data.s[k++] = data.s[i];
-            }
-        data.n = k;
-        free(bad);
-        if (c.q_step_deg == 0.0)
-            c.q_step_deg = -1.0; /* the joints are no longer on the display grid */
-    }
-    if (data.n > 100000)
-        fprintf(stderr, "rcal diagnose: %zu samples, %u folds: this takes minutes\n", data.n, c.folds ? c.folds : 5u);
-    const int rc = rch_diagnose_run(out, data.s, data.n, &robot.nominal, &c, d);
-    out->dequant_corrected = dq.n_corrected;
-    out->dequant_refused = dq.n_refused;
-    for (unsigned k = 0; rc == 0 && k < out->jumps.n_jumps; ++k)
-        for (size_t i = 0; i < data.n; ++i)
-            if (data.s[i].t == out->jumps.at_t[k]) {
-                out->jump_line[k] = data.line[i];
-                break;
-            }
-    rch_data_free(&data);
     return rc;
 }
 
@@ -794,6 +890,9 @@ void rch_diagnose_free(rch_diagnose_result *r)
     free(r->res_before_mm);
     free(r->res_after_mm);
     free(r->floor_mm);
+    free(r->line);
+    free(r->file);
+    r->line = r->file = NULL;
     r->s = NULL;
     r->res_before_mm = r->res_after_mm = r->floor_mm = NULL;
 }

@@ -64,9 +64,11 @@
 #include "rch_jumps.h"
 #include "rch_resid.h"
 
-#define RCH_DIAGNOSE_MAX_CAND 16
+#define RCH_DIAGNOSE_MAX_CAND 24
 #define RCH_DIAGNOSE_MAX_STEPS 4
-#define RCH_DIAGNOSE_MAX_TESTS 16
+#define RCH_DIAGNOSE_MAX_TESTS 40
+#define RCH_DIAGNOSE_MAX_SENSORS 17 /* the tracker and up to RC_MAX_OUTLETS cable outlets */
+#define RCH_DIAGNOSE_MAX_FILES 16
 #define RCH_DIAGNOSE_MAX_FOLDS 20
 #define RCH_DIAGNOSE_MAX_NOTES 8
 #define RCH_DIAGNOSE_MAX_PARAMS 16
@@ -91,7 +93,40 @@ typedef struct rch_diagnose_cfg {
     int no_jumps;            /* 1: do not look for length jumps in acquisition order */
     int dequantize;          /* rch_diagnose_file: recover rounded joints from x, y, z (rch_dequant); the
                                 joint step of the floor is then the 0.05 mm rounding of x, y, z */
+    int keep_effects;        /* 1: the nominal model's effects stay (the sensors' frames, outlets and targets,
+                                effects already known): the search adds to them; 0: geometry alone (they are
+                                dropped, as before) */
+    int jumps;               /* 1: length jumps found are removed as nuisance (rcal calibrate --jumps) even
+                                where they coincide with a set-up change */
 } rch_diagnose_cfg;
+
+/* What one sensor saw and how well the model predicts it held out: a cable
+ * outlet (lengths, mm) or the tracker (positions: 3-D errors, mm). */
+typedef struct rch_diagnose_sensor {
+    char name[40];         /* "cable", "cable outlet 2" (the file's label), "tracker" */
+    int tracker;           /* 1: positions (three coordinates a row) */
+    unsigned label;        /* the outlet's label in the file (cable) */
+    size_t rows;           /* lengths, or position rows (three samples each) */
+    double before_mm;      /* held-out RMS, geometry only (3-D for the tracker) */
+    double after_mm;       /* held-out RMS with the effects found */
+    double floor_mm;       /* the quantization floor of its rows (3-D for the tracker) */
+} rch_diagnose_sensor;
+
+/* Every input `rcal calibrate` takes, with the same meaning (issue 31):
+ * cable-length files (one or several outlets: the `outlet` column), laser
+ * tracker positions files (several targets: the `target` column), both
+ * mixed; the robot; the effects already known. The paths must outlive the
+ * result (it keeps them for the next step and the model file). */
+typedef struct rch_diagnose_in {
+    const char *const *data_paths;      /* (n_data) cable-length CSV files, merged in order */
+    size_t n_data;
+    const char *const *positions_paths; /* (n_positions) tracker positions CSV files (docs/positions.md) */
+    size_t n_positions;
+    const char *robot_path;             /* the nominal robot (required) */
+    int robot_given;                    /* 1: the user named it (the next step names it too) */
+    const char *effects;                /* effects already known, as `rcal calibrate --effects` names them, or
+                                           NULL: the search adds to them and never offers them again */
+} rch_diagnose_in;
 
 /* One structure test of residuals against an explanatory variable. */
 typedef struct rch_diagnose_test {
@@ -140,6 +175,15 @@ typedef struct rch_diagnose_param {
 
 typedef struct rch_diagnose_result {
     size_t n;
+    size_t n_poses;            /* distinct poses (the folds keep each whole: all its outlets and targets) */
+    unsigned n_sensors;
+    rch_diagnose_sensor sensors[RCH_DIAGNOSE_MAX_SENSORS];
+    size_t n_cable, n_tracker; /* samples of each kind (a position row is three) */
+    unsigned n_known;          /* effects in the model before the search (given, e.g. --effects) */
+    rch_diagnose_in in;        /* the inputs (rch_diagnose_inputs; zero after rch_diagnose_run alone) */
+    uint8_t outlet_label[RC_MAX_OUTLETS]; /* the files' label of outlet k (k = 0: the robot's encoder) */
+    unsigned *line;            /* (n) each sample's line in its file (rch_diagnose_inputs), or NULL */
+    unsigned *file;            /* (n) its file: data files first, then positions files, or NULL */
     unsigned n_groups;
     unsigned n_flicker;        /* samples whose wrist reading moved by one display step within a group */
     unsigned folds;
@@ -195,9 +239,17 @@ typedef struct rch_diagnose_result {
 int rch_diagnose_run(rch_diagnose_result *out, const rc_sample *samples, size_t n,
                      const rc_model *nominal, const rch_diagnose_cfg *cfg, rch_diag *d);
 
-/* rch_diagnose_run on a data file and a robot file: cfg->groups_given and
- * cfg->have_encoder are taken from the files (the group column, the robot's
- * encoder_mm). Same returns; free the result also after a failure. */
+/* rch_diagnose_run on the files of in (rch_diagnose_in): the cable files
+ * merged (acquisition order over all of them; set-up groups never across two
+ * files), each outlet an RC_EFF_OUTLET of the model, the positions appended
+ * with the tracker frame and targets (rch_positions.h), the effects already
+ * known added; cfg->groups_given, cfg->have_encoder and cfg->keep_effects are
+ * set from them. With cfg->dequantize the cable rows' joints are recovered
+ * first (rch_dequant). Same returns; free the result also after a failure. */
+int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, const rch_diagnose_cfg *cfg,
+                        rch_diag *d);
+
+/* rch_diagnose_inputs on one data file and a robot file. */
 int rch_diagnose_file(rch_diagnose_result *out, const char *data_path, const char *robot_path,
                       const rch_diagnose_cfg *cfg, rch_diag *d);
 

@@ -35,6 +35,10 @@ typedef struct ctx {
     rc_solve_work *w;
     unsigned max_iter;
     int verbose;
+    unsigned *pose;                        /* (n) the pose of each sample (0..n_poses-1, by first appearance) */
+    size_t n_poses;
+    int have_fixed;                        /* fixed0 holds the base model's parameters no sample sees */
+    uint8_t fixed0[RC_MAX_PARAMS];         /* (RC_MAX_PARAMS) 1: held (an unseen encoder, target); 0 beyond */
 } ctx;
 
 /* The state of one diagnosis run, handed from phase to phase. The phases run
@@ -54,21 +58,34 @@ typedef struct run_state {
     double *r0;               /* (n) held-out residuals of the current model */
     double *tmp;              /* (n x 6) scratch */
     double (*var)[V_N];       /* (n) explanatory variables of the structure tests */
-    unsigned *order;          /* (n) shuffled sample order */
+    unsigned *order;          /* (n) shuffled pose order */
+    uint8_t *cls;             /* (n) each sample's sensor (index into out->sensors) */
 } run_state;
 
 /* The number of candidate effects (rch_diagnose_search.c's table). */
-#define RCH_DG_N_CANDS 16u
+#define RCH_DG_N_CANDS 19u
 
 /* rch_diagnose.c: the fits of the workflow. */
 int rch_dg_fit(rc_model *m, rc_solve_result *res, ctx *c, const uint8_t *fixed, const rc_sample *s, size_t n);
 int rch_dg_cv_run(rc_model *models, double *res, ctx *c);
 unsigned rch_dg_rank_at(const rc_model *m, unsigned np, const rc_sample *s, size_t n, rc_solve_work *w, int dump);
 
+/* The paired held-out gain of b over a (squared errors, per sample; a, b:
+ * (n) residuals), its standard error and z, the poses as the units (the
+ * samples of one pose are not independent). */
+void rch_dg_paired_gain(double *gain_mm2, double *se_mm2, const double *a, const double *b, const ctx *c);
+
 /* rch_diagnose_tests.c */
 unsigned rch_dg_groups_usable(unsigned n_groups, size_t n);
 unsigned rch_dg_structure_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
                                 const double (*var)[V_N], unsigned n_groups, double alpha);
+
+/* The structure tests of each sensor in the data (rch_dg_structure_tests on
+ * the cable rows and on the tracker rows apart, with an ANOVA over the
+ * outlets, the coordinates and the targets; Bonferroni over all of them).
+ * One outlet's lengths alone: rch_dg_structure_tests itself. */
+unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
+                             const double (*var)[V_N], unsigned n_groups, double alpha);
 
 /* rch_diagnose_search.c */
 int rch_dg_has_effect(const rc_model *m, rc_effect_kind kind, unsigned joint0);

@@ -16,17 +16,51 @@
 
 static void print_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
 {
-    fprintf(f, "  %-28s %5s %6s %10s %9s %7s\n", "variable", "dof1", "dof2", "F", "p", "R^2");
+    fprintf(f, "  %-36s %5s %6s %10s %9s %7s\n", "variable", "dof1", "dof2", "F", "p", "R^2");
     char pb[16];
     for (unsigned k = 0; k < n; ++k)
-        fprintf(f, "  %-28s %5u %6u %10.2f %9s %6.1f%% %s\n", t[k].name, t[k].dof1, t[k].dof2, t[k].f_stat,
+        fprintf(f, "  %-36s %5u %6u %10.2f %9s %6.1f%% %s\n", t[k].name, t[k].dof1, t[k].dof2, t[k].f_stat,
                 rch_plot_fmt_p(pb, sizeof pb, t[k].p_value), 100.0 * t[k].r2, t[k].significant ? "STRUCTURE" : "");
+}
+
+/* The first screen: the verdict with the size of what was found, the held-out
+ * error of each sensor before and after (3-D for the tracker), what to run
+ * next. */
+static void print_summary(FILE *f, const rch_diagnose_result *r)
+{
+    fprintf(f, "\nVerdict: %s", r->effect);
+    if (r->joint)
+        fprintf(f, " (joint %u)", r->joint);
+    if (r->n_known)
+        fprintf(f, "  (beside the %u effect(s) already in the model)", r->n_known);
+    fprintf(f, "\n");
+    for (unsigned k = 0; k < r->n_params; ++k)
+        fprintf(f, "  %-34s %12.5f +- %.5f %s\n", r->params[k].name, r->params[k].value, r->params[k].se,
+                r->params[k].unit);
+    fprintf(f, "  %-34s %8s %10s %10s %10s\n", "held-out error by sensor (RMS, mm)", "rows", "before", "after",
+            "floor");
+    for (unsigned k = 0; k < r->n_sensors; ++k) {
+        char name[64];
+        snprintf(name, sizeof name, "%s%s", r->sensors[k].name, r->sensors[k].tracker ? " (3-D)" : "");
+        fprintf(f, "  %-34s %8zu %10.4f %10.4f %10.4f\n", name, r->sensors[k].rows, r->sensors[k].before_mm,
+                r->sensors[k].after_mm, r->sensors[k].floor_mm);
+    }
+    if (r->in.n_data + r->in.n_positions > 0) {
+        char next[1400];
+        if (rch_diagnose_next(next, sizeof next, r, NULL, r->in.robot_given ? r->in.robot_path : NULL) == 0)
+            fprintf(f, "  next: %s%s\n", next,
+                    strcmp(r->remaining, "none") == 0 && r->n_chosen == 0
+                        ? "  (nothing more to add: the held-out residual is noise)"
+                        : "");
+    }
 }
 
 int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
 {
-    fprintf(f, "rcal diagnose: %zu samples, %u set-up groups, %u-fold cross-validation (random within groups)\n",
-            r->n, r->n_groups, r->folds);
+    fprintf(f, "rcal diagnose: %zu residual rows (%zu poses), %u set-up groups, %u-fold cross-validation (random "
+               "within groups, every pose whole)\n",
+            r->n, r->n_poses, r->n_groups, r->folds);
+    print_summary(f, r);
     if (r->n_flicker)
         fprintf(f, "  %u sample(s) kept in their group although a wrist reading moved by one display step\n",
                 r->n_flicker);
@@ -34,9 +68,9 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
                "length step %.3g mm%s: %.4f mm)\n",
             r->noise_floor_mm, r->q_step_deg, r->floor_joints_mm, r->len_step_mm,
             r->len_noise_mm > 0.0 ? " + noise" : "", r->floor_len_mm);
-    fprintf(f, "Geometric model (27 parameters, rank %u of %u): training RMSE %.4f mm, held-out RMSE %.4f mm "
+    fprintf(f, "Geometric model (%u parameters, rank %u of %u free): training RMSE %.4f mm, held-out RMSE %.4f mm "
                "= %.2f x floor\n",
-            r->geo_rank, r->geo_free, r->train_rmse_geo_mm, r->rmse_before_mm,
+            r->geo.n_params, r->geo_rank, r->geo_free, r->train_rmse_geo_mm, r->rmse_before_mm,
             r->rmse_before_mm / r->noise_floor_mm);
     fprintf(f, "\nStructure of the held-out residuals (geometry only; F tests, Bonferroni over %u tests):\n",
             r->n_tests);
@@ -99,11 +133,8 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
         for (unsigned s = 0; s < r->n_steps; ++s)
             if (r->steps[s].chosen >= 0)
                 fprintf(f, " %s", r->steps[s].cand[r->steps[s].chosen].name);
-        fprintf(f, "\nFitted (all samples; +- fold-jackknife standard error):\n");
-        for (unsigned k = 0; k < r->n_params; ++k)
-            fprintf(f, "  %-28s %12.5f +- %.5f %s\n", r->params[k].name, r->params[k].value, r->params[k].se,
-                    r->params[k].unit);
-        fprintf(f, "  contribution to the cable length: %.4f mm rms\n", r->effect_rms_mm);
+        fprintf(f, "\n(fitted on all samples, +- fold-jackknife standard error: see the verdict above)\n");
+        fprintf(f, "  contribution to the measurements: %.4f mm rms\n", r->effect_rms_mm);
     }
     fprintf(f, "\nHeld-out RMSE: before %.4f mm (%.2f x floor) -> after %.4f mm (%.2f x floor); floor %.4f mm\n",
             r->rmse_before_mm, r->rmse_before_mm / r->noise_floor_mm, r->rmse_after_mm,
@@ -113,7 +144,7 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
         fprintf(f, "\nStructure of the held-out residuals after:\n");
         print_tests(f, r->after, r->n_tests);
     }
-    fprintf(f, "\nWhat cable lengths cannot identify:\n");
+    fprintf(f, "\nWhat these data cannot identify:\n");
     for (unsigned k = 0; k < r->n_notes; ++k)
         fprintf(f, "  - %s\n", r->notes[k]);
     fprintf(f, "\nTime: %.0f ms\n", r->time_ms);
@@ -267,12 +298,22 @@ int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const
 {
     char list[512];
     chosen_effects(list, sizeof list, r);
-    const char *argv[12];
+    const char *argv[16 + 4 * RCH_DIAGNOSE_MAX_FILES];
     int n = 0;
     argv[n++] = "rcal";
     argv[n++] = "calibrate";
-    argv[n++] = "--data";
-    argv[n++] = data_path;
+    if (r->in.n_data + r->in.n_positions == 0) {
+        argv[n++] = "--data";
+        argv[n++] = data_path;
+    }
+    for (size_t k = 0; k < r->in.n_data && k < RCH_DIAGNOSE_MAX_FILES; ++k) {
+        argv[n++] = "--data";
+        argv[n++] = r->in.data_paths[k];
+    }
+    for (size_t k = 0; k < r->in.n_positions && k < RCH_DIAGNOSE_MAX_FILES; ++k) {
+        argv[n++] = "--positions";
+        argv[n++] = r->in.positions_paths[k];
+    }
     if (robot_path) {
         argv[n++] = "--robot";
         argv[n++] = robot_path;
@@ -302,6 +343,13 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path,
     rch_calib_cfg cfg;
     rch_calib_cfg_init(&cfg);
     cfg.data_path = data_path;
+    if (r->in.n_data + r->in.n_positions > 0) { /* every input the diagnosis read */
+        cfg.data_path = r->in.n_data ? r->in.data_paths[0] : NULL;
+        cfg.data_paths = r->in.n_data > 1 ? r->in.data_paths : NULL;
+        cfg.n_data_paths = r->in.n_data > 1 ? r->in.n_data : 0;
+        cfg.positions_paths = r->in.positions_paths;
+        cfg.n_positions_paths = r->in.n_positions;
+    }
     cfg.robot_path = robot_path;
     cfg.test_fraction = 0.0;
     cfg.effects = list[0] ? list : NULL;

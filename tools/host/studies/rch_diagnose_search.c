@@ -41,19 +41,39 @@ int rch_dg_has_effect(const rc_model *m, rc_effect_kind kind, unsigned joint0)
     return 0;
 }
 
+/* What a candidate acts on: any sensor (the joint side moves the flange
+ * every sensor sees), the cable's lengths, the lengths of two or more
+ * outlets, or the tracker's positions. A candidate whose sensor is not in
+ * the data is not listed. */
+enum { ON_ANY = 0, ON_CABLE, ON_OUTLETS, ON_TRACKER };
+
 typedef struct cdef {
     rc_effect_kind kind;
     unsigned joint0;
+    unsigned on;
 } cdef;
 
 static const cdef all_cands[] = {
-    {RC_EFF_LENGTH_OFFSET, 0},    {RC_EFF_LENGTH_SCALE, 0},     {RC_EFF_TIME_DRIFT, 0},
-    {RC_EFF_GROUP_OFFSET, 0},     {RC_EFF_JOINT_COMPLIANCE, 1}, {RC_EFF_JOINT_COMPLIANCE, 2},
-    {RC_EFF_JOINT_PERIODIC, 0},   {RC_EFF_JOINT_PERIODIC, 1},   {RC_EFF_JOINT_PERIODIC, 2},
-    {RC_EFF_JOINT_PERIODIC, 3},   {RC_EFF_JOINT_PERIODIC, 4},   {RC_EFF_JOINT_PERIODIC, 5},
-    {RC_EFF_TOOL_OFFSET, 0},      {RC_EFF_CABLE_SAG, 0},        {RC_EFF_LENGTH_NONLIN, 0},
-    {RC_EFF_LENGTH_PERIODIC, 0},
+    {RC_EFF_LENGTH_OFFSET, 0, ON_CABLE},    {RC_EFF_LENGTH_SCALE, 0, ON_CABLE},
+    {RC_EFF_TIME_DRIFT, 0, ON_CABLE},       {RC_EFF_GROUP_OFFSET, 0, ON_CABLE},
+    {RC_EFF_JOINT_COMPLIANCE, 1, ON_ANY},   {RC_EFF_JOINT_COMPLIANCE, 2, ON_ANY},
+    {RC_EFF_JOINT_PERIODIC, 0, ON_ANY},     {RC_EFF_JOINT_PERIODIC, 1, ON_ANY},
+    {RC_EFF_JOINT_PERIODIC, 2, ON_ANY},     {RC_EFF_JOINT_PERIODIC, 3, ON_ANY},
+    {RC_EFF_JOINT_PERIODIC, 4, ON_ANY},     {RC_EFF_JOINT_PERIODIC, 5, ON_ANY},
+    {RC_EFF_TOOL_OFFSET, 0, ON_CABLE},      {RC_EFF_CABLE_SAG, 0, ON_CABLE},
+    {RC_EFF_LENGTH_NONLIN, 0, ON_CABLE},    {RC_EFF_LENGTH_PERIODIC, 0, ON_CABLE},
+    {RC_EFF_OUTLET_OFFSET, 0, ON_OUTLETS},  {RC_EFF_OUTLET_SCALE, 0, ON_OUTLETS},
+    {RC_EFF_TRACKER_SCALE, 0, ON_TRACKER},
 };
+
+/* Whether the data hold the sensor candidate cd acts on. */
+static int cand_relevant(const run_state *S, const cdef *cd)
+{
+    const rch_diagnose_result *out = S->out;
+    const unsigned outlets = out->n_sensors - (out->n_tracker > 0);
+    return cd->on == ON_ANY || (cd->on == ON_CABLE && out->n_cable > 0) || (cd->on == ON_OUTLETS && outlets > 1) ||
+           (cd->on == ON_TRACKER && out->n_tracker > 0);
+}
 #define N_ALL_CANDS (sizeof all_cands / sizeof all_cands[0])
 RC_STATIC_ASSERT(sizeof all_cands / sizeof all_cands[0] <= RCH_DIAGNOSE_MAX_CAND, candidates_fit_the_step);
 RC_STATIC_ASSERT(sizeof all_cands / sizeof all_cands[0] == RCH_DG_N_CANDS, candidates_counted_in_the_header);
@@ -73,6 +93,11 @@ static const char *known_reason(rc_effect_kind kind, unsigned joint0, const rc_m
 {
     if (kind == RC_EFF_LENGTH_SCALE)
         return "a cable scale error equals a uniformly larger robot (every a, d and the encoder scaled)";
+    if (kind == RC_EFF_OUTLET_SCALE)
+        return "the outlets' common scale equals a uniformly larger robot; only their differences are seen";
+    if (kind == RC_EFF_TRACKER_SCALE)
+        return "a tracker scale error equals a uniformly larger robot (every a, d, the targets and the tracker's "
+               "position scaled): a length reference (cable lengths, a scale bar) separates them";
     if (kind == RC_EFF_TOOL_OFFSET)
         return "a cable attachment offset in the flange frame trades against a6, d6 and theta6";
     if (kind == RC_EFF_JOINT_PERIODIC && joint0 == 5)
@@ -246,6 +271,28 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
     return 1;
 }
 
+void rch_dg_paired_gain(double *gain_mm2, double *se_mm2, const double *a, const double *b, const ctx *c)
+{
+    const size_t n = c->n, np = c->n_poses;
+    double *dp = calloc(np ? np : 1, sizeof *dp), sd = 0.0, sd2 = 0.0;
+    if (!dp || np < 2) {
+        free(dp);
+        *gain_mm2 = *se_mm2 = 0.0;
+        return;
+    }
+    for (size_t i = 0; i < n; ++i)
+        dp[c->pose[i]] += a[i] * a[i] - b[i] * b[i];
+    for (size_t p = 0; p < np; ++p) {
+        sd += dp[p];
+        sd2 += dp[p] * dp[p];
+    }
+    free(dp);
+    const double mean = sd / (double)np; /* per pose; reported per sample */
+    const double var_d = (sd2 - (double)np * mean * mean) / (double)(np - 1);
+    *gain_mm2 = sd / (double)n;
+    *se_mm2 = sqrt(var_d > 0.0 ? var_d / (double)np : 0.0) * ((double)np / (double)n);
+}
+
 /* Cross-validate candidate ci (per-fold models from the current ones) and
  * test its held-out gain: paired differences of squared errors. 0 or -1. */
 static int cand_cv(run_state *S, unsigned ci, unsigned count, rch_diagnose_cand *ca)
@@ -269,18 +316,12 @@ static int cand_cv(run_state *S, unsigned ci, unsigned count, rch_diagnose_cand 
         snprintf(ca->note, sizeof ca->note, "a cross-validation fit failed");
         return -1;
     }
-    double sd = 0.0, sd2 = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        const double di = S->r0[i] * S->r0[i] - rc_[i] * rc_[i];
-        sd += di;
-        sd2 += di * di;
-    }
-    const double mean = sd / (double)n;
-    const double var_d = (sd2 - (double)n * mean * mean) / (double)(n - 1);
+    double mean, se;
+    rch_dg_paired_gain(&mean, &se, S->r0, rc_, &S->c);
     ca->tested = 1;
     ca->rmse_cv_mm = rch_rms(rc_, n);
     ca->gain_mm2 = mean;
-    ca->gain_se_mm2 = sqrt(var_d > 0.0 ? var_d / (double)n : 0.0);
+    ca->gain_se_mm2 = se;
     ca->z = ca->gain_se_mm2 > 0.0 ? mean / ca->gain_se_mm2 : 0.0;
     ca->p_value = 0.5 * erfc(ca->z / sqrt(2.0));
     return 0;
@@ -314,8 +355,8 @@ static unsigned step_candidates(run_state *S, rch_diagnose_step *st, unsigned st
         ca->kind = cd->kind;
         ca->joint = is_joint_kind(cd->kind) ? cd->joint0 + 1 : 0;
         cand_name(ca->name, sizeof ca->name, cd->kind, cd->joint0);
-        if (rch_dg_has_effect(&S->base, cd->kind, cd->joint0))
-            continue; /* already in the model */
+        if (rch_dg_has_effect(&S->base, cd->kind, cd->joint0) || !cand_relevant(S, cd))
+            continue; /* already in the model, or its sensor is not in the data */
         st->n_cand++;
         if (!cand_applicable(S, cd, ca, &count) || !cand_identify(S, ci, count, ca, &res) ||
             cand_cv(S, ci, count, ca) != 0)
@@ -341,14 +382,8 @@ static int one_se_rule(const run_state *S, const rch_diagnose_step *st, int best
         if ((int)k == best || !ca->significant || ca->n_params >= st->cand[best].n_params)
             continue;
         const double *rk = &S->cand_res[(size_t)slot_ci[k] * n];
-        double s1 = 0.0, s2 = 0.0;
-        for (size_t i = 0; i < n; ++i) {
-            const double di = rk[i] * rk[i] - rb[i] * rb[i];
-            s1 += di;
-            s2 += di * di;
-        }
-        const double m1 = s1 / (double)n;
-        const double se = sqrt(fmax(s2 - (double)n * m1 * m1, 0.0) / (double)(n - 1) / (double)n);
+        double m1, se;
+        rch_dg_paired_gain(&m1, &se, rk, rb, &S->c);
         if (m1 <= se &&
             (chosen == best || ca->n_params < st->cand[chosen].n_params ||
              (ca->n_params == st->cand[chosen].n_params && ca->gain_mm2 > st->cand[chosen].gain_mm2)))
@@ -393,7 +428,7 @@ static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
     }
     unsigned slot_ci[RCH_DIAGNOSE_MAX_CAND], k = 0;
     for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci)
-        if (!rch_dg_has_effect(&S->base, all_cands[ci].kind, all_cands[ci].joint0))
+        if (!rch_dg_has_effect(&S->base, all_cands[ci].kind, all_cands[ci].joint0) && cand_relevant(S, &all_cands[ci]))
             slot_ci[k++] = ci;
     const int chosen = one_se_rule(S, st, best, slot_ci);
     st->chosen = chosen;

@@ -204,3 +204,101 @@ unsigned rch_dg_structure_tests(rch_diagnose_test *out, const double *r, const r
     free(X);
     return k;
 }
+
+/* The tests of one subset of the samples (sel: 1 = in it): the structure
+ * tests with a Bonferroni share a_each, names prefixed, plus an ANOVA over
+ * the label each sample's key gives (outlet, coordinate, target) when the
+ * subset holds two or more. Returns the tests written. */
+typedef unsigned (*sample_key)(const rc_sample *s);
+static unsigned key_outlet(const rc_sample *s) { return s->outlet; }
+static unsigned key_coordinate(const rc_sample *s) { return (unsigned)(s->sensor - RC_SENSOR_TRACKER_X); }
+static unsigned key_target(const rc_sample *s) { return s->target; }
+
+static unsigned anova_by(rch_diagnose_test *t, const char *name, const double *r, const rc_sample *s, size_t n,
+                         sample_key key, double a_each)
+{
+    unsigned mx = 0;
+    for (size_t i = 0; i < n; ++i)
+        mx = key(&s[i]) > mx ? key(&s[i]) : mx;
+    if (mx == 0)
+        return 0;
+    rc_sample *c = malloc(n * sizeof *c);
+    if (!c)
+        return 0;
+    for (size_t i = 0; i < n; ++i) {
+        c[i] = s[i];
+        c[i].group = (uint16_t)key(&s[i]);
+    }
+    test_groups(t, r, c, n, mx + 1, a_each);
+    snprintf(t->name, sizeof t->name, "%s", name);
+    free(c);
+    return 1;
+}
+
+unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
+                             const double (*var)[V_N], unsigned n_groups, double alpha)
+{
+    size_t nc = 0, nt = 0;
+    unsigned outlets = 0, targets = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const int tr = s[i].sensor != RC_SENSOR_LENGTH;
+        nt += (size_t)tr;
+        nc += (size_t)!tr;
+        if (!tr && s[i].outlet + 1u > outlets)
+            outlets = s[i].outlet + 1u;
+        if (tr && s[i].target + 1u > targets)
+            targets = s[i].target + 1u;
+    }
+    if (nt == 0 && outlets <= 1) /* one outlet's lengths: the tests as they always were */
+        return rch_dg_structure_tests(out, r, s, n, var, n_groups, alpha);
+    double *rs = malloc((n ? n : 1) * sizeof *rs);
+    rc_sample *ss = malloc((n ? n : 1) * sizeof *ss);
+    double (*vs)[V_N] = malloc((n ? n : 1) * sizeof *vs);
+    unsigned k = 0;
+    if (!rs || !ss || !vs)
+        goto done;
+    /* Bonferroni over every test of both sensors: each subset's own count
+     * of structure tests (12 or 13) and the ANOVAs */
+    const unsigned per = 12u + rch_dg_groups_usable(n_groups, n);
+    const unsigned total = (nc ? per + (outlets > 1) : 0u) + (nt ? per + 1u + (targets > 1) : 0u);
+    const double a_each = alpha / (double)total;
+    for (int tracker = 0; tracker < 2; ++tracker) {
+        size_t m = 0;
+        for (size_t i = 0; i < n; ++i)
+            if ((s[i].sensor != RC_SENSOR_LENGTH) == tracker) {
+                rs[m] = r[i];
+                ss[m] = s[i];
+                memcpy(vs[m], var[i], sizeof vs[m]);
+                ++m;
+            }
+        if (m == 0)
+            continue;
+        unsigned g = 0; /* the subset's groups, renumbered densely */
+        for (size_t i = 0; i < m; ++i)
+            g = ss[i].group + 1u > g ? ss[i].group + 1u : g;
+        const unsigned k0 = k;
+        k += rch_dg_structure_tests(out + k, rs, ss, m, (const double(*)[V_N])vs, g, a_each * (double)per);
+        for (unsigned j = k0; j < k; ++j) { /* names say the sensor; the cable's "length" is the tracker's distance */
+            char nm[40];
+            const char *base = out[j].name;
+            if (tracker && strcmp(base, "cable length") == 0)
+                base = "distance from the tracker";
+            else if (tracker && strcmp(base, "cable direction") == 0)
+                base = "direction from the tracker";
+            snprintf(nm, sizeof nm, "%s: %s", tracker ? "tracker" : "cable", base);
+            memcpy(out[j].name, nm, sizeof nm);
+        }
+        if (!tracker && outlets > 1)
+            k += anova_by(&out[k], "cable: outlet (ANOVA)", rs, ss, m, key_outlet, a_each);
+        if (tracker) {
+            k += anova_by(&out[k], "tracker: coordinate x, y, z (ANOVA)", rs, ss, m, key_coordinate, a_each);
+            if (targets > 1)
+                k += anova_by(&out[k], "tracker: target (ANOVA)", rs, ss, m, key_target, a_each);
+        }
+    }
+done:
+    free(rs);
+    free(ss);
+    free(vs);
+    return k;
+}
