@@ -17,13 +17,16 @@
 
 static const char summary[] = "which missing physical effect explains the residuals";
 static const char details[] =
-    "Fits the geometric model with K-fold cross-validation (folds random within set-up\n"
-    "groups), compares the held-out residuals with the noise floor (length step and the\n"
-    "joint display step through the Jacobian), tests the residuals for structure, and\n"
-    "tries each candidate effect (length_offset, length_scale, time_drift, group_offset,\n"
-    "joint_compliance j2/j3, joint_periodic j1..j6) jointly with the geometry. An effect\n"
-    "is chosen only on a significant held-out gain; the verdict is the effect, 'none'\n"
-    "or 'unexplained'. Up to N effects are added one after the other.\n"
+    "Takes every input rcal calibrate takes: cable lengths from one or several outlets\n"
+    "(--data), tracker positions (--positions), both, and the effects already known\n"
+    "(--effects). Fits the geometric model with K-fold cross-validation (folds random\n"
+    "within set-up groups, every pose whole), compares the held-out residuals of each\n"
+    "sensor with its noise floor, tests them for structure, and tries each candidate\n"
+    "effect of the sensors in the data (joint side: compliance j2/j3, periodic j1..j6;\n"
+    "cable: offset, scale, drift, groups, sag, nonlinearity, drum period, per-outlet\n"
+    "offset and scale; tracker: scale) jointly with the geometry. An effect is chosen\n"
+    "only on a significant held-out gain; the verdict is the effect, 'none' or\n"
+    "'unexplained'. Up to N effects are added one after the other.\n"
     "Steps are detected from the data unless given (a negative value: no quantization).";
 
 /* --residuals: the data lines from the file again (the diagnosis keeps the

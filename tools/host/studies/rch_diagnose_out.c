@@ -230,6 +230,33 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
     rch_jw_str(&w, "remaining", r->remaining);
     rch_jw_str(&w, "remaining_why", r->remaining_why);
     json_num(&w, "noise_est_mm", r->noise_est_mm);
+    rch_jw_uint(&w, "poses", r->n_poses);
+    rch_jw_uint(&w, "known_effects", r->n_known);
+    rch_jw_arr(&w, "sensors"); /* per sensor: held-out RMS before and after (3-D for the tracker) */
+    for (unsigned k = 0; k < r->n_sensors; ++k) {
+        const rch_diagnose_sensor *z = &r->sensors[k];
+        rch_jw_obj(&w, NULL);
+        rch_jw_str(&w, "name", z->name);
+        rch_jw_str(&w, "kind", z->tracker ? "tracker" : "cable");
+        if (z->tracker)
+            rch_jw_null(&w, "outlet");
+        else
+            rch_jw_uint(&w, "outlet", z->label);
+        rch_jw_uint(&w, "rows", z->rows);
+        json_num(&w, "before_mm", z->before_mm);
+        json_num(&w, "after_mm", z->after_mm);
+        json_num(&w, "floor_mm", z->floor_mm);
+        rch_jw_end(&w);
+    }
+    rch_jw_end(&w);
+    {
+        char next[1400];
+        if (r->in.n_data + r->in.n_positions > 0 &&
+            rch_diagnose_next(next, sizeof next, r, NULL, r->in.robot_given ? r->in.robot_path : NULL) == 0)
+            rch_jw_str(&w, "next", next);
+        else
+            rch_jw_null(&w, "next");
+    }
     rch_jw_arr(&w, "length_jumps");
     for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
         rch_jw_obj(&w, NULL);
