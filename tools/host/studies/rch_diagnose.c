@@ -785,7 +785,7 @@ static void phase_after(run_state *S)
                  "(%.2f x the quantization floor %.4f mm)",
                  out->noise_est_mm, out->noise_est_mm / out->noise_floor_mm, out->noise_floor_mm);
     snprintf(out->remaining, sizeof out->remaining, "%s", unexpl ? "unexplained" : "none");
-    if (out->jumps.n_jumps > 0) {
+    if (out->jumps.n_jumps > 0 && !S->cfg.jumps) { /* with --jumps they are known: not the verdict */
         snprintf(out->effect, sizeof out->effect, "length_jump");
         out->joint = 0;
     } else if (out->n_chosen == 0) {

@@ -23,6 +23,19 @@ static void print_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
                 rch_plot_fmt_p(pb, sizeof pb, t[k].p_value), 100.0 * t[k].r2, t[k].significant ? "STRUCTURE" : "");
 }
 
+/* The effects found that the model file can carry (not nuisance, not
+ * already known): what a next calibration adds. */
+static unsigned addable_effects(const rch_diagnose_result *r)
+{
+    unsigned k = 0;
+    for (unsigned s = 0; s < r->n_steps; ++s) {
+        const int c = r->steps[s].chosen;
+        const rc_effect_desc *ds = c >= 0 ? rc_effect_describe(r->steps[s].cand[c].kind) : NULL;
+        k += ds && !ds->nuisance && ds->user;
+    }
+    return k + (r->jumps.n_jumps > 0 && strcmp(r->effect, "length_jump") == 0);
+}
+
 /* The first screen: the verdict with the size of what was found, the held-out
  * error of each sensor before and after (3-D for the tracker), what to run
  * next. */
@@ -46,12 +59,17 @@ static void print_summary(FILE *f, const rch_diagnose_result *r)
                 r->sensors[k].after_mm, r->sensors[k].floor_mm);
     }
     if (r->in.n_data + r->in.n_positions > 0) {
-        char next[1400];
+        char next[1400], why[400] = "";
+        const unsigned addable = addable_effects(r);
+        if (addable == 0 && strcmp(r->remaining, "none") == 0)
+            snprintf(why, sizeof why, "  (the end: %s)",
+                     r->n_chosen ? "what was found describes this acquisition (a nuisance), not the robot; the "
+                                   "held-out residual left is noise"
+                                 : "nothing more to add, the held-out residual is noise");
+        else if (addable == 0)
+            snprintf(why, sizeof why, "  (the end of what the candidates explain: %s)", r->remaining_why);
         if (rch_diagnose_next(next, sizeof next, r, NULL, r->in.robot_given ? r->in.robot_path : NULL) == 0)
-            fprintf(f, "  next: %s%s\n", next,
-                    strcmp(r->remaining, "none") == 0 && r->n_chosen == 0
-                        ? "  (nothing more to add: the held-out residual is noise)"
-                        : "");
+            fprintf(f, "  next: %s%s\n", next, why);
     }
 }
 
