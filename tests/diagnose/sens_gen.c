@@ -163,6 +163,19 @@ void sg_draw(sg_truth *t, sg_effect e, uint64_t seed)
     draw_effect(t, e, &g);
 }
 
+void sg_scale_effect(sg_truth *t, double k)
+{
+    t->compl_rad_per_nm[0] *= k;
+    t->compl_rad_per_nm[1] *= k;
+    for (int h = 0; h < 3; ++h)
+        t->gear_amp_rad[h] *= k;
+    t->trk_scale *= k;
+    for (int o = 0; o < SG_OUTLETS; ++o) {
+        t->cab_offset_mm[o] *= k;
+        t->cab_scale[o] *= k;
+    }
+}
+
 /* Torque (N m) about the axis through o along z of a weight m at r (mm). */
 static double weight_torque(const double o[3], const double z[3], const double r[3], double m_kg)
 {

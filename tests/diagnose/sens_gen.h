@@ -77,6 +77,10 @@ typedef struct {
 /* Draws a truth with effect e from seed. */
 void sg_draw(sg_truth *t, sg_effect e, uint64_t seed);
 
+/* Multiplies the hidden effect's size by k (compliances, gear amplitudes,
+ * tracker scale, cable offsets and scales). */
+void sg_scale_effect(sg_truth *t, double k);
+
 /* The joint angles the arm really takes at readings q (rad): the hidden
  * joint-side effect (gravity deflection, gear error) added. qe (6). */
 void sg_joints_true(double qe[6], const sg_truth *t, const double q[6]);

@@ -5,16 +5,17 @@
  * independent generator sens_gen.h; the CLI is run as a user would.
  *
  * For each case x seed: write the files into a directory, then
- *   geometry:  rcal calibrate IN --test-fraction 0 --json --out G.json
- *   true:      rcal calibrate IN --test-fraction 0 --effects E --out T.json
+ *   geometry:  rcal calibrate IN --test-fraction %s --json --out G.json
+ *   true:      rcal calibrate IN --test-fraction %s --effects E --out T.json
  *              (E names the hidden effect; skipped where calibrate has none)
  *   diagnosed: rcal diagnose IN --json --out D.json  (verdict: "effect",
  *              "joint"; "not supported by this rcal" when refused as an
  *              unknown option / input)
  * IN is --positions pos.csv (tracker), --data cab.csv (cable) or both.
  * Each model compensates 200 random joint targets (rcal compensate --tool
- * t0, t0 the true target 0 in the flange frame with a tracker, the flange
- * centre otherwise); the TRUE robot (hidden effect included) is driven to
+ * t0, t0 the true target 0 in the flange frame with a tracker; with cables
+ * alone the true attachment point, which is the flange centre in half the
+ * draws: off it the flange centre is known only to the prior); the TRUE robot (hidden effect included) is driven to
  * the compensated joints and its tool point compared with where the
  * nominal robot puts it at the original joints, after the best rigid
  * motion between the two point sets (no sensor sees the cell frame; Kabsch,
@@ -26,7 +27,8 @@
  * geometry-only fit leaves of the effect; the controls give the baseline,
  * above 1 by the joint display step).
  *
- * usage: sens_rates [--seeds N=5] [--cases a,b,...] [--keep DIR] [--targets N=200]
+ * usage: sens_rates [--seeds N=5] [--cases a,b,...] [--keep DIR] [--targets N=200] [--size K=1]
+ * --size multiplies every hidden effect (sg_scale_effect).
  * RCAL_BIN in the environment overrides the build's tools/rcal.
  * Depends on: sens_gen.h, POSIX (mkdtemp, system). Memory: static and
  * small heap buffers. Errors: a run whose fit fails is counted and named. */
@@ -42,8 +44,11 @@
 #define DEG (3.14159265358979323846 / 180.0)
 #define MAX_T 2000
 #define MAX_SEEDS 200
+/* calibrate's held-out share: 0 refuses positions today ("cannot place the tracker: the positions do not
+ * spread in three directions", where 0.03 fits the same file); 3 % held out in every column but the diagnosed */
+#define TEST_FRAC "0.03"
 
-typedef enum { S_TRK, S_CAB, S_MIX } sensor;
+typedef enum { S_TRK, S_CAB, S_MIX, S_CAB1 } sensor; /* S_CAB1: outlet 0's rows only (what diagnose takes today) */
 
 typedef struct {
     const char *name;
@@ -62,6 +67,9 @@ static const scase cases[] = {
     {"cab_gravity", S_CAB, SG_GRAVITY, NULL},
     {"cab_gear", S_CAB, SG_GEAR, NULL},
     {"cab_outlet", S_CAB, SG_OUTLET, NULL},
+    {"cab1_none", S_CAB1, SG_NONE, "control"},
+    {"cab1_gravity", S_CAB1, SG_GRAVITY, NULL},
+    {"cab1_gear", S_CAB1, SG_GEAR, NULL},
 };
 #define N_CASES (sizeof cases / sizeof cases[0])
 
@@ -205,16 +213,19 @@ static double median(double *v, unsigned n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/* Median distance (mm) between the true robot's tool point at qc and the
- * nominal's at q, after the best rigid motion (Kabsch, trimmed once). */
-static double landed_error(const sg_truth *t, double (*q)[6], double (*qc)[6], unsigned n, const double tool[3])
+/* Median distance (mm) between where the true robot puts the sensed point
+ * (tool_true in its flange frame) at qc and where the nominal robot puts the
+ * model's estimate of it (tool_model) at q, after the best rigid motion
+ * (Kabsch, then again without points 10 x the median off). */
+static double landed_error(const sg_truth *t, double (*q)[6], double (*qc)[6], unsigned n, const double tool_true[3],
+                           const double tool_model[3])
 {
     static double a[MAX_T][3], b[MAX_T][3], d[MAX_T], s[MAX_T];
     static unsigned char use[MAX_T];
     double R[9], T[3];
     for (unsigned i = 0; i < n; ++i) {
-        sg_true_point(a[i], t, qc[i], tool);
-        sg_nominal_point(b[i], q[i], tool);
+        sg_true_point(a[i], t, qc[i], tool_true);
+        sg_nominal_point(b[i], q[i], tool_model);
         use[i] = 1;
     }
     for (int pass = 0; pass < 2; ++pass) {
@@ -233,23 +244,48 @@ static double landed_error(const sg_truth *t, double (*q)[6], double (*qc)[6], u
     return median(s, n);
 }
 
-/* Compensates the targets with model M; the landed error or NAN. */
+/* The first 3 parameters of the model file's effect `kind` (e.g.
+ * "tracker_targets": target 0; "tool_offset": the cable attachment) into
+ * v (3); zeros when the model has no such effect. */
+static void model_point(double v[3], const char *path, const char *kind)
+{
+    char *js = slurp(path), pat[64];
+    v[0] = v[1] = v[2] = 0.0;
+    snprintf(pat, sizeof pat, "\"%s\"", kind);
+    const char *p = js ? strstr(js, pat) : NULL;
+    p = p ? strstr(p, "\"params\"") : NULL;
+    p = p ? strchr(p, '[') : NULL;
+    for (int k = 0; p && k < 3; ++k) {
+        char *end;
+        ++p;
+        while (*p == ' ' || *p == '\n' || *p == '\r' || *p == '\t')
+            ++p;
+        v[k] = strtod(p, &end);
+        p = end == p ? NULL : strpbrk(end, ",]");
+    }
+    free(js);
+}
+
+/* Compensates the targets with model M at the model's own estimate of the
+ * sensed point (its target 0 with a tracker, its cable attachment with
+ * cables alone; the point a user's TCP is then known to); the landed error
+ * of that point on the true robot, or NAN. */
 static double judge(const char *dir, const char *model, const char *tag, const sg_truth *t, double (*q)[6],
-                    unsigned n, const double tool[3], int with_tool)
+                    unsigned n, const double tool_true[3], const char *kind)
 {
     static double qc[MAX_T][6];
-    char toolarg[128] = "", out[1200];
-    if (with_tool)
-        snprintf(toolarg, sizeof toolarg, "--tool %.6f,%.6f,%.6f", tool[0], tool[1], tool[2]);
+    char out[1200];
+    double tool[3];
+    model_point(tool, model, kind);
     snprintf(out, sizeof out, "%s/comp_%s.csv", dir, tag);
-    const int rc = sh("'%s' compensate --model '%s' --in '%s/targets.csv' --out '%s' %s --max-uncertainty-mm 1000 "
-                      ">'%s/comp_%s.out' 2>&1",
-                      rcal, model, dir, out, toolarg, dir, tag);
+    const int rc = sh("'%s' compensate --model '%s' --in '%s/targets.csv' --out '%s' --tool %.6f,%.6f,%.6f "
+                      "--max-uncertainty-mm 1000 >'%s/comp_%s.out' 2>&1",
+                      rcal, model, dir, out, tool[0], tool[1], tool[2], dir, tag);
     if (rc != 0 && rc != 1)
         return NAN;
     if (read_joints(out, qc, n) != n)
         return NAN;
-    return landed_error(t, q, qc, n, tool);
+    return landed_error(t, q, qc, n, tool_true, tool);
 }
 
 typedef struct {
@@ -284,12 +320,14 @@ static void inputs(char *buf, size_t len, const scase *c, const char *dir)
         snprintf(buf, len, "--positions '%s/pos.csv'", dir);
     else if (c->s == S_CAB)
         snprintf(buf, len, "--data '%s/cab.csv'", dir);
+    else if (c->s == S_CAB1)
+        snprintf(buf, len, "--data '%s/cab1.csv'", dir);
     else
         snprintf(buf, len, "--positions '%s/pos.csv' --data '%s/cab.csv'", dir, dir);
 }
 
 static void diagnose(row *r, const scase *c, const sg_truth *t, const char *dir, const char *in, double (*q)[6],
-                     unsigned n, const double tool[3])
+                     unsigned n, const double tool[3], const char *kind)
 {
     char path[1200], eff[64];
     const int rc = sh("'%s' diagnose %s --json --out '%s/D.json' >'%s/D.out' 2>'%s/D.err'", rcal, in, dir, dir, dir);
@@ -300,8 +338,8 @@ static void diagnose(row *r, const scase *c, const sg_truth *t, const char *dir,
                     strstr(err, "--positions") || strstr(err, "required")))
             r->unsupported++;
         else {
-            r->failed++;
-            note(r, " (diagnose exit %d: %.60s)", rc, err ? err : "");
+            if (r->failed++ == 0) /* the first message: the same in every seed as a rule */
+                note(r, " (diagnose exit %d: %.70s)", rc, err ? strtok(err, "\n") : "");
         }
         free(err);
         return;
@@ -321,10 +359,30 @@ static void diagnose(row *r, const scase *c, const sg_truth *t, const char *dir,
         note(r, joint ? " %s j%u" : " %s", eff, joint);
     snprintf(path, sizeof path, "%s/D.json", dir);
     if (access(path, R_OK) == 0)
-        add(r->dia, &r->n_dia, judge(dir, path, "D", t, q, n, tool, c->s != S_CAB));
+        add(r->dia, &r->n_dia, judge(dir, path, "D", t, q, n, tool, kind));
 }
 
-static int one_run(row *r, const scase *c, unsigned seed, const char *keep, unsigned n_targets)
+/* Outlet 0's rows of the cable file (the header kept) into cab1.csv. */
+static int one_outlet(const char *dir)
+{
+    char src[1200], dst[1200], line[512];
+    snprintf(src, sizeof src, "%s/cab.csv", dir);
+    snprintf(dst, sizeof dst, "%s/cab1.csv", dir);
+    FILE *f = fopen(src, "r"), *o = fopen(dst, "w");
+    int ok = f && o;
+    for (unsigned k = 0; ok && fgets(line, sizeof line, f); ++k) {
+        const char *c = strrchr(line, ',');
+        if (k == 0 || (c && atoi(c + 1) == 0))
+            fputs(line, o);
+    }
+    if (f)
+        fclose(f);
+    if (o && fclose(o) != 0)
+        ok = 0;
+    return ok ? 0 : -1;
+}
+
+static int one_run(row *r, const scase *c, unsigned seed, const char *keep, unsigned n_targets, double size)
 {
     static double q[MAX_T][6], qn[MAX_T][6];
     char dir[1024], path[1200], in[3000], eff[128];
@@ -339,46 +397,50 @@ static int one_run(row *r, const scase *c, unsigned seed, const char *keep, unsi
             return -1;
     }
     sg_draw(&t, c->e, seed); /* the same robot, tracker and outlets for a seed in every case */
+    sg_scale_effect(&t, size);
     rct_rng g = {7919ull * seed + 17u};
     snprintf(path, sizeof path, "%s/pos.csv", dir);
     if (sg_write_positions(path, &t, &g) != 0)
         return -1;
     snprintf(path, sizeof path, "%s/cab.csv", dir);
-    if (sg_write_cable(path, &t, &g) != 0)
+    if (sg_write_cable(path, &t, &g) != 0 || one_outlet(dir) != 0)
         return -1;
     snprintf(path, sizeof path, "%s/targets.csv", dir);
     if (sg_write_targets(path, q, n_targets, &g) != 0)
         return -1;
-    const double zero[3] = {0, 0, 0};
-    const double *tool = c->s == S_CAB ? zero : t.trk_target_mm[0];
-    const int with_tool = c->s != S_CAB;
-    const double noise = c->s == S_CAB ? t.cab_noise_mm : t.trk_noise_mm;
+    /* the sensed point: target 0 with a tracker; with cables alone the cable attachment (the flange centre
+     * in half the draws); judge() compensates each model's own estimate of it: the flange frame itself
+     * trades with a6, d6, theta6 and the targets or attachment, known only to the prior */
+    const int cable_only = c->s == S_CAB || c->s == S_CAB1;
+    const double *tool = cable_only ? t.attach_mm : t.trk_target_mm[0];
+    const char *kind = cable_only ? "tool_offset" : "tracker_targets";
+    const double noise = cable_only ? t.cab_noise_mm : t.trk_noise_mm;
     inputs(in, sizeof in, c, dir);
     r->runs++;
     memcpy(qn, q, sizeof q[0] * n_targets);
-    add(r->unc, &r->n_unc, landed_error(&t, q, qn, n_targets, tool));
+    add(r->unc, &r->n_unc, landed_error(&t, q, qn, n_targets, tool, tool));
     /* geometry only */
-    if (sh("'%s' calibrate %s --test-fraction 0 --json --out '%s/G.json' >'%s/G.out' 2>'%s/G.err'", rcal, in, dir,
-           dir, dir) == 0) {
+    if (sh("'%s' calibrate %s --test-fraction %s --json --out '%s/G.json' >'%s/G.out' 2>'%s/G.err'", rcal, in, TEST_FRAC,
+           dir, dir, dir) == 0) {
         snprintf(path, sizeof path, "%s/G.out", dir);
         char *js = slurp(path);
         add(r->vis, &r->n_vis, json_num(js, "\"train_after\"", "rmse_mm") / noise);
         free(js);
         snprintf(path, sizeof path, "%s/G.json", dir);
-        add(r->geo, &r->n_geo, judge(dir, path, "G", &t, q, n_targets, tool, with_tool));
+        add(r->geo, &r->n_geo, judge(dir, path, "G", &t, q, n_targets, tool, kind));
     } else
         note(r, " (geometry fit failed)");
     /* the true effect named */
     true_effects(eff, sizeof eff, c, &t);
     if (eff[0]) {
-        if (sh("'%s' calibrate %s --test-fraction 0 --effects %s --out '%s/T.json' >'%s/T.out' 2>'%s/T.err'", rcal,
-               in, eff, dir, dir, dir) == 0) {
+        if (sh("'%s' calibrate %s --test-fraction %s --effects %s --out '%s/T.json' >'%s/T.out' 2>'%s/T.err'", rcal,
+               in, TEST_FRAC, eff, dir, dir, dir) == 0) {
             snprintf(path, sizeof path, "%s/T.json", dir);
-            add(r->tru, &r->n_tru, judge(dir, path, "T", &t, q, n_targets, tool, with_tool));
+            add(r->tru, &r->n_tru, judge(dir, path, "T", &t, q, n_targets, tool, kind));
         } else
             note(r, " (calibrate --effects %s failed)", eff);
     }
-    diagnose(r, c, &t, dir, in, q, n_targets, tool);
+    diagnose(r, c, &t, dir, in, q, n_targets, tool, kind);
     if (!keep)
         sh("rm -rf '%s'", dir);
     return 0;
@@ -415,6 +477,8 @@ static void print_row(row *r, const scase *c)
         fmt_mm(tru, sizeof tru, r->tru, r->n_tru);
     if (r->diag_runs == 0 && r->unsupported)
         snprintf(dia, sizeof dia, "not supported");
+    else if (r->diag_runs == 0 && r->failed)
+        snprintf(dia, sizeof dia, "failed");
     else
         fmt_mm(dia, sizeof dia, r->dia, r->n_dia);
     const double mg = r->n_geo ? median(r->geo, r->n_geo) : NAN, mt = r->n_tru ? median(r->tru, r->n_tru) : NAN,
@@ -441,6 +505,7 @@ static int selected(const char *list, const char *name)
 int main(int argc, char **argv)
 {
     unsigned seeds = 5, n_targets = 200;
+    double size = 1.0;
     const char *only = NULL, *keep = NULL;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--seeds") == 0 && i + 1 < argc)
@@ -449,10 +514,12 @@ int main(int argc, char **argv)
             only = argv[++i];
         else if (strcmp(argv[i], "--keep") == 0 && i + 1 < argc)
             keep = argv[++i];
+        else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc)
+            size = atof(argv[++i]);
         else if (strcmp(argv[i], "--targets") == 0 && i + 1 < argc)
             n_targets = (unsigned)atoi(argv[++i]);
         else {
-            fprintf(stderr, "usage: sens_rates [--seeds N=5] [--cases a,b,...] [--keep DIR] [--targets N=200]\n"
+            fprintf(stderr, "usage: sens_rates [--seeds N=5] [--cases a,b,...] [--keep DIR] [--targets N=200] [--size K=1]\n"
                             "cases:");
             for (size_t c = 0; c < N_CASES; ++c)
                 fprintf(stderr, " %s", cases[c].name);
@@ -460,11 +527,12 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (seeds == 0 || seeds > MAX_SEEDS || n_targets < 10 || n_targets > MAX_T)
+    if (seeds == 0 || seeds > MAX_SEEDS || n_targets < 10 || n_targets > MAX_T || !(size >= 0.0 && size <= 100.0))
         return 2;
     rcal = getenv("RCAL_BIN") ? getenv("RCAL_BIN") : RCAL_DEFAULT_BIN;
-    printf("sens_rates: %s, %u seeds, %u targets; tracker %d poses x %d targets, cable %d poses x %d outlets\n", rcal,
-           seeds, n_targets, SG_TRK_POSES, SG_TARGETS, SG_CAB_POSES, SG_OUTLETS);
+    printf("sens_rates: %s, %u seeds, %u targets, effect size x%g; tracker %d poses x %d targets, cable %d poses x %d "
+           "outlets\n",
+           rcal, seeds, n_targets, size, SG_TRK_POSES, SG_TARGETS, SG_CAB_POSES, SG_OUTLETS);
     printf("compensated-point error on the true robot after the best rigid motion: median over seeds of each "
            "run's median (mm)\n");
     printf("%-12s %4s %6s %7s %8s %8s %8s %13s %5s %5s  %s\n", "case", "runs", "vis", "verdict", "uncomp",
@@ -477,7 +545,7 @@ int main(int argc, char **argv)
         static row r;
         memset(&r, 0, sizeof r);
         for (unsigned s = 1; s <= seeds; ++s)
-            if (one_run(&r, c, s, keep, n_targets) != 0) {
+            if (one_run(&r, c, s, keep, n_targets, size) != 0) {
                 fprintf(stderr, "sens_rates: %s seed %u: cannot write the files\n", c->name, s);
                 return 1;
             }
