@@ -334,7 +334,7 @@ static void diagnose(row *r, const scase *c, const sg_truth *t, const char *dir,
     snprintf(path, sizeof path, "%s/D.err", dir);
     char *err = slurp(path);
     if (rc != 0) {
-        if (err && (strstr(err, "unknown option") || strstr(err, "not supported") || strstr(err, "outlet") ||
+        if (err && (strstr(err, "unknown option") || strstr(err, "not supported") ||
                     strstr(err, "--positions") || strstr(err, "required")))
             r->unsupported++;
         else {
