@@ -2,7 +2,7 @@
 """Build of the rcal package: the pure-Python files, plus librcal_ffi.so
 compiled from the repository's C sources by CMake (the rcal_ffi target of
 the top-level CMakeLists.txt: core, host library and tools/host/outputs/
-rch_ffi.c, linked with LAPACKE) and copied into the package next to
+rch_ffi*.c, linked with LAPACKE) and copied into the package next to
 _lib.py, where the package finds it. The shipped data files (data/irb120.json,
 ...) go into rcal/data. The version is the CMake project's (rc_version()).
 

@@ -1,0 +1,268 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_report_html.c - the pieces of the report's page: a value escaped or
+ * "not in this run" (counted, with what it stands for and how a run gets
+ * it), key-value rows, tables of JSON arrays, the CSS, the page's head and
+ * the verdict on the first screen (pass or fail against --tolerance-mm).
+ * Every string from a JSON file goes out through rch_xml_put (files/rch_text).
+ * Depends on: rch_text, rch_json (through the model). Memory: none.
+ * Errors: none (a write error shows in ferror of the page). See
+ * rch_report_int.h. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rch_report_int.h"
+#include "rch_text.h"
+
+void rch_rep_missing(rep *r, const char *what, const char *how)
+{
+    rch_report_result *res = r->res;
+    res->n_missing++;
+    if (!what)
+        what = "a figure";
+    if (!how)
+        how = "";
+    for (unsigned k = 0; k < res->n_missing_items; ++k)
+        if (strcmp(res->missing[k].what, what) == 0 && strcmp(res->missing[k].how, how) == 0)
+            return;
+    if (res->n_missing_items == RCH_REPORT_MAX_MISSING)
+        return;
+    snprintf(res->missing[res->n_missing_items].what, sizeof res->missing[0].what, "%s", what);
+    snprintf(res->missing[res->n_missing_items].how, sizeof res->missing[0].how, "%s", how);
+    res->n_missing_items++;
+}
+
+void rch_rep_section(rep *r, const char *name, const char *how)
+{
+    r->section = r->where = name;
+    r->how = how;
+}
+
+void rch_rep_put_esc(FILE *f, const char *s) { rch_xml_put(f, s, 0); }
+
+/* A JSON string escaped, or "not in this run". */
+void rch_rep_put_str(rep *r, const char *s)
+{
+    if (s) {
+        rch_rep_put_esc(r->f, s);
+    } else {
+        fputs(NA, r->f);
+        rch_rep_missing(r, r->where, r->how);
+    }
+}
+
+/* A number with printf format fmt, or "not in this run". */
+void rch_rep_put_num(rep *r, double v, const char *fmt)
+{
+    if (isfinite(v)) {
+        fprintf(r->f, fmt, v);
+    } else {
+        fputs(NA, r->f);
+        rch_rep_missing(r, r->where, r->how);
+    }
+}
+
+/* Three significant digits without an exponent between 1e-3 and 1e6
+ * ("1610 mm", not "1.61e+03 mm"), then `unit`; or "not in this run". */
+void rch_rep_put_sig(rep *r, double v, const char *unit)
+{
+    const double a = fabs(v);
+    if (isfinite(v) && a >= 1e-3 && a < 1e6) {
+        const int dec = 2 - (int)floor(log10(a));
+        fprintf(r->f, "%.*f%s", dec > 0 ? dec : 0, v, unit);
+    } else {
+        rch_rep_put_num(r, v, "%.3g");
+        if (isfinite(v))
+            fputs(unit, r->f);
+    }
+}
+
+void rch_rep_put_p(rep *r, double p)
+{
+    if (isfinite(p) && p <= 0.0)
+        fputs("&lt; 1e-300", r->f);
+    else
+        rch_rep_put_num(r, p, "%.3g");
+}
+
+static const char css[] =
+    "body{font:14px/1.45 system-ui,-apple-system,'Segoe UI',Helvetica,Arial,sans-serif;margin:0;"
+    "background:#eef0f3;color:#1d2330}"
+    "main{max-width:1130px;margin:0 auto;padding:10px 20px}"
+    "header{padding:6px 0}h1{font-size:22px;margin:6px 0 2px}"
+    ".sub{color:#445;margin:0}"
+    ".glance{margin:8px 0 0;padding:8px 12px;background:#fff;border-left:5px solid #0072B2;border-radius:4px}"
+    ".flag{color:#b34700;font-size:12px}.glance p{margin:4px 0}.glance .big{font-size:16px}"
+    ".glance.pass{border-left-color:#009E73}.glance.fail{border-left-color:#D55E00}"
+    ".glance.pass b:first-child{color:#007a5a}.glance.fail b:first-child{color:#b34700}.rests{color:#334;font-size:13px}"
+    "section{background:#fff;border:1px solid #d6dae0;border-radius:6px;padding:8px 16px 12px;margin:12px 0}"
+    "h2{font-size:17px;margin:2px 0 8px;padding-bottom:3px;border-bottom:1px solid #e4e7eb}"
+    "h3{font-size:14px;margin:10px 0 4px}"
+    "table{border-collapse:collapse;font-size:13px;margin:4px 0}"
+    "td,th{padding:1px 8px;border-bottom:1px solid #eceef1;text-align:right;vertical-align:top;white-space:nowrap}"
+    "td.w{white-space:normal}.two{display:grid;grid-template-columns:1fr 1fr;gap:12px}.two section{margin:0}"
+    "th{background:#f1f3f6;font-weight:600}td.l,th.l{text-align:left}"
+    "table.kv th{text-align:left;background:none;color:#445;font-weight:normal;white-space:nowrap}"
+    "table.kv td{text-align:left;white-space:normal}"
+    ".na{color:#888;font-style:italic}.mono{font-family:ui-monospace,'DejaVu Sans Mono',monospace;"
+    "font-size:12px;word-break:break-all}"
+    ".row{display:flex;flex-wrap:wrap;gap:14px;align-items:flex-start}"
+    ".note{color:#556;font-size:12.5px;margin:4px 0}"
+    ".verdict{font-size:15px;padding:6px 10px;background:#f4f8fb;border-left:4px solid #009E73}"
+    "ul.warn{margin:4px 0;padding-left:0;list-style:none}"
+    "ul.warn li{background:#fff6e5;border-left:4px solid #E69F00;padding:4px 10px;margin:4px 0}"
+    "svg.chart{border:1px solid #e4e7eb;border-radius:4px;background:#fff}"
+    ".sw{display:inline-block;width:10px;height:10px;margin-right:4px;vertical-align:baseline}"
+    "details summary{cursor:pointer;color:#234}"
+    "@media print{body{background:#fff}main{max-width:none;padding:0}section{break-inside:avoid;border:none}}";
+
+void rch_rep_kv(rep *r, const char *key)
+{
+    fprintf(r->f, "<tr><th>%s</th><td>", key);
+    r->where = key;
+}
+
+void rch_rep_kv_end(rep *r)
+{
+    fputs("</td></tr>\n", r->f);
+    r->where = r->section;
+}
+
+void rch_rep_json_table(rep *r, const rch_json *arr, const jcol *cols, size_t n_cols)
+{
+    FILE *f = r->f;
+    fputs("<table><tr>", f);
+    for (size_t c = 0; c < n_cols; ++c)
+        fprintf(f, "<th%s>%s</th>", cols[c].kind == 's' ? " class=\"l\"" : "", cols[c].head);
+    fputs("</tr>\n", f);
+    for (size_t k = 0; arr && k < arr->n; ++k) {
+        fputs("<tr>", f);
+        for (size_t c = 0; c < n_cols; ++c) {
+            fputs(cols[c].kind == 's' ? "<td class=\"l\">" : "<td>", f);
+            if (cols[c].kind == 's')
+                rch_rep_put_str(r, jstr(arr->items[k], cols[c].key));
+            else if (cols[c].kind == 'p')
+                rch_rep_put_p(r, jnum(arr->items[k], cols[c].key));
+            else
+                rch_rep_put_num(r, jnum(arr->items[k], cols[c].key), cols[c].fmt);
+            fputs("</td>", f);
+        }
+        fputs("</tr>\n", f);
+    }
+    fputs("</table>\n", f);
+}
+
+/* The first screen: the verdict (the accuracy of the compensated robot, 95 %,
+ * over the data's poses and the workspace; pass or fail against the user's
+ * tolerance), the held-out measurements it is checked on, and what it rests
+ * on (the prior, the outlets, every nuisance fitted). */
+static void verdict(rep *r, size_t n_warn)
+{
+    FILE *f = r->f;
+    const double in = jnum(r->unc, "position95_mm.data_median"), in_max = jnum(r->unc, "position95_mm.data_max"),
+                 ws = jnum(r->unc, "position95_mm.workspace_median");
+    const double tol = r->cfg->tolerance_mm;
+    const int have = isfinite(in) && isfinite(in_max);
+    const int pass = have && tol > 0.0 && in_max <= tol;
+    rch_rep_section(r, "the verdict (first screen)", NULL);
+    fprintf(f, "<div class=\"glance %s\" id=\"verdict\"><p class=\"big\">",
+            !have || !(tol > 0.0) ? "" : pass ? "pass" : "fail");
+    if (have && tol > 0.0)
+        fprintf(f, "<b>%s</b> against the tolerance of %.4g mm: ", pass ? "PASS" : "FAIL", tol);
+    if (have) {
+        fputs("predicted from the fit, after compensation the robot lands within &plusmn;<b>", f);
+        rch_rep_put_sig(r, in, " mm");
+        fputs("</b> (95 %) over the measured region (the median over the data's poses; the largest &plusmn;", f);
+        rch_rep_put_sig(r, in_max, " mm");
+        fputs("), &plusmn;", f);
+        rch_rep_put_sig(r, ws, " mm");
+        fputs(" over the whole workspace.", f);
+        if (!(tol > 0.0))
+            fputs(" <span class=\"note\">(no tolerance given: <code>rcal report --tolerance-mm MM</code> gives a "
+                  "pass or fail)</span>",
+                  f);
+    } else {
+        fputs("No predicted accuracy in this run: the calibration output carries no uncertainty (pass the model "
+              "file of the run with <code>--model</code>, or calibrate again with <code>rcal calibrate --json</code>).",
+              f);
+        rch_rep_missing(r, "the predicted accuracy", HOW_MODEL);
+    }
+    const double b = jnum(r->cal, "before.rmse_mm"), a = jnum(r->cal, "after.rmse_mm");
+    const double nt = jnum(r->cal, "after.n");
+    fprintf(f, "</p>\n<p>%s: cable-length RMSE <b>",
+            jbool(r->cal, "held_out") == 0 ? "Measured on the training samples (none held out)"
+                                           : "Measured on samples the fit never saw");
+    rch_rep_put_num(r, b, "%.4f");
+    fputs(" mm &rarr; ", f);
+    rch_rep_put_num(r, a, "%.4f");
+    fputs(" mm</b>", f);
+    if (isfinite(nt))
+        fprintf(f, " (%.0f samples)", nt);
+    if (isfinite(a) && isfinite(b) && b > 0)
+        fprintf(f, ", %+.1f %%", 100.0 * (a - b) / b);
+    fputs(".</p>\n<p class=\"rests\">It rests on: ", f);
+    const rch_json *est = rch_rep_jpath(r->cal, "estimation");
+    if (jbool(est, "prior") == 1) {
+        fputs("the posterior of a fit with the physical prior (link lengths &plusmn;", f);
+        rch_rep_put_sig(r, jnum(est, "prior_length_mm"), " mm");
+        fputs(", twists &plusmn;", f);
+        rch_rep_put_sig(r, jnum(est, "prior_twist_deg"), "&deg;");
+        fputs(", joint zeros &plusmn;", f);
+        rch_rep_put_sig(r, jnum(est, "prior_offset_deg"), "&deg;");
+        fputs(": what the data did not determine counts at the prior's width), the noise estimated from the data (",
+              f);
+        rch_rep_put_sig(r, jnum(est, "noise_mm"), " mm");
+        fputs(")", f);
+    } else if (est) {
+        fputs("the covariance of a least-squares fit (no prior: directions the data did not determine are held "
+              "nominal and not counted)",
+              f);
+    } else {
+        rch_rep_put_str(r, NULL);
+    }
+    const double outlets = jnum(est, "outlets");
+    if (isfinite(outlets))
+        fprintf(f, "; %.0f cable outlet%s%s", outlets, outlets == 1 ? "" : "s",
+                outlets < 3 ? " (lengths from fewer than three outlets cannot see every rigid motion of the robot "
+                              "about them: the figures hold for positions relative to each other)"
+                            : "");
+    const char *att = jstr(est, "attachment");
+    if (att)
+        fprintf(f, "; the cable attachment %s",
+                strcmp(att, "estimated") == 0 ? "estimated (a vector in the flange frame)" : "at the flange centre");
+    const rch_json *jumps = jarr(r->cal, "length_jumps");
+    if (jumps && jumps->n)
+        fprintf(f, "; %zu length jump%s fitted as nuisance", jumps->n, jumps->n == 1 ? "" : "s");
+    const double dq = jnum(r->cal, "dequantized.corrected"), dqr = jnum(r->cal, "dequantized.refused");
+    if (isfinite(dq))
+        fprintf(f, "; joint angles recovered from x, y, z for %.0f rows (%.0f refused)", dq,
+                isfinite(dqr) ? dqr : 0.0);
+    const double g = jnum(r->unc, "groups");
+    if (isfinite(g) && g > 0)
+        fprintf(f, "; %.0f set-up groups (cluster-robust covariance)", g);
+    fprintf(f, ".</p>\n<p><a href=\"#warnings\">%zu warning%s</a></p></div>\n", n_warn, n_warn == 1 ? "" : "s");
+}
+
+void rch_rep_page_head(rep *r, size_t n_warn)
+{
+    FILE *f = r->f;
+    const char *data = jstr(r->cal, "data"), *robot = jstr(r->model, "name");
+    fputs("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>Calibration report: ",
+          f);
+    rch_rep_put_esc(f, data ? data : "?");
+    fprintf(f, "</title>\n<style>%s</style>\n</head>\n<body>\n<main>\n<header>\n<h1>Calibration report</h1>\n", css);
+    fputs("<p class=\"sub\">robot <b>", f);
+    rch_rep_section(r, "the robot's name", HOW_MODEL);
+    rch_rep_put_str(r, robot ? robot : jstr(r->cal, "robot"));
+    rch_rep_section(r, "the page's head", NULL);
+    fputs("</b> &middot; data <b>", f);
+    rch_rep_put_str(r, data);
+    fputs("</b> &middot; method <b>", f);
+    rch_rep_put_str(r, jstr(r->cal, "method"));
+    fputs("</b> &middot; calibrated ", f);
+    rch_rep_put_str(r, rch_rep_prov_str(r, "date"));
+    fputs("</p>\n", f);
+    verdict(r, n_warn);
+    fputs("</header>\n", f);
+}
