@@ -697,8 +697,9 @@ static int phase_jumps(run_state *S, rch_diag *d)
     rch_diagnose_result *out = S->out;
     const size_t n = out->n;
     char err[256];
-    if (S->cfg.no_jumps || out->n_tracker > 0)
-        return 0; /* a tracker's coordinates do not jump like a display's count */
+    if (S->cfg.no_jumps || out->n_tracker > 0 || (out->n_sensors > 1 && !S->cfg.jumps))
+        return 0; /* a tracker's coordinates do not jump like a display's count; several outlets' rows
+                     interleave in acquisition order (their jumps only when --jumps says so) */
     for (size_t i = 1; i < n; ++i)
         if (out->s[i].t < out->s[i - 1].t)
             return 0; /* not in acquisition order: no change points to look for */
