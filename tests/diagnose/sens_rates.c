@@ -507,8 +507,14 @@ int main(int argc, char **argv)
     unsigned seeds = 5, n_targets = 200;
     double size = 1.0;
     const char *only = NULL, *keep = NULL;
+    int check = 0; /* --check: the ctest (diag_sensors): controls and gravity on both sensors, asserted */
     for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--seeds") == 0 && i + 1 < argc)
+        if (strcmp(argv[i], "--check") == 0) {
+            check = 1;
+            seeds = 3;
+            n_targets = 60;
+            only = "trk_none,trk_gravity,cab_none,cab_gravity";
+        } else if (strcmp(argv[i], "--seeds") == 0 && i + 1 < argc)
             seeds = (unsigned)atoi(argv[++i]);
         else if (strcmp(argv[i], "--cases") == 0 && i + 1 < argc)
             only = argv[++i];
@@ -537,7 +543,7 @@ int main(int argc, char **argv)
            "run's median (mm)\n");
     printf("%-12s %4s %6s %7s %8s %8s %8s %13s %5s %5s  %s\n", "case", "runs", "vis", "verdict", "uncomp",
            "geometry", "true-eff", "diagnosed", "D/T", "D/G", "other verdicts, notes");
-    unsigned ctl_runs = 0, ctl_none = 0, any_unsupported = 0;
+    unsigned ctl_runs = 0, ctl_none = 0, any_unsupported = 0, bad = 0;
     for (size_t ci = 0; ci < N_CASES; ++ci) {
         const scase *c = &cases[ci];
         if (!selected(only, c->name))
@@ -555,6 +561,15 @@ int main(int argc, char **argv)
             ctl_runs += r.diag_runs;
             ctl_none += r.hits;
         }
+        if (check) { /* every run diagnosed and named right; an effect's diagnosed model at most half the
+                        geometry's error and within 1.5 x the true effect's (medians over the seeds) */
+            const unsigned nd = r.diag_runs;
+            const double dm = median(r.dia, r.n_dia), gm = median(r.geo, r.n_geo), tm = c->e == SG_NONE ? dm : median(r.tru, r.n_tru);
+            const int ok = nd == seeds && r.hits == seeds && (c->e == SG_NONE || (dm <= 0.5 * gm && dm <= 1.5 * tm));
+            printf("check %-12s %s (verdicts %u/%u, diagnosed %.4f mm, geometry %.4f, true effect %.4f)\n", c->name,
+                   ok ? "ok" : "FAIL", r.hits, seeds, dm, gm, tm);
+            bad += !ok;
+        }
         any_unsupported += r.unsupported;
     }
     if (ctl_runs)
@@ -563,5 +578,5 @@ int main(int argc, char **argv)
         printf("diagnose: not supported by this rcal (%u runs refused: the input it does not take yet)\n",
                any_unsupported);
     printf("goals: D/T <= 1.25, D/G <= 0.5 on the effect cases\n");
-    return 0;
+    return bad ? 1 : 0;
 }

@@ -461,6 +461,51 @@ static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
 }
 
 /* 5. Candidate search, one effect per step, at most max_steps. */
+/* Gravity loads joints 2 and 3 together: when the search took the
+ * compliance of one of them, the other's is added too unless the data
+ * identify it not at all, it is implausible, or its held-out error is worse
+ * by more than one standard error (z < -1); its effect on the lengths may be
+ * below the test's reach while it still moves the flange. One more step in
+ * the result, its reason said. */
+static void gravity_pair(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    const int h2 = rch_dg_has_effect(&S->base, RC_EFF_JOINT_COMPLIANCE, 1),
+              h3 = rch_dg_has_effect(&S->base, RC_EFF_JOINT_COMPLIANCE, 2);
+    if (h2 == h3 || out->n_steps >= RCH_DIAGNOSE_MAX_STEPS)
+        return;
+    unsigned ci = 0;
+    while (ci < N_ALL_CANDS && !(all_cands[ci].kind == RC_EFF_JOINT_COMPLIANCE && all_cands[ci].joint0 == (h2 ? 2u : 1u)))
+        ++ci;
+    rch_diagnose_step *st = &out->steps[out->n_steps];
+    memset(st, 0, sizeof *st);
+    st->chosen = -1;
+    st->rmse_base_mm = rch_rms(S->r0, out->n);
+    rch_diagnose_cand *ca = &st->cand[0];
+    const cdef *cd = &all_cands[ci];
+    unsigned count;
+    rc_solve_result res;
+    ca->kind = cd->kind;
+    ca->joint = cd->joint0 + 1;
+    cand_name(ca->name, sizeof ca->name, cd->kind, cd->joint0);
+    st->n_cand = 1;
+    if (!cand_applicable(S, cd, ca, &count) || !cand_identify(S, ci, count, ca, &res) || cand_cv(S, ci, count, ca) != 0 ||
+        ca->implausible || ca->z < -1.0)
+        return; /* the step is not kept */
+    out->n_steps++;
+    st->chosen = 0;
+    char cn[40];
+    memcpy(cn, ca->name, sizeof cn);
+    snprintf(st->why, sizeof st->why,
+             "%s: gravity loads joints 2 and 3 together; added beside the other (held-out gain z = %.1f, not worse "
+             "by one standard error)",
+             cn, ca->z);
+    S->base = S->cand_full[ci];
+    memcpy(S->base_folds, &S->cand_folds[(size_t)ci * S->c.k], S->c.k * sizeof *S->base_folds);
+    memcpy(S->r0, &S->cand_res[(size_t)ci * out->n], out->n * sizeof *S->r0);
+    out->n_chosen++;
+}
+
 void rch_dg_phase_search(run_state *S)
 {
     rch_diagnose_result *out = S->out;
@@ -474,5 +519,6 @@ void rch_dg_phase_search(run_state *S)
         if (!step_choose(S, st, n_tested))
             break;
     }
+    gravity_pair(S);
     out->final = S->base;
 }
