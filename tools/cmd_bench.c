@@ -35,6 +35,12 @@ static void report_text(const rch_bench_result *r, const char *data_path)
            "    its time (MAP noise passes, the attachment's evidence test, a jump search, a jump fit when found)\n",
            r->calib_ls_ms, r->calib_ls_min_ms, r->calib_ls_max_ms,
            r->calib_ls_ms > 0.0 ? r->calib_ms / r->calib_ls_ms : 0.0);
+    if (r->diag_ms > 0.0)
+        printf("  diagnose (rcal diagnose --data, defaults, in one process): median %.1f ms (%.1f..%.1f)\n", r->diag_ms,
+               r->diag_min_ms, r->diag_max_ms);
+    if (r->diag_pos_ms > 0.0)
+        printf("  diagnose --positions (%zu position rows): median %.1f ms (%.1f..%.1f)\n", r->diag_pos_rows,
+               r->diag_pos_ms, r->diag_pos_min_ms, r->diag_pos_max_ms);
 }
 
 static int report_json(const rch_bench_result *r, const char *data_path, int argc, char **argv)
@@ -64,6 +70,17 @@ static int report_json(const rch_bench_result *r, const char *data_path, int arg
     rch_jw_numf(&w, "min_ms", r->calib_min_ms, "%.4f");
     rch_jw_numf(&w, "max_ms", r->calib_max_ms, "%.4f");
     rch_jw_end(&w);
+    rch_jw_obj(&w, "diagnose");
+    rch_jw_numf(&w, "median_ms", r->diag_ms, "%.4f");
+    rch_jw_numf(&w, "min_ms", r->diag_min_ms, "%.4f");
+    rch_jw_numf(&w, "max_ms", r->diag_max_ms, "%.4f");
+    rch_jw_end(&w);
+    rch_jw_obj(&w, "diagnose_positions");
+    rch_jw_uint(&w, "rows", r->diag_pos_rows);
+    rch_jw_numf(&w, "median_ms", r->diag_pos_ms, "%.4f");
+    rch_jw_numf(&w, "min_ms", r->diag_pos_min_ms, "%.4f");
+    rch_jw_numf(&w, "max_ms", r->diag_pos_max_ms, "%.4f");
+    rch_jw_end(&w);
     rch_jw_obj(&w, "calibrate_least_squares");
     rch_jw_numf(&w, "median_ms", r->calib_ls_ms, "%.4f");
     rch_jw_numf(&w, "min_ms", r->calib_ls_min_ms, "%.4f");
@@ -75,13 +92,17 @@ static int report_json(const rch_bench_result *r, const char *data_path, int arg
 
 int rcal_cmd_bench(int argc, char **argv)
 {
-    rch_bench_cfg cfg = {"../shared/data/robotcali.csv", RCAL_DEFAULT_ROBOT, 21};
+    rch_bench_cfg cfg = {"../shared/data/robotcali.csv", RCAL_DEFAULT_ROBOT, 21, 5, NULL};
     int json = 0;
     rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--data", RCH_OPT_STR, &cfg.data_path, 0, 0, "FILE", "measurements (all samples are fitted)", 0, NULL},
         {"--robot", RCH_OPT_STR, &cfg.robot_path, 0, 0, "MODEL.json", "nominal robot model", 0, NULL},
         {"--runs", RCH_OPT_UINT, &cfg.runs, 1, 10000, "N", "repetitions of each measurement", 0, NULL},
+        {"--diagnose-runs", RCH_OPT_UINT, &cfg.diag_runs, 0, 1000, "N",
+         "repetitions of rcal diagnose on --data (and --positions) with its defaults (0: not timed)", 0, NULL},
+        {"--positions", RCH_OPT_STR, &cfg.positions_path, 0, 0, "FILE",
+         "a tracker positions file rcal diagnose --positions is also timed on", 0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
     };
     const int ps = rch_opt_cmd(&spec, "bench", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);

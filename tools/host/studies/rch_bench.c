@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_bench.c - calibration speed in one process (see rch_bench.h). */
 #include "rch_bench.h"
+#include "rch_diagnose.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -98,6 +99,43 @@ static int bench_calibrate(double *med, double *lo, double *hi, const rch_bench_
     return 0;
 }
 
+/* `rcal diagnose` with its defaults on one data file or one positions file,
+ * diag_runs times (the whole workflow in one process, files included). */
+static int bench_diagnose(double *med, double *lo, double *hi, size_t *rows, const rch_bench_cfg *cfg, int positions,
+                          double *t, rch_diag *d)
+{
+    const char *path = positions ? cfg->positions_path : cfg->data_path;
+    rch_diagnose_in in;
+    memset(&in, 0, sizeof in);
+    in.data_paths = positions ? NULL : &path;
+    in.n_data = positions ? 0 : 1;
+    in.positions_paths = positions ? &path : NULL;
+    in.n_positions = positions ? 1 : 0;
+    in.robot_path = cfg->robot_path;
+    rch_diagnose_cfg dc;
+    memset(&dc, 0, sizeof dc);
+    rch_diagnose_result *dr = malloc(sizeof *dr);
+    if (!dr) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    for (unsigned long k = 0; k < cfg->diag_runs; ++k) {
+        const double t0 = now_ms();
+        const int rc = rch_diagnose_inputs(dr, &in, &dc, d);
+        t[k] = now_ms() - t0;
+        if (rows)
+            *rows = dr->n / 3;
+        rch_diagnose_free(dr);
+        if (rc != 0) {
+            free(dr);
+            return -1;
+        }
+    }
+    free(dr);
+    med_range(med, lo, hi, t, cfg->diag_runs);
+    return 0;
+}
+
 int rch_bench_run(rch_bench_result *r, const rch_bench_cfg *cfg, rch_diag *d)
 {
     rch_robot robot;
@@ -123,7 +161,8 @@ int rch_bench_run(rch_bench_result *r, const rch_bench_cfg *cfg, rch_diag *d)
         return -2;
     }
     rc_solve_work *w = malloc(sizeof *w);
-    double *t_start = malloc(cfg->runs * sizeof *t_start), *t_solve = malloc(cfg->runs * sizeof *t_solve);
+    const unsigned long nt = cfg->runs > cfg->diag_runs ? cfg->runs : cfg->diag_runs;
+    double *t_start = malloc(nt * sizeof *t_start), *t_solve = malloc(nt * sizeof *t_solve);
     int rc = (w && t_start && t_solve) ? 0 : -1;
     if (rc != 0)
         rch_diag_set(d, "", 0, 0, "out of memory");
@@ -133,6 +172,11 @@ int rch_bench_run(rch_bench_result *r, const rch_bench_cfg *cfg, rch_diag *d)
         rc = bench_calibrate(&r->calib_ms, &r->calib_min_ms, &r->calib_max_ms, cfg, 0, t_solve, d);
     if (rc == 0)
         rc = bench_calibrate(&r->calib_ls_ms, &r->calib_ls_min_ms, &r->calib_ls_max_ms, cfg, 1, t_solve, d);
+    if (rc == 0 && cfg->diag_runs)
+        rc = bench_diagnose(&r->diag_ms, &r->diag_min_ms, &r->diag_max_ms, NULL, cfg, 0, t_solve, d);
+    if (rc == 0 && cfg->diag_runs && cfg->positions_path)
+        rc = bench_diagnose(&r->diag_pos_ms, &r->diag_pos_min_ms, &r->diag_pos_max_ms, &r->diag_pos_rows, cfg, 1,
+                            t_solve, d);
     free(w);
     free(t_start);
     free(t_solve);

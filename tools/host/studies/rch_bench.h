@@ -36,6 +36,8 @@ typedef struct rch_bench_cfg {
     const char *data_path;  /* measurements (every sample is fitted) */
     const char *robot_path; /* nominal robot model */
     unsigned long runs;     /* repetitions of each measurement, >= 1 */
+    unsigned long diag_runs; /* repetitions of `rcal diagnose` (0: not timed) */
+    const char *positions_path; /* a tracker positions file `rcal diagnose --positions` is timed on, or NULL */
 } rch_bench_cfg;
 
 typedef struct rch_bench_row {
@@ -52,6 +54,9 @@ typedef struct rch_bench_result {
     rch_bench_row rows[RCH_BENCH_N_METHODS];     /* lm first: the reference of the ratios */
     double calib_ms, calib_min_ms, calib_max_ms; /* rch_calib_run, --test-fraction 0, default method */
     double calib_ls_ms, calib_ls_min_ms, calib_ls_max_ms; /* the same with --no-prior --no-jump-check */
+    double diag_ms, diag_min_ms, diag_max_ms;    /* rch_diagnose_inputs on the data, defaults (diag_runs) */
+    double diag_pos_ms, diag_pos_min_ms, diag_pos_max_ms; /* on positions_path (diag_runs; 0: not given) */
+    size_t diag_pos_rows;                        /* its position rows */
 } rch_bench_result;
 
 /* Run the benchmark. -2 (d set) when the work (runs x samples x methods)

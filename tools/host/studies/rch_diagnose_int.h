@@ -60,6 +60,7 @@ typedef struct run_state {
     double (*var)[V_N];       /* (n) explanatory variables of the structure tests */
     unsigned *order;          /* (n) shuffled pose order */
     uint8_t *cls;             /* (n) each sample's sensor (index into out->sensors) */
+    unsigned base_rank;       /* identifiable directions of base (0: not yet computed this step) */
 } run_state;
 
 /* The number of candidate effects (rch_diagnose_search.c's table). */

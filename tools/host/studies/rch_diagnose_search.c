@@ -236,7 +236,9 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
         return 0;
     }
     const unsigned ra = rch_dg_rank_at(full, full->n_params, out->s, out->n, S->c.w, S->cfg.verbose > 2);
-    const unsigned rb = rch_dg_rank_at(full, S->base.n_params, out->s, out->n, S->c.w, 0);
+    if (S->base_rank == 0) /* the base's own rank: once a step, at the base's solution */
+        S->base_rank = rch_dg_rank_at(&S->base, S->base.n_params, out->s, out->n, S->c.w, 0);
+    const unsigned rb = S->base_rank;
     ca->n_ident = ra > rb ? ra - rb : 0;
     if (ca->n_ident > ca->n_params)
         ca->n_ident = ca->n_params;
@@ -481,6 +483,7 @@ static void gravity_pair(run_state *S)
     memset(st, 0, sizeof *st);
     st->chosen = -1;
     st->rmse_base_mm = rch_rms(S->r0, out->n);
+    S->base_rank = 0;
     rch_diagnose_cand *ca = &st->cand[0];
     const cdef *cd = &all_cands[ci];
     unsigned count;
@@ -515,6 +518,7 @@ void rch_dg_phase_search(run_state *S)
         memset(st, 0, sizeof *st);
         st->chosen = -1;
         st->rmse_base_mm = rch_rms(S->r0, out->n);
+        S->base_rank = 0;
         const unsigned n_tested = step_candidates(S, st, step);
         if (!step_choose(S, st, n_tested))
             break;
