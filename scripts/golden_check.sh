@@ -26,7 +26,8 @@
 #      "WaitTime 5" is a setting and kept); JSON members named time_*ms/us/s,
 #      time_ratio_*, time_*per_target or *_ms, *_us, *_ns, *_s, *_seconds ->
 #      <T>; the time and "x LM" columns of rcal compare's table (its 4th
-#      "a +- b" and the number after it) -> <T>;
+#      "a +- b" and the number after it, with the blanks around them: their
+#      width follows the figures) -> " <T> +- <T> <T> ";
 #   3. dates and times of day (ISO 8601 2025-01-31[T12:34:56[.123][Z|+01:00]]:
 #      the model's provenance date, the report's "calibrated"/"date (UTC)")
 #      -> <DATE>;
@@ -76,8 +77,8 @@ mask() {
         -e 's#WaitTime@#WaitTime #g' \
         -e 's#("(time_[a-z_]*(ms|us|ns|s|ratio_[a-z]+|per_target)|[a-z_]*_(ms|us|ns|s|seconds))"): ?-?[0-9][0-9.eE+-]*#\1: <T>#g' \
         -e '/^  [A-Za-z][A-Za-z0-9-]* +[0-9]+[.][0-9]+ [+]- [0-9]/ {
-                s#[0-9]+[.][0-9]+ [+]- [0-9]+[.][0-9]+#<T> +- <T>#4
-                s#(<T> [+]- <T>) +[0-9]+[.][0-9]+#\1 <T>#
+                s# +[0-9]+[.][0-9]+ [+]- [0-9]+[.][0-9]+# <T> +- <T>#4
+                s# <T> [+]- <T> +[0-9]+[.][0-9]+ +# <T> +- <T> <T> #
             }' \
         -e 's#[12][0-9]{3}-[01][0-9]-[0-3][0-9]([T ][0-2][0-9]:[0-5][0-9](:[0-5][0-9]([.][0-9]+)?)?(Z|[+-][0-2][0-9]:?[0-5][0-9])?)?#<DATE>#g' \
         -e 's#\b[0-9a-f]{64}\b#<SHA256>#g' \
