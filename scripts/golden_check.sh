@@ -170,8 +170,12 @@ run comp_rapid "$R" compensate --model "$M" --in ../in/every_form.mod --out ever
 run export_urdf "$R" export --model "$M" --format urdf --out model.urdf
 run export_dh_csv "$R" export --model "$M" --format dh-csv --out model_dh.csv --json
 run export_robot "$R" export --model ../in/irb120.json --format dh-csv
+rt=0
 if [ -x "$RT" ]; then
+    rt=1
     run rt_emit_c "$RT" --emit-c "$M"
+else
+    echo "golden_check: $RT not built: the rcal-rt runs (rt_*) skipped"
 fi
 
 run diag_text "$R" diagnose --data "$D" --plots plots
@@ -209,7 +213,7 @@ if [ $record = 1 ]; then
     for d in "$gold"/*/; do
         [ -d "$d" ] || continue
         n=$(basename "$d")
-        case $n in real_*) [ $real = 1 ] || continue ;; esac
+        case $n in real_*) [ $real = 1 ] || continue ;; rt_*) [ $rt = 1 ] || continue ;; esac
         rm -rf "$d"
     done
     for n in "${RUNS[@]}"; do cp -R "$out/$n" "$gold/$n"; done
@@ -281,7 +285,7 @@ done
 for d in "$gold"/*/; do
     [ -d "$d" ] || continue
     n=$(basename "$d")
-    case $n in real_*) [ $real = 1 ] || continue ;; esac
+    case $n in real_*) [ $real = 1 ] || continue ;; rt_*) [ $rt = 1 ] || continue ;; esac
     case " ${RUNS[*]} " in *" $n "*) ;; *) echo "FAIL $n: expected but not in the run list"; failed=$((failed + 1));; esac
 done
 total=${#RUNS[@]}
