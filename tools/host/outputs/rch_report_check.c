@@ -185,6 +185,16 @@ void rch_rep_sec_diag(rep *r, const crow *c, size_t n)
     rch_rep_put_num(r, jnum(r->diag, "folds"), "%.0f");
     rch_rep_kv_end(r);
     fputs("</table>\n", f);
+    const rch_json *ss = jarr(r->diag, "sensors");
+    if (ss && ss->n) {
+        static const jcol scols[] = {{"sensor", "name", 's', NULL},
+                                     {"rows", "rows", 'n', "%.0f"},
+                                     {"held-out before (mm)", "before_mm", 'n', "%.4f"},
+                                     {"after (mm)", "after_mm", 'n', "%.4f"},
+                                     {"floor (mm)", "floor_mm", 'n', "%.4f"}};
+        fputs("<h3>Held-out error by sensor (RMS; 3-D for a tracker)</h3>\n", f);
+        rch_rep_json_table(r, ss, scols, sizeof scols / sizeof scols[0]);
+    }
     if (n) {
         cands_chart(r, c, n);
         cands_table(r, c, n);

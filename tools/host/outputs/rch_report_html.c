@@ -156,6 +156,36 @@ void rch_rep_json_table(rep *r, const rch_json *arr, const jcol *cols, size_t n_
  * over the data's poses and the workspace; pass or fail against the user's
  * tolerance), the held-out measurements it is checked on, and what it rests
  * on (the prior, the outlets, every nuisance fitted). */
+/* The diagnosis on the first screen (when given): its verdict, each sensor's
+ * held-out error before and after (3-D for a tracker), what to run next. */
+static void diagnosis_glance(rep *r)
+{
+    FILE *f = r->f;
+    if (!r->diag)
+        return;
+    fputs("<p>Diagnosis: <b>", f);
+    rch_rep_put_str(r, jstr(r->diag, "effect"));
+    fputs("</b>", f);
+    const rch_json *ss = jarr(r->diag, "sensors");
+    for (size_t k = 0; ss && k < ss->n; ++k) {
+        const rch_json *z = ss->items[k];
+        const char *kind = jstr(z, "kind");
+        fputs(k ? "; " : "; held-out ", f);
+        rch_rep_put_str(r, jstr(z, "name"));
+        fputs(kind && strcmp(kind, "tracker") == 0 ? " (3-D) " : " ", f);
+        rch_rep_put_num(r, jnum(z, "before_mm"), "%.4f");
+        fputs(" &rarr; ", f);
+        rch_rep_put_num(r, jnum(z, "after_mm"), "%.4f mm");
+    }
+    const char *next = jstr(r->diag, "next");
+    if (next) {
+        fputs(". Next: <code>", f);
+        rch_rep_put_esc(f, next);
+        fputs("</code>", f);
+    }
+    fputs(".</p>\n", f);
+}
+
 static void verdict(rep *r, size_t n_warn)
 {
     FILE *f = r->f;
@@ -240,7 +270,9 @@ static void verdict(rep *r, size_t n_warn)
     const double g = jnum(r->unc, "groups");
     if (isfinite(g) && g > 0)
         fprintf(f, "; %.0f set-up groups (cluster-robust covariance)", g);
-    fprintf(f, ".</p>\n<p><a href=\"#warnings\">%zu warning%s</a></p></div>\n", n_warn, n_warn == 1 ? "" : "s");
+    fputs(".</p>\n", f);
+    diagnosis_glance(r);
+    fprintf(f, "<p><a href=\"#warnings\">%zu warning%s</a></p></div>\n", n_warn, n_warn == 1 ? "" : "s");
 }
 
 void rch_rep_page_head(rep *r, size_t n_warn)
