@@ -512,49 +512,60 @@ static int opt_ulong(const char *name, const char *v, unsigned long *out)
     return 0;
 }
 
-static int run(int argc, char **argv)
+/* The command line of rcal-rt. */
+typedef struct rt_opts {
+    const char *model_path, *nominal_path, *in_path, *emit;
+    double rate_hz, seconds;
+    unsigned long n_bench, repeat, cpu;
+    int bench, cold, fifo, json, position_only, pin;
+} rt_opts;
+
+/* The options into o: -1 when they were read, else the exit status (0 after
+ * --help, 2 for a bad option, with its message). */
+static int parse_args(rt_opts *o, int argc, char **argv)
 {
-    const char *model_path = NULL, *nominal_path = NULL, *in_path = NULL, *emit = NULL;
-    double rate_hz = 1000.0, seconds = 10.0;
-    unsigned long n_bench = 200000, repeat = 5, cpu = 0;
-    int bench = 0, cold = 0, fifo = 0, json = 0, position_only = 0, pin = 0;
+    memset(o, 0, sizeof *o);
+    o->rate_hz = 1000.0;
+    o->seconds = 10.0;
+    o->n_bench = 200000;
+    o->repeat = 5;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const int has = i + 1 < argc;
         if (strcmp(a, "--model") == 0 && has)
-            model_path = argv[++i];
+            o->model_path = argv[++i];
         else if (strcmp(a, "--nominal") == 0 && has)
-            nominal_path = argv[++i];
+            o->nominal_path = argv[++i];
         else if (strcmp(a, "--in") == 0 && has)
-            in_path = argv[++i];
+            o->in_path = argv[++i];
         else if (strcmp(a, "--emit-c") == 0 && has)
-            emit = argv[++i];
+            o->emit = argv[++i];
         else if (strcmp(a, "--rate-hz") == 0 && has) {
-            if (opt_double(a, argv[++i], &rate_hz) != 0)
+            if (opt_double(a, argv[++i], &o->rate_hz) != 0)
                 return 2;
         } else if (strcmp(a, "--seconds") == 0 && has) {
-            if (opt_double(a, argv[++i], &seconds) != 0)
+            if (opt_double(a, argv[++i], &o->seconds) != 0)
                 return 2;
         } else if (strcmp(a, "--targets") == 0 && has) {
-            if (opt_ulong(a, argv[++i], &n_bench) != 0)
+            if (opt_ulong(a, argv[++i], &o->n_bench) != 0)
                 return 2;
         } else if (strcmp(a, "--repeat") == 0 && has) {
-            if (opt_ulong(a, argv[++i], &repeat) != 0)
+            if (opt_ulong(a, argv[++i], &o->repeat) != 0)
                 return 2;
         } else if (strcmp(a, "--cpu") == 0 && has) {
-            if (opt_ulong(a, argv[++i], &cpu) != 0)
+            if (opt_ulong(a, argv[++i], &o->cpu) != 0)
                 return 2;
-            pin = 1;
+            o->pin = 1;
         } else if (strcmp(a, "--bench") == 0)
-            bench = 1;
+            o->bench = 1;
         else if (strcmp(a, "--cold") == 0)
-            cold = 1;
+            o->cold = 1;
         else if (strcmp(a, "--fifo") == 0)
-            fifo = 1;
+            o->fifo = 1;
         else if (strcmp(a, "--json") == 0)
-            json = 1;
+            o->json = 1;
         else if (strcmp(a, "--position-only") == 0)
-            position_only = 1;
+            o->position_only = 1;
         else if (strcmp(a, "--help") == 0) {
             usage(stdout);
             return 0;
@@ -572,87 +583,101 @@ static int run(int argc, char **argv)
             return 2;
         }
     }
-    if (emit)
-        return emit_c(emit, nominal_path, position_only);
-    if (!(rate_hz >= 1.0 && rate_hz <= 100000.0)) {
-        fprintf(stderr, "rcal-rt: --rate-hz %g is out of range (1 to 100000)\n", rate_hz);
+    return -1;
+}
+
+/* The options' ranges: 0, or 2 with the message. */
+static int check_args(const rt_opts *o)
+{
+    if (!(o->rate_hz >= 1.0 && o->rate_hz <= 100000.0)) {
+        fprintf(stderr, "rcal-rt: --rate-hz %g is out of range (1 to 100000)\n", o->rate_hz);
         return 2;
     }
-    if (!(seconds > 0.0 && seconds <= 3600.0)) {
-        fprintf(stderr, "rcal-rt: --seconds %g is out of range (more than 0, at most 3600)\n", seconds);
+    if (!(o->seconds > 0.0 && o->seconds <= 3600.0)) {
+        fprintf(stderr, "rcal-rt: --seconds %g is out of range (more than 0, at most 3600)\n", o->seconds);
         return 2;
     }
-    if (n_bench == 0 || n_bench > RT_MAX_TARGETS) {
-        fprintf(stderr, "rcal-rt: --targets %lu is out of range (1 to %lu)\n", n_bench, (unsigned long)RT_MAX_TARGETS);
+    if (o->n_bench == 0 || o->n_bench > RT_MAX_TARGETS) {
+        fprintf(stderr, "rcal-rt: --targets %lu is out of range (1 to %lu)\n", o->n_bench,
+                (unsigned long)RT_MAX_TARGETS);
         return 2;
     }
-    if (repeat == 0 || repeat > 1000) {
-        fprintf(stderr, "rcal-rt: --repeat %lu is out of range (1 to 1000)\n", repeat);
+    if (o->repeat == 0 || o->repeat > 1000) {
+        fprintf(stderr, "rcal-rt: --repeat %lu is out of range (1 to 1000)\n", o->repeat);
         return 2;
     }
-    if (bench && (double)n_bench * (double)repeat > RT_MAX_BENCH_WORK) {
+    if (o->bench && (double)o->n_bench * (double)o->repeat > RT_MAX_BENCH_WORK) {
         fprintf(stderr, "rcal-rt: --targets times --repeat is %.0f, over the limit of %.0f compensations\n",
-                (double)n_bench * (double)repeat, RT_MAX_BENCH_WORK);
+                (double)o->n_bench * (double)o->repeat, RT_MAX_BENCH_WORK);
         return 2;
     }
-    if (!bench && rate_hz * seconds > RT_MAX_CYCLES) {
+    if (!o->bench && o->rate_hz * o->seconds > RT_MAX_CYCLES) {
         fprintf(stderr, "rcal-rt: --rate-hz times --seconds is %.0f cycles, over the limit of %.0f (24 bytes of "
-                        "timings each)\n", rate_hz * seconds, RT_MAX_CYCLES);
+                        "timings each)\n", o->rate_hz * o->seconds, RT_MAX_CYCLES);
         return 2;
     }
-    if (!bench && rate_hz * seconds < 0.5) {
+    if (!o->bench && o->rate_hz * o->seconds < 0.5) {
         fprintf(stderr, "rcal-rt: --rate-hz times --seconds must be at least one cycle\n");
         return 2;
     }
-    if (pin && cpu >= (unsigned long)CPU_SETSIZE) {
+    if (o->pin && o->cpu >= (unsigned long)CPU_SETSIZE) {
         fprintf(stderr, "rcal-rt: --cpu must be 0..%d\n", CPU_SETSIZE - 1);
         return 2;
     }
+    return 0;
+}
 
+/* The kinematics to compensate with: the compiled-in firmware tables, or
+ * --model's determined model and its nominal (static storage). cfg's flags
+ * set (o->position_only raised when the model's orientation is not
+ * determined). 0, or 1 with the message. */
+static int load_kin(const rc_kin **cal, const rc_kin **nom, rc_comp_config *cfg, rt_opts *o)
+{
     static rch_robot robot, nominal;
     static rc_kin kin_cal, kin_nom;
-    const rc_kin *cal = &fw_kin_cal, *nom = &fw_kin_nom;
     unsigned flags = FW_MODEL_COMP_FLAGS;
-    if (model_path) {
+    *cal = &fw_kin_cal;
+    *nom = &fw_kin_nom;
+    if (o->model_path) {
         rch_diag d;
         char msg[1024];
-        if (rch_robot_load(&robot, model_path, &d) != 0 ||
-            (nominal_path && rch_robot_load(&nominal, nominal_path, &d) != 0)) {
+        if (rch_robot_load(&robot, o->model_path, &d) != 0 ||
+            (o->nominal_path && rch_robot_load(&nominal, o->nominal_path, &d) != 0)) {
             fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
             return 1;
         }
         static rc_model det;
         if (determined(&det, &robot))
-            position_only = 1;
+            o->position_only = 1;
         rc_status st = rc_kin_compile(&kin_cal, &det);
         if (st == RC_OK)
-            st = rc_kin_compile(&kin_nom, nominal_path ? &nominal.model : &robot.nominal);
+            st = rc_kin_compile(&kin_nom, o->nominal_path ? &nominal.model : &robot.nominal);
         if (st != RC_OK) {
-            fprintf(stderr, "rcal-rt: %s: the model cannot be compiled: %s\n", model_path, rc_strerror(st));
+            fprintf(stderr, "rcal-rt: %s: the model cannot be compiled: %s\n", o->model_path, rc_strerror(st));
             return 1;
         }
-        cal = &kin_cal;
-        nom = &kin_nom;
+        *cal = &kin_cal;
+        *nom = &kin_nom;
         flags = 0;
     }
-    if (position_only)
+    if (o->position_only)
         flags |= RC_COMP_FLAG_POSITION_ONLY;
-    rc_comp_config cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.flags = flags;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->flags = flags;
+    return 0;
+}
 
-    targets t = {NULL, 0};
-    if (in_path && load_targets(&t, in_path, cal) != 0)
-        return 1;
-
-    if (pin) {
+/* --cpu and --fifo: each refusal a note, never fatal. */
+static void set_realtime(const rt_opts *o)
+{
+    if (o->pin) {
         cpu_set_t set;
         CPU_ZERO(&set);
-        CPU_SET((size_t)cpu, &set);
+        CPU_SET((size_t)o->cpu, &set);
         if (sched_setaffinity(0, sizeof set, &set) != 0)
-            fprintf(stderr, "rcal-rt: note: cannot pin to CPU %lu: %s\n", cpu, strerror(errno));
+            fprintf(stderr, "rcal-rt: note: cannot pin to CPU %lu: %s\n", o->cpu, strerror(errno));
     }
-    if (fifo) {
+    if (o->fifo) {
         struct sched_param sp;
         memset(&sp, 0, sizeof sp);
         sp.sched_priority = 80;
@@ -661,8 +686,28 @@ static int run(int argc, char **argv)
         if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
             fprintf(stderr, "rcal-rt: note: mlockall refused (%s)\n", strerror(errno));
     }
-    int rc = bench ? run_bench(cal, nom, &cfg, &t, n_bench, (unsigned)repeat, cold, json)
-                   : run_loop(cal, nom, &cfg, &t, rate_hz, seconds, json);
+}
+
+static int run(int argc, char **argv)
+{
+    rt_opts o;
+    int rc = parse_args(&o, argc, argv);
+    if (rc >= 0)
+        return rc;
+    if (o.emit)
+        return emit_c(o.emit, o.nominal_path, o.position_only);
+    if ((rc = check_args(&o)) != 0)
+        return rc;
+    const rc_kin *cal, *nom;
+    rc_comp_config cfg;
+    if (load_kin(&cal, &nom, &cfg, &o) != 0)
+        return 1;
+    targets t = {NULL, 0};
+    if (o.in_path && load_targets(&t, o.in_path, cal) != 0)
+        return 1;
+    set_realtime(&o);
+    rc = o.bench ? run_bench(cal, nom, &cfg, &t, o.n_bench, (unsigned)o.repeat, o.cold, o.json)
+                 : run_loop(cal, nom, &cfg, &t, o.rate_hz, o.seconds, o.json);
     free(t.q);
     return rc;
 }

@@ -602,6 +602,245 @@ static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, doub
     }
 }
 
+/* The robust LM's settings, read once from the configuration. */
+typedef struct lm_opts {
+    unsigned max_iter;
+    double tau, tol_step, tol_cost;
+    double rcond;   /* 0: rc_ident's rule */
+    double snr_min;
+    int ltlm;
+} lm_opts;
+
+static void lm_opts_from(lm_opts *o, const rc_solve_config *cfg)
+{
+    o->max_iter = cfg->max_iter ? cfg->max_iter : 100u;
+    o->tau = cfg->mu0 > 0.0 ? cfg->mu0 : 1e-3;
+    o->tol_step = cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9;
+    o->tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-4;
+    o->rcond = cfg->rcond > 0.0 ? cfg->rcond : 0.0;
+    o->snr_min = has_prior(cfg) ? 0.0 : cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 1.0);
+    o->ltlm = cfg->method == RC_METHOD_LTLM;
+}
+
+/* What the LM loop carries from one iteration to the next. */
+typedef struct lm_state {
+    unsigned nf;      /* free parameters (w->idx, w->D) */
+    unsigned rank;    /* directions stepped in (lm_subspace) */
+    double cost, mu, nu, gnorm, chaos_n;
+    int have_eig;     /* the decomposition at m is already in w (LTLM kept x1) */
+    int have_ne;      /* A, w->g hold the normal equations at m */
+} lm_state;
+
+/* Fixed scaling from the starting normal equations A (nf x nf), w->g:
+ * D_i = column norm. A column that is zero (a parameter the data cannot move
+ * at all) keeps D = 1 and falls in the null space. alpha6 turns the flange
+ * about x6 after the last translation: it can never move the cable length,
+ * so it is dropped from the free set (A, w->g, w->idx compacted, *nf
+ * lowered) and keeps its value exactly. (theta6 also has a zero column while
+ * a6 = 0, but becomes identifiable as soon as a6 moves: it stays free, and
+ * the eigen-truncation keeps it still while it is null.) */
+static rc_status lm_scale(rc_solve_work *w, double *A, unsigned *nf_io)
+{
+    unsigned nf = *nf_io, keep = 0;
+    double dmax = 0.0;
+    for (unsigned i = 0; i < nf; ++i) {
+        const double a = A[(size_t)i * nf + i];
+        if (a > dmax)
+            dmax = a;
+    }
+    /* rc_ident's zero column: squared norm at most RC_IDENT_ZERO_COL^2 of the largest */
+    const double zero_col = RC_IDENT_ZERO_COL * RC_IDENT_ZERO_COL * dmax;
+    for (unsigned i = 0; i < nf; ++i) {
+        if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || A[(size_t)i * nf + i] > zero_col)
+            w->D[keep++] = (double)i;
+    }
+    if (keep == 0)
+        return RC_ERR_RANK;
+    for (unsigned a = 0; a < keep; ++a) {
+        const unsigned ia = (unsigned)w->D[a];
+        for (unsigned b = 0; b < keep; ++b)
+            A[(size_t)a * keep + b] = A[(size_t)ia * nf + (unsigned)w->D[b]];
+        w->g[a] = w->g[ia];
+        w->idx[a] = w->idx[ia];
+    }
+    nf = keep;
+    for (unsigned i = 0; i < nf; ++i) {
+        const double a = A[(size_t)i * nf + i];
+        w->D[i] = a > zero_col ? sqrt(a) : 1.0;
+    }
+    *nf_io = nf;
+    return RC_OK;
+}
+
+/* The normal equations at the start (A, w->g), the starting RMS and the
+ * scaling (lm_scale): s ready for the first iteration. */
+static rc_status lm_start(lm_state *s, rc_solve_result *res, rc_solve_work *w, double *A, passbuf tab,
+                          const rc_model *m, const lm_opts *o, const rc_solve_config *cfg, const rc_sample *samples,
+                          size_t n)
+{
+    rc_status st = normal_eq_tab(A, w->g, &s->cost, w->jrow, m, w->idx, s->nf, samples, tab, n);
+    ++res->cost_evals;
+    if (st != RC_OK)
+        return st;
+    rc_prior_normal_eq(A, w->g, &s->cost, m, w->idx, s->nf, cfg);
+    const double prior0 = rc_prior_cost(m, cfg); /* the figures are the data's RMS, without the prior */
+    res->rms_start_mm = res->rms_final_mm = rms_of(s->cost - prior0 > 0.0 ? s->cost - prior0 : 0.0, n);
+    st = lm_scale(w, A, &s->nf);
+    if (st != RC_OK)
+        return st;
+    s->mu = 0.0;
+    s->nu = 2.0;
+    s->chaos_n = o->ltlm ? ltlm_n0(cfg) : 0.0;
+    s->rank = 0;
+    s->gnorm = 0.0;
+    s->have_eig = 0;
+    /* A trial point is evaluated with its normal equations (one pass gives
+     * the cost, the Jacobian and J^T J, the cost to the last bit as
+     * cost_tab's: same samples, same order, same sum), so an accepted step
+     * leaves in A, w->g the normal equations the next iteration needs and
+     * its pass is saved; a rejected one costs the Jacobian for nothing
+     * (rare: damping is tuned for acceptance). A and w->g are free during
+     * the trials: the step comes from w->ev, w->c and V. */
+    s->have_ne = 1;
+    return RC_OK;
+}
+
+/* Algorithm I on the accepted x1 (w->trial, cost cnew; A, w->g its normal
+ * equations): x2 is the robust LM's own next step from x1 (new normal
+ * equations, the updated damping, the same truncation), so both segments
+ * lie in subspaces the robust LM steps in. w->trial becomes the best point
+ * found; its cost is returned. */
+static double lm_ltlm(lm_state *s, const rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V,
+                      const lm_opts *o, const rc_solve_config *cfg, double cnew, unsigned it,
+                      const rc_sample *samples, size_t n)
+{
+    const unsigned nf = s->nf;
+    double c1 = cnew, cbest;
+    if (lm_subspace(&s->rank, &s->gnorm, w, A, V, nf, c1, n, o->rcond, o->snr_min) != RC_OK)
+        return cnew;
+    if (s->gnorm > 0.0)
+        (void)lm_subspace_step(w->lt_x2, w, V, nf, s->rank, s->mu);
+    else
+        memset(w->lt_x2, 0, nf * sizeof w->lt_x2[0]);
+    for (unsigned i = 0; i < nf; ++i)
+        w->lt_x2[i] = w->trial.x[w->idx[i]] + w->lt_x2[i] / w->D[i];
+    if (ltlm_segments(&w->best, &cbest, m, &w->trial, cnew, w, nf, cfg, &s->chaos_n, it + 1, 1, samples, n,
+                      &res->cost_evals)) {
+        ++res->ltlm_wins;
+        w->trial = w->best;
+        return cbest;
+    }
+    s->have_eig = 1; /* x1 kept: its decomposition serves the next iteration */
+    return c1;
+}
+
+/* One damped trial step of iteration it from m at damping s->mu: 1 when it
+ * was accepted (m moved, the damping lowered), else 0 (the damping raised).
+ * *done: the step or the cost change fell below its tolerance (res->exit). */
+static int lm_trial(int *done, lm_state *s, rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A,
+                    double *V, passbuf tab, const lm_opts *o, const rc_solve_config *cfg, unsigned it,
+                    const rc_sample *samples, size_t n)
+{
+    const unsigned nf = s->nf;
+    double xs = 0.0, ds = 0.0;
+    const double pred = lm_subspace_step(w->dx, w, V, nf, s->rank, s->mu);
+    for (unsigned i = 0; i < nf; ++i) {
+        ds += w->dx[i] * w->dx[i];
+        xs += (m->x[w->idx[i]] * w->D[i]) * (m->x[w->idx[i]] * w->D[i]);
+    }
+    apply_step(&w->trial, m, w, nf, w->dx);
+    double cnew;
+    ++res->cost_evals;
+    const rc_status st = normal_eq_tab(A, w->g, &cnew, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
+    if (st == RC_OK)
+        rc_prior_normal_eq(A, w->g, &cnew, &w->trial, w->idx, nf, cfg);
+    const double rho = (st == RC_OK && pred > 0.0) ? (s->cost - cnew) / pred : -1.0;
+    if (!(rho > 0.0)) {
+        if (sqrt(ds) <= o->tol_step * (sqrt(xs) + o->tol_step)) {
+            res->exit = RC_EXIT_SMALL_STEP;
+            *done = 1;
+            return 0;
+        }
+        s->mu *= s->nu;
+        s->nu *= 2.0;
+        return 0;
+    }
+    const double t = 2.0 * rho - 1.0;
+    double f = 1.0 - t * t * t;
+    s->mu *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
+    s->nu = 2.0;
+    if (o->ltlm)
+        cnew = lm_ltlm(s, m, res, w, A, V, o, cfg, cnew, it, samples, n);
+    s->have_ne = !o->ltlm; /* LTLM: A is decomposed (x1 kept: have_eig) or m is a candidate */
+    const double rel = (s->cost - cnew) / (s->cost + 1e-300);
+    *m = w->trial;
+    s->cost = cnew;
+    if (sqrt(ds) <= o->tol_step * (sqrt(xs) + o->tol_step) || rel < o->tol_cost) {
+        res->exit = sqrt(ds) <= o->tol_step * (sqrt(xs) + o->tol_step) ? RC_EXIT_SMALL_STEP : RC_EXIT_SMALL_COST;
+        *done = 1;
+    }
+    return 1;
+}
+
+/* The decomposition at m for iteration it (the normal equations first when
+ * the last step did not leave them). */
+static rc_status lm_decompose(lm_state *s, rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A,
+                              double *V, passbuf tab, const lm_opts *o, const rc_solve_config *cfg,
+                              const rc_sample *samples, size_t n)
+{
+    if (!s->have_ne) {
+        const rc_status st = normal_eq_tab(A, w->g, &s->cost, w->jrow, m, w->idx, s->nf, samples, tab, n);
+        ++res->cost_evals;
+        if (st != RC_OK)
+            return st;
+        rc_prior_normal_eq(A, w->g, &s->cost, m, w->idx, s->nf, cfg);
+    }
+    return lm_subspace(&s->rank, &s->gnorm, w, A, V, s->nf, s->cost, n, o->rcond, o->snr_min);
+}
+
+/* The robust LM / LTLM loop (rc_solve's methods RC_METHOD_LM, _LTLM) from
+ * s (lm_start) on m. */
+static rc_status lm_loop(lm_state *s, rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V,
+                         passbuf tab, const lm_opts *o, const rc_solve_config *cfg, const rc_sample *samples,
+                         size_t n)
+{
+    res->exit = RC_EXIT_MAX_ITER;
+    for (unsigned it = 0; it < o->max_iter; ++it) {
+        if (!s->have_eig) {
+            const rc_status st = lm_decompose(s, m, res, w, A, V, tab, o, cfg, samples, n);
+            if (st != RC_OK)
+                return st;
+        }
+        s->have_eig = s->have_ne = 0;
+        const double lmax = w->ev[0];
+        res->rank = s->rank;
+        res->cond = sqrt(lmax / w->ev[s->rank - 1]);
+        if (s->gnorm == 0.0 || sqrt(s->gnorm) <= 1e-14 * (s->cost + 1e-300)) {
+            res->exit = RC_EXIT_SMALL_GRAD;
+            break;
+        }
+        if (it == 0)
+            s->mu = o->tau * lmax;
+        int accepted = 0, done = 0;
+        for (unsigned tries = 0; tries < 60 && !accepted && !done; ++tries)
+            accepted = lm_trial(&done, s, m, res, w, A, V, tab, o, cfg, it, samples, n);
+        res->iterations = it + 1;
+        {
+            const double data_cost = s->cost - rc_prior_cost(m, cfg);
+            res->rms_final_mm = rms_of(data_cost > 0.0 ? data_cost : 0.0, n);
+        }
+        if (cfg->on_iter)
+            cfg->on_iter(cfg->cb_ctx, it + 1, res->rms_final_mm, m);
+        if (!accepted && !done) {
+            res->exit = RC_EXIT_NO_DESCENT;
+            break;
+        }
+        if (done)
+            break;
+    }
+    return RC_OK;
+}
+
 /* rc_solve on w's small fields and the matrices A, V ((nf x nf) each, n_params^2
  * entries of room) and the sample tables t. */
 static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, passbuf tab,
@@ -636,179 +875,17 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     if (cfg->method != RC_METHOD_LM && cfg->method != RC_METHOD_LTLM)
         return RC_ERR_ARG;
 
-    const unsigned max_iter = cfg->max_iter ? cfg->max_iter : 100u;
-    const double tau = cfg->mu0 > 0.0 ? cfg->mu0 : 1e-3;
-    const double tol_step = cfg->tol_step > 0.0 ? cfg->tol_step : 1e-9;
-    const double tol_cost = cfg->tol_cost > 0.0 ? cfg->tol_cost : 1e-4;
-    const double rcond = cfg->rcond > 0.0 ? cfg->rcond : 0.0; /* 0: rc_ident's rule */
-    const double snr_min =
-        has_prior(cfg) ? 0.0 : cfg->snr_min > 0.0 ? cfg->snr_min : (cfg->snr_min < 0.0 ? 0.0 : 1.0);
-    const int ltlm = cfg->method == RC_METHOD_LTLM;
-    double cost, mu = 0.0, nu = 2.0;
-
-    rc_status st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
-    ++res->cost_evals;
+    lm_opts o;
+    lm_state s;
+    lm_opts_from(&o, cfg);
+    s.nf = nf;
+    rc_status st = lm_start(&s, res, w, A, tab, m, &o, cfg, samples, n);
+    if (st == RC_OK)
+        st = lm_loop(&s, m, res, w, A, V, tab, &o, cfg, samples, n);
     if (st != RC_OK)
         return st;
-    rc_prior_normal_eq(A, w->g, &cost, m, w->idx, nf, cfg);
-    const double prior0 = rc_prior_cost(m, cfg); /* the figures are the data's RMS, without the prior */
-    res->rms_start_mm = res->rms_final_mm = rms_of(cost - prior0 > 0.0 ? cost - prior0 : 0.0, n);
-    /* Fixed scaling from the starting Jacobian: D_i = column norm. A column
-     * that is zero (a parameter the data cannot move at all) keeps D = 1 and
-     * falls in the null space below. */
-    double dmax = 0.0;
-    for (unsigned i = 0; i < nf; ++i) {
-        const double a = A[(size_t)i * nf + i];
-        if (a > dmax)
-            dmax = a;
-    }
-    /* rc_ident's zero column: squared norm at most RC_IDENT_ZERO_COL^2 of the largest */
-    const double zero_col = RC_IDENT_ZERO_COL * RC_IDENT_ZERO_COL * dmax;
-    /* alpha6 turns the flange about x6 after the last translation: it can
-     * never move the cable length, so it is dropped from the free set and
-     * keeps its value exactly. (theta6 also has a zero column while a6 = 0,
-     * but becomes identifiable as soon as a6 moves: it stays free, and the
-     * eigen-truncation below keeps it still while it is null.) */
-    {
-        unsigned keep = 0;
-        for (unsigned i = 0; i < nf; ++i) {
-            if (w->idx[i] != RC_P_ALPHA(RC_NJ - 1) || A[(size_t)i * nf + i] > zero_col)
-                w->D[keep++] = (double)i;
-        }
-        if (keep == 0)
-            return RC_ERR_RANK;
-        for (unsigned a = 0; a < keep; ++a) {
-            const unsigned ia = (unsigned)w->D[a];
-            for (unsigned b = 0; b < keep; ++b)
-                A[(size_t)a * keep + b] = A[(size_t)ia * nf + (unsigned)w->D[b]];
-            w->g[a] = w->g[ia];
-            w->idx[a] = w->idx[ia];
-        }
-        nf = keep;
-    }
-    for (unsigned i = 0; i < nf; ++i) {
-        const double a = A[(size_t)i * nf + i];
-        w->D[i] = a > zero_col ? sqrt(a) : 1.0;
-    }
-    double chaos_n = ltlm ? ltlm_n0(cfg) : 0.0;
-    unsigned rank = 0;
-    double gnorm = 0.0;
-    int have_eig = 0; /* the decomposition at m is already in w (LTLM kept x1) */
-    /* A trial point is evaluated with its normal equations (one pass gives
-     * the cost, the Jacobian and J^T J, the cost to the last bit as
-     * cost_tab's: same samples, same order, same sum), so an accepted step
-     * leaves in A, w->g the normal equations the next iteration needs and
-     * its pass is saved; a rejected one costs the Jacobian for nothing
-     * (rare: damping is tuned for acceptance). A and w->g are free during
-     * the trials: the step comes from w->ev, w->c and V. */
-    int have_ne = 1; /* A, w->g hold the normal equations at m */
-
-    res->exit = RC_EXIT_MAX_ITER;
-    for (unsigned it = 0; it < max_iter; ++it) {
-        if (!have_eig) {
-            if (!have_ne) {
-                st = normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n);
-                ++res->cost_evals;
-                if (st != RC_OK)
-                    return st;
-                rc_prior_normal_eq(A, w->g, &cost, m, w->idx, nf, cfg);
-            }
-            st = lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, rcond, snr_min);
-            if (st != RC_OK)
-                return st;
-        }
-        have_eig = have_ne = 0;
-        const double lmax = w->ev[0];
-        res->rank = rank;
-        res->cond = sqrt(lmax / w->ev[rank - 1]);
-        if (gnorm == 0.0 || sqrt(gnorm) <= 1e-14 * (cost + 1e-300)) {
-            res->exit = RC_EXIT_SMALL_GRAD;
-            break;
-        }
-        if (it == 0)
-            mu = tau * lmax;
-
-        int accepted = 0, done = 0;
-        for (unsigned tries = 0; tries < 60 && !accepted; ++tries) {
-            double xs = 0.0, ds = 0.0;
-            const double pred = lm_subspace_step(w->dx, w, V, nf, rank, mu);
-            for (unsigned i = 0; i < nf; ++i) {
-                ds += w->dx[i] * w->dx[i];
-                xs += (m->x[w->idx[i]] * w->D[i]) * (m->x[w->idx[i]] * w->D[i]);
-            }
-            apply_step(&w->trial, m, w, nf, w->dx);
-            double cnew;
-            ++res->cost_evals;
-            st = normal_eq_tab(A, w->g, &cnew, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
-            if (st == RC_OK)
-                rc_prior_normal_eq(A, w->g, &cnew, &w->trial, w->idx, nf, cfg);
-            const double rho = (st == RC_OK && pred > 0.0) ? (cost - cnew) / pred : -1.0;
-            if (rho > 0.0) {
-                accepted = 1;
-                const double t = 2.0 * rho - 1.0;
-                double f = 1.0 - t * t * t;
-                mu *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
-                nu = 2.0;
-                if (ltlm) {
-                    /* Algorithm I on the accepted x1: x2 is the robust LM's
-                     * own next step from x1 (new normal equations, the
-                     * updated damping, the same truncation), so both
-                     * segments lie in subspaces the robust LM steps in. */
-                    double c1 = cnew, cbest; /* A, w->g: the normal equations at x1 */
-                    st = lm_subspace(&rank, &gnorm, w, A, V, nf, c1, n, rcond, snr_min);
-                    if (st == RC_OK) {
-                        if (gnorm > 0.0)
-                            (void)lm_subspace_step(w->lt_x2, w, V, nf, rank, mu);
-                        else
-                            memset(w->lt_x2, 0, nf * sizeof w->lt_x2[0]);
-                        for (unsigned i = 0; i < nf; ++i)
-                            w->lt_x2[i] = w->trial.x[w->idx[i]] + w->lt_x2[i] / w->D[i];
-                        if (ltlm_segments(&w->best, &cbest, m, &w->trial, cnew, w, nf, cfg, &chaos_n,
-                                          it + 1, 1, samples, n, &res->cost_evals)) {
-                            ++res->ltlm_wins;
-                            w->trial = w->best;
-                            cnew = cbest;
-                        } else {
-                            have_eig = 1; /* x1 kept: its decomposition serves the next iteration */
-                            cnew = c1;
-                        }
-                    }
-                }
-                have_ne = !ltlm; /* LTLM: A is decomposed (x1 kept: have_eig) or m is a candidate */
-                const double rel = (cost - cnew) / (cost + 1e-300);
-                *m = w->trial;
-                cost = cnew;
-                if (sqrt(ds) <= tol_step * (sqrt(xs) + tol_step) || rel < tol_cost) {
-                    res->exit = sqrt(ds) <= tol_step * (sqrt(xs) + tol_step) ? RC_EXIT_SMALL_STEP
-                                                                            : RC_EXIT_SMALL_COST;
-                    done = 1;
-                }
-            } else {
-                if (sqrt(ds) <= tol_step * (sqrt(xs) + tol_step)) {
-                    res->exit = RC_EXIT_SMALL_STEP;
-                    done = 1;
-                    break;
-                }
-                mu *= nu;
-                nu *= 2.0;
-            }
-        }
-        res->iterations = it + 1;
-        {
-            const double data_cost = cost - rc_prior_cost(m, cfg);
-            res->rms_final_mm = rms_of(data_cost > 0.0 ? data_cost : 0.0, n);
-        }
-        if (cfg->on_iter)
-            cfg->on_iter(cfg->cb_ctx, it + 1, res->rms_final_mm, m);
-        if (!accepted && !done) {
-            res->exit = RC_EXIT_NO_DESCENT;
-            break;
-        }
-        if (done)
-            break;
-    }
     if (has_prior(cfg))
-        map_polish(m, res, w, A, V, tab, cfg, nf, samples, n);
+        map_polish(m, res, w, A, V, tab, cfg, s.nf, samples, n);
     rc_model_wrap_angles(m);
     return RC_OK;
 }

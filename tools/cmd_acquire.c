@@ -144,108 +144,143 @@ static void report_text(const rch_acq_result *r, const rch_acq_config *c)
                "--jumps\n", r->jumps[k].jump_mm, r->jumps[k].pose);
 }
 
-int rcal_cmd_acquire(int argc, char **argv)
-{
+/* The options of rcal acquire: the run's configuration and the values
+ * turned into it. */
+typedef struct acquire_args {
     rch_acq_config c;
-    rch_acq_result r;
-    const char *proto = NULL, *parity = "none", *flow = "none", *mbf = "int32", *mbo = "abcd", *poll = NULL,
-               *joints = "plan", *on_jump = "stop";
-    unsigned long baud = 9600, bits = 8, stop = 1, mb_addr = 1, mb_reg = 0, mb_dec = 0, n = 5, pose_s = 60, outlet = 0,
-                  tau_ms = 0;
-    int rc, json = 0, no_learn = 0;
-    rch_acq_config_default(&c);
-    memset(&r, 0, sizeof r);
-    c.robot_path = RCAL_DEFAULT_ROBOT;
+    const char *proto, *parity, *flow, *mbf, *mbo, *poll, *joints, *on_jump;
+    unsigned long baud, bits, stop, mb_addr, mb_reg, mb_dec, n, pose_s, outlet, tau_ms;
+    int json, no_learn;
+} acquire_args;
+
+/* The parsed options into a->c (outlet_given: --outlet was given). -1, or 2
+ * (reported). */
+static int to_config(acquire_args *a, int outlet_given)
+{
+    a->c.outlet_p1 = outlet_given ? (int)a->outlet + 1 : 0;
+    if (!(a->c.stable.min_mm < a->c.stable.max_mm)) {
+        fprintf(stderr, "rcal acquire: need --min-mm < --max-mm\n");
+        return 2;
+    }
+    a->c.proto.protocol = (rcd_protocol)pick(a->proto, "ascii|ascii-poll|stx|modbus");
+    a->c.ser.baud = (unsigned)a->baud;
+    a->c.ser.data_bits = (unsigned)a->bits;
+    a->c.ser.stop_bits = (unsigned)a->stop;
+    a->c.ser.parity = (rcd_parity)pick(a->parity, "none|odd|even|mark|space");
+    a->c.ser.flow = (rcd_flow)pick(a->flow, "none|xonxoff|rtscts|dtrdsr");
+    if (a->poll && unescape(a->c.proto.poll_cmd, sizeof a->c.proto.poll_cmd, a->poll) != 0) {
+        fprintf(stderr, "rcal acquire: --poll-cmd '%s' is longer than the %zu bytes a poll command may have (\\r and "
+                        "\\n count one each): refused, not cut\n",
+                a->poll, sizeof a->c.proto.poll_cmd - 1);
+        return 2;
+    }
+    a->c.proto.mb_addr = (uint8_t)a->mb_addr;
+    a->c.proto.mb_reg = (uint16_t)a->mb_reg;
+    a->c.proto.mb_decimals = (uint8_t)a->mb_dec;
+    a->c.proto.mb_format = (rcd_mb_format)pick(a->mbf, "int32|float");
+    a->c.proto.mb_order = (rcd_word_order)pick(a->mbo, "abcd|cdab|badc|dcba");
+    a->c.stable.n = (unsigned)a->n;
+    a->c.stable.timeout_ms = (uint32_t)(a->pose_s * 1000ul);
+    a->c.stable.tau_ms = (uint32_t)a->tau_ms;
+    a->c.stable.learn_tau = !a->no_learn;
+    a->c.on_jump_record = strcmp(a->on_jump, "record") == 0;
+    return -1;
+}
+
+/* The options into a: -1 when the command should run, else its exit status
+ * (0 for --help, 2 for an error, reported). */
+static int parse(acquire_args *a, int argc, char **argv)
+{
     rch_cmdspec spec;
+    unsigned long long seen = 0;
+    memset(a, 0, sizeof *a);
+    a->parity = "none";
+    a->flow = "none";
+    a->mbf = "int32";
+    a->mbo = "abcd";
+    a->joints = "plan";
+    a->on_jump = "stop";
+    a->baud = 9600;
+    a->bits = 8;
+    a->stop = 1;
+    a->mb_addr = 1;
+    a->n = 5;
+    a->pose_s = 60;
+    rch_acq_config_default(&a->c);
+    a->c.robot_path = RCAL_DEFAULT_ROBOT;
     const rch_opt opts[] = {
-        {"--port", RCH_OPT_STR, &c.port_path, 0, 0, "PATH", "serial device", RCH_OPT_REQUIRED, NULL},
-        {"--protocol", RCH_OPT_CHOICE, &proto, 0, 0, NULL, "display protocol", RCH_OPT_REQUIRED, "ascii|ascii-poll|stx|modbus"},
-        {"--poses", RCH_OPT_STR, &c.poses_path, 0, 0, "POSES.csv", "pose plan (rcal poses)", RCH_OPT_REQUIRED, NULL},
-        {"--out", RCH_OPT_STR, &c.out_path, 0, 0, "DATA.csv", "acquisition file (appended)", RCH_OPT_REQUIRED, NULL},
-        {"--outlet", RCH_OPT_UINT, &outlet, 0, 255, "N",
+        {"--port", RCH_OPT_STR, &a->c.port_path, 0, 0, "PATH", "serial device", RCH_OPT_REQUIRED, NULL},
+        {"--protocol", RCH_OPT_CHOICE, &a->proto, 0, 0, NULL, "display protocol", RCH_OPT_REQUIRED, "ascii|ascii-poll|stx|modbus"},
+        {"--poses", RCH_OPT_STR, &a->c.poses_path, 0, 0, "POSES.csv", "pose plan (rcal poses)", RCH_OPT_REQUIRED, NULL},
+        {"--out", RCH_OPT_STR, &a->c.out_path, 0, 0, "DATA.csv", "acquisition file (appended)", RCH_OPT_REQUIRED, NULL},
+        {"--outlet", RCH_OPT_UINT, &a->outlet, 0, 255, "N",
          "the encoder place this run measures from (a label 0..255, written as the file's outlet column): "
          "the same plan run again from another place appends to the same file; a plan with an outlet "
          "column (rcal poses --outlet ...) has its rows of outlet N recorded; give --encoder as this "
          "place's position for the follow check", 0, NULL},
-        {"--robot", RCH_OPT_STR, &c.robot_path, 0, 0, "MODEL.json", "nominal model: limits, follow check", 0, NULL},
-        {"--encoder", RCH_OPT_TRIPLE, c.encoder_mm, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none", 0, NULL},
-        {"--backend", RCH_OPT_CHOICE, &c.backend, 0, 0, NULL, "port backend", 0, "serialport|posix"},
-        {"--baud", RCH_OPT_UINT, &baud, 50, 4000000, NULL, "bits per second", 0, NULL},
-        {"--data-bits", RCH_OPT_UINT, &bits, 5, 8, NULL, NULL, 0, NULL},
-        {"--parity", RCH_OPT_CHOICE, &parity, 0, 0, NULL, NULL, 0, "none|odd|even|mark|space"},
-        {"--stop-bits", RCH_OPT_UINT, &stop, 1, 2, NULL, NULL, 0, NULL},
-        {"--flow", RCH_OPT_CHOICE, &flow, 0, 0, NULL, "flow control", 0, "none|xonxoff|rtscts|dtrdsr"},
-        {"--poll-cmd", RCH_OPT_STR, &poll, 0, 0, "TEXT", "poll command (\\r, \\n allowed; default R\\r)", 0, NULL},
-        {"--mb-addr", RCH_OPT_UINT, &mb_addr, 1, 247, NULL, "Modbus slave address", 0, NULL},
-        {"--mb-reg", RCH_OPT_UINT, &mb_reg, 0, 65535, NULL, "first holding register", 0, NULL},
-        {"--mb-format", RCH_OPT_CHOICE, &mbf, 0, 0, NULL, NULL, 0, "int32|float"},
-        {"--mb-order", RCH_OPT_CHOICE, &mbo, 0, 0, NULL, "word order", 0, "abcd|cdab|badc|dcba"},
-        {"--mb-decimals", RCH_OPT_UINT, &mb_dec, 0, 9, NULL, "int32 scale 10^-D mm", 0, NULL},
-        {"--samples-per-pose", RCH_OPT_UINT, &n, 1, RC_STABLE_MAX_N, "N", "consecutive readings per sample", 0, NULL},
-        {"--stable-mm", RCH_OPT_DOUBLE, &c.stable.tol_mm, 0, 1000, "TOL", "max - min of the N readings", 0, NULL},
-        {"--min-mm", RCH_OPT_DOUBLE, &c.stable.min_mm, 0, 1e6, NULL, "smallest plausible reading", 0, NULL},
-        {"--max-mm", RCH_OPT_DOUBLE, &c.stable.max_mm, 0, 1e6, NULL, "largest plausible reading", 0, NULL},
-        {"--settle-ms", RCH_OPT_UINT, &c.settle_ms, 0, 86400000, NULL, "wait after each move", 0, NULL},
-        {"--read-timeout-ms", RCH_OPT_UINT, &c.read_timeout_ms, 1, 3600000, NULL, NULL, 0, NULL},
-        {"--retries", RCH_OPT_UINT, &c.retries, 1, 1000, "R", NULL, 0, NULL},
-        {"--pose-timeout-s", RCH_OPT_UINT, &pose_s, 1, 86400, NULL, NULL, 0, NULL},
-        {"--reconnect-s", RCH_OPT_UINT, &c.reconnect_s, 0, 3600, NULL, NULL, 0, NULL},
-        {"--poll-interval-ms", RCH_OPT_UINT, &c.poll_interval_ms, 0, 60000, NULL, NULL, 0, NULL},
-        {"--follow-tol-mm", RCH_OPT_DOUBLE, &c.follow_tol_mm, 0.001, 1e4, NULL, "follow check tolerance", 0, NULL},
-        {"--jump-mm", RCH_OPT_DOUBLE, &c.jump_mm, 0.001, 1e4, "MM",
+        {"--robot", RCH_OPT_STR, &a->c.robot_path, 0, 0, "MODEL.json", "nominal model: limits, follow check", 0, NULL},
+        {"--encoder", RCH_OPT_TRIPLE, a->c.encoder_mm, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none", 0, NULL},
+        {"--backend", RCH_OPT_CHOICE, &a->c.backend, 0, 0, NULL, "port backend", 0, "serialport|posix"},
+        {"--baud", RCH_OPT_UINT, &a->baud, 50, 4000000, NULL, "bits per second", 0, NULL},
+        {"--data-bits", RCH_OPT_UINT, &a->bits, 5, 8, NULL, NULL, 0, NULL},
+        {"--parity", RCH_OPT_CHOICE, &a->parity, 0, 0, NULL, NULL, 0, "none|odd|even|mark|space"},
+        {"--stop-bits", RCH_OPT_UINT, &a->stop, 1, 2, NULL, NULL, 0, NULL},
+        {"--flow", RCH_OPT_CHOICE, &a->flow, 0, 0, NULL, "flow control", 0, "none|xonxoff|rtscts|dtrdsr"},
+        {"--poll-cmd", RCH_OPT_STR, &a->poll, 0, 0, "TEXT", "poll command (\\r, \\n allowed; default R\\r)", 0, NULL},
+        {"--mb-addr", RCH_OPT_UINT, &a->mb_addr, 1, 247, NULL, "Modbus slave address", 0, NULL},
+        {"--mb-reg", RCH_OPT_UINT, &a->mb_reg, 0, 65535, NULL, "first holding register", 0, NULL},
+        {"--mb-format", RCH_OPT_CHOICE, &a->mbf, 0, 0, NULL, NULL, 0, "int32|float"},
+        {"--mb-order", RCH_OPT_CHOICE, &a->mbo, 0, 0, NULL, "word order", 0, "abcd|cdab|badc|dcba"},
+        {"--mb-decimals", RCH_OPT_UINT, &a->mb_dec, 0, 9, NULL, "int32 scale 10^-D mm", 0, NULL},
+        {"--samples-per-pose", RCH_OPT_UINT, &a->n, 1, RC_STABLE_MAX_N, "N", "consecutive readings per sample", 0, NULL},
+        {"--stable-mm", RCH_OPT_DOUBLE, &a->c.stable.tol_mm, 0, 1000, "TOL", "max - min of the N readings", 0, NULL},
+        {"--min-mm", RCH_OPT_DOUBLE, &a->c.stable.min_mm, 0, 1e6, NULL, "smallest plausible reading", 0, NULL},
+        {"--max-mm", RCH_OPT_DOUBLE, &a->c.stable.max_mm, 0, 1e6, NULL, "largest plausible reading", 0, NULL},
+        {"--settle-ms", RCH_OPT_UINT, &a->c.settle_ms, 0, 86400000, NULL, "wait after each move", 0, NULL},
+        {"--read-timeout-ms", RCH_OPT_UINT, &a->c.read_timeout_ms, 1, 3600000, NULL, NULL, 0, NULL},
+        {"--retries", RCH_OPT_UINT, &a->c.retries, 1, 1000, "R", NULL, 0, NULL},
+        {"--pose-timeout-s", RCH_OPT_UINT, &a->pose_s, 1, 86400, NULL, NULL, 0, NULL},
+        {"--reconnect-s", RCH_OPT_UINT, &a->c.reconnect_s, 0, 3600, NULL, NULL, 0, NULL},
+        {"--poll-interval-ms", RCH_OPT_UINT, &a->c.poll_interval_ms, 0, 60000, NULL, NULL, 0, NULL},
+        {"--follow-tol-mm", RCH_OPT_DOUBLE, &a->c.follow_tol_mm, 0.001, 1e4, NULL, "follow check tolerance", 0, NULL},
+        {"--jump-mm", RCH_OPT_DOUBLE, &a->c.jump_mm, 0.001, 1e4, "MM",
          "a change this far from the model's sends the run back to the last recorded pose", 0, NULL},
-        {"--verify-tol-mm", RCH_OPT_DOUBLE, &c.verify_tol_mm, 0, 1000, "MM",
+        {"--verify-tol-mm", RCH_OPT_DOUBLE, &a->c.verify_tol_mm, 0, 1000, "MM",
          "the last recorded pose read again must agree within this (default --stable-mm)", 0, NULL},
-        {"--on-jump", RCH_OPT_CHOICE, &on_jump, 0, 0, NULL,
+        {"--on-jump", RCH_OPT_CHOICE, &a->on_jump, 0, 0, NULL,
          "a confirmed jump stops the run, or is reported and recorded past", 0, "stop|record"},
-        {"--display-tau-ms", RCH_OPT_UINT, &tau_ms, 0, 600000, "MS",
+        {"--display-tau-ms", RCH_OPT_UINT, &a->tau_ms, 0, 600000, "MS",
          "the display's filter time constant, when known (the trend test)", 0, NULL},
-        {"--no-learn-tau", RCH_OPT_FLAG, &no_learn, 0, 0, NULL,
+        {"--no-learn-tau", RCH_OPT_FLAG, &a->no_learn, 0, 0, NULL,
          "do not learn the display's time constant from the readings", 0, NULL},
-        {"--no-follow-check", RCH_OPT_FLAG, &c.no_follow_check, 0, 0, NULL, "skip the follow check", 0, NULL},
-        {"--announce", RCH_OPT_STR, &c.announce_path, 0, 0, "FILE", "pose for the robot side", 0, NULL},
-        {"--confirm", RCH_OPT_FLAG, &c.confirm, 0, 0, NULL, "wait for Enter at each pose", 0, NULL},
-        {"--joints", RCH_OPT_CHOICE, &joints, 0, 0, NULL, "source of q1..q6", 0, "plan"},
-        {"--quiet", RCH_OPT_FLAG, &c.quiet, 0, 0, NULL,
+        {"--no-follow-check", RCH_OPT_FLAG, &a->c.no_follow_check, 0, 0, NULL, "skip the follow check", 0, NULL},
+        {"--announce", RCH_OPT_STR, &a->c.announce_path, 0, 0, "FILE", "pose for the robot side", 0, NULL},
+        {"--confirm", RCH_OPT_FLAG, &a->c.confirm, 0, 0, NULL, "wait for Enter at each pose", 0, NULL},
+        {"--joints", RCH_OPT_CHOICE, &a->joints, 0, 0, NULL, "source of q1..q6", 0, "plan"},
+        {"--quiet", RCH_OPT_FLAG, &a->c.quiet, 0, 0, NULL,
          "no per-pose lines (kept with --confirm) and fewer notes; the closing summary and every warning stay", 0, NULL},
-        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
+        {"--json", RCH_OPT_FLAG, &a->json, 0, 0, NULL,
          "the run summary as one JSON object on stdout (progress then goes to stderr)", 0, NULL},
     };
-    unsigned long long seen = 0;
     const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (st >= 0)
         return st;
-    c.outlet_p1 = rch_opt_given(&spec, seen, "--outlet") ? (int)outlet + 1 : 0;
-    if (!(c.stable.min_mm < c.stable.max_mm)) {
-        fprintf(stderr, "rcal acquire: need --min-mm < --max-mm\n");
-        return 2;
-    }
-    c.proto.protocol = (rcd_protocol)pick(proto, "ascii|ascii-poll|stx|modbus");
-    c.ser.baud = (unsigned)baud;
-    c.ser.data_bits = (unsigned)bits;
-    c.ser.stop_bits = (unsigned)stop;
-    c.ser.parity = (rcd_parity)pick(parity, "none|odd|even|mark|space");
-    c.ser.flow = (rcd_flow)pick(flow, "none|xonxoff|rtscts|dtrdsr");
-    if (poll && unescape(c.proto.poll_cmd, sizeof c.proto.poll_cmd, poll) != 0) {
-        fprintf(stderr, "rcal acquire: --poll-cmd '%s' is longer than the %zu bytes a poll command may have (\\r and "
-                        "\\n count one each): refused, not cut\n",
-                poll, sizeof c.proto.poll_cmd - 1);
-        return 2;
-    }
-    c.proto.mb_addr = (uint8_t)mb_addr;
-    c.proto.mb_reg = (uint16_t)mb_reg;
-    c.proto.mb_decimals = (uint8_t)mb_dec;
-    c.proto.mb_format = (rcd_mb_format)pick(mbf, "int32|float");
-    c.proto.mb_order = (rcd_word_order)pick(mbo, "abcd|cdab|badc|dcba");
-    c.stable.n = (unsigned)n;
-    c.stable.timeout_ms = (uint32_t)(pose_s * 1000ul);
-    c.stable.tau_ms = (uint32_t)tau_ms;
-    c.stable.learn_tau = !no_learn;
-    c.on_jump_record = strcmp(on_jump, "record") == 0;
-    rc = rch_acquire_run(&r, &c, NULL, json ? stderr : stdout, stderr);
-    if (json)
-        return report_json(&r, &c, proto, rc, argc, argv) != 0 && rc == 0 ? 1 : rc;
+    return to_config(a, rch_opt_given(&spec, seen, "--outlet"));
+}
+
+int rcal_cmd_acquire(int argc, char **argv)
+{
+    acquire_args a;
+    rch_acq_result r;
+    memset(&r, 0, sizeof r);
+    const int st = parse(&a, argc, argv);
+    if (st >= 0)
+        return st;
+    const rch_acq_config *c = &a.c;
+    const int rc = rch_acquire_run(&r, c, NULL, a.json ? stderr : stdout, stderr);
+    if (a.json)
+        return report_json(&r, c, a.proto, rc, argc, argv) != 0 && rc == 0 ? 1 : rc;
     if (rc == 0 && r.n_new + r.n_before == r.n_poses && r.n_new)
-        report_text(&r, &c);
+        report_text(&r, c);
     return rc;
 }

@@ -48,6 +48,39 @@ typedef struct {
     double tracker_pos[3], tracker_rot[3];
 } calib_args;
 
+/* The parsed options into a->cfg (spec, seen: what was given). -1, or 2
+ * (reported). */
+static int to_config(calib_args *a, const rch_cmdspec *spec, unsigned long long seen)
+{
+    rch_calib_cfg *cfg = &a->cfg;
+    if (rch_method_parse(&cfg->method, a->method) != 0)
+        return 2; /* unreachable: the choice list is the method list */
+    cfg->seed = a->seed;
+    cfg->max_iter = (unsigned)a->max_iter;
+    cfg->cases = a->cases;
+    cfg->case_samples = a->case_samples;
+    if (a->data.n == 0 && a->positions.n == 0) {
+        fprintf(stderr, "rcal calibrate: --data or --positions is required (rcal calibrate --help)\n");
+        return 2;
+    }
+    cfg->data_path = a->data.n ? a->data.v[0] : NULL;
+    cfg->data_paths = a->data.n ? a->data.v : NULL;
+    cfg->n_data_paths = a->data.n;
+    cfg->positions_paths = a->positions.v;
+    cfg->n_positions_paths = a->positions.n;
+    cfg->have_tracker_start = rch_opt_given(spec, seen, "--tracker-position") ||
+                              rch_opt_given(spec, seen, "--tracker-rotation");
+    for (int k = 0; k < 3; ++k) { /* the one not given: 0 */
+        cfg->tracker_start[k] = a->tracker_pos[k];
+        cfg->tracker_start[3 + k] = a->tracker_rot[k] * (3.14159265358979323846 / 180.0);
+    }
+    if (cfg->have_tracker_start && a->positions.n == 0) {
+        fprintf(stderr, "rcal calibrate: --tracker-position and --tracker-rotation need --positions\n");
+        return 2;
+    }
+    return -1;
+}
+
 static int parse(calib_args *a, int argc, char **argv)
 {
     rch_calib_cfg *cfg = &a->cfg;
@@ -128,32 +161,7 @@ static int parse(calib_args *a, int argc, char **argv)
     const int ps = rch_opt_cmd(&spec, "calibrate", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (ps >= 0)
         return ps;
-    if (rch_method_parse(&cfg->method, a->method) != 0)
-        return 2; /* unreachable: the choice list is the method list */
-    cfg->seed = a->seed;
-    cfg->max_iter = (unsigned)a->max_iter;
-    cfg->cases = a->cases;
-    cfg->case_samples = a->case_samples;
-    if (a->data.n == 0 && a->positions.n == 0) {
-        fprintf(stderr, "rcal calibrate: --data or --positions is required (rcal calibrate --help)\n");
-        return 2;
-    }
-    cfg->data_path = a->data.n ? a->data.v[0] : NULL;
-    cfg->data_paths = a->data.n ? a->data.v : NULL;
-    cfg->n_data_paths = a->data.n;
-    cfg->positions_paths = a->positions.v;
-    cfg->n_positions_paths = a->positions.n;
-    cfg->have_tracker_start = rch_opt_given(&spec, seen, "--tracker-position") ||
-                              rch_opt_given(&spec, seen, "--tracker-rotation");
-    for (int k = 0; k < 3; ++k) { /* the one not given: 0 */
-        cfg->tracker_start[k] = a->tracker_pos[k];
-        cfg->tracker_start[3 + k] = a->tracker_rot[k] * (3.14159265358979323846 / 180.0);
-    }
-    if (cfg->have_tracker_start && a->positions.n == 0) {
-        fprintf(stderr, "rcal calibrate: --tracker-position and --tracker-rotation need --positions\n");
-        return 2;
-    }
-    return -1;
+    return to_config(a, &spec, seen);
 }
 
 /* 1 (with the message) when --out, --residuals, --report (or a file beside

@@ -259,134 +259,173 @@ static int choose_places(rch_poses_choice *ch, rch_poses_config *pc, const rc_mo
     return 0;
 }
 
-int rcal_cmd_poses(int argc, char **argv)
-{
-    const char *robot_path = RCAL_DEFAULT_ROBOT, *out_path = NULL, *criterion = "position", *format = "csv";
-    unsigned long n = 0, seed = 1, n_cand = 0, passes = 4, choose = 0;
-    double max_minutes = 60.0;
-    double enc[3] = {250.0, -460.0, 10.0}, tool[3] = {0, 0, 0}, settle_s = 5.0;
+/* The options of rcal poses, and the planner's configuration made of them. */
+typedef struct poses_args {
+    const char *robot_path, *out_path, *criterion, *format;
+    unsigned long n, seed, n_cand, passes, choose;
+    double max_minutes, settle_s;
+    double enc[3], tool[3];
     rch_poses_config pc;
-    rch_opt_strs outlets = {{0}, 0}, cands = {{0}, 0};
-    int json = 0, split = 0;
+    rch_opt_strs outlets, cands;
+    int json, split;
+    double cand[RCH_OPT_MAX_STRS][3]; /* (n_c x 3) the --candidate places */
+    unsigned n_places, n_c;
+} poses_args;
+
+/* The parsed options into a->pc (has_tool: --tool given). -1, or 2 (reported). */
+static int to_config(poses_args *a, int has_tool)
+{
+    rch_poses_config *pc = &a->pc;
+    if (parse_places(pc->outlet_mm, &a->n_places, &a->outlets, "--outlet") != 0 ||
+        parse_places(a->cand, &a->n_c, &a->cands, "--candidate") != 0 ||
+        check_places(a->choose, a->n_places, a->n_c, a->split) != 0)
+        return 2;
+    pc->count = a->n;
+    pc->candidates = a->n_cand;
+    pc->passes = a->passes;
+    pc->max_minutes = a->max_minutes;
+    pc->seed = a->seed;
+    pc->n_outlets = a->n_places;
+    pc->split = a->split;
+    pc->criterion = strcmp(a->criterion, "length") == 0 ? RCH_POSES_LENGTH : RCH_POSES_POSITION;
+    pc->has_tool = has_tool;
+    memcpy(pc->tool_mm, a->tool, sizeof a->tool);
+    if (pc->criterion == RCH_POSES_LENGTH && (a->choose || pc->has_tool)) {
+        fprintf(stderr, "rcal poses: --choose-outlets and --tool need --criterion position\n");
+        return 2;
+    }
+    return -1;
+}
+
+/* The options into a: -1 when the command should run, else its exit status
+ * (0 for --help, 2 for an error, reported). */
+static int parse(poses_args *a, int argc, char **argv)
+{
+    rch_poses_config *pc = &a->pc;
     rch_cmdspec spec;
     unsigned long long seen = 0;
-    memset(&pc, 0, sizeof pc);
-    pc.len_min_mm = 250;
-    pc.len_max_mm = 800;
-    pc.margin_deg = 5;
-    pc.noise_mm = RCH_POSES_NOISE_MM;
+    memset(a, 0, sizeof *a);
+    a->robot_path = RCAL_DEFAULT_ROBOT;
+    a->criterion = "position";
+    a->format = "csv";
+    a->seed = 1;
+    a->passes = 4;
+    a->max_minutes = 60.0;
+    a->enc[0] = 250.0;
+    a->enc[1] = -460.0;
+    a->enc[2] = 10.0;
+    a->settle_s = 5.0;
+    pc->len_min_mm = 250;
+    pc->len_max_mm = 800;
+    pc->margin_deg = 5;
+    pc->noise_mm = RCH_POSES_NOISE_MM;
     const rch_opt opts[] = {
-        {"--count", RCH_OPT_UINT, &n, 1, RCH_POSES_MAX_COUNT, "N", "poses to plan", RCH_OPT_REQUIRED, NULL},
-        {"--out", RCH_OPT_STR, &out_path, 0, 0, "FILE", "the plan (CSV, or RAPID with --format rapid)",
+        {"--count", RCH_OPT_UINT, &a->n, 1, RCH_POSES_MAX_COUNT, "N", "poses to plan", RCH_OPT_REQUIRED, NULL},
+        {"--out", RCH_OPT_STR, &a->out_path, 0, 0, "FILE", "the plan (CSV, or RAPID with --format rapid)",
          RCH_OPT_REQUIRED, NULL},
-        {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL.json", "nominal model", 0, NULL},
-        {"--seed", RCH_OPT_UINT, &seed, 0, 4294967295.0, "S", NULL, 0, NULL},
-        {"--encoder", RCH_OPT_TRIPLE, enc, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none and no --outlet",
+        {"--robot", RCH_OPT_STR, &a->robot_path, 0, 0, "MODEL.json", "nominal model", 0, NULL},
+        {"--seed", RCH_OPT_UINT, &a->seed, 0, 4294967295.0, "S", NULL, 0, NULL},
+        {"--encoder", RCH_OPT_TRIPLE, a->enc, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none and no --outlet",
          0, NULL},
-        {"--outlet", RCH_OPT_STRS, &outlets, 0, 0, "X,Y,Z",
+        {"--outlet", RCH_OPT_STRS, &a->outlets, 0, 0, "X,Y,Z",
          "an outlet's approximate place (mm, base frame); repeatable: outlets 0, 1, ...", 0, NULL},
-        {"--split", RCH_OPT_FLAG, &split, 0, 0, NULL, "each pose from one outlet (default: every pose from each)", 0,
+        {"--split", RCH_OPT_FLAG, &a->split, 0, 0, NULL, "each pose from one outlet (default: every pose from each)", 0,
          NULL},
-        {"--criterion", RCH_OPT_CHOICE, &criterion, 0, 0, NULL, "3-D position accuracy, or the lengths' D-optimum",
+        {"--criterion", RCH_OPT_CHOICE, &a->criterion, 0, 0, NULL, "3-D position accuracy, or the lengths' D-optimum",
          0, "position|length"},
-        {"--noise-mm", RCH_OPT_DOUBLE, &pc.noise_mm, 1e-6, 100, "MM", "length noise of the predicted accuracy", 0,
+        {"--noise-mm", RCH_OPT_DOUBLE, &pc->noise_mm, 1e-6, 100, "MM", "length noise of the predicted accuracy", 0,
          NULL},
-        {"--tool", RCH_OPT_TRIPLE, tool, -2000.0, 2000.0, "X,Y,Z", "plan for this tool point (flange frame, mm)", 0,
+        {"--tool", RCH_OPT_TRIPLE, a->tool, -2000.0, 2000.0, "X,Y,Z", "plan for this tool point (flange frame, mm)", 0,
          NULL},
-        {"--choose-outlets", RCH_OPT_UINT, &choose, 1, RC_MAX_OUTLETS, "K",
+        {"--choose-outlets", RCH_OPT_UINT, &a->choose, 1, RC_MAX_OUTLETS, "K",
          "choose the best K of the --candidate places", 0, NULL},
-        {"--candidate", RCH_OPT_STRS, &cands, 0, 0, "X,Y,Z", "a candidate outlet place (repeatable)", 0, NULL},
-        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "what --out holds", 0, "csv|rapid"},
-        {"--settle-s", RCH_OPT_DOUBLE, &settle_s, 0, 600, "S", "RAPID: WaitTime at each pose (settle and read)", 0,
+        {"--candidate", RCH_OPT_STRS, &a->cands, 0, 0, "X,Y,Z", "a candidate outlet place (repeatable)", 0, NULL},
+        {"--format", RCH_OPT_CHOICE, &a->format, 0, 0, NULL, "what --out holds", 0, "csv|rapid"},
+        {"--settle-s", RCH_OPT_DOUBLE, &a->settle_s, 0, 600, "S", "RAPID: WaitTime at each pose (settle and read)", 0,
          NULL},
-        {"--len-min-mm", RCH_OPT_DOUBLE, &pc.len_min_mm, 0, 20000, "A", "shortest cable length", 0, NULL},
-        {"--len-max-mm", RCH_OPT_DOUBLE, &pc.len_max_mm, 0, 20000, "B", "longest cable length", 0, NULL},
-        {"--candidates", RCH_OPT_UINT, &n_cand, 0, RCH_POSES_MAX_CANDIDATES, "M", "0: max(2000, 40 N)", 0, NULL},
-        {"--margin-deg", RCH_OPT_DOUBLE, &pc.margin_deg, 0, 360, "D", "kept from every joint limit", 0, NULL},
-        {"--passes", RCH_OPT_UINT, &passes, 0, 100, "P", "exchange passes", 0, NULL},
-        {"--max-minutes", RCH_OPT_DOUBLE, &max_minutes, 0.01, 1e7, "MIN",
+        {"--len-min-mm", RCH_OPT_DOUBLE, &pc->len_min_mm, 0, 20000, "A", "shortest cable length", 0, NULL},
+        {"--len-max-mm", RCH_OPT_DOUBLE, &pc->len_max_mm, 0, 20000, "B", "longest cable length", 0, NULL},
+        {"--candidates", RCH_OPT_UINT, &a->n_cand, 0, RCH_POSES_MAX_CANDIDATES, "M", "0: max(2000, 40 N)", 0, NULL},
+        {"--margin-deg", RCH_OPT_DOUBLE, &pc->margin_deg, 0, 360, "D", "kept from every joint limit", 0, NULL},
+        {"--passes", RCH_OPT_UINT, &a->passes, 0, 100, "P", "exchange passes", 0, NULL},
+        {"--max-minutes", RCH_OPT_DOUBLE, &a->max_minutes, 0.01, 1e7, "MIN",
          "refuse a plan estimated longer (the estimate is printed before the work when over 10 s)", 0, NULL},
-        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "what was planned and written, as one JSON object on stdout", 0,
+        {"--json", RCH_OPT_FLAG, &a->json, 0, 0, NULL, "what was planned and written, as one JSON object on stdout", 0,
          NULL},
     };
+    const int st = rch_opt_cmd(&spec, "poses", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
+    if (st >= 0)
+        return st;
+    return to_config(a, rch_opt_given(&spec, seen, "--tool"));
+}
+
+/* The plan written (to out, then committed) and reported. 0, or 1 (reported). */
+static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a, const rch_poses_choice *ch,
+                  int argc, char **argv)
+{
+    rch_diag dg;
+    char dbuf[900];
+    if (!a->json)
+        print_plan(res, &a->pc, a->out_path);
+    if (write_out(out->f, res, &a->pc, a->format, a->settle_s) != 0) {
+        rch_out_abort(out);
+        fprintf(stderr, "rcal poses: writing %s failed; nothing was replaced\n", a->out_path);
+        return 1;
+    }
+    if (rch_out_commit(out, &dg) != 0) {
+        fprintf(stderr, "rcal poses: %s\n", rch_diag_str(&dg, dbuf, sizeof dbuf));
+        return 1;
+    }
+    if (a->json)
+        return report_json(res, &a->pc, ch, (const double(*)[3])a->cand, a->out_path, a->format, argc, argv) != 0;
+    printf("  written to %s%s\n", a->out_path, strcmp(a->format, "rapid") == 0 ? " (RAPID module)" : "");
+    return 0;
+}
+
+int rcal_cmd_poses(int argc, char **argv)
+{
+    poses_args a;
+    rch_poses_config *pc = &a.pc;
     rch_poses_result res;
     rch_poses_choice *ch = NULL;
-    double cand[RCH_OPT_MAX_STRS][3];
-    unsigned n_places = 0, n_c = 0;
     rch_robot *robot;
     rch_diag dg;
     rch_out out;
     char dbuf[900];
-    int rc = 1;
-    const int st = rch_opt_cmd(&spec, "poses", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
+    const int st = parse(&a, argc, argv);
     if (st >= 0)
         return st;
-    if (parse_places(pc.outlet_mm, &n_places, &outlets, "--outlet") != 0 ||
-        parse_places(cand, &n_c, &cands, "--candidate") != 0 || check_places(choose, n_places, n_c, split) != 0)
-        return 2;
-    pc.count = n;
-    pc.candidates = n_cand;
-    pc.passes = passes;
-    pc.max_minutes = max_minutes;
-    pc.seed = seed;
-    pc.n_outlets = n_places;
-    pc.split = split;
-    pc.criterion = strcmp(criterion, "length") == 0 ? RCH_POSES_LENGTH : RCH_POSES_POSITION;
-    pc.has_tool = rch_opt_given(&spec, seen, "--tool");
-    memcpy(pc.tool_mm, tool, sizeof tool);
-    if (pc.criterion == RCH_POSES_LENGTH && (choose || pc.has_tool)) {
-        fprintf(stderr, "rcal poses: --choose-outlets and --tool need --criterion position\n");
-        return 2;
-    }
     robot = calloc(1, sizeof *robot);
-    if (!robot || rch_robot_load(robot, robot_path, &dg) != 0) {
+    if (!robot || rch_robot_load(robot, a.robot_path, &dg) != 0) {
         fprintf(stderr, "rcal poses: %s\n", robot ? rch_diag_str(&dg, dbuf, sizeof dbuf) : "out of memory");
         free(robot);
         return 1;
     }
     if (!robot->has_encoder)
-        memcpy(&robot->model.x[RC_P_ENC], enc, sizeof enc);
-    pc.prior = &robot->prior;
-    if (!n_places && !choose) { /* one outlet: the model's encoder */
-        pc.n_outlets = 1;
-        memcpy(pc.outlet_mm[0], &robot->model.x[RC_P_ENC], sizeof pc.outlet_mm[0]);
+        memcpy(&robot->model.x[RC_P_ENC], a.enc, sizeof a.enc);
+    pc->prior = &robot->prior;
+    if (!a.n_places && !a.choose) { /* one outlet: the model's encoder */
+        pc->n_outlets = 1;
+        memcpy(pc->outlet_mm[0], &robot->model.x[RC_P_ENC], sizeof pc->outlet_mm[0]);
     }
-    if (rch_out_open(&out, out_path, "--out", &robot_path, 1, &dg) != 0) { /* before the work */
+    if (rch_out_open(&out, a.out_path, "--out", &a.robot_path, 1, &dg) != 0) { /* before the work */
         fprintf(stderr, "rcal poses: %s\n", rch_diag_str(&dg, dbuf, sizeof dbuf));
         free(robot);
         return 1;
     }
-    if (choose && (!(ch = malloc(sizeof *ch)) ||
-                   choose_places(ch, &pc, &robot->model, (const double(*)[3])cand, n_c, (unsigned)choose, json) != 0)) {
+    int rc = 1;
+    if (a.choose && (!(ch = malloc(sizeof *ch)) || choose_places(ch, pc, &robot->model, (const double(*)[3])a.cand,
+                                                                 a.n_c, (unsigned)a.choose, a.json) != 0)) {
         if (!ch)
             fprintf(stderr, "rcal poses: out of memory\n");
         rch_out_abort(&out);
-        free(ch);
-        free(robot);
-        return 1;
-    }
-    if (rch_poses_plan(&res, &robot->model, &pc, stderr, &dg) != 0) {
+    } else if (rch_poses_plan(&res, &robot->model, pc, stderr, &dg) != 0) {
         rch_out_abort(&out);
         fprintf(stderr, "rcal poses: %s\n", dg.msg);
-        free(ch);
-        free(robot);
-        return 1;
-    }
-    if (!json)
-        print_plan(&res, &pc, out_path);
-    const int wr = write_out(out.f, &res, &pc, format, settle_s);
-    if (wr != 0) {
-        rch_out_abort(&out);
-        fprintf(stderr, "rcal poses: writing %s failed; nothing was replaced\n", out_path);
-    } else if (rch_out_commit(&out, &dg) != 0) {
-        fprintf(stderr, "rcal poses: %s\n", rch_diag_str(&dg, dbuf, sizeof dbuf));
-    } else if (json) {
-        rc = report_json(&res, &pc, ch, (const double(*)[3])cand, out_path, format, argc, argv) != 0;
     } else {
-        printf("  written to %s%s\n", out_path, strcmp(format, "rapid") == 0 ? " (RAPID module)" : "");
-        rc = 0;
+        rc = finish(&out, &res, &a, ch, argc, argv);
+        rch_poses_free(&res);
     }
-    rch_poses_free(&res);
     free(ch);
     free(robot);
     return rc;

@@ -1,0 +1,655 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_poses_position.c - the position criterion of rch_poses_plan
+ * (RCH_POSES_POSITION, issue 20; the default) and rch_poses_predict: the
+ * model `rcal calibrate` fits for K outlets, the candidates' scaled rows,
+ * the I-optimal greedy design and its exchange passes (phi = mean trace of
+ * the point's position covariance over workspace poses), and the predicted
+ * 3-D accuracy (the 95 % radius, rch_uncert_radius95) of the plan and of
+ * random poses.
+ * Depends on: rc_model, rc_rand, rc_meas; rch_prior, rch_uncert
+ * (rch_uncert_point_sens), rch_stats, rch_ident; LAPACKE (dpotrf, dpotri,
+ * dposv). Memory: heap for the work (pos_work), freed before return; the
+ * plan's rows in the result (rch_poses_free). Errors: -1 with d set. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <lapacke.h>
+
+#include "rc_rand.h"
+#include "rch_ident.h"
+#include "rch_poses_int.h"
+#include "rch_stats.h"
+#include "rch_uncert.h"
+
+/* The model `rcal calibrate` fits for these outlets: m's geometry, the
+ * encoder at outlet 0, Hayati's tilt of each nominally parallel axis, one
+ * outlet effect per further place. */
+static int plan_model(rc_model *out, const rc_model *m, const rch_poses_config *c, unsigned *K, rch_diag *d)
+{
+    *out = *m;
+    *K = c->n_outlets ? c->n_outlets : 1u;
+    if (*K > RC_MAX_OUTLETS) {
+        rch_diag_set(d, "", 0, 0, "%u outlets: at most %d", *K, RC_MAX_OUTLETS);
+        return -1;
+    }
+    if (c->n_outlets)
+        memcpy(&out->x[RC_P_ENC], c->outlet_mm[0], 3 * sizeof(double));
+    for (unsigned i = 1; i + 1 < RC_NJ; ++i) {
+        int have = 0;
+        for (unsigned e = 0; e < out->n_effects; ++e)
+            have |= out->effects[e].kind == RC_EFF_AXIS_TILT && out->effects[e].joint == i;
+        if (!have && fabs(sin(out->x[RC_P_ALPHA(i)])) < 1e-6 &&
+            rc_model_add_effect(out, RC_EFF_AXIS_TILT, i, 0) != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "cannot add the axis tilt of row %u (RC_MAX_PARAMS)", i + 1);
+            return -1;
+        }
+    }
+    for (unsigned k = 1; k < *K; ++k) {
+        if (rc_model_add_effect(out, RC_EFF_OUTLET, k, 0) != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "cannot add outlet %u (RC_MAX_PARAMS or RC_MAX_EFFECTS)", k);
+            return -1;
+        }
+        memcpy(&out->x[out->effects[out->n_effects - 1].first], c->outlet_mm[k], 3 * sizeof(double));
+    }
+    return 0;
+}
+
+typedef struct pos_work {
+    rc_model m, mp;           /* the planning model; the point model (m with the tool, or m) */
+    unsigned K, nf, rows_per; /* outlets; free parameters; rows per candidate (K, or 1 with split) */
+    unsigned fi[RC_MAX_PARAMS]; /* (nf) the free parameters' indices in x */
+    double sc[RC_MAX_PARAMS];   /* (nf) their scale: prior sd (RCH_POSES_OUTLET_SD_MM for the outlets) */
+    double noise;
+    size_t n, n_pose, n_cand;   /* poses to plan; candidate poses; candidates */
+    rc_sample *pose;            /* (n_pose) */
+    size_t *cand_pose;          /* (n_cand) */
+    uint8_t *cand_outlet;       /* (n_cand) the outlet of a split candidate (0 otherwise) */
+    double *X;                  /* (n_cand x rows_per x nf) scaled rows g_j sc_j / noise */
+    double *Q, *M, *C, *B, *T;  /* (nf x nf) */
+    double *u, *v;              /* (rows_per x nf) */
+    size_t *design, *rnd;       /* (n) candidates */
+    uint8_t *in_design, *pose_used;
+} pos_work;
+
+static void pos_free(pos_work *w)
+{
+    free(w->pose);
+    free(w->cand_pose);
+    free(w->cand_outlet);
+    free(w->X);
+    free(w->Q);
+    free(w->M);
+    free(w->C);
+    free(w->B);
+    free(w->T);
+    free(w->u);
+    free(w->v);
+    free(w->design);
+    free(w->rnd);
+    free(w->in_design);
+    free(w->pose_used);
+}
+
+/* The model, its free parameters and their scales; the point model. */
+static int pos_setup(pos_work *w, const rc_model *m, const rch_poses_config *c, rch_diag *d)
+{
+    double mean[RC_MAX_PARAMS], sd[RC_MAX_PARAMS];
+    rch_prior_cfg pd;
+    if (plan_model(&w->m, m, c, &w->K, d) != 0)
+        return -1;
+    if (!c->prior)
+        rch_prior_defaults(&pd);
+    rch_prior_fill(mean, sd, &w->m, &w->m, c->prior ? c->prior : &pd);
+    w->nf = 0;
+    for (unsigned k = 0; k < w->m.n_params; ++k) {
+        if (k == RC_P_THETA(0) || k == RC_P_D(0)) /* the gauge */
+            continue;
+        w->fi[w->nf] = k;
+        w->sc[w->nf++] = sd[k] > 0.0 ? sd[k] : RCH_POSES_OUTLET_SD_MM;
+    }
+    w->rows_per = c->split ? 1u : w->K;
+    w->noise = c->noise_mm > 0.0 ? c->noise_mm : RCH_POSES_NOISE_MM;
+    w->mp = w->m;
+    if (c->has_tool) {
+        if (rc_model_add_effect(&w->mp, RC_EFF_TOOL_OFFSET, 0, 0) != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "cannot add the tool point (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
+            return -1;
+        }
+        memcpy(&w->mp.x[w->mp.effects[w->mp.n_effects - 1].first], c->tool_mm, 3 * sizeof(double));
+    }
+    return 0;
+}
+
+/* One pose's scaled rows: row j (nf) for outlet j; len (K) the lengths.
+ * 0, or -1 when a length cannot be computed. */
+static int pose_rows(double *rows, double *len, const pos_work *w, const rc_sample *q)
+{
+    double g[RC_MAX_PARAMS];
+    for (unsigned k = 0; k < w->K; ++k) {
+        rc_sample s = *q;
+        s.outlet = (uint8_t)k;
+        if (rc_meas(&len[k], g, &w->m, &s) != RC_OK)
+            return -1;
+        for (unsigned j = 0; rows && j < w->nf; ++j)
+            rows[k * w->nf + j] = g[w->fi[j]] * w->sc[j] / w->noise;
+    }
+    return 0;
+}
+
+/* 1-2: candidate poses inside the limits whose lengths are in range: every
+ * outlet's (all poses from every outlet), or one candidate per reaching
+ * outlet (split). */
+static int pos_candidates(pos_work *w, const rch_poses_config *c, rch_diag *d)
+{
+    const unsigned nf = w->nf, K = w->K;
+    const double mg = c->margin_deg * PI_ / 180.0;
+    size_t tries = 0, cap = w->n_pose * (c->split ? K : 1u);
+    if (K == 0 || nf == 0 || cap == 0) {
+        rch_diag_set(d, "", 0, 0, "no outlet, parameter or pose to plan");
+        return -1;
+    }
+    double *rows = malloc((size_t)K * nf * sizeof *rows), len[RC_MAX_OUTLETS];
+    rc_rng g;
+    rc_rng_seed(&g, c->seed);
+    w->pose = malloc(w->n_pose * sizeof *w->pose);
+    w->cand_pose = malloc(cap * sizeof *w->cand_pose);
+    w->cand_outlet = calloc(cap, 1);
+    w->X = malloc(cap * w->rows_per * nf * sizeof *w->X);
+    if (!rows || !w->pose || !w->cand_pose || !w->cand_outlet || !w->X) {
+        free(rows);
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    size_t got = 0;
+    w->n_cand = 0;
+    while (got < w->n_pose) {
+        rc_sample s;
+        if (++tries > 1000 * w->n_pose) {
+            free(rows);
+            rch_diag_set(d, "", 0, 0, "only %zu of %zu candidate poses have a cable length within [%g, %g] mm from "
+                         "%s; check --outlet/--encoder and the length range", got, w->n_pose, c->len_min_mm,
+                         c->len_max_mm, c->split ? "any outlet" : "every outlet");
+            return -1;
+        }
+        memset(&s, 0, sizeof s);
+        for (int j = 0; j < RC_NJ; ++j) {
+            const double lo = w->m.q_min_rad[j] + mg, hi = w->m.q_max_rad[j] - mg;
+            const double q = lo + (hi - lo) * rc_rng_u01(&g);
+            double qr = round(q * 180.0 / PI_ * 100.0) / 100.0 * PI_ / 180.0; /* 0.01 deg */
+            if (qr < lo || qr > hi)
+                qr = (qr < lo ? ceil(q * 180.0 / PI_ * 100.0) : floor(q * 180.0 / PI_ * 100.0)) / 100.0 * PI_ / 180.0;
+            s.q_rad[j] = qr;
+        }
+        if (pose_rows(rows, len, w, &s) != 0)
+            continue;
+        unsigned reach = 0;
+        for (unsigned k = 0; k < K; ++k)
+            reach += len[k] >= c->len_min_mm && len[k] <= c->len_max_mm;
+        if (c->split ? reach == 0 : reach < K)
+            continue;
+        for (unsigned k = 0; k < K; ++k) {
+            if (!(len[k] >= c->len_min_mm && len[k] <= c->len_max_mm))
+                continue;
+            if (!c->split) {
+                memcpy(w->X + w->n_cand * w->rows_per * nf, rows, (size_t)K * nf * sizeof *rows);
+                w->cand_pose[w->n_cand] = got;
+                w->cand_outlet[w->n_cand++] = 0;
+                break;
+            }
+            memcpy(w->X + w->n_cand * nf, rows + (size_t)k * nf, nf * sizeof *rows);
+            w->cand_pose[w->n_cand] = got;
+            w->cand_outlet[w->n_cand++] = (uint8_t)k;
+        }
+        w->pose[got++] = s;
+    }
+    free(rows);
+    return 0;
+}
+
+/* C = M^-1 (M symmetric positive definite, nf x nf; either storage). 0 or -1. */
+static int spd_inverse(double *C, const double *M, unsigned nf)
+{
+    memcpy(C, M, (size_t)nf * nf * sizeof *C);
+    if (LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)nf, C, (lapack_int)nf) != 0 ||
+        LAPACKE_dpotri(LAPACK_COL_MAJOR, 'L', (lapack_int)nf, C, (lapack_int)nf) != 0)
+        return -1;
+    for (unsigned j = 0; j < nf; ++j) /* column j, rows i > j hold the lower triangle */
+        for (unsigned i = j + 1; i < nf; ++i)
+            C[(size_t)i * nf + j] = C[(size_t)j * nf + i];
+    return 0;
+}
+
+/* C = M^-1 and B = C Q C. 0 or -1. */
+static int pos_refresh(pos_work *w)
+{
+    const unsigned nf = w->nf;
+    if (spd_inverse(w->C, w->M, nf) != 0)
+        return -1;
+    for (unsigned i = 0; i < nf; ++i) /* T = Q C */
+        for (unsigned j = 0; j < nf; ++j) {
+            double s = 0.0;
+            for (unsigned k = 0; k < nf; ++k)
+                s += w->Q[(size_t)i * nf + k] * w->C[(size_t)k * nf + j];
+            w->T[(size_t)i * nf + j] = s;
+        }
+    for (unsigned i = 0; i < nf; ++i) /* B = C T */
+        for (unsigned j = 0; j < nf; ++j) {
+            double s = 0.0;
+            for (unsigned k = 0; k < nf; ++k)
+                s += w->C[(size_t)i * nf + k] * w->T[(size_t)k * nf + j];
+            w->B[(size_t)i * nf + j] = s;
+        }
+    return 0;
+}
+
+static void add_rows(double *M, const double *X, unsigned r, unsigned nf, double sign)
+{
+    for (unsigned j = 0; j < r; ++j)
+        rch_poses_add_outer(M, X + (size_t)j * nf, sign, nf);
+}
+
+/* How much the r rows X (r x nf) lower phi = trace(Q M^-1):
+ * trace((I + X^T C X)^-1 X^T B X). */
+static double pos_gain(pos_work *w, const double *X, unsigned r)
+{
+    const unsigned nf = w->nf;
+    double S[RC_MAX_OUTLETS * RC_MAX_OUTLETS] = {0}, D[RC_MAX_OUTLETS * RC_MAX_OUTLETS] = {0};
+    if (r == 0 || r > RC_MAX_OUTLETS)
+        return 0.0;
+    for (unsigned j = 0; j < r; ++j) {
+        const double *x = X + (size_t)j * nf;
+        double *u = w->u + (size_t)j * nf, *v = w->v + (size_t)j * nf;
+        for (unsigned a = 0; a < nf; ++a) {
+            const double *ca = w->C + (size_t)a * nf, *ba = w->B + (size_t)a * nf;
+            double su = 0.0, sv = 0.0;
+            for (unsigned b = 0; b < nf; ++b) {
+                su += ca[b] * x[b];
+                sv += ba[b] * x[b];
+            }
+            u[a] = su;
+            v[a] = sv;
+        }
+    }
+    for (unsigned j = 0; j < r; ++j)
+        for (unsigned l = 0; l < r; ++l) {
+            const double *x = X + (size_t)j * nf, *u = w->u + (size_t)l * nf, *v = w->v + (size_t)l * nf;
+            double su = 0.0, sv = 0.0;
+            for (unsigned a = 0; a < nf; ++a) {
+                su += x[a] * u[a];
+                sv += x[a] * v[a];
+            }
+            S[j * r + l] = su + (j == l);
+            D[j * r + l] = sv;
+        }
+    if (r == 1)
+        return D[0] / S[0];
+    if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'L', (lapack_int)r, (lapack_int)r, S, (lapack_int)r, D, (lapack_int)r) != 0)
+        return -1.0;
+    double t = 0.0;
+    for (unsigned j = 0; j < r; ++j)
+        t += D[j * r + j];
+    return t;
+}
+
+static int pos_available(const pos_work *w, size_t i)
+{
+    return !w->in_design[i] && !w->pose_used[w->cand_pose[i]];
+}
+
+/* The available candidate that lowers phi most (none_idx: none); with
+ * split, among those of design slot t's outlet (slot t is outlet t mod K). */
+static size_t pos_best(pos_work *w, size_t none_idx, double *bg, size_t t)
+{
+    size_t best = none_idx;
+    *bg = -1.0;
+    for (size_t i = 0; i < w->n_cand; ++i) {
+        if (!pos_available(w, i) || (w->rows_per == 1 && w->K > 1 && w->cand_outlet[i] != t % w->K))
+            continue;
+        const double g = pos_gain(w, w->X + i * w->rows_per * w->nf, w->rows_per);
+        if (g > *bg) {
+            *bg = g;
+            best = i;
+        }
+    }
+    return best;
+}
+
+static void pos_take(pos_work *w, size_t t, size_t i, int take)
+{
+    const double *X = w->X + i * w->rows_per * w->nf;
+    add_rows(w->M, X, w->rows_per, w->nf, take ? 1.0 : -1.0);
+    w->in_design[i] = (uint8_t)take;
+    w->pose_used[w->cand_pose[i]] = (uint8_t)take;
+    if (take)
+        w->design[t] = i;
+}
+
+/* The prior in scaled coordinates: the identity. */
+static void prior_info(double *M, unsigned nf)
+{
+    memset(M, 0, (size_t)nf * nf * sizeof *M);
+    for (unsigned k = 0; k < nf; ++k)
+        M[(size_t)k * nf + k] = 1.0;
+}
+
+/* Q = mean over n workspace poses (uniform in the joint limits, seed) of
+ * Jps^T Jps, Jps the point's sensitivity to the scaled free parameters. */
+static void workspace_q(double *Q, const pos_work *w, size_t n, unsigned long long seed)
+{
+    const unsigned nf = w->nf;
+    rc_rng g;
+    rc_rng_seed(&g, seed);
+    memset(Q, 0, (size_t)nf * nf * sizeof *Q);
+    for (size_t t = 0; t < n; ++t) {
+        double q[RC_NJ], Jp[3][RC_MAX_PARAMS], J[3][RC_MAX_PARAMS];
+        for (int j = 0; j < RC_NJ; ++j)
+            q[j] = w->m.q_min_rad[j] + (w->m.q_max_rad[j] - w->m.q_min_rad[j]) * rc_rng_u01(&g);
+        rch_uncert_point_sens(Jp, &w->mp, q);
+        for (int i = 0; i < 3; ++i)
+            for (unsigned a = 0; a < nf; ++a)
+                J[i][a] = Jp[i][w->fi[a]] * w->sc[a];
+        for (unsigned a = 0; a < nf; ++a)
+            for (unsigned b = 0; b < nf; ++b)
+                Q[(size_t)a * nf + b] += (J[0][a] * J[0][b] + J[1][a] * J[1][b] + J[2][a] * J[2][b]) / (double)n;
+    }
+}
+
+/* The predicted accuracy of the design whose information is M: the 95 %
+ * radius at n_eval workspace poses (their own seed). */
+static int pos_accuracy(rch_poses_accuracy *acc, const pos_work *w, const double *M, size_t n_eval,
+                        unsigned long long seed)
+{
+    const unsigned nf = w->nf;
+    double *C = malloc((size_t)nf * nf * sizeof *C), *r = malloc((n_eval ? n_eval : 1) * sizeof *r);
+    int rc = -1;
+    memset(acc, 0, sizeof *acc);
+    if (!C || !r || spd_inverse(C, M, nf) != 0)
+        goto out;
+    rc_rng g;
+    rc_rng_seed(&g, seed);
+    double phi = 0.0;
+    for (size_t t = 0; t < n_eval; ++t) {
+        double q[RC_NJ], Jp[3][RC_MAX_PARAMS], J[3][RC_MAX_PARAMS], P[9];
+        for (int j = 0; j < RC_NJ; ++j)
+            q[j] = w->m.q_min_rad[j] + (w->m.q_max_rad[j] - w->m.q_min_rad[j]) * rc_rng_u01(&g);
+        rch_uncert_point_sens(Jp, &w->mp, q);
+        for (int i = 0; i < 3; ++i)
+            for (unsigned a = 0; a < nf; ++a)
+                J[i][a] = Jp[i][w->fi[a]] * w->sc[a];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                double s = 0.0;
+                for (unsigned a = 0; a < nf; ++a) {
+                    if (J[i][a] == 0.0)
+                        continue;
+                    double ta = 0.0;
+                    for (unsigned b = 0; b < nf; ++b)
+                        ta += C[(size_t)a * nf + b] * J[j][b];
+                    s += J[i][a] * ta;
+                }
+                P[i * 3 + j] = s;
+            }
+        phi += P[0] + P[4] + P[8];
+        r[t] = rch_uncert_radius95(P);
+    }
+    acc->phi_mm2 = n_eval ? phi / (double)n_eval : NAN;
+    acc->median_mm = rch_quantile(r, n_eval, 0.5);
+    acc->p95_mm = rch_quantile(r, n_eval, 0.95);
+    rc = 0;
+out:
+    free(C);
+    free(r);
+    return rc;
+}
+
+#define SEED_WORK 0x5851F42D4C957F2Dull
+#define SEED_EVAL 0x2545F4914F6CDD1Dull
+
+static int pos_alloc(pos_work *w)
+{
+    const unsigned nf = w->nf;
+    const size_t mm = (size_t)nf * nf;
+    w->Q = malloc(mm * sizeof *w->Q);
+    w->M = malloc(mm * sizeof *w->M);
+    w->C = malloc(mm * sizeof *w->C);
+    w->B = malloc(mm * sizeof *w->B);
+    w->T = malloc(mm * sizeof *w->T);
+    w->u = malloc((size_t)w->rows_per * nf * sizeof *w->u);
+    w->v = malloc((size_t)w->rows_per * nf * sizeof *w->v);
+    w->design = malloc((w->n ? w->n : 1) * sizeof *w->design);
+    w->rnd = malloc((w->n ? w->n : 1) * sizeof *w->rnd);
+    w->in_design = calloc(w->n_cand ? w->n_cand : 1, 1);
+    w->pose_used = calloc(w->n_pose ? w->n_pose : 1, 1);
+    return w->Q && w->M && w->C && w->B && w->T && w->u && w->v && w->design && w->rnd && w->in_design &&
+                   w->pose_used
+               ? 0
+               : -1;
+}
+
+/* Greedy additions, then exchange passes (each design pose swapped for the
+ * candidate that lowers phi most, while one does). 0 or -1 (numeric). */
+static int pos_design(pos_work *w, const rch_poses_config *c, FILE *progress)
+{
+    prior_info(w->M, w->nf);
+    for (size_t t = 0; t < w->n; ++t) {
+        double bg;
+        if (pos_refresh(w) != 0)
+            return -1;
+        const size_t best = pos_best(w, w->n_cand, &bg, t);
+        if (best >= w->n_cand)
+            return -1;
+        pos_take(w, t, best, 1);
+        rch_poses_progress(w->n >= 200 ? progress : NULL, "greedy design, pose", t, w->n);
+    }
+    for (unsigned long pass = 0; pass < c->passes; ++pass) {
+        unsigned swaps = 0;
+        if (progress && w->n >= 200)
+            fprintf(progress, "rcal poses: exchange pass %lu/%lu\n", pass + 1, c->passes);
+        for (size_t t = 0; t < w->n; ++t) {
+            const size_t cur = w->design[t];
+            double bg;
+            pos_take(w, t, cur, 0);
+            if (pos_refresh(w) != 0)
+                return -1;
+            const double gc = pos_gain(w, w->X + cur * w->rows_per * w->nf, w->rows_per);
+            const size_t best = pos_best(w, w->n_cand, &bg, t);
+            if (best < w->n_cand && best != cur && bg > gc * (1.0 + 1e-9) + 1e-300) {
+                pos_take(w, t, best, 1);
+                ++swaps;
+            } else {
+                pos_take(w, t, cur, 1);
+            }
+        }
+        if (!swaps)
+            break;
+    }
+    return 0;
+}
+
+/* The information of the design idx (n candidates) into M. */
+static void design_info(double *M, const pos_work *w, const size_t *idx, size_t n)
+{
+    prior_info(M, w->nf);
+    for (size_t t = 0; t < n; ++t)
+        add_rows(M, w->X + idx[t] * w->rows_per * w->nf, w->rows_per, w->nf, 1.0);
+}
+
+/* The plan's rows, by outlet: outlet 0's poses, then outlet 1's, ... */
+static int pos_rows_out(rch_poses_result *res, const pos_work *w)
+{
+    const size_t rows = w->n * w->rows_per;
+    res->poses = malloc((rows ? rows : 1) * sizeof *res->poses);
+    if (!res->poses)
+        return -1;
+    res->n = 0;
+    for (unsigned k = 0; k < w->K; ++k) {
+        res->rows_per_outlet[k] = 0;
+        for (size_t t = 0; t < w->n; ++t) {
+            const size_t i = w->design[t];
+            if (w->rows_per == 1 && w->K > 1 && w->cand_outlet[i] != k)
+                continue;
+            rc_sample s = w->pose[w->cand_pose[i]];
+            s.outlet = (uint8_t)k;
+            res->poses[res->n++] = s;
+            res->rows_per_outlet[k]++;
+        }
+    }
+    return 0;
+}
+
+static int check_position(const rch_poses_config *c, rch_diag *d)
+{
+    if (c->n_outlets > RC_MAX_OUTLETS) {
+        rch_diag_set(d, "", 0, 0, "%u outlets: at most %d", c->n_outlets, RC_MAX_OUTLETS);
+        return -1;
+    }
+    if (c->split && c->n_outlets < 2) {
+        rch_diag_set(d, "", 0, 0, "--split needs at least two --outlet places");
+        return -1;
+    }
+    return 0;
+}
+
+int rch_poses_plan_position(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, FILE *progress,
+                            rch_diag *d)
+{
+    pos_work *w = calloc(1, sizeof *w);
+    int rc = -1;
+    size_t n_pose = 0;
+    if (!w) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    if (rch_poses_check_config(m, c, &n_pose, d) != 0 || check_position(c, d) != 0 || pos_setup(w, m, c, d) != 0)
+        goto done;
+    w->n = c->count;
+    w->n_pose = n_pose;
+    if (rch_poses_plan_cost(c, progress, w->n, w->n_pose * w->K, w->nf, 0, d) != 0)
+        goto done;
+    if (pos_candidates(w, c, d) != 0)
+        goto done;
+    if (w->n_cand < w->n) {
+        rch_diag_set(d, "", 0, 0, "only %zu candidates for %zu poses: raise --candidates", w->n_cand, w->n);
+        goto done;
+    }
+    if (pos_alloc(w) != 0) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    workspace_q(w->Q, w, c->n_work ? c->n_work : 300, c->seed ^ SEED_WORK);
+    if (pos_design(w, c, progress) != 0) {
+        rch_diag_set(d, "", 0, 0, "the design's information matrix is not positive definite (numeric failure)");
+        goto done;
+    }
+    { /* n random candidates of distinct poses */
+        rc_rng g2;
+        rc_rng_seed(&g2, c->seed ^ 0x9E3779B97F4A7C15ull);
+        uint8_t *used = calloc(w->n_pose, 1);
+        if (!used) {
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            goto done;
+        }
+        for (size_t t = 0; t < w->n; ++t) {
+            size_t i;
+            unsigned guard = 0;
+            do
+                i = rc_rng_below(&g2, (uint32_t)w->n_cand);
+            while ((used[w->cand_pose[i]] || (w->rows_per == 1 && w->K > 1 && w->cand_outlet[i] != t % w->K)) &&
+                   ++guard < 1000000u);
+            used[w->cand_pose[i]] = 1;
+            w->rnd[t] = i;
+        }
+        free(used);
+    }
+    const size_t n_eval = c->n_eval ? c->n_eval : 1000;
+    design_info(w->M, w, w->design, w->n);
+    if (pos_accuracy(&res->plan, w, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
+        goto numeric;
+    design_info(w->M, w, w->rnd, w->n);
+    if (pos_accuracy(&res->random, w, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
+        goto numeric;
+    if (pos_rows_out(res, w) != 0) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto done;
+    }
+    res->n_candidates = w->n_pose;
+    res->n_params = w->m.n_params;
+    res->n_ident = w->nf;
+    res->n_outlets = w->K;
+    res->n_distinct = w->n;
+    res->rows_advised = w->nf + 3u + RCH_POSES_ROWS_SPARE;
+    {   /* O1 (rch_ident) of the plan's rows and of the random ones, as for the length criterion */
+        rc_sample *rs = w->n > 0 && w->rows_per > 0 ? malloc(w->n * w->rows_per * sizeof *rs) : NULL;
+        rch_ident *id = calloc(1, sizeof *id);
+        if (rs && id) {
+            for (int pass = 0; pass < 2; ++pass) {
+                const size_t *idx = pass ? w->rnd : w->design;
+                size_t nr = 0;
+                for (size_t t = 0; t < w->n; ++t)
+                    for (unsigned j = 0; j < w->rows_per; ++j) {
+                        rs[nr] = w->pose[w->cand_pose[idx[t]]];
+                        rs[nr++].outlet = (uint8_t)(w->rows_per == 1 ? w->cand_outlet[idx[t]] : j);
+                    }
+                if (rch_ident_compute(id, &w->m, rs, nr) == 0) {
+                    *(pass ? &res->o1_random : &res->o1_plan) = id->observability;
+                    *(pass ? &res->rank_random : &res->rank_plan) = id->rank;
+                }
+            }
+        }
+        free(rs);
+        free(id);
+    }
+    rc = 0;
+    goto done;
+numeric:
+    rch_diag_set(d, "", 0, 0, "the predicted accuracy could not be computed (numeric failure)");
+done:
+    if (rc != 0)
+        rch_poses_free(res);
+    pos_free(w);
+    free(w);
+    return rc;
+}
+
+int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_poses_config *c, const rc_sample *rows,
+                      size_t n, rch_diag *d)
+{
+    pos_work *w = calloc(1, sizeof *w);
+    double *M = NULL, *X = NULL, len[RC_MAX_OUTLETS];
+    int rc = -1;
+    if (!w) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    if (check_position(c, d) != 0 || pos_setup(w, m, c, d) != 0)
+        goto out;
+    M = malloc((size_t)w->nf * w->nf * sizeof *M);
+    X = malloc((size_t)w->K * w->nf * sizeof *X);
+    if (!M || !X) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto out;
+    }
+    prior_info(M, w->nf);
+    for (size_t i = 0; i < n; ++i) {
+        if (rows[i].outlet >= w->K) {
+            rch_diag_set(d, "", 0, 0, "row %zu: outlet %u, but %u outlet(s) given", i, rows[i].outlet, w->K);
+            goto out;
+        }
+        if (pose_rows(X, len, w, &rows[i]) != 0) {
+            rch_diag_set(d, "", 0, 0, "row %zu: the cable length cannot be computed (the point is at an outlet)", i);
+            goto out;
+        }
+        rch_poses_add_outer(M, X + (size_t)rows[i].outlet * w->nf, 1.0, w->nf);
+    }
+    if (pos_accuracy(acc, w, M, c->n_eval ? c->n_eval : 1000, c->seed ^ SEED_EVAL) != 0) {
+        rch_diag_set(d, "", 0, 0, "the predicted accuracy could not be computed (numeric failure)");
+        goto out;
+    }
+    rc = 0;
+out:
+    free(M);
+    free(X);
+    free(w);
+    return rc;
+}
