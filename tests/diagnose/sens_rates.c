@@ -61,8 +61,8 @@ static const scase cases[] = {
     {"trk_none", S_TRK, SG_NONE, "control"},
     {"trk_gravity", S_TRK, SG_GRAVITY, NULL},
     {"trk_gear", S_TRK, SG_GEAR, NULL},
-    {"trk_temp", S_TRK, SG_TEMP, "calibrate has no tracker scale effect"},
-    {"mix_temp", S_MIX, SG_TEMP, "calibrate has no tracker scale effect"},
+    {"trk_temp", S_TRK, SG_TEMP, NULL},
+    {"mix_temp", S_MIX, SG_TEMP, NULL},
     {"cab_none", S_CAB, SG_NONE, "control"},
     {"cab_gravity", S_CAB, SG_GRAVITY, NULL},
     {"cab_gear", S_CAB, SG_GEAR, NULL},
@@ -82,8 +82,10 @@ static void true_effects(char *buf, size_t len, const scase *c, const sg_truth *
         snprintf(buf, len, "joint_compliance:2,joint_compliance:3");
     else if (c->e == SG_GEAR)
         snprintf(buf, len, "joint_periodic:%u", t->gear_joint);
-    else if (c->e == SG_OUTLET) /* the common part only: calibrate has no per-outlet offset or scale */
-        snprintf(buf, len, "length_offset");
+    else if (c->e == SG_OUTLET)
+        snprintf(buf, len, "outlet_offset,outlet_scale");
+    else if (c->e == SG_TEMP)
+        snprintf(buf, len, "tracker_scale");
     else
         buf[0] = '\0';
 }
@@ -95,7 +97,8 @@ static int verdict_ok(const scase *c, const sg_truth *t, const char *eff, unsign
     case SG_NONE: return strcmp(eff, "none") == 0;
     case SG_GRAVITY: return strcmp(eff, "joint_compliance") == 0 && (joint == 2 || joint == 3);
     case SG_GEAR: return strcmp(eff, "joint_periodic") == 0 && joint == t->gear_joint;
-    case SG_TEMP: return strstr(eff, "scale") != NULL;
+    case SG_TEMP: /* a tracker alone cannot see its own scale (it trades with the robot's size): none is right */
+        return strstr(eff, "scale") != NULL || (c->s == S_TRK && strcmp(eff, "none") == 0);
     case SG_OUTLET: return strstr(eff, "offset") != NULL;
     case SG_N_EFFECTS: break;
     }
