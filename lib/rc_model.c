@@ -666,6 +666,84 @@ static rc_status sensor_chain(double *value, double *jac, const rc_model *m, con
     return st;
 }
 
+/* The length-side and outlet columns of a length's Jacobian jac (the
+ * chain's and the point's are point_jac's): g (3) is dl/dp, dist the chord,
+ * h2 its horizontal span squared, outlet_first the sample's outlet effect
+ * (-1: e). */
+static void length_effects_jac(double *jac, const rc_model *m, const rc_sample *s, const chain *c, const double g[3],
+                               double dist, double h2, int outlet_first)
+{
+    for (int r = 0; r < 3; ++r)
+        jac[RC_P_ENC + r] = outlet_first < 0 ? -g[r] : 0.0;
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *ef = &m->effects[i];
+        double *J = &jac[ef->first];
+        switch ((rc_effect_kind)ef->kind) {
+        case RC_EFF_OUTLET:
+            for (unsigned k = 0; k < 3; ++k)
+                J[k] = (int)ef->first == outlet_first ? -g[k] : 0.0;
+            break;
+        case RC_EFF_AXIS_TILT: /* the chain's (point_jac) */
+        case RC_EFF_JOINT_COMPLIANCE:
+        case RC_EFF_JOINT_PERIODIC: break;
+        case RC_EFF_TRACKER_POSITION: /* another sensor's: no part in a length */
+        case RC_EFF_TRACKER_ROTATION:
+        case RC_EFF_TRACKER_TARGETS:
+        case RC_EFF_TRACKER_SCALE:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = 0.0;
+            break;
+        case RC_EFF_OUTLET_OFFSET:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = k == s->outlet ? 1.0 : 0.0;
+            break;
+        case RC_EFF_OUTLET_SCALE:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = k == s->outlet ? dist : 0.0;
+            break;
+        case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
+        case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
+        case RC_EFF_TIME_DRIFT: {
+            double tp = s->t;
+            for (unsigned k = 0; k < ef->count; ++k) {
+                J[k] = tp;
+                tp *= s->t;
+            }
+            break;
+        }
+        case RC_EFF_GROUP_OFFSET:
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = (k == s->group) ? 1.0 : 0.0;
+            break;
+        case RC_EFF_TOOL_OFFSET: { /* dp/dt = R6 */
+            const double *R = c->R[RC_NJ];
+            for (unsigned k = 0; k < 3; ++k)
+                J[k] = g[0] * R[k] + g[1] * R[3 + k] + g[2] * R[6 + k];
+            break;
+        }
+        case RC_EFF_CABLE_SAG: J[0] = 1e-9 * h2 * dist; break;
+        case RC_EFF_LENGTH_NONLIN: {
+            const double v = dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
+            J[0] = v * v;
+            J[1] = v * v * v;
+            break;
+        }
+        case RC_EFF_LENGTH_PERIODIC: {
+            const double *x = &m->x[ef->first];
+            J[0] = J[1] = J[2] = 0.0;
+            if (!(fabs(x[2]) > 1e-9))
+                break;
+            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
+            J[0] = sp;
+            J[1] = cp;
+            J[2] = (x[0] * cp - x[1] * sp) * (-ph / x[2]); /* d ph / dP = -dist 2 pi / P^2 */
+            break;
+        }
+        case RC_EFF_NONE: break;
+        }
+    }
+}
+
 /* Length (and its Jacobian) of sample s from the model's chain c at s and
  * the measured point p; other sensors through sensor_chain. */
 static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, const rc_sample *s, const chain *c,
@@ -760,74 +838,6 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
     for (int r = 0; r < 3; ++r)
         g[r] = scale * u[r] + gd[r];
     point_jac(jac, dl_dtheta, m, s, c, p, g);
-    for (int r = 0; r < 3; ++r)
-        jac[RC_P_ENC + r] = outlet_first < 0 ? -g[r] : 0.0;
-    for (unsigned i = 0; i < m->n_effects; ++i) {
-        const rc_effect *ef = &m->effects[i];
-        double *J = &jac[ef->first];
-        switch ((rc_effect_kind)ef->kind) {
-        case RC_EFF_OUTLET:
-            for (unsigned k = 0; k < 3; ++k)
-                J[k] = (int)ef->first == outlet_first ? -g[k] : 0.0;
-            break;
-        case RC_EFF_AXIS_TILT: /* the chain's (point_jac) */
-        case RC_EFF_JOINT_COMPLIANCE:
-        case RC_EFF_JOINT_PERIODIC: break;
-        case RC_EFF_TRACKER_POSITION: /* another sensor's: no part in a length */
-        case RC_EFF_TRACKER_ROTATION:
-        case RC_EFF_TRACKER_TARGETS:
-        case RC_EFF_TRACKER_SCALE:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = 0.0;
-            break;
-        case RC_EFF_OUTLET_OFFSET:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = k == s->outlet ? 1.0 : 0.0;
-            break;
-        case RC_EFF_OUTLET_SCALE:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = k == s->outlet ? dist : 0.0;
-            break;
-        case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
-        case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
-        case RC_EFF_TIME_DRIFT: {
-            double tp = s->t;
-            for (unsigned k = 0; k < ef->count; ++k) {
-                J[k] = tp;
-                tp *= s->t;
-            }
-            break;
-        }
-        case RC_EFF_GROUP_OFFSET:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = (k == s->group) ? 1.0 : 0.0;
-            break;
-        case RC_EFF_TOOL_OFFSET: { /* dp/dt = R6 */
-            const double *R = c->R[RC_NJ];
-            for (unsigned k = 0; k < 3; ++k)
-                J[k] = g[0] * R[k] + g[1] * R[3 + k] + g[2] * R[6 + k];
-            break;
-        }
-        case RC_EFF_CABLE_SAG: J[0] = 1e-9 * h2 * dist; break;
-        case RC_EFF_LENGTH_NONLIN: {
-            const double v = dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
-            J[0] = v * v;
-            J[1] = v * v * v;
-            break;
-        }
-        case RC_EFF_LENGTH_PERIODIC: {
-            const double *x = &m->x[ef->first];
-            J[0] = J[1] = J[2] = 0.0;
-            if (!(fabs(x[2]) > 1e-9))
-                break;
-            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
-            J[0] = sp;
-            J[1] = cp;
-            J[2] = (x[0] * cp - x[1] * sp) * (-ph / x[2]); /* d ph / dP = -dist 2 pi / P^2 */
-            break;
-        }
-        case RC_EFF_NONE: break;
-        }
-    }
+    length_effects_jac(jac, m, s, c, g, dist, h2, outlet_first);
     return RC_OK;
 }

@@ -111,128 +111,140 @@ static int report(rch_diagnose_result *r, const char *plots, const char *const i
     return 0;
 }
 
-int rcal_cmd_diagnose(int argc, char **argv)
-{
-    const char *const default_robot = RCAL_DEFAULT_ROBOT;
-    const char *robot_path = default_robot, *plots = NULL, *out_path = NULL, *resid = NULL, *report_path = NULL,
-               *effects = NULL;
+/* The options of rcal diagnose. */
+typedef struct {
+    const char *robot_path, *plots, *out_path, *resid, *report_path, *effects;
     rch_opt_strs data, positions;
-    memset(&data, 0, sizeof data);
-    memset(&positions, 0, sizeof positions);
-    unsigned long seed = 1, folds = 5, steps = 3, max_iter = 0, verbosity = 0;
-    int json = 0, verbose = 0;
+    unsigned long seed, folds, steps, max_iter, verbosity;
+    int json, verbose;
     rch_diagnose_cfg cfg;
-    memset(&cfg, 0, sizeof cfg);
+    const char *ins[2 * RCH_OPT_MAX_STRS + 1]; /* every input file, for the outputs' check */
+    size_t n_ins;
+} diag_args;
+
+/* Options into a; -1 when the command should run, else its exit status. */
+static int parse(diag_args *a, int argc, char **argv)
+{
+    rch_diagnose_cfg *cfg = &a->cfg;
     rch_cmdspec spec;
     const rch_opt opts[] = {
-        {"--data", RCH_OPT_STRS, &data, 0, 0, "FILE",
+        {"--data", RCH_OPT_STRS, &a->data, 0, 0, "FILE",
          "cable lengths: CSV with q1..q6 (deg) and L (mm), optional outlet; several --data are merged", 0, NULL},
-        {"--positions", RCH_OPT_STRS, &positions, 0, 0, "FILE",
+        {"--positions", RCH_OPT_STRS, &a->positions, 0, 0, "FILE",
          "laser-tracker positions: CSV with q1..q6 (deg), x, y, z (mm, tracker frame), optional target, pose; "
          "several are merged, mixable with --data",
          0, NULL},
-        {"--effects", RCH_OPT_STR, &effects, 0, 0, "LIST",
+        {"--effects", RCH_OPT_STR, &a->effects, 0, 0, "LIST",
          "effects already known (as rcal calibrate --effects names them): fitted from the start, never offered again",
          0, NULL},
-        {"--jumps", RCH_OPT_FLAG, &cfg.jumps, 0, 0, NULL,
+        {"--jumps", RCH_OPT_FLAG, &cfg->jumps, 0, 0, NULL,
          "length jumps found are removed as nuisance even at a set-up change (rcal calibrate --jumps)", 0, NULL},
-        {"--robot", RCH_OPT_STR, &robot_path, 0, 0, "MODEL", "nominal robot model", 0, NULL},
-        {"--seed", RCH_OPT_UINT, &seed, 0, 0, "S", "fold assignment seed", 0, NULL},
-        {"--folds", RCH_OPT_UINT, &folds, 2, RCH_DIAGNOSE_MAX_FOLDS, "K", "cross-validation folds", 0, NULL},
-        {"--steps", RCH_OPT_UINT, &steps, 1, RCH_DIAGNOSE_MAX_STEPS, "N", "effects added at most", 0, NULL},
-        {"--plots", RCH_OPT_STR, &plots, 0, 0, "DIR", "write residual plots (SVG, each with its data as .csv) into DIR", 0, NULL},
-        {"--out", RCH_OPT_STR, &out_path, 0, 0, "MODEL.json",
+        {"--robot", RCH_OPT_STR, &a->robot_path, 0, 0, "MODEL", "nominal robot model", 0, NULL},
+        {"--seed", RCH_OPT_UINT, &a->seed, 0, 0, "S", "fold assignment seed", 0, NULL},
+        {"--folds", RCH_OPT_UINT, &a->folds, 2, RCH_DIAGNOSE_MAX_FOLDS, "K", "cross-validation folds", 0, NULL},
+        {"--steps", RCH_OPT_UINT, &a->steps, 1, RCH_DIAGNOSE_MAX_STEPS, "N", "effects added at most", 0, NULL},
+        {"--plots", RCH_OPT_STR, &a->plots, 0, 0, "DIR", "write residual plots (SVG, each with its data as .csv) into DIR",
+         0, NULL},
+        {"--out", RCH_OPT_STR, &a->out_path, 0, 0, "MODEL.json",
          "write the calibrated model with the effects found (nuisances left out); never over an input", 0, NULL},
-        {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
-        {"--residuals", RCH_OPT_STR, &resid, 0, 0, "FILE.csv",
+        {"--json", RCH_OPT_FLAG, &a->json, 0, 0, NULL, "one JSON object on stdout", 0, NULL},
+        {"--residuals", RCH_OPT_STR, &a->resid, 0, 0, "FILE.csv",
          "each sample's residual under the final model and its cross-validated residual before and after the "
          "chosen effects; never over an input",
          0, NULL},
-        {"--report", RCH_OPT_STR, &report_path, 0, 0, "FILE.html",
+        {"--report", RCH_OPT_STR, &a->report_path, 0, 0, "FILE.html",
          "also the HTML page of rcal report: this diagnosis with a calibration of the same data (rcal calibrate "
          "--seed S defaults); both JSON kept beside it",
          0, NULL},
-        {"--q-step-deg", RCH_OPT_DOUBLE, &cfg.q_step_deg, -1, 10, "D", "joint display step (0: detected)", 0, NULL},
-        {"--len-step-mm", RCH_OPT_DOUBLE, &cfg.len_step_mm, -1, 10, "D", "length display step (0: detected)", 0,
+        {"--q-step-deg", RCH_OPT_DOUBLE, &cfg->q_step_deg, -1, 10, "D", "joint display step (0: detected)", 0, NULL},
+        {"--len-step-mm", RCH_OPT_DOUBLE, &cfg->len_step_mm, -1, 10, "D", "length display step (0: detected)", 0,
          NULL},
-        {"--len-noise-mm", RCH_OPT_DOUBLE, &cfg.len_noise_mm, 0, 100, "S", "the encoder's stated noise, added", 0,
+        {"--len-noise-mm", RCH_OPT_DOUBLE, &cfg->len_noise_mm, 0, 100, "S", "the encoder's stated noise, added", 0,
          NULL},
-        {"--alpha", RCH_OPT_DOUBLE, &cfg.alpha, 0, 0.5, "A", "family-wise level of each decision (0: 0.01)", 0,
+        {"--alpha", RCH_OPT_DOUBLE, &cfg->alpha, 0, 0.5, "A", "family-wise level of each decision (0: 0.01)", 0,
          NULL},
-        {"--max-iter", RCH_OPT_UINT, &max_iter, 0, 100000, "N",
+        {"--max-iter", RCH_OPT_UINT, &a->max_iter, 0, 100000, "N",
          "LM iterations of each warm-started fold fit (0: 100)", 0, NULL},
-        {"--no-jumps", RCH_OPT_FLAG, &cfg.no_jumps, 0, 0, NULL, "do not look for length jumps in acquisition order", 0,
-         NULL},
-        {"--dequantize-joints", RCH_OPT_FLAG, &cfg.dequantize, 0, 0, NULL,
+        {"--no-jumps", RCH_OPT_FLAG, &cfg->no_jumps, 0, 0, NULL, "do not look for length jumps in acquisition order",
+         0, NULL},
+        {"--dequantize-joints", RCH_OPT_FLAG, &cfg->dequantize, 0, 0, NULL,
          "recover joint angles rounded for the file from its x, y, z columns (nominal FK); inconsistent rows refused",
          0, NULL},
-        {"--verbose", RCH_OPT_FLAG, &verbose, 0, 0, NULL, "progress to stderr", 0, NULL},
-        {"--verbosity", RCH_OPT_UINT, &verbosity, 0, 3, "V", "progress level (3: also singular values)", 0, NULL},
+        {"--verbose", RCH_OPT_FLAG, &a->verbose, 0, 0, NULL, "progress to stderr", 0, NULL},
+        {"--verbosity", RCH_OPT_UINT, &a->verbosity, 0, 3, "V", "progress level (3: also singular values)", 0, NULL},
     };
     const int ps = rch_opt_cmd(&spec, "diagnose", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, NULL);
     if (ps >= 0)
         return ps;
-    cfg.folds = (unsigned)folds;
-    cfg.max_steps = (unsigned)steps;
-    cfg.seed = seed;
-    cfg.max_iter = (unsigned)max_iter;
-    cfg.verbose = verbosity > 0 ? (int)verbosity : verbose;
-
-    const char *ins[2 * RCH_OPT_MAX_STRS + 1];
-    size_t n_ins = 0;
-    for (size_t k = 0; k < data.n; ++k)
-        ins[n_ins++] = data.v[k];
-    for (size_t k = 0; k < positions.n; ++k)
-        ins[n_ins++] = positions.v[k];
-    ins[n_ins++] = robot_path;
-    if (data.n + positions.n == 0) {
+    cfg->folds = (unsigned)a->folds;
+    cfg->max_steps = (unsigned)a->steps;
+    cfg->seed = a->seed;
+    cfg->max_iter = (unsigned)a->max_iter;
+    cfg->verbose = a->verbosity > 0 ? (int)a->verbosity : a->verbose;
+    for (size_t k = 0; k < a->data.n; ++k)
+        a->ins[a->n_ins++] = a->data.v[k];
+    for (size_t k = 0; k < a->positions.n; ++k)
+        a->ins[a->n_ins++] = a->positions.v[k];
+    a->ins[a->n_ins++] = a->robot_path;
+    if (a->data.n + a->positions.n == 0) {
         fprintf(stderr, "rcal diagnose: give --data FILE (cable lengths) or --positions FILE (tracker), or both\n");
         return 2;
     }
-    const int one_file = data.n == 1 && positions.n == 0; /* --residuals and --report read it again */
-    if (!one_file && (resid || report_path)) {
+    if (!(a->data.n == 1 && a->positions.n == 0) && (a->resid || a->report_path)) { /* they read it again */
         fprintf(stderr, "rcal diagnose: --residuals and --report take one --data file (no --positions) for now; "
                         "the diagnosis itself takes them all\n");
         return 2;
     }
-    {   /* outputs that name each other or an input: refused before the work */
-        const char *const outs[3] = {out_path, resid, report_path};
-        static const char *const what[3] = {"--out", "--residuals", "--report"};
-        if (rcal_outputs_check("diagnose", outs, what, 3, report_path, ins, n_ins) != 0)
-            return 2;
-    }
+    /* outputs that name each other or an input: refused before the work */
+    const char *const outs[3] = {a->out_path, a->resid, a->report_path};
+    static const char *const what[3] = {"--out", "--residuals", "--report"};
+    return rcal_outputs_check("diagnose", outs, what, 3, a->report_path, a->ins, a->n_ins) != 0 ? 2 : -1;
+}
+
+int rcal_cmd_diagnose(int argc, char **argv)
+{
+    const char *const default_robot = RCAL_DEFAULT_ROBOT;
+    static diag_args a;
+    memset(&a, 0, sizeof a);
+    a.robot_path = default_robot;
+    a.seed = 1;
+    a.folds = 5;
+    a.steps = 3;
+    const int ps = parse(&a, argc, argv);
+    if (ps >= 0)
+        return ps;
     rch_diagnose_in in;
     memset(&in, 0, sizeof in);
-    in.data_paths = data.v;
-    in.n_data = data.n;
-    in.positions_paths = positions.v;
-    in.n_positions = positions.n;
-    in.robot_path = robot_path;
-    in.robot_given = robot_path != default_robot;
-    in.effects = effects;
+    in.data_paths = a.data.v;
+    in.n_data = a.data.n;
+    in.positions_paths = a.positions.v;
+    in.n_positions = a.positions.n;
+    in.robot_path = a.robot_path;
+    in.robot_given = a.robot_path != default_robot;
+    in.effects = a.effects;
     rch_diagnose_result r;
     rch_diag d;
     char msg[1024];
-    if (rch_diagnose_inputs(&r, &in, &cfg, &d) != 0) {
+    if (rch_diagnose_inputs(&r, &in, &a.cfg, &d) != 0) {
         fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
         rch_diagnose_free(&r);
         return 1;
     }
-    const char *data_path = data.n ? data.v[0] : NULL;
-    const char *inputs[2] = {data_path ? data_path : positions.v[0], robot_path};
-    int rc = report(&r, plots, inputs, robot_path != default_robot, json, argc, argv);
-    if (rc == 0 && out_path) {
-        if (rch_diagnose_save_model(&r, data_path, robot_path, out_path, ins, n_ins, &d) != 0) {
+    const char *data_path = a.data.n ? a.data.v[0] : NULL;
+    const char *inputs[2] = {data_path ? data_path : a.positions.v[0], a.robot_path};
+    int rc = report(&r, a.plots, inputs, in.robot_given, a.json, argc, argv);
+    if (rc == 0 && a.out_path) {
+        if (rch_diagnose_save_model(&r, data_path, a.robot_path, a.out_path, a.ins, a.n_ins, &d) != 0) {
             fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
             rc = 1;
-        } else if (!json) {
-            printf("model with the effects found written to %s\n", out_path);
+        } else if (!a.json) {
+            printf("model with the effects found written to %s\n", a.out_path);
         }
     }
-    if (rc == 0 && resid)
-        rc = save_residuals(&r, data_path, robot_path, resid);
-    if (rc == 0 && report_path)
-        rc = diagnose_report(&r, data_path, robot_path, seed, cfg.dequantize, report_path, json, argc, argv);
+    if (rc == 0 && a.resid)
+        rc = save_residuals(&r, data_path, a.robot_path, a.resid);
+    if (rc == 0 && a.report_path)
+        rc = diagnose_report(&r, data_path, a.robot_path, a.seed, a.cfg.dequantize, a.report_path, a.json, argc, argv);
     rch_diagnose_free(&r);
     return rc;
 }
