@@ -18,12 +18,12 @@ typedef struct {
     int failed;
 } jp;
 
-static unsigned jcol(const jp *p) { return (unsigned)(p->pos - p->line_start + 1); }
+static unsigned json_col(const jp *p) { return (unsigned)(p->pos - p->line_start + 1); }
 
 static void jfail(jp *p, const char *msg)
 {
     if (!p->failed)
-        rch_diag_set(p->d, p->name, p->line, jcol(p), "%s", msg);
+        rch_diag_set(p->d, p->name, p->line, json_col(p), "%s", msg);
     p->failed = 1;
 }
 
@@ -50,7 +50,7 @@ static rch_json *jnew(jp *p, rch_jtype t)
     }
     j->type = t;
     j->line = p->line;
-    j->col = jcol(p);
+    j->col = json_col(p);
     return j;
 }
 
@@ -211,7 +211,7 @@ static rch_json *jcontainer(jp *p, int depth, int obj)
                 jfail(p, "expected a string key");
                 goto bad;
             }
-            unsigned kl = p->line, kc = jcol(p);
+            unsigned kl = p->line, kc = json_col(p);
             key = jstring(p);
             if (!key)
                 goto bad;

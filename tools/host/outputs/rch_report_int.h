@@ -87,30 +87,16 @@ void rch_rep_section(rep *r, const char *name, const char *how);
 
 const rch_json *rch_rep_jpath(const rch_json *o, const char *path);
 
-static inline double jnum(const rch_json *o, const char *path)
-{
-    const rch_json *j = rch_rep_jpath(o, path);
-    return j && j->type == RCH_JNUM ? j->num : NAN;
-}
-
-static inline const char *jstr(const rch_json *o, const char *path)
-{
-    const rch_json *j = rch_rep_jpath(o, path);
-    return j && j->type == RCH_JSTR ? j->str : NULL;
-}
-
-/* 1 true, 0 false, -1 absent */
-static inline int jbool(const rch_json *o, const char *path)
-{
-    const rch_json *j = rch_rep_jpath(o, path);
-    return j && j->type == RCH_JBOOL ? j->num != 0.0 : -1;
-}
-
-static inline const rch_json *jarr(const rch_json *o, const char *path)
-{
-    const rch_json *j = rch_rep_jpath(o, path);
-    return j && j->type == RCH_JARR ? j : NULL;
-}
+/* A number (NAN when absent or not a number), a string (NULL), a flag (1
+ * true, 0 false, -1 absent) and an array (NULL) at a dotted path. */
+double rch_rep_jnum(const rch_json *o, const char *path);
+const char *rch_rep_jstr(const rch_json *o, const char *path);
+int rch_rep_jbool(const rch_json *o, const char *path);
+const rch_json *rch_rep_jarr(const rch_json *o, const char *path);
+#define jnum rch_rep_jnum
+#define jstr rch_rep_jstr
+#define jbool rch_rep_jbool
+#define jarr rch_rep_jarr
 
 /* ---- the model: the tables the page, the charts and the CSVs share (rch_report_model.c) */
 
@@ -120,7 +106,7 @@ typedef struct {
 } metric_def;
 #define RCH_REP_N_METRICS 4
 extern const metric_def rch_rep_metric_defs[RCH_REP_N_METRICS];
-#define N_METRICS (sizeof rch_rep_metric_defs / sizeof rch_rep_metric_defs[0])
+#define N_METRICS ((size_t)RCH_REP_N_METRICS)
 
 typedef struct {
     char name[64], unit[16], cls[24], comp[24]; /* comp: "fitted", "nominal", "not used" or "" */

@@ -32,6 +32,30 @@ const rch_json *rch_rep_jpath(const rch_json *o, const char *path)
     return o;
 }
 
+double rch_rep_jnum(const rch_json *o, const char *path)
+{
+    const rch_json *j = rch_rep_jpath(o, path);
+    return j && j->type == RCH_JNUM ? j->num : NAN;
+}
+
+const char *rch_rep_jstr(const rch_json *o, const char *path)
+{
+    const rch_json *j = rch_rep_jpath(o, path);
+    return j && j->type == RCH_JSTR ? j->str : NULL;
+}
+
+int rch_rep_jbool(const rch_json *o, const char *path)
+{
+    const rch_json *j = rch_rep_jpath(o, path);
+    return j && j->type == RCH_JBOOL ? j->num != 0.0 : -1;
+}
+
+const rch_json *rch_rep_jarr(const rch_json *o, const char *path)
+{
+    const rch_json *j = rch_rep_jpath(o, path);
+    return j && j->type == RCH_JARR ? j : NULL;
+}
+
 const metric_def rch_rep_metric_defs[RCH_REP_N_METRICS] = {
     {"RMSE", "rmse_mm"}, {"mean |e|", "mean_abs_mm"}, {"SD", "sd_mm"}, {"MAX", "max_mm"}};
 

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* rch_poses.c - planning a pose set (see rch_poses.h): the entry point that
- * picks the criterion, the checks and the cost estimate both criteria share,
- * and the result's release. The criteria live in rch_poses_position.c (the
+/* rch_poses.c - what the pose planner's criteria share (see rch_poses.h):
+ * the checks and the cost estimate, the outer-product update, the progress
+ * lines, and the result's release. The entry that picks the criterion is
+ * rch_poses_plan.c. The criteria live in rch_poses_position.c (the
  * predicted 3-D accuracy, the default) and rch_poses_length.c (D-optimal on
  * the lengths); the choice of outlet places in rch_poses_outlets.c and the
  * RAPID module in rch_poses_rapid.c. What they share: rch_poses_int.h.
@@ -89,26 +90,6 @@ int rch_poses_check_config(const rc_model *m, const rch_poses_config *c, size_t 
         }
     }
     return 0;
-}
-
-int rch_poses_plan(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, FILE *progress,
-                   rch_diag *d)
-{
-    memset(res, 0, sizeof *res);
-    if (c->criterion == RCH_POSES_LENGTH) {
-        if (c->n_outlets > 1 || c->split) {
-            rch_diag_set(d, "", 0, 0, "--criterion length plans for one outlet; several outlets need --criterion "
-                                      "position");
-            return -1;
-        }
-        if (c->n_outlets == 1) {
-            rc_model one = *m;
-            memcpy(&one.x[RC_P_ENC], c->outlet_mm[0], 3 * sizeof(double));
-            return rch_poses_plan_length(res, &one, c, progress, d);
-        }
-        return rch_poses_plan_length(res, m, c, progress, d);
-    }
-    return rch_poses_plan_position(res, m, c, progress, d);
 }
 
 void rch_poses_free(rch_poses_result *res)
