@@ -15,6 +15,7 @@
 #include "rc_solve.h"
 #include "rc_version.h"
 #include "rch_calib.h"
+#include "rch_calib_effects.h"
 #include "rch_data.h"
 #include "rch_diag.h"
 #include "rch_diagnose.h"

@@ -15,6 +15,7 @@
 #include "rc_linalg.h"
 #include "rc_rand.h"
 #include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_data.h"
 #include "rch_jw.h"
 #include "rch_plot.h"
