@@ -10,6 +10,8 @@
  */
 #include "rch_calib_int.h"
 
+#include "rch_calib.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>

@@ -12,6 +12,8 @@
  */
 #include "rch_calib_int.h"
 
+#include "rch_calib.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
