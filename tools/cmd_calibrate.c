@@ -10,6 +10,7 @@
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
+#include "rch_calib_effects.h"
 #include "rch_data.h"
 #include "rch_file.h"
 #include "rch_opt.h"

@@ -13,7 +13,7 @@
 #include "rcal_cmds.h"
 #include "rch_compare.h"
 #include "rch_cost.h"
-#include "rch_calib.h" /* rch_calib_effects */
+#include "rch_calib_effects.h"
 #include "rch_data.h"
 #include "rch_dequant.h"
 #include "rch_opt.h"

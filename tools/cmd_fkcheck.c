@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_fkcheck.c - rcal fkcheck: does our forward kinematics reproduce the
  * controller's nominal x, y, z columns? Reports every row that does not. The
- * work is rch_fkcheck_run (tools/host/fit/rch_calib.h). */
+ * work is rch_fkcheck_run (tools/host/fit/rch_fkcheck.h). */
 #include <stdio.h>
 
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
-#include "rch_calib.h"
+#include "rch_fkcheck.h"
 #include "rch_jw.h"
 #include "rch_opt.h"
 

@@ -17,7 +17,7 @@
 
 #include "rc_kin.h"
 #include "rc_model.h"
-#include "rch_calib.h"
+#include "rch_calib_effects.h"
 #include "rch_robot.h"
 
 #define DEGR (3.14159265358979323846 / 180.0)

@@ -20,6 +20,7 @@
 
 #include "rc_ident.h"
 #include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_data.h"
 #include "rch_json.h"
 #include "rch_sim.h"

@@ -22,7 +22,7 @@
 
 #include "rc_comp.h"
 #include "rc_solve.h"
-#include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_comp.h"
 #include "rch_robot.h"
 #include "rch_uncert.h"

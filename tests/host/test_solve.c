@@ -15,7 +15,7 @@
 #include "rc_est.h"
 #include "rc_ident.h"
 #include "rc_solve.h"
-#include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_data.h"
 #include "rch_ident.h"
 #include "rch_robot.h"

@@ -16,7 +16,7 @@
 #include <cmocka.h>
 
 #include "rc_solve.h"
-#include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_robot.h"
 #include "rch_uncert.h"
 #include "rct_indep.h"

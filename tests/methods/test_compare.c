@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_chaos.h"
 #include "rch_eval.h"
 #include "rch_compare.h"

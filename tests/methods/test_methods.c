@@ -16,7 +16,7 @@
 
 #include "rc_est.h"
 #include "rc_solve.h"
-#include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_est.h"
 #include "rch_prior.h"
 #include "rch_robot.h"

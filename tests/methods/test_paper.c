@@ -24,7 +24,7 @@
 #include "rc_est.h"
 #include "rc_rand.h"
 #include "rc_solve.h"
-#include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_data.h"
 #include "rch_robot.h"
 

@@ -1,21 +1,26 @@
 /* SPDX-License-Identifier: MIT */
-/* rch_calib.h - the calibration pipeline behind `rcal calibrate` and the
- * nominal-FK check behind `rcal fkcheck`.
+/* rch_calib.h - the calibration pipeline behind `rcal calibrate`: the result
+ * of one calibration and its outputs.
  *
- * Before calibration (BC): the one definition of the start model. Nominal
- * geometry; the encoder outlet from the robot file when it has one, else from
- * rc_encoder_guess; then the encoder alone is refined by LM with everything
- * else held (rch_calib_bc). `rcal calibrate`, `rcal compare`, `rcal bench`
- * and `rcal diagnose` all start from it. Then every parameter is identified
- * with the chosen method (rch_calib_run), the held-out samples give the
+ * The inputs are read by rch_inputs_load (rch_inputs.h); every fit starts
+ * from the BC model (rch_start.h); then every parameter is identified with
+ * the chosen method (rch_calib_run), the held-out samples give the
  * before/after figures, an optional simulated truth gives flange errors over
  * random poses, and rch_ident describes what the data could not identify.
+ * The request is an rch_calib_cfg (rch_calib_cfg.h); --method, --effects and
+ * --fix are read by rch_calib_effects.h.
  *
- * Depends on: the core (rc_model, rc_solve), rch_data, rch_robot, rch_sim,
- * rch_ident, rch_jw. Memory: the result owns nothing on the heap (the pipeline
- * frees its scratch before returning). Errors: 0, or a negative code with a
- * message in rch_diag (see rch_calib_run). Not thread-safe only in that a
- * result must not be shared while it is written.
+ * Where each part lives (tools/host/fit/): rch_calib.c the run (split,
+ * cases, residuals, cost), rch_calib_fit.c one fit, rch_calib_figures.c what
+ * follows it (truth, uncertainty, validation), rch_calib_print.c the text
+ * report, rch_calib_json.c the JSON, rch_calib_model.c the model file.
+ *
+ * Depends on: the core (rc_model, rc_solve), rch_calib_cfg, rch_robot,
+ * rch_ident, rch_uncert, rch_jumps, rch_positions, rch_dequant,
+ * rch_evaluate, rch_stats. Memory: the result owns nothing on the heap (the
+ * pipeline frees its scratch before returning). Errors: 0, or a negative
+ * code with a message in rch_diag (see rch_calib_run). Not thread-safe only
+ * in that a result must not be shared while it is written.
  */
 #ifndef RCH_CALIB_H
 #define RCH_CALIB_H
@@ -24,6 +29,7 @@
 #include <stdio.h>
 
 #include "rc_solve.h"
+#include "rch_calib_cfg.h"
 #include "rch_diag.h"
 #include "rch_ident.h"
 #include "rch_robot.h"
@@ -37,83 +43,11 @@
 /* Poses (and their seed) of the flange comparison against a simulated truth. */
 #define RCH_CALIB_TRUTH_POSES 2000
 #define RCH_CALIB_TRUTH_SEED 12345
-/* Iteration cap of the encoder-only fit of the BC model. */
-#define RCH_CALIB_BC_MAX_ITER 200
-
-/* BC model from the samples (n): start = nominal as given (the caller chooses
- * which effects it carries; they stay at their values), encoder from nominal
- * when has_encoder, else from rc_encoder_guess; then the encoder alone fitted
- * (LM, at most RCH_CALIB_BC_MAX_ITER iterations). w: solver scratch. Returns 0
- * or -1 with d set. */
-int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int has_encoder, const rc_sample *s,
-                 size_t n, rch_diag *d);
-
-/* rch_calib_bc with the robot file's model and encoder. */
-int rch_calib_start(rc_model *start, rc_solve_work *w, const rch_robot *robot, const rc_sample *train, size_t n,
-                    rch_diag *d);
-
-/* Parse a method name (lm, ltlm, lm-paper, ltlm-paper). Returns 0 or -1. */
-int rch_method_parse(rc_method *out, const char *name);
-
-/* Add the effects of list to m: comma-separated, "length_offset",
- * "length_scale", "time_drift", "tool_offset", "cable_sag",
- * "length_nonlinearity", "length_periodic:P" (P the period's start value
- * in mm, 1..1000), "joint_compliance:J" (J = 2
- * or 3), "joint_periodic:J" (J = 1..6). 0, or -1 with d naming the entry. */
-int rch_calib_effects(rc_model *m, const char *list, rch_diag *d);
-
-/* A copy of m without its nuisance effects (group offsets, time drift):
- * they describe one acquisition, not the robot, and predict nothing at a new
- * pose. */
-void rch_model_strip_nuisance(rc_model *out, const rc_model *m);
-
-/* Mark the comma-separated parameter names of list (e.g. "a1,theta6") in
- * fixed (m->n_params). 0, or -1 with d naming the unknown parameter. */
-int rch_calib_fix(uint8_t *fixed, const rc_model *m, const char *list, rch_diag *d);
-
-#define RCH_CALIB_MAX_FILES 16
-typedef struct rch_calib_cfg {
-    const char *data_path;  /* measurements CSV (required; the first of data_paths when several) */
-    const char *const *data_paths; /* (n_data_paths) several files merged, NULL: data_path alone */
-    size_t n_data_paths;
-    const char *validate_path; /* data the fit never sees: evaluated with no refit, or NULL */
-    const char *plots_dir;  /* predicted-uncertainty plot and its CSV, or NULL */
-    const char *robot_path; /* nominal robot model (required) */
-    const char *truth_path; /* simulated truth model, or NULL */
-    const char *fix;        /* parameters held at nominal ("a1,theta6"), or NULL */
-    rc_method method;
-    double test_fraction;   /* share held out, [0, 1) */
-    unsigned long seed;     /* split and LTLM seed */
-    unsigned max_iter;      /* 0: the method's default */
-    int tool_offset;        /* 1: also identify the cable attachment in the flange frame */
-    const char *effects;    /* effects fitted with the geometry (rch_calib_effects), or NULL */
-    int jumps;              /* 1: fit length jumps at change points in acquisition order (nuisance, rch_jumps) */
-    int dequantize;         /* 1: recover rounded joint angles from the file's x, y, z (rch_dequant) */
-    int holdout_groups;     /* 1: hold out whole set-up groups instead of random rows */
-    unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
-    size_t case_samples;    /* rows per case (0: every row) */
-    const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
-    int no_jump_check;      /* 1: the default run does not look for length jumps (rch_calib_save_model
-                               refuses a model fitted across jumps it found) */
-    int no_prior;           /* 1: least squares without the physical prior (rch_prior.h), no cable
-                               attachment vector unless asked, no gauge: the earlier behaviour */
-    const char *const *positions_paths; /* (n_positions_paths) laser-tracker positions files
-                                           (rch_positions.h), merged after the data; data_path may
-                                           then be NULL */
-    size_t n_positions_paths;
-    int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
-    double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
-    double max_minutes;     /* refuse a run estimated longer (rch_calib_estimate_s); 0: 60 */
-} rch_calib_cfg;
 
 /* The run's cost on the reference machine (docs/methods.md, "Cost
  * estimates"): seconds for n_rows rows as cfg would run them; *bound_s the
  * most it can take when nothing converges early (the iteration cap). */
 double rch_calib_estimate_s(const rch_calib_cfg *cfg, size_t n_rows, double *bound_s);
-
-/* The defaults of `rcal calibrate`: everything zero or NULL but method LM,
- * test fraction 0.1, seed 1, one case. */
-void rch_calib_cfg_init(rch_calib_cfg *cfg);
 
 typedef struct rch_calib_result {
     rch_calib_cfg cfg;        /* as given (paths point at the caller's strings) */
@@ -188,9 +122,12 @@ typedef struct rch_calib_result {
     rch_pos_err pos_train_after;
 } rch_calib_result;
 
-/* The whole calibration. Returns 0 (the solver ran; r->after_ok says whether
- * the result is usable), -1 on a failure of the work (unreadable file, too few
- * samples, solver error: d set), -2 on a bad request (unknown --fix name: d
+/* The whole calibration: the inputs (rch_inputs_load), the cost (refused
+ * above cfg->max_minutes), the effects the fit carries, one fit or the
+ * cases. Returns 0 (the solver ran; r->after_ok says whether the result is
+ * usable), -1 on a failure of the work (unreadable file, too few samples,
+ * solver error: d set), -2 on a bad request (unknown --fix or --effects
+ * name, --residuals with --cases or --jumps, a run estimated too long: d
  * set). */
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d);
 
@@ -206,28 +143,5 @@ int rch_calib_write_model(FILE *f, const rch_calib_result *r);
 /* rch_calib_write_model into path, whole or not at all (rch_save), never over
  * one of the inputs (--data, --robot, --truth). 0, or -1 with d set. */
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d);
-
-/* rcal fkcheck: the nominal FK at each row's joint angles against the row's
- * x, y, z columns. A row further than tol_mm is explained by the display
- * rounding when a joint change of at most RCH_FK_ROUNDING_DEG (max over the
- * joints of the minimum-norm change) reproduces the difference, else a fault. */
-#define RCH_FK_ROUNDING_DEG 0.1
-typedef struct rch_fk_fault {
-    unsigned line;        /* line in the data file */
-    double dist_mm;       /* |FK - xyz| */
-    double dq_deg;        /* joint change that would explain it */
-    double fk_mm[3], file_mm[3];
-} rch_fk_fault;
-typedef struct rch_fkcheck_result {
-    size_t rows, faults, rounding;
-    double rms_mm, max_mm, max_consistent_mm;
-    rch_fk_fault *fault;      /* (faults) on the heap: rch_fkcheck_free */
-    char robot_name[128];
-} rch_fkcheck_result;
-
-/* 0, or -1 with d set (unreadable files, no x, y, z columns, no memory). */
-int rch_fkcheck_run(rch_fkcheck_result *r, const char *data_path, const char *robot_path, double tol_mm,
-                    rch_diag *d);
-void rch_fkcheck_free(rch_fkcheck_result *r);
 
 #endif

@@ -3,7 +3,7 @@
  * characteristics (see rch_evaluate.h). */
 #include "rch_evaluate.h"
 
-#include "rch_calib.h"
+#include "rch_start.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -17,6 +17,7 @@
 #include "rch_data.h"
 #include "rch_evaluate.h"
 #include "rch_ffi_int.h"
+#include "rch_calib_effects.h"
 #include "rch_file.h"
 #include "rch_prior.h"
 

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "rch_calib.h"
+#include "rch_start.h"
 #include "rch_data.h"
 #include "rch_robot.h"
 

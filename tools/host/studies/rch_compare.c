@@ -9,6 +9,8 @@
 #include <time.h>
 
 #include "rch_calib.h"
+#include "rch_calib_effects.h"
+#include "rch_start.h"
 #include "rch_cost.h"
 #include "rch_eval.h"
 #include "rch_jumps.h"

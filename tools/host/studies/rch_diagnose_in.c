@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "rch_diagnose_int.h"
-#include "rch_calib.h"
+#include "rch_calib_effects.h"
 #include "rch_data.h"
 #include "rch_dequant.h"
 #include "rch_groups.h"

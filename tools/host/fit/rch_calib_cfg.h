@@ -1,0 +1,61 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_calib_cfg.h - what `rcal calibrate` is asked to do: the input files and
+ * the options of one calibration (rch_calib_cfg), read by the inputs
+ * (rch_inputs_load) and by the pipeline (rch_calib_run).
+ *
+ * Depends on: the core (rc_method). Memory: the configuration points at the
+ * caller's strings and owns nothing. Errors: none (plain data).
+ */
+#ifndef RCH_CALIB_CFG_H
+#define RCH_CALIB_CFG_H
+
+#include <stddef.h>
+
+#include "rc_solve.h"
+
+#define RCH_CALIB_MAX_FILES 16
+typedef struct rch_calib_cfg {
+    const char *data_path;  /* measurements CSV (required; the first of data_paths when several) */
+    const char *const *data_paths; /* (n_data_paths) several files merged, NULL: data_path alone */
+    size_t n_data_paths;
+    const char *validate_path; /* data the fit never sees: evaluated with no refit, or NULL */
+    const char *plots_dir;  /* predicted-uncertainty plot and its CSV, or NULL */
+    const char *robot_path; /* nominal robot model (required) */
+    const char *truth_path; /* simulated truth model, or NULL */
+    const char *fix;        /* parameters held at nominal ("a1,theta6"), or NULL */
+    rc_method method;
+    double test_fraction;   /* share held out, [0, 1) */
+    unsigned long seed;     /* split and LTLM seed */
+    unsigned max_iter;      /* 0: the method's default */
+    int tool_offset;        /* 1: also identify the cable attachment in the flange frame */
+    const char *effects;    /* effects fitted with the geometry (rch_calib_effects), or NULL */
+    int jumps;              /* 1: fit length jumps at change points in acquisition order (nuisance, rch_jumps) */
+    int dequantize;         /* 1: recover rounded joint angles from the file's x, y, z (rch_dequant) */
+    int holdout_groups;     /* 1: hold out whole set-up groups instead of random rows */
+    unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
+    size_t case_samples;    /* rows per case (0: every row) */
+    const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
+    int no_jump_check;      /* 1: the default run does not look for length jumps (rch_calib_save_model
+                               refuses a model fitted across jumps it found) */
+    int no_prior;           /* 1: least squares without the physical prior (rch_prior.h), no cable
+                               attachment vector unless asked, no gauge: the earlier behaviour */
+    const char *const *positions_paths; /* (n_positions_paths) laser-tracker positions files
+                                           (rch_positions.h), merged after the data; data_path may
+                                           then be NULL */
+    size_t n_positions_paths;
+    int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
+    double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
+    double max_minutes;     /* refuse a run estimated longer (rch_calib_estimate_s); 0: 60 */
+} rch_calib_cfg;
+
+/* The defaults of `rcal calibrate`: everything zero or NULL but method LM,
+ * test fraction 0.1, seed 1, one case. */
+void rch_calib_cfg_init(rch_calib_cfg *cfg);
+
+/* The cable-length files of cfg: data_paths when given, else data_path
+ * alone; 0 with tracker positions only. */
+size_t rch_calib_cfg_n_files(const rch_calib_cfg *cfg);
+/* Cable-length file i (< rch_calib_cfg_n_files). */
+const char *rch_calib_cfg_file(const rch_calib_cfg *cfg, size_t i);
+
+#endif

@@ -1,0 +1,220 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_calib_json.c - the report of `rcal calibrate --json` as one JSON
+ * object, "rcal-calibrate/1" (rch_calib_json; docs/json-formats.md).
+ *
+ * Depends on: rch_calib.h, rch_jw, rch_robot (the uncertainty and provenance
+ * members), rch_positions. Memory: none on the heap. Errors: -1 on a write
+ * error.
+ */
+#include "rch_calib.h"
+#include "rch_calib_int.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rch_jw.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+static void json_metrics(rch_jw *w, const char *name, const rc_metrics *m)
+{
+    rch_jw_obj(w, name);
+    rch_jw_uint(w, "n", m->n);
+    rch_jw_numf(w, "rmse_mm", m->rmse_mm, "%.6f");
+    rch_jw_numf(w, "mean_abs_mm", m->mean_abs_mm, "%.6f");
+    rch_jw_numf(w, "sd_mm", m->sd_mm, "%.6f");
+    rch_jw_numf(w, "mean_mm", m->mean_mm, "%.6f");
+    rch_jw_numf(w, "max_mm", m->max_mm, "%.6f");
+    rch_jw_num(w, "rmse_full_mm", m->rmse_mm); /* rmse_mm to the last bit (%.17g): checks of --residuals */
+    rch_jw_end(w);
+}
+
+static void json_params(rch_jw *w, const rch_calib_result *r)
+{
+    const rc_model *m = &r->model;
+    rch_jw_arr(w, "params");
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        char name[64];
+        const int unit = rc_param_unit(m, k);
+        const double scale = unit == 1 ? 1.0 / DEG : 1.0;
+        const double nominal = k < RC_N_DH ? r->robot.model.x[k] : (k < RC_N_BASE ? r->before.x[k] : 0.0);
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "name", rc_param_name(name, sizeof name, m, k));
+        rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "-");
+        rch_jw_numf(w, "value", r->finite ? m->x[k] * scale : 0.0, "%.9g");
+        rch_jw_numf(w, "delta", r->finite ? (m->x[k] - nominal) * scale : 0.0, "%.9g");
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_arr(w, "encoder_mm");
+    for (unsigned k = 0; k < 3; ++k)
+        rch_jw_numf(w, NULL, m->x[RC_P_ENC + k], "%.6f");
+    rch_jw_end(w);
+}
+
+static void json_ident(rch_jw *w, const rch_ident *id)
+{
+    rch_jw_obj(w, "identifiability");
+    rch_jw_uint(w, "params", id->n_params);
+    rch_jw_uint(w, "rank", id->rank);
+    rch_jw_uint(w, "weak", id->n_weak);
+    rch_jw_numf(w, "cond", id->cond, "%.6g");
+    rch_jw_numf(w, "observability", id->observability, "%.6g");
+    rch_jw_arr(w, "directions");
+    for (unsigned k = 0; k < id->n_dirs; ++k) {
+        rch_jw_obj(w, NULL);
+        rch_jw_numf(w, "sv_rel", id->dirs[k].sv_rel, "%.3g");
+        rch_jw_str(w, "identifiable", id->dirs[k].weak ? "weakly" : "no");
+        rch_jw_str(w, "combo", id->dirs[k].combo);
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_arr(w, "dependent_sets");
+    for (unsigned k = 0; k < id->n_combos; ++k) {
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "params", id->combos[k].params);
+        rch_jw_str(w, "identifiable", id->combos[k].weak ? "weakly" : "no");
+        rch_jw_numf(w, "sv_rel", id->combos[k].sv_rel, "%.3g");
+        rch_jw_str(w, "why", id->combos[k].why);
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_end(w);
+}
+
+static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
+{
+    const rch_model_unc *u = &r->unc;
+    rch_jw_obj(w, "uncertainty");
+    rch_jw_str(w, "covariance", u->kind == RCH_COV_CLUSTER ? "cluster-robust" : "classical");
+    rch_jw_uint(w, "groups", u->n_groups);
+    rch_jw_str(w, "groups_from", r->groups_from_file ? "file" : "wrist joints");
+    rch_jw_numf(w, "sigma_mm", u->sigma_mm, "%.6g");
+    rch_jw_uint(w, "rank", u->rank);
+    rch_jw_bool(w, "posterior", u->has_prior);
+    rch_robot_write_unc_params(w, &r->model, u, "%.9g");
+    rch_robot_write_unc_map(w, &u->map);
+    rch_jw_bool(w, "orientation_determined", u->orientation_determined);
+    rch_jw_end(w);
+}
+
+/* With --positions: the "positions" member (docs/json-formats.md). */
+static void json_positions(rch_jw *w, const rch_calib_result *r)
+{
+    rch_jw_obj(w, "positions");
+    rch_jw_uint(w, "rows", r->n_pos_rows);
+    rch_jw_uint(w, "poses", r->n_pos_poses);
+    rch_jw_uint(w, "targets", r->n_targets);
+    rch_jw_num(w, "sigma_mm", r->pos_has_sigma ? r->pos_sigma_mm : NAN);
+    if (r->have_pos) {
+        rch_pos_err_json(w, "position_error_mm", &r->pos_after);
+        rch_pos_err_json(w, "before_mm", &r->pos_before);
+        rch_pos_err_json(w, "train_after_mm", &r->pos_train_after);
+    }
+    rch_jw_end(w);
+}
+
+int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
+{
+    rch_jw w;
+    rch_jw_begin(&w, f, 0, "rcal-calibrate/1", argc, argv);
+    rch_jw_str(&w, "method", rc_method_name(r->cfg.method));
+    rch_jw_str(&w, "data", rch_calib_data_name(r));
+    rch_jw_uint(&w, "n_train", r->n_train);
+    rch_jw_uint(&w, "n_test", r->n_test);
+    rch_jw_uint(&w, "seed", r->cfg.seed);
+    json_metrics(&w, "before", &r->before_m);
+    json_metrics(&w, "after", &r->after_m);
+    json_metrics(&w, "train_before", &r->train_before);
+    json_metrics(&w, "train_after", &r->train_after);
+    rch_jw_bool(&w, "held_out", r->n_test > 0);
+    rch_jw_bool(&w, "converged", r->after_ok);
+    rch_jw_str(&w, "exit", rc_exit_str(r->solve.exit));
+    rch_jw_uint(&w, "iterations", r->solve.iterations);
+    rch_jw_uint(&w, "cost_evals", r->solve.cost_evals);
+    rch_jw_numf(&w, "time_ms", r->time_ms, "%.3f");
+    json_params(&w, r);
+    rch_jw_obj(&w, "estimation");
+    rch_jw_bool(&w, "prior", r->prior_on);
+    if (r->prior_on) {
+        rch_jw_num(&w, "prior_length_mm", r->robot.prior.length_mm);
+        rch_jw_num(&w, "prior_twist_deg", r->robot.prior.twist_deg);
+        rch_jw_num(&w, "prior_offset_deg", r->robot.prior.offset_deg);
+        rch_jw_num(&w, "prior_attachment_mm", r->robot.prior.attachment_mm);
+        rch_jw_numf(&w, "noise_mm", r->noise_mm, "%.6g");
+        rch_jw_numf(&w, "effective_params", r->p_eff, "%.4g");
+    }
+    rch_jw_uint(&w, "outlets", r->n_outlets ? r->n_outlets : 1u);
+    if (r->attach_auto) {
+        rch_jw_str(&w, "attachment", r->attach_centred ? "flange centre" : "estimated");
+        rch_jw_numf(&w, "attachment_dchi2", r->attach_dchi2, "%.6g");
+        rch_jw_numf(&w, "attachment_occam", r->attach_occam, "%.6g");
+    }
+    rch_jw_bool(&w, "jumps_found_by_default", r->jumps_auto);
+    rch_jw_end(&w);
+    if (r->n_pos_rows)
+        json_positions(&w, r);
+    if (r->cfg.truth_path) {
+        rch_jw_obj(&w, "truth_flange");
+        rch_jw_numf(&w, "before_rms_mm", r->truth_before_rms_mm, "%.6f");
+        rch_jw_numf(&w, "before_max_mm", r->truth_before_max_mm, "%.6f");
+        rch_jw_numf(&w, "after_rms_mm", r->truth_after_rms_mm, "%.6f");
+        rch_jw_numf(&w, "after_max_mm", r->truth_after_max_mm, "%.6f");
+        rch_jw_end(&w);
+    }
+    if (r->have_ident)
+        json_ident(&w, &r->ident);
+    if (r->have_unc)
+        json_uncertainty(&w, r);
+    if (r->have_jumps) {
+        rch_jw_arr(&w, "length_jumps");
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+            rch_jw_obj(&w, NULL);
+            rch_jw_uint(&w, "line", r->jump_lines[k]);
+            rch_jw_numf(&w, "t", r->jumps.at_t[k], "%.6f");
+            rch_jw_numf(&w, "size_mm", r->jumps.size_mm[k], "%.6f");
+            rch_jw_numf(&w, "se_mm", r->jumps.se_mm[k], "%.6f");
+            rch_jw_end(&w);
+        }
+        rch_jw_end(&w);
+        rch_jw_uint(&w, "held_out_ambiguous", r->n_ambiguous);
+        json_metrics(&w, "after_unambiguous", &r->after_unambiguous);
+    }
+    if (r->have_dequant) {
+        rch_jw_obj(&w, "dequantized");
+        rch_jw_uint(&w, "corrected", r->dequant.n_corrected);
+        rch_jw_uint(&w, "refused", r->dequant.n_refused);
+        rch_jw_numf(&w, "dq_rms_deg", r->dequant.dq_rms_deg, "%.6f");
+        rch_jw_end(&w);
+    }
+    if (r->cases_done > 1) {
+        rch_jw_obj(&w, "protocol");
+        rch_jw_uint(&w, "cases", r->cases_done);
+        rch_jw_numf(&w, "before_rmse_mean_mm", r->case_before.mean, "%.6f");
+        rch_jw_numf(&w, "before_rmse_sd_mm", rch_stats_sd(&r->case_before), "%.6f");
+        rch_jw_numf(&w, "after_rmse_mean_mm", r->case_after.mean, "%.6f");
+        rch_jw_numf(&w, "after_rmse_sd_mm", rch_stats_sd(&r->case_after), "%.6f");
+        rch_jw_uint(&w, "held_out_ambiguous", r->case_ambiguous);
+        rch_jw_numf(&w, "after_unambiguous_rmse_mean_mm", r->case_unamb.n ? r->case_unamb.mean : NAN, "%.6f");
+        rch_jw_numf(&w, "after_unambiguous_rmse_sd_mm", r->case_unamb.n ? rch_stats_sd(&r->case_unamb) : NAN, "%.6f");
+        rch_jw_end(&w);
+    }
+    if (r->have_validate) {
+        rch_jw_obj(&w, "validation");
+        rch_jw_str(&w, "data", r->cfg.validate_path);
+        json_metrics(&w, "residual", &r->validate.m);
+        rch_jw_uint(&w, "repeated_poses", r->validate.n_repeated);
+        rch_jw_numf(&w, "iso9283_ad_mean_mm", r->validate.ad_mean_mm, "%.6f");
+        rch_jw_numf(&w, "iso9283_ad_max_mm", r->validate.ad_max_mm, "%.6f");
+        rch_jw_numf(&w, "iso9283_rd_mean_mm", r->validate.rd_mean_mm, "%.6f");
+        rch_jw_numf(&w, "iso9283_rd_max_mm", r->validate.rd_max_mm, "%.6f");
+        rch_jw_end(&w);
+    }
+    rch_robot_write_provenance(&w, &r->prov);
+    rch_jw_end(&w);
+    return rch_jw_finish(&w);
+}

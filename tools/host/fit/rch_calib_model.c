@@ -1,0 +1,74 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_calib_model.c - the calibrated model file (rcal-model/2) with its
+ * "calibration" member (rch_calib_write_model), and its safe save, refused
+ * for a geometry fitted across length jumps (rch_calib_save_model).
+ *
+ * Depends on: rch_calib.h, rch_robot (rch_robot_write), rch_save, rch_jw.
+ * Memory: none on the heap. Errors: -1 (d set by rch_calib_save_model).
+ */
+#include "rch_calib.h"
+#include "rch_calib_int.h"
+
+#include <stdio.h>
+
+#include "rch_jw.h"
+#include "rch_save.h"
+
+static void calib_info(rch_jw *w, const void *ctx)
+{
+    const rch_calib_result *r = ctx;
+    rch_jw_str(w, "method", rc_method_name(r->cfg.method));
+    rch_jw_str(w, "data", rch_calib_data_name(r));
+    rch_jw_uint(w, "n_train", r->n_train);
+    rch_jw_uint(w, "n_test", r->n_test);
+    rch_jw_uint(w, "seed", r->cfg.seed);
+    rch_jw_numf(w, "rmse_before_mm", r->before_m.rmse_mm, "%.6f");
+    rch_jw_numf(w, "rmse_after_mm", r->after_m.rmse_mm, "%.6f");
+    if (r->have_jumps && r->jumps.n_jumps) { /* read back: rcal evaluate says they are not applied */
+        rch_jw_arr(w, "length_jumps");
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
+            rch_jw_obj(w, NULL);
+            rch_jw_uint(w, "line", r->jump_lines[k]);
+            rch_jw_numf(w, "t", r->jumps.at_t[k], "%.6f");
+            rch_jw_numf(w, "size_mm", r->jumps.size_mm[k], "%.6f");
+            rch_jw_numf(w, "se_mm", r->jumps.se_mm[k], "%.6f");
+            rch_jw_end(w);
+        }
+        rch_jw_end(w);
+    }
+}
+
+int rch_calib_write_model(FILE *f, const rch_calib_result *r)
+{
+    if (!r->finite)
+        return -1;
+    const rch_robot_info info = {calib_info, r, r->have_unc ? &r->unc : NULL, r->have_unc ? &r->determined : NULL,
+                                 &r->prov};
+    return rch_robot_write(f, r->robot.name, &r->model, &r->robot.nominal, &info);
+}
+
+static int write_model_fn(FILE *f, const void *ctx)
+{
+    return rch_calib_write_model(f, ctx);
+}
+
+int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
+{
+    if (r->jumps_found && !r->cfg.jumps) {
+        char counts[200];
+        rch_calib_jump_counts(counts, sizeof counts, r);
+        rch_diag_set(d, path, 0, 0,
+                     "not written: the lengths jump in acquisition order (%s), which this fit does not model, so "
+                     "its geometry is wrong; run again with --jumps, which fits the %u step%s found (or "
+                     "--no-jump-check to write it anyway)",
+                     counts, r->jump_check_steps, r->jump_check_steps == 1 ? "" : "s");
+        return -1;
+    }
+    const char *inputs[2 * RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
+    size_t n = 3;
+    for (size_t f = 0; f < rch_calib_cfg_n_files(&r->cfg); ++f)
+        inputs[n++] = rch_calib_cfg_file(&r->cfg, f);
+    for (size_t f = 0; f < r->cfg.n_positions_paths && f < RCH_CALIB_MAX_FILES; ++f)
+        inputs[n++] = r->cfg.positions_paths[f];
+    return rch_save(path, "--out", inputs, n, write_model_fn, r, d);
+}

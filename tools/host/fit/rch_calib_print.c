@@ -1,0 +1,434 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_calib_print.c - the text report of `rcal calibrate` (rch_calib_print):
+ * the paper's Table 7 form, the effects, the outlets, the predicted
+ * uncertainty, identifiability, the tracker positions, the summary and the
+ * next step; and the words the model file's refusal shares
+ * (rch_calib_int.h).
+ *
+ * Depends on: rch_calib.h, rch_prior, rch_uncert, rch_positions, rch_text.
+ * Memory: none on the heap. Errors: none (write errors are the stream's).
+ */
+#include "rch_calib.h"
+#include "rch_calib_int.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rch_prior.h"
+#include "rch_text.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+static void print_metrics_row(FILE *f, const char *label, const rc_metrics *m)
+{
+    fprintf(f, "  %-38s %8.4f %8.4f %8.4f %8.4f\n", label, m->rmse_mm, m->mean_abs_mm, m->sd_mm, m->max_mm);
+}
+
+static void print_model(FILE *f, const rch_calib_result *r)
+{
+    const rc_model *m = &r->model, *nom = &r->robot.model, *bc = &r->before;
+    fprintf(f, "identified model (the paper's Table 7 form; deltas against nominal):\n");
+    fprintf(f, "  joint     a (mm)     d (mm)   alpha (deg)  theta (deg) |   da (mm)    dd (mm)  dalpha(deg)  "
+               "dtheta(deg)\n");
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        const double *x = &m->x[4 * j], *x0 = &nom->x[4 * j];
+        fprintf(f, "  %5u %10.4f %10.4f %12.5f %12.5f | %9.4f %10.4f %12.5f %12.5f\n", j + 1, x[0], x[1],
+                x[2] / DEG, x[3] / DEG, x[0] - x0[0], x[1] - x0[1], (x[2] - x0[2]) / DEG, (x[3] - x0[3]) / DEG);
+    }
+    if (r->n_pos_rows && r->n_data == 3 * r->n_pos_rows)
+        fprintf(f, "  encoder e: no cable lengths (tracker positions only), held\n\n");
+    else
+        fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
+                m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
+}
+
+/* Dequantized joints, length jumps, the protocol over cases. */
+static void print_effects(FILE *f, const rch_calib_result *r)
+{
+    if (r->have_dequant) {
+        const rch_dequant_result *q = &r->dequant;
+        fprintf(f,
+                "joints dequantized from x, y, z: %zu rows corrected (RMS %.4f deg, largest %.4f deg; |FK - xyz| "
+                "%.4f -> %.6f mm), %zu refused as inconsistent",
+                q->n_corrected, q->dq_rms_deg, q->dq_max_deg, q->fk_rms_before_mm, q->fk_rms_after_mm, q->n_refused);
+        for (size_t i = 0; i < q->n_refused && i < 16; ++i)
+            fprintf(f, "%s%u", i ? ", " : " (lines ", r->dequant_refused_lines[i]);
+        fprintf(f, "%s\n", q->n_refused ? ")" : "");
+    }
+    if (r->have_jumps) {
+        const rch_jumps *j = &r->jumps;
+        fprintf(f, "length jumps in acquisition order (nuisance, not used at a new pose): %u found; training RMS "
+                   "%.4f mm without them, %.4f mm with them\n",
+                j->n_jumps, j->rms_before_mm, j->rms_after_mm);
+        for (unsigned k = 0; k < j->n_jumps; ++k) {
+            char where[48] = "";
+            if (r->jump_lines[k])
+                snprintf(where, sizeof where, " at line %u", r->jump_lines[k]);
+            fprintf(f, "  jump %u%s (t %.4f): %+.4f +- %.4f mm\n", k + 1, where, j->at_t[k], j->size_mm[k],
+                    j->se_mm[k]);
+        }
+        if (r->n_ambiguous)
+            fprintf(f,
+                    "  %zu held-out samples lie between a jump and the training samples around it (their segment "
+                    "cannot be known): RMSE without them %.4f mm\n",
+                    r->n_ambiguous, r->after_unambiguous.rmse_mm);
+    }
+    if (r->cases_done > 1)
+        fprintf(f,
+                "protocol: %lu cases of %zu random rows, %.0f %% held out%s: held-out RMSE before %.4f +- %.4f mm, "
+                "after %.4f +- %.4f mm (mean +- sd over the cases; the figures below are case 1's)\n",
+                r->cases_done, r->n_train + r->n_test, 100.0 * r->cfg.test_fraction,
+                r->cfg.holdout_groups ? " (whole set-up groups)" : "", r->case_before.mean,
+                rch_stats_sd(&r->case_before), r->case_after.mean, rch_stats_sd(&r->case_after));
+    if (r->cases_done > 1 && r->case_unamb.n)
+        fprintf(f,
+                "  without the %zu held-out samples (of all cases) that lie between a jump and the training samples "
+                "around it: after %.4f +- %.4f mm\n",
+                r->case_ambiguous, r->case_unamb.mean, rch_stats_sd(&r->case_unamb));
+    if (r->have_dequant || r->have_jumps || r->cases_done > 1)
+        fprintf(f, "\n");
+}
+
+/* What the outlets add: the rigid motion their places fix (rch_prior_outlet_span). */
+static void print_outlets(FILE *f, const rc_model *m)
+{
+    double pos[RC_MAX_OUTLETS][3], off = 0.0;
+    unsigned n = 1;
+    memcpy(pos[0], &m->x[RC_P_ENC], sizeof pos[0]);
+    for (unsigned e = 0; e < m->n_effects && n < RC_MAX_OUTLETS; ++e)
+        if (m->effects[e].kind == RC_EFF_OUTLET)
+            memcpy(pos[n++], &m->x[m->effects[e].first], sizeof pos[0]);
+    const int span = rch_prior_outlet_span(&off, (const double(*)[3])pos, n);
+    fprintf(f, "  outlets: %u place%s", n, n == 1 ? "" : "s");
+    if (n > 2)
+        fprintf(f, " (largest distance from the line through the two farthest apart: %.0f mm)", off);
+    fprintf(f, "; %s\n", rch_prior_outlet_span_text(span));
+}
+
+/* Parameters more than 3 prior sd from the prior's mean (the "OUTSIDE"
+ * rows of the uncertainty table). */
+static unsigned outside_prior(const rch_calib_result *r)
+{
+    const rch_model_unc *u = &r->unc;
+    unsigned n = 0;
+    for (unsigned k = 0; u->has_prior && k < r->model.n_params; ++k)
+        if (u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED)
+            n += fabs(r->model.x[k] - r->prior_mean[k]) / u->prior_sd[k] > 3.0;
+    return n;
+}
+
+/* The 3-D accuracy is far worse than the lengths: the poses leave the
+ * geometry to the prior. */
+static int accuracy_needs_poses(const rch_calib_result *r)
+{
+    const double a = r->unc.map.data_median_mm;
+    return r->have_unc && r->after_ok && a > 10.0 * r->after_m.rmse_mm && a > 0.1;
+}
+
+/* The data file and the robot file as a next-step command names them,
+ * quoted for the shell (rch_shell_join). */
+typedef struct {
+    char data[1100], robot[1100];
+} hint_paths;
+
+static void hint_paths_of(hint_paths *h, const rch_calib_result *r)
+{
+    const char *d = r->cfg.data_path ? r->cfg.data_path : "FILE";
+    const char *b = r->cfg.robot_path ? r->cfg.robot_path : "ROBOT.json";
+    rch_shell_join(h->data, sizeof h->data, 1, &d);
+    rch_shell_join(h->robot, sizeof h->robot, 1, &b);
+}
+
+static void print_uncertainty(FILE *f, const rch_calib_result *r)
+{
+    const rch_model_unc *u = &r->unc;
+    const rc_model *m = &r->model;
+    if (u->kind == RCH_COV_CLUSTER)
+        fprintf(f, "uncertainty (cluster-robust covariance over %u set-up groups%s; residual sigma %.4f mm):\n",
+                u->n_groups, r->groups_from_file ? " of the file" : " found from the wrist joints", u->sigma_mm);
+    else
+        fprintf(f, "uncertainty (classical covariance: the samples carry no usable set-up groups; residual sigma "
+                   "%.4f mm):\n",
+                u->sigma_mm);
+    if (u->has_prior)
+        fprintf(f, "  maximum a posteriori with the physical prior (sd: lengths %.3g mm, twists %.3g deg, joint zeros "
+                   "%.3g deg, cable attachment %.3g mm%s); noise %.4f mm estimated from the residuals "
+                   "(%u fits, %.1f effective parameters)\n",
+                r->robot.prior.length_mm, r->robot.prior.twist_deg, r->robot.prior.offset_deg,
+                r->robot.prior.attachment_mm, r->robot.prior.from_file ? ", from the robot file" : ", defaults",
+                r->noise_mm, r->noise_passes, r->p_eff);
+    if (u->has_prior && r->n_pos_rows)
+        fprintf(f, "  theta1 and d1 held (gauge): the tracker's frame absorbs the robot's heading and height, as "
+                   "an outlet does for lengths; a cell sets its base frame anyway\n");
+    else if (u->has_prior)
+        fprintf(f, "  theta1 and d1 held (gauge): lengths from outlets whose places are estimated cannot see the "
+                   "robot's heading and height against them; a cell sets its base frame anyway\n");
+    print_outlets(f, m);
+    if (r->attach_auto)
+        fprintf(f, "  cable attachment: %s (an attachment vector improves the fit by %.1f against its Occam "
+                   "penalty %.1f)\n",
+                r->attach_centred ? "at the flange centre" : "estimated in the flange frame (the flange centre "
+                                                             "relative to it is known only from the prior of a6, d6)",
+                r->attach_dchi2, r->attach_occam);
+    fprintf(f, "  parameter        value   1 std.error  class%s\n", u->has_prior ? "              data vs prior" : "");
+    unsigned held = 0, outside = 0;
+    char list[512] = "";
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        char nm[64], se[32];
+        const int unit = rc_param_unit(m, k);
+        const double sc = unit == 1 ? 1.0 / DEG : 1.0;
+        if (isfinite(u->se[k]))
+            snprintf(se, sizeof se, "%11.5f", u->se[k] * sc);
+        else
+            snprintf(se, sizeof se, "%11s", "-");
+        rc_param_name(nm, sizeof nm, m, k);
+        char pc[96] = "";
+        if (u->has_prior && u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED) {
+            const double dev = fabs(m->x[k] - r->prior_mean[k]) / u->prior_sd[k];
+            outside += dev > 3.0;
+            snprintf(pc, sizeof pc, "  %-10s (se %.0f %% of prior)%s",
+                     rch_prior_class_name((rch_prior_class)u->prior_cls[k]), 100.0 * u->se[k] / u->prior_sd[k],
+                     dev > 3.0 ? "  OUTSIDE the prior's plausible range (> 3 sd from nominal)" : "");
+        }
+        fprintf(f, "  %-10s %12.5f %s %-3s %-16s%s\n", nm, m->x[k] * sc, se,
+                unit == 0 ? "mm" : unit == 1 ? "deg" : "", rch_param_class_name((rch_param_class)u->cls[k]), pc);
+        if (k < RC_N_DH && u->comp_nominal[k]) {
+            size_t len = strlen(list);
+            snprintf(list + len, sizeof list - len, "%s%s", held ? " " : "", nm);
+            ++held;
+        }
+    }
+    hint_paths hp;
+    hint_paths_of(&hp, r);
+    if (outside)
+        fprintf(f, "  next: %u parameter(s) OUTSIDE the prior's range are a real deviation (check the drawing) or "
+                   "stand in for an effect the model lacks: rcal diagnose --data %s --robot %s%s\n",
+                outside, hp.data, hp.robot, r->cfg.dequantize ? " --dequantize-joints" : "");
+    fprintf(f,
+            "predicted 3-D accuracy after compensation (95 %%, longest semi-axis of the flange-position "
+            "ellipsoid): over the sampled region +-%.4f mm (median over the data's poses; max %.4f), whole "
+            "workspace +-%.4f mm (median over %d random poses; max %.4f)\n",
+            u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
+            u->map.work_max_mm);
+    if (accuracy_needs_poses(r))
+        fprintf(f, "  next: the lengths are predicted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave "
+                   "most of the geometry to the prior; plan poses that move every joint, from more than one outlet: "
+                   "rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv\n",
+                r->after_m.rmse_mm, u->map.data_median_mm, hp.robot);
+    fprintf(f,
+            "predicted flange-orientation uncertainty (95 %%) inside the data: +-%.4f deg with every parameter, "
+            "+-%.4f deg with those compensation uses: orientation %s\n",
+            u->map.rot_data_median_deg, u->map.rot_det_median_deg,
+            u->orientation_determined ? "determined (compensation matches position and orientation)"
+                                      : "NOT determined (compensation defaults to position-only)");
+    fprintf(f,
+            "compensation uses %u of 24 DH parameters as fitted; held at nominal (tied to a weak or not-identifiable "
+            "combination that moves the robot): %s\n\n",
+            RC_N_DH - held, held ? list : "none");
+}
+
+static void print_ident(FILE *f, const rch_ident *id, int prior)
+{
+    fprintf(f,
+            "identifiability (%u parameters, at the solution): rank %u, %u not identifiable, %u weakly "
+            "identifiable;\n  condition number %.3g over the identifiable part, observability index O1 %.4g\n",
+            id->n_params, id->rank, id->n_params - id->rank, id->n_weak, id->cond, id->observability);
+    for (unsigned k = 0; k < id->n_dirs; ++k) {
+        fprintf(f, "  - %s (relative singular value %.1e): %s\n", id->dirs[k].weak ? "weak" : "NOT identifiable",
+                id->dirs[k].sv_rel, id->dirs[k].combo);
+        if (id->dirs[k].why[0])
+            fprintf(f, "      %s\n", id->dirs[k].why);
+    }
+    if (id->n_combos)
+        fprintf(f, "  what these directions hold (known sets of parameters whose columns are dependent):\n");
+    for (unsigned k = 0; k < id->n_combos; ++k)
+        fprintf(f, "    %s %s (%.1e): %s\n", id->combos[k].params, id->combos[k].weak ? "weak" : "NOT identifiable",
+                id->combos[k].sv_rel, id->combos[k].why);
+    fprintf(f, prior ? "  With the prior, what the data cannot identify stays where the drawing puts it (the prior's mean), "
+                       "with the prior's uncertainty (the parameters' classes above).\n\n"
+                     : "  The solver leaves directions it cannot identify where they started (nominal).\n\n");
+}
+
+static void print_pos_err(FILE *f, const char *label, const rch_pos_err *e)
+{
+    fprintf(f, "  %-36s %8.4f %8.4f %8.4f", label, e->rms_mm, e->mean_mm, e->max_mm);
+    if (e->repeated)
+        fprintf(f, "   AP %.4f  RP %.4f (%zu repeated)", e->ap_max_mm, e->rp_max_mm, e->repeated);
+    fprintf(f, "\n");
+}
+
+/* The tracker positions in 3-D: |p_model - p_measured| (rch_positions.h). */
+static void print_positions(FILE *f, const rch_calib_result *r)
+{
+    if (!r->n_pos_rows)
+        return;
+    fprintf(f, "tracker positions: %zu rows (%zu poses, %u target(s)), %zu cable lengths; every row weighs the "
+               "same%s\n",
+            r->n_pos_rows, r->n_pos_poses, r->n_targets, r->n_data - 3 * r->n_pos_rows,
+            r->pos_has_sigma ? " (the files' sigma_mm is reported, not used as a weight)" : "");
+    fprintf(f, "  (the table above counts every row: a length or one coordinate of a position)\n");
+    if (!r->have_pos) {
+        fprintf(f, "  3-D errors: none (the fit did not converge)\n\n");
+        return;
+    }
+    fprintf(f, "3-D position error, %s (%zu positions, mm)   RMS     mean      MAX   ISO 9283 (worst pose)\n",
+            r->n_test ? "held-out" : "training", r->pos_after.points);
+    print_pos_err(f, "before (nominal DH, fitted tracker)", &r->pos_before);
+    print_pos_err(f, "after", &r->pos_after);
+    fprintf(f, "training 3-D RMS after: %.4f mm over %zu positions\n", r->pos_train_after.rms_mm,
+            r->pos_train_after.points);
+    unsigned nt = 0;
+    const int tf = rch_pos_effect_at(&r->model, RC_EFF_TRACKER_POSITION, NULL),
+              rf = rch_pos_effect_at(&r->model, RC_EFF_TRACKER_ROTATION, NULL),
+              kf = rch_pos_effect_at(&r->model, RC_EFF_TRACKER_TARGETS, &nt);
+    if (tf >= 0 && rf >= 0) {
+        const double *w = &r->model.x[rf];
+        fprintf(f, "tracker frame (base in the tracker's): T %.3f %.3f %.3f mm, rotation vector %.4f %.4f %.4f deg "
+                   "(it absorbs the base: theta1 and d1 stay held, the gauge)\n",
+                r->model.x[tf], r->model.x[tf + 1], r->model.x[tf + 2], w[0] / DEG, w[1] / DEG, w[2] / DEG);
+    }
+    for (unsigned j = 0; kf >= 0 && j < nt / 3; ++j)
+        fprintf(f, "  target %u in the flange frame: %.4f %.4f %.4f mm\n", j, r->model.x[kf + 3 * (int)j],
+                r->model.x[kf + 3 * (int)j + 1], r->model.x[kf + 3 * (int)j + 2]);
+    fprintf(f, "\n");
+}
+
+/* "2 of the 3 steps the change-point search found are far above the
+ * residual (...)", or, when every one is, "the change-point search found 2
+ * steps far above the residual (...)". */
+void rch_calib_jump_counts(char *buf, size_t len, const rch_calib_result *r)
+{
+    const unsigned found = r->jumps_found, steps = r->jump_check_steps;
+    if (found == steps)
+        snprintf(buf, len, "the change-point search found %u step%s far above the residual (8 x its RMS; largest "
+                 "%.3f mm)", found, found == 1 ? "" : "s", r->jump_check_max_mm);
+    else
+        snprintf(buf, len, "%u of the %u steps the change-point search found %s far above the residual (8 x its "
+                 "RMS; largest %.3f mm)", found, steps, found == 1 ? "is" : "are", r->jump_check_max_mm);
+}
+
+const char *rch_calib_data_name(const rch_calib_result *r)
+{
+    return r->cfg.data_path ? r->cfg.data_path : r->cfg.n_positions_paths ? r->cfg.positions_paths[0] : "";
+}
+
+/* The last lines on the screen: the held-out RMSE before -> after, the
+ * predicted 3-D accuracy after compensation, and the first next step the
+ * report above names (the jumps it does not model, parameters outside the
+ * prior, poses that leave the geometry to the prior). */
+static void print_summary(FILE *f, const rch_calib_result *r)
+{
+    hint_paths hp;
+    hint_paths_of(&hp, r);
+    fputs("\nsummary:\n", f);
+    if (r->after_ok)
+        fprintf(f, "  %s RMSE %.4f mm before -> %.4f mm after calibration (%zu samples%s)\n",
+                r->n_test ? "held-out" : "training", r->before_m.rmse_mm, r->after_m.rmse_mm,
+                r->n_test ? r->n_test : r->n_train, r->n_test ? " the fit never saw" : ", none held out");
+    else
+        fprintf(f, "  %s RMSE %.4f mm before; after: the solver diverged, no figures\n",
+                r->n_test ? "held-out" : "training", r->before_m.rmse_mm);
+    if (r->have_unc)
+        fprintf(f, "  predicted 3-D accuracy after compensation (95 %%): +-%.4f mm over the data's poses (median; "
+                   "max %.4f), +-%.4f mm over the whole workspace (median; max %.4f)\n",
+                r->unc.map.data_median_mm, r->unc.map.data_max_mm, r->unc.map.work_median_mm, r->unc.map.work_max_mm);
+    else
+        fputs("  predicted 3-D accuracy: none in this run (no uncertainty: too few samples or a model that is not "
+              "finite)\n",
+              f);
+    const unsigned outside = r->have_unc ? outside_prior(r) : 0;
+    if (r->jumps_found && !r->cfg.jumps)
+        fprintf(f, "  next: rcal calibrate --data %s --robot %s --jumps (the lengths jump and this fit does not model "
+                   "them)\n",
+                hp.data, hp.robot);
+    else if (outside)
+        fprintf(f, "  next: rcal diagnose --data %s --robot %s%s (%u parameter%s outside the prior's range)\n",
+                hp.data, hp.robot, r->cfg.dequantize ? " --dequantize-joints" : "", outside, outside == 1 ? "" : "s");
+    else if (accuracy_needs_poses(r))
+        fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
+                   "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",
+                hp.robot, r->unc.map.data_median_mm / r->after_m.rmse_mm);
+}
+
+void rch_calib_print(FILE *f, const rch_calib_result *r)
+{
+    const char *method = rc_method_name(r->cfg.method);
+    if (r->prov.n_files > 1)
+        fprintf(f, "rcal calibrate: %u files merged (%zu samples), robot \"%s\", method %s\n", r->prov.n_files,
+                r->n_data, r->robot.name, method);
+    else
+        fprintf(f, "rcal calibrate: %s (%zu samples), robot \"%s\", method %s\n", rch_calib_data_name(r), r->n_data,
+                r->robot.name, method);
+    fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
+            r->cfg.test_fraction, r->cfg.seed);
+    /* the check counts the steps far above the residual; the fit then takes
+     * every step the search found, the smaller ones too: both numbers said */
+    const unsigned steps = r->jump_check_steps, fitted = r->have_jumps ? r->jumps.n_jumps : steps;
+    char counts[200], all[64];
+    rch_calib_jump_counts(counts, sizeof counts, r);
+    snprintf(all, sizeof all, steps == 1 ? "it is" : r->jumps_found == steps ? "they are" : "all %u are", steps);
+    hint_paths hp;
+    hint_paths_of(&hp, r);
+    if (r->jumps_found && !r->cfg.jumps)
+        fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
+                   "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --robot %s --jumps (it "
+                   "fits the %u step%s found; and --dequantize-joints when the file's joints are rounded; rcal "
+                   "diagnose tells)\n\n",
+                counts, hp.data, hp.robot, steps, steps == 1 ? "" : "s");
+    if (r->jumps_auto) {
+        char also[64] = "";
+        if (fitted != steps)
+            snprintf(also, sizeof also, " (%u after the fit with them)", fitted);
+        fprintf(f, "note: the lengths jump in acquisition order: %s, so %s fitted as nuisance%s, as --jumps does "
+                   "(--no-jump-check: not looked for)%s\n\n",
+                counts, all, also,
+                r->cfg.dequantize ? "" : "; if the file's joint angles are rounded, add --dequantize-joints "
+                                         "(rcal fkcheck tells)");
+    }
+    fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
+            r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
+    print_metrics_row(f, "before (nominal DH, fitted encoder)", &r->before_m);
+    if (r->after_ok)
+        print_metrics_row(f, "after", &r->after_m);
+    else
+        fprintf(f, "  after: the solver diverged (non-finite model or cable length): no figures\n");
+    fprintf(f, "  (mean|e| is what the paper's Eq. 20 calls SD; SD here is the true standard deviation)\n");
+    fprintf(f, "training RMSE: before %.4f mm, after %.4f mm\n\n", r->train_before.rmse_mm, r->train_after.rmse_mm);
+    print_positions(f, r);
+    if (r->have_truth)
+        fprintf(f,
+                "flange position against the truth (%d random poses, base heading/height aligned):\n"
+                "  before RMS %.4f mm, max %.4f mm;  after RMS %.4f mm, max %.4f mm\n\n",
+                RCH_CALIB_TRUTH_POSES, r->truth_before_rms_mm, r->truth_before_max_mm, r->truth_after_rms_mm,
+                r->truth_after_max_mm);
+    print_effects(f, r);
+    print_model(f, r);
+    if (r->have_unc)
+        print_uncertainty(f, r);
+    if (r->have_ident)
+        print_ident(f, &r->ident, r->prior_on);
+    if (r->have_validate) {
+        const rch_evaluate_result *v = &r->validate;
+        fprintf(f,
+                "validation on %s (%zu samples the fit never saw, no refit): RMSE %.4f mm, mean|e| %.4f, SD %.4f, "
+                "MAX %.4f mm\n",
+                r->cfg.validate_path, v->m.n, v->m.rmse_mm, v->m.mean_abs_mm, v->m.sd_mm, v->m.max_mm);
+        if (v->n_repeated)
+            fprintf(f, "  ISO 9283 over %zu repeated poses: AD mean %.4f / max %.4f mm, RD mean %.4f / max %.4f mm\n",
+                    v->n_repeated, v->ad_mean_mm, v->ad_max_mm, v->rd_mean_mm, v->rd_max_mm);
+        fprintf(f, "\n");
+    }
+    if (r->plot_paths[0])
+        fprintf(f, "plots:\n%s\n", r->plot_paths);
+    if (r->have_jumps && r->solve.iterations == 0)
+        fprintf(f, "solver: %s with %u length jump(s) (a change-point search, each candidate a fit), %.2f ms\n",
+                method, r->jumps.n_jumps, r->time_ms);
+    else
+        fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
+                r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
+    print_summary(f, r);
+}

@@ -1,0 +1,292 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_inputs.c - a calibration's inputs read, merged and checked in the
+ * order of rch_inputs.h. */
+#include "rch_inputs.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "rc_version.h"
+#include "rch_groups.h"
+#include "rch_positions.h"
+#include "rch_sha256.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+/* Load every data file and merge them in the order given: samples, x, y, z
+ * (kept only when every file has them), source lines; t becomes the
+ * acquisition order over all files; the group column is kept only when
+ * every file has one (numbers offset per file). counts (files): samples
+ * of each. */
+static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    const size_t nf = rch_calib_cfg_n_files(cfg);
+    memset(out, 0, sizeof *out);
+    if (nf > RCH_CALIB_MAX_FILES) {
+        rch_diag_set(d, "", 0, 0, "at most %d data files", RCH_CALIB_MAX_FILES);
+        return -1;
+    }
+    if (nf == 0)
+        return 0; /* tracker positions only (append_positions) */
+    if (nf == 1) {
+        int rc = rch_data_load(out, rch_calib_cfg_file(cfg, 0), 0, d);
+        counts[0] = out->n;
+        if (rc == 0 && rch_data_check_units(out, rch_calib_cfg_file(cfg, 0), d) != 0) {
+            rch_data_free(out);
+            return -1;
+        }
+        return rc;
+    }
+    rch_data part[RCH_CALIB_MAX_FILES];
+    size_t total = 0, k = 0;
+    int all_xyz = 1, all_group = 1;
+    for (size_t f = 0; f < nf; ++f) {
+        if (rch_data_load(&part[f], rch_calib_cfg_file(cfg, f), 0, d) != 0 ||
+            rch_data_check_units(&part[f], rch_calib_cfg_file(cfg, f), d) != 0) {
+            if (part[f].s)
+                rch_data_free(&part[f]);
+            for (size_t g = 0; g < f; ++g)
+                rch_data_free(&part[g]);
+            return -1;
+        }
+        counts[f] = part[f].n;
+        total += part[f].n;
+        all_xyz &= part[f].xyz != NULL;
+        all_group &= part[f].has_group;
+    }
+    out->s = malloc(total * sizeof *out->s);
+    out->line = malloc(total * sizeof *out->line);
+    out->xyz = all_xyz ? malloc(total * sizeof *out->xyz) : NULL;
+    int ok = out->s && out->line && (!all_xyz || out->xyz);
+    unsigned goff = 0;
+    for (size_t f = 0; f < nf; ++f) {
+        unsigned gmax = 0;
+        for (size_t i = 0; ok && i < part[f].n; ++i, ++k) {
+            out->s[k] = part[f].s[i];
+            out->s[k].t = total > 1 ? (double)k / (double)(total - 1) : 0.0;
+            gmax = out->s[k].group > gmax ? out->s[k].group : gmax;
+            out->s[k].group = (uint16_t)(all_group ? goff + out->s[k].group : f);
+            out->line[k] = part[f].line[i];
+            if (all_xyz)
+                memcpy(out->xyz[k], part[f].xyz[i], sizeof out->xyz[k]);
+        }
+        goff += gmax + 1;
+        rch_data_free(&part[f]);
+    }
+    out->n = total;
+    out->has_group = all_group;
+    out->has_t = 1;
+    if (!ok) {
+        rch_data_free(out);
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
+/* Set-up groups: the file's group column, else consecutive samples sharing
+ * the wrist joints at the joints' display step, never across two files. */
+static void groups(rch_inputs *in, const rch_calib_cfg *cfg)
+{
+    rch_data *data = &in->data;
+    const size_t *counts = in->counts;
+    in->groups_from_file = data->has_group;
+    if (data->has_group) {
+        unsigned mx = 0;
+        for (size_t i = 0; i < data->n; ++i)
+            mx = data->s[i].group > mx ? data->s[i].group : mx;
+        in->n_groups = mx + 1;
+        return;
+    }
+    double *q = calloc(data->n * 3 + 1, sizeof *q), step = 0.0;
+    if (q) {
+        for (size_t i = 0; i < data->n; ++i)
+            for (unsigned j = 0; j < 3; ++j)
+                q[i * 3 + j] = data->s[i].q_rad[3 + j] / DEG;
+        step = rch_dequant_detect_step(q, data->n * 3);
+        free(q);
+    }
+    in->n_groups = 0;
+    for (size_t f = 0, at = 0; f < rch_calib_cfg_n_files(cfg); at += counts[f], ++f) {
+        unsigned g = rch_groups_by_wrist(data->s + at, counts[f], step, NULL);
+        for (size_t i = at; i < at + counts[f]; ++i)
+            data->s[i].group = (uint16_t)(data->s[i].group + in->n_groups);
+        in->n_groups += g;
+    }
+}
+
+/* Provenance: the data files, their samples and digests, the date, the tool. */
+static void provenance(rch_inputs *in, const rch_calib_cfg *cfg)
+{
+    rch_provenance *p = &in->prov;
+    const size_t *counts = in->counts;
+    p->n_files = (unsigned)rch_calib_cfg_n_files(cfg);
+    for (unsigned f = 0; f < p->n_files; ++f) {
+        p->file[f] = rch_calib_cfg_file(cfg, f);
+        p->samples[f] = counts[f];
+        if (rch_sha256_file(p->sha256[f], p->file[f]) != 0)
+            snprintf(p->sha256[f], sizeof p->sha256[f], "unreadable");
+    }
+    time_t now = time(NULL);
+    struct tm tmv;
+    if (gmtime_r(&now, &tmv))
+        strftime(p->date, sizeof p->date, "%Y-%m-%dT%H:%M:%SZ", &tmv);
+    p->tool = "rcal " RC_VERSION_STRING;
+}
+
+/* The tracker positions files (cfg.positions_paths) appended to data: three
+ * samples a row (rch_positions.h), one set-up group a file, the tracker
+ * frame and targets added to the model. 0, or -1 with d set. */
+static int append_positions(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    rch_data *data = &in->data;
+    if (cfg->cases > 1 || cfg->residuals_path || cfg->dequantize || cfg->jumps) {
+        rch_diag_set(d, "", 0, 0,
+                     "--positions is not yet combined with --cases, --residuals, --dequantize-joints or --jumps");
+        return -1;
+    }
+    rch_pos p;
+    if (rch_pos_load(&p, cfg->positions_paths, cfg->n_positions_paths, 0.0, &in->robot.model, d) != 0)
+        return -1;
+    rc_sample *s = realloc(data->s, (data->n + p.n) * sizeof *s);
+    if (s)
+        data->s = s;
+    unsigned *ln = s ? realloc(data->line, (data->n + p.n) * sizeof *ln) : NULL;
+    if (ln)
+        data->line = ln;
+    unsigned *fo = ln ? realloc(in->file_of, (data->n + p.n ? data->n + p.n : 1) * sizeof *fo) : NULL;
+    if (fo)
+        in->file_of = fo;
+    if (!fo || rch_pos_add_effects(&in->robot.model, p.n_targets) != 0 ||
+        (cfg->have_tracker_start && rch_pos_set_frame(&in->robot.model, cfg->tracker_start) != 0)) {
+        rch_diag_set(d, "", 0, 0, fo ? "no room for the tracker frame and %u targets (RC_MAX_EFFECTS, RC_MAX_PARAMS)"
+                                     : "out of memory", p.n_targets);
+        rch_pos_free(&p);
+        return -1;
+    }
+    for (size_t i = 0; i < p.n; ++i) {
+        data->s[data->n + i] = p.s[i];
+        data->s[data->n + i].group = (uint16_t)(in->n_groups + p.file[i]);
+        data->line[data->n + i] = p.line[i];
+        in->file_of[data->n + i] = (unsigned)(in->n_files + p.file[i]);
+    }
+    data->n += p.n;
+    free(data->xyz); /* the length files' x, y, z (only --dequantize-joints reads them) */
+    data->xyz = NULL;
+    in->n_groups += (unsigned)cfg->n_positions_paths;
+    in->n_pos_rows = p.rows;
+    in->n_pos_poses = p.poses;
+    in->n_targets = p.n_targets;
+    in->pos_has_sigma = p.has_sigma;
+    in->pos_sigma_mm = p.sigma_mm;
+    rch_provenance *pv = &in->prov;
+    for (size_t f = 0; f < cfg->n_positions_paths && pv->n_files < RCH_PROV_MAX_FILES; ++f) {
+        size_t c = 0;
+        for (size_t i = 0; i < p.n; ++i)
+            c += p.file[i] == f;
+        pv->file[pv->n_files] = cfg->positions_paths[f];
+        pv->samples[pv->n_files] = c;
+        if (rch_sha256_file(pv->sha256[pv->n_files], cfg->positions_paths[f]) != 0)
+            snprintf(pv->sha256[pv->n_files], sizeof pv->sha256[0], "unreadable");
+        pv->n_files++;
+    }
+    rch_pos_free(&p);
+    return 0;
+}
+
+/* Joint angles from the file's x, y, z; inconsistent rows dropped (and from
+ * file_of). */
+static int dequantize(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    rch_data *data = &in->data;
+    unsigned *file_of = in->file_of;
+    if (!data->xyz) {
+        rch_diag_set(d, cfg->data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
+        return -1;
+    }
+    uint8_t *bad = calloc(data->n + 1, 1);
+    if (!bad) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    rch_dequant(&in->dequant, bad, data->s, data->n, (const double(*)[3])data->xyz, &in->robot.nominal, 0.0);
+    size_t k = 0;
+    unsigned nr = 0;
+    for (size_t i = 0; i < data->n; ++i) {
+        if (bad[i]) {
+            if (nr < 16)
+                in->dequant_refused_lines[nr++] = data->line[i];
+            continue;
+        }
+        data->s[k] = data->s[i];
+        data->line[k] = data->line[i];
+        if (file_of)
+            file_of[k] = file_of[i];
+        memcpy(data->xyz[k], data->xyz[i], sizeof data->xyz[k]);
+        ++k;
+    }
+    data->n = k;
+    free(bad);
+    in->have_dequant = 1;
+    return 0;
+}
+
+/* The outlets numbered 0, 1, ... (rch_data_outlets); an outlet effect for
+ * each after the first. */
+static int outlets(rch_inputs *in, rch_diag *d)
+{
+    const int no = rch_data_outlets(in->outlet_label, in->data.s, in->data.n, d);
+    if (no < 0)
+        return -1;
+    in->n_outlets = (unsigned)no;
+    for (unsigned k = 1; k < in->n_outlets; ++k)
+        if (rc_model_add_effect(&in->robot.model, RC_EFF_OUTLET, k, 0) != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "cannot add outlet %u (RC_MAX_PARAMS or RC_MAX_EFFECTS)", k);
+            return -1;
+        }
+    return 0;
+}
+
+int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    memset(out, 0, sizeof *out);
+    out->n_files = rch_calib_cfg_n_files(cfg);
+    if (rch_robot_load(&out->robot, cfg->robot_path, d) != 0)
+        return -1;
+    if (load_all(&out->data, out->counts, cfg, d) != 0) {
+        memset(&out->data, 0, sizeof out->data); /* the readers keep nothing when they fail */
+        return -1;
+    }
+    groups(out, cfg);
+    provenance(out, cfg);
+    out->file_of = malloc((out->data.n ? out->data.n : 1) * sizeof *out->file_of);
+    if (!out->file_of) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        goto fail;
+    }
+    for (size_t f = 0, i = 0; f < out->n_files; ++f)
+        for (size_t k = 0; k < out->counts[f] && i < out->data.n; ++k)
+            out->file_of[i++] = (unsigned)f;
+    if (outlets(out, d) != 0 || (cfg->n_positions_paths && append_positions(out, cfg, d) != 0))
+        goto fail;
+    out->n_read = out->data.n;
+    if (cfg->dequantize && dequantize(out, cfg, d) != 0)
+        goto fail;
+    return 0;
+fail:
+    rch_inputs_free(out);
+    return -1;
+}
+
+void rch_inputs_free(rch_inputs *in)
+{
+    rch_data_free(&in->data);
+    free(in->file_of);
+    in->file_of = NULL;
+}
