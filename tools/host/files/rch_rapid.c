@@ -779,9 +779,12 @@ enum { NB = 1024 };
 typedef struct {
     scan *s;
     size_t head[NB];
-    size_t *next; /* (out->n) the next named target in the bucket */
-    int *known;   /* (out->n) a motion instruction's use is noted */
-    char (*unk)[160]; /* (out->n) its first use rcal cannot read */
+    rch_rapid_target *ps; /* (nps) the names declared with a target type and no literal (VAR robtarget p;):
+                             their uses, for the targets assigned to them; index out->n + k */
+    size_t nps;
+    size_t *next; /* (out->n + nps) the next named target in the bucket */
+    int *known;   /* (out->n + nps) a motion instruction's use is noted */
+    char (*unk)[160]; /* (out->n + nps) its first use rcal cannot read */
     struct flow {
         size_t src, dest; /* a target's index, the assigned name's token */
         unsigned line;
@@ -801,10 +804,15 @@ static void use_text(char *buf, size_t n, const char *tool, const char *wobj)
 
 /* Target k is used by instruction instr (line) with tool and wobj, or, bad
  * set, with a tool or work object that cannot be read. */
+static rch_rapid_target *tgt(const uses *u, size_t k)
+{
+    return k < u->s->out->n ? &u->s->out->t[k] : &u->ps[k - u->s->out->n];
+}
+
 static void mark_known(uses *u, size_t k, const char *tool, const char *wobj, const char *instr, unsigned line,
                        const char *bad)
 {
-    rch_rapid_target *t = &u->s->out->t[k];
+    rch_rapid_target *t = tgt(u, k);
     if (t->use_error[0])
         return;
     if (bad) {
@@ -859,7 +867,7 @@ static size_t named_first(const uses *u, size_t j)
         return (size_t)-1;
     const tok *t = &s->tk.t[j];
     for (size_t h = u->head[hash_ci(s->text + t->off, t->len) % NB]; h != (size_t)-1; h = u->next[h])
-        if (strlen(s->out->t[h].name) == t->len && strncasecmp(s->out->t[h].name, s->text + t->off, t->len) == 0)
+        if (strlen(tgt(u, h)->name) == t->len && strncasecmp(tgt(u, h)->name, s->text + t->off, t->len) == 0)
             return h;
     return (size_t)-1;
 }
@@ -876,7 +884,7 @@ static size_t mentions(const uses *u, size_t b, size_t e, size_t *idx, size_t ca
     for (size_t j = b; j < e; ++j)
         for (size_t h = named_first(u, j); h != (size_t)-1 && n < cap; h = u->next[h]) {
             const tok *t = &s->tk.t[j];
-            if (strlen(o->t[h].name) == t->len && strncasecmp(o->t[h].name, s->text + t->off, t->len) == 0)
+            if (strlen(tgt(u, h)->name) == t->len && strncasecmp(tgt(u, h)->name, s->text + t->off, t->len) == 0)
                 idx[n++] = h;
         }
     const size_t to = s->tk.t[e - 1].off + s->tk.t[e - 1].len;
@@ -1108,20 +1116,20 @@ static int stmt_uses(uses *u, size_t i, size_t e)
  * one's uses; assigned to anything else, its use is unknown. */
 static void flow_uses(uses *u)
 {
-    rch_rapid_targets *o = u->s->out;
     for (int pass = 0; pass < 4; ++pass)
         for (size_t f = 0; f < u->nfl; ++f) {
             const struct flow *fl = &u->fl[f];
             const size_t d = named_first(u, fl->dest);
             char nm[48], what[160];
             tok_name(nm, sizeof nm, u->s, fl->dest);
-            if (d == (size_t)-1 || o->t[d].kind != o->t[fl->src].kind) {
+            const rch_rapid_target *td = d == (size_t)-1 ? NULL : tgt(u, d), *ts = tgt(u, fl->src);
+            if (!td || td->kind != ts->kind) {
                 snprintf(what, sizeof what, "assigned to %s (line %u), which is not a %s of this module", nm, fl->line,
-                         rch_rapid_kind_name(o->t[fl->src].kind));
+                         rch_rapid_kind_name(ts->kind));
                 mark_unknown(u, fl->src, what);
-            } else if (strcasecmp(o->t[d].name, o->t[fl->src].name) != 0) {
+            } else if (strcasecmp(td->name, ts->name) != 0) {
                 if (u->known[d])
-                    mark_known(u, fl->src, o->t[d].tool, o->t[d].wobj, o->t[d].use_instr, o->t[d].use_line, NULL);
+                    mark_known(u, fl->src, td->tool, td->wobj, td->use_instr, td->use_line, NULL);
                 else if (u->unk[d][0]) {
                     snprintf(what, sizeof what, "assigned to %.40s (line %u), which is %.80s", nm, fl->line, u->unk[d]);
                     mark_unknown(u, fl->src, what);
@@ -1138,11 +1146,12 @@ static int note_uses(scan *s)
     uses u;
     memset(&u, 0, sizeof u);
     u.s = s;
-    const size_t n = o->n ? o->n : 1;
+    const size_t n = o->n + s->ndc + 1;
     u.next = malloc(n * sizeof *u.next);
     u.known = calloc(n, sizeof *u.known);
     u.unk = calloc(n, sizeof *u.unk);
-    int rc = u.next && u.known && u.unk ? 0 : -1;
+    u.ps = calloc(s->ndc + 1, sizeof *u.ps);
+    int rc = u.next && u.known && u.unk && u.ps ? 0 : -1;
     for (size_t b = 0; b < NB; ++b)
         u.head[b] = (size_t)-1;
     for (size_t k = 0; rc == 0 && k < o->n; ++k) { /* in reverse text order: the first is found first */
@@ -1152,6 +1161,22 @@ static int note_uses(scan *s)
         if (nl == 0 || o->t[m].context == RCH_RAPID_INLINE)
             continue;
         const unsigned hb = hash_ci(o->t[m].name, nl) % NB;
+        u.next[m] = u.head[hb];
+        u.head[hb] = m;
+    }
+    for (size_t k = 0; rc == 0 && k < s->ndc; ++k) { /* declared without a literal */
+        const decl *dc = &s->dc[k];
+        const unsigned hb = hash_ci(dc->name, strlen(dc->name)) % NB;
+        size_t h = u.head[hb];
+        while (h != (size_t)-1 && strcasecmp(tgt(&u, h)->name, dc->name) != 0)
+            h = u.next[h];
+        if (dc->kind <= 0 || h != (size_t)-1)
+            continue;
+        rch_rapid_target *p = &u.ps[u.nps];
+        snprintf(p->name, sizeof p->name, "%s", dc->name);
+        p->kind = (rch_rapid_kind)dc->kind;
+        p->context = RCH_RAPID_DECLARATION;
+        const size_t m = o->n + u.nps++;
         u.next[m] = u.head[hb];
         u.head[hb] = m;
     }
@@ -1193,6 +1218,7 @@ static int note_uses(scan *s)
     }
     if (rc != 0)
         rch_diag_set(s->d, s->name, 0, 0, "out of memory");
+    free(u.ps);
     free(u.next);
     free(u.known);
     free(u.unk);
