@@ -417,16 +417,16 @@ static void test_refused_names_confdata(void **state)
     }
 }
 
-/* A tool the module declares: without --tool the message gives the --tool
- * its tooldata means; with it the robtarget is that TCP's pose, and the real
- * robot's TCP lands on it. */
+/* A tool the module declares: its tooldata is used (no --tool needed), the
+ * robtarget is that TCP's pose, and the real robot's TCP lands on it; a
+ * --tool with the same TCP gives the same module. */
 static void test_declared_tool(void **state)
 {
     (void)state;
-    char in[128], out[128], err[128], cmd[768];
+    char in[128], out[128], out2[128], cmd[768];
     snprintf(in, sizeof in, "%s/pen.mod", dir);
     snprintf(out, sizeof out, "%s/pen_comp.mod", dir);
-    snprintf(err, sizeof err, "%s/pen.err", dir);
+    snprintf(out2, sizeof out2, "%s/pen_comp2.mod", dir);
     FILE *f = fopen(in, "w");
     assert_non_null(f);
     fputs("MODULE m\n  PERS tooldata tPen:=[TRUE,[[10,-5,150],[1,0,0,0]],[0.5,[0,0,50],[1,0,0,0],0,0,0]];\n"
@@ -434,18 +434,14 @@ static void test_declared_tool(void **state)
           "[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tPen;\n  ENDPROC\nENDMODULE\n",
           f);
     fclose(f);
-    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --in '%s' --out '%s' 2> '%s'", RCAL,
-             model_path, in, out, err);
-    assert_int_equal(run(cmd), 1);
-    size_t n;
-    char *msg = slurp(err, &n);
-    if (!strstr(msg, "pen.mod:4:11: error: robtarget (inline) cannot be corrected: used with tool tPen (line 4), "
-                     "whose TCP is [10,-5,150] in tool0's frame: give --tool -10,5,150 (the flange frame)"))
-        fail_msg("%s", msg);
-    free(msg);
-    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --tool=-10,5,150 --in '%s' --out '%s'", RCAL,
-             model_path, in, out);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --in '%s' --out '%s'", RCAL, model_path, in,
+             out);
     assert_int_equal(run(cmd), 0);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose --tool=-10,5,150 --in '%s' --out '%s'", RCAL,
+             model_path, in, out2);
+    assert_int_equal(run(cmd), 0);
+    size_t n, n2;
+    char *t2 = slurp(out2, &n2);
     char *txt = slurp(out, &n);
     rch_rapid_targets to;
     memset(&to, 0, sizeof to);
@@ -471,8 +467,314 @@ static void test_declared_tool(void **state)
            "intended point (written trans [%.4f,%.4f,%.4f])\n", e, b->val[0], b->val[1], b->val[2]);
     assert_true(e < 2e-3);
     assert_true(fabs(b->val[0] - want[0]) > 0.01); /* it was corrected */
+    assert_int_equal(n, n2);
+    assert_memory_equal(txt, t2, n);
     rch_rapid_free(&to);
     free(txt);
+    free(t2);
+}
+
+/* Issue 33: the test's own rigid-body kinematics (quaternions w first). */
+static void q_mul(double o[4], const double a[4], const double b[4])
+{
+    const double r[4] = {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+                         a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+                         a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+                         a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+    memcpy(o, r, sizeof r);
+}
+
+static void q_rot(double o[3], const double q[4], const double v[3])
+{
+    const double p[4] = {0, v[0], v[1], v[2]}, c[4] = {q[0], -q[1], -q[2], -q[3]};
+    double t[4];
+    q_mul(t, q, p);
+    q_mul(t, t, c);
+    memcpy(o, t + 1, 3 * sizeof o[0]);
+}
+
+static void q_unit(double q[4])
+{
+    const double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int i = 0; i < 4; ++i)
+        q[i] /= n;
+}
+
+/* (op, oq) = (ap, aq) (bp, bq) */
+static void f_mul(double op[3], double oq[4], const double ap[3], const double aq[4], const double bp[3],
+                  const double bq[4])
+{
+    double r[3], q[4];
+    q_rot(r, aq, bp);
+    q_mul(q, aq, bq);
+    for (int i = 0; i < 3; ++i)
+        op[i] = ap[i] + r[i];
+    memcpy(oq, q, sizeof q);
+}
+
+static void f_inv(double op[3], double oq[4], const double ap[3], const double aq[4])
+{
+    const double c[4] = {aq[0], -aq[1], -aq[2], -aq[3]};
+    double r[3];
+    q_rot(r, c, ap);
+    for (int i = 0; i < 3; ++i)
+        op[i] = -r[i];
+    memcpy(oq, c, sizeof c);
+}
+
+/* the fixture's tool tGrip (tframe) and work object wTable (uframe oframe) */
+typedef struct {
+    double Fp[3], Fq[4], Wp[3], Wq[4];
+} frames;
+
+static void fixture_frames(frames *f, int with_wobj)
+{
+    const double Fp[3] = {12, -8, 160}, Up[3] = {350, -120, 80}, Op[3] = {20, 10, 5};
+    double Fq[4] = {0.965926, 0, 0.258819, 0}, Uq[4] = {0.92388, 0, 0, 0.382683}, Oq[4] = {0.996195, 0.087156, 0, 0};
+    q_unit(Fq);
+    q_unit(Uq);
+    q_unit(Oq);
+    memcpy(f->Fp, Fp, sizeof Fp);
+    memcpy(f->Fq, Fq, sizeof Fq);
+    f_mul(f->Wp, f->Wq, Up, Uq, Op, Oq);
+    if (!with_wobj) {
+        const double z[3] = {0, 0, 0}, one[4] = {1, 0, 0, 0};
+        memcpy(f->Wp, z, sizeof z);
+        memcpy(f->Wq, one, sizeof one);
+    }
+}
+
+/* What the controller does with the written robtarget b (tool F, work
+ * object W): its flange pose W b F^-1, the nominal IK with b's confdata; the
+ * real robot (det) there puts its TCP at FK_det tool0 F. Returns the
+ * distance (mm) of that TCP from W a (a: the robtarget as taught), *ang its
+ * orientation's angle (rad). */
+static double landing(double *ang, const rch_rapid_target *a, const rch_rapid_target *b, const frames *f,
+                      const rc_model *det)
+{
+    double Tq[4] = {b->val[3], b->val[4], b->val[5], b->val[6]}, Xp[3], Xq[4], Fip[3], Fiq[4];
+    q_unit(Tq);
+    f_mul(Xp, Xq, f->Wp, f->Wq, b->val, Tq);
+    f_inv(Fip, Fiq, f->Fp, f->Fq);
+    f_mul(Xp, Xq, Xp, Xq, Fip, Fiq);
+    const int cf[4] = {(int)b->val[7], (int)b->val[8], (int)b->val[9], (int)b->val[10]};
+    double q[RC_NJ], pr[3], Rr[9];
+    char why[256];
+    if (rch_ik_solve(q, &robot.nominal, Xp, Xq, cf, NULL, why, sizeof why) != 0)
+        fail_msg("line %u: the controller's IK of the written robtarget: %s", b->line, why);
+    rc_fk(pr, Rr, det, q);
+    /* the real TCP: flange, turned 180 deg about z (tool0), then F */
+    double tcp[3], Fr[3] = {-f->Fp[0], -f->Fp[1], f->Fp[2]}; /* F's origin in the flange frame */
+    for (int i = 0; i < 3; ++i)
+        tcp[i] = pr[i] + Rr[3 * i] * Fr[0] + Rr[3 * i + 1] * Fr[1] + Rr[3 * i + 2] * Fr[2];
+    double Aq[4] = {a->val[3], a->val[4], a->val[5], a->val[6]}, Ip[3], Iq[4];
+    q_unit(Aq);
+    f_mul(Ip, Iq, f->Wp, f->Wq, a->val, Aq); /* intended TCP pose in the base frame */
+    /* the real tool frame's axes against the intended ones */
+    double ang_max = 0;
+    for (int k = 0; k < 3; ++k) {
+        double e[3] = {0, 0, 0}, ai[3], at[3], a0[3];
+        e[k] = 1;
+        q_rot(ai, Iq, e);  /* intended axis k */
+        q_rot(a0, f->Fq, e); /* the tool's axis k in tool0 */
+        const double t0[3] = {-a0[0], -a0[1], a0[2]}; /* in the flange frame */
+        for (int i = 0; i < 3; ++i)
+            at[i] = Rr[3 * i] * t0[0] + Rr[3 * i + 1] * t0[1] + Rr[3 * i + 2] * t0[2];
+        const double dot = ai[0] * at[0] + ai[1] * at[1] + ai[2] * at[2];
+        ang_max = fmax(ang_max, acos(fmin(1.0, fmax(-1.0, dot))));
+    }
+    *ang = ang_max;
+    return sqrt((tcp[0] - Ip[0]) * (tcp[0] - Ip[0]) + (tcp[1] - Ip[1]) * (tcp[1] - Ip[1]) +
+                (tcp[2] - Ip[2]) * (tcp[2] - Ip[2]));
+}
+
+/* Every byte of in outside its targets' numbers is in out. */
+static void same_outside_numbers(const char *in, size_t n_in, const rch_rapid_targets *ti, const char *ou,
+                                 size_t n_out, const rch_rapid_targets *to)
+{
+    size_t ai = 0, ao = 0;
+    assert_int_equal(ti->n, to->n);
+    for (size_t k = 0; k < ti->n; ++k)
+        for (unsigned j = 0; j < ti->t[k].n; ++j) {
+            const size_t li = ti->t[k].num_off[j] - ai, lo = to->t[k].num_off[j] - ao;
+            assert_int_equal(li, lo);
+            assert_memory_equal(in + ai, ou + ao, li);
+            ai = ti->t[k].num_off[j] + ti->t[k].num_len[j];
+            ao = to->t[k].num_off[j] + to->t[k].num_len[j];
+        }
+    assert_int_equal(n_in - ai, n_out - ao);
+    assert_memory_equal(in + ai, ou + ao, n_in - ai);
+}
+
+/* Compensate path (extra options opts) to out; its targets before and after. */
+static void comp_module(char **in, size_t *n_in, rch_rapid_targets *ti, char **ou, size_t *n_out,
+                        rch_rapid_targets *to, const char *path, const char *out, const char *opts)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --full-pose %s --in '%s' --out '%s'", RCAL, model_path,
+             opts, path, out);
+    assert_int_equal(run(cmd), 0);
+    *in = slurp(path, n_in);
+    *ou = slurp(out, n_out);
+    memset(ti, 0, sizeof *ti);
+    memset(to, 0, sizeof *to);
+    rch_diag d;
+    assert_int_equal(rch_rapid_scan(ti, *in, *n_in, "in", &d), 0);
+    assert_int_equal(rch_rapid_scan(to, *ou, *n_out, "out", &d), 0);
+    same_outside_numbers(*in, *n_in, ti, *ou, *n_out, to);
+}
+
+/* Issue 33: robtargets used by every motion instruction form (MoveL/J/C,
+ * the DO/AO/GO/Sync variants, TriggL/J/C, SearchL/C, ArcL/C, optional
+ * arguments between, Offs/RelTool, an assignment, a user PROC besides a
+ * MoveL, CalcJointT, a compact IF) with a declared tool whose frame is
+ * turned and a declared work object: each corrected for that tool and work
+ * object, the real TCP landing on the taught pose; the same module read as
+ * tool0/wobj0 (what rcal did before) misses by a measured amount. */
+static void test_tools_wobjs(void **state)
+{
+    (void)state;
+    rc_model det;
+    rch_model_unc unc;
+    int v1;
+    char held[256], out[128], old_in[128], old_out[128], cmd[1024];
+    rch_comp_determined(&det, &unc, &v1, held, sizeof held, &robot, &robot.nominal);
+    const char *path = RCAL_SOURCE_DIR "/tests/comp/data/tools_wobjs.mod";
+    snprintf(out, sizeof out, "%s/tools_wobjs_comp.mod", dir);
+    char *in, *ou;
+    size_t n_in, n_out;
+    rch_rapid_targets ti, to;
+    comp_module(&in, &n_in, &ti, &ou, &n_out, &to, path, out, "");
+    assert_int_equal(ti.n, 30);
+    /* the same module with the tool-only uses (pTool1, pTool2) read as tool0 (what rcal did for an
+     * instruction it did not read; the work object ones are out of reach read so) */
+    snprintf(old_in, sizeof old_in, "%s/tools_wobjs_as_tool0.mod", dir);
+    snprintf(old_out, sizeof old_out, "%s/tools_wobjs_as_tool0_comp.mod", dir);
+    snprintf(cmd, sizeof cmd, "sed -e 's/fine, tGrip;/fine, tool0;/' '%s' > '%s'", path, old_in);
+    assert_int_equal(run(cmd), 0);
+    char *oin, *oou;
+    size_t n_oin, n_oou;
+    rch_rapid_targets oti, oto;
+    comp_module(&oin, &n_oin, &oti, &oou, &n_oou, &oto, old_in, old_out, "");
+    assert_int_equal(oti.n, 30);
+    double worst_mm = 0, worst_rad = 0, old_min = INFINITY, old_max = 0;
+    for (size_t k = 0; k < ti.n; ++k) {
+        const rch_rapid_target *a = &ti.t[k], *b = &to.t[k];
+        assert_int_equal(a->kind, RCH_RAPID_ROBTARGET);
+        assert_string_equal(a->tool, "tGrip");
+        frames f;
+        fixture_frames(&f, strncmp(a->name, "pTool", 5) != 0);
+        double ang, ang_old;
+        const int tool_only = strncmp(a->name, "pTool", 5) == 0;
+        const double e = landing(&ang, a, b, &f, &det), e_old = tool_only ? landing(&ang_old, a, &oto.t[k], &f, &det) : NAN;
+        printf("%-8s %-9s (line %3u) the real TCP lands %.5f mm, %.2g rad from the taught pose (read as "
+               "tool0/wobj0: %.4f mm)\n", a->name, a->use_instr, a->use_line, e, ang, e_old);
+        worst_mm = fmax(worst_mm, e);
+        worst_rad = fmax(worst_rad, ang);
+        if (tool_only) {
+            old_min = fmin(old_min, e_old);
+            old_max = fmax(old_max, e_old);
+        }
+    }
+    printf("tools and work objects: %zu robtargets land within %.5f mm and %.2g rad; read as tool0/wobj0 the "
+           "tool-only ones missed by %.4f..%.4f mm\n", ti.n, worst_mm, worst_rad, old_min, old_max);
+    assert_true(worst_mm < 2e-3);
+    assert_true(worst_rad < 1e-5);
+    assert_true(old_min > 0.02);
+    rch_rapid_free(&ti);
+    rch_rapid_free(&to);
+    rch_rapid_free(&oti);
+    rch_rapid_free(&oto);
+    free(in);
+    free(ou);
+    free(oin);
+    free(oou);
+}
+
+/* A run that must fail: exit 1, no output, each expected line in stderr. */
+static void expect_refused(const char *fixture, const char *const *want, size_t n_want)
+{
+    char out[128], err[128], cmd[1024];
+    snprintf(out, sizeof out, "%s/refused_comp.mod", dir);
+    snprintf(err, sizeof err, "%s/refused.err", dir);
+    snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s/tests/comp/data/%s' --out '%s' 2> '%s'", RCAL,
+             model_path, RCAL_SOURCE_DIR, fixture, out, err);
+    assert_int_equal(run(cmd), 1);
+    assert_int_equal(access(out, F_OK), -1); /* nothing written */
+    size_t n;
+    char *msg = slurp(err, &n);
+    for (size_t k = 0; k < n_want; ++k)
+        if (!strstr(msg, want[k]))
+            fail_msg("expected '%s' in:\n%s", want[k], msg);
+    free(msg);
+}
+
+/* Issue 33: uses rcal cannot read, each refused with line, column, reason. */
+static void test_refused_uses(void **state)
+{
+    (void)state;
+    static const char *const want[] = {
+        "refuse_uses.mod:6:26: error: robtarget pProc (declaration) cannot be corrected: passed to Draw (line 14), "
+        "which is not a motion instruction rcal reads (a user PROC or another instruction): the tool and work object "
+        "it is used with cannot be told",
+        "refuse_uses.mod:7:26: error: robtarget pLate (declaration) cannot be corrected: passed to a late-bound "
+        "procedure call (line 15)",
+        "refuse_uses.mod:8:25: error: robtarget pTwo (declaration) cannot be corrected: used with tGrip (MoveL, line "
+        "16) and with tool0 (MoveL, line 17)",
+        "refuse_uses.mod:9:26: error: robtarget pConv (declaration) cannot be corrected: used in work object wConv "
+        "(line 18), whose user frame moves (ufprog FALSE, ufmec \"CNV1\")",
+        "refuse_uses.mod:10:28: error: robtarget pNoWobj (declaration) cannot be corrected: used in work object wElse "
+        "(line 19), which this module does not declare with a literal wobjdata",
+        "refuse_uses.mod:11:30: error: robtarget pToolExpr (declaration) cannot be corrected: the Tool argument of "
+        "MoveL (line 20) is not a tool's name",
+        "refuse_uses.mod:12:26: error: robtarget pSpot (declaration) cannot be corrected: passed to SpotL (line 21)",
+        "refuse_uses.mod: 7 targets cannot be corrected",
+    };
+    expect_refused("refuse_uses.mod", want, sizeof want / sizeof want[0]);
+}
+
+/* Issue 33: a robtarget of an ALIAS type is corrected (the real robot lands
+ * on it); one inside a RECORD is refused, naming the record and field. */
+static void test_record_alias(void **state)
+{
+    (void)state;
+    static const char *const want[] = {
+        "record_alias.mod:9:22: error: robtarget st1 (declaration) cannot be corrected: a robtarget inside the RECORD "
+        "station (field approach)",
+    };
+    expect_refused("record_alias.mod", want, 1);
+    rc_model det;
+    rch_model_unc unc;
+    int v1;
+    char held[256], out[128];
+    rch_comp_determined(&det, &unc, &v1, held, sizeof held, &robot, &robot.nominal);
+    snprintf(out, sizeof out, "%s/alias_comp.mod", dir);
+    char *in, *ou;
+    size_t n_in, n_out;
+    rch_rapid_targets ti, to;
+    comp_module(&in, &n_in, &ti, &ou, &n_out, &to, RCAL_SOURCE_DIR "/tests/comp/data/alias.mod", out, "");
+    assert_int_equal(ti.n, 1);
+    frames f;
+    memset(&f, 0, sizeof f);
+    f.Fq[0] = f.Wq[0] = 1;
+    double ang;
+    const double e = landing(&ang, &ti.t[0], &to.t[0], &f, &det);
+    printf("ALIAS robtarget: the real flange lands %.5f mm, %.2g rad from the taught pose\n", e, ang);
+    assert_true(e < 2e-3 && ang < 1e-5);
+    assert_true(fabs(to.t[0].val[0] - ti.t[0].val[0]) > 1e-3); /* corrected */
+    rch_rapid_free(&ti);
+    rch_rapid_free(&to);
+    free(in);
+    free(ou);
+}
+
+/* Issue 33: a module without any target is an error (exit 1, nothing written). */
+static void test_no_target(void **state)
+{
+    (void)state;
+    static const char *const want[] = {"no_target.mod: no jointtarget or robtarget in this module (declarations, "
+                                       "assignments, instruction arguments): nothing to correct; nothing written"};
+    expect_refused("no_target.mod", want, 1);
 }
 
 int main(void)
@@ -483,6 +785,10 @@ int main(void)
         cmocka_unit_test(test_refused),
         cmocka_unit_test(test_refused_names_confdata),
         cmocka_unit_test(test_declared_tool),
+        cmocka_unit_test(test_tools_wobjs),
+        cmocka_unit_test(test_refused_uses),
+        cmocka_unit_test(test_record_alias),
+        cmocka_unit_test(test_no_target),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -15,10 +15,25 @@
  *  - anywhere else (an instruction's argument, MoveAbsJ [[...]], MoveL
  *    [[...]], \ToPoint:=[...]): the shape decides, [[6],[6]] a jointtarget,
  *    [[3],[4],[4],[6]] a robtarget.
- * Each target also gets the tool and work object of a Move* instruction that
- * uses it (its last positional argument, its \WObj:=), inline or by name,
- * and that tool's frame when the module declares it with a literal tooldata.
- * A target literal whose shape is wrong or whose numbers are not literal
+ * Declared types: jointtarget, robtarget and an ALIAS of them (ALIAS
+ * robtarget mypos;) are targets; a value of a RECORD type with a target
+ * field (directly or in a nested record) is listed with an error naming the
+ * field (rcal does not rewrite targets inside records).
+ * Uses: each statement's instruction is read with ABB's argument order
+ * (RAPID reference: the target arguments and the Tool by position, \WObj:=
+ * by name): MoveL/J/C, MoveAbsJ, their DO/AO/GO/Sync variants, TriggL/J/C,
+ * TriggLIOs/TriggJIOs, SearchL/C, ArcL/C (and their Start/End), ContactL,
+ * MoveExtJ, SearchExtJ and the function CalcJointT. A target named (or
+ * written inline) in one of their target arguments gets that instruction's
+ * tool and work object, and the frames the module declares for them
+ * (literal tooldata, wobjdata). A robtarget passed to any other procedure
+ * (a user PROC, an instruction rcal does not know, a late-bound call),
+ * returned, or assigned to what is not a robtarget of the module has an
+ * unknown use; one assigned to a robtarget of the module takes that one's
+ * uses. use_error is set for a robtarget whose tool and work object cannot
+ * be told: only unknown uses, two uses with different tools or work
+ * objects, a tool argument that is not a name (or names data of another
+ * type). A target literal whose shape is wrong or whose numbers are not literal
  * numbers is listed with its error (the caller names it and refuses).
  * Nothing here computes; the caller rewrites the numbers' bytes
  * (num_off/num_len) and copies every other byte.
@@ -57,14 +72,19 @@ typedef struct rch_rapid_target {
     double val[RCH_RAPID_NUMS];    /* robax (deg) | x, y, z (mm), q1..q4, cf1, cf4, cf6, cfx */
     unsigned num_line[RCH_RAPID_NUMS], num_col[RCH_RAPID_NUMS];
     char name[48];                 /* the declared or assigned name; "" inline */
-    char tool[48], wobj[48];       /* of the Move instruction that uses it (inline: its own; named: a use
-                                      with another tool than tool0 or another work object than wobj0 if
-                                      there is one, else the first); "" when no Move instruction names it */
-    unsigned use_line;             /* that instruction's line */
+    char tool[48], wobj[48];       /* of the first motion instruction that uses it ("" wobj: wobj0); "" tool
+                                      when none does */
+    char use_instr[24];            /* that instruction's name */
+    unsigned use_line;             /* its line */
     int tool_declared;             /* that tool is declared in the module with a literal tooldata: */
     int tool_robhold;              /*   its robhold (1 TRUE: held by the robot) */
     double tool_frame[7];          /*   its tframe: trans (mm, in tool0's frame), rot (q1..q4) */
-    char error[200];               /* not empty: the literal cannot be read (shape, not a number) */
+    int wobj_declared;             /* that work object is declared in the module with a literal wobjdata: */
+    int wobj_robhold, wobj_ufprog; /*   robhold (1: held by the robot), ufprog (0: a moving user frame) */
+    char wobj_ufmec[48];           /*   ufmec */
+    double wobj_uframe[7], wobj_oframe[7]; /* uframe (in world), oframe (in uframe): trans (mm), rot */
+    char use_error[400];           /* not empty: its tool and work object cannot be told (robtargets only) */
+    char error[256];               /* not empty: the literal cannot be read (shape, not a number) */
 } rch_rapid_target;
 
 typedef struct rch_rapid_targets {

@@ -29,9 +29,21 @@
  * one, or a stream without line ends (/dev/zero), is refused, not buffered */
 #define MAX_LINE 65536
 
+/* a stream compensating another TCP than the job's (a robtarget's tool) */
+typedef struct {
+    double tcp[3]; /* mm, flange frame */
+    rc_model det, nom, fit;
+    rc_comp_stream s;
+} tcp_stream;
+#define MAX_TCPS 16
+
 typedef struct {
     rc_comp_stream *stream;
-    const rc_model *cal;
+    const rc_model *cal, *fit; /* the stream's calibrated model, the full fit (may be NULL) at its point */
+    rc_comp_stream *stream0;   /* the job's: its TCP */
+    const rc_model *cal0, *fit0;
+    tcp_stream *tcps[MAX_TCPS];
+    size_t ntcps;
     const rch_comp_gate *gate;
     rch_comp_result *res;
     FILE *out, *warn;
@@ -126,8 +138,8 @@ static int compensate(comp_ctx *c, double out_deg[RC_NJ], const double in_deg[RC
         double qd[RC_NJ], pf[3], pd[3];
         for (unsigned i = 0; i < RC_NJ; ++i)
             qd[i] = (double)q[i];
-        if (c->gate->fit) {
-            rc_fk(pf, NULL, c->gate->fit, qd);
+        if (c->fit) {
+            rc_fk(pf, NULL, c->fit, qd);
             rc_fk(pd, NULL, m, qd);
             double e = sqrt((pf[0] - pd[0]) * (pf[0] - pd[0]) + (pf[1] - pd[1]) * (pf[1] - pd[1]) +
                             (pf[2] - pd[2]) * (pf[2] - pd[2]));
@@ -357,54 +369,206 @@ static void rapid_refuse(comp_ctx *c, unsigned long *n_bad, rch_diag *d, const r
     ++*n_bad;
 }
 
-/* The tool and work object of the instruction that uses robtarget t fit
- * what the command was given (tool0, or the --tool TCP; wobj0): 0, or -1
- * with why set. */
-static int robtarget_frame(const rch_rapid_target *t, const double *tool, unsigned base, char *why, size_t why_len)
+/* A rigid pose: trans (mm), rotation (3 x 3, row-major). */
+typedef struct {
+    double p[3], R[9];
+} pose;
+
+static void pose_mul(pose *o, const pose *a, const pose *b)
 {
-    if (t->wobj[0] && strcasecmp(t->wobj, "wobj0") != 0) {
-        snprintf(why, why_len, "used in work object %s (line %u): rcal corrects robtargets in the base frame (wobj0)",
-                 t->wobj, base + t->use_line);
+    pose r;
+    for (int i = 0; i < 3; ++i) {
+        r.p[i] = a->p[i];
+        for (int j = 0; j < 3; ++j) {
+            r.p[i] += a->R[3 * i + j] * b->p[j];
+            r.R[3 * i + j] = 0;
+            for (int k = 0; k < 3; ++k)
+                r.R[3 * i + j] += a->R[3 * i + k] * b->R[3 * k + j];
+        }
+    }
+    *o = r;
+}
+
+static void pose_inv(pose *o, const pose *a)
+{
+    pose r;
+    for (int i = 0; i < 3; ++i) {
+        r.p[i] = 0;
+        for (int j = 0; j < 3; ++j) {
+            r.R[3 * i + j] = a->R[3 * j + i];
+            r.p[i] -= a->R[3 * j + i] * a->p[j];
+        }
+    }
+    *o = r;
+}
+
+/* v (7): trans, ABB quaternion (its norm within 1e-3 of 1, normalised). 0 or -1. */
+static int pose_from(pose *o, const double v[7])
+{
+    const double n = sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
+    if (!(fabs(n - 1.0) <= 1e-3))
+        return -1;
+    const double q[4] = {v[3] / n, v[4] / n, v[5] / n, v[6] / n};
+    memcpy(o->p, v, 3 * sizeof o->p[0]);
+    rch_ik_quat_to_rot(o->R, q);
+    return 0;
+}
+
+static int rot_is_identity(const double v[7])
+{
+    return v[3] == 1.0 && v[4] == 0.0 && v[5] == 0.0 && v[6] == 0.0;
+}
+
+/* How robtarget t is read: the pose of its TCP (F, in tool0's frame) in its
+ * work object (W, in the base frame). */
+typedef struct {
+    pose W, F;
+    int simple;       /* W is the base and F has tool0's orientation: the TCP path of rch_ik */
+    double tcp[3];    /* F's origin in the flange frame (mm): the point compensated */
+    int has_tcp;      /* not the flange */
+} rt_frames;
+
+/* The tool and work object the instruction that uses robtarget t names, as
+ * the module declares them (or --tool for a tool it does not): 0, or -1
+ * with why set. tool: --tool (3) or NULL. */
+static int robtarget_frames(rt_frames *fr, const rch_rapid_target *t, const double *tool, unsigned base, char *why,
+                            size_t why_len)
+{
+    double fv[7] = {0, 0, 0, 1, 0, 0, 0}, wv[7] = {0, 0, 0, 1, 0, 0, 0};
+    if (t->use_error[0]) {
+        snprintf(why, why_len, "%s", t->use_error);
         return -1;
     }
+    pose_from(&fr->W, wv);
+    fr->simple = 1;
+    if (t->wobj[0] && strcasecmp(t->wobj, "wobj0") != 0) {
+        if (!t->wobj_declared) {
+            snprintf(why, why_len, "used in work object %s (line %u), which this module does not declare with a "
+                     "literal wobjdata: rcal needs its uframe and oframe (declare it in this module)", t->wobj,
+                     base + t->use_line);
+            return -1;
+        }
+        if (t->wobj_robhold) {
+            snprintf(why, why_len, "used in work object %s (line %u), which the robot holds (robhold TRUE: a "
+                     "stationary tool): rcal corrects robtargets of a tool the robot holds", t->wobj,
+                     base + t->use_line);
+            return -1;
+        }
+        if (!t->wobj_ufprog) {
+            snprintf(why, why_len, "used in work object %s (line %u), whose user frame moves (ufprog FALSE, ufmec "
+                     "\"%.40s\"): rcal corrects robtargets in a fixed frame", t->wobj, base + t->use_line,
+                     t->wobj_ufmec);
+            return -1;
+        }
+        pose U, O;
+        if (pose_from(&U, t->wobj_uframe) != 0 || pose_from(&O, t->wobj_oframe) != 0) {
+            snprintf(why, why_len, "used in work object %s (line %u), whose uframe or oframe rot is not a unit "
+                     "quaternion", t->wobj, base + t->use_line);
+            return -1;
+        }
+        pose_mul(&fr->W, &U, &O);
+        fr->simple = 0;
+    }
     if (t->tool_declared) {
-        /* the module's own tooldata: its TCP in the flange frame is tool0's
-         * vector turned by RCH_IK_TOOL0_RZ_DEG about z */
-        const double *f = t->tool_frame, c0 = cos(RCH_IK_TOOL0_RZ_DEG * DEG), s0 = sin(RCH_IK_TOOL0_RZ_DEG * DEG);
-        const double fl[3] = {c0 * f[0] - s0 * f[1], s0 * f[0] + c0 * f[1], f[2]};
-        const double qn = sqrt(f[3] * f[3] + f[4] * f[4] + f[5] * f[5] + f[6] * f[6]);
         if (!t->tool_robhold) {
             snprintf(why, why_len, "used with tool %s (line %u), a stationary tool (robhold FALSE): its robtargets "
                      "are not TCP poses", t->tool, base + t->use_line);
             return -1;
         }
-        if (!(qn > 0) || fabs(fabs(f[3]) / qn - 1.0) > 1e-9) {
-            snprintf(why, why_len, "used with tool %s (line %u), whose frame is turned against tool0 (rot [%g,%g,%g,%g]): "
-                     "rcal reads robtargets of a TCP with tool0's orientation", t->tool, base + t->use_line, f[3],
-                     f[4], f[5], f[6]);
+        memcpy(fv, t->tool_frame, sizeof fv);
+        if (!rot_is_identity(fv))
+            fr->simple = 0;
+    } else if (t->tool[0] && strcasecmp(t->tool, "tool0") != 0) {
+        if (!tool) {
+            snprintf(why, why_len, "used with tool %s (line %u), which this module does not declare with a literal "
+                     "tooldata: a robtarget is the pose of that tool's TCP; give --tool X,Y,Z (its TCP in the "
+                     "flange frame, tool0's orientation) or declare %s in this module", t->tool, base + t->use_line,
+                     t->tool);
             return -1;
         }
-        if (!tool || fabs(tool[0] - fl[0]) > 1e-6 || fabs(tool[1] - fl[1]) > 1e-6 || fabs(tool[2] - fl[2]) > 1e-6) {
-            snprintf(why, why_len, "used with tool %s (line %u), whose TCP is [%g,%g,%g] in tool0's frame: give "
-                     "--tool %g,%g,%g (the flange frame)%s", t->tool, base + t->use_line, f[0], f[1], f[2],
-                     fl[0] + 0.0, fl[1] + 0.0, fl[2] + 0.0, tool ? ", not the --tool given" : "");
-            return -1;
-        }
-    } else if (t->tool[0] && !tool && strcasecmp(t->tool, "tool0") != 0) {
-        snprintf(why, why_len, "used with tool %s (line %u): a robtarget is the pose of that tool's TCP; give "
-                 "--tool X,Y,Z (its TCP in the flange frame) or use tool0", t->tool, base + t->use_line);
+        /* tool0 is the flange turned 180 deg about z (RCH_IK_TOOL0_RZ_DEG) */
+        fv[0] = -tool[0];
+        fv[1] = -tool[1];
+        fv[2] = tool[2];
+    } else if (!t->tool[0] && tool) { /* no instruction of the module uses it: --tool */
+        fv[0] = -tool[0];
+        fv[1] = -tool[1];
+        fv[2] = tool[2];
+    }
+    if (pose_from(&fr->F, fv) != 0) {
+        snprintf(why, why_len, "used with tool %s (line %u), whose tframe rot is not a unit quaternion", t->tool,
+                 base + t->use_line);
         return -1;
     }
-    if (t->tool[0] && tool && strcasecmp(t->tool, "tool0") == 0) {
-        snprintf(why, why_len, "used with tool0 (line %u) while --tool gives a TCP: it would be read as that TCP's "
-                 "pose", base + t->use_line);
-        return -1;
-    }
+    fr->tcp[0] = -fv[0];
+    fr->tcp[1] = -fv[1];
+    fr->tcp[2] = fv[2];
+    fr->has_tcp = fv[0] != 0.0 || fv[1] != 0.0 || fv[2] != 0.0 || (tool && !t->tool[0]);
     return 0;
 }
 
-/* One robtarget: the nominal IK with its confdata gives the joints, the
- * compensation corrects them, the nominal pose of the corrected joints (its
+/* Compensate at tcp (3, flange frame): the job's stream when it is the
+ * job's point, else one made for it (kept for the module). 0, or -1 with
+ * why set. */
+static int use_tcp(comp_ctx *c, const double tcp[3], int has_tcp, char *why, size_t why_len)
+{
+    const double *jt = c->gate ? c->gate->tool_mm : NULL;
+    c->stream = c->stream0;
+    c->cal = c->cal0;
+    c->fit = c->fit0;
+    if ((!has_tcp && !jt) || (has_tcp && jt && tcp[0] == jt[0] && tcp[1] == jt[1] && tcp[2] == jt[2]) ||
+        (!jt && tcp[0] == 0.0 && tcp[1] == 0.0 && tcp[2] == 0.0))
+        return 0;
+    for (size_t k = 0; k < c->ntcps; ++k)
+        if (memcmp(c->tcps[k]->tcp, tcp, sizeof c->tcps[k]->tcp) == 0) {
+            c->stream = &c->tcps[k]->s;
+            c->cal = &c->tcps[k]->det;
+            c->fit = &c->tcps[k]->fit;
+            return 0;
+        }
+    const rch_comp_gate *g = c->gate;
+    if (!g || !g->det_any || !g->cfg || !g->nominal || c->ntcps == MAX_TCPS) {
+        snprintf(why, why_len, "its tool's TCP [%g,%g,%g] (flange frame) is not the point this compensation was set "
+                 "up for%s", tcp[0], tcp[1], tcp[2], c->ntcps == MAX_TCPS ? " (more than 16 TCPs in one module)" : "");
+        return -1;
+    }
+    tcp_stream *ts = calloc(1, sizeof *ts);
+    if (!ts) {
+        snprintf(why, why_len, "out of memory");
+        return -1;
+    }
+    memcpy(ts->tcp, tcp, sizeof ts->tcp);
+    rch_comp_point_model(&ts->det, g->det_any, tcp);
+    rch_comp_point_model(&ts->nom, g->nominal, tcp);
+    rch_comp_point_model(&ts->fit, g->fit_any ? g->fit_any : g->det_any, tcp);
+    const rc_status st = rc_comp_stream_init(&ts->s, &ts->det, &ts->nom, g->cfg);
+    if (st != RC_OK) {
+        snprintf(why, why_len, "the model cannot be used for compensation at its tool's TCP: %s", rc_strerror(st));
+        free(ts);
+        return -1;
+    }
+    c->tcps[c->ntcps++] = ts;
+    c->stream = &ts->s;
+    c->cal = &ts->det;
+    c->fit = g->fit_any ? &ts->fit : NULL;
+    return 0;
+}
+
+/* The flange (tool0) pose of robtarget t read with fr: pos, quat (4). */
+static void tool0_pose(double pos[3], double quat[4], const rt_frames *fr, const rch_rapid_target *t)
+{
+    pose T, Fi, X;
+    pose_from(&T, t->val); /* its norm is checked by rch_ik_solve */
+    pose_mul(&X, &fr->W, &T);
+    pose_inv(&Fi, &fr->F);
+    pose_mul(&X, &X, &Fi);
+    memcpy(pos, X.p, sizeof X.p);
+    rch_ik_rot_to_quat(quat, X.R);
+}
+
+/* One robtarget: the nominal IK with its confdata gives the joints (of its
+ * tool's TCP in its work object), the compensation corrects them at that
+ * TCP, the nominal pose of the corrected joints in the same frames (its
  * confdata recomputed) is written. 0 ok, 1 flagged, 2 left as it was,
  * -1 refused (why set). */
 static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_rapid_target *t, unsigned base,
@@ -415,8 +579,8 @@ static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_ra
         snprintf(why, why_len, "no nominal model to invert");
         return -1;
     }
-    const double *tool = c->gate->tool_mm;
-    if (robtarget_frame(t, tool, base, why, why_len) != 0)
+    rt_frames fr;
+    if (robtarget_frames(&fr, t, c->gate->tool_mm, base, why, why_len) != 0)
         return -1;
     int cf[4];
     for (int k = 0; k < 4; ++k) {
@@ -427,8 +591,21 @@ static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_ra
         }
         cf[k] = (int)v;
     }
-    double q[RC_NJ], qd[RC_NJ], qo[RC_NJ];
-    if (rch_ik_solve(q, nom, &t->val[0], &t->val[3], cf, c->gate->tool_mm, why, why_len) != 0)
+    const double qn = sqrt(t->val[3] * t->val[3] + t->val[4] * t->val[4] + t->val[5] * t->val[5] + t->val[6] * t->val[6]);
+    if (!fr.simple && !(fabs(qn - 1.0) <= 1e-3)) {
+        snprintf(why, why_len, "its rot is not a unit quaternion (norm %g)", qn);
+        return -1;
+    }
+    const double *tcp = fr.has_tcp ? fr.tcp : NULL;
+    double q[RC_NJ], qd[RC_NJ], qo[RC_NJ], px[3], qx[4];
+    int ik;
+    if (fr.simple)
+        ik = rch_ik_solve(q, nom, &t->val[0], &t->val[3], cf, tcp, why, why_len);
+    else {
+        tool0_pose(px, qx, &fr, t);
+        ik = rch_ik_solve(q, nom, px, qx, cf, NULL, why, why_len);
+    }
+    if (ik != 0 || use_tcp(c, fr.tcp, fr.has_tcp, why, why_len) != 0)
         return -1;
     unsigned cols[RC_NJ];
     for (unsigned i = 0; i < RC_NJ; ++i) {
@@ -438,6 +615,9 @@ static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_ra
     rch_diag dd;
     const unsigned long before_unc = c->res->n_uncertain;
     const int r = compensate(c, qo, qd, base + t->line, cols, &dd);
+    c->stream = c->stream0;
+    c->cal = c->cal0;
+    c->fit = c->fit0;
     if (r < 0) {
         snprintf(why, why_len, "%.300s", dd.msg);
         return -1;
@@ -449,7 +629,19 @@ static int rapid_robtarget(comp_ctx *c, double out[RCH_RAPID_NUMS], const rch_ra
     int cfo[4];
     for (unsigned i = 0; i < RC_NJ; ++i)
         qr[i] = qo[i] * DEG;
-    rch_ik_fk(pos, quat, cfo, nom, qr, c->gate->tool_mm);
+    if (fr.simple)
+        rch_ik_fk(pos, quat, cfo, nom, qr, tcp);
+    else { /* T' = W^-1 X' F */
+        rch_ik_fk(pos, quat, cfo, nom, qr, NULL);
+        double v[7] = {pos[0], pos[1], pos[2], quat[0], quat[1], quat[2], quat[3]};
+        pose X, Wi, T;
+        pose_from(&X, v);
+        pose_inv(&Wi, &fr.W);
+        pose_mul(&T, &Wi, &X);
+        pose_mul(&T, &T, &fr.F);
+        memcpy(pos, T.p, sizeof T.p);
+        rch_ik_rot_to_quat(quat, T.R);
+    }
     /* the quaternion's sign as written */
     const double dot = quat[0] * t->val[3] + quat[1] * t->val[4] + quat[2] * t->val[5] + quat[3] * t->val[6];
     for (int k = 0; k < 3; ++k)
@@ -473,6 +665,12 @@ static int do_rapid_text(comp_ctx *c, const char *text, size_t len, unsigned bas
         d->line += d->line ? base : 0;
         return -1;
     }
+    if (ts.n == 0) { /* a module with nothing to correct is most likely not the one meant */
+        rch_diag_set(d, c->in_name, 0, 0, "no jointtarget or robtarget in this module (declarations, assignments, "
+                     "instruction arguments): nothing to correct; nothing written");
+        rch_rapid_free(&ts);
+        return -1;
+    }
     edit *ed = NULL;
     size_t ne = 0, cap = 0;
     unsigned long n_bad = 0;
@@ -483,7 +681,7 @@ static int do_rapid_text(comp_ctx *c, const char *text, size_t len, unsigned bas
             rapid_refuse(c, &n_bad, d, t, base, t->error);
             continue;
         }
-        char why[320];
+        char why[512];
         double out[RCH_RAPID_NUMS];
         int r;
         if (t->kind == RCH_RAPID_JOINTTARGET) {
@@ -635,8 +833,9 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                          const rc_model *cal, const rch_comp_gate *gate, rch_comp_format format, FILE *warn,
                          rch_diag *d)
 {
-    comp_ctx c = {.stream = s, .cal = cal, .gate = gate, .res = res, .out = out, .warn = warn, .in_name = in_name,
-                  .format = (int)format};
+    comp_ctx c = {.stream = s, .cal = cal, .fit = gate ? gate->fit : NULL, .stream0 = s, .cal0 = cal,
+                  .fit0 = gate ? gate->fit : NULL, .gate = gate, .res = res, .out = out, .warn = warn,
+                  .in_name = in_name, .format = (int)format};
     char *line = NULL;
     size_t cap = 0;
     long got;
@@ -706,6 +905,8 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         }
     }
     free(line);
+    for (size_t k = 0; k < c.ntcps; ++k)
+        free(c.tcps[k]);
     res->format = (rch_comp_format)c.format;
     if (rc >= 0 && ferror(in)) {
         rch_diag_set(d, c.in_name, 0, 0, "read error: %s", strerror(errno));
@@ -744,7 +945,8 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
                                                      (robot.has_nominal || robot.unc.present));
     /* the point compensation moves: the flange (or the given TCP) of both
      * models, never the cable attachment the calibration measured */
-    static rc_model nom_pt;
+    static rc_model nom_pt, det_any;
+    det_any = det;
     rch_comp_point_model(&det, &det, job->tool_mm);
     rch_comp_point_model(&nom_pt, nom, job->tool_mm);
     nom = &nom_pt;
@@ -792,7 +994,8 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
         fprintf(uo.f, "line,u95_mm\n");
     }
     const rch_comp_gate gate = {&fit_pt, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
-                                job->accept_robtargets, have_uo ? uo.f : NULL, nom_raw, job->tool_mm};
+                                job->accept_robtargets, have_uo ? uo.f : NULL, nom_raw, job->tool_mm,
+                                &det_any, &robot.model, &cfg};
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);

@@ -96,6 +96,12 @@ typedef struct rch_comp_gate {
     const rc_model *nominal;   /* the nominal model the program was made with (pure DH): the robtargets'
                                   inverse kinematics; NULL: a robtarget is refused */
     const double *tool_mm;     /* (3) the TCP the robtargets are poses of, in the flange frame; NULL: tool0 */
+    /* A robtarget used with another TCP (a tooldata the module declares) is
+     * compensated at that point: these models without a point (the stream's
+     * cal, fit and nominal before rch_comp_point_model) and the stream's
+     * config; NULL: such a robtarget is refused */
+    const rc_model *det_any, *fit_any;
+    const rc_comp_config *cfg;
 } rch_comp_gate;
 
 /* What u95_mm says of one target, by how its compensation ended (status: 0
