@@ -369,7 +369,7 @@ static void describe_mirror(char *buf, size_t len, const double A[9])
             if (fabs(A[3 * r + c]) > fabs(A[3 * r + perm[r]]))
                 perm[r] = c;
         sign[r] = A[3 * r + perm[r]] < 0 ? -1 : 1;
-        ok &= fabs(A[3 * r + perm[r]]) > 0.9;
+        ok &= fabs(A[3 * r + perm[r]]) > 0.99; /* within 8 deg: a tracker aligned with the base */
     }
     ok &= perm[0] != perm[1] && perm[1] != perm[2] && perm[0] != perm[2];
     if (!ok) {
