@@ -542,13 +542,11 @@ static int append_file(rch_pos *out, const rch_data *dt, const uint8_t *drop, co
     return 0;
 }
 
-/* One file: read, check, append. 0 or -1 with d set. */
-static int load_one(rch_pos *out, const char *path, unsigned f, double *next, const rc_model *limits, double **sig,
-                    size_t *nsig, rch_diag *d)
+/* One file read into dt: check, append; dt freed. 0 or -1 with d set. */
+static int add_one(rch_pos *out, rch_data *dtp, const char *path, unsigned f, double *next, const rc_model *limits,
+                   double **sig, size_t *nsig, rch_diag *d)
 {
-    rch_data dt;
-    if (rch_data_load_limited(&dt, path, RCH_DATA_POSITIONS | RCH_DATA_NO_LEN, limits, d) != 0)
-        return -1;
+    const rch_data dt = *dtp;
     int rc = check_units(&dt, path, d);
     uint8_t *drop = calloc(dt.n + 1, 1);
     double *key = malloc((dt.n + 1) * sizeof *key), *ns = realloc(*sig, (*nsig + dt.n + 1) * sizeof *ns);
@@ -575,8 +573,20 @@ static int load_one(rch_pos *out, const char *path, unsigned f, double *next, co
     free(drop);
     free(key);
     free(ref);
-    rch_data_free(&dt);
+    rch_data_free(dtp);
     return rc;
+}
+
+/* The median of the sigma_mm column: sig (nsig), freed. */
+static void finish(rch_pos *out, double next, double pose0, double *sig, size_t nsig)
+{
+    out->poses = (size_t)(next - pose0);
+    if (nsig) {
+        qsort(sig, nsig, sizeof *sig, cmp_double);
+        out->has_sigma = 1;
+        out->sigma_mm = sig[nsig / 2];
+    }
+    free(sig);
 }
 
 int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0, const rc_model *limits,
@@ -585,18 +595,32 @@ int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0,
     memset(out, 0, sizeof *out);
     double next = pose0, *sig = NULL;
     size_t nsig = 0;
-    for (size_t f = 0; f < k; ++f)
-        if (load_one(out, paths[f], (unsigned)f, &next, limits, &sig, &nsig, d) != 0) {
+    for (size_t f = 0; f < k; ++f) {
+        rch_data dt;
+        if (rch_data_load_limited(&dt, paths[f], RCH_DATA_POSITIONS | RCH_DATA_NO_LEN, limits, d) != 0 ||
+            add_one(out, &dt, paths[f], (unsigned)f, &next, limits, &sig, &nsig, d) != 0) {
             rch_pos_free(out);
             free(sig);
             return -1;
         }
-    out->poses = (size_t)(next - pose0);
-    if (nsig) {
-        qsort(sig, nsig, sizeof *sig, cmp_double);
-        out->has_sigma = 1;
-        out->sigma_mm = sig[nsig / 2];
     }
-    free(sig);
+    finish(out, next, pose0, sig, nsig);
+    return 0;
+}
+
+int rch_pos_parse(rch_pos *out, const char *text, size_t len, const char *name, const rc_model *model, rch_diag *d)
+{
+    rch_data dt;
+    double next = 0.0, *sig = NULL;
+    size_t nsig = 0;
+    memset(out, 0, sizeof *out);
+    if (rch_data_parse(&dt, text, len, name, RCH_DATA_POSITIONS | RCH_DATA_NO_LEN, d) != 0)
+        return -1;
+    if (add_one(out, &dt, name, 0, &next, model, &sig, &nsig, d) != 0) {
+        rch_pos_free(out);
+        free(sig);
+        return -1;
+    }
+    finish(out, next, 0.0, sig, nsig);
     return 0;
 }

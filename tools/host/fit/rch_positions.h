@@ -72,6 +72,10 @@ typedef struct rch_pos {
  * ("file:line: warning: ...") and dropped (dropped), not a repeat. 0 or -1. */
 int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0, const rc_model *limits,
                  rch_diag *d);
+/* The same for one file's text (len bytes; name in the diagnostics), the
+ * joints not checked against limits, model's kinematics the nominal (NULL:
+ * none). What fuzz/fuzz_pos_load.c drives. 0, or -1 with d set. */
+int rch_pos_parse(rch_pos *out, const char *text, size_t len, const char *name, const rc_model *model, rch_diag *d);
 void rch_pos_free(rch_pos *p);
 
 /* Samples of s (n) that are lengths (RC_SENSOR_LENGTH) and that are tracker components. */
