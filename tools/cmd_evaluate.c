@@ -69,7 +69,7 @@ static int evaluate_positions(const char *model_path, const char *pos_path, int 
     rch_pos p;
     rch_diag d;
     char msg[1024];
-    if (rch_robot_load(&robot, model_path, &d) != 0 || rch_pos_load(&p, &pos_path, 1, 0.0, &robot.model, &d) != 0) {
+    if (rch_robot_load(&robot, model_path, &d) != 0 || rch_pos_load(&p, &pos_path, 1, 0.0, &robot.nominal, &d) != 0) {
         fprintf(stderr, "rcal evaluate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }

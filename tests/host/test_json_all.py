@@ -142,14 +142,30 @@ def diagnose():
     check(d.get("n") == 600 and "effect" in d, "diagnose: 600 samples, an effect named")
 
 
+def flange_irb120(q_deg):
+    """The IRB120's flange (standard DH of data/irb120.json), mm: test-side kinematics, not rcal's."""
+    import math
+    dh = [(0, 290, -90, 0), (270, 0, 0, -90), (70, 0, -90, 0), (0, 302, 90, 0), (0, 0, -90, 0), (0, 72, 0, 0)]
+    T = [[1.0 if r == c else 0.0 for c in range(4)] for r in range(4)]
+    for (a, d, al, off), qd in zip(dh, q_deg):
+        th, al = math.radians(qd + off), math.radians(al)
+        ct, st, ca, sa = math.cos(th), math.sin(th), math.cos(al), math.sin(al)
+        A = [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]]
+        T = [[sum(T[r][k] * A[k][c] for k in range(4)) for c in range(4)] for r in range(4)]
+    return [T[0][3], T[1][3], T[2][3]]
+
+
 def evaluate():
     d = doc_of("evaluate", run("evaluate", "--model", w("cal.json"), "--data", w("sim.csv"), "--json"))
     check(d.get("n") == 40, "evaluate: 40 samples")
     pos = w("positions.csv")  # tracker positions (docs/positions.md): the frame and target fitted here
-    with open(pos, "w") as f:
+    with open(pos, "w") as f:  # plausible ones (rcal refuses others): the IRB120's flange, a turned tracker, noise
         f.write("q1,q2,q3,q4,q5,q6,x,y,z\n")
         for i in range(8):
-            f.write("%d,%d,-20,30,40,50,%.3f,%.3f,%.3f\n" % (10 * i - 40, 3 * i, 1000 + 7 * i, -500 + 3 * i * i, 200 + i))
+            q = [10 * i - 40, 3 * i, -20, 30, 40, 50]
+            p = flange_irb120(q)
+            x, y = 1500 + 0.6 * p[0] - 0.8 * p[1], -200 + 0.8 * p[0] + 0.6 * p[1]
+            f.write("%d,%d,%d,%d,%d,%d,%.3f,%.3f,%.3f\n" % tuple(q + [x + 0.3 * (-1) ** i, y + 0.1 * i, p[2] + 300 - 0.2 * i]))
     d = doc_of("evaluate", run("evaluate", "--model", w("cal.json"), "--positions", pos, "--json"))
     pe = d.get("position_error_mm", {})
     check(d.get("rows") == 8 and d.get("n") == 24 and d.get("tracker_frame") == "fitted" and

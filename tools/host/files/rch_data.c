@@ -117,6 +117,7 @@ typedef struct parse_ctx {
     size_t cap;      /* allocated rows */
     unsigned line_no;
     const rc_model *lim; /* joint limits of the robot, or NULL */
+    size_t n_header;     /* fields of the header line */
 } parse_ctx;
 
 /* The header line: find the known columns. 0 or -1 with d set. */
@@ -267,12 +268,43 @@ static int check_value(const parse_ctx *pc, int k, double v, const field *f)
     return -1;
 }
 
+/* A row of as many fields as the header: a decimal comma ("12,5") or a
+ * lost field shifts every later column, so neither is read. Empty fields
+ * after the header's last (a trailing comma) are no shift. 0 or -1 with d set. */
+static int check_field_count(const parse_ctx *pc, const field *fields, size_t nf, size_t ll)
+{
+    const size_t nh = pc->n_header;
+    size_t last = nf;
+    while (last > nh && fields[last - 1].len == 0)
+        --last;
+    if (last > nh) {
+        rch_diag_set(pc->d, pc->name, pc->line_no, fields[nh].col,
+                     "the row has %zu fields, the header %zu: a decimal comma ('12,5' for 12.5; rcal reads '.' "
+                     "decimals) or a field too many shifts the columns; fix or remove the row",
+                     last, nh);
+        return -1;
+    }
+    if (nf < nh) {
+        int k_lost = -1; /* the first column read that the row lacks */
+        for (int k = 0; k < C_N; ++k)
+            if (pc->col_of[k] >= (int)nf && (k_lost < 0 || pc->col_of[k] < pc->col_of[k_lost]))
+                k_lost = k;
+        rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)ll + 1,
+                     "%s%s%sthe row has %zu fields, the header %zu: a field is missing and the columns after it are "
+                     "shifted (an empty field is still written: 1,,3); fix or remove the row",
+                     k_lost >= 0 ? "missing field '" : "", k_lost >= 0 ? col_names[k_lost] : "",
+                     k_lost >= 0 ? "': " : "", nf, nh);
+        return -1;
+    }
+    return 0;
+}
+
 /* One data row into out->[n]. 0 or -1 with d set. */
 static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t nf, size_t ll)
 {
     double v[C_N] = {0};
     rc_sample *s;
-    if (grow(out, pc) != 0)
+    if (check_field_count(pc, fields, nf, ll) != 0 || grow(out, pc) != 0)
         return -1;
     for (int k = 0; k < C_N; ++k) {
         if (pc->col_of[k] < 0 || (k == C_P && !(pc->flags & (RCH_DATA_POSE | RCH_DATA_POSITIONS))))
@@ -388,6 +420,7 @@ static int parse(rch_data *out, const char *text, size_t len, const char *name, 
         if (!have_header) {
             if (parse_header(&pc, fields, nf, line, ll) != 0)
                 goto fail;
+            pc.n_header = nf;
             have_header = 1;
         } else if (parse_row(out, &pc, fields, nf, ll) != 0) {
             goto fail;

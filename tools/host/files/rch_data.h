@@ -11,7 +11,10 @@
  * that is not a number, NaN, infinity, and values no sensor produces
  * (|q| > 720 deg, L < 1 mm or L > 20000 mm; with a robot model, a joint
  * beyond its limits by more than RCH_DATA_LIMIT_TOL_DEG), hexadecimal floats.
- * Nothing is silently used.
+ * A row with more or fewer fields than the header (a decimal comma, a lost
+ * field: the columns after it shifted) is refused with its line and the
+ * counts; empty fields after the header's last (a trailing comma) are not
+ * counted. Nothing is silently used.
  * Memory: the loader allocates; rch_data_free releases.
  */
 #ifndef RCH_DATA_H

@@ -38,13 +38,44 @@ typedef struct rch_pos {
     unsigned n_targets; /* largest target + 1 */
     int has_sigma;
     double sigma_mm;    /* the median of the sigma_mm column (has_sigma); not a row weight */
+    size_t dropped;     /* rows identical in every field to an earlier one: warned, dropped */
 } rch_pos;
 
+/* Plausibility checks of rch_pos_load (tools/host/fit/rch_pos_read.c). */
+#define RCH_POS_REPEAT_MM 1.0      /* one pose and target measured twice: at most this apart (mm) */
+#define RCH_POS_SAME_Q_DEG 0.1     /* rows of one pose number: joints at most this apart (deg) */
+#define RCH_POS_MIN_SPREAD_MM 50.0 /* scale judged when the nominal points spread this far (RMS, mm) */
+#define RCH_POS_SCALE_MIN 0.5      /* measured spread / nominal spread accepted: [MIN, MAX] */
+#define RCH_POS_SCALE_MAX 3.0
+#define RCH_POS_MIRROR_MIN_MM 3.0  /* mirrored: the rotation leaves more than this (RMS, mm) */
+#define RCH_POS_MIRROR_RATIO 0.2   /*   and the reflection less than this part of it */
+#define RCH_POS_MIN_ROWS_RIGID 6   /* the controller's positions judged with rows >= this + targets */
+
 /* Load positions files paths (k), pose numbers counted on over the files
- * from pose0 (the merged data's first free number); limits: joint limits
- * checked (NULL: none). 0, or -1 with d set (file:line:col). */
+ * from pose0 (the merged data's first free number); limits: the robot's
+ * model, its joint limits checked and its kinematics the nominal the
+ * points are judged against (NULL: neither). Before any fit, each file is
+ * refused (-1, d: file:line:col, or file: for a finding over the whole
+ * file) for: rows with another field count than the header (rch_data);
+ * joints or coordinates all within +-7 / +-5 (radians, metres); a pose
+ * number reused for other joints (> RCH_POS_SAME_Q_DEG); one pose and
+ * target at places more than RCH_POS_REPEAT_MM apart (several targets
+ * without a target column, a wrong target); two targets' distance
+ * changing from pose to pose by more than that; with limits: a spread of
+ * the points outside [RCH_POS_SCALE_MIN, _MAX] times the nominal's (the
+ * likely unit named: cm, inches, dm, m, µm); a mirrored frame (the best
+ * reflection fits to less than RCH_POS_MIRROR_RATIO of the best rotation's
+ * RMS, itself above RCH_POS_MIRROR_MIN_MM; the likely swap named); points
+ * the nominal kinematics give after a rigid motion to within 0.75 x the
+ * file's decimal step + 1e-6 mm (the controller's computed positions). A
+ * row identical in every field to an earlier one is warned on stderr
+ * ("file:line: warning: ...") and dropped (dropped), not a repeat. 0 or -1. */
 int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0, const rc_model *limits,
                  rch_diag *d);
+/* The same for one file's text (len bytes; name in the diagnostics), the
+ * joints not checked against limits, model's kinematics the nominal (NULL:
+ * none). What fuzz/fuzz_pos_load.c drives. 0, or -1 with d set. */
+int rch_pos_parse(rch_pos *out, const char *text, size_t len, const char *name, const rc_model *model, rch_diag *d);
 void rch_pos_free(rch_pos *p);
 
 /* Samples of s (n) that are lengths (RC_SENSOR_LENGTH) and that are tracker components. */
