@@ -92,7 +92,7 @@ static int report_json(const rch_bench_result *r, const char *data_path, int arg
 
 int rcal_cmd_bench(int argc, char **argv)
 {
-    rch_bench_cfg cfg = {"../shared/data/robotcali.csv", RCAL_DEFAULT_ROBOT, 21, 5, NULL};
+    rch_bench_cfg cfg = {"../shared/data/robotcali.csv", RCAL_DEFAULT_ROBOT, 21, 0, NULL};
     int json = 0;
     rch_cmdspec spec;
     const rch_opt opts[] = {
