@@ -147,8 +147,8 @@ static const rc_effect_desc effect_table[] = {
     {RC_EFF_TRACKER_TARGETS, "tracker_targets", 0, RC_SIDE_SENSOR, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z",
      "", 0},
     {RC_EFF_OUTLET_OFFSET, "outlet_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 0, 1, "mm", 1000.0, "", "o", 0},
-    {RC_EFF_OUTLET_SCALE, "outlet_scale", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 2, 0, 1, "", 0.1, "", "o", 0},
-    {RC_EFF_TRACKER_SCALE, "tracker_scale", 1, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 2, 0, 1, "", 0.01, "", "", 0},
+    {RC_EFF_OUTLET_SCALE, "outlet_scale", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 2, 0, 1, "", 0.001, "", "o", 0},
+    {RC_EFF_TRACKER_SCALE, "tracker_scale", 1, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 2, 0, 1, "", 3e-4, "", "", 0},
 };
 RC_STATIC_ASSERT(sizeof effect_table / sizeof effect_table[0] == RC_EFF_LAST + 1, effect_table_covers_every_kind);
 

@@ -42,7 +42,9 @@ void rch_prior_fill(double *mean, double *sd, const rc_model *m, const rc_model 
                 sd[ef->first + k] = p->attachment_mm;
         } else if (ef->kind == RC_EFF_AXIS_TILT) { /* a twist about the other axis: the twists' tolerance */
             sd[ef->first] = p->twist_deg * DEG;
-        } else if (ds && !ds->nuisance && ds->side != RC_SIDE_OUTLET && ds->side != RC_SIDE_SENSOR) {
+        } else if (ds && !ds->nuisance && ds->side != RC_SIDE_OUTLET &&
+                   (ds->side != RC_SIDE_SENSOR || ef->kind == RC_EFF_TRACKER_SCALE)) {
+            /* (the tracker's scale is physical, its frame and targets are where it stands: no prior) */
             /* a physical effect: its plausible range (the table's limit) as
              * 3 sd about its start value, so that a fit cannot trade it into
              * something no sensor or joint does (a 31 m "drum period") */
