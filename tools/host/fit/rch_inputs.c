@@ -24,7 +24,7 @@
  * acquisition order over all files; the group column is kept only when
  * every file has one (numbers offset per file). counts (files): samples
  * of each. */
-static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch_diag *d)
+static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, const rc_model *limits, rch_diag *d)
 {
     const size_t nf = rch_calib_cfg_n_files(cfg);
     memset(out, 0, sizeof *out);
@@ -35,7 +35,7 @@ static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch
     if (nf == 0)
         return 0; /* tracker positions only (append_positions) */
     if (nf == 1) {
-        int rc = rch_data_load(out, rch_calib_cfg_file(cfg, 0), 0, d);
+        int rc = rch_data_load_limited(out, rch_calib_cfg_file(cfg, 0), 0, limits, d);
         counts[0] = out->n;
         if (rc == 0 && rch_data_check_units(out, rch_calib_cfg_file(cfg, 0), d) != 0) {
             rch_data_free(out);
@@ -47,7 +47,7 @@ static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, rch
     size_t total = 0, k = 0;
     int all_xyz = 1, all_group = 1;
     for (size_t f = 0; f < nf; ++f) {
-        if (rch_data_load(&part[f], rch_calib_cfg_file(cfg, f), 0, d) != 0 ||
+        if (rch_data_load_limited(&part[f], rch_calib_cfg_file(cfg, f), 0, limits, d) != 0 ||
             rch_data_check_units(&part[f], rch_calib_cfg_file(cfg, f), d) != 0) {
             if (part[f].s)
                 rch_data_free(&part[f]);
@@ -259,7 +259,7 @@ int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
     out->n_files = rch_calib_cfg_n_files(cfg);
     if (rch_robot_load(&out->robot, cfg->robot_path, d) != 0)
         return -1;
-    if (load_all(&out->data, out->counts, cfg, d) != 0) {
+    if (load_all(&out->data, out->counts, cfg, &out->robot.model, d) != 0) { /* joints within the robot's limits */
         memset(&out->data, 0, sizeof out->data); /* the readers keep nothing when they fail */
         return -1;
     }

@@ -8,7 +8,7 @@
  *
  * In this order, as rch_calib_run has always done it:
  *   1. the robot file (rch_robot_load);
- *   2. every cable file (rch_data_load, rch_data_check_units) merged in the
+ *   2. every cable file (rch_data_load_limited against the robot's joint limits, rch_data_check_units) merged in the
  *      order given: x, y, z kept only when every file has them; t becomes
  *      the acquisition order over all files; the group column kept only
  *      when every file has one (numbers offset per file);
