@@ -623,23 +623,47 @@ class Diagnosis:
             self.effect, self.rmse_before_mm, self.rmse_after_mm, self.noise_floor_mm)
 
 
-def diagnose(data, robot=None, seed=1, folds=5, steps=3, jumps=True, dequantize=False, q_step_deg=0.0,
-             len_step_mm=0.0, len_noise_mm=0.0, alpha=0.0, max_iter=0):
+def _path_list(v, what):
+    """One path or a list of paths as the "\\n"-separated bytes the C API takes (b"" for None)."""
+    if v is None:
+        return b"", []
+    paths = [os.fspath(p) for p in ([v] if isinstance(v, (str, bytes, os.PathLike)) else list(v))]
+    if not all(isinstance(p, str) for p in paths) or any("\n" in p or not p for p in paths):
+        raise ValueError(f"{what}: a path or a list of paths, none empty or with a newline")
+    return "\n".join(paths).encode(), paths
+
+
+def diagnose(data=None, robot=None, seed=1, folds=5, steps=3, jumps=True, dequantize=False, q_step_deg=0.0,
+             len_step_mm=0.0, len_noise_mm=0.0, alpha=0.0, max_iter=0, positions=None, effects=None,
+             known_jumps=False):
     """Which missing physical effect explains the residuals, as `rcal
-    diagnose` finds it (rch_diagnose_file): --data, --robot, --seed,
-    --folds, --steps, jumps=False for --no-jumps, --dequantize-joints,
-    --q-step-deg, --len-step-mm (0: detected, < 0: none), --len-noise-mm,
-    --alpha (0: 0.01), --max-iter (0: 100). Returns a Diagnosis."""
+    diagnose` finds it (rch_diagnose_inputs): data (--data: one path or a
+    list, one or several outlets), positions (--positions: tracker files,
+    one path or a list), both mixed, --robot, effects (--effects: those
+    already known), --seed, --folds, --steps, jumps=False for --no-jumps,
+    known_jumps=True for --jumps, --dequantize-joints, --q-step-deg,
+    --len-step-mm (0: detected, < 0: none), --len-noise-mm, --alpha (0:
+    0.01), --max-iter (0: 100). Returns a Diagnosis."""
     lib = _lib.lib()
     robot_given = robot is not None
     robot = default_robot() if robot is None else robot
+    dbytes, dlist = _path_list(data, "data")
+    pbytes, plist = _path_list(positions, "positions")
+    if not dlist and not plist:
+        raise ValueError("diagnose: give data (cable lengths) or positions (tracker), or both")
     h = ctypes.c_void_p()
     err = ctypes.create_string_buffer(_ERR_LEN)
-    flags = (0 if jumps else 1) | (2 if dequantize else 0)
-    _check(lib.rch_ffi_diagnose(ctypes.byref(h), _path(data), _path(robot), int(seed), int(folds), int(steps), flags,
-                                float(q_step_deg), float(len_step_mm), float(len_noise_mm), float(alpha),
-                                int(max_iter), err, _ERR_LEN), err)
-    return Diagnosis(h.value, os.fspath(data), robot_given)
+    flags = (0 if jumps else 1) | (2 if dequantize else 0) | (4 if known_jumps else 0)
+    if len(dlist) == 1 and not plist and effects is None and not known_jumps:  # the one-file call of before
+        _check(lib.rch_ffi_diagnose(ctypes.byref(h), _path(dlist[0]), _path(robot), int(seed), int(folds), int(steps),
+                                    flags, float(q_step_deg), float(len_step_mm), float(len_noise_mm), float(alpha),
+                                    int(max_iter), err, _ERR_LEN), err)
+    else:
+        _check(lib.rch_ffi_diagnose_inputs(ctypes.byref(h), dbytes, pbytes, _path(robot), _opt_str(effects),
+                                           int(seed), int(folds), int(steps), flags, float(q_step_deg),
+                                           float(len_step_mm), float(len_noise_mm), float(alpha), int(max_iter), err,
+                                           _ERR_LEN), err)
+    return Diagnosis(h.value, dlist[0] if dlist else plist[0], robot_given)
 
 
 Evaluation = collections.namedtuple("Evaluation", "metrics encoder_refitted encoder_mm encoder_shift_mm poses "

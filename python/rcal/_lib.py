@@ -68,6 +68,7 @@ def _declare(lib):
         "rch_ffi_calib_jumps": (i, [vp, _c_uint_p, _c_uint_p, _c_double_p, _c_double_p, u]),
         "rch_ffi_calib_outlets": (i, [vp, _c_uint_p, _c_int_p, u]),
         "rch_ffi_diagnose": (i, [pvp, cp, cp, ul, u, u, u, d, d, d, d, u, cp, sz]),
+        "rch_ffi_diagnose_inputs": (i, [pvp, cp, cp, cp, cp, ul, u, u, u, d, d, d, d, u, cp, sz]),
         "rch_ffi_diag_free": (None, [vp]),
         "rch_ffi_diag_verdict": (i, [vp, cp, sz, _c_uint_p, cp, sz, cp, sz]),
         "rch_ffi_diag_chosen": (i, [vp, u, cp, sz, _c_double_p, _c_double_p, _c_double_p]),

@@ -230,7 +230,8 @@ typedef struct rch_ffi_diag rch_ffi_diag; /* the result of one diagnosis */
 
 enum {
     RCH_FFI_DIAG_NO_JUMPS = 1,   /* --no-jumps */
-    RCH_FFI_DIAG_DEQUANTIZE = 2  /* --dequantize-joints */
+    RCH_FFI_DIAG_DEQUANTIZE = 2, /* --dequantize-joints */
+    RCH_FFI_DIAG_JUMPS = 4       /* --jumps: the jumps found are known (removed, not the verdict) */
 };
 /* Which missing effect explains the residuals, with the host function
  * `rcal diagnose` runs (rch_diagnose_file). seed, folds (0: 5), steps (0:
@@ -239,6 +240,14 @@ enum {
 int rch_ffi_diagnose(rch_ffi_diag **out, const char *data_path, const char *robot_path, unsigned long seed,
                      unsigned folds, unsigned steps, unsigned flags, double q_step_deg, double len_step_mm,
                      double len_noise_mm, double alpha, unsigned max_iter, char *err, size_t err_len);
+/* The same with every input `rcal diagnose` takes (rch_diagnose_inputs):
+ * data_paths and positions_paths each "\n"-separated (NULL or "": none; at
+ * most 16 each), effects the known effects as --effects names them (NULL:
+ * none). The handle keeps copies of the paths. */
+int rch_ffi_diagnose_inputs(rch_ffi_diag **out, const char *data_paths, const char *positions_paths,
+                            const char *robot_path, const char *effects, unsigned long seed, unsigned folds,
+                            unsigned steps, unsigned flags, double q_step_deg, double len_step_mm,
+                            double len_noise_mm, double alpha, unsigned max_iter, char *err, size_t err_len);
 void rch_ffi_diag_free(rch_ffi_diag *g);
 /* The verdict: effect ("length_jump", "cable_sag", ..., "none",
  * "unexplained") into effect (len), its 1-based joint (0: none) into

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_ffi_diag.c - the diagnosis of the flat C API (see rch_ffi.h):
- * rch_diagnose_file with the options of `rcal diagnose`, its verdict,
+ * rch_diagnose_file and rch_diagnose_inputs with the options of `rcal diagnose`, its verdict,
  * chosen effects, parameters, figures by name, Next command, residuals,
  * JSON and model file. Depends on: rch_diagnose. Memory: a diagnosis
  * handle on the heap, the caller's until rch_ffi_diag_free. Errors: a
@@ -22,6 +22,32 @@ int rch_ffip_diag_json(FILE *f, const void *ctx)
 
 /* ---- diagnosis ---- */
 
+/* The options of a diagnosis into cfg: 0, or a status with err set. */
+static int diag_cfg(rch_diagnose_cfg *cfg, unsigned long seed, unsigned folds, unsigned steps, unsigned flags,
+                    double q_step_deg, double len_step_mm, double len_noise_mm, double alpha, unsigned max_iter,
+                    char *err, size_t err_len)
+{
+    if ((folds && (folds < 2 || folds > RCH_DIAGNOSE_MAX_FOLDS)) || steps > RCH_DIAGNOSE_MAX_STEPS ||
+        !(q_step_deg >= -1 && q_step_deg <= 10) || !(len_step_mm >= -1 && len_step_mm <= 10) ||
+        !(len_noise_mm >= 0 && len_noise_mm <= 100) || !(alpha >= 0 && alpha <= 0.5) || max_iter > 100000)
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
+                    "diagnose: folds 2..20, steps 1..4, q_step_deg and len_step_mm -1..10, len_noise_mm 0..100, "
+                    "alpha 0..0.5, max_iter at most 100000");
+    memset(cfg, 0, sizeof *cfg);
+    cfg->folds = folds ? folds : 5;
+    cfg->max_steps = steps ? steps : 3;
+    cfg->seed = seed;
+    cfg->q_step_deg = q_step_deg;
+    cfg->len_step_mm = len_step_mm;
+    cfg->len_noise_mm = len_noise_mm;
+    cfg->alpha = alpha;
+    cfg->max_iter = max_iter;
+    cfg->no_jumps = (flags & RCH_FFI_DIAG_NO_JUMPS) != 0;
+    cfg->dequantize = (flags & RCH_FFI_DIAG_DEQUANTIZE) != 0;
+    cfg->jumps = (flags & RCH_FFI_DIAG_JUMPS) != 0;
+    return RCH_FFI_OK;
+}
+
 int rch_ffi_diagnose(rch_ffi_diag **out, const char *data_path, const char *robot_path, unsigned long seed,
                      unsigned folds, unsigned steps, unsigned flags, double q_step_deg, double len_step_mm,
                      double len_noise_mm, double alpha, unsigned max_iter, char *err, size_t err_len)
@@ -29,13 +55,12 @@ int rch_ffi_diagnose(rch_ffi_diag **out, const char *data_path, const char *robo
     if (!out || !data_path || !robot_path)
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "diagnose: NULL argument (data and robot are required)");
     *out = NULL;
-    if ((folds && (folds < 2 || folds > RCH_DIAGNOSE_MAX_FOLDS)) || steps > RCH_DIAGNOSE_MAX_STEPS ||
-        !(q_step_deg >= -1 && q_step_deg <= 10) || !(len_step_mm >= -1 && len_step_mm <= 10) ||
-        !(len_noise_mm >= 0 && len_noise_mm <= 100) || !(alpha >= 0 && alpha <= 0.5) || max_iter > 100000)
-        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
-                    "diagnose: folds 2..20, steps 1..4, q_step_deg and len_step_mm -1..10, len_noise_mm 0..100, "
-                    "alpha 0..0.5, max_iter at most 100000");
-    rch_ffi_diag *g = malloc(sizeof *g);
+    rch_diagnose_cfg cfg;
+    const int st = diag_cfg(&cfg, seed, folds, steps, flags, q_step_deg, len_step_mm, len_noise_mm, alpha, max_iter,
+                            err, err_len);
+    if (st != RCH_FFI_OK)
+        return st;
+    rch_ffi_diag *g = calloc(1, sizeof *g);
     if (!g)
         return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
     int too_long = 0;
@@ -45,21 +70,81 @@ int rch_ffi_diagnose(rch_ffi_diag **out, const char *data_path, const char *robo
         free(g);
         return fail(RCH_FFI_ERR_ARG, err, err_len, "diagnose: a path longer than %s bytes", "1023");
     }
-    rch_diagnose_cfg cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.folds = folds ? folds : 5;
-    cfg.max_steps = steps ? steps : 3;
-    cfg.seed = seed;
-    cfg.q_step_deg = q_step_deg;
-    cfg.len_step_mm = len_step_mm;
-    cfg.len_noise_mm = len_noise_mm;
-    cfg.alpha = alpha;
-    cfg.max_iter = max_iter;
-    cfg.no_jumps = (flags & RCH_FFI_DIAG_NO_JUMPS) != 0;
-    cfg.dequantize = (flags & RCH_FFI_DIAG_DEQUANTIZE) != 0;
     rch_diag d;
     memset(&d, 0, sizeof d);
     if (rch_diagnose_file(&g->r, g->data_path, g->robot_path, &cfg, &d) != 0) {
+        rch_diagnose_free(&g->r);
+        free(g);
+        return fail_diag(d.file[0] ? RCH_FFI_ERR_INPUT : RCH_FFI_ERR_SOLVER, err, err_len, &d);
+    }
+    *out = g;
+    return RCH_FFI_OK;
+}
+
+/* The "\n"-separated paths of list into g->files from slot at (v: their
+ * pointers); the count, or -1 when one is too long or there are too many. */
+static int split_paths(const char **v, rch_ffi_diag *g, size_t at, const char *list)
+{
+    int k = 0;
+    for (const char *p = list; p && *p;) {
+        const char *e = strchr(p, '\n');
+        const size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (len > 0) {
+            if (k >= RCH_DIAGNOSE_MAX_FILES || len >= PATH_LEN)
+                return -1;
+            memcpy(g->files[at + (size_t)k], p, len);
+            g->files[at + (size_t)k][len] = '\0';
+            v[k] = g->files[at + (size_t)k];
+            ++k;
+        }
+        p = e ? e + 1 : p + len;
+    }
+    return k;
+}
+
+int rch_ffi_diagnose_inputs(rch_ffi_diag **out, const char *data_paths, const char *positions_paths,
+                            const char *robot_path, const char *effects, unsigned long seed, unsigned folds,
+                            unsigned steps, unsigned flags, double q_step_deg, double len_step_mm,
+                            double len_noise_mm, double alpha, unsigned max_iter, char *err, size_t err_len)
+{
+    if (!out || !robot_path)
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "diagnose: NULL argument (the robot is required)");
+    *out = NULL;
+    rch_diagnose_cfg cfg;
+    const int st = diag_cfg(&cfg, seed, folds, steps, flags, q_step_deg, len_step_mm, len_noise_mm, alpha, max_iter,
+                            err, err_len);
+    if (st != RCH_FFI_OK)
+        return st;
+    rch_ffi_diag *g = calloc(1, sizeof *g);
+    if (!g)
+        return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
+    int too_long = 0;
+    rch_ffip_copy_opt(g->robot_path, robot_path, &too_long);
+    rch_ffip_copy_opt(g->effects, effects ? effects : "", &too_long);
+    const int nd = split_paths(g->data_v, g, 0, data_paths);
+    const int np = split_paths(g->pos_v, g, RCH_DIAGNOSE_MAX_FILES, positions_paths);
+    if (too_long || nd < 0 || np < 0) {
+        free(g);
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "diagnose: at most 16 files of each kind, each path shorter than %s "
+                                                   "bytes", "1024");
+    }
+    if (nd + np == 0) {
+        free(g);
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "diagnose: no data: give data or positions files");
+    }
+    if (nd > 0)
+        snprintf(g->data_path, sizeof g->data_path, "%s", g->data_v[0]);
+    rch_diagnose_in in;
+    memset(&in, 0, sizeof in);
+    in.data_paths = g->data_v;
+    in.n_data = (size_t)nd;
+    in.positions_paths = g->pos_v;
+    in.n_positions = (size_t)np;
+    in.robot_path = g->robot_path;
+    in.effects = g->effects[0] ? g->effects : NULL;
+    rch_diag d;
+    memset(&d, 0, sizeof d);
+    if (rch_diagnose_inputs(&g->r, &in, &cfg, &d) != 0) {
         rch_diagnose_free(&g->r);
         free(g);
         return fail_diag(d.file[0] ? RCH_FFI_ERR_INPUT : RCH_FFI_ERR_SOLVER, err, err_len, &d);

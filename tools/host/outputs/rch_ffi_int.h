@@ -63,6 +63,9 @@ struct rch_ffi_calib {
 struct rch_ffi_diag {
     rch_diagnose_result r;
     char data_path[PATH_LEN], robot_path[PATH_LEN];
+    char files[2 * RCH_DIAGNOSE_MAX_FILES][PATH_LEN]; /* rch_ffi_diagnose_inputs: the data, then the positions files */
+    const char *data_v[RCH_DIAGNOSE_MAX_FILES], *pos_v[RCH_DIAGNOSE_MAX_FILES];
+    char effects[1024];
 };
 
 /* Message into err (may be NULL) and the status back. */
