@@ -23,7 +23,6 @@ static double now_ns(void)
     return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
 }
 
-
 double rch_comp_u95_written(double u95_mm, int status, double miss_mm)
 {
     if (status == 3)
@@ -44,7 +43,7 @@ static void u95_line(const rch_cpi_ctx *c, unsigned line, double u95_mm)
  * (output still written), -1 range error (d set). cols: (6) columns of the
  * fields for diagnostics. */
 int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_deg[RC_NJ], unsigned line,
-                      const unsigned cols[RC_NJ], rch_diag *d)
+                       const unsigned cols[RC_NJ], rch_diag *d)
 {
     rc_real q[RC_NJ], qc[RC_NJ];
     const rc_model *m = c->cal;

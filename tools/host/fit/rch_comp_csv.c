@@ -52,7 +52,6 @@ int rch_cpi_parse_num(double *v, const char *text, size_t len)
     return rch_parse_double(buf, v);
 }
 
-
 /* One CSV line (not blank, not a comment). 0 ok, 1 not converged, -1 error. */
 int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d)
 {

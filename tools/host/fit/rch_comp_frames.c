@@ -63,8 +63,8 @@ static int rot_is_identity(const double v[7])
 /* The tool and work object the instruction that uses robtarget t names, as
  * the module declares them (or --tool for a tool it does not): 0, or -1
  * with why set. tool: --tool (3) or NULL. */
-int rch_cpi_robtarget_frames(rch_cpi_frames *fr, const rch_rapid_target *t, const double *tool, unsigned base, char *why,
-                            size_t why_len)
+int rch_cpi_robtarget_frames(rch_cpi_frames *fr, const rch_rapid_target *t, const double *tool, unsigned base,
+                             char *why, size_t why_len)
 {
     double fv[7] = {0, 0, 0, 1, 0, 0, 0}, wv[7] = {0, 0, 0, 1, 0, 0, 0};
     if (t->use_error[0]) {
@@ -150,7 +150,6 @@ void rch_cpi_tool0_pose(double pos[3], double quat[4], const rch_cpi_frames *fr,
     memcpy(pos, X.p, sizeof X.p);
     rch_ik_rot_to_quat(quat, X.R);
 }
-
 
 /* The robtarget read with fr whose flange (tool0) pose is pos, quat (4),
  * in place: T = W^-1 X F. */

@@ -55,7 +55,6 @@ static void rapid_refuse(rch_cpi_ctx *c, unsigned long *n_bad, rch_diag *d, cons
     ++*n_bad;
 }
 
-
 /* Compensate at tcp (3, flange frame): the job's stream when it is the
  * job's point, else one made for it (kept for the module). 0, or -1 with
  * why set. */
@@ -78,7 +77,8 @@ static int use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why, 
     const rch_comp_gate *g = c->gate;
     if (!g || !g->det_any || !g->cfg || !g->nominal || c->ntcps == RCH_CPI_MAX_TCPS) {
         snprintf(why, why_len, "its tool's TCP [%g,%g,%g] (flange frame) is not the point this compensation was set "
-                 "up for%s", tcp[0], tcp[1], tcp[2], c->ntcps == RCH_CPI_MAX_TCPS ? " (more than 16 TCPs in one module)" : "");
+                 "up for%s", tcp[0], tcp[1], tcp[2],
+                 c->ntcps == RCH_CPI_MAX_TCPS ? " (more than 16 TCPs in one module)" : "");
         return -1;
     }
     rch_cpi_tcp_stream *ts = calloc(1, sizeof *ts);
@@ -102,7 +102,6 @@ static int use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why, 
     c->fit = g->fit_any ? &ts->fit : NULL;
     return 0;
 }
-
 
 /* One robtarget: the nominal IK with its confdata gives the joints (of its
  * tool's TCP in its work object), the compensation corrects them at that

@@ -52,7 +52,6 @@ static const char *find_ci(const char *s, size_t n, const char *w)
     return NULL;
 }
 
-
 /* One line of at most MAX_LINE bytes into *line (grown as needed, '\n'
  * kept): its length, -1 at the end of the input, -2 when longer. */
 static long read_line(char **line, size_t *cap, FILE *in)
