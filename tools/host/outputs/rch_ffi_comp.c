@@ -18,7 +18,7 @@
 
 /* ---- compensation ---- */
 
-/* The compensation set-up of rch_comp_run (rch_comp.c): the determined
+/* The compensation set-up of rch_comp_run (rch_comp_run.c): the determined
  * model, the mode, the point both models move. Heap: too large for a
  * thread's stack, and no static state. */
 typedef struct {

@@ -1,0 +1,105 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_comp_int.h - what the compensation's files share: the state of one
+ * program going through (the job's stream and the streams made for other
+ * TCPs), the frames a robtarget is read in, and the steps each file does:
+ * one target through the stream and its gate (rch_comp.c), a CSV line or
+ * header (rch_comp_csv.c), a RAPID module (rch_comp_rapid.c) with its
+ * robtargets' frames (rch_comp_frames.c); the run and the lines
+ * (rch_comp_run.c) call them; the point and determined models are
+ * rch_comp_model.c. Internal to the compensation (prefix rch_cpi_), not part
+ * of the host library's API (rch_comp.h is).
+ * Depends on: rch_comp.h, rch_rapid.h. Memory: the streams for other TCPs
+ * on the heap (freed by rch_comp_lines_gated). Errors: -1 with d (or why)
+ * set. */
+#ifndef RCH_COMP_INT_H
+#define RCH_COMP_INT_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "rch_comp.h"
+#include "rch_rapid.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+#define RCH_CPI_MAX_FIELDS 64
+
+/* a stream compensating another TCP than the job's (a robtarget's tool) */
+typedef struct {
+    double tcp[3]; /* mm, flange frame */
+    rc_model det, nom, fit;
+    rc_comp_stream s;
+} rch_cpi_tcp_stream;
+#define RCH_CPI_MAX_TCPS 16
+
+typedef struct {
+    rc_comp_stream *stream;
+    const rc_model *cal, *fit; /* the stream's calibrated model, the full fit (may be NULL) at its point */
+    rc_comp_stream *stream0;   /* the job's: its TCP */
+    const rc_model *cal0, *fit0;
+    rch_cpi_tcp_stream *tcps[RCH_CPI_MAX_TCPS];
+    size_t ntcps;
+    const rch_comp_gate *gate;
+    rch_comp_result *res;
+    FILE *out, *warn;
+    const char *in_name;
+    int format; /* 0 auto, 1 csv, 2 rapid */
+    int have_header;
+    int qcol[RC_NJ]; /* header column of each joint */
+    unsigned nfields_header;
+} rch_cpi_ctx;
+
+/* A rigid pose: trans (mm), rotation (3 x 3, row-major). */
+typedef struct {
+    double p[3], R[9];
+} rch_cpi_pose;
+
+/* How robtarget t is read: the pose of its TCP (F, in tool0's frame) in its
+ * work object (W, in the base frame). */
+typedef struct {
+    rch_cpi_pose W, F;
+    int simple;       /* W is the base and F has tool0's orientation: the TCP path of rch_ik */
+    double tcp[3];    /* F's origin in the flange frame (mm): the point compensated */
+    int has_tcp;      /* not the flange */
+} rch_cpi_frames;
+
+/* rch_comp.c: one target */
+/* Compensate one target (degrees in, degrees out), gated by the posterior's
+ * u95 at the target. 0 ok, 1 not converged or left uncompensated (output
+ * still written), -1 range error (d set). cols: (6) columns of the fields
+ * for diagnostics. */
+int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_deg[RC_NJ], unsigned line,
+                       const unsigned cols[RC_NJ], rch_diag *d);
+
+/* rch_comp_csv.c: CSV lines */
+/* Split a line at commas. start[k]/len[k]: field k (trimmed); returns the
+ * number of fields, or -1 when more than RCH_CPI_MAX_FIELDS. */
+int rch_cpi_split_csv(const char *line, size_t n, size_t start[RCH_CPI_MAX_FIELDS], size_t len[RCH_CPI_MAX_FIELDS]);
+/* A number occupying exactly text[0..len) (rch_parse_double). 0 or -1. */
+int rch_cpi_parse_num(double *v, const char *text, size_t len);
+/* One CSV line (not blank, not a comment). 0 ok, 1 not converged, -1 error. */
+int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d);
+/* A header line: q1..q6 (or j1..j6) found, the line copied. 0 or -1. */
+int rch_cpi_csv_header(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d);
+
+/* rch_comp_rapid.c: a RAPID module */
+/* The rest of a RAPID input: the line already read (raw, got bytes) and
+ * everything after it, at most RCH_RAPID_MAX_BYTES, corrected all or
+ * nothing. 0, 1 (some flagged), -1 (d set). */
+int rch_cpi_rapid(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d);
+
+/* rch_comp_frames.c: a robtarget's frames */
+/* The tool and work object the instruction that uses robtarget t names, as
+ * the module declares them (or --tool for a tool it does not): 0, or -1
+ * with why set. tool: --tool (3) or NULL. base: the module's first line - 1. */
+int rch_cpi_robtarget_frames(rch_cpi_frames *fr, const rch_rapid_target *t, const double *tool, unsigned base,
+                             char *why, size_t why_len);
+/* The flange (tool0) pose of robtarget t read with fr: pos, quat (4). */
+void rch_cpi_tool0_pose(double pos[3], double quat[4], const rch_cpi_frames *fr, const rch_rapid_target *t);
+/* The robtarget read with fr whose flange (tool0) pose is pos, quat (4),
+ * in place: T = W^-1 X F. */
+void rch_cpi_target_pose(double pos[3], double quat[4], const rch_cpi_frames *fr);
+
+#endif
