@@ -143,6 +143,38 @@ static void hint_paths_of(hint_paths *h, const rch_calib_result *r)
     rch_shell_join(h->robot, sizeof h->robot, 1, &b);
 }
 
+/* The diagnosis of this run's inputs with what the run already fitted
+ * (its files, --jumps, --dequantize-joints, --effects: the diagnosis then
+ * offers only what the model lacks and ends at none when nothing is left),
+ * quoted for the shell, into buf. */
+static void diagnose_hint(char *buf, size_t len, const rch_calib_result *r)
+{
+    const rch_calib_cfg *c = &r->cfg;
+    const char *argv[12 + 4 * RCH_CALIB_MAX_FILES];
+    int n = 0;
+    argv[n++] = "rcal";
+    argv[n++] = "diagnose";
+    for (size_t k = 0; k < rch_calib_cfg_n_files(c) && k < RCH_CALIB_MAX_FILES; ++k) {
+        argv[n++] = "--data";
+        argv[n++] = rch_calib_cfg_file(c, k);
+    }
+    for (size_t k = 0; k < c->n_positions_paths && k < RCH_CALIB_MAX_FILES; ++k) {
+        argv[n++] = "--positions";
+        argv[n++] = c->positions_paths[k];
+    }
+    argv[n++] = "--robot";
+    argv[n++] = c->robot_path ? c->robot_path : "ROBOT.json";
+    if (c->jumps)
+        argv[n++] = "--jumps";
+    if (c->dequantize)
+        argv[n++] = "--dequantize-joints";
+    if (c->effects && c->effects[0]) {
+        argv[n++] = "--effects";
+        argv[n++] = c->effects;
+    }
+    rch_shell_join(buf, len, n, argv);
+}
+
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {
     const rch_model_unc *u = &r->unc;
@@ -204,10 +236,12 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
     }
     hint_paths hp;
     hint_paths_of(&hp, r);
+    char dh[2400];
+    diagnose_hint(dh, sizeof dh, r);
     if (outside)
         fprintf(f, "  next: %u parameter(s) OUTSIDE the prior's range are a real deviation (check the drawing) or "
-                   "stand in for an effect the model lacks: rcal diagnose --data %s --robot %s%s\n",
-                outside, hp.data, hp.robot, r->cfg.dequantize ? " --dequantize-joints" : "");
+                   "stand in for an effect the model lacks: %s\n",
+                outside, dh);
     fprintf(f,
             "predicted 3-D accuracy after compensation (95 %%, longest semi-axis of the flange-position "
             "ellipsoid): over the sampled region +-%.4f mm (median over the data's poses; max %.4f), whole "
@@ -345,9 +379,11 @@ static void print_summary(FILE *f, const rch_calib_result *r)
         fprintf(f, "  next: rcal calibrate --data %s --robot %s --jumps (the lengths jump and this fit does not model "
                    "them)\n",
                 hp.data, hp.robot);
-    else if (outside)
-        fprintf(f, "  next: rcal diagnose --data %s --robot %s%s (%u parameter%s outside the prior's range)\n",
-                hp.data, hp.robot, r->cfg.dequantize ? " --dequantize-joints" : "", outside, outside == 1 ? "" : "s");
+    else if (outside) {
+        char dh[2400];
+        diagnose_hint(dh, sizeof dh, r);
+        fprintf(f, "  next: %s (%u parameter%s outside the prior's range)\n", dh, outside, outside == 1 ? "" : "s");
+    }
     else if (accuracy_needs_poses(r))
         fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
                    "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",
