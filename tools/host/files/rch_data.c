@@ -593,3 +593,27 @@ int rch_data_outlets(uint8_t label[RC_MAX_OUTLETS], rc_sample *s, size_t n, rch_
     }
     return (int)k;
 }
+
+int rch_data_outlets_as(const uint8_t *label, unsigned n_labels, rc_sample *s, size_t n, const unsigned *lines,
+                        const char *name, rch_diag *d)
+{
+    for (size_t i = 0; i < n; ++i) {
+        if (s[i].sensor != RC_SENSOR_LENGTH)
+            continue;
+        unsigned k = 0;
+        while (k < n_labels && label[k] != s[i].outlet)
+            ++k;
+        if (k == n_labels) {
+            char list[4 * RC_MAX_OUTLETS + 1] = "";
+            for (unsigned j = 0, pos = 0; j < n_labels && pos < sizeof list; ++j)
+                pos += (unsigned)snprintf(list + pos, sizeof list - pos, "%s%u", j ? "," : "", label[j]);
+            rch_diag_set(d, name, lines ? lines[i] : 0, 0,
+                         "outlet %u is not an outlet of the model (its outlets, as the calibration's data labelled "
+                         "them: %s)",
+                         s[i].outlet, list);
+            return -1;
+        }
+        s[i].outlet = (uint8_t)k;
+    }
+    return 0;
+}

@@ -54,6 +54,13 @@ typedef struct rch_data {
  * model's e; label (RC_MAX_OUTLETS) receives each number's label. Returns
  * the number of outlets, or -1 with d set (more than RC_MAX_OUTLETS). */
 int rch_data_outlets(uint8_t label[RC_MAX_OUTLETS], rc_sample *s, size_t n, rch_diag *d);
+/* The other way: the labels of samples s (n) as read replaced by the outlet
+ * numbers a calibration gave them, label (n_labels) being the label of
+ * number k (what rch_data_outlets returned then), so that new data read with
+ * the same labels meet the same outlets. A label not among them is refused
+ * with its line (lines (n), may be NULL) in file name. 0, or -1 with d set. */
+int rch_data_outlets_as(const uint8_t *label, unsigned n_labels, rc_sample *s, size_t n, const unsigned *lines,
+                        const char *name, rch_diag *d);
 
 #define RCH_DATA_MAX_BYTES ((size_t)1 << 30) /* largest file loaded (1 GiB) */
 /* most rows loaded: 1 GiB of short rows is 60 million, about 35 GB for a

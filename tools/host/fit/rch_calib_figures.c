@@ -141,6 +141,10 @@ static int validate(rch_calib_result *r, rc_solve_work *w, rch_diag *d)
     char err[256];
     if (rch_data_load(&v, r->cfg.validate_path, 0, d) != 0)
         return -1;
+    if (rch_data_outlets_as(r->outlet_label, r->n_outlets, v.s, v.n, v.line, r->cfg.validate_path, d) != 0) {
+        rch_data_free(&v); /* the validation file's labels are the calibration data's */
+        return -1;
+    }
     int rc = rch_evaluate(&r->validate, &r->model, v.s, v.n, NULL, w, err, sizeof err);
     rch_data_free(&v);
     if (rc != 0) {

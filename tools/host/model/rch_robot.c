@@ -348,6 +348,46 @@ static int read_calibration(rch_robot *out, const rch_json *c, const char *name,
     return 0;
 }
 
+/* "outlet_labels": one distinct label 0..255 per outlet (encoder_mm first,
+ * then the outlet effects by number). Absent: 0 labels. 0 or -1 (d set). */
+static int read_outlet_labels(rch_robot *out, const rch_json *a, const char *name, rch_diag *d)
+{
+    out->n_outlet_labels = 0;
+    if (!a)
+        return 0;
+    unsigned outlets = 1;
+    for (unsigned e = 0; e < out->model.n_effects; ++e)
+        outlets += out->model.effects[e].kind == RC_EFF_OUTLET;
+    if (a->type != RCH_JARR || a->n != outlets) {
+        rch_diag_set(d, name, a->line, a->col, "\"outlet_labels\" must be an array of %u labels (the encoder's, then "
+                                              "one per outlet effect)", outlets);
+        return -1;
+    }
+    for (size_t k = 0; k < a->n; ++k) {
+        const rch_json *v = a->items[k];
+        if (v->type != RCH_JNUM || !(v->num >= 0 && v->num <= 255) || v->num != floor(v->num)) {
+            rch_diag_set(d, name, v->line, v->col, "an outlet label is an integer 0..255");
+            return -1;
+        }
+        for (size_t j = 0; j < k; ++j)
+            if (out->outlet_label[j] == (uint8_t)v->num) {
+                rch_diag_set(d, name, v->line, v->col, "outlet label %g twice", v->num);
+                return -1;
+            }
+        out->outlet_label[k] = (uint8_t)v->num;
+    }
+    out->n_outlet_labels = (unsigned)a->n;
+    return 0;
+}
+
+int rch_robot_outlets_of(const rch_robot *robot, rc_sample *s, size_t n, const unsigned *lines, const char *name,
+                         rch_diag *d)
+{
+    return robot->n_outlet_labels == 0
+               ? 0
+               : rch_data_outlets_as(robot->outlet_label, robot->n_outlet_labels, s, n, lines, name, d);
+}
+
 /* "uncertainty" of an rcal-model/2 file. */
 static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name, rch_diag *d)
 {
@@ -471,6 +511,8 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     if (read_prior(&out->prior, rch_json_get(root, "prior"), name, d) != 0)
         goto done;
     if (read_calibration(out, rch_json_get(root, "calibration"), name, d) != 0)
+        goto done;
+    if (read_outlet_labels(out, rch_json_get(root, "outlet_labels"), name, d) != 0)
         goto done;
     rc = 0;
 done:
@@ -607,6 +649,17 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
     }
     rch_jw_end(&w);
     write_numsf(&w, "encoder_mm", &m->x[RC_P_ENC], 3, "%.9g");
+    if (info && info->outlet_label && info->n_outlets > 0) {
+        int plain = 1; /* labels 0, 1, ... are the numbers: nothing to say */
+        for (unsigned k = 0; k < info->n_outlets; ++k)
+            plain &= info->outlet_label[k] == k;
+        if (!plain) {
+            rch_jw_arr(&w, "outlet_labels");
+            for (unsigned k = 0; k < info->n_outlets; ++k)
+                rch_jw_uint(&w, NULL, info->outlet_label[k]);
+            rch_jw_end(&w);
+        }
+    }
     if (m->n_effects) {
         rch_jw_arr(&w, "effects");
         for (unsigned i = 0; i < m->n_effects; ++i) {
@@ -651,7 +704,11 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
 int rch_load_model_and_data(struct rch_robot *robot, const char *model_path, rch_data *data, const char *data_path,
                             rch_diag *d)
 {
-    if (rch_robot_load(robot, model_path, d) != 0)
+    if (rch_robot_load(robot, model_path, d) != 0 || rch_data_load_limited(data, data_path, 0, &robot->model, d) != 0)
         return -1;
-    return rch_data_load_limited(data, data_path, 0, &robot->model, d) != 0 ? -1 : 0;
+    if (rch_robot_outlets_of(robot, data->s, data->n, data->line, data_path, d) != 0) {
+        rch_data_free(data);
+        return -1;
+    }
+    return 0;
 }

@@ -47,6 +47,9 @@ typedef struct rch_robot {
                                never applied to new data */
     double cal_jump_max_mm; /* the largest |size_mm| of them */
     char cal_data[512];     /* "data": the file the model was calibrated on */
+    unsigned n_outlet_labels; /* "outlet_labels": the data files' label of outlet k (k = 0: encoder_mm, k the
+                                 outlet effect numbered k); 0: absent (the labels are the numbers) */
+    uint8_t outlet_label[RC_MAX_OUTLETS];
 } rch_robot;
 
 /* Where a calibration came from (rcal-model/2 "provenance"). */
@@ -72,6 +75,9 @@ typedef struct rch_robot_info {
     const rch_model_unc *unc;      /* uncertainty, classes, determined model */
     const rc_model *determined;    /* the model compensation uses */
     const rch_provenance *prov;
+    const uint8_t *outlet_label;   /* (n_outlets) the data's label of outlet k, written as "outlet_labels" when
+                                      they are not simply 0, 1, ... (NULL: none) */
+    unsigned n_outlets;
 } rch_robot_info;
 
 /* Write a model file through rch_jw (every string escaped, non-finite numbers
@@ -91,6 +97,14 @@ void rch_robot_write_provenance(rch_jw *w, const rch_provenance *p);
 /* A command's two inputs: the robot (or calibrated) model file and a data
  * file, its joints inside the model's limits. 0, or -1 with d set (nothing
  * left allocated). */
+/* The data's outlet labels (rc_sample.outlet as read) replaced by the
+ * model's outlet numbers through robot's "outlet_labels" (when the file has
+ * them; else the labels are the numbers, as before). A label the model has
+ * no outlet for is refused with the file's line. lines (n) may be NULL. 0,
+ * or -1 with d set. */
+int rch_robot_outlets_of(const struct rch_robot *robot, rc_sample *s, size_t n, const unsigned *lines,
+                         const char *name, rch_diag *d);
+
 int rch_load_model_and_data(rch_robot *robot, const char *model_path, rch_data *data, const char *data_path,
                             rch_diag *d);
 

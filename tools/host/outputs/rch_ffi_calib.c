@@ -465,6 +465,10 @@ int rch_ffi_evaluate(double *out, const rch_ffi_model *m, const char *data_path,
     rch_diag d;
     if (rch_data_load_limited(&data, data_path, 0, &m->robot.model, &d) != 0)
         return fail_diag(RCH_FFI_ERR_INPUT, err, err_len, &d);
+    if (rch_robot_outlets_of(&m->robot, data.s, data.n, data.line, data_path, &d) != 0) {
+        rch_data_free(&data);
+        return fail_diag(RCH_FFI_ERR_INPUT, err, err_len, &d);
+    }
     const rch_evaluate_config cfg = {refit_encoder != 0, same_pose_deg > 0 ? same_pose_deg : 1e-6};
     rch_evaluate_result r;
     rc_solve_work *w = malloc(sizeof *w);
