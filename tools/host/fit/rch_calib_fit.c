@@ -141,7 +141,14 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     memset(&jc, 0, sizeof jc);
     jc.solve = scfg;
     jc.counts = &r->counts;
-    if (jumps_fit(r, w, fixed, &jc, tr, err, sizeof err) != 0) {
+    rc_model *warm = r->have_jump_at ? malloc(sizeof *warm) : NULL;
+    if (warm) { /* the last noise pass's fit at these change points: the final fit starts there */
+        *warm = r->jumps.model;
+        jc.warm = warm;
+    }
+    const int jf = jumps_fit(r, w, fixed, &jc, tr, err, sizeof err);
+    free(warm);
+    if (jf != 0) {
         if (r->n_test)
             rch_diag_set(d, "", 0, 0, "length jumps: %s: the training samples, %zu of the %zu rows after %zu held "
                          "out (--test-fraction 0 fits them all; or record more poses)", err, r->n_train,
@@ -210,7 +217,8 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
         rc_metrics m0;
         double noise = rc_eval(&m0, &r->before, train, r->n_train) == RC_OK && m0.rmse_mm > 0.0 ? m0.rmse_mm : 1.0;
         rc_sample *sorted = NULL;
-        if (r->cfg.jumps && (sorted = malloc(r->n_train * sizeof *sorted)) != NULL) {
+        rc_model *warm = r->cfg.jumps ? malloc(sizeof *warm) : NULL;
+        if (r->cfg.jumps && warm && (sorted = malloc(r->n_train * sizeof *sorted)) != NULL) {
             memcpy(sorted, train, r->n_train * sizeof *sorted);
             qsort(sorted, r->n_train, sizeof *sorted, cmp_t);
         }
@@ -220,16 +228,25 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
             const rc_sample *fs = train;
             const uint8_t *fx = fixed;
             uint8_t fxj[RC_MAX_PARAMS];
-            r->model = r->before;
+            if (pass == 0)
+                r->model = r->before; /* later passes start from the previous one's optimum */
             if (r->cfg.jumps && sorted) {
                 rch_jumps_config jc;
                 char err[256];
                 memset(&jc, 0, sizeof jc);
                 jc.solve = &cfg;
                 jc.counts = &r->counts;
-                if (pass <= 1 && !r->attach_m0)
-                    r->have_jump_at = 0; /* the change points depend on the prior's weight: searched again
-                                            until the noise is near its final value (pass 1), refitted after */
+                /* The change points depend on the prior's weight: searched
+                 * again until the noise is near its final value (pass 1),
+                 * refitted after, each refit from the previous pass's fit.
+                 * Pass 0 only gives pass 1 its noise: when the default run's
+                 * check found the points (jumps_auto), pass 0 refits there. */
+                if (!r->attach_m0 && (pass == 1 || (pass == 0 && !r->jumps_auto)))
+                    r->have_jump_at = 0;
+                if (pass > 0 && r->have_jump_at) {
+                    *warm = r->jumps.model;
+                    jc.warm = warm;
+                }
                 if (jumps_fit(r, w, fixed, &jc, sorted, err, sizeof err) != 0)
                     break; /* fit_jumps reports it */
                 fitm = &r->jumps.model;
@@ -262,9 +279,9 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 break;
         }
         free(sorted);
+        free(warm);
         r->noise_mm = cfg.prior_noise_mm = noise;
-        r->model = r->before;
-        if (st == RC_OK && !r->cfg.jumps)
+        if (st == RC_OK && !r->cfg.jumps) /* the last pass's optimum, at the settled noise */
             st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
     }
     *chi2 = r->cfg.jumps ? chi2_loop : INFINITY;

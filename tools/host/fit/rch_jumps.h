@@ -55,6 +55,11 @@ typedef struct rch_jumps_config {
      * the start model's parameters: the segment offsets are added there. */
     const rc_solve_config *solve;
     rch_fit_counts *counts; /* NULL, or where the search adds its fits and passes */
+    /* rch_jumps_refit only: NULL (start from start, offsets 0), or an earlier
+     * fit at the same change points (its model: start's parameters and the
+     * m + 1 segment offsets, or start's alone when m is 0) the fit starts
+     * from (a noise pass after another moves the optimum little). */
+    const rc_model *warm;
 } rch_jumps_config;
 
 typedef struct rch_jumps {
