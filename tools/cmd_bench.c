@@ -30,6 +30,11 @@ static void report_text(const rch_bench_result *r, const char *data_path)
     printf("  calibrate (rcal calibrate --test-fraction 0 in one process: files, fit, identifiability, uncertainty "
            "and its map): median %.2f ms (%.2f..%.2f)\n",
            r->calib_ms, r->calib_min_ms, r->calib_max_ms);
+    const double *sp = r->split_ms;
+    printf("    split (medians, ms): read %.2f, start model %.2f, MAP fits %.2f, jump search %.2f, figures and "
+           "uncertainty %.2f, writing the model file %.2f\n"
+           "    work: %u fits, %u residual-and-Jacobian passes\n",
+           sp[0], sp[1], sp[2], sp[3], sp[4], sp[5], r->calib_fits, r->calib_jac_passes);
     printf("  calibrate --no-prior --no-jump-check (least squares, no jump check: the work of the path before the\n"
            "    prior, the attachment test and the jump check): median %.2f ms (%.2f..%.2f); the default does %.1fx\n"
            "    its time (MAP noise passes, the attachment's evidence test, a jump search, a jump fit when found)\n",
@@ -69,6 +74,14 @@ static int report_json(const rch_bench_result *r, const char *data_path, int arg
     rch_jw_numf(&w, "median_ms", r->calib_ms, "%.4f");
     rch_jw_numf(&w, "min_ms", r->calib_min_ms, "%.4f");
     rch_jw_numf(&w, "max_ms", r->calib_max_ms, "%.4f");
+    static const char *const names[RCH_BENCH_N_SPLIT] = {"read_ms", "start_ms", "fits_ms", "jump_search_ms",
+                                                         "uncertainty_ms", "write_ms"};
+    rch_jw_obj(&w, "split_median");
+    for (unsigned j = 0; j < RCH_BENCH_N_SPLIT; ++j)
+        rch_jw_numf(&w, names[j], r->split_ms[j], "%.4f");
+    rch_jw_end(&w);
+    rch_jw_uint(&w, "fits", r->calib_fits);
+    rch_jw_uint(&w, "jacobian_passes", r->calib_jac_passes);
     rch_jw_end(&w);
     rch_jw_obj(&w, "diagnose");
     rch_jw_numf(&w, "median_ms", r->diag_ms, "%.4f");

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "rch_calib_effects.h"
 #include "rch_cost.h"
@@ -342,10 +343,14 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     if (rch_inputs_load(in, cfg, d) != 0) {
         free(in);
         return -1;
     }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    r->read_ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) / 1e6;
     const rch_data *data = &in->data;
     size_t n_cable = 0; /* the cost is the cable files' rows' */
     for (size_t f = 0; f < in->n_files; ++f)

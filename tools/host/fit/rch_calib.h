@@ -57,6 +57,12 @@ typedef struct rch_calib_result {
     rc_model model;           /* identified model */
     rc_solve_result solve;
     double time_ms;           /* the identification alone */
+    /* Where the run's time went (ms; wall clock) and how much work it did:
+     * reading the files, the start model, the MAP fits (noise passes and the
+     * attachment test), the jump search (the check's and --jumps'), the
+     * figures and uncertainty (rch_calib_finish). Writing is the caller's. */
+    double read_ms, start_ms, fits_ms, jumps_ms, uncert_ms;
+    rch_fit_counts counts;
     int finite;               /* every parameter of model is finite */
     int after_ok;             /* model is finite and gives finite lengths */
     rc_metrics before_m;      /* on the held-out samples (the training ones when none is held out) */

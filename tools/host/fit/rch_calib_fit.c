@@ -32,6 +32,19 @@ static double now_ms(void)
     return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
 }
 
+/* rc_solve, counted in r->counts (res may be NULL). */
+static rc_status solve_counted(rch_calib_result *r, rc_model *m, rc_solve_result *res, rc_solve_work *w,
+                               const rc_solve_config *cfg, const rc_sample *s, size_t n)
+{
+    rc_solve_result local;
+    rc_solve_result *out = res ? res : &local;
+    memset(out, 0, sizeof *out);
+    const rc_status st = rc_solve(m, out, w, cfg, s, n);
+    r->counts.fits++;
+    r->counts.jac_passes += out->cost_evals;
+    return st;
+}
+
 /* Effective number of parameters of a MAP fit at m: trace(H^-1 A), A = J^T J
  * of the data and H = A + W with W the prior rows' weights (rc_solve.h). The
  * noise estimate SSR / (n - p_eff) counts as fitted only what the data (not
@@ -86,7 +99,10 @@ static int jumps_fit(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
         r->jumps.rms_before_mm = r->jump_rms_before_mm; /* the geometry alone, from the search */
         return rc;
     }
-    if (rch_jumps_find(&r->jumps, &r->before, fixed, sorted, r->n_train, jc, w, err, errlen) != 0)
+    const double t0 = now_ms();
+    const int rc = rch_jumps_find(&r->jumps, &r->before, fixed, sorted, r->n_train, jc, w, err, errlen);
+    r->jumps_ms += now_ms() - t0;
+    if (rc != 0)
         return -1;
     r->jump_rms_before_mm = r->jumps.rms_before_mm;
     r->n_jump_at = r->jumps.n_jumps;
@@ -124,7 +140,15 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     rch_jumps_config jc;
     memset(&jc, 0, sizeof jc);
     jc.solve = scfg;
-    if (jumps_fit(r, w, fixed, &jc, tr, err, sizeof err) != 0) {
+    jc.counts = &r->counts;
+    rc_model *warm = r->have_jump_at ? malloc(sizeof *warm) : NULL;
+    if (warm) { /* the last noise pass's fit at these change points: the final fit starts there */
+        *warm = r->jumps.model;
+        jc.warm = warm;
+    }
+    const int jf = jumps_fit(r, w, fixed, &jc, tr, err, sizeof err);
+    free(warm);
+    if (jf != 0) {
         if (r->n_test)
             rch_diag_set(d, "", 0, 0, "length jumps: %s: the training samples, %zu of the %zu rows after %zu held "
                          "out (--test-fraction 0 fits them all; or record more poses)", err, r->n_train,
@@ -161,7 +185,9 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     memcpy(fxj, fixed, sizeof fxj);
     if (r->jumps.n_jumps) /* the first segment's offset is the reference */
         fxj[r->jumps.model.effects[r->jumps.model.n_effects - 1].first] = 1;
+    const double tu = now_ms();
     rc = rch_calib_finish(r, fxj, tr, &r->jumps.model, setup, d);
+    r->uncert_ms += now_ms() - tu;
 done:
     free(tr);
     free(ev);
@@ -191,7 +217,8 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
         rc_metrics m0;
         double noise = rc_eval(&m0, &r->before, train, r->n_train) == RC_OK && m0.rmse_mm > 0.0 ? m0.rmse_mm : 1.0;
         rc_sample *sorted = NULL;
-        if (r->cfg.jumps && (sorted = malloc(r->n_train * sizeof *sorted)) != NULL) {
+        rc_model *warm = r->cfg.jumps ? malloc(sizeof *warm) : NULL;
+        if (r->cfg.jumps && warm && (sorted = malloc(r->n_train * sizeof *sorted)) != NULL) {
             memcpy(sorted, train, r->n_train * sizeof *sorted);
             qsort(sorted, r->n_train, sizeof *sorted, cmp_t);
         }
@@ -201,15 +228,25 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
             const rc_sample *fs = train;
             const uint8_t *fx = fixed;
             uint8_t fxj[RC_MAX_PARAMS];
-            r->model = r->before;
+            if (pass == 0)
+                r->model = r->before; /* later passes start from the previous one's optimum */
             if (r->cfg.jumps && sorted) {
                 rch_jumps_config jc;
                 char err[256];
                 memset(&jc, 0, sizeof jc);
                 jc.solve = &cfg;
-                if (pass <= 1 && !r->attach_m0)
-                    r->have_jump_at = 0; /* the change points depend on the prior's weight: searched again
-                                            until the noise is near its final value (pass 1), refitted after */
+                jc.counts = &r->counts;
+                /* The change points depend on the prior's weight: searched
+                 * again until the noise is near its final value (pass 1),
+                 * refitted after, each refit from the previous pass's fit.
+                 * Pass 0 only gives pass 1 its noise: when the default run's
+                 * check found the points (jumps_auto), pass 0 refits there. */
+                if (!r->attach_m0 && (pass == 1 || (pass == 0 && !r->jumps_auto)))
+                    r->have_jump_at = 0;
+                if (pass > 0 && r->have_jump_at) {
+                    *warm = r->jumps.model;
+                    jc.warm = warm;
+                }
                 if (jumps_fit(r, w, fixed, &jc, sorted, err, sizeof err) != 0)
                     break; /* fit_jumps reports it */
                 fitm = &r->jumps.model;
@@ -222,7 +259,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 for (size_t i = 0; i < r->n_train; ++i)
                     sorted[i].group = (uint16_t)rch_jumps_segment(&r->jumps, sorted[i].t);
             } else {
-                st = rc_solve(&r->model, &r->solve, w, &cfg, train, r->n_train);
+                st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
                 if (st != RC_OK)
                     break;
             }
@@ -232,6 +269,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 break;
             chi2_loop = (ssr + rc_prior_cost(fitm, &pc)) / (noise * noise);
             r->p_eff = effective_params(fitm, &pc, fs, r->n_train);
+            r->counts.jac_passes++;
             r->noise_passes = pass + 1;
             const double dof = (double)r->n_train - r->p_eff;
             const double next = dof > 1.0 ? sqrt(ssr / dof) : noise;
@@ -241,10 +279,10 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 break;
         }
         free(sorted);
+        free(warm);
         r->noise_mm = cfg.prior_noise_mm = noise;
-        r->model = r->before;
-        if (st == RC_OK && !r->cfg.jumps)
-            st = rc_solve(&r->model, &r->solve, w, &cfg, train, r->n_train);
+        if (st == RC_OK && !r->cfg.jumps) /* the last pass's optimum, at the settled noise */
+            st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
     }
     *chi2 = r->cfg.jumps ? chi2_loop : INFINITY;
     if (st == RC_OK && !r->cfg.jumps) {
@@ -296,6 +334,7 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
     if (r->cfg.jumps && j1.n_jumps)
         fx[j1.model.effects[j1.model.n_effects - 1].first] = 1;
     double occam = 0.0;
+    r->counts.jac_passes++;
     if (rch_uncert_compute_map(&u, fm, fx, train, NULL, r->n_train, 0, r->prior_sd, noise1, err, sizeof err) != 0)
         return RC_OK; /* keep the attachment */
     for (int k = 0; k < 3; ++k)
@@ -357,7 +396,11 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
         char err[128];
         memset(&jc, 0, sizeof jc);
         jc.solve = cfg;
-        if (rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0) {
+        jc.counts = &r->counts;
+        const double t0 = now_ms();
+        const int found = rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0;
+        r->jumps_ms += now_ms() - t0;
+        if (found) {
             r->n_jump_at = j->n_jumps; /* every change point found: the nuisance fit starts from them */
             r->jump_check_steps = j->n_jumps;
             r->jump_rms_before_mm = j->rms_before_mm;
@@ -389,8 +432,10 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
 {
     if (!r->keep_jump_at)
         r->have_jump_at = 0; /* a new training set: its change points are searched */
+    const double ts = now_ms();
     if (rch_calib_start(&r->before, w, &r->robot, train, r->n_train, d) != 0)
         return -1;
+    r->start_ms += now_ms() - ts;
     r->model = r->before;
     uint8_t fixed[RC_MAX_PARAMS];
     memset(fixed, 0, sizeof fixed);
@@ -412,7 +457,7 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
         cfg.prior_mean = r->prior_mean;
         cfg.prior_sd = r->prior_sd;
     }
-    const double t0 = now_ms();
+    const double t0 = now_ms(), jumps0 = r->jumps_ms;
     rc_status st = RC_OK;
     if (r->prior_on) {
         double chi2_1 = 0.0;
@@ -420,9 +465,10 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
         if (st == RC_OK && r->attach_auto)
             st = choose_attachment(r, w, &cfg, fixed, train, chi2_1);
     } else {
-        st = rc_solve(&r->model, &r->solve, w, &cfg, train, r->n_train);
+        st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
     }
     r->time_ms = now_ms() - t0;
+    r->fits_ms += r->time_ms - (r->jumps_ms - jumps0);
     if (st != RC_OK) {
         rch_diag_set(d, "", 0, 0, "solver failed: %s", rc_strerror(st));
         return -1;
@@ -434,7 +480,10 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
     const size_t n_eval = r->n_test ? r->n_test : r->n_train;
     rc_eval(&r->before_m, &r->before, eval_set, n_eval);
     if (r->cfg.jumps) {
-        return fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
+        const double tj = now_ms(), u0 = r->uncert_ms, j0 = r->jumps_ms;
+        const int rc = fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
+        r->fits_ms += now_ms() - tj - (r->uncert_ms - u0) - (r->jumps_ms - j0); /* the refit at the points */
+        return rc;
     }
     if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40 && !r->n_pos_rows) { /* jumps: a cable's */
         jump_check(r, w, fixed, &cfg, train);
@@ -461,5 +510,8 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
     }
     if (!train_ok)
         memset(&r->train_after, 0, sizeof r->train_after);
-    return rch_calib_finish(r, fixed, train, &r->model, NULL, d);
+    const double tu = now_ms();
+    const int rc = rch_calib_finish(r, fixed, train, &r->model, NULL, d);
+    r->uncert_ms += now_ms() - tu;
+    return rc;
 }

@@ -19,10 +19,37 @@ unsigned rch_jumps_segment(const rch_jumps *j, double t)
     return k;
 }
 
+/* A fit at change points from_at (from_m) whose solution starts another:
+ * its geometry, and each new segment the offset of the old segment its first
+ * row lay in (a new change point splits one old segment into two equal
+ * ones; a dropped one merges two into the first's). */
+typedef struct warm_from {
+    const rc_model *model; /* start's parameters, then the from_m + 1 offsets when from_m > 0 */
+    const size_t *at;
+    unsigned m;
+} warm_from;
+
+static void warm_start(rc_model *mdl, const rc_model *start, const warm_from *wf, const size_t *at, unsigned m)
+{
+    memcpy(mdl->x, wf->model->x, start->n_params * sizeof mdl->x[0]);
+    if (m == 0 || wf->m == 0)
+        return;
+    const unsigned nf = mdl->effects[mdl->n_effects - 1].first, of = wf->model->effects[wf->model->n_effects - 1].first;
+    for (unsigned j = 0; j <= m; ++j) {
+        const size_t first = j ? at[j - 1] : 0;
+        unsigned old = 0;
+        while (old < wf->m && wf->at[old] <= first)
+            ++old;
+        mdl->x[nf + j] = wf->model->x[of + old] - wf->model->x[of];
+    }
+}
+
 /* Model = start + segment offsets (first held at 0), fitted on s labelled
- * by the change points at[0..m-1] (indices into s). */
+ * by the change points at[0..m-1] (indices into s), from start or (wf not
+ * NULL) warm from an earlier fit. */
 static int fit_segments(rc_model *out, double *ssr, const rc_model *start, const uint8_t *fixed, rc_sample *s,
-                        size_t n, const size_t *at, unsigned m, const rc_solve_config *base, rc_solve_work *w)
+                        size_t n, const size_t *at, unsigned m, const rc_solve_config *base, rc_solve_work *w,
+                        rch_fit_counts *counts, const warm_from *wf)
 {
     rc_model mdl = *start;
     unsigned seg = 0;
@@ -40,12 +67,21 @@ static int fit_segments(rc_model *out, double *ssr, const rc_model *start, const
             return -1;
         fx[mdl.effects[mdl.n_effects - 1].first] = 1; /* first segment: the reference */
     }
+    if (wf && wf->model && wf->model->n_params >= start->n_params)
+        warm_start(&mdl, start, wf, at, m);
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
     if (base)
         cfg = *base;
     cfg.fixed = fx;
-    if (rc_solve(&mdl, NULL, w, &cfg, s, n) != RC_OK)
+    rc_solve_result res;
+    memset(&res, 0, sizeof res);
+    const rc_status st = rc_solve(&mdl, &res, w, &cfg, s, n);
+    if (counts) {
+        counts->fits++;
+        counts->jac_passes += res.cost_evals;
+    }
+    if (st != RC_OK)
         return -1;
     if (rc_cost(ssr, &mdl, s, n) != RC_OK)
         return -1;
@@ -151,7 +187,7 @@ static void jump_sizes(rch_jumps *j, const rc_sample *s, size_t n)
  * the points, the geometry without the nuisance offsets, and the sizes with
  * their standard errors (c: the samples' copy, relabelled here). */
 static void finish(rch_jumps *out, const rc_model *cur, double ssr, const rc_sample *s, rc_sample *c, size_t n,
-                   const size_t *at, unsigned m)
+                   const size_t *at, unsigned m, rch_fit_counts *cnt)
 {
     out->n_jumps = m;
     out->model = *cur;
@@ -168,6 +204,8 @@ static void finish(rch_jumps *out, const rc_model *cur, double ssr, const rc_sam
     for (size_t i = 0; i < n; ++i)
         c[i].group = (uint16_t)rch_jumps_segment(out, c[i].t);
     jump_sizes(out, c, n);
+    if (cnt && m > 0)
+        cnt->jac_passes++; /* the sizes' covariance */
 }
 
 int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, const rc_sample *s, size_t n,
@@ -178,6 +216,7 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
     unsigned max_j = cfg && cfg->max_jumps ? cfg->max_jumps : (unsigned)(n / 20);
     double factor = cfg && cfg->size_factor > 0 ? cfg->size_factor : 3.0;
     const rc_solve_config *base = cfg ? cfg->solve : NULL;
+    rch_fit_counts *cnt = cfg ? cfg->counts : NULL;
     if (max_j > RCH_JUMPS_MAX)
         max_j = RCH_JUMPS_MAX;
     if (n < 2 * min_seg + 30) {
@@ -194,7 +233,7 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
     unsigned m = 0;
     double ssr;
     rc_model cur;
-    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, base, w) != 0) {
+    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, base, w, cnt, NULL) != 0) {
         snprintf(err, errlen, "the geometric fit failed");
         free(c);
         return -1;
@@ -205,6 +244,8 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
     /* forward: add the best change point while the penalised fit improves */
     while (m < max_j) {
         size_t k = best_candidate(&cur, fixed, c, n, at, m, min_seg);
+        if (cnt)
+            cnt->jac_passes++; /* the Jacobian at the fit */
         if (k == 0)
             break;
         size_t trial[RCH_JUMPS_MAX + 1];
@@ -213,7 +254,8 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
         qsort(trial, m + 1, sizeof *trial, cmp_size);
         rc_model nm;
         double ssr2;
-        if (fit_segments(&nm, &ssr2, start, fixed, c, n, trial, m + 1, base, w) != 0)
+        const warm_from wf = {&cur, at, m}; /* the fit at hand: the new segment's offset starts at its parent's */
+        if (fit_segments(&nm, &ssr2, start, fixed, c, n, trial, m + 1, base, w, cnt, &wf) != 0)
             break;
         if (!((double)n * log(ssr / ssr2) > pen))
             break;
@@ -237,15 +279,19 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
         }
         if (drop == m)
             break;
+        size_t old_at[RCH_JUMPS_MAX + 1];
+        const rc_model old = cur;
+        memcpy(old_at, at, m * sizeof *at);
+        const warm_from wf = {&old, old_at, m};
         memmove(&at[drop], &at[drop + 1], (m - drop - 1) * sizeof *at);
         --m;
-        if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, base, w) != 0) {
+        if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, base, w, cnt, &wf) != 0) {
             snprintf(err, errlen, "refit without a jump failed");
             free(c);
             return -1;
         }
     }
-    finish(out, &cur, ssr, s, c, n, at, m);
+    finish(out, &cur, ssr, s, c, n, at, m, cnt);
     free(c);
     return 0;
 }
@@ -255,6 +301,7 @@ int rch_jumps_refit(rch_jumps *out, const rc_model *start, const uint8_t *fixed,
                     size_t errlen)
 {
     const rc_solve_config *base = cfg ? cfg->solve : NULL;
+    rch_fit_counts *cnt = cfg ? cfg->counts : NULL;
     if (m > RCH_JUMPS_MAX) {
         snprintf(err, errlen, "more than %d jumps", RCH_JUMPS_MAX);
         return -1;
@@ -273,12 +320,15 @@ int rch_jumps_refit(rch_jumps *out, const rc_model *start, const uint8_t *fixed,
     memset(out, 0, sizeof *out);
     double ssr;
     rc_model cur;
-    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, base, w) != 0) {
+    warm_from wf = {cfg ? cfg->warm : NULL, at, m};
+    if (wf.model && wf.model->n_params != start->n_params + (m ? m + 1 : 0))
+        wf.model = NULL; /* not a fit at these change points */
+    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, m, base, w, cnt, wf.model ? &wf : NULL) != 0) {
         snprintf(err, errlen, "the fit at the given change points failed");
         free(c);
         return -1;
     }
-    finish(out, &cur, ssr, s, c, n, at, m);
+    finish(out, &cur, ssr, s, c, n, at, m, cnt);
     out->rms_before_mm = out->rms_after_mm;
     free(c);
     return 0;

@@ -37,6 +37,14 @@
 
 #define RCH_JUMPS_MAX 32
 
+/* The work a fit pipeline did, counted by whoever is handed one (no
+ * global): solver runs and residual-and-Jacobian passes over the samples
+ * (the solver's normal equations, a Jacobian for a search or a covariance). */
+typedef struct rch_fit_counts {
+    unsigned fits;        /* rc_solve runs */
+    unsigned jac_passes;  /* passes computing residuals and Jacobian rows */
+} rch_fit_counts;
+
 typedef struct rch_jumps_config {
     size_t min_seg;       /* rows between change points, 0: 5 */
     unsigned max_jumps;   /* 0: min(RCH_JUMPS_MAX, n / 20) */
@@ -46,6 +54,12 @@ typedef struct rch_jumps_config {
      * prior's arrays must cover RC_MAX_PARAMS entries, 0 (no prior) past
      * the start model's parameters: the segment offsets are added there. */
     const rc_solve_config *solve;
+    rch_fit_counts *counts; /* NULL, or where the search adds its fits and passes */
+    /* rch_jumps_refit only: NULL (start from start, offsets 0), or an earlier
+     * fit at the same change points (its model: start's parameters and the
+     * m + 1 segment offsets, or start's alone when m is 0) the fit starts
+     * from (a noise pass after another moves the optimum little). */
+    const rc_model *warm;
 } rch_jumps_config;
 
 typedef struct rch_jumps {

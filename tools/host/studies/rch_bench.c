@@ -3,6 +3,7 @@
 #include "rch_bench.h"
 #include "rch_diagnose.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -72,11 +73,14 @@ static int bench_method(rch_bench_row *row, rc_method method, unsigned long runs
 /* The whole calibrate path (rch_calib_run, every sample in training),
  * runs times, by default or (least_squares) with --no-prior --no-jump-check;
  * t (runs) scratch; med, lo, hi: the median and range. */
-static int bench_calibrate(double *med, double *lo, double *hi, const rch_bench_cfg *cfg, int least_squares,
-                           double *t, rch_diag *d)
+static int bench_calibrate(double *med, double *lo, double *hi, rch_bench_result *split, const rch_bench_cfg *cfg,
+                           int least_squares, double *t, rch_diag *d)
 {
     rch_calib_result *cr = malloc(sizeof *cr);
-    if (!cr) {
+    double *ts = malloc(cfg->runs * RCH_BENCH_N_SPLIT * sizeof *ts); /* (RCH_BENCH_N_SPLIT x runs) */
+    if (!cr || !ts) {
+        free(cr);
+        free(ts);
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
@@ -90,12 +94,33 @@ static int bench_calibrate(double *med, double *lo, double *hi, const rch_bench_
         const double t0 = now_ms();
         const int rc = rch_calib_run(cr, &cc, d);
         t[k] = now_ms() - t0;
+        double tw = 0.0;
+        if (rc == 0 && split) { /* writing the model file: to a temporary file */
+            FILE *f = tmpfile();
+            const double t1 = now_ms();
+            if (f) {
+                rch_calib_write_model(f, cr);
+                fclose(f);
+            }
+            tw = now_ms() - t1;
+        }
         if (rc != 0) {
             free(cr);
+            free(ts);
             return -1;
         }
+        const double sp[RCH_BENCH_N_SPLIT] = {cr->read_ms, cr->start_ms, cr->fits_ms, cr->jumps_ms, cr->uncert_ms, tw};
+        for (unsigned j = 0; j < RCH_BENCH_N_SPLIT; ++j)
+            ts[j * cfg->runs + k] = sp[j];
+        if (split) {
+            split->calib_fits = cr->counts.fits;
+            split->calib_jac_passes = cr->counts.jac_passes;
+        }
     }
+    for (unsigned j = 0; split && j < RCH_BENCH_N_SPLIT; ++j)
+        med_range(&split->split_ms[j], NULL, NULL, ts + j * cfg->runs, cfg->runs);
     free(cr);
+    free(ts);
     med_range(med, lo, hi, t, cfg->runs);
     return 0;
 }
@@ -170,9 +195,9 @@ int rch_bench_run(rch_bench_result *r, const rch_bench_cfg *cfg, rch_diag *d)
     for (size_t k = 0; k < RCH_BENCH_N_METHODS && rc == 0; ++k)
         rc = bench_method(&r->rows[k], k_methods[k], cfg->runs, w, &robot, &data, t_start, t_solve, d);
     if (rc == 0)
-        rc = bench_calibrate(&r->calib_ms, &r->calib_min_ms, &r->calib_max_ms, cfg, 0, t_solve, d);
+        rc = bench_calibrate(&r->calib_ms, &r->calib_min_ms, &r->calib_max_ms, r, cfg, 0, t_solve, d);
     if (rc == 0)
-        rc = bench_calibrate(&r->calib_ls_ms, &r->calib_ls_min_ms, &r->calib_ls_max_ms, cfg, 1, t_solve, d);
+        rc = bench_calibrate(&r->calib_ls_ms, &r->calib_ls_min_ms, &r->calib_ls_max_ms, NULL, cfg, 1, t_solve, d);
     if (rc == 0 && cfg->diag_runs)
         rc = bench_diagnose(&r->diag_ms, &r->diag_min_ms, &r->diag_max_ms, NULL, cfg, 0, t_solve, d);
     if (rc == 0 && cfg->diag_runs && cfg->positions_path)

@@ -32,6 +32,8 @@
 /* runs x samples x methods at most (about 8 minutes) */
 #define RCH_BENCH_MAX_WORK 1e7
 
+#define RCH_BENCH_N_SPLIT 6 /* read, start, fits, jumps, uncertainty, write */
+
 typedef struct rch_bench_cfg {
     const char *data_path;  /* measurements (every sample is fitted) */
     const char *robot_path; /* nominal robot model */
@@ -54,6 +56,11 @@ typedef struct rch_bench_result {
     rch_bench_row rows[RCH_BENCH_N_METHODS];     /* lm first: the reference of the ratios */
     double calib_ms, calib_min_ms, calib_max_ms; /* rch_calib_run, --test-fraction 0, default method */
     double calib_ls_ms, calib_ls_min_ms, calib_ls_max_ms; /* the same with --no-prior --no-jump-check */
+    /* The default run's split (medians, ms): reading the files, the start
+     * model, the MAP fits, the jump search, figures and uncertainty, writing
+     * the model file (to a temporary file); and its work (the last run). */
+    double split_ms[RCH_BENCH_N_SPLIT];
+    unsigned calib_fits, calib_jac_passes;
     double diag_ms, diag_min_ms, diag_max_ms;    /* rch_diagnose_inputs on the data, defaults (diag_runs) */
     double diag_pos_ms, diag_pos_min_ms, diag_pos_max_ms; /* on positions_path (diag_runs; 0: not given) */
     size_t diag_pos_rows;                        /* its position rows */
