@@ -485,7 +485,9 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
         r->fits_ms += now_ms() - tj - (r->uncert_ms - u0) - (r->jumps_ms - j0); /* the refit at the points */
         return rc;
     }
-    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40 && !r->n_pos_rows) { /* jumps: a cable's */
+    /* jumps: a cable's display; several outlets' rows interleave in acquisition order, where a step of the
+     * sequence is no display's event (their jumps only with --jumps, as rcal diagnose) */
+    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40 && !r->n_pos_rows && r->n_outlets <= 1) {
         jump_check(r, w, fixed, &cfg, train);
         if (r->jumps_found && !r->cfg.residuals_path) {
             /* fit them as nuisance, as --jumps does: the default run never
