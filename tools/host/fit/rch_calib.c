@@ -329,6 +329,71 @@ static int fit_effects(rch_calib_result *r, const rch_calib_cfg *cfg, size_t n_l
     return 0;
 }
 
+/* The rows the fit cannot reconcile with the rest (rch_calib_screen): none,
+ * or the calibration again without them, from the start (the same inputs,
+ * effects and split seed), the screen's findings kept. Every row is screened
+ * again under the refitted model, until the rows left out no longer change
+ * (at most RCH_SCREEN_ROUNDS fits): a row that only the first, contaminated
+ * fit put far off comes back. Not with length jumps fitted (their offsets
+ * are the fit's, not the model's) or a model that did not fit. 0, or -1 with
+ * d set (refused: too many). */
+#define RCH_SCREEN_ROUNDS 4
+static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, rch_diag *d)
+{
+    if (!r->after_ok || r->have_jumps || r->jumps_auto || r->jumps_found)
+        return 0;
+    rch_data *data = &in->data;
+    const size_t n = data->n;
+    uint8_t *drop = malloc(n ? n : 1), *prev = calloc(n ? n : 1, 1);
+    rc_sample *s0 = malloc((n ? n : 1) * sizeof *s0);
+    unsigned *l0 = malloc((n ? n : 1) * sizeof *l0), *f0 = malloc((n ? n : 1) * sizeof *f0);
+    int rc = 0;
+    if (!drop || !prev || !s0 || !l0 || !f0) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        rc = -1;
+        goto done;
+    }
+    memcpy(s0, data->s, n * sizeof *s0); /* every row, for each round's screen */
+    memcpy(l0, data->line, n * sizeof *l0);
+    memcpy(f0, in->file_of, n * sizeof *f0);
+    for (unsigned round = 0; round < RCH_SCREEN_ROUNDS; ++round) {
+        const int out = rch_calib_screen(r, drop, s0, n, l0, f0, d);
+        if (out < 0) {
+            rc = -1;
+            break;
+        }
+        if (memcmp(drop, prev, n) == 0) /* the same rows as the fit at hand left out: done */
+            break;
+        memcpy(prev, drop, n);
+        const rch_calib_screen_result keep = r->screen;
+        size_t k = 0;
+        for (size_t i = 0; i < n; ++i)
+            if (!drop[i]) {
+                data->s[k] = s0[i];
+                data->line[k] = l0[i];
+                in->file_of[k++] = f0[i];
+            }
+        data->n = k;
+        const rch_calib_cfg cfg = r->cfg;
+        memset(r, 0, sizeof *r);
+        r->cfg = cfg;
+        take_inputs(r, in);
+        rc = fit_effects(r, &cfg, rch_pos_count_lengths(data->s, data->n), d);
+        if (rc == 0)
+            rc = run_once(r, w, data->s, data->n, cfg.seed, NULL, d);
+        r->screen = keep;
+        if (rc != 0 || !r->after_ok)
+            break;
+    }
+done:
+    free(drop);
+    free(prev);
+    free(s0);
+    free(l0);
+    free(f0);
+    return rc;
+}
+
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
 {
     memset(r, 0, sizeof *r);
@@ -376,6 +441,8 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
         rc = run_cases(r, w, data, d);
     else
         rc = run_once(r, w, data->s, data->n, cfg->seed, held, d);
+    if (rc == 0 && cfg->cases <= 1 && !cfg->no_screen && !cfg->residuals_path)
+        rc = screen_and_refit(r, w, in, d);
     if (rc == 0 && cfg->residuals_path && r->finite && save_residuals(r, data, in->file_of, held, d) != 0)
         rc = -1;
     if (rc == 0 && r->have_jumps && r->prov.n_files == 1)

@@ -49,6 +49,32 @@
  * most it can take when nothing converges early (the iteration cap). */
 double rch_calib_estimate_s(const rch_calib_cfg *cfg, size_t n_rows, double *bound_s);
 
+/* The rows a fit cannot reconcile with the rest (rch_calib_screen.c): beyond
+ * RCH_SCREEN_K robust standard deviations of their sensor's residuals (and
+ * RCH_SCREEN_FLOOR_MM), left out of the refit; more than
+ * RCH_SCREEN_MAX_SHARE of the rows: the file is refused. */
+#define RCH_SCREEN_K 8.0
+#define RCH_SCREEN_FLOOR_MM 0.05
+#define RCH_SCREEN_MAX_SHARE 0.05
+#define RCH_SCREEN_MAX_NAMED 64
+typedef struct rch_screen_row {
+    unsigned line, file;   /* the data file's line; file: the input's index (cable files, then positions) */
+    double residual_mm;    /* |model - measured| (a tracker row: its largest coordinate) under the first fit */
+    double scale_mm;       /* its sensor's robust scale */
+    int tracker;           /* a position row (else a length) */
+    unsigned label_fits;   /* 1 + the outlet label whose place explains the length (a wrong label), 0: none */
+    int block;             /* one of three or more out rows in a row (a different session) */
+} rch_screen_row;
+typedef struct rch_calib_screen_result {
+    size_t rows, out;      /* rows screened, rows left out */
+    double scale_mm[2];    /* the robust scale of the cable's and the tracker's residuals */
+    unsigned n_named;      /* (at most RCH_SCREEN_MAX_NAMED) */
+    rch_screen_row row[RCH_SCREEN_MAX_NAMED];
+} rch_calib_screen_result;
+
+/* What an out row likely is, in words. */
+const char *rch_screen_kind(const rch_screen_row *w);
+
 typedef struct rch_calib_result {
     rch_calib_cfg cfg;        /* as given (paths point at the caller's strings) */
     rch_robot robot;          /* the robot file; robot.model has the tool offset when asked */
@@ -126,6 +152,7 @@ typedef struct rch_calib_result {
     int have_pos;             /* the 3-D figures below are set */
     rch_pos_err pos_before, pos_after; /* held-out positions (the training ones when none is held out) */
     rch_pos_err pos_train_after;
+    rch_calib_screen_result screen; /* the rows left out as irreconcilable (screen.out 0: none) */
 } rch_calib_result;
 
 /* The whole calibration: the inputs (rch_inputs_load), the cost (refused
@@ -139,6 +166,9 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d);
 
 /* The text report (the paper's Table 7 form, identifiability, solver line). */
 void rch_calib_print(FILE *f, const rch_calib_result *r);
+/* The rows the fit left out (r->screen), one line each: "FILE:LINE: left
+ * out: ... likely ...", each line after prefix. */
+void rch_calib_print_screened(FILE *f, const rch_calib_result *r, const char *prefix);
 /* The report as one JSON object (rch_jw), "rcal-calibrate/1", starting with
  * rch_jw_header's members (argv: the command line from the command's name;
  * argc 0 gives "rcal"). docs/json-formats.md. 0, or -1 on a write error. */

@@ -45,6 +45,7 @@ typedef struct rch_calib_cfg {
     size_t n_positions_paths;
     int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
     double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
+    int no_screen;          /* 1: every row fitted, none screened out (rch_calib_screen.c) */
     double max_minutes;     /* refuse a run estimated longer (rch_calib_estimate_s); 0: 60 */
 } rch_calib_cfg;
 

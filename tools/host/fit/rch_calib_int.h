@@ -42,4 +42,11 @@ void rch_calib_jump_counts(char *buf, size_t len, const struct rch_calib_result 
  * without one). */
 const char *rch_calib_data_name(const struct rch_calib_result *r);
 
+/* rch_calib_screen.c: the rows of s (n; their lines and files) the fitted
+ * r->model cannot reconcile with the rest, marked in drop (n) and named in
+ * r->screen. Returns how many rows are out (0: none), or -1 with d set when
+ * too many are (the file refused) or memory runs out. */
+int rch_calib_screen(struct rch_calib_result *r, uint8_t *drop, const rc_sample *s, size_t n, const unsigned *line,
+                     const unsigned *file_of, rch_diag *d);
+
 #endif

@@ -158,6 +158,31 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
     rch_jw_end(&w);
     if (r->n_pos_rows)
         json_positions(&w, r);
+    if (r->screen.out) { /* rows left out as irreconcilable (rch_calib_screen.c) */
+        rch_jw_obj(&w, "screened");
+        rch_jw_uint(&w, "rows", r->screen.rows);
+        rch_jw_uint(&w, "left_out", r->screen.out);
+        rch_jw_numf(&w, "k", RCH_SCREEN_K, "%g");
+        rch_jw_numf(&w, "scale_length_mm", r->screen.scale_mm[0], "%.6g");
+        rch_jw_numf(&w, "scale_position_mm", r->screen.scale_mm[1], "%.6g");
+        rch_jw_arr(&w, "rows_left_out");
+        for (unsigned k = 0; k < r->screen.n_named; ++k) {
+            const rch_screen_row *q = &r->screen.row[k];
+            rch_jw_obj(&w, NULL);
+            rch_jw_str(&w, "file", q->file < r->prov.n_files ? r->prov.file[q->file] : "");
+            rch_jw_uint(&w, "line", q->line);
+            rch_jw_str(&w, "sensor", q->tracker ? "tracker" : "cable");
+            rch_jw_numf(&w, "residual_mm", q->residual_mm, "%.6g");
+            rch_jw_str(&w, "likely", rch_screen_kind(q));
+            if (q->label_fits)
+                rch_jw_uint(&w, "fits_outlet", q->label_fits - 1u);
+            else
+                rch_jw_null(&w, "fits_outlet");
+            rch_jw_end(&w);
+        }
+        rch_jw_end(&w);
+        rch_jw_end(&w);
+    }
     if (r->cfg.truth_path) {
         rch_jw_obj(&w, "truth_flange");
         rch_jw_numf(&w, "before_rms_mm", r->truth_before_rms_mm, "%.6f");

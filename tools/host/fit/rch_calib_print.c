@@ -390,6 +390,23 @@ static void print_summary(FILE *f, const rch_calib_result *r)
                 hp.robot, r->unc.map.data_median_mm / r->after_m.rmse_mm);
 }
 
+void rch_calib_print_screened(FILE *f, const rch_calib_result *r, const char *prefix)
+{
+    const rch_calib_screen_result *z = &r->screen;
+    for (unsigned k = 0; k < z->n_named; ++k) {
+        const rch_screen_row *w = &z->row[k];
+        const char *file = w->file < r->prov.n_files ? r->prov.file[w->file] : "?";
+        char why[64] = "";
+        if (w->label_fits)
+            snprintf(why, sizeof why, " (its length fits outlet %u)", w->label_fits - 1u);
+        fprintf(f, "%s%s:%u: left out: %s %.4g mm off (%.0f x its sensor's robust scale %.3g mm): likely %s%s\n", prefix,
+                file, w->line, w->tracker ? "position" : "length", w->residual_mm,
+                w->scale_mm > 0.0 ? w->residual_mm / w->scale_mm : 0.0, w->scale_mm, rch_screen_kind(w), why);
+    }
+    if (z->out > z->n_named)
+        fprintf(f, "%s... and %zu more rows left out\n", prefix, z->out - z->n_named);
+}
+
 void rch_calib_print(FILE *f, const rch_calib_result *r)
 {
     const char *method = rc_method_name(r->cfg.method);
@@ -401,6 +418,14 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 r->robot.name, method);
     fprintf(f, "split: %zu train / %zu held out (test fraction %.2f, seed %lu)\n\n", r->n_train, r->n_test,
             r->cfg.test_fraction, r->cfg.seed);
+    if (r->screen.out) {
+        fprintf(f, "ROWS LEFT OUT: %zu of %zu rows cannot be reconciled with the rest (beyond %.0f x their sensor's "
+                   "robust scale, 1.4826 x the median absolute deviation of its residuals, and %.2g mm): the fit ran "
+                   "again without them (--no-screen keeps them)\n",
+                r->screen.out, r->screen.rows, RCH_SCREEN_K, RCH_SCREEN_FLOOR_MM);
+        rch_calib_print_screened(f, r, "  ");
+        fputc('\n', f);
+    }
     /* the check counts the steps far above the residual; the fit then takes
      * every step the search found, the smaller ones too: both numbers said */
     const unsigned steps = r->jump_check_steps, fitted = r->have_jumps ? r->jumps.n_jumps : steps;
