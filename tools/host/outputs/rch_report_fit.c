@@ -301,9 +301,9 @@ static void params_chart(rep *r, const prow *p, size_t n, const char *unit, cons
     static const struct {
         unsigned char c;
         const char *label;
-    } classes[] = {{C_IDENT, "determined by the data"},
-                   {C_WEAK, "partly determined"},
-                   {C_NOTID, "prior only / not seen by the data"},
+    } classes[] = {{C_IDENT, "determined"},
+                   {C_WEAK, "partly"},
+                   {C_NOTID, "prior only"},
                    {C_FIXED, "held"},
                    {C_UNKNOWN, "class not in this run"}};
     for (size_t k = 0; k < sizeof classes / sizeof classes[0]; ++k)
