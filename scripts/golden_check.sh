@@ -34,7 +34,11 @@
 #   4. SHA-256 digests (64 hex digits: the report's provenance hashes files
 #      that hold the masked figures; those files are compared themselves)
 #      -> <SHA256>;
-#   5. stderr only: the progress lines a long step prints every 5 s
+#   5. a direction the data do not see at all (relative singular value below
+#      1e-12: a null space, whose basis any change of start point or CPU
+#      turns) -> its combination "<NULL DIRECTION>"; a printed zero's sign
+#      ("-0.00000") -> "0.0";
+#   6. stderr only: the progress lines a long step prints every 5 s
 #      ("WHAT N of M, T elapsed, about T left"; their number depends on the
 #      host's speed) are dropped. Estimates ("about 12.0 min") come from the
 #      cost model, not the host, and are kept (their seconds masked by 2).
@@ -84,6 +88,9 @@ mask() {
             }' \
         -e 's#[12][0-9]{3}-[01][0-9]-[0-3][0-9]([T ][0-2][0-9]:[0-5][0-9](:[0-5][0-9]([.][0-9]+)?)?(Z|[+-][0-2][0-9]:?[0-5][0-9])?)?#<DATE>#g' \
         -e 's#\b[0-9a-f]{64}\b#<SHA256>#g' \
+        -e 's#(NOT seen by the data \(relative singular value [0-9.]+e-(1[3-9]|[2-9][0-9])\)): .*#\1: <NULL DIRECTION>#' \
+        -e 's#("sv_rel":[0-9.]+e-(1[3-9]|[2-9][0-9]),"identifiable":"no","combo":)"[^"]*"#\1"<NULL DIRECTION>"#g' \
+        -e 's#(-|\b)0[.]0+\b#0.0#g' \
         "$1"
 }
 # mask_err FILE: mask, and drop the progress lines printed every 5 s of a long step (rch_progress_step:

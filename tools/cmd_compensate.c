@@ -172,7 +172,7 @@ int rcal_cmd_compensate(int argc, char **argv)
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
     int position_only = 0, full_pose = 0, want_summary = 0, accept_rt = 0, json = 0;
     double max_unc_mm = 0.0, tool[3] = {0.0, 0.0, 0.0};
-    const char *unc_out = NULL;
+    const char *unc_out = NULL, *u95_policy = "skip";
     rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/2 or /1, from rcal calibrate --out)",
@@ -202,6 +202,11 @@ int rcal_cmd_compensate(int argc, char **argv)
          "leave a target uncompensated (with a warning) where the model's 95 % position uncertainty is larger "
          "(0: no limit for a model with a posterior, whose compensation never widens the error; 1 mm for one "
          "without)", 0, NULL},
+        {"--u95-policy", RCH_OPT_CHOICE, &u95_policy, 0, 0, NULL,
+         "what a target beyond --max-uncertainty-mm (u95 at the compensated point: the flange or the --tool TCP) "
+         "does: skip (left uncompensated, a warning), warn (compensated, a warning naming its line and u95) or "
+         "refuse (exit 1, nothing written)",
+         0, "skip|warn|refuse"},
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
          "deprecated, no effect: RAPID robtargets are corrected (through the nominal inverse kinematics)", 0, NULL},
@@ -230,6 +235,9 @@ int rcal_cmd_compensate(int argc, char **argv)
         .position_only = position_only,
         .full_pose = full_pose,
         .max_unc_mm = max_unc_mm,
+        .u95_policy = strcmp(u95_policy, "warn") == 0     ? RCH_COMP_U95_WARN
+                      : strcmp(u95_policy, "refuse") == 0 ? RCH_COMP_U95_REFUSE
+                                                          : RCH_COMP_U95_SKIP,
         .accept_robtargets = accept_rt,
         .max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0, /* 0: the core's 0.1 rad */
         .tool_mm = rch_opt_given(&spec, seen, "--tool") ? tool : NULL,

@@ -192,7 +192,12 @@ def make_report(rcal, src, work):
 
 
 def post_class(u):
-    """The class the report shows: what the data did to the prior for a MAP fit, else the identifiability class."""
+    """The class the report shows: the one vocabulary ("seen", rch_seen.h) when the file has it, else what the data
+    did to the prior for a MAP fit, else the identifiability class."""
+    words = {'data': 'determined by the data', 'partly': 'partly determined', 'prior_only': 'prior only',
+             'unseen': 'not seen by the data', 'held': 'held'}
+    if u.get('seen') in words:
+        return words[u['seen']]
     p = u.get('data_vs_prior')
     return p if p and p != 'no prior' else u['class']
 

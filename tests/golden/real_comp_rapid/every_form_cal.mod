@@ -1,14 +1,14 @@
 MODULE EveryForm
   ! rcal compensate test module (issue 21): every joint target and robtarget form.
   ! In a comment a target stays as it is: MoveAbsJ [[1,2,3,4,5,6],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
-  CONST jointtarget jHome:=[[-0.0398,-0.6537,-0.3186,-0.0041,29.9967,-0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  CONST jointtarget jHome:=[[-0.0398,-0.6537,-0.3186,-0.0041,29.9967,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST jointtarget jA:=[[9.9515,19.3472,-30.5270,40.0505,49.9219,60.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]; CONST jointtarget jB := [[-15.0441,4.3672,9.6722,-20.0145,35.0099,-45.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
   PERS jointtarget jLong:=[[ 25.4639, -12.8331,
                              17.7564, ! a comment inside the aggregate
                              -33.1404, 44.0497, 90.0000 ],
                            [9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   VAR jointtarget jC;
-  CONST jointtarget jArr{2}:=[[[4.9322,9.3722,14.6410,-0.0094,45.0164,-0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]],[[-5.0092,-10.6979,-15.2464,0.0020,-45.0925,-0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]];
+  CONST jointtarget jArr{2}:=[[[4.9322,9.3722,14.6410,-0.0094,45.0164,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]],[[-5.0092,-10.6979,-15.2464,0.0020,-45.0925,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]]];
   CONST num table{2,6}:=[[1,2,3,4,5,6],[1,2,3,4,5,6]];
   CONST speeddata vSlow:=[50,500,5000,1000];
   PERS tooldata tPen:=[TRUE,[[0,0,150],[1,0,0,0]],[0.5,[0,0,50],[1,0,0,0],0,0,0]];
@@ -25,8 +25,8 @@ MODULE EveryForm
   PROC main()
     TPWrite "a string is copied: jointtarget j:=[[1,2,3,4,5,6],[0,0,0,0,0,0]]; "" [";
     MoveAbsJ jHome\NoEOffs, v100, fine, tool0;
-    MoveAbsJ [[4.9322,9.3722,14.6410,-0.0094,45.0164,-0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]\NoEOffs, v100, z10, tool0;
-    MoveAbsJ jA, v100, z10, tool0; MoveAbsJ [[-5.0092,-10.6979,-15.2464,0.0020,-45.0925,-0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
+    MoveAbsJ [[4.9322,9.3722,14.6410,-0.0094,45.0164,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]]\NoEOffs, v100, z10, tool0;
+    MoveAbsJ jA, v100, z10, tool0; MoveAbsJ [[-5.0092,-10.6979,-15.2464,0.0020,-45.0925,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
     jC:=[[0.9562,1.3561,2.6750,3.9994,4.9592,6.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
     MoveAbsJ jC, vSlow, fine, tool0;
     MoveJ p10, v200, z10, tool0;

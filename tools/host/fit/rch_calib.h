@@ -75,6 +75,8 @@ typedef struct rch_calib_screen_result {
 /* What an out row likely is, in words. */
 const char *rch_screen_kind(const rch_screen_row *w);
 
+enum { RCH_CALIB_SEEN_FLANGE = 0, RCH_CALIB_SEEN_ATTACHMENT = 1, RCH_CALIB_SEEN_TARGETS = 2 };
+
 typedef struct rch_calib_result {
     rch_calib_cfg cfg;        /* as given (paths point at the caller's strings) */
     rch_robot robot;          /* the robot file; robot.model has the tool offset when asked */
@@ -102,6 +104,15 @@ typedef struct rch_calib_result {
     rch_ident ident;          /* at the solution, over the training samples */
     int have_unc;             /* uncertainty computed (model finite, enough samples) */
     rch_model_unc unc;        /* covariance, standard errors, classes, predicted uncertainty */
+    /* The headline: the predicted 95 % accuracy at the point the data see
+     * (rch_calib_figures.c): the tracker's targets, the cable attachment, or
+     * the flange centre when the cable is hooked there; the flange centre's
+     * own figure said apart when the point is off it. */
+    int seen_at;              /* RCH_CALIB_SEEN_FLANGE, _ATTACHMENT or _TARGETS */
+    double seen_median_mm, seen_max_mm; /* over the data's poses (every target) */
+    int flange_apart;         /* the point is off the flange centre: its figure below is said apart */
+    double flange_median_mm, flange_max_mm; /* the flange centre over the data's poses */
+    int flange_prior_only;    /* the flange centre's figure is the prior's (> 2 x the seen point's) */
     rc_model determined;      /* the model compensation uses (the whole estimate) */
     int prior_on;             /* maximum a posteriori with the physical prior (robust methods, no --no-prior) */
     double prior_mean[RC_MAX_PARAMS]; /* (RC_MAX_PARAMS) the prior: nominal DH, start attachment */

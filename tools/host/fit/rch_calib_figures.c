@@ -21,7 +21,9 @@
 #include "rc_rand.h"
 #include "rch_data.h"
 #include "rch_plot.h"
+#include "rch_positions.h"
 #include "rch_sim.h"
+#include "rch_stats.h"
 
 /* Flange positions of the BC and the identified model against a simulated
  * truth over random poses, base heading and height aligned (cable lengths
@@ -107,6 +109,48 @@ done:
     return rc;
 }
 
+/* The headline's point (rch_calib_result.seen_at): every tracker target
+ * (its covariance with the rest counted), else the cable attachment when
+ * the model has one off the flange centre (the map's own point), else the
+ * flange; and the flange centre's figure apart when the point is off it. */
+static void seen_point(rch_calib_result *r, const rch_uncert *u, const rc_sample *train)
+{
+    const rc_model *m = &r->model;
+    const size_t n = r->n_train;
+    double *v = malloc((n + 1) * sizeof *v);
+    unsigned nt = 0;
+    const int kf = rch_pos_effect_at(m, RC_EFF_TRACKER_TARGETS, &nt);
+    const int tf = rch_pos_effect_at(m, RC_EFF_TOOL_OFFSET, NULL);
+    const double zero[3] = {0.0, 0.0, 0.0};
+    r->seen_at = RCH_CALIB_SEEN_FLANGE;
+    r->seen_median_mm = r->unc.map.data_median_mm;
+    r->seen_max_mm = r->unc.map.data_max_mm;
+    r->flange_apart = 0;
+    if (!v)
+        return;
+    if (kf >= 0 && nt >= 3 && r->n_pos_rows) {
+        size_t c = 0;
+        for (unsigned j = 0; j < nt / 3; ++j)
+            c += rch_uncert_point95(v + c, u, m, train, n - c, &m->x[kf + 3 * (int)j], kf + 3 * (int)j, (int)j);
+        if (c) {
+            r->seen_at = RCH_CALIB_SEEN_TARGETS;
+            rch_median_max(&r->seen_median_mm, &r->seen_max_mm, v, c);
+            r->flange_apart = 1;
+            r->flange_median_mm = r->unc.map.data_median_mm;
+            r->flange_max_mm = r->unc.map.data_max_mm;
+        }
+    } else if (tf >= 0 && sqrt(m->x[tf] * m->x[tf] + m->x[tf + 1] * m->x[tf + 1] + m->x[tf + 2] * m->x[tf + 2]) > 1.0) {
+        const size_t c = rch_uncert_point95(v, u, m, train, n, zero, -1, -1);
+        if (c) {
+            r->seen_at = RCH_CALIB_SEEN_ATTACHMENT;
+            r->flange_apart = 1;
+            rch_median_max(&r->flange_median_mm, &r->flange_max_mm, v, c);
+        }
+    }
+    r->flange_prior_only = r->flange_apart && r->flange_median_mm > 2.0 * r->seen_median_mm;
+    free(v);
+}
+
 /* Covariance (cluster-robust by set-up group when the groups allow it),
  * standard errors, classes, predicted uncertainty over the data and the
  * workspace, and the determined model. Leaves have_unc 0 when it cannot be
@@ -126,6 +170,7 @@ static int uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sampl
                                RCH_CALIB_TRUTH_SEED) == 0) {
         r->unc.orientation_determined = r->unc.map.rot_det_median_deg < RCH_ORIENT_DETERMINED_DEG;
         r->have_unc = 1;
+        seen_point(r, &u, train);
     }
     if (r->cfg.plots_dir)
         rc = uncertainty_plot(r, &u, train, d);

@@ -99,6 +99,19 @@ static void json_uncertainty(rch_jw *w, const rch_calib_result *r)
     rch_robot_write_unc_params(w, &r->model, u, "%.9g");
     rch_robot_write_unc_map(w, &u->map);
     rch_jw_bool(w, "orientation_determined", u->orientation_determined);
+    /* the headline: the accuracy at the point the data see (new members) */
+    rch_jw_obj(w, "seen_point");
+    rch_jw_str(w, "at", r->seen_at == RCH_CALIB_SEEN_TARGETS      ? "targets"
+                        : r->seen_at == RCH_CALIB_SEEN_ATTACHMENT ? "attachment"
+                                                                  : "flange");
+    rch_jw_numf(w, "position95_median_mm", r->seen_median_mm, "%.6g");
+    rch_jw_numf(w, "position95_max_mm", r->seen_max_mm, "%.6g");
+    if (r->flange_apart) {
+        rch_jw_numf(w, "flange_position95_median_mm", r->flange_median_mm, "%.6g");
+        rch_jw_numf(w, "flange_position95_max_mm", r->flange_max_mm, "%.6g");
+        rch_jw_str(w, "flange", r->flange_prior_only ? "prior_only" : "partly");
+    }
+    rch_jw_end(w);
     rch_jw_end(w);
 }
 

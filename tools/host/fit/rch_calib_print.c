@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "rch_prior.h"
+#include "rch_seen.h"
 #include "rch_text.h"
 
 #ifndef M_PI
@@ -125,7 +126,7 @@ static unsigned outside_prior(const rch_calib_result *r)
  * geometry to the prior. */
 static int accuracy_needs_poses(const rch_calib_result *r)
 {
-    const double a = r->unc.map.data_median_mm;
+    const double a = r->seen_median_mm;
     return r->have_unc && r->after_ok && a > 10.0 * r->after_m.rmse_mm && a > 0.1;
 }
 
@@ -175,6 +176,49 @@ static void diagnose_hint(char *buf, size_t len, const rch_calib_result *r)
     rch_shell_join(buf, len, n, argv);
 }
 
+/* Cable lengths only (one attachment point, no tracker). */
+static int one_point_cable(const rch_calib_result *r)
+{
+    return r->n_pos_rows == 0;
+}
+
+/* Tracker positions and no cable lengths. */
+static int tracker_only(const rch_calib_result *r)
+{
+    return r->n_pos_rows && r->n_data == 3 * r->n_pos_rows;
+}
+
+/* What the headline's point is, in words. */
+static const char *seen_point_words(const rch_calib_result *r)
+{
+    switch (r->seen_at) {
+    case RCH_CALIB_SEEN_TARGETS: return "at the tracker's targets";
+    case RCH_CALIB_SEEN_ATTACHMENT: return "at the cable attachment point";
+    default: return "at the flange centre";
+    }
+}
+
+/* The headline: the 95 % accuracy at the point the data see, then the
+ * flange centre's apart when the point is off it. */
+static void print_headline(FILE *f, const rch_calib_result *r, const char *lead)
+{
+    const rch_uncert_map *mp = &r->unc.map;
+    fprintf(f, "%s%s: +-%.4f mm (median over the data's poses; max %.4f)", lead, seen_point_words(r),
+            r->seen_median_mm, r->seen_max_mm);
+    if (r->seen_at != RCH_CALIB_SEEN_TARGETS)
+        fprintf(f, ", whole workspace +-%.4f mm (median over %d random poses; max %.4f)", mp->work_median_mm,
+                RCH_CALIB_TRUTH_POSES, mp->work_max_mm);
+    fputc('\n', f);
+    if (!r->flange_apart)
+        return;
+    fprintf(f, "  the flange centre behind %s: +-%.4f mm (median; max %.4f)%s\n",
+            r->seen_at == RCH_CALIB_SEEN_TARGETS ? "them" : "it", r->flange_median_mm, r->flange_max_mm,
+            r->flange_prior_only
+                ? ": prior only (the data see the point above, not the flange centre behind it: compensate at "
+                  "that point, rcal compensate --tool X,Y,Z, or measure at the flange centre)"
+                : "");
+}
+
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {
     const rch_model_unc *u = &r->unc;
@@ -199,14 +243,16 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
     else if (u->has_prior)
         fprintf(f, "  theta1 and d1 held (gauge): lengths from outlets whose places are estimated cannot see the "
                    "robot's heading and height against them; a cell sets its base frame anyway\n");
-    print_outlets(f, m);
+    if (!tracker_only(r))
+        print_outlets(f, m);
     if (r->attach_auto)
         fprintf(f, "  cable attachment: %s (an attachment vector improves the fit by %.1f against its Occam "
                    "penalty %.1f)\n",
                 r->attach_centred ? "at the flange centre" : "estimated in the flange frame (the flange centre "
                                                              "relative to it is known only from the prior of a6, d6)",
                 r->attach_dchi2, r->attach_occam);
-    fprintf(f, "  parameter        value   1 std.error  class%s\n", u->has_prior ? "              data vs prior" : "");
+    fprintf(f, "  parameter        value   1 std.error  what the data see (%s)\n",
+            u->has_prior ? "posterior sd against the prior's; why" : "why");
     unsigned held = 0, outside = 0;
     char list[512] = "";
     for (unsigned k = 0; k < m->n_params; ++k) {
@@ -218,16 +264,18 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         else
             snprintf(se, sizeof se, "%11s", "-");
         rc_param_name(nm, sizeof nm, m, k);
-        char pc[96] = "";
+        const rch_seen cl = rch_seen_of_unc(u, k);
+        const char *why = rch_seen_why(cl, (rch_param_class)u->cls[k]);
+        char pc[200] = "";
+        int dev3 = 0;
         if (u->has_prior && u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED) {
-            const double dev = fabs(m->x[k] - r->prior_mean[k]) / u->prior_sd[k];
-            outside += dev > 3.0;
-            snprintf(pc, sizeof pc, "  %-10s (se %.0f %% of prior)%s",
-                     rch_prior_class_name((rch_prior_class)u->prior_cls[k]), 100.0 * u->se[k] / u->prior_sd[k],
-                     dev > 3.0 ? "  OUTSIDE the prior's plausible range (> 3 sd from nominal)" : "");
+            dev3 = fabs(m->x[k] - r->prior_mean[k]) / u->prior_sd[k] > 3.0;
+            outside += dev3;
+            snprintf(pc, sizeof pc, " (sd %.0f %% of prior)", 100.0 * u->se[k] / u->prior_sd[k]);
         }
-        fprintf(f, "  %-10s %12.5f %s %-3s %-16s%s\n", nm, m->x[k] * sc, se,
-                unit == 0 ? "mm" : unit == 1 ? "deg" : "", rch_param_class_name((rch_param_class)u->cls[k]), pc);
+        fprintf(f, "  %-10s %12.5f %s %-3s %s%s%s%s%s\n", nm, m->x[k] * sc, se, unit == 0 ? "mm" : unit == 1 ? "deg" : "",
+                rch_seen_words(cl), pc, why[0] ? "; " : "", why,
+                dev3 ? "  OUTSIDE the prior's plausible range (> 3 sd from nominal)" : "");
         if (k < RC_N_DH && u->comp_nominal[k]) {
             size_t len = strlen(list);
             snprintf(list + len, sizeof list - len, "%s%s", held ? " " : "", nm);
@@ -242,37 +290,40 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         fprintf(f, "  next: %u parameter(s) OUTSIDE the prior's range are a real deviation (check the drawing) or "
                    "stand in for an effect the model lacks: %s\n",
                 outside, dh);
-    fprintf(f,
-            "predicted 3-D accuracy after compensation (95 %%, longest semi-axis of the flange-position "
-            "ellipsoid): over the sampled region +-%.4f mm (median over the data's poses; max %.4f), whole "
-            "workspace +-%.4f mm (median over %d random poses; max %.4f)\n",
-            u->map.data_median_mm, u->map.data_max_mm, u->map.work_median_mm, RCH_CALIB_TRUTH_POSES,
-            u->map.work_max_mm);
-    if (accuracy_needs_poses(r))
+    print_headline(f, r, "predicted 3-D accuracy after compensation (95 %, longest semi-axis of the position "
+                         "ellipsoid) ");
+    if (accuracy_needs_poses(r) && tracker_only(r))
+        fprintf(f, "  next: the positions are fitted to %.3f mm but the targets only to %.3f mm: the poses leave "
+                   "most of the geometry to the prior; measure poses that move every joint, with the targets "
+                   "spread on the tool\n",
+                r->after_m.rmse_mm, r->seen_median_mm);
+    else if (accuracy_needs_poses(r))
         fprintf(f, "  next: the lengths are predicted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave "
                    "most of the geometry to the prior; plan poses that move every joint, from more than one outlet: "
                    "rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv\n",
-                r->after_m.rmse_mm, u->map.data_median_mm, hp.robot);
+                r->after_m.rmse_mm, r->seen_median_mm, hp.robot);
     fprintf(f,
             "predicted flange-orientation uncertainty (95 %%) inside the data: +-%.4f deg with every parameter, "
             "+-%.4f deg with those compensation uses: orientation %s\n",
             u->map.rot_data_median_deg, u->map.rot_det_median_deg,
-            u->orientation_determined ? "determined (compensation matches position and orientation)"
-                                      : "NOT determined (compensation defaults to position-only)");
+            u->orientation_determined ? "determined by the data (compensation matches position and orientation)"
+            : one_point_cable(r) ? "not seen by the data (one cable attachment point: the lengths measure a point, "
+                                   "not the turn about it; compensation defaults to position-only)"
+                                 : "NOT determined by the data (compensation defaults to position-only)");
     fprintf(f,
-            "compensation uses %u of 24 DH parameters as fitted; held at nominal (tied to a weak or not-identifiable "
-            "combination that moves the robot): %s\n\n",
+            "compensation uses %u of 24 DH parameters as fitted; held at nominal (tied to a direction the data do not "
+            "see or see only weakly, that moves the robot): %s\n\n",
             RC_N_DH - held, held ? list : "none");
 }
 
 static void print_ident(FILE *f, const rch_ident *id, int prior)
 {
     fprintf(f,
-            "identifiability (%u parameters, at the solution): rank %u, %u not identifiable, %u weakly "
-            "identifiable;\n  condition number %.3g over the identifiable part, observability index O1 %.4g\n",
+            "identifiability (%u parameters, at the solution): rank %u: %u direction(s) the data do not see, %u "
+            "seen only weakly;\n  condition number %.3g over the identifiable part, observability index O1 %.4g\n",
             id->n_params, id->rank, id->n_params - id->rank, id->n_weak, id->cond, id->observability);
     for (unsigned k = 0; k < id->n_dirs; ++k) {
-        fprintf(f, "  - %s (relative singular value %.1e): %s\n", id->dirs[k].weak ? "weak" : "NOT identifiable",
+        fprintf(f, "  - %s (relative singular value %.1e): %s\n", id->dirs[k].weak ? "seen only weakly" : "NOT seen by the data",
                 id->dirs[k].sv_rel, id->dirs[k].combo);
         if (id->dirs[k].why[0])
             fprintf(f, "      %s\n", id->dirs[k].why);
@@ -280,11 +331,11 @@ static void print_ident(FILE *f, const rch_ident *id, int prior)
     if (id->n_combos)
         fprintf(f, "  what these directions hold (known sets of parameters whose columns are dependent):\n");
     for (unsigned k = 0; k < id->n_combos; ++k)
-        fprintf(f, "    %s %s (%.1e): %s\n", id->combos[k].params, id->combos[k].weak ? "weak" : "NOT identifiable",
+        fprintf(f, "    %s %s (%.1e): %s\n", id->combos[k].params, id->combos[k].weak ? "seen only weakly" : "NOT seen by the data",
                 id->combos[k].sv_rel, id->combos[k].why);
-    fprintf(f, prior ? "  With the prior, what the data cannot identify stays where the drawing puts it (the prior's mean), "
-                       "with the prior's uncertainty (the parameters' classes above).\n\n"
-                     : "  The solver leaves directions it cannot identify where they started (nominal).\n\n");
+    fprintf(f, prior ? "  With the prior, what the data do not see stays where the drawing puts it (the prior's mean), "
+                       "with the prior's uncertainty (\"prior only\" above).\n\n"
+                     : "  The solver leaves directions the data do not see where they started (nominal).\n\n");
 }
 
 static void print_pos_err(FILE *f, const char *label, const rch_pos_err *e)
@@ -367,9 +418,7 @@ static void print_summary(FILE *f, const rch_calib_result *r)
         fprintf(f, "  %s RMSE %.4f mm before; after: the solver diverged, no figures\n",
                 r->n_test ? "held-out" : "training", r->before_m.rmse_mm);
     if (r->have_unc)
-        fprintf(f, "  predicted 3-D accuracy after compensation (95 %%): +-%.4f mm over the data's poses (median; "
-                   "max %.4f), +-%.4f mm over the whole workspace (median; max %.4f)\n",
-                r->unc.map.data_median_mm, r->unc.map.data_max_mm, r->unc.map.work_median_mm, r->unc.map.work_max_mm);
+        print_headline(f, r, "  predicted 3-D accuracy after compensation (95 %) ");
     else
         fputs("  predicted 3-D accuracy: none in this run (no uncertainty: too few samples or a model that is not "
               "finite)\n",
@@ -384,10 +433,15 @@ static void print_summary(FILE *f, const rch_calib_result *r)
         diagnose_hint(dh, sizeof dh, r);
         fprintf(f, "  next: %s (%u parameter%s outside the prior's range)\n", dh, outside, outside == 1 ? "" : "s");
     }
+    else if (accuracy_needs_poses(r) && tracker_only(r))
+        fprintf(f, "  next: measure poses that move every joint, with the targets spread on the tool (the 3-D "
+                   "accuracy at the targets is %.0f x the position RMSE: the poses leave most of the geometry to "
+                   "the prior)\n",
+                r->seen_median_mm / r->after_m.rmse_mm);
     else if (accuracy_needs_poses(r))
         fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
                    "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",
-                hp.robot, r->unc.map.data_median_mm / r->after_m.rmse_mm);
+                hp.robot, r->seen_median_mm / r->after_m.rmse_mm);
 }
 
 void rch_calib_print_screened(FILE *f, const rch_calib_result *r, const char *prefix)

@@ -78,7 +78,21 @@ int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_de
              * there is no limit unless the user sets one. A model without
              * (least squares): 1 mm, its covariance leaves out what it held. */
             double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm : c->gate->unc->has_prior ? INFINITY : 1.0;
-            if (!(u95 <= lim)) {
+            if (!(u95 <= lim) && c->gate->u95_policy == RCH_COMP_U95_REFUSE) {
+                rch_diag_set(d, c->in_name, line, 0,
+                             "the model's 95 %% position uncertainty at the compensated point is %.4f mm here, above "
+                             "%.4f mm (--u95-policy refuse: nothing written)",
+                             u95, lim);
+                return -1;
+            }
+            if (!(u95 <= lim) && c->gate->u95_policy == RCH_COMP_U95_WARN) {
+                c->res->n_uncertain++;
+                if (c->warn)
+                    fprintf(c->warn,
+                            "%s:%u: warning: compensated, but the model's 95 %% position uncertainty at the "
+                            "compensated point is %.4f mm here, above %.4f mm\n",
+                            c->in_name, line, u95, lim);
+            } else if (!(u95 <= lim)) {
                 for (unsigned i = 0; i < RC_NJ; ++i)
                     out_deg[i] = in_deg[i];
                 u95_line(c, line, rch_comp_u95_written(u95, 3, 0.0));

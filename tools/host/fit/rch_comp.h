@@ -54,6 +54,17 @@ typedef enum rch_comp_format {
     RCH_COMP_RAPID = 2
 } rch_comp_format;
 
+/* What a target whose u95 at the compensated point (the flange or the
+ * --tool TCP) exceeds max_unc_mm does: left uncompensated with a warning
+ * (SKIP, the default), compensated with a warning naming its line and u95
+ * (WARN), or the whole run refused (REFUSE: -1 naming the line and u95,
+ * the --out file not written). */
+typedef enum rch_comp_u95_policy {
+    RCH_COMP_U95_SKIP = 0,
+    RCH_COMP_U95_WARN = 1,
+    RCH_COMP_U95_REFUSE = 2
+} rch_comp_u95_policy;
+
 /* What rch_comp_run does; zero-initialise, then set the paths. */
 typedef struct rch_comp_job {
     const char *model_path;   /* calibrated model (rcal-model/1); required */
@@ -67,6 +78,7 @@ typedef struct rch_comp_job {
     double max_unc_mm;        /* a target where the model's 95 % position uncertainty exceeds this is left
                                  uncompensated, with a warning; 0: 1 mm */
     int accept_robtargets;    /* accepted for old command lines: robtargets are corrected now */
+    rch_comp_u95_policy u95_policy; /* what a target beyond max_unc_mm does (default: left uncompensated) */
     const double *tool_mm;    /* (3) the TCP in the flange frame (mm) that compensation places; NULL: the
                                  flange centre. Never the cable attachment point the calibration measured */
     const char *uncertainty_path; /* per target its predicted 95 % position uncertainty (u95_mm, of the point
@@ -102,6 +114,7 @@ typedef struct rch_comp_gate {
      * config; NULL: such a robtarget is refused */
     const rc_model *det_any, *fit_any;
     const rc_comp_config *cfg;
+    rch_comp_u95_policy u95_policy; /* see rch_comp_job */
 } rch_comp_gate;
 
 /* What u95_mm says of one target, by how its compensation ended (status: 0

@@ -10,6 +10,7 @@
 #include "rch_file.h"
 #include "rch_json.h"
 #include "rch_jw.h"
+#include "rch_seen.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -588,6 +589,11 @@ void rch_robot_write_unc_params(rch_jw *w, const rc_model *m, const rch_model_un
             rch_jw_numf(w, "prior_sd", u->prior_sd[k] * sc, "%.6g");
             rch_jw_str(w, "data_vs_prior", rch_prior_class_name((rch_prior_class)u->prior_cls[k]));
         }
+        /* the one class every report prints (rch_seen.h); "class" and
+         * "data_vs_prior" above are the two facts it is made of */
+        const rch_seen seen = rch_seen_of_unc(u, k);
+        rch_jw_str(w, "seen", rch_seen_key(seen));
+        rch_jw_str(w, "seen_why", rch_seen_why(seen, (rch_param_class)u->cls[k]));
         rch_jw_end(w);
     }
     rch_jw_end(w);

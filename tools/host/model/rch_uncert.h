@@ -125,6 +125,15 @@ typedef struct rch_uncert_map {
 int rch_uncert_map_compute(rch_uncert_map *out, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
                            size_t n_random, uint64_t seed);
 
+/* 95 % position semi-axis (mm) of a point t_mm (3, in the flange frame)
+ * of m at the poses of s (n; with target >= 0 only the rows of that
+ * tracker target): the flange of m without its tool offset, plus R t. With
+ * t_first >= 0 t is m->x[t_first .. t_first + 2] (a tracker target, the
+ * cable attachment) and its covariance counts with the rest. Values into v
+ * (n); returns how many. */
+size_t rch_uncert_point95(double *v, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
+                          const double t_mm[3], int t_first, int target);
+
 /* Sensitivity of the point of m at q (the flange, or the tool point when m
  * carries a tool offset) to every parameter: Jp (3 x m->n_params), the DH
  * columns in closed form (rc_kin), the effects' by central differences of

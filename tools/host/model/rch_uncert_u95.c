@@ -502,6 +502,57 @@ double rch_uncert_radius95(const double C[9])
     return radius95(ev);
 }
 
+size_t rch_uncert_point95(double *v, const rch_uncert *u, const rc_model *m, const rc_sample *s, size_t n,
+                          const double t_mm[3], int t_first, int target)
+{
+    const unsigned np = u->n_params;
+    uint8_t use[RC_MAX_PARAMS], use_fk[RC_MAX_PARAMS];
+    rc_model f = *m; /* the flange: m with its tool offset at zero (its columns filled below) */
+    use_pos(use, u);
+    memcpy(use_fk, use, sizeof use_fk);
+    for (unsigned e = 0; e < f.n_effects; ++e)
+        if (f.effects[e].kind == RC_EFF_TOOL_OFFSET)
+            for (unsigned c = 0; c < f.effects[e].count; ++c) {
+                f.x[f.effects[e].first + c] = 0.0;
+                use_fk[f.effects[e].first + c] = 0;
+                if ((int)(f.effects[e].first + c) < t_first || (int)(f.effects[e].first + c) > t_first + 2)
+                    use[f.effects[e].first + c] = 0;
+            }
+    if (t_first >= 0)
+        for (int c = 0; c < 3; ++c)
+            use_fk[t_first + c] = 0;
+    double *buf = malloc((size_t)np * np * sizeof *buf + 1);
+    if (!buf)
+        return 0;
+    cov_pack p;
+    pack_cov(&p, buf, u->cov, np, use, np);
+    factor_cov(&p);
+    rc_kin kin;
+    const rc_kin *k = sens_compile(&kin, &f);
+    size_t out = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (target >= 0 && (s[i].sensor == RC_SENSOR_LENGTH || s[i].target != (unsigned)target))
+            continue;
+        double Jp[3][RC_MAX_PARAMS], Jr[3][RC_MAX_PARAMS], pf[3], R[9], t[3];
+        fk_sensitivity(Jp, Jr, use_fk, np, &f, k, s[i].q_rad);
+        rc_fk(pf, R, &f, s[i].q_rad);
+        for (int a = 0; a < 3; ++a)
+            t[a] = R[a * 3] * t_mm[0] + R[a * 3 + 1] * t_mm[1] + R[a * 3 + 2] * t_mm[2];
+        for (unsigned c = 0; c < np; ++c) { /* d(p + R t) = dp + w x (R t) */
+            const double w0 = Jr[0][c], w1 = Jr[1][c], w2 = Jr[2][c];
+            Jp[0][c] += w1 * t[2] - w2 * t[1];
+            Jp[1][c] += w2 * t[0] - w0 * t[2];
+            Jp[2][c] += w0 * t[1] - w1 * t[0];
+        }
+        for (int c = 0; t_first >= 0 && c < 3; ++c)
+            for (int a = 0; a < 3; ++a)
+                Jp[a][t_first + c] = R[a * 3 + c];
+        v[out++] = ellipsoid95(Jp, &p);
+    }
+    free(buf);
+    return out;
+}
+
 void rch_uncert_point_sens(double Jp[3][RC_MAX_PARAMS], const rc_model *m, const double q_rad[RC_NJ])
 {
     uint8_t use[RC_MAX_PARAMS];

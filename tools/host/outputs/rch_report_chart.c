@@ -9,6 +9,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "rch_seen.h"
+
 #include "rch_report_int.h"
 #include "rch_svg.h"
 
@@ -18,6 +20,14 @@ const char *const rch_rep_colour[C_N] = {"#999999", "#0072B2", "#0072B2", "#E69F
 
 unsigned char rch_rep_class_colour(const char *cls)
 {
+    switch (rch_seen_parse(cls)) { /* the one vocabulary (rch_seen.h); older files' words below */
+    case RCH_SEEN_DATA: return C_IDENT;
+    case RCH_SEEN_PARTLY: return C_WEAK;
+    case RCH_SEEN_PRIOR:
+    case RCH_SEEN_UNSEEN: return C_NOTID;
+    case RCH_SEEN_HELD: return C_FIXED;
+    default: break;
+    }
     if (strcmp(cls, "identifiable") == 0 || strcmp(cls, "determined") == 0)
         return C_IDENT;
     if (strcmp(cls, "weak") == 0 || strcmp(cls, "partly") == 0)

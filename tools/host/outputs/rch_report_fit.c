@@ -11,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_seen.h"
+
 #include "rch_report_int.h"
 
 void rch_rep_sec_data(rep *r, const dfile *df, size_t n_df)
@@ -232,7 +234,9 @@ static void params_table(rep *r, const prow *p, size_t n)
         if (have_se) {
             /* no standard error by design for a parameter the data cannot determine or that was fixed */
             const int none = !isfinite(p[k].se) && (strcmp(p[k].cls, "not identifiable") == 0 ||
-                                                    strcmp(p[k].cls, "fixed") == 0);
+                                                    strcmp(p[k].cls, "fixed") == 0 ||
+                                                    rch_seen_parse(p[k].cls) == RCH_SEEN_UNSEEN ||
+                                                    rch_seen_parse(p[k].cls) == RCH_SEEN_HELD);
             fputs("</td><td>", f);
             if (none)
                 fputs("&mdash;", f);
@@ -297,10 +301,10 @@ static void params_chart(rep *r, const prow *p, size_t n, const char *unit, cons
     static const struct {
         unsigned char c;
         const char *label;
-    } classes[] = {{C_IDENT, "identifiable"},
-                   {C_WEAK, "weak"},
-                   {C_NOTID, "not identifiable"},
-                   {C_FIXED, "fixed"},
+    } classes[] = {{C_IDENT, "determined"},
+                   {C_WEAK, "partly"},
+                   {C_NOTID, "prior only"},
+                   {C_FIXED, "held"},
                    {C_UNKNOWN, "class not in this run"}};
     for (size_t k = 0; k < sizeof classes / sizeof classes[0]; ++k)
         if (used[classes[k].c]) {

@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_seen.h"
+
 #include "rch_file.h"
 #include "rch_report_int.h"
 #include "rch_sha256.h"
@@ -76,7 +78,10 @@ static void param_unc(const rep *r, const rch_json *pk, prow *p)
         if (!isfinite(p->se))
             p->se = jnum(list->items[i], "std_error");
         const char *post = jstr(list->items[i], "data_vs_prior"); /* a MAP fit: what the data did to the prior */
-        if (post && strcmp(post, "no prior") != 0)
+        const int seen = rch_seen_parse(jstr(list->items[i], "seen")); /* the one class (rch_seen.h) */
+        if (seen >= 0)
+            cls = rch_seen_words((rch_seen)seen);
+        else if (post && strcmp(post, "no prior") != 0)
             cls = post;
         else if (!cls)
             cls = jstr(list->items[i], "class");

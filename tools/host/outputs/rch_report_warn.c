@@ -12,6 +12,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "rch_seen.h"
+
 #include "rch_report_int.h"
 
 static void warnf(rep *r, const char *fmt, ...) RCH_PRINTF(2, 3);
@@ -60,10 +62,12 @@ void rch_rep_warn_params(rep *r, const prow *p, size_t n)
     char weak[512] = "", notid[512] = "", far[512] = "";
     int posterior = 0;
     for (size_t k = 0; k < n; ++k) {
-        const int po = strcmp(p[k].cls, "prior only") == 0, pa = strcmp(p[k].cls, "partly") == 0;
-        posterior |= po || pa || strcmp(p[k].cls, "determined") == 0;
-        char *dst = strcmp(p[k].cls, "weak") == 0 || pa   ? weak
-                    : strcmp(p[k].cls, "not identifiable") == 0 || po ? notid
+        const int sc = rch_seen_parse(p[k].cls); /* the one vocabulary, or an older file's words */
+        const int po = strcmp(p[k].cls, "prior only") == 0 || sc == RCH_SEEN_PRIOR,
+                  pa = strcmp(p[k].cls, "partly") == 0 || (sc == RCH_SEEN_PARTLY && p[k].prior_sd > 0.0);
+        posterior |= po || pa || strcmp(p[k].cls, "determined") == 0 || (sc == RCH_SEEN_DATA && p[k].prior_sd > 0.0);
+        char *dst = strcmp(p[k].cls, "weak") == 0 || pa || sc == RCH_SEEN_PARTLY ? weak
+                    : strcmp(p[k].cls, "not identifiable") == 0 || po || sc == RCH_SEEN_UNSEEN ? notid
                                                                       : NULL;
         if (dst && strlen(dst) + strlen(p[k].name) + 3 < sizeof weak)
             snprintf(dst + strlen(dst), sizeof weak - strlen(dst), "%s%s", dst[0] ? ", " : "", p[k].name);
