@@ -351,7 +351,8 @@ static void test_verdict_worse(void **state)
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         put_file("cal.json", cases[k].cal_what ? edited(cal_full, cases[k].cal_what, cases[k].cal_with) : cal_full);
-        put_file("diag.json", cases[k].diag_what ? edited(diag_full, cases[k].diag_what, cases[k].diag_with) : diag_full);
+        put_file("diag.json",
+                 cases[k].diag_what ? edited(diag_full, cases[k].diag_what, cases[k].diag_with) : diag_full);
         if (report_tol(&res, "cal.json", "diag.json", "w.html", cases[k].tol, &d) != 0)
             fail_msg("%s", rch_diag_str(&d, msg, sizeof msg));
         char *h = get_file("w.html");

@@ -356,11 +356,12 @@ static int read_undetermined(uint8_t und[RC_N_DH], const rch_robot *out, const r
         const rch_json *s = ul->items[i];
         unsigned k = 0;
         char nm[64];
-        while (k < RC_N_DH && !(s->type == RCH_JSTR && strcmp(s->str, rc_param_name(nm, sizeof nm, &out->model, k)) == 0))
+        while (k < RC_N_DH &&
+               !(s->type == RCH_JSTR && strcmp(s->str, rc_param_name(nm, sizeof nm, &out->model, k)) == 0))
             ++k;
         if (k == RC_N_DH) {
-            rch_diag_set(d, name, s->line, s->col, "\"undetermined\": item %zu is not a DH parameter name (a1 .. theta6)",
-                         i + 1);
+            rch_diag_set(d, name, s->line, s->col,
+                         "\"undetermined\": item %zu is not a DH parameter name (a1 .. theta6)", i + 1);
             return -1;
         }
         und[k] = 1;

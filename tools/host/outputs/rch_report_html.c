@@ -240,15 +240,16 @@ static unsigned worse_than_nominal(const rep *r, char *why, size_t len)
         const double b = jnum(z, "before_mm"), a = jnum(z, "after_mm");
         const char *nm = jstr(z, "name"), *kind = jstr(z, "kind");
         if (isfinite(a) && isfinite(b) && a > b)
-            why_add(why, len, &n, "held-out error of %s%s %.4g mm calibrated against %.4g mm nominal", nm ? nm : "a sensor",
-                kind && strcmp(kind, "tracker") == 0 ? " (3-D)" : "", a, b);
+            why_add(why, len, &n, "held-out error of %s%s %.4g mm calibrated against %.4g mm nominal",
+                    nm ? nm : "a sensor", kind && strcmp(kind, "tracker") == 0 ? " (3-D)" : "", a, b);
     }
     const char *eff = jstr(r->diag, "effect"), *rem = jstr(r->diag, "remaining");
     if ((eff && strcmp(eff, "unexplained") == 0) || (rem && strcmp(rem, "unexplained") == 0)) {
         const double fl = jnum(r->diag, "noise_floor_mm"), ra = jnum(r->diag, "rmse_after_mm");
         if (isfinite(fl) && fl > 0 && isfinite(ra))
-            why_add(why, len, &n, "the diagnosis finds structure beyond the noise floor that no effect explains (held-out %.4g mm, "
-                "%.2f x the floor)", ra, ra / fl);
+            why_add(why, len, &n,
+                    "the diagnosis finds structure beyond the noise floor that no effect explains (held-out %.4g mm, "
+                    "%.2f x the floor)", ra, ra / fl);
         else
             why_add(why, len, &n, "the diagnosis finds structure beyond the noise floor that no effect explains");
     }
@@ -288,6 +289,54 @@ static void glance_extra(rep *r)
             fputs(" <span class=\"note\">(the nominal model's figure on it is not in this run)</span>", f);
         fputs(".</p>\n", f);
     }
+}
+
+/* The first screen's "It rests on:" paragraph: the estimation (prior or
+ * least squares), the outlets, the attachment, every nuisance fitted. */
+static void rests_on(rep *r)
+{
+    FILE *f = r->f;
+    fputs("<p class=\"rests\">It rests on: ", f);
+    const rch_json *est = rch_rep_jpath(r->cal, "estimation");
+    if (jbool(est, "prior") == 1) {
+        fputs("the posterior of a fit with the physical prior (link lengths &plusmn;", f);
+        rch_rep_put_sig(r, jnum(est, "prior_length_mm"), " mm");
+        fputs(", twists &plusmn;", f);
+        rch_rep_put_sig(r, jnum(est, "prior_twist_deg"), "&deg;");
+        fputs(", joint zeros &plusmn;", f);
+        rch_rep_put_sig(r, jnum(est, "prior_offset_deg"), "&deg;");
+        fputs(": what the data did not determine counts at the prior's width), the noise estimated from the data (",
+              f);
+        rch_rep_put_sig(r, jnum(est, "noise_mm"), " mm");
+        fputs(")", f);
+    } else if (est) {
+        fputs("the covariance of a least-squares fit (no prior: directions the data did not determine are held "
+              "nominal and not counted)",
+              f);
+    } else {
+        rch_rep_put_str(r, NULL);
+    }
+    const double outlets = jnum(est, "outlets");
+    if (isfinite(outlets))
+        fprintf(f, "; %.0f cable outlet%s%s", outlets, outlets == 1 ? "" : "s",
+                outlets < 3 ? " (lengths from fewer than three outlets cannot see every rigid motion of the robot "
+                              "about them: the figures hold for positions relative to each other)"
+                            : "");
+    const char *att = jstr(est, "attachment");
+    if (att)
+        fprintf(f, "; the cable attachment %s",
+                strcmp(att, "estimated") == 0 ? "estimated (a vector in the flange frame)" : "at the flange centre");
+    const rch_json *jumps = jarr(r->cal, "length_jumps");
+    if (jumps && jumps->n)
+        fprintf(f, "; %zu length jump%s fitted as nuisance", jumps->n, jumps->n == 1 ? "" : "s");
+    const double dq = jnum(r->cal, "dequantized.corrected"), dqr = jnum(r->cal, "dequantized.refused");
+    if (isfinite(dq))
+        fprintf(f, "; joint angles recovered from x, y, z for %.0f rows (%.0f refused)", dq,
+                isfinite(dqr) ? dqr : 0.0);
+    const double g = jnum(r->unc, "groups");
+    if (isfinite(g) && g > 0)
+        fprintf(f, "; %.0f set-up groups (cluster-robust covariance)", g);
+    fputs(".</p>\n", f);
 }
 
 static void verdict(rep *r, size_t n_warn)
@@ -345,47 +394,8 @@ static void verdict(rep *r, size_t n_warn)
         fprintf(f, " (%.0f samples)", nt);
     if (isfinite(a) && isfinite(b) && b > 0)
         fprintf(f, ", %+.1f %%", 100.0 * (a - b) / b);
-    fputs(".</p>\n<p class=\"rests\">It rests on: ", f);
-    const rch_json *est = rch_rep_jpath(r->cal, "estimation");
-    if (jbool(est, "prior") == 1) {
-        fputs("the posterior of a fit with the physical prior (link lengths &plusmn;", f);
-        rch_rep_put_sig(r, jnum(est, "prior_length_mm"), " mm");
-        fputs(", twists &plusmn;", f);
-        rch_rep_put_sig(r, jnum(est, "prior_twist_deg"), "&deg;");
-        fputs(", joint zeros &plusmn;", f);
-        rch_rep_put_sig(r, jnum(est, "prior_offset_deg"), "&deg;");
-        fputs(": what the data did not determine counts at the prior's width), the noise estimated from the data (",
-              f);
-        rch_rep_put_sig(r, jnum(est, "noise_mm"), " mm");
-        fputs(")", f);
-    } else if (est) {
-        fputs("the covariance of a least-squares fit (no prior: directions the data did not determine are held "
-              "nominal and not counted)",
-              f);
-    } else {
-        rch_rep_put_str(r, NULL);
-    }
-    const double outlets = jnum(est, "outlets");
-    if (isfinite(outlets))
-        fprintf(f, "; %.0f cable outlet%s%s", outlets, outlets == 1 ? "" : "s",
-                outlets < 3 ? " (lengths from fewer than three outlets cannot see every rigid motion of the robot "
-                              "about them: the figures hold for positions relative to each other)"
-                            : "");
-    const char *att = jstr(est, "attachment");
-    if (att)
-        fprintf(f, "; the cable attachment %s",
-                strcmp(att, "estimated") == 0 ? "estimated (a vector in the flange frame)" : "at the flange centre");
-    const rch_json *jumps = jarr(r->cal, "length_jumps");
-    if (jumps && jumps->n)
-        fprintf(f, "; %zu length jump%s fitted as nuisance", jumps->n, jumps->n == 1 ? "" : "s");
-    const double dq = jnum(r->cal, "dequantized.corrected"), dqr = jnum(r->cal, "dequantized.refused");
-    if (isfinite(dq))
-        fprintf(f, "; joint angles recovered from x, y, z for %.0f rows (%.0f refused)", dq,
-                isfinite(dqr) ? dqr : 0.0);
-    const double g = jnum(r->unc, "groups");
-    if (isfinite(g) && g > 0)
-        fprintf(f, "; %.0f set-up groups (cluster-robust covariance)", g);
     fputs(".</p>\n", f);
+    rests_on(r);
     glance_extra(r);
     diagnosis_glance(r);
     fprintf(f, "<p><a href=\"#warnings\">%zu warning%s</a></p></div>\n", n_warn, n_warn == 1 ? "" : "s");
