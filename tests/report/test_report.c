@@ -301,6 +301,80 @@ static void test_verdict(void **state)
     }
 }
 
+/* text with the first `what` replaced by `with` (static buffer) */
+static const char *edited(const char *text, const char *what, const char *with)
+{
+    static char buf[16384];
+    const char *at = strstr(text, what);
+    assert_non_null(at);
+    snprintf(buf, sizeof buf, "%.*s%s%s", (int)(at - text), text, with, at + strlen(what));
+    return buf;
+}
+
+/* The verdict never passes a model that the same page shows worse than
+ * nominal (issue 33): each figure worse after than before (held-out RMSE,
+ * a validation file, the 3-D positions, a diagnosis sensor, the
+ * diagnosis' RMSE) and a diagnosis that says "unexplained" turn the PASS of
+ * cal_full at 0.1 mm into FAIL with the reason on the first screen; without
+ * a tolerance into NOT PASSED; the clean run with its diagnosis still
+ * passes. */
+static void test_verdict_worse(void **state)
+{
+    (void)state;
+    rch_report_result res;
+    rch_diag d;
+    char msg[1024];
+    static const char *const pos = "{\"positions\": {\"rows\": 30, \"position_error_mm\": {\"points\": 30, "
+                                   "\"rms\": 0.9}, \"before_mm\": {\"points\": 30, \"rms\": 0.4}}, ";
+    static const char *const val = "{\"validation\": {\"data\": \"v<1>.csv\", \"residual\": {\"rmse_mm\": 0.3}, "
+                                   "\"before\": {\"rmse_mm\": 0.2}}, ";
+    static const char *const sens = "{\"sensors\": [{\"name\": \"tracker\", \"kind\": \"tracker\", \"rows\": 9, "
+                                    "\"before_mm\": 0.1, \"after_mm\": 0.2}], ";
+    const struct {
+        const char *cal_what, *cal_with, *diag_what, *diag_with;
+        double tol;
+        const char *want, *why;
+    } cases[] = {
+        {"\"after\": {\"n\": 10, \"rmse_mm\": 0.02", "\"after\": {\"n\": 10, \"rmse_mm\": 0.6", NULL, NULL, 0.1,
+         "<b>FAIL</b> against the tolerance of 0.1 mm, although", "cable-length RMSE 0.6 mm calibrated against 0.5 mm"},
+        {"{", pos, NULL, NULL, 0.1, "<b>FAIL</b>", "3-D position error (rms) 0.9 mm calibrated against 0.4 mm"},
+        {"{", val, NULL, NULL, 0.1, "<b>FAIL</b>", "RMSE on the validation file 0.3 mm calibrated against 0.2 mm"},
+        {NULL, NULL, "{", sens, 0.1, "<b>FAIL</b>", "held-out error of tracker (3-D) 0.2 mm calibrated against 0.1"},
+        {NULL, NULL, "\"rmse_after_mm\": 0.02", "\"rmse_after_mm\": 0.07", 0.1, "<b>FAIL</b>",
+         "held-out RMSE in the diagnosis 0.07 mm calibrated against 0.05 mm"},
+        {NULL, NULL, "\"remaining\": \"none\"", "\"remaining\": \"unexplained\"", 0.1, "<b>FAIL</b>",
+         "no effect explains (held-out 0.02 mm, 2.00 x the floor)"},
+        {NULL, NULL, "\"effect\": \"joint_compliance\"", "\"effect\": \"unexplained\"", 0.0, "<b>NOT PASSED</b>",
+         "no effect explains"},
+        {"{", pos, NULL, NULL, 0.0, "<b>NOT PASSED</b>", "3-D position error"},
+        {NULL, NULL, NULL, NULL, 0.1, "<b>PASS</b> against the tolerance of 0.1 mm", NULL},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        put_file("cal.json", cases[k].cal_what ? edited(cal_full, cases[k].cal_what, cases[k].cal_with) : cal_full);
+        put_file("diag.json",
+                 cases[k].diag_what ? edited(diag_full, cases[k].diag_what, cases[k].diag_with) : diag_full);
+        if (report_tol(&res, "cal.json", "diag.json", "w.html", cases[k].tol, &d) != 0)
+            fail_msg("%s", rch_diag_str(&d, msg, sizeof msg));
+        char *h = get_file("w.html");
+        assert_non_null(h);
+        const char *v = strstr(h, "id=\"verdict\""), *end = v ? strstr(v, "</div>") : NULL;
+        assert_non_null(end);
+        const char *want = strstr(v, cases[k].want);
+        if (!want || want > end)
+            fail_msg("case %zu: no \"%s\" on the first screen", k, cases[k].want);
+        const char *pass = strstr(v, "PASS</b>");
+        if (cases[k].why) {
+            const char *why = strstr(v, cases[k].why);
+            if (!why || why > end)
+                fail_msg("case %zu: the reason \"%s\" is not on the first screen", k, cases[k].why);
+            assert_true(pass == NULL || pass > end);
+            const char *cls = "<div class=\"glance fail\" ";
+            assert_true(v - h >= (long)strlen(cls) && strncmp(v - strlen(cls), cls, strlen(cls)) == 0);
+        }
+        free(h);
+    }
+}
+
 static void test_minimal_run(void **state)
 {
     (void)state;
@@ -423,6 +497,7 @@ int main(void)
         cmocka_unit_test(test_cmdline),
         cmocka_unit_test(test_full_run_escaped),
         cmocka_unit_test(test_verdict),
+        cmocka_unit_test(test_verdict_worse),
         cmocka_unit_test(test_minimal_run),
         cmocka_unit_test(test_wrong_types),
         cmocka_unit_test(test_refusals),

@@ -151,9 +151,9 @@ def screenshot(chrome, profile, page, png, size, netlog=None):
     run(chromium_cmd(chrome, profile, *extra, 'file://' + page), cwd=os.path.dirname(page))
 
 
-def dump_dom(chrome, profile, page):
-    """The DOM after parsing and layout at the screenshot's width."""
-    return run(chromium_cmd(chrome, profile, '--window-size=1200,3000', '--dump-dom', 'file://' + page),
+def dump_dom(chrome, profile, page, size=(1200, 3000)):
+    """The DOM after parsing and layout at the screenshot's width (or size)."""
+    return run(chromium_cmd(chrome, profile, '--window-size=%d,%d' % size, '--dump-dom', 'file://' + page),
                cwd=os.path.dirname(page)).stdout.decode('utf-8', errors='replace')
 
 
@@ -262,6 +262,10 @@ def check_browser(chrome, work, page, n_plots, shot_out):
     if not m:
         return
     probe = json.loads(html.unescape(m.group(1)))
+    # a laptop's 1280 px: the page never scrolls sideways (issue 33; a wide table scrolls inside its section)
+    m1280 = re.search(r'<pre id="probe">(.*?)</pre>', dump_dom(chrome, profile, probe_page, (1280, 900)), re.S)
+    w1280 = json.loads(html.unescape(m1280.group(1)))['page_w'] if m1280 else -1
+    check(0 < w1280 <= 1280, 'at 1280 px wide the page is %s px wide: no sideways scrolling' % w1280)
     check(len(probe['svgs']) == n_plots, '%d plots laid out (rcal report drew %d)' % (len(probe['svgs']), n_plots))
     full = os.path.join(work, 'report_full.png')
     h = int(probe['page_h']) + 20

@@ -27,6 +27,15 @@
  *                             length moves from the old to the new value over
  *                             --settle-ms with a decaying 0.5 mm vibration, as
  *                             the arm travels and settles.
+ *   --outlet X,Y,Z (repeatable)  the true places of the encoder's outlets
+ *                             0, 1, ... (mm, base frame) for a plan with an
+ *                             outlet column (rcal poses --outlet ...): each
+ *                             pose's length is from the place of its row's
+ *                             outlet (rcal acquire --outlet N runs the rows
+ *                             of one place at a time). Without it, the truth
+ *                             model's own (encoder_mm for outlet 0, its
+ *                             outlet effects for the others); a plan row of
+ *                             an outlet neither gives is refused at start.
  * Realism and faults:
  *   --rate-hz R         measuring rate: a new value every 1/R s (streamed, or
  *                       shown to polls: polls in between get the same value)
@@ -431,7 +440,43 @@ static int load_script(sim *s, const char *path)
     return 0;
 }
 
-static int load_robot(sim *s, const char *truth_path, const char *poses_path)
+/* The true length of plan row smp (its outlet column as read) on the truth
+ * model m, from places[outlet] when --outlet gave n_places places (else m's
+ * own outlets). 0, or -1 with the message printed (line: the row's). */
+static int row_length(double *len_mm, const rc_model *m, rc_sample smp, const double (*places)[3], size_t n_places,
+                      const char *poses_path, unsigned line)
+{
+    rc_model mk;
+    const rc_model *use = m;
+    if (n_places) {
+        if (smp.outlet >= n_places) {
+            fprintf(stderr,
+                    "simdisplay: %s:%u: a pose from outlet %u, but --outlet gave %zu place%s (outlets 0 .. %zu): give "
+                    "one --outlet X,Y,Z per outlet of the plan\n",
+                    poses_path, line, (unsigned)smp.outlet, n_places, n_places == 1 ? "" : "s", n_places - 1);
+            return -1;
+        }
+        mk = *m;
+        memcpy(&mk.x[RC_P_ENC], places[smp.outlet], 3 * sizeof mk.x[0]);
+        smp.outlet = 0;
+        use = &mk;
+    }
+    const rc_status st = rc_meas(len_mm, NULL, use, &smp);
+    if (st == RC_OK)
+        return 0;
+    if (smp.outlet != 0)
+        fprintf(stderr,
+                "simdisplay: %s:%u: a pose from outlet %u, a place the truth model does not have: give the true "
+                "places of the plan's outlets with --outlet X,Y,Z (once per outlet 0, 1, ..., in order)\n",
+                poses_path, line, (unsigned)smp.outlet);
+    else
+        fprintf(stderr, "simdisplay: %s:%u: no length at this pose (the flange at the encoder outlet)\n", poses_path,
+                line);
+    return -1;
+}
+
+static int load_robot(sim *s, const char *truth_path, const char *poses_path, const double (*places)[3],
+                      size_t n_places)
 {
     rch_robot *r = calloc(1, sizeof *r);
     rch_data d;
@@ -463,8 +508,7 @@ static int load_robot(sim *s, const char *truth_path, const char *poses_path)
         rc_sample smp = d.s[i];
         double l;
         smp.t = d.n > 1 ? (double)i / (double)(d.n - 1) : 0.0;
-        if (rc_meas(&l, NULL, &r->model, &smp) != RC_OK) {
-            fprintf(stderr, "simdisplay: pose %zu: no length (flange at the encoder)\n", i);
+        if (row_length(&l, &r->model, smp, places, n_places, poses_path, d.line ? d.line[i] : (unsigned)i + 2) != 0) {
             rch_data_free(&d);
             free(r);
             return -1;
@@ -480,6 +524,9 @@ static int load_robot(sim *s, const char *truth_path, const char *poses_path)
  * parser (rch_opt: strict numbers, --opt=value, -h, generated usage). */
 typedef struct sim_args {
     const char *protocol, *script, *truth, *poses, *style, *unit, *mb_format, *mb_order, *poll_cmd;
+    rch_opt_strs outlets;                 /* --outlet X,Y,Z, as given */
+    double places[RCH_OPT_MAX_STRS][3];  /* (n_places x 3) mm, parsed */
+    size_t n_places;
     unsigned long decimals, mb_addr, mb_reg, mb_decimals, reply_delay_ms, seed;
     long reconnect_ms;
 } sim_args;
@@ -495,6 +542,8 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
         {"--truth", RCH_OPT_STR, &g->truth, 0, 0, "MODEL.json", "true robot (with --poses)", 0, NULL},
         {"--poses", RCH_OPT_STR, &g->poses, 0, 0, "POSES.csv", "the plan the acquisition follows", 0, NULL},
         {"--follow", RCH_OPT_STR, &s->follow, 0, 0, "FILE", "the pose announced by rcal acquire", 0, NULL},
+        {"--outlet", RCH_OPT_STRS, &g->outlets, 0, 0, "X,Y,Z",
+         "true place of outlet 0, 1, ... (repeatable; default: the truth model's)", 0, NULL},
         {"--noise-mm", RCH_OPT_DOUBLE, &s->noise_mm, 0, 1e9, "S", "Gaussian noise per value", 0, NULL},
         {"--decimals", RCH_OPT_UINT, &g->decimals, 0, 6, "D", "digits after the point", 0, NULL},
         {"--style", RCH_OPT_CHOICE, &g->style, 0, 0, NULL, "+0509.190 or + 509.190, MM", 0, "zero|unit"},
@@ -558,6 +607,19 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
                 s->pc.poll_cmd[k++] = *p;
             }
         }
+    }
+    for (size_t i = 0; i < g->outlets.n; ++i) {
+        double *p = g->places[i];
+        if (rch_parse_triple(g->outlets.v[i], p) != 0 || fabs(p[0]) > 1e5 || fabs(p[1]) > 1e5 || fabs(p[2]) > 1e5) {
+            fprintf(stderr, "simdisplay: --outlet '%s': expected X,Y,Z in mm (three finite numbers within 1e5)\n",
+                    g->outlets.v[i]);
+            return 2;
+        }
+    }
+    g->n_places = g->outlets.n;
+    if (g->n_places && !g->truth) {
+        fprintf(stderr, "simdisplay: --outlet goes with --truth and --poses\n");
+        return 2;
     }
     if ((g->truth != NULL) != (g->poses != NULL)) {
         fprintf(stderr, "simdisplay: --truth and --poses go together\n");
@@ -682,7 +744,8 @@ static int serve(sim *s, unsigned long reply_delay_ms)
 static int run(int argc, char **argv)
 {
     sim s;
-    sim_args g = {"ascii", NULL, NULL, NULL, "zero", "mm", "int32", "abcd", NULL, 3, 0, 0, 0, 0, 1, -1};
+    static sim_args g = {"ascii", NULL, NULL, NULL, "zero", "mm", "int32", "abcd", NULL, {{0}, 0}, {{0}}, 0,
+                         3, 0, 0, 0, 0, 1, -1};
     int rc;
     memset(&s, 0, sizeof s);
     s.rate_hz = 20;
@@ -697,7 +760,7 @@ static int run(int argc, char **argv)
         rc = load_script(&s, g.script) != 0;
     } else if (g.truth) {
         s.src = SRC_ROBOT;
-        rc = load_robot(&s, g.truth, g.poses) != 0;
+        rc = load_robot(&s, g.truth, g.poses, (const double(*)[3])g.places, g.n_places) != 0;
     } else {
         s.src = SRC_CONST;
     }

@@ -269,17 +269,34 @@ static int read_unc_param(rch_robot *out, unsigned k, const rch_json *p, const c
     return 0;
 }
 
+/* Is DH parameter i's variance v beyond what any calibration determines (a
+ * standard error above 1 m or 1 rad, RCH_UNDETERMINED_*)? Not a number
+ * counts as beyond. */
+static double undetermined_lim(unsigned i)
+{
+    return (i % 4 == 0 || i % 4 == 1) ? RCH_UNDETERMINED_MM2 : RCH_UNDETERMINED_RAD2;
+}
+
+int rch_robot_unc_undetermined(const rch_model_unc *u, unsigned k)
+{
+    return k < RC_N_DH && !(u->cov_dh[k * RC_N_DH + k] <= undetermined_lim(k));
+}
+
 /* A covariance read from outside is checked as data (issue 23): symmetric,
  * of physical size (a standard error below 1 m or 1 rad: beyond, no
  * calibration determined anything and every uncertainty figure would be
  * meaningless) and positive semi-definite (its smallest eigenvalue not below
  * -1e-9 of its largest); otherwise it would turn the safety checks of
- * compensation into noise (a -1 diagonal printed "0.0000 mm"). */
-static int check_cov(const double *c, const rch_json *arr, const char *name, rch_diag *d)
+ * compensation into noise (a -1 diagonal printed "0.0000 mm"). The rows and
+ * columns of undetermined parameters (und[i], issue 33) are out of the
+ * check: read_uncertainty has set them aside. */
+static int check_cov(const double *c, const uint8_t *und, const rch_json *arr, const char *name, rch_diag *d)
 {
     const unsigned n = RC_N_DH;
     for (unsigned i = 0; i < n; ++i) {
-        const double v = c[i * n + i], lim = (i % 4 == 0 || i % 4 == 1) ? 1e6 : 1.0;
+        if (und[i])
+            continue;
+        const double v = c[i * n + i], lim = undetermined_lim(i);
         if (!(v >= 0.0) || v > lim) {
             const rch_json *it = arr->items[i * n + i];
             rch_diag_set(d, name, it->line, it->col,
@@ -288,6 +305,8 @@ static int check_cov(const double *c, const rch_json *arr, const char *name, rch
             return -1;
         }
         for (unsigned j = 0; j < i; ++j) {
+            if (und[j])
+                continue;
             const double a = c[i * n + j], b = c[j * n + i];
             if (fabs(a - b) > 1e-9 * sqrt(c[i * n + i] * c[j * n + j]) + 1e-300) {
                 const rch_json *it = arr->items[i * n + j];
@@ -298,7 +317,9 @@ static int check_cov(const double *c, const rch_json *arr, const char *name, rch
         }
     }
     double A[RC_N_DH * RC_N_DH], V[RC_N_DH * RC_N_DH], ev[RC_N_DH];
-    memcpy(A, c, sizeof A);
+    for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = 0; j < n; ++j)
+            A[i * n + j] = und[i] || und[j] ? 0.0 : c[i * n + j];
     if (rcu_eig_sym(ev, V, A, n, 0) != RC_OK) {
         rch_diag_set(d, name, arr->line, arr->col, "covariance_dh: its eigenvalues cannot be computed");
         return -1;
@@ -313,6 +334,52 @@ static int check_cov(const double *c, const rch_json *arr, const char *name, rch
                      "covariance_dh is not positive semi-definite (eigenvalue %g against a largest of %g): not the "
                      "covariance of any calibration", mn, mx);
         return -1;
+    }
+    return 0;
+}
+
+/* The DH parameters the data left undetermined (issue 33): those named in
+ * "undetermined" (written since) and, in files written before, those whose
+ * variance is beyond RCH_UNDETERMINED_* while compensation holds them
+ * nominal (a no-prior fit's weak direction). Each must be held nominal by
+ * compensation: a file that says it uses an undetermined value is refused.
+ * und: (24) set to 1 for each. */
+static int read_undetermined(uint8_t und[RC_N_DH], const rch_robot *out, const rch_json *u, const rch_json *cov,
+                             const char *name, rch_diag *d)
+{
+    const rch_json *ul = rch_json_get(u, "undetermined");
+    memset(und, 0, RC_N_DH);
+    if (ul && ul->type != RCH_JARR) {
+        rch_diag_set(d, name, ul->line, ul->col, "\"undetermined\" must be an array of DH parameter names");
+        return -1;
+    }
+    for (size_t i = 0; ul && i < ul->n; ++i) {
+        const rch_json *s = ul->items[i];
+        unsigned k = 0;
+        char nm[64];
+        while (k < RC_N_DH &&
+               !(s->type == RCH_JSTR && strcmp(s->str, rc_param_name(nm, sizeof nm, &out->model, k)) == 0))
+            ++k;
+        if (k == RC_N_DH) {
+            rch_diag_set(d, name, s->line, s->col,
+                         "\"undetermined\": item %zu is not a DH parameter name (a1 .. theta6)", i + 1);
+            return -1;
+        }
+        und[k] = 1;
+    }
+    for (unsigned k = 0; k < RC_N_DH; ++k) {
+        const rch_json *it = cov->items[k * RC_N_DH + k];
+        if (!und[k] && it->type == RCH_JNUM && it->num > undetermined_lim(k) && out->unc.comp_nominal[k] &&
+            out->unc.cls[k] != RCH_PARAM_FIXED)
+            und[k] = 1;
+        char nm[64];
+        if (und[k] && !out->unc.comp_nominal[k]) {
+            rch_diag_set(d, name, it->line, it->col,
+                         "%s is undetermined by the data but its \"compensation\" is \"fitted\": compensation cannot "
+                         "use a value the data did not determine (make it \"nominal\")",
+                         rc_param_name(nm, sizeof nm, &out->model, k));
+            return -1;
+        }
     }
     return 0;
 }
@@ -407,15 +474,33 @@ static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name,
                      RC_N_DH * RC_N_DH);
         return -1;
     }
+    uint8_t und[RC_N_DH];
+    if (read_undetermined(und, out, u, cov, name, d) != 0)
+        return -1;
     for (unsigned k = 0; k < cov->n; ++k) {
+        const unsigned i = k / RC_N_DH, j = k % RC_N_DH;
+        if (und[i] || und[j]) { /* null (or a number beyond belief): no information */
+            if (cov->items[k]->type != RCH_JNULL && cov->items[k]->type != RCH_JNUM) {
+                rch_diag_set(d, name, cov->items[k]->line, cov->items[k]->col,
+                             "covariance_dh: a number, or null in the row and column of an undetermined parameter");
+                return -1;
+            }
+            out->unc.cov_dh[k] = i == j ? INFINITY : 0.0;
+            continue;
+        }
         if (cov->items[k]->type != RCH_JNUM || !isfinite(cov->items[k]->num)) {
-            rch_diag_set(d, name, cov->items[k]->line, cov->items[k]->col, "covariance_dh: not a finite number");
+            rch_diag_set(d, name, cov->items[k]->line, cov->items[k]->col,
+                         "covariance_dh: not a finite number (null only in the row and column of a parameter listed "
+                         "in \"undetermined\")");
             return -1;
         }
         out->unc.cov_dh[k] = cov->items[k]->num;
     }
-    if (check_cov(out->unc.cov_dh, cov, name, d) != 0)
+    if (check_cov(out->unc.cov_dh, und, cov, name, d) != 0)
         return -1;
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        if (und[k])
+            out->unc.se[k] = NAN;
     out->unc.orientation_determined = od && od->type == RCH_JBOOL && od->num != 0.0;
     out->unc.sigma_mm = sg && sg->type == RCH_JNUM ? sg->num : NAN;
     const rch_json *po = rch_json_get(u, "posterior");
@@ -582,7 +667,8 @@ void rch_robot_write_unc_params(rch_jw *w, const rc_model *m, const rch_model_un
         rch_jw_str(w, "name", rc_param_name(nm, sizeof nm, m, k));
         rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "SI");
         rch_jw_numf(w, "value", m->x[k] * sc, value_fmt);
-        rch_jw_numf(w, "std_error", u->se[k] * sc, "%.6g"); /* NaN -> null */
+        /* NaN -> null; so is an undetermined parameter's */
+        rch_jw_numf(w, "std_error", rch_robot_unc_undetermined(u, k) ? NAN : u->se[k] * sc, "%.6g");
         rch_jw_str(w, "class", rch_param_class_name((rch_param_class)u->cls[k]));
         rch_jw_str(w, "compensation", k < RC_N_DH ? (u->comp_nominal[k] ? "nominal" : "fitted") : "not used");
         if (u->has_prior && u->prior_sd[k] > 0.0) {
@@ -608,9 +694,24 @@ static void write_uncertainty(rch_jw *w, const rc_model *m, const rch_model_unc 
     rch_jw_uint(w, "rank", u->rank);
     rch_jw_bool(w, "posterior", u->has_prior); /* the covariance of a MAP fit: prior-only directions included */
     rch_robot_write_unc_params(w, m, u, "%.12g");
+    /* the parameters the data left undetermined (issue 33): named, their
+     * rows and columns of covariance_dh null */
+    uint8_t und[RC_N_DH];
+    unsigned n_und = 0;
+    for (unsigned k = 0; k < RC_N_DH; ++k)
+        n_und += und[k] = (uint8_t)rch_robot_unc_undetermined(u, k);
+    if (n_und) {
+        rch_jw_arr(w, "undetermined");
+        for (unsigned k = 0; k < RC_N_DH; ++k) {
+            char nm[64];
+            if (und[k])
+                rch_jw_str(w, NULL, rc_param_name(nm, sizeof nm, m, k));
+        }
+        rch_jw_end(w);
+    }
     rch_jw_arr(w, "covariance_dh");
     for (unsigned k = 0; k < RC_N_DH * RC_N_DH; ++k)
-        rch_jw_numf(w, NULL, u->cov_dh[k], "%.9g");
+        rch_jw_numf(w, NULL, und[k / RC_N_DH] || und[k % RC_N_DH] ? NAN : u->cov_dh[k], "%.9g");
     rch_jw_end(w);
     if (det) {
         rch_jw_obj(w, "determined");

@@ -91,6 +91,20 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
  * error, class, compensation use; values printed with value_fmt), the
  * "position95_mm" and "orientation95_deg" objects, the "provenance" object. */
 void rch_robot_write_unc_params(rch_jw *w, const rc_model *m, const rch_model_unc *u, const char *value_fmt);
+
+/* Undetermined DH parameters (issue 33): a standard error above 1 m or
+ * 1 rad is no calibration's result but a direction the data did not see (a
+ * no-prior fit's weak one). The model file lists them by name in
+ * "uncertainty": {"undetermined": ["alpha5", ...]}, their "std_error" and
+ * their rows and columns of "covariance_dh" null; read back, such a
+ * parameter has se NaN and in cov_dh an infinite variance and zero
+ * covariances, so every figure that uses a standard error leaves it out as
+ * it does a not-identifiable one (compensation holds it nominal: a file
+ * that says otherwise is refused). 1: DH parameter k of u is undetermined
+ * (cov_dh[k][k] beyond the limit or not a number). */
+#define RCH_UNDETERMINED_MM2 1e6
+#define RCH_UNDETERMINED_RAD2 1.0
+int rch_robot_unc_undetermined(const rch_model_unc *u, unsigned k);
 void rch_robot_write_unc_map(rch_jw *w, const rch_uncert_map *mp);
 void rch_robot_write_provenance(rch_jw *w, const rch_provenance *p);
 

@@ -2,12 +2,14 @@
 /* rch_report_html.c - the pieces of the report's page: a value escaped or
  * "not in this run" (counted, with what it stands for and how a run gets
  * it), key-value rows, tables of JSON arrays, the CSS, the page's head and
- * the verdict on the first screen (pass or fail against --tolerance-mm).
+ * the verdict on the first screen (pass or fail against --tolerance-mm; never
+ * a pass when a figure of the page shows the model worse than nominal).
  * Every string from a JSON file goes out through rch_xml_put (files/rch_text).
  * Depends on: rch_text, rch_json (through the model). Memory: none.
  * Errors: none (a write error shows in ferror of the page). See
  * rch_report_int.h. */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -95,13 +97,14 @@ static const char css[] =
     ".flag{color:#b34700;font-size:12px}.glance p{margin:4px 0}.glance .big{font-size:16px}"
     ".glance.pass{border-left-color:#009E73}.glance.fail{border-left-color:#D55E00}"
     ".glance.pass b:first-child{color:#007a5a}.glance.fail b:first-child{color:#b34700}.rests{color:#334;font-size:13px}"
-    "section{background:#fff;border:1px solid #d6dae0;border-radius:6px;padding:8px 16px 12px;margin:12px 0}"
+    "section{background:#fff;border:1px solid #d6dae0;border-radius:6px;padding:8px 16px 12px;margin:12px 0;"
+    "overflow-x:auto}main{overflow-wrap:break-word}svg{max-width:100%;height:auto}"
     "h2{font-size:17px;margin:2px 0 8px;padding-bottom:3px;border-bottom:1px solid #e4e7eb}"
     "h3{font-size:14px;margin:10px 0 4px}"
     "table{border-collapse:collapse;font-size:13px;margin:4px 0}"
     "td,th{padding:1px 8px;border-bottom:1px solid #eceef1;text-align:right;vertical-align:top;white-space:nowrap}"
     "td.w{white-space:normal}.two{display:grid;grid-template-columns:1fr 1fr;gap:12px}.two section{margin:0}"
-    "th{background:#f1f3f6;font-weight:600}td.l,th.l{text-align:left}"
+    "th{background:#f1f3f6;font-weight:600}td.l,th.l{text-align:left;white-space:normal}"
     "table.kv th{text-align:left;background:none;color:#445;font-weight:normal;white-space:nowrap}"
     "table.kv td{text-align:left;white-space:normal}"
     ".na{color:#888;font-style:italic}.mono{font-family:ui-monospace,'DejaVu Sans Mono',monospace;"
@@ -186,51 +189,114 @@ static void diagnosis_glance(rep *r)
     fputs(".</p>\n", f);
 }
 
-static void verdict(rep *r, size_t n_warn)
+/* One reason more in why (len): "; " before all but the first; n counts. */
+static void why_add(char *why, size_t len, unsigned *n, const char *fmt, ...) RCH_PRINTF(4, 5);
+static void why_add(char *why, size_t len, unsigned *n, const char *fmt, ...)
+{
+    const size_t at = strlen(why);
+    if (at + 3 < len) {
+        va_list ap;
+        snprintf(why + at, len - at, "%s", *n ? "; " : "");
+        va_start(ap, fmt);
+        vsnprintf(why + strlen(why), len - strlen(why), fmt, ap);
+        va_end(ap);
+    }
+    ++*n;
+}
+
+/* What the page's own figures say against the nominal model (issue 33):
+ * each figure of the calibrated model worse than the nominal one's on the
+ * same samples, and a diagnosis that finds error beyond the noise floor
+ * that no effect explains. Appended to why (len) as "; "-separated
+ * reasons; returns how many. Counted: the held-out cable-length RMSE (the
+ * training one when nothing was held out), a validation file's RMSE (when
+ * its JSON carries the nominal model's, "validation.before"), the 3-D
+ * position error of --positions, every sensor's held-out error in the
+ * diagnosis and its RMSE with the chosen effects, the diagnosis saying
+ * "unexplained", and the flange against a simulated truth. Equal is not
+ * worse. */
+static unsigned worse_than_nominal(const rep *r, char *why, size_t len)
+{
+    unsigned n = 0;
+    why[0] = '\0';
+    const struct {
+        const rch_json *o;
+        const char *before, *after, *what;
+    } pairs[] = {
+        {r->cal, "before.rmse_mm", "after.rmse_mm", "cable-length RMSE"},
+        {r->cal, "validation.before.rmse_mm", "validation.residual.rmse_mm", "RMSE on the validation file"},
+        {r->cal, "positions.before_mm.rms", "positions.position_error_mm.rms", "3-D position error (rms)"},
+        {r->cal, "truth_flange.before_rms_mm", "truth_flange.after_rms_mm", "flange error against the simulated truth"},
+        {r->diag, "rmse_before_mm", "rmse_after_mm", "held-out RMSE in the diagnosis"},
+    };
+    for (size_t k = 0; k < sizeof pairs / sizeof pairs[0]; ++k) {
+        const double b = jnum(pairs[k].o, pairs[k].before), a = jnum(pairs[k].o, pairs[k].after);
+        if (isfinite(a) && isfinite(b) && a > b)
+            why_add(why, len, &n, "%s %.4g mm calibrated against %.4g mm nominal", pairs[k].what, a, b);
+    }
+    const rch_json *ss = jarr(r->diag, "sensors");
+    for (size_t k = 0; ss && k < ss->n; ++k) {
+        const rch_json *z = ss->items[k];
+        const double b = jnum(z, "before_mm"), a = jnum(z, "after_mm");
+        const char *nm = jstr(z, "name"), *kind = jstr(z, "kind");
+        if (isfinite(a) && isfinite(b) && a > b)
+            why_add(why, len, &n, "held-out error of %s%s %.4g mm calibrated against %.4g mm nominal",
+                    nm ? nm : "a sensor", kind && strcmp(kind, "tracker") == 0 ? " (3-D)" : "", a, b);
+    }
+    const char *eff = jstr(r->diag, "effect"), *rem = jstr(r->diag, "remaining");
+    if ((eff && strcmp(eff, "unexplained") == 0) || (rem && strcmp(rem, "unexplained") == 0)) {
+        const double fl = jnum(r->diag, "noise_floor_mm"), ra = jnum(r->diag, "rmse_after_mm");
+        if (isfinite(fl) && fl > 0 && isfinite(ra))
+            why_add(why, len, &n,
+                    "the diagnosis finds structure beyond the noise floor that no effect explains (held-out %.4g mm, "
+                    "%.2f x the floor)", ra, ra / fl);
+        else
+            why_add(why, len, &n, "the diagnosis finds structure beyond the noise floor that no effect explains");
+    }
+    return n;
+}
+
+/* The figures worse_than_nominal reads that no other part of the page
+ * shows: a validation file's and the 3-D positions' error, on the first
+ * screen. */
+static void glance_extra(rep *r)
 {
     FILE *f = r->f;
-    const double in = jnum(r->unc, "position95_mm.data_median"), in_max = jnum(r->unc, "position95_mm.data_max"),
-                 ws = jnum(r->unc, "position95_mm.workspace_median");
-    const double tol = r->cfg->tolerance_mm;
-    const int have = isfinite(in) && isfinite(in_max);
-    const int pass = have && tol > 0.0 && in_max <= tol;
-    rch_rep_section(r, "the verdict (first screen)", NULL);
-    fprintf(f, "<div class=\"glance %s\" id=\"verdict\"><p class=\"big\">",
-            !have || !(tol > 0.0) ? "" : pass ? "pass" : "fail");
-    if (have && tol > 0.0)
-        fprintf(f, "<b>%s</b> against the tolerance of %.4g mm: ", pass ? "PASS" : "FAIL", tol);
-    if (have) {
-        fputs("predicted from the fit, after compensation the robot lands within &plusmn;<b>", f);
-        rch_rep_put_sig(r, in, " mm");
-        fputs("</b> (95 %) over the measured region (the median over the data's poses; the largest &plusmn;", f);
-        rch_rep_put_sig(r, in_max, " mm");
-        fputs("), &plusmn;", f);
-        rch_rep_put_sig(r, ws, " mm");
-        fputs(" over the whole workspace.", f);
-        if (!(tol > 0.0))
-            fputs(" <span class=\"note\">(no tolerance given: <code>rcal report --tolerance-mm MM</code> gives a "
-                  "pass or fail)</span>",
-                  f);
-    } else {
-        fputs("No predicted accuracy in this run: the calibration output carries no uncertainty (pass the model "
-              "file of the run with <code>--model</code>, or calibrate again with <code>rcal calibrate --json</code>).",
-              f);
-        rch_rep_missing(r, "the predicted accuracy", HOW_MODEL);
+    const double pb = jnum(r->cal, "positions.before_mm.rms"), pa = jnum(r->cal, "positions.position_error_mm.rms");
+    if (isfinite(pa)) {
+        fputs("<p>Positions (3-D, rms): <b>", f);
+        rch_rep_put_num(r, pb, "%.4f");
+        fputs(" mm &rarr; ", f);
+        rch_rep_put_num(r, pa, "%.4f");
+        fputs(" mm</b>", f);
+        const double np = jnum(r->cal, "positions.position_error_mm.points");
+        if (isfinite(np))
+            fprintf(f, " (%.0f points)", np);
+        fputs(".</p>\n", f);
     }
-    const double b = jnum(r->cal, "before.rmse_mm"), a = jnum(r->cal, "after.rmse_mm");
-    const double nt = jnum(r->cal, "after.n");
-    fprintf(f, "</p>\n<p>%s: cable-length RMSE <b>",
-            jbool(r->cal, "held_out") == 0 ? "Measured on the training samples (none held out)"
-                                           : "Measured on samples the fit never saw");
-    rch_rep_put_num(r, b, "%.4f");
-    fputs(" mm &rarr; ", f);
-    rch_rep_put_num(r, a, "%.4f");
-    fputs(" mm</b>", f);
-    if (isfinite(nt))
-        fprintf(f, " (%.0f samples)", nt);
-    if (isfinite(a) && isfinite(b) && b > 0)
-        fprintf(f, ", %+.1f %%", 100.0 * (a - b) / b);
-    fputs(".</p>\n<p class=\"rests\">It rests on: ", f);
+    const double vb = jnum(r->cal, "validation.before.rmse_mm"), va = jnum(r->cal, "validation.residual.rmse_mm");
+    if (isfinite(va)) {
+        fputs("<p>Validation file <b>", f);
+        rch_rep_put_str(r, jstr(r->cal, "validation.data"));
+        fputs("</b>: cable-length RMSE <b>", f);
+        if (isfinite(vb)) {
+            rch_rep_put_num(r, vb, "%.4f");
+            fputs(" mm &rarr; ", f);
+        }
+        rch_rep_put_num(r, va, "%.4f");
+        fputs(" mm</b>", f);
+        if (!isfinite(vb))
+            fputs(" <span class=\"note\">(the nominal model's figure on it is not in this run)</span>", f);
+        fputs(".</p>\n", f);
+    }
+}
+
+/* The first screen's "It rests on:" paragraph: the estimation (prior or
+ * least squares), the outlets, the attachment, every nuisance fitted. */
+static void rests_on(rep *r)
+{
+    FILE *f = r->f;
+    fputs("<p class=\"rests\">It rests on: ", f);
     const rch_json *est = rch_rep_jpath(r->cal, "estimation");
     if (jbool(est, "prior") == 1) {
         fputs("the posterior of a fit with the physical prior (link lengths &plusmn;", f);
@@ -271,6 +337,66 @@ static void verdict(rep *r, size_t n_warn)
     if (isfinite(g) && g > 0)
         fprintf(f, "; %.0f set-up groups (cluster-robust covariance)", g);
     fputs(".</p>\n", f);
+}
+
+static void verdict(rep *r, size_t n_warn)
+{
+    FILE *f = r->f;
+    const double in = jnum(r->unc, "position95_mm.data_median"), in_max = jnum(r->unc, "position95_mm.data_max"),
+                 ws = jnum(r->unc, "position95_mm.workspace_median");
+    const double tol = r->cfg->tolerance_mm;
+    const int have = isfinite(in) && isfinite(in_max);
+    char why[1024];
+    const unsigned n_worse = worse_than_nominal(r, why, sizeof why);
+    const int pass = have && tol > 0.0 && in_max <= tol && n_worse == 0;
+    rch_rep_section(r, "the verdict (first screen)", NULL);
+    fprintf(f, "<div class=\"glance %s\" id=\"verdict\"><p class=\"big\">",
+            n_worse ? "fail" : !have || !(tol > 0.0) ? "" : pass ? "pass" : "fail");
+    if (n_worse) {
+        if (have && tol > 0.0)
+            fprintf(f, "<b>FAIL</b> against the tolerance of %.4g mm%s: ", tol,
+                    in_max <= tol ? ", although the predicted accuracy is within it" : "");
+        else
+            fputs("<b>NOT PASSED</b>: ", f);
+        fputs("this page shows the calibrated model worse than the nominal one (<span id=\"verdict-why\">", f);
+        rch_rep_put_esc(f, why);
+        fputs("</span>).</p>\n<p>", f);
+    } else if (have && tol > 0.0)
+        fprintf(f, "<b>%s</b> against the tolerance of %.4g mm: ", pass ? "PASS" : "FAIL", tol);
+    if (have) {
+        fputs("predicted from the fit, after compensation the robot lands within &plusmn;<b>", f);
+        rch_rep_put_sig(r, in, " mm");
+        fputs("</b> (95 %) over the measured region (the median over the data's poses; the largest &plusmn;", f);
+        rch_rep_put_sig(r, in_max, " mm");
+        fputs("), &plusmn;", f);
+        rch_rep_put_sig(r, ws, " mm");
+        fputs(" over the whole workspace.", f);
+        if (!(tol > 0.0))
+            fputs(" <span class=\"note\">(no tolerance given: <code>rcal report --tolerance-mm MM</code> gives a "
+                  "pass or fail)</span>",
+                  f);
+    } else {
+        fputs("No predicted accuracy in this run: the calibration output carries no uncertainty (pass the model "
+              "file of the run with <code>--model</code>, or calibrate again with <code>rcal calibrate --json</code>).",
+              f);
+        rch_rep_missing(r, "the predicted accuracy", HOW_MODEL);
+    }
+    const double b = jnum(r->cal, "before.rmse_mm"), a = jnum(r->cal, "after.rmse_mm");
+    const double nt = jnum(r->cal, "after.n");
+    fprintf(f, "</p>\n<p>%s: cable-length RMSE <b>",
+            jbool(r->cal, "held_out") == 0 ? "Measured on the training samples (none held out)"
+                                           : "Measured on samples the fit never saw");
+    rch_rep_put_num(r, b, "%.4f");
+    fputs(" mm &rarr; ", f);
+    rch_rep_put_num(r, a, "%.4f");
+    fputs(" mm</b>", f);
+    if (isfinite(nt))
+        fprintf(f, " (%.0f samples)", nt);
+    if (isfinite(a) && isfinite(b) && b > 0)
+        fprintf(f, ", %+.1f %%", 100.0 * (a - b) / b);
+    fputs(".</p>\n", f);
+    rests_on(r);
+    glance_extra(r);
     diagnosis_glance(r);
     fprintf(f, "<p><a href=\"#warnings\">%zu warning%s</a></p></div>\n", n_warn, n_warn == 1 ? "" : "s");
 }
