@@ -285,7 +285,7 @@ unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_s
                 base = "distance from the tracker";
             else if (tracker && strcmp(base, "cable direction") == 0)
                 base = "direction from the tracker";
-            snprintf(nm, sizeof nm, "%s: %s", tracker ? "tracker" : "cable", base);
+            snprintf(nm, sizeof nm, "%s: %.30s", tracker ? "tracker" : "cable", base);
             memcpy(out[j].name, nm, sizeof nm);
         }
         if (!tracker && outlets > 1)
