@@ -749,7 +749,7 @@ static int lm_trial(int *done, lm_state *s, rc_model *m, rc_solve_result *res, r
         xs += (m->x[w->idx[i]] * w->D[i]) * (m->x[w->idx[i]] * w->D[i]);
     }
     apply_step(&w->trial, m, w, nf, w->dx);
-    double cnew;
+    double cnew = 0.0; /* set by normal_eq_tab when it succeeds */
     ++res->cost_evals;
     const rc_status st = normal_eq_tab(A, w->g, &cnew, w->jrow, &w->trial, w->idx, nf, samples, tab, n);
     if (st == RC_OK)
@@ -854,7 +854,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     if (res == NULL)
         res = &local;
     memset(res, 0, sizeof *res);
-    if (samples == NULL || n == 0)
+    if (samples == NULL || n == 0 || m == NULL || w == NULL)
         return RC_ERR_ARG;
     if (m->n_params > RC_MAX_PARAMS || m->n_params < RC_N_BASE)
         return RC_ERR_ARG;

@@ -37,6 +37,7 @@ static rc_status solve_counted(rch_calib_result *r, rc_model *m, rc_solve_result
                                const rc_solve_config *cfg, const rc_sample *s, size_t n)
 {
     rc_solve_result local;
+    memset(&local, 0, sizeof local);
     rc_solve_result *out = res ? res : &local;
     memset(out, 0, sizeof *out);
     const rc_status st = rc_solve(m, out, w, cfg, s, n);

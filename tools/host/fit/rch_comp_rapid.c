@@ -68,7 +68,7 @@ static int use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why, 
         (!jt && tcp[0] == 0.0 && tcp[1] == 0.0 && tcp[2] == 0.0))
         return 0;
     for (size_t k = 0; k < c->ntcps; ++k)
-        if (memcmp(c->tcps[k]->tcp, tcp, sizeof c->tcps[k]->tcp) == 0) {
+        if (c->tcps[k]->tcp[0] == tcp[0] && c->tcps[k]->tcp[1] == tcp[1] && c->tcps[k]->tcp[2] == tcp[2]) {
             c->stream = &c->tcps[k]->s;
             c->cal = &c->tcps[k]->det;
             c->fit = &c->tcps[k]->fit;

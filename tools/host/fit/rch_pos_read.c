@@ -89,7 +89,7 @@ static int check_units(const rch_data *dt, const char *path, rch_diag *d)
 /* Every field of row i as read: joints, x, y, z, target, pose, sigma. */
 static int same_row(const rch_data *dt, size_t a, size_t b)
 {
-    return same_q(dt->s[a].q_rad, dt->s[b].q_rad) && memcmp(dt->xyz[a], dt->xyz[b], sizeof dt->xyz[a]) == 0 &&
+    return same_q(dt->s[a].q_rad, dt->s[b].q_rad) && dt->xyz[a][0] == dt->xyz[b][0] && dt->xyz[a][1] == dt->xyz[b][1] && dt->xyz[a][2] == dt->xyz[b][2] &&
            dt->s[a].target == dt->s[b].target && (!dt->pose || dt->pose[a] == dt->pose[b]) &&
            (!dt->sigma_mm || dt->sigma_mm[a] == dt->sigma_mm[b]) && (!dt->has_t || dt->s[a].t == dt->s[b].t);
 }
@@ -395,7 +395,7 @@ static void describe_mirror(char *buf, size_t len, const double A[9])
                     b = r;
             }
         snprintf(buf, len, "it looks like %c and %c swapped (the file's x, y, z are %s of the robot's base frame)",
-                 ax[a], ax[b], map);
+                 ax[a < 0 ? 0 : a], ax[b < 0 ? 1 : b], map); /* one fixed axis: the other two swap (a, b >= 0) */
     } else if (fixed == 3 && neg == 1) {
         int a = sign[0] < 0 ? 0 : sign[1] < 0 ? 1 : 2;
         snprintf(buf, len, "it looks like %c negated (the file's x, y, z are %s of the robot's base frame)", ax[a],

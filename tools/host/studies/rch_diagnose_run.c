@@ -257,6 +257,14 @@ typedef struct {
     size_t i;
 } pose_key;
 
+static int same_joints(const rc_sample *a, const rc_sample *b)
+{
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        if (a->q_rad[j] != b->q_rad[j])
+            return 0;
+    return 1;
+}
+
 static int cmp_pose(const void *a, const void *b)
 {
     const pose_key *x = a, *y = b;
@@ -286,7 +294,7 @@ static int phase_sensors(run_state *S)
     }
     qsort(k, n, sizeof *k, cmp_pose);
     for (size_t a = 0, b; a < n; a = b) { /* a run of equal joints: its first sample in file order */
-        for (b = a + 1; b < n && memcmp(k[b].s->q_rad, k[a].s->q_rad, sizeof k[a].s->q_rad) == 0; ++b)
+        for (b = a + 1; b < n && same_joints(k[b].s, k[a].s); ++b)
             ;
         for (size_t j = a; j < b; ++j)
             first[k[j].i] = k[a].i;

@@ -361,7 +361,7 @@ static int pos_accuracy(rch_poses_accuracy *acc, const pos_work *w, const double
                         unsigned long long seed)
 {
     const unsigned nf = w->nf;
-    double *C = malloc((size_t)nf * nf * sizeof *C), *r = malloc((n_eval ? n_eval : 1) * sizeof *r);
+    double *C = malloc(((size_t)nf * nf + 1) * sizeof *C), *r = malloc((n_eval ? n_eval : 1) * sizeof *r);
     int rc = -1;
     memset(acc, 0, sizeof *acc);
     if (!C || !r || spd_inverse(C, M, nf) != 0)
@@ -624,8 +624,8 @@ int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_pose
     }
     if (check_position(c, d) != 0 || pos_setup(w, m, c, d) != 0)
         goto out;
-    M = malloc((size_t)w->nf * w->nf * sizeof *M);
-    X = malloc((size_t)w->K * w->nf * sizeof *X);
+    M = malloc(((size_t)w->nf * w->nf + 1) * sizeof *M);
+    X = malloc(((size_t)w->K * w->nf + 1) * sizeof *X);
     if (!M || !X) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto out;
