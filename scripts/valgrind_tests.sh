@@ -20,7 +20,10 @@
 #                      diag_stats/diag_cli), drv_e2e runs rcal against the
 #                      simulated display on a pty with real timeouts that a
 #                      30x slow-down breaks. Both run under ASan+UBSan+LSan in
-#                      the RCAL_SANITIZE build. pkg_limits_define_refused and
+#                      the RCAL_SANITIZE build. diag_sensors runs rcal 61 times
+#                      on the independent generator's files (282 s under
+#                      memcheck; diag_cli and sens_gen_check run the same
+#                      diagnose code under it). pkg_limits_define_refused and
 #                      pkg_limits_link_refused run the compiler and pass on
 #                      the error it prints (ctest's PASS_REGULAR_EXPRESSION),
 #                      which this script cannot judge; no project code runs.
@@ -42,7 +45,7 @@ set -u -o pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-$ROOT/build-valgrind}
-EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|drv_e2e|robust_issue23|pkg_limits_define_refused|pkg_limits_link_refused)\$}
+EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|pkg_limits_define_refused|pkg_limits_link_refused)\$}
 TMO=${VALGRIND_TIMEOUT:-900}
 CHILDREN=${VALGRIND_CHILDREN:-1}
 JOBS=${JOBS:-1}
