@@ -79,6 +79,10 @@ static int to_config(calib_args *a, const rch_cmdspec *spec, unsigned long long 
         fprintf(stderr, "rcal calibrate: --tracker-position and --tracker-rotation need --positions\n");
         return 2;
     }
+    if (cfg->dequantize && cfg->no_dequantize) {
+        fprintf(stderr, "rcal calibrate: --dequantize-joints and --no-dequantize-joints contradict each other\n");
+        return 2;
+    }
     return -1;
 }
 
@@ -122,8 +126,11 @@ static int parse(calib_args *a, int argc, char **argv)
          "geometry; they are not used at a new pose",
          0, NULL},
         {"--dequantize-joints", RCH_OPT_FLAG, &cfg->dequantize, 0, 0, NULL,
-         "recover joint angles rounded for the file from its x, y, z columns (nominal FK); inconsistent rows refused",
+         "recover joint angles rounded for the file from its x, y, z columns (nominal FK); inconsistent rows refused "
+         "(the default when the joints sit on a display step and x, y, z are the FK of finer angles; forced here)",
          0, NULL},
+        {"--no-dequantize-joints", RCH_OPT_FLAG, &cfg->no_dequantize, 0, 0, NULL,
+         "keep the joint angles as read, even when the file's x, y, z show they were rounded", 0, NULL},
         {"--holdout-groups", RCH_OPT_FLAG, &cfg->holdout_groups, 0, 0, NULL,
          "hold out whole set-up groups (the file's group column, else from the wrist joints) instead of random rows",
          0, NULL},

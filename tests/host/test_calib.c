@@ -105,6 +105,7 @@ static void ident_routes(const char *path)
     rch_calib_cfg cfg = demo_cfg();
     cfg.data_path = path;
     cfg.no_prior = 1; /* the routes of the data's own identifiability, without the attachment vector */
+    cfg.no_dequantize = 1; /* the samples as this test reads them again below */
     assert_int_equal(rch_calib_run(&r, &cfg, &d), 0);
     rch_data data;
     assert_int_equal(rch_data_load(&data, path, 0, &d), 0);
@@ -181,11 +182,13 @@ static void test_real_jump_counts(void **state)
     char *text = real_text(&r);
     assert_true(r.jumps_auto && r.have_jumps);
     assert_true(r.jumps_found >= 1 && r.jumps_found < r.jump_check_steps);
-    assert_int_equal(r.jumps.n_jumps, r.jump_check_steps);
-    char note[256], found[160];
+    assert_true(r.jumps.n_jumps >= r.jump_check_steps); /* the fit with them may find one more */
+    char note[256], found[160], after[48] = "";
+    if (r.jumps.n_jumps != r.jump_check_steps)
+        snprintf(after, sizeof after, " (%u after the fit with them)", r.jumps.n_jumps);
     snprintf(note, sizeof note, "note: the lengths jump in acquisition order: %u of the %u steps the change-point "
              "search found are far above the residual (8 x its RMS; largest %.3f mm), so all %u are fitted as "
-             "nuisance", r.jumps_found, r.jump_check_steps, r.jump_check_max_mm, r.jump_check_steps);
+             "nuisance%s", r.jumps_found, r.jump_check_steps, r.jump_check_max_mm, r.jump_check_steps, after);
     snprintf(found, sizeof found, "length jumps in acquisition order (nuisance, not used at a new pose): %u found;",
              r.jumps.n_jumps);
     if (!strstr(text, note) || !strstr(text, found))
@@ -198,7 +201,7 @@ static void test_real_jump_counts(void **state)
 /* The text report ends with the summary: held-out RMSE before -> after and
  * the predicted 3-D accuracy (the figures of the run, as the lines above
  * print them), then the next step when the report names one (the real
- * file: plan poses). */
+ * file: diagnose with what the run fitted). */
 static void test_summary_last(void **state)
 {
     (void)state;
@@ -229,9 +232,10 @@ static void test_summary_last(void **state)
     len = strlen(text);
     const char *sum = strstr(text, "\nsummary:\n");
     assert_non_null(sum);
-    const char *next = strstr(sum, "  next: rcal poses --robot ");
-    if (!next || !strstr(next, "the poses leave most of the geometry to the prior)\n") ||
-        strchr(next, '\n') != text + len - 1)
+    /* the file's joints are dequantized by default: the next step is the diagnosis of what the model
+     * still lacks (a1 beyond its prior), one line, the last */
+    const char *next = strstr(sum, "  next: rcal diagnose --data ");
+    if (!next || !strstr(next, " --jumps --dequantize-joints (") || strchr(next, '\n') != text + len - 1)
         fail_msg("the real file's report should end with the next step:\n%s", sum);
     free(text);
 }

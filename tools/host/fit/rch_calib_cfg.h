@@ -30,7 +30,10 @@ typedef struct rch_calib_cfg {
     int tool_offset;        /* 1: also identify the cable attachment in the flange frame */
     const char *effects;    /* effects fitted with the geometry (rch_calib_effects), or NULL */
     int jumps;              /* 1: fit length jumps at change points in acquisition order (nuisance, rch_jumps) */
-    int dequantize;         /* 1: recover rounded joint angles from the file's x, y, z (rch_dequant) */
+    int dequantize;         /* 1: recover rounded joint angles from the file's x, y, z (rch_dequant), refused
+                               without them; 0: automatic, when the joints sit on a display step and x, y, z
+                               are the nominal FK of finer angles (rch_inputs) */
+    int no_dequantize;      /* 1: the joints as read, never dequantized */
     int holdout_groups;     /* 1: hold out whole set-up groups instead of random rows */
     unsigned long cases;    /* > 1: repeat on `cases` random subsets (the paper's protocol) */
     size_t case_samples;    /* rows per case (0: every row) */

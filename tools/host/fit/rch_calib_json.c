@@ -227,6 +227,7 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
         rch_jw_uint(&w, "corrected", r->dequant.n_corrected);
         rch_jw_uint(&w, "refused", r->dequant.n_refused);
         rch_jw_numf(&w, "dq_rms_deg", r->dequant.dq_rms_deg, "%.6f");
+        rch_jw_bool(&w, "automatic", r->dequant.automatic);
         rch_jw_end(&w);
     }
     if (r->cases_done > 1) {

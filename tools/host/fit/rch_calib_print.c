@@ -59,6 +59,10 @@ static void print_effects(FILE *f, const rch_calib_result *r)
         for (size_t i = 0; i < q->n_refused && i < 16; ++i)
             fprintf(f, "%s%u", i ? ", " : " (lines ", r->dequant_refused_lines[i]);
         fprintf(f, "%s\n", q->n_refused ? ")" : "");
+        if (q->automatic)
+            fprintf(f, "  (%s)\n", q->why);
+    } else if (r->dequant.automatic && r->dequant.q_step_deg >= 0.01 && r->dequant.fk_rms_before_mm > 0.02) {
+        fprintf(f, "%s\n", r->dequant.why); /* rounded joints whose x, y, z say more, left: why */
     }
     if (r->have_jumps) {
         const rch_jumps *j = &r->jumps;
@@ -167,7 +171,7 @@ static void diagnose_hint(char *buf, size_t len, const rch_calib_result *r)
     argv[n++] = c->robot_path ? c->robot_path : "ROBOT.json";
     if (c->jumps)
         argv[n++] = "--jumps";
-    if (c->dequantize)
+    if (r->have_dequant) /* forced or automatic: diagnose is told (its own default keeps the joints) */
         argv[n++] = "--dequantize-joints";
     if (c->effects && c->effects[0]) {
         argv[n++] = "--effects";
@@ -491,18 +495,15 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     if (r->jumps_found && !r->cfg.jumps)
         fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
                    "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --robot %s --jumps (it "
-                   "fits the %u step%s found; and --dequantize-joints when the file's joints are rounded; rcal "
-                   "diagnose tells)\n\n",
+                   "fits the %u step%s found; rcal diagnose tells)\n\n",
                 counts, hp.data, hp.robot, steps, steps == 1 ? "" : "s");
     if (r->jumps_auto) {
         char also[64] = "";
         if (fitted != steps)
             snprintf(also, sizeof also, " (%u after the fit with them)", fitted);
         fprintf(f, "note: the lengths jump in acquisition order: %s, so %s fitted as nuisance%s, as --jumps does "
-                   "(--no-jump-check: not looked for)%s\n\n",
-                counts, all, also,
-                r->cfg.dequantize ? "" : "; if the file's joint angles are rounded, add --dequantize-joints "
-                                         "(rcal fkcheck tells)");
+                   "(--no-jump-check: not looked for)\n\n",
+                counts, all, also);
     }
     fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
             r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);

@@ -29,6 +29,9 @@ typedef struct rch_dequant_result {
     double dq_rms_deg;     /* RMS of the applied corrections */
     double dq_max_deg;     /* largest applied |dq_j| */
     double fk_rms_before_mm, fk_rms_after_mm; /* |FK(q) - xyz| over the corrected rows */
+    int automatic;         /* 1: decided from the file (rch_inputs: no --dequantize-joints given) */
+    double q_step_deg;     /* the joints' display step found (rch_dequant_detect_step; 0: none) */
+    char why[200];         /* what the automatic decision saw (applied or not); empty when forced */
 } rch_dequant_result;
 
 /* s (n): joint angles corrected in place; xyz (n x 3); nominal: the

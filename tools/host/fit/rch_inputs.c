@@ -200,22 +200,80 @@ static int append_positions(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *
     return 0;
 }
 
+/* The automatic rule: the joints sit on a display step of 0.01 deg or
+ * coarser, x, y, z miss the nominal FK of the rounded joints by more than
+ * 0.02 mm RMS (they were computed from finer angles), at most 5 % of the rows
+ * need more than the rounding (rch_dequant refuses them) and the corrected
+ * joints reproduce x, y, z at least 4 times closer. 1: apply; 0: keep the
+ * joints as read; the reason in res->why either way. */
+static int auto_rule(rch_dequant_result *res, const rch_data *data)
+{
+    const rch_dequant_result *q = res;
+    if (q->q_step_deg < 0.01) {
+        snprintf(res->why, sizeof res->why, "joints kept as read: they sit on no display step of 0.01 deg or coarser");
+        return 0;
+    }
+    if (q->n_refused * 20 > data->n) {
+        snprintf(res->why, sizeof res->why,
+                 "joints kept as read: %zu of %zu rows' x, y, z are not the nominal FK of angles within the "
+                 "rounding (not the controller's own FK)", q->n_refused, data->n);
+        return 0;
+    }
+    if (!(q->fk_rms_before_mm > 0.02) || !(q->fk_rms_after_mm * 4.0 < q->fk_rms_before_mm)) {
+        snprintf(res->why, sizeof res->why,
+                 "joints kept as read: x, y, z agree with the rounded joints already (|FK - xyz| %.4f mm RMS)",
+                 q->fk_rms_before_mm);
+        return 0;
+    }
+    snprintf(res->why, sizeof res->why,
+             "automatic: the joints sit on a %g deg step and x, y, z are the nominal FK of finer angles"
+             "; --no-dequantize-joints keeps them as read", q->q_step_deg);
+    return 1;
+}
+
 /* Joint angles from the file's x, y, z; inconsistent rows dropped (and from
- * file_of). */
+ * file_of). cfg->dequantize forces it (refused without x, y, z); otherwise
+ * auto_rule decides, and a file without x, y, z keeps its joints. */
 static int dequantize(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *d)
 {
     rch_data *data = &in->data;
     unsigned *file_of = in->file_of;
     if (!data->xyz) {
+        if (!cfg->dequantize)
+            return 0;
         rch_diag_set(d, cfg->data_path, 0, 0, "--dequantize-joints needs the x, y, z columns");
         return -1;
     }
     uint8_t *bad = calloc(data->n + 1, 1);
-    if (!bad) {
+    rc_sample *keep = cfg->dequantize ? NULL : malloc((data->n ? data->n : 1) * sizeof *keep);
+    double *qd = cfg->dequantize ? NULL : malloc((data->n ? data->n : 1) * RC_NJ * sizeof *qd);
+    if (!bad || (!cfg->dequantize && (!keep || !qd))) {
+        free(bad);
+        free(keep);
+        free(qd);
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
+    double step = 0.0;
+    if (!cfg->dequantize) {
+        memcpy(keep, data->s, data->n * sizeof *keep);
+        for (size_t i = 0; i < data->n; ++i)
+            for (unsigned j = 0; j < RC_NJ; ++j)
+                qd[i * RC_NJ + j] = data->s[i].q_rad[j] / DEG;
+        step = rch_dequant_detect_step(qd, data->n * RC_NJ);
+    }
     rch_dequant(&in->dequant, bad, data->s, data->n, (const double(*)[3])data->xyz, &in->robot.nominal, 0.0);
+    in->dequant.q_step_deg = step;
+    in->dequant.automatic = !cfg->dequantize;
+    if (!cfg->dequantize && !auto_rule(&in->dequant, data)) {
+        memcpy(data->s, keep, data->n * sizeof *keep); /* the joints as read */
+        free(bad);
+        free(keep);
+        free(qd);
+        return 0;
+    }
+    free(keep);
+    free(qd);
     size_t k = 0;
     unsigned nr = 0;
     for (size_t i = 0; i < data->n; ++i) {
@@ -276,7 +334,7 @@ int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
     if (outlets(out, d) != 0 || (cfg->n_positions_paths && append_positions(out, cfg, d) != 0))
         goto fail;
     out->n_read = out->data.n;
-    if (cfg->dequantize && dequantize(out, cfg, d) != 0)
+    if (!cfg->no_dequantize && dequantize(out, cfg, d) != 0)
         goto fail;
     return 0;
 fail:

@@ -22,8 +22,11 @@
  *      one set-up group a file, the tracker frame and targets added to
  *      robot.model (the start frame cfg->tracker_start when given), their
  *      provenance after the cable files'; the cable files' x, y, z dropped;
- *   7. with cfg->dequantize: joint angles recovered from x, y, z (rch_dequant),
- *      inconsistent rows dropped.
+ *   7. joint angles recovered from x, y, z (rch_dequant), inconsistent rows
+ *      dropped: forced by cfg->dequantize, off with cfg->no_dequantize, and
+ *      by default when the file shows rounding (the joints on a display step
+ *      of 0.01 deg or coarser, x, y, z the nominal FK of finer angles, at most
+ *      5 % of rows refused; the decision and its reason in dequant.why).
  * Not here: the pipeline's own checks (--residuals with --cases, the cost
  * estimate), the effects a fit adds to the model (attachment, axis tilts,
  * --effects) and the validation file, which only a fitted model reads.
@@ -65,7 +68,7 @@ typedef struct rch_inputs {
     int pos_has_sigma;
     double pos_sigma_mm;    /* the files' median sigma_mm (rows are weighed equally) */
     rch_provenance prov;    /* data files, samples, sha256, date, tool (paths point at cfg's strings) */
-    int have_dequant;       /* with cfg->dequantize */
+    int have_dequant;       /* the joints were dequantized (forced or automatic) */
     rch_dequant_result dequant;
     unsigned dequant_refused_lines[16]; /* first refused rows (file lines) */
 } rch_inputs;

@@ -60,6 +60,7 @@ int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, con
     cc.n_positions_paths = in->n_positions;
     cc.robot_path = in->robot_path;
     cc.dequantize = cfg->dequantize;
+    cc.no_dequantize = !cfg->dequantize; /* diagnose dequantizes only when told (calibrate's hint tells it) */
     rch_inputs *data = calloc(1, sizeof *data);
     if (!data) {
         rch_diag_set(d, "", 0, 0, "out of memory");
