@@ -153,6 +153,10 @@ static int parse(calib_args *a, int argc, char **argv)
         {"--no-jump-check", RCH_OPT_FLAG, &cfg->no_jump_check, 0, 0, NULL,
          "do not look for length jumps in the default run (a model fitted across jumps it found is not written: "
          "use --jumps)", 0, NULL},
+        {"--prior-stated", RCH_OPT_FLAG, &cfg->prior_stated, 0, 0, NULL,
+         "the prior's sd as stated (defaults or the robot file's), not widened to the spread this robot's "
+         "determined parameters show (type-II maximum likelihood; a robot file's \"prior\" is always kept)", 0,
+         NULL},
         {"--no-prior", RCH_OPT_FLAG, &cfg->no_prior, 0, 0, NULL,
          "plain least squares: no physical prior (the robot file's \"prior\", DESIGN.md), no attachment vector "
          "unless --tool-offset, base heading and height free (to reproduce earlier results)", 0, NULL},

@@ -37,6 +37,7 @@
 #include "rch_evaluate.h"
 #include "rch_jumps.h"
 #include "rch_positions.h"
+#include "rch_prior_scale.h"
 #include "rch_stats.h"
 #include "rch_uncert.h"
 
@@ -116,7 +117,10 @@ typedef struct rch_calib_result {
     rc_model determined;      /* the model compensation uses (the whole estimate) */
     int prior_on;             /* maximum a posteriori with the physical prior (robust methods, no --no-prior) */
     double prior_mean[RC_MAX_PARAMS]; /* (RC_MAX_PARAMS) the prior: nominal DH, start attachment */
-    double prior_sd[RC_MAX_PARAMS];   /* (RC_MAX_PARAMS) its sd (mm, rad); 0: none (outlet, nuisance) */
+    double prior_sd[RC_MAX_PARAMS];   /* (RC_MAX_PARAMS) its sd (mm, rad); 0: none (outlet, nuisance); the DH
+                                         types scaled by prior_scale when it was estimated */
+    int prior_scaled;                 /* the prior's scale was estimated from the data (rch_prior_scale) */
+    rch_prior_scale prior_scale;      /* the factors, their uncertainty, the fallbacks */
     double noise_mm;          /* residual sd the prior was weighed against (estimated: SSR / (n - p_eff)) */
     double p_eff;             /* effective number of parameters the data determined (trace of the hat matrix) */
     unsigned noise_passes;    /* fits it took for the noise estimate to settle */

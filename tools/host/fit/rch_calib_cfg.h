@@ -40,6 +40,7 @@ typedef struct rch_calib_cfg {
     const char *residuals_path; /* per-sample residual CSV (rch_resid.h) of a single run, or NULL */
     int no_jump_check;      /* 1: the default run does not look for length jumps (rch_calib_save_model
                                refuses a model fitted across jumps it found) */
+    int prior_stated;       /* 1: the prior's sd as stated, not scaled from the data (rch_prior_scale) */
     int no_prior;           /* 1: least squares without the physical prior (rch_prior.h), no cable
                                attachment vector unless asked, no gauge: the earlier behaviour */
     const char *const *positions_paths; /* (n_positions_paths) laser-tracker positions files

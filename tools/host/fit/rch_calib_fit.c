@@ -427,6 +427,34 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
     free(j);
 }
 
+/* The prior's scale from this robot's data (rch_prior_scale: type-II ML of
+ * the sd of each DH type): when it widens a type, the MAP fit again under
+ * the wider prior. A prior the robot file states is kept as stated, and so
+ * with --prior-stated. */
+static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, const uint8_t *fixed,
+                             const rc_sample *train)
+{
+    if (r->robot.prior.from_file || r->cfg.prior_stated)
+        return RC_OK;
+    char err[160];
+    rch_prior_scale ps;
+    r->counts.jac_passes++;
+    if (rch_prior_scale_estimate(&ps, &r->model, r->prior_mean, r->prior_sd, fixed, train, r->n_train, r->noise_mm,
+                                 err, sizeof err) != 0)
+        return RC_OK; /* the stated prior, as before */
+    r->prior_scaled = 1;
+    r->prior_scale = ps;
+    int wider = 0;
+    for (int t = 0; t < RCH_PS_TYPES; ++t)
+        wider |= ps.factor[t] > 1.0 + 1e-6;
+    if (!wider)
+        return RC_OK;
+    rch_prior_scale_apply(r->prior_sd, r->prior_sd, r->model.n_params, &ps);
+    double chi2 = 0.0;
+    cfg->prior_sd = r->prior_sd;
+    return map_fit(r, w, cfg, fixed, train, &chi2);
+}
+
 /* Identification and the figures, once the split is made. */
 int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
                           rch_diag *d)
@@ -465,6 +493,8 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
         st = map_fit(r, w, &cfg, fixed, train, &chi2_1);
         if (st == RC_OK && r->attach_auto)
             st = choose_attachment(r, w, &cfg, fixed, train, chi2_1);
+        if (st == RC_OK)
+            st = scale_prior(r, w, &cfg, fixed, train);
     } else {
         st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
     }

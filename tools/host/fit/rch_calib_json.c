@@ -158,6 +158,21 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
         rch_jw_num(&w, "prior_twist_deg", r->robot.prior.twist_deg);
         rch_jw_num(&w, "prior_offset_deg", r->robot.prior.offset_deg);
         rch_jw_num(&w, "prior_attachment_mm", r->robot.prior.attachment_mm);
+        if (r->prior_scaled) { /* the factors on the stated sd the data gave (rch_prior_scale) */
+            static const char *const key[RCH_PS_TYPES] = {"lengths", "twists", "joint_zeros"};
+            rch_jw_obj(&w, "prior_scale");
+            for (int t = 0; t < RCH_PS_TYPES; ++t) {
+                rch_jw_obj(&w, key[t]);
+                rch_jw_numf(&w, "factor", r->prior_scale.factor[t], "%.6g");
+                rch_jw_numf(&w, "factor_ml", r->prior_scale.factor_ml[t], "%.6g");
+                rch_jw_numf(&w, "rel_se", r->prior_scale.rel_se[t], "%.6g");
+                rch_jw_numf(&w, "determined", r->prior_scale.gamma[t], "%.6g");
+                rch_jw_uint(&w, "parameters", r->prior_scale.n[t]);
+                rch_jw_bool(&w, "fallback", r->prior_scale.fallback[t]);
+                rch_jw_end(&w);
+            }
+            rch_jw_end(&w);
+        }
         rch_jw_numf(&w, "noise_mm", r->noise_mm, "%.6g");
         rch_jw_numf(&w, "effective_params", r->p_eff, "%.4g");
     }

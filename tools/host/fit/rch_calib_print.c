@@ -223,6 +223,29 @@ static void print_headline(FILE *f, const rch_calib_result *r, const char *lead)
                 : "");
 }
 
+/* The prior's scale estimated from the data: each DH type's factor with its
+ * uncertainty, or why the stated sd was kept. */
+static void print_prior_scale(FILE *f, const rch_calib_result *r)
+{
+    static const char *const name[RCH_PS_TYPES] = {"lengths", "twists", "joint zeros"};
+    const double stated[RCH_PS_TYPES] = {r->robot.prior.length_mm, r->robot.prior.twist_deg,
+                                         r->robot.prior.offset_deg};
+    static const char *const unit[RCH_PS_TYPES] = {"mm", "deg", "deg"};
+    const rch_prior_scale *ps = &r->prior_scale;
+    fprintf(f, "  the prior's scale from this robot's data (type-II maximum likelihood; never below the stated sd, "
+               "at most %g x):", RCH_PRIOR_SCALE_MAX);
+    for (int t = 0; t < RCH_PS_TYPES; ++t) {
+        if (ps->fallback[t])
+            fprintf(f, "%s %s %.3g %s kept (the data determine %.1f of %u: too few to say their spread)",
+                    t ? ";" : "", name[t], stated[t], unit[t], ps->gamma[t], ps->n[t]);
+        else
+            fprintf(f, "%s %s %.3g -> %.3g %s (x %.2f +- %.0f %%, from %.1f of %u determined%s)", t ? ";" : "",
+                    name[t], stated[t], stated[t] * ps->factor[t], unit[t], ps->factor[t], 100.0 * ps->rel_se[t],
+                    ps->gamma[t], ps->n[t], ps->factor_ml[t] < 1.0 ? "; their spread is within the stated sd" : "");
+    }
+    fputc('\n', f);
+}
+
 static void print_uncertainty(FILE *f, const rch_calib_result *r)
 {
     const rch_model_unc *u = &r->unc;
@@ -241,6 +264,8 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                 r->robot.prior.length_mm, r->robot.prior.twist_deg, r->robot.prior.offset_deg,
                 r->robot.prior.attachment_mm, r->robot.prior.from_file ? ", from the robot file" : ", defaults",
                 r->noise_mm, r->noise_passes, r->p_eff);
+    if (u->has_prior && r->prior_scaled)
+        print_prior_scale(f, r);
     if (u->has_prior && r->n_pos_rows)
         fprintf(f, "  theta1 and d1 held (gauge): the tracker's frame absorbs the robot's heading and height, as "
                    "an outlet does for lengths; a cell sets its base frame anyway\n");

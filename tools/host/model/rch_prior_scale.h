@@ -1,0 +1,74 @@
+/* SPDX-License-Identifier: MIT */
+/* rch_prior_scale.h - the prior's scale estimated from the data (empirical
+ * Bayes, type-II maximum likelihood; prefix rch_prior_scale_).
+ *
+ * The physical prior's standard deviations (rch_prior.h: 0.5 mm, 0.1 deg,
+ * 1 deg) are a statement about robots in general; a given robot may be
+ * built looser. What this robot's data determine tells how far its
+ * parameters really are from the drawing: for each type t (link lengths,
+ * twists, joint zeros) the factor c_t on the stated sd that maximises the
+ * marginal likelihood of the data (the evidence, parameters integrated out
+ * in the linearised model at the MAP fit). MacKay's fixed point:
+ *
+ *   c_t^2 = sum_{k in t} (x_k - mu_k)^2 / sd_k^2  /  gamma_t,
+ *   gamma_t = sum_{k in t} (1 - Sigma_kk / (c_t sd_k)^2),
+ *
+ * with Sigma = (J^T J / s^2 + P(c))^-1 and x the MAP under P(c), predicted
+ * from the fit under the stated prior by one exact step of the linearised
+ * problem (no refit inside the loop). gamma_t counts the parameters of the
+ * type the data determine; below 2 the data say too little of the type's
+ * spread and the stated sd is kept (said as the fallback). The estimate's
+ * relative standard error is 1 / sqrt(2 gamma_t) (the spread of a variance
+ * estimated from gamma_t values).
+ *
+ * Decisions: the factor is kept within [1, RCH_PRIOR_SCALE_MAX]: never
+ * narrower than the stated tolerance (a robot whose determined parameters
+ * sit near the drawing does not make the undetermined ones better known),
+ * never wider than 10 x (a prior of 5 mm, 1 deg twists, 10 deg zeros would
+ * no longer be physical). Only the DH types scale; the attachment, effects
+ * and sensors keep theirs.
+ *
+ * Depends on: rc_model, rc_solve (rc_normal_eq), LAPACKE. Memory: heap
+ * scratch inside the call, freed before it returns. Errors: -1 with a
+ * message on a degenerate problem or out of memory.
+ */
+#ifndef RCH_PRIOR_SCALE_H
+#define RCH_PRIOR_SCALE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rc_model.h"
+
+#define RCH_PRIOR_SCALE_MAX 10.0
+#define RCH_PRIOR_SCALE_MIN_GAMMA 2.0
+
+typedef enum { RCH_PS_LENGTH = 0, RCH_PS_TWIST = 1, RCH_PS_OFFSET = 2, RCH_PS_TYPES = 3 } rch_ps_type;
+
+typedef struct rch_prior_scale {
+    double factor[RCH_PS_TYPES];    /* the factor applied on the stated sd (within [1, RCH_PRIOR_SCALE_MAX]) */
+    double factor_ml[RCH_PS_TYPES]; /* the type-II ML factor before the bounds */
+    double rel_se[RCH_PS_TYPES];    /* relative standard error of the factor, 1 / sqrt(2 gamma) */
+    double gamma[RCH_PS_TYPES];     /* parameters of the type the data determine */
+    unsigned n[RCH_PS_TYPES];       /* free parameters of the type with a prior */
+    int fallback[RCH_PS_TYPES];     /* 1: gamma below RCH_PRIOR_SCALE_MIN_GAMMA: the stated sd kept */
+    unsigned iterations;
+    int converged;
+} rch_prior_scale;
+
+/* The type of DH parameter k (a, d: length; alpha: twist; theta: zero), or
+ * -1 for every other parameter. */
+int rch_prior_scale_type(unsigned k);
+
+/* Estimate the factors at m, the MAP fit under the prior (mean, sd:
+ * n_params, sd 0 = no prior) with the noise noise_mm weighing the data,
+ * over the samples s (n); fixed (n_params, may be NULL) marks held
+ * parameters. 0, or -1 (message in err). */
+int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const double *mean, const double *sd,
+                             const uint8_t *fixed, const rc_sample *s, size_t n, double noise_mm, char *err,
+                             size_t errlen);
+
+/* sd_out (n_params) = sd scaled by the factors (DH types only). */
+void rch_prior_scale_apply(double *sd_out, const double *sd, unsigned n_params, const rch_prior_scale *ps);
+
+#endif
