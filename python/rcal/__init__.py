@@ -215,8 +215,7 @@ def _doubles(values, width, what):
             raise ValueError("%s: expected shape %s, got shape %s" % (what, _shape_text(width), values.shape))
         a = a.reshape(-1, width) if width > 1 else a.reshape(-1)
         if not _np.all(_np.isfinite(a)):
-            bad = int(_np.flatnonzero(~_np.isfinite(a.reshape(-1)))[0])
-            _finite_flat([float(a.reshape(-1)[bad])], width, what)  # raises
+            _finite_flat(a.reshape(-1).tolist(), width, what)  # raises
         n = a.shape[0]
         buf = (ctypes.c_double * max(a.size, 1))()
         ctypes.memmove(buf, a.ctypes.data, a.size * 8)
