@@ -470,8 +470,9 @@ static double mad(double *v, size_t n)
     return v[n / 2];
 }
 
-/* The unit a spread ratio (file / robot) points to, or NULL for mm: within a
- * factor 2 of another unit's ratio and more than 3x away from 1. */
+/* The unit a spread ratio (file / robot) points to, or NULL for mm: more
+ * than 3x away from 1 and within 2x of another unit's ratio, the nearest
+ * (in log scale: cm and inches are 2.54 apart). */
 static const char *unit_of_ratio(double ratio, const char **fix)
 {
     static const struct {
@@ -482,12 +483,17 @@ static const char *unit_of_ratio(double ratio, const char **fix)
              {100.0, "hundredths of a millimetre", "divide by 100"}, {1000.0, "micrometres", "divide by 1000"}};
     if (!(ratio > 0.0) || (ratio > 1.0 / 3.0 && ratio < 3.0))
         return NULL;
-    for (size_t k = 0; k < sizeof u / sizeof u[0]; ++k)
-        if (ratio > u[k].ratio / 2.0 && ratio < u[k].ratio * 2.0) {
+    const char *best = NULL;
+    double best_d = log(2.0);
+    for (size_t k = 0; k < sizeof u / sizeof u[0]; ++k) {
+        const double dist = fabs(log(ratio / u[k].ratio));
+        if (dist < best_d) {
+            best_d = dist;
+            best = u[k].unit;
             *fix = u[k].fix;
-            return u[k].unit;
         }
-    return NULL;
+    }
+    return best;
 }
 
 int rch_data_check_scale(const rch_data *data, const char *name, const rc_model *m, rch_diag *d)
