@@ -31,10 +31,11 @@ import math
 import os
 import shutil
 import tempfile
+import warnings
 
 from . import _lib
 
-__all__ = ["RcalError", "Model", "Metrics", "Param", "Jump", "Result", "Diagnosis", "Evaluation", "Compensation",
+__all__ = ["RcalError", "RcalWarning", "Model", "Metrics", "Param", "Jump", "Result", "Diagnosis", "Evaluation", "Compensation",
            "calibrate", "diagnose", "evaluate", "compensate", "export", "report", "default_robot", "data_file",
            "library_path"]
 
@@ -81,6 +82,12 @@ sample after it (0 when several files were merged), its size and standard
 error, mm."""
 
 _UNITS = {0: "mm", 1: "deg", 2: "-"}
+
+
+class RcalWarning(UserWarning):
+    """What the CLI writes on stderr as a warning: a row left out of the fit
+    (calibrate), a target not compensated or beyond the uncertainty limit
+    (compensate)."""
 
 
 class RcalError(Exception):
@@ -148,45 +155,113 @@ def _text(fn, h):
     return buf.value.decode()
 
 
-def _ints(values, n, what):
+def _ints(values, n, what, hi):
+    """Labels (n integers in 0..hi) -> a ctypes int array; ValueError naming
+    the argument for a wrong length, a non-integer or a label out of range
+    (the CSV reader's limits: group 0..65535, outlet 0..255)."""
     if values is None:
         return None
-    vals = [int(v) for v in (values.tolist() if _np is not None and isinstance(values, _np.ndarray) else values)]
+    if _np is not None and isinstance(values, _np.ndarray):
+        if values.ndim != 1:
+            raise ValueError("%s: expected shape (%d,), got shape %s" % (what, n, values.shape))
+        if values.dtype.kind not in "iuf":
+            raise ValueError("%s: expected integer labels, got dtype %s" % (what, values.dtype))
+        values = values.tolist()
+    elif isinstance(values, (str, bytes)) or not hasattr(values, "__len__"):
+        raise ValueError("%s: expected a sequence of %d integer labels" % (what, n))
+    vals = []
+    for k, v in enumerate(values):
+        if not _real(v):
+            raise ValueError("%s: sample %d: %r is not an integer label" % (what, k, v))
+        f = float(v)
+        if not math.isfinite(f) or f != math.floor(f) or f < 0 or f > hi:
+            raise ValueError("%s: sample %d: %r is not an integer in 0..%d" % (what, k, v, hi))
+        vals.append(int(f))
     if len(vals) != n:
-        raise ValueError("%s: %d values for %d samples" % (what, len(vals), n))
+        raise ValueError("%s: %d values for %d samples, expected shape (%d,)" % (what, len(vals), n, n))
     return (ctypes.c_int * max(n, 1))(*vals)
+
+
+def _shape_text(width):
+    return "(%d,) or (n, %d)" % (width, width) if width > 1 else "(n,)"
+
+
+def _finite_flat(flat, width, what):
+    for k, v in enumerate(flat):
+        if not math.isfinite(v):
+            raise ValueError("%s: %s at %s is not finite (NaN or infinity refused)"
+                             % (what, v, ("row %d, column %d" % (k // width, k % width)) if width > 1
+                                else "sample %d" % k))
 
 
 def _doubles(values, width, what):
     """Rows of `width` numbers -> (ctypes double array, n, single, numpy).
-    single: the input was one row (width numbers) rather than a batch."""
+    single: the input was one row (width numbers) rather than a batch.
+    Accepted shapes: (width,) one row, (n, width) a batch; for width 1,
+    (n,) (and a plain number, single). Anything else, a non-numeric dtype or
+    a non-finite value raises ValueError naming the argument and the
+    expected shape."""
     if _np is not None and isinstance(values, _np.ndarray):
+        if values.dtype.kind not in "iuf":
+            raise ValueError("%s: expected real numbers (float or int dtype), got dtype %s" % (what, values.dtype))
         a = _np.ascontiguousarray(values, dtype=_np.float64)
-        single = (a.ndim == 1 and width > 1) or a.ndim == 0
-        if a.size % width or (a.ndim == 2 and a.shape[1] != width) or a.ndim > 2:
-            raise ValueError("%s: expected rows of %d numbers, got shape %s" % (what, width, values.shape))
+        if width > 1:
+            ok = (a.ndim == 1 and a.shape[0] == width) or (a.ndim == 2 and a.shape[1] == width)
+            single = a.ndim == 1
+        else:
+            ok = a.ndim <= 1
+            single = a.ndim == 0
+        if not ok:
+            raise ValueError("%s: expected shape %s, got shape %s" % (what, _shape_text(width), values.shape))
         a = a.reshape(-1, width) if width > 1 else a.reshape(-1)
+        if not _np.all(_np.isfinite(a)):
+            _finite_flat(a.reshape(-1).tolist(), width, what)  # raises
         n = a.shape[0]
         buf = (ctypes.c_double * max(a.size, 1))()
         ctypes.memmove(buf, a.ctypes.data, a.size * 8)
         return buf, n, single, True
-    rows = list(values) if not isinstance(values, (int, float)) else [values]
+    if isinstance(values, (str, bytes)):
+        raise ValueError("%s: expected numbers of shape %s, got a string" % (what, _shape_text(width)))
+    if _real(values):
+        if width > 1:
+            raise ValueError("%s: expected shape %s, got one number" % (what, _shape_text(width)))
+        rows = [values]
+    else:
+        rows = list(values)
     if width > 1:
-        single = len(rows) == width and all(isinstance(v, (int, float)) or _is_scalar(v) for v in rows)
+        single = len(rows) > 0 and all(_real(v) for v in rows)
+        if single and len(rows) != width:
+            raise ValueError("%s: expected shape %s, got %d numbers in one flat list (give n rows of %d)"
+                             % (what, _shape_text(width), len(rows), width))
         if single:
             rows = [rows]
         flat = []
         for k, row in enumerate(rows):
+            if _real(row) or isinstance(row, (str, bytes)):
+                raise ValueError("%s: row %d is %r, expected %d numbers (shape %s)"
+                                 % (what, k, row, width, _shape_text(width)))
             row = list(row)
-            if len(row) != width:
-                raise ValueError("%s: row %d has %d numbers, expected %d" % (what, k, len(row), width))
+            if len(row) != width or not all(_real(v) for v in row):
+                raise ValueError("%s: row %d has %d values, expected %d numbers (shape %s)"
+                                 % (what, k, len(row), width, _shape_text(width)))
             flat.extend(float(v) for v in row)
     else:
-        single = isinstance(values, (int, float))
+        single = _real(values)
+        for k, v in enumerate(rows):
+            if not _real(v):
+                raise ValueError("%s: sample %d is %r, expected a number (shape (n,))" % (what, k, v))
         flat = [float(v) for v in rows]
+    _finite_flat(flat, width, what)
     n = len(flat) // width
     buf = (ctypes.c_double * max(len(flat), 1))(*flat)
     return buf, n, single, False
+
+
+def _real(v):
+    """A real number (int, float or a numpy real scalar; not a bool)."""
+    if isinstance(v, bool) or (_np is not None and isinstance(v, _np.bool_)):
+        return False
+    return isinstance(v, (int, float)) or (_np is not None and isinstance(v, (_np.integer, _np.floating)))
 
 
 def _is_scalar(v):
@@ -385,6 +460,14 @@ class Result:
         _check(lib.rch_ffi_calib_outlets(self._h, ctypes.byref(n), labels, 64))
         self.outlets = list(labels[:min(n.value, 64)])
 
+    @property
+    def screened(self):
+        """The rows left out of the fit as irreconcilable with the rest (the
+        JSON's "screened" "rows_left_out": dicts with file, line, sensor,
+        residual_mm, likely, fits_outlet), [] when none."""
+        sc = self.json().get("screened") or {}
+        return list(sc.get("rows_left_out") or [])
+
     def figure(self, name):
         """A figure of the run by name (rch_ffi_calib_get in rch_ffi.h:
         "noise_mm", "effective_params", "prior", "groups", "jumps_fitted",
@@ -442,13 +525,13 @@ class Result:
 
 
 _CAL_FLAGS = {"tool_offset": 1, "jumps": 2, "dequantize": 4, "no_prior": 8, "holdout_groups": 16,
-              "no_jump_check": 32}
+              "no_jump_check": 32, "no_screen": 64}
 
 
 def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=None, robot=None, method="lm",
               test_fraction=0.1, seed=1, max_iter=0, fix=None, effects=None, jumps=False, dequantize=False,
               prior=True, tool_offset=False, holdout_groups=False, jump_check=True, validate=None, truth=None,
-              cases=1, samples=0, plots=None, residuals=None, data_csv=None):
+              cases=1, samples=0, plots=None, residuals=None, data_csv=None, positions=None, screen=True):
     """Identify the DH errors and the encoder outlet from cable lengths, as
     `rcal calibrate` does (the same host function: identical figures).
     Each argument is the CLI option of the same meaning.
@@ -476,19 +559,35 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
     truth:          a simulated truth model file: Result.truth_flange
     cases, samples: --cases, --samples (the paper's protocol)
     plots, residuals: --plots DIR, --residuals FILE.csv
+    positions:      laser-tracker positions CSV(s) (--positions: one path or
+                    a list), alone or with data; the same plausibility checks
+                    (units, handedness, targets, pose ids, duplicates, the
+                    controller's own x, y, z) as the CLI
+    screen:         False for --no-screen (every row fitted); by default rows
+                    irreconcilable with the rest are left out and listed in
+                    Result.screened (a RcalWarning names each, as the CLI's
+                    stderr does), a file with too many refused
     Returns a Result. Raises RcalError (bad file with file:line:col, too few
     samples, unknown method or effect) or ValueError (bad arguments)."""
     if data is None:
         data = data_csv
     elif data_csv is not None:
         raise ValueError("calibrate: give data or data_csv, not both")
-    if (data is None) == (q_deg is None):
-        raise ValueError("calibrate: give either data (a file or a list of files) or q_deg and L_mm")
+    pbytes, plist = _path_list(positions, "positions")
+    if q_deg is not None and (data is not None or plist):
+        raise ValueError("calibrate: give either files (data and/or positions) or q_deg and L_mm")
+    if data is None and q_deg is None and not plist:
+        raise ValueError("calibrate: give either data (a file or a list of files), positions, or q_deg and L_mm")
+    if q_deg is None and (L_mm is not None or xyz_mm is not None or group is not None or outlet is not None):
+        raise ValueError("calibrate: L_mm, xyz_mm, group and outlet go with q_deg (arrays), not with files")
+    if not isinstance(method, str):
+        raise ValueError("calibrate: method must be a string")
     lib = _lib.lib()
     robot = default_robot() if robot is None else robot
     flags = 0
     for name, on in (("tool_offset", tool_offset), ("jumps", jumps), ("dequantize", dequantize),
-                     ("no_prior", not prior), ("holdout_groups", holdout_groups), ("no_jump_check", not jump_check)):
+                     ("no_prior", not prior), ("holdout_groups", holdout_groups), ("no_jump_check", not jump_check),
+                     ("no_screen", not screen)):
         if on:
             flags |= _CAL_FLAGS[name]
     h = ctypes.c_void_p()
@@ -496,30 +595,37 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
     common = (_path(robot), method.encode(), float(test_fraction), int(seed), int(max_iter), _opt_str(fix),
               _opt_str(effects), flags, _opt_path(validate), _opt_path(truth), int(cases), int(samples),
               _opt_path(plots), _opt_path(residuals), err, _ERR_LEN)
-    if data is not None:
-        files = [data] if isinstance(data, (str, bytes, os.PathLike)) else list(data)
-        if not files:
+    if data is not None or plist:
+        _, files = _path_list(data, "data") if data is not None else (b"", [])
+        if data is not None and not files:
             raise ValueError("calibrate: no data file")
-        arr = (ctypes.c_char_p * len(files))(*[_path(f) for f in files])
-        st = lib.rch_ffi_calibrate(ctypes.byref(h), arr, len(files), *common)
-        label = os.fspath(files[0]) if len(files) == 1 else [os.fspath(f) for f in files]
+        arr = (ctypes.c_char_p * max(len(files), 1))(*[_path(f) for f in files])
+        parr = (ctypes.c_char_p * max(len(plist), 1))(*[_path(f) for f in plist])
+        st = lib.rch_ffi_calibrate_inputs(ctypes.byref(h), arr, len(files), parr, len(plist), *common)
+        every = files + plist
+        label = every[0] if len(every) == 1 else every
     else:
         if L_mm is None:
             raise ValueError("calibrate: q_deg needs L_mm")
         q, n, _, _ = _doubles(q_deg, 6, "q_deg")
         L, nl, _, _ = _doubles(L_mm, 1, "L_mm")
         if n != nl:
-            raise ValueError("calibrate: %d poses but %d lengths" % (n, nl))
+            raise ValueError("calibrate: %d poses but %d lengths (L_mm: expected shape (%d,))" % (n, nl, n))
         xyz = None
         if xyz_mm is not None:
             xyz, nx, _, _ = _doubles(xyz_mm, 3, "xyz_mm")
             if nx != n:
-                raise ValueError("calibrate: %d poses but %d xyz rows" % (n, nx))
-        st = lib.rch_ffi_calibrate_arrays(ctypes.byref(h), q, L, xyz, _ints(group, n, "group"),
-                                          _ints(outlet, n, "outlet"), n, *common)
+                raise ValueError("calibrate: %d poses but %d xyz rows (xyz_mm: expected shape (%d, 3))" % (n, nx, n))
+        st = lib.rch_ffi_calibrate_arrays(ctypes.byref(h), q, L, xyz, _ints(group, n, "group", 65535),
+                                          _ints(outlet, n, "outlet", 255), n, *common)
         label = None
     _check(st, err)
-    return Result(h.value, method, label, int(seed))
+    r = Result(h.value, method, label, int(seed))
+    for w in r.screened:
+        warnings.warn("rcal.calibrate: %s:%s: left out of the fit: %s residual %.4g mm, likely %s"
+                      % (w.get("file"), w.get("line"), w.get("sensor"), w.get("residual_mm") or float("nan"),
+                         w.get("likely")), RcalWarning, stacklevel=2)
+    return r
 
 
 Chosen = collections.namedtuple("Chosen", "name rmse_cv_mm gain_mm2 p_value")
@@ -721,8 +827,12 @@ the predicted 95 % position uncertainty of the compensated point per target
 (what --uncertainty-out writes; NaN when the model has no uncertainty)."""
 
 
+_U95_POLICIES = {"skip": 0, "warn": 1, "refuse": 2}
+_ON_FAIL = ("warn", "raise", "ignore")
+
+
 def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=None, max_dev_deg=0.0,
-               max_uncertainty_mm=0.0, return_status=False, details=False):
+               max_uncertainty_mm=0.0, return_status=False, details=False, u95_policy="skip", on_fail="warn"):
     """Correct joint targets made with the nominal model so that the
     calibrated robot reaches the nominal pose: q' with FK_cal(q') =
     FK_nom(q) for the tool point, target by target in order with one
@@ -743,10 +853,27 @@ def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=Non
     max_dev_deg:   largest correction per joint (--max-dev-deg; 0: 0.1 rad)
     max_uncertainty_mm: --max-uncertainty-mm (0: none for a model with a
                    posterior, 1 mm for one without)
+    u95_policy:    --u95-policy: "skip" (default: a target beyond the limit
+                   is left uncompensated, status 3), "warn" (compensated
+                   anyway, a RcalWarning), "refuse" (RcalError, nothing
+                   returned)
+    on_fail:       a target not compensated (status 2 or 3): "warn" (default,
+                   a RcalWarning naming it, as the CLI's stderr), "raise"
+                   (RcalError naming the first), "ignore"
     Returns the corrected targets in degrees, shaped like the input (numpy in,
     numpy out); return_status=True: (targets, status codes); details=True: a
     Compensation (targets, status, u95_mm). A target outside the joint
-    limits raises RcalError."""
+    limits raises RcalError; a wrong shape or a non-finite value
+    ValueError."""
+    if u95_policy not in _U95_POLICIES:
+        raise ValueError("compensate: u95_policy must be 'skip', 'warn' or 'refuse', not %r" % (u95_policy,))
+    if on_fail not in _ON_FAIL:
+        raise ValueError("compensate: on_fail must be 'warn', 'raise' or 'ignore', not %r" % (on_fail,))
+    if position_only not in (None, True, False):
+        raise ValueError("compensate: position_only must be None, True or False")
+    for name, v in (("max_dev_deg", max_dev_deg), ("max_uncertainty_mm", max_uncertainty_mm)):
+        if not _real(v) or not math.isfinite(float(v)) or float(v) < 0:
+            raise ValueError("compensate: %s must be a finite number >= 0, not %r" % (name, v))
     lib = _lib.lib()
     cal = _model(model, "compensate: model")
     nom = None if nominal is None else _model(nominal, "compensate: nominal")
@@ -756,22 +883,46 @@ def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=Non
     u95 = (ctypes.c_double * max(n, 1))()
     tool = None
     if tool_mm is not None:
-        t = [float(v) for v in tool_mm]
-        if len(t) != 3:
-            raise ValueError("tool_mm: expected 3 numbers (x, y, z in the flange frame, mm)")
-        tool = (ctypes.c_double * 3)(*t)
+        tb, nt, _, _ = _doubles(tool_mm, 3, "tool_mm")
+        if nt != 1:
+            raise ValueError("tool_mm: expected shape (3,) (x, y, z in the flange frame, mm)")
+        tool = tb
     err = ctypes.create_string_buffer(_ERR_LEN)
     _check(lib.rch_ffi_compensate(cal._h, nom._h if nom is not None else None, out, status, u95, q, n,
                                   0 if position_only is None else (1 if position_only else 2),
-                                  float(max_dev_deg), float(max_uncertainty_mm), tool, err, _ERR_LEN), err)
+                                  float(max_dev_deg), float(max_uncertainty_mm), _U95_POLICIES[u95_policy], tool, err,
+                                  _ERR_LEN), err)
     corrected = _rows(out, n, 6, single, numpy)
     codes = list(status[:n])
+    _flag_targets(codes, list(u95[:n]), max_uncertainty_mm, u95_policy, on_fail)
     if details:
         u = _rows(u95, n, 1, single, numpy)
         return Compensation(corrected, codes[0] if single else codes, u)
     if return_status:
         return corrected, (codes[0] if single else codes)
     return corrected
+
+
+def _flag_targets(codes, u95, max_unc_mm, u95_policy, on_fail):
+    """The CLI's per-target warnings (rch_comp.c) as RcalWarning, or the
+    first as RcalError (on_fail="raise")."""
+    msgs = []
+    for i, c in enumerate(codes):
+        if c == 2:
+            msgs.append("target %d: not compensated (the solver did not converge or hit a limit); returned the target "
+                        "plus the last good correction" % i)
+        elif c == 3:
+            msgs.append("target %d: left uncompensated: the model's 95 %% position uncertainty here is %.4f mm, above "
+                        "the limit (the data did not determine the model at this pose)" % (i, u95[i]))
+        elif u95_policy == "warn" and max_unc_mm and math.isfinite(u95[i]) and u95[i] > max_unc_mm:
+            msgs.append("target %d: compensated, but the model's 95 %% position uncertainty at the compensated point "
+                        "is %.4f mm here, above %.4f mm" % (i, u95[i], max_unc_mm))
+    if not msgs or on_fail == "ignore":
+        return
+    if on_fail == "raise" and any(c in (2, 3) for c in codes):
+        raise RcalError(-3, msgs[0] + ("" if len(msgs) == 1 else " (and %d more)" % (len(msgs) - 1)))
+    for m in msgs:
+        warnings.warn("rcal.compensate: " + m, RcalWarning, stacklevel=3)
 
 
 _FORMATS = {"urdf": 0, "dh-csv": 1}

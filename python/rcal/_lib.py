@@ -14,7 +14,7 @@ import ctypes
 import glob
 import os
 
-ABI = 2  # RCH_FFI_ABI this package is written for
+ABI = 3  # RCH_FFI_ABI this package is written for
 LIB_NAME = "librcal_ffi.so"
 
 _c_double_p = ctypes.POINTER(ctypes.c_double)
@@ -63,6 +63,8 @@ def _declare(lib):
         "rch_ffi_calibrate": (i, [pvp, ppc, sz, cp, cp, d, ul, u, cp, cp, u, cp, cp, ul, sz, cp, cp, cp, sz]),
         "rch_ffi_calibrate_arrays": (i, [pvp, _c_double_p, _c_double_p, _c_double_p, _c_int_p, _c_int_p, sz, cp, cp,
                                          d, ul, u, cp, cp, u, cp, cp, ul, sz, cp, cp, cp, sz]),
+        "rch_ffi_calibrate_inputs": (i, [pvp, ppc, sz, ppc, sz, cp, cp, d, ul, u, cp, cp, u, cp, cp, ul, sz, cp, cp,
+                                         cp, sz]),
         "rch_ffi_calib_param_unc": (i, [vp, u, _c_double_p, _c_double_p, cp, sz, cp, sz, _c_int_p]),
         "rch_ffi_calib_get": (i, [vp, cp, _c_double_p]),
         "rch_ffi_calib_jumps": (i, [vp, _c_uint_p, _c_uint_p, _c_double_p, _c_double_p, u]),
@@ -90,7 +92,7 @@ def _declare(lib):
         "rch_ffi_calib_write": (i, [vp, cp, cp, sz]),
         "rch_ffi_calib_truth": (i, [vp, _c_double_p]),
         "rch_ffi_calib_json": (i, [vp, cp, sz, _c_size_p]),
-        "rch_ffi_compensate": (i, [vp, vp, _c_double_p, _c_int_p, _c_double_p, _c_double_p, sz, i, d, d,
+        "rch_ffi_compensate": (i, [vp, vp, _c_double_p, _c_int_p, _c_double_p, _c_double_p, sz, i, d, d, i,
                                    _c_double_p, cp, sz]),
     }
     for name, (res, args) in sigs.items():

@@ -451,6 +451,124 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
     return parse(out, text, len, name, flags, NULL, d);
 }
 
+/* ---- scale of lengths and positions against the robot (issue 33) ---- */
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median absolute deviation of v (n), sorted in place. */
+static double mad(double *v, size_t n)
+{
+    qsort(v, n, sizeof v[0], cmp_double);
+    const double med = v[n / 2];
+    for (size_t i = 0; i < n; ++i)
+        v[i] = fabs(v[i] - med);
+    qsort(v, n, sizeof v[0], cmp_double);
+    return v[n / 2];
+}
+
+/* The unit a spread ratio (file / robot) points to, or NULL for mm: more
+ * than 3x away from 1 and within 2x of another unit's ratio, the nearest
+ * (in log scale: cm and inches are 2.54 apart). */
+static const char *unit_of_ratio(double ratio, const char **fix)
+{
+    static const struct {
+        double ratio;
+        const char *unit, *fix;
+    } u[] = {{0.1, "cm", "multiply by 10"},         {1.0 / 25.4, "inches", "multiply by 25.4"},
+             {0.001, "metres", "multiply by 1000"}, {10.0, "tenths of a millimetre", "divide by 10"},
+             {100.0, "hundredths of a millimetre", "divide by 100"}, {1000.0, "micrometres", "divide by 1000"}};
+    if (!(ratio > 0.0) || (ratio > 1.0 / 3.0 && ratio < 3.0))
+        return NULL;
+    const char *best = NULL;
+    double best_d = log(2.0);
+    for (size_t k = 0; k < sizeof u / sizeof u[0]; ++k) {
+        const double dist = fabs(log(ratio / u[k].ratio));
+        if (dist < best_d) {
+            best_d = dist;
+            best = u[k].unit;
+            *fix = u[k].fix;
+        }
+    }
+    return best;
+}
+
+int rch_data_check_scale(const rch_data *data, const char *name, const rc_model *m, rch_diag *d)
+{
+    const size_t n = data->n;
+    if (!m || n < RCH_DATA_SCALE_MIN_ROWS)
+        return 0;
+    double *a = malloc(2 * n * sizeof *a);
+    if (!a)
+        return 0; /* a check, not a reader: no memory, no check */
+    double *b = a + n;
+    const double *e = &m->x[RC_N_DH];
+    size_t k = 0;
+    const unsigned first = data->s[0].outlet; /* the model's e: the lengths of one outlet */
+    for (size_t i = 0; i < n; ++i) {
+        if (data->s[i].outlet != first)
+            continue;
+        double p[3];
+        rc_fk(p, NULL, m, data->s[i].q_rad);
+        a[k] = data->s[i].len_mm;
+        b[k++] = sqrt((p[0] - e[0]) * (p[0] - e[0]) + (p[1] - e[1]) * (p[1] - e[1]) + (p[2] - e[2]) * (p[2] - e[2]));
+    }
+    int rc = 0;
+    const char *fix = NULL, *unit = NULL;
+    double sl = 0.0, sr = 0.0;
+    if (k >= RCH_DATA_SCALE_MIN_ROWS && data->s[0].len_mm > 0.0) {
+        sl = mad(a, k);
+        sr = mad(b, k);
+        if (sr >= RCH_DATA_SCALE_MIN_SPREAD_MM)
+            unit = unit_of_ratio(sl / sr, &fix);
+    }
+    if (unit) {
+        rch_diag_set(d, name, 0, 0,
+                     "the cable lengths look like %s: their spread (median absolute deviation) is %.4g against %.4g "
+                     "mm of the nominal flange-to-encoder distance at the same joints; rcal reads millimetres (%s)",
+                     unit, sl, sr, fix);
+        rc = -1;
+    }
+    if (rc == 0 && data->xyz) {
+        k = 0;
+        double c[2][3] = {{0}};
+        for (size_t i = 0; i < n; ++i) {
+            double p[3];
+            rc_fk(p, NULL, m, data->s[i].q_rad);
+            for (int j = 0; j < 3; ++j) {
+                c[0][j] += data->xyz[i][j] / (double)n;
+                c[1][j] += p[j] / (double)n;
+            }
+        }
+        for (size_t i = 0; i < n; ++i) {
+            double p[3], f2 = 0.0, r2 = 0.0;
+            rc_fk(p, NULL, m, data->s[i].q_rad);
+            for (int j = 0; j < 3; ++j) {
+                f2 += (data->xyz[i][j] - c[0][j]) * (data->xyz[i][j] - c[0][j]);
+                r2 += (p[j] - c[1][j]) * (p[j] - c[1][j]);
+            }
+            a[i] = sqrt(f2);
+            b[i] = sqrt(r2);
+        }
+        qsort(a, n, sizeof a[0], cmp_double);
+        qsort(b, n, sizeof b[0], cmp_double);
+        sl = a[n / 2];
+        sr = b[n / 2];
+        if (sr >= RCH_DATA_SCALE_MIN_SPREAD_MM && (unit = unit_of_ratio(sl / sr, &fix)) != NULL) {
+            rch_diag_set(d, name, 0, 0,
+                         "the x, y, z columns look like %s: their median distance from their centre is %.4g against "
+                         "%.4g mm of the nominal flange at the same joints; rcal reads millimetres (%s)",
+                         unit, sl, sr, fix);
+            rc = -1;
+        }
+    }
+    free(a);
+    return rc;
+}
+
 int rch_data_load_limited(rch_data *out, const char *path, unsigned flags, const rc_model *limits, rch_diag *d)
 {
     char *buf = NULL;
@@ -460,6 +578,11 @@ int rch_data_load_limited(rch_data *out, const char *path, unsigned flags, const
         return -1;
     int rc = parse(out, buf, len, path, flags, limits, d);
     free(buf);
+    if (rc == 0 && limits && !(flags & (RCH_DATA_NO_LEN | RCH_DATA_POSITIONS)) &&
+        rch_data_check_scale(out, path, limits, d) != 0) {
+        rch_data_free(out);
+        rc = -1;
+    }
     return rc;
 }
 

@@ -74,12 +74,29 @@ int rch_data_outlets_as(const uint8_t *label, unsigned n_labels, rc_sample *s, s
  * rounding of a file written with 0.1 deg) are refused. */
 #define RCH_DATA_LIMIT_TOL_DEG 0.05
 
+/* rch_data_check_scale: at least this many rows, and the robot's spread at
+ * least this (mm), else no verdict. */
+#define RCH_DATA_SCALE_MIN_ROWS 8
+#define RCH_DATA_SCALE_MIN_SPREAD_MM 5.0
+
 /* Load a file (at most RCH_DATA_MAX_BYTES); on failure returns non-zero with d filled in. */
 int rch_data_load(rch_data *out, const char *path, unsigned flags, rch_diag *d);
 /* The same, also refusing joint readings outside the limits of limits
  * (q_min_rad..q_max_rad, with RCH_DATA_LIMIT_TOL_DEG) with file:line:column;
  * limits NULL: no such check. */
 int rch_data_load_limited(rch_data *out, const char *path, unsigned flags, const rc_model *limits, rch_diag *d);
+/* Units estimated from the data (issue 33): the spread of the cable lengths
+ * (median absolute deviation, the rows of the first row's outlet) against
+ * the spread of the distance from m's nominal flange to its encoder outlet
+ * at the same joints, and the spread of the x, y, z columns about their
+ * centre against m's flange's: a ratio more than 3x from 1 and within 2x of
+ * another unit's (cm 0.1, inches 1/25.4, metres 0.001, 0.1 mm 10, ...) is
+ * refused naming the unit and the fix ("the cable lengths look like cm: ...
+ * (multiply by 10)"). Fewer than RCH_DATA_SCALE_MIN_ROWS rows, or poses
+ * spreading less than RCH_DATA_SCALE_MIN_SPREAD_MM: no verdict. Called by
+ * rch_data_load_limited for cable files (not plans, not positions).
+ * 0, or -1 with d set. */
+int rch_data_check_scale(const rch_data *data, const char *name, const rc_model *m, rch_diag *d);
 /* The same from memory (name is used in the diagnostics). */
 int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
                    rch_diag *d);

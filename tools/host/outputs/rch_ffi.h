@@ -42,7 +42,7 @@
 
 /* Version of this interface; a caller checks it against what it was written
  * for (python/rcal does). Bumped when a signature or a meaning changes. */
-#define RCH_FFI_ABI 2
+#define RCH_FFI_ABI 3
 
 typedef enum rch_ffi_status {
     RCH_FFI_OK = 0,
@@ -109,7 +109,8 @@ enum {
     RCH_FFI_CAL_DEQUANTIZE = 4,      /* --dequantize-joints: rounded joints recovered from x, y, z */
     RCH_FFI_CAL_NO_PRIOR = 8,        /* --no-prior: plain least squares, no physical prior */
     RCH_FFI_CAL_HOLDOUT_GROUPS = 16, /* --holdout-groups: hold out whole set-up groups */
-    RCH_FFI_CAL_NO_JUMP_CHECK = 32   /* --no-jump-check */
+    RCH_FFI_CAL_NO_JUMP_CHECK = 32,  /* --no-jump-check */
+    RCH_FFI_CAL_NO_SCREEN = 64       /* --no-screen: every row fitted, none left out as irreconcilable */
 };
 
 /* Calibrate with the host function `rcal calibrate` runs (rch_calib_run):
@@ -141,6 +142,16 @@ int rch_ffi_calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t
  * holding a file's values give that file's result. */
 int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const double *len_mm, const double *xyz_mm,
                              const int *group, const int *outlet, size_t n, const char *robot_path,
+                             const char *method, double test_fraction, unsigned long seed, unsigned max_iter,
+                             const char *fix, const char *effects, unsigned flags, const char *validate_path,
+                             const char *truth_path, unsigned long cases, size_t case_samples, const char *plots_dir,
+                             const char *residuals_path, char *err, size_t err_len);
+/* The same with laser-tracker positions files (--positions, rch_positions.h:
+ * the same plausibility checks and screening as `rcal calibrate`):
+ * positions_paths (n_positions, 0..16), data_paths (n_data, 0..16), at
+ * least one file in all; each file once among both lists. */
+int rch_ffi_calibrate_inputs(rch_ffi_calib **out, const char *const *data_paths, size_t n_data,
+                             const char *const *positions_paths, size_t n_positions, const char *robot_path,
                              const char *method, double test_fraction, unsigned long seed, unsigned max_iter,
                              const char *fix, const char *effects, unsigned flags, const char *validate_path,
                              const char *truth_path, unsigned long cases, size_t case_samples, const char *plots_dir,
@@ -317,11 +328,15 @@ int rch_ffi_evaluate(double *out, const rch_ffi_model *m, const char *data_path,
  * (--position-only), 2 position and orientation (--full-pose);
  * max_dev_deg: largest correction per joint, 0 for the default (0.1 rad);
  * max_unc_mm: --max-uncertainty-mm (0: none for a posterior model, 1 mm for
- * one without). A target outside cal's joint limits stops the batch with
- * RCH_FFI_ERR_RANGE ("target i: q j = ... is outside ..."). */
+ * one without); u95_policy: what a target beyond it does (--u95-policy):
+ * 0 skip (left uncompensated, status 3), 1 warn (compensated anyway; the
+ * caller sees u95_mm), 2 refuse (RCH_FFI_ERR_RANGE, "target i: ..."). A
+ * target outside cal's joint limits stops the batch with RCH_FFI_ERR_RANGE
+ * ("target i: q j = ... is outside ..."); a non-finite one with
+ * RCH_FFI_ERR_ARG. */
 int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, double *out_deg, int *status,
                        double *u95_mm, const double *q_deg, size_t n, int position_only, double max_dev_deg,
-                       double max_unc_mm, const double *tool_mm, char *err, size_t err_len);
+                       double max_unc_mm, int u95_policy, const double *tool_mm, char *err, size_t err_len);
 
 /* ---- export and report (rcal export, rcal report) ---- */
 

@@ -34,6 +34,8 @@ typedef struct {
     unsigned long cases;
     size_t case_samples;
     const char *plots, *residuals;
+    const char *const *positions; /* (n_positions) tracker positions files, or NULL */
+    size_t n_positions;
 } cal_opts;
 
 /* ---- calibration ---- */
@@ -58,6 +60,13 @@ static int precheck(const rch_calib_cfg *cfg, char *err, size_t err_len)
                 snprintf(err, err_len, "validate %s is the same file as data %s: refused (validation data must be "
                          "samples the fit never saw)", cfg->validate_path, cfg->data_paths[i]);
             return RCH_FFI_ERR_ARG;
+        }
+    for (size_t i = 0; i < cfg->n_positions_paths; ++i)
+        for (size_t j = 0; j < cfg->n_data_paths + i; ++j) {
+            const char *o = j < cfg->n_data_paths ? cfg->data_paths[j] : cfg->positions_paths[j - cfg->n_data_paths];
+            if (rch_same_file(cfg->positions_paths[i], o) || strcmp(cfg->positions_paths[i], o) == 0)
+                return fail(RCH_FFI_ERR_ARG, err, err_len, "positions %s is given twice or is another input: refused",
+                            cfg->positions_paths[i]);
         }
     if (cfg->residuals_path && (cfg->cases > 1 || cfg->jumps))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
@@ -85,11 +94,13 @@ static int precheck(const rch_calib_cfg *cfg, char *err, size_t err_len)
 static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t n_data, const cal_opts *o,
                      char *err, size_t err_len)
 {
-    if (!out || !data_paths || n_data == 0 || !o->robot)
-        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: NULL argument (data and robot are required)");
+    if (!out || (n_data > 0 && !data_paths) || (o->n_positions > 0 && !o->positions) ||
+        n_data + o->n_positions == 0 || !o->robot)
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
+                    "calibrate: NULL argument (data or positions, and robot, are required)");
     *out = NULL;
-    if (n_data > RCH_CALIB_MAX_FILES)
-        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: at most 16 data files");
+    if (n_data > RCH_CALIB_MAX_FILES || o->n_positions > RCH_CALIB_MAX_FILES)
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: at most 16 data and 16 positions files");
     rch_calib_cfg cfg;
     rch_calib_cfg_init(&cfg);
     if (rch_method_parse(&cfg.method, o->method ? o->method : "lm") != 0)
@@ -110,9 +121,19 @@ static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t 
         }
         c->data_v[i] = rch_ffip_copy_opt(c->data[i], data_paths[i], &too_long);
     }
-    cfg.data_path = c->data_v[0];
-    cfg.data_paths = c->data_v;
+    for (size_t i = 0; i < o->n_positions; ++i) {
+        if (!o->positions[i]) {
+            free(c);
+            return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: a NULL positions path");
+        }
+        c->pos_v[i] = rch_ffip_copy_opt(c->pos[i], o->positions[i], &too_long);
+    }
+    cfg.data_path = n_data ? c->data_v[0] : NULL;
+    cfg.data_paths = n_data ? c->data_v : NULL;
     cfg.n_data_paths = n_data;
+    cfg.positions_paths = o->n_positions ? c->pos_v : NULL;
+    cfg.n_positions_paths = o->n_positions;
+    cfg.no_screen = (o->flags & RCH_FFI_CAL_NO_SCREEN) != 0;
     cfg.robot_path = rch_ffip_copy_opt(c->robot_path, o->robot, &too_long);
     cfg.truth_path = rch_ffip_copy_opt(c->truth_path, o->truth, &too_long);
     cfg.fix = rch_ffip_copy_opt(c->fix, o->fix, &too_long);
@@ -160,8 +181,47 @@ int rch_ffi_calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t
                       const char *residuals_path, char *err, size_t err_len)
 {
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path};
+                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0};
     return calibrate(out, data_paths, n_data, &o, err, err_len);
+}
+
+int rch_ffi_calibrate_inputs(rch_ffi_calib **out, const char *const *data_paths, size_t n_data,
+                             const char *const *positions_paths, size_t n_positions, const char *robot_path,
+                             const char *method, double test_fraction, unsigned long seed, unsigned max_iter,
+                             const char *fix, const char *effects, unsigned flags, const char *validate_path,
+                             const char *truth_path, unsigned long cases, size_t case_samples, const char *plots_dir,
+                             const char *residuals_path, char *err, size_t err_len)
+{
+    const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
+                        truth_path, cases, case_samples, plots_dir, residuals_path, positions_paths, n_positions};
+    return calibrate(out, data_paths, n_data, &o, err, err_len);
+}
+
+/* A message about the temporary CSV of the arrays names the arrays: "TMP:L:C: m"
+ * becomes "arrays, sample L-2 (0-based): m" (the header is line 1), any other
+ * mention of TMP "<arrays>". */
+static void name_arrays(char *err, size_t err_len, const char *tmp)
+{
+    if (!err || err_len == 0)
+        return;
+    const size_t tl = strlen(tmp);
+    char out[2048], *hit = strstr(err, tmp);
+    if (!hit)
+        return;
+    char *end = NULL;
+    const unsigned long line = hit[tl] == ':' ? strtoul(hit + tl + 1, &end, 10) : 0;
+    if (line >= 2 && end && *end == ':') {
+        const char *rest = end + 1;
+        while (*rest >= '0' && *rest <= '9')
+            ++rest;
+        if (*rest == ':')
+            ++rest;
+        while (*rest == ' ')
+            ++rest;
+        snprintf(out, sizeof out, "%.*sarrays, sample %lu (0-based): %s", (int)(hit - err), err, line - 2, rest);
+    } else
+        snprintf(out, sizeof out, "%.*s<arrays>%s", (int)(hit - err), err, hit + tl);
+    snprintf(err, err_len, "%s", out);
 }
 
 int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const double *len_mm, const double *xyz_mm,
@@ -175,8 +235,13 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: no samples");
     *out = NULL;
     for (size_t i = 0; i < n; ++i)
-        if ((group && group[i] < 0) || (outlet && outlet[i] < 0))
-            return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: group and outlet labels must be >= 0");
+        if ((group && (group[i] < 0 || group[i] > 65535)) || (outlet && (outlet[i] < 0 || outlet[i] > 255)))
+        {
+            if (err && err_len > 0)
+                snprintf(err, err_len, "calibrate: sample %zu: group labels must be in 0..65535, outlet labels in "
+                         "0..255", i);
+            return RCH_FFI_ERR_ARG;
+        }
     const char *dir = getenv("TMPDIR");
     char tmp[PATH_LEN];
     snprintf(tmp, sizeof tmp, "%s/rcal-ffi-XXXXXX", dir && dir[0] ? dir : "/tmp");
@@ -207,11 +272,13 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
     bad |= fclose(f) != 0;
     const char *paths[1] = {tmp};
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path};
+                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0};
     int rc = bad ? fail(RCH_FFI_ERR_IO, err, err_len, "writing the temporary file %s failed", tmp)
                  : calibrate(out, paths, 1, &o, err, err_len);
     unlink(tmp);
     rch_tmp_forget(tmp);
+    if (rc != RCH_FFI_OK)
+        name_arrays(err, err_len, tmp);
     if (rc == RCH_FFI_OK) {
         int unused = 0;
         rch_ffip_copy_opt((*out)->data[0], "<arrays>", &unused); /* the model file's "data" */

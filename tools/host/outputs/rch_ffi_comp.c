@@ -29,14 +29,22 @@ typedef struct {
 
 int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, double *out_deg, int *status,
                        double *u95_mm, const double *q_deg, size_t n, int position_only, double max_dev_deg,
-                       double max_unc_mm, const double *tool_mm, char *err, size_t err_len)
+                       double max_unc_mm, int u95_policy, const double *tool_mm, char *err, size_t err_len)
 {
     if (!cal || !out_deg || (!q_deg && n > 0))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate: NULL argument");
     if (!(max_dev_deg >= 0.0) || !isfinite(max_dev_deg) || !(max_unc_mm >= 0.0) || position_only < 0 ||
-        position_only > 2)
+        position_only > 2 || u95_policy < 0 || u95_policy > 2)
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
-                    "compensate: max_dev_deg and max_unc_mm must be >= 0, position_only 0, 1 or 2");
+                    "compensate: max_dev_deg and max_unc_mm must be >= 0, position_only 0, 1 or 2, u95_policy 0, 1 "
+                    "or 2");
+    for (size_t i = 0; i < RC_NJ * n; ++i)
+        if (!isfinite(q_deg[i])) {
+            if (err && err_len > 0)
+                snprintf(err, err_len, "compensate: target %zu: q%u is not finite", i / RC_NJ,
+                         (unsigned)(i % RC_NJ) + 1u);
+            return RCH_FFI_ERR_ARG;
+        }
     for (unsigned k = 0; tool_mm && k < 3; ++k)
         if (!isfinite(tool_mm[k]) || fabs(tool_mm[k]) > 2000.0)
             return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate: tool_mm must be 3 finite numbers within "
@@ -89,7 +97,14 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
         const double u95 = !gate ? NAN
                            : gate->has_prior ? rch_model_unc_radius95_mm(gate, m, qd)
                                              : rch_model_unc_pos95_mm(gate, m, qd);
-        if (gate && !(u95 <= lim)) {
+        if (gate && !(u95 <= lim) && u95_policy == 2) {
+            if (err && err_len > 0)
+                snprintf(err, err_len, "target %zu: the model's 95 %% position uncertainty at the compensated point is "
+                         "%.4f mm here, above %.4f mm (u95_policy refuse: nothing returned)", i, u95, lim);
+            rc = RCH_FFI_ERR_RANGE;
+            break;
+        }
+        if (gate && !(u95 <= lim) && u95_policy == 0) {
             for (unsigned j = 0; j < RC_NJ; ++j)
                 out_deg[RC_NJ * i + j] = in[j]; /* left uncompensated: uncertainty above the limit */
             if (status)

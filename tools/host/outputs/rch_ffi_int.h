@@ -55,6 +55,8 @@ struct rch_ffi_calib {
     rch_calib_result r;
     char data[RCH_CALIB_MAX_FILES][PATH_LEN];
     const char *data_v[RCH_CALIB_MAX_FILES];
+    char pos[RCH_CALIB_MAX_FILES][PATH_LEN]; /* tracker positions files */
+    const char *pos_v[RCH_CALIB_MAX_FILES];
     char robot_path[PATH_LEN], truth_path[PATH_LEN], fix[PATH_LEN], effects[PATH_LEN], validate[PATH_LEN],
         plots[PATH_LEN], residuals[PATH_LEN];
 };
