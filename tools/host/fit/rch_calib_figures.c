@@ -162,7 +162,11 @@ static int uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sampl
     rch_uncert u;
     char err[256];
     int rc = 0;
-    if (rch_uncert_compute_map(&u, fit, fixed, train, setup, r->n_train, 1, r->prior_on ? r->prior_sd : NULL,
+    double psd[RC_MAX_PARAMS]; /* the prior as the 95 % figures read it: an estimated scale's predictive width */
+    memcpy(psd, r->prior_sd, sizeof psd);
+    if (r->prior_scaled)
+        rch_prior_scale_apply_predictive(psd, psd, fit->n_params, &r->prior_scale);
+    if (rch_uncert_compute_map(&u, fit, fixed, train, setup, r->n_train, 1, r->prior_on ? psd : NULL,
                                r->noise_mm, err, sizeof err) != 0)
         return 0;
     rch_model_unc_from(&r->unc, &u);

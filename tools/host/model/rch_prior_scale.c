@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "rc_solve.h"
+#include "rch_stats.h"
 
 int rch_prior_scale_type(unsigned k)
 {
@@ -160,4 +161,20 @@ void rch_prior_scale_apply(double *sd_out, const double *sd, unsigned n_params, 
         const int t = rch_prior_scale_type(k);
         sd_out[k] = t >= 0 && sd[k] > 0.0 ? sd[k] * ps->factor[t] : sd[k];
     }
+}
+
+double rch_prior_scale_predictive(const rch_prior_scale *ps, int type)
+{
+    if (type < 0 || type >= RCH_PS_TYPES || ps->fallback[type] || !(ps->factor[type] > 1.0) ||
+        !(ps->gamma[type] >= RCH_PRIOR_SCALE_MIN_GAMMA))
+        return 1.0;
+    const double f = rch_f_isf(0.05, 1.0, ps->gamma[type]); /* t_{nu, 0.975}^2 = F_{1, nu} upper 5 % */
+    return isfinite(f) && f > 0.0 ? fmax(1.0, sqrt(f) / 1.959963984540054) : 1.0;
+}
+
+void rch_prior_scale_apply_predictive(double *sd_out, const double *sd, unsigned n_params,
+                                      const rch_prior_scale *ps)
+{
+    for (unsigned k = 0; k < n_params; ++k)
+        sd_out[k] = sd[k] * rch_prior_scale_predictive(ps, rch_prior_scale_type(k));
 }

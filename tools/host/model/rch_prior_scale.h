@@ -28,7 +28,15 @@
  * no longer be physical). Only the DH types scale; the attachment, effects
  * and sensors keep theirs.
  *
- * Depends on: rc_model, rc_solve (rc_normal_eq), LAPACKE. Memory: heap
+ * The u95 figures read an estimated scale as what it is: with the scale
+ * from gamma_t values, an undetermined parameter of the type is Student-t
+ * with gamma_t degrees of freedom about the drawing, so the prior enters the
+ * posterior's 95 % figures widened by t_{gamma_t, 0.975} / 1.96
+ * (rch_prior_scale_predictive; 1.18 at gamma 8, 1.42 at 4); the fit itself
+ * uses the estimated sd.
+ *
+ * Depends on: rc_model, rc_solve (rc_normal_eq), rch_stats (the F
+ * distribution), LAPACKE. Memory: heap
  * scratch inside the call, freed before it returns. Errors: -1 with a
  * message on a degenerate problem or out of memory.
  */
@@ -70,5 +78,17 @@ int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const doub
 
 /* sd_out (n_params) = sd scaled by the factors (DH types only). */
 void rch_prior_scale_apply(double *sd_out, const double *sd, unsigned n_params, const rch_prior_scale *ps);
+
+/* The predictive width of a type whose scale was estimated (factor above
+ * 1, no fallback): a parameter the data do not see is then Student-t with
+ * gamma degrees of freedom about the prior mean, not Gaussian (the scale
+ * itself comes from gamma values); its 95 % interval is t_{gamma, 0.975} /
+ * 1.96 times the Gaussian one. 1 for a type kept at its stated sd. */
+double rch_prior_scale_predictive(const rch_prior_scale *ps, int type);
+
+/* sd_out (n_params) = sd times the predictive width of each DH type: the
+ * prior as the posterior's 95 % figures (u95) read it; sd_out may be sd. */
+void rch_prior_scale_apply_predictive(double *sd_out, const double *sd, unsigned n_params,
+                                      const rch_prior_scale *ps);
 
 #endif
