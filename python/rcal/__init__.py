@@ -525,12 +525,12 @@ class Result:
 
 
 _CAL_FLAGS = {"tool_offset": 1, "jumps": 2, "dequantize": 4, "no_prior": 8, "holdout_groups": 16,
-              "no_jump_check": 32, "no_screen": 64}
+              "no_jump_check": 32, "no_screen": 64, "no_dequantize": 128, "prior_stated": 256}
 
 
 def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=None, robot=None, method="lm",
-              test_fraction=0.1, seed=1, max_iter=0, fix=None, effects=None, jumps=False, dequantize=False,
-              prior=True, tool_offset=False, holdout_groups=False, jump_check=True, validate=None, truth=None,
+              test_fraction=0.1, seed=1, max_iter=0, fix=None, effects=None, jumps=False, dequantize=None,
+              prior=True, prior_stated=False, tool_offset=False, holdout_groups=False, jump_check=True, validate=None, truth=None,
               cases=1, samples=0, plots=None, residuals=None, data_csv=None, positions=None, screen=True):
     """Identify the DH errors and the encoder outlet from cable lengths, as
     `rcal calibrate` does (the same host function: identical figures).
@@ -551,8 +551,12 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
     fix:            parameters held at nominal: "a1,theta6" or a list of names
     effects:        effects fitted with the geometry (--effects): "cable_sag,
                     joint_periodic:2" or a list, e.g. Diagnosis.effects
-    jumps:          fit length jumps (--jumps); dequantize: --dequantize-joints
-    prior:          False for --no-prior (plain least squares)
+    jumps:          fit length jumps (--jumps); dequantize: None (default) recovers
+                    rounded joints from x, y, z when the file shows rounding,
+                    True forces it (--dequantize-joints), False keeps the
+                    joints as read (--no-dequantize-joints)
+    prior:          False for --no-prior (plain least squares); prior_stated:
+                    True for --prior-stated (no scale from the data)
     tool_offset:    --tool-offset; holdout_groups: --holdout-groups;
     jump_check:     False for --no-jump-check
     validate:       a file the fit never sees (--validate): Result.validation
@@ -585,7 +589,10 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
     lib = _lib.lib()
     robot = default_robot() if robot is None else robot
     flags = 0
-    for name, on in (("tool_offset", tool_offset), ("jumps", jumps), ("dequantize", dequantize),
+    if dequantize not in (None, True, False):
+        raise ValueError("calibrate: dequantize must be None (automatic), True or False")
+    for name, on in (("tool_offset", tool_offset), ("jumps", jumps), ("dequantize", dequantize is True),
+                     ("no_dequantize", dequantize is False), ("prior_stated", prior_stated),
                      ("no_prior", not prior), ("holdout_groups", holdout_groups), ("no_jump_check", not jump_check),
                      ("no_screen", not screen)):
         if on:

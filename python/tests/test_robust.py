@@ -5,6 +5,7 @@ failures. Each test is a gap found by comparing what `rcal` refuses
 non-finite values; labels; tracker positions through the same plausibility
 checks and screening as `rcal calibrate --positions` (the same messages);
 failed compensation targets flagged per target."""
+import json
 import math
 import os
 import random
@@ -192,3 +193,23 @@ def test_failed_target_is_flagged(tmp_path):
         rcal.compensate(m, targets, tool_mm=(0, 0))
     with pytest.raises(ValueError, match="targets_deg: nan at row 1"):
         rcal.compensate(m, [POSE, [float("nan")] * 6])
+
+
+REAL_FILE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "data", "robotcali.csv")
+
+
+@pytest.mark.skipif(not os.path.exists(REAL_FILE), reason="the real data ../shared/data/robotcali.csv is absent")
+def test_default_run_as_the_cli_dequantize_and_prior_scale(run_cli):
+    """The default dequantizes a file whose joints are rounded (as `rcal calibrate` does), False keeps
+    them as read, True forces it; the prior's scale is estimated unless prior_stated."""
+    auto = rcal.calibrate(REAL_FILE)
+    off = rcal.calibrate(REAL_FILE, dequantize=False)
+    assert auto.figure("dequant_corrected") == 1039
+    assert off.figure("dequant_corrected") is None
+    assert auto.after.rmse_mm < 0.12 < off.after.rmse_mm
+    cli = json.loads(run_cli("calibrate", "--data", REAL_FILE, "--json").stdout)
+    assert abs(cli["after"]["rmse_mm"] - auto.after.rmse_mm) < 1e-6
+    assert "prior_scale" in auto.json()["estimation"]
+    assert "prior_scale" not in rcal.calibrate(REAL_FILE, prior_stated=True).json()["estimation"]
+    with pytest.raises(ValueError):
+        rcal.calibrate(REAL_FILE, dequantize="yes")

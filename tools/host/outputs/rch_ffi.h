@@ -110,7 +110,9 @@ enum {
     RCH_FFI_CAL_NO_PRIOR = 8,        /* --no-prior: plain least squares, no physical prior */
     RCH_FFI_CAL_HOLDOUT_GROUPS = 16, /* --holdout-groups: hold out whole set-up groups */
     RCH_FFI_CAL_NO_JUMP_CHECK = 32,  /* --no-jump-check */
-    RCH_FFI_CAL_NO_SCREEN = 64       /* --no-screen: every row fitted, none left out as irreconcilable */
+    RCH_FFI_CAL_NO_SCREEN = 64,      /* --no-screen: every row fitted, none left out as irreconcilable */
+    RCH_FFI_CAL_NO_DEQUANTIZE = 128, /* --no-dequantize-joints: the joints as read (default: automatic) */
+    RCH_FFI_CAL_PRIOR_STATED = 256   /* --prior-stated: the prior's sd as stated, not scaled from the data */
 };
 
 /* Calibrate with the host function `rcal calibrate` runs (rch_calib_run):

@@ -134,6 +134,8 @@ static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t 
     cfg.positions_paths = o->n_positions ? c->pos_v : NULL;
     cfg.n_positions_paths = o->n_positions;
     cfg.no_screen = (o->flags & RCH_FFI_CAL_NO_SCREEN) != 0;
+    cfg.no_dequantize = (o->flags & RCH_FFI_CAL_NO_DEQUANTIZE) != 0;
+    cfg.prior_stated = (o->flags & RCH_FFI_CAL_PRIOR_STATED) != 0;
     cfg.robot_path = rch_ffip_copy_opt(c->robot_path, o->robot, &too_long);
     cfg.truth_path = rch_ffip_copy_opt(c->truth_path, o->truth, &too_long);
     cfg.fix = rch_ffip_copy_opt(c->fix, o->fix, &too_long);
