@@ -174,6 +174,7 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
             rch_jw_end(&w);
         }
         rch_jw_numf(&w, "noise_mm", r->noise_mm, "%.6g");
+        rch_jw_numf(&w, "noise_se_mm", rch_sd_se(r->noise_mm, (double)r->n_train - r->p_eff), "%.4g");
         rch_jw_numf(&w, "effective_params", r->p_eff, "%.4g");
     }
     rch_jw_uint(&w, "outlets", r->n_outlets ? r->n_outlets : 1u);

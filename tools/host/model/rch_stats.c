@@ -226,3 +226,8 @@ double rch_t2_ratio95_3d(double nu)
     const double chi2_3_95 = 7.814727903251178;
     return nu * 3.0 / (nu - 2.0) * rch_f_isf(0.05, 3.0, nu - 2.0) / chi2_3_95;
 }
+
+double rch_sd_se(double sd, double dof)
+{
+    return dof > 0.0 ? sd / sqrt(2.0 * dof) : NAN;
+}

@@ -35,6 +35,9 @@ void rch_stats_of(rch_stats *s, const double *v, size_t n);
 double rch_stats_rms(const rch_stats *s);      /* sqrt(sum e^2 / n); 0 when empty */
 double rch_stats_mean_abs(const rch_stats *s); /* mean |e|; 0 when empty */
 double rch_stats_sd(const rch_stats *s);       /* standard deviation, n - 1; 0 below two values */
+/* The standard error of a standard deviation sd estimated with dof degrees
+ * of freedom (chi-square: sd / sqrt(2 dof)); NAN when dof <= 0. */
+double rch_sd_se(double sd, double dof);
 
 /* The same figures in the core's rc_metrics (rmse, mean |e|, SD, mean, max). */
 void rch_stats_metrics(rc_metrics *out, const rch_stats *s);
