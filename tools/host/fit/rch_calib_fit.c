@@ -439,8 +439,29 @@ static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_con
     char err[160];
     rch_prior_scale ps;
     r->counts.jac_passes++;
-    if (rch_prior_scale_estimate(&ps, &r->model, r->prior_mean, r->prior_sd, fixed, train, r->n_train, r->noise_mm,
-                                 err, sizeof err) != 0)
+    /* with --jumps the fit is r->jumps.model over the samples in acquisition order, each in its segment
+     * (the jumps' group), the first segment's offset held: as map_fit fitted it */
+    const rc_model *fm = &r->model;
+    const rc_sample *fs = train;
+    rc_sample *sorted = NULL;
+    uint8_t fxj[RC_MAX_PARAMS];
+    memcpy(fxj, fixed, sizeof fxj);
+    if (r->cfg.jumps) {
+        if (!(sorted = malloc(r->n_train * sizeof *sorted)))
+            return RC_OK;
+        memcpy(sorted, train, r->n_train * sizeof *sorted);
+        qsort(sorted, r->n_train, sizeof *sorted, cmp_t);
+        for (size_t i = 0; i < r->n_train; ++i)
+            sorted[i].group = (uint16_t)rch_jumps_segment(&r->jumps, sorted[i].t);
+        if (r->jumps.n_jumps)
+            fxj[r->jumps.model.effects[r->jumps.model.n_effects - 1].first] = 1;
+        fm = &r->jumps.model;
+        fs = sorted;
+    }
+    const int est = rch_prior_scale_estimate(&ps, fm, r->prior_mean, r->prior_sd, fxj, fs, r->n_train, r->noise_mm,
+                                             err, sizeof err);
+    free(sorted);
+    if (est != 0)
         return RC_OK; /* the stated prior, as before */
     r->prior_scaled = 1;
     r->prior_scale = ps;
