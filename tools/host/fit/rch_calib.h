@@ -132,7 +132,8 @@ typedef struct rch_calib_result {
     unsigned jump_check_steps; /* every change point the check's search found (jumps_found of them far above) */
     int jumps_auto;           /* they were then fitted as nuisance (cfg.jumps set by the run) */
     int have_jump_at, keep_jump_at; /* the change points of this training set are known (searched once) */
-    int attach_m0;                  /* fitting the no-attachment model: refit at the attachment model's points */
+    int attach_m0;                  /* refit at the change points found (the no-attachment model, the refit under
+                                       the prior's estimated scale) */
     unsigned n_jump_at;
     double jump_rms_before_mm; /* training RMS of the geometry alone (the search's) */
     size_t jump_at[RCH_JUMPS_MAX];    /* (n_jump_at) first training sample (in t order) after each jump */

@@ -473,7 +473,29 @@ static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_con
     rch_prior_scale_apply(r->prior_sd, r->prior_sd, r->model.n_params, &ps);
     double chi2 = 0.0;
     cfg->prior_sd = r->prior_sd;
-    return map_fit(r, w, cfg, fixed, train, &chi2);
+    r->attach_m0 = 1; /* at the change points already found: a wider prior moves the geometry, not the jumps */
+    const rc_status st = map_fit(r, w, cfg, fixed, train, &chi2);
+    r->attach_m0 = 0;
+    return st;
+}
+
+/* scale_prior with a prior, its time counted with the fits; -1 (d set) when the refit fails. */
+static int scale_prior_timed(rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, const uint8_t *fixed,
+                             const rc_sample *train, rch_diag *d)
+{
+    if (!r->prior_on)
+        return 0;
+    const double t0 = now_ms(), j0 = r->jumps_ms;
+    const rc_status st = scale_prior(r, w, cfg, fixed, train);
+    r->fits_ms += now_ms() - t0 - (r->jumps_ms - j0);
+    if (st != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "solver failed under the prior's estimated scale: %s", rc_strerror(st));
+        return -1;
+    }
+    r->finite = 1;
+    for (unsigned k = 0; k < r->model.n_params; ++k)
+        r->finite &= isfinite(r->model.x[k]) != 0;
+    return 0;
 }
 
 /* Identification and the figures, once the split is made. */
@@ -514,8 +536,6 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
         st = map_fit(r, w, &cfg, fixed, train, &chi2_1);
         if (st == RC_OK && r->attach_auto)
             st = choose_attachment(r, w, &cfg, fixed, train, chi2_1);
-        if (st == RC_OK)
-            st = scale_prior(r, w, &cfg, fixed, train);
     } else {
         st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
     }
@@ -532,6 +552,8 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
     const size_t n_eval = r->n_test ? r->n_test : r->n_train;
     rc_eval(&r->before_m, &r->before, eval_set, n_eval);
     if (r->cfg.jumps) {
+        if (scale_prior_timed(r, w, &cfg, fixed, train, d) != 0)
+            return -1;
         const double tj = now_ms(), u0 = r->uncert_ms, j0 = r->jumps_ms;
         const int rc = fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
         r->fits_ms += now_ms() - tj - (r->uncert_ms - u0) - (r->jumps_ms - j0); /* the refit at the points */
@@ -553,6 +575,8 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
             return rc;
         }
     }
+    if (scale_prior_timed(r, w, &cfg, fixed, train, d) != 0) /* after the jump check: once, on the final model */
+        return -1;
     r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
     int train_ok = r->after_ok;
     if (eval_set == train) { /* nothing held out: the training figures are those */
