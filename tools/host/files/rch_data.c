@@ -533,7 +533,6 @@ int rch_data_check_scale(const rch_data *data, const char *name, const rc_model 
         rc = -1;
     }
     if (rc == 0 && data->xyz) {
-        k = 0;
         double c[2][3] = {{0}};
         for (size_t i = 0; i < n; ++i) {
             double p[3];

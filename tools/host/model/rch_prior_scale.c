@@ -114,6 +114,10 @@ int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const doub
     }
     int type[RC_MAX_PARAMS];
     double dx[RC_MAX_PARAMS], p0[RC_MAX_PARAMS];
+    for (unsigned k = 0; k < RC_MAX_PARAMS; ++k) { /* every entry defined (those of held parameters unused) */
+        type[k] = -1;
+        dx[k] = p0[k] = 0.0;
+    }
     for (unsigned k = 0; k < m->n_params; ++k)
         if (!fixed || !fixed[k]) {
             const unsigned a = w->nf++;
