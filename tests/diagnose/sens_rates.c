@@ -510,13 +510,13 @@ int main(int argc, char **argv)
     unsigned seeds = 5, n_targets = 200;
     double size = 1.0;
     const char *only = NULL, *keep = NULL;
-    int check = 0; /* --check: the ctest (diag_sensors): controls and gravity on both sensors, asserted */
+    int check = 0; /* --check: the ctest (diag_sensors): controls, gravity and gear on both sensors, asserted */
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--check") == 0) {
             check = 1;
             seeds = 3;
             n_targets = 60;
-            only = "trk_none,trk_gravity,cab_none,cab_gravity";
+            only = "trk_none,trk_gravity,trk_gear,cab_none,cab_gravity,cab_gear";
         } else if (strcmp(argv[i], "--seeds") == 0 && i + 1 < argc)
             seeds = (unsigned)atoi(argv[++i]);
         else if (strcmp(argv[i], "--cases") == 0 && i + 1 < argc)

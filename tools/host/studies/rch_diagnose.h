@@ -28,9 +28,14 @@
  *     period started from the largest sine in the residuals against the
  *     length). A
  *     candidate that adds no identifiable direction (rank of the scaled
- *     normal matrix does not grow) is flagged, not tested. Held-out gain:
- *     paired one-sided z test on the per-sample differences of held-out
- *     squared errors, Bonferroni over the tested candidates at level alpha.
+ *     normal matrix does not grow) is flagged, not tested. Significance:
+ *     the score test of the candidate's added directions at the current
+ *     model (cluster-robust by pose, F(q, poses - q); rch_diagnose_score.c),
+ *     Bonferroni over the tested candidates at level alpha; for
+ *     length_periodic, whose period is searched on the same residuals, the
+ *     held-out gain's paired one-sided z test instead. The held-out gain
+ *     (per-pose paired differences of held-out squared errors) is measured
+ *     and reported for every candidate.
  *     Among the significant ones the best gain wins, except that a candidate
  *     with fewer parameters whose held-out MSE is within one standard error
  *     of the best is preferred (one-standard-error rule).
@@ -151,8 +156,13 @@ typedef struct rch_diagnose_cand {
     double gain_mm2;       /* mean reduction of held-out squared error */
     double gain_se_mm2;    /* its standard error */
     double z;              /* gain / se */
-    double p_value;        /* one-sided */
-    int significant;       /* p < alpha / tested candidates */
+    double p_value;        /* one-sided, of the held-out gain */
+    int scored;            /* the score test could be formed */
+    double score_f;        /* its F statistic (cluster-robust by pose) */
+    unsigned score_dof;    /* its numerator dof (the directions tested) */
+    double score_p;        /* its p-value */
+    double p_decision;     /* the p the decision reads: score_p, or p_value for length_periodic (a searched period) */
+    int significant;       /* p_decision < alpha / tested candidates */
     char note[160];
 } rch_diagnose_cand;
 

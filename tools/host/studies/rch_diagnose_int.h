@@ -5,6 +5,7 @@
  *   rch_diagnose.c         the workflow: inputs, floor, folds, geometry, jumps, verdict
  *   rch_diagnose_tests.c   the structure tests of residuals
  *   rch_diagnose_search.c  the candidate effects and the search among them
+ *   rch_diagnose_score.c   the score test of one candidate
  *   rch_diagnose_out.c     text, JSON, next step, model file, residual table
  *   rch_diagnose_plot.c    the plots */
 #ifndef RCH_DIAGNOSE_INT_H
@@ -87,6 +88,16 @@ unsigned rch_dg_structure_tests(rch_diagnose_test *out, const double *r, const r
  * One outlet's lengths alone: rch_dg_structure_tests itself. */
 unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
                              const double (*var)[V_N], unsigned n_groups, double alpha);
+
+/* rch_diagnose_score.c: the cluster-robust score test of the candidate
+ * parameters nb..n_params-1 of m0 (the current model with the candidate
+ * added at zero; m1: it fitted, whose residuals give the score's
+ * covariance, or NULL) over c's samples, poses as clusters. q_ident: the
+ * directions the candidate adds; k_fitted: the current model's fitted
+ * directions. 0 with F, its numerator dof and p; -1 when it cannot be
+ * formed (nothing identifiable, too few poses, a LAPACK failure). */
+int rch_dg_score_test(double *f_stat, unsigned *dof, double *p_value, const rc_model *m0, const rc_model *m1,
+                      unsigned nb, unsigned q_ident, unsigned k_fitted, const ctx *c);
 
 /* rch_diagnose_search.c */
 int rch_dg_has_effect(const rc_model *m, rc_effect_kind kind, unsigned joint0);

@@ -97,19 +97,21 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
         const rch_diagnose_step *st = &r->steps[s];
         fprintf(f, "\nStep %u: candidates fitted jointly with the geometry (model held-out RMSE %.4f mm)\n", s + 1,
                 st->rmse_base_mm);
-        fprintf(f, "  %-22s %6s %6s %10s %11s %7s %9s  %s\n", "effect", "params", "ident", "held-out",
-                "gain mm^2", "z", "p", "");
+        fprintf(f, "  %-22s %6s %6s %10s %11s %7s %9s %8s %9s  %s\n", "effect", "params", "ident", "held-out",
+                "gain mm^2", "z", "p", "score F", "p score", "");
         for (unsigned k = 0; k < st->n_cand; ++k) {
             const rch_diagnose_cand *ca = &st->cand[k];
-            char pb[16];
+            char pb[16], ps[16], fs[16];
+            snprintf(fs, sizeof fs, "%.2f", ca->score_f);
             if (ca->tested)
-                fprintf(f, "  %-22s %6u %6u %10.4f %11.5f %7.2f %9s  %s%s%s\n", ca->name, ca->n_params,
+                fprintf(f, "  %-22s %6u %6u %10.4f %11.5f %7.2f %9s %8s %9s  %s%s%s\n", ca->name, ca->n_params,
                         ca->n_ident, ca->rmse_cv_mm, ca->gain_mm2, ca->z, rch_plot_fmt_p(pb, sizeof pb, ca->p_value),
+                        ca->scored ? fs : "-", ca->scored ? rch_plot_fmt_p(ps, sizeof ps, ca->score_p) : "-",
                         (int)k == st->chosen ? "<- CHOSEN" : ca->significant ? "significant" : "",
                         ca->note[0] ? "  " : "", ca->note);
             else
-                fprintf(f, "  %-22s %6u %6u %10s %11s %7s %9s  %s\n", ca->name, ca->n_params, ca->n_ident, "-", "-",
-                        "-", "-", ca->note);
+                fprintf(f, "  %-22s %6u %6u %10s %11s %7s %9s %8s %9s  %s\n", ca->name, ca->n_params, ca->n_ident, "-",
+                        "-", "-", "-", "-", "-", ca->note);
         }
         fprintf(f, "  -> %s\n", st->chosen >= 0 ? st->why : st->why[0] ? st->why : "stop");
     }
@@ -218,6 +220,12 @@ static void json_cands(rch_jw *w, const rch_diagnose_result *r)
                 json_num(w, "gain_se_mm2", ca->gain_se_mm2);
                 json_num(w, "z", ca->z);
                 json_num(w, "p", ca->p_value);
+                if (ca->scored) {
+                    json_num(w, "score_f", ca->score_f);
+                    rch_jw_uint(w, "score_dof", ca->score_dof);
+                    json_num(w, "score_p", ca->score_p);
+                }
+                rch_jw_str(w, "test", ca->scored ? "score" : "held-out");
             }
             rch_jw_bool(w, "significant", ca->significant);
             rch_jw_bool(w, "chosen", (int)k == r->steps[s].chosen);

@@ -227,6 +227,7 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
         return 0;
     }
     ca->n_params = full->n_params - S->base.n_params;
+    const rc_model m0 = *full; /* the candidate at zero: it predicts as the base */
     if (cd->kind == RC_EFF_LENGTH_PERIODIC && periodic_start(full, &S->base, out->s, out->n) != 0) {
         snprintf(ca->note, sizeof ca->note, "not applicable: the lengths span too little for a period");
         return 0;
@@ -249,6 +250,9 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
     if (ca->n_ident < ca->n_params)
         snprintf(ca->note, sizeof ca->note, "%u of %u parameters identifiable (%s)", ca->n_ident, ca->n_params,
                  known_reason(cd->kind, cd->joint0, &S->base));
+    if (cd->kind != RC_EFF_LENGTH_PERIODIC) /* a searched period: its score test would not hold its level */
+        ca->scored = rch_dg_score_test(&ca->score_f, &ca->score_dof, &ca->score_p, &m0, full, S->base.n_params,
+                                       ca->n_ident, rb, &S->c) == 0;
     if (cd->kind == RC_EFF_LENGTH_PERIODIC) { /* a drum turn: 10 mm .. the lengths' range */
         double lmin = 1e300, lmax = -1e300;
         for (size_t i = 0; i < out->n; ++i) {
@@ -401,30 +405,36 @@ static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
 {
     rch_diagnose_result *out = S->out;
     int best = -1, second = -1;
-    /* Among the significant candidates the simpler cause wins unless the
-     * larger one explains clearly more: held-out MSE penalised by the
-     * parameters it adds (n ln MSE + p ln n, BIC-like), so 30 set-up offsets
-     * do not beat a 2-parameter drift that explains nearly the same. */
+    /* Among the significant candidates the strongest evidence wins (the
+     * smallest p of its test, which counts the directions it adds); the
+     * held-out MSE penalised by the parameters it adds (n ln MSE + p ln n,
+     * BIC-like) breaks ties and says when two explain the same. */
     double crit[RCH_DIAGNOSE_MAX_CAND];
     const double nn = (double)out->n;
     for (unsigned k = 0; k < st->n_cand; ++k) {
         rch_diagnose_cand *ca = &st->cand[k];
         if (!ca->tested)
             continue;
-        ca->significant = ca->p_value < S->cfg.alpha / n_tested && ca->gain_mm2 > 0.0 && !ca->implausible;
+        ca->p_decision = ca->scored ? ca->score_p : ca->p_value;
+        ca->significant = ca->p_decision < S->cfg.alpha / n_tested && !ca->implausible &&
+                          (ca->scored || ca->gain_mm2 > 0.0);
         crit[k] = nn * log(ca->rmse_cv_mm * ca->rmse_cv_mm) + (double)ca->n_ident * log(nn);
         if (!ca->significant)
             continue;
-        if (best < 0 || crit[k] < crit[best]) {
+#define RCH_DG_BEFORE(a, b)                                                                                            \
+    (st->cand[a].p_decision < st->cand[b].p_decision ||                                                                \
+     (st->cand[a].p_decision == st->cand[b].p_decision && crit[a] < crit[b]))
+        if (best < 0 || RCH_DG_BEFORE(k, (unsigned)best)) {
             second = best;
             best = (int)k;
-        } else if (second < 0 || crit[k] < crit[second]) {
+        } else if (second < 0 || RCH_DG_BEFORE(k, (unsigned)second)) {
             second = (int)k;
         }
+#undef RCH_DG_BEFORE
     }
     if (best < 0) {
         snprintf(st->why, sizeof st->why,
-                 "no candidate improves the held-out error significantly (one-sided p < %.2g each)",
+                 "no candidate is significant (p < %.2g each, Bonferroni)",
                  S->cfg.alpha / (n_tested ? n_tested : 1));
         return 0;
     }
@@ -440,7 +450,7 @@ static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
     if (chosen != best)
         snprintf(st->why, sizeof st->why,
                  "%s: significant, and within one standard error of the best (%s) with fewer parameters", cn, bn);
-    else if (second >= 0 && crit[second] - crit[best] < 2.0 * log(nn)) {
+    else if (second >= 0 && fabs(crit[second] - crit[best]) < 2.0 * log(nn)) {
         char sn[40];
         memcpy(sn, st->cand[second].name, sizeof sn);
         snprintf(st->why, sizeof st->why,
@@ -448,7 +458,8 @@ static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
                  "that revisits set-ups in shuffled order would separate them",
                  cn, sn);
     } else
-        snprintf(st->why, sizeof st->why, "%s: best significant held-out fit for its parameters (z = %.1f)", cn,
+        snprintf(st->why, sizeof st->why, "%s: the strongest significant evidence (%s p = %.2g; held-out z = %.1f)",
+                 cn, st->cand[chosen].scored ? "score test" : "held-out gain", st->cand[chosen].p_decision,
                  st->cand[chosen].z);
     const unsigned ci = slot_ci[chosen];
     S->base = S->cand_full[ci];
