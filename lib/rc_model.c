@@ -149,6 +149,7 @@ static const rc_effect_desc effect_table[] = {
     {RC_EFF_OUTLET_OFFSET, "outlet_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 0, 1, "mm", 1000.0, "", "o", 0},
     {RC_EFF_OUTLET_SCALE, "outlet_scale", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 2, 0, 1, "", 0.001, "", "o", 0},
     {RC_EFF_TRACKER_SCALE, "tracker_scale", 1, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 2, 0, 1, "", 3e-4, "", "", 0},
+    {RC_EFF_CABLE_POINTS, "cable_points", 0, RC_SIDE_POINT, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z", "", 0},
 };
 RC_STATIC_ASSERT(sizeof effect_table / sizeof effect_table[0] == RC_EFF_LAST + 1, effect_table_covers_every_kind);
 
@@ -203,12 +204,12 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     } else if (joint >= RC_NJ) {
         return RC_ERR_ARG;
     }
-    if (kind == RC_EFF_TRACKER_TARGETS && (n % 3 != 0 || n > 3 * RC_MAX_TARGETS))
-        return RC_ERR_ARG; /* three per target */
-    if (ds->side == RC_SIDE_SENSOR)
+    if ((kind == RC_EFF_TRACKER_TARGETS || kind == RC_EFF_CABLE_POINTS) && (n % 3 != 0 || n > 3 * RC_MAX_TARGETS))
+        return RC_ERR_ARG; /* three per target, per point */
+    if (ds->side == RC_SIDE_SENSOR || kind == RC_EFF_CABLE_POINTS)
         for (unsigned i = 0; i < m->n_effects; ++i)
             if (m->effects[i].kind == (uint8_t)kind)
-                return RC_ERR_ARG; /* one tracker frame, one set of targets */
+                return RC_ERR_ARG; /* one tracker frame, one set of targets, one plate */
     if (n == 0)
         return RC_ERR_ARG;
     if (m->n_effects >= RC_MAX_EFFECTS || (unsigned)m->n_params + n > RC_MAX_PARAMS)
@@ -425,6 +426,27 @@ static int tool_index(const rc_model *m)
     return -1;
 }
 
+/* Index of the cable points' parameters in x, or -1; *count: their points. */
+static int points_index(const rc_model *m, unsigned *count)
+{
+    *count = 0;
+    for (unsigned i = 0; i < m->n_effects; ++i)
+        if (m->effects[i].kind == RC_EFF_CABLE_POINTS) {
+            *count = m->effects[i].count / 3u;
+            return (int)m->effects[i].first;
+        }
+    return -1;
+}
+
+/* The index in x of the point sample s measures (its cable point with
+ * RC_EFF_CABLE_POINTS: pi its first parameter, np the points; else tool). */
+static int sample_point(const rc_sample *s, int tool, int pi, unsigned np)
+{
+    if (pi >= 0 && s->sensor == RC_SENSOR_LENGTH && s->target < np)
+        return pi + 3 * (int)s->target;
+    return tool;
+}
+
 /* The measured point tool (3) of chain c: the flange origin, plus R6 t with
  * a tool offset at x[ti] (ti < 0: none). */
 static void chain_tool(double tool[3], const chain *c, const rc_model *m, int ti)
@@ -525,6 +547,9 @@ void rc_meas_prepare(rc_meas_prep *p, const rc_model *m)
         p->sin_alpha[i] = sin(al);
     }
     p->tool = (int16_t)tool_index(m);
+    unsigned np;
+    p->points = (int16_t)points_index(m, &np);
+    p->n_points = (uint8_t)np;
     p->has_tilt = (uint8_t)model_tilts(p->tilt_cm1, p->tilt_s, p->tilt_at, m);
     for (unsigned i = 0; i < m->n_effects; ++i) {
         const rc_effect *e = &m->effects[i];
@@ -542,8 +567,12 @@ rc_status rc_meas(double *len_mm, double *jac, const rc_model *m, const rc_sampl
 {
     chain c;
     double p[3];
+    unsigned np;
     RC_ASSERT(len_mm != NULL && m != NULL && s != NULL);
     model_chain(&c, p, m, s->q_rad);
+    const int pi = points_index(m, &np), tool = tool_index(m), at = sample_point(s, tool, pi, np);
+    if (at != tool)
+        chain_tool(p, &c, m, at);
     return meas_chain(len_mm, jac, m, s, &c, p);
 }
 
@@ -571,9 +600,10 @@ static void chain_prepared(chain *c, double p[3], const rc_model *m, const rc_me
                 st[i] = sin(th[i]);
             }
     }
-    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || pr->tool >= 0 || pr->has_tilt || s->sensor != 0,
+    const int at = sample_point(s, pr->tool, pr->points, pr->n_points);
+    chain_axes(c, m, ct, st, pr->cos_alpha, pr->sin_alpha, full || at >= 0 || pr->has_tilt || s->sensor != 0,
                pr->has_tilt ? pr : NULL);
-    chain_tool(p, c, m, pr->tool);
+    chain_tool(p, c, m, at);
 }
 
 void rc_point_prepared(double pos_mm[3], const rc_model *m, const rc_meas_prep *p, const rc_sample *s,
@@ -673,6 +703,7 @@ static rc_status sensor_chain(double *value, double *jac, const rc_model *m, con
 static void length_effects_jac(double *jac, const rc_model *m, const rc_sample *s, const chain *c, const double g[3],
                                double dist, double h2, int outlet_first)
 {
+    unsigned np;
     for (int r = 0; r < 3; ++r)
         jac[RC_P_ENC + r] = outlet_first < 0 ? -g[r] : 0.0;
     for (unsigned i = 0; i < m->n_effects; ++i) {
@@ -715,10 +746,14 @@ static void length_effects_jac(double *jac, const rc_model *m, const rc_sample *
             for (unsigned k = 0; k < ef->count; ++k)
                 J[k] = (k == s->group) ? 1.0 : 0.0;
             break;
-        case RC_EFF_TOOL_OFFSET: { /* dp/dt = R6 */
+        case RC_EFF_TOOL_OFFSET:   /* dp/dt = R6, for the point the sample measures */
+        case RC_EFF_CABLE_POINTS: {
             const double *R = c->R[RC_NJ];
-            for (unsigned k = 0; k < 3; ++k)
-                J[k] = g[0] * R[k] + g[1] * R[3 + k] + g[2] * R[6 + k];
+            const int pi = points_index(m, &np), at = sample_point(s, tool_index(m), pi, np);
+            for (unsigned k = 0; k < ef->count; ++k)
+                J[k] = (int)(ef->first + k - k % 3u) == at ? g[0] * R[k % 3u] + g[1] * R[3 + k % 3u] +
+                                                                 g[2] * R[6 + k % 3u]
+                                                           : 0.0;
             break;
         }
         case RC_EFF_CABLE_SAG: J[0] = 1e-9 * h2 * dist; break;

@@ -78,12 +78,18 @@ typedef enum rc_effect_kind {
                                    params, one per outlet (0: 1 + the largest RC_EFF_OUTLET number), mm */
     RC_EFF_OUTLET_SCALE = 17,   /* l *= 1 + s_k for samples from outlet k (each encoder's own scale, or
                                    one cable stretched differently); count params as OUTLET_OFFSET */
-    RC_EFF_TRACKER_SCALE = 18   /* the tracker's length scale: p_tracker = (1 + s) (R p_base + T), e.g.
+    RC_EFF_TRACKER_SCALE = 18,  /* the tracker's length scale: p_tracker = (1 + s) (R p_base + T), e.g.
                                    a wrong air temperature in its refractive index; 1 param, unitless */
+    RC_EFF_CABLE_POINTS = 19    /* the points of a tool plate the cable is hooked on in turn: a length
+                                   sample with rc_sample.target == k is measured to flange + R6 (x_k, y_k,
+                                   z_k) instead of the flange centre or RC_EFF_TOOL_OFFSET's point; 3
+                                   params per point (count = 3 x points, at most RC_MAX_TARGETS), mm in
+                                   the flange frame. Points apart on the plate make the flange's
+                                   orientation visible to the cable, as targets make it to a tracker */
 } rc_effect_kind;
 
 /* Last effect kind (for range checks of stored kinds). */
-#define RC_EFF_LAST RC_EFF_TRACKER_SCALE
+#define RC_EFF_LAST RC_EFF_CABLE_POINTS
 
 /* Targets a position data set may use (rc_sample.target, RC_EFF_TRACKER_TARGETS). */
 #define RC_MAX_TARGETS 16
@@ -195,7 +201,8 @@ typedef struct rc_sample {
     uint8_t outlet;      /* the encoder outlet it was measured from: 0 = e, k = the RC_EFF_OUTLET effect
                             with joint k (a sample whose outlet the model lacks has no length: RC_ERR_ARG) */
     uint8_t sensor;      /* rc_sensor_kind: what len_mm is */
-    uint8_t target;      /* tracker samples: the target seen (its three parameters in RC_EFF_TRACKER_TARGETS) */
+    uint8_t target;      /* tracker samples: the target seen (its three parameters in RC_EFF_TRACKER_TARGETS);
+                            length samples of a model with RC_EFF_CABLE_POINTS: the point the cable is on */
 } rc_sample;
 
 /* Initialise a model from a DH table and an encoder position.
@@ -273,6 +280,8 @@ typedef struct rc_meas_prep {
     uint8_t joint_effect[RC_NJ];               /* nonzero: joint i has a joint-side effect */
     uint8_t has_joint_effect;                  /* any of joint_effect */
     int16_t tool;                              /* index of the tool offset in x, -1: none */
+    int16_t points;                            /* index of RC_EFF_CABLE_POINTS in x, -1: none */
+    uint8_t n_points;                          /* its points */
     double tilt_cm1[RC_NJ], tilt_s[RC_NJ];     /* (6) cos(beta) - 1 and sin(beta) of each row's axis tilt */
     int16_t tilt_at[RC_NJ];                    /* (6) index of row i's tilt in x, -1: none */
     uint8_t has_tilt;                          /* any row tilted */
@@ -280,8 +289,9 @@ typedef struct rc_meas_prep {
 
 void rc_meas_prepare(rc_meas_prep *p, const rc_model *m);
 
-/* The measured point (the flange point, or the tool point with
- * RC_EFF_TOOL_OFFSET) of sample s as rc_meas_prepared sees it: pos_mm (3).
+/* The measured point (the flange point, the tool point with
+ * RC_EFF_TOOL_OFFSET, or a length sample's cable point with
+ * RC_EFF_CABLE_POINTS) of sample s as rc_meas_prepared sees it: pos_mm (3).
  * sin_q, cos_q as there. */
 void rc_point_prepared(double pos_mm[3], const rc_model *m, const rc_meas_prep *p, const rc_sample *s,
                        const double *sin_q, const double *cos_q);

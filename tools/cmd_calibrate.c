@@ -2,6 +2,7 @@
 /* cmd_calibrate.c - rcal calibrate: identify the DH errors and the encoder
  * position from cable lengths, with a held-out before/after report. The work
  * is rch_calib_run (tools/host/fit/rch_calib.h). */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,7 +44,7 @@ static const char details[] = "mean|e| is what the paper's Eq. 20 calls SD; SD i
 typedef struct {
     rch_calib_cfg cfg;
     const char *out_path, *method, *report_path;
-    rch_opt_strs data, positions;
+    rch_opt_strs data, positions, cable_points;
     unsigned long seed, max_iter, cases, case_samples;
     int json;
     double tracker_pos[3], tracker_rot[3];
@@ -58,6 +59,26 @@ static int to_config(calib_args *a, const rch_cmdspec *spec, unsigned long long 
         return 2; /* unreachable: the choice list is the method list */
     cfg->seed = a->seed;
     cfg->max_iter = (unsigned)a->max_iter;
+    if (a->cable_points.n > RC_MAX_TARGETS) {
+        fprintf(stderr, "rcal calibrate: --cable-point given %zu times: at most %d points\n", a->cable_points.n,
+                RC_MAX_TARGETS);
+        return 2;
+    }
+    for (size_t k = 0; k < a->cable_points.n; ++k) { /* "X,Y,Z" in mm, the flange frame */
+        const char *p = a->cable_points.v[k];
+        char *end = NULL;
+        for (unsigned c = 0; c < 3; ++c) {
+            const double v = strtod(p, &end);
+            if (end == p || !isfinite(v) || fabs(v) > 2000.0 || (c < 2 ? *end != ',' : *end != '\0')) {
+                fprintf(stderr, "rcal calibrate: --cable-point '%s' (point %zu): need X,Y,Z in mm in the flange frame, "
+                                "each within 2000\n", a->cable_points.v[k], k);
+                return 2;
+            }
+            cfg->cable_points_mm[k][c] = v;
+            p = end + 1;
+        }
+    }
+    cfg->n_cable_points = (unsigned)a->cable_points.n;
     cfg->cases = a->cases;
     cfg->case_samples = a->case_samples;
     if (a->data.n == 0 && a->positions.n == 0) {
@@ -144,6 +165,12 @@ static int parse(calib_args *a, int argc, char **argv)
          "length_nonlinearity, length_periodic:P (start period, mm), joint_compliance:J, joint_periodic:J "
          "(e.g. what rcal diagnose named)",
          0, NULL},
+        {"--cable-point", RCH_OPT_STRS, &a->cable_points, 0, 0, "X,Y,Z",
+         "a point of a tool plate the cable is hooked on, nominal, in the flange frame (mm); once per point, in the "
+         "order of the data's target column (0, 1, ...): points apart make the flange's orientation visible",
+         0, NULL},
+        {"--cable-point-sd", RCH_OPT_DOUBLE, &cfg->cable_point_sd_mm, 1e-6, 100.0, "MM",
+         "the plate's tolerance: the prior sd of each point coordinate (default 0.05)", 0, NULL},
         {"--tool-offset", RCH_OPT_FLAG, &cfg->tool_offset, 0, 0, NULL,
          "identify where the cable is attached in the flange frame (tx, ty, tz); the default with the prior, "
          "needed with --no-prior", 0, NULL},

@@ -113,6 +113,79 @@ static void test_param_jacobian_effects(void **state)
     check_param_jacobian(&m, &g);
 }
 
+/* A cable on the points of a tool plate (RC_EFF_CABLE_POINTS): the length of
+ * a sample with target k is the distance from the encoder to flange + R6
+ * p_k (written here from rc_fk's flange pose), every derivative by
+ * differences with the other effects present (the tool offset's columns
+ * zero for such a sample), the prepared path equal, and the effect's
+ * argument checks. */
+static void test_cable_points(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 5);
+    static const double pts[3][3] = {{60.0, 0.0, 20.0}, {-30.0, 52.0, 20.0}, {-30.0, -52.0, 21.0}};
+    rc_model plain = nominal();
+    assert_int_equal(rc_model_add_effect(&plain, RC_EFF_CABLE_POINTS, 0, 4), RC_ERR_ARG); /* 3 per point */
+    assert_int_equal(rc_model_add_effect(&plain, RC_EFF_CABLE_POINTS, 0, 3 * RC_MAX_TARGETS + 3), RC_ERR_ARG);
+    assert_int_equal(rc_model_add_effect(&plain, RC_EFF_CABLE_POINTS, 0, 9), RC_OK);
+    assert_int_equal(rc_model_add_effect(&plain, RC_EFF_CABLE_POINTS, 0, 9), RC_ERR_ARG); /* one plate */
+    const unsigned pf = plain.effects[plain.n_effects - 1].first;
+    memcpy(&plain.x[pf], pts, sizeof pts);
+    for (int trial = 0; trial < 30; ++trial) {
+        rc_sample s;
+        memset(&s, 0, sizeof s);
+        random_pose(&s, &g);
+        s.target = (uint8_t)(trial % 3);
+        double o[3], R[9], p[3], l, d2 = 0.0;
+        rc_fk(o, R, &plain, s.q_rad); /* the flange: the plate moves no flange */
+        for (int r = 0; r < 3; ++r) {
+            const double *t = pts[s.target];
+            p[r] = o[r] + R[3 * r] * t[0] + R[3 * r + 1] * t[1] + R[3 * r + 2] * t[2] - plain.x[RC_P_ENC + r];
+            d2 += p[r] * p[r];
+        }
+        assert_int_equal(rc_meas(&l, NULL, &plain, &s), RC_OK);
+        assert_true(fabs(l - sqrt(d2)) < 1e-9);
+    }
+    rc_model m = model_with_effects(&g); /* with a tool offset, which a point's length does not see */
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_CABLE_POINTS, 0, 9), RC_OK);
+    const unsigned mf = m.effects[m.n_effects - 1].first, tf = m.effects[m.n_effects - 2].first;
+    memcpy(&m.x[mf], pts, sizeof pts);
+    rc_meas_prep pr;
+    rc_meas_prepare(&pr, &m);
+    for (int trial = 0; trial < 30; ++trial) {
+        rc_sample s;
+        memset(&s, 0, sizeof s);
+        random_pose(&s, &g);
+        s.target = (uint8_t)(trial % 3);
+        double l, lp, jac[RC_MAX_PARAMS], jp[RC_MAX_PARAMS];
+        assert_int_equal(rc_meas(&l, jac, &m, &s), RC_OK);
+        assert_int_equal(rc_meas_prepared(&lp, jp, &m, &pr, &s, NULL, NULL), RC_OK);
+        assert_true(fabs(l - lp) < 1e-9);
+        for (unsigned k = 0; k < m.n_params; ++k) {
+            assert_true(fabs(jac[k] - jp[k]) < 1e-9 * (1.0 + fabs(jac[k])));
+            const double h = rc_param_unit(&m, k) == 0 ? 1e-4 : 1e-7;
+            rc_model mp = m, mm = m;
+            mp.x[k] += h;
+            mm.x[k] -= h;
+            double a, b;
+            assert_int_equal(rc_meas(&a, NULL, &mp, &s), RC_OK);
+            assert_int_equal(rc_meas(&b, NULL, &mm, &s), RC_OK);
+            const double fd = (a - b) / (2.0 * h);
+            if (fabs(fd - jac[k]) > 1e-5 * (1.0 + fabs(fd))) {
+                char name[64];
+                print_error("param %s: analytic %.9g, finite difference %.9g\n", rc_param_name(name, 64, &m, k),
+                            jac[k], fd);
+                fail();
+            }
+        }
+        for (unsigned k = 0; k < 3; ++k) /* the tool offset: not this sample's point */
+            assert_true(jac[tf + k] == 0.0);
+        for (unsigned k = 0; k < 9; ++k) /* only its own point's three columns */
+            assert_true((k / 3u == s.target) == (jac[mf + k] != 0.0));
+    }
+}
+
 /* A laser tracker's position (rc_sensor.h): every derivative of each
  * component by differences (a model with every effect, axis tilts and a
  * tracker turned by about 1 rad), lengths blind to the tracker's parameters,
@@ -507,6 +580,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_param_jacobian_base), cmocka_unit_test(test_param_jacobian_effects),
+        cmocka_unit_test(test_cable_points),
         cmocka_unit_test(test_effect_capacity),     cmocka_unit_test(test_joint_jacobian),
         cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
         cmocka_unit_test(test_prepared_base),       cmocka_unit_test(test_prepared_effects),

@@ -215,7 +215,7 @@ def run(cmd):
 
 
 def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), beta_deg=0.0, n_poses=300, outlets=1,
-             split=False):
+             split=False, points=0):
     lim = ROBOTS[name]["lim"]
     reach = ROBOTS[name]["reach"]
     truth = true_robot(rng, name, beta_deg)
@@ -234,18 +234,29 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
         attach = v * attach_mm
     else:
         attach = np.zeros(3)
-    Q = poses(rng, truth, lim, outlet, attach, n_poses, fixed_wrist)
+    plate_nom = plate_true = None
+    if points:  # a tool plate: points on a 60 mm circle 20 mm above the flange, machined to 0.02 mm (sd)
+        plate_nom = np.array([[60.0 * np.cos(2 * np.pi * j / points), 60.0 * np.sin(2 * np.pi * j / points), 20.0]
+                              for j in range(points)])
+        plate_true = plate_nom + np.random.default_rng([k, 77]).normal(0.0, 0.02, plate_nom.shape)
+        attach = plate_true[0]
+        attach_mm = float(np.linalg.norm(plate_nom[0]))
+    Q = poses(rng, truth, lim, outlet, attach, n_poses // max(points, 1), fixed_wrist)
     sigma = rng.uniform(0.005, 0.04)
-    rows_q, rows_o = [], []
+    rows_q, rows_o, rows_t = [], [], []
     for i, q in enumerate(Q):
-        for o in range(outlets):
-            if split and i % outlets != o:
-                continue
-            rows_q.append(q)
-            rows_o.append(o)
+        for j in range(max(points, 1)):  # the program run once with the cable on each point in turn
+            for o in range(outlets):
+                if split and i % outlets != o:
+                    continue
+                rows_q.append(q)
+                rows_o.append(o)
+                rows_t.append(j)
     Q = np.array(rows_q)
     O = np.array(rows_o)
-    L = np.array([np.linalg.norm(truth.point(q, attach) - outs[o]) for q, o in zip(Q, O)])
+    Tg = np.array(rows_t)
+    L = np.array([np.linalg.norm(truth.point(q, plate_true[t] if points else attach) - outs[o])
+                  for q, o, t in zip(Q, O, Tg)])
     L = L + sigma * rng.standard_normal(len(L))
     L = np.round(L, 3)
     qdeg = np.round(Q / DEG, 3)  # what a controller display shows
@@ -253,9 +264,10 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     write_robot(robot_path, name)
     data_path = os.path.join(tmp, "data.csv")
     with open(data_path, "w") as f:
-        f.write("q1,q2,q3,q4,q5,q6,L" + (",outlet" if outlets > 1 else "") + "\n")
-        for q, l, o in zip(qdeg, L, O):
-            f.write(",".join("%.3f" % v for v in q) + ",%.3f" % l + (",%d" % (o + 1) if outlets > 1 else "") + "\n")
+        f.write("q1,q2,q3,q4,q5,q6,L" + (",outlet" if outlets > 1 else "") + (",target" if points else "") + "\n")
+        for q, l, o, t in zip(qdeg, L, O, Tg):
+            f.write(",".join("%.3f" % v for v in q) + ",%.3f" % l + (",%d" % (o + 1) if outlets > 1 else "") +
+                    (",%d" % t if points else "") + "\n")
     if os.environ.get("TRUTH_STUDY_KEEP"):  # keep each case's data and robot for a look by hand
         import shutil
         keep = os.path.join(os.environ["TRUTH_STUDY_KEEP"], "case%02d" % k)
@@ -267,8 +279,11 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     model = os.path.join(tmp, "model.json")
     if os.path.exists(model):
         os.remove(model)
+    told = []
+    for j in range(points):
+        told += ["--cable-point", ",".join("%.3f" % v for v in plate_nom[j])]
     rc, out, err = run([rcal, "calibrate", "--data", data_path, "--robot", robot_path, "--out", model,
-                        "--test-fraction", "0"] + list(extra))
+                        "--test-fraction", "0"] + told + list(extra))
     if not os.path.exists(model):
         return {"case": k, "error": "calibrate rc %d: %s" % (rc, err.strip()[:300])}
     # 500 targets over the workspace
@@ -342,6 +357,9 @@ def main():
     ap.add_argument("--split", action="store_true", help="the pose set split among the outlets (else every pose "
                                                          "from each)")
     ap.add_argument("--extra", default="", help="extra calibrate options, space separated")
+    ap.add_argument("--points", type=int, default=0,
+                    help="the cable hooked in turn on K points of a tool plate (60 mm circle, 20 mm up; machined to "
+                         "0.02 mm), every pose on each, at the same rows (poses / K); rcal told the nominal points")
     ap.add_argument("--align", choices=["gauge", "rigid"], default="gauge",
                     help="per-target errors after the gauge (base heading, height) or a best-fit rigid motion")
     ap.add_argument("--errors", choices=["study", "wide"], default="study",
@@ -371,7 +389,7 @@ def main():
                 att = 0.0 if (k // 4) % 2 == 0 else float(rng.uniform(5, 60))
             crng = np.random.default_rng([a.seed, k])  # one case's robot, poses and noise: the same for every design
             r = one_case(a.rcal, k, crng, name, att, fixed, tcp, tmp, extra, a.beta_deg, outlets=a.outlets,
-                         split=a.split)
+                         split=a.split, points=a.points)
             out.append(r)
             if "error" in r:
                 print("case %2d ERROR %s" % (k, r["error"]), flush=True)

@@ -162,7 +162,8 @@ static int parse_header(parse_ctx *pc, field *fields, size_t nf, const char *lin
     if ((pc->col_of[C_X] >= 0) != (pc->col_of[C_Y] >= 0) || (pc->col_of[C_X] >= 0) != (pc->col_of[C_Z] >= 0))
         pc->col_of[C_X] = pc->col_of[C_Y] = pc->col_of[C_Z] = -1; /* use x,y,z only as a triple */
     if (!(flags & RCH_DATA_POSITIONS))
-        pc->col_of[C_TG] = pc->col_of[C_SG] = -1; /* a positions file's columns only */
+        pc->col_of[C_SG] = -1; /* a positions file's column only (a cable file's target: the tool point the
+                                  cable is on, RC_EFF_CABLE_POINTS) */
     return 0;
 }
 

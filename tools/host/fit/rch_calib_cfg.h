@@ -51,6 +51,10 @@ typedef struct rch_calib_cfg {
     double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
     int no_screen;          /* 1: every row fitted, none screened out (rch_calib_screen.c) */
     double max_minutes;     /* refuse a run estimated longer (rch_calib_estimate_s); 0: 60 */
+    unsigned n_cable_points; /* points of a tool plate the cable is hooked on in turn (the data's target
+                                column names them; RC_EFF_CABLE_POINTS), 0: none */
+    double cable_points_mm[RC_MAX_TARGETS][3]; /* (n_cable_points x 3) their nominal coordinates, flange frame */
+    double cable_point_sd_mm; /* their tolerance (prior sd of each coordinate); 0: RCH_PRIOR_POINTS_MM */
 } rch_calib_cfg;
 
 /* The defaults of `rcal calibrate`: everything zero or NULL but method LM,

@@ -180,10 +180,10 @@ static void diagnose_hint(char *buf, size_t len, const rch_calib_result *r)
     rch_shell_join(buf, len, n, argv);
 }
 
-/* Cable lengths only (one attachment point, no tracker). */
+/* Cable lengths only to one attachment point (no tracker, no cable points). */
 static int one_point_cable(const rch_calib_result *r)
 {
-    return r->n_pos_rows == 0;
+    return r->n_pos_rows == 0 && rch_pos_effect_at(&r->model, RC_EFF_CABLE_POINTS, NULL) < 0;
 }
 
 /* Tracker positions and no cable lengths. */

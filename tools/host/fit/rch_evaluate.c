@@ -13,6 +13,10 @@
 static int cmp_pose(const void *a, const void *b)
 {
     const rc_sample *x = a, *y = b;
+    if (x->sensor != y->sensor || x->outlet != y->outlet || x->target != y->target) /* another measurand */
+        return x->sensor != y->sensor ? (x->sensor < y->sensor ? -1 : 1)
+               : x->outlet != y->outlet ? (x->outlet < y->outlet ? -1 : 1)
+                                        : (x->target < y->target ? -1 : 1);
     for (int j = 0; j < RC_NJ; ++j)
         if (x->q_rad[j] != y->q_rad[j])
             return x->q_rad[j] < y->q_rad[j] ? -1 : 1;
@@ -21,6 +25,8 @@ static int cmp_pose(const void *a, const void *b)
 
 static int same_pose(const rc_sample *a, const rc_sample *b, double tol_rad)
 {
+    if (a->sensor != b->sensor || a->outlet != b->outlet || a->target != b->target)
+        return 0; /* the same joints from another outlet or to another point: not a repeat */
     for (int j = 0; j < RC_NJ; ++j)
         if (fabs(a->q_rad[j] - b->q_rad[j]) > tol_rad)
             return 0;

@@ -17,6 +17,7 @@ void rch_prior_defaults(rch_prior_cfg *p)
     p->twist_deg = RCH_PRIOR_TWIST_DEG;
     p->offset_deg = RCH_PRIOR_OFFSET_DEG;
     p->attachment_mm = RCH_PRIOR_ATTACHMENT_MM;
+    p->points_mm = RCH_PRIOR_POINTS_MM;
 }
 
 void rch_prior_fill(double *mean, double *sd, const rc_model *m, const rc_model *nominal, const rch_prior_cfg *p)
@@ -40,6 +41,9 @@ void rch_prior_fill(double *mean, double *sd, const rc_model *m, const rc_model 
         if (ef->kind == RC_EFF_TOOL_OFFSET) {
             for (unsigned k = 0; k < ef->count; ++k)
                 sd[ef->first + k] = p->attachment_mm;
+        } else if (ef->kind == RC_EFF_CABLE_POINTS) { /* the plate's drawing, to its tolerance */
+            for (unsigned k = 0; k < ef->count; ++k)
+                sd[ef->first + k] = p->points_mm > 0.0 ? p->points_mm : RCH_PRIOR_POINTS_MM;
         } else if (ef->kind == RC_EFF_AXIS_TILT) { /* a twist about the other axis: the twists' tolerance */
             sd[ef->first] = p->twist_deg * DEG;
         } else if (ds && !ds->nuisance && ds->side != RC_SIDE_OUTLET &&

@@ -23,6 +23,10 @@
  *   attachment_mm  100   the cable attachment point in the flange frame (the
  *                         measured point): a fixture of the user's, known only
  *                         roughly; centred on the start value (0 or the robot file's)
+ *   points_mm      0.05  each coordinate of a cable point of a tool plate
+ *                         (cable_points), about the nominal coordinates the
+ *                         user states: the plate is machined and pinned to
+ *                         the flange, so its points are known to its tolerance
  * Every other physical effect (length scale, sag, joint compliance, ...):
  * its plausible range from the effect table (rc_effect_desc.limit) as 3 sd
  * about its start value. The encoder outlets, the nuisance effects
@@ -52,6 +56,7 @@ typedef struct rch_prior_cfg {
     double twist_deg;     /* sd of alpha_i */
     double offset_deg;    /* sd of theta_i */
     double attachment_mm; /* sd of each component of the cable attachment (tool_offset effect) */
+    double points_mm;     /* sd of each coordinate of a cable point (cable_points effect) */
     int from_file;        /* 1: the robot file had a "prior" member */
 } rch_prior_cfg;
 
@@ -59,6 +64,7 @@ typedef struct rch_prior_cfg {
 #define RCH_PRIOR_TWIST_DEG 0.1
 #define RCH_PRIOR_OFFSET_DEG 1.0
 #define RCH_PRIOR_ATTACHMENT_MM 100.0
+#define RCH_PRIOR_POINTS_MM 0.05
 
 void rch_prior_defaults(rch_prior_cfg *p);
 
