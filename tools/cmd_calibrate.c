@@ -2,7 +2,6 @@
 /* cmd_calibrate.c - rcal calibrate: identify the DH errors and the encoder
  * position from cable lengths, with a held-out before/after report. The work
  * is rch_calib_run (tools/host/fit/rch_calib.h). */
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -59,26 +58,11 @@ static int to_config(calib_args *a, const rch_cmdspec *spec, unsigned long long 
         return 2; /* unreachable: the choice list is the method list */
     cfg->seed = a->seed;
     cfg->max_iter = (unsigned)a->max_iter;
-    if (a->cable_points.n > RC_MAX_TARGETS) {
-        fprintf(stderr, "rcal calibrate: --cable-point given %zu times: at most %d points\n", a->cable_points.n,
-                RC_MAX_TARGETS);
+    char perr[160];
+    if (rch_calib_cfg_cable_points(cfg, a->cable_points.v, a->cable_points.n, perr, sizeof perr) != 0) {
+        fprintf(stderr, "rcal calibrate: %s\n", perr);
         return 2;
     }
-    for (size_t k = 0; k < a->cable_points.n; ++k) { /* "X,Y,Z" in mm, the flange frame */
-        const char *p = a->cable_points.v[k];
-        char *end = NULL;
-        for (unsigned c = 0; c < 3; ++c) {
-            const double v = strtod(p, &end);
-            if (end == p || !isfinite(v) || fabs(v) > 2000.0 || (c < 2 ? *end != ',' : *end != '\0')) {
-                fprintf(stderr, "rcal calibrate: --cable-point '%s' (point %zu): need X,Y,Z in mm in the flange frame, "
-                                "each within 2000\n", a->cable_points.v[k], k);
-                return 2;
-            }
-            cfg->cable_points_mm[k][c] = v;
-            p = end + 1;
-        }
-    }
-    cfg->n_cable_points = (unsigned)a->cable_points.n;
     cfg->cases = a->cases;
     cfg->case_samples = a->case_samples;
     if (a->data.n == 0 && a->positions.n == 0) {

@@ -114,7 +114,7 @@ static int report(rch_diagnose_result *r, const char *plots, const char *const i
 /* The options of rcal diagnose. */
 typedef struct {
     const char *robot_path, *plots, *out_path, *resid, *report_path, *effects;
-    rch_opt_strs data, positions;
+    rch_opt_strs data, positions, cable_points;
     unsigned long seed, folds, steps, max_iter, verbosity;
     int json, verbose;
     rch_diagnose_cfg cfg;
@@ -136,6 +136,10 @@ static int parse(diag_args *a, int argc, char **argv)
          0, NULL},
         {"--effects", RCH_OPT_STR, &a->effects, 0, 0, "LIST",
          "effects already known (as rcal calibrate --effects names them): fitted from the start, never offered again",
+         0, NULL},
+        {"--cable-point", RCH_OPT_STRS, &a->cable_points, 0, 0, "X,Y,Z",
+         "a point of a tool plate the cable is hooked on (nominal, flange frame, mm), once per point in the data's "
+         "target order, as rcal calibrate --cable-point",
          0, NULL},
         {"--jumps", RCH_OPT_FLAG, &cfg->jumps, 0, 0, NULL,
          "length jumps found are removed as nuisance even at a set-up change (rcal calibrate --jumps)", 0, NULL},
@@ -222,6 +226,8 @@ int rcal_cmd_diagnose(int argc, char **argv)
     in.robot_path = a.robot_path;
     in.robot_given = a.robot_path != default_robot;
     in.effects = a.effects;
+    in.cable_points = a.cable_points.v;
+    in.n_cable_points = a.cable_points.n;
     rch_diagnose_result r;
     rch_diag d;
     char msg[1024];

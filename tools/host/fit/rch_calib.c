@@ -290,64 +290,16 @@ static void take_inputs(rch_calib_result *r, const rch_inputs *in)
     memcpy(r->dequant_refused_lines, in->dequant_refused_lines, sizeof r->dequant_refused_lines);
 }
 
-/* The cable's points (the data's target column on length rows) against
- * --cable-point: a point named must be given, and given points must be
- * used. 0, or -1 with d naming the file and line. */
-static int check_cable_points(const rch_calib_cfg *cfg, const rch_inputs *in, rch_diag *d)
-{
-    const rch_data *data = &in->data;
-    unsigned used = 0;
-    for (size_t i = 0; i < data->n; ++i) {
-        const rc_sample *s = &data->s[i];
-        if (s->sensor != RC_SENSOR_LENGTH)
-            continue;
-        const unsigned fi = in->file_of ? in->file_of[i] : 0;
-        const char *file = fi < in->n_files && cfg->data_paths ? cfg->data_paths[fi] : cfg->data_path ? cfg->data_path : "";
-        if (s->target > 0 && cfg->n_cable_points == 0) {
-            rch_diag_set(d, file, data->line ? data->line[i] : 0, 0,
-                         "the cable is on point %u of the tool (the target column), but the points' places are not "
-                         "given: --cable-point X,Y,Z for each (nominal, flange frame, mm, in target order)",
-                         (unsigned)s->target);
-            return -1;
-        }
-        if (cfg->n_cable_points > 0 && s->target >= cfg->n_cable_points) {
-            rch_diag_set(d, file, data->line ? data->line[i] : 0, 0,
-                         "the cable is on point %u of the tool, but --cable-point gives %u (points 0..%u)",
-                         (unsigned)s->target, cfg->n_cable_points, cfg->n_cable_points - 1);
-            return -1;
-        }
-        used |= 1u << (s->target < 31 ? s->target : 31);
-    }
-    if (cfg->n_cable_points > 0 && used != (1u << cfg->n_cable_points) - 1u) {
-        rch_diag_set(d, "", 0, 0,
-                     "--cable-point gives %u points but the cable files do not use every one of them (their target "
-                     "column: 0..%u, each at least once)",
-                     cfg->n_cable_points, cfg->n_cable_points - 1);
-        return -1;
-    }
-    return 0;
-}
-
 /* The effects the fit adds to r->robot.model: the cable attachment vector
  * and the axis tilts by default (with the prior), then --effects. n_len:
  * the cable-length samples. 0, -1 (no room) or -2 (a bad --effects entry),
  * d set. */
 static int fit_effects(rch_calib_result *r, const rch_calib_cfg *cfg, size_t n_len, rch_diag *d)
 {
-    if (cfg->n_cable_points > 0) { /* the cable on the points of a tool plate: their drawing, no attachment vector */
-        rc_model *m = &r->robot.model;
-        if (rc_model_add_effect(m, RC_EFF_CABLE_POINTS, 0, 3u * cfg->n_cable_points) != RC_OK) {
-            rch_diag_set(d, "", 0, 0, "cannot add %u cable points (RC_MAX_PARAMS or RC_MAX_EFFECTS)",
-                         cfg->n_cable_points);
-            return -1;
-        }
-        const unsigned f = m->effects[m->n_effects - 1].first;
-        for (unsigned k = 0; k < cfg->n_cable_points; ++k)
-            for (unsigned c = 0; c < 3; ++c)
-                m->x[f + 3 * k + c] = cfg->cable_points_mm[k][c];
+    if (cfg->n_cable_points > 0) { /* the cable on a tool plate's points (the reader added them): no attachment */
         if (cfg->cable_point_sd_mm > 0.0)
             r->robot.prior.points_mm = cfg->cable_point_sd_mm;
-        n_len = 0; /* every length is on a point: no attachment vector to choose */
+        n_len = 0;
     }
     int has_tool = 0;
     for (unsigned e = 0; e < r->robot.model.n_effects; ++e)
@@ -485,10 +437,6 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     held = cfg->residuals_path ? calloc(data->n ? data->n : 1, 1) : NULL;
     if (!w || (cfg->residuals_path && !held)) {
         rch_diag_set(d, "", 0, 0, "out of memory");
-        goto done;
-    }
-    if (check_cable_points(cfg, in, d) != 0) {
-        rc = -2;
         goto done;
     }
     rc = fit_effects(r, cfg, rch_pos_count_lengths(data->s, data->n), d);

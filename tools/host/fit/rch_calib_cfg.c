@@ -3,6 +3,9 @@
  * (see rch_calib_cfg.h). */
 #include "rch_calib_cfg.h"
 
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 void rch_calib_cfg_init(rch_calib_cfg *cfg)
@@ -22,4 +25,28 @@ size_t rch_calib_cfg_n_files(const rch_calib_cfg *cfg)
 const char *rch_calib_cfg_file(const rch_calib_cfg *cfg, size_t i)
 {
     return cfg->data_paths && cfg->n_data_paths ? cfg->data_paths[i] : cfg->data_path;
+}
+
+int rch_calib_cfg_cable_points(rch_calib_cfg *cfg, const char *const *v, size_t n, char *err, size_t errlen)
+{
+    if (n > RC_MAX_TARGETS) {
+        snprintf(err, errlen, "--cable-point given %zu times: at most %d points", n, RC_MAX_TARGETS);
+        return -1;
+    }
+    for (size_t k = 0; k < n; ++k) { /* "X,Y,Z" in mm, the flange frame */
+        const char *p = v[k];
+        for (unsigned c = 0; c < 3; ++c) {
+            char *end = NULL;
+            const double x = strtod(p, &end);
+            if (end == p || !isfinite(x) || fabs(x) > 2000.0 || (c < 2 ? *end != ',' : *end != '\0')) {
+                snprintf(err, errlen, "--cable-point '%s' (point %zu): need X,Y,Z in mm in the flange frame, each "
+                                      "within 2000", v[k], k);
+                return -1;
+            }
+            cfg->cable_points_mm[k][c] = x;
+            p = end + 1;
+        }
+    }
+    cfg->n_cable_points = (unsigned)n;
+    return 0;
 }

@@ -311,6 +311,56 @@ static int outlets(rch_inputs *in, rch_diag *d)
     return 0;
 }
 
+/* The cable's points (the data's target column on length rows) against
+ * --cable-point: a point named must be given, and given points must be
+ * used; the points (RC_EFF_CABLE_POINTS at their drawing) into the robot's
+ * model. 0, or -1 with d naming the file and line. */
+static int cable_points(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    const rch_data *data = &in->data;
+    unsigned used = 0;
+    for (size_t i = 0; i < data->n; ++i) {
+        const rc_sample *s = &data->s[i];
+        if (s->sensor != RC_SENSOR_LENGTH)
+            continue;
+        const unsigned fi = in->file_of ? in->file_of[i] : 0;
+        const char *file = fi < in->n_files && cfg->data_paths ? cfg->data_paths[fi] : cfg->data_path ? cfg->data_path : "";
+        if (s->target > 0 && cfg->n_cable_points == 0) {
+            rch_diag_set(d, file, data->line ? data->line[i] : 0, 0,
+                         "the cable is on point %u of the tool (the target column), but the points' places are not "
+                         "given: --cable-point X,Y,Z for each (nominal, flange frame, mm, in target order)",
+                         (unsigned)s->target);
+            return -1;
+        }
+        if (cfg->n_cable_points > 0 && s->target >= cfg->n_cable_points) {
+            rch_diag_set(d, file, data->line ? data->line[i] : 0, 0,
+                         "the cable is on point %u of the tool, but --cable-point gives %u (points 0..%u)",
+                         (unsigned)s->target, cfg->n_cable_points, cfg->n_cable_points - 1);
+            return -1;
+        }
+        used |= 1u << (s->target < 31 ? s->target : 31);
+    }
+    if (cfg->n_cable_points > 0 && used != (1u << cfg->n_cable_points) - 1u) {
+        rch_diag_set(d, "", 0, 0,
+                     "--cable-point gives %u points but the cable files do not use every one of them (their target "
+                     "column: 0..%u, each at least once)",
+                     cfg->n_cable_points, cfg->n_cable_points - 1);
+        return -1;
+    }
+    if (cfg->n_cable_points == 0)
+        return 0;
+    rc_model *m = &in->robot.model;
+    if (rc_model_add_effect(m, RC_EFF_CABLE_POINTS, 0, 3u * cfg->n_cable_points) != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "cannot add %u cable points (RC_MAX_PARAMS or RC_MAX_EFFECTS)", cfg->n_cable_points);
+        return -1;
+    }
+    const unsigned f = m->effects[m->n_effects - 1].first;
+    for (unsigned k = 0; k < cfg->n_cable_points; ++k)
+        for (unsigned c = 0; c < 3; ++c)
+            m->x[f + 3 * k + c] = cfg->cable_points_mm[k][c];
+    return 0;
+}
+
 int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
 {
     memset(out, 0, sizeof *out);
@@ -331,7 +381,8 @@ int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
     for (size_t f = 0, i = 0; f < out->n_files; ++f)
         for (size_t k = 0; k < out->counts[f] && i < out->data.n; ++k)
             out->file_of[i++] = (unsigned)f;
-    if (outlets(out, d) != 0 || (cfg->n_positions_paths && append_positions(out, cfg, d) != 0))
+    if (outlets(out, d) != 0 || cable_points(out, cfg, d) != 0 ||
+        (cfg->n_positions_paths && append_positions(out, cfg, d) != 0))
         goto fail;
     out->n_read = out->data.n;
     if (!cfg->no_dequantize && dequantize(out, cfg, d) != 0)

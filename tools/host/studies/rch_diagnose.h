@@ -131,6 +131,9 @@ typedef struct rch_diagnose_in {
     int robot_given;                    /* 1: the user named it (the next step names it too) */
     const char *effects;                /* effects already known, as `rcal calibrate --effects` names them, or
                                            NULL: the search adds to them and never offers them again */
+    const char *const *cable_points;    /* (n_cable_points) "X,Y,Z": the tool plate's points the cable is
+                                           hooked on (rcal calibrate --cable-point), or NULL */
+    size_t n_cable_points;
 } rch_diagnose_in;
 
 /* One structure test of residuals against an explanatory variable. */

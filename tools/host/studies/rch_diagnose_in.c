@@ -14,8 +14,8 @@
 #include "rch_inputs.h"
 
 /* The start model: the nominal geometry (the robot file's own effects left
- * out, as always), the outlets and the tracker frame and targets that the
- * reader added to the robot's model (with their values), then the effects
+ * out, as always), the outlets, the cable points and the tracker frame and
+ * targets that the reader added to the robot's model (with their values), then the effects
  * already known. 0, or -1 with d set. */
 static int start_model(rc_model *m, const rch_inputs *in, const char *effects, rch_diag *d)
 {
@@ -26,7 +26,7 @@ static int start_model(rc_model *m, const rch_inputs *in, const char *effects, r
     for (unsigned e = 0; e < src->n_effects; ++e) {
         const rc_effect *ef = &src->effects[e];
         const rc_effect_desc *ds = rc_effect_describe(ef->kind);
-        if (!ds || (ds->side != RC_SIDE_OUTLET && ds->side != RC_SIDE_SENSOR))
+        if (!ds || (ds->side != RC_SIDE_OUTLET && ds->side != RC_SIDE_SENSOR && ef->kind != RC_EFF_CABLE_POINTS))
             continue;
         if (rc_model_add_effect(m, (rc_effect_kind)ef->kind, ef->joint, ef->count) != RC_OK) {
             rch_diag_set(d, "", 0, 0, "no room for the %s effect (RC_MAX_EFFECTS %d, RC_MAX_PARAMS %d)",
@@ -59,6 +59,11 @@ int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, con
     cc.positions_paths = in->positions_paths;
     cc.n_positions_paths = in->n_positions;
     cc.robot_path = in->robot_path;
+    char perr[160];
+    if (rch_calib_cfg_cable_points(&cc, in->cable_points, in->n_cable_points, perr, sizeof perr) != 0) {
+        rch_diag_set(d, "", 0, 0, "%s", perr);
+        return -1;
+    }
     cc.dequantize = cfg->dequantize;
     cc.no_dequantize = !cfg->dequantize; /* diagnose dequantizes only when told (calibrate's hint tells it) */
     rch_inputs *data = calloc(1, sizeof *data);

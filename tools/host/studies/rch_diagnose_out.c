@@ -351,7 +351,7 @@ int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const
 {
     char list[512];
     chosen_effects(list, sizeof list, r);
-    const char *argv[16 + 4 * RCH_DIAGNOSE_MAX_FILES];
+    const char *argv[16 + 4 * RCH_DIAGNOSE_MAX_FILES + 2 * RC_MAX_TARGETS];
     int n = 0;
     argv[n++] = "rcal";
     argv[n++] = "calibrate";
@@ -370,6 +370,10 @@ int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const
     if (robot_path) {
         argv[n++] = "--robot";
         argv[n++] = robot_path;
+    }
+    for (size_t k = 0; k < r->in.n_cable_points && k < RC_MAX_TARGETS; ++k) {
+        argv[n++] = "--cable-point";
+        argv[n++] = r->in.cable_points[k];
     }
     if (strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps)
         argv[n++] = "--jumps";
@@ -404,6 +408,11 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path,
         cfg.n_positions_paths = r->in.n_positions;
     }
     cfg.robot_path = robot_path;
+    if (rch_calib_cfg_cable_points(&cfg, r->in.cable_points, r->in.n_cable_points, list, sizeof list) != 0) {
+        rch_diag_set(d, "", 0, 0, "%s", list); /* checked when read: not reached */
+        return -1;
+    }
+    chosen_effects(list, sizeof list, r);
     cfg.test_fraction = 0.0;
     cfg.effects = list[0] ? list : NULL;
     cfg.jumps = strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps > 0;
