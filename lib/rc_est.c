@@ -119,13 +119,14 @@ typedef struct est_ctx {
     double best_cost;   /* objective of w->ubest (normalised methods) */
     rc_solve_config pc; /* the prior (rc_prior_cost, rc_prior_normal_eq); no prior: all zero */
     int prior;
+    const double *sin_q, *cos_q; /* (n x 6) the readings' sines and cosines in w->T's unused tail, or NULL */
 } est_ctx;
 
 /* The objective every method minimises: the squared residuals, plus the
  * prior's rows when there is a prior (the MAP objective, as rc_solve's). */
 static rc_status objective(double *f, const est_ctx *c, const rc_model *m)
 {
-    const rc_status st = rc_cost(f, m, c->s, c->n);
+    const rc_status st = rc_cost_tab(f, m, c->s, c->sin_q, c->cos_q, c->n);
     if (st == RC_OK && c->prior)
         *f += rc_prior_cost(m, &c->pc);
     return st;
@@ -733,6 +734,15 @@ rc_status rc_est_solve(rc_model *m, rc_est_result *res, rc_est_work *w, const rc
     c.n = n;
     c.nf = nf;
     c.res = res;
+    c.sin_q = c.cos_q = NULL;
+    if ((size_t)nf * nf + 2u * RC_NJ * n <= (size_t)RC_MAX_PARAMS * RC_MAX_PARAMS) {
+        /* every method evaluates the objective on the same readings: their trigonometry once, in the tail of
+         * w->T past the nf x nf the methods use */
+        double *sq = &w->T[(size_t)nf * nf], *cq = sq + (size_t)RC_NJ * n;
+        rc_qtrig_fill(sq, cq, samples, n);
+        c.sin_q = sq;
+        c.cos_q = cq;
+    }
     ++res->cost_evals;
     st = objective(&c.best_cost, &c, m);
     if (st != RC_OK)

@@ -94,6 +94,13 @@ rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples,
     return cost_tab(cost_mm2, m, samples, none, n);
 }
 
+rc_status rc_cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *samples, const double *sin_q,
+                      const double *cos_q, size_t n)
+{
+    const passbuf t = {sin_q && cos_q ? sin_q : NULL, sin_q && cos_q ? cos_q : NULL, NULL};
+    return cost_tab(cost_mm2, m, samples, t, n);
+}
+
 /* Samples per block of the normal-equation update: A += Jb^T Jb with NE_BLOCK
  * rows at a time reads and writes A once per block instead of once per row.
  * The rows are added one after the other (left to right), so the sums are

@@ -196,6 +196,11 @@ void rc_prior_normal_eq(double *A, double *g, double *cost, const rc_model *m, c
 /* Sum of squared residuals over samples (n). RC_ERR_NUMERIC on a degenerate
  * sample or a non-finite result. */
 rc_status rc_cost(double *cost_mm2, const rc_model *m, const rc_sample *samples, size_t n);
+/* rc_cost with the readings' sines and cosines sin_q, cos_q ((n x 6) each,
+ * rc_qtrig_fill of samples; both NULL: per sample): the same sum to the last
+ * bit, without the readings' trigonometry on every call. */
+rc_status rc_cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *samples, const double *sin_q,
+                      const double *cos_q, size_t n);
 
 /* Accumulate the normal equations over the samples for the free parameters
  * idx (nf): A (nf x nf, full) = J^T J, g (nf) = J^T r, cost = sum r^2.
