@@ -14,6 +14,7 @@
 
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
+#include "rch_calib_cfg.h"
 #include "rch_data.h"
 #include "rch_file.h"
 #include "rch_jw.h"
@@ -164,7 +165,33 @@ static void print_choice(const rch_poses_choice *ch, const double (*cand)[3])
     }
 }
 
-static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
+/* What each further cable point gains: the plan's poses measured on points
+ * 0..j only, predicted at the same point (flange or --tool). */
+static void print_point_gains(const rch_poses_result *res, const rch_poses_config *pc, const rc_model *m)
+{
+    printf("  the same poses on the first j cable points of the plate (every pose on each; the plate's drawing "
+           "to its prior sd):\n");
+    rc_sample *rows = malloc((res->n ? res->n : 1) * sizeof *rows);
+    for (unsigned j = 1; rows && j <= pc->n_points; ++j) {
+        rch_poses_config cj = *pc;
+        cj.n_points = j;
+        size_t n = 0;
+        for (size_t i = 0; i < res->n; ++i)
+            if (res->poses[i].target < j)
+                rows[n++] = res->poses[i];
+        rch_poses_accuracy acc;
+        rch_diag d;
+        if (rch_poses_predict(&acc, m, &cj, rows, n, &d) == 0)
+            printf("    %u point(s), %zu rows: median %.4f mm, 95th percentile %.4f mm\n", j, n, acc.median_mm,
+                   acc.p95_mm);
+        else
+            printf("    %u point(s): %s\n", j, d.msg);
+    }
+    free(rows);
+}
+
+static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path,
+                       const rc_model *m)
 {
     if (pc->criterion == RCH_POSES_LENGTH) {
         printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
@@ -197,6 +224,8 @@ static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, 
            res->random.p95_mm);
     printf("  observability O1 of the lengths (rch_ident): planned %.5g, random %.5g, ratio %.2f\n", res->o1_plan,
            res->o1_random, res->o1_random > 0 ? res->o1_plan / res->o1_random : 0.0);
+    if (pc->n_points > 0)
+        print_point_gains(res, pc, m);
     if (res->n < res->rows_advised)
         printf("  WARNING: %zu rows for about %zu parameters calibrate fits: it estimates the noise from the "
                "residuals and needs at least %zu rows, else the fit follows the noise and the predicted accuracy is "
@@ -210,8 +239,7 @@ static int write_out(FILE *f, const rch_poses_result *res, const rch_poses_confi
                      double settle_s)
 {
     if (strcmp(format, "rapid") != 0)
-        return res->n_outlets > 1 ? rch_data_write_plan_outlets(f, res->poses, res->n)
-                                  : rch_data_write_plan(f, res->poses, res->n);
+        return rch_data_write_plan_cols(f, res->poses, res->n, res->n_outlets > 1, pc->n_points > 0);
     unsigned char *lab = malloc(res->n ? res->n : 1);
     char comment[200];
     snprintf(comment, sizeof comment, "rcal poses --count %zu --seed %llu: %u outlet(s)%s", res->n_distinct,
@@ -266,10 +294,11 @@ typedef struct poses_args {
     double max_minutes, settle_s;
     double enc[3], tool[3];
     rch_poses_config pc;
-    rch_opt_strs outlets, cands;
+    rch_opt_strs outlets, cands, cable_points;
     int json, split;
     double cand[RCH_OPT_MAX_STRS][3]; /* (n_c x 3) the --candidate places */
     unsigned n_places, n_c;
+    const rc_model *model; /* the nominal robot (the predictions of fewer cable points) */
 } poses_args;
 
 /* The parsed options into a->pc (has_tool: --tool given). -1, or 2 (reported). */
@@ -290,6 +319,21 @@ static int to_config(poses_args *a, int has_tool)
     pc->criterion = strcmp(a->criterion, "length") == 0 ? RCH_POSES_LENGTH : RCH_POSES_POSITION;
     pc->has_tool = has_tool;
     memcpy(pc->tool_mm, a->tool, sizeof a->tool);
+    if (a->cable_points.n) { /* the calibrate option's one parser */
+        static rch_calib_cfg cc;
+        char perr[160];
+        if (rch_calib_cfg_cable_points(&cc, a->cable_points.v, a->cable_points.n, perr, sizeof perr) != 0) {
+            fprintf(stderr, "rcal poses: %s\n", perr);
+            return 2;
+        }
+        pc->n_points = cc.n_cable_points;
+        memcpy(pc->points_mm, cc.cable_points_mm, sizeof pc->points_mm);
+        if (a->split || pc->criterion == RCH_POSES_LENGTH || a->choose) {
+            fprintf(stderr, "rcal poses: --cable-point plans every pose on each point from every outlet: not with "
+                            "--split, --choose-outlets or --criterion length\n");
+            return 2;
+        }
+    }
     if (pc->criterion == RCH_POSES_LENGTH && (a->choose || pc->has_tool)) {
         fprintf(stderr, "rcal poses: --choose-outlets and --tool need --criterion position\n");
         return 2;
@@ -337,6 +381,10 @@ static int parse(poses_args *a, int argc, char **argv)
          NULL},
         {"--tool", RCH_OPT_TRIPLE, a->tool, -2000.0, 2000.0, "X,Y,Z", "plan for this tool point (flange frame, mm)", 0,
          NULL},
+        {"--cable-point", RCH_OPT_STRS, &a->cable_points, 0, 0, "X,Y,Z",
+         "a point of a tool plate the cable is hooked on in turn (nominal, flange frame, mm; repeatable, points 0, "
+         "1, ...): every pose is planned on each (a target column), and the gain of each further point is printed",
+         0, NULL},
         {"--choose-outlets", RCH_OPT_UINT, &a->choose, 1, RC_MAX_OUTLETS, "K",
          "choose the best K of the --candidate places", 0, NULL},
         {"--candidate", RCH_OPT_STRS, &a->cands, 0, 0, "X,Y,Z", "a candidate outlet place (repeatable)", 0, NULL},
@@ -366,7 +414,7 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
     rch_diag dg;
     char dbuf[900];
     if (!a->json)
-        print_plan(res, &a->pc, a->out_path);
+        print_plan(res, &a->pc, a->out_path, a->model);
     if (write_out(out->f, res, &a->pc, a->format, a->settle_s) != 0) {
         rch_out_abort(out);
         fprintf(stderr, "rcal poses: writing %s failed; nothing was replaced\n", a->out_path);
@@ -404,6 +452,7 @@ int rcal_cmd_poses(int argc, char **argv)
     if (!robot->has_encoder)
         memcpy(&robot->model.x[RC_P_ENC], a.enc, sizeof a.enc);
     pc->prior = &robot->prior;
+    a.model = &robot->model;
     if (!a.n_places && !a.choose) { /* one outlet: the model's encoder */
         pc->n_outlets = 1;
         memcpy(pc->outlet_mm[0], &robot->model.x[RC_P_ENC], sizeof pc->outlet_mm[0]);

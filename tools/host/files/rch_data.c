@@ -629,9 +629,9 @@ int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nomina
     return fflush(f) == 0 ? 0 : -1;
 }
 
-static int write_plan(FILE *f, const rc_sample *s, size_t n, int with_outlet)
+static int write_plan(FILE *f, const rc_sample *s, size_t n, int with_outlet, int with_target)
 {
-    if (fprintf(f, "pose,q1,q2,q3,q4,q5,q6%s\n", with_outlet ? ",outlet" : "") < 0)
+    if (fprintf(f, "pose,q1,q2,q3,q4,q5,q6%s%s\n", with_outlet ? ",outlet" : "", with_target ? ",target" : "") < 0)
         return -1;
     for (size_t t = 0; t < n; ++t) {
         fprintf(f, "%zu", t);
@@ -639,6 +639,8 @@ static int write_plan(FILE *f, const rc_sample *s, size_t n, int with_outlet)
             fprintf(f, ",%.4f", s[t].q_rad[j] * 180.0 / M_PI);
         if (with_outlet)
             fprintf(f, ",%u", (unsigned)s[t].outlet);
+        if (with_target)
+            fprintf(f, ",%u", (unsigned)s[t].target);
         if (fprintf(f, "\n") < 0)
             return -1;
     }
@@ -647,12 +649,17 @@ static int write_plan(FILE *f, const rc_sample *s, size_t n, int with_outlet)
 
 int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n)
 {
-    return write_plan(f, s, n, 0);
+    return write_plan(f, s, n, 0, 0);
 }
 
 int rch_data_write_plan_outlets(FILE *f, const rc_sample *s, size_t n)
 {
-    return write_plan(f, s, n, 1);
+    return write_plan(f, s, n, 1, 0);
+}
+
+int rch_data_write_plan_cols(FILE *f, const rc_sample *s, size_t n, int with_outlet, int with_target)
+{
+    return write_plan(f, s, n, with_outlet, with_target);
 }
 
 void rch_split(size_t *idx, size_t n, unsigned long long seed)

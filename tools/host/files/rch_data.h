@@ -121,6 +121,9 @@ int rch_data_write_plan(FILE *f, const rc_sample *s, size_t n);
 /* The same with a last column outlet (rc_sample.outlet): a plan for several
  * places of the encoder (`rcal acquire --outlet N` records its rows). */
 int rch_data_write_plan_outlets(FILE *f, const rc_sample *s, size_t n);
+/* The same with the columns asked for: outlet, and target (rc_sample.target:
+ * the cable point of a tool plate each row is measured on). */
+int rch_data_write_plan_cols(FILE *f, const rc_sample *s, size_t n, int with_outlet, int with_target);
 
 /* Random train/test split: a permutation of 0..n-1 from seed; the first
  * n_test indices go to test. idx: (n) output. */

@@ -69,6 +69,9 @@ typedef struct rch_poses_config {
     double outlet_mm[RC_MAX_OUTLETS][3]; /* (K x 3) their approximate places, base frame */
     int split;                     /* 1: each pose measured from one outlet; 0: from every outlet */
     double noise_mm;               /* length noise the prediction is for; 0: RCH_POSES_NOISE_MM */
+    unsigned n_points;             /* P points of a tool plate the cable is hooked on in turn (every pose
+                                      measured on each; RC_EFF_CABLE_POINTS), 0: the flange point alone */
+    double points_mm[RC_MAX_TARGETS][3]; /* (P x 3) their drawing, flange frame */
     int has_tool;                  /* 1: plan for the tool point tool_mm (flange frame), else the flange */
     double tool_mm[3];
     const rch_prior_cfg *prior;    /* NULL: rch_prior_defaults */

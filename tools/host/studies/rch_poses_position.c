@@ -52,12 +52,22 @@ static int plan_model(rc_model *out, const rc_model *m, const rch_poses_config *
         }
         memcpy(&out->x[out->effects[out->n_effects - 1].first], c->outlet_mm[k], 3 * sizeof(double));
     }
+    if (c->n_points > 0) { /* the plate's points at their drawing, with the plate's prior */
+        if (c->n_points > RC_MAX_TARGETS || rc_model_add_effect(out, RC_EFF_CABLE_POINTS, 0, 3u * c->n_points) != RC_OK) {
+            rch_diag_set(d, "", 0, 0, "cannot add %u cable points (at most %d; RC_MAX_PARAMS)", c->n_points,
+                         RC_MAX_TARGETS);
+            return -1;
+        }
+        memcpy(&out->x[out->effects[out->n_effects - 1].first], c->points_mm, 3u * c->n_points * sizeof(double));
+    }
     return 0;
 }
 
 typedef struct pos_work {
     rc_model m, mp;           /* the planning model; the point model (m with the tool, or m) */
-    unsigned K, nf, rows_per; /* outlets; free parameters; rows per candidate (K, or 1 with split) */
+    unsigned K, nf, rows_per; /* outlets; free parameters; rows per candidate ((K, or 1 with split) x P) */
+    unsigned P;               /* cable points (1: the flange or attachment point) */
+    int split;                /* each pose from one outlet */
     unsigned fi[RC_MAX_PARAMS]; /* (nf) the free parameters' indices in x */
     double sc[RC_MAX_PARAMS];   /* (nf) their scale: prior sd (RCH_POSES_OUTLET_SD_MM for the outlets) */
     double noise;
@@ -108,7 +118,9 @@ static int pos_setup(pos_work *w, const rc_model *m, const rch_poses_config *c, 
         w->fi[w->nf] = k;
         w->sc[w->nf++] = sd[k] > 0.0 ? sd[k] : RCH_POSES_OUTLET_SD_MM;
     }
-    w->rows_per = c->split ? 1u : w->K;
+    w->P = c->n_points ? c->n_points : 1u;
+    w->split = c->split && w->K > 1;
+    w->rows_per = (c->split ? 1u : w->K) * w->P;
     w->noise = c->noise_mm > 0.0 ? c->noise_mm : RCH_POSES_NOISE_MM;
     w->mp = w->m;
     if (c->has_tool) {
@@ -121,18 +133,27 @@ static int pos_setup(pos_work *w, const rc_model *m, const rch_poses_config *c, 
     return 0;
 }
 
-/* One pose's scaled rows: row j (nf) for outlet j; len (K) the lengths.
- * 0, or -1 when a length cannot be computed. */
-static int pose_rows(double *rows, double *len, const pos_work *w, const rc_sample *q)
+/* One pose's scaled rows: row k P + p (nf) for outlet k and cable point p;
+ * len (K) each outlet's shortest and longest length to the points, lo and
+ * hi. 0, or -1 when a length cannot be computed. */
+static int pose_rows(double *rows, double *lo, double *hi, const pos_work *w, const rc_sample *q)
 {
     double g[RC_MAX_PARAMS];
     for (unsigned k = 0; k < w->K; ++k) {
-        rc_sample s = *q;
-        s.outlet = (uint8_t)k;
-        if (rc_meas(&len[k], g, &w->m, &s) != RC_OK)
-            return -1;
-        for (unsigned j = 0; rows && j < w->nf; ++j)
-            rows[k * w->nf + j] = g[w->fi[j]] * w->sc[j] / w->noise;
+        lo[k] = 1e300;
+        hi[k] = -1e300;
+        for (unsigned p = 0; p < w->P; ++p) {
+            rc_sample s = *q;
+            double l;
+            s.outlet = (uint8_t)k;
+            s.target = (uint8_t)p;
+            if (rc_meas(&l, g, &w->m, &s) != RC_OK)
+                return -1;
+            lo[k] = l < lo[k] ? l : lo[k];
+            hi[k] = l > hi[k] ? l : hi[k];
+            for (unsigned j = 0; rows && j < w->nf; ++j)
+                rows[(k * w->P + p) * w->nf + j] = g[w->fi[j]] * w->sc[j] / w->noise;
+        }
     }
     return 0;
 }
@@ -149,7 +170,8 @@ static int pos_candidates(pos_work *w, const rch_poses_config *c, rch_diag *d)
         rch_diag_set(d, "", 0, 0, "no outlet, parameter or pose to plan");
         return -1;
     }
-    double *rows = malloc((size_t)K * nf * sizeof *rows), len[RC_MAX_OUTLETS];
+    const unsigned P = w->P;
+    double *rows = malloc((size_t)K * P * nf * sizeof *rows), llo[RC_MAX_OUTLETS], lhi[RC_MAX_OUTLETS];
     rc_rng g;
     rc_rng_seed(&g, c->seed);
     w->pose = malloc(w->n_pose * sizeof *w->pose);
@@ -181,23 +203,23 @@ static int pos_candidates(pos_work *w, const rch_poses_config *c, rch_diag *d)
                 qr = (qr < lo ? ceil(q * 180.0 / PI_ * 100.0) : floor(q * 180.0 / PI_ * 100.0)) / 100.0 * PI_ / 180.0;
             s.q_rad[j] = qr;
         }
-        if (pose_rows(rows, len, w, &s) != 0)
+        if (pose_rows(rows, llo, lhi, w, &s) != 0)
             continue;
         unsigned reach = 0;
         for (unsigned k = 0; k < K; ++k)
-            reach += len[k] >= c->len_min_mm && len[k] <= c->len_max_mm;
+            reach += llo[k] >= c->len_min_mm && lhi[k] <= c->len_max_mm;
         if (c->split ? reach == 0 : reach < K)
             continue;
         for (unsigned k = 0; k < K; ++k) {
-            if (!(len[k] >= c->len_min_mm && len[k] <= c->len_max_mm))
+            if (!(llo[k] >= c->len_min_mm && lhi[k] <= c->len_max_mm))
                 continue;
             if (!c->split) {
-                memcpy(w->X + w->n_cand * w->rows_per * nf, rows, (size_t)K * nf * sizeof *rows);
+                memcpy(w->X + w->n_cand * w->rows_per * nf, rows, (size_t)K * P * nf * sizeof *rows);
                 w->cand_pose[w->n_cand] = got;
                 w->cand_outlet[w->n_cand++] = 0;
                 break;
             }
-            memcpy(w->X + w->n_cand * nf, rows + (size_t)k * nf, nf * sizeof *rows);
+            memcpy(w->X + w->n_cand * w->rows_per * nf, rows + (size_t)k * P * nf, (size_t)P * nf * sizeof *rows);
             w->cand_pose[w->n_cand] = got;
             w->cand_outlet[w->n_cand++] = (uint8_t)k;
         }
@@ -304,7 +326,7 @@ static size_t pos_best(pos_work *w, size_t none_idx, double *bg, size_t t)
     size_t best = none_idx;
     *bg = -1.0;
     for (size_t i = 0; i < w->n_cand; ++i) {
-        if (!pos_available(w, i) || (w->rows_per == 1 && w->K > 1 && w->cand_outlet[i] != t % w->K))
+        if (!pos_available(w, i) || (w->split && w->cand_outlet[i] != t % w->K))
             continue;
         const double g = pos_gain(w, w->X + i * w->rows_per * w->nf, w->rows_per);
         if (g > *bg) {
@@ -487,12 +509,15 @@ static int pos_rows_out(rch_poses_result *res, const pos_work *w)
         res->rows_per_outlet[k] = 0;
         for (size_t t = 0; t < w->n; ++t) {
             const size_t i = w->design[t];
-            if (w->rows_per == 1 && w->K > 1 && w->cand_outlet[i] != k)
+            if (w->split && w->cand_outlet[i] != k)
                 continue;
-            rc_sample s = w->pose[w->cand_pose[i]];
-            s.outlet = (uint8_t)k;
-            res->poses[res->n++] = s;
-            res->rows_per_outlet[k]++;
+            for (unsigned p = 0; p < w->P; ++p) { /* the pose on each cable point in turn */
+                rc_sample s = w->pose[w->cand_pose[i]];
+                s.outlet = (uint8_t)k;
+                s.target = (uint8_t)p;
+                res->poses[res->n++] = s;
+                res->rows_per_outlet[k]++;
+            }
         }
     }
     return 0;
@@ -506,6 +531,10 @@ static int check_position(const rch_poses_config *c, rch_diag *d)
     }
     if (c->split && c->n_outlets < 2) {
         rch_diag_set(d, "", 0, 0, "--split needs at least two --outlet places");
+        return -1;
+    }
+    if (c->n_points > RC_MAX_TARGETS) {
+        rch_diag_set(d, "", 0, 0, "%u cable points: at most %d", c->n_points, RC_MAX_TARGETS);
         return -1;
     }
     return 0;
@@ -525,7 +554,7 @@ int rch_poses_plan_position(rch_poses_result *res, const rc_model *m, const rch_
         goto done;
     w->n = c->count;
     w->n_pose = n_pose;
-    if (rch_poses_plan_cost(c, progress, w->n, w->n_pose * w->K, w->nf, 0, d) != 0)
+    if (rch_poses_plan_cost(c, progress, w->n, w->n_pose * w->K * w->P, w->nf, 0, d) != 0)
         goto done;
     if (pos_candidates(w, c, d) != 0)
         goto done;
@@ -555,7 +584,7 @@ int rch_poses_plan_position(rch_poses_result *res, const rc_model *m, const rch_
             unsigned guard = 0;
             do
                 i = rc_rng_below(&g2, (uint32_t)w->n_cand);
-            while ((used[w->cand_pose[i]] || (w->rows_per == 1 && w->K > 1 && w->cand_outlet[i] != t % w->K)) &&
+            while ((used[w->cand_pose[i]] || (w->split && w->cand_outlet[i] != t % w->K)) &&
                    ++guard < 1000000u);
             used[w->cand_pose[i]] = 1;
             w->rnd[t] = i;
@@ -589,7 +618,8 @@ int rch_poses_plan_position(rch_poses_result *res, const rc_model *m, const rch_
                 for (size_t t = 0; t < w->n; ++t)
                     for (unsigned j = 0; j < w->rows_per; ++j) {
                         rs[nr] = w->pose[w->cand_pose[idx[t]]];
-                        rs[nr++].outlet = (uint8_t)(w->rows_per == 1 ? w->cand_outlet[idx[t]] : j);
+                        rs[nr].target = (uint8_t)(j % w->P);
+                        rs[nr++].outlet = (uint8_t)(w->split ? w->cand_outlet[idx[t]] : j / w->P);
                     }
                 if (rch_ident_compute(id, &w->m, rs, nr) == 0) {
                     *(pass ? &res->o1_random : &res->o1_plan) = id->observability;
@@ -616,7 +646,7 @@ int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_pose
                       size_t n, rch_diag *d)
 {
     pos_work *w = calloc(1, sizeof *w);
-    double *M = NULL, *X = NULL, len[RC_MAX_OUTLETS];
+    double *M = NULL, *X = NULL, lo[RC_MAX_OUTLETS], hi[RC_MAX_OUTLETS];
     int rc = -1;
     if (!w) {
         rch_diag_set(d, "", 0, 0, "out of memory");
@@ -625,7 +655,7 @@ int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_pose
     if (check_position(c, d) != 0 || pos_setup(w, m, c, d) != 0)
         goto out;
     M = malloc(((size_t)w->nf * w->nf + 1) * sizeof *M);
-    X = malloc(((size_t)w->K * w->nf + 1) * sizeof *X);
+    X = malloc(((size_t)w->K * w->P * w->nf + 1) * sizeof *X);
     if (!M || !X) {
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto out;
@@ -636,11 +666,15 @@ int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_pose
             rch_diag_set(d, "", 0, 0, "row %zu: outlet %u, but %u outlet(s) given", i, rows[i].outlet, w->K);
             goto out;
         }
-        if (pose_rows(X, len, w, &rows[i]) != 0) {
+        if (rows[i].target >= w->P) {
+            rch_diag_set(d, "", 0, 0, "row %zu: cable point %u, but %u point(s) given", i, rows[i].target, w->P);
+            goto out;
+        }
+        if (pose_rows(X, lo, hi, w, &rows[i]) != 0) {
             rch_diag_set(d, "", 0, 0, "row %zu: the cable length cannot be computed (the point is at an outlet)", i);
             goto out;
         }
-        rch_poses_add_outer(M, X + (size_t)rows[i].outlet * w->nf, 1.0, w->nf);
+        rch_poses_add_outer(M, X + ((size_t)rows[i].outlet * w->P + rows[i].target) * w->nf, 1.0, w->nf);
     }
     if (pos_accuracy(acc, w, M, c->n_eval ? c->n_eval : 1000, c->seed ^ SEED_EVAL) != 0) {
         rch_diag_set(d, "", 0, 0, "the predicted accuracy could not be computed (numeric failure)");
