@@ -13,6 +13,7 @@
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_acqfile.h"
 #include "rch_acquire.h"
+#include "rch_calib_cfg.h"
 #include "rch_jw.h"
 #include "rch_opt.h"
 
@@ -149,15 +150,27 @@ static void report_text(const rch_acq_result *r, const rch_acq_config *c)
 typedef struct acquire_args {
     rch_acq_config c;
     const char *proto, *parity, *flow, *mbf, *mbo, *poll, *joints, *on_jump;
-    unsigned long baud, bits, stop, mb_addr, mb_reg, mb_dec, n, pose_s, outlet, tau_ms;
+    rch_opt_strs cable_points;
+    unsigned long baud, bits, stop, mb_addr, mb_reg, mb_dec, n, pose_s, outlet, tau_ms, target;
     int json, no_learn;
 } acquire_args;
 
 /* The parsed options into a->c (outlet_given: --outlet was given). -1, or 2
  * (reported). */
-static int to_config(acquire_args *a, int outlet_given)
+static int to_config(acquire_args *a, int outlet_given, int target_given)
 {
     a->c.outlet_p1 = outlet_given ? (int)a->outlet + 1 : 0;
+    a->c.target_p1 = target_given ? (int)a->target + 1 : 0;
+    if (a->cable_points.n) { /* the calibrate option's one parser */
+        static rch_calib_cfg cc;
+        char perr[160];
+        if (rch_calib_cfg_cable_points(&cc, a->cable_points.v, a->cable_points.n, perr, sizeof perr) != 0) {
+            fprintf(stderr, "rcal acquire: %s\n", perr);
+            return 2;
+        }
+        a->c.n_points = cc.n_cable_points;
+        memcpy(a->c.points_mm, cc.cable_points_mm, sizeof a->c.points_mm);
+    }
     if (!(a->c.stable.min_mm < a->c.stable.max_mm)) {
         fprintf(stderr, "rcal acquire: need --min-mm < --max-mm\n");
         return 2;
@@ -219,6 +232,12 @@ static int parse(acquire_args *a, int argc, char **argv)
          "column (rcal poses --outlet ...) has its rows of outlet N recorded; give --encoder as this "
          "place's position for the follow check", 0, NULL},
         {"--robot", RCH_OPT_STR, &a->c.robot_path, 0, 0, "MODEL.json", "nominal model: limits, follow check", 0, NULL},
+        {"--cable-point", RCH_OPT_STRS, &a->cable_points, 0, 0, "X,Y,Z",
+         "with --target: the plate's points (nominal, flange frame, mm; once each, in target order) the follow check "
+         "predicts the lengths to", 0, NULL},
+        {"--target", RCH_OPT_UINT, &a->target, 0, RC_MAX_TARGETS - 1, "P",
+         "the point of the tool plate the cable is on in this run (the plan's target column, rcal poses "
+         "--cable-point): its rows are recorded, the file's target column says P; run again on each point", 0, NULL},
         {"--encoder", RCH_OPT_TRIPLE, a->c.encoder_mm, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none", 0, NULL},
         {"--backend", RCH_OPT_CHOICE, &a->c.backend, 0, 0, NULL, "port backend", 0, "serialport|posix"},
         {"--baud", RCH_OPT_UINT, &a->baud, 50, 4000000, NULL, "bits per second", 0, NULL},
@@ -265,7 +284,7 @@ static int parse(acquire_args *a, int argc, char **argv)
     const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (st >= 0)
         return st;
-    return to_config(a, rch_opt_given(&spec, seen, "--outlet"));
+    return to_config(a, rch_opt_given(&spec, seen, "--outlet"), rch_opt_given(&spec, seen, "--target"));
 }
 
 int rcal_cmd_acquire(int argc, char **argv)

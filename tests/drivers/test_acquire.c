@@ -560,6 +560,96 @@ static void test_plan_outlets(void **state)
     snprintf(g_plan, sizeof g_plan, "%s", saved);
 }
 
+/* a plan on two points of a tool plate (rcal poses --cable-point: the
+ * poses repeated per point, column target): without --target refused,
+ * naming it; point 0 then point 1 into the same file, which carries the
+ * target column; the follow check predicts the length to the point the
+ * cable is on (--cable-point: a reading at the flange's length is off by
+ * the plate and stops the run); a --target on a file without the column is
+ * refused, nothing changed */
+static void test_plan_points(void **state)
+{
+    char text[2048], p[512];
+    size_t n = 0;
+    double v[NP];
+    tio t;
+    rch_acq_config c;
+    rch_acq_result r;
+    rch_data back;
+    rch_diag dg;
+    (void)state;
+    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6,target\n");
+    for (int i = 0; i < NP; ++i)
+        for (int k = 0; k < 2; ++k) {
+            n += (size_t)snprintf(text + n, sizeof text - n, "%d", 2 * i + k);
+            for (int j = 0; j < RC_NJ; ++j)
+                n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
+            n += (size_t)snprintf(text + n, sizeof text - n, ",%d\n", k);
+        }
+    write_text("plan_points.csv", text);
+    char saved[512];
+    snprintf(saved, sizeof saved, "%s", g_plan);
+    path_in(g_plan, sizeof g_plan, "plan_points.csv");
+    for (int i = 0; i < NP; ++i)
+        v[i] = nominal_mm[i] + 0.5;
+    /* no --target: refused, nothing written */
+    tio_init(&t);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+    config(&c, "points.csv");
+    c.stable.n = 5;
+    assert_int_not_equal(run(&r, &c, &t), 0);
+    assert_non_null(strstr(g_err, "--target"));
+    assert_true(fsize("points.csv") <= 0);
+    /* point 0, then point 1 (the flange point given as both: the lengths the display shows) */
+    c.n_points = 2;
+    memset(c.points_mm, 0, sizeof c.points_mm);
+    for (int k = 0; k < 2; ++k) {
+        tio_init(&t);
+        t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+        c.target_p1 = k + 1;
+        assert_int_equal(run(&r, &c, &t), 0);
+        assert_int_equal(r.n_poses, NP);
+        assert_int_equal(r.n_new, NP);
+    }
+    path_in(p, sizeof p, "points.csv");
+    assert_int_equal(rch_data_load(&back, p, 0, &dg), 0);
+    assert_int_equal(back.n, 2 * NP);
+    assert_true(back.has_target);
+    for (size_t i = 0; i < back.n; ++i)
+        assert_int_equal(back.s[i].target, i < NP ? 0 : 1);
+    rch_data_free(&back);
+    /* the follow check to a point 80 mm off the flange: the flange's lengths are refused as not following */
+    tio_init(&t);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+    config(&c, "points2.csv");
+    c.stable.n = 5;
+    c.n_points = 2;
+    memset(c.points_mm, 0, sizeof c.points_mm);
+    c.points_mm[0][0] = 80.0;
+    c.target_p1 = 1;
+    assert_int_not_equal(run(&r, &c, &t), 0);
+    print_message("point 0 said 80 mm off the flange: %zu of %d recorded; %s", r.n_new, NP, g_err);
+    assert_true(r.n_new < NP);
+    /* a file of one point (no target column) and --target: refused */
+    memset(c.points_mm, 0, sizeof c.points_mm);
+    c.n_points = 0;
+    c.target_p1 = 0;
+    snprintf(g_plan, sizeof g_plan, "%s", saved);
+    tio_init(&t);
+    t.m[0].rx_len = script(t.rx[0], sizeof t.rx[0], v, NP, 8);
+    config(&c, "onepoint.csv");
+    c.stable.n = 5;
+    assert_int_equal(run(&r, &c, &t), 0);
+    path_in(g_plan, sizeof g_plan, "plan_points.csv");
+    tio_init(&t);
+    c.target_p1 = 1;
+    const long before = fsize("onepoint.csv");
+    assert_int_not_equal(run(&r, &c, &t), 0);
+    assert_non_null(strstr(g_err, "target"));
+    assert_true(fsize("onepoint.csv") == before);
+    snprintf(g_plan, sizeof g_plan, "%s", saved);
+}
+
 /* the position criterion with several outlets: a balanced split, the
  * prediction of the plan's own rows (rch_poses_predict) equal to the plan's,
  * the choice of 2 of 3 places, the RAPID module with every row */
@@ -962,6 +1052,7 @@ int main(void)
         cmocka_unit_test(test_nul_last_line_dropped),
         cmocka_unit_test(test_plan_limits),
         cmocka_unit_test(test_plan_outlets),
+        cmocka_unit_test(test_plan_points),
         cmocka_unit_test(test_plan_split_choose),
         cmocka_unit_test(test_reconnect_5mm_off),
         cmocka_unit_test(test_reconnect_same_device),

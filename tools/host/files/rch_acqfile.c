@@ -112,7 +112,8 @@ static long good_prefix(const char *text, size_t len, const char *path, rch_diag
 }
 
 static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state *st,
-                      const double (*plan_deg)[RC_NJ], size_t n_poses, const char *path, int outlet_p1, rch_diag *d)
+                      const double (*plan_deg)[RC_NJ], size_t n_poses, const char *path, int outlet_p1, int target_p1,
+                      rch_diag *d)
 {
     size_t last = f->n;
     for (size_t i = 0; i < f->n; ++i) {
@@ -132,6 +133,8 @@ static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state 
         }
         if (outlet_p1 && f->s[i].outlet != (unsigned)(outlet_p1 - 1))
             continue; /* measured from another place: not done from this one */
+        if (target_p1 && f->s[i].target != (unsigned)(target_p1 - 1))
+            continue; /* the cable on another point */
         if (!done[pose])
             st->n_done++;
         done[pose] = 1;
@@ -153,7 +156,7 @@ static int has_header(const char *text, size_t len, const char *h)
 }
 
 static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *path,
-                const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, rch_diag *d)
+                const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, rch_diag *d)
 {
     struct stat sb;
     char *text;
@@ -190,11 +193,25 @@ static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *
     good = good_prefix(text, len, path, d);
     if (good < 0)
         goto out;
-    const int plain = good > 0 && has_header(text, (size_t)good, RCH_ACQ_HEADER);
-    const int with_outlet = good > 0 && has_header(text, (size_t)good, RCH_ACQ_HEADER_OUTLET);
-    if (good > 0 && !plain && !with_outlet) {
+    static const char *const headers[4] = {RCH_ACQ_HEADER, RCH_ACQ_HEADER_OUTLET, RCH_ACQ_HEADER_TARGET,
+                                           RCH_ACQ_HEADER_OUTLET_TARGET};
+    int kind = -1; /* the file's header: bit 0 outlet, bit 1 target */
+    for (int k = 0; good > 0 && k < 4 && kind < 0; ++k)
+        if (has_header(text, (size_t)good, headers[k]))
+            kind = k;
+    const int want = (outlet_p1 ? 1 : 0) | (target_p1 ? 2 : 0);
+    if (good > 0 && kind < 0) {
         rch_diag_set(d, path, 1, 1, "exists but is not an acquisition file (header '%s' expected); choose "
-                     "another --out (nothing was changed)", outlet_p1 ? RCH_ACQ_HEADER_OUTLET : RCH_ACQ_HEADER);
+                     "another --out (nothing was changed)", headers[want]);
+        goto out;
+    }
+    const int plain = kind >= 0 && !(kind & 1), with_outlet = kind >= 0 && (kind & 1);
+    if (kind >= 0 && (kind & 2) != (want & 2)) {
+        rch_diag_set(d, path, 1, 1, (kind & 2) ? "records the cable on several points of a tool plate (column "
+                                                 "target): say which one this run has with --target N (nothing was "
+                                                 "changed)"
+                                               : "holds samples of the cable on one point (no target column): a run "
+                                                 "with --target needs a file of its own (nothing was changed)");
         goto out;
     }
     if (plain && outlet_p1) {
@@ -211,7 +228,7 @@ static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *
         rch_data f;
         if (rch_data_parse(&f, text, (size_t)good, path, RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY, d) != 0)
             goto out;
-        rc = check_plan(&f, done, st, plan_deg, n_poses, path, outlet_p1, d);
+        rc = check_plan(&f, done, st, plan_deg, n_poses, path, outlet_p1, target_p1, d);
         rch_data_free(&f);
         if (rc != 0)
             goto out;
@@ -226,7 +243,8 @@ static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *
         }
         st->dropped_bytes = len - (size_t)good;
     }
-    const char *header = outlet_p1 ? RCH_ACQ_HEADER_OUTLET "\n" : RCH_ACQ_HEADER "\n";
+    char header[128];
+    snprintf(header, sizeof header, "%s\n", headers[want]);
     if (good == 0 && write_all(fd, header, strlen(header)) != 0) {
         rch_diag_set(d, path, 0, 0, "cannot write the header: %s", strerror(errno));
         goto out;
@@ -250,10 +268,17 @@ int rch_acqfile_open(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done,
 int rch_acqfile_open_outlet(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
                             const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, rch_diag *d)
 {
+    return rch_acqfile_open_at(a, st, done, path, plan_deg, n_poses, outlet_p1, 0, d);
+}
+
+int rch_acqfile_open_at(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
+                        const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, rch_diag *d)
+{
     memset(st, 0, sizeof *st);
     memset(done, 0, n_poses);
     a->fd = -1;
     a->outlet_p1 = outlet_p1 > 0 && outlet_p1 <= 256 ? outlet_p1 : 0;
+    a->target_p1 = target_p1 > 0 && target_p1 <= RC_MAX_TARGETS ? target_p1 : 0;
     if (strlen(path) >= sizeof a->path) {
         rch_diag_set(d, path, 0, 0, "path too long");
         return -1;
@@ -264,7 +289,7 @@ int rch_acqfile_open_outlet(rch_acqfile *a, rch_acqfile_state *st, unsigned char
         rch_diag_set(d, path, 0, 0, "cannot open for appending: %s", strerror(errno));
         return -1;
     }
-    if (lock_file(a->fd, path, d) != 0 || scan(st, done, a->fd, path, plan_deg, n_poses, a->outlet_p1, d) != 0) {
+    if (lock_file(a->fd, path, d) != 0 || scan(st, done, a->fd, path, plan_deg, n_poses, a->outlet_p1, a->target_p1, d) != 0) {
         close(a->fd);
         a->fd = -1;
         return -1;
@@ -283,6 +308,8 @@ int rch_acqfile_append(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], c
                   t_unix_ms);
     if (a->outlet_p1)
         n += snprintf(line + n, sizeof line - (size_t)n, ",%d", a->outlet_p1 - 1);
+    if (a->target_p1)
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%d", a->target_p1 - 1);
     n += snprintf(line + n, sizeof line - (size_t)n, "\n");
     if (n <= 0 || (size_t)n >= sizeof line) {
         rch_diag_set(d, a->path, 0, 0, "sample line too long");

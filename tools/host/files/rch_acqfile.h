@@ -11,7 +11,9 @@
  * place's label, 0..255: RCH_ACQ_HEADER_OUTLET): the same plan run again from
  * another place appends to the same file, and a pose counts as done only for
  * the place it was measured from. A file's header decides: an outlet is
- * given exactly when the file has the column.
+ * given exactly when the file has the column. The same for a cable hooked in
+ * turn on the points of a tool plate: a last column target (after outlet)
+ * names the point, each run records one.
  *
  * rch_acqfile_open() takes an exclusive lock on the file (fcntl F_SETLK,
  * held until rch_acqfile_close): a second acquisition on the same file is
@@ -37,6 +39,8 @@
 
 #define RCH_ACQ_HEADER "pose,q1,q2,q3,q4,q5,q6,L,spread_mm,n_readings,t_unix_ms"
 #define RCH_ACQ_HEADER_OUTLET RCH_ACQ_HEADER ",outlet"
+#define RCH_ACQ_HEADER_TARGET RCH_ACQ_HEADER ",target"
+#define RCH_ACQ_HEADER_OUTLET_TARGET RCH_ACQ_HEADER ",outlet,target"
 #define RCH_ACQ_MAX_LINE 4096u                  /* longest line accepted when resuming */
 #define RCH_ACQ_MAX_BYTES (256u * 1024u * 1024u) /* largest file resumed (about 2.5 M samples) */
 
@@ -44,6 +48,7 @@ typedef struct rch_acqfile {
     int fd;              /* -1 when closed */
     char path[1024];
     int outlet_p1;       /* 0 no outlet column, k + 1 the outlet label k recorded (rch_acqfile_open_outlet) */
+    int target_p1;       /* 0 no target column, p + 1 the cable point p of a tool plate recorded (rch_acqfile_open_at) */
 } rch_acqfile;
 
 /* What the file held when it was opened. */
@@ -68,6 +73,12 @@ int rch_acqfile_open(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done,
  * place, no outlet column): poses count as done only when measured from it. */
 int rch_acqfile_open_outlet(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
                             const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, rch_diag *d);
+
+/* rch_acqfile_open_outlet with the cable point target_p1 - 1 of a tool plate
+ * (0: no target column): the file has a target column exactly when a point
+ * is given, and poses count as done only for this outlet and point. */
+int rch_acqfile_open_at(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
+                        const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, rch_diag *d);
 
 /* Append one sample line and fsync. 0, or -1 with d set. */
 int rch_acqfile_append(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], const rc_stable_result *r,

@@ -45,7 +45,7 @@ typedef struct rch_data {
     int has_t;          /* a t column was present */
     int has_group;      /* a group column was present */
     int has_outlet;     /* an outlet column was present (rc_sample.outlet holds the file's label) */
-    int has_target;     /* RCH_DATA_POSITIONS: a target column was present */
+    int has_target;     /* a target column was present (a tracker's target, a cable's point on a tool plate) */
     double *sigma_mm;   /* (n) RCH_DATA_POSITIONS: the sigma_mm column, or NULL when absent */
 } rch_data;
 

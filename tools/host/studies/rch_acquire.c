@@ -120,6 +120,7 @@ typedef struct acq {
     unsigned char *other;     /* (n) 1: a row of another outlet of the plan (its outlet column): not this run's */
     size_t n_mine;            /* rows this run measures */
     int outlet_p1;            /* this run's outlet + 1 (--outlet, or the plan's only outlet), 0: one place */
+    int target_p1;            /* this run's cable point + 1 (--target, or the plan's only one), 0: one point */
     rch_acqfile file;
     int has_ref;              /* a recorded sample to check the next against */
     size_t ref_pose;
@@ -389,11 +390,51 @@ static int load_inputs(acq *a)
             WARN(a, "%s has no rows for outlet %d; nothing was recorded\n", c->poses_path, a->outlet_p1 - 1);
             goto out;
         }
-        a->n_mine = 0;
-        for (size_t i = 0; i < plan.n; ++i) {
+        for (size_t i = 0; i < plan.n; ++i)
             a->other[i] = plan.s[i].outlet != (unsigned)(a->outlet_p1 - 1);
-            a->n_mine += !a->other[i];
+    }
+    /* a plan on the points of a tool plate (rcal poses --cable-point): this
+     * run records the rows of the point the cable is on (--target N) */
+    a->target_p1 = c->target_p1;
+    if (plan.has_target && plan.n) {
+        unsigned char seen[RC_MAX_TARGETS] = {0};
+        unsigned n_pt = 0;
+        for (size_t i = 0; i < plan.n; ++i)
+            n_pt += plan.s[i].target < RC_MAX_TARGETS && !seen[plan.s[i].target]++;
+        if (!a->target_p1 && n_pt == 1)
+            a->target_p1 = plan.s[0].target + 1;
+        if (!a->target_p1) {
+            WARN(a, "%s plans the cable on %u points of the tool (column target): say which one it is on in this run "
+                    "with --target N; nothing was recorded\n", c->poses_path, n_pt);
+            goto out;
         }
+        if (a->target_p1 > RC_MAX_TARGETS || !seen[a->target_p1 - 1]) {
+            WARN(a, "%s has no rows for point %d; nothing was recorded\n", c->poses_path, a->target_p1 - 1);
+            goto out;
+        }
+        for (size_t i = 0; i < plan.n; ++i)
+            a->other[i] |= plan.s[i].target != (unsigned)(a->target_p1 - 1);
+    } else if (a->target_p1) {
+        WARN(a, "--target %d: %s has no target column (plan the points with rcal poses --cable-point); nothing was "
+                "recorded\n", a->target_p1 - 1, c->poses_path);
+        goto out;
+    }
+    a->n_mine = 0;
+    for (size_t i = 0; i < plan.n; ++i)
+        a->n_mine += !a->other[i];
+    if (c->n_points > 0) { /* the follow check predicts the length to the point the cable is on */
+        if (rc_model_add_effect(&robot->model, RC_EFF_CABLE_POINTS, 0, 3u * c->n_points) != RC_OK) {
+            WARN(a, "cannot add %u cable points to %s; nothing was recorded\n", c->n_points, c->robot_path);
+            goto out;
+        }
+        memcpy(&robot->model.x[robot->model.effects[robot->model.n_effects - 1].first], c->points_mm,
+               3u * c->n_points * sizeof(double));
+        for (size_t i = 0; i < plan.n; ++i)
+            if (plan.s[i].target >= c->n_points) {
+                WARN(a, "%s:%u: the cable on point %u, but --cable-point gives %u; nothing was recorded\n",
+                     c->poses_path, plan.line[i], (unsigned)plan.s[i].target, c->n_points);
+                goto out;
+            }
     }
     for (size_t i = 0; i < plan.n; ++i) {
         rc_sample s = plan.s[i];
@@ -607,17 +648,17 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     if (check_paths(&a) != 0 || load_inputs(&a) != 0)
         goto out;
     res->n_poses = a.n_mine;
-    if (rch_acqfile_open_outlet(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n,
-                                a.outlet_p1, &dg) != 0) {
+    if (rch_acqfile_open_at(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n,
+                            a.outlet_p1, a.target_p1, &dg) != 0) {
         WARN(&a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
         goto out;
     }
     file_open = 1;
     for (size_t i = 0; i < a.n; ++i)
         if (a.done[i] && a.other[i]) {
-            WARN(&a, "%s: pose %zu was recorded from outlet %d, but the plan %s gives it to another outlet: the file "
-                     "belongs to another plan (nothing was changed)\n",
-                 c->out_path, i, a.outlet_p1 - 1, c->poses_path);
+            WARN(&a, "%s: pose %zu was recorded from outlet %d%s, but the plan %s gives it to another outlet or "
+                     "point: the file belongs to another plan (nothing was changed)\n",
+                 c->out_path, i, a.outlet_p1 - 1, a.target_p1 ? " on this point" : "", c->poses_path);
             goto out;
         }
     res->n_before = fst.n_done;

@@ -111,6 +111,11 @@ typedef struct rch_acq_config {
     int no_follow_check;        /* 1: skip it (a plan of tiny moves) */
     int outlet_p1;              /* 0: one encoder place; k + 1: this run measures from outlet k (the file's
                                    outlet column; give --encoder as this place's position for the follow check) */
+    int target_p1;              /* 0: the cable on one point; p + 1: on point p of a tool plate (the plan's and
+                                   the file's target column, rcal poses --cable-point) */
+    unsigned n_points;          /* the plate's points for the follow check's prediction (--cable-point), 0: the
+                                   flange point */
+    double points_mm[RC_MAX_TARGETS][3]; /* (n_points x 3) their drawing, flange frame */
     int confirm, quiet; /* quiet: no per-pose progress lines (kept with confirm), no notes */
 } rch_acq_config;
 
