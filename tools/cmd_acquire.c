@@ -162,14 +162,12 @@ static int to_config(acquire_args *a, int outlet_given, int target_given)
     a->c.outlet_p1 = outlet_given ? (int)a->outlet + 1 : 0;
     a->c.target_p1 = target_given ? (int)a->target + 1 : 0;
     if (a->cable_points.n) { /* the calibrate option's one parser */
-        static rch_calib_cfg cc;
         char perr[160];
-        if (rch_calib_cfg_cable_points(&cc, a->cable_points.v, a->cable_points.n, perr, sizeof perr) != 0) {
+        if (rch_cable_points_parse(a->c.points_mm, &a->c.n_points, a->cable_points.v, a->cable_points.n, perr,
+                                   sizeof perr) != 0) {
             fprintf(stderr, "rcal acquire: %s\n", perr);
             return 2;
         }
-        a->c.n_points = cc.n_cable_points;
-        memcpy(a->c.points_mm, cc.cable_points_mm, sizeof a->c.points_mm);
     }
     if (!(a->c.stable.min_mm < a->c.stable.max_mm)) {
         fprintf(stderr, "rcal acquire: need --min-mm < --max-mm\n");

@@ -320,14 +320,12 @@ static int to_config(poses_args *a, int has_tool)
     pc->has_tool = has_tool;
     memcpy(pc->tool_mm, a->tool, sizeof a->tool);
     if (a->cable_points.n) { /* the calibrate option's one parser */
-        static rch_calib_cfg cc;
         char perr[160];
-        if (rch_calib_cfg_cable_points(&cc, a->cable_points.v, a->cable_points.n, perr, sizeof perr) != 0) {
+        if (rch_cable_points_parse(pc->points_mm, &pc->n_points, a->cable_points.v, a->cable_points.n, perr,
+                                   sizeof perr) != 0) {
             fprintf(stderr, "rcal poses: %s\n", perr);
             return 2;
         }
-        pc->n_points = cc.n_cable_points;
-        memcpy(pc->points_mm, cc.cable_points_mm, sizeof pc->points_mm);
         if (a->split || pc->criterion == RCH_POSES_LENGTH || a->choose) {
             fprintf(stderr, "rcal poses: --cable-point plans every pose on each point from every outlet: not with "
                             "--split, --choose-outlets or --criterion length\n");

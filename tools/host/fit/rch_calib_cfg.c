@@ -29,6 +29,11 @@ const char *rch_calib_cfg_file(const rch_calib_cfg *cfg, size_t i)
 
 int rch_calib_cfg_cable_points(rch_calib_cfg *cfg, const char *const *v, size_t n, char *err, size_t errlen)
 {
+    return rch_cable_points_parse(cfg->cable_points_mm, &cfg->n_cable_points, v, n, err, errlen);
+}
+
+int rch_cable_points_parse(double (*pts)[3], unsigned *n_out, const char *const *v, size_t n, char *err, size_t errlen)
+{
     if (n > RC_MAX_TARGETS) {
         snprintf(err, errlen, "--cable-point given %zu times: at most %d points", n, RC_MAX_TARGETS);
         return -1;
@@ -43,10 +48,10 @@ int rch_calib_cfg_cable_points(rch_calib_cfg *cfg, const char *const *v, size_t 
                                       "within 2000", v[k], k);
                 return -1;
             }
-            cfg->cable_points_mm[k][c] = x;
+            pts[k][c] = x;
             p = end + 1;
         }
     }
-    cfg->n_cable_points = (unsigned)n;
+    *n_out = (unsigned)n;
     return 0;
 }

@@ -67,6 +67,8 @@ size_t rch_calib_cfg_n_files(const rch_calib_cfg *cfg);
 /* The --cable-point values v (n, "X,Y,Z" mm each, flange frame) into
  * cfg->cable_points_mm, n_cable_points. 0, or -1 with err naming the value. */
 int rch_calib_cfg_cable_points(rch_calib_cfg *cfg, const char *const *v, size_t n, char *err, size_t errlen);
+/* The same into pts (RC_MAX_TARGETS x 3) and *n_out: the one parser of --cable-point. */
+int rch_cable_points_parse(double (*pts)[3], unsigned *n_out, const char *const *v, size_t n, char *err, size_t errlen);
 /* Cable-length file i (< rch_calib_cfg_n_files). */
 const char *rch_calib_cfg_file(const rch_calib_cfg *cfg, size_t i);
 
