@@ -203,7 +203,13 @@ typedef struct rc_sample {
     uint8_t sensor;      /* rc_sensor_kind: what len_mm is */
     uint8_t target;      /* tracker samples: the target seen (its three parameters in RC_EFF_TRACKER_TARGETS);
                             length samples of a model with RC_EFF_CABLE_POINTS: the point the cable is on */
+    double weight;       /* the row's weight in a fit: its residual and derivatives times this (a stated sd's
+                            ratio, sigma_ref / sigma_i); 0: 1 (rc_sample_weight). Read by the solver's passes,
+                            not by rc_meas or rc_eval (a value and its error stay physical) */
 } rc_sample;
+
+/* The weight of sample s in a fit (rc_sample.weight, 0 read as 1). */
+static inline double rc_sample_weight(const rc_sample *s) { return s->weight > 0.0 ? s->weight : 1.0; }
 
 /* Initialise a model from a DH table and an encoder position.
  * dh: (6 x 4) rows a_mm, d_mm, alpha_rad, theta_off_rad; enc_mm: (3).

@@ -81,7 +81,7 @@ static rc_status cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *
         rc_status st = rc_meas_prepared(&l, NULL, m, &p, &samples[i], tab_row(t.sin_q, i), tab_row(t.cos_q, i));
         if (st != RC_OK)
             return st;
-        const double r = l - samples[i].len_mm;
+        const double r = (l - samples[i].len_mm) * rc_sample_weight(&samples[i]);
         sum += r * r;
     }
     *cost_mm2 = sum;
@@ -124,10 +124,11 @@ static rc_status block_rows(double *jb, double rb[NE_BLOCK], double *sum, double
         rc_status st = rc_meas_prepared(&l, jrow, m, p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
         if (st != RC_OK)
             return st;
-        rb[b] = l - samples[s].len_mm;
+        const double wt = rc_sample_weight(&samples[s]);
+        rb[b] = (l - samples[s].len_mm) * wt;
         *sum += rb[b] * rb[b];
         for (unsigned i = 0; i < nf; ++i)
-            row[i] = jrow[idx[i]];
+            row[i] = jrow[idx[i]] * wt;
     }
     return RC_OK;
 }
@@ -178,16 +179,16 @@ static rc_status normal_eq_tab(double *A, double *g, double *cost_mm2, double *j
         rc_status st = rc_meas_prepared(&l, jrow, m, &p, &samples[s], tab_row(t.sin_q, s), tab_row(t.cos_q, s));
         if (st != RC_OK)
             return st;
-        const double r = l - samples[s].len_mm;
+        const double wt = rc_sample_weight(&samples[s]), r = (l - samples[s].len_mm) * wt;
         sum += r * r;
         for (unsigned i = 0; i < nf; ++i) {
-            const double ji = jrow[idx[i]];
+            const double ji = jrow[idx[i]] * wt;
             if (ji == 0.0)
                 continue;
             g[i] += ji * r;
             double *Ai = &A[(size_t)i * nf];
             for (unsigned k = i; k < nf; ++k)
-                Ai[k] += ji * jrow[idx[k]];
+                Ai[k] += ji * jrow[idx[k]] * wt;
         }
     }
     for (size_t s0 = 0; s0 < n && t.jblk != NULL; s0 += NE_BLOCK) {

@@ -380,10 +380,14 @@ static void print_positions(FILE *f, const rch_calib_result *r)
 {
     if (!r->n_pos_rows)
         return;
-    fprintf(f, "tracker positions: %zu rows (%zu poses, %u target(s)), %zu cable lengths; every row weighs the "
-               "same%s\n",
-            r->n_pos_rows, r->n_pos_poses, r->n_targets, r->n_data - 3 * r->n_pos_rows,
-            r->pos_has_sigma ? " (the files' sigma_mm is reported, not used as a weight)" : "");
+    if (r->pos_has_sigma)
+        fprintf(f, "tracker positions: %zu rows (%zu poses, %u target(s)), %zu cable lengths; each position row "
+                   "weighed by its sigma_mm against the files' median %.4g mm (the noise figures are a median row's)\n",
+                r->n_pos_rows, r->n_pos_poses, r->n_targets, r->n_data - 3 * r->n_pos_rows, r->pos_sigma_mm);
+    else
+        fprintf(f, "tracker positions: %zu rows (%zu poses, %u target(s)), %zu cable lengths; every row weighs the "
+                   "same (no sigma_mm column)\n",
+                r->n_pos_rows, r->n_pos_poses, r->n_targets, r->n_data - 3 * r->n_pos_rows);
     fprintf(f, "  (the table above counts every row: a length or one coordinate of a position)\n");
     if (!r->have_pos) {
         fprintf(f, "  3-D errors: none (the fit did not converge)\n\n");

@@ -72,7 +72,7 @@ int rch_calib_screen(rch_calib_result *r, uint8_t *drop, const rc_sample *s, siz
     }
     for (size_t i = 0; i < n; ++i) {
         double l;
-        res[i] = rc_meas(&l, NULL, &r->model, &s[i]) == RC_OK ? l - s[i].len_mm : NAN;
+        res[i] = rc_meas(&l, NULL, &r->model, &s[i]) == RC_OK ? (l - s[i].len_mm) * rc_sample_weight(&s[i]) : NAN;
     }
     double scale[2] = {0.0, 0.0}; /* cable, tracker */
     for (int tr = 0; tr < 2; ++tr) {

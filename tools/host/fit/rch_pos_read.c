@@ -529,6 +529,7 @@ static int append_file(rch_pos *out, const rch_data *dt, const uint8_t *drop, co
             o->t = base + key[i];
             o->outlet = 0;
             o->group = 0;
+            o->weight = dt->sigma_mm ? dt->sigma_mm[i] : 0.0; /* the row's stated sd, made a weight in finish */
             out->line[out->n] = dt->line[i];
             out->file[out->n] = f;
             out->n++;
@@ -586,6 +587,8 @@ static void finish(rch_pos *out, double next, double pose0, double *sig, size_t 
         out->has_sigma = 1;
         out->sigma_mm = sig[nsig / 2];
     }
+    for (size_t i = 0; i < out->n; ++i) /* a stated sd weighs its row against the files' median: sd_ref / sd_i */
+        out->s[i].weight = out->s[i].weight > 0.0 && out->has_sigma ? out->sigma_mm / out->s[i].weight : 0.0;
     free(sig);
 }
 

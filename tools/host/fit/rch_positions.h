@@ -37,7 +37,8 @@ typedef struct rch_pos {
     size_t poses;       /* distinct pose numbers */
     unsigned n_targets; /* largest target + 1 */
     int has_sigma;
-    double sigma_mm;    /* the median of the sigma_mm column (has_sigma); not a row weight */
+    double sigma_mm;    /* the median of the sigma_mm column (has_sigma): each row's weight is sigma_mm / its
+                           own (rc_sample.weight), so the fit's noise is that of a row at the median */
     size_t dropped;     /* rows identical in every field to an earlier one: warned, dropped */
 } rch_pos;
 

@@ -50,9 +50,10 @@ int rch_jac_eval(rch_jac *out, const rc_model *m, const uint16_t *idx, unsigned 
             snprintf(err, errlen, "sample %zu has no defined length derivative (the flange on the outlet?)", i + 1);
             return -2;
         }
-        out->r[i] = l - s[i].len_mm;
+        const double wt = rc_sample_weight(&s[i]); /* the fit's rows: weighed as the solver weighs them */
+        out->r[i] = (l - s[i].len_mm) * wt;
         for (unsigned k = 0; k < nf; ++k) {
-            const double v = jrow[out->idx[k]];
+            const double v = jrow[out->idx[k]] * wt;
             out->J[i * nf + k] = v;
             out->norm2[k] += v * v;
         }

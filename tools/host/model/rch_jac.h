@@ -17,8 +17,9 @@
 #include "rc_model.h"
 
 typedef struct rch_jac {
-    double *J;                    /* (n x nf) row-major: d(model - measured)_i / d x_idx[k] */
-    double *r;                    /* (n) residuals, model - measured (mm) */
+    double *J;                    /* (n x nf) row-major: d(model - measured)_i / d x_idx[k], times the row's
+                                     weight (rc_sample_weight) as the solver weighs it */
+    double *r;                    /* (n) residuals, model - measured (mm), times the row's weight */
     double norm2[RC_MAX_PARAMS];  /* (nf) squared column norms */
     uint16_t idx[RC_MAX_PARAMS];  /* (nf) the parameter of each column */
     unsigned nf;
