@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 typedef struct {
@@ -82,6 +83,24 @@ static inline double rct_lever2_m(double dh[6][4], const double q[6])
 static inline double rct_dist(const double p[3], const double e[3])
 {
     return sqrt((p[0] - e[0]) * (p[0] - e[0]) + (p[1] - e[1]) * (p[1] - e[1]) + (p[2] - e[2]) * (p[2] - e[2]));
+}
+
+/* The robot dh (rad for the angles) as a truth model file (rcal-model/1,
+ * the IRB120's limits, the encoder at (250, -460, 10)) for
+ * rch_calib_cfg.truth_path, into path. 0, or -1 when it cannot be written. */
+static inline int rct_write_truth(const char *path, const char *name, double dh[6][4])
+{
+    const double deg = 3.14159265358979323846 / 180.0;
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fprintf(f, "{\"format\": \"rcal-model/1\", \"name\": \"%s\", \"dh\": [", name);
+    for (int i = 0; i < 6; ++i)
+        fprintf(f, "%s{\"a_mm\": %.12g, \"d_mm\": %.12g, \"alpha_deg\": %.12g, \"theta_deg\": %.12g}", i ? ", " : "",
+                dh[i][0], dh[i][1], dh[i][2] / deg, dh[i][3] / deg);
+    fprintf(f, "], \"joint_limits_deg\": [[-165, 165], [-110, 110], [-110, 70], [-160, 160], [-120, 120], "
+               "[-400, 400]], \"encoder_mm\": [250, -460, 10]}\n");
+    return fclose(f) == 0 ? 0 : -1;
 }
 
 #endif

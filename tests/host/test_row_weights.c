@@ -49,15 +49,7 @@ static void random_q(double q_deg[6], rct_rng *g)
 static void write_truth(void)
 {
     snprintf(g_truth, sizeof g_truth, "row_weights_truth_%ld.json", (long)getpid());
-    FILE *f = fopen(g_truth, "w");
-    assert_non_null(f);
-    fprintf(f, "{\"format\": \"rcal-model/1\", \"name\": \"row weights truth\", \"dh\": [");
-    for (int i = 0; i < 6; ++i)
-        fprintf(f, "%s{\"a_mm\": %.12g, \"d_mm\": %.12g, \"alpha_deg\": %.12g, \"theta_deg\": %.12g}", i ? ", " : "",
-                g_dh[i][0], g_dh[i][1], g_dh[i][2] / DEG, g_dh[i][3] / DEG);
-    fprintf(f, "], \"joint_limits_deg\": [[-165, 165], [-110, 110], [-110, 70], [-160, 160], [-120, 120], "
-               "[-400, 400]], \"encoder_mm\": [250, -460, 10]}\n");
-    assert_int_equal(fclose(f), 0);
+    assert_int_equal(rct_write_truth(g_truth, "row weights truth", g_dh), 0);
 }
 
 /* The positions file into path: sigma column: 0 none, 1 each row's own sd,

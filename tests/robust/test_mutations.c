@@ -98,14 +98,8 @@ static void write_truth(void)
     strcpy(g_truth, "/tmp/rcal_mut_truthXXXXXX");
     const int fd = mkstemp(g_truth);
     assert_true(fd >= 0);
-    FILE *f = fdopen(fd, "w");
-    fprintf(f, "{\"format\": \"rcal-model/1\", \"name\": \"mutation truth\", \"dh\": [");
-    for (int i = 0; i < 6; ++i)
-        fprintf(f, "%s{\"a_mm\": %.12g, \"d_mm\": %.12g, \"alpha_deg\": %.12g, \"theta_deg\": %.12g}", i ? ", " : "",
-                g_dh[i][0], g_dh[i][1], g_dh[i][2] / DEG, g_dh[i][3] / DEG);
-    fprintf(f, "], \"joint_limits_deg\": [[-165, 165], [-110, 110], [-110, 70], [-160, 160], [-120, 120], "
-               "[-400, 400]], \"encoder_mm\": [250, -460, 10]}\n");
-    assert_int_equal(fclose(f), 0);
+    close(fd);
+    assert_int_equal(rct_write_truth(g_truth, "mutation truth", g_dh), 0);
 }
 
 /* How a file is written wrong. */
