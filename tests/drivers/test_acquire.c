@@ -500,14 +500,31 @@ static void test_plan_limits(void **state)
     assert_null(res.poses);
 }
 
+/* The plan's NP poses twice, labelled 0 and 1 in column col: label-major
+ * (every pose of label 0, then of label 1: rcal poses --outlet) or pose-major
+ * (each pose on label 0, then 1: rcal poses --cable-point), into name. */
+static void write_labelled_plan(const char *name, const char *col, int pose_major)
+{
+    char text[2048];
+    size_t n = 0;
+    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6,%s\n", col);
+    for (int r = 0; r < 2 * NP; ++r) {
+        const int i = pose_major ? r / 2 : r % NP, k = pose_major ? r % 2 : r / NP;
+        n += (size_t)snprintf(text + n, sizeof text - n, "%d", r);
+        for (int j = 0; j < RC_NJ; ++j)
+            n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
+        n += (size_t)snprintf(text + n, sizeof text - n, ",%d\n", k);
+    }
+    write_text(name, text);
+}
+
 /* a plan for two places of the encoder (rcal poses --outlet A --outlet B:
  * the poses repeated per outlet, column outlet): a run records the rows of
  * its outlet only, the run from the other outlet appends to the same file,
  * and a run that names no outlet is refused */
 static void test_plan_outlets(void **state)
 {
-    char text[2048], p[512];
-    size_t n = 0;
+    char p[512];
     double v[NP];
     tio t;
     rch_acq_config c;
@@ -515,15 +532,7 @@ static void test_plan_outlets(void **state)
     rch_data back;
     rch_diag dg;
     (void)state;
-    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6,outlet\n");
-    for (int k = 0; k < 2; ++k)
-        for (int i = 0; i < NP; ++i) {
-            n += (size_t)snprintf(text + n, sizeof text - n, "%d", k * NP + i);
-            for (int j = 0; j < RC_NJ; ++j)
-                n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
-            n += (size_t)snprintf(text + n, sizeof text - n, ",%d\n", k);
-        }
-    write_text("plan_outlets.csv", text);
+    write_labelled_plan("plan_outlets.csv", "outlet", 0);
     char saved[512];
     snprintf(saved, sizeof saved, "%s", g_plan);
     path_in(g_plan, sizeof g_plan, "plan_outlets.csv");
@@ -569,8 +578,7 @@ static void test_plan_outlets(void **state)
  * refused, nothing changed */
 static void test_plan_points(void **state)
 {
-    char text[2048], p[512];
-    size_t n = 0;
+    char p[512];
     double v[NP];
     tio t;
     rch_acq_config c;
@@ -578,15 +586,7 @@ static void test_plan_points(void **state)
     rch_data back;
     rch_diag dg;
     (void)state;
-    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6,target\n");
-    for (int i = 0; i < NP; ++i)
-        for (int k = 0; k < 2; ++k) {
-            n += (size_t)snprintf(text + n, sizeof text - n, "%d", 2 * i + k);
-            for (int j = 0; j < RC_NJ; ++j)
-                n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
-            n += (size_t)snprintf(text + n, sizeof text - n, ",%d\n", k);
-        }
-    write_text("plan_points.csv", text);
+    write_labelled_plan("plan_points.csv", "target", 1);
     char saved[512];
     snprintf(saved, sizeof saved, "%s", g_plan);
     path_in(g_plan, sizeof g_plan, "plan_points.csv");

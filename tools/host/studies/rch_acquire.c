@@ -4,6 +4,8 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -342,6 +344,35 @@ static rc_status measure_checked(rc_stable_result *r, acq *a, size_t i)
 }
 
 /* Plan, robot, limits and nominal lengths. 0, or 1 with a message. */
+/* This run's label of a plan column (the uint8_t rc_sample field at off:
+ * outlet or target, labels below max): the one given (*p1 = label + 1), else
+ * the plan's only one; the plan's other rows marked in a->other. 0, or -1
+ * with the reason said (many: what the labels are, which: how to name one). */
+static int run_label(acq *a, int *p1, const rch_data *plan, size_t off, unsigned max, const char *many,
+                     const char *which, const char *one)
+{
+    unsigned char seen[256] = {0};
+    unsigned n_lab = 0;
+    for (size_t i = 0; i < plan->n; ++i) {
+        const unsigned lab = *((const uint8_t *)&plan->s[i] + off);
+        n_lab += lab < max && !seen[lab]++;
+    }
+    if (!*p1 && n_lab == 1)
+        *p1 = *((const uint8_t *)&plan->s[0] + off) + 1;
+    if (!*p1) {
+        WARN(a, "%s plans %u %s: say which one this run %s; nothing was recorded\n", a->c->poses_path, n_lab, many,
+             which);
+        return -1;
+    }
+    if (*p1 > (int)max || !seen[*p1 - 1]) {
+        WARN(a, "%s has no rows for %s %d; nothing was recorded\n", a->c->poses_path, one, *p1 - 1);
+        return -1;
+    }
+    for (size_t i = 0; i < plan->n; ++i)
+        a->other[i] |= *((const uint8_t *)&plan->s[i] + off) != (unsigned)(*p1 - 1);
+    return 0;
+}
+
 static int load_inputs(acq *a)
 {
     const rch_acq_config *c = a->c;
@@ -370,51 +401,20 @@ static int load_inputs(acq *a)
         WARN(a, "out of memory\n");
         goto out;
     }
-    /* a plan for several places (rcal poses --outlet ...): this run records
-     * the rows of its outlet (--outlet N, or the plan's only one) */
+    /* a plan for several places (rcal poses --outlet ...) or on several points of a tool plate (rcal poses
+     * --cable-point): this run records the rows of its outlet and its point (--outlet N, --target P, or the
+     * plan's only one) */
     a->outlet_p1 = c->outlet_p1;
-    a->n_mine = plan.n;
-    if (plan.has_outlet && plan.n) {
-        unsigned char seen[256] = {0};
-        unsigned n_lab = 0;
-        for (size_t i = 0; i < plan.n; ++i)
-            n_lab += !seen[plan.s[i].outlet]++;
-        if (!a->outlet_p1 && n_lab == 1)
-            a->outlet_p1 = plan.s[0].outlet + 1;
-        if (!a->outlet_p1) {
-            WARN(a, "%s plans %u places of the encoder (column outlet): say which one this run measures from with "
-                    "--outlet N; nothing was recorded\n", c->poses_path, n_lab);
-            goto out;
-        }
-        if (a->outlet_p1 > 256 || !seen[a->outlet_p1 - 1]) {
-            WARN(a, "%s has no rows for outlet %d; nothing was recorded\n", c->poses_path, a->outlet_p1 - 1);
-            goto out;
-        }
-        for (size_t i = 0; i < plan.n; ++i)
-            a->other[i] = plan.s[i].outlet != (unsigned)(a->outlet_p1 - 1);
-    }
-    /* a plan on the points of a tool plate (rcal poses --cable-point): this
-     * run records the rows of the point the cable is on (--target N) */
     a->target_p1 = c->target_p1;
-    if (plan.has_target && plan.n) {
-        unsigned char seen[RC_MAX_TARGETS] = {0};
-        unsigned n_pt = 0;
-        for (size_t i = 0; i < plan.n; ++i)
-            n_pt += plan.s[i].target < RC_MAX_TARGETS && !seen[plan.s[i].target]++;
-        if (!a->target_p1 && n_pt == 1)
-            a->target_p1 = plan.s[0].target + 1;
-        if (!a->target_p1) {
-            WARN(a, "%s plans the cable on %u points of the tool (column target): say which one it is on in this run "
-                    "with --target N; nothing was recorded\n", c->poses_path, n_pt);
-            goto out;
-        }
-        if (a->target_p1 > RC_MAX_TARGETS || !seen[a->target_p1 - 1]) {
-            WARN(a, "%s has no rows for point %d; nothing was recorded\n", c->poses_path, a->target_p1 - 1);
-            goto out;
-        }
-        for (size_t i = 0; i < plan.n; ++i)
-            a->other[i] |= plan.s[i].target != (unsigned)(a->target_p1 - 1);
-    } else if (a->target_p1) {
+    if (plan.n && plan.has_outlet &&
+        run_label(a, &a->outlet_p1, &plan, offsetof(rc_sample, outlet), 256, "places of the encoder (column outlet)",
+                  "measures from with --outlet N", "outlet") != 0)
+        goto out;
+    if (plan.n && plan.has_target &&
+        run_label(a, &a->target_p1, &plan, offsetof(rc_sample, target), RC_MAX_TARGETS,
+                  "cable points of the tool (column target)", "has the cable on with --target P", "point") != 0)
+        goto out;
+    if (!plan.has_target && a->target_p1) {
         WARN(a, "--target %d: %s has no target column (plan the points with rcal poses --cable-point); nothing was "
                 "recorded\n", a->target_p1 - 1, c->poses_path);
         goto out;
