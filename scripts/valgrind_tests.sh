@@ -7,7 +7,7 @@
 # runs each test executable under
 #   valgrind --leak-check=full --errors-for-leak-kinds=definite,indirect,possible
 # Child processes the tests start (rcal, rcal_simdisplay, ...) are traced too,
-# except system programs (/bin, /usr/bin). A test fails on its own failure or on
+# except system programs (python3, the compiler; see --trace-children-skip). A test fails on its own failure or on
 # any memcheck error or leak in it or its children. Disabled tests are skipped;
 # tests whose command is not an executable of the build tree (scripts:
 # python, cmake -E env, shell) are not run again here: memcheck cannot see
@@ -111,7 +111,6 @@ run_test() { # name workdir env disabled argv
         (cd "$wd" && env "${envv[@]}" timeout "$TMO" "${VG[@]}" --log-file="$log.%p.vg" "${cmd[@]}") \
             >"$log.out" 2>&1
         rc=$?
-        under=valgrind
     else
         # A script (python, cmake -E env, sh): memcheck would not see into it,
         # and the Release and sanitizer ctest runs already run it as it is.
@@ -143,8 +142,7 @@ run_test() { # name workdir env disabled argv
     else
         status=ok
     fi
-    [ "$under" = valgrind ] && under="vg x$nlogs"
-    printf '%-24s %-8s %5ss  %s\n' "$name" "$under" "$((t1 - t0))" "$status" >"$log.result"
+    printf '%-24s %-8s %5ss  %s\n' "$name" "vg x$nlogs" "$((t1 - t0))" "$status" >"$log.result"
     [ -n "$leaks" ] && echo "$leaks" | sed 's/^/    /' >>"$log.result"
 }
 

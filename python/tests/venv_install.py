@@ -19,8 +19,7 @@ python_venv_install).
 4. the wheel of the same source installed into a virtual environment with
    nothing in it (no system site packages: no numpy, setuptools, wheel), and
    session_check.py --demo-only there.
---demo-only (the sanitizer build, whose CLI is 20 times slower) checks the
-demo data only. Exit 77 (ctest: skipped) with the reason when venv or pip
+--demo-only (passed on to session_check.py) checks the demo data only. Exit 77 (ctest: skipped) with the reason when venv or pip
 is unavailable.
 """
 import os
