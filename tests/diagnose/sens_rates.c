@@ -97,8 +97,10 @@ static int verdict_ok(const scase *c, const sg_truth *t, const char *eff, unsign
     case SG_NONE: return strcmp(eff, "none") == 0;
     case SG_GRAVITY: return strcmp(eff, "joint_compliance") == 0 && (joint == 2 || joint == 3);
     case SG_GEAR: return strcmp(eff, "joint_periodic") == 0 && joint == t->gear_joint;
-    case SG_TEMP: /* a tracker alone cannot see its own scale (it trades with the robot's size): none is right */
-        return strstr(eff, "scale") != NULL || (c->s == S_TRK && strcmp(eff, "none") == 0);
+    case SG_TEMP: /* a tracker alone cannot see its own scale (it trades with the robot's size): none is right;
+                     beside a cable the tracker's scale, not the cable's (which would leave the tracker's error in
+                     the robot's size) */
+        return strcmp(eff, "tracker_scale") == 0 || (c->s == S_TRK && strcmp(eff, "none") == 0);
     case SG_OUTLET: return strstr(eff, "offset") != NULL;
     case SG_N_EFFECTS: break;
     }
@@ -510,13 +512,14 @@ int main(int argc, char **argv)
     unsigned seeds = 5, n_targets = 200;
     double size = 1.0;
     const char *only = NULL, *keep = NULL;
-    int check = 0; /* --check: the ctest (diag_sensors): controls, gravity and gear on both sensors, asserted */
+    int check = 0; /* --check: the ctest (diag_sensors): controls, gravity and gear on both sensors, the tracker
+                      scale beside a cable, asserted */
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--check") == 0) {
             check = 1;
             seeds = 3;
             n_targets = 60;
-            only = "trk_none,trk_gravity,trk_gear,cab_none,cab_gravity,cab_gear";
+            only = "trk_none,trk_gravity,trk_gear,mix_temp,cab_none,cab_gravity,cab_gear";
         } else if (strcmp(argv[i], "--seeds") == 0 && i + 1 < argc)
             seeds = (unsigned)atoi(argv[++i]);
         else if (strcmp(argv[i], "--cases") == 0 && i + 1 < argc)

@@ -753,10 +753,23 @@ static void phase_report(run_state *S)
 {
     rch_diagnose_result *out = S->out;
     report_params(out, S->base_folds, S->c.k);
+    /* the chosen effects alone set to zero: the outlets' and the tracker's
+     * places, the attachment and the geometry stay (zeroing an outlet's
+     * place would count metres of "effect") */
     rc_model z = out->final;
-    for (unsigned e = 0; e < z.n_effects; ++e)
-        for (unsigned p = 0; p < z.effects[e].count; ++p)
+    for (unsigned e = 0; e < z.n_effects; ++e) {
+        int chosen = 0;
+        for (unsigned st = 0; st < out->n_steps; ++st) {
+            const rch_diagnose_step *sp = &out->steps[st];
+            if (sp->chosen < 0)
+                continue;
+            const rch_diagnose_cand *c = &sp->cand[sp->chosen];
+            chosen |= z.effects[e].kind == (uint8_t)c->kind &&
+                      (c->joint == 0 || (unsigned)z.effects[e].joint + 1 == c->joint);
+        }
+        for (unsigned p = 0; chosen && p < z.effects[e].count; ++p)
             z.x[z.effects[e].first + p] = 0.0;
+    }
     double s2 = 0.0;
     for (size_t i = 0; i < out->n; ++i) {
         double la, lb;

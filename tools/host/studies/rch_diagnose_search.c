@@ -398,6 +398,74 @@ static int one_se_rule(const run_state *S, const rch_diagnose_step *st, int best
     return chosen;
 }
 
+static int is_scale_kind(rc_effect_kind k)
+{
+    return k == RC_EFF_LENGTH_SCALE || k == RC_EFF_OUTLET_SCALE || k == RC_EFF_TRACKER_SCALE;
+}
+
+/* The Laplace log evidence of a scale candidate (slot k, all_cands index
+ * ci) up to a constant common to the step: the held-out fit, -(n/2) ln MSE,
+ * and for each parameter it adds the Occam factor ln(se / prior sd) - x^2 /
+ * (2 prior sd^2), se its fold-jackknife standard error and the prior the
+ * effect's plausible range as 3 sd (rch_prior_fill's). A parameter the data
+ * do not determine (se at or above the prior) adds its prior term alone. */
+static double scale_log_evidence(const run_state *S, const rch_diagnose_cand *ca, unsigned ci)
+{
+    const rc_model *m = &S->cand_full[ci];
+    const rc_model *folds = &S->cand_folds[(size_t)ci * S->c.k];
+    const unsigned k = S->c.k;
+    const rc_effect_desc *ds = rc_effect_describe(ca->kind);
+    double ev = -0.5 * (double)S->out->n * log(ca->rmse_cv_mm * ca->rmse_cv_mm);
+    for (unsigned e = 0; ds && e < m->n_effects; ++e) {
+        if (m->effects[e].kind != (uint8_t)ca->kind)
+            continue;
+        const double sd = ds->limit / 3.0;
+        for (unsigned p = 0; p < m->effects[e].count; ++p) {
+            const unsigned idx = m->effects[e].first + p;
+            double mean = 0.0, v = 0.0;
+            for (unsigned f = 0; f < k; ++f)
+                mean += folds[f].x[idx] / (double)k;
+            for (unsigned f = 0; f < k; ++f)
+                v += (folds[f].x[idx] - mean) * (folds[f].x[idx] - mean);
+            const double se = sqrt(v * (double)(k - 1) / (double)k);
+            if (se > 0.0 && se < sd)
+                ev += log(se / sd);
+            ev -= m->x[idx] * m->x[idx] / (2.0 * sd * sd);
+        }
+    }
+    return ev;
+}
+
+/* Where the tracker and a cable both measure, a scale error of one equals a
+ * scale error of the other with the robot scaled: only their ratio is seen.
+ * When the best candidate is a scale and other significant scale candidates
+ * explain the same (penalised held-out fit within 2 ln n), the one whose
+ * prior makes the measured ratio most probable is named (its Laplace
+ * evidence): a tracker's scale is known to about 100 ppm, a draw-wire's to
+ * per cent, so a ratio of tens of ppm is the tracker's. -1: no such choice,
+ * else the slot chosen. */
+static int scale_alias_choice(const run_state *S, const rch_diagnose_step *st, int best, const double *crit,
+                              const unsigned *slot_ci)
+{
+    if (S->out->n_tracker == 0 || S->out->n_cable == 0 || !is_scale_kind(st->cand[best].kind))
+        return -1;
+    const double tie = 2.0 * log((double)S->out->n);
+    int pick = -1, others = 0;
+    double best_ev = -INFINITY;
+    for (unsigned k = 0; k < st->n_cand; ++k) {
+        const rch_diagnose_cand *ca = &st->cand[k];
+        if (!ca->tested || !ca->significant || !is_scale_kind(ca->kind) || fabs(crit[k] - crit[best]) >= tie)
+            continue;
+        others += (int)k != best;
+        const double ev = scale_log_evidence(S, ca, slot_ci[k]);
+        if (ev > best_ev) {
+            best_ev = ev;
+            pick = (int)k;
+        }
+    }
+    return others > 0 ? pick : -1;
+}
+
 /* Significance (Bonferroni over the tested candidates) and the choice of one
  * step; the chosen candidate becomes the current model. 1 when one was
  * chosen, 0 when the search ends. */
@@ -442,12 +510,20 @@ static int step_choose(run_state *S, rch_diagnose_step *st, unsigned n_tested)
     for (unsigned ci = 0; ci < N_ALL_CANDS; ++ci)
         if (!rch_dg_has_effect(&S->base, all_cands[ci].kind, all_cands[ci].joint0) && cand_relevant(S, &all_cands[ci]))
             slot_ci[k++] = ci;
-    const int chosen = one_se_rule(S, st, best, slot_ci);
+    const int alias = scale_alias_choice(S, st, best, crit, slot_ci);
+    const int chosen = alias >= 0 ? alias : one_se_rule(S, st, best, slot_ci);
     st->chosen = chosen;
     char cn[40], bn[40]; /* copies: snprintf must not read from the object it writes */
     memcpy(cn, st->cand[chosen].name, sizeof cn);
     memcpy(bn, st->cand[best].name, sizeof bn);
-    if (chosen != best)
+    if (alias >= 0) {
+        char on[40];
+        memcpy(on, chosen == best && second >= 0 ? st->cand[second].name : bn, sizeof on);
+        snprintf(st->why, sizeof st->why,
+                 "%s: tracker and cable disagree in scale, only the ratio is seen (%.24s alike); named by the "
+                 "priors' evidence (tracker ~100 ppm, draw-wire ~%%)",
+                 cn, on);
+    } else if (chosen != best)
         snprintf(st->why, sizeof st->why,
                  "%s: significant, and within one standard error of the best (%s) with fewer parameters", cn, bn);
     else if (second >= 0 && fabs(crit[second] - crit[best]) < 2.0 * log(nn)) {
