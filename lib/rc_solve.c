@@ -573,8 +573,16 @@ static double lm_subspace_step(double *dx, const rc_solve_work *w, const double 
 static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, passbuf tab,
                        const rc_solve_config *cfg, unsigned nf, const rc_sample *samples, size_t n)
 {
+    /* Where the residuals are large, Gauss-Newton lacks their curvature and
+     * converges linearly along the prior-held directions, with a rate that
+     * the steps show: moving x by t d leaves the next step d' = (1 - (1 -
+     * rho) t) d there, rho the rate. The step length that would finish that
+     * direction, t' = t / (1 - q) with q = d'.d / d.d (a secant on the
+     * step), is tried first (1 to 8 x the step); refused when it does not
+     * lower the cost, then the plain step and its halvings. */
+    double prev[RC_MAX_PARAMS] = {0}, t_prev = 1.0, pp = 0.0;
     for (unsigned k = 0; k < RC_MAP_POLISH_ITER; ++k) {
-        double cost, gnorm = 0.0, cnew;
+        double cost, gnorm = 0.0, cnew = 0.0;
         unsigned rank = 0;
         ++res->cost_evals;
         if (normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n) != RC_OK)
@@ -585,14 +593,43 @@ static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, doub
         if (lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, 1e-300, 0.0) != RC_OK || gnorm == 0.0)
             return;
         (void)lm_subspace_step(w->dx, w, V, nf, rank, 0.0);
+        double t = 1.0;
+        if (pp > 0.0) {
+            double dq = 0.0;
+            for (unsigned i = 0; i < nf; ++i)
+                dq += w->dx[i] * prev[i];
+            const double q = dq / pp, tn = t_prev / (1.0 - q);
+            if (q < 1.0 && tn > 1.0)
+                t = tn < 8.0 ? tn : 8.0;
+        }
+        memcpy(prev, w->dx, nf * sizeof prev[0]);
+        pp = 0.0;
+        for (unsigned i = 0; i < nf; ++i)
+            pp += w->dx[i] * w->dx[i];
+        int ok = 0;
+        if (t > 1.0) {
+            for (unsigned i = 0; i < nf; ++i)
+                w->dx[i] *= t;
+            apply_step(&w->trial, m, w, nf, w->dx);
+            ++res->cost_evals;
+            if (cost_tab(&cnew, &w->trial, samples, tab, n) == RC_OK) {
+                cnew += rc_prior_cost(&w->trial, cfg);
+                ok = cnew < cost;
+            }
+            if (!ok) {
+                memcpy(w->dx, prev, nf * sizeof prev[0]);
+                t = 1.0;
+            }
+        }
         /* the near-null directions are rotations of the last frames traded
          * against the attachment: far from linear over tens of mm, so the
          * step is halved until the cost falls */
-        int ok = 0;
         for (unsigned h = 0; h < RC_MAP_POLISH_HALVINGS && !ok; ++h) {
-            if (h > 0)
+            if (h > 0) {
                 for (unsigned i = 0; i < nf; ++i)
                     w->dx[i] *= 0.5;
+                t *= 0.5;
+            }
             apply_step(&w->trial, m, w, nf, w->dx);
             ++res->cost_evals;
             if (cost_tab(&cnew, &w->trial, samples, tab, n) != RC_OK)
@@ -602,6 +639,7 @@ static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, doub
         }
         if (!ok)
             return;
+        t_prev = t;
         *m = w->trial;
         const double data_cost = cnew - rc_prior_cost(m, cfg);
         res->rms_final_mm = rms_of(data_cost > 0.0 ? data_cost : 0.0, n);

@@ -36,8 +36,10 @@
 #      -> <SHA256>;
 #   5. a direction the data do not see at all (relative singular value below
 #      1e-12: a null space, whose basis any change of start point or CPU
-#      turns) -> its combination "<NULL DIRECTION>"; a printed zero's sign
-#      ("-0.00000") -> "0.0";
+#      turns) -> its value "<ZERO>" and its combination "<NULL DIRECTION>",
+#      and the words under it (which known set lands under which of several
+#      such directions is as arbitrary) are dropped; a printed zero's sign
+#      ("-0.00000") -> " 0.00000" (the width kept);
 #   6. stderr only: the progress lines a long step prints every 5 s
 #      ("WHAT N of M, T elapsed, about T left"; their number depends on the
 #      host's speed) are dropped. Estimates ("about 12.0 min") come from the
@@ -88,10 +90,17 @@ mask() {
             }' \
         -e 's#[12][0-9]{3}-[01][0-9]-[0-3][0-9]([T ][0-2][0-9]:[0-5][0-9](:[0-5][0-9]([.][0-9]+)?)?(Z|[+-][0-2][0-9]:?[0-5][0-9])?)?#<DATE>#g' \
         -e 's#\b[0-9a-f]{64}\b#<SHA256>#g' \
-        -e 's#(NOT seen by the data \(relative singular value [0-9.]+e-(1[3-9]|[2-9][0-9])\)): .*#\1: <NULL DIRECTION>#' \
+        -e 's#NOT seen by the data \(relative singular value [0-9.]+e-(1[3-9]|[2-9][0-9])\): .*#NOT seen by the data (relative singular value <ZERO>): <NULL DIRECTION>#' \
+        -e 's#( NOT seen by the data) \([0-9.]+e-(1[3-9]|[2-9][0-9])\):#\1 (<ZERO>):#' \
         -e 's#("sv_rel":[0-9.]+e-(1[3-9]|[2-9][0-9]),"identifiable":"no","combo":)"[^"]*"#\1"<NULL DIRECTION>"#g' \
-        -e 's#(-|\b)0[.]0+\b#0.0#g' \
-        "$1"
+        -e 's#-0[.](0+)\b# 0.\1#g' \
+        "$1" | awk '
+            # the words under a null direction: which of several directions at
+            # round-off level (relative singular value below 1e-13) a known set
+            # falls under is arbitrary, so the words are dropped there
+            /<NULL DIRECTION>/ { print; nul = 1; next }
+            nul && /^      [a-z]/ { next }
+            { nul = 0; print }'
 }
 # mask_err FILE: mask, and drop the progress lines printed every 5 s of a long step (rch_progress_step:
 # "WHAT N of M, T elapsed, about T left"; how many there are depends on the host's speed)

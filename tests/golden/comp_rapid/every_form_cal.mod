@@ -1,14 +1,14 @@
 MODULE EveryForm
   ! rcal compensate test module (issue 21): every joint target and robtarget form.
   ! In a comment a target stays as it is: MoveAbsJ [[1,2,3,4,5,6],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
-  CONST jointtarget jHome:=[[0.0217,0.1496,-0.0740,0.0021,29.9528,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  CONST jointtarget jHome:=[[0.0217,0.1496,-0.0740,0.0021,29.9528, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST jointtarget jA:=[[10.0280,20.1270,-30.1179,40.0225,49.9175,60.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]; CONST jointtarget jB := [[-15.0010,5.1585,9.9294,-20.0051,34.9523,-45.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
   PERS jointtarget jLong:=[[ 25.4969, -12.0799,
                              17.9284, ! a comment inside the aggregate
                              -33.1362, 43.9481, 90.0000 ],
                            [9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   VAR jointtarget jC;
-  CONST jointtarget jArr{2}:=[[[5.0123,10.1568,14.9238,0.0016,44.9448,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]],[[-4.9380,-9.7993,-15.1413,-0.0147,-44.9678,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]]];
+  CONST jointtarget jArr{2}:=[[[5.0123,10.1568,14.9238,0.0016,44.9448, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]],[[-4.9380,-9.7993,-15.1413,-0.0147,-44.9678, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]];
   CONST num table{2,6}:=[[1,2,3,4,5,6],[1,2,3,4,5,6]];
   CONST speeddata vSlow:=[50,500,5000,1000];
   PERS tooldata tPen:=[TRUE,[[0,0,150],[1,0,0,0]],[0.5,[0,0,50],[1,0,0,0],0,0,0]];
@@ -25,8 +25,8 @@ MODULE EveryForm
   PROC main()
     TPWrite "a string is copied: jointtarget j:=[[1,2,3,4,5,6],[0,0,0,0,0,0]]; "" [";
     MoveAbsJ jHome\NoEOffs, v100, fine, tool0;
-    MoveAbsJ [[5.0123,10.1568,14.9238,0.0016,44.9448,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]]\NoEOffs, v100, z10, tool0;
-    MoveAbsJ jA, v100, z10, tool0; MoveAbsJ [[-4.9380,-9.7993,-15.1413,-0.0147,-44.9678,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
+    MoveAbsJ [[5.0123,10.1568,14.9238,0.0016,44.9448, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]\NoEOffs, v100, z10, tool0;
+    MoveAbsJ jA, v100, z10, tool0; MoveAbsJ [[-4.9380,-9.7993,-15.1413,-0.0147,-44.9678, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
     jC:=[[1.0336,2.1674,2.9196,4.0006,4.9686,6.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
     MoveAbsJ jC, vSlow, fine, tool0;
     MoveJ p10, v200, z10, tool0;

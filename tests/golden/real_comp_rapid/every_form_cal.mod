@@ -1,14 +1,14 @@
 MODULE EveryForm
   ! rcal compensate test module (issue 21): every joint target and robtarget form.
   ! In a comment a target stays as it is: MoveAbsJ [[1,2,3,4,5,6],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
-  CONST jointtarget jHome:=[[-0.0415,-0.1891,-0.4154,-0.0045,29.8935,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  CONST jointtarget jHome:=[[-0.0415,-0.1891,-0.4154,-0.0045,29.8935, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST jointtarget jA:=[[10.0119,19.8046,-30.7039,40.0922,49.7331,60.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]; CONST jointtarget jB := [[-15.0956,4.8283,9.5706,-20.0291,34.9052,-45.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
   PERS jointtarget jLong:=[[ 25.3707, -12.3656,
                              17.6758, ! a comment inside the aggregate
                              -33.1714, 43.9472, 90.0000 ],
                            [9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   VAR jointtarget jC;
-  CONST jointtarget jArr{2}:=[[[4.9269,9.8171,14.5359,-0.0104,44.8943,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]],[[-5.0139,-10.2184,-15.3681,0.0026,-45.0212,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]]];
+  CONST jointtarget jArr{2}:=[[[4.9269,9.8171,14.5359,-0.0104,44.8943, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]],[[-5.0139,-10.2184,-15.3681,0.0026,-45.0212, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]];
   CONST num table{2,6}:=[[1,2,3,4,5,6],[1,2,3,4,5,6]];
   CONST speeddata vSlow:=[50,500,5000,1000];
   PERS tooldata tPen:=[TRUE,[[0,0,150],[1,0,0,0]],[0.5,[0,0,50],[1,0,0,0],0,0,0]];
@@ -25,8 +25,8 @@ MODULE EveryForm
   PROC main()
     TPWrite "a string is copied: jointtarget j:=[[1,2,3,4,5,6],[0,0,0,0,0,0]]; "" [";
     MoveAbsJ jHome\NoEOffs, v100, fine, tool0;
-    MoveAbsJ [[4.9269,9.8171,14.5359,-0.0104,44.8943,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]]\NoEOffs, v100, z10, tool0;
-    MoveAbsJ jA, v100, z10, tool0; MoveAbsJ [[-5.0139,-10.2184,-15.3681,0.0026,-45.0212,0.0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
+    MoveAbsJ [[4.9269,9.8171,14.5359,-0.0104,44.8943, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]]\NoEOffs, v100, z10, tool0;
+    MoveAbsJ jA, v100, z10, tool0; MoveAbsJ [[-5.0139,-10.2184,-15.3681,0.0026,-45.0212, 0.0000],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, z10, tool0;
     jC:=[[0.9613,1.8412,2.5488,3.9994,4.8943,6.0000],[9E9,9E9,9E9,9E9,9E9,9E9]];
     MoveAbsJ jC, vSlow, fine, tool0;
     MoveJ p10, v200, z10, tool0;

@@ -139,6 +139,7 @@ typedef struct rch_calib_result {
     size_t jump_at[RCH_JUMPS_MAX];    /* (n_jump_at) first training sample (in t order) after each jump */
     int attach_auto;          /* the cable attachment vector was the default's to decide (not --tool-offset) */
     int attach_centred;       /* decided: the cable is at the flange centre (no attachment vector) */
+    int attach_bound;         /* attach_dchi2 is a lower bound (one centred fit proved the attachment needed) */
     double attach_dchi2;      /* how much the attachment vector improved the MAP objective (noise units) */
     double attach_occam;      /* its Occam penalty 2 sum ln(prior sd / posterior sd) */
     unsigned n_groups;        /* set-up groups of the data (file column, else from the wrist) */

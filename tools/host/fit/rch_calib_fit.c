@@ -87,6 +87,18 @@ static int cmp_t(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* A copy of s[0..n) in time order (what a jump search reads), or NULL when
+ * out of memory; the caller frees it. */
+static rc_sample *by_time(const rc_sample *s, size_t n)
+{
+    rc_sample *c = malloc((n ? n : 1) * sizeof *c);
+    if (c) {
+        memcpy(c, s, n * sizeof *c);
+        qsort(c, n, sizeof *c, cmp_t);
+    }
+    return c;
+}
+
 /* The jump fit of one pass: the first search finds the change points
  * (rch_jumps_find), every later fit of the same training set refits at them
  * (rch_jumps_refit): the noise passes, the attachment comparison and the
@@ -219,10 +231,8 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
         double noise = rc_eval(&m0, &r->before, train, r->n_train) == RC_OK && m0.rmse_mm > 0.0 ? m0.rmse_mm : 1.0;
         rc_sample *sorted = NULL;
         rc_model *warm = r->cfg.jumps ? malloc(sizeof *warm) : NULL;
-        if (r->cfg.jumps && warm && (sorted = malloc(r->n_train * sizeof *sorted)) != NULL) {
-            memcpy(sorted, train, r->n_train * sizeof *sorted);
-            qsort(sorted, r->n_train, sizeof *sorted, cmp_t);
-        }
+        if (r->cfg.jumps && warm)
+            sorted = by_time(train, r->n_train);
         for (unsigned pass = 0; pass < 6; ++pass) {
             cfg.prior_noise_mm = noise;
             const rc_model *fitm = &r->model;
@@ -300,6 +310,70 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
     return st;
 }
 
+/* A lower bound of the centred model's MAP objective at its own noise,
+ * in units of the attachment model's noise nu1 (what choose_attachment
+ * compares), from one fit at nu1 instead of its noise loop. With
+ * F_nu(x) = SSR(x) + nu^2 Q(x) (Q the prior's sum of squares), the loop's
+ * result is F_nu0(x0) / nu1^2 at its settled noise nu0, the fixed point of
+ * g(nu)^2 = SSR(x_nu) / (n - p_eff(nu)) that map_fit reaches from above
+ * (from the start model's RMS). A wider noise weighs the prior more: SSR of
+ * the optimum does not fall and p_eff does not rise, so g is nondecreasing,
+ * and if g(nu1) >= nu1 the iteration from above stops at a nu0 >= nu1.
+ * g(nu1) >= nu1 is checked with p_eff taken as 0 (SSR1 / n >= nu1^2, a
+ * sufficient test). Then every F_nu0 >= F_nu1 gives F_nu0(x0) >= F_nu1(x1)
+ * = F1, and *bound = F1 / nu1^2 (0); -1 when the test or the fit fails
+ * (the loop decides). fm: the attachment model's fit (its jump offsets
+ * with --jumps), the centred fit's start. */
+static int centred_bound(double *bound, rch_calib_result *r, rc_solve_work *w, const rc_solve_config *c0,
+                         const uint8_t *fixed, const rc_sample *train, const rc_model *fm, double nu1)
+{
+    rc_solve_config c = *c0;
+    c.prior_noise_mm = nu1;
+    rc_model x;
+    rch_comp_point_model(&x, fm, NULL); /* the attachment dropped, the rest (jump offsets last) kept */
+    uint8_t fx[RC_MAX_PARAMS];
+    memset(fx, 0, sizeof fx);
+    memcpy(fx, fixed, r->before.n_params);
+    double ssr = 0.0;
+    int ok = 0;
+    if (r->cfg.jumps) {
+        rc_sample *sorted = by_time(train, r->n_train);
+        rch_jumps *jj = malloc(sizeof *jj);
+        if (sorted && jj) {
+            rch_jumps_config jc;
+            char err[128];
+            memset(&jc, 0, sizeof jc);
+            jc.solve = &c;
+            jc.counts = &r->counts;
+            jc.warm = &x;
+            ok = rch_jumps_refit(jj, &r->before, fixed, sorted, r->n_train, r->jump_at, r->n_jump_at, &jc, w, err,
+                                 sizeof err) == 0;
+            if (ok) {
+                x = jj->model;
+                ssr = jj->rms_after_mm * jj->rms_after_mm * (double)r->n_train;
+                if (r->n_jump_at)
+                    fx[x.effects[x.n_effects - 1].first] = 1;
+            }
+        }
+        free(sorted);
+        free(jj);
+    } else {
+        c.fixed = fx;
+        ok = solve_counted(r, &x, NULL, w, &c, train, r->n_train) == RC_OK &&
+             rc_cost(&ssr, &x, train, r->n_train) == RC_OK;
+    }
+    if (!ok)
+        return -1;
+    unsigned n_free = 0;
+    for (unsigned k = 0; k < x.n_params; ++k)
+        n_free += !fx[k];
+    c.fixed = fx;
+    if (!(n_free + 1u < r->n_train) || ssr / (double)r->n_train < nu1 * nu1)
+        return -1;
+    *bound = (ssr + rc_prior_cost(&x, &c)) / (nu1 * nu1);
+    return 0;
+}
+
 /* The cable attachment, decided by the data. Lengths cannot tell the flange
  * centre from a point on the flange axis (d6 against the attachment's z,
  * a6 and theta6 against its x, y): with an attachment vector the flange
@@ -353,14 +427,24 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
     rc_solve_config c0 = *cfg;
     c0.prior_mean = r->prior_mean;
     c0.prior_sd = r->prior_sd;
-    r->attach_m0 = 1; /* at the attachment model's change points */
-    rc_status st = map_fit(r, w, &c0, fixed, train, &chi2_0);
-    r->attach_m0 = 0;
-    /* both objectives in units of the attachment model's noise */
-    const double chi2_0n = st == RC_OK ? chi2_0 * (r->noise_mm * r->noise_mm) / (noise1 * noise1) : INFINITY;
-    r->attach_dchi2 = chi2_0n - chi2_1;
     r->attach_occam = 2.0 * occam;
-    if (st == RC_OK && r->attach_dchi2 <= r->attach_occam) {
+    r->attach_bound = 0;
+    rc_status st = RC_OK;
+    double bound = 0.0;
+    if (centred_bound(&bound, r, w, &c0, fixed, train, fm, noise1) == 0 && bound - chi2_1 > r->attach_occam) {
+        /* the centred model's objective is at least `bound` at its own noise: the attachment is kept, and
+         * the centred model's noise loop is not needed to say so */
+        r->attach_dchi2 = bound - chi2_1;
+        r->attach_bound = 1;
+    } else {
+        r->attach_m0 = 1; /* at the attachment model's change points */
+        st = map_fit(r, w, &c0, fixed, train, &chi2_0);
+        r->attach_m0 = 0;
+        /* both objectives in units of the attachment model's noise */
+        const double chi2_0n = st == RC_OK ? chi2_0 * (r->noise_mm * r->noise_mm) / (noise1 * noise1) : INFINITY;
+        r->attach_dchi2 = chi2_0n - chi2_1;
+    }
+    if (st == RC_OK && !r->attach_bound && r->attach_dchi2 <= r->attach_occam) {
         r->attach_centred = 1;
         r->robot.model = m0; /* the model file carries no attachment */
         *cfg = c0;
@@ -387,17 +471,16 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
 static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rc_solve_config *cfg,
                        const rc_sample *train)
 {
-    rc_sample *tr = malloc(r->n_train * sizeof *tr);
+    rc_sample *tr = by_time(train, r->n_train);
     rch_jumps *j = malloc(sizeof *j);
     rc_model keep_model = r->model;
     if (tr && j) {
-        memcpy(tr, train, r->n_train * sizeof *tr);
-        qsort(tr, r->n_train, sizeof *tr, cmp_t);
         rch_jumps_config jc;
         char err[128];
         memset(&jc, 0, sizeof jc);
         jc.solve = cfg;
         jc.counts = &r->counts;
+        jc.warm = &keep_model; /* the MAP fit at hand is the search's geometry fit at this prior and noise */
         const double t0 = now_ms();
         const int found = rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0;
         r->jumps_ms += now_ms() - t0;

@@ -182,6 +182,7 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
         rch_jw_str(&w, "attachment", r->attach_centred ? "flange centre" : "estimated");
         rch_jw_numf(&w, "attachment_dchi2", r->attach_dchi2, "%.6g");
         rch_jw_numf(&w, "attachment_occam", r->attach_occam, "%.6g");
+        rch_jw_bool(&w, "attachment_dchi2_is_bound", r->attach_bound);
     }
     rch_jw_bool(&w, "jumps_found_by_default", r->jumps_auto);
     rch_jw_end(&w);

@@ -275,11 +275,11 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
     if (!tracker_only(r))
         print_outlets(f, m);
     if (r->attach_auto)
-        fprintf(f, "  cable attachment: %s (an attachment vector improves the fit by %.1f against its Occam "
+        fprintf(f, "  cable attachment: %s (an attachment vector improves the fit by %s%.1f against its Occam "
                    "penalty %.1f)\n",
                 r->attach_centred ? "at the flange centre" : "estimated in the flange frame (the flange centre "
                                                              "relative to it is known only from the prior of a6, d6)",
-                r->attach_dchi2, r->attach_occam);
+                r->attach_bound ? "at least " : "", r->attach_dchi2, r->attach_occam);
     fprintf(f, "  parameter        value   1 std.error  what the data see (%s)\n",
             u->has_prior ? "posterior sd against the prior's; why" : "why");
     unsigned held = 0, outside = 0;

@@ -55,10 +55,12 @@ typedef struct rch_jumps_config {
      * the start model's parameters: the segment offsets are added there. */
     const rc_solve_config *solve;
     rch_fit_counts *counts; /* NULL, or where the search adds its fits and passes */
-    /* rch_jumps_refit only: NULL (start from start, offsets 0), or an earlier
-     * fit at the same change points (its model: start's parameters and the
-     * m + 1 segment offsets, or start's alone when m is 0) the fit starts
-     * from (a noise pass after another moves the optimum little). */
+    /* NULL (start from start, offsets 0), or an earlier fit the first fit
+     * starts from: rch_jumps_refit, a fit at the same change points (its
+     * model: start's parameters and the m + 1 segment offsets, or start's
+     * alone when m is 0; a noise pass after another moves the optimum
+     * little); rch_jumps_find, a fit of start's parameters alone (the
+     * geometry fit the search begins with, e.g. the caller's fit at hand). */
     const rc_model *warm;
 } rch_jumps_config;
 
