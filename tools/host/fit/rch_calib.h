@@ -134,6 +134,10 @@ typedef struct rch_calib_result {
     int have_jump_at, keep_jump_at; /* the change points of this training set are known (searched once) */
     int attach_m0;                  /* refit at the change points found (the no-attachment model, the refit under
                                        the prior's estimated scale) */
+    rc_model check_model;           /* the jump check's fit at its change points (geometry + offsets) */
+    int have_check_model;           /* check_model is set: the first nuisance fit starts from it */
+    int map_warm;                   /* map_fit's first pass from the fit at hand (r->model, r->jumps.model) at its
+                                       noise r->noise_mm, not from the start model at its RMS */
     unsigned n_jump_at;
     double jump_rms_before_mm; /* training RMS of the geometry alone (the search's) */
     size_t jump_at[RCH_JUMPS_MAX];    /* (n_jump_at) first training sample (in t order) after each jump */

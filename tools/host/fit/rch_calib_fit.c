@@ -229,6 +229,9 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
          * model, so a pass never inherits the previous one's excursions. */
         rc_metrics m0;
         double noise = rc_eval(&m0, &r->before, train, r->n_train) == RC_OK && m0.rmse_mm > 0.0 ? m0.rmse_mm : 1.0;
+        const int warm_first = r->map_warm && r->noise_mm > 0.0;
+        if (warm_first)
+            noise = r->noise_mm;
         rc_sample *sorted = NULL;
         rc_model *warm = r->cfg.jumps ? malloc(sizeof *warm) : NULL;
         if (r->cfg.jumps && warm)
@@ -239,7 +242,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
             const rc_sample *fs = train;
             const uint8_t *fx = fixed;
             uint8_t fxj[RC_MAX_PARAMS];
-            if (pass == 0)
+            if (pass == 0 && !warm_first)
                 r->model = r->before; /* later passes start from the previous one's optimum */
             if (r->cfg.jumps && sorted) {
                 rch_jumps_config jc;
@@ -254,8 +257,18 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                  * check found the points (jumps_auto), pass 0 refits there. */
                 if (!r->attach_m0 && (pass == 1 || (pass == 0 && !r->jumps_auto)))
                     r->have_jump_at = 0;
-                if (pass > 0 && r->have_jump_at) {
+                if ((pass > 0 || warm_first) && r->have_jump_at) {
                     *warm = r->jumps.model;
+                    jc.warm = warm;
+                } else if (pass == 0 && r->have_jump_at && r->have_check_model) {
+                    jc.warm = &r->check_model; /* the check's fit at these points, at its noise */
+                } else if (pass > 0 && !r->have_jump_at) {
+                    /* the search's geometry fit from the last pass's geometry (its offsets dropped) */
+                    *warm = r->jumps.model;
+                    if (r->jumps.n_jumps) {
+                        warm->n_params = (uint16_t)warm->effects[warm->n_effects - 1].first;
+                        warm->n_effects--;
+                    }
                     jc.warm = warm;
                 }
                 if (jumps_fit(r, w, fixed, &jc, sorted, err, sizeof err) != 0)
@@ -486,6 +499,8 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
         r->jumps_ms += now_ms() - t0;
         if (found) {
             r->n_jump_at = j->n_jumps; /* every change point found: the nuisance fit starts from them */
+            r->check_model = j->model;
+            r->have_check_model = 1;
             r->jump_check_steps = j->n_jumps;
             r->jump_rms_before_mm = j->rms_before_mm;
             memcpy(r->jump_at, j->at, j->n_jumps * sizeof r->jump_at[0]);
@@ -557,8 +572,10 @@ static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_con
     double chi2 = 0.0;
     cfg->prior_sd = r->prior_sd;
     r->attach_m0 = 1; /* at the change points already found: a wider prior moves the geometry, not the jumps */
+    r->map_warm = 1;  /* from the fit at hand and its noise: a wider prior moves both a little */
     const rc_status st = map_fit(r, w, cfg, fixed, train, &chi2);
     r->attach_m0 = 0;
+    r->map_warm = 0;
     return st;
 }
 
@@ -585,8 +602,10 @@ static int scale_prior_timed(rch_calib_result *r, rc_solve_work *w, rc_solve_con
 int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
                           rch_diag *d)
 {
-    if (!r->keep_jump_at)
+    if (!r->keep_jump_at) {
         r->have_jump_at = 0; /* a new training set: its change points are searched */
+        r->have_check_model = 0;
+    }
     const double ts = now_ms();
     if (rch_calib_start(&r->before, w, &r->robot, train, r->n_train, d) != 0)
         return -1;

@@ -260,10 +260,11 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
     if (u->has_prior)
         fprintf(f, "  maximum a posteriori with the physical prior (sd: lengths %.3g mm, twists %.3g deg, joint zeros "
                    "%.3g deg, cable attachment %.3g mm%s); noise %.4f +- %.4f mm estimated from the residuals "
-                   "(%u fits, %.1f effective parameters; +- from its chi-square degrees of freedom)\n",
+                   "(%u fit%s, %.1f effective parameters; +- from its chi-square degrees of freedom)\n",
                 r->robot.prior.length_mm, r->robot.prior.twist_deg, r->robot.prior.offset_deg,
                 r->robot.prior.attachment_mm, r->robot.prior.from_file ? ", from the robot file" : ", defaults",
-                r->noise_mm, rch_sd_se(r->noise_mm, (double)r->n_train - r->p_eff), r->noise_passes, r->p_eff);
+                r->noise_mm, rch_sd_se(r->noise_mm, (double)r->n_train - r->p_eff), r->noise_passes,
+                r->noise_passes == 1 ? "" : "s", r->p_eff);
     if (u->has_prior && r->prior_scaled)
         print_prior_scale(f, r);
     if (u->has_prior && r->n_pos_rows)

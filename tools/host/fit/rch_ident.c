@@ -120,7 +120,10 @@ static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
 }
 
 /* "+0.71 d2 -0.71 d3": the (at most five) components of v (np) of at least
- * 0.1, largest first, then the plain-words reason. */
+ * 0.1, largest first (as printed, to 2 decimals; equal ones in parameter
+ * order), the sign chosen so that the first is positive (a singular
+ * vector's sign is arbitrary: the same direction prints the same), then
+ * the plain-words reason. */
 static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
 {
     const unsigned np = m->n_params;
@@ -128,18 +131,22 @@ static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
     unsigned order[RC_MAX_PARAMS];
     for (unsigned i = 0; i < np; ++i)
         order[i] = i;
-    for (unsigned i = 0; i < np; ++i) /* by |component|, descending */
-        for (unsigned j = i + 1; j < np; ++j)
-            if (fabs(v[order[j]]) > fabs(v[order[i]])) {
-                unsigned t = order[i];
-                order[i] = order[j];
-                order[j] = t;
-            }
+    for (unsigned i = 1; i < np; ++i) { /* by |component| to 2 decimals, descending; stable */
+        const unsigned t = order[i];
+        const double key = floor(100.0 * fabs(v[t]) + 0.5);
+        unsigned j = i;
+        while (j > 0 && floor(100.0 * fabs(v[order[j - 1]]) + 0.5) < key) {
+            order[j] = order[j - 1];
+            --j;
+        }
+        order[j] = t;
+    }
+    const double sign = np && v[order[0]] < 0.0 ? -1.0 : 1.0;
     for (unsigned i = 0; i < np && i < 5; ++i) {
         char name[48];
         if (fabs(v[order[i]]) < 0.1)
             break;
-        int w = snprintf(d->combo + pos, sizeof d->combo - pos, "%s%+.2f %s", i ? " " : "", v[order[i]],
+        int w = snprintf(d->combo + pos, sizeof d->combo - pos, "%s%+.2f %s", i ? " " : "", sign * v[order[i]],
                          rc_param_name(name, sizeof name, m, order[i]));
         if (w < 0 || (size_t)w >= sizeof d->combo - pos)
             break;
