@@ -19,6 +19,16 @@ RCAL=$BUILD/tools/rcal
 [ -x "$RCAL" ] || { echo "bench_ceres: build rcal first ($RCAL missing)" >&2; exit 1; }
 if ! dpkg -s libceres-dev >/dev/null 2>&1; then
     apt-get install -y libceres-dev >/dev/null
+    # libceres-dev pulls in ATLAS, whose install points the system's BLAS and
+    # LAPACK alternatives at it; rcal links the reference ones statically
+    # (ATLAS's libblas.a does not link without its own libatlas): set them back
+    ma=$(gcc -print-multiarch)
+    for a in libblas.so libblas.so.3; do
+        update-alternatives --set "$a-$ma" "/usr/lib/$ma/blas/$a" >/dev/null 2>&1 || true
+    done
+    for a in liblapack.so liblapack.so.3; do
+        update-alternatives --set "$a-$ma" "/usr/lib/$ma/lapack/$a" >/dev/null 2>&1 || true
+    done
 fi
 CB=$BUILD/ceres-bench
 cmake -S bench/ceres -B "$CB" -DCMAKE_BUILD_TYPE=Release >/dev/null

@@ -136,6 +136,8 @@ typedef struct rch_calib_result {
                                        the prior's estimated scale) */
     rc_model check_model;           /* the jump check's fit at its change points (geometry + offsets) */
     int have_check_model;           /* check_model is set: the first nuisance fit starts from it */
+    unsigned map_passes0;           /* noise passes made before a resumed map_fit (added to noise_passes) */
+    int map_one_pass;               /* map_fit stops after its first noise pass (the jump check's early look) */
     int map_warm;                   /* map_fit's first pass from the fit at hand (r->model, r->jumps.model) at its
                                        noise r->noise_mm, not from the start model at its RMS */
     unsigned n_jump_at;

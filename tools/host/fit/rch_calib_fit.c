@@ -299,13 +299,13 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
             const double next = dof > 1.0 ? sqrt(ssr / dof) : noise;
             const int settled = fabs(next - noise) <= 0.02 * noise;
             noise = next > 1e-6 ? next : 1e-6;
-            if (settled)
+            if (settled || r->map_one_pass)
                 break;
         }
         free(sorted);
         free(warm);
         r->noise_mm = cfg.prior_noise_mm = noise;
-        if (st == RC_OK && !r->cfg.jumps) /* the last pass's optimum, at the settled noise */
+        if (st == RC_OK && !r->cfg.jumps && !r->map_one_pass) /* the last pass's optimum, at the settled noise */
             st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
     }
     *chi2 = r->cfg.jumps ? chi2_loop : INFINITY;
@@ -633,9 +633,46 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
     }
     const double t0 = now_ms(), jumps0 = r->jumps_ms;
     rc_status st = RC_OK;
+    /* jumps: a cable's display; several outlets' rows interleave in acquisition order, where a step of the
+     * sequence is no display's event (their jumps only with --jumps, as rcal diagnose) */
+    const int check = r->prior_on && !r->cfg.jumps && !r->cfg.no_jump_check && r->n_train >= 40 &&
+                      !r->n_pos_rows && r->n_outlets <= 1;
+    if (check) {
+        /* The check looks at the first noise pass's fit (the weakest prior
+         * of the loop): when it finds jumps the rest of the loop, fitted
+         * across them, would be thrown away; when it does not, the loop
+         * goes on from that pass (map_warm: the same passes as one loop). */
+        double chi2_e = 0.0;
+        r->map_one_pass = 1;
+        st = map_fit(r, w, &cfg, fixed, train, &chi2_e);
+        r->map_one_pass = 0;
+        if (st == RC_OK) {
+            const unsigned passes = r->noise_passes;
+            jump_check(r, w, fixed, &cfg, train);
+            if (r->jumps_found && !r->cfg.residuals_path) {
+                /* fit them as nuisance, as --jumps does: the default run never
+                 * hands on a geometry fitted across jumps */
+                r->time_ms = now_ms() - t0;
+                r->fits_ms += r->time_ms - (r->jumps_ms - jumps0);
+                r->cfg.jumps = 1;
+                r->jumps_auto = 1;
+                r->have_jump_at = 1; /* at the change points the check found */
+                r->keep_jump_at = 1;
+                const int rc = rch_calib_fit_and_report(r, w, train, test, d);
+                r->keep_jump_at = 0;
+                return rc;
+            }
+            r->map_warm = 1;
+            r->map_passes0 = passes;
+        }
+    }
     if (r->prior_on) {
         double chi2_1 = 0.0;
-        st = map_fit(r, w, &cfg, fixed, train, &chi2_1);
+        if (st == RC_OK)
+            st = map_fit(r, w, &cfg, fixed, train, &chi2_1);
+        r->map_warm = 0;
+        r->noise_passes += r->map_passes0;
+        r->map_passes0 = 0;
         if (st == RC_OK && r->attach_auto)
             st = choose_attachment(r, w, &cfg, fixed, train, chi2_1);
     } else {
@@ -660,22 +697,6 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
         const int rc = fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
         r->fits_ms += now_ms() - tj - (r->uncert_ms - u0) - (r->jumps_ms - j0); /* the refit at the points */
         return rc;
-    }
-    /* jumps: a cable's display; several outlets' rows interleave in acquisition order, where a step of the
-     * sequence is no display's event (their jumps only with --jumps, as rcal diagnose) */
-    if (r->prior_on && !r->cfg.no_jump_check && r->n_train >= 40 && !r->n_pos_rows && r->n_outlets <= 1) {
-        jump_check(r, w, fixed, &cfg, train);
-        if (r->jumps_found && !r->cfg.residuals_path) {
-            /* fit them as nuisance, as --jumps does: the default run never
-             * hands on a geometry fitted across jumps */
-            r->cfg.jumps = 1;
-            r->jumps_auto = 1;
-            r->have_jump_at = 1; /* at the change points the check found */
-            r->keep_jump_at = 1;
-            const int rc = rch_calib_fit_and_report(r, w, train, test, d);
-            r->keep_jump_at = 0;
-            return rc;
-        }
     }
     if (scale_prior_timed(r, w, &cfg, fixed, train, d) != 0) /* after the jump check: once, on the final model */
         return -1;
