@@ -122,12 +122,57 @@ static void test_coverage_cluster(void **state)
     coverage("noise 0.005-0.015 mm, cluster-robust (30 groups of 10)", 0.005, 0.015, 1);
 }
 
+/* The closed-form sensitivity columns (DH rows, tool offset, axis tilts) and
+ * the zero ones (encoder, length side) against central differences of the
+ * model's own forward kinematics rc_fk, on a model that carries them all. */
+static void test_point_sens_closed_form(void **state)
+{
+    (void)state;
+    rch_robot nom;
+    rch_diag d;
+    assert_int_equal(rch_robot_load(&nom, RCAL_SOURCE_DIR "/data/irb120.json", &d), 0);
+    rc_model m = nom.model;
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOOL_OFFSET, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_AXIS_TILT, 1, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_AXIS_TILT, 2, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_LENGTH_OFFSET, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 3, 0), RC_OK);
+    G.s = 777u;
+    for (unsigned k = 0; k < m.n_params; ++k) /* every parameter off zero, the tilts of a few mrad */
+        m.x[k] += (k >= RC_N_BASE ? (rc_param_unit(&m, k) == 1 ? 0.003 : 20.0) : 0.0) * (u01() - 0.5);
+    double worst = 0.0;
+    for (int pose = 0; pose < 20; ++pose) {
+        double q[RC_NJ], Jp[3][RC_MAX_PARAMS];
+        for (int j = 0; j < RC_NJ; ++j)
+            q[j] = m.q_min_rad[j] * 0.9 + (m.q_max_rad[j] - m.q_min_rad[j]) * 0.9 * u01();
+        rch_uncert_point_sens(Jp, &m, q);
+        for (unsigned k = 0; k < m.n_params; ++k) {
+            const double h = rc_param_unit(&m, k) == 1 ? 1e-6 : 1e-4;
+            rc_model t = m;
+            double pp[3], pm[3];
+            t.x[k] = m.x[k] + h;
+            rc_fk(pp, NULL, &t, q);
+            t.x[k] = m.x[k] - h;
+            rc_fk(pm, NULL, &t, q);
+            for (int i = 0; i < 3; ++i) {
+                const double fd = (pp[i] - pm[i]) / (2.0 * h), e = fabs(Jp[i][k] - fd);
+                if (e > 1e-5 * (1.0 + fabs(fd)))
+                    fail_msg("parameter %u row %d pose %d: %.9g against the FK's %.9g", k, i, pose, Jp[i][k], fd);
+                worst = fmax(worst, e / (1.0 + fabs(fd)));
+            }
+        }
+    }
+    print_message("point sensitivity of %u parameters at 20 poses: largest relative difference from rc_fk's "
+                  "central differences %.2g\n", (unsigned)m.n_params, worst);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_coverage_default_noise),
         cmocka_unit_test(test_coverage_ten_times_noise),
         cmocka_unit_test(test_coverage_cluster),
+        cmocka_unit_test(test_point_sens_closed_form),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

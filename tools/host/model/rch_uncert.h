@@ -135,9 +135,10 @@ size_t rch_uncert_point95(double *v, const rch_uncert *u, const rc_model *m, con
                           const double t_mm[3], int t_first, int target);
 
 /* Sensitivity of the point of m at q (the flange, or the tool point when m
- * carries a tool offset) to every parameter: Jp (3 x m->n_params), the DH
- * columns in closed form (rc_kin), the effects' by central differences of
- * rc_fk, the outlets' zero. The one definition the uncertainty figures use
+ * carries a tool offset) to every parameter: Jp (3 x m->n_params), the DH,
+ * tool offset and axis tilt columns in closed form (rc_kin), the joint-side
+ * effects' by central differences of rc_fk, the encoder's, outlets' and
+ * length-side effects' zero. The one definition the uncertainty figures use
  * (rch_poses plans with it). */
 void rch_uncert_point_sens(double Jp[3][RC_MAX_PARAMS], const rc_model *m, const double q_rad[RC_NJ]);
 /* The 95 % quantile of |e| for e ~ N(0, C), C (3 x 3, row-major,

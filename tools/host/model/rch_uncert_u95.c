@@ -25,24 +25,34 @@
 /* chi-square quantile with 3 degrees of freedom at 0.95 */
 #define CHI2_3_95 7.814727903251178
 
+/* The effect of m that parameter k belongs to, or NULL (geometry, encoder). */
+static const rc_effect *param_effect(const rc_model *m, unsigned k)
+{
+    for (unsigned i = 0; i < m->n_effects; ++i)
+        if (k >= m->effects[i].first && k < (unsigned)m->effects[i].first + m->effects[i].count)
+            return &m->effects[i];
+    return NULL;
+}
+
 /* Sensitivity of the flange position (Jp, may be NULL) and of its
  * small-rotation vector (Jr, may be NULL) to the parameters k < n with
  * use[k] set; the others' columns are zero. The DH columns in closed form
  * from one chain (rc_kin_fk_dh_jac on kin, the model compiled by
- * sens_compile); the encoder's are zero (it does not move the flange); the
- * effects' by central differences of rc_fk (none in a default fit). kin
+ * sens_compile); the encoder's and those of effects that move neither the
+ * flange nor the point it carries (length, outlet and sensor side) are zero;
+ * the tool offset's and the axis tilts' in closed form from the same chain
+ * (with kin); the other effects' by central differences of rc_fk (the
+ * joint-side effects). kin
  * NULL (a model rc_kin cannot hold): central differences for all. */
 static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARAMS], const uint8_t *use, unsigned n,
                            const rc_model *m, const rc_kin *kin, const double q_rad[RC_NJ])
 {
     rc_model t; /* m with one parameter moved: copied when a difference needs it */
     int have_t = 0;
-    double jp[3 * RC_N_DH], jr[3 * RC_N_DH];
-    if (kin != NULL) {
-        rc_kin_data kd;
-        double pos[3];
-        rc_kin_fk_dh_jac(pos, NULL, Jp ? jp : NULL, Jr ? jr : NULL, &kd, kin, q_rad);
-    }
+    double jp[3 * RC_N_DH], jr[3 * RC_N_DH], rot[9], pos[3];
+    rc_kin_data kd;
+    if (kin != NULL)
+        rc_kin_fk_dh_jac(pos, rot, Jp ? jp : NULL, Jr ? jr : NULL, &kd, kin, q_rad);
     for (unsigned k = 0; k < n; ++k) {
         for (int i = 0; i < 3; ++i) {
             if (Jp)
@@ -58,6 +68,29 @@ static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARA
                     Jp[i][k] = jp[i * RC_N_DH + (int)k];
                 if (Jr)
                     Jr[i][k] = jr[i * RC_N_DH + (int)k];
+            }
+            continue;
+        }
+        const rc_effect *e = k >= RC_N_BASE ? param_effect(m, k) : NULL;
+        const rc_effect_desc *ds = e != NULL ? rc_effect_describe(e->kind) : NULL;
+        if (ds != NULL && (ds->side == RC_SIDE_LENGTH || ds->side == RC_SIDE_OUTLET || ds->side == RC_SIDE_SENSOR))
+            continue; /* moves nothing the flange carries: a zero column */
+        if (kin != NULL && e != NULL && e->kind == RC_EFF_TOOL_OFFSET) {
+            for (int i = 0; Jp && i < 3; ++i) /* p = flange + R6 t: d p / d t_j = R6's column j, no rotation */
+                Jp[i][k] = rot[i * 3 + (int)(k - e->first)];
+            continue;
+        }
+        if (kin != NULL && e != NULL && e->kind == RC_EFF_AXIS_TILT && e->joint < RC_NJ) {
+            /* Ry(beta) after Rx(alpha) turns frame j+1 about its own y axis, which it leaves in place:
+             * d p / d beta = y_{j+1} x (p - o_{j+1}), d w / d beta = y_{j+1} */
+            const double *R = kd.R[e->joint + 1], *o = kd.o[e->joint + 1];
+            const double y[3] = {R[1], R[4], R[7]}, r[3] = {pos[0] - o[0], pos[1] - o[1], pos[2] - o[2]};
+            const double v[3] = {y[1] * r[2] - y[2] * r[1], y[2] * r[0] - y[0] * r[2], y[0] * r[1] - y[1] * r[0]};
+            for (int i = 0; i < 3; ++i) {
+                if (Jp)
+                    Jp[i][k] = v[i];
+                if (Jr)
+                    Jr[i][k] = y[i];
             }
             continue;
         }
