@@ -338,20 +338,28 @@ const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned
     return buf;
 }
 
+const rc_effect *rc_param_effect(const rc_model *m, unsigned k)
+{
+    RC_ASSERT(m != NULL);
+    for (unsigned i = 0; i < m->n_effects; ++i) {
+        const rc_effect *e = &m->effects[i];
+        if (k >= e->first && k < (unsigned)e->first + e->count)
+            return e;
+    }
+    return NULL;
+}
+
 int rc_param_unit(const rc_model *m, unsigned k)
 {
     if (k < RC_N_DH)
         return (k % 4 == 0 || k % 4 == 1) ? 0 : 1;
     if (k < RC_N_BASE)
         return 0;
-    for (unsigned i = 0; i < m->n_effects; ++i) {
-        const rc_effect *e = &m->effects[i];
-        if (k >= e->first && k < (unsigned)e->first + e->count) {
-            const rc_effect_desc *ds = rc_effect_describe(e->kind);
-            return ds ? ds->unit : 2;
-        }
-    }
-    return 2;
+    const rc_effect *e = rc_param_effect(m, k);
+    if (e == NULL)
+        return 2;
+    const rc_effect_desc *ds = rc_effect_describe(e->kind);
+    return ds ? ds->unit : 2;
 }
 
 double rc_gravity_lever_m(const double ref_dh[4][4], unsigned joint, const double q_rad[RC_NJ])

@@ -233,6 +233,10 @@ const char *rc_effect_name(rc_effect_kind kind);
  * "joint_periodic.j3.s1"); returns buf. */
 const char *rc_param_name(char *buf, size_t buf_len, const rc_model *m, unsigned k);
 
+/* The effect of m that parameter k belongs to, or NULL (the geometry and
+ * the encoder, k < RC_N_BASE, or k beyond the model). */
+const rc_effect *rc_param_effect(const rc_model *m, unsigned k);
+
 /* Unit class of parameter k: 0 = mm, 1 = rad, 2 = other (rad/m, unitless). */
 int rc_param_unit(const rc_model *m, unsigned k);
 

@@ -25,15 +25,6 @@
 /* chi-square quantile with 3 degrees of freedom at 0.95 */
 #define CHI2_3_95 7.814727903251178
 
-/* The effect of m that parameter k belongs to, or NULL (geometry, encoder). */
-static const rc_effect *param_effect(const rc_model *m, unsigned k)
-{
-    for (unsigned i = 0; i < m->n_effects; ++i)
-        if (k >= m->effects[i].first && k < (unsigned)m->effects[i].first + m->effects[i].count)
-            return &m->effects[i];
-    return NULL;
-}
-
 /* Sensitivity of the flange position (Jp, may be NULL) and of its
  * small-rotation vector (Jr, may be NULL) to the parameters k < n with
  * use[k] set; the others' columns are zero. The DH columns in closed form
@@ -71,7 +62,7 @@ static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARA
             }
             continue;
         }
-        const rc_effect *e = k >= RC_N_BASE ? param_effect(m, k) : NULL;
+        const rc_effect *e = k >= RC_N_BASE ? rc_param_effect(m, k) : NULL;
         const rc_effect_desc *ds = e != NULL ? rc_effect_describe(e->kind) : NULL;
         if (ds != NULL && (ds->side == RC_SIDE_LENGTH || ds->side == RC_SIDE_OUTLET || ds->side == RC_SIDE_SENSOR))
             continue; /* moves nothing the flange carries: a zero column */
