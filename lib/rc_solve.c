@@ -592,7 +592,10 @@ static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, doub
          * what the data do not (no null truncation, no significance rule) */
         if (lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, 1e-300, 0.0) != RC_OK || gnorm == 0.0)
             return;
-        (void)lm_subspace_step(w->dx, w, V, nf, rank, 0.0);
+        /* a step that promises less than the stop rule's decrease ends the
+         * polish here (at an optimum it would only be halved to nothing) */
+        if (!(lm_subspace_step(w->dx, w, V, nf, rank, 0.0) > 1e-12 * cost))
+            return;
         double t = 1.0;
         if (pp > 0.0) {
             double dq = 0.0;

@@ -99,12 +99,21 @@ typedef enum rc_exit {
 /* Callback after each iteration: training RMS (mm) and the current model. */
 typedef void (*rc_iter_cb)(void *ctx, unsigned iter, double train_rms_mm, const rc_model *m);
 
+/* The robust LM's initial damping for a start near the optimum (a refit
+ * from an earlier fit of nearly the same problem): Gauss-Newton steps from
+ * the first iteration, the damping raised only where a step is refused. The
+ * default 1e-3 holds the directions only the prior determines (eigenvalues
+ * near 1e-8 of the largest) all but still, so a warm refit crawled along
+ * them for 10 iterations. */
+#define RC_SOLVE_MU0_WARM 1e-9
+
 /* All-zero means defaults. */
 typedef struct rc_solve_config {
     rc_method method;
     unsigned max_iter;       /* 0: 100 (paper variants: 50) */
     double mu0;              /* robust: initial damping relative to the largest
-                                scaled eigenvalue, 0: 1e-3; paper: absolute mu, 0: 5 */
+                                scaled eigenvalue, 0: 1e-3; paper: absolute mu, 0: 5;
+                                RC_SOLVE_MU0_WARM (robust only) for a start near the optimum */
     double tol_step;         /* 0: 1e-9 (relative, scaled) */
     double tol_cost;         /* 0: 1e-4 (relative decrease of the cost in one iteration) */
     double rcond;            /* 0: rc_ident's rule (null below a relative singular value of

@@ -122,6 +122,7 @@ typedef struct rch_calib_result {
     int prior_scaled;                 /* the prior's scale was estimated from the data (rch_prior_scale) */
     rch_prior_scale prior_scale;      /* the factors, their uncertainty, the fallbacks */
     double noise_mm;          /* residual sd the prior was weighed against (estimated: SSR / (n - p_eff)) */
+    double noise_fit_mm;      /* the noise map_fit's last pass was fitted at (noise_mm: the next pass's) */
     double p_eff;             /* effective number of parameters the data determined (trace of the hat matrix) */
     unsigned noise_passes;    /* fits it took for the noise estimate to settle */
     unsigned n_outside_prior; /* DH parameters more than 3 prior sd from nominal (flagged) */

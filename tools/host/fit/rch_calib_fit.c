@@ -117,7 +117,10 @@ static int jumps_fit(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     r->jumps_ms += now_ms() - t0;
     if (rc != 0)
         return -1;
-    r->jump_rms_before_mm = r->jumps.rms_before_mm;
+    if (isfinite(r->jumps.rms_before_mm)) /* a search linearised at the fit at hand keeps the earlier one */
+        r->jump_rms_before_mm = r->jumps.rms_before_mm;
+    else
+        r->jumps.rms_before_mm = r->jump_rms_before_mm;
     r->n_jump_at = r->jumps.n_jumps;
     memcpy(r->jump_at, r->jumps.at, r->jumps.n_jumps * sizeof r->jump_at[0]);
     r->have_jump_at = 1;
@@ -238,6 +241,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
             sorted = by_time(train, r->n_train);
         for (unsigned pass = 0; pass < 6; ++pass) {
             cfg.prior_noise_mm = noise;
+            r->noise_fit_mm = noise;
             const rc_model *fitm = &r->model;
             const rc_sample *fs = train;
             const uint8_t *fx = fixed;
@@ -250,6 +254,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 memset(&jc, 0, sizeof jc);
                 jc.solve = &cfg;
                 jc.counts = &r->counts;
+                jc.skip_se = 1; /* sizes only: the final fit gives their standard errors */
                 /* The change points depend on the prior's weight: searched
                  * again until the noise is near its final value (pass 1),
                  * refitted after, each refit from the previous pass's fit.
@@ -263,13 +268,11 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 } else if (pass == 0 && r->have_jump_at && r->have_check_model) {
                     jc.warm = &r->check_model; /* the check's fit at these points, at its noise */
                 } else if (pass > 0 && !r->have_jump_at) {
-                    /* the search's geometry fit from the last pass's geometry (its offsets dropped) */
+                    /* the search linearised at the last pass's fit (its geometry, its offsets dropped):
+                     * no geometry-alone fit at this noise */
                     *warm = r->jumps.model;
-                    if (r->jumps.n_jumps) {
-                        warm->n_params = (uint16_t)warm->effects[warm->n_effects - 1].first;
-                        warm->n_effects--;
-                    }
                     jc.warm = warm;
+                    jc.warm_role = RCH_WARM_LINEARISE;
                 }
                 if (jumps_fit(r, w, fixed, &jc, sorted, err, sizeof err) != 0)
                     break; /* fit_jumps reports it */
@@ -283,7 +286,10 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                 for (size_t i = 0; i < r->n_train; ++i)
                     sorted[i].group = (uint16_t)rch_jumps_segment(&r->jumps, sorted[i].t);
             } else {
-                st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
+                rc_solve_config wc = cfg; /* a later pass (or a warm first) starts at the fit at hand */
+                if ((pass > 0 || warm_first) && !(wc.mu0 > 0.0))
+                    wc.mu0 = RC_SOLVE_MU0_WARM;
+                st = solve_counted(r, &r->model, &r->solve, w, &wc, train, r->n_train);
                 if (st != RC_OK)
                     break;
             }
@@ -305,8 +311,12 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
         free(sorted);
         free(warm);
         r->noise_mm = cfg.prior_noise_mm = noise;
-        if (st == RC_OK && !r->cfg.jumps && !r->map_one_pass) /* the last pass's optimum, at the settled noise */
-            st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
+        if (st == RC_OK && !r->cfg.jumps && !r->map_one_pass) { /* the last pass's optimum, at the settled noise */
+            rc_solve_config wc = cfg;
+            if (!(wc.mu0 > 0.0))
+                wc.mu0 = RC_SOLVE_MU0_WARM;
+            st = solve_counted(r, &r->model, &r->solve, w, &wc, train, r->n_train);
+        }
     }
     *chi2 = r->cfg.jumps ? chi2_loop : INFINITY;
     if (st == RC_OK && !r->cfg.jumps) {
@@ -358,6 +368,7 @@ static int centred_bound(double *bound, rch_calib_result *r, rc_solve_work *w, c
             memset(&jc, 0, sizeof jc);
             jc.solve = &c;
             jc.counts = &r->counts;
+            jc.skip_se = 1; /* sizes only: the final fit gives their standard errors */
             jc.warm = &x;
             ok = rch_jumps_refit(jj, &r->before, fixed, sorted, r->n_train, r->jump_at, r->n_jump_at, &jc, w, err,
                                  sizeof err) == 0;
@@ -491,9 +502,13 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
         rch_jumps_config jc;
         char err[128];
         memset(&jc, 0, sizeof jc);
-        jc.solve = cfg;
+        rc_solve_config c0 = *cfg;
+        c0.prior_noise_mm = r->noise_fit_mm; /* the noise that fit was made at (cfg's is the next pass's) */
+        jc.solve = &c0;
         jc.counts = &r->counts;
+        jc.skip_se = 1; /* sizes only: the final fit gives their standard errors */
         jc.warm = &keep_model; /* the MAP fit at hand is the search's geometry fit at this prior and noise */
+        jc.warm_role = RCH_WARM_OPTIMUM;
         const double t0 = now_ms();
         const int found = rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0;
         r->jumps_ms += now_ms() - t0;

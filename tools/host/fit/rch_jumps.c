@@ -67,13 +67,16 @@ static int fit_segments(rc_model *out, double *ssr, const rc_model *start, const
             return -1;
         fx[mdl.effects[mdl.n_effects - 1].first] = 1; /* first segment: the reference */
     }
-    if (wf && wf->model && wf->model->n_params >= start->n_params)
+    const int warm = wf && wf->model && wf->model->n_params >= start->n_params;
+    if (warm)
         warm_start(&mdl, start, wf, at, m);
     rc_solve_config cfg;
     memset(&cfg, 0, sizeof cfg);
     if (base)
         cfg = *base;
     cfg.fixed = fx;
+    if (warm && !(cfg.mu0 > 0.0) && (cfg.method == RC_METHOD_LM || cfg.method == RC_METHOD_LTLM))
+        cfg.mu0 = RC_SOLVE_MU0_WARM; /* from an earlier fit: near the optimum (the paper variants keep theirs) */
     rc_solve_result res;
     memset(&res, 0, sizeof res);
     const rc_status st = rc_solve(&mdl, &res, w, &cfg, s, n);
@@ -322,7 +325,7 @@ static int cmp_size(const void *x, const void *y)
 }
 
 /* Jump sizes and standard errors from the segment offsets of j->model. */
-static void jump_sizes(rch_jumps *j, const rc_sample *s, size_t n)
+static void jump_sizes(rch_jumps *j, const rc_sample *s, size_t n, int with_se)
 {
     if (j->n_jumps == 0)
         return;
@@ -332,7 +335,7 @@ static void jump_sizes(rch_jumps *j, const rc_sample *s, size_t n)
     uint8_t fx[RC_MAX_PARAMS];
     memset(fx, 0, sizeof fx);
     fx[e->first] = 1;
-    int have = rch_uncert_compute(&u, &j->model, fx, s, n, 0, err, sizeof err) == 0;
+    int have = with_se && rch_uncert_compute(&u, &j->model, fx, s, n, 0, err, sizeof err) == 0;
     for (unsigned k = 0; k < j->n_jumps; ++k) {
         unsigned a = e->first + k, b = e->first + k + 1;
         j->size_mm[k] = j->model.x[b] - j->model.x[a];
@@ -351,7 +354,7 @@ static void jump_sizes(rch_jumps *j, const rc_sample *s, size_t n)
  * the points, the geometry without the nuisance offsets, and the sizes with
  * their standard errors (c: the samples' copy, relabelled here). */
 static void finish(rch_jumps *out, const rc_model *cur, double ssr, const rc_sample *s, rc_sample *c, size_t n,
-                   const size_t *at, unsigned m, rch_fit_counts *cnt)
+                   const size_t *at, unsigned m, rch_fit_counts *cnt, int with_se)
 {
     out->n_jumps = m;
     out->model = *cur;
@@ -367,8 +370,8 @@ static void finish(rch_jumps *out, const rc_model *cur, double ssr, const rc_sam
     }
     for (size_t i = 0; i < n; ++i)
         c[i].group = (uint16_t)rch_jumps_segment(out, c[i].t);
-    jump_sizes(out, c, n);
-    if (cnt && m > 0)
+    jump_sizes(out, c, n, with_se);
+    if (cnt && m > 0 && with_se)
         cnt->jac_passes++; /* the sizes' covariance */
 }
 
@@ -475,9 +478,23 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
     double ssr;
     rc_model cur;
     /* the geometry alone; from cfg->warm when it is a fit of start's parameters (the caller's fit at hand) */
+    const int role = cfg && cfg->warm ? cfg->warm_role : RCH_WARM_START;
     const warm_from w0 = {cfg ? cfg->warm : NULL, at, 0};
     const int warm0 = w0.model && w0.model->n_params == start->n_params;
-    if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, base, w, cnt, warm0 ? &w0 : NULL) != 0) {
+    if (role == RCH_WARM_LINEARISE && w0.model->n_params >= start->n_params) {
+        cur = *start; /* the fit at hand's geometry; no fit: the first round starts from no point there */
+        memcpy(cur.x, w0.model->x, start->n_params * sizeof cur.x[0]);
+        ssr = NAN;
+    } else if (role == RCH_WARM_OPTIMUM && warm0) {
+        cur = *w0.model;
+        for (size_t i = 0; i < n; ++i)
+            c[i].group = 0;
+        if (rc_cost(&ssr, &cur, c, n) != RC_OK) {
+            snprintf(err, errlen, "the geometric fit failed");
+            free(c);
+            return -1;
+        }
+    } else if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, base, w, cnt, warm0 ? &w0 : NULL) != 0) {
         snprintf(err, errlen, "the geometric fit failed");
         free(c);
         return -1;
@@ -529,7 +546,18 @@ int rch_jumps_find(rch_jumps *out, const rc_model *start, const uint8_t *fixed, 
             geo.n_params = (uint16_t)cur.effects[cur.n_effects - 1].first;
         }
     }
-    finish(out, &cur, ssr, s, c, n, at, m, cnt);
+    if (isnan(ssr)) { /* linearised at a fit at hand and no point kept: the geometry alone, fitted from there */
+        const rc_model g = cur;
+        const warm_from wg = {&g, at, 0};
+        m = 0;
+        if (fit_segments(&cur, &ssr, start, fixed, c, n, at, 0, base, w, cnt, &wg) != 0) {
+            snprintf(err, errlen, "the geometric fit failed");
+            free(c);
+            return -1;
+        }
+        out->rms_before_mm = sqrt(ssr / (double)n);
+    }
+    finish(out, &cur, ssr, s, c, n, at, m, cnt, !(cfg && cfg->skip_se));
     free(c);
     return 0;
 }
@@ -566,7 +594,7 @@ int rch_jumps_refit(rch_jumps *out, const rc_model *start, const uint8_t *fixed,
         free(c);
         return -1;
     }
-    finish(out, &cur, ssr, s, c, n, at, m, cnt);
+    finish(out, &cur, ssr, s, c, n, at, m, cnt, !(cfg && cfg->skip_se));
     out->rms_before_mm = out->rms_after_mm;
     free(c);
     return 0;

@@ -62,7 +62,21 @@ typedef struct rch_jumps_config {
      * little); rch_jumps_find, a fit of start's parameters alone (the
      * geometry fit the search begins with, e.g. the caller's fit at hand). */
     const rc_model *warm;
+    /* What rch_jumps_find's warm is (rch_jumps_refit reads only warm):
+     * RCH_WARM_START a point the geometry fit starts from; RCH_WARM_OPTIMUM
+     * that fit itself, at this solve set-up (the caller's fit at hand: no
+     * geometry fit is made, its RMS is rms_before_mm); RCH_WARM_LINEARISE a
+     * fit at other change points (its offsets, if any, are dropped): the
+     * search's first round is linearised at its geometry and no geometry
+     * fit is made (rms_before_mm NAN: the caller keeps an earlier one). */
+    int warm_role;
+    /* 1: the jumps' standard errors are not computed (se_mm NAN): a fit
+     * whose sizes are an intermediate (a noise pass, a comparison's bound)
+     * saves the covariance pass. */
+    int skip_se;
 } rch_jumps_config;
+
+enum { RCH_WARM_START = 0, RCH_WARM_OPTIMUM = 1, RCH_WARM_LINEARISE = 2 };
 
 typedef struct rch_jumps {
     unsigned n_jumps;
