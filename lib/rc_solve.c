@@ -571,7 +571,8 @@ static double lm_subspace_step(double *dx, const rc_solve_work *w, const double 
 #define RC_MAP_POLISH_ITER 60
 #define RC_MAP_POLISH_HALVINGS 12
 static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, double *A, double *V, passbuf tab,
-                       const rc_solve_config *cfg, unsigned nf, const rc_sample *samples, size_t n)
+                       const rc_solve_config *cfg, unsigned nf, const rc_sample *samples, size_t n, int have_ne,
+                       double cost_at_m)
 {
     /* Where the residuals are large, Gauss-Newton lacks their curvature and
      * converges linearly along the prior-held directions, with a rate that
@@ -582,12 +583,14 @@ static void map_polish(rc_model *m, rc_solve_result *res, rc_solve_work *w, doub
      * lower the cost, then the plain step and its halvings. */
     double prev[RC_MAX_PARAMS] = {0}, t_prev = 1.0, pp = 0.0;
     for (unsigned k = 0; k < RC_MAP_POLISH_ITER; ++k) {
-        double cost, gnorm = 0.0, cnew = 0.0;
+        double cost = cost_at_m, gnorm = 0.0, cnew = 0.0;
         unsigned rank = 0;
-        ++res->cost_evals;
-        if (normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n) != RC_OK)
-            return;
-        rc_prior_normal_eq(A, w->g, &cost, m, w->idx, nf, cfg);
+        if (!(k == 0 && have_ne)) { /* (the LM's last accepted step left them in A, w->g) */
+            ++res->cost_evals;
+            if (normal_eq_tab(A, w->g, &cost, w->jrow, m, w->idx, nf, samples, tab, n) != RC_OK)
+                return;
+            rc_prior_normal_eq(A, w->g, &cost, m, w->idx, nf, cfg);
+        }
         /* every direction with a positive eigenvalue: the prior determines
          * what the data do not (no null truncation, no significance rule) */
         if (lm_subspace(&rank, &gnorm, w, A, V, nf, cost, n, 1e-300, 0.0) != RC_OK || gnorm == 0.0)
@@ -934,7 +937,7 @@ static rc_status solve_core(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     if (st != RC_OK)
         return st;
     if (has_prior(cfg))
-        map_polish(m, res, w, A, V, tab, cfg, s.nf, samples, n);
+        map_polish(m, res, w, A, V, tab, cfg, s.nf, samples, n, s.have_ne, s.cost);
     rc_model_wrap_angles(m);
     return RC_OK;
 }

@@ -347,8 +347,9 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
  * = F1, and *bound = F1 / nu1^2 (0); -1 when the test or the fit fails
  * (the loop decides). fm: the attachment model's fit (its jump offsets
  * with --jumps), the centred fit's start. */
-static int centred_bound(double *bound, rch_calib_result *r, rc_solve_work *w, const rc_solve_config *c0,
-                         const uint8_t *fixed, const rc_sample *train, const rc_model *fm, double nu1)
+static int centred_bound(double *bound, rc_model *fit, rch_calib_result *r, rc_solve_work *w,
+                         const rc_solve_config *c0, const uint8_t *fixed, const rc_sample *train, const rc_model *fm,
+                         double nu1)
 {
     rc_solve_config c = *c0;
     c.prior_noise_mm = nu1;
@@ -388,6 +389,7 @@ static int centred_bound(double *bound, rch_calib_result *r, rc_solve_work *w, c
     }
     if (!ok)
         return -1;
+    *fit = x; /* the centred fit at nu1: where the centred noise loop starts when the bound does not decide */
     unsigned n_free = 0;
     for (unsigned k = 0; k < x.n_params; ++k)
         n_free += !fx[k];
@@ -455,15 +457,27 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
     r->attach_bound = 0;
     rc_status st = RC_OK;
     double bound = 0.0;
-    if (centred_bound(&bound, r, w, &c0, fixed, train, fm, noise1) == 0 && bound - chi2_1 > r->attach_occam) {
+    rc_model xc;
+    xc.n_params = 0;
+    const int bd = centred_bound(&bound, &xc, r, w, &c0, fixed, train, fm, noise1);
+    if (bd == 0 && bound - chi2_1 > r->attach_occam) {
         /* the centred model's objective is at least `bound` at its own noise: the attachment is kept, and
          * the centred model's noise loop is not needed to say so */
         r->attach_dchi2 = bound - chi2_1;
         r->attach_bound = 1;
     } else {
         r->attach_m0 = 1; /* at the attachment model's change points */
+        if (xc.n_params > 0) { /* the loop from the centred fit at nu1 and nu1: near its fixed point */
+            if (r->cfg.jumps)
+                r->jumps.model = xc;
+            else
+                r->model = xc;
+            r->noise_mm = noise1;
+            r->map_warm = 1;
+        }
         st = map_fit(r, w, &c0, fixed, train, &chi2_0);
         r->attach_m0 = 0;
+        r->map_warm = 0;
         /* both objectives in units of the attachment model's noise */
         const double chi2_0n = st == RC_OK ? chi2_0 * (r->noise_mm * r->noise_mm) / (noise1 * noise1) : INFINITY;
         r->attach_dchi2 = chi2_0n - chi2_1;

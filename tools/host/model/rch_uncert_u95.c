@@ -51,8 +51,8 @@ static void fk_sensitivity(double Jp[3][RC_MAX_PARAMS], double Jr[3][RC_MAX_PARA
             if (Jr)
                 Jr[i][k] = 0.0;
         }
-        if (!use[k] || (kin != NULL && k >= RC_N_DH && k < RC_N_BASE))
-            continue;
+        if (!use[k] || k >= m->n_params || (kin != NULL && k >= RC_N_DH && k < RC_N_BASE))
+            continue; /* (k past m: a covariance's nuisance, e.g. the jumps' offsets, which m drops) */
         if (kin != NULL && k < RC_N_DH) {
             for (int i = 0; i < 3; ++i) {
                 if (Jp)
