@@ -99,12 +99,13 @@ typedef enum rc_exit {
 /* Callback after each iteration: training RMS (mm) and the current model. */
 typedef void (*rc_iter_cb)(void *ctx, unsigned iter, double train_rms_mm, const rc_model *m);
 
-/* The robust LM's initial damping for a start near the optimum (a refit
- * from an earlier fit of nearly the same problem): Gauss-Newton steps from
- * the first iteration, the damping raised only where a step is refused. The
- * default 1e-3 holds the directions only the prior determines (eigenvalues
- * near 1e-8 of the largest) all but still, so a warm refit crawled along
- * them for 10 iterations. */
+/* The robust LM's initial damping for a MAP fit started near its optimum
+ * (a refit from an earlier fit of nearly the same problem): Gauss-Newton
+ * steps from the first iteration, the damping raised only where a step is
+ * refused. The default 1e-3 holds the directions only the prior determines
+ * (eigenvalues near 1e-8 of the largest) all but still, so a warm refit
+ * crawled along them for 10 iterations. Not for least squares without a
+ * prior: there the damping is what keeps ill-determined directions still. */
 #define RC_SOLVE_MU0_WARM 1e-9
 
 /* All-zero means defaults. */

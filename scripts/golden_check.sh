@@ -217,6 +217,7 @@ if [ -f "$real_src" ]; then
     run real_cal "$R" calibrate --data ../in/robotcali.csv
     run real_cal_jumps_dq "$R" calibrate --data ../in/robotcali.csv --jumps --dequantize-joints --out model.json
     run real_fkcheck "$R" fkcheck --data ../in/robotcali.csv
+    run real_diag "$R" diagnose --data ../in/robotcali.csv
     run real_comp_rapid "$R" compensate --model ../real_cal_jumps_dq/model.json --in ../in/every_form.mod \
         --out every_form_cal.mod --uncertainty-out u95.csv
 else
