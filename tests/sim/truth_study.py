@@ -276,6 +276,10 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
         shutil.copy(robot_path, keep)
         with open(os.path.join(keep, "truth.txt"), "w") as f:
             f.write("attach %s\noutlets %s\n" % (attach.tolist(), [o.tolist() for o in outs]))
+            for j, (a, d, al, th) in enumerate(truth.rows):  # the true DH rows against the nominal
+                a0, d0, al0, th0 = ROBOTS[name]["dh"][j]
+                f.write("dh%d a %+.4f d %+.4f alpha %+.5f theta %+.5f (mm, deg, true - nominal)\n"
+                        % (j + 1, a - a0, d - d0, al / DEG - al0, th / DEG - th0))
     model = os.path.join(tmp, "model.json")
     if os.path.exists(model):
         os.remove(model)

@@ -119,6 +119,8 @@ typedef struct rch_calib_result {
     double prior_mean[RC_MAX_PARAMS]; /* (RC_MAX_PARAMS) the prior: nominal DH, start attachment */
     double prior_sd[RC_MAX_PARAMS];   /* (RC_MAX_PARAMS) its sd (mm, rad); 0: none (outlet, nuisance); the DH
                                          types scaled by prior_scale when it was estimated */
+    double prior_sd_fit[RC_MAX_PARAMS]; /* (RC_MAX_PARAMS) the sd the final fit used when prior_scaled (the
+                                           joint zeros may be narrower than prior_sd's: rch_prior_scale.h) */
     int prior_scaled;                 /* the prior's scale was estimated from the data (rch_prior_scale) */
     rch_prior_scale prior_scale;      /* the factors, their uncertainty, the fallbacks */
     double noise_mm;          /* residual sd the prior was weighed against (estimated: SSR / (n - p_eff)) */

@@ -555,9 +555,10 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
 }
 
 /* The prior's scale from this robot's data (rch_prior_scale: type-II ML of
- * the sd of each DH type): when it widens a type, the MAP fit again under
- * the wider prior. A prior the robot file states is kept as stated, and so
- * with --prior-stated. */
+ * the sd of each DH type): when it changes a type, the MAP fit again under
+ * the estimate's prior (r->prior_sd_fit: the joint zeros may narrow), the
+ * uncertainty's (never below the stated sd) in r->prior_sd. A prior the
+ * robot file states is kept as stated, and so with --prior-stated. */
 static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, const uint8_t *fixed,
                              const rc_sample *train)
 {
@@ -592,16 +593,17 @@ static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_con
         return RC_OK; /* the stated prior, as before */
     r->prior_scaled = 1;
     r->prior_scale = ps;
-    int wider = 0;
+    int changed = 0;
     for (int t = 0; t < RCH_PS_TYPES; ++t)
-        wider |= ps.factor[t] > 1.0 + 1e-6;
-    if (!wider)
+        changed |= fabs(ps.factor_fit[t] - 1.0) > 1e-6;
+    if (!changed)
         return RC_OK;
+    rch_prior_scale_apply_fit(r->prior_sd_fit, r->prior_sd, r->model.n_params, &ps);
     rch_prior_scale_apply(r->prior_sd, r->prior_sd, r->model.n_params, &ps);
     double chi2 = 0.0;
-    cfg->prior_sd = r->prior_sd;
-    r->attach_m0 = 1; /* at the change points already found: a wider prior moves the geometry, not the jumps */
-    r->map_warm = 1;  /* from the fit at hand and its noise: a wider prior moves both a little */
+    cfg->prior_sd = r->prior_sd_fit;
+    r->attach_m0 = 1; /* at the change points already found: another prior moves the geometry, not the jumps */
+    r->map_warm = 1;  /* from the fit at hand and its noise: another prior moves both a little */
     const rc_status st = map_fit(r, w, cfg, fixed, train, &chi2);
     r->attach_m0 = 0;
     r->map_warm = 0;

@@ -164,6 +164,7 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
             for (int t = 0; t < RCH_PS_TYPES; ++t) {
                 rch_jw_obj(&w, key[t]);
                 rch_jw_numf(&w, "factor", r->prior_scale.factor[t], "%.6g");
+                rch_jw_numf(&w, "factor_fit", r->prior_scale.factor_fit[t], "%.6g");
                 rch_jw_numf(&w, "factor_ml", r->prior_scale.factor_ml[t], "%.6g");
                 rch_jw_numf(&w, "rel_se", r->prior_scale.rel_se[t], "%.6g");
                 rch_jw_numf(&w, "determined", r->prior_scale.gamma[t], "%.6g");

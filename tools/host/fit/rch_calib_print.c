@@ -232,16 +232,21 @@ static void print_prior_scale(FILE *f, const rch_calib_result *r)
                                          r->robot.prior.offset_deg};
     static const char *const unit[RCH_PS_TYPES] = {"mm", "deg", "deg"};
     const rch_prior_scale *ps = &r->prior_scale;
-    fprintf(f, "  the prior's scale from this robot's data (type-II maximum likelihood; never below the stated sd, "
-               "at most %g x):", RCH_PRIOR_SCALE_MAX);
+    fprintf(f, "  the prior's scale from this robot's data (type-II maximum likelihood; the uncertainty never below "
+               "the stated sd, at most %g x):", RCH_PRIOR_SCALE_MAX);
     for (int t = 0; t < RCH_PS_TYPES; ++t) {
-        if (ps->fallback[t])
+        if (ps->fallback[t]) {
             fprintf(f, "%s %s %.3g %s kept (the data determine %.1f of %u: too few to say their spread)",
                     t ? ";" : "", name[t], stated[t], unit[t], ps->gamma[t], ps->n[t]);
-        else
-            fprintf(f, "%s %s %.3g -> %.3g %s (x %.2f +- %.0f %%, from %.1f of %u determined%s)", t ? ";" : "",
-                    name[t], stated[t], stated[t] * ps->factor[t], unit[t], ps->factor[t], 100.0 * ps->rel_se[t],
-                    ps->gamma[t], ps->n[t], ps->factor_ml[t] < 1.0 ? "; their spread is within the stated sd" : "");
+            continue;
+        }
+        fprintf(f, "%s %s %.3g -> %.3g %s (x %.2f +- %.0f %%, from %.1f of %u determined%s", t ? ";" : "", name[t],
+                stated[t], stated[t] * ps->factor[t], unit[t], ps->factor[t], 100.0 * ps->rel_se[t], ps->gamma[t],
+                ps->n[t], ps->factor_ml[t] < 1.0 ? "; their spread is within the stated sd" : "");
+        if (ps->factor_fit[t] < ps->factor[t])
+            fprintf(f, ": the estimate draws the ones the data barely see toward the drawing with %.3g %s, x %.2f",
+                    stated[t] * ps->factor_fit[t], unit[t], ps->factor_fit[t]);
+        fputc(')', f);
     }
     fputc('\n', f);
 }

@@ -89,7 +89,8 @@ static int update(rch_prior_scale *out, double *c, ps_work *w, const double *dx,
         out->fallback[t] = 0;
         const double ml = sqrt(ss[t] / gam[t]);
         out->factor_ml[t] = ml;
-        const double cn = fmin(fmax(ml, 1.0), RCH_PRIOR_SCALE_MAX);
+        const double lo = t == RCH_PS_OFFSET ? RCH_PRIOR_SCALE_MIN_FIT : 1.0; /* (factor_fit's bounds) */
+        const double cn = fmin(fmax(ml, lo), RCH_PRIOR_SCALE_MAX);
         done &= fabs(cn / c[t] - 1.0) < 1e-5;
         c[t] = cn;
     }
@@ -102,7 +103,7 @@ int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const doub
 {
     memset(out, 0, sizeof *out);
     for (int t = 0; t < RCH_PS_TYPES; ++t)
-        out->factor[t] = out->factor_ml[t] = 1.0;
+        out->factor[t] = out->factor_fit[t] = out->factor_ml[t] = 1.0;
     if (!(noise_mm > 0.0) || !isfinite(noise_mm) || n == 0) {
         snprintf(err, errlen, "the prior's scale needs samples and a positive noise (got %zu, %g mm)", n, noise_mm);
         return -1;
@@ -150,7 +151,8 @@ int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const doub
         }
     }
     for (int t = 0; t < RCH_PS_TYPES; ++t) {
-        out->factor[t] = out->fallback[t] ? 1.0 : c[t];
+        out->factor_fit[t] = out->fallback[t] ? 1.0 : c[t];
+        out->factor[t] = fmax(out->factor_fit[t], 1.0); /* the uncertainty: never below the stated sd */
         out->rel_se[t] = out->gamma[t] > 0.0 ? 1.0 / sqrt(2.0 * out->gamma[t]) : INFINITY;
     }
     rc = 0;
@@ -164,6 +166,14 @@ void rch_prior_scale_apply(double *sd_out, const double *sd, unsigned n_params, 
     for (unsigned k = 0; k < n_params; ++k) {
         const int t = rch_prior_scale_type(k);
         sd_out[k] = t >= 0 && sd[k] > 0.0 ? sd[k] * ps->factor[t] : sd[k];
+    }
+}
+
+void rch_prior_scale_apply_fit(double *sd_out, const double *sd, unsigned n_params, const rch_prior_scale *ps)
+{
+    for (unsigned k = 0; k < n_params; ++k) {
+        const int t = rch_prior_scale_type(k);
+        sd_out[k] = t >= 0 && sd[k] > 0.0 ? sd[k] * ps->factor_fit[t] : sd[k];
     }
 }
 
