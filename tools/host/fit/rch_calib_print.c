@@ -306,7 +306,10 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
         if (u->has_prior && u->prior_sd[k] > 0.0 && u->cls[k] != RCH_PARAM_FIXED) {
             dev3 = fabs(m->x[k] - r->prior_mean[k]) / u->prior_sd[k] > 3.0;
             outside += dev3;
-            snprintf(pc, sizeof pc, " (sd %.0f %% of prior)", 100.0 * u->se[k] / u->prior_sd[k]);
+            const double ratio = u->se[k] / u->prior_sd[k];
+            /* above 100 %: the cluster-robust covariance scales the posterior by the set-up groups' scatter */
+            snprintf(pc, sizeof pc, " (sd %.0f %% of prior%s)", 100.0 * ratio,
+                     ratio > 1.005 && u->kind == RCH_COV_CLUSTER ? ", widened by the set-up groups' scatter" : "");
         }
         fprintf(f, "  %-10s %12.5f %s %-3s %s%s%s%s%s\n", nm, m->x[k] * sc, se, unit == 0 ? "mm" : unit == 1 ? "deg" : "",
                 rch_seen_words(cl), pc, why[0] ? "; " : "", why,
