@@ -910,6 +910,13 @@ static rc_status solve_with(rc_model *m, rc_solve_result *res, rc_solve_work *w,
     return solve_core(m, res, w, A, V, tab, cfg, samples, n);
 }
 
+void rc_solve_config_warm(rc_solve_config *cfg)
+{
+    RC_ASSERT(cfg != NULL);
+    if (!(cfg->mu0 > 0.0) && (cfg->method == RC_METHOD_LM || cfg->method == RC_METHOD_LTLM) && has_prior(cfg))
+        cfg->mu0 = RC_SOLVE_MU0_WARM;
+}
+
 rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,
                    const rc_sample *samples, size_t n)
 {

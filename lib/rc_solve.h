@@ -218,6 +218,11 @@ rc_status rc_cost_tab(double *cost_mm2, const rc_model *m, const rc_sample *samp
 rc_status rc_normal_eq(double *A, double *g, double *cost_mm2, double *jrow, const rc_model *m,
                        const uint16_t *idx, unsigned nf, const rc_sample *samples, size_t n);
 
+/* Mark cfg as a start near the optimum: RC_SOLVE_MU0_WARM as its initial
+ * damping when it is a robust LM or LTLM fit with a prior and no mu0 of its
+ * own; otherwise cfg is left as it is (the one place that rule is made). */
+void rc_solve_config_warm(rc_solve_config *cfg);
+
 /* Identify the parameters of m (in: start, out: solution) from samples (n).
  * res may be NULL. RC_ERR_RANK when no parameter is free. */
 rc_status rc_solve(rc_model *m, rc_solve_result *res, rc_solve_work *w, const rc_solve_config *cfg,

@@ -6,7 +6,9 @@
  *     1.5 mm and 0.3 deg sd): the length and twist factors found between
  *     1.5 and 6, with a relative standard error that says how well;
  *   - a robot built within a tenth of it: the type-II ML factors below 1,
- *     the factors applied kept at 1 (never narrower than stated);
+ *     the uncertainty's factors kept at 1 (never narrower than stated), the
+ *     estimate's joint zeros narrowed within [RCH_PRIOR_SCALE_MIN_FIT, 1)
+ *     and the final fit made under them;
  *   - --prior-stated and a robot file with its own prior: nothing scaled.
  * What the wider prior does to u95's coverage is measured by
  * tests/sim/truth_study.py --errors wide (robots it never saw). */
@@ -122,6 +124,13 @@ static void test_tight_robot(void **state)
         assert_true(ps->factor[t] == 1.0);
     assert_false(ps->fallback[RCH_PS_LENGTH]);
     assert_true(ps->factor_ml[RCH_PS_LENGTH] < 1.0);
+    /* the estimate: only the joint zeros narrow, never below the floor; the uncertainty keeps the stated sd */
+    assert_true(ps->factor_fit[RCH_PS_LENGTH] == 1.0 && ps->factor_fit[RCH_PS_TWIST] == 1.0);
+    assert_false(ps->fallback[RCH_PS_OFFSET]);
+    assert_true(ps->factor_fit[RCH_PS_OFFSET] < 1.0 && ps->factor_fit[RCH_PS_OFFSET] >= RCH_PRIOR_SCALE_MIN_FIT);
+    const unsigned k = RC_P_THETA(5);
+    assert_true(fabs(r.prior_sd_fit[k] - r.prior_sd[k] * ps->factor_fit[RCH_PS_OFFSET]) < 1e-15);
+    assert_true(fabs(r.prior_sd[k] - 1.0 * PI / 180.0) < 1e-12);
 }
 
 static void test_file_prior_kept(void **state)

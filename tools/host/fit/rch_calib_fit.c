@@ -287,8 +287,8 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                     sorted[i].group = (uint16_t)rch_jumps_segment(&r->jumps, sorted[i].t);
             } else {
                 rc_solve_config wc = cfg; /* a later pass (or a warm first) starts at the fit at hand */
-                if ((pass > 0 || warm_first) && !(wc.mu0 > 0.0))
-                    wc.mu0 = RC_SOLVE_MU0_WARM;
+                if (pass > 0 || warm_first)
+                    rc_solve_config_warm(&wc);
                 st = solve_counted(r, &r->model, &r->solve, w, &wc, train, r->n_train);
                 if (st != RC_OK)
                     break;
@@ -313,8 +313,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
         r->noise_mm = cfg.prior_noise_mm = noise;
         if (st == RC_OK && !r->cfg.jumps && !r->map_one_pass) { /* the last pass's optimum, at the settled noise */
             rc_solve_config wc = cfg;
-            if (!(wc.mu0 > 0.0))
-                wc.mu0 = RC_SOLVE_MU0_WARM;
+            rc_solve_config_warm(&wc);
             st = solve_counted(r, &r->model, &r->solve, w, &wc, train, r->n_train);
         }
     }

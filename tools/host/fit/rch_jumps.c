@@ -75,12 +75,8 @@ static int fit_segments(rc_model *out, double *ssr, const rc_model *start, const
     if (base)
         cfg = *base;
     cfg.fixed = fx;
-    /* from an earlier fit of a MAP problem: near the optimum of a posterior that determines every direction
-     * (least squares keeps the default damping: there it is what holds the ill-determined directions; the
-     * paper variants keep theirs) */
-    if (warm && !(cfg.mu0 > 0.0) && (cfg.method == RC_METHOD_LM || cfg.method == RC_METHOD_LTLM) &&
-        cfg.prior_mean && cfg.prior_sd && cfg.prior_noise_mm > 0.0)
-        cfg.mu0 = RC_SOLVE_MU0_WARM;
+    if (warm) /* from an earlier fit: near the optimum (a MAP fit then starts undamped) */
+        rc_solve_config_warm(&cfg);
     rc_solve_result res;
     memset(&res, 0, sizeof res);
     const rc_status st = rc_solve(&mdl, &res, w, &cfg, s, n);
