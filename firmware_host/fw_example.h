@@ -13,7 +13,8 @@
  * Thread safety: call fw_comp_init once, then fw_comp_cycle from one task
  * (the control loop) only.
  * Errors: fw_comp_cycle never leaves q_cmd undefined: on a flagged cycle it
- * holds the target plus the last good correction (see rc_comp_stream_step).
+ * holds the target plus the last good correction on a path, the closest
+ * point found after a jump (see rc_comp_stream_step).
  */
 #ifndef FW_EXAMPLE_H
 #define FW_EXAMPLE_H
@@ -26,7 +27,8 @@ rc_status fw_comp_init(void);
 /* One control cycle. q_target_rad: (6) planner output (nominal model);
  * q_cmd_rad: (6) command for the servo loop. RC_OK, or the flag of
  * rc_comp_stream_step (RC_ERR_NOCONV: command = target + last good
- * correction; RC_ERR_RANGE: command = target). */
+ * correction on a path, the closest point found after a jump; RC_ERR_RANGE:
+ * command = target). */
 rc_status fw_comp_cycle(rc_real q_cmd_rad[RC_NJ], const rc_real q_target_rad[RC_NJ]);
 
 /* Cycles that were flagged since fw_comp_init, modulo 2^32: a 32-bit counter

@@ -133,6 +133,8 @@ typedef struct rc_comp_result {
     rc_real corr_max_rad;     /* max_i |q_out_i - q_i| (rc_comp_joint: the correction) */
     unsigned bound_mask;      /* bit i: joint i ended on a bound (limit or max_dev) */
     unsigned limit_mask;      /* bit i: joint i ended on its joint limit */
+    int held_last;            /* the stream's RC_ERR_NOCONV: 1 = q_out is the target plus the last good
+                                 correction (on a path), 0 = the solver's closest point (a jump) */
 } rc_comp_result;
 
 /* Short English text of an exit reason; never NULL. */
@@ -206,11 +208,14 @@ rc_status rc_comp_joint(rc_real q_out_rad[RC_NJ], rc_comp_result *res, const rc_
 /* ---- a stream of targets, one call per control cycle ----
  * Keeps the last good correction dq = q_out - q: each call is seeded with
  * q + dq (successive targets are close, so this usually converges in one or
- * two iterations), and a call that does not converge outputs q + the last
- * good dq (clamped into the joint limits; q itself before any success) and
- * returns RC_ERR_NOCONV, so the controller keeps a continuous, nearly right
- * command and sees the flag; res then describes that output (its position
- * error is the error of what was output, not of the best iterate).
+ * two iterations), and a call that does not converge returns RC_ERR_NOCONV
+ * with, on a path (no joint moved more than RC_COMP_WARM_RAD since the last
+ * good target), q + the last good dq (clamped into the joint limits), so the
+ * controller keeps a continuous, nearly right command and sees the flag, and
+ * after a jump the solver's closest point inside the bounds (never worse
+ * than q: the last dq belongs to another pose); res then describes that
+ * output (res->held_last says which; its position error is the error of
+ * what was output).
  *
  * Counters: n_ok and n_fail are 32-bit and wrap modulo 2^32, i.e. after
  * 4,294,967,296 calls (49.7 days at 1 kHz, 4.97 days at 10 kHz): read them as
@@ -260,7 +265,8 @@ rc_status rc_comp_stream_init(rc_comp_stream *s, const rc_model *cal, const rc_m
 #endif
 
 /* q_rad: (6) this cycle's nominal target; q_out_rad: (6) corrected target.
- * res may be NULL. Returns RC_OK, RC_ERR_NOCONV (q + last good dq), or
+ * res may be NULL. Returns RC_OK, RC_ERR_NOCONV (q + last good dq on a
+ * path, else the closest point found), or
  * RC_ERR_RANGE / RC_ERR_NUMERIC (q unchanged, zeros if not finite). */
 rc_status rc_comp_stream_step(rc_comp_stream *s, rc_real q_out_rad[RC_NJ], rc_comp_result *res,
                               const rc_real q_rad[RC_NJ]);

@@ -21,8 +21,8 @@ static const char details[] =
     "corrected, every other byte copied; a robtarget through the nominal IK with its confdata, written as the "
     "nominal pose of the corrected joints (tool0, or the --tool TCP; base frame). A RAPID target that cannot be "
     "corrected is named with line, column and reason and nothing is written. A target that does not converge is written as the "
-    "target plus the last good correction, with a warning naming the cause and its position error; the exit "
-    "status is then 1.";
+    "closest point found within the bounds (the target plus the last good correction when it follows the previous "
+    "target on a path), with a warning naming the cause and its position error; the exit status is then 1.";
 
 /* Which parameters the corrections came from (issue 10). */
 static void print_sources(const rch_comp_result *r, const char *model)

@@ -703,8 +703,8 @@ def evaluate(model, data, refit_encoder=False, same_pose_deg=1e-6):
 Compensation = collections.namedtuple("Compensation", "q_deg status u95_mm")
 Compensation.__doc__ = """compensate(..., details=True): the corrected targets (deg, shaped like the
 input), a status per target (0 converged, 1 position matched with the
-orientation best effort, 2 not converged: target plus the last good
-correction, 3 left uncompensated: uncertainty above the limit) and u95_mm,
+orientation best effort, 2 not converged: the closest point found (on a path:
+the target plus the last good correction), 3 left uncompensated: uncertainty above the limit) and u95_mm,
 the predicted 95 % position uncertainty of the compensated point per target
 (what --uncertainty-out writes; NaN when the model has no uncertainty)."""
 
@@ -791,8 +791,8 @@ def _flag_targets(codes, u95, max_unc_mm, u95_policy, on_fail):
     msgs = []
     for i, c in enumerate(codes):
         if c == 2:
-            msgs.append("target %d: not compensated (the solver did not converge or hit a limit); returned the target "
-                        "plus the last good correction" % i)
+            msgs.append("target %d: not compensated (the solver did not converge or hit a limit); returned the closest "
+                        "point found (on a path: the target plus the last good correction)" % i)
         elif c == 3:
             msgs.append("target %d: left uncompensated: the model's 95 %% position uncertainty here is %.4f mm, above "
                         "the limit (the data did not determine the model at this pose)" % (i, u95[i]))

@@ -326,6 +326,9 @@ static void test_joint_limit_named(void **state)
     cfg.flags = RC_COMP_FLAG_POSITION_ONLY;
     cfg.max_iter = 40;
     assert_int_equal(rc_comp_joint(qc, &res, &truth, &nom, q, NULL, &cfg), RC_ERR_NOCONV);
+    rc_real qj[RC_NJ];
+    memcpy(qj, qc, sizeof qj);
+    const double err_joint = (double)res.pos_err_mm;
     assert_int_equal(res.exit, RC_COMP_JOINT_LIMIT);
     assert_true(res.limit_mask & 1u);
     assert_non_null(strstr(rc_comp_exit_str(res.exit), "joint limit"));
@@ -334,14 +337,19 @@ static void test_joint_limit_named(void **state)
     assert_true(fabs(dist3(pt, pn) - (double)res.pos_err_mm) < TOL_POS);
     assert_true(res.pos_err_mm > RC_REAL_C(1.0)); /* it really is off */
 
-    /* the stream writes q + the last good correction (none yet: q): the
-     * error it reports is that of q, about 0.05 rad x the reach */
+    /* no good correction yet (a jump): the stream writes the solver's
+     * closest point, what a cold rc_comp_joint gives, and reports its error,
+     * below that of the target itself (about 0.05 rad x the reach) */
     rc_comp_stream s;
     assert_int_equal(rc_comp_stream_init(&s, &truth, &nom, &cfg), RC_OK);
     assert_int_equal(rc_comp_stream_step(&s, qc, &res, q), RC_ERR_NOCONV);
-    assert_memory_equal(qc, q, sizeof q);
+    assert_memory_equal(qc, qj, sizeof qj);
+    assert_int_equal(res.held_last, 0);
     fk_r(pt, NULL, &truth, qc);
     assert_true(fabs(dist3(pt, pn) - (double)res.pos_err_mm) < TOL_POS);
+    assert_true(fabs((double)res.pos_err_mm - err_joint) < TOL_POS);
+    fk_r(pt, NULL, &truth, q);
+    assert_true((double)res.pos_err_mm < dist3(pt, pn));
     assert_int_equal(res.exit, RC_COMP_JOINT_LIMIT);
 }
 
@@ -461,23 +469,42 @@ static void test_stream(void **state)
     assert_true(s.n_ok == (unsigned long)n && s.n_fail == 0);
     assert_true(iters <= 2u * (unsigned)n);
 
-    /* force a failure: one iteration, impossible tolerance */
+    /* force a failure on the path (the next cycle): one iteration,
+     * impossible tolerance: the target plus the last good correction */
     s.cfg.max_iter = 1;
     s.cfg.tol_mm = RC_REAL_C(1e-30);
-    const rc_real q[RC_NJ] = {RC_REAL_C(0.3), RC_REAL_C(0.1), RC_REAL_C(-0.2), RC_REAL_C(0.4), RC_REAL_C(0.9),
-                              RC_REAL_C(0.2)};
+    rc_real q[RC_NJ];
+    for (int i = 0; i < RC_NJ; ++i)
+        q[i] = (rc_real)(0.5 * sin(2.0 * 3.14159265 * 0.5 * 1.0 + i) * (i == 4 ? 0.5 : 1.0) + (i == 4 ? 0.8 : 0.0));
     rc_real qc[RC_NJ];
     double pn[3], pt[3];
     rc_comp_result res;
     assert_int_equal(rc_comp_stream_step(&s, qc, &res, q), RC_ERR_NOCONV);
     for (int i = 0; i < RC_NJ; ++i)
         assert_true(qc[i] == q[i] + last_dq[i]);
+    assert_int_equal(res.held_last, 1);
     assert_int_equal(s.fail_run, 1);
     assert_int_equal(s.n_fail, 1);
     /* the error reported is the error of what was output (issue 12) */
     fk_r(pn, NULL, &nom, q);
     fk_r(pt, NULL, &truth, qc);
     assert_true(fabs(dist3(pt, pn) - (double)res.pos_err_mm) < (RC_REAL_IS_FLOAT ? 1e-3 : 1e-9));
+    /* a failure after a jump: the closest point found from the target itself
+     * (what rc_comp_joint gives), never further off than the target */
+    const rc_real qf[RC_NJ] = {RC_REAL_C(0.3), RC_REAL_C(0.1), RC_REAL_C(-0.2), RC_REAL_C(0.4), RC_REAL_C(0.9),
+                               RC_REAL_C(0.2)};
+    rc_real qj[RC_NJ];
+    rc_comp_result rj;
+    assert_int_equal(rc_comp_joint(qj, &rj, &truth, &nom, qf, NULL, &s.cfg), RC_ERR_NOCONV);
+    assert_int_equal(rc_comp_stream_step(&s, qc, &res, qf), RC_ERR_NOCONV);
+    assert_int_equal(res.held_last, 0);
+    assert_memory_equal(qc, qj, sizeof qj);
+    assert_int_equal(s.fail_run, 2);
+    fk_r(pn, NULL, &nom, qf);
+    fk_r(pt, NULL, &truth, qc);
+    assert_true(fabs(dist3(pt, pn) - (double)res.pos_err_mm) < (RC_REAL_IS_FLOAT ? 1e-3 : 1e-9));
+    fk_r(pt, NULL, &truth, qf);
+    assert_true((double)res.pos_err_mm <= dist3(pt, pn));
 }
 
 /* A jump (the next target of a program, more than RC_COMP_WARM_RAD on a

@@ -399,6 +399,39 @@ static int centred_bound(double *bound, rc_model *fit, rch_calib_result *r, rc_s
     return 0;
 }
 
+/* The prior's scale at the fit at hand (r->model, or r->jumps.model over
+ * the samples in acquisition order, each in its segment, the first
+ * segment's offset held, as map_fit fitted it with --jumps), fitted under
+ * the sd sd_fit (n_params; the stated r->prior_sd or another scale of it).
+ * 0, or -1 when it cannot be estimated. */
+static int estimate_scale(rch_prior_scale *ps, rch_calib_result *r, const uint8_t *fixed, const rc_sample *train,
+                          const double *sd_fit)
+{
+    char err[160];
+    r->counts.jac_passes++;
+    const rc_model *fm = &r->model;
+    const rc_sample *fs = train;
+    rc_sample *sorted = NULL;
+    uint8_t fxj[RC_MAX_PARAMS];
+    memcpy(fxj, fixed, sizeof fxj);
+    if (r->cfg.jumps) {
+        if (!(sorted = malloc(r->n_train * sizeof *sorted)))
+            return -1;
+        memcpy(sorted, train, r->n_train * sizeof *sorted);
+        qsort(sorted, r->n_train, sizeof *sorted, cmp_t);
+        for (size_t i = 0; i < r->n_train; ++i)
+            sorted[i].group = (uint16_t)rch_jumps_segment(&r->jumps, sorted[i].t);
+        if (r->jumps.n_jumps)
+            fxj[r->jumps.model.effects[r->jumps.model.n_effects - 1].first] = 1;
+        fm = &r->jumps.model;
+        fs = sorted;
+    }
+    const int est = rch_prior_scale_estimate(ps, fm, r->prior_mean, r->prior_sd, sd_fit, fxj, fs, r->n_train,
+                                             r->noise_mm, err, sizeof err);
+    free(sorted);
+    return est;
+}
+
 /* The cable attachment, decided by the data. Lengths cannot tell the flange
  * centre from a point on the flange axis (d6 against the attachment's z,
  * a6 and theta6 against its x, y): with an attachment vector the flange
@@ -441,6 +474,26 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
         if (u.se[first + k] > 0.0 && r->prior_sd[first + k] > 0.0)
             occam += log(r->prior_sd[first + k] / u.se[first + k]);
     rch_uncert_free(&u);
+    /* Both models are weighed at this robot's prior scale: under the stated
+     * sd a d6 3 mm off the drawing costs (3 / 0.5)^2 = 36 of prior the
+     * attachment's z takes over at no cost, and a centred cable would be
+     * read as off-centre, the flange centre left to the prior (measured:
+     * tests/sim/truth_study.py --errors wide, a centred robot with d6 -3 mm
+     * compensated 2.4 mm off). The attachment fit's objective is taken at
+     * the scaled prior without a refit (a bound from above: it leans to the
+     * centred model by at most what a refit would gain). */
+    rch_prior_scale ps;
+    const int scaled = !r->robot.prior.from_file && !r->cfg.prior_stated &&
+                       estimate_scale(&ps, r, fixed, train, r->prior_sd) == 0;
+    if (scaled) {
+        double sd_a[RC_MAX_PARAMS];
+        rch_prior_scale_apply_fit(sd_a, r->prior_sd, RC_MAX_PARAMS, &ps); /* (the jumps' offsets too) */
+        rc_solve_config pa = *cfg, pst = *cfg;
+        pa.prior_sd = sd_a;
+        pst.prior_sd = r->prior_sd;
+        pa.fixed = pst.fixed = fx;
+        chi2_1 += (rc_prior_cost(fm, &pa) - rc_prior_cost(fm, &pst)) / (noise1 * noise1);
+    }
     /* the model with the cable at the flange centre */
     rc_model m0;
     rch_comp_point_model(&m0, &before1, NULL);
@@ -452,6 +505,10 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
     rc_solve_config c0 = *cfg;
     c0.prior_mean = r->prior_mean;
     c0.prior_sd = r->prior_sd;
+    if (scaled) { /* the centred model's fit at the same scale (scale_prior estimates its own after) */
+        rch_prior_scale_apply_fit(r->prior_sd_fit, r->prior_sd, RC_MAX_PARAMS, &ps);
+        c0.prior_sd = r->prior_sd_fit;
+    }
     r->attach_occam = 2.0 * occam;
     r->attach_bound = 0;
     rc_status st = RC_OK;
@@ -554,53 +611,33 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
 }
 
 /* The prior's scale from this robot's data (rch_prior_scale: type-II ML of
- * the sd of each DH type): when it changes a type, the MAP fit again under
- * the estimate's prior (r->prior_sd_fit: the joint zeros may narrow), the
- * uncertainty's (never below the stated sd) in r->prior_sd. A prior the
- * robot file states is kept as stated, and so with --prior-stated. */
+ * the sd of each DH type): when it changes the prior the fit at hand was
+ * made under (cfg->prior_sd), the MAP fit again under the estimate's prior
+ * (r->prior_sd_fit: the joint zeros may narrow), the uncertainty's (never
+ * below the stated sd) in r->prior_sd. A prior the robot file states is
+ * kept as stated, and so with --prior-stated. */
 static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, const uint8_t *fixed,
                              const rc_sample *train)
 {
     if (r->robot.prior.from_file || r->cfg.prior_stated)
         return RC_OK;
-    char err[160];
     rch_prior_scale ps;
-    r->counts.jac_passes++;
-    /* with --jumps the fit is r->jumps.model over the samples in acquisition order, each in its segment
-     * (the jumps' group), the first segment's offset held: as map_fit fitted it */
-    const rc_model *fm = &r->model;
-    const rc_sample *fs = train;
-    rc_sample *sorted = NULL;
-    uint8_t fxj[RC_MAX_PARAMS];
-    memcpy(fxj, fixed, sizeof fxj);
-    if (r->cfg.jumps) {
-        if (!(sorted = malloc(r->n_train * sizeof *sorted)))
-            return RC_OK;
-        memcpy(sorted, train, r->n_train * sizeof *sorted);
-        qsort(sorted, r->n_train, sizeof *sorted, cmp_t);
-        for (size_t i = 0; i < r->n_train; ++i)
-            sorted[i].group = (uint16_t)rch_jumps_segment(&r->jumps, sorted[i].t);
-        if (r->jumps.n_jumps)
-            fxj[r->jumps.model.effects[r->jumps.model.n_effects - 1].first] = 1;
-        fm = &r->jumps.model;
-        fs = sorted;
-    }
-    const int est = rch_prior_scale_estimate(&ps, fm, r->prior_mean, r->prior_sd, fxj, fs, r->n_train, r->noise_mm,
-                                             err, sizeof err);
-    free(sorted);
-    if (est != 0)
+    const double *sd_at = cfg->prior_sd ? cfg->prior_sd : r->prior_sd;
+    if (estimate_scale(&ps, r, fixed, train, sd_at) != 0)
         return RC_OK; /* the stated prior, as before */
     r->prior_scaled = 1;
     r->prior_scale = ps;
+    double sd_fit[RC_MAX_PARAMS];
+    rch_prior_scale_apply_fit(sd_fit, r->prior_sd, RC_MAX_PARAMS, &ps); /* (the jumps' offsets too) */
     int changed = 0;
-    for (int t = 0; t < RCH_PS_TYPES; ++t)
-        changed |= fabs(ps.factor_fit[t] - 1.0) > 1e-6;
+    for (unsigned k = 0; k < RC_MAX_PARAMS; ++k)
+        changed |= fabs(sd_fit[k] - sd_at[k]) > 1e-6 * sd_at[k];
+    memcpy(r->prior_sd_fit, sd_fit, sizeof sd_fit);
+    rch_prior_scale_apply(r->prior_sd, r->prior_sd, RC_MAX_PARAMS, &ps);
+    cfg->prior_sd = r->prior_sd_fit;
     if (!changed)
         return RC_OK;
-    rch_prior_scale_apply_fit(r->prior_sd_fit, r->prior_sd, r->model.n_params, &ps);
-    rch_prior_scale_apply(r->prior_sd, r->prior_sd, r->model.n_params, &ps);
     double chi2 = 0.0;
-    cfg->prior_sd = r->prior_sd_fit;
     r->attach_m0 = 1; /* at the change points already found: another prior moves the geometry, not the jumps */
     r->map_warm = 1;  /* from the fit at hand and its noise: another prior moves both a little */
     const rc_status st = map_fit(r, w, cfg, fixed, train, &chi2);

@@ -285,7 +285,10 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                    "penalty %.1f)\n",
                 r->attach_centred ? "at the flange centre" : "estimated in the flange frame (the flange centre "
                                                              "relative to it is known only from the prior of a6, d6)",
-                r->attach_bound ? "at least " : "", r->attach_dchi2, r->attach_occam);
+                r->attach_bound ? "at least " : "",
+                fmax(r->attach_dchi2, 0.0), /* below 0 only by the scaled prior taken without a refit: with
+                                               more freedom the optimum does not fit worse */
+                r->attach_occam);
     fprintf(f, "  parameter        value   1 std.error  what the data see (%s)\n",
             u->has_prior ? "posterior sd against the prior's; why" : "why");
     unsigned held = 0, outside = 0;

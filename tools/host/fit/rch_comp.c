@@ -143,9 +143,11 @@ int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_de
         r->n_joint_limit++;
     if (c->warn != NULL)
         fprintf(c->warn,
-                "%s:%u: warning: target not compensated: %s%s; wrote the target plus the last good correction, "
-                "%.4f mm from the nominal position\n",
+                "%s:%u: warning: target not compensated: %s%s; wrote %s, %.4f mm from the nominal position\n",
                 c->in_name, line, st == RC_ERR_NOCONV ? rc_comp_exit_str(res.exit) : rc_strerror(st), joints,
+                st != RC_ERR_NOCONV ? "the target"
+                : res.held_last     ? "the target plus the last good correction (on a path)"
+                                    : "the closest point found within the bounds",
                 (double)res.pos_err_mm);
     return 1;
 }

@@ -24,8 +24,9 @@
  *    written.
  * Blank lines and lines starting with '#' are copied. A malformed line or a
  * target outside the joint limits is an error with file:line:col. A target
- * that does not converge is written as the target plus the last good
- * correction (the stream's fallback) and counted; its warning names the
+ * that does not converge is written as the stream's fallback (the closest
+ * point found within the bounds; the target plus the last good correction
+ * when it follows the previous target on a path) and counted; its warning names the
  * cause (a joint limit, the largest allowed correction, the iteration limit)
  * and the position error of what was written.
  *
@@ -131,7 +132,7 @@ double rch_comp_u95_written(double u95_mm, int status, double miss_mm);
 typedef struct rch_comp_result {
     rch_comp_format format;       /* the form read (detected or forced) */
     unsigned long n;              /* targets compensated */
-    unsigned long n_fail;         /* not converged: written as target + last good correction */
+    unsigned long n_fail;         /* not converged: written as the stream's fallback */
     unsigned long n_pos_only;     /* position matched, orientation best effort */
     unsigned long n_joint_limit;  /* of n_fail: a joint limit was the cause */
     unsigned long iters;          /* iterations, all targets */

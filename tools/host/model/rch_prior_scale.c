@@ -56,17 +56,19 @@ static int posterior(ps_work *w, const double *p)
 
 /* One fixed-point update of the factors c (RCH_PS_TYPES) into out; 1 when
  * every factor moved by less than 1e-5 (relative). */
-static int update(rch_prior_scale *out, double *c, ps_work *w, const double *dx, const double *p0, const int *type)
+static int update(rch_prior_scale *out, double *c, ps_work *w, const double *dx, const double *p0, const double *pf,
+                  const int *type)
 {
     const unsigned nf = w->nf;
     double p[RC_MAX_PARAMS], step[RC_MAX_PARAMS], del[RC_MAX_PARAMS];
     for (unsigned a = 0; a < nf; ++a)
-        p[a] = type[a] >= 0 ? p0[a] / (c[type[a]] * c[type[a]]) : p0[a];
+        p[a] = type[a] >= 0 ? p0[a] / (c[type[a]] * c[type[a]]) : pf[a];
     if (posterior(w, p) != 0)
         return -1;
-    /* the MAP under p from the one under p0: x - Sigma (P - P0)(x - mu) (exact when linear) */
+    /* the MAP under p from the one under pf (the prior m was fitted under): x - Sigma (P - Pf)(x - mu)
+     * (exact when linear) */
     for (unsigned a = 0; a < nf; ++a)
-        step[a] = (p[a] - p0[a]) * dx[a];
+        step[a] = (p[a] - pf[a]) * dx[a];
     for (unsigned a = 0; a < nf; ++a) {
         double s = 0.0;
         for (unsigned b = 0; b < nf; ++b)
@@ -98,9 +100,11 @@ static int update(rch_prior_scale *out, double *c, ps_work *w, const double *dx,
 }
 
 int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const double *mean, const double *sd,
-                             const uint8_t *fixed, const rc_sample *s, size_t n, double noise_mm, char *err,
-                             size_t errlen)
+                             const double *sd_fit, const uint8_t *fixed, const rc_sample *s, size_t n,
+                             double noise_mm, char *err, size_t errlen)
 {
+    if (!sd_fit)
+        sd_fit = sd;
     memset(out, 0, sizeof *out);
     for (int t = 0; t < RCH_PS_TYPES; ++t)
         out->factor[t] = out->factor_fit[t] = out->factor_ml[t] = 1.0;
@@ -114,16 +118,17 @@ int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const doub
         return -1;
     }
     int type[RC_MAX_PARAMS];
-    double dx[RC_MAX_PARAMS], p0[RC_MAX_PARAMS];
+    double dx[RC_MAX_PARAMS], p0[RC_MAX_PARAMS], pf[RC_MAX_PARAMS];
     for (unsigned k = 0; k < RC_MAX_PARAMS; ++k) { /* every entry defined (those of held parameters unused) */
         type[k] = -1;
-        dx[k] = p0[k] = 0.0;
+        dx[k] = p0[k] = pf[k] = 0.0;
     }
     for (unsigned k = 0; k < m->n_params; ++k)
         if (!fixed || !fixed[k]) {
             const unsigned a = w->nf++;
             w->idx[a] = (uint16_t)k;
             p0[a] = sd[k] > 0.0 ? 1.0 / (sd[k] * sd[k]) : 0.0;
+            pf[a] = sd_fit[k] > 0.0 ? 1.0 / (sd_fit[k] * sd_fit[k]) : 0.0;
             dx[a] = sd[k] > 0.0 ? m->x[k] - mean[k] : 0.0;
             type[a] = sd[k] > 0.0 ? rch_prior_scale_type(k) : -1;
             if (type[a] >= 0)
@@ -140,7 +145,7 @@ int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const doub
         w->A[a] /= s2;
     double c[RCH_PS_TYPES] = {1.0, 1.0, 1.0};
     for (out->iterations = 1; out->iterations <= 200; ++out->iterations) {
-        const int u = update(out, c, w, dx, p0, type);
+        const int u = update(out, c, w, dx, p0, pf, type);
         if (u < 0) {
             snprintf(err, errlen, "the prior's scale: the posterior is not definite");
             goto done;

@@ -81,13 +81,15 @@ typedef struct rch_prior_scale {
  * -1 for every other parameter. */
 int rch_prior_scale_type(unsigned k);
 
-/* Estimate the factors at m, the MAP fit under the prior (mean, sd:
- * n_params, sd 0 = no prior) with the noise noise_mm weighing the data,
- * over the samples s (n); fixed (n_params, may be NULL) marks held
- * parameters. 0, or -1 (message in err). */
+/* Estimate the factors on the stated prior (mean, sd: n_params, sd 0 = no
+ * prior) at m, the MAP fit under the prior (mean, sd_fit: n_params, NULL =
+ * sd; another scale of the same prior, as when the attachment is decided at
+ * an estimated scale) with the noise noise_mm weighing the data, over the
+ * samples s (n); fixed (n_params, may be NULL) marks held parameters. 0, or
+ * -1 (message in err). */
 int rch_prior_scale_estimate(rch_prior_scale *out, const rc_model *m, const double *mean, const double *sd,
-                             const uint8_t *fixed, const rc_sample *s, size_t n, double noise_mm, char *err,
-                             size_t errlen);
+                             const double *sd_fit, const uint8_t *fixed, const rc_sample *s, size_t n,
+                             double noise_mm, char *err, size_t errlen);
 
 /* sd_out (n_params) = sd scaled by the factors (DH types only): the
  * uncertainty's (factor). */

@@ -319,8 +319,9 @@ int rch_ffi_evaluate(double *out, const rch_ffi_model *m, const char *data_path,
  * cal: calibrated model; nominal: the model the targets were made with, or
  * NULL for cal's "nominal" table. out_deg: (n x 6) corrected targets;
  * status: (n) or NULL, per target 0 converged, 1 position matched with the
- * orientation best effort, 2 not converged (written as the target plus the
- * last good correction), 3 left uncompensated (the model's 95 % position
+ * orientation best effort, 2 not converged (written as the stream's
+ * fallback: the closest point found, or on a path the target plus the last
+ * good correction), 3 left uncompensated (the model's 95 % position
  * uncertainty there is above the limit); u95_mm: (n) or NULL, per target
  * the predicted 95 % position uncertainty of the compensated point (what
  * --uncertainty-out writes; NaN when the model carries no uncertainty);
