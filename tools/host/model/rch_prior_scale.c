@@ -187,7 +187,7 @@ double rch_prior_scale_predictive(const rch_prior_scale *ps, int type)
     if (type < 0 || type >= RCH_PS_TYPES || ps->fallback[type] || !(ps->factor[type] > 1.0) ||
         !(ps->gamma[type] >= RCH_PRIOR_SCALE_MIN_GAMMA))
         return 1.0;
-    const double f = rch_f_isf(0.05, 1.0, ps->gamma[type]); /* t_{nu, 0.975}^2 = F_{1, nu} upper 5 % */
+    const double f = rch_f_isf(0.05, 1.0, fmin(ps->gamma[type], RCH_PRIOR_SCALE_TAIL_DOF)); /* t_{nu, 0.975}^2 = F_{1, nu} upper 5 % */
     return isfinite(f) && f > 0.0 ? fmax(1.0, sqrt(f) / 1.959963984540054) : 1.0;
 }
 
