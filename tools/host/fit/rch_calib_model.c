@@ -9,6 +9,7 @@
 #include "rch_calib.h"
 #include "rch_calib_int.h"
 
+#include <math.h>
 #include <stdio.h>
 
 #include "rch_jw.h"
@@ -63,6 +64,24 @@ int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *
                      "--no-jump-check to write it anyway)",
                      counts, r->jump_check_steps, r->jump_check_steps == 1 ? "" : "s");
         return -1;
+    }
+    /* every command reads a model file through rch_robot_load, which refuses an effect outside its
+     * plausible range (rc_effect_desc.limit): a fit that ends there is said here, not written for the
+     * next command to refuse */
+    const rc_model *fm = &r->model;
+    for (unsigned e = 0; e < fm->n_effects; ++e) {
+        const rc_effect_desc *ds = rc_effect_describe(fm->effects[e].kind);
+        for (unsigned k = 0; ds && k < fm->effects[e].count; ++k) {
+            const double v = fm->x[fm->effects[e].first + k];
+            if (!(fabs(v) <= ds->limit)) {
+                rch_diag_set(d, path, 0, 0,
+                             "not written: effect %s parameter %u = %g is outside its plausible range (|value| at "
+                             "most %g %s), which every rcal command refuses to load: the fit traded it against "
+                             "something the data do not see, or the effect is not this one",
+                             ds->name, k + 1, v, ds->limit, ds->unit_text);
+                return -1;
+            }
+        }
     }
     const char *inputs[2 * RCH_CALIB_MAX_FILES + 4] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
     size_t n = 3;

@@ -70,9 +70,14 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
     uint8_t fixed[RC_MAX_PARAMS];
     memset(fixed, 1, sizeof fixed);
     fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 0;
+    /* the sensors' placements (outlets, the tracker's frame and targets) are fitted to the nominal robot; the
+     * tracker's scale is physical (its prior is centred on this start): fitted here it would take up the
+     * robot's size error (405 ppm on a tracker file of sens_rates, 4 x its prior sd, a model rcal compensate
+     * then refused as implausible) */
     for (unsigned i = 0; i < start->n_effects; ++i) {
         const rc_effect_desc *ds = rc_effect_describe(start->effects[i].kind);
-        if (start->effects[i].kind == RC_EFF_OUTLET || (ds && ds->side == RC_SIDE_SENSOR))
+        if (start->effects[i].kind == RC_EFF_OUTLET ||
+            (ds && ds->side == RC_SIDE_SENSOR && start->effects[i].kind != RC_EFF_TRACKER_SCALE))
             memset(&fixed[start->effects[i].first], 0, start->effects[i].count);
     }
     rch_pos_fix_unseen(fixed, start, s, n);
