@@ -218,7 +218,9 @@ class Model:
 
     def fk(self, q_deg, nominal=False, rotation=False, determined=False):
         """Forward kinematics: the flange point (x, y, z) in mm, base frame, at
-        joint angles q_deg (degrees). One pose (6 numbers) gives one (x, y, z);
+        joint angles q_deg (degrees); the cable's attachment point where the
+        model has a tool_offset (a one-point cable calibration's, in the
+        flange frame: the flange is pos - R t). One pose (6 numbers) gives one (x, y, z);
         a batch (n x 6) gives n of them ((n, 3) numpy array for numpy input).
         nominal=True uses the nominal table of a calibrated model;
         determined=True the part of it compensation uses (the DH parameters
@@ -406,7 +408,8 @@ _CAL_FLAGS = {"tool_offset": 1, "jumps": 2, "dequantize": 4, "no_prior": 8, "hol
 def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=None, robot=None, method="lm",
               test_fraction=0.1, seed=1, max_iter=0, fix=None, effects=None, jumps=False, dequantize=None,
               prior=True, prior_stated=False, tool_offset=False, holdout_groups=False, jump_check=True, validate=None, truth=None,
-              cases=1, samples=0, plots=None, residuals=None, data_csv=None, positions=None, screen=True):
+              cases=1, samples=0, plots=None, residuals=None, data_csv=None, positions=None, screen=True,
+              target=None, cable_points=None, cable_point_sd=None):
     """Identify the DH errors and the encoder outlet from cable lengths, as
     `rcal calibrate` does (the same host function: identical figures).
     Each argument is the CLI option of the same meaning.
@@ -446,6 +449,12 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
                     irreconcilable with the rest are left out and listed in
                     Result.screened (a RcalWarning names each, as the CLI's
                     stderr does), a file with too many refused
+    cable_points:   the nominal points of a tool plate the cable is hooked on in
+                    turn, flange frame, mm: a list of (x, y, z), in the order of
+                    the data's target column (--cable-point, once per point);
+                    cable_point_sd: their tolerance in mm (--cable-point-sd)
+    target:         with q_deg: (n) the plate point (0, 1, ...) each length
+                    was measured on (a file's target column)
     Returns a Result. Raises RcalError (bad file with file:line:col, too few
     samples, unknown method or effect) or ValueError (bad arguments)."""
     if data is None:
@@ -457,8 +466,15 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
         raise ValueError("calibrate: give either files (data and/or positions) or q_deg and L_mm")
     if data is None and q_deg is None and not plist:
         raise ValueError("calibrate: give either data (a file or a list of files), positions, or q_deg and L_mm")
-    if q_deg is None and (L_mm is not None or xyz_mm is not None or group is not None or outlet is not None):
-        raise ValueError("calibrate: L_mm, xyz_mm, group and outlet go with q_deg (arrays), not with files")
+    if q_deg is None and (L_mm is not None or xyz_mm is not None or group is not None or outlet is not None or
+                          target is not None):
+        raise ValueError("calibrate: L_mm, xyz_mm, group, outlet and target go with q_deg (arrays), not with files")
+    pts, npts = None, 0
+    if cable_points is not None:
+        pts, npts, _, _ = _doubles(cable_points, 3, "cable_points")
+    if cable_point_sd is not None and not (_real(cable_point_sd) and 1e-6 <= float(cable_point_sd) <= 100.0):
+        raise ValueError("calibrate: cable_point_sd must be a number of mm in [1e-06, 100]")
+    pts_sd = 0.0 if cable_point_sd is None else float(cable_point_sd)
     if not isinstance(method, str):
         raise ValueError("calibrate: method must be a string")
     lib = _lib.lib()
@@ -483,7 +499,8 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
             raise ValueError("calibrate: no data file")
         arr = (ctypes.c_char_p * max(len(files), 1))(*[_path(f) for f in files])
         parr = (ctypes.c_char_p * max(len(plist), 1))(*[_path(f) for f in plist])
-        st = lib.rch_ffi_calibrate_inputs(ctypes.byref(h), arr, len(files), parr, len(plist), *common)
+        st = lib.rch_ffi_calibrate_inputs(ctypes.byref(h), arr, len(files), parr, len(plist), pts, npts, pts_sd,
+                                          *common)
         every = files + plist
         label = every[0] if len(every) == 1 else every
     else:
@@ -499,7 +516,8 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
             if nx != n:
                 raise ValueError("calibrate: %d poses but %d xyz rows (xyz_mm: expected shape (%d, 3))" % (n, nx, n))
         st = lib.rch_ffi_calibrate_arrays(ctypes.byref(h), q, L, xyz, _ints(group, n, "group", 65535),
-                                          _ints(outlet, n, "outlet", 255), n, *common)
+                                          _ints(outlet, n, "outlet", 255), _ints(target, n, "target", 15), n, pts,
+                                          npts, pts_sd, *common)
         label = None
     _check(st, err)
     r = Result(h.value, method, label, int(seed))

@@ -139,11 +139,18 @@ int rch_ffi_calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t
  * cable lengths in mm, in acquisition order; xyz_mm (n x 3) the
  * controller's flange positions or NULL (needed by RCH_FFI_CAL_DEQUANTIZE);
  * group (n) set-up groups (>= 0) or NULL; outlet (n) encoder-place labels
- * (>= 0) or NULL. They are written exactly ("%.17g") to a temporary CSV
- * that goes through the same reader and pipeline as a file, so arrays
- * holding a file's values give that file's result. */
+ * (>= 0) or NULL; target (n) the tool plate's point each length was
+ * measured on (0..RC_MAX_TARGETS-1, a positions file's target column) or
+ * NULL, with cable_points_mm (n_cable_points x 3) those points' nominal
+ * coordinates in the flange frame (--cable-point, in label order) and
+ * cable_point_sd_mm their tolerance (--cable-point-sd; 0: the default).
+ * They are written exactly ("%.17g") to a temporary CSV that goes through
+ * the same reader and pipeline as a file, so arrays holding a file's
+ * values give that file's result. */
 int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const double *len_mm, const double *xyz_mm,
-                             const int *group, const int *outlet, size_t n, const char *robot_path,
+                             const int *group, const int *outlet, const int *target, size_t n,
+                             const double *cable_points_mm, size_t n_cable_points, double cable_point_sd_mm,
+                             const char *robot_path,
                              const char *method, double test_fraction, unsigned long seed, unsigned max_iter,
                              const char *fix, const char *effects, unsigned flags, const char *validate_path,
                              const char *truth_path, unsigned long cases, size_t case_samples, const char *plots_dir,
@@ -151,9 +158,12 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
 /* The same with laser-tracker positions files (--positions, rch_positions.h:
  * the same plausibility checks and screening as `rcal calibrate`):
  * positions_paths (n_positions, 0..16), data_paths (n_data, 0..16), at
- * least one file in all; each file once among both lists. */
+ * least one file in all; each file once among both lists; cable_points_mm
+ * (n_cable_points x 3, or NULL and 0) and cable_point_sd_mm as for
+ * rch_ffi_calibrate_arrays, for data files with a target column. */
 int rch_ffi_calibrate_inputs(rch_ffi_calib **out, const char *const *data_paths, size_t n_data,
-                             const char *const *positions_paths, size_t n_positions, const char *robot_path,
+                             const char *const *positions_paths, size_t n_positions, const double *cable_points_mm,
+                             size_t n_cable_points, double cable_point_sd_mm, const char *robot_path,
                              const char *method, double test_fraction, unsigned long seed, unsigned max_iter,
                              const char *fix, const char *effects, unsigned flags, const char *validate_path,
                              const char *truth_path, unsigned long cases, size_t case_samples, const char *plots_dir,

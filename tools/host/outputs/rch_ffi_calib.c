@@ -8,6 +8,7 @@
  * calibration handle on the heap, the caller's until rch_ffi_calib_free;
  * the solver's workspace freed before return. Errors: a status, the message
  * into err. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,6 +37,9 @@ typedef struct {
     const char *plots, *residuals;
     const char *const *positions; /* (n_positions) tracker positions files, or NULL */
     size_t n_positions;
+    const double *cable_points_mm; /* (n_cable_points x 3) a tool plate's nominal points, flange frame, or NULL */
+    size_t n_cable_points;
+    double cable_point_sd_mm; /* their tolerance (0: the default) */
 } cal_opts;
 
 /* ---- calibration ---- */
@@ -158,6 +162,28 @@ static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t 
     cfg.no_jump_check = (o->flags & RCH_FFI_CAL_NO_JUMP_CHECK) != 0;
     cfg.cases = o->cases > 1 ? o->cases : 1;
     cfg.case_samples = o->case_samples;
+    if (o->n_cable_points > RC_MAX_TARGETS || (o->n_cable_points > 0 && !o->cable_points_mm) ||
+        !(o->cable_point_sd_mm == 0.0 || (o->cable_point_sd_mm >= 1e-6 && o->cable_point_sd_mm <= 100.0))) {
+        free(c);
+        if (err && err_len > 0)
+            snprintf(err, err_len, "calibrate: at most %d cable points (mm, flange frame) and their sd in [1e-06, "
+                     "100] mm (0: the default)", RC_MAX_TARGETS);
+        return RCH_FFI_ERR_ARG;
+    }
+    for (size_t k = 0; k < o->n_cable_points; ++k)
+        for (unsigned a = 0; a < 3; ++a) {
+            const double x = o->cable_points_mm[3 * k + a];
+            if (!isfinite(x) || fabs(x) > 2000.0) {
+                free(c);
+                if (err && err_len > 0)
+                    snprintf(err, err_len, "calibrate: cable point %zu: need X, Y, Z in mm in the flange frame, "
+                             "each within 2000", k);
+                return RCH_FFI_ERR_ARG;
+            }
+            cfg.cable_points_mm[k][a] = x;
+        }
+    cfg.n_cable_points = (unsigned)o->n_cable_points;
+    cfg.cable_point_sd_mm = o->cable_point_sd_mm;
     int rc = precheck(&cfg, err, err_len);
     if (rc != RCH_FFI_OK) {
         free(c);
@@ -183,19 +209,21 @@ int rch_ffi_calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t
                       const char *residuals_path, char *err, size_t err_len)
 {
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0};
+                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0, NULL, 0, 0.0};
     return calibrate(out, data_paths, n_data, &o, err, err_len);
 }
 
 int rch_ffi_calibrate_inputs(rch_ffi_calib **out, const char *const *data_paths, size_t n_data,
-                             const char *const *positions_paths, size_t n_positions, const char *robot_path,
+                             const char *const *positions_paths, size_t n_positions, const double *cable_points_mm,
+                             size_t n_cable_points, double cable_point_sd_mm, const char *robot_path,
                              const char *method, double test_fraction, unsigned long seed, unsigned max_iter,
                              const char *fix, const char *effects, unsigned flags, const char *validate_path,
                              const char *truth_path, unsigned long cases, size_t case_samples, const char *plots_dir,
                              const char *residuals_path, char *err, size_t err_len)
 {
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path, positions_paths, n_positions};
+                        truth_path, cases, case_samples, plots_dir, residuals_path, positions_paths, n_positions, cable_points_mm, n_cable_points,
+                        cable_point_sd_mm};
     return calibrate(out, data_paths, n_data, &o, err, err_len);
 }
 
@@ -227,7 +255,9 @@ static void name_arrays(char *err, size_t err_len, const char *tmp)
 }
 
 int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const double *len_mm, const double *xyz_mm,
-                             const int *group, const int *outlet, size_t n, const char *robot_path,
+                             const int *group, const int *outlet, const int *target, size_t n,
+                             const double *cable_points_mm, size_t n_cable_points, double cable_point_sd_mm,
+                             const char *robot_path,
                              const char *method, double test_fraction, unsigned long seed, unsigned max_iter,
                              const char *fix, const char *effects, unsigned flags, const char *validate_path,
                              const char *truth_path, unsigned long cases, size_t case_samples, const char *plots_dir,
@@ -237,11 +267,11 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: no samples");
     *out = NULL;
     for (size_t i = 0; i < n; ++i)
-        if ((group && (group[i] < 0 || group[i] > 65535)) || (outlet && (outlet[i] < 0 || outlet[i] > 255)))
-        {
+        if ((group && (group[i] < 0 || group[i] > 65535)) || (outlet && (outlet[i] < 0 || outlet[i] > 255)) ||
+            (target && (target[i] < 0 || target[i] >= RC_MAX_TARGETS))) {
             if (err && err_len > 0)
                 snprintf(err, err_len, "calibrate: sample %zu: group labels must be in 0..65535, outlet labels in "
-                         "0..255", i);
+                         "0..255, target (cable point) labels in 0..%d", i, RC_MAX_TARGETS - 1);
             return RCH_FFI_ERR_ARG;
         }
     const char *dir = getenv("TMPDIR");
@@ -257,8 +287,8 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
         return fail(RCH_FFI_ERR_IO, err, err_len, "cannot create a temporary file %s", tmp);
     }
     rch_tmp_register(tmp);
-    int bad = fprintf(f, "q1,q2,q3,q4,q5,q6,L%s%s%s\n", xyz_mm ? ",x,y,z" : "", group ? ",group" : "",
-                      outlet ? ",outlet" : "") < 0;
+    int bad = fprintf(f, "q1,q2,q3,q4,q5,q6,L%s%s%s%s\n", xyz_mm ? ",x,y,z" : "", group ? ",group" : "",
+                      outlet ? ",outlet" : "", target ? ",target" : "") < 0;
     for (size_t i = 0; i < n && !bad; ++i) {
         const double *q = &q_deg[RC_NJ * i];
         bad = fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", q[0], q[1], q[2], q[3], q[4], q[5],
@@ -269,12 +299,15 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
             bad |= fprintf(f, ",%d", group[i]) < 0;
         if (outlet)
             bad |= fprintf(f, ",%d", outlet[i]) < 0;
+        if (target)
+            bad |= fprintf(f, ",%d", target[i]) < 0;
         bad |= fputc('\n', f) == EOF;
     }
     bad |= fclose(f) != 0;
     const char *paths[1] = {tmp};
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0};
+                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0, cable_points_mm, n_cable_points,
+                        cable_point_sd_mm};
     int rc = bad ? fail(RCH_FFI_ERR_IO, err, err_len, "writing the temporary file %s failed", tmp)
                  : calibrate(out, paths, 1, &o, err, err_len);
     unlink(tmp);
