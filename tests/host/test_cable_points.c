@@ -114,19 +114,20 @@ static int run(rch_calib_result *r, int points, int max_target, unsigned n_told,
     return rc;
 }
 
-/* RMS distance (mm) between the model's TCP and the true one over N_EVAL
- * new poses, after the best rigid motion between the two point sets. */
-static double tcp_rms(const rc_model *fit)
+/* RMS distance (mm) between the model's point pt (flange frame) and the
+ * true one over N_EVAL new poses, after the best rigid motion between the
+ * two point sets. */
+static double point_rms(const rc_model *fit, const double pt[3])
 {
     static double a[N_EVAL][3], b[N_EVAL][3];
     rc_model m;
-    rch_comp_point_model(&m, fit, tcp);
+    rch_comp_point_model(&m, fit, pt);
     rct_rng g = {404};
     for (int i = 0; i < N_EVAL; ++i) {
         double q[6];
         random_q(q, &g);
         rc_fk(a[i], NULL, &m, q);
-        true_point(b[i], q, tcp);
+        true_point(b[i], q, pt);
     }
     double R[9], T[3], ss = 0.0;
     sg_kabsch(R, T, (const double(*)[3])a, (const double(*)[3])b, N_EVAL, NULL);
@@ -136,6 +137,11 @@ static double tcp_rms(const rc_model *fit)
             ss += v * v;
         }
     return sqrt(ss / N_EVAL);
+}
+
+static double tcp_rms(const rc_model *fit)
+{
+    return point_rms(fit, tcp);
 }
 
 static void test_three_points_see_the_orientation(void **state)
@@ -164,6 +170,33 @@ static void test_three_points_see_the_orientation(void **state)
     assert_true(worst < 0.1);
 }
 
+/* One point 60 mm off the flange centre: a6, d6 and the attachment are one
+ * direction for the lengths, so the flange centre is the prior's unless the
+ * user says where the cable is hooked (one --cable-point, no target column:
+ * the drawing's point, true within 0.02 mm sd, told to 0.05). */
+static void test_one_point_told_places_the_flange(void **state)
+{
+    (void)state;
+    static rch_calib_result told, untold;
+    rch_diag d;
+    if (run(&told, 1, 0, 1, &d) != 0)
+        fail_msg("calibrate, the point told: %s", d.msg);
+    if (run(&untold, 1, 0, 0, &d) != 0)
+        fail_msg("calibrate, the point not told: %s", d.msg);
+    static const double centre[3] = {0.0, 0.0, 0.0};
+    const double e_told = point_rms(&told.model, centre), e_untold = point_rms(&untold.model, centre);
+    double nom[6][4];
+    rct_irb120_dh(nom);
+    const double a6 = truth[5][0] - nom[5][0], d6 = truth[5][1] - nom[5][1];
+    print_message("flange centre, RMS over %d new poses: the point told %.4f mm, not told %.4f mm (true a6 %+.3f, "
+                  "d6 %+.3f mm off the drawing); flange headline %s\n", N_EVAL, e_told, e_untold, a6, d6,
+                  told.flange_prior_only ? "prior only" : "determined");
+    assert_true(e_told < 0.1);
+    assert_true(e_untold > 0.5 * hypot(a6, d6)); /* not told: the prior's nominal a6, d6 */
+    assert_true(e_told < e_untold / 3.0);
+    assert_true(!told.flange_prior_only && untold.flange_prior_only);
+}
+
 static void test_points_refused(void **state)
 {
     (void)state;
@@ -186,6 +219,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_three_points_see_the_orientation),
+        cmocka_unit_test(test_one_point_told_places_the_flange),
         cmocka_unit_test(test_points_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -97,6 +97,7 @@ def clipped(rng, scale, lim):
 # "wide" (issue 32: wider and heavier-tailed than rcal's prior, whose sd are
 # 0.5 mm, 0.1 deg, 1 deg): Student-t(3) 1 mm up to 3 mm, 0.2 deg up to 0.6 deg.
 ERRORS = "study"
+STATED_ATTACH = 0.0  # --stated-attach: the attachment told to rcal, measured to this sd (mm); 0: not told
 
 
 def true_robot(rng, name, beta_deg=0.0):
@@ -286,6 +287,9 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     told = []
     for j in range(points):
         told += ["--cable-point", ",".join("%.3f" % v for v in plate_nom[j])]
+    if STATED_ATTACH > 0 and not points:  # the attachment measured by hand to STATED_ATTACH mm (sd), and said so
+        said = attach + np.random.default_rng([k, 55]).normal(0.0, STATED_ATTACH, 3)
+        told += ["--cable-point", ",".join("%.3f" % v for v in said), "--cable-point-sd", "%g" % STATED_ATTACH]
     rc, out, err = run([rcal, "calibrate", "--data", data_path, "--robot", robot_path, "--out", model,
                         "--test-fraction", "0"] + told + list(extra))
     if not os.path.exists(model):
@@ -373,9 +377,13 @@ def main():
                     help="check the goals (flange: centred <= 0.02 mm, off-centre <= 0.7 mm median; TCP <= 0.45 mm; "
                          "no case worse than uncompensated; targets made worse <= 1 %% median; u95 covers >= 90 %%); "
                          "exit 1 when one fails")
+    ap.add_argument("--stated-attach", type=float, default=0.0, metavar="SD",
+                    help="tell rcal where the cable is attached (--cable-point), measured to SD mm (sd; "
+                         "--cable-point-sd SD), as a user with a drawing or a caliper would; 0: not told")
     a = ap.parse_args()
-    global ERRORS, ALIGN
+    global ERRORS, ALIGN, STATED_ATTACH
     ERRORS = a.errors
+    STATED_ATTACH = a.stated_attach
     ALIGN = a.align
     rng = np.random.default_rng(a.seed)
     tcp = [float(v) for v in a.tcp.split(",")]

@@ -217,10 +217,14 @@ static void print_headline(FILE *f, const rch_calib_result *r, const char *lead)
         return;
     fprintf(f, "  the flange centre behind %s: +-%.4f mm (median; max %.4f)%s\n",
             r->seen_at == RCH_CALIB_SEEN_TARGETS ? "them" : "it", r->flange_median_mm, r->flange_max_mm,
-            r->flange_prior_only
+            !r->flange_prior_only ? ""
+            : r->seen_at == RCH_CALIB_SEEN_TARGETS
                 ? ": prior only (the data see the point above, not the flange centre behind it: compensate at "
                   "that point, rcal compensate --tool X,Y,Z, or measure at the flange centre)"
-                : "");
+                : ": prior only (the data see the point above, not the flange centre behind it: compensate at "
+                  "that point, rcal compensate --tool X,Y,Z; or measure where the cable is hooked and say so, "
+                  "--cable-point X,Y,Z --cable-point-sd MM (hooked to 0.1 mm: about 0.1 mm at the flange), or hook "
+                  "it at the flange centre)");
 }
 
 /* The prior's scale estimated from the data: each DH type's factor with its
