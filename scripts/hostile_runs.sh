@@ -178,7 +178,7 @@ rc=$?
 # ---- the devices' verdicts ----
 wait "${pids[0]}"
 pids=()
-TEST[deceptive devices]="drv_acquire (test_reconnect_5mm_off, test_jump_mid_run, test_display_filter), core_stable"
+TEST[deceptive devices]="drv_acquire_device (test_reconnect_5mm_off, test_jump_mid_run, test_display_filter), core_stable"
 if [ -x "$SD" ]; then
     # L of every recorded pose against the clean run: the largest difference (mm), "none" without samples
     worst() { awk -F, 'BEGIN{m=0} NR==FNR{if(FNR>1)L[$1]=$8; next} FNR>1{d=$8-L[$1]; d=d<0?-d:d; if(d>m)m=d; n++} END{printf "%s", n?m:"none"}' "$2" "$1"; }
