@@ -74,6 +74,7 @@ static int to_config(calib_args *a, const rch_cmdspec *spec, unsigned long long 
     cfg->n_data_paths = a->data.n;
     cfg->positions_paths = a->positions.v;
     cfg->n_positions_paths = a->positions.n;
+    cfg->joint_step_given = rch_opt_given(spec, seen, "--joint-step-deg");
     cfg->have_tracker_start = rch_opt_given(spec, seen, "--tracker-position") ||
                               rch_opt_given(spec, seen, "--tracker-rotation");
     for (int k = 0; k < 3; ++k) { /* the one not given: 0 */
@@ -164,6 +165,21 @@ static int parse(calib_args *a, int argc, char **argv)
         {"--no-jump-check", RCH_OPT_FLAG, &cfg->no_jump_check, 0, 0, NULL,
          "do not look for length jumps in the default run (a model fitted across jumps it found is not written: "
          "use --jumps)", 0, NULL},
+        {"--no-length-offset", RCH_OPT_FLAG, &cfg->no_length_offset, 0, 0, NULL,
+         "never weigh a length offset (a display's zero set off the outlet; each outlet's own) by default: by "
+         "default it is fitted when its evidence beats its Occam penalty", 0, NULL},
+        {"--no-drift", RCH_OPT_FLAG, &cfg->no_drift, 0, 0, NULL,
+         "never weigh a drift of the lengths over the run (linear in acquisition order) by default", 0, NULL},
+        {"--sensor-sd-mm", RCH_OPT_DOUBLE, &cfg->sensor_sd_mm, 1e-6, 100.0, "MM",
+         "what the length sensor can repeat (the encoder's repeatability with the robot's; default 0.02): the fit's "
+         "noise is judged against it with the display steps", 0, NULL},
+        {"--display-step-mm", RCH_OPT_DOUBLE, &cfg->display_step_mm, 1e-9, 100.0, "MM",
+         "the length display's step (default: from the data's digits)", 0, NULL},
+        {"--joint-step-deg", RCH_OPT_DOUBLE, &cfg->joint_step_deg, 0.0, 10.0, "DEG",
+         "the joint readings' step (default: from the data's digits; 0: exact)", 0, NULL},
+        {"--force", RCH_OPT_FLAG, &cfg->force, 0, 0, NULL,
+         "write the model even when its noise is far beyond what the sensor can produce or it predicts its own "
+         "data worse than the nominal model (said, never silent)", 0, NULL},
         {"--prior-stated", RCH_OPT_FLAG, &cfg->prior_stated, 0, 0, NULL,
          "the prior's sd as stated (defaults or the robot file's), not widened to the spread this robot's "
          "determined parameters show (type-II maximum likelihood; a robot file's \"prior\" is always kept)", 0,

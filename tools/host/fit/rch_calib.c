@@ -329,8 +329,121 @@ static int fit_effects(rch_calib_result *r, const rch_calib_cfg *cfg, size_t n_l
         rch_diag_set(d, "", 0, 0, "cannot add the tool offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
         return -1;
     }
+    /* the systematic length errors the default run decided to fit (rch_calib_sys.c) */
+    if (r->sys.offset_fitted &&
+        rc_model_add_effect(&r->robot.model, r->n_outlets > 1 ? RC_EFF_OUTLET_OFFSET : RC_EFF_LENGTH_OFFSET, 0, 0) !=
+            RC_OK) {
+        rch_diag_set(d, "", 0, 0, "cannot add the length offset (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
+        return -1;
+    }
+    if (r->sys.drift_fitted && rc_model_add_effect(&r->robot.model, RC_EFF_TIME_DRIFT, 0, 1) != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "cannot add the drift (RC_MAX_PARAMS or RC_MAX_EFFECTS)");
+        return -1;
+    }
     if (cfg->effects && rch_calib_effects(&r->robot.model, cfg->effects, d) != 0)
         return -2;
+    return 0;
+}
+
+/* The calibration again from the start on in's rows (the same inputs, split
+ * seed and effects, the screen's and the systematic decision's findings
+ * kept). 0, or as run_once. */
+static int refit_all(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, const rch_calib_cfg *cfg0,
+                     rch_diag *d)
+{
+    const rch_calib_cfg cfg = *cfg0; /* as asked (the run sets cfg.jumps when its check found jumps) */
+    const rch_calib_screen_result keep = r->screen;
+    const rch_calib_sys sys = r->sys;
+    memset(r, 0, sizeof *r);
+    r->cfg = cfg;
+    r->sys = sys;
+    take_inputs(r, in);
+    int rc = fit_effects(r, &cfg, rch_pos_count_lengths(in->data.s, in->data.n), d);
+    if (rc == 0)
+        rc = run_once(r, w, in->data.s, in->data.n, cfg.seed, NULL, d);
+    r->screen = keep;
+    return rc;
+}
+
+/* Whether the model already carries an effect of kind. */
+static int has_effect(const rc_model *m, rc_effect_kind kind)
+{
+    for (unsigned e = 0; e < m->n_effects; ++e)
+        if (m->effects[e].kind == kind)
+            return 1;
+    return 0;
+}
+
+/* The systematic length errors (rch_calib_sys.c): a length offset and a
+ * drift weighed at the fit at hand by their score against their Occam
+ * penalty; the winners fitted by a refit, kept when its profile likelihood
+ * gain n ln(noise0^2 / noise1^2) still beats the penalty (else the fit at
+ * hand is restored and the refit said). 0, or -1 with d set. */
+static int systematic(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, const rch_calib_cfg *cfg0, rch_diag *d)
+{
+    const rch_calib_cfg *cfg = cfg0;
+    if (!r->after_ok || !r->prior_on || cfg->cases > 1 || cfg->residuals_path ||
+        (cfg->no_length_offset && cfg->no_drift) || rch_pos_count_lengths(in->data.s, in->data.n) < 40)
+        return 0;
+    const rc_model *m = &r->model;
+    int off_ok = !cfg->no_length_offset && !has_effect(m, RC_EFF_LENGTH_OFFSET) &&
+                 !has_effect(m, RC_EFF_OUTLET_OFFSET) && !has_effect(m, RC_EFF_GROUP_OFFSET);
+    int dr_ok = !cfg->no_drift && !has_effect(m, RC_EFF_TIME_DRIFT);
+    /* one at a time, the stronger first, the other scored again at the fit with it: an offset's score
+     * leaks into a drift's at the fit with neither (and back) */
+    for (int round = 0; round < 2 && (off_ok || dr_ok); ++round) {
+        char err[160];
+        rch_calib_sys y = r->sys;
+        if (rch_calib_sys_score(&y, r, r->fixed, in->data.s, in->data.n, err, sizeof err) != 0)
+            return 0; /* not testable at this fit: nothing said, nothing more changed */
+        rch_calib_sys *z = &r->sys;
+        z->tested = 1;
+        z->n_offsets = y.n_offsets;
+        if (off_ok) {
+            z->offset_testable = y.offset_testable;
+            z->offset_score = y.offset_score;
+            z->offset_occam = y.offset_occam;
+            z->offset_size_mm = y.offset_size_mm;
+        }
+        if (dr_ok) {
+            z->drift_testable = y.drift_testable;
+            z->drift_score = y.drift_score;
+            z->drift_occam = y.drift_occam;
+            z->drift_size_mm = y.drift_size_mm;
+        }
+        const double m_off = off_ok && z->offset_testable ? z->offset_score - z->offset_occam : -INFINITY,
+                     m_dr = dr_ok && z->drift_testable ? z->drift_score - z->drift_occam : -INFINITY;
+        if (!(m_off > 0.0) && !(m_dr > 0.0))
+            break;
+        const int take_off = m_off >= m_dr;
+        rch_calib_result *old = malloc(sizeof *old);
+        if (!old) {
+            rch_diag_set(d, "", 0, 0, "out of memory");
+            return -1;
+        }
+        memcpy(old, r, sizeof *old);
+        if (take_off) {
+            r->sys.offset_fitted = 1;
+            off_ok = 0;
+        } else {
+            r->sys.drift_fitted = 1;
+            dr_ok = 0;
+        }
+        const int rc = refit_all(r, w, in, cfg0, d);
+        const double occam = take_off ? old->sys.offset_occam : old->sys.drift_occam;
+        const double gain = rc == 0 && r->after_ok && r->noise_mm > 0.0
+                                ? (double)r->n_train * log(old->noise_mm * old->noise_mm / (r->noise_mm * r->noise_mm))
+                                : -INFINITY;
+        if (!(gain > occam)) {
+            memcpy(r, old, sizeof *r);
+            r->sys.refit_kept_out = take_off ? 1 : 2;
+        }
+        r->sys.refit_gain = gain;
+        r->sys.refit_occam = occam;
+        free(old);
+        if (r->sys.refit_kept_out)
+            break;
+    }
     return 0;
 }
 
@@ -343,7 +456,8 @@ static int fit_effects(rch_calib_result *r, const rch_calib_cfg *cfg, size_t n_l
  * are the fit's, not the model's) or a model that did not fit. 0, or -1 with
  * d set (refused: too many). */
 #define RCH_SCREEN_ROUNDS 4
-static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, rch_diag *d)
+static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, const rch_calib_cfg *cfg0,
+                            rch_diag *d)
 {
     if (!r->after_ok || r->have_jumps || r->jumps_auto || r->jumps_found)
         return 0;
@@ -370,7 +484,6 @@ static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *i
         if (memcmp(drop, prev, n) == 0) /* the same rows as the fit at hand left out: done */
             break;
         memcpy(prev, drop, n);
-        const rch_calib_screen_result keep = r->screen;
         size_t k = 0;
         for (size_t i = 0; i < n; ++i)
             if (!drop[i]) {
@@ -379,14 +492,7 @@ static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *i
                 in->file_of[k++] = f0[i];
             }
         data->n = k;
-        const rch_calib_cfg cfg = r->cfg;
-        memset(r, 0, sizeof *r);
-        r->cfg = cfg;
-        take_inputs(r, in);
-        rc = fit_effects(r, &cfg, rch_pos_count_lengths(data->s, data->n), d);
-        if (rc == 0)
-            rc = run_once(r, w, data->s, data->n, cfg.seed, NULL, d);
-        r->screen = keep;
+        rc = refit_all(r, w, in, cfg0, d);
         if (rc != 0 || !r->after_ok)
             break;
     }
@@ -446,8 +552,10 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
         rc = run_cases(r, w, data, d);
     else
         rc = run_once(r, w, data->s, data->n, cfg->seed, held, d);
+    if (rc == 0 && cfg->cases <= 1)
+        rc = systematic(r, w, in, cfg, d);
     if (rc == 0 && cfg->cases <= 1 && !cfg->no_screen && !cfg->residuals_path)
-        rc = screen_and_refit(r, w, in, d);
+        rc = screen_and_refit(r, w, in, cfg, d);
     if (rc == 0 && cfg->residuals_path && r->finite && save_residuals(r, data, in->file_of, held, d) != 0)
         rc = -1;
     if (rc == 0 && r->have_jumps && r->prov.n_files == 1)

@@ -76,6 +76,46 @@ typedef struct rch_calib_screen_result {
 /* What an out row likely is, in words. */
 const char *rch_screen_kind(const rch_screen_row *w);
 
+/* The systematic length errors the default run weighs (rch_calib_sys.c):
+ * a length offset (a display's zero; each outlet's own) and a linear drift
+ * over the run, each by its score against its Occam penalty at the fit
+ * without it, fitted (a refit) when it wins and the refit confirms. */
+typedef struct rch_calib_sys {
+    int tested;                /* the score test ran (lengths, the default run, not --no-length-offset and
+                                  --no-drift both) */
+    int offset_testable, drift_testable; /* 0: the model's own columns hold it (e.g. --effects group_offset) */
+    unsigned n_offsets;        /* offset columns: one per outlet */
+    double offset_score, offset_occam, offset_size_mm; /* chi-square gain, penalty, the largest offset (mm) */
+    double drift_score, drift_occam, drift_size_mm;    /* the same for the drift (mm over the run) */
+    int offset_fitted, drift_fitted; /* in the final model by this decision */
+    int refit_kept_out;        /* a refit with one was made and did not confirm its score (not kept): 1 the
+                                  offset, 2 the drift */
+    double refit_gain, refit_occam; /* that refit's profile-likelihood gain and its penalty */
+} rch_calib_sys;
+
+/* How far the fit's residual lies from what its sensor can produce
+ * (rch_calib_judge.c): a fit whose noise is far beyond it explains nothing
+ * and is not written unless forced. */
+#define RCH_JUDGE_FACTOR 10.0
+typedef struct rch_calib_judge {
+    int done;
+    double floor_mm;           /* what the length sensor can produce: sqrt(sd^2 + step^2/12 + joints^2) */
+    double sensor_sd_mm;       /* the encoder's (and the robot's) repeatability: stated or the default */
+    int sensor_sd_stated;
+    double display_step_mm;    /* the lengths' display step (from the data's digits, or stated) */
+    double joint_step_deg;     /* the joints' display step (from the data's digits, or stated; 0: finer) */
+    double joint_part_mm;      /* that step's effect on a length through the joints (rms over the rows) */
+    double pos_floor_mm;       /* the tracker's: its stated sigma (or the default) and the joints' step */
+    double noise_mm, ratio;    /* the fit's noise and noise / floor (the worse sensor's) */
+    int beyond;                /* ratio > RCH_JUDGE_FACTOR */
+    int worse_than_nominal;    /* the model predicts its own training rows worse than the nominal one */
+    /* causes tried when beyond (rch_calib_judge.c): a relabelling of the joint columns or the plate's
+     * points whose nominal fit explains the data far better than the file as read */
+    int cause_found;
+    char cause[240];           /* what it is and the fix, or "" */
+    char tried[240];           /* the causes tried, in words */
+} rch_calib_judge;
+
 enum { RCH_CALIB_SEEN_FLANGE = 0, RCH_CALIB_SEEN_ATTACHMENT = 1, RCH_CALIB_SEEN_TARGETS = 2 };
 
 typedef struct rch_calib_result {
@@ -179,6 +219,9 @@ typedef struct rch_calib_result {
     rch_pos_err pos_before, pos_after; /* held-out positions (the training ones when none is held out) */
     rch_pos_err pos_train_after;
     rch_calib_screen_result screen; /* the rows left out as irreconcilable (screen.out 0: none) */
+    uint8_t fixed[RC_MAX_PARAMS];   /* the parameters the final fit held (gauge, --fix, unseen) */
+    rch_calib_sys sys;              /* the systematic length errors weighed */
+    rch_calib_judge judge;          /* the fit against what its sensor can produce */
 } rch_calib_result;
 
 /* The whole calibration: the inputs (rch_inputs_load), the cost (refused

@@ -55,6 +55,13 @@ typedef struct rch_calib_cfg {
                                 column names them; RC_EFF_CABLE_POINTS), 0: none */
     double cable_points_mm[RC_MAX_TARGETS][3]; /* (n_cable_points x 3) their nominal coordinates, flange frame */
     double cable_point_sd_mm; /* their tolerance (prior sd of each coordinate); 0: RCH_PRIOR_POINTS_MM */
+    int no_length_offset;   /* 1: a length offset (display zero) is never weighed by default (rch_calib_sys.c) */
+    int no_drift;           /* 1: a drift over the run is never weighed by default */
+    int force;              /* 1: write a model the judge refuses (its noise far beyond the sensor's) */
+    double sensor_sd_mm;    /* the length sensor's repeatability (with the robot's); 0: RCH_JUDGE_SENSOR_SD_MM */
+    double display_step_mm; /* the lengths' display step; 0: from the data's digits */
+    double joint_step_deg;  /* the joints' display step; < 0: from the data's digits; 0 given: none */
+    int joint_step_given;
 } rch_calib_cfg;
 
 /* The defaults of `rcal calibrate`: everything zero or NULL but method LM,

@@ -698,6 +698,7 @@ int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sam
         cfg.prior_mean = r->prior_mean;
         cfg.prior_sd = r->prior_sd;
     }
+    memcpy(r->fixed, fixed, sizeof r->fixed);
     const double t0 = now_ms(), jumps0 = r->jumps_ms;
     rc_status st = RC_OK;
     /* jumps: a cable's display; several outlets' rows interleave in acquisition order, where a step of the

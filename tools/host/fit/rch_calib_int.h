@@ -49,4 +49,12 @@ const char *rch_calib_data_name(const struct rch_calib_result *r);
 int rch_calib_screen(struct rch_calib_result *r, uint8_t *drop, const rc_sample *s, size_t n, const unsigned *line,
                      const unsigned *file_of, rch_diag *d);
 
+/* rch_calib_sys.c: the score statistics of a length offset (each outlet's)
+ * and a linear drift at the fit at hand (r->model, or r->jumps.model), over
+ * the rows s (n), the parameters fixed held; into out's scores, penalties,
+ * sizes and testable flags. 0, or -1 with err set. */
+struct rch_calib_sys;
+int rch_calib_sys_score(struct rch_calib_sys *out, const struct rch_calib_result *r, const uint8_t *fixed,
+                        const rc_sample *s, size_t n, char *err, size_t errlen);
+
 #endif

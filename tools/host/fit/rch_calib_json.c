@@ -185,6 +185,17 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
         rch_jw_numf(&w, "attachment_occam", r->attach_occam, "%.6g");
         rch_jw_bool(&w, "attachment_dchi2_is_bound", r->attach_bound);
     }
+    if (r->sys.tested) {
+        rch_jw_obj(&w, "systematic");
+        rch_jw_bool(&w, "length_offset_fitted", r->sys.offset_fitted);
+        rch_jw_numf(&w, "length_offset_score", r->sys.offset_score, "%.6g");
+        rch_jw_numf(&w, "length_offset_occam", r->sys.offset_occam, "%.6g");
+        rch_jw_bool(&w, "drift_fitted", r->sys.drift_fitted);
+        rch_jw_numf(&w, "drift_score", r->sys.drift_score, "%.6g");
+        rch_jw_numf(&w, "drift_occam", r->sys.drift_occam, "%.6g");
+        rch_jw_bool(&w, "refit_kept_out", r->sys.refit_kept_out);
+        rch_jw_end(&w);
+    }
     rch_jw_bool(&w, "jumps_found_by_default", r->jumps_auto);
     rch_jw_end(&w);
     if (r->n_pos_rows)

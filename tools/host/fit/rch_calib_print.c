@@ -99,6 +99,49 @@ static void print_effects(FILE *f, const rch_calib_result *r)
 }
 
 /* What the outlets add: the rigid motion their places fix (rch_prior_outlet_span). */
+/* The value of the first parameter of the effect kind in m (and its count), or NAN. */
+static double effect_value(const rc_model *m, rc_effect_kind kind, unsigned k)
+{
+    for (unsigned e = 0; e < m->n_effects; ++e)
+        if (m->effects[e].kind == kind && k < m->effects[e].count)
+            return m->x[m->effects[e].first + k];
+    return NAN;
+}
+
+/* The systematic length errors weighed by default (rch_calib_sys.c), a line each. */
+static void print_sys(FILE *f, const rch_calib_result *r)
+{
+    const rch_calib_sys *y = &r->sys;
+    if (!y->tested)
+        return;
+    const rc_model *m = &r->model;
+    if (y->offset_fitted) {
+        fprintf(f, "  length offset (a display's zero set off the outlet): fitted,");
+        if (y->n_offsets > 1)
+            for (unsigned k = 0; k < y->n_offsets; ++k)
+                fprintf(f, " outlet %u %+.4f mm%s", (unsigned)r->outlet_label[k],
+                        effect_value(m, RC_EFF_OUTLET_OFFSET, k), k + 1 < y->n_offsets ? "," : "");
+        else
+            fprintf(f, " %+.4f mm", effect_value(m, RC_EFF_LENGTH_OFFSET, 0));
+        fprintf(f, " (its evidence %.1f beats its Occam penalty %.1f; --no-length-offset: not weighed)\n",
+                y->offset_score, y->offset_occam);
+    } else if (y->offset_testable) {
+        fprintf(f, "  length offset (a display's zero): not needed (its evidence %.1f against its Occam penalty "
+                   "%.1f)\n", y->offset_score, y->offset_occam);
+    }
+    if (y->drift_fitted)
+        fprintf(f, "  drift of the lengths over the run: fitted as nuisance, %+.4f mm from the first row to the last "
+                   "(its evidence %.1f beats its Occam penalty %.1f; not used at a new pose; --no-drift: not "
+                   "weighed)\n", effect_value(m, RC_EFF_TIME_DRIFT, 0), y->drift_score, y->drift_occam);
+    else if (y->drift_testable)
+        fprintf(f, "  drift of the lengths over the run: not needed (its evidence %.1f against its Occam penalty "
+                   "%.1f)\n", y->drift_score, y->drift_occam);
+    if (y->refit_kept_out)
+        fprintf(f, "  (a refit with %s gained %.1f against its penalty %.1f: not kept)\n",
+                y->refit_kept_out == 1 ? "the offset" : "the drift",
+                y->refit_gain, y->refit_occam);
+}
+
 static void print_outlets(FILE *f, const rc_model *m)
 {
     double pos[RC_MAX_OUTLETS][3], off = 0.0;
@@ -293,6 +336,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                 fmax(r->attach_dchi2, 0.0), /* below 0 only by the scaled prior taken without a refit: with
                                                more freedom the optimum does not fit worse */
                 r->attach_occam);
+    print_sys(f, r);
     fprintf(f, "  parameter        value   1 std.error  what the data see (%s)\n",
             u->has_prior ? "posterior sd against the prior's; why" : "why");
     unsigned held = 0, outside = 0;
