@@ -459,7 +459,7 @@ static int systematic(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, con
 static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, const rch_calib_cfg *cfg0,
                             rch_diag *d)
 {
-    if (!r->after_ok || r->have_jumps || r->jumps_auto || r->jumps_found)
+    if (!r->after_ok)
         return 0;
     rch_data *data = &in->data;
     const size_t n = data->n;

@@ -172,6 +172,7 @@ typedef struct rch_calib_result {
     uint8_t outlet_label[RC_MAX_OUTLETS]; /* (n_outlets) the file's label of outlet k (k = 0: e) */
     unsigned jumps_found;     /* the default run's jump check: jumps the fit does not model (0: none) */
     double jump_check_max_mm; /* the largest of them */
+    double jump_check_scale_mm; /* the robust sd of the residual with the steps (a step counts above 8 x it) */
     unsigned jump_check_steps; /* every change point the check's search found (jumps_found of them far above) */
     int jumps_auto;           /* they were then fitted as nuisance (cfg.jumps set by the run) */
     int have_jump_at, keep_jump_at; /* the change points of this training set are known (searched once) */

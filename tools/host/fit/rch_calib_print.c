@@ -482,11 +482,12 @@ void rch_calib_jump_counts(char *buf, size_t len, const rch_calib_result *r)
 {
     const unsigned found = r->jumps_found, steps = r->jump_check_steps;
     if (found == steps)
-        snprintf(buf, len, "the change-point search found %u step%s far above the residual (8 x its RMS; largest "
-                 "%.3f mm)", found, found == 1 ? "" : "s", r->jump_check_max_mm);
+        snprintf(buf, len, "the change-point search found %u step%s far above the residual (8 x its robust sd "
+                 "%.4f mm; largest %.3f mm)", found, found == 1 ? "" : "s", r->jump_check_scale_mm, r->jump_check_max_mm);
     else
         snprintf(buf, len, "%u of the %u steps the change-point search found %s far above the residual (8 x its "
-                 "RMS; largest %.3f mm)", found, steps, found == 1 ? "is" : "are", r->jump_check_max_mm);
+                 "robust sd %.4f mm; largest %.3f mm)", found, steps, found == 1 ? "is" : "are", r->jump_check_scale_mm,
+                 r->jump_check_max_mm);
 }
 
 const char *rch_calib_data_name(const rch_calib_result *r)

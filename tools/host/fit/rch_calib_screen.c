@@ -21,25 +21,7 @@
 
 #include "rch_calib.h"
 #include "rch_calib_int.h"
-
-static int cmp_d(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* 1.4826 MAD of v (n, reordered). */
-static double robust_scale(double *v, size_t n)
-{
-    if (n == 0)
-        return 0.0;
-    qsort(v, n, sizeof *v, cmp_d);
-    const double med = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    for (size_t i = 0; i < n; ++i)
-        v[i] = fabs(v[i] - med);
-    qsort(v, n, sizeof *v, cmp_d);
-    return 1.4826 * (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
+#include "rch_stats.h"
 
 /* Whether another outlet of m explains sample s's length to within tol:
  * its label (1..) or 0. */
@@ -70,9 +52,27 @@ int rch_calib_screen(rch_calib_result *r, uint8_t *drop, const rc_sample *s, siz
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
+    /* under the fit at hand: with length jumps fitted, their segment offsets too (an outlier must not hide
+     * behind a jump the screen does not know, nor a jump be taken for a block of outliers) */
+    const rc_model *fm = r->have_jumps ? &r->jumps.model : &r->model;
     for (size_t i = 0; i < n; ++i) {
         double l;
-        res[i] = rc_meas(&l, NULL, &r->model, &s[i]) == RC_OK ? (l - s[i].len_mm) * rc_sample_weight(&s[i]) : NAN;
+        rc_sample c = s[i];
+        const unsigned seg = r->have_jumps ? rch_jumps_segment(&r->jumps, c.t) : 0u;
+        c.group = (uint16_t)seg;
+        res[i] = rc_meas(&l, NULL, fm, &c) == RC_OK ? (l - s[i].len_mm) * rc_sample_weight(&s[i]) : NAN;
+        /* a row the fit did not see just before a jump's first training row may lie after the jump (the
+         * change point is known only between training rows): the segment that explains it (a misread stays
+         * far under both); only for the last few rows before it */
+        if (r->have_jumps && seg < r->jumps.n_jumps && isfinite(res[i]) && fabs(res[i]) > RCH_SCREEN_FLOOR_MM) {
+            unsigned between = 0;
+            for (size_t k = 0; k < n && between <= 2; ++k)
+                between += s[k].t > c.t && s[k].t < r->jumps.at_t[seg];
+            c.group = (uint16_t)(seg + 1);
+            if (between <= 2 && rc_meas(&l, NULL, fm, &c) == RC_OK &&
+                fabs((l - s[i].len_mm) * rc_sample_weight(&s[i])) < fabs(res[i]))
+                res[i] = (l - s[i].len_mm) * rc_sample_weight(&s[i]);
+        }
     }
     double scale[2] = {0.0, 0.0}; /* cable, tracker */
     for (int tr = 0; tr < 2; ++tr) {
@@ -80,7 +80,7 @@ int rch_calib_screen(rch_calib_result *r, uint8_t *drop, const rc_sample *s, siz
         for (size_t i = 0; i < n; ++i)
             if ((s[i].sensor != RC_SENSOR_LENGTH) == tr && isfinite(res[i]))
                 tmp[m++] = res[i];
-        scale[tr] = robust_scale(tmp, m);
+        scale[tr] = rch_mad_sd(tmp, m);
     }
     free(tmp);
     size_t rows = 0, out_rows = 0;
@@ -104,7 +104,7 @@ int rch_calib_screen(rch_calib_result *r, uint8_t *drop, const rc_sample *s, siz
                 w->residual_mm = worst;
                 w->scale_mm = scale[tr];
                 w->tracker = tr;
-                w->label_fits = tr ? 0 : other_outlet(&r->model, &s[i], 3.0 * scale[tr] + RCH_SCREEN_FLOOR_MM,
+                w->label_fits = tr ? 0 : other_outlet(fm, &s[i], 3.0 * scale[tr] + RCH_SCREEN_FLOOR_MM,
                                                        r->outlet_label, r->n_outlets);
             }
         }

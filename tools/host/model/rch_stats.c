@@ -231,3 +231,15 @@ double rch_sd_se(double sd, double dof)
 {
     return dof > 0.0 ? sd / sqrt(2.0 * dof) : NAN;
 }
+
+double rch_mad_sd(double *v, size_t n)
+{
+    if (n == 0)
+        return 0.0;
+    double med, mx;
+    rch_median_max(&med, &mx, v, n);
+    for (size_t i = 0; i < n; ++i)
+        v[i] = fabs(v[i] - med);
+    rch_median_max(&med, &mx, v, n);
+    return 1.4826 * med;
+}

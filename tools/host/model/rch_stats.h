@@ -49,6 +49,10 @@ double rch_rms(const double *v, size_t n);
  * finite values, reordered): an O(n) selection (Hoare's FIND), the very
  * values a sort gives. Both NaN for n = 0. */
 void rch_median_max(double *med, double *max, double *v, size_t n);
+/* The robust standard deviation of v (n finite values, reordered): 1.4826
+ * x the median absolute deviation from the median (the standard deviation
+ * for Gaussian values, not inflated by a few far ones). 0 for n = 0. */
+double rch_mad_sd(double *v, size_t n);
 
 /* The p quantile (0..1) of v (n finite values, sorted in place), linear
  * between order statistics (numpy's default): NaN for n = 0. */
