@@ -556,6 +556,8 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
         rc = systematic(r, w, in, cfg, d);
     if (rc == 0 && cfg->cases <= 1 && !cfg->no_screen && !cfg->residuals_path)
         rc = screen_and_refit(r, w, in, cfg, d);
+    if (rc == 0 && cfg->cases <= 1)
+        rch_calib_judge_run(r, w, in->data.s, in->data.n);
     if (rc == 0 && cfg->residuals_path && r->finite && save_residuals(r, data, in->file_of, held, d) != 0)
         rc = -1;
     if (rc == 0 && r->have_jumps && r->prov.n_files == 1)

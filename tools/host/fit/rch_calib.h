@@ -97,6 +97,10 @@ typedef struct rch_calib_sys {
  * (rch_calib_judge.c): a fit whose noise is far beyond it explains nothing
  * and is not written unless forced. */
 #define RCH_JUDGE_FACTOR 10.0
+/* The default repeatability of a draw-wire encoder reading with the
+ * robot's own (mm): a 0.01 mm display on an arm of 0.01-0.03 mm
+ * repeatability (ABB IRB120: 0.01 mm). */
+#define RCH_JUDGE_SENSOR_SD_MM 0.02
 typedef struct rch_calib_judge {
     int done;
     double floor_mm;           /* what the length sensor can produce: sqrt(sd^2 + step^2/12 + joints^2) */
@@ -233,6 +237,12 @@ typedef struct rch_calib_result {
  * name, --residuals with --cases or --jumps, a run estimated too long: d
  * set). */
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d);
+
+/* Why r's model is not one to use (r->judge: the noise against the
+ * sensor's floor, the model against the nominal one, the cause found or
+ * the causes tried), one sentence into buf (len); and the floor's parts. */
+void rch_calib_judge_text(char *buf, size_t len, const rch_calib_result *r);
+void rch_calib_judge_floor_text(char *buf, size_t len, const rch_calib_result *r);
 
 /* The text report (the paper's Table 7 form, identifiability, solver line). */
 void rch_calib_print(FILE *f, const rch_calib_result *r);

@@ -57,4 +57,9 @@ struct rch_calib_sys;
 int rch_calib_sys_score(struct rch_calib_sys *out, const struct rch_calib_result *r, const uint8_t *fixed,
                         const rc_sample *s, size_t n, char *err, size_t errlen);
 
+/* rch_calib_judge.c: r->judge from the fit at hand over its rows s (n):
+ * the sensor's floor, the noise against it, the model against the
+ * nominal one, and (when either fails) the causes tried. */
+void rch_calib_judge_run(struct rch_calib_result *r, rc_solve_work *w, const rc_sample *s, size_t n);
+
 #endif

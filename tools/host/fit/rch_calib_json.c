@@ -196,6 +196,30 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
         rch_jw_bool(&w, "refit_kept_out", r->sys.refit_kept_out);
         rch_jw_end(&w);
     }
+    if (r->judge.done) {
+        const rch_calib_judge *j = &r->judge;
+        rch_jw_obj(&w, "judge");
+        rch_jw_numf(&w, "noise_mm", j->noise_mm, "%.6g");
+        rch_jw_numf(&w, "floor_mm", j->floor_mm, "%.6g");
+        rch_jw_numf(&w, "sensor_sd_mm", j->sensor_sd_mm, "%.6g");
+        rch_jw_bool(&w, "sensor_sd_stated", j->sensor_sd_stated);
+        rch_jw_numf(&w, "display_step_mm", j->display_step_mm, "%.6g");
+        rch_jw_numf(&w, "joint_step_deg", j->joint_step_deg, "%.6g");
+        rch_jw_numf(&w, "joint_part_mm", j->joint_part_mm, "%.6g");
+        if (r->n_pos_rows)
+            rch_jw_numf(&w, "tracker_floor_mm", j->pos_floor_mm, "%.6g");
+        rch_jw_numf(&w, "ratio", j->ratio, "%.6g");
+        rch_jw_numf(&w, "factor", RCH_JUDGE_FACTOR, "%.6g");
+        rch_jw_bool(&w, "beyond", j->beyond);
+        rch_jw_bool(&w, "worse_than_nominal", j->worse_than_nominal);
+        rch_jw_bool(&w, "usable", !j->beyond && !j->worse_than_nominal);
+        if (j->beyond || j->worse_than_nominal) {
+            char why[1400];
+            rch_calib_judge_text(why, sizeof why, r);
+            rch_jw_str(&w, "why", why);
+        }
+        rch_jw_end(&w);
+    }
     rch_jw_bool(&w, "jumps_found_by_default", r->jumps_auto);
     rch_jw_end(&w);
     if (r->n_pos_rows)

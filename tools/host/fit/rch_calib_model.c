@@ -65,6 +65,13 @@ int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *
                      counts, r->jump_check_steps, r->jump_check_steps == 1 ? "" : "s");
         return -1;
     }
+    const rch_calib_judge *j = &r->judge;
+    if (j->done && (j->beyond || j->worse_than_nominal) && !r->cfg.force) {
+        char why[1400];
+        rch_calib_judge_text(why, sizeof why, r);
+        rch_diag_set(d, path, 0, 0, "not written: %s (--force writes it anyway)", why);
+        return -1;
+    }
     /* every command reads a model file through rch_robot_load, which refuses an effect outside its
      * plausible range (rc_effect_desc.limit): a fit that ends there is said here, not written for the
      * next command to refuse */

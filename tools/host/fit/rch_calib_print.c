@@ -99,6 +99,60 @@ static void print_effects(FILE *f, const rch_calib_result *r)
 }
 
 /* What the outlets add: the rigid motion their places fix (rch_prior_outlet_span). */
+/* The fit against what its sensor can produce (rch_calib_judge.c), one line. */
+static void print_judge(FILE *f, const rch_calib_result *r)
+{
+    const rch_calib_judge *j = &r->judge;
+    if (!j->done)
+        return;
+    char floor[400];
+    rch_calib_judge_floor_text(floor, sizeof floor, r);
+    fprintf(f, "  the fit against its sensor: noise %.4g mm, %.2g x what the sensor can produce (%s)%s\n",
+            j->noise_mm, j->ratio, floor, j->beyond ? ": FAR BEYOND IT" : "");
+}
+
+void rch_calib_judge_floor_text(char *buf, size_t len, const rch_calib_result *r)
+{
+    const rch_calib_judge *j = &r->judge;
+    const size_t n_len = r->n_data > r->n_pos_rows * 3 ? 1 : 0;
+    size_t pos = 0;
+    if (n_len)
+        pos += (size_t)snprintf(buf + pos, len - pos,
+                                "%.3g mm: repeatability %.3g mm%s, display step %.3g mm, joints' step %.3g deg "
+                                "(%.3g mm on a length)",
+                                j->floor_mm, j->sensor_sd_mm, j->sensor_sd_stated ? " stated" : " (default; --sensor-sd-mm)",
+                                j->display_step_mm, j->joint_step_deg, j->joint_part_mm);
+    if (r->n_pos_rows && pos < len)
+        snprintf(buf + pos, len - pos, "%stracker %.3g mm", pos ? "; " : "", j->pos_floor_mm);
+}
+
+void rch_calib_judge_text(char *buf, size_t len, const rch_calib_result *r)
+{
+    const rch_calib_judge *j = &r->judge;
+    char floor[400];
+    rch_calib_judge_floor_text(floor, sizeof floor, r);
+    size_t pos = 0;
+    if (j->beyond)
+        pos += (size_t)snprintf(buf + pos, len - pos,
+                                "the fit's noise %.4g mm is %.0f x what the sensor can produce (%s): the model "
+                                "explains nothing the sensor measured",
+                                j->noise_mm, j->ratio, floor);
+    if (j->worse_than_nominal && pos < len)
+        pos += (size_t)snprintf(buf + pos, len - pos, "%sit predicts its own data worse than the nominal robot "
+                                                      "(%.4f against %.4f mm RMS)",
+                                pos ? "; " : "", r->train_after.rmse_mm, r->train_before.rmse_mm);
+    if (pos >= len)
+        return;
+    if (j->cause_found)
+        snprintf(buf + pos, len - pos, "; likely: %s", j->cause);
+    else
+        snprintf(buf + pos, len - pos,
+                 "; tried: a length offset and a drift (weighed by default), length jumps and rows far off (the "
+                 "screen), %s: none explains it. Look for wrong units or columns, another robot's or session's "
+                 "data, a sensor far noisier than stated (--sensor-sd-mm)",
+                 j->tried[0] ? j->tried : "relabelled joint columns");
+}
+
 /* The value of the first parameter of the effect kind in m (and its count), or NAN. */
 static double effect_value(const rc_model *m, rc_effect_kind kind, unsigned k)
 {
@@ -337,6 +391,7 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                                                more freedom the optimum does not fit worse */
                 r->attach_occam);
     print_sys(f, r);
+    print_judge(f, r);
     fprintf(f, "  parameter        value   1 std.error  what the data see (%s)\n",
             u->has_prior ? "posterior sd against the prior's; why" : "why");
     unsigned held = 0, outside = 0;
@@ -504,6 +559,12 @@ static void print_summary(FILE *f, const rch_calib_result *r)
     hint_paths hp;
     hint_paths_of(&hp, r);
     fputs("\nsummary:\n", f);
+    if (r->judge.done && (r->judge.beyond || r->judge.worse_than_nominal)) {
+        char why[1400];
+        rch_calib_judge_text(why, sizeof why, r);
+        fprintf(f, "  NOT A MODEL TO USE: %s; %s\n", why,
+                r->cfg.force ? "written anyway (--force)" : "rcal calibrate --out refuses to write it (--force writes it)");
+    }
     if (r->after_ok)
         fprintf(f, "  %s RMSE %.4f mm before -> %.4f mm after calibration (%zu samples%s)\n",
                 r->n_test ? "held-out" : "training", r->before_m.rmse_mm, r->after_m.rmse_mm,

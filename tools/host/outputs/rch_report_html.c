@@ -234,6 +234,18 @@ static unsigned worse_than_nominal(const rep *r, char *why, size_t len)
         if (isfinite(a) && isfinite(b) && a > b)
             why_add(why, len, &n, "%s %.4g mm calibrated against %.4g mm nominal", pairs[k].what, a, b);
     }
+    /* the calibration's own judge (rch_calib_judge.c): its noise far beyond what the sensor can produce, or
+     * its model worse than the nominal one on its own data */
+    const rch_json *jg = rch_rep_jpath(r->cal, "estimation.judge");
+    if (jg) {
+        const double ra = jnum(jg, "ratio"), fa = jnum(jg, "factor");
+        const char *jw = jstr(jg, "why");
+        const rch_json *bey = rch_rep_jpath(jg, "beyond"), *wn = rch_rep_jpath(jg, "worse_than_nominal");
+        if ((bey && bey->type == RCH_JBOOL && bey->num != 0.0) || (wn && wn->type == RCH_JBOOL && wn->num != 0.0))
+            why_add(why, len, &n, "%s", jw ? jw : "the fit's noise is far beyond what its sensor can produce");
+        else if (isfinite(ra) && isfinite(fa) && ra > fa)
+            why_add(why, len, &n, "the fit's noise is %.3g x what its sensor can produce", ra);
+    }
     const rch_json *ss = jarr(r->diag, "sensors");
     for (size_t k = 0; ss && k < ss->n; ++k) {
         const rch_json *z = ss->items[k];
