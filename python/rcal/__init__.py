@@ -402,14 +402,15 @@ class Result:
 
 
 _CAL_FLAGS = {"tool_offset": 1, "jumps": 2, "dequantize": 4, "no_prior": 8, "holdout_groups": 16,
-              "no_jump_check": 32, "no_screen": 64, "no_dequantize": 128, "prior_stated": 256}
+              "no_jump_check": 32, "no_screen": 64, "no_dequantize": 128, "prior_stated": 256,
+              "no_length_offset": 512, "no_drift": 1024, "force": 2048}
 
 
 def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=None, robot=None, method="lm",
               test_fraction=0.1, seed=1, max_iter=0, fix=None, effects=None, jumps=False, dequantize=None,
               prior=True, prior_stated=False, tool_offset=False, holdout_groups=False, jump_check=True, validate=None, truth=None,
               cases=1, samples=0, plots=None, residuals=None, data_csv=None, positions=None, screen=True,
-              target=None, cable_points=None, cable_point_sd=None):
+              target=None, cable_points=None, cable_point_sd=None, length_offset=True, drift=True, force=False):
     """Identify the DH errors and the encoder outlet from cable lengths, as
     `rcal calibrate` does (the same host function: identical figures).
     Each argument is the CLI option of the same meaning.
@@ -455,6 +456,13 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
                     cable_point_sd: their tolerance in mm (--cable-point-sd)
     target:         with q_deg: (n) the plate point (0, 1, ...) each length
                     was measured on (a file's target column)
+    length_offset, drift: False for --no-length-offset, --no-drift (by default
+                    each is weighed by its evidence and fitted when it wins:
+                    Result.figure("length_offset_fitted"), "drift_fitted")
+    force:          --force: Result.write writes a model the judge refuses
+                    (its noise beyond 10 x what the sensor can produce, or
+                    worse than the nominal model: Result.figure("judge_usable"),
+                    Result.json()["estimation"]["judge"])
     Returns a Result. Raises RcalError (bad file with file:line:col, too few
     samples, unknown method or effect) or ValueError (bad arguments)."""
     if data is None:
@@ -485,7 +493,8 @@ def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=
     for name, on in (("tool_offset", tool_offset), ("jumps", jumps), ("dequantize", dequantize is True),
                      ("no_dequantize", dequantize is False), ("prior_stated", prior_stated),
                      ("no_prior", not prior), ("holdout_groups", holdout_groups), ("no_jump_check", not jump_check),
-                     ("no_screen", not screen)):
+                     ("no_screen", not screen), ("no_length_offset", not length_offset), ("no_drift", not drift),
+                     ("force", force)):
         if on:
             flags |= _CAL_FLAGS[name]
     h = ctypes.c_void_p()

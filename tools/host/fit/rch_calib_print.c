@@ -147,10 +147,13 @@ void rch_calib_judge_text(char *buf, size_t len, const rch_calib_result *r)
         snprintf(buf + pos, len - pos, "; likely: %s", j->cause);
     else
         snprintf(buf + pos, len - pos,
-                 "; tried: a length offset and a drift (weighed by default), length jumps and rows far off (the "
-                 "screen), %s: none explains it. Look for wrong units or columns, another robot's or session's "
-                 "data, a sensor far noisier than stated (--sensor-sd-mm)",
-                 j->tried[0] ? j->tried : "relabelled joint columns");
+                 "; tried: %s%s: none explains it. Look for wrong units or columns, another robot's or session's "
+                 "data, a sensor far noisier than stated (%s)",
+                 r->n_data > r->n_pos_rows * 3 ? "a length offset and a drift (weighed by default), length jumps and "
+                                                  "rows far off (the screen), "
+                                               : "rows far off (the screen), ",
+                 j->tried[0] ? j->tried : "relabelled joint columns",
+                 r->n_data > r->n_pos_rows * 3 ? "--sensor-sd-mm" : "the positions file's sigma_mm column");
 }
 
 /* The value of the first parameter of the effect kind in m (and its count), or NAN. */

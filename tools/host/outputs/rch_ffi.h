@@ -112,7 +112,10 @@ enum {
     RCH_FFI_CAL_NO_JUMP_CHECK = 32,  /* --no-jump-check */
     RCH_FFI_CAL_NO_SCREEN = 64,      /* --no-screen: every row fitted, none left out as irreconcilable */
     RCH_FFI_CAL_NO_DEQUANTIZE = 128, /* --no-dequantize-joints: the joints as read (default: automatic) */
-    RCH_FFI_CAL_PRIOR_STATED = 256   /* --prior-stated: the prior's sd as stated, not scaled from the data */
+    RCH_FFI_CAL_PRIOR_STATED = 256,  /* --prior-stated: the prior's sd as stated, not scaled from the data */
+    RCH_FFI_CAL_NO_LENGTH_OFFSET = 512, /* --no-length-offset: a display's zero never weighed by default */
+    RCH_FFI_CAL_NO_DRIFT = 1024,     /* --no-drift: a drift over the run never weighed by default */
+    RCH_FFI_CAL_FORCE = 2048         /* --force: write a model the judge refuses (rch_calib_judge.c) */
 };
 
 /* Calibrate with the host function `rcal calibrate` runs (rch_calib_run):

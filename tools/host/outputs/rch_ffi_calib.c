@@ -140,6 +140,9 @@ static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t 
     cfg.no_screen = (o->flags & RCH_FFI_CAL_NO_SCREEN) != 0;
     cfg.no_dequantize = (o->flags & RCH_FFI_CAL_NO_DEQUANTIZE) != 0;
     cfg.prior_stated = (o->flags & RCH_FFI_CAL_PRIOR_STATED) != 0;
+    cfg.no_length_offset = (o->flags & RCH_FFI_CAL_NO_LENGTH_OFFSET) != 0;
+    cfg.no_drift = (o->flags & RCH_FFI_CAL_NO_DRIFT) != 0;
+    cfg.force = (o->flags & RCH_FFI_CAL_FORCE) != 0;
     cfg.robot_path = rch_ffip_copy_opt(c->robot_path, o->robot, &too_long);
     cfg.truth_path = rch_ffip_copy_opt(c->truth_path, o->truth, &too_long);
     cfg.fix = rch_ffip_copy_opt(c->fix, o->fix, &too_long);
@@ -427,6 +430,11 @@ static int calib_figure(const rch_calib_result *r, const char *name, double *v)
         {"groups", 1, r->n_groups},
         {"attachment_centred", 1, r->attach_centred},
         {"jumps_found_by_default", 1, r->jumps_found},
+        {"length_offset_fitted", r->sys.tested, r->sys.offset_fitted},
+        {"drift_fitted", r->sys.tested, r->sys.drift_fitted},
+        {"judge_ratio", r->judge.done, r->judge.ratio},
+        {"judge_floor_mm", r->judge.done, r->judge.floor_mm},
+        {"judge_usable", r->judge.done, !r->judge.beyond && !r->judge.worse_than_nominal},
         {"jump_check_max_mm", 1, r->jump_check_max_mm},
         {"jumps_fitted", 1, r->have_jumps ? r->jumps.n_jumps : 0},
         {"n_ambiguous", 1, (double)r->n_ambiguous},
