@@ -637,12 +637,13 @@ static rc_status recheck(acq *a, size_t i)
     return RC_ERR_IO;
 }
 
-/* Append pose i's sample to the file. 0, or 1 with the message. */
-static int append(acq *a, size_t i, const double q_deg[RC_NJ], const rc_stable_result *r)
+/* Append pose i's sample, taken at wall-clock t_ms, to the file. 0, or 1
+ * with the message. */
+static int append(acq *a, size_t i, const double q_deg[RC_NJ], const rc_stable_result *r, long long t_ms)
 {
     rch_diag dg;
     char buf[900];
-    if (rch_acqfile_append(&a->file, i, q_deg, r, a->io->wall_ms(a->io->ctx), &dg) != 0) {
+    if (rch_acqfile_append(&a->file, i, q_deg, r, t_ms, &dg) != 0) {
         WARN(a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
         return 1;
     }
@@ -658,6 +659,7 @@ static int run_poses(acq *a)
     int held = 0;
     size_t held_pose = 0;
     double held_q[RC_NJ];
+    long long held_t = 0;
     rc_stable_result held_r;
     memset(&held_r, 0, sizeof held_r);
     for (size_t i = 0; i < a->n; ++i) {
@@ -697,14 +699,15 @@ static int run_poses(acq *a)
             held = 1;
             held_pose = i;
             held_r = r;
+            held_t = a->io->wall_ms(a->io->ctx); /* when it was taken, not when it is written */
             memcpy(held_q, q_deg, sizeof held_q);
             PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings; recorded once the next pose follows it)\n",
                      r.mean_mm, r.spread_mm, r.count);
         } else {
-            if (held && append(a, held_pose, held_q, &held_r) != 0)
+            if (held && append(a, held_pose, held_q, &held_r, held_t) != 0)
                 return 1;
             held = 0;
-            if (append(a, i, q_deg, &r) != 0)
+            if (append(a, i, q_deg, &r, a->io->wall_ms(a->io->ctx)) != 0)
                 return 1;
             PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
         }
@@ -717,7 +720,7 @@ static int run_poses(acq *a)
     if (held) { /* the run's only pose: nothing could follow it */
         WARN(a, "pose %zu: recorded WITHOUT the follow check: it is the only pose this run measures (a frozen "
                 "display could not be told from a good one; check its length)\n", held_pose);
-        if (append(a, held_pose, held_q, &held_r) != 0)
+        if (append(a, held_pose, held_q, &held_r, held_t) != 0)
             return 1;
     }
     return 0;
