@@ -210,6 +210,40 @@ static void test_no_prediction_stops(void **state)
     free(d);
 }
 
+/* the held first sample is dropped only when the next pose does not follow
+ * it: a run that stops for another reason (here: after a hang-up at pose 1
+ * the device reads 5 mm off at pose 0) writes it, unchecked, as before, so
+ * that a rerun re-reads it and refuses the changed device again */
+static void test_held_kept_on_other_stops(void **state)
+{
+    tio t;
+    pdev *d = calloc(1, sizeof *d);
+    rch_acq_config c;
+    rch_acq_result r;
+    (void)state;
+    assert_non_null(d);
+    tio_init(&t);
+    pdev_init(d, 0.0, 5.0);
+    d->hang_at = 1;
+    config(&c, "held_kept.csv");
+    c.read_timeout_ms = 500;
+    assert_int_equal(run_pd(&r, &c, &t, d), 1);
+    assert_int_equal(r.n_new, 1);
+    assert_int_equal(r.verify_fails, 1);
+    assert_true(r.stopped && r.stopped_at == 1);
+    assert_non_null(strstr(g_err, "+5.000 mm off"));
+    assert_non_null(strstr(g_err, "is recorded unchecked"));
+    assert_true(fabs(recorded(g_out, 0) - nominal_mm[0]) < 0.006);
+    /* the rerun with the changed device: pose 0 re-read first, refused again, nothing added */
+    tio_init(&t);
+    pdev_init(d, 5.0, 5.0);
+    assert_int_equal(run_pd(&r, &c, &t, d), 1);
+    assert_int_equal(r.n_before, 1);
+    assert_int_equal(r.n_new, 0);
+    assert_int_equal(r.verify_fails, 1);
+    free(d);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -228,6 +262,7 @@ int main(void)
         cmocka_unit_test(test_outlet1_frozen_refused),
         cmocka_unit_test(test_point1_frozen_refused),
         cmocka_unit_test(test_no_prediction_stops),
+        cmocka_unit_test(test_held_kept_on_other_stops),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

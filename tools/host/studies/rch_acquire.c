@@ -132,6 +132,8 @@ typedef struct acq {
     const char *verify_why;   /* non-NULL: go back to ref_pose before the next sample counts */
     int reconnected;          /* set by reconnect(): the pose's readings so far are void */
     size_t jump_cleared;      /* pose + 1 whose suspected jump the check at ref_pose cleared; 0 none */
+    int not_following;        /* the follow check refused a pose `retries` times: the run stops */
+    int holding;              /* 1: the reference is a held sample, not yet written (run_poses) */
 } acq;
 
 #define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
@@ -339,6 +341,7 @@ static rc_status measure_checked(rc_stable_result *r, acq *a, size_t i)
             WARN(a, "pose %zu: the display does not follow the robot; nothing recorded. Check the display (HOLD?), "
                     "the port (--port %s), the robot's position and --robot/--encoder, then rerun to resume "
                     "(--follow-tol-mm sets the tolerance)\n", i, c->port_path);
+            a->not_following = 1;
             return RC_ERR_RANGE;
         }
         a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
@@ -615,7 +618,8 @@ static rc_status recheck(acq *a, size_t i)
         WARN(a, "pose %zu re-read %s: L = %.4f mm where %.4f mm was recorded: the device now reads %+.3f mm off "
                 "(more than %g mm): a slipped or re-hooked cable, an encoder counter that reset, a display "
                 "re-zeroed, or another device on the port. The %zu samples up to pose %zu are kept in %s; %s\n",
-             r, why, v.mean_mm, a->ref_len_mm, off, tol, a->res->n_before + a->res->n_new, r, c->out_path,
+             r, why, v.mean_mm, a->ref_len_mm, off, tol, a->res->n_before + a->res->n_new + (size_t)a->holding, r,
+             c->out_path,
              c->on_jump_record ? "--on-jump record: this jump is recorded past; the run goes on from the length "
                                  "read now (fit with calibrate --jumps, or calibrate's jump check will stop)"
                                : "nothing more is recorded. Check the cable hook and the display, then rerun the "
@@ -651,6 +655,26 @@ static int append(acq *a, size_t i, const double q_deg[RC_NJ], const rc_stable_r
     return 0;
 }
 
+/* The run stops with pose `held`'s sample held (the first of this place and
+ * point, not yet followed by a move). Refused by the follow check at the
+ * next pose: the display may have been frozen all along, it is dropped.
+ * Stopped for anything else (a reconnect to a device that reads otherwise,
+ * a timeout, the robot side): it is written as the first sample always was,
+ * unchecked, so that a rerun re-reads it before going on. 0, or 1. */
+static int stop_held(acq *a, size_t held, const double q_deg[RC_NJ], const rc_stable_result *r, long long t_ms)
+{
+    if (a->not_following) {
+        WARN(a, "pose %zu's sample (L = %.4f mm), the first from this %s, is not recorded either: no move after it "
+                "followed, so it cannot be told from a frozen display\n", held, r->mean_mm,
+             a->target_p1 ? "place and point" : "place");
+        return 0;
+    }
+    WARN(a, "pose %zu's sample (L = %.4f mm), the first from this %s, is recorded unchecked (the run stopped before a "
+            "move could confirm it); a rerun reads it again first\n", held, r->mean_mm,
+         a->target_p1 ? "place and point" : "place");
+    return append(a, held, q_deg, r, t_ms);
+}
+
 static int run_poses(acq *a)
 {
     const rch_acq_config *c = a->c;
@@ -678,19 +702,20 @@ static int run_poses(acq *a)
             }
             if (go_to(a, i, q_deg, 0) != 0) {
                 if (held)
-                    WARN(a, "pose %zu's sample (L = %.4f mm) was held for the follow check and is not recorded\n",
-                         held_pose, held_r.mean_mm);
+                    (void)stop_held(a, held_pose, held_q, &held_r, held_t);
                 return 1;
             }
             st = measure_checked(&r, a, i);
         }
         if (st != RC_OK) {
             a->res->stopped = 1;
-            a->res->stopped_at = held ? held_pose : i;
-            if (held)
-                WARN(a, "pose %zu's sample (L = %.4f mm), the first from this %s, is not recorded either: no move "
-                        "after it followed, so it cannot be told from a frozen display\n", held_pose,
-                     held_r.mean_mm, a->target_p1 ? "place and point" : "place");
+            a->res->stopped_at = i;
+            if (held) {
+                if (stop_held(a, held_pose, held_q, &held_r, held_t) != 0)
+                    return 1;
+                if (a->not_following)
+                    a->res->stopped_at = held_pose;
+            }
             WARN(a, "stopped at pose %zu; %zu of %zu poses recorded in %s; rerun the same command to resume\n",
                  a->res->stopped_at, a->res->n_before + a->res->n_new, a->n_mine, c->out_path);
             return 1;
@@ -701,12 +726,13 @@ static int run_poses(acq *a)
             held_r = r;
             held_t = a->io->wall_ms(a->io->ctx); /* when it was taken, not when it is written */
             memcpy(held_q, q_deg, sizeof held_q);
+            a->holding = 1;
             PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings; recorded once the next pose follows it)\n",
                      r.mean_mm, r.spread_mm, r.count);
         } else {
             if (held && append(a, held_pose, held_q, &held_r, held_t) != 0)
                 return 1;
-            held = 0;
+            held = a->holding = 0;
             if (append(a, i, q_deg, &r, a->io->wall_ms(a->io->ctx)) != 0)
                 return 1;
             PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
