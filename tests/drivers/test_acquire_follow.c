@@ -210,6 +210,67 @@ static void test_no_prediction_stops(void **state)
     free(d);
 }
 
+/* a calibrated model that knows the place (an outlet effect, the file's
+ * labels through "outlet_labels" when it has them) predicts outlet 1's
+ * lengths without --encoder: a display that follows is recorded, a frozen
+ * one refused; labels that make outlet 1 the model's encoder_mm predict
+ * from there */
+static void test_model_outlet_predicts(void **state)
+{
+    static const char *const labels[3] = {"", ",\"outlet_labels\": [7, 1]", ",\"outlet_labels\": [1, 7]"};
+    tio t;
+    pdev *d = calloc(1, sizeof *d);
+    rch_acq_config c;
+    rch_acq_result r;
+    char text[2048], model[512];
+    (void)state;
+    assert_non_null(d);
+    path_in(model, sizeof model, "model_outlets.json");
+    for (int v = 0; v < 3; ++v) {
+        snprintf(text, sizeof text,
+                 "{\"format\": \"rcal-model/1\", \"name\": \"two places\", \"dh\": ["
+                 "{\"a_mm\": 0, \"d_mm\": 290, \"alpha_deg\": -90, \"theta_deg\": 0},"
+                 "{\"a_mm\": 270, \"d_mm\": 0, \"alpha_deg\": 0, \"theta_deg\": -90},"
+                 "{\"a_mm\": 70, \"d_mm\": 0, \"alpha_deg\": -90, \"theta_deg\": 0},"
+                 "{\"a_mm\": 0, \"d_mm\": 302, \"alpha_deg\": 90, \"theta_deg\": 0},"
+                 "{\"a_mm\": 0, \"d_mm\": 0, \"alpha_deg\": -90, \"theta_deg\": 0},"
+                 "{\"a_mm\": 0, \"d_mm\": 72, \"alpha_deg\": 0, \"theta_deg\": 0}],"
+                 "\"joint_limits_deg\": [[-165, 165], [-110, 110], [-110, 70], [-160, 160], [-120, 120], [-400, 400]],"
+                 "\"encoder_mm\": [250, -460, 10],"
+                 "\"effects\": [{\"kind\": \"outlet\", \"outlet\": 1, \"params\": [-250, -460, 10]}]%s}\n",
+                 labels[v]);
+        write_text("model_outlets.json", text);
+        if (v == 2)
+            break;
+        tio_init(&t);
+        display_rows(d, 0, 0);
+        outlet1_config(&c, "model_outlet.csv");
+        c.robot_path = model;
+        c.encoder_given = 0;
+        assert_int_equal(run_pd(&r, &c, &t, d), 0);
+        assert_int_equal(r.n_new, NP);
+        assert_true(r.worst_follow_mm < 0.05);
+        tio_init(&t);
+        display_rows(d, 0, 0);
+        d->freeze_at = NP + 1;
+        outlet1_config(&c, "model_outlet_frozen.csv");
+        c.robot_path = model;
+        c.encoder_given = 0;
+        assert_int_equal(run_pd(&r, &c, &t, d), 1);
+        assert_int_equal(r.n_new, 0);
+        assert_int_equal(r.follow_refusals, c.retries);
+    }
+    /* labels [1, 7]: the data's outlet 1 is the model's encoder_mm (250, -460, 10): the place-1 display refused */
+    tio_init(&t);
+    display_rows(d, 0, 0);
+    outlet1_config(&c, "model_label.csv");
+    c.robot_path = model;
+    c.encoder_given = 0;
+    assert_int_equal(run_pd(&r, &c, &t, d), 1);
+    assert_true(r.follow_refusals >= 1);
+    free(d);
+}
+
 /* the held first sample is dropped only when the next pose does not follow
  * it: a run that stops for another reason (here: after a hang-up at pose 1
  * the device reads 5 mm off at pose 0) writes it, unchecked, as before, so
@@ -263,6 +324,7 @@ int main(void)
         cmocka_unit_test(test_point1_frozen_refused),
         cmocka_unit_test(test_no_prediction_stops),
         cmocka_unit_test(test_held_kept_on_other_stops),
+        cmocka_unit_test(test_model_outlet_predicts),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -378,34 +378,53 @@ static int run_label(acq *a, int *p1, const rch_data *plan, size_t off, unsigned
     return 0;
 }
 
+/* The model's outlet number (0: encoder_mm, k: its RC_EFF_OUTLET k) for the
+ * data label `label` (through the file's "outlet_labels" when it has them),
+ * -1 when the model has no such place. */
+static int model_outlet_of(const rch_robot *robot, int label)
+{
+    const rc_model *m = &robot->model;
+    int k = -1;
+    if (robot->n_outlet_labels) {
+        for (unsigned j = 0; j < robot->n_outlet_labels && k < 0; ++j)
+            if (robot->outlet_label[j] == label)
+                k = (int)j;
+    } else {
+        k = label == 0 ? 0 : -1;
+        for (unsigned e = 0; e < m->n_effects && k < 0; ++e)
+            if (m->effects[e].kind == RC_EFF_OUTLET && m->effects[e].joint == label)
+                k = label;
+    }
+    return k;
+}
+
 /* The follow check's model for this run: the place it measures from (outlet
- * 0: the robot file's encoder, else --encoder; outlet k > 0: --encoder when
- * given, else the model's outlet k) and the point the cable is on (the
+ * 0: the robot file's encoder, else --encoder; outlet N > 0: --encoder when
+ * given, else the model's outlet N) and the point the cable is on (the
  * plate's --cable-point, or the model's own plate). 0, or -1 with what is
  * missing and the option that supplies it said: no prediction, no run. */
-static int predict_setup(acq *a, rc_model *m, const rch_data *plan, int has_encoder)
+static int predict_setup(acq *a, rch_robot *robot, const rch_data *plan)
 {
     const rch_acq_config *c = a->c;
-    const int place = a->outlet_p1 > 0 ? a->outlet_p1 - 1 : 0;
+    rc_model *m = &robot->model;
+    const int place = a->outlet_p1 > 0 ? a->outlet_p1 - 1 : 0, k = model_outlet_of(robot, place);
     unsigned model_points = 0;
-    int model_outlet = 0;
-    for (unsigned k = 0; k < m->n_effects; ++k) {
-        model_outlet |= m->effects[k].kind == RC_EFF_OUTLET && place > 0 && m->effects[k].joint == place;
-        if (m->effects[k].kind == RC_EFF_CABLE_POINTS)
-            model_points = m->effects[k].count / 3u;
-    }
+    for (unsigned e = 0; e < m->n_effects; ++e)
+        if (m->effects[e].kind == RC_EFF_CABLE_POINTS)
+            model_points = m->effects[e].count / 3u;
     a->pred_outlet = 0;
-    if (place == 0 || c->encoder_given) {
-        if (!has_encoder || place > 0) /* outlet 0: the robot file's own place first (documented) */
-            memcpy(&m->x[RC_P_ENC], c->encoder_mm, sizeof c->encoder_mm);
-        else if (c->encoder_given &&
-                 (m->x[RC_P_ENC] != c->encoder_mm[0] || m->x[RC_P_ENC + 1] != c->encoder_mm[1] ||
-                  m->x[RC_P_ENC + 2] != c->encoder_mm[2]))
+    if ((place > 0 && c->encoder_given) || (k == 0 && !robot->has_encoder)) {
+        memcpy(&m->x[RC_P_ENC], c->encoder_mm, sizeof c->encoder_mm); /* --encoder, or its default at outlet 0 */
+    } else if (k == 0) { /* the robot file's own place first (documented) */
+        if (c->encoder_given && (m->x[RC_P_ENC] != c->encoder_mm[0] || m->x[RC_P_ENC + 1] != c->encoder_mm[1] ||
+                                 m->x[RC_P_ENC + 2] != c->encoder_mm[2]))
             NOTE(a, "--encoder %g,%g,%g not used: %s gives the encoder's place (%g, %g, %g) mm, which the follow "
                     "check predicts from\n", c->encoder_mm[0], c->encoder_mm[1], c->encoder_mm[2], c->robot_path,
                  m->x[RC_P_ENC], m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2]);
-    } else if (model_outlet) {
-        a->pred_outlet = (uint8_t)place; /* a calibrated model that knows this place */
+    } else if (k > 0) {
+        a->pred_outlet = (uint8_t)k; /* a calibrated model that knows this place */
+    } else if (c->encoder_given) {
+        memcpy(&m->x[RC_P_ENC], c->encoder_mm, sizeof c->encoder_mm);
     } else if (!c->no_follow_check) {
         WARN(a, "--outlet %d: the follow check needs the place this run measures from to predict the lengths, and "
                 "%s has no outlet %d: give its position with --encoder X,Y,Z (mm, base frame; rcal poses prints it "
@@ -511,7 +530,7 @@ static int load_inputs(acq *a)
     a->n_mine = 0;
     for (size_t i = 0; i < plan.n; ++i)
         a->n_mine += !a->other[i];
-    if (predict_setup(a, &robot->model, &plan, robot->has_encoder) != 0)
+    if (predict_setup(a, robot, &plan) != 0)
         goto out;
     for (size_t i = 0; i < plan.n; ++i) {
         for (int j = 0; j < RC_NJ; ++j) {

@@ -24,8 +24,11 @@
  *    run unchecked). The first sample of a place and point in a file has
  *    nothing to be compared with: it is held, not written, until the next
  *    pose's sample follows it (both are then written, in order), so a
- *    display frozen from the start is never recorded either; a run with a
- *    single pose writes it with a warning that it is unchecked. The
+ *    display frozen from the start is never recorded either: refused at the
+ *    next pose, the held sample is dropped too. A run that stops for any
+ *    other reason (a device reading otherwise after a reconnect, a timeout)
+ *    writes it unchecked, as before, so that a rerun re-reads it; so does a
+ *    run with a single pose, with a warning. The
  *    same check is what a display that reappears after a reconnect must pass
  *    (its format lock is kept, so its protocol settings must match as well);
  *  - the device must still read what it read (issue 23): after a reconnect,
@@ -124,8 +127,9 @@ typedef struct rch_acq_config {
     int no_follow_check;        /* 1: skip it (a plan of tiny moves) */
     int outlet_p1;              /* 0: one encoder place; k + 1: this run measures from outlet k (the file's
                                    outlet column). k > 0: the follow check predicts from encoder_mm when
-                                   encoder_given, else from the robot model's outlet k; neither: the run stops
-                                   before recording, naming --encoder */
+                                   encoder_given, else from the robot model's outlet of label k (its
+                                   "outlet_labels", else its outlet effect k); neither: the run stops before
+                                   recording, naming --encoder */
     int target_p1;              /* 0: the cable on one point; p + 1: on point p of a tool plate (the plan's and
                                    the file's target column, rcal poses --cable-point) */
     unsigned n_points;          /* the plate's points for the follow check's prediction (--cable-point), 0: the
