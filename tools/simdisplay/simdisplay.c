@@ -583,6 +583,25 @@ typedef struct sim_args {
     long reconnect_ms;
 } sim_args;
 
+/* The values of a repeatable X,Y,Z option (mm, each within lim) into out
+ * (at most max). 0, or -1 with the message printed. */
+static int parse_triples(double (*out)[3], const rch_opt_strs *v, size_t max, const char *opt, double lim)
+{
+    if (v->n > max) {
+        fprintf(stderr, "simdisplay: %zu %s: at most %zu\n", v->n, opt, max);
+        return -1;
+    }
+    for (size_t i = 0; i < v->n; ++i) {
+        double *p = out[i];
+        if (rch_parse_triple(v->v[i], p) != 0 || fabs(p[0]) > lim || fabs(p[1]) > lim || fabs(p[2]) > lim) {
+            fprintf(stderr, "simdisplay: %s '%s': expected X,Y,Z in mm (three finite numbers within %g)\n", opt,
+                    v->v[i], lim);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 /* 0 run, 1 help printed, 2 usage error. */
 static int parse_options(sim *s, sim_args *g, int argc, char **argv)
 {
@@ -663,33 +682,15 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
             }
         }
     }
-    for (size_t i = 0; i < g->outlets.n; ++i) {
-        double *p = g->places[i];
-        if (rch_parse_triple(g->outlets.v[i], p) != 0 || fabs(p[0]) > 1e5 || fabs(p[1]) > 1e5 || fabs(p[2]) > 1e5) {
-            fprintf(stderr, "simdisplay: --outlet '%s': expected X,Y,Z in mm (three finite numbers within 1e5)\n",
-                    g->outlets.v[i]);
-            return 2;
-        }
-    }
+    if (parse_triples(g->places, &g->outlets, RCH_OPT_MAX_STRS, "--outlet", 1e5) != 0)
+        return 2;
     g->n_places = g->outlets.n;
     if (g->n_places && !g->truth) {
         fprintf(stderr, "simdisplay: --outlet goes with --truth and --poses\n");
         return 2;
     }
-    if (g->cable_points.n > RC_MAX_TARGETS) {
-        fprintf(stderr, "simdisplay: %zu --cable-point: a plate has at most %d points\n", g->cable_points.n,
-                RC_MAX_TARGETS);
+    if (parse_triples(g->points, &g->cable_points, RC_MAX_TARGETS, "--cable-point", 1e4) != 0)
         return 2;
-    }
-    for (size_t i = 0; i < g->cable_points.n; ++i) {
-        double *p = g->points[i];
-        if (rch_parse_triple(g->cable_points.v[i], p) != 0 || fabs(p[0]) > 1e4 || fabs(p[1]) > 1e4 ||
-            fabs(p[2]) > 1e4) {
-            fprintf(stderr, "simdisplay: --cable-point '%s': expected X,Y,Z in mm (three finite numbers within 1e4)\n",
-                    g->cable_points.v[i]);
-            return 2;
-        }
-    }
     g->n_points = g->cable_points.n;
     if (g->n_points && !g->truth) {
         fprintf(stderr, "simdisplay: --cable-point goes with --truth and --poses\n");
