@@ -28,7 +28,11 @@ static const char details[] =
     "Follow check: from the last recorded pose to this one the length must change by what the nominal --robot\n"
     "model (cable outlet: the file's encoder_mm, else --encoder) predicts, within --follow-tol-mm; a frozen\n"
     "display or another device fails it: the pose is measured again up to --retries times, then the run stops\n"
-    "and nothing is recorded. Plan poses must be inside the robot's joint limits.\n"
+    "and nothing is recorded. It holds at every place and point: --outlet N other than 0 predicts from\n"
+    "--encoder (that place's position) or a MODEL with outlet N, --target P to --cable-point P; where no\n"
+    "prediction can be made the run stops before recording, naming the option (--no-follow-check: unchecked).\n"
+    "The first sample of a place and point is written once the next pose's sample follows it.\n"
+    "Plan poses must be inside the robot's joint limits.\n"
     "Jump check: a change more than --jump-mm (3) from the model's, and every reconnect and resume, send the run\n"
     "back to the last recorded pose (announced; with --confirm you are asked to return there) to read it again:\n"
     "within --verify-tol-mm (default --stable-mm) the run goes on; off (a slipped cable, a counter reset) it\n"
@@ -155,10 +159,11 @@ typedef struct acquire_args {
     int json, no_learn;
 } acquire_args;
 
-/* The parsed options into a->c (outlet_given: --outlet was given). -1, or 2
- * (reported). */
-static int to_config(acquire_args *a, int outlet_given, int target_given)
+/* The parsed options into a->c (outlet_given: --outlet was given, and so
+ * on). -1, or 2 (reported). */
+static int to_config(acquire_args *a, int outlet_given, int target_given, int encoder_given)
 {
+    a->c.encoder_given = encoder_given;
     a->c.outlet_p1 = outlet_given ? (int)a->outlet + 1 : 0;
     a->c.target_p1 = target_given ? (int)a->target + 1 : 0;
     if (a->cable_points.n) { /* the calibrate option's one parser */
@@ -227,16 +232,17 @@ static int parse(acquire_args *a, int argc, char **argv)
         {"--outlet", RCH_OPT_UINT, &a->outlet, 0, 255, "N",
          "the encoder place this run measures from (a label 0..255, written as the file's outlet column): "
          "the same plan run again from another place appends to the same file; a plan with an outlet "
-         "column (rcal poses --outlet ...) has its rows of outlet N recorded; give --encoder as this "
-         "place's position for the follow check", 0, NULL},
+         "column (rcal poses --outlet ...) has its rows of outlet N recorded; N other than 0 needs --encoder, "
+         "this place's position, for the follow check (or a MODEL with outlet N)", 0, NULL},
         {"--robot", RCH_OPT_STR, &a->c.robot_path, 0, 0, "MODEL.json", "nominal model: limits, follow check", 0, NULL},
         {"--cable-point", RCH_OPT_STRS, &a->cable_points, 0, 0, "X,Y,Z",
          "with --target: the plate's points (nominal, flange frame, mm; once each, in target order) the follow check "
-         "predicts the lengths to", 0, NULL},
+         "predicts the lengths to; a plan with a target column needs them", 0, NULL},
         {"--target", RCH_OPT_UINT, &a->target, 0, RC_MAX_TARGETS - 1, "P",
          "the point of the tool plate the cable is on in this run (the plan's target column, rcal poses "
          "--cable-point): its rows are recorded, the file's target column says P; run again on each point", 0, NULL},
-        {"--encoder", RCH_OPT_TRIPLE, a->c.encoder_mm, -1e5, 1e5, "X,Y,Z", "cable outlet (mm) if MODEL has none", 0, NULL},
+        {"--encoder", RCH_OPT_TRIPLE, a->c.encoder_mm, -1e5, 1e5, "X,Y,Z",
+         "cable outlet (mm) if MODEL has none; with --outlet N > 0 that place's position", 0, NULL},
         {"--backend", RCH_OPT_CHOICE, &a->c.backend, 0, 0, NULL, "port backend", 0, "serialport|posix"},
         {"--baud", RCH_OPT_UINT, &a->baud, 50, 4000000, NULL, "bits per second", 0, NULL},
         {"--data-bits", RCH_OPT_UINT, &a->bits, 5, 8, NULL, NULL, 0, NULL},
@@ -282,7 +288,8 @@ static int parse(acquire_args *a, int argc, char **argv)
     const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (st >= 0)
         return st;
-    return to_config(a, rch_opt_given(&spec, seen, "--outlet"), rch_opt_given(&spec, seen, "--target"));
+    return to_config(a, rch_opt_given(&spec, seen, "--outlet"), rch_opt_given(&spec, seen, "--target"),
+                     rch_opt_given(&spec, seen, "--encoder"));
 }
 
 int rcal_cmd_acquire(int argc, char **argv)

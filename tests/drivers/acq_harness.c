@@ -196,7 +196,7 @@ static double pdev_now(const tio *t, int k)
 static void pdev_load(tio *t, int k)
 {
     pdev *d = t->pd;
-    const double target = d->val[k][d->pose] + (d->jumped ? d->jump_mm : 0.0);
+    const double target = d->frozen ? d->frozen_mm : d->val[k][d->pose] + (d->jumped ? d->jump_mm : 0.0);
     size_t len = 0;
     t->m[k].rx = d->rx[k];
     t->m[k].ms_per_read = 50;
@@ -210,7 +210,7 @@ static void pdev_load(tio *t, int k)
     for (int f = 0; f < PD_FRAMES; ++f) {
         /* settle_ms (100) after the move, then one frame per 50 ms */
         const double tt = 100.0 + 50.0 * f;
-        double y = d->tau_ms > 0.0 ? target + (d->shown[k] - target) * exp(-tt / d->tau_ms) : target;
+        double y = d->tau_ms > 0.0 && !d->frozen ? target + (d->shown[k] - target) * exp(-tt / d->tau_ms) : target;
         size_t n;
         y = round(y * 100.0) / 100.0;
         d->frames[k][f] = y;
@@ -233,6 +233,10 @@ static int t_joints(void *ctx, double q_deg[RC_NJ], const double plan[RC_NJ], si
     (void)plan;
     t->pd->shown[k] = pdev_now(t, k);
     t->pd->pose = (int)pose;
+    if ((int)pose == t->pd->freeze_at && !t->pd->frozen) {
+        t->pd->frozen = 1;
+        t->pd->frozen_mm = t->pd->shown[k];
+    }
     if (t->pd->jump_at && (int)pose == t->pd->jump_at)
         t->pd->jumped = 1;
     pdev_load(t, k);
@@ -258,9 +262,10 @@ void pdev_init(pdev *d, double off0, double off1)
 {
     memset(d, 0, sizeof *d);
     d->hang_at = -1;
-    for (int p = 0; p < NP; ++p) {
-        d->val[0][p] = nominal_mm[p] + off0;
-        d->val[1][p] = nominal_mm[p] + off1;
+    d->freeze_at = -1;
+    for (int p = 0; p < NROWS; ++p) {
+        d->val[0][p] = nominal_mm[p % NP] + off0;
+        d->val[1][p] = nominal_mm[p % NP] + off1;
     }
     d->shown[0] = d->shown[1] = nominal_mm[0];
 }
@@ -293,4 +298,48 @@ char *slurp(const char *path, size_t *n)
     *n = fread(b, 1, sizeof buf[0], f);
     fclose(f);
     return b;
+}
+
+double nominal_at(const double q_deg[RC_NJ], const double enc_mm[3], const double *point_mm)
+{
+    static rch_robot rb;
+    rch_diag dg;
+    rc_sample s;
+    double len = NAN;
+    assert_int_equal(rch_robot_load(&rb, ROBOT, &dg), 0);
+    memcpy(&rb.model.x[RC_P_ENC], enc_mm, 3 * sizeof(double));
+    if (point_mm) {
+        assert_int_equal(rc_model_add_effect(&rb.model, RC_EFF_CABLE_POINTS, 0, 3), RC_OK);
+        memcpy(&rb.model.x[rb.model.effects[rb.model.n_effects - 1].first], point_mm, 3 * sizeof(double));
+    }
+    memset(&s, 0, sizeof s);
+    for (int j = 0; j < RC_NJ; ++j)
+        s.q_rad[j] = q_deg[j] * 3.14159265358979323846 / 180.0;
+    assert_int_equal(rc_meas(&len, NULL, &rb.model, &s), RC_OK);
+    return len;
+}
+
+int row_pose(int r, int pose_major)
+{
+    return pose_major ? r / 2 : r % NP;
+}
+
+int row_label(int r, int pose_major)
+{
+    return pose_major ? r % 2 : r / NP;
+}
+
+void write_labelled_plan(const char *name, const char *col, int pose_major)
+{
+    char text[2048];
+    size_t n = 0;
+    n += (size_t)snprintf(text + n, sizeof text - n, "pose,q1,q2,q3,q4,q5,q6,%s\n", col);
+    for (int r = 0; r < NROWS; ++r) {
+        const int i = row_pose(r, pose_major), k = row_label(r, pose_major);
+        n += (size_t)snprintf(text + n, sizeof text - n, "%d", r);
+        for (int j = 0; j < RC_NJ; ++j)
+            n += (size_t)snprintf(text + n, sizeof text - n, ",%.4f", plan_deg[i][j]);
+        n += (size_t)snprintf(text + n, sizeof text - n, ",%d\n", k);
+    }
+    write_text(name, text);
 }

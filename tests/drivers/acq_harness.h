@@ -17,6 +17,7 @@
 #define ROBOT RCAL_SOURCE_DIR "/data/irb120.json"
 #define NP 4
 #define PD_FRAMES 2400
+#define NROWS (2 * NP) /* rows of a plan with every pose twice (two outlets, two points of a plate) */
 
 extern const double plan_deg[NP][RC_NJ];
 extern char dir_[256];
@@ -42,7 +43,7 @@ typedef struct tio {
  * reconnect), through a first-order filter of time constant tau_ms when set,
  * read every 50 ms at the display's 0.01 mm. */
 typedef struct pdev {
-    double val[2][NP];   /* what device k shows at pose p (mm) */
+    double val[2][NROWS]; /* what device k shows at plan row p (mm) */
     int hang_at;         /* device 0 hangs up when the robot reaches this pose (-1: never) */
     double tau_ms;       /* the display's filter; 0: none */
     int pose;            /* where the robot is */
@@ -50,6 +51,10 @@ typedef struct pdev {
     int jump_at;         /* the device jumps by jump_mm when the robot first reaches this pose (0: never) */
     double jump_mm;
     int jumped;
+    int freeze_at;       /* the display freezes when the robot reaches this plan row (-1: never): from then on
+                            it shows what it showed (HOLD pressed, firmware hung) */
+    int frozen;
+    double frozen_mm;
     double frames[2][PD_FRAMES];
     uint8_t rx[2][PD_FRAMES * 16];
     size_t flen;
@@ -67,7 +72,17 @@ int run(rch_acq_result *r, const rch_acq_config *c, tio *t); /* over t's scripts
  * may run at once), the plan in it and its nominal lengths; 0. */
 int acq_setup(const char *sub);
 int run_pd(rch_acq_result *r, const rch_acq_config *c, tio *t, pdev *d); /* with the display d */
-void pdev_init(pdev *d, double off0, double off1); /* device k shows nominal + off_k */
+void pdev_init(pdev *d, double off0, double off1); /* device k shows nominal + off_k (row p: pose p % NP) */
+/* The nominal model's length at q_deg from the encoder at enc_mm to the
+ * flange, or to point_mm (flange frame; NULL: the flange centre). */
+double nominal_at(const double q_deg[RC_NJ], const double enc_mm[3], const double *point_mm);
+/* The plan's NP poses twice, labelled 0 and 1 in column col: label-major
+ * (every pose of label 0, then of label 1: rcal poses --outlet) or pose-major
+ * (each pose on label 0, then 1: rcal poses --cable-point), into name; row r
+ * is pose row_pose(r, pose_major) labelled row_label(r, pose_major). */
+void write_labelled_plan(const char *name, const char *col, int pose_major);
+int row_pose(int r, int pose_major);
+int row_label(int r, int pose_major);
 double recorded(const char *path, int pose); /* the recorded L of pose (NAN: not there) */
 char *slurp(const char *path, size_t *n); /* the file, in one of two static buffers */
 

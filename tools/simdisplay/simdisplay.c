@@ -36,6 +36,19 @@
  *                             model's own (encoder_mm for outlet 0, its
  *                             outlet effects for the others); a plan row of
  *                             an outlet neither gives is refused at start.
+ *                             One --outlet on a plan without an outlet
+ *                             column puts the display at that place (the
+ *                             run of rcal acquire --outlet N --encoder X,Y,Z
+ *                             on the same plan from a second place).
+ *   --cable-point X,Y,Z (repeatable)  the true points of a tool plate the
+ *                             cable is hooked on (mm, flange frame; point
+ *                             0, 1, ... in order) for a plan with a target
+ *                             column (rcal poses --cable-point): each row's
+ *                             length is to the point of its target (rcal
+ *                             acquire --target P runs one point's rows at
+ *                             a time). A plan with a target column needs
+ *                             them (or a truth model with a plate); one on a
+ *                             plan without the column hooks the cable there.
  * Realism and faults:
  *   --rate-hz R         measuring rate: a new value every 1/R s (streamed, or
  *                       shown to polls: polls in between get the same value)
@@ -475,8 +488,39 @@ static int row_length(double *len_mm, const rc_model *m, rc_sample smp, const do
     return -1;
 }
 
+/* The plate's true points on the truth model m (--cable-point, n of them):
+ * every target of the plan d must be one of them. 0, or -1 with the message
+ * printed (the first row beyond them, file:line). */
+static int add_points(rc_model *m, const rch_data *d, const double (*points)[3], size_t n, const char *truth_path,
+                      const char *poses_path)
+{
+    unsigned have = 0;
+    for (unsigned k = 0; k < m->n_effects; ++k)
+        if (m->effects[k].kind == RC_EFF_CABLE_POINTS)
+            have = m->effects[k].count / 3u;
+    if (n) {
+        if (have || rc_model_add_effect(m, RC_EFF_CABLE_POINTS, 0, (unsigned)(3 * n)) != RC_OK) {
+            fprintf(stderr, "simdisplay: %s: cannot add %zu cable points%s\n", truth_path, n,
+                    have ? " (it has a plate of its own: leave out --cable-point)" : "");
+            return -1;
+        }
+        memcpy(&m->x[m->effects[m->n_effects - 1].first], points, 3 * n * sizeof m->x[0]);
+        have = (unsigned)n;
+    }
+    for (size_t i = 0; i < d->n && d->has_target; ++i)
+        if (d->s[i].target >= have) {
+            fprintf(stderr,
+                    "simdisplay: %s:%u: a pose with the cable on point %u of a tool plate, but %s%u point%s: give the "
+                    "plate's true points with --cable-point X,Y,Z (flange frame, mm; once per point 0, 1, ..., in "
+                    "order)\n", poses_path, d->line ? d->line[i] : (unsigned)i + 2, (unsigned)d->s[i].target,
+                    n ? "--cable-point gave " : "the truth model has ", have, have == 1 ? "" : "s");
+            return -1;
+        }
+    return 0;
+}
+
 static int load_robot(sim *s, const char *truth_path, const char *poses_path, const double (*places)[3],
-                      size_t n_places)
+                      size_t n_places, const double (*points)[3], size_t n_points)
 {
     rch_robot *r = calloc(1, sizeof *r);
     rch_data d;
@@ -493,6 +537,11 @@ static int load_robot(sim *s, const char *truth_path, const char *poses_path, co
         fprintf(stderr, "simdisplay: warning: %s has no encoder_mm; using its default\n", truth_path);
     if (rch_data_load(&d, poses_path, RCH_DATA_NO_LEN, &dg) != 0) {
         fprintf(stderr, "simdisplay: %s\n", rch_diag_str(&dg, buf, sizeof buf));
+        free(r);
+        return -1;
+    }
+    if (add_points(&r->model, &d, points, n_points, truth_path, poses_path) != 0) {
+        rch_data_free(&d);
         free(r);
         return -1;
     }
@@ -527,9 +576,31 @@ typedef struct sim_args {
     rch_opt_strs outlets;                 /* --outlet X,Y,Z, as given */
     double places[RCH_OPT_MAX_STRS][3];  /* (n_places x 3) mm, parsed */
     size_t n_places;
+    rch_opt_strs cable_points;            /* --cable-point X,Y,Z, as given */
+    double points[RC_MAX_TARGETS][3];    /* (n_points x 3) mm, flange frame, parsed */
+    size_t n_points;
     unsigned long decimals, mb_addr, mb_reg, mb_decimals, reply_delay_ms, seed;
     long reconnect_ms;
 } sim_args;
+
+/* The values of a repeatable X,Y,Z option (mm, each within lim) into out
+ * (at most max). 0, or -1 with the message printed. */
+static int parse_triples(double (*out)[3], const rch_opt_strs *v, size_t max, const char *opt, double lim)
+{
+    if (v->n > max) {
+        fprintf(stderr, "simdisplay: %zu %s: at most %zu\n", v->n, opt, max);
+        return -1;
+    }
+    for (size_t i = 0; i < v->n; ++i) {
+        double *p = out[i];
+        if (rch_parse_triple(v->v[i], p) != 0 || fabs(p[0]) > lim || fabs(p[1]) > lim || fabs(p[2]) > lim) {
+            fprintf(stderr, "simdisplay: %s '%s': expected X,Y,Z in mm (three finite numbers within %g)\n", opt,
+                    v->v[i], lim);
+            return -1;
+        }
+    }
+    return 0;
+}
 
 /* 0 run, 1 help printed, 2 usage error. */
 static int parse_options(sim *s, sim_args *g, int argc, char **argv)
@@ -544,6 +615,9 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
         {"--follow", RCH_OPT_STR, &s->follow, 0, 0, "FILE", "the pose announced by rcal acquire", 0, NULL},
         {"--outlet", RCH_OPT_STRS, &g->outlets, 0, 0, "X,Y,Z",
          "true place of outlet 0, 1, ... (repeatable; default: the truth model's)", 0, NULL},
+        {"--cable-point", RCH_OPT_STRS, &g->cable_points, 0, 0, "X,Y,Z",
+         "true point 0, 1, ... of the tool plate the cable is on (flange frame; repeatable; for a plan's target "
+         "column)", 0, NULL},
         {"--noise-mm", RCH_OPT_DOUBLE, &s->noise_mm, 0, 1e9, "S", "Gaussian noise per value", 0, NULL},
         {"--decimals", RCH_OPT_UINT, &g->decimals, 0, 6, "D", "digits after the point", 0, NULL},
         {"--style", RCH_OPT_CHOICE, &g->style, 0, 0, NULL, "+0509.190 or + 509.190, MM", 0, "zero|unit"},
@@ -608,17 +682,18 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
             }
         }
     }
-    for (size_t i = 0; i < g->outlets.n; ++i) {
-        double *p = g->places[i];
-        if (rch_parse_triple(g->outlets.v[i], p) != 0 || fabs(p[0]) > 1e5 || fabs(p[1]) > 1e5 || fabs(p[2]) > 1e5) {
-            fprintf(stderr, "simdisplay: --outlet '%s': expected X,Y,Z in mm (three finite numbers within 1e5)\n",
-                    g->outlets.v[i]);
-            return 2;
-        }
-    }
+    if (parse_triples(g->places, &g->outlets, RCH_OPT_MAX_STRS, "--outlet", 1e5) != 0)
+        return 2;
     g->n_places = g->outlets.n;
     if (g->n_places && !g->truth) {
         fprintf(stderr, "simdisplay: --outlet goes with --truth and --poses\n");
+        return 2;
+    }
+    if (parse_triples(g->points, &g->cable_points, RC_MAX_TARGETS, "--cable-point", 1e4) != 0)
+        return 2;
+    g->n_points = g->cable_points.n;
+    if (g->n_points && !g->truth) {
+        fprintf(stderr, "simdisplay: --cable-point goes with --truth and --poses\n");
         return 2;
     }
     if ((g->truth != NULL) != (g->poses != NULL)) {
@@ -745,7 +820,7 @@ static int run(int argc, char **argv)
 {
     sim s;
     static sim_args g = {"ascii", NULL, NULL, NULL, "zero", "mm", "int32", "abcd", NULL, {{0}, 0}, {{0}}, 0,
-                         3, 0, 0, 0, 0, 1, -1};
+                         {{0}, 0}, {{0}}, 0, 3, 0, 0, 0, 0, 1, -1};
     int rc;
     memset(&s, 0, sizeof s);
     s.rate_hz = 20;
@@ -760,7 +835,8 @@ static int run(int argc, char **argv)
         rc = load_script(&s, g.script) != 0;
     } else if (g.truth) {
         s.src = SRC_ROBOT;
-        rc = load_robot(&s, g.truth, g.poses, (const double(*)[3])g.places, g.n_places) != 0;
+        rc = load_robot(&s, g.truth, g.poses, (const double(*)[3])g.places, g.n_places,
+                        (const double(*)[3])g.points, g.n_points) != 0;
     } else {
         s.src = SRC_CONST;
     }

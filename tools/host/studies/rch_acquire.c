@@ -123,6 +123,7 @@ typedef struct acq {
     size_t n_mine;            /* rows this run measures */
     int outlet_p1;            /* this run's outlet + 1 (--outlet, or the plan's only outlet), 0: one place */
     int target_p1;            /* this run's cable point + 1 (--target, or the plan's only one), 0: one point */
+    uint8_t pred_outlet;      /* the outlet of the follow check's model this run's lengths are predicted from */
     rch_acqfile file;
     int has_ref;              /* a recorded sample to check the next against */
     size_t ref_pose;
@@ -131,6 +132,8 @@ typedef struct acq {
     const char *verify_why;   /* non-NULL: go back to ref_pose before the next sample counts */
     int reconnected;          /* set by reconnect(): the pose's readings so far are void */
     size_t jump_cleared;      /* pose + 1 whose suspected jump the check at ref_pose cleared; 0 none */
+    int not_following;        /* the follow check refused a pose `retries` times: the run stops */
+    int holding;              /* 1: the reference is a held sample, not yet written (run_poses) */
 } acq;
 
 #define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
@@ -306,7 +309,8 @@ static rc_status measure_checked(rc_stable_result *r, acq *a, size_t i)
         st = measure(r, a, i);
         if (st != RC_OK)
             return st;
-        if (c->no_follow_check || !a->has_ref || !isfinite(a->pred_mm[i]) || !isfinite(a->pred_mm[a->ref_pose]) ||
+        /* every row of this run has a prediction (predict_lengths); a NaN would refuse, never skip */
+        if (c->no_follow_check || !a->has_ref ||
             rch_acq_follows(&miss, r->mean_mm, a->pred_mm[i], a->ref_len_mm, a->pred_mm[a->ref_pose],
                             c->follow_tol_mm) == 0) {
             if (a->has_ref && !c->no_follow_check && miss > c->jump_mm && a->jump_cleared != i + 1) {
@@ -337,6 +341,7 @@ static rc_status measure_checked(rc_stable_result *r, acq *a, size_t i)
             WARN(a, "pose %zu: the display does not follow the robot; nothing recorded. Check the display (HOLD?), "
                     "the port (--port %s), the robot's position and --robot/--encoder, then rerun to resume "
                     "(--follow-tol-mm sets the tolerance)\n", i, c->port_path);
+            a->not_following = 1;
             return RC_ERR_RANGE;
         }
         a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
@@ -373,6 +378,111 @@ static int run_label(acq *a, int *p1, const rch_data *plan, size_t off, unsigned
     return 0;
 }
 
+/* The model's outlet number (0: encoder_mm, k: its RC_EFF_OUTLET k) for the
+ * data label `label` (through the file's "outlet_labels" when it has them),
+ * -1 when the model has no such place. */
+static int model_outlet_of(const rch_robot *robot, int label)
+{
+    const rc_model *m = &robot->model;
+    int k = -1;
+    if (robot->n_outlet_labels) {
+        for (unsigned j = 0; j < robot->n_outlet_labels && k < 0; ++j)
+            if (robot->outlet_label[j] == label)
+                k = (int)j;
+    } else {
+        k = label == 0 ? 0 : -1;
+        for (unsigned e = 0; e < m->n_effects && k < 0; ++e)
+            if (m->effects[e].kind == RC_EFF_OUTLET && m->effects[e].joint == label)
+                k = label;
+    }
+    return k;
+}
+
+/* The follow check's model for this run: the place it measures from (outlet
+ * 0: the robot file's encoder, else --encoder; outlet N > 0: --encoder when
+ * given, else the model's outlet N) and the point the cable is on (the
+ * plate's --cable-point, or the model's own plate). 0, or -1 with what is
+ * missing and the option that supplies it said: no prediction, no run. */
+static int predict_setup(acq *a, rch_robot *robot, const rch_data *plan)
+{
+    const rch_acq_config *c = a->c;
+    rc_model *m = &robot->model;
+    const int place = a->outlet_p1 > 0 ? a->outlet_p1 - 1 : 0, k = model_outlet_of(robot, place);
+    unsigned model_points = 0;
+    for (unsigned e = 0; e < m->n_effects; ++e)
+        if (m->effects[e].kind == RC_EFF_CABLE_POINTS)
+            model_points = m->effects[e].count / 3u;
+    a->pred_outlet = 0;
+    if ((place > 0 && c->encoder_given) || (k == 0 && !robot->has_encoder)) {
+        memcpy(&m->x[RC_P_ENC], c->encoder_mm, sizeof c->encoder_mm); /* --encoder, or its default at outlet 0 */
+    } else if (k == 0) { /* the robot file's own place first (documented) */
+        if (c->encoder_given && (m->x[RC_P_ENC] != c->encoder_mm[0] || m->x[RC_P_ENC + 1] != c->encoder_mm[1] ||
+                                 m->x[RC_P_ENC + 2] != c->encoder_mm[2]))
+            NOTE(a, "--encoder %g,%g,%g not used: %s gives the encoder's place (%g, %g, %g) mm, which the follow "
+                    "check predicts from\n", c->encoder_mm[0], c->encoder_mm[1], c->encoder_mm[2], c->robot_path,
+                 m->x[RC_P_ENC], m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2]);
+    } else if (k > 0) {
+        a->pred_outlet = (uint8_t)k; /* a calibrated model that knows this place */
+    } else if (c->encoder_given) {
+        memcpy(&m->x[RC_P_ENC], c->encoder_mm, sizeof c->encoder_mm);
+    } else if (!c->no_follow_check) {
+        WARN(a, "--outlet %d: the follow check needs the place this run measures from to predict the lengths, and "
+                "%s has no outlet %d: give its position with --encoder X,Y,Z (mm, base frame; rcal poses prints it "
+                "with the plan); nothing was recorded\n", place, c->robot_path, place);
+        return -1;
+    }
+    if (c->n_points > 0) { /* the follow check predicts the length to the point the cable is on */
+        if (model_points || rc_model_add_effect(m, RC_EFF_CABLE_POINTS, 0, 3u * c->n_points) != RC_OK) {
+            WARN(a, "cannot add %u cable points to %s%s; nothing was recorded\n", c->n_points, c->robot_path,
+                 model_points ? " (it has a plate of its own: leave out --cable-point)" : "");
+            return -1;
+        }
+        memcpy(&m->x[m->effects[m->n_effects - 1].first], c->points_mm, 3u * c->n_points * sizeof(double));
+        model_points = c->n_points;
+    } else if (plan->has_target && !model_points && !c->no_follow_check) {
+        WARN(a, "%s puts the cable on points of a tool plate (column target): the follow check predicts the length "
+                "to the point the cable is on and needs the plate's points: give --cable-point X,Y,Z once per point "
+                "(flange frame, mm, in target order, as rcal poses was given them); nothing was recorded\n",
+             c->poses_path);
+        return -1;
+    }
+    if (model_points)
+        for (size_t i = 0; i < plan->n; ++i)
+            if (!a->other[i] && plan->s[i].target >= model_points) {
+                WARN(a, "%s:%u: the cable on point %u, but %s gives %u; nothing was recorded\n", c->poses_path,
+                     plan->line[i], (unsigned)plan->s[i].target, c->n_points ? "--cable-point" : c->robot_path,
+                     model_points);
+                return -1;
+            }
+    return 0;
+}
+
+/* The nominal length of each of this run's plan rows (a->pred_mm; NaN for
+ * the rows of other places and points). 0, or -1: a row the model gives no
+ * length at (the point at the outlet) stops the run unless the check is off. */
+static int predict_lengths(acq *a, const rc_model *m, const rch_data *plan)
+{
+    for (size_t i = 0; i < plan->n; ++i) {
+        rc_sample s = plan->s[i];
+        a->pred_mm[i] = NAN;
+        if (a->other[i])
+            continue;
+        s.len_mm = 0.0;
+        s.outlet = a->pred_outlet;
+        if (rc_meas(&a->pred_mm[i], NULL, m, &s) != RC_OK || !isfinite(a->pred_mm[i])) {
+            a->pred_mm[i] = NAN;
+            if (!a->c->no_follow_check) {
+                WARN(a, "%s:%u: pose %zu: the nominal model gives no cable length there (the cable's point at the "
+                        "outlet %g, %g, %g mm?): the follow check cannot predict it; check --encoder and --robot "
+                        "(--no-follow-check runs unchecked); nothing was recorded\n", a->c->poses_path, plan->line[i],
+                     i, m->x[RC_P_ENC], m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2]);
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
 static int load_inputs(acq *a)
 {
     const rch_acq_config *c = a->c;
@@ -390,8 +500,6 @@ static int load_inputs(acq *a)
         WARN(a, "%s\n", robot ? rch_diag_str(&dg, buf, sizeof buf) : "out of memory");
         goto out;
     }
-    if (!robot->has_encoder)
-        memcpy(&robot->model.x[RC_P_ENC], c->encoder_mm, sizeof c->encoder_mm);
     a->n = plan.n;
     a->plan_deg = calloc(plan.n, sizeof *a->plan_deg);
     a->pred_mm = calloc(plan.n, sizeof *a->pred_mm);
@@ -422,24 +530,11 @@ static int load_inputs(acq *a)
     a->n_mine = 0;
     for (size_t i = 0; i < plan.n; ++i)
         a->n_mine += !a->other[i];
-    if (c->n_points > 0) { /* the follow check predicts the length to the point the cable is on */
-        if (rc_model_add_effect(&robot->model, RC_EFF_CABLE_POINTS, 0, 3u * c->n_points) != RC_OK) {
-            WARN(a, "cannot add %u cable points to %s; nothing was recorded\n", c->n_points, c->robot_path);
-            goto out;
-        }
-        memcpy(&robot->model.x[robot->model.effects[robot->model.n_effects - 1].first], c->points_mm,
-               3u * c->n_points * sizeof(double));
-        for (size_t i = 0; i < plan.n; ++i)
-            if (plan.s[i].target >= c->n_points) {
-                WARN(a, "%s:%u: the cable on point %u, but --cable-point gives %u; nothing was recorded\n",
-                     c->poses_path, plan.line[i], (unsigned)plan.s[i].target, c->n_points);
-                goto out;
-            }
-    }
+    if (predict_setup(a, robot, &plan) != 0)
+        goto out;
     for (size_t i = 0; i < plan.n; ++i) {
-        rc_sample s = plan.s[i];
         for (int j = 0; j < RC_NJ; ++j) {
-            const double q = s.q_rad[j];
+            const double q = plan.s[i].q_rad[j];
             if (!(q >= robot->model.q_min_rad[j] - 1e-9 && q <= robot->model.q_max_rad[j] + 1e-9)) {
                 WARN(a, "%s:%u: pose %zu: q%d = %.4f deg is outside the joint limits [%.2f, %.2f] deg of %s; "
                         "nothing was recorded\n", c->poses_path, plan.line[i], i, j + 1, q * DEG_PER_RAD,
@@ -450,10 +545,9 @@ static int load_inputs(acq *a)
             /* back to the file's degrees, at its 4 decimals */
             a->plan_deg[i][j] = round(q * DEG_PER_RAD * 1e4) / 1e4;
         }
-        s.len_mm = 0.0;
-        if (rc_meas(&a->pred_mm[i], NULL, &robot->model, &s) != RC_OK)
-            a->pred_mm[i] = NAN;
     }
+    if (predict_lengths(a, &robot->model, &plan) != 0)
+        goto out;
     rc = 0;
 out:
     free(robot);
@@ -543,7 +637,8 @@ static rc_status recheck(acq *a, size_t i)
         WARN(a, "pose %zu re-read %s: L = %.4f mm where %.4f mm was recorded: the device now reads %+.3f mm off "
                 "(more than %g mm): a slipped or re-hooked cable, an encoder counter that reset, a display "
                 "re-zeroed, or another device on the port. The %zu samples up to pose %zu are kept in %s; %s\n",
-             r, why, v.mean_mm, a->ref_len_mm, off, tol, a->res->n_before + a->res->n_new, r, c->out_path,
+             r, why, v.mean_mm, a->ref_len_mm, off, tol, a->res->n_before + a->res->n_new + (size_t)a->holding, r,
+             c->out_path,
              c->on_jump_record ? "--on-jump record: this jump is recorded past; the run goes on from the length "
                                  "read now (fit with calibrate --jumps, or calibrate's jump check will stop)"
                                : "nothing more is recorded. Check the cable hook and the display, then rerun the "
@@ -565,11 +660,51 @@ static rc_status recheck(acq *a, size_t i)
     return RC_ERR_IO;
 }
 
+/* Append pose i's sample, taken at wall-clock t_ms, to the file. 0, or 1
+ * with the message. */
+static int append(acq *a, size_t i, const double q_deg[RC_NJ], const rc_stable_result *r, long long t_ms)
+{
+    rch_diag dg;
+    char buf[900];
+    if (rch_acqfile_append(&a->file, i, q_deg, r, t_ms, &dg) != 0) {
+        WARN(a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
+        return 1;
+    }
+    a->res->n_new++;
+    return 0;
+}
+
+/* The run stops with pose `held`'s sample held (the first of this place and
+ * point, not yet followed by a move). Refused by the follow check at the
+ * next pose: the display may have been frozen all along, it is dropped.
+ * Stopped for anything else (a reconnect to a device that reads otherwise,
+ * a timeout, the robot side): it is written as the first sample always was,
+ * unchecked, so that a rerun re-reads it before going on. 0, or 1. */
+static int stop_held(acq *a, size_t held, const double q_deg[RC_NJ], const rc_stable_result *r, long long t_ms)
+{
+    if (a->not_following) {
+        WARN(a, "pose %zu's sample (L = %.4f mm), the first from this %s, is not recorded either: no move after it "
+                "followed, so it cannot be told from a frozen display\n", held, r->mean_mm,
+             a->target_p1 ? "place and point" : "place");
+        return 0;
+    }
+    WARN(a, "pose %zu's sample (L = %.4f mm), the first from this %s, is recorded unchecked (the run stopped before a "
+            "move could confirm it); a rerun reads it again first\n", held, r->mean_mm,
+         a->target_p1 ? "place and point" : "place");
+    return append(a, held, q_deg, r, t_ms);
+}
+
 static int run_poses(acq *a)
 {
     const rch_acq_config *c = a->c;
-    rch_diag dg;
-    char buf[900];
+    /* the first sample of this place and point in the file: nothing to compare it with, so it is held until the
+     * next pose's sample follows it (a display frozen from the start is never recorded) */
+    int held = 0;
+    size_t held_pose = 0;
+    double held_q[RC_NJ];
+    long long held_t = 0;
+    rc_stable_result held_r;
+    memset(&held_r, 0, sizeof held_r);
     for (size_t i = 0; i < a->n; ++i) {
         rc_stable_result r;
         double q_deg[RC_NJ];
@@ -584,28 +719,54 @@ static int run_poses(acq *a)
                 st = RC_ERR_IO;
                 break;
             }
-            if (go_to(a, i, q_deg, 0) != 0)
+            if (go_to(a, i, q_deg, 0) != 0) {
+                if (held)
+                    (void)stop_held(a, held_pose, held_q, &held_r, held_t);
                 return 1;
+            }
             st = measure_checked(&r, a, i);
         }
         if (st != RC_OK) {
             a->res->stopped = 1;
             a->res->stopped_at = i;
-            WARN(a, "stopped at pose %zu; %zu of %zu poses recorded in %s; rerun the same command to resume\n", i,
-                 a->res->n_before + a->res->n_new, a->n_mine, c->out_path);
+            if (held) {
+                if (stop_held(a, held_pose, held_q, &held_r, held_t) != 0)
+                    return 1;
+                if (a->not_following)
+                    a->res->stopped_at = held_pose;
+            }
+            WARN(a, "stopped at pose %zu; %zu of %zu poses recorded in %s; rerun the same command to resume\n",
+                 a->res->stopped_at, a->res->n_before + a->res->n_new, a->n_mine, c->out_path);
             return 1;
         }
-        if (rch_acqfile_append(&a->file, i, q_deg, &r, a->io->wall_ms(a->io->ctx), &dg) != 0) {
-            WARN(a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
-            return 1;
+        if (!a->has_ref && !c->no_follow_check) { /* held, not written */
+            held = 1;
+            held_pose = i;
+            held_r = r;
+            held_t = a->io->wall_ms(a->io->ctx); /* when it was taken, not when it is written */
+            memcpy(held_q, q_deg, sizeof held_q);
+            a->holding = 1;
+            PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings; recorded once the next pose follows it)\n",
+                     r.mean_mm, r.spread_mm, r.count);
+        } else {
+            if (held && append(a, held_pose, held_q, &held_r, held_t) != 0)
+                return 1;
+            held = a->holding = 0;
+            if (append(a, i, q_deg, &r, a->io->wall_ms(a->io->ctx)) != 0)
+                return 1;
+            PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
         }
         a->has_ref = 1;
         a->ref_pose = i;
         a->ref_len_mm = r.mean_mm;
-        a->res->n_new++;
-        PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
         if (a->out)
             fflush(a->out);
+    }
+    if (held) { /* the run's only pose: nothing could follow it */
+        WARN(a, "pose %zu: recorded WITHOUT the follow check: it is the only pose this run measures (a frozen "
+                "display could not be told from a good one; check its length)\n", held_pose);
+        if (append(a, held_pose, held_q, &held_r, held_t) != 0)
+            return 1;
     }
     return 0;
 }

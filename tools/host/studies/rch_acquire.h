@@ -16,6 +16,19 @@
  *    not change (HOLD pressed, firmware hung) or another device on the port
  *    fails it: the pose is measured again after --settle-ms, up to `retries`
  *    times, then the run stops loudly; the sample is never recorded. The
+ *    check holds at every place of the encoder (--outlet N predicts from
+ *    --encoder, that place's position) and on every point of a tool plate
+ *    (--target P predicts to --cable-point P); where no prediction can be
+ *    made the run stops before recording anything, saying what is missing
+ *    and which option supplies it (--no-follow-check is the only way to
+ *    run unchecked). The first sample of a place and point in a file has
+ *    nothing to be compared with: it is held, not written, until the next
+ *    pose's sample follows it (both are then written, in order), so a
+ *    display frozen from the start is never recorded either: refused at the
+ *    next pose, the held sample is dropped too. A run that stops for any
+ *    other reason (a device reading otherwise after a reconnect, a timeout)
+ *    writes it unchecked, as before, so that a rerun re-reads it; so does a
+ *    run with a single pose, with a warning. The
  *    same check is what a display that reappears after a reconnect must pass
  *    (its format lock is kept, so its protocol settings must match as well);
  *  - the device must still read what it read (issue 23): after a reconnect,
@@ -77,7 +90,10 @@ typedef struct rch_acq_config {
     const char *out_path;       /* acquisition file */
     const char *announce_path;  /* "INDEX q1..q6" for the robot side; NULL: none */
     const char *robot_path;     /* nominal model: joint limits and the follow check */
-    double encoder_mm[3];       /* cable outlet when the robot file has none */
+    double encoder_mm[3];       /* cable outlet when the robot file has none; with outlet_p1 > 1 the place
+                                   this run measures from (when encoder_given) */
+    int encoder_given;          /* 1: encoder_mm was given (--encoder). An outlet other than 0 needs it, or a
+                                   robot model with that outlet (RC_EFF_OUTLET), for the follow check */
     rcd_serial_config ser;
     rcd_proto_config proto;
     rc_stable_config stable;    /* n, tol_mm, [min_mm, max_mm], timeout_ms (pose timeout) */
@@ -110,11 +126,16 @@ typedef struct rch_acq_config {
     int on_jump_record;         /* 0: stop at a confirmed jump (default); 1: report it and go on */
     int no_follow_check;        /* 1: skip it (a plan of tiny moves) */
     int outlet_p1;              /* 0: one encoder place; k + 1: this run measures from outlet k (the file's
-                                   outlet column; give --encoder as this place's position for the follow check) */
+                                   outlet column). k > 0: the follow check predicts from encoder_mm when
+                                   encoder_given, else from the robot model's outlet of label k (its
+                                   "outlet_labels", else its outlet effect k); neither: the run stops before
+                                   recording, naming --encoder */
     int target_p1;              /* 0: the cable on one point; p + 1: on point p of a tool plate (the plan's and
                                    the file's target column, rcal poses --cable-point) */
     unsigned n_points;          /* the plate's points for the follow check's prediction (--cable-point), 0: the
-                                   flange point */
+                                   flange point. A plan with a target column needs them (or a robot model with
+                                   RC_EFF_CABLE_POINTS): else the run stops before recording, naming
+                                   --cable-point */
     double points_mm[RC_MAX_TARGETS][3]; /* (n_points x 3) their drawing, flange frame */
     int confirm, quiet; /* quiet: no per-pose progress lines (kept with confirm), no notes */
 } rch_acq_config;
