@@ -106,6 +106,11 @@ static void try_causes(rch_calib_judge *j, const rch_calib_result *r, rc_solve_w
     const double base = nominal_rms(&r->robot, w, s, n);
     double best = base;
     char what[200] = "", fix[200] = "";
+    /* every relabelling's RMS and name, to say the ones that explain the data as well as the best (one
+     * outlet cannot tell the robot from its mirror image: q1 negated reads as well as q4 negated) */
+    double cand_e[32];
+    char cand_name[32][24];
+    unsigned n_cand = 0;
     size_t pos = 0;
     pos += (size_t)snprintf(j->tried + pos, sizeof j->tried - pos,
                             "each joint column negated (another controller's sign convention), each pair of joint "
@@ -116,6 +121,10 @@ static void try_causes(rch_calib_judge *j, const rch_calib_result *r, rc_solve_w
         for (size_t i = 0; i < n; ++i)
             c[i].q_rad[a] = -c[i].q_rad[a];
         const double e = nominal_rms(&r->robot, w, c, n);
+        if (n_cand < 32) {
+            cand_e[n_cand] = e;
+            snprintf(cand_name[n_cand++], sizeof cand_name[0], "q%u negated", a + 1);
+        }
         if (e < best) {
             best = e;
             snprintf(what, sizeof what, "q%u is read in another sign convention", a + 1);
@@ -132,6 +141,10 @@ static void try_causes(rch_calib_judge *j, const rch_calib_result *r, rc_solve_w
                 c[i].q_rad[b] = t;
             }
             const double e = nominal_rms(&r->robot, w, c, n);
+            if (n_cand < 32) {
+                cand_e[n_cand] = e;
+                snprintf(cand_name[n_cand++], sizeof cand_name[0], "q%u and q%u swapped", a + 1, b + 1);
+            }
             if (e < best) {
                 best = e;
                 snprintf(what, sizeof what, "the columns q%u and q%u are swapped", a + 1, b + 1);
@@ -181,9 +194,15 @@ static void try_causes(rch_calib_judge *j, const rch_calib_result *r, rc_solve_w
     /* far better: under half the file's RMS, and near what a robot off its drawing leaves (a few mm) */
     if (what[0] && best < 0.5 * base && best < 0.25 * base + 5.0) {
         j->cause_found = 1;
+        char alt[120] = "";
+        size_t ap = 0;
+        for (unsigned k = 0; k < n_cand; ++k)
+            if (cand_e[k] < 1.1 * best && cand_e[k] != best && ap < sizeof alt)
+                ap += (size_t)snprintf(alt + ap, sizeof alt - ap, "%s%s", ap ? ", " : "", cand_name[k]);
         snprintf(j->cause, sizeof j->cause, "%s: the nominal robot then explains the data to %.3g mm RMS where "
-                                            "the file as read leaves %.3g mm; %s",
-                 what, best, base, fix);
+                                            "the file as read leaves %.3g mm; %s%s%s%s",
+                 what, best, base, fix, alt[0] ? " (as well explained by a mirror image of it: " : "", alt,
+                 alt[0] ? "; check which one the controller exported)" : "");
     }
     free(c);
 }
