@@ -411,9 +411,11 @@ static int systematic(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, con
             z->drift_occam = y.drift_occam;
             z->drift_size_mm = y.drift_size_mm;
         }
+        /* a margin: a score within RCH_SYS_TIE of its penalty is a tie, decided for the simpler model (a
+         * decision must not flip with the last digits another BLAS or CPU gives) */
         const double m_off = off_ok && z->offset_testable ? z->offset_score - z->offset_occam : -INFINITY,
                      m_dr = dr_ok && z->drift_testable ? z->drift_score - z->drift_occam : -INFINITY;
-        if (!(m_off > 0.0) && !(m_dr > 0.0))
+        if (!(m_off > RCH_SYS_TIE) && !(m_dr > RCH_SYS_TIE))
             break;
         const int take_off = m_off >= m_dr;
         rch_calib_result *old = malloc(sizeof *old);

@@ -80,6 +80,7 @@ const char *rch_screen_kind(const rch_screen_row *w);
  * a length offset (a display's zero; each outlet's own) and a linear drift
  * over the run, each by its score against its Occam penalty at the fit
  * without it, fitted (a refit) when it wins and the refit confirms. */
+#define RCH_SYS_TIE 1.0 /* a score within this of its Occam penalty is a tie: not fitted, said so */
 typedef struct rch_calib_sys {
     int tested;                /* the score test ran (lengths, the default run, not --no-length-offset and
                                   --no-drift both) */

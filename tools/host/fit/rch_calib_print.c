@@ -184,7 +184,8 @@ static void print_sys(FILE *f, const rch_calib_result *r)
                 y->offset_score, y->offset_occam);
     } else if (y->offset_testable) {
         fprintf(f, "  length offset (a display's zero): not needed (its evidence %.1f against its Occam penalty "
-                   "%.1f)\n", y->offset_score, y->offset_occam);
+                   "%.1f%s)\n", y->offset_score, y->offset_occam,
+                fabs(y->offset_score - y->offset_occam) <= RCH_SYS_TIE ? ": a tie, decided for the simpler model" : "");
     }
     if (y->drift_fitted)
         fprintf(f, "  drift of the lengths over the run: fitted as nuisance, %+.4f mm from the first row to the last "
@@ -192,7 +193,8 @@ static void print_sys(FILE *f, const rch_calib_result *r)
                    "weighed)\n", effect_value(m, RC_EFF_TIME_DRIFT, 0), y->drift_score, y->drift_occam);
     else if (y->drift_testable)
         fprintf(f, "  drift of the lengths over the run: not needed (its evidence %.1f against its Occam penalty "
-                   "%.1f)\n", y->drift_score, y->drift_occam);
+                   "%.1f%s)\n", y->drift_score, y->drift_occam,
+                fabs(y->drift_score - y->drift_occam) <= RCH_SYS_TIE ? ": a tie, decided for the simpler model" : "");
     if (y->refit_kept_out)
         fprintf(f, "  (a refit with %s gained %.1f against its penalty %.1f: not kept)\n",
                 y->refit_kept_out == 1 ? "the offset" : "the drift",
