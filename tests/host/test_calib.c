@@ -187,8 +187,9 @@ static void test_real_jump_counts(void **state)
     if (r.jumps.n_jumps != r.jump_check_steps)
         snprintf(after, sizeof after, " (%u after the fit with them)", r.jumps.n_jumps);
     snprintf(note, sizeof note, "note: the lengths jump in acquisition order: %u of the %u steps the change-point "
-             "search found are far above the residual (8 x its RMS; largest %.3f mm), so all %u are fitted as "
-             "nuisance%s", r.jumps_found, r.jump_check_steps, r.jump_check_max_mm, r.jump_check_steps, after);
+             "search found are far above the residual (8 x its robust sd %.4f mm; largest %.3f mm), so all %u are "
+             "fitted as nuisance%s", r.jumps_found, r.jump_check_steps, r.jump_check_scale_mm, r.jump_check_max_mm,
+             r.jump_check_steps, after);
     snprintf(found, sizeof found, "length jumps in acquisition order (nuisance, not used at a new pose): %u found;",
              r.jumps.n_jumps);
     if (!strstr(text, note) || !strstr(text, found))
