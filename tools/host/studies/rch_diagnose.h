@@ -231,6 +231,7 @@ typedef struct rch_diagnose_result {
     double jump_max_mm;        /* the bound of a display event used (cfg.jump_max_mm) */
     unsigned jumps_implausible; /* of the jumps, larger than jump_max_mm: not a display event (said so) */
     char known_effects[512];   /* the effects given as known (rch_diagnose_in.effects), as given */
+    int jumps_asked;           /* cfg.jumps: the jumps are known (--jumps), not the verdict */
     size_t dequant_corrected, dequant_refused; /* with cfg.dequantize */
     unsigned geo_rank, geo_free;
 

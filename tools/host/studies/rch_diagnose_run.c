@@ -655,6 +655,7 @@ static int phase_jumps(run_state *S, rch_diag *d)
     const size_t n = out->n;
     char err[256];
     out->jump_max_mm = S->cfg.jump_max_mm > 0.0 ? S->cfg.jump_max_mm : 10.0;
+    out->jumps_asked = S->cfg.jumps;
     if (S->cfg.jumps_given) { /* rcal calibrate's jumps: its search and its rule decided */
         out->jumps_by_calibrate = 1;
         if (S->cfg.n_given_jumps == 0)
