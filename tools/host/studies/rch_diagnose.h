@@ -301,6 +301,13 @@ void rch_diagnose_free(rch_diagnose_result *r);
 int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path,
                       const char *robot_path);
 
+/* The nuisance the diagnosis named (length_jump, time_drift, group_offset:
+ * what describes this acquisition, not the robot), comma-separated into buf
+ * (len): the next step fits each with the geometry (--jumps, --effects
+ * time_drift; group offsets as the jumps at the set-up changes, --jumps)
+ * and a model never uses them at a new pose. 0, or -1 when it does not fit. */
+int rch_diagnose_nuisance(char *buf, size_t len, const rch_diagnose_result *r);
+
 int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path, const char *path,
                             const char *const *inputs, size_t n_inputs, rch_diag *d);
 

@@ -309,6 +309,20 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
         else
             rch_jw_null(&w, "next");
     }
+    {
+        char nu[256];
+        rch_jw_arr(&w, "nuisance"); /* named and fitted by the next step, never used at a new pose */
+        if (rch_diagnose_nuisance(nu, sizeof nu, r) == 0)
+            for (char *p = nu, *q; *p; p = q) {
+                q = strchr(p, ',');
+                if (q)
+                    *q++ = '\0';
+                else
+                    q = p + strlen(p);
+                rch_jw_str(&w, NULL, p);
+            }
+        rch_jw_end(&w);
+    }
     rch_jw_arr(&w, "length_jumps");
     for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
         rch_jw_obj(&w, NULL);
@@ -385,6 +399,23 @@ static void chosen_effects(char *list, size_t len, const rch_diagnose_result *r)
             pos += (size_t)snprintf(list + pos, len - pos, "%s%s", pos ? "," : "", ds->name);
         }
     }
+}
+
+int rch_diagnose_nuisance(char *buf, size_t len, const rch_diagnose_result *r)
+{
+    size_t pos = 0;
+    buf[0] = '\0';
+    if (len == 0)
+        return -1;
+    if (r->jumps.n_jumps > 0)
+        pos += (size_t)snprintf(buf + pos, len - pos, "length_jump");
+    for (unsigned s = 0; s < r->n_steps && pos < len; ++s) {
+        const int c = r->steps[s].chosen;
+        const rc_effect_desc *ds = c >= 0 ? rc_effect_describe(r->steps[s].cand[c].kind) : NULL;
+        if (ds && ds->nuisance)
+            pos += (size_t)snprintf(buf + pos, len - pos, "%s%s", pos ? "," : "", ds->name);
+    }
+    return pos < len ? 0 : -1;
 }
 
 int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path,
