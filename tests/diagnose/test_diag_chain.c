@@ -255,6 +255,20 @@ static void test_drift(void **state)
 {
     (void)state;
     fault_chain(1, "drift2.csv", "time_drift");
+    /* --out fits what Next names: the model file carries the drift it was fitted with */
+    static char out[1 << 20];
+    char cmd[1024], path[512];
+    snprintf(cmd, sizeof cmd, "cd '%s' && rm -f out_drift.json && %s diagnose --data drift2.csv --out out_drift.json",
+             sim_dir, RCAL);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    snprintf(path, sizeof path, "%s/out_drift.json", sim_dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    const size_t got = fread(out, 1, sizeof out - 1, f);
+    out[got] = '\0';
+    fclose(f);
+    if (!strstr(out, "\"time_drift\""))
+        fail_msg("diagnose --out: the model has no time_drift");
 }
 
 static void test_jump(void **state)
