@@ -277,6 +277,42 @@ static void test_jump(void **state)
     fault_chain(2, "jump3.csv", "--jumps");
 }
 
+/* A 30 mm jump is more than a display event: named as implausible beside
+ * it and counted in the JSON (--jump-max-mm, default 10 mm); under a bound
+ * of 50 mm it is not. */
+static void test_jump_bound(void **state)
+{
+    (void)state;
+    static char out[1 << 20];
+    char src[512], dst[512], cmd[1024];
+    snprintf(src, sizeof src, "%s/jump3.csv", sim_dir);
+    snprintf(dst, sizeof dst, "%s/jump30.csv", sim_dir);
+    FILE *in = fopen(src, "r"), *o = fopen(dst, "w");
+    assert_true(in && o);
+    char line[1024];
+    size_t row = 0;
+    while (fgets(line, sizeof line, in)) { /* jump3's 3 mm step made 30 mm */
+        char *comma = strrchr(line, ',');
+        if (row++ >= 300 && comma) {
+            const double L = strtod(comma + 1, NULL) + 27.0;
+            *comma = '\0';
+            fprintf(o, "%s,%.4f\n", line, L);
+        } else {
+            fputs(line, o);
+        }
+    }
+    fclose(in);
+    fclose(o);
+    snprintf(cmd, sizeof cmd, "cd '%s' && %s diagnose --data jump30.csv", sim_dir, RCAL);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    if (!strstr(out, "IMPLAUSIBLE as a display event") || !strstr(out, "larger than 10 mm"))
+        fail_msg("a 30 mm jump not named implausible:\n%s", out);
+    snprintf(cmd, sizeof cmd, "cd '%s' && %s diagnose --data jump30.csv --json --jump-max-mm 50", sim_dir, RCAL);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_non_null(strstr(out, "\"jumps_implausible\":0"));
+    assert_non_null(strstr(out, "\"jump_max_mm\":50"));
+}
+
 /* The real file: both chains end in accepted commands at <= 0.12 mm held
  * out, no fitted jump over 10 mm. */
 static void real_chain(const char *extra)
@@ -323,6 +359,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_offset),
         cmocka_unit_test(test_drift),
         cmocka_unit_test(test_jump),
+        cmocka_unit_test(test_jump_bound),
     };
     return cmocka_run_group_tests(tests, sim_setup, sim_teardown);
 }
