@@ -64,6 +64,16 @@ static void print_summary(FILE *f, const rch_diagnose_result *r)
     for (unsigned k = 0; k < r->n_params; ++k)
         fprintf(f, "  %-34s %12.5f +- %.5f %s\n", r->params[k].name, r->params[k].value, r->params[k].se,
                 r->params[k].unit);
+    if (r->jumps.n_jumps > 0) { /* the nuisance the next step fits with --jumps, on the first screen */
+        unsigned big = 0;
+        for (unsigned k = 1; k < r->jumps.n_jumps; ++k)
+            big = fabs(r->jumps.size_mm[k]) > fabs(r->jumps.size_mm[big]) ? k : big;
+        char where[32] = "";
+        if (r->jump_line[big])
+            snprintf(where, sizeof where, " at line %u", r->jump_line[big]);
+        fprintf(f, "  %-34s %u, largest %+.4f mm%s%s\n", "length jumps (nuisance)", r->jumps.n_jumps,
+                r->jumps.size_mm[big], where, r->jumps_implausible ? " (more than a display event: below)" : "");
+    }
     fprintf(f, "  %-34s %8s %10s %10s %10s\n", "held-out error by sensor (RMS, mm)", "rows", "before", "after",
             "floor");
     for (unsigned k = 0; k < r->n_sensors; ++k) {
