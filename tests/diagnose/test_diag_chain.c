@@ -14,7 +14,9 @@
  *   diag_chain --real   the real IRB120 file, with and without
  *                       --dequantize-joints: the end's held-out RMSE (as
  *                       calibrate prints it) <= 0.12 mm and no fitted jump
- *                       over 10 mm; exit 77 when the file is absent */
+ *                       over 10 mm; exit 77 when the file is absent
+ *   diag_chain --walk ARGS...   any start, walked in the current directory
+ *                       and printed (a measurement) */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <math.h>
@@ -341,8 +343,31 @@ static void test_real_dequantized(void **state)
     real_chain(" --dequantize-joints");
 }
 
+/* diag_chain --walk ARGS...: the chain from `rcal diagnose ARGS` in the
+ * current directory, printed (a measurement: any start by hand). */
+static char walk_args[2048];
+
+static void test_walk(void **state)
+{
+    (void)state;
+    char cwd[1024];
+    chain ch;
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    walk(&ch, cwd, walk_args);
+    print_message("%s after %u diagnose run(s); held-out after %.4f mm, largest jump %.3f mm\n",
+                  ch.ended ? "ended" : "NOT ENDED", ch.diagnoses, ch.heldout_after_mm, ch.max_jump_mm);
+    assert_true(ch.ended);
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "--walk") == 0) {
+        size_t pos = 0;
+        for (int k = 2; k < argc && pos < sizeof walk_args; ++k)
+            pos += (size_t)snprintf(walk_args + pos, sizeof walk_args - pos, "%s%s", pos ? " " : "", argv[k]);
+        const struct CMUnitTest one[] = {cmocka_unit_test(test_walk)};
+        return cmocka_run_group_tests(one, NULL, NULL);
+    }
     if (argc > 1 && strcmp(argv[1], "--real") == 0) {
         if (access(RCAL_SHARED_DATA, R_OK) != 0) {
             printf("SKIP: %s is absent; the real file's chains not walked\n", RCAL_SHARED_DATA);
