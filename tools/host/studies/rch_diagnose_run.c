@@ -620,9 +620,6 @@ static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t 
     return fabs(m1 - m0) > 5.0 * se && fabs((m0 - m1) - size) < 0.3 * fabs(size) && ss_ramp - ss_step > 4.0 * v;
 }
 
-/* 4b. Length jumps in acquisition order: found, removed from the lengths
- * (their offsets fitted on all samples: a nuisance), geometry refitted and
- * cross-validated again. */
 /* The jumps rcal calibrate fitted on the same inputs (cfg.jumps_given):
  * their change points and sizes into out->jumps, the segments' offsets
  * removed from the lengths (the folds' training copies too). */
@@ -649,6 +646,10 @@ static void given_jumps(run_state *S)
             S->c.train[f][i].len_mm -= cfg->given_offset_mm[rch_jumps_segment(j, S->c.train[f][i].t)];
 }
 
+/* 4b. Length jumps in acquisition order: rcal calibrate's (cfg.jumps_given,
+ * from rch_diagnose_inputs), or found here (rch_diagnose_run on samples),
+ * removed from the lengths (a nuisance), geometry refitted and
+ * cross-validated again. Those above cfg.jump_max_mm are counted. */
 static int phase_jumps(run_state *S, rch_diag *d)
 {
     rch_diagnose_result *out = S->out;
