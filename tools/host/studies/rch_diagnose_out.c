@@ -92,6 +92,12 @@ static void print_summary(FILE *f, const rch_diagnose_result *r)
                                  : "nothing more to add, the held-out residual is noise");
         else if (addable == 0)
             snprintf(why, sizeof why, "  (the end of what the candidates explain: %s)", r->remaining_why);
+        int groups = 0;
+        for (unsigned s = 0; s < r->n_steps; ++s)
+            groups |= r->steps[s].chosen >= 0 && r->steps[s].cand[r->steps[s].chosen].kind == RC_EFF_GROUP_OFFSET;
+        if (groups)
+            fprintf(f, "  group_offset: calibrate has no per-set-up offset; the next step fits the set-up changes its "
+                       "jump search tells from the noise as length jumps (--jumps)\n");
         if (r->jumps_implausible)
             fprintf(f, "  warning: %u length jump(s) larger than %.3g mm, more than a display event (below)\n",
                     r->jumps_implausible, r->jump_max_mm);
