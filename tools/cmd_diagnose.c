@@ -169,6 +169,10 @@ static int parse(diag_args *a, int argc, char **argv)
          NULL},
         {"--max-iter", RCH_OPT_UINT, &a->max_iter, 0, 100000, "N",
          "LM iterations of each warm-started fold fit (0: 100)", 0, NULL},
+        {"--jump-max-mm", RCH_OPT_DOUBLE, &cfg->jump_max_mm, 0, 10000, "MM",
+         "the largest length jump a display event explains (re-zeroed, counts lost); a larger one is named as "
+         "implausible (0: 10)",
+         0, NULL},
         {"--no-jumps", RCH_OPT_FLAG, &cfg->no_jumps, 0, 0, NULL, "do not look for length jumps in acquisition order",
          0, NULL},
         {"--dequantize-joints", RCH_OPT_FLAG, &cfg->dequantize, 0, 0, NULL,

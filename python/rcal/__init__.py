@@ -550,7 +550,13 @@ class Diagnosis:
     chosen:          list of Chosen(name, rmse_cv_mm, gain_mm2, p_value), the
                      effects added one after the other
     effects:         the --effects list the Next command passes (names as
-                     calibrate(effects=...) takes them), jumps, dequantize
+                     calibrate(effects=...) takes them), jumps, dequantize;
+                     the nuisance named is in it (time_drift) or in jumps
+                     (length jumps; per set-up offsets, which calibrate fits
+                     as the jumps at the set-up changes)
+    nuisance:        the nuisance named (length_jump, time_drift,
+                     group_offset): fitted by the Next command, never used
+                     at a new pose
     params:          list of DiagParam(name, value, se, unit) fitted
     next_command:    the command that acts on the verdict (`Next:` of the CLI)
     noise_floor_mm, rmse_before_mm, rmse_after_mm, noise_est_mm, n, n_groups,
@@ -560,7 +566,8 @@ class Diagnosis:
     """
 
     _FIGURES = ("n", "n_groups", "folds", "noise_floor_mm", "floor_joints_mm", "floor_len_mm", "train_rmse_geo_mm",
-                "rmse_before_mm", "rmse_after_mm", "noise_est_mm", "n_jumps", "rmse_jumps_mm", "dequant_corrected",
+                "rmse_before_mm", "rmse_after_mm", "noise_est_mm", "n_jumps", "rmse_jumps_mm", "jumps_implausible",
+                "jump_max_mm", "dequant_corrected",
                 "dequant_refused", "effect_rms_mm", "q_step_deg", "len_step_mm", "time_ms")
 
     def __init__(self, handle, data, robot_given=False):
@@ -576,7 +583,7 @@ class Diagnosis:
         self.remaining, self.remaining_why = rem.value.decode(), why.value.decode()
         for k in self._FIGURES:
             v = self.figure(k)
-            setattr(self, k, int(v) if k in ("n", "n_groups", "folds", "n_jumps", "dequant_corrected",
+            setattr(self, k, int(v) if k in ("n", "n_groups", "folds", "n_jumps", "jumps_implausible", "dequant_corrected",
                                              "dequant_refused") else v)
         self.chosen = []
         for k in range(int(self.figure("n_chosen"))):
@@ -597,6 +604,9 @@ class Diagnosis:
         self.jumps = "--jumps" in args
         self.dequantize = "--dequantize-joints" in args
         self.effects = args[args.index("--effects") + 1].split(",") if "--effects" in args else []
+        nb = ctypes.create_string_buffer(256)
+        _check(lib.rch_ffi_diag_nuisance(self._h, nb, 256))
+        self.nuisance = [x for x in nb.value.decode().split(",") if x]
 
     def figure(self, name):
         """A figure by name (rch_ffi_diag_get), or None when unknown."""

@@ -78,6 +78,7 @@ def _declare(lib):
         "rch_ffi_diag_param": (i, [vp, u, cp, sz, _c_double_p, _c_double_p, cp, sz]),
         "rch_ffi_diag_get": (i, [vp, cp, _c_double_p]),
         "rch_ffi_diag_next": (i, [vp, i, cp, sz]),
+        "rch_ffi_diag_nuisance": (i, [vp, cp, sz]),
         "rch_ffi_diag_residuals": (i, [vp, _c_double_p, _c_double_p, _c_double_p]),
         "rch_ffi_diag_json": (i, [vp, cp, sz, _c_size_p]),
         "rch_ffi_diag_write": (i, [vp, cp, cp, sz]),

@@ -302,6 +302,9 @@ int rch_ffi_diag_get(const rch_ffi_diag *g, const char *name, double *value);
  * caller's (then --robot names it, as the CLI does after --robot), 0 for
  * the default robot. */
 int rch_ffi_diag_next(const rch_ffi_diag *g, int name_robot, char *buf, size_t len);
+/* The nuisance the diagnosis named and the next step fits ("length_jump,
+ * time_drift,group_offset", rch_diagnose_nuisance), into buf (len). */
+int rch_ffi_diag_nuisance(const rch_ffi_diag *g, char *buf, size_t len);
 /* Per sample (the file's rows as used): the cross-validated held-out
  * residuals of the geometry (before) and with the chosen effects (after),
  * and the noise floor sigma, mm. Each (n) array may be NULL. */

@@ -246,6 +246,9 @@ int rch_ffi_diag_get(const rch_ffi_diag *g, const char *name, double *value)
         {"noise_est_mm", r->noise_est_mm},
         {"n_jumps", r->jumps.n_jumps},
         {"rmse_jumps_mm", r->rmse_jumps_mm},
+        {"jumps_implausible", r->jumps_implausible},
+        {"jump_max_mm", r->jump_max_mm},
+        {"jumps_by_calibrate", r->jumps_by_calibrate},
         {"dequant_corrected", (double)r->dequant_corrected},
         {"dequant_refused", (double)r->dequant_refused},
         {"effect_rms_mm", r->effect_rms_mm},
@@ -268,6 +271,13 @@ int rch_ffi_diag_next(const rch_ffi_diag *g, int name_robot, char *buf, size_t l
     return rch_diagnose_next(buf, len, &g->r, g->data_path, name_robot ? g->robot_path : NULL) == 0
                ? RCH_FFI_OK
                : RCH_FFI_ERR_ARG;
+}
+
+int rch_ffi_diag_nuisance(const rch_ffi_diag *g, char *buf, size_t len)
+{
+    if (!g || !buf || len == 0)
+        return RCH_FFI_ERR_ARG;
+    return rch_diagnose_nuisance(buf, len, &g->r) == 0 ? RCH_FFI_OK : RCH_FFI_ERR_ARG;
 }
 
 int rch_ffi_diag_residuals(const rch_ffi_diag *g, double *before_mm, double *after_mm, double *floor_mm)

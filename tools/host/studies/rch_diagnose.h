@@ -103,6 +103,19 @@ typedef struct rch_diagnose_cfg {
                                 dropped, as before) */
     int jumps;               /* 1: length jumps found are removed as nuisance (rcal calibrate --jumps) even
                                 where they coincide with a set-up change */
+    double jump_max_mm;      /* the largest jump a display event explains (a re-zeroed display, counts lost);
+                                a jump found above it is named as implausible in the report; 0: 10 mm */
+    /* The jumps rcal calibrate fits on the same inputs (rch_diagnose_inputs sets them: calibrate's jump
+     * search and its rule decide, so that both agree on whether a file has jumps). jumps_given 1: no
+     * search of the diagnosis's own; n_given_jumps change points at acquisition times given_jump_t
+     * (ascending) with the lengths' offsets of the n_given_jumps + 1 segments (given_offset_mm[0]: the
+     * first, the reference) removed from the lengths. */
+    int jumps_given;
+    unsigned n_given_jumps;
+    double given_jump_t[RCH_JUMPS_MAX];
+    double given_jump_mm[RCH_JUMPS_MAX];      /* each jump's size (length change at it) */
+    double given_jump_se_mm[RCH_JUMPS_MAX];
+    double given_offset_mm[RCH_JUMPS_MAX + 1];
 } rch_diagnose_cfg;
 
 /* What one sensor saw and how well the model predicts it held out: a cable
@@ -214,6 +227,11 @@ typedef struct rch_diagnose_result {
     double rmse_jumps_mm;      /* held-out, geometry on the lengths with the jumps removed */
     unsigned jumps_at_setup_change; /* of the jumps found, at a set-up change (confounded) */
     unsigned jumps_confounded; /* steps found only at set-up changes: not taken as jumps */
+    int jumps_by_calibrate;    /* 1: the jumps are rcal calibrate's (its search and rule on the same inputs) */
+    double jump_max_mm;        /* the bound of a display event used (cfg.jump_max_mm) */
+    unsigned jumps_implausible; /* of the jumps, larger than jump_max_mm: not a display event (said so) */
+    char known_effects[512];   /* the effects given as known (rch_diagnose_in.effects), as given */
+    int jumps_asked;           /* cfg.jumps: the jumps are known (--jumps), not the verdict */
     size_t dequant_corrected, dequant_refused; /* with cfg.dequantize */
     unsigned geo_rank, geo_free;
 
@@ -282,6 +300,13 @@ void rch_diagnose_free(rch_diagnose_result *r);
  * 0, or -1 when it does not fit. */
 int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path,
                       const char *robot_path);
+
+/* The nuisance the diagnosis named (length_jump, time_drift, group_offset:
+ * what describes this acquisition, not the robot), comma-separated into buf
+ * (len): the next step fits each with the geometry (--jumps, --effects
+ * time_drift; group offsets as the jumps at the set-up changes, --jumps)
+ * and a model never uses them at a new pose. 0, or -1 when it does not fit. */
+int rch_diagnose_nuisance(char *buf, size_t len, const rch_diagnose_result *r);
 
 int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path, const char *robot_path, const char *path,
                             const char *const *inputs, size_t n_inputs, rch_diag *d);

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_calib.h"
 #include "rch_calib_effects.h"
 #include "rch_diagnose_int.h"
 #include "rch_inputs.h"
@@ -36,6 +37,48 @@ static int start_model(rc_model *m, const rch_inputs *in, const char *effects, r
         memcpy(&m->x[m->effects[m->n_effects - 1].first], &src->x[ef->first], ef->count * sizeof m->x[0]);
     }
     return effects ? rch_calib_effects(m, effects, d) : 0;
+}
+
+/* Whether the file has length jumps, as rcal calibrate decides it on the
+ * same inputs (cc: the files, the robot, the effects known, --jumps; its
+ * default test fraction and seed: the run the next step makes): its one
+ * jump search (rch_jumps) at its MAP fit with the physical prior, its rule
+ * (a step 8 x the residual, or every change point with --jumps). The
+ * change points and the segments' offsets into c (jumps_given). A search
+ * without the prior could trade a step near either end of the file for a
+ * common length offset, which the geometry nearly absorbs: that gave jumps
+ * of hundreds of millimetres. 0, or -1 when calibrate fails (c unchanged:
+ * the diagnosis searches on its own). */
+static int calibrate_jumps(rch_diagnose_cfg *c, const rch_calib_cfg *cc_in, const char *effects, int jumps)
+{
+    rch_calib_cfg cc = *cc_in;
+    cc.effects = effects;
+    cc.jumps = jumps;
+    rch_calib_result *cr = malloc(sizeof *cr);
+    rch_diag d;
+    if (!cr)
+        return -1;
+    if (rch_calib_run(cr, &cc, &d) != 0 || !cr->after_ok) {
+        free(cr);
+        return -1;
+    }
+    c->jumps_given = 1;
+    c->n_given_jumps = 0;
+    memset(c->given_offset_mm, 0, sizeof c->given_offset_mm);
+    if (cr->have_jumps && cr->jumps.n_jumps > 0) {
+        const rch_jumps *j = &cr->jumps;
+        const rc_effect *e = &j->model.effects[j->model.n_effects - 1];
+        c->n_given_jumps = j->n_jumps;
+        for (unsigned k = 0; k < j->n_jumps; ++k) {
+            c->given_jump_t[k] = j->at_t[k];
+            c->given_jump_mm[k] = j->size_mm[k];
+            c->given_jump_se_mm[k] = j->se_mm[k];
+        }
+        for (unsigned k = 0; k <= j->n_jumps && k < e->count; ++k)
+            c->given_offset_mm[k] = j->model.x[e->first + k];
+    }
+    free(cr);
+    return 0;
 }
 
 int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, const rch_diagnose_cfg *cfg,
@@ -84,6 +127,12 @@ int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, con
     c.keep_effects = 1;
     if (cfg->dequantize && c.q_step_deg == 0.0)
         c.q_step_deg = -1.0; /* the joints are no longer on the display grid */
+    /* the jumps: calibrate's, where it looks for them (one outlet, no tracker; several outlets with --jumps) */
+    if (!cfg->no_jumps && !cfg->jumps_given && in->n_positions == 0 && (data->n_outlets <= 1 || cfg->jumps)) {
+        rch_calib_cfg cj = cc;
+        cj.no_dequantize = 0; /* as the next step runs it: calibrate dequantizes by itself where it can */
+        (void)calibrate_jumps(&c, &cj, in->effects, cfg->jumps);
+    }
     rc_model m;
     int rc = start_model(&m, data, in->effects, d);
     const size_t n = data->data.n;
@@ -93,6 +142,7 @@ int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, con
         rc = rch_diagnose_run(out, data->data.s, n, &m, &c, d);
     memcpy(out->outlet_label, data->outlet_label, sizeof out->outlet_label);
     out->in = *in;
+    snprintf(out->known_effects, sizeof out->known_effects, "%s", in->effects ? in->effects : "");
     out->dequant_corrected = data->dequant.n_corrected;
     out->dequant_refused = data->dequant.n_refused;
     for (unsigned k = 0; k < out->n_sensors; ++k) /* the outlets by the files' labels */

@@ -23,17 +23,31 @@ static void print_tests(FILE *f, const rch_diagnose_test *t, unsigned n)
                 rch_plot_fmt_p(pb, sizeof pb, t[k].p_value), 100.0 * t[k].r2, t[k].significant ? "STRUCTURE" : "");
 }
 
-/* The effects found that the model file can carry (not nuisance, not
- * already known): what a next calibration adds. */
-static unsigned addable_effects(const rch_diagnose_result *r)
+/* Whether the next step fits length jumps (--jumps): the diagnosis found
+ * them (calibrate's, or its own), was told (--jumps), or named per set-up
+ * offsets (group_offset), which calibrate fits as the jumps at the set-up
+ * changes its search tells from the noise (it has no per-set-up offset of
+ * its own). */
+static int next_jumps(const rch_diagnose_result *r)
 {
-    unsigned k = 0;
-    for (unsigned s = 0; s < r->n_steps; ++s) {
-        const int c = r->steps[s].chosen;
-        const rc_effect_desc *ds = c >= 0 ? rc_effect_describe(r->steps[s].cand[c].kind) : NULL;
-        k += ds && !ds->nuisance && ds->user;
-    }
-    return k + (r->jumps.n_jumps > 0 && strcmp(r->effect, "length_jump") == 0);
+    if (r->jumps_asked || r->jumps.n_jumps > 0 || strcmp(r->effect, "length_jump") == 0)
+        return 1;
+    for (unsigned s = 0; s < r->n_steps; ++s)
+        if (r->steps[s].chosen >= 0 && r->steps[s].cand[r->steps[s].chosen].kind == RC_EFF_GROUP_OFFSET)
+            return 1;
+    return 0;
+}
+
+static void chosen_effects(char *list, size_t len, const rch_diagnose_result *r);
+
+/* What the next step adds to the diagnosis's own inputs: effects to the
+ * known ones, --jumps. 0: the chain ends here (the next step is the
+ * calibration of what this diagnosis was given). */
+static unsigned next_adds(const rch_diagnose_result *r)
+{
+    char list[512];
+    chosen_effects(list, sizeof list, r);
+    return (strcmp(list, r->known_effects) != 0) + (next_jumps(r) && !r->jumps_asked);
 }
 
 /* The first screen: the verdict with the size of what was found, the held-out
@@ -50,6 +64,16 @@ static void print_summary(FILE *f, const rch_diagnose_result *r)
     for (unsigned k = 0; k < r->n_params; ++k)
         fprintf(f, "  %-34s %12.5f +- %.5f %s\n", r->params[k].name, r->params[k].value, r->params[k].se,
                 r->params[k].unit);
+    if (r->jumps.n_jumps > 0) { /* the nuisance the next step fits with --jumps, on the first screen */
+        unsigned big = 0;
+        for (unsigned k = 1; k < r->jumps.n_jumps; ++k)
+            big = fabs(r->jumps.size_mm[k]) > fabs(r->jumps.size_mm[big]) ? k : big;
+        char where[32] = "";
+        if (r->jump_line[big])
+            snprintf(where, sizeof where, " at line %u", r->jump_line[big]);
+        fprintf(f, "  %-34s %u, largest %+.4f mm%s%s\n", "length jumps (nuisance)", r->jumps.n_jumps,
+                r->jumps.size_mm[big], where, r->jumps_implausible ? " (more than a display event: below)" : "");
+    }
     fprintf(f, "  %-34s %8s %10s %10s %10s\n", "held-out error by sensor (RMS, mm)", "rows", "before", "after",
             "floor");
     for (unsigned k = 0; k < r->n_sensors; ++k) {
@@ -60,14 +84,23 @@ static void print_summary(FILE *f, const rch_diagnose_result *r)
     }
     if (r->in.n_data + r->in.n_positions > 0) {
         char next[1400], why[400] = "";
-        const unsigned addable = addable_effects(r);
+        const unsigned addable = next_adds(r);
         if (addable == 0 && strcmp(r->remaining, "none") == 0)
             snprintf(why, sizeof why, "  (the end: %s)",
-                     r->n_chosen ? "what was found describes this acquisition (a nuisance), not the robot; the "
-                                   "held-out residual left is noise"
+                     r->n_chosen ? "what was found is already in this command (nuisance fitted with the geometry, "
+                                   "never used at a new pose); the held-out residual left is noise"
                                  : "nothing more to add, the held-out residual is noise");
         else if (addable == 0)
             snprintf(why, sizeof why, "  (the end of what the candidates explain: %s)", r->remaining_why);
+        int groups = 0;
+        for (unsigned s = 0; s < r->n_steps; ++s)
+            groups |= r->steps[s].chosen >= 0 && r->steps[s].cand[r->steps[s].chosen].kind == RC_EFF_GROUP_OFFSET;
+        if (groups)
+            fprintf(f, "  group_offset: calibrate has no per-set-up offset; the next step fits the set-up changes its "
+                       "jump search tells from the noise as length jumps (--jumps)\n");
+        if (r->jumps_implausible)
+            fprintf(f, "  warning: %u length jump(s) larger than %.3g mm, more than a display event (below)\n",
+                    r->jumps_implausible, r->jump_max_mm);
         if (rch_diagnose_next(next, sizeof next, r, NULL, r->in.robot_given ? r->in.robot_path : NULL) == 0)
             fprintf(f, "  next: %s%s\n", next, why);
     }
@@ -131,11 +164,20 @@ int rch_diagnose_print(FILE *f, const rch_diagnose_result *r)
             char where[48] = "";
             if (r->jump_line[k])
                 snprintf(where, sizeof where, "line %u, ", r->jump_line[k]);
-            fprintf(f, "  at %ssample %zu (1-based, in file order; t %.4f): %+.4f +- %.4f mm\n", where,
-                    r->jumps.at[k] + 1, r->jumps.at_t[k], r->jumps.size_mm[k], r->jumps.se_mm[k]);
+            fprintf(f, "  at %ssample %zu (1-based, in file order; t %.4f): %+.4f +- %.4f mm%s\n", where,
+                    r->jumps.at[k] + 1, r->jumps.at_t[k], r->jumps.size_mm[k], r->jumps.se_mm[k],
+                    fabs(r->jumps.size_mm[k]) > r->jump_max_mm ? "  IMPLAUSIBLE as a display event" : "");
         }
         fprintf(f, "  geometry held-out RMSE %.4f mm with the jumps in the data, %.4f mm with them removed\n",
                 r->rmse_before_mm, r->rmse_jumps_mm);
+        if (r->jumps_by_calibrate)
+            fprintf(f, "  (found as rcal calibrate finds them on the same inputs: its search at its fit with the prior, "
+                       "and its rule)\n");
+        if (r->jumps_implausible)
+            fprintf(f,
+                    "  %u of them larger than %.3g mm (--jump-max-mm): more than a display re-zeroed or counts lost; "
+                    "look for a cable re-hooked, rows from another set-up, or an effect the model lacks\n",
+                    r->jumps_implausible, r->jump_max_mm);
         if (r->jumps_at_setup_change)
             fprintf(f,
                     "  %u of them fall where the set-up changes: there a jump is confounded with anything that depends "
@@ -283,6 +325,20 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
         else
             rch_jw_null(&w, "next");
     }
+    {
+        char nu[256];
+        rch_jw_arr(&w, "nuisance"); /* named and fitted by the next step, never used at a new pose */
+        if (rch_diagnose_nuisance(nu, sizeof nu, r) == 0)
+            for (char *p = nu, *q; *p; p = q) {
+                q = strchr(p, ',');
+                if (q)
+                    *q++ = '\0';
+                else
+                    q = p + strlen(p);
+                rch_jw_str(&w, NULL, p);
+            }
+        rch_jw_end(&w);
+    }
     rch_jw_arr(&w, "length_jumps");
     for (unsigned k = 0; k < r->jumps.n_jumps; ++k) {
         rch_jw_obj(&w, NULL);
@@ -298,6 +354,9 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
     }
     rch_jw_end(&w);
     json_num(&w, "rmse_jumps_removed_mm", r->jumps.n_jumps ? r->rmse_jumps_mm : NAN);
+    rch_jw_str(&w, "jumps_found_by", r->jumps_by_calibrate ? "calibrate" : "diagnose");
+    json_num(&w, "jump_max_mm", r->jump_max_mm);
+    rch_jw_uint(&w, "jumps_implausible", r->jumps_implausible);
     rch_jw_arr(&w, "sequence");
     for (unsigned s = 0; s < r->n_steps; ++s)
         if (r->steps[s].chosen >= 0)
@@ -326,24 +385,53 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
     return rch_jw_finish(&w);
 }
 
-/* The chosen effects as `rcal calibrate --effects` names them, into list. */
+/* The effects of the next step as `rcal calibrate --effects` names them,
+ * into list: the known ones as given (the chain repeats them as the user
+ * wrote them: a period refitted without the prior may wander), then each
+ * effect the search chose that calibrate fits, nuisance (time_drift)
+ * included: it is fitted with the geometry and left out at a new pose. Per
+ * set-up offsets (group_offset) go by --jumps (next_jumps); tool_offset is
+ * calibrate's attachment, decided by the data. */
 static void chosen_effects(char *list, size_t len, const rch_diagnose_result *r)
 {
-    size_t pos = 0;
-    list[0] = '\0';
-    for (unsigned e = 0; e < r->final.n_effects && pos < len; ++e) {
-        const rc_effect *ef = &r->final.effects[e];
-        const rc_effect_desc *ds = rc_effect_describe(ef->kind);
-        if (!ds || ds->nuisance || !ds->user || ef->kind == RC_EFF_TOOL_OFFSET)
+    size_t pos = (size_t)snprintf(list, len, "%s", r->known_effects);
+    for (unsigned s = 0; s < r->n_steps && pos < len; ++s) {
+        const int c = r->steps[s].chosen;
+        if (c < 0)
             continue;
-        if (ds->arg == RC_EFF_ARG_JOINT)
-            pos += (size_t)snprintf(list + pos, len - pos, "%s%s:%u", pos ? "," : "", ds->name, ef->joint + 1u);
-        else if (ds->arg == RC_EFF_ARG_PERIOD)
-            pos += (size_t)snprintf(list + pos, len - pos, "%s%s:%.6g", pos ? "," : "", ds->name,
-                                    fabs(r->final.x[ef->first + 2]));
-        else
+        const rch_diagnose_cand *ca = &r->steps[s].cand[c];
+        const rc_effect_desc *ds = rc_effect_describe(ca->kind);
+        if (!ds || !ds->user || ca->kind == RC_EFF_TOOL_OFFSET)
+            continue;
+        if (ds->arg == RC_EFF_ARG_JOINT) {
+            pos += (size_t)snprintf(list + pos, len - pos, "%s%s:%u", pos ? "," : "", ds->name, ca->joint);
+        } else if (ds->arg == RC_EFF_ARG_PERIOD) {
+            double per = 0.0;
+            for (unsigned e = 0; e < r->final.n_effects; ++e)
+                if (r->final.effects[e].kind == (uint8_t)ca->kind)
+                    per = fabs(r->final.x[r->final.effects[e].first + 2]);
+            pos += (size_t)snprintf(list + pos, len - pos, "%s%s:%.6g", pos ? "," : "", ds->name, per);
+        } else {
             pos += (size_t)snprintf(list + pos, len - pos, "%s%s", pos ? "," : "", ds->name);
+        }
     }
+}
+
+int rch_diagnose_nuisance(char *buf, size_t len, const rch_diagnose_result *r)
+{
+    size_t pos = 0;
+    buf[0] = '\0';
+    if (len == 0)
+        return -1;
+    if (r->jumps.n_jumps > 0)
+        pos += (size_t)snprintf(buf + pos, len - pos, "length_jump");
+    for (unsigned s = 0; s < r->n_steps && pos < len; ++s) {
+        const int c = r->steps[s].chosen;
+        const rc_effect_desc *ds = c >= 0 ? rc_effect_describe(r->steps[s].cand[c].kind) : NULL;
+        if (ds && ds->nuisance)
+            pos += (size_t)snprintf(buf + pos, len - pos, "%s%s", pos ? "," : "", ds->name);
+    }
+    return pos < len ? 0 : -1;
 }
 
 int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const char *data_path,
@@ -375,7 +463,7 @@ int rch_diagnose_next(char *buf, size_t len, const rch_diagnose_result *r, const
         argv[n++] = "--cable-point";
         argv[n++] = r->in.cable_points[k];
     }
-    if (strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps)
+    if (next_jumps(r))
         argv[n++] = "--jumps";
     if (r->dequant_corrected)
         argv[n++] = "--dequantize-joints";
@@ -415,7 +503,7 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path,
     chosen_effects(list, sizeof list, r);
     cfg.test_fraction = 0.0;
     cfg.effects = list[0] ? list : NULL;
-    cfg.jumps = strcmp(r->effect, "length_jump") == 0 || r->jumps.n_jumps > 0;
+    cfg.jumps = next_jumps(r);
     cfg.dequantize = r->dequant_corrected > 0;
     const int rc = rch_calib_run(&cr, &cfg, d);
     if (rc != 0)

@@ -620,14 +620,66 @@ static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t 
     return fabs(m1 - m0) > 5.0 * se && fabs((m0 - m1) - size) < 0.3 * fabs(size) && ss_ramp - ss_step > 4.0 * v;
 }
 
-/* 4b. Length jumps in acquisition order: found, removed from the lengths
- * (their offsets fitted on all samples: a nuisance), geometry refitted and
- * cross-validated again. */
+/* The jumps rcal calibrate fitted on the same inputs (cfg.jumps_given):
+ * their change points and sizes into out->jumps, the segments' offsets
+ * removed from the lengths (the folds' training copies too). */
+static void given_jumps(run_state *S)
+{
+    rch_diagnose_result *out = S->out;
+    const rch_diagnose_cfg *cfg = &S->cfg;
+    rch_jumps *j = &out->jumps;
+    memset(j, 0, sizeof *j);
+    j->n_jumps = cfg->n_given_jumps < RCH_JUMPS_MAX ? cfg->n_given_jumps : RCH_JUMPS_MAX;
+    for (unsigned k = 0; k < j->n_jumps; ++k) {
+        size_t a = 0;
+        while (a < out->n && out->s[a].t < cfg->given_jump_t[k])
+            ++a;
+        j->at[k] = a;
+        j->at_t[k] = cfg->given_jump_t[k];
+        j->size_mm[k] = cfg->given_jump_mm[k];
+        j->se_mm[k] = cfg->given_jump_se_mm[k];
+    }
+    for (size_t i = 0; i < out->n; ++i)
+        out->s[i].len_mm -= cfg->given_offset_mm[rch_jumps_segment(j, out->s[i].t)];
+    for (unsigned f = 0; f < S->c.k; ++f)
+        for (size_t i = 0; i < S->c.n_train[f]; ++i)
+            S->c.train[f][i].len_mm -= cfg->given_offset_mm[rch_jumps_segment(j, S->c.train[f][i].t)];
+}
+
+/* 4b. Length jumps in acquisition order: rcal calibrate's (cfg.jumps_given,
+ * from rch_diagnose_inputs), or found here (rch_diagnose_run on samples),
+ * removed from the lengths (a nuisance), geometry refitted and
+ * cross-validated again. Those above cfg.jump_max_mm are counted. */
 static int phase_jumps(run_state *S, rch_diag *d)
 {
     rch_diagnose_result *out = S->out;
     const size_t n = out->n;
     char err[256];
+    out->jump_max_mm = S->cfg.jump_max_mm > 0.0 ? S->cfg.jump_max_mm : 10.0;
+    out->jumps_asked = S->cfg.jumps;
+    if (S->cfg.jumps_given) { /* rcal calibrate's jumps: its search and its rule decided */
+        out->jumps_by_calibrate = 1;
+        if (S->cfg.n_given_jumps == 0)
+            return 0;
+        given_jumps(S);
+        for (unsigned k = 0; k < out->jumps.n_jumps; ++k)
+            out->jumps_implausible += fabs(out->jumps.size_mm[k]) > out->jump_max_mm;
+        rc_solve_result res;
+        if (rch_dg_fit(&out->geo, &res, &S->c, NULL, out->s, n) != 0) {
+            rch_diag_set(d, "", 0, 0, "the geometric fit failed (after removing the length jumps)");
+            return -1;
+        }
+        out->jumps.geometry = out->geo;
+        out->jumps.rms_after_mm = res.rms_final_mm;
+        for (unsigned f = 0; f < S->c.k; ++f)
+            S->base_folds[f] = out->geo;
+        if (rch_dg_cv_run(S->base_folds, S->r0, &S->c) != 0) {
+            rch_diag_set(d, "", 0, 0, "a cross-validation fit failed (after removing the length jumps)");
+            return -1;
+        }
+        out->rmse_jumps_mm = rch_rms(S->r0, n);
+        return 0;
+    }
     if (S->cfg.no_jumps || out->n_tracker > 0 || (out->n_sensors > 1 && !S->cfg.jumps))
         return 0; /* a tracker's coordinates do not jump like a display's count; several outlets' rows
                      interleave in acquisition order (their jumps only when --jumps says so) */
@@ -665,6 +717,8 @@ static int phase_jumps(run_state *S, rch_diag *d)
         out->jumps.n_jumps = 0;
         return 0;
     }
+    for (unsigned k = 0; k < out->jumps.n_jumps; ++k)
+        out->jumps_implausible += fabs(out->jumps.size_mm[k]) > out->jump_max_mm;
     const rc_effect *e = &out->jumps.model.effects[out->jumps.model.n_effects - 1];
     for (size_t i = 0; i < n; ++i)
         out->s[i].len_mm -= out->jumps.model.x[e->first + rch_jumps_segment(&out->jumps, out->s[i].t)];
