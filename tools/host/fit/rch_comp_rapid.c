@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "rch_comp_int.h"
+#include "rch_data.h"
 #include "rch_ik.h"
 
 /* One replacement of the rewritten module: text[off..off+len) -> rep. */
@@ -201,6 +202,26 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
         rch_rapid_free(&ts);
         return -1;
     }
+    /* joint targets in radians where RAPID means degrees (issue 47): the module's jointtargets together */
+    double max_abs_deg[RC_NJ] = {0};
+    size_t n_joint = 0;
+    const rch_rapid_target *first_joint = NULL;
+    for (size_t i = 0; i < ts.n; ++i)
+        if (ts.t[i].kind == RCH_RAPID_JOINTTARGET && !ts.t[i].error[0]) {
+            first_joint = first_joint ? first_joint : &ts.t[i];
+            ++n_joint;
+            for (unsigned k = 0; k < RC_NJ; ++k)
+                max_abs_deg[k] = fmax(max_abs_deg[k], fabs(ts.t[i].val[k]));
+        }
+    char why_rad[320];
+    if (first_joint && !(c->gate && c->gate->assume_degrees) &&
+        rch_data_q_look_rad(why_rad, sizeof why_rad, max_abs_deg, n_joint)) {
+        rch_diag_set(d, c->in_name, base + first_joint->line, first_joint->col,
+                     "jointtarget: %s (RAPID robax is in degrees); nothing written (if they are degrees: "
+                     "--assume-degrees)", why_rad);
+        rch_rapid_free(&ts);
+        return -1;
+    }
     edit *ed = NULL;
     size_t ne = 0, cap = 0;
     unsigned long n_bad = 0;
@@ -267,9 +288,7 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
             fputs(ed[k].rep, c->out);
             at = ed[k].off + ed[k].len;
         }
-        fwrite(text + at, 1, len - at, c->out);
-        if (len > 0 && text[len - 1] != '\n')
-            fputc('\n', c->out);
+        fwrite(text + at, 1, len - at, c->out); /* the input's bytes: its BOM and line ends as they were */
     }
     free(ed);
     rch_rapid_free(&ts);
