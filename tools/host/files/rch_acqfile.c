@@ -21,8 +21,11 @@ static int write_all(int fd, const char *p, size_t n)
         ssize_t w = write(fd, p, n);
         if (w < 0 && errno == EINTR)
             continue;
-        if (w <= 0)
+        if (w <= 0) {
+            if (w == 0)
+                errno = EIO; /* no progress and no reason: never a stale errno in the message */
             return -1;
+        }
         p += w;
         n -= (size_t)w;
     }

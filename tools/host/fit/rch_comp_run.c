@@ -324,6 +324,8 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);
+    if (rc < 0 && !d->file[0] && o.f != stdout && ferror(o.f)) /* a write error: the file it was writing */
+        snprintf(d->file, sizeof d->file, "%.255s", o.path);
     if (rc < 0) {
         if (o.f != stdout)
             rch_out_abort(&o);
