@@ -106,6 +106,10 @@ static const char *number_hint(const field *f)
         return " (hexadecimal numbers are not accepted: write decimals)";
     if (memchr(f->p, ';', f->len) || memchr(f->p, '\t', f->len))
         return " (separators must be commas)";
+    if (f->len > 1 && (f->p[f->len - 1] == 'e' || f->p[f->len - 1] == 'E' ||
+                       ((f->p[f->len - 1] == '+' || f->p[f->len - 1] == '-') &&
+                        (f->p[f->len - 2] == 'e' || f->p[f->len - 2] == 'E'))))
+        return " (an exponent without its digits)";
     return "";
 }
 
@@ -353,9 +357,12 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
             return -1;
         }
         if (parse_number(&v[k], &fields[c]) != 0) {
-            rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s",
+            rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s%s",
                          col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
-                         number_hint(&fields[c]));
+                         number_hint(&fields[c]),
+                         pc->implicit && out->n == 0 && isalpha((unsigned char)fields[c].p[0])
+                             ? " (a first line is a header only when it names its columns: q1,q2,q3,q4,q5,q6)"
+                             : "");
             return -1;
         }
         if (check_value(pc, k, v[k], &fields[c]) != 0)

@@ -179,9 +179,10 @@ unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, c
                              const rch_robot *robot, const rc_model *nominal);
 
 /* --nominal that names the calibrated model itself (issue 47): the same
- * file (rch_path_same) or the same numbers (every parameter of the model,
- * effects included, equal): compensation would correct nothing. 0, or -1
- * with d set naming both options. */
+ * file (rch_path_same) or the same numbers (every DH parameter and effect
+ * parameter equal; the encoder's place, which moves no joint, is not
+ * compared): compensation would correct nothing. 0, or -1 with d set naming
+ * both options. */
 int rch_comp_same_model(rch_diag *d, const rch_comp_job *job, const rch_robot *model, const rch_robot *nominal);
 
 /* The whole command: load the models, open the input, refuse an output
