@@ -222,6 +222,10 @@ static void test_comp_radians(void **state)
     assert_string_equal(out, "");
     assert_non_null(strstr(d.msg, "look like radians"));
     assert_non_null(strstr(d.msg, "--assume-degrees"));
+    /* --format csv likewise */
+    assert_int_equal(comp_text(out, sizeof out, rad + 18, strlen(rad + 18), RCH_COMP_CSV, &d), -1);
+    assert_string_equal(out, "");
+    assert_non_null(strstr(d.msg, "look like radians"));
     /* a single target likewise */
     const char *one = "0.5,-0.3,0.2,0,1.2,0\n";
     assert_int_equal(comp_text(out, sizeof out, one, strlen(one), RCH_COMP_AUTO, &d), -1);

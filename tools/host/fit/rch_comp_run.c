@@ -119,6 +119,8 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
     long got;
     unsigned lineno = 0;
     int rc = 0, decided = c.format != 0;
+    if (c.format == 1 && !(gate && gate->assume_degrees) && rch_cpi_csv_hold(&c, d) != 0)
+        return -1; /* --format csv: held from the start as a detected CSV is */
     while ((got = read_line(&line, &cap, in)) != -1) {
         size_t n = (size_t)got;
         ++lineno;
