@@ -6,6 +6,10 @@
  *   rcal-rt --bench [--targets N] [--repeat R] [--model MODEL.json]
  *   rcal-rt --emit-c MODEL.json [--position-only] > fw_model_data.h
  *
+ * Exit status: 0, 1 when a cycle failed (the compensation did not converge)
+ * or missed its deadline (the counts on stderr), or an input was refused,
+ * 2 for a usage error.
+ *
  * Loop: wakes at absolute times t_k = t_0 + k * period (clock_nanosleep with
  * TIMER_ABSTIME on CLOCK_MONOTONIC), compensates the k-th target of the
  * stream, and records: the compute latency (the rc_comp_stream_step call),
@@ -58,8 +62,10 @@ static void usage(FILE *f)
             "  loop:    compensates one target per period (default 1000 Hz for 10 s) with\n"
             "           clock_nanosleep(TIMER_ABSTIME) and reports compute latency, wake-up\n"
             "           lateness and completion time (median, p99, p99.99, max) and deadline misses\n"
-            "  --in     targets (q1..q6 degrees per line, optional header), cycled; default: a\n"
-            "           smooth synthetic joint-space path through the workspace\n"
+            "  --in     targets (q1..q6 degrees per line; a header line, optional, names its columns),\n"
+            "           cycled; default: a smooth synthetic joint-space path through the workspace.\n"
+            "           Read as every rcal CSV: a field that is not a finite decimal number is refused\n"
+            "           with file:line:col, targets that look like radians are refused\n"
             "  --fifo   run as SCHED_FIFO priority 80 with memory locked (needs the privilege)\n"
             "  --bench  compensates N targets back to back (default 200000), R times (default 5),\n"
             "           reports latency per target and targets/s for each run and their medians;\n"
