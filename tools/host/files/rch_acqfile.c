@@ -47,8 +47,14 @@ static int save_tail(const char *path, const char *text, size_t from, size_t len
     rc = write_all(fd, text + from, len - from);
     if (rc == 0)
         rc = fsync(fd);
-    if (close(fd) != 0 || rc != 0) {
-        rch_diag_set(d, path, 0, 0, "cannot save the unfinished last line to %s", dpath);
+    int err = rc != 0 ? errno : 0;
+    if (close(fd) != 0 && rc == 0) {
+        rc = -1;
+        err = errno;
+    }
+    if (rc != 0) {
+        rch_diag_set(d, path, 0, 0, "cannot save the unfinished last line to %s: %s", dpath,
+                     strerror(err ? err : EIO));
         return -1;
     }
     return 0;
