@@ -184,6 +184,30 @@ static int rapid_robtarget(rch_cpi_ctx *c, double out[RCH_RAPID_NUMS], const rch
     return r;
 }
 
+/* The module's jointtargets together in radians where RAPID means degrees
+ * (issue 47, rch_data_q_look_rad): refused at the first one. 0, or -1 with
+ * d set. */
+static int rapid_radians(const rch_cpi_ctx *c, const rch_rapid_targets *ts, unsigned base, rch_diag *d)
+{
+    double max_abs_deg[RC_NJ] = {0};
+    size_t n_joint = 0;
+    const rch_rapid_target *first = NULL;
+    for (size_t i = 0; i < ts->n; ++i)
+        if (ts->t[i].kind == RCH_RAPID_JOINTTARGET && !ts->t[i].error[0]) {
+            first = first ? first : &ts->t[i];
+            ++n_joint;
+            for (unsigned k = 0; k < RC_NJ; ++k)
+                max_abs_deg[k] = fmax(max_abs_deg[k], fabs(ts->t[i].val[k]));
+        }
+    char why[320];
+    if (!first || (c->gate && c->gate->assume_degrees) || !rch_data_q_look_rad(why, sizeof why, max_abs_deg, n_joint))
+        return 0;
+    rch_diag_set(d, c->in_name, base + first->line, first->col,
+                 "jointtarget: %s (RAPID robax is in degrees); nothing written (if they are degrees: "
+                 "--assume-degrees)", why);
+    return -1;
+}
+
 /* A whole RAPID module text[0..len), its first line being line base + 1:
  * every joint target and robtarget corrected, every other byte copied. All
  * or nothing: a target that cannot be corrected is named (line, column,
@@ -202,23 +226,7 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
         rch_rapid_free(&ts);
         return -1;
     }
-    /* joint targets in radians where RAPID means degrees (issue 47): the module's jointtargets together */
-    double max_abs_deg[RC_NJ] = {0};
-    size_t n_joint = 0;
-    const rch_rapid_target *first_joint = NULL;
-    for (size_t i = 0; i < ts.n; ++i)
-        if (ts.t[i].kind == RCH_RAPID_JOINTTARGET && !ts.t[i].error[0]) {
-            first_joint = first_joint ? first_joint : &ts.t[i];
-            ++n_joint;
-            for (unsigned k = 0; k < RC_NJ; ++k)
-                max_abs_deg[k] = fmax(max_abs_deg[k], fabs(ts.t[i].val[k]));
-        }
-    char why_rad[320];
-    if (first_joint && !(c->gate && c->gate->assume_degrees) &&
-        rch_data_q_look_rad(why_rad, sizeof why_rad, max_abs_deg, n_joint)) {
-        rch_diag_set(d, c->in_name, base + first_joint->line, first_joint->col,
-                     "jointtarget: %s (RAPID robax is in degrees); nothing written (if they are degrees: "
-                     "--assume-degrees)", why_rad);
+    if (rapid_radians(c, &ts, base, d) != 0) {
         rch_rapid_free(&ts);
         return -1;
     }

@@ -101,6 +101,51 @@ static int out_failed(const rch_cpi_ctx *c, unsigned lineno, rch_diag *d)
     return 1;
 }
 
+/* The form of the input from its first line that is not blank or a comment
+ * (line, a BOM of bom bytes, then tn bytes of text): RAPID, or CSV (then
+ * held back for the radians check) whose first line is a header when its
+ * first field is not a number (read and copied here). 0, 1 (the header
+ * consumed) or -1 (d set). */
+static int decide_form(rch_cpi_ctx *c, const char *line, size_t bom, size_t tn, unsigned lineno, rch_diag *d)
+{
+    const char *text = line + bom;
+    if (starts_with_ci(text, tn, "MODULE") || starts_with_ci(text, tn, "%%%") || starts_with_ci(text, tn, "!") ||
+        find_ci(text, tn, "jointtarget") || find_ci(text, tn, "robtarget")) {
+        c->format = 2;
+        return 0;
+    }
+    size_t st[RCH_CPI_MAX_FIELDS], ln[RCH_CPI_MAX_FIELDS];
+    double v;
+    c->format = 1;
+    if (!(c->gate && c->gate->assume_degrees) && rch_cpi_csv_hold(c, d) != 0)
+        return -1;
+    if (!(rch_cpi_split_csv(text, tn, st, ln) > 0 && rch_cpi_parse_num(&v, text + st[0], ln[0]) != 0))
+        return 0;
+    fwrite(line, 1, bom, c->out);
+    return rch_cpi_csv_header(c, text, tn, lineno, d) < 0 || out_failed(c, lineno, d) ? -1 : 1;
+}
+
+/* The end of a CSV input held back (rch_cpi_csv_hold) because it looked like
+ * radians so far: refused when it still does (rch_data_q_look_rad; nothing
+ * written), else what was held written out. rc as the lines left it; returns
+ * the run's. */
+static int held_end(rch_cpi_ctx *c, int rc, unsigned lineno, rch_diag *d)
+{
+    if (!c->held)
+        return rc;
+    char why[320];
+    if (rc >= 0 && rch_data_q_look_rad(why, sizeof why, c->max_abs_deg, c->n_targets)) {
+        rch_diag_set(d, c->in_name, 0, 0, "%s; nothing written (if they are degrees: --assume-degrees)", why);
+        rc = -1;
+    }
+    if (rc < 0) {
+        rch_cpi_csv_drop(c);
+        return rc;
+    }
+    rch_cpi_csv_release(c);
+    return out_failed(c, lineno, d) ? -1 : rc;
+}
+
 int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
                    const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d)
 {
@@ -154,26 +199,12 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         int r;
         if (!decided) {
             decided = 1;
-            if (starts_with_ci(text, tn, "MODULE") || starts_with_ci(text, tn, "%%%") ||
-                starts_with_ci(text, tn, "!") || find_ci(text, tn, "jointtarget") || find_ci(text, tn, "robtarget")) {
-                c.format = 2;
-            } else {
-                size_t st[RCH_CPI_MAX_FIELDS], ln[RCH_CPI_MAX_FIELDS];
-                double v;
-                c.format = 1;
-                if (!(gate && gate->assume_degrees) && rch_cpi_csv_hold(&c, d) != 0) {
-                    rc = -1;
-                    break;
-                }
-                if (rch_cpi_split_csv(text, tn, st, ln) > 0 && rch_cpi_parse_num(&v, text + st[0], ln[0]) != 0) {
-                    fwrite(line, 1, bom, c.out);
-                    if (rch_cpi_csv_header(&c, text, tn, lineno, d) < 0 || out_failed(&c, lineno, d)) {
-                        rc = -1;
-                        break;
-                    }
-                    continue;
-                }
+            if ((r = decide_form(&c, line, bom, tn, lineno, d)) < 0) {
+                rc = -1;
+                break;
             }
+            if (r > 0)
+                continue; /* a CSV header, copied */
         }
         if (c.format == 2) { /* a module is read whole, its bytes as they are: all or nothing */
             rc = rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d);
@@ -197,19 +228,7 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
     free(line);
     for (size_t k = 0; k < c.ntcps; ++k)
         free(c.tcps[k]);
-    if (c.held) { /* the whole input looked like radians so far */
-        char why[320];
-        if (rc >= 0 && rch_data_q_look_rad(why, sizeof why, c.max_abs_deg, c.n_targets)) {
-            rch_diag_set(d, c.in_name, 0, 0, "%s; nothing written (if they are degrees: --assume-degrees)", why);
-            rc = -1;
-        }
-        if (rc >= 0) {
-            rch_cpi_csv_release(&c);
-            if (out_failed(&c, lineno, d))
-                rc = -1;
-        } else
-            rch_cpi_csv_drop(&c);
-    }
+    rc = held_end(&c, rc, lineno, d);
     res->format = (rch_comp_format)c.format;
     if (rc >= 0 && ferror(in)) {
         rch_diag_set(d, c.in_name, 0, 0, "read error: %s", strerror(errno));
