@@ -590,8 +590,13 @@ static int load_kin(const rc_kin **cal, const rc_kin **nom, rc_comp_config *cfg,
     if (o->model_path) {
         rch_diag d;
         char msg[1024];
+        rch_comp_job job; /* the paths, for the check that --nominal is not the model itself */
+        memset(&job, 0, sizeof job);
+        job.model_path = o->model_path;
+        job.nominal_path = o->nominal_path;
         if (rch_robot_load(&robot, o->model_path, &d) != 0 ||
-            (o->nominal_path && rch_robot_load(&nominal, o->nominal_path, &d) != 0)) {
+            (o->nominal_path && (rch_robot_load(&nominal, o->nominal_path, &d) != 0 ||
+                                 rch_comp_same_model(&d, &job, &robot, &nominal) != 0))) {
             fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
             return 1;
         }

@@ -168,6 +168,10 @@ static void test_rt(void **state)
         fail_msg("rcal-rt: not every cycle run counted as failed: %s", g_err);
     expect(1, run(RT " --model far.json --in ok.csv --bench --targets 20 --repeat 1"), "rcal-rt --bench: failed");
     says("rcal-rt --bench: failed", "20 of 20 compensations failed");
+    /* --nominal that is the model itself */
+    expect(1, run(RT " --model '" MODEL "' --nominal '" MODEL "' --in ok.csv --bench --targets 20 --repeat 1"),
+           "rcal-rt --nominal = --model");
+    says("rcal-rt --nominal = --model", "itself");
     /* the control: the same targets on the firmware's model converge */
     expect(0, run(RT " --in ok.csv --bench --targets 20 --repeat 1"), "rcal-rt --bench: converged");
 }
