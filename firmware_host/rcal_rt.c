@@ -6,6 +6,10 @@
  *   rcal-rt --bench [--targets N] [--repeat R] [--model MODEL.json]
  *   rcal-rt --emit-c MODEL.json [--position-only] > fw_model_data.h
  *
+ * Exit status: 0, 1 when a cycle failed (the compensation did not converge)
+ * or missed its deadline (the counts on stderr), or an input was refused,
+ * 2 for a usage error.
+ *
  * Loop: wakes at absolute times t_k = t_0 + k * period (clock_nanosleep with
  * TIMER_ABSTIME on CLOCK_MONOTONIC), compensates the k-th target of the
  * stream, and records: the compute latency (the rc_comp_stream_step call),
@@ -28,7 +32,9 @@
 #include "rc_comp.h"
 #include "rch_diag.h"
 #include "rch_comp.h"
+#include "rch_data.h"
 #include "rch_emit.h"
+#include "rch_file.h"
 #include "rch_opt.h"
 #include "rch_robot.h"
 #include "rch_stdio.h"
@@ -39,8 +45,8 @@
 #define DEG (M_PI / 180.0)
 /* --bench --targets limit: 56 bytes per target (its q and its latency) */
 #define RT_MAX_TARGETS 10000000UL
-/* --in: longest line */
-#define RT_MAX_LINE 1024
+/* --in: largest file (about 1.5 million targets of 40 bytes) */
+#define RT_MAX_BYTES ((size_t)64 << 20)
 /* --bench: targets times repeats (about 2 minutes at 1 us per target) */
 #define RT_MAX_BENCH_WORK 100000000.0
 /* the loop: cycles (24 bytes of timings each: 240 MB) */
@@ -56,8 +62,10 @@ static void usage(FILE *f)
             "  loop:    compensates one target per period (default 1000 Hz for 10 s) with\n"
             "           clock_nanosleep(TIMER_ABSTIME) and reports compute latency, wake-up\n"
             "           lateness and completion time (median, p99, p99.99, max) and deadline misses\n"
-            "  --in     targets (q1..q6 degrees per line, optional header), cycled; default: a\n"
-            "           smooth synthetic joint-space path through the workspace\n"
+            "  --in     targets (q1..q6 degrees per line; a header line, optional, names its columns),\n"
+            "           cycled; default: a smooth synthetic joint-space path through the workspace.\n"
+            "           Read as every rcal CSV: a field that is not a finite decimal number is refused\n"
+            "           with file:line:col, targets that look like radians are refused\n"
             "  --fifo   run as SCHED_FIFO priority 80 with memory locked (needs the privilege)\n"
             "  --bench  compensates N targets back to back (default 200000), R times (default 5),\n"
             "           reports latency per target and targets/s for each run and their medians;\n"
@@ -129,123 +137,56 @@ static void synth_target(double q[RC_NJ], size_t k, double rate_hz)
         q[i] = c[i] + a[i] * sin(2.0 * M_PI * f[i] * t + i);
 }
 
-/* One line of the targets file into line (at most RT_MAX_LINE bytes, '\n'
- * dropped): its length, -1 at the end, -2 when longer, -3 at a NUL byte
- * (*col its column). */
-static long read_target_line(char line[RT_MAX_LINE + 1], FILE *f, long *col)
-{
-    long n = 0;
-    int ch = EOF;
-    while ((ch = getc(f)) != EOF && ch != '\n') {
-        if (ch == '\0') {
-            *col = n + 1;
-            return -3;
-        }
-        if (n == RT_MAX_LINE)
-            return -2;
-        line[n++] = (char)ch;
-    }
-    if (n == 0 && ch == EOF)
-        return -1;
-    line[n] = '\0';
-    return n;
-}
-
+/* --in: the project's one CSV reader (rch_data, RCH_DATA_TARGETS: q1..q6 in
+ * degrees per row, the header optional and recognised by its names; every
+ * field refused with file:line:col unless it is a finite decimal number; a
+ * joint beyond m's limits refused). A file that looks like radians (every
+ * joint within +-pi and two of them moving: rch_data_q_look_rad) is refused.
+ * 0, or -1 with the message. */
 static int load_targets(targets *t, const char *path, const rc_kin *m)
 {
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        fprintf(stderr, "rcal-rt: %s: %s\n", path, strerror(errno));
-        return -1;
-    }
-    char line[RT_MAX_LINE + 1];
-    unsigned lineno = 0;
-    size_t cap = 0;
-    long got, col = 0;
+    static rc_model lim; /* the limits of the model compensating (the reader's check) */
+    char *text = NULL, msg[1024];
+    size_t len = 0;
+    rch_diag d;
+    rch_data data;
+    memset(&d, 0, sizeof d);
     t->q = NULL;
     t->n = 0;
-    while ((got = read_target_line(line, f, &col)) != -1) {
-        ++lineno;
-        if (got < 0 || t->n == RT_MAX_TARGETS) {
-            if (got == -3)
-                fprintf(stderr, "rcal-rt: %s:%u:%ld: NUL byte in a text file: refused\n", path, lineno, col);
-            else if (got == -2)
-                fprintf(stderr, "rcal-rt: %s:%u: line longer than %d bytes: refused\n", path, lineno, RT_MAX_LINE);
-            else
-                fprintf(stderr, "rcal-rt: %s:%u: more than %lu targets: refused\n", path, lineno,
-                        (unsigned long)RT_MAX_TARGETS);
-            fclose(f);
-            free(t->q);
-            return -1;
-        }
-        double v[RC_NJ];
-        char *p = line;
-        while (*p == ' ' || *p == '\t')
-            ++p;
-        if (*p == '#' || *p == '\r' || *p == '\0')
-            continue;
-        int ok = 1;
-        for (int i = 0; i < RC_NJ && ok; ++i) {
-            char *end;
-            errno = 0;
-            v[i] = strtod(p, &end);
-            if (end == p || errno != 0 || !isfinite(v[i])) {
-                ok = 0;
-                break;
-            }
-            p = end;
-            while (*p == ' ' || *p == '\t')
-                ++p;
-            if (i < RC_NJ - 1) {
-                if (*p != ',') {
-                    ok = 0;
-                    break;
-                }
-                ++p;
-            }
-        }
-        if (ok && *p != '\0' && *p != '\r')
-            ok = 0; /* something after q6: a seventh column or a typo */
-        if (!ok) {
-            if (t->n == 0 && lineno == 1)
-                continue; /* a header */
-            fprintf(stderr, "rcal-rt: %s:%u:%ld: expected q1..q6 in degrees\n", path, lineno, (long)(p - line) + 1);
-            fclose(f);
-            free(t->q);
-            return -1;
-        }
-        for (int i = 0; i < RC_NJ; ++i) {
-            v[i] *= DEG;
-            if (v[i] < (double)m->q_min_rad[i] || v[i] > (double)m->q_max_rad[i]) {
-                fprintf(stderr, "rcal-rt: %s:%u: q%d outside the joint limits\n", path, lineno, i + 1);
-                fclose(f);
-                free(t->q);
-                return -1;
-            }
-        }
-        if (t->n == cap) {
-            cap = cap ? 2 * cap : 1024;
-            void *nq = realloc(t->q, cap * sizeof t->q[0]);
-            if (!nq) {
-                fclose(f);
-                free(t->q);
-                return -1;
-            }
-            t->q = nq;
-        }
-        memcpy(t->q[t->n++], v, sizeof v);
+    for (int i = 0; i < RC_NJ; ++i) {
+        lim.q_min_rad[i] = (double)m->q_min_rad[i];
+        lim.q_max_rad[i] = (double)m->q_max_rad[i];
     }
-    if (ferror(f)) {
-        fprintf(stderr, "rcal-rt: %s: read error\n", path);
-        fclose(f);
-        free(t->q);
+    if (rch_read_file(&text, &len, path, RT_MAX_BYTES, &d) != 0) {
+        fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return -1;
     }
-    fclose(f);
-    if (t->n == 0) {
-        fprintf(stderr, "rcal-rt: %s has no targets\n", path);
+    const int rc = rch_data_parse_limited(&data, text, len, path, RCH_DATA_TARGETS | RCH_DATA_NO_LEN, &lim, &d);
+    free(text);
+    if (rc != 0) {
+        fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return -1;
     }
+    double max_abs_deg[RC_NJ] = {0};
+    for (size_t k = 0; k < data.n; ++k)
+        for (int i = 0; i < RC_NJ; ++i)
+            max_abs_deg[i] = fmax(max_abs_deg[i], fabs(data.s[k].q_rad[i] / DEG));
+    char why[256];
+    if (rch_data_q_look_rad(why, sizeof why, max_abs_deg, data.n)) {
+        fprintf(stderr, "rcal-rt: %s: %s\n", path, why);
+        rch_data_free(&data);
+        return -1;
+    }
+    t->q = malloc(data.n * sizeof t->q[0]);
+    if (!t->q) {
+        fprintf(stderr, "rcal-rt: %s: out of memory for %zu targets\n", path, data.n);
+        rch_data_free(&data);
+        return -1;
+    }
+    for (size_t k = 0; k < data.n; ++k)
+        memcpy(t->q[k], data.s[k].q_rad, sizeof t->q[0]);
+    t->n = data.n;
+    rch_data_free(&data);
     return 0;
 }
 
@@ -346,6 +287,9 @@ static int run_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config 
     free(meds);
     free(p4s);
     free(tps);
+    if (fails)
+        fprintf(stderr, "rcal-rt: %lu of %zu compensations failed: they did not converge (the stream's fallback "
+                        "was used); exit status 1\n", fails, n * (size_t)repeat);
     return fails ? 1 : 0;
 }
 
@@ -435,7 +379,12 @@ static int run_loop(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *
     free(lat);
     free(wake);
     free(done);
-    return misses ? 1 : 0;
+    if (fails)
+        fprintf(stderr, "rcal-rt: %lu of %zu cycles failed: the compensation did not converge (the stream's "
+                        "fallback was used); exit status 1\n", fails, ran);
+    if (misses)
+        fprintf(stderr, "rcal-rt: %zu of %zu cycles missed their deadline; exit status 1\n", misses, n);
+    return misses || fails ? 1 : 0;
 }
 
 /* The model compensation uses (rch_comp_determined): det; returns 1 when
@@ -641,8 +590,13 @@ static int load_kin(const rc_kin **cal, const rc_kin **nom, rc_comp_config *cfg,
     if (o->model_path) {
         rch_diag d;
         char msg[1024];
+        rch_comp_job job; /* the paths, for the check that --nominal is not the model itself */
+        memset(&job, 0, sizeof job);
+        job.model_path = o->model_path;
+        job.nominal_path = o->nominal_path;
         if (rch_robot_load(&robot, o->model_path, &d) != 0 ||
-            (o->nominal_path && rch_robot_load(&nominal, o->nominal_path, &d) != 0)) {
+            (o->nominal_path && (rch_robot_load(&nominal, o->nominal_path, &d) != 0 ||
+                                 rch_comp_same_model(&d, &job, &robot, &nominal) != 0))) {
             fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
             return 1;
         }

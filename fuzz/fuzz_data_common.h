@@ -2,7 +2,8 @@
 /* fuzz_data_common.h - one fuzz body for the CSV reader (rch_data_parse),
  * used with flags 0 (measurement files), RCH_DATA_NO_LEN (pose plans) and
  * RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY (acquisition files, as rch_acqfile reads them) and
- * RCH_DATA_POSITIONS | RCH_DATA_NO_LEN (tracker positions, as rch_pos_load reads them). */
+ * RCH_DATA_POSITIONS | RCH_DATA_NO_LEN (tracker positions, as rch_pos_load reads them) and
+ * RCH_DATA_TARGETS | RCH_DATA_NO_LEN (joint target lists, as rcal-rt --in reads them). */
 #ifndef FUZZ_DATA_COMMON_H
 #define FUZZ_DATA_COMMON_H
 
@@ -48,7 +49,8 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
             FZ_CHECK(s->len_mm > 0.0 && s->len_mm <= 20000.0);
         /* documented: t scaled to [0, 1] */
         FZ_CHECK(isfinite(s->t) && s->t >= 0.0 && s->t <= 1.0);
-        FZ_CHECK(d.line[i] >= 2);
+        /* a header takes line 1, except in a target list without one (RCH_DATA_TARGETS) */
+        FZ_CHECK(d.line[i] >= ((flags & RCH_DATA_TARGETS) ? 1u : 2u));
         if (i > 0)
             FZ_CHECK(d.line[i] > d.line[i - 1]);
         if (d.pose)
@@ -59,6 +61,16 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
         if (d.xyz)
             for (int k = 0; k < 3; ++k)
                 FZ_CHECK(isfinite(d.xyz[i][k]));
+    }
+    if (flags & RCH_DATA_TARGETS) { /* the radians check on what was read: a verdict with its reason */
+        double mx[RC_NJ] = {0};
+        char why[320];
+        why[0] = '\0';
+        for (size_t i = 0; i < d.n; ++i)
+            for (int j = 0; j < RC_NJ; ++j)
+                mx[j] = fmax(mx[j], fabs(d.s[i].q_rad[j]) * (180.0 / 3.14159265358979323846));
+        const int rad = rch_data_q_look_rad(why, sizeof why, mx, d.n);
+        FZ_CHECK(rad == 0 || (rad == 1 && why[0] != '\0'));
     }
     rch_data_free(&d);
     FZ_CHECK(d.s == NULL && d.n == 0);

@@ -130,6 +130,39 @@ for name in /dev/zero /dev/urandom fifo; do
         || verdict "FIFO provenance" 0 "provenance $name: exit $rc"
 done
 
+# ---- inputs taken for what they are not (issue 47) ----
+TEST[wrong inputs]="robust_inputs_cli, host_inputs"
+RT="$build/firmware_host/rcal-rt"
+if [ -x "$RT" ]; then
+    printf '10,20,-30,40,50,60\n0x10,20,-30,40,50,60\n' > hex.csv
+    to "$RT" --in hex.csv --seconds 0.01 > /dev/null 2> e.txt
+    [ $? -ne 0 ] && has e.txt "hex.csv:2:1:" && verdict "wrong inputs" 1 || verdict "wrong inputs" 0 "rcal-rt --in 0x10"
+    printf 'joint1,joint2,joint3,joint4,joint5,joint6\n10,20,-30,40,50,60\n' > named.csv
+    to "$RT" --in named.csv --seconds 0.01 > /dev/null 2> e.txt
+    [ $? -ne 0 ] && has e.txt "named.csv:1:1:" && verdict "wrong inputs" 1 \
+        || verdict "wrong inputs" 0 "rcal-rt: a first line of unknown names taken for a header"
+fi
+sed 's/joint_limits_deg/joint_limit_deg/' r.json > typo.json
+to "$R" calibrate --data d.csv --robot typo.json > /dev/null 2> e.txt
+[ $? -ne 0 ] && has e.txt "did you mean joint_limits_deg" && verdict "wrong inputs" 1 \
+    || verdict "wrong inputs" 0 "joint_limit_deg read in silence"
+awk '{if ($0 ~ /alpha_deg/) { gsub(/"alpha_deg": -90/, "\"alpha_deg\": -1.5708"); gsub(/"alpha_deg": 90/, "\"alpha_deg\": 1.5708") } print}' \
+    r.json > rad.json
+to "$R" calibrate --data d.csv --robot rad.json > /dev/null 2> e.txt
+[ $? -ne 0 ] && has e.txt "radians" && ! has e.txt "tenths" && verdict "wrong inputs" 1 \
+    || verdict "wrong inputs" 0 "alpha_deg in radians blamed on the cable"
+printf 'q1,q2,q3,q4,q5,q6\n0.1,0.3,-0.5,0.7,0.9,1.0\n0.2,0.3,-0.5,0.7,0.9,1.0\n' > prog_rad.csv
+to "$R" compensate --model m.json --in prog_rad.csv --out rad_out.csv 2> e.txt
+[ $? -ne 0 ] && has e.txt "radians" && [ ! -e rad_out.csv ] && verdict "wrong inputs" 1 \
+    || verdict "wrong inputs" 0 "compensate took radians"
+to "$R" compensate --model m.json --nominal m.json --in t.csv --out nom_out.csv 2> e.txt
+[ $? -ne 0 ] && has e.txt "itself" && [ ! -e nom_out.csv ] && verdict "wrong inputs" 1 \
+    || verdict "wrong inputs" 0 "compensate --nominal = --model"
+# a write error: the file and the reason (every write past 1 KiB fails with EFBIG)
+( trap '' XFSZ; ulimit -f 1; "$R" calibrate --data d.csv --robot r.json --out big.json > /dev/null 2> e.txt )
+[ $? -ne 0 ] && has e.txt "big.json" && has e.txt "File too large" && [ ! -e big.json ] && verdict "wrong inputs" 1 \
+    || verdict "wrong inputs" 0 "a write error without the file or the reason"
+
 # ---- data no sensor produces ----
 TEST[impossible data]="robust_issue23 (test_impossible_data)"
 for spec in "10:1e-300" "10:4.9e-324" "10:0.001" "4:175"; do

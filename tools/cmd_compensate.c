@@ -170,7 +170,7 @@ int rcal_cmd_compensate(int argc, char **argv)
 {
     const char *model = NULL, *nominal = NULL, *in = "-", *out = "-", *format = "auto";
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
-    int position_only = 0, full_pose = 0, want_summary = 0, accept_rt = 0, json = 0;
+    int position_only = 0, full_pose = 0, want_summary = 0, accept_rt = 0, json = 0, assume_deg = 0;
     double max_unc_mm = 0.0, tool[3] = {0.0, 0.0, 0.0};
     const char *unc_out = NULL, *u95_policy = "skip";
     rch_cmdspec spec;
@@ -211,6 +211,10 @@ int rcal_cmd_compensate(int argc, char **argv)
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
          "deprecated, no effect: RAPID robtargets are corrected (through the nominal inverse kinematics)", 0, NULL},
         {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
+        {"--assume-degrees", RCH_OPT_FLAG, &assume_deg, 0, 0, NULL,
+         "the joint targets are degrees even where they all look like radians (every joint within +-pi and two "
+         "joints moving by 0.2 or more: refused without this option)",
+         0, NULL},
         {"--summary", RCH_OPT_FLAG, &want_summary, 0, 0, NULL, "targets, iterations, largest correction and time on stderr",
          0, NULL},
         {"--json", RCH_OPT_FLAG, &json, 0, 0, NULL,
@@ -242,6 +246,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         .max_dev_deg = rch_opt_given(&spec, seen, "--max-dev-deg") ? max_dev_deg : 0.0, /* 0: the core's 0.1 rad */
         .tool_mm = rch_opt_given(&spec, seen, "--tool") ? tool : NULL,
         .uncertainty_path = unc_out,
+        .assume_degrees = assume_deg,
     };
     rch_comp_result r;
     memset(&r, 0, sizeof r);

@@ -80,6 +80,8 @@ int rcal_cmd_export(int argc, char **argv)
         return 1;
     }
     if (rch_export_file(&res, out.f, fmt, model, nominal, drop, &d) != 0) {
+        if (!d.file[0]) /* a write error: the file it was writing */
+            snprintf(d.file, sizeof d.file, "%.255s", out.path);
         rch_out_abort(&out);
         fprintf(stderr, "rcal export: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;

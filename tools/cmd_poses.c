@@ -414,8 +414,9 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
     if (!a->json)
         print_plan(res, &a->pc, a->out_path, a->model);
     if (write_out(out->f, res, &a->pc, a->format, a->settle_s) != 0) {
+        const int err = rch_out_errno(out);
         rch_out_abort(out);
-        fprintf(stderr, "rcal poses: writing %s failed; nothing was replaced\n", a->out_path);
+        fprintf(stderr, "rcal poses: %s: cannot write --out: %s; nothing was replaced\n", a->out_path, strerror(err));
         return 1;
     }
     if (rch_out_commit(out, &dg) != 0) {

@@ -21,8 +21,11 @@ static int write_all(int fd, const char *p, size_t n)
         ssize_t w = write(fd, p, n);
         if (w < 0 && errno == EINTR)
             continue;
-        if (w <= 0)
+        if (w <= 0) {
+            if (w == 0)
+                errno = EIO; /* no progress and no reason: never a stale errno in the message */
             return -1;
+        }
         p += w;
         n -= (size_t)w;
     }
@@ -44,8 +47,14 @@ static int save_tail(const char *path, const char *text, size_t from, size_t len
     rc = write_all(fd, text + from, len - from);
     if (rc == 0)
         rc = fsync(fd);
-    if (close(fd) != 0 || rc != 0) {
-        rch_diag_set(d, path, 0, 0, "cannot save the unfinished last line to %s", dpath);
+    int err = rc != 0 ? errno : 0;
+    if (close(fd) != 0 && rc == 0) {
+        rc = -1;
+        err = errno;
+    }
+    if (rc != 0) {
+        rch_diag_set(d, path, 0, 0, "cannot save the unfinished last line to %s: %s", dpath,
+                     strerror(err ? err : EIO));
         return -1;
     }
     return 0;

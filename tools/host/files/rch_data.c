@@ -4,6 +4,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -105,6 +106,10 @@ static const char *number_hint(const field *f)
         return " (hexadecimal numbers are not accepted: write decimals)";
     if (memchr(f->p, ';', f->len) || memchr(f->p, '\t', f->len))
         return " (separators must be commas)";
+    if (f->len > 1 && (f->p[f->len - 1] == 'e' || f->p[f->len - 1] == 'E' ||
+                       ((f->p[f->len - 1] == '+' || f->p[f->len - 1] == '-') &&
+                        (f->p[f->len - 2] == 'e' || f->p[f->len - 2] == 'E'))))
+        return " (an exponent without its digits)";
     return "";
 }
 
@@ -118,7 +123,34 @@ typedef struct parse_ctx {
     unsigned line_no;
     const rc_model *lim; /* joint limits of the robot, or NULL */
     size_t n_header;     /* fields of the header line */
+    int implicit;        /* RCH_DATA_TARGETS without a header: the columns are q1..q6 by position */
 } parse_ctx;
+
+/* 1 when field f (quotes removed) is a column name the reader knows. */
+static int names_a_column(const field *f)
+{
+    const char *p = f->p;
+    size_t n = f->len;
+    if (n >= 2 && p[0] == '"' && p[n - 1] == '"') {
+        ++p;
+        n -= 2;
+    }
+    for (int k = 0; k < C_N; ++k)
+        if (n == strlen(col_names[k]) && strncasecmp(p, col_names[k], n) == 0)
+            return 1;
+    return 0;
+}
+
+/* RCH_DATA_TARGETS: is the first line a header? By its names only: a line
+ * none of whose fields names a column is the first target (and its fields
+ * are then read as numbers, each refused with its column if it is not). */
+static int is_header_line(const field *fields, size_t nf)
+{
+    for (size_t i = 0; i < nf; ++i)
+        if (names_a_column(&fields[i]))
+            return 1;
+    return 0;
+}
 
 /* The header line: find the known columns. 0 or -1 with d set. */
 static int parse_header(parse_ctx *pc, field *fields, size_t nf, const char *line, size_t ll)
@@ -278,6 +310,14 @@ static int check_field_count(const parse_ctx *pc, const field *fields, size_t nf
     size_t last = nf;
     while (last > nh && fields[last - 1].len == 0)
         --last;
+    if (pc->implicit && (last > nh || nf < nh)) {
+        rch_diag_set(pc->d, pc->name, pc->line_no, last > nh ? fields[nh].col : (unsigned)ll + 1,
+                     "the row has %zu field%s: a file without a header line holds the six joint angles q1..q6 "
+                     "(degrees) per row; a decimal comma ('12,5' for 12.5) or a missing or extra field shifts them "
+                     "(name the columns in a header line to add others)",
+                     last > nh ? last : nf, (last > nh ? last : nf) == 1 ? "" : "s");
+        return -1;
+    }
     if (last > nh) {
         rch_diag_set(pc->d, pc->name, pc->line_no, fields[nh].col,
                      "the row has %zu fields, the header %zu: a decimal comma ('12,5' for 12.5; rcal reads '.' "
@@ -317,9 +357,12 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
             return -1;
         }
         if (parse_number(&v[k], &fields[c]) != 0) {
-            rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s",
+            rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s%s",
                          col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
-                         number_hint(&fields[c]));
+                         number_hint(&fields[c]),
+                         pc->implicit && out->n == 0 && isalpha((unsigned char)fields[c].p[0])
+                             ? " (a first line is a header only when it names its columns: q1,q2,q3,q4,q5,q6)"
+                             : "");
             return -1;
         }
         if (check_value(pc, k, v[k], &fields[c]) != 0)
@@ -418,6 +461,13 @@ static int parse(rch_data *out, const char *text, size_t len, const char *name, 
             rch_diag_set(d, name, pc.line_no, 1, "too many columns (%zu, at most 256)", nf);
             goto fail;
         }
+        if (!have_header && (flags & RCH_DATA_TARGETS) && !is_header_line(fields, nf)) {
+            for (int k = 0; k < RC_NJ; ++k) /* no header: q1..q6 by position, this line the first row */
+                pc.col_of[C_Q1 + k] = k;
+            pc.n_header = RC_NJ;
+            pc.implicit = 1;
+            have_header = 1;
+        }
         if (!have_header) {
             if (parse_header(&pc, fields, nf, line, ll) != 0)
                 goto fail;
@@ -428,7 +478,7 @@ static int parse(rch_data *out, const char *text, size_t len, const char *name, 
         }
     }
     if (!have_header) {
-        rch_diag_set(d, name, 0, 0, "empty file: no header line");
+        rch_diag_set(d, name, 0, 0, (flags & RCH_DATA_TARGETS) ? "empty file: no targets" : "empty file: no header line");
         goto fail;
     }
     if (out->n == 0 && !(flags & RCH_DATA_ALLOW_EMPTY)) {
@@ -450,6 +500,12 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
                    rch_diag *d)
 {
     return parse(out, text, len, name, flags, NULL, d);
+}
+
+int rch_data_parse_limited(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                           const rc_model *limits, rch_diag *d)
+{
+    return parse(out, text, len, name, flags, limits, d);
 }
 
 /* ---- scale of lengths and positions against the robot (issue 33) ---- */
@@ -701,6 +757,25 @@ int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d)
         return -1;
     }
     return 0;
+}
+
+int rch_data_q_look_rad(char *why, size_t why_len, const double max_abs_deg[RC_NJ], size_t n)
+{
+    double mx = 0.0;
+    unsigned moving = 0;
+    for (unsigned j = 0; j < RC_NJ; ++j) {
+        if (!(max_abs_deg[j] <= RCH_DATA_RAD_BOUND))
+            return 0; /* a value beyond pi (or not a number): degrees */
+        mx = fmax(mx, max_abs_deg[j]);
+        moving += max_abs_deg[j] >= RCH_DATA_RAD_MOVE;
+    }
+    if (n == 0 || moving < RCH_DATA_RAD_JOINTS)
+        return 0;
+    snprintf(why, why_len,
+             "the joint targets look like radians: every joint of the %zu target%s lies within +-%.4f (the largest "
+             "|q| is %.4g) and %u joints move by %g or more; rcal reads degrees (multiply by 180/pi)",
+             n, n == 1 ? "" : "s", RCH_DATA_RAD_BOUND, mx, moving, RCH_DATA_RAD_MOVE);
+    return 1;
 }
 
 int rch_data_outlets(uint8_t label[RC_MAX_OUTLETS], rc_sample *s, size_t n, rch_diag *d)

@@ -30,10 +30,16 @@ enum {
     RCH_DATA_NO_LEN = 1u,      /* pose plan: L is not required (len_mm = 0) */
     RCH_DATA_POSE = 2u,        /* a 'pose' column (index 0..1e9) is required: pose[] */
     RCH_DATA_ALLOW_EMPTY = 4u, /* a header without rows is not an error */
-    RCH_DATA_POSITIONS = 8u    /* a tracker's positions file: x, y, z (mm, tracker frame) required, L not;
+    RCH_DATA_POSITIONS = 8u,   /* a tracker's positions file: x, y, z (mm, tracker frame) required, L not;
                                   optional target (0..RC_MAX_TARGETS-1, rc_sample.target), pose (pose[]),
                                   sigma_mm (sigma_mm[]); docs/positions.md. Rows stay rows: rch_pos_load
                                   (tools/host/fit/rch_positions.h) makes the three samples of each */
+    RCH_DATA_TARGETS = 16u     /* joint targets (rcal-rt --in): the header is optional. The first line is a
+                                  header when one of its fields names a column (q1, L, pose, ... any case),
+                                  never because a field fails to parse; otherwise it is the first row of a
+                                  file of exactly six fields q1..q6 (degrees), each read as in any row (so
+                                  0x10, 1e, inf, nan are refused there with file:line:col). Use with
+                                  RCH_DATA_NO_LEN */
 };
 
 typedef struct rch_data {
@@ -100,6 +106,9 @@ int rch_data_check_scale(const rch_data *data, const char *name, const rc_model 
 /* The same from memory (name is used in the diagnostics). */
 int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
                    rch_diag *d);
+/* The same with joint limits (as rch_data_load_limited; limits may be NULL). */
+int rch_data_parse_limited(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
+                           const rc_model *limits, rch_diag *d);
 void rch_data_free(rch_data *data);
 
 /* Units: joint angles that all stay within +-7 (degrees, as read) look
@@ -107,6 +116,21 @@ void rch_data_free(rch_data *data);
  * with a message naming the likely unit (file name in d). 0 or -1. */
 int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d);
 
+/* Joint targets that look like radians where degrees are read (issue 47:
+ * rcal compensate, rcal-rt --in). max_abs_deg (RC_NJ): the largest |q| of
+ * each joint over the n targets, as read. The rule: every value of every
+ * joint within +-RCH_DATA_RAD_BOUND (pi, and its 4-decimal rounding
+ * 3.1416) and at least RCH_DATA_RAD_JOINTS joints reaching
+ * RCH_DATA_RAD_MOVE somewhere (a radians program moves its joints by tenths
+ * of a radian). A program in degrees is refused by it only when every one
+ * of its targets stays within 3.14 deg of the all-zero pose in all six
+ * joints (q5 near 0: the wrist singularity) while two joints move more than
+ * 0.2 deg; all-zero targets (a home position) are never refused. Returns 1
+ * with why (why_len) set to the reason, else 0. */
+#define RCH_DATA_RAD_BOUND 3.1421
+#define RCH_DATA_RAD_MOVE 0.2
+#define RCH_DATA_RAD_JOINTS 2
+int rch_data_q_look_rad(char *why, size_t why_len, const double max_abs_deg[RC_NJ], size_t n);
 
 /* Copy of the samples selected by idx (k). Returns NULL on allocation failure. */
 rc_sample *rch_data_pick(const rc_sample *s, const size_t *idx, size_t k);

@@ -521,6 +521,19 @@ int rch_out_commit_all(rch_out *o, size_t n, rch_diag *d)
     return rc;
 }
 
+int rch_out_errno(rch_out *o)
+{
+    const int before = errno;
+    if (!o->f)
+        return before ? before : EIO;
+    if (o->f == stdout)
+        return rch_stdio_errno(stdout);
+    errno = 0;
+    if (fflush(o->f) != 0 && errno != 0)
+        return errno;
+    return before ? before : EIO;
+}
+
 void rch_out_abort(rch_out *o)
 {
     if (o->f && o->f != stdout)

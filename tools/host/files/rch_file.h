@@ -48,6 +48,12 @@ int rch_out_open(rch_out *o, const char *path, const char *what, const char *con
                  rch_diag *d);
 int rch_out_commit(rch_out *o, rch_diag *d);
 void rch_out_abort(rch_out *o);
+/* Why a writer's output o failed (an errno value, issue 47: "a full disk
+ * says 'cannot write' without the reason"): the stream flushed once more so
+ * that a failure still in its buffer shows (ENOSPC, EFBIG, EIO, ...); errno
+ * as the writer left it otherwise; EIO when nothing says more. Call it
+ * before rch_out_abort. */
+int rch_out_errno(rch_out *o);
 
 /* A bundle, whole or not at all: every one of the n outputs is flushed and
  * synced first; only when all were written are they renamed into place.

@@ -31,8 +31,8 @@ static void jws(jp *p)
 {
     while (p->pos < p->len) {
         char c = p->s[p->pos];
-        if (c == '\n') {
-            ++p->line;
+        if (c == '\n' || (c == '\r' && (p->pos + 1 >= p->len || p->s[p->pos + 1] != '\n'))) {
+            ++p->line; /* LF, CRLF (at its LF) and a lone CR each end a line */
             p->line_start = p->pos + 1;
         } else if (c != ' ' && c != '\t' && c != '\r') {
             break;
@@ -205,13 +205,15 @@ static rch_json *jcontainer(jp *p, int depth, int obj)
     }
     for (;;) {
         char *key = NULL;
+        unsigned kl = 0, kc = 0;
         jws(p);
         if (obj) {
             if (p->pos >= p->len || p->s[p->pos] != '"') {
                 jfail(p, "expected a string key");
                 goto bad;
             }
-            unsigned kl = p->line, kc = json_col(p);
+            kl = p->line;
+            kc = json_col(p);
             key = jstring(p);
             if (!key)
                 goto bad;
@@ -233,6 +235,10 @@ static rch_json *jcontainer(jp *p, int depth, int obj)
             ++p->pos;
         }
         rch_json *v = jvalue(p, depth + 1);
+        if (v && obj) {
+            v->key_line = kl;
+            v->key_col = kc;
+        }
         if (!v || jappend(p, j, v, key) != 0) {
             rch_json_free(v);
             free(key);

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_json.h - a small strict JSON reader (RFC 8259) for model files.
  * Builds a tree on the heap; every node remembers its line and column so that
- * callers can report "file:line:col: what is wrong". Depth is limited to 64,
+ * callers can report "file:line:col: what is wrong" (a line ends at LF, CRLF
+ * or a lone CR; a UTF-8 byte-order mark is skipped). Depth is limited to 64,
  * strings and keys to 4096 bytes; duplicate keys are refused. */
 #ifndef RCH_JSON_H
 #define RCH_JSON_H
@@ -20,6 +21,7 @@ typedef struct rch_json {
     char **keys;              /* (n) object keys */
     size_t n;
     unsigned line, col;
+    unsigned key_line, key_col; /* an object member's key (0 otherwise): where an unknown key is named */
 } rch_json;
 
 rch_json *rch_json_parse(const char *text, size_t len, const char *name, rch_diag *d);

@@ -40,10 +40,14 @@ int rch_rpi_tokenize(rch_rpi_scan *s)
     const char *p = s->text;
     size_t i = 0;
     unsigned line = 1, col = 1;
+    if (s->len >= 3 && memcmp(p, "\xEF\xBB\xBF", 3) == 0)
+        i = 3; /* a UTF-8 byte-order mark: skipped (its bytes stay in the text the caller copies) */
+    /* a line ends at LF, CRLF (counted at its LF) or a lone CR */
+#define EOL_AT(j) (p[j] == '\n' || (p[j] == '\r' && ((j) + 1 >= s->len || p[(j) + 1] != '\n')))
 #define ADV(k)                                                                                                     \
     do {                                                                                                           \
         for (size_t a_ = 0; a_ < (k); ++a_, ++i) {                                                                 \
-            if (p[i] == '\n') {                                                                                    \
+            if (EOL_AT(i)) {                                                                                       \
                 ++line;                                                                                            \
                 col = 1;                                                                                           \
             } else                                                                                                 \
@@ -61,7 +65,7 @@ int rch_rpi_tokenize(rch_rpi_scan *s)
         if (isspace(c)) {
             ADV(1);
         } else if (c == '!') { /* comment to the end of the line */
-            while (i < s->len && p[i] != '\n') {
+            while (i < s->len && p[i] != '\n' && p[i] != '\r') {
                 if (p[i] == '\0') {
                     rch_diag_set(s->d, s->name, line, col, "NUL byte in a RAPID module");
                     return -1;
@@ -71,7 +75,7 @@ int rch_rpi_tokenize(rch_rpi_scan *s)
         } else if (c == '"') {
             ADV(1);
             for (;;) {
-                if (i >= s->len || p[i] == '\n' || p[i] == '\0') {
+                if (i >= s->len || p[i] == '\n' || p[i] == '\r' || p[i] == '\0') {
                     rch_diag_set(s->d, s->name, bl, bc, "string not closed on its line");
                     return -1;
                 }
@@ -115,6 +119,7 @@ int rch_rpi_tokenize(rch_rpi_scan *s)
         }
     }
 #undef ADV
+#undef EOL_AT
     return 0;
 }
 

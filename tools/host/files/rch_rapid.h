@@ -38,6 +38,10 @@
  * Nothing here computes; the caller rewrites the numbers' bytes
  * (num_off/num_len) and copies every other byte.
  *
+ * Lines end at LF, CRLF or a lone CR (old Mac files), each counted for
+ * line:col; a UTF-8 byte-order mark at the start is skipped (offsets stay
+ * offsets into text, so a caller that copies the text keeps both).
+ *
  * Host side: heap, no file I/O. Errors (a string not closed, a NUL byte, an
  * aggregate not closed, too large an input): -1 with rch_diag set. */
 #ifndef RCH_RAPID_H

@@ -125,7 +125,8 @@ int rch_stdio_end(int status)
             fprintf(stderr, "%s: write error on standard output: %s; the output is incomplete\n", g_prog,
                     strerror(err));
         else
-            fprintf(stderr, "%s: write error on standard output; the output is incomplete\n", g_prog);
+            fprintf(stderr, "%s: write error on standard output: %s; the output is incomplete\n", g_prog,
+                    strerror(EIO)); /* the stream failed with no errno left: an I/O error, never no reason */
         if (status == 0)
             status = 1;
     }

@@ -84,6 +84,9 @@ typedef struct rch_comp_job {
                                  flange centre. Never the cable attachment point the calibration measured */
     const char *uncertainty_path; /* per target its predicted 95 % position uncertainty (u95_mm, of the point
                                      compensated) as CSV, or NULL */
+    int assume_degrees;       /* joint targets are degrees even where they all look like radians; 0: such a
+                                 program (rch_data_q_look_rad: every joint within +-pi, two of them moving by
+                                 0.2 or more) is refused, nothing written (issue 47) */
 } rch_comp_job;
 
 /* The model whose point compensation moves: m without its cable attachment
@@ -116,6 +119,7 @@ typedef struct rch_comp_gate {
     const rc_model *det_any, *fit_any;
     const rc_comp_config *cfg;
     rch_comp_u95_policy u95_policy; /* see rch_comp_job */
+    int assume_degrees;        /* see rch_comp_job (0: joint targets that look like radians are refused) */
 } rch_comp_gate;
 
 /* What u95_mm says of one target, by how its compensation ended (status: 0
@@ -173,6 +177,13 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
  * held/held_len: the held parameters' names. Returns how many are held. */
 unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, char *held, size_t held_len,
                              const rch_robot *robot, const rc_model *nominal);
+
+/* --nominal that names the calibrated model itself (issue 47): the same
+ * file (rch_path_same) or the same numbers (every DH parameter and effect
+ * parameter equal; the encoder's place, which moves no joint, is not
+ * compared): compensation would correct nothing. 0, or -1 with d set naming
+ * both options. */
+int rch_comp_same_model(rch_diag *d, const rch_comp_job *job, const rch_robot *model, const rch_robot *nominal);
 
 /* The whole command: load the models, open the input, refuse an output
  * that is one of the inputs, compensate, commit the output. res: counts

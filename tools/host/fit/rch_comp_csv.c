@@ -5,11 +5,13 @@
  * other field copied.
  * Depends on: one target (rch_comp.c), rch_parse_double (rch_opt).
  * Memory: none. Errors: -1 with d set (file:line:col). */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
 #include "rch_comp_int.h"
+#include "rch_data.h"
 #include "rch_opt.h"
 
 /* Split a line at commas. start[k]/len[k]: field k (trimmed); returns the
@@ -52,6 +54,44 @@ int rch_cpi_parse_num(double *v, const char *text, size_t len)
     return rch_parse_double(buf, v);
 }
 
+int rch_cpi_csv_hold(rch_cpi_ctx *c, rch_diag *d)
+{
+    c->held_buf = NULL;
+    c->held_len = 0;
+    c->held = open_memstream(&c->held_buf, &c->held_len);
+    if (!c->held) {
+        rch_diag_set(d, c->in_name, 0, 0, "out of memory");
+        return -1;
+    }
+    c->held_out = c->out;
+    c->out = c->held;
+    return 0;
+}
+
+static void unhold(rch_cpi_ctx *c, int write)
+{
+    if (!c->held)
+        return;
+    const int ok = fclose(c->held) == 0;
+    c->out = c->held_out;
+    if (write && ok && c->held_len > 0)
+        fwrite(c->held_buf, 1, c->held_len, c->out);
+    free(c->held_buf);
+    c->held = NULL;
+    c->held_buf = NULL;
+    c->held_len = 0;
+}
+
+void rch_cpi_csv_release(rch_cpi_ctx *c)
+{
+    unhold(c, 1);
+}
+
+void rch_cpi_csv_drop(rch_cpi_ctx *c)
+{
+    unhold(c, 0);
+}
+
 /* One CSV line (not blank, not a comment). 0 ok, 1 not converged, -1 error. */
 int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d)
 {
@@ -83,6 +123,15 @@ int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno
             return -1;
         }
     }
+    /* the radians check (rch_data_q_look_rad): a value beyond pi says degrees, and what was held goes out */
+    int beyond = 0;
+    for (unsigned i = 0; i < RC_NJ; ++i) {
+        c->max_abs_deg[i] = fmax(c->max_abs_deg[i], fabs(qd[i]));
+        beyond |= !(c->max_abs_deg[i] <= RCH_DATA_RAD_BOUND);
+    }
+    ++c->n_targets;
+    if (beyond)
+        rch_cpi_csv_release(c);
     const int r = rch_cpi_compensate(c, qo, qd, lineno, cols, d);
     if (r < 0)
         return r;
@@ -98,7 +147,7 @@ int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno
         else
             fwrite(line + st[k], 1, ln[k], c->out);
     }
-    fputc('\n', c->out);
+    fputs(c->eol ? c->eol : "\n", c->out);
     return r;
 }
 
@@ -138,6 +187,6 @@ int rch_cpi_csv_header(rch_cpi_ctx *c, const char *line, size_t n, unsigned line
     c->have_header = 1;
     c->nfields_header = (unsigned)nf;
     fwrite(line, 1, n, c->out);
-    fputc('\n', c->out);
+    fputs(c->eol ? c->eol : "\n", c->out);
     return 0;
 }

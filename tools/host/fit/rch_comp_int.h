@@ -46,6 +46,14 @@ typedef struct {
     FILE *out, *warn;
     const char *in_name;
     int format; /* 0 auto, 1 csv, 2 rapid */
+    const char *eol; /* the line end of the line being read ("\n", "\r\n" or "\r"): a CSV line keeps it */
+    double max_abs_deg[RC_NJ]; /* the largest |q| of each joint of the targets read (degrees as read) */
+    unsigned long n_targets;   /* joint targets read (the radians check, rch_data_q_look_rad) */
+    FILE *held;                /* the CSV output held back while the targets still look like radians (the
+                                  real output in held_out) */
+    FILE *held_out;
+    char *held_buf;
+    size_t held_len;
     int have_header;
     int qcol[RC_NJ]; /* header column of each joint */
     unsigned nfields_header;
@@ -79,6 +87,13 @@ int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_de
 int rch_cpi_split_csv(const char *line, size_t n, size_t start[RCH_CPI_MAX_FIELDS], size_t len[RCH_CPI_MAX_FIELDS]);
 /* A number occupying exactly text[0..len) (rch_parse_double). 0 or -1. */
 int rch_cpi_parse_num(double *v, const char *text, size_t len);
+/* The CSV output held back (c->held) from the start of a CSV input until
+ * a joint value beyond pi shows the targets are degrees: what was held is
+ * written to the real output (release), or dropped when the input ends
+ * looking like radians (drop). rch_comp_csv.c. hold: 0 or -1 (d set). */
+int rch_cpi_csv_hold(rch_cpi_ctx *c, rch_diag *d);
+void rch_cpi_csv_release(rch_cpi_ctx *c);
+void rch_cpi_csv_drop(rch_cpi_ctx *c);
 /* One CSV line (not blank, not a comment). 0 ok, 1 not converged, -1 error. */
 int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d);
 /* A header line: q1..q6 (or j1..j6) found, the line copied. 0 or -1. */

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "rch_comp_int.h"
+#include "rch_data.h"
 #include "rch_ik.h"
 
 /* One replacement of the rewritten module: text[off..off+len) -> rep. */
@@ -183,6 +184,30 @@ static int rapid_robtarget(rch_cpi_ctx *c, double out[RCH_RAPID_NUMS], const rch
     return r;
 }
 
+/* The module's jointtargets together in radians where RAPID means degrees
+ * (issue 47, rch_data_q_look_rad): refused at the first one. 0, or -1 with
+ * d set. */
+static int rapid_radians(const rch_cpi_ctx *c, const rch_rapid_targets *ts, unsigned base, rch_diag *d)
+{
+    double max_abs_deg[RC_NJ] = {0};
+    size_t n_joint = 0;
+    const rch_rapid_target *first = NULL;
+    for (size_t i = 0; i < ts->n; ++i)
+        if (ts->t[i].kind == RCH_RAPID_JOINTTARGET && !ts->t[i].error[0]) {
+            first = first ? first : &ts->t[i];
+            ++n_joint;
+            for (unsigned k = 0; k < RC_NJ; ++k)
+                max_abs_deg[k] = fmax(max_abs_deg[k], fabs(ts->t[i].val[k]));
+        }
+    char why[320];
+    if (!first || (c->gate && c->gate->assume_degrees) || !rch_data_q_look_rad(why, sizeof why, max_abs_deg, n_joint))
+        return 0;
+    rch_diag_set(d, c->in_name, base + first->line, first->col,
+                 "jointtarget: %s (RAPID robax is in degrees); nothing written (if they are degrees: "
+                 "--assume-degrees)", why);
+    return -1;
+}
+
 /* A whole RAPID module text[0..len), its first line being line base + 1:
  * every joint target and robtarget corrected, every other byte copied. All
  * or nothing: a target that cannot be corrected is named (line, column,
@@ -198,6 +223,10 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
     if (ts.n == 0) { /* a module with nothing to correct is most likely not the one meant */
         rch_diag_set(d, c->in_name, 0, 0, "no jointtarget or robtarget in this module (declarations, assignments, "
                      "instruction arguments): nothing to correct; nothing written");
+        rch_rapid_free(&ts);
+        return -1;
+    }
+    if (rapid_radians(c, &ts, base, d) != 0) {
         rch_rapid_free(&ts);
         return -1;
     }
@@ -267,9 +296,7 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
             fputs(ed[k].rep, c->out);
             at = ed[k].off + ed[k].len;
         }
-        fwrite(text + at, 1, len - at, c->out);
-        if (len > 0 && text[len - 1] != '\n')
-            fputc('\n', c->out);
+        fwrite(text + at, 1, len - at, c->out); /* the input's bytes: its BOM and line ends as they were */
     }
     free(ed);
     rch_rapid_free(&ts);

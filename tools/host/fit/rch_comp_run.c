@@ -18,6 +18,7 @@
 #include <strings.h>
 
 #include "rch_comp_int.h"
+#include "rch_data.h"
 #include "rch_file.h"
 #include "rch_stdio.h"
 
@@ -52,14 +53,15 @@ static const char *find_ci(const char *s, size_t n, const char *w)
     return NULL;
 }
 
-/* One line of at most MAX_LINE bytes into *line (grown as needed, '\n'
- * kept): its length, -1 at the end of the input, -2 when longer. */
+/* One line of at most MAX_LINE bytes into *line (grown as needed, its end
+ * kept): its length, -1 at the end of the input, -2 when longer. A line ends
+ * at LF, CRLF or a lone CR (each counted as a line for file:line:col). */
 static long read_line(char **line, size_t *cap, FILE *in)
 {
     size_t n = 0;
     int ch = EOF;
     while (n <= MAX_LINE && (ch = getc(in)) != EOF) {
-        if (n + 2 > *cap) {
+        if (n + 3 > *cap) {
             const size_t nc = *cap ? 2 * *cap : 256;
             char *nl = realloc(*line, nc);
             if (!nl)
@@ -70,6 +72,14 @@ static long read_line(char **line, size_t *cap, FILE *in)
         (*line)[n++] = (char)ch;
         if (ch == '\n')
             break;
+        if (ch == '\r') {
+            const int next = getc(in);
+            if (next == '\n')
+                (*line)[n++] = '\n';
+            else if (next != EOF)
+                ungetc(next, in);
+            break;
+        }
     }
     if (n == 0 && ch == EOF)
         return -1;
@@ -91,6 +101,51 @@ static int out_failed(const rch_cpi_ctx *c, unsigned lineno, rch_diag *d)
     return 1;
 }
 
+/* The form of the input from its first line that is not blank or a comment
+ * (line, a BOM of bom bytes, then tn bytes of text): RAPID, or CSV (then
+ * held back for the radians check) whose first line is a header when its
+ * first field is not a number (read and copied here). 0, 1 (the header
+ * consumed) or -1 (d set). */
+static int decide_form(rch_cpi_ctx *c, const char *line, size_t bom, size_t tn, unsigned lineno, rch_diag *d)
+{
+    const char *text = line + bom;
+    if (starts_with_ci(text, tn, "MODULE") || starts_with_ci(text, tn, "%%%") || starts_with_ci(text, tn, "!") ||
+        find_ci(text, tn, "jointtarget") || find_ci(text, tn, "robtarget")) {
+        c->format = 2;
+        return 0;
+    }
+    size_t st[RCH_CPI_MAX_FIELDS], ln[RCH_CPI_MAX_FIELDS];
+    double v;
+    c->format = 1;
+    if (!(c->gate && c->gate->assume_degrees) && rch_cpi_csv_hold(c, d) != 0)
+        return -1;
+    if (!(rch_cpi_split_csv(text, tn, st, ln) > 0 && rch_cpi_parse_num(&v, text + st[0], ln[0]) != 0))
+        return 0;
+    fwrite(line, 1, bom, c->out);
+    return rch_cpi_csv_header(c, text, tn, lineno, d) < 0 || out_failed(c, lineno, d) ? -1 : 1;
+}
+
+/* The end of a CSV input held back (rch_cpi_csv_hold) because it looked like
+ * radians so far: refused when it still does (rch_data_q_look_rad; nothing
+ * written), else what was held written out. rc as the lines left it; returns
+ * the run's. */
+static int held_end(rch_cpi_ctx *c, int rc, unsigned lineno, rch_diag *d)
+{
+    if (!c->held)
+        return rc;
+    char why[320];
+    if (rc >= 0 && rch_data_q_look_rad(why, sizeof why, c->max_abs_deg, c->n_targets)) {
+        rch_diag_set(d, c->in_name, 0, 0, "%s; nothing written (if they are degrees: --assume-degrees)", why);
+        rc = -1;
+    }
+    if (rc < 0) {
+        rch_cpi_csv_drop(c);
+        return rc;
+    }
+    rch_cpi_csv_release(c);
+    return out_failed(c, lineno, d) ? -1 : rc;
+}
+
 int rch_comp_lines(FILE *out, rch_comp_result *res, FILE *in, const char *in_name, rc_comp_stream *s,
                    const rc_model *cal, rch_comp_format format, FILE *warn, rch_diag *d)
 {
@@ -109,6 +164,8 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
     long got;
     unsigned lineno = 0;
     int rc = 0, decided = c.format != 0;
+    if (c.format == 1 && !(gate && gate->assume_degrees) && rch_cpi_csv_hold(&c, d) != 0)
+        return -1; /* --format csv: held from the start as a detected CSV is */
     while ((got = read_line(&line, &cap, in)) != -1) {
         size_t n = (size_t)got;
         ++lineno;
@@ -119,15 +176,20 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         }
         while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'))
             --n;
+        c.eol = (size_t)got == n ? "\n" : (size_t)got - n == 2 ? "\r\n" : line[n] == '\r' ? "\r" : "\n";
+        /* a UTF-8 byte-order mark: not part of the first line's text; kept in the output */
+        const size_t bom = lineno == 1 && n >= 3 && memcmp(line, "\xEF\xBB\xBF", 3) == 0 ? 3u : 0u;
+        const char *text = line + bom;
+        const size_t tn = n - bom;
         if (memchr(line, '\0', n) != NULL) {
             rch_diag_set(d, c.in_name, lineno, (unsigned)((const char *)memchr(line, '\0', n) - line) + 1,
                          "NUL byte in text input");
             rc = -1;
             break;
         }
-        if (c.format != 2 && is_comment_or_blank(line, n)) {
+        if (c.format != 2 && is_comment_or_blank(text, tn)) {
             fwrite(line, 1, n, c.out);
-            fputc('\n', c.out);
+            fputs(c.eol, c.out);
             if (out_failed(&c, lineno, d)) {
                 rc = -1;
                 break;
@@ -137,30 +199,21 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
         int r;
         if (!decided) {
             decided = 1;
-            if (starts_with_ci(line, n, "MODULE") || starts_with_ci(line, n, "%%%") || starts_with_ci(line, n, "!") ||
-                find_ci(line, n, "jointtarget") ||
-                find_ci(line, n, "robtarget")) {
-                c.format = 2;
-            } else {
-                size_t st[RCH_CPI_MAX_FIELDS], ln[RCH_CPI_MAX_FIELDS];
-                double v;
-                c.format = 1;
-                if (rch_cpi_split_csv(line, n, st, ln) > 0 && rch_cpi_parse_num(&v, line + st[0], ln[0]) != 0) {
-                    if (rch_cpi_csv_header(&c, line, n, lineno, d) < 0 || out_failed(&c, lineno, d)) {
-                        rc = -1;
-                        break;
-                    }
-                    continue;
-                }
+            if ((r = decide_form(&c, line, bom, tn, lineno, d)) < 0) {
+                rc = -1;
+                break;
             }
+            if (r > 0)
+                continue; /* a CSV header, copied */
         }
-        if (c.format == 2) { /* a module is read whole: all or nothing */
+        if (c.format == 2) { /* a module is read whole, its bytes as they are: all or nothing */
             rc = rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d);
             if (rc >= 0 && out_failed(&c, lineno, d))
                 rc = -1;
             break;
         }
-        r = rch_cpi_csv_line(&c, line, n, lineno, d);
+        fwrite(line, 1, bom, c.out);
+        r = rch_cpi_csv_line(&c, text, tn, lineno, d);
         if (r < 0) {
             rc = -1;
             break;
@@ -175,12 +228,35 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
     free(line);
     for (size_t k = 0; k < c.ntcps; ++k)
         free(c.tcps[k]);
+    rc = held_end(&c, rc, lineno, d);
     res->format = (rch_comp_format)c.format;
     if (rc >= 0 && ferror(in)) {
         rch_diag_set(d, c.in_name, 0, 0, "read error: %s", strerror(errno));
         rc = -1;
     }
     return rc;
+}
+
+int rch_comp_same_model(rch_diag *d, const rch_comp_job *job, const rch_robot *model, const rch_robot *nominal)
+{
+    const char *how = NULL;
+    if (rch_path_same(job->model_path, job->nominal_path))
+        how = "the same file";
+    else if (model->model.n_params == nominal->model.n_params && model->model.n_effects == nominal->model.n_effects) {
+        int equal = 1;
+        for (unsigned k = 0; k < model->model.n_params && equal; ++k) /* the encoder's place moves no joint */
+            equal = (k >= RC_P_ENC && k < RC_P_ENC + 3) || model->model.x[k] == nominal->model.x[k];
+        if (equal)
+            how = "the same numbers: every DH parameter and effect equal";
+    }
+    if (!how)
+        return 0;
+    rch_diag_set(d, job->nominal_path, 0, 0,
+                 "--nominal %s is the calibrated model --model %s itself (%s): compensation would correct nothing; "
+                 "give the nominal robot file the program was made with (e.g. data/irb120.json), or leave "
+                 "--nominal out to use the model file's own \"nominal\" table",
+                 job->nominal_path, job->model_path, how);
+    return -1;
 }
 
 int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_diag *d)
@@ -197,6 +273,8 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     }
     if (rch_robot_load(&robot, job->model_path, d) != 0 ||
         (job->nominal_path && rch_robot_load(&nominal_robot, job->nominal_path, d) != 0))
+        return -1;
+    if (job->nominal_path && rch_comp_same_model(d, job, &robot, &nominal_robot) != 0)
         return -1;
     const rc_model *nom = job->nominal_path ? &nominal_robot.model : &robot.nominal;
     const rc_model *nom_raw = nom; /* what the program was made with: the robtargets' IK */
@@ -263,10 +341,12 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     }
     const rch_comp_gate gate = {&fit_pt, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
                                 job->accept_robtargets, have_uo ? uo.f : NULL, nom_raw, job->tool_mm,
-                                &det_any, &robot.model, &cfg, job->u95_policy};
+                                &det_any, &robot.model, &cfg, job->u95_policy, job->assume_degrees};
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);
+    if (rc < 0 && !d->file[0] && o.f != stdout && ferror(o.f)) /* a write error: the file it was writing */
+        snprintf(d->file, sizeof d->file, "%.255s", o.path);
     if (rc < 0) {
         if (o.f != stdout)
             rch_out_abort(&o);

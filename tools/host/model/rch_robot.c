@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 #include "rch_robot.h"
 
+#include <ctype.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,6 +19,78 @@
 #endif
 #define DEG (M_PI / 180.0)
 
+/* ---- keys (issue 47: a misspelled key is refused, never skipped) ---- */
+
+/* Edit distance of a and b (case-insensitive; each at most 63 bytes
+ * counted, the rest ignored). */
+static unsigned key_distance(const char *a, const char *b)
+{
+    unsigned row[64], la = (unsigned)(strlen(a) > 63 ? 63 : strlen(a)), lb = (unsigned)(strlen(b) > 63 ? 63 : strlen(b));
+    for (unsigned j = 0; j <= lb; ++j)
+        row[j] = j;
+    for (unsigned i = 1; i <= la; ++i) {
+        unsigned diag = row[0];
+        row[0] = i;
+        for (unsigned j = 1; j <= lb; ++j) {
+            const unsigned up = row[j];
+            const int same = tolower((unsigned char)a[i - 1]) == tolower((unsigned char)b[j - 1]);
+            unsigned v = diag + (same ? 0u : 1u);
+            if (up + 1 < v)
+                v = up + 1;
+            if (row[j - 1] + 1 < v)
+                v = row[j - 1] + 1;
+            row[j] = v;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
+/* Every key of object o must be one of known (NULL-terminated): an unknown
+ * one is refused at its key's line:col with the nearest known key when it
+ * is near (at most half its length away), else the list. where names the
+ * object ("the model file", "dh row 3"). 0, or -1 with d set. */
+static int check_keys(const rch_json *o, const char *const *known, const char *where, const char *file, rch_diag *d)
+{
+    if (!o || o->type != RCH_JOBJ)
+        return 0;
+    for (size_t i = 0; i < o->n; ++i) {
+        const char *k = o->keys[i];
+        const char *best = NULL;
+        unsigned best_d = ~0u;
+        size_t m = 0;
+        for (; known[m]; ++m) {
+            if (strcmp(k, known[m]) == 0)
+                break;
+            const unsigned dist = key_distance(k, known[m]);
+            if (dist < best_d) {
+                best_d = dist;
+                best = known[m];
+            }
+        }
+        if (known[m])
+            continue;
+        const rch_json *v = o->items[i];
+        const unsigned line = v->key_line ? v->key_line : v->line, col = v->key_line ? v->key_col : v->col;
+        if (best && 2 * best_d <= (unsigned)strlen(best)) {
+            rch_diag_set(d, file, line, col,
+                         "unknown key \"%.60s\" in %s: did you mean %s? (a key rcal does not know is refused, "
+                         "never skipped)", k, where, best);
+        } else {
+            char list[400] = "";
+            for (size_t j = 0; known[j]; ++j) {
+                const size_t at = strlen(list);
+                snprintf(list + at, sizeof list - at, "%s%s", j ? ", " : "", known[j]);
+            }
+            rch_diag_set(d, file, line, col, "unknown key \"%.60s\" in %s (its keys: %s)", k, where, list);
+        }
+        return -1;
+    }
+    return 0;
+}
+
+static const char *const dh_keys[] = {"a_mm", "d_mm", "alpha_deg", "theta_deg", NULL};
+
 static int want_num(double *v, const rch_json *j, const char *what, const char *file, rch_diag *d,
                     const rch_json *parent)
 {
@@ -29,6 +103,47 @@ static int want_num(double *v, const rch_json *j, const char *what, const char *
         return -1;
     }
     *v = j->num;
+    return 0;
+}
+
+/* The DH angles of a table (dh, already in rad) written in radians where
+ * degrees are read (issue 47), checked before anything uses the model (so
+ * that no data check blames the cable for it). A robot's twists and joint
+ * offsets are multiples of 90 degrees (0, +-90, 180), a calibration moving
+ * them by a fraction of a degree; in radians those are 0, +-1.5708 and
+ * 3.1416. The rule, per column (alpha_deg, theta_deg) of the six rows: every
+ * |value| at most RCH_ROBOT_RAD_BOUND (3.2) and at least one within
+ * RCH_ROBOT_RAD_TOL (0.05) of pi/2 or pi. In degrees such a column would be
+ * a robot whose twists (offsets) all lie within 3.2 deg of 0 while one is
+ * 1.5-1.6 or 3.1-3.2 deg off it: no robot's, no calibration's. A table of
+ * zeros (a planar test arm) is never refused. 0, or -1 with d set at the
+ * value that shows it. */
+#define RCH_ROBOT_RAD_BOUND 3.2
+#define RCH_ROBOT_RAD_TOL 0.05
+static int angles_in_degrees(double dh[RC_NJ][4], const rch_json *arr, const char *file, rch_diag *d)
+{
+    static const char *const keys[2] = {"alpha_deg", "theta_deg"};
+    for (unsigned k = 2; k < 4; ++k) {
+        int bounded = 1;
+        unsigned sign_row = RC_NJ;
+        for (unsigned i = 0; i < RC_NJ; ++i) {
+            const double v = fabs(dh[i][k] / DEG);
+            bounded &= v <= RCH_ROBOT_RAD_BOUND;
+            if (sign_row == RC_NJ && (fabs(v - M_PI / 2) <= RCH_ROBOT_RAD_TOL || fabs(v - M_PI) <= RCH_ROBOT_RAD_TOL))
+                sign_row = i;
+        }
+        if (!bounded || sign_row == RC_NJ)
+            continue;
+        const rch_json *at = rch_json_get(arr->items[sign_row], keys[k - 2]);
+        rch_diag_set(d, file, at->line, at->col,
+                     "dh[%u].%s = %g looks like radians: every %s of the table is within +-%g and this one is "
+                     "%s in radians (a robot's %s are multiples of 90 degrees); rcal reads degrees (multiply by "
+                     "180/pi)",
+                     sign_row + 1, keys[k - 2], dh[sign_row][k] / DEG, keys[k - 2], RCH_ROBOT_RAD_BOUND,
+                     fabs(fabs(dh[sign_row][k] / DEG) - M_PI / 2) <= RCH_ROBOT_RAD_TOL ? "pi/2" : "pi",
+                     k == 2 ? "twists" : "joint offsets");
+        return -1;
+    }
     return 0;
 }
 
@@ -47,6 +162,10 @@ static int read_dh(double dh[RC_NJ][4], const rch_json *arr, const char *file, r
             rch_diag_set(d, file, row->line, row->col, "dh row %u must be an object", i + 1);
             return -1;
         }
+        char where[32];
+        snprintf(where, sizeof where, "dh row %u", i + 1);
+        if (check_keys(row, dh_keys, where, file, d) != 0)
+            return -1;
         for (unsigned k = 0; k < 4; ++k) {
             char what[64];
             snprintf(what, sizeof what, "dh[%u].%s", i + 1, keys[k]);
@@ -65,7 +184,7 @@ static int read_dh(double dh[RC_NJ][4], const rch_json *arr, const char *file, r
                 dh[i][k] *= DEG;
         }
     }
-    return 0;
+    return angles_in_degrees(dh, arr, file, d);
 }
 
 static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_diag *d)
@@ -83,6 +202,11 @@ static int read_effects(rc_model *m, const rch_json *arr, const char *file, rch_
             rch_diag_set(d, file, e->line, e->col, "effect %zu needs a \"kind\" string", i + 1);
             return -1;
         }
+        static const char *const effect_keys[] = {"kind", "joint", "outlet", "params", "ref_dh", NULL};
+        char where[32];
+        snprintf(where, sizeof where, "effect %zu", i + 1);
+        if (check_keys(e, effect_keys, where, file, d) != 0)
+            return -1;
         const int k = rc_effect_by_name(kind->str);
         const rc_effect_desc *ds = k > 0 ? rc_effect_describe((unsigned)k) : NULL;
         if (ds == NULL) {
@@ -222,7 +346,9 @@ static int read_nominal(rch_robot *out, const rch_json *root, const char *name, 
         rch_diag_set(d, name, nom->line, nom->col, "\"nominal\" must be an object with \"dh\"");
         return -1;
     }
-    if (read_dh(ndh, rch_json_get(nom, "dh"), name, d, nom) != 0)
+    static const char *const nominal_keys[] = {"dh", NULL};
+    if (check_keys(nom, nominal_keys, "\"nominal\"", name, d) != 0 ||
+        read_dh(ndh, rch_json_get(nom, "dh"), name, d, nom) != 0)
         return -1;
     for (unsigned i = 0; i < RC_NJ; ++i)
         for (unsigned k = 0; k < 4; ++k)
@@ -239,6 +365,12 @@ static int read_unc_param(rch_robot *out, unsigned k, const rch_json *p, const c
         rch_diag_set(d, name, p->line, p->col, "uncertainty parameter %u: needs \"class\"", k + 1);
         return -1;
     }
+    static const char *const param_keys[] = {"name",     "unit", "value",    "std_error", "class",         "compensation",
+                                             "prior_sd", "seen", "seen_why", "data_vs_prior", NULL};
+    char where[48];
+    snprintf(where, sizeof where, "uncertainty parameter %u", k + 1);
+    if (check_keys(p, param_keys, where, name, d) != 0)
+        return -1;
     unsigned c = 0;
     while (c < 4 && strcmp(cl->str, rch_param_class_name((rch_param_class)c)) != 0)
         ++c;
@@ -466,6 +598,14 @@ static int read_uncertainty(rch_robot *out, const rch_json *u, const char *name,
                      out->model.n_params);
         return -1;
     }
+    static const char *const unc_keys[] = {"covariance",   "groups",        "sigma_mm",
+                                           "rank",         "posterior",     "parameters",
+                                           "undetermined", "covariance_dh", "determined",
+                                           "orientation_determined", "position95_mm", "orientation95_deg", NULL};
+    static const char *const det_keys[] = {"dh", NULL};
+    if (check_keys(u, unc_keys, "\"uncertainty\"", name, d) != 0 ||
+        check_keys(rch_json_get(u, "determined"), det_keys, "\"uncertainty\".\"determined\"", name, d) != 0)
+        return -1;
     for (unsigned k = 0; k < ps->n; ++k)
         if (read_unc_param(out, k, ps->items[k], name, d) != 0)
             return -1;
@@ -568,6 +708,13 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
         rch_diag_set(d, name, root->line, root->col, "a model file must be a JSON object");
         goto done;
     }
+    /* every member is one rcal knows ("calibration", "fit" and "provenance"
+     * are informational: their contents are not checked) */
+    static const char *const top_keys[] = {"format",  "name",        "dh",          "joint_limits_deg", "encoder_mm",
+                                           "effects", "prior",       "nominal",     "calibration",      "uncertainty",
+                                           "fit",     "provenance",  "outlet_labels", "$schema",        NULL};
+    if (check_keys(root, top_keys, "the model file", name, d) != 0)
+        goto done;
     const rch_json *fmt = rch_json_get(root, "format");
     if (fmt && (fmt->type != RCH_JSTR ||
                 (strcmp(fmt->str, "rcal-model/1") != 0 && strcmp(fmt->str, "rcal-model/2") != 0))) {

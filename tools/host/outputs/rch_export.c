@@ -3,6 +3,7 @@
 #include "rch_export.h"
 #include "rch_comp.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -413,8 +414,10 @@ int rch_export_write(rch_export_result *res, FILE *f, const rch_export_cfg *cfg,
     } else {
         write_csv(f, cfg, r, res);
     }
+    const int err = errno;
+    errno = 0;
     if (fflush(f) != 0 || ferror(f)) {
-        rch_diag_set(d, "", 0, 0, "write error");
+        rch_diag_set(d, "", 0, 0, "write error: %s", strerror(errno ? errno : err ? err : EIO));
         return -1;
     }
     return 0;

@@ -185,7 +185,7 @@ int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag
     job_write(&j, r, date);
     for (unsigned k = 0; k < j.n_out; ++k)
         if (ferror(j.out[k].f)) {
-            rch_diag_set(d, j.out[k].path, 0, 0, "write error");
+            rch_diag_set(d, j.out[k].path, 0, 0, "write error: %s", strerror(rch_out_errno(&j.out[k])));
             goto done;
         }
     /* whole or not at all: every file written and synced before any is renamed */
