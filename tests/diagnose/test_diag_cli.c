@@ -210,11 +210,15 @@ static void test_real_data(void **state)
     assert_non_null(jl);
     assert_true(jl->n >= 3);
     static const double want_at[3] = {28, 140, 506}, want_mm[3] = {-1.3, -3.5, 4.9};
-    for (unsigned k = 0; k < 3; ++k) {
-        assert_true(fabs(rch_json_get(jl->items[k], "sample")->num - want_at[k]) <= 1.0);
-        assert_true(fabs(rch_json_get(jl->items[k], "size_mm")->num - want_mm[k]) < 0.3);
+    for (unsigned k = 0; k < 3; ++k) { /* each among those found (the screen's blocks add small ones between) */
+        const rch_json *it = NULL;
+        for (size_t q = 0; q < jl->n && !it; ++q)
+            if (fabs(rch_json_get(jl->items[q], "sample")->num - want_at[k]) <= 1.0)
+                it = jl->items[q];
+        assert_non_null(it);
+        assert_true(fabs(rch_json_get(it, "size_mm")->num - want_mm[k]) < 0.3);
         /* named by the file's line, as rcal calibrate names them */
-        assert_true(fabs(rch_json_get(jl->items[k], "line")->num - (want_at[k] + 2.0)) <= 1.0);
+        assert_true(fabs(rch_json_get(it, "line")->num - (want_at[k] + 2.0)) <= 1.0);
     }
     assert_true(after < 0.5 * before);
     assert_true(after < 1.5 * floor_mm);

@@ -277,6 +277,16 @@ static const claim *claimed(const char *path)
     return NULL;
 }
 
+void rch_out_unclaim(const char *path)
+{
+    const claim *c = claimed(path);
+    if (!c)
+        return;
+    const size_t i = (size_t)(c - g_claims);
+    memmove(&g_claims[i], &g_claims[i + 1], (g_n_claims - i - 1) * sizeof *g_claims);
+    g_n_claims--;
+}
+
 static void claim_add(const char *path, const char *what)
 {
     struct stat st;

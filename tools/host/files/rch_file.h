@@ -72,6 +72,10 @@ int rch_path_same(const char *a, const char *b);
 /* Remember every output of this process from now on (see above). */
 void rch_out_one_command(void);
 
+/* Forget that this command wrote path (a result it replaces with a later
+ * one of its own: the calibration's refits rewrite their plot). */
+void rch_out_unclaim(const char *path);
+
 /* The command's output options, before any work: paths[n] (NULL entries
  * skipped, "-" ignored) named by whats[n] ("--out"). 0, or -1 with d set
  * ("--residuals x names the same file as --out x"). */

@@ -9,6 +9,7 @@
  * scratch freed before returning. Errors: see rch_calib_run.
  */
 #include "rch_calib.h"
+#include "rch_file.h"
 #include "rch_calib_int.h"
 
 #include <math.h>
@@ -352,6 +353,15 @@ static int refit_all(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, cons
                      rch_diag *d)
 {
     const rch_calib_cfg cfg = *cfg0; /* as asked (the run sets cfg.jumps when its check found jumps) */
+    /* the refit's plot replaces the fit's (the same command's) */
+    for (const char *q = r->plot_paths, *e; *q && (e = strchr(q, '\n')) != NULL; q = e + 1) {
+        char one[1200];
+        if ((size_t)(e - q) < sizeof one) {
+            memcpy(one, q, (size_t)(e - q));
+            one[e - q] = '\0';
+            rch_out_unclaim(one);
+        }
+    }
     const rch_calib_screen_result keep = r->screen;
     const rch_calib_sys sys = r->sys;
     memset(r, 0, sizeof *r);
