@@ -48,44 +48,8 @@ def tail(s):
     return s.strip()[-400:]
 
 
-# ---- this file's own kinematics: standard DH, theta_i = q_i + theta_off_i ----
-def matmul(A, B):
-    return [[sum(A[i][k] * B[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
-
-
-def fk(dh, q_deg):
-    T = [[1.0 if i == j else 0.0 for j in range(4)] for i in range(4)]
-    for row, q in zip(dh, q_deg):
-        th = (q + row["theta_deg"]) * DEG
-        al = row["alpha_deg"] * DEG
-        ct, st, ca, sa = math.cos(th), math.sin(th), math.cos(al), math.sin(al)
-        T = matmul(T, [[ct, -st * ca, st * sa, row["a_mm"] * ct],
-                       [st, ct * ca, -ct * sa, row["a_mm"] * st],
-                       [0.0, sa, ca, row["d_mm"]],
-                       [0.0, 0.0, 0.0, 1.0]])
-    return T
-
-
-def point(dh, q_deg, t):
-    """flange + R6 t in the base frame"""
-    T = fk(dh, q_deg)
-    return [T[i][3] + sum(T[i][k] * t[k] for k in range(3)) for i in range(3)]
-
-
-def dist(a, b):
-    return math.sqrt(sum((x - y) ** 2 for x, y in zip(a, b)))
-
-
-def draw_q(rng):
-    lim = [(-160, 160), (-100, 100), (-100, 60), (-150, 150), (-110, 110), (-300, 300)]
-    while True:
-        q = [rng.uniform(lo, hi) for lo, hi in lim]
-        if abs(math.sin(q[4] * DEG)) > 0.15:
-            return q
-
-
-def qtext(q):
-    return ",".join("%.6f" % v for v in q)
+sys.path.insert(0, os.path.join(SRC, "tests", "common"))
+from rct_dh import dist, draw_q, point, qtext  # noqa: E402  (the tests' own kinematics)
 
 
 def write_plate(path, dh, enc, pts, rng, n):
