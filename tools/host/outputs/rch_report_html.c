@@ -378,9 +378,9 @@ static void verdict(rep *r, size_t n_warn)
         }
         fputs("; <span id=\"aim-before\">before compensation ", f);
         if (isfinite(am->before_median)) {
-            fputs("it misses by <b>", f);
+            fputs("it misses by <strong>", f); /* not a <b>: the verdict colours its first <b> */
             rch_rep_put_sig(r, am->before_median, " mm");
-            fputs("</b> (the median over ", f);
+            fputs("</strong> (the median over ", f);
             if (am->before_over_data)
                 fprintf(f, "the data's %zu poses", am->before_n);
             else
