@@ -7,9 +7,10 @@ only; the positions come from the tests' own kinematics (tests/common/rct_dh.py)
      file and line of the first row past the gap (before, target 1 was stored
      at (0, 0, 0) and `evaluate` judged a 0.02 mm model 39 mm off);
   2. the controller's own x, y, z with joints rounded to 0.1 deg: refused as
-     computed positions (the rigid fit leaves what the rounding alone leaves);
-     a tracker's measurements of a robot 0.3 mm off its drawing, with the same
-     rounded joints, still calibrate;
+     computed positions (the rigid fit leaves what the rounding alone leaves,
+     within 1.25 x either way); a tracker's measurements of a robot 0.3 mm off
+     its drawing, with the same rounded joints or at joints exactly on whole
+     degrees (a plan), still calibrate;
   3. the calibrate text of a positions-only run: the "before" row fits the
      tracker (not the encoder) and no known set trades against the encoder.
 
@@ -100,6 +101,18 @@ for seed in (1, 2, 3):
           % (seed, out[-330:]))
     rc, out = run("calibrate", "--positions", "meas%d.csv" % seed)
     check(rc == 0, "seed %d: a tracker's measurements with the same joints calibrate: %s" % (seed, out[-200:]))
+
+# joints exactly on whole degrees (a plan's poses, the robot there): not rounded, the robot's own errors are
+# left whatever their size relative to a degree's rounding effect; accepted
+rng = random.Random(9)
+true = robot(rng, 0.3, 0.03)
+plan = ["q1,q2,q3,q4,q5,q6,x,y,z"]
+for _ in range(40):
+    q = [float(round(v)) for v in draw_q(rng)]
+    plan.append("%s,%.3f,%.3f,%.3f" % (",".join("%.0f" % v for v in q), *tracker(true, q, [0, 0, 80], rng)))
+write("plan.csv", plan)
+rc, out = run("calibrate", "--positions", "plan.csv")
+check(rc == 0, "a tracker's measurements at joints exactly on whole degrees calibrate: %s" % out[-200:])
 
 # ---- 3. a positions-only run speaks of positions and the tracker ----
 rc, out = run("calibrate", "--positions", "meas1.csv")

@@ -520,7 +520,13 @@ static int check_frame(const rc_model *m, const rc_sample *s, size_t n, double s
          * about 0.5 mm, far above the x, y, z rounding, and passed as measurements) */
         double qstep = 0.0;
         const double eff = rounding_effect(&qstep, &fit[0], s, n), lim = sqrt(eff * eff + 0.25 * step * step);
-        if (eff > 0.0 && rp <= RCH_POS_ROUNDING_RATIO * lim) {
+        /* the rigid fit's RMS with its degrees of freedom restored (the frame's 6, 3 per target): what the
+         * rounding left is then about lim; joints exactly on round values (a plan of whole degrees)
+         * leave the robot's own errors, whatever their size, so the window is two-sided */
+        const double k3 = (double)(n / 3 * 3), dof = k3 - 6.0 - 3.0 * targets_of(s, n);
+        const double rpc = dof > 0.0 ? rp * sqrt(k3 / dof) : rp;
+        if (eff > 0.0 && qstep >= RCH_POS_ROUNDING_MIN_DEG && rpc >= lim / RCH_POS_ROUNDING_RATIO &&
+            rpc <= RCH_POS_ROUNDING_RATIO * lim) {
             rch_diag_set(d, path, 0, 0,
                          "these are the controller's computed positions, not measurements: the robot's nominal "
                          "kinematics at the joints give x, y, z to %.3g mm RMS after a rigid motion, what the joints' "

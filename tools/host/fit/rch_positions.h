@@ -51,8 +51,9 @@ typedef struct rch_pos {
 #define RCH_POS_MIRROR_MIN_MM 3.0  /* mirrored: the rotation leaves more than this (RMS, mm) */
 #define RCH_POS_MIRROR_RATIO 0.2   /*   and the reflection less than this part of it */
 #define RCH_POS_MIN_ROWS_RIGID 6   /* the controller's positions judged with rows >= this + targets */
-#define RCH_POS_ROUNDING_RATIO 1.25 /* rounded joints: the controller's positions when the rigid fit leaves no more
-                                       than this times what the joints' rounding alone leaves */
+#define RCH_POS_ROUNDING_RATIO 1.25 /* rounded joints: the controller's positions when the rigid fit leaves what
+                                       the joints' rounding alone leaves, within this factor either way */
+#define RCH_POS_ROUNDING_MIN_DEG 0.05 /* joints on a display step of at least this (deg) are judged so */
 
 /* Load positions files paths (k), pose numbers counted on over the files
  * from pose0 (the merged data's first free number); limits: the robot's
