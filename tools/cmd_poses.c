@@ -111,6 +111,22 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
         json_acc(&w, "plan", &res->plan);
         json_acc(&w, "random", &res->random);
         rch_jw_end(&w);
+        if (res->n_points) {
+            /* the tool plate: its points as told, and the same poses on the first j of them */
+            rch_jw_arr(&w, "cable_points_mm");
+            json_places(&w, (const double(*)[3])pc->points_mm, NULL, pc->n_points);
+            rch_jw_end(&w);
+            rch_jw_arr(&w, "predicted_by_points");
+            for (unsigned j = 1; j <= res->n_points; ++j) {
+                rch_jw_obj(&w, NULL);
+                rch_jw_uint(&w, "points", j);
+                rch_jw_uint(&w, "rows", res->by_points[j - 1].rows);
+                rch_jw_num(&w, "median_mm", res->by_points[j - 1].ok ? res->by_points[j - 1].acc.median_mm : NAN);
+                rch_jw_num(&w, "p95_mm", res->by_points[j - 1].ok ? res->by_points[j - 1].acc.p95_mm : NAN);
+                rch_jw_end(&w);
+            }
+            rch_jw_end(&w);
+        }
     }
     rch_jw_num(&w, "o1_plan", res->o1_plan);
     rch_jw_uint(&w, "rank_plan", res->rank_plan);
@@ -165,33 +181,21 @@ static void print_choice(const rch_poses_choice *ch, const double (*cand)[3])
     }
 }
 
-/* What each further cable point gains: the plan's poses measured on points
- * 0..j only, predicted at the same point (flange or --tool). */
-static void print_point_gains(const rch_poses_result *res, const rch_poses_config *pc, const rc_model *m)
+/* What each further cable point gains (rch_poses_result.by_points). */
+static void print_point_gains(const rch_poses_result *res)
 {
     printf("  the same poses on the first j cable points of the plate (every pose on each; the plate's drawing "
            "to its prior sd):\n");
-    rc_sample *rows = malloc((res->n ? res->n : 1) * sizeof *rows);
-    for (unsigned j = 1; rows && j <= pc->n_points; ++j) {
-        rch_poses_config cj = *pc;
-        cj.n_points = j;
-        size_t n = 0;
-        for (size_t i = 0; i < res->n; ++i)
-            if (res->poses[i].target < j)
-                rows[n++] = res->poses[i];
-        rch_poses_accuracy acc;
-        rch_diag d;
-        if (rch_poses_predict(&acc, m, &cj, rows, n, &d) == 0)
-            printf("    %u point(s), %zu rows: median %.4f mm, 95th percentile %.4f mm\n", j, n, acc.median_mm,
-                   acc.p95_mm);
+    for (unsigned j = 1; j <= res->n_points; ++j) {
+        if (res->by_points[j - 1].ok)
+            printf("    %u point(s), %zu rows: median %.4f mm, 95th percentile %.4f mm\n", j,
+                   res->by_points[j - 1].rows, res->by_points[j - 1].acc.median_mm, res->by_points[j - 1].acc.p95_mm);
         else
-            printf("    %u point(s): %s\n", j, d.msg);
+            printf("    %u point(s): the prediction failed\n", j);
     }
-    free(rows);
 }
 
-static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path,
-                       const rc_model *m)
+static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
 {
     if (pc->criterion == RCH_POSES_LENGTH) {
         printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
@@ -225,7 +229,7 @@ static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, 
     printf("  observability O1 of the lengths (rch_ident): planned %.5g, random %.5g, ratio %.2f\n", res->o1_plan,
            res->o1_random, res->o1_random > 0 ? res->o1_plan / res->o1_random : 0.0);
     if (pc->n_points > 0)
-        print_point_gains(res, pc, m);
+        print_point_gains(res);
     if (res->n < res->rows_advised)
         printf("  WARNING: %zu rows for about %zu parameters calibrate fits: it estimates the noise from the "
                "residuals and needs at least %zu rows, else the fit follows the noise and the predicted accuracy is "
@@ -412,7 +416,7 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
     rch_diag dg;
     char dbuf[900];
     if (!a->json)
-        print_plan(res, &a->pc, a->out_path, a->model);
+        print_plan(res, &a->pc, a->out_path);
     if (write_out(out->f, res, &a->pc, a->format, a->settle_s) != 0) {
         const int err = rch_out_errno(out);
         rch_out_abort(out);

@@ -733,6 +733,32 @@ static void test_refused_uses(void **state)
     expect_refused("refuse_uses.mod", want, sizeof want / sizeof want[0]);
 }
 
+/* Issue 47: a robtarget whose external axes are in use (a value other than
+ * 9E9: a robot on a track) is refused at that value with the reason; 9E9 in
+ * any spelling (9E+09, 9.0E9) is unused and corrected. */
+static void test_refused_extax(void **state)
+{
+    (void)state;
+    static const char *const want[] = {
+        "refuse_extax.mod:3:27: error: robtarget pTrack (declaration) cannot be corrected: external axis eax_a = 1200 "
+        "(line 3, column 108): a robtarget with an external axis in use (a track moving the base, a positioner) "
+        "cannot be corrected: the model has no track, its corrections assume the base fixed; only 9E9 (unused) is "
+        "accepted",
+        "refuse_extax.mod:4:28: error: robtarget pSecond (declaration) cannot be corrected: external axis eax_c = "
+        "-35.5 (line 4, column 117)",
+        "refuse_extax.mod:5:26: error: robtarget pName (declaration) cannot be corrected: external axis eax_b is not "
+        "a literal number (line 5, column 108)",
+        "refuse_extax.mod: 3 targets cannot be corrected",
+    };
+    expect_refused("refuse_extax.mod", want, sizeof want / sizeof want[0]);
+    char err[128];
+    snprintf(err, sizeof err, "%s/refused.err", dir); /* expect_refused's */
+    size_t n;
+    char *msg = slurp(err, &n);
+    assert_null(strstr(msg, "pUnused")); /* 9E+09, 9.0E9: unused, corrected */
+    free(msg);
+}
+
 /* Issue 33: a robtarget of an ALIAS type is corrected (the real robot lands
  * on it); one inside a RECORD is refused, naming the record and field. */
 static void test_record_alias(void **state)
@@ -787,6 +813,7 @@ int main(void)
         cmocka_unit_test(test_declared_tool),
         cmocka_unit_test(test_tools_wobjs),
         cmocka_unit_test(test_refused_uses),
+        cmocka_unit_test(test_refused_extax),
         cmocka_unit_test(test_record_alias),
         cmocka_unit_test(test_no_target),
     };

@@ -110,6 +110,23 @@ def poses():
     with open(w("plan.csv")) as f:
         rows = len(f.read().strip().split("\n")) - 1
     check(d.get("poses") == 5 == rows and d.get("out") == w("plan.csv"), "poses: 5 poses written (%d rows)" % rows)
+    # a tool plate (issue 47): the JSON carries the points as told and each point count's prediction, the
+    # figures the text prints
+    plate = ["--robot", ROBOT, "--count", "6", "--candidates", "200", "--seed", "4", "--tool", "50,0,150",
+             "--cable-point", "30,0,20", "--cable-point", "-15,26,20", "--cable-point", "-15,-26,20"]
+    d = doc_of("poses", run("poses", *plate, "--out", w("plate_plan.csv"), "--json"))
+    text = run("poses", *plate, "--out", w("plate_plan_text.csv")).stdout
+    printed = [(int(m.group(1)), int(m.group(2)), float(m.group(3)), float(m.group(4))) for m in re.finditer(
+        r"(\d) point\(s\), (\d+) rows: median ([0-9.]+) mm, 95th percentile ([0-9.]+) mm", text)]
+    by = d.get("predicted_by_points", [])
+    check(d.get("cable_points_mm") == [[30, 0, 20], [-15, 26, 20], [-15, -26, 20]],
+          "poses --json: the plate's points as told: %s" % d.get("cable_points_mm"))
+    check(len(by) == 3 == len(printed) and all(
+        b["points"] == p[0] and b["rows"] == p[1] == 6 * p[0] and abs(b["median_mm"] - p[2]) < 6e-5 and
+        abs(b["p95_mm"] - p[3]) < 6e-5 for b, p in zip(by, printed)),
+        "poses --json: the prediction on 1, 2, 3 points as printed: %s against %s" % (by, printed))
+    check(bool(by) and by[-1]["median_mm"] == d["predicted_position95_mm"]["plan"]["median_mm"],
+          "poses --json: every point's prediction is the plan's")
 
 
 def acquire():

@@ -88,6 +88,10 @@ typedef struct rch_rapid_target {
     char wobj_ufmec[48];           /*   ufmec */
     double wobj_uframe[7], wobj_oframe[7]; /* uframe (in world), oframe (in uframe): trans (mm), rot */
     char use_error[400];           /* not empty: its tool and work object cannot be told (robtargets only) */
+    unsigned extax_used;           /* robtargets: 1 + the first external axis (eax_a ..) whose value is not 9E9
+                                      (unused: a track, a positioner or another axis in use), 0: none */
+    double extax_val;              /*   its value (NaN: not a literal number) */
+    unsigned extax_line, extax_col; /*  and where it stands */
     char error[256];               /* not empty: the literal cannot be read (shape, not a number) */
 } rch_rapid_target;
 

@@ -10,6 +10,7 @@
  * (rch_rapid_types.c), rch_parse_double (rch_opt). Memory: the targets on
  * the heap (s->out, rch_rapid_free). Errors: -1 with the scan's diag set
  * (out of memory); a target that cannot be read is listed with its error. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -130,6 +131,8 @@ static rch_rapid_target *new_target(rch_rpi_scan *s, size_t i, size_t c, rch_rap
 static const char *const jt_names[] = {"axis 1", "axis 2", "axis 3", "axis 4", "axis 5", "axis 6"};
 static const char *const rt_names[] = {"x", "y", "z", "q1", "q2", "q3", "q4", "cf1", "cf4", "cf6", "cfx"};
 
+static void extax_of(rch_rapid_target *t, const rch_rpi_scan *s, const shape *sh);
+
 /* A target literal of kind at tokens [i, c]: its numbers, or its error. */
 static int add_target(rch_rpi_scan *s, size_t i, size_t c, rch_rapid_kind kind, rch_rapid_context ctx, const char *name)
 {
@@ -184,7 +187,39 @@ static int add_target(rch_rpi_scan *s, size_t i, size_t c, rch_rapid_kind kind, 
             t->val[k] = v;
         }
     t->n = k;
+    if (kind == RCH_RAPID_ROBTARGET)
+        extax_of(t, s, &sh);
     return 0;
+}
+
+/* A robtarget's external axes (group 3): the first one in use (a value
+ * other than 9E9, or not a literal number) into t->extax_*. */
+static void extax_of(rch_rapid_target *t, const rch_rpi_scan *s, const shape *sh)
+{
+    for (int l = 0; l < sh->nl[3] && l < MAXL; ++l) {
+        const size_t b = sh->lb[3][l], e = sh->le[3][l];
+        size_t nb = b;
+        if (e - b == 2 && (rch_rpi_punct(s, b, '-') || rch_rpi_punct(s, b, '+')))
+            nb = b + 1;
+        const rch_rpi_tok *tn = &s->tk.t[nb];
+        char buf[64];
+        double v = NAN;
+        if (e > b && nb + 1 == e && tn->type == RCH_RPI_NUM && tn->len < sizeof buf) {
+            memcpy(buf, s->text + tn->off, tn->len);
+            buf[tn->len] = '\0';
+            if (rch_parse_double(buf, &v) != 0)
+                v = NAN;
+            else if (nb > b && rch_rpi_punct(s, b, '-'))
+                v = -v;
+        }
+        if (!(fabs(v - 9e9) < 1.0)) {
+            t->extax_used = (unsigned)l + 1;
+            t->extax_val = v;
+            t->extax_line = s->tk.t[b].line;
+            t->extax_col = s->tk.t[b].col;
+            return;
+        }
+    }
 }
 
 /* The value of a declaration or assignment of a target kind at tokens [i, c]:

@@ -33,6 +33,28 @@ static void json_metrics(rch_jw *w, const char *name, const rc_metrics *m)
     rch_jw_end(w);
 }
 
+/* What parameter k's "delta" is taken from: the nominal DH, the start's
+ * encoder, a tool plate's point as told (--cable-point: the start's, by
+ * name), else 0. */
+static double param_nominal(const rch_calib_result *r, unsigned k)
+{
+    const rc_model *m = &r->model;
+    if (k < RC_N_DH)
+        return r->robot.model.x[k];
+    if (k < RC_N_BASE)
+        return r->before.x[k];
+    char name[64], other[64];
+    for (unsigned e = 0; e < m->n_effects; ++e)
+        if (m->effects[e].kind == RC_EFF_CABLE_POINTS && k >= m->effects[e].first &&
+            k < m->effects[e].first + m->effects[e].count) {
+            rc_param_name(name, sizeof name, m, k);
+            for (unsigned j = RC_N_BASE; j < r->before.n_params; ++j)
+                if (strcmp(rc_param_name(other, sizeof other, &r->before, j), name) == 0)
+                    return r->before.x[j];
+        }
+    return 0.0;
+}
+
 static void json_params(rch_jw *w, const rch_calib_result *r)
 {
     const rc_model *m = &r->model;
@@ -41,7 +63,7 @@ static void json_params(rch_jw *w, const rch_calib_result *r)
         char name[64];
         const int unit = rc_param_unit(m, k);
         const double scale = unit == 1 ? 1.0 / DEG : 1.0;
-        const double nominal = k < RC_N_DH ? r->robot.model.x[k] : (k < RC_N_BASE ? r->before.x[k] : 0.0);
+        const double nominal = param_nominal(r, k);
         rch_jw_obj(w, NULL);
         rch_jw_str(w, "name", rc_param_name(name, sizeof name, m, k));
         rch_jw_str(w, "unit", unit == 0 ? "mm" : unit == 1 ? "deg" : "-");

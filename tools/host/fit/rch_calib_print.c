@@ -465,7 +465,24 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
             RC_N_DH - held, held ? list : "none");
 }
 
-static void print_ident(FILE *f, const rch_ident *id, int prior)
+/* Does a known set name the encoder outlet (ex, ey, ez)? */
+static int names_encoder(const char *params)
+{
+    static const char *const e[3] = {"ex", "ey", "ez"};
+    for (const char *p = params; *p;) {
+        const size_t len = strcspn(p, " ");
+        for (int k = 0; k < 3; ++k)
+            if (len == 2 && strncmp(p, e[k], 2) == 0)
+                return 1;
+        p += len;
+        p += *p == ' ';
+    }
+    return 0;
+}
+
+/* no_lengths: a tracker-only run (the encoder held: the sets that trade
+ * against it say nothing of these data). */
+static void print_ident(FILE *f, const rch_ident *id, int prior, int no_lengths)
 {
     fprintf(f,
             "identifiability (%u parameters, at the solution): rank %u: %u direction(s) the data do not see, %u "
@@ -474,13 +491,17 @@ static void print_ident(FILE *f, const rch_ident *id, int prior)
     for (unsigned k = 0; k < id->n_dirs; ++k) {
         fprintf(f, "  - %s (relative singular value %.1e): %s\n", id->dirs[k].weak ? "seen only weakly" : "NOT seen by the data",
                 id->dirs[k].sv_rel, id->dirs[k].combo);
-        if (id->dirs[k].why[0])
+        if (id->dirs[k].why[0] && !(no_lengths && strstr(id->dirs[k].why, "encoder")))
             fprintf(f, "      %s\n", id->dirs[k].why);
     }
-    if (id->n_combos)
+    unsigned shown = 0;
+    for (unsigned k = 0; k < id->n_combos; ++k)
+        shown += !(no_lengths && names_encoder(id->combos[k].params));
+    if (shown)
         fprintf(f, "  what these directions hold (known sets of parameters whose columns are dependent):\n");
     for (unsigned k = 0; k < id->n_combos; ++k)
-        fprintf(f, "    %s %s (%.1e): %s\n", id->combos[k].params, id->combos[k].weak ? "seen only weakly" : "NOT seen by the data",
+        if (!(no_lengths && names_encoder(id->combos[k].params)))
+            fprintf(f, "    %s %s (%.1e): %s\n", id->combos[k].params, id->combos[k].weak ? "seen only weakly" : "NOT seen by the data",
                 id->combos[k].sv_rel, id->combos[k].why);
     fprintf(f, prior ? "  With the prior, what the data do not see stays where the drawing puts it (the prior's mean), "
                        "with the prior's uncertainty (\"prior only\" above).\n\n"
@@ -661,9 +682,14 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                    "(--no-jump-check: not looked for)\n\n",
                 counts, all, also);
     }
-    fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
-            r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
-    print_metrics_row(f, "before (nominal DH, fitted encoder)", &r->before_m);
+    if (tracker_only(r)) /* no cable: the rows are the positions' coordinates */
+        fprintf(f, "%s error (%zu coordinates, mm)      RMSE  mean|e|       SD      MAX\n",
+                r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
+    else
+        fprintf(f, "%s error (%zu samples, mm)          RMSE  mean|e|       SD      MAX\n",
+                r->n_test ? "held-out" : "training", r->n_test ? r->n_test : r->n_train);
+    print_metrics_row(f, tracker_only(r) ? "before (nominal DH, fitted tracker)"
+                                         : "before (nominal DH, fitted encoder)", &r->before_m);
     if (r->after_ok)
         print_metrics_row(f, "after", &r->after_m);
     else
@@ -682,7 +708,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     if (r->have_unc)
         print_uncertainty(f, r);
     if (r->have_ident)
-        print_ident(f, &r->ident, r->prior_on);
+        print_ident(f, &r->ident, r->prior_on, tracker_only(r));
     if (r->have_validate) {
         const rch_evaluate_result *v = &r->validate;
         fprintf(f,

@@ -117,6 +117,22 @@ static int rapid_robtarget(rch_cpi_ctx *c, double out[RCH_RAPID_NUMS], const rch
         snprintf(why, why_len, "no nominal model to invert");
         return -1;
     }
+    if (t->extax_used) {
+        /* the pose is the TCP's in the work object; with a track the base
+         * moves with eax, and the nominal IK of a fixed base (what the
+         * correction inverts) is no longer the controller's */
+        char v[48];
+        if (isfinite(t->extax_val))
+            snprintf(v, sizeof v, " = %g", t->extax_val);
+        else
+            snprintf(v, sizeof v, " is not a literal number");
+        snprintf(why, why_len,
+                 "external axis eax_%c%s (line %u, column %u): a robtarget with an external axis in use (a track "
+                 "moving the base, a positioner) cannot be corrected: the model has no track, its corrections "
+                 "assume the base fixed; only 9E9 (unused) is accepted",
+                 'a' + (int)t->extax_used - 1, v, base + t->extax_line, t->extax_col);
+        return -1;
+    }
     rch_cpi_frames fr;
     if (rch_cpi_robtarget_frames(&fr, t, c->gate->tool_mm, base, why, why_len) != 0)
         return -1;

@@ -154,6 +154,10 @@ static int append_positions(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *
     rch_pos p;
     if (rch_pos_load(&p, cfg->positions_paths, cfg->n_positions_paths, 0.0, &in->robot.model, d) != 0)
         return -1;
+    if (rch_pos_targets_whole(&p, cfg->positions_paths, d) != 0) {
+        rch_pos_free(&p);
+        return -1;
+    }
     rc_sample *s = realloc(data->s, (data->n + p.n) * sizeof *s);
     if (s)
         data->s = s;

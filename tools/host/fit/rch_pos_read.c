@@ -35,6 +35,7 @@
 
 #include "rc_sensor.h"
 #include "rch_data.h"
+#include "rch_dequant.h"
 
 #define RAD2DEG (180.0 / 3.14159265358979323846)
 
@@ -428,6 +429,53 @@ static int rigid_fit(double *rms, rc_model *fit, const rc_model *m, const rc_sam
     return 0;
 }
 
+/* The joints' display step (deg; 0: not on one of 0.01 deg or coarser) of
+ * the tracker samples s (n), and the 3-D RMS by which that rounding alone
+ * moves the points of fit (its targets) at those joints: each joint's
+ * rounding error uniform in +-step/2 (variance step^2 / 12), through the
+ * point's joint Jacobian (central differences). */
+static double rounding_effect(double *step_deg, const rc_model *fit, const rc_sample *s, size_t n)
+{
+    *step_deg = 0.0;
+    const size_t k = n / 3;
+    double *v = malloc((k * RC_NJ + 1) * sizeof *v);
+    if (!v || k == 0) {
+        free(v);
+        return 0.0;
+    }
+    for (size_t i = 0; i < k; ++i)
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            v[i * RC_NJ + j] = s[3 * i].q_rad[j] * RAD2DEG;
+    *step_deg = rch_dequant_detect_step(v, k * RC_NJ);
+    free(v);
+    if (*step_deg < 0.01)
+        return 0.0;
+    unsigned nt = 0;
+    const int kf = rch_pos_effect_at(fit, RC_EFF_TRACKER_TARGETS, &nt);
+    const double h = 1e-6, var = (*step_deg / RAD2DEG) * (*step_deg / RAD2DEG) / 12.0;
+    double sum = 0.0;
+    for (size_t i = 0; i < k; ++i) {
+        const rc_sample *si = &s[3 * i];
+        const double zero[3] = {0.0, 0.0, 0.0};
+        const double *t = kf >= 0 && 3u * si->target + 2u < nt ? &fit->x[kf + 3 * (int)si->target] : zero;
+        for (unsigned j = 0; j < RC_NJ; ++j) {
+            double qa[RC_NJ], qb[RC_NJ], pa[3], pb[3], Ra[9], Rb[9];
+            memcpy(qa, si->q_rad, sizeof qa);
+            memcpy(qb, si->q_rad, sizeof qb);
+            qa[j] += h;
+            qb[j] -= h;
+            rc_fk(pa, Ra, fit, qa);
+            rc_fk(pb, Rb, fit, qb);
+            for (int c = 0; c < 3; ++c) {
+                const double da = pa[c] + Ra[3 * c] * t[0] + Ra[3 * c + 1] * t[1] + Ra[3 * c + 2] * t[2],
+                             db = pb[c] + Rb[3 * c] * t[0] + Rb[3 * c + 1] * t[1] + Rb[3 * c + 2] * t[2];
+                sum += (da - db) / (2.0 * h) * (da - db) / (2.0 * h) * var;
+            }
+        }
+    }
+    return sqrt(sum / (double)k);
+}
+
 /* Handedness (the best reflection against the best rotation) and the
  * controller's computed positions (a rigid fit to the rounding), for the
  * file's tracker samples s (n). 0 or -1 with d set. */
@@ -466,6 +514,27 @@ static int check_frame(const rc_model *m, const rc_sample *s, size_t n, double s
                      "%g mm; a real robot and tracker differ by 0.05 mm or more); give the tracker's measured x, y, z",
                      rp, step);
         rc = -1;
+    } else if (n / 3 >= RCH_POS_MIN_ROWS_RIGID + targets_of(s, n)) {
+        /* rounded joints: the controller's x, y, z are the nominal kinematics of the unrounded angles, so
+         * they miss those of the rounded ones by the rounding's effect alone (issue 47: 0.1 deg joints left
+         * about 0.5 mm, far above the x, y, z rounding, and passed as measurements) */
+        double qstep = 0.0;
+        const double eff = rounding_effect(&qstep, &fit[0], s, n), lim = sqrt(eff * eff + 0.25 * step * step);
+        /* the rigid fit's RMS with its degrees of freedom restored (the frame's 6, 3 per target): what the
+         * rounding left is then about lim; joints exactly on round values (a plan of whole degrees)
+         * leave the robot's own errors, whatever their size, so the window is two-sided */
+        const double k3 = (double)(n / 3 * 3), dof = k3 - 6.0 - 3.0 * targets_of(s, n);
+        const double rpc = dof > 0.0 ? rp * sqrt(k3 / dof) : rp;
+        if (eff > 0.0 && qstep >= RCH_POS_ROUNDING_MIN_DEG && rpc >= lim / RCH_POS_ROUNDING_RATIO &&
+            rpc <= RCH_POS_ROUNDING_RATIO * lim) {
+            rch_diag_set(d, path, 0, 0,
+                         "these are the controller's computed positions, not measurements: the robot's nominal "
+                         "kinematics at the joints give x, y, z to %.3g mm RMS after a rigid motion, what the joints' "
+                         "rounding to %g deg alone leaves (%.3g mm expected; a real robot and tracker differ by more); "
+                         "give the tracker's measured x, y, z",
+                         rp, qstep, eff);
+            rc = -1;
+        }
     }
 done:
     free(fit);
@@ -608,6 +677,32 @@ int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0,
         }
     }
     finish(out, next, pose0, sig, nsig);
+    return 0;
+}
+
+int rch_pos_targets_whole(const rch_pos *p, const char *const *paths, rch_diag *d)
+{
+    unsigned char seen[RC_MAX_TARGETS] = {0};
+    size_t first[RC_MAX_TARGETS] = {0};
+    for (size_t i = 0; i < p->n; ++i)
+        if (p->s[i].target < RC_MAX_TARGETS && !seen[p->s[i].target]) {
+            seen[p->s[i].target] = 1;
+            first[p->s[i].target] = i;
+        }
+    for (unsigned k = 0; k < p->n_targets && k < RC_MAX_TARGETS; ++k) {
+        if (seen[k])
+            continue;
+        unsigned above = k + 1;
+        while (above < p->n_targets && !seen[above])
+            ++above; /* the first label past the gap (there is one: n_targets is the largest + 1) */
+        const size_t i = first[above];
+        rch_diag_set(d, paths[p->file[i]], p->line[i], 1,
+                     "target %u, but no row has target %u: the targets are numbered 0, 1, ... without a gap (a "
+                     "target with no rows would be fitted from nothing, kept at the flange centre, and judge every "
+                     "later file there); renumber the target column or measure target %u",
+                     above, k, k);
+        return -1;
+    }
     return 0;
 }
 

@@ -51,6 +51,9 @@ typedef struct rch_pos {
 #define RCH_POS_MIRROR_MIN_MM 3.0  /* mirrored: the rotation leaves more than this (RMS, mm) */
 #define RCH_POS_MIRROR_RATIO 0.2   /*   and the reflection less than this part of it */
 #define RCH_POS_MIN_ROWS_RIGID 6   /* the controller's positions judged with rows >= this + targets */
+#define RCH_POS_ROUNDING_RATIO 1.25 /* rounded joints: the controller's positions when the rigid fit leaves what
+                                       the joints' rounding alone leaves, within this factor either way */
+#define RCH_POS_ROUNDING_MIN_DEG 0.05 /* joints on a display step of at least this (deg) are judged so */
 
 /* Load positions files paths (k), pose numbers counted on over the files
  * from pose0 (the merged data's first free number); limits: the robot's
@@ -76,6 +79,12 @@ int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0,
 /* The same for one file's text (len bytes; name in the diagnostics), the
  * joints not checked against limits, model's kinematics the nominal (NULL:
  * none). What fuzz/fuzz_pos_load.c drives. 0, or -1 with d set. */
+/* For a fit (calibrate, diagnose): every target label 0 .. n_targets - 1
+ * has rows; a gap is refused at the first row of the label after it (issue
+ * 47: target 1 absent was stored at (0, 0, 0), and evaluate then judged a
+ * 0.02 mm model 39 mm off). paths: the files p was loaded from. 0, or -1
+ * with d set. */
+int rch_pos_targets_whole(const rch_pos *p, const char *const *paths, rch_diag *d);
 int rch_pos_parse(rch_pos *out, const char *text, size_t len, const char *name, const rc_model *model, rch_diag *d);
 void rch_pos_free(rch_pos *p);
 

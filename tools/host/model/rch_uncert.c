@@ -13,6 +13,7 @@
 #include "rch_uncert.h"
 #include "rch_jac.h"
 #include "rch_prior.h"
+#include "rch_robot.h"
 #include "rch_stats.h"
 
 #include <lapacke.h>
@@ -412,6 +413,18 @@ static int comp_nominal(rch_uncert *u, const scaled *z, const rc_model *m, const
     for (unsigned a = 0; a < nf; ++a)
         if (u->cls[z->idx[a]] == RCH_PARAM_WEAK)
             u->comp_nominal[z->idx[a]] = 1;
+    /* a DH parameter the model file will call undetermined (a standard error
+     * above 1 m or 1 rad, rch_robot_unc_undetermined) is held too, whatever
+     * its null directions move: a share below RC_IDENT_SHARE of a weak
+     * direction seen at 1e-3 of the strongest can still give it 60 deg
+     * (alpha5 of compare's BC model on the real file); written "fitted",
+     * every reader refused it */
+    for (unsigned a = 0; a < nf; ++a) {
+        const unsigned k = z->idx[a];
+        const double lim = (k % 4 < 2) ? RCH_UNDETERMINED_MM2 : RCH_UNDETERMINED_RAD2;
+        if (k < RC_N_DH && !(u->cov[(size_t)k * np + k] <= lim))
+            u->comp_nominal[k] = 1;
+    }
     free(g);
     free(U);
     free(M);

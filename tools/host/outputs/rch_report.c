@@ -83,6 +83,7 @@ static int job_load(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
     j->c = rch_rep_cands_read(r, &j->n_c);
     j->n_a = rch_rep_accuracy_read(r, j->a);
     j->n_df = rch_rep_data_files(r, j->df);
+    rch_rep_aim(&r->aim, r, j->df, j->n_df);
     return 0;
 }
 

@@ -268,16 +268,47 @@ void rch_rep_sec_accuracy(rep *r, const arow *a, size_t n)
     FILE *f = r->f;
     rch_rep_section(r, "section 6 (predicted accuracy)", NULL);
     fputs("<section id=\"accuracy\"><h2>6. Predicted accuracy over the workspace</h2>\n<table class=\"kv\">\n", f);
+    const aim_fig *am = &r->aim;
+    /* the flange's workspace figure comes from the model file when the data see another point */
+    rch_rep_section(r, "section 6 (predicted accuracy)", am->seen ? HOW_MODEL : NULL);
     rch_rep_kv(r, "flange position, 95 %");
     fputs("inside the data &plusmn;", f);
-    rch_rep_put_sig(r, jnum(r->unc, "position95_mm.data_median"), " mm");
+    rch_rep_put_sig(r, am->after_median, " mm");
     fputs(" (median; up to &plusmn;", f);
-    rch_rep_put_sig(r, jnum(r->unc, "position95_mm.data_max"), " mm");
+    rch_rep_put_sig(r, am->after_max, " mm");
     fputs("), whole workspace &plusmn;", f);
-    rch_rep_put_sig(r, jnum(r->unc, "position95_mm.workspace_median"), " mm");
+    rch_rep_put_sig(r, am->ws_median, " mm");
     fputs(" (median; up to &plusmn;", f);
-    rch_rep_put_sig(r, jnum(r->unc, "position95_mm.workspace_max"), " mm");
+    rch_rep_put_sig(r, am->ws_max, " mm");
     fputs(")", f);
+    rch_rep_kv_end(r);
+    if (am->seen) {
+        /* the calibration's map is at the point the data see */
+        rch_rep_kv(r, "the point the data see, 95 %");
+        rch_rep_put_esc(f, am->seen);
+        fputs(": inside the data &plusmn;", f);
+        rch_rep_put_sig(r, jnum(r->unc, "position95_mm.data_median"), " mm");
+        fputs(" (median; up to &plusmn;", f);
+        rch_rep_put_sig(r, jnum(r->unc, "position95_mm.data_max"), " mm");
+        fputs("), whole workspace &plusmn;", f);
+        rch_rep_put_sig(r, jnum(r->unc, "position95_mm.workspace_median"), " mm");
+        fputs(" (compensation never aims at it)", f);
+        rch_rep_kv_end(r);
+    }
+    rch_rep_kv(r, "flange, uncompensated");
+    if (isfinite(am->before_median)) {
+        fputs("the nominal table misses it by ", f);
+        rch_rep_put_sig(r, am->before_median, " mm");
+        fputs(" (median; up to ", f);
+        rch_rep_put_sig(r, am->before_max, " mm");
+        fprintf(f, ") over %s%zu poses, as the calibrated model predicts", am->before_over_data ? "the data's " : "",
+                am->before_n);
+        if (!am->before_over_data)
+            fputs(" (random, in the joint limits: the data files cannot be read from here)", f);
+    } else {
+        fputs(NA, f);
+        rch_rep_missing(r, "the uncompensated figure", HOW_MODEL);
+    }
     rch_rep_kv_end(r);
     rch_rep_kv(r, "flange orientation, 95 %");
     fputs("inside the data &plusmn;", f);

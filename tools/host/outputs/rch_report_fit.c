@@ -206,7 +206,7 @@ static void params_table(rep *r, const prow *p, size_t n)
         have_cls |= p[k].cls[0] != '\0';
         have_comp |= p[k].comp[0] != '\0';
     }
-    fputs("<table><tr><th class=\"l\">parameter</th><th>unit</th><th>nominal</th><th>calibrated</th>"
+    fputs("<table class=\"p\"><tr><th class=\"l\">parameter</th><th>unit</th><th>nominal</th><th>calibrated</th>"
           "<th>correction</th>",
           f);
     if (have_se)
@@ -417,7 +417,9 @@ void rch_rep_sec_params(rep *r, const prow *p, size_t n)
         rch_rep_put_num(r, jnum(r->unc, "sigma_mm"), "%.4g mm");
         fprintf(f, " (%s)", r->unc_from);
     }
-    fputs("</p>\n<div class=\"row\"><div style=\"flex:0 0 auto\">\n", f);
+    /* the table scrolls inside its own box, never past the page's edge (issue 47: a plate's 37 rows and
+     * their flags cut at the right edge) */
+    fputs("</p>\n<div class=\"row\"><div class=\"tw\">\n", f);
     params_table(r, p, n);
     fputs("<p class=\"note\" style=\"max-width:520px\">correction: against the nominal table (DH) or the encoder outlet's first estimate "
           "(ex, ey, ez).</p>\n</div><div style=\"display:flex;flex-direction:column;gap:10px\">\n",

@@ -10,6 +10,7 @@
  *   rch_report_model.c     the run's JSON into the model (dotted paths, rows)
  *   rch_report_chart.c     the charts (horizontal rows on files/rch_svg)
  *   rch_report_warn.c      the warnings the page lists
+ *   rch_report_aim.c       the headline's figures at the flange, before and after
  *   rch_report_html.c      the page's pieces: values or "not in this run",
  *                          key-value rows, JSON tables, CSS, head and verdict
  *   rch_report_fit.c       sections 1-4: data, split, before/after, parameters
@@ -56,6 +57,19 @@ enum {
 };
 extern const char *const rch_rep_colour[C_N]; /* "#rrggbb" of each C_ */
 
+/* The headline's figures at the point compensation aims at (the flange
+ * centre; rch_report_aim.c). NaN where the run has none. */
+typedef struct {
+    const char *point;               /* "the flange centre" (or "the measured point": an output that names none) */
+    double after_median, after_max;  /* 95 % position radius after compensation over the data's poses */
+    double ws_median, ws_max;        /* the same over random poses in the joint limits */
+    const char *seen;                /* the point the data see when it is not the flange, else NULL */
+    double seen_median;              /* its figure (what the headline said before issue 47) */
+    double before_median, before_max; /* uncompensated: |flange of the calibrated model - nominal|, mm */
+    size_t before_n;                 /* over how many poses */
+    int before_over_data;            /* 1: the data's poses, 0: random poses in the joint limits */
+} aim_fig;
+
 typedef struct {
     FILE *f; /* the HTML */
     const rch_json *cal, *diag, *model;
@@ -67,6 +81,7 @@ typedef struct {
     char warn[RCH_REPORT_MAX_WARN][640];
     unsigned n_warn;
     const char *section, *where, *how; /* what a "not in this run" here stands for, and how to get it */
+    aim_fig aim; /* the headline's figures (rch_rep_aim) */
 } rep;
 
 /* How a run gets what the diagnosis, the model file or a truth holds. */
@@ -147,6 +162,10 @@ size_t rch_rep_accuracy_read(const rep *r, arow out[10]);
 size_t rch_rep_data_files(const rep *r, dfile out[MAX_DFILES]);
 /* A provenance member, else the calibration's own. */
 const char *rch_rep_prov_str(const rep *r, const char *key);
+
+/* The headline's figures at the flange centre, after and before
+ * compensation (rch_report_aim.c; the model file of --model for before). */
+void rch_rep_aim(aim_fig *a, const rep *r, const dfile *df, size_t n_df);
 
 /* ---- charts: horizontal rows, bars from zero or dots with 95 % intervals (rch_report_chart.c) */
 

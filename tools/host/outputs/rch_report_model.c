@@ -169,6 +169,9 @@ size_t rch_rep_accuracy_read(const rep *r, arow out[10])
         {"95 % inside the data, max", "position95_mm.data_max", 0, C_PRED},
         {"95 % whole workspace, median", "position95_mm.workspace_median", 0, C_PRED},
         {"95 % whole workspace, max", "position95_mm.workspace_max", 0, C_PRED},
+        /* when the data see another point than the flange (the rows above are at it) */
+        {"95 % at the flange, median", "seen_point.flange_position95_median_mm", 0, C_AFTER},
+        {"95 % at the flange, max", "seen_point.flange_position95_max_mm", 0, C_AFTER},
         {"truth, before: RMS", "truth_flange.before_rms_mm", 1, C_BEFORE},
         {"truth, before: max", "truth_flange.before_max_mm", 1, C_BEFORE},
         {"truth, after: RMS", "truth_flange.after_rms_mm", 1, C_AFTER},

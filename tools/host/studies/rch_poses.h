@@ -105,6 +105,14 @@ typedef struct rch_poses_result {
     size_t rows_per_outlet[RC_MAX_OUTLETS];
     size_t rows_advised;       /* fewest rows advised: calibrate's parameters (the free ones + the cable
                                   attachment it tries) + RCH_POSES_ROWS_SPARE */
+    /* with a tool plate (c->n_points > 0, the position criterion): what each further point gains, the
+     * plan's poses measured on points 0..j only (by_points[j - 1]), predicted at the same point */
+    unsigned n_points;
+    struct {
+        size_t rows;
+        int ok;                   /* 0: the prediction failed (why: not kept) */
+        rch_poses_accuracy acc;
+    } by_points[RC_MAX_TARGETS];
 } rch_poses_result;
 /* `rcal calibrate` estimates the noise from its residuals (SSR / (n - p_eff)):
  * with about as many rows as parameters the estimate collapses, the prior
