@@ -89,26 +89,29 @@ int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_de
         const double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm
                            : !unc || unc->has_prior ? INFINITY
                                                     : 1.0;
+        /* beyond the limit: a known u95 above it (or not a number), an
+         * unknown one against a limit the user set */
+        const int beyond = unc ? !(u95 <= lim) : isfinite(lim);
         char u95s[64];
         if (isnan(u95))
             snprintf(u95s, sizeof u95s, "unknown (the model carries no uncertainty)");
         else
             snprintf(u95s, sizeof u95s, "%.4f mm", u95);
-        if (!(u95 <= lim) && c->gate->u95_policy == RCH_COMP_U95_REFUSE) {
+        if (beyond && c->gate->u95_policy == RCH_COMP_U95_REFUSE) {
             rch_diag_set(d, c->in_name, line, 0,
                          "the model's 95 %% position uncertainty at the compensated point is %s here, above %.4f mm "
                          "(--u95-policy refuse: nothing written)",
                          u95s, lim);
             return -1;
         }
-        if (!(u95 <= lim) && c->gate->u95_policy == RCH_COMP_U95_WARN) {
+        if (beyond && c->gate->u95_policy == RCH_COMP_U95_WARN) {
             c->res->n_uncertain++;
             if (c->warn)
                 fprintf(c->warn,
                         "%s:%u: warning: compensated, but the model's 95 %% position uncertainty at the "
                         "compensated point is %s here, above %.4f mm\n",
                         c->in_name, line, u95s, lim);
-        } else if (!(u95 <= lim)) {
+        } else if (beyond) {
             for (unsigned i = 0; i < RC_NJ; ++i)
                 out_deg[i] = in_deg[i];
             u95_line(c, line, rch_comp_u95_written(u95, 3, 0.0));

@@ -61,7 +61,10 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
     if (calibrated)
         rch_comp_determined(&cs->det, &cs->unc, &version1, held, sizeof held, robot, &robot->nominal);
     const int orient = cs->unc.present && !version1 && cs->unc.orientation_determined;
-    const int pos_only = position_only == 1 || (position_only == 0 && !orient && calibrated);
+    rch_comp_orient od; /* the mode as rch_comp_run chooses it */
+    rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det,
+                           nominal ? &nominal->robot.model : &robot->nominal);
+    const int pos_only = rch_comp_position_only(&od, position_only == 1, position_only == 2, calibrated, orient);
     rch_comp_point_model(&cs->det, &cs->det, tool_mm);
     rch_comp_point_model(&cs->nom_pt, nominal ? &nominal->robot.model : &robot->nominal, tool_mm);
     rc_comp_config cfg;
@@ -75,7 +78,7 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
                     rc_strerror(st0));
     }
     const rch_model_unc *gate = cs->unc.present && !version1 ? &cs->unc : NULL;
-    const double lim = max_unc_mm > 0 ? max_unc_mm : gate && gate->has_prior ? INFINITY : 1.0;
+    const double lim = max_unc_mm > 0 ? max_unc_mm : !gate || gate->has_prior ? INFINITY : 1.0;
     const rc_model *m = &cs->det;
     int rc = RCH_FFI_OK;
     for (size_t i = 0; i < n && rc == RCH_FFI_OK; ++i) {
@@ -97,14 +100,16 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
         const double u95 = !gate ? NAN
                            : gate->has_prior ? rch_model_unc_radius95_mm(gate, m, qd)
                                              : rch_model_unc_pos95_mm(gate, m, qd);
-        if (gate && !(u95 <= lim) && u95_policy == 2) {
+        /* no uncertainty: u95 NaN (unknown), beyond any limit the caller sets (as rch_comp.c) */
+        const int beyond = gate ? !(u95 <= lim) : isfinite(lim);
+        if (beyond && u95_policy == 2) {
             if (err && err_len > 0)
                 snprintf(err, err_len, "target %zu: the model's 95 %% position uncertainty at the compensated point is "
                          "%.4f mm here, above %.4f mm (u95_policy refuse: nothing returned)", i, u95, lim);
             rc = RCH_FFI_ERR_RANGE;
             break;
         }
-        if (gate && !(u95 <= lim) && u95_policy == 0) {
+        if (beyond && u95_policy == 0) {
             for (unsigned j = 0; j < RC_NJ; ++j)
                 out_deg[RC_NJ * i + j] = in[j]; /* left uncompensated: uncertainty above the limit */
             if (status)
@@ -125,4 +130,34 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
     }
     free(cs);
     return rc;
+}
+
+int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nominal, int position_only, double out[4],
+                            char *err, size_t err_len)
+{
+    if (!cal || !out)
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate_mode: NULL argument");
+    if (position_only < 0 || position_only > 2)
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate_mode: position_only must be 0, 1 or 2");
+    comp_setup *cs = malloc(sizeof *cs);
+    if (!cs)
+        return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
+    const rch_robot *robot = &cal->robot;
+    int version1 = 0;
+    char held[256];
+    cs->det = robot->model;
+    memset(&cs->unc, 0, sizeof cs->unc);
+    const int calibrated = robot->has_nominal || robot->unc.present;
+    if (calibrated)
+        rch_comp_determined(&cs->det, &cs->unc, &version1, held, sizeof held, robot, &robot->nominal);
+    rch_comp_orient od;
+    rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det,
+                           nominal ? &nominal->robot.model : &robot->nominal);
+    out[0] = rch_comp_position_only(&od, position_only == 1, position_only == 2, calibrated,
+                                    cs->unc.present && !version1 && cs->unc.orientation_determined);
+    out[1] = position_only ? 0.0 : od.known ? 1.0 : 2.0;
+    out[2] = od.known ? od.uncorr_deg : NAN;
+    out[3] = od.known ? od.unc_deg : NAN;
+    free(cs);
+    return RCH_FFI_OK;
 }
