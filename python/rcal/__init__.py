@@ -808,8 +808,8 @@ def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=Non
         u = _rows(u95, n, 1, single, numpy)
         mode = (ctypes.c_double * 4)()
         _check(lib.rch_ffi_compensate_mode(cal._h, nom._h if nom is not None else None,
-                                           0 if position_only is None else (1 if position_only else 2), mode, err,
-                                           _ERR_LEN), err)
+                                           0 if position_only is None else (1 if position_only else 2),
+                                           float(max_dev_deg), tool, mode, err, _ERR_LEN), err)
         orient = {"corrected": mode[0] == 0.0, "chosen_by": ("option", "uncertainty", "model_file")[int(mode[1])],
                   "uncorrected_rms_deg": mode[2], "correction_error_rms_deg": mode[3]}
         return Compensation(corrected, codes[0] if single else codes, u, orient)

@@ -84,47 +84,49 @@ static void make_unc(rch_model_unc *u, unsigned k, double sd_k, rch_prior_class 
     u->prior_cls[k] = (uint8_t)cls_k;
 }
 
-/* alpha5 tilts the flange z axis by itself at every pose (it turns frame 5
- * about x5, and z6 = z5 with alpha6 0); its uncertainty is all tilt too: the
- * decision is |d alpha5| against its sd. */
+/* alpha6 tilts the flange z axis by itself at every pose (it turns the
+ * flange about its x axis after the last translation: the flange point does
+ * not move, so position-only compensation moves no joint); its uncertainty
+ * is all tilt too: the decision is |d alpha6| against its sd. */
 static void test_decide_weighs_tilt_against_uncertainty(void **state)
 {
     (void)state;
     rc_model det = nom.model;
     const double d_rad = 0.3 * DEG;
-    det.x[RC_P_ALPHA(4)] += d_rad;
+    det.x[RC_P_ALPHA(5)] += d_rad;
     rch_model_unc u;
     rch_comp_orient o;
 
-    make_unc(&u, RC_P_ALPHA(4), 0.2 * DEG, RCH_PRIOR_CLASS_DETERMINED);
-    rch_comp_orient_decide(&o, &u, &det, &nom.model);
+    make_unc(&u, RC_P_ALPHA(5), 0.2 * DEG, RCH_PRIOR_CLASS_DETERMINED);
+    rch_comp_orient_decide(&o, &u, &det, &nom.model, NULL);
     assert_true(o.known);
     if (fabs(o.uncorr_deg - 0.3) > 1e-6 || fabs(o.unc_deg - 0.2) > 1e-6)
         fail_msg("tilt %.9f deg (expected 0.3), its predicted error %.9f deg (expected 0.2)", o.uncorr_deg, o.unc_deg);
     assert_true(o.correct);
     assert_int_equal(rch_comp_position_only(&o, 0, 0, 1, 0), 0);
 
-    make_unc(&u, RC_P_ALPHA(4), 0.4 * DEG, RCH_PRIOR_CLASS_DETERMINED);
-    rch_comp_orient_decide(&o, &u, &det, &nom.model);
+    make_unc(&u, RC_P_ALPHA(5), 0.4 * DEG, RCH_PRIOR_CLASS_DETERMINED);
+    rch_comp_orient_decide(&o, &u, &det, &nom.model, NULL);
     assert_true(o.known && !o.correct);
     assert_true(fabs(o.unc_deg - 0.4) < 1e-6);
     assert_int_equal(rch_comp_position_only(&o, 0, 0, 1, 1), 1); /* the file's flag no longer decides */
     /* the options still force either */
     assert_int_equal(rch_comp_position_only(&o, 0, 1, 1, 0), 0);
-    make_unc(&u, RC_P_ALPHA(4), 0.2 * DEG, RCH_PRIOR_CLASS_DETERMINED);
-    rch_comp_orient_decide(&o, &u, &det, &nom.model);
+    make_unc(&u, RC_P_ALPHA(5), 0.2 * DEG, RCH_PRIOR_CLASS_DETERMINED);
+    rch_comp_orient_decide(&o, &u, &det, &nom.model, NULL);
     assert_int_equal(rch_comp_position_only(&o, 1, 0, 1, 1), 1);
 
     /* a parameter the data left to the prior: its estimate sits at the
      * drawing's value whatever is chosen, it does not weigh */
-    make_unc(&u, RC_P_ALPHA(4), 0.4 * DEG, RCH_PRIOR_CLASS_PRIOR_ONLY);
-    rch_comp_orient_decide(&o, &u, &det, &nom.model);
+    make_unc(&u, RC_P_ALPHA(5), 0.4 * DEG, RCH_PRIOR_CLASS_PRIOR_ONLY);
+    rch_comp_orient_decide(&o, &u, &det, &nom.model, NULL);
     assert_true(o.unc_deg < 1e-5 && o.correct);
 }
 
-/* theta6 turns the flange about its own z axis: the tool's axis does not
- * tilt, so however sure the model is of it, correcting gains the axis
- * nothing (a full-rotation rule would have corrected it). */
+/* theta6 turns the flange about its own z axis (a6 is 0: the flange point
+ * does not move): the tool's axis does not tilt, so however sure the model
+ * is of it, correcting gains the axis nothing (a full-rotation rule would
+ * have corrected it). */
 static void test_decide_roll_is_not_tilt(void **state)
 {
     (void)state;
@@ -133,13 +135,13 @@ static void test_decide_roll_is_not_tilt(void **state)
     rch_model_unc u;
     rch_comp_orient o;
     make_unc(&u, RC_P_ALPHA(3), 0.01 * DEG, RCH_PRIOR_CLASS_DETERMINED);
-    rch_comp_orient_decide(&o, &u, &det, &nom.model);
+    rch_comp_orient_decide(&o, &u, &det, &nom.model, NULL);
     assert_true(o.known);
     if (!(o.uncorr_deg < 1e-6))
         fail_msg("a roll about the flange z axis tilts it by %.9f deg", o.uncorr_deg);
     assert_false(o.correct);
     /* without a covariance: not decided here, the file's flag decides */
-    rch_comp_orient_decide(&o, NULL, &det, &nom.model);
+    rch_comp_orient_decide(&o, NULL, &det, &nom.model, NULL);
     assert_false(o.known);
     assert_int_equal(rch_comp_position_only(&o, 0, 0, 1, 0), 1);
     assert_int_equal(rch_comp_position_only(&o, 0, 0, 0, 0), 0); /* a bare model: full pose, as before */
@@ -171,8 +173,11 @@ static void test_command_says_which(void **state)
     int v1;
     char held[256];
     rch_comp_determined(&det, &unc, &v1, held, sizeof held, &cal, &cal.nominal);
+    rc_model nom_pt; /* the run's point models: the flange (no --tool), without the cable attachment */
+    rch_comp_point_model(&det, &det, NULL);
+    rch_comp_point_model(&nom_pt, &cal.nominal, NULL);
     rch_comp_orient o;
-    rch_comp_orient_decide(&o, &unc, &det, &cal.nominal);
+    rch_comp_orient_decide(&o, &unc, &det, &nom_pt, NULL);
     assert_true(o.known);
 
     snprintf(cmd, sizeof cmd, "'%s' compensate --model '%s' --in '%s' --out '%s' --summary 2> '%s'", RCAL, mp, in, out,

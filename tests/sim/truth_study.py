@@ -97,6 +97,7 @@ def clipped(rng, scale, lim):
 # "wide" (issue 32: wider and heavier-tailed than rcal's prior, whose sd are
 # 0.5 mm, 0.1 deg, 1 deg): Student-t(3) 1 mm up to 3 mm, 0.2 deg up to 0.6 deg.
 ERRORS = "study"
+POOL = []  # per case (true errors, u95) of the targets, for the figures pooled over the robots
 MODE = "position-only"  # --mode: how compensate is asked to treat the orientation
 STATED_ATTACH = 0.0  # --stated-attach: the attachment told to rcal, measured to this sd (mm); 0: not told
 
@@ -385,6 +386,7 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
         res["u95_cover"] = float(np.mean(e_c <= u95))
         res["u95_over_p95"] = float(np.median(u95[known]) / max(np.percentile(e_c, 95), 1e-12)) if known.any() \
             else float("nan")
+        POOL.append((e_c, u95))
         res["u95_ratio_p95"] = float(np.percentile(e_c / np.maximum(u95, 1e-12), 95))
         res["u95_med"] = float(np.median(u95))
     return res
@@ -492,6 +494,14 @@ def main():
                       "highest %.2f); targets with an unknown u95 %.3f" % (
                           label, np.nanmedian(ratio), np.nanmin(ratio), np.nanmax(ratio),
                           1.0 - np.mean([r.get("u95_known", 1.0) for r in sel])))
+                if label == "all" and POOL:  # pooled over every robot's targets: the figure of a calibrated u95
+                    e = np.concatenate([a for a, _ in POOL])
+                    u = np.concatenate([b for _, b in POOL])
+                    fin = np.isfinite(u)
+                    print("%-10s pooled over all robots: median u95 %.4f mm / 95th percentile of the true errors "
+                          "%.4f mm = %.2f; coverage %.3f" % (label, np.median(u[fin]), np.percentile(e, 95),
+                                                              np.median(u[fin]) / np.percentile(e, 95),
+                                                              np.mean(e <= u)))
     if a.json:
         with open(a.json, "w") as f:
             json.dump(out, f, indent=1)

@@ -132,17 +132,20 @@ double rch_comp_u95_written(double u95_mm, int status, double miss_mm);
 /* Whether compensation corrects the orientation when neither
  * --position-only nor --full-pose forces it (issue 47): when doing so is
  * expected to leave the tool's orientation closer to the program's than not
- * doing it. Over RCH_COMP_ORIENT_POSES poses uniform in the joint limits
- * (fixed seed): delta, the angle between the calibrated (determined) and the
- * nominal flange orientation (what is left uncorrected in position-only
- * mode), and tr C_r, the predicted variance of the orientation after
- * correcting (rch_model_unc_rot_trace, determined part: parameters the data
- * left to the prior sit at the drawing's value either way). |delta|^2 is
- * the true uncorrected error squared plus tr C_r on average, so the
- * uncorrected error is expected at mean |delta|^2 - mean tr C_r and the
- * corrected one at mean tr C_r: corrected when mean |delta|^2 > 2 mean tr C_r
- * (uncorr_deg > sqrt 2 unc_deg). A model without a covariance (rcal-model/1)
- * is not decided (known 0): position only, as before. */
+ * doing it. The tool's axis is the flange z axis (a spindle's or a wheel's
+ * on the flange). Over RCH_COMP_ORIENT_POSES poses q uniform in the joint
+ * limits (fixed seed): delta, the tilt of that axis that position-only
+ * compensation leaves on the calibrated (determined) model, the angle
+ * between its z axis at the position-only solution q' and the nominal one at
+ * q (the calibrated-vs-nominal rotation at the target, turned by the
+ * correction's own joint moves); and tr C_r, the predicted variance of the
+ * tilt after correcting (rch_model_unc_rot_trace at q', the rotation
+ * perpendicular to the axis; determined part: parameters the data left to
+ * the prior sit at the drawing's value either way, and a roll about the
+ * axis does not move it). Corrected when the RMS of delta exceeds the RMS
+ * of the predicted error (uncorr_deg > unc_deg). A model without a
+ * covariance (rcal-model/1) is not decided (known 0): position only, as
+ * before. */
 #define RCH_COMP_ORIENT_POSES 256
 typedef struct rch_comp_orient {
     int known;         /* the model carries a covariance: the figures are numbers */
@@ -150,10 +153,12 @@ typedef struct rch_comp_orient {
     double uncorr_deg; /* RMS over the poses of the calibrated-vs-nominal flange rotation angle */
     double unc_deg;    /* RMS over the poses of the predicted orientation error after correcting */
 } rch_comp_orient;
-/* det: the determined model, nominal: the model the targets were made with;
- * unc NULL or without a covariance: known 0, correct 0. */
+/* det: the determined model, nominal: the model the targets were made with
+ * (both at the point compensated: rch_comp_point_model); cfg: the run's
+ * (its bound; NULL: defaults). unc NULL or without a covariance: known 0,
+ * correct 0. */
 void rch_comp_orient_decide(rch_comp_orient *o, const rch_model_unc *unc, const rc_model *det,
-                            const rc_model *nominal);
+                            const rc_model *nominal, const rc_comp_config *cfg);
 /* The mode a run uses: 1 position only. forced_position / forced_pose: the
  * options; calibrated: the model file has a nominal table or an uncertainty
  * (a bare model is compensated in full pose, as before). */

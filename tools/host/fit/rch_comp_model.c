@@ -101,11 +101,17 @@ unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, c
 }
 
 void rch_comp_orient_decide(rch_comp_orient *o, const rch_model_unc *unc, const rc_model *det,
-                            const rc_model *nominal)
+                            const rc_model *nominal, const rc_comp_config *cfg)
 {
     memset(o, 0, sizeof *o);
     if (!unc || !unc->present)
         return;
+    rc_comp_config pc; /* the position-only mode of the run */
+    if (cfg)
+        pc = *cfg;
+    else
+        memset(&pc, 0, sizeof pc);
+    pc.flags |= RC_COMP_FLAG_POSITION_ONLY;
     rc_rng g;
     rc_rng_seed(&g, 20261205u);
     double sd = 0.0, st = 0.0;
@@ -114,7 +120,18 @@ void rch_comp_orient_decide(rch_comp_orient *o, const rch_model_unc *unc, const 
         double q[RC_NJ], p[3], Rc[9], Rn[9], D[9], w[3];
         for (unsigned j = 0; j < RC_NJ; ++j)
             q[j] = det->q_min_rad[j] + (det->q_max_rad[j] - det->q_min_rad[j]) * rc_rng_u01(&g);
-        rc_fk(p, Rc, det, q);
+        /* what position-only compensation leaves: the calibrated orientation at
+         * its joints q' (its correction turns the flange too) against the
+         * nominal one at the target */
+        rc_real qr[RC_NJ], qc[RC_NJ];
+        double qcd[RC_NJ];
+        rc_comp_result cr;
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            qr[j] = (rc_real)q[j];
+        (void)rc_comp_joint(qc, &cr, det, nominal, qr, NULL, &pc); /* not converged: its best point */
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            qcd[j] = (double)qc[j];
+        rc_fk(p, Rc, det, qcd);
         rc_fk(p, Rn, nominal, q);
         for (int r = 0; r < 3; ++r) /* D = Rc Rn^T: the uncorrected rotation, base frame */
             for (int c = 0; c < 3; ++c)
@@ -123,7 +140,7 @@ void rch_comp_orient_decide(rch_comp_orient *o, const rch_model_unc *unc, const 
         const double z[3] = {Rc[2], Rc[5], Rc[8]}; /* the tool's axis: the flange z axis */
         const double wz = w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
         const double a2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - wz * wz;
-        const double t = rch_model_unc_rot_trace(unc, det, q, 1, z);
+        const double t = rch_model_unc_rot_trace(unc, det, qcd, 1, z);
         if (!isfinite(a2) || !isfinite(t))
             continue;
         sd += a2 > 0.0 ? a2 : 0.0;

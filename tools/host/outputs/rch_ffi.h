@@ -352,15 +352,16 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
                        double *u95_mm, const double *q_deg, size_t n, int position_only, double max_dev_deg,
                        double max_unc_mm, int u95_policy, const double *tool_mm, char *err, size_t err_len);
 
-/* How rch_ffi_compensate with these arguments treats the orientation, as
+/* How rch_ffi_compensate with these arguments (position_only, max_dev_deg,
+ * tool_mm: as there) treats the orientation, as
  * `rcal compensate --summary` says it: out[0] 1 position only, 0 position
  * and orientation; out[1] what chose it: 0 the option (position_only 1 or
  * 2), 1 the model's uncertainty (rch_comp_orient_decide), 2 the model file
  * (no covariance to weigh by); out[2] the calibrated-vs-nominal tilt of the
  * tool's axis (the flange z axis), RMS over the joint limits, deg; out[3] the
  * correction's predicted error of that tilt, RMS, deg (NaN: not known). */
-int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nominal, int position_only, double out[4],
-                            char *err, size_t err_len);
+int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nominal, int position_only,
+                            double max_dev_deg, const double *tool_mm, double out[4], char *err, size_t err_len);
 
 /* ---- export and report (rcal export, rcal report) ---- */
 

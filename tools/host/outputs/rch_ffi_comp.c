@@ -61,15 +61,16 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
     if (calibrated)
         rch_comp_determined(&cs->det, &cs->unc, &version1, held, sizeof held, robot, &robot->nominal);
     const int orient = cs->unc.present && !version1 && cs->unc.orientation_determined;
-    rch_comp_orient od; /* the mode as rch_comp_run chooses it */
-    rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det,
-                           nominal ? &nominal->robot.model : &robot->nominal);
-    const int pos_only = rch_comp_position_only(&od, position_only == 1, position_only == 2, calibrated, orient);
     rch_comp_point_model(&cs->det, &cs->det, tool_mm);
     rch_comp_point_model(&cs->nom_pt, nominal ? &nominal->robot.model : &robot->nominal, tool_mm);
     rc_comp_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.max_dev_rad = (rc_real)(max_dev_deg * DEG);
+    rch_comp_orient od; /* the mode as rch_comp_run chooses it */
+    memset(&od, 0, sizeof od);
+    if (position_only == 0)
+        rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det, &cs->nom_pt, &cfg);
+    const int pos_only = rch_comp_position_only(&od, position_only == 1, position_only == 2, calibrated, orient);
     cfg.flags = pos_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
     const rc_status st0 = rc_comp_stream_init(&cs->s, &cs->det, &cs->nom_pt, &cfg);
     if (st0 != RC_OK) {
@@ -132,13 +133,14 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
     return rc;
 }
 
-int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nominal, int position_only, double out[4],
-                            char *err, size_t err_len)
+int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nominal, int position_only,
+                            double max_dev_deg, const double *tool_mm, double out[4], char *err, size_t err_len)
 {
     if (!cal || !out)
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate_mode: NULL argument");
-    if (position_only < 0 || position_only > 2)
-        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate_mode: position_only must be 0, 1 or 2");
+    if (position_only < 0 || position_only > 2 || !(max_dev_deg >= 0.0) || !isfinite(max_dev_deg))
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
+                    "compensate_mode: position_only must be 0, 1 or 2, max_dev_deg finite and >= 0");
     comp_setup *cs = malloc(sizeof *cs);
     if (!cs)
         return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
@@ -150,9 +152,15 @@ int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nomin
     const int calibrated = robot->has_nominal || robot->unc.present;
     if (calibrated)
         rch_comp_determined(&cs->det, &cs->unc, &version1, held, sizeof held, robot, &robot->nominal);
+    rch_comp_point_model(&cs->det, &cs->det, tool_mm);
+    rch_comp_point_model(&cs->nom_pt, nominal ? &nominal->robot.model : &robot->nominal, tool_mm);
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.max_dev_rad = (rc_real)(max_dev_deg * DEG);
     rch_comp_orient od;
-    rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det,
-                           nominal ? &nominal->robot.model : &robot->nominal);
+    memset(&od, 0, sizeof od);
+    if (position_only == 0)
+        rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det, &cs->nom_pt, &cfg);
     out[0] = rch_comp_position_only(&od, position_only == 1, position_only == 2, calibrated,
                                     cs->unc.present && !version1 && cs->unc.orientation_determined);
     out[1] = position_only ? 0.0 : od.known ? 1.0 : 2.0;
