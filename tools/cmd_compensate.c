@@ -33,10 +33,10 @@ static void print_orientation(const rch_comp_result *r)
                 r->position_only_used ? "--position-only" : "--full-pose");
     } else if (r->orient.known) {
         fprintf(stderr,
-                "rcal compensate: orientation %s: the calibrated model tilts the tool's axis (the flange z axis) "
-                "from the nominal one by %.4f deg (RMS over the joint limits), the correction's predicted error is "
-                "%.4f deg: correcting is expected to leave the axis %s (--position-only / --full-pose force "
-                "either)\n",
+                "rcal compensate: orientation %s: position only, the calibrated model leaves the tool's axis (the "
+                "flange z axis) %.4f deg off the nominal one (RMS over the joint limits); corrected, its predicted "
+                "error is %.4f deg: correcting is expected to leave the axis %s (--position-only / --full-pose "
+                "force either)\n",
                 r->position_only_used ? "not corrected" : "corrected", r->orient.uncorr_deg, r->orient.unc_deg,
                 r->position_only_used ? "no closer than not correcting" : "closer than not correcting");
     } else {

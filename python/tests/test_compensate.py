@@ -105,8 +105,8 @@ def test_orientation_mode_as_cli(cal_file, run_cli, tmp_path):
     src.write_text("".join(",".join("%.4f" % v for v in r) + "\n" for r in rows))
     p = run_cli("compensate", "--model", str(cal_file), "--in", str(src), "--out", str(tmp_path / "o.csv"),
                 "--summary")
-    m = re.search(r"orientation (corrected|not corrected): the calibrated model tilts the tool's axis \(the flange "
-                  r"z axis\) from the nominal one by ([0-9.]+) deg .*?predicted error is ([0-9.]+) deg", p.stderr)
+    m = re.search(r"orientation (corrected|not corrected): position only, the calibrated model leaves the tool's "
+                  r"axis \(the flange z axis\) ([0-9.]+) deg off .*?predicted error is ([0-9.]+) deg", p.stderr)
     assert m, p.stderr
     c = rcal.compensate(model, rows, details=True)
     o = c.orientation

@@ -185,8 +185,8 @@ static void test_command_says_which(void **state)
     assert_int_equal(run(cmd), 0);
     const char *txt = slurp(err);
     char want[256];
-    snprintf(want, sizeof want, "orientation %s: the calibrated model tilts the tool's axis (the flange z axis) "
-                                "from the nominal one by %.4f deg",
+    snprintf(want, sizeof want, "orientation %s: position only, the calibrated model leaves the tool's axis (the "
+                                "flange z axis) %.4f deg off the nominal one",
              o.correct ? "corrected" : "not corrected", o.uncorr_deg);
     if (!strstr(txt, want))
         fail_msg("--summary lacks \"%s\":\n%s", want, txt);
