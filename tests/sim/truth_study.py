@@ -422,6 +422,12 @@ def main():
                          "with --full-pose")
     ap.add_argument("--tool-axis", default="0,0,1",
                     help="the tool's axis in the flange frame whose angle after compensation is measured")
+    ap.add_argument("--axis-goal", type=float, default=0.0, metavar="DEG",
+                    help="with --check: the tool axis after compensation at most DEG (median over the robots of their "
+                         "median) and, on that median, not worse than uncompensated; 0: not checked")
+    ap.add_argument("--u95-ratio-goal", type=float, default=0.0, metavar="R",
+                    help="with --check: the median u95 at most R x the 95th percentile of the true errors, both pooled "
+                         "over every robot's targets, with a pooled coverage of at least 0.9; 0: not checked")
     ap.add_argument("--stated-attach", type=float, default=0.0, metavar="SD",
                     help="tell rcal where the cable is attached (--cable-point), measured to SD mm (sd; "
                          "--cable-point-sd SD), as a user with a drawing or a caliper would; 0: not told")
@@ -527,6 +533,17 @@ def main():
     cov = [r["u95_cover"] for r in ok if "u95_cover" in r]
     check(len(cov) == len(ok) and np.median(cov) >= 0.9, "u95_mm covers the truth at %.3f (median) >= 0.90 of targets"
           % (np.median(cov) if cov else 0))
+    if a.axis_goal > 0:
+        ax = np.median([r["axis_med_comp"] for r in ok])
+        axu = np.median([r["axis_med_uncomp"] for r in ok])
+        check(ax <= a.axis_goal and ax <= axu, "tool axis after compensation %.4f deg (median of medians) <= %.3f and "
+              "<= uncompensated %.4f" % (ax, a.axis_goal, axu))
+    if a.u95_ratio_goal > 0 and POOL:
+        e = np.concatenate([x for x, _ in POOL])
+        u = np.concatenate([y for _, y in POOL])
+        ratio = np.median(u[np.isfinite(u)]) / np.percentile(e, 95)
+        check(ratio <= a.u95_ratio_goal and np.mean(e <= u) >= 0.9, "u95 pooled: median / p95 of the true errors %.2f "
+              "<= %.2f, coverage %.3f >= 0.90" % (ratio, a.u95_ratio_goal, np.mean(e <= u)))
     print("%d passed, %d failed" % (len(passes), len(failures)))
     return 1 if failures else 0
 
