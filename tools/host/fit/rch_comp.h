@@ -74,7 +74,7 @@ typedef struct rch_comp_job {
     const char *out_path;     /* result; NULL or "-": standard output */
     rch_comp_format format;
     int position_only;        /* match the flange position only (forced) */
-    int full_pose;            /* position and orientation (forced); neither: from the model file */
+    int full_pose;            /* position and orientation (forced); neither: rch_comp_orient_decide */
     double max_dev_deg;       /* largest correction per joint; 0: the default 0.1 rad */
     double max_unc_mm;        /* a target where the model's 95 % position uncertainty exceeds this is left
                                  uncompensated, with a warning; 0: 1 mm */
