@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 """Where a tool point 100 mm along the flange x axis lands on a TRUE robot
 (a model file, e.g. data/sim_irb120_truth.json) for joint targets, against
-where the program meant it (the nominal model at the original targets).
+where the program meant it (the nominal model at the original targets), and
+the angle of the tool's axis (the flange z axis) against the meant one.
 
 usage: scripts/tool_point_check.py TRUTH.json NOMINAL.json TARGET.csv [COMPENSATED.csv ...]
 Each CSV holds lines of q1..q6 in degrees; the first is the original target
@@ -31,6 +32,17 @@ def tool(model, q, nominal=False):
     return [p[i] + 100.0 * r[3 * i] for i in range(3)]
 
 
+def axis_deg(model, q, nominal=False):
+    """The flange z axis (the tool's axis of a spindle or wheel on the flange) at q."""
+    _, r = model.fk(q, rotation=True, nominal=nominal)
+    return [r[3 * i + 2] for i in range(3)]
+
+
+def angle_deg(a, b):
+    c = sum(x * y for x, y in zip(a, b)) / math.sqrt(sum(x * x for x in a) * sum(y * y for y in b))
+    return math.degrees(math.acos(max(-1.0, min(1.0, c))))
+
+
 def main():
     if len(sys.argv) < 4:
         print(__doc__)
@@ -40,8 +52,10 @@ def main():
     for path in sys.argv[3:]:
         qs = rows(path)
         errs = [math.dist(tool(truth, q), tool(nominal, t)) for q, t in zip(qs, targets)]
-        print("%-40s tool point error on the true robot: mean %.4f mm, max %.4f mm (%d targets)"
-              % (path, sum(errs) / len(errs), max(errs), len(errs)))
+        axes = sorted(angle_deg(axis_deg(truth, q), axis_deg(nominal, t, nominal=True)) for q, t in zip(qs, targets))
+        print("%-40s tool point error on the true robot: mean %.4f mm, max %.4f mm (%d targets); tool axis (flange "
+              "z) median %.4f deg, max %.4f deg" % (path, sum(errs) / len(errs), max(errs), len(errs),
+                                                    axes[len(axes) // 2], axes[-1]))
     return 0
 
 

@@ -24,6 +24,27 @@ static const char details[] =
     "closest point found within the bounds (the target plus the last good correction when it follows the previous "
     "target on a path), with a warning naming the cause and its position error; the exit status is then 1.";
 
+/* Why the orientation is or is not corrected (issue 47). */
+static void print_orientation(const rch_comp_result *r)
+{
+    if (r->mode_forced) {
+        fprintf(stderr, "rcal compensate: orientation %s (forced by %s)\n",
+                r->position_only_used ? "not corrected" : "corrected",
+                r->position_only_used ? "--position-only" : "--full-pose");
+    } else if (r->orient.known) {
+        fprintf(stderr,
+                "rcal compensate: orientation %s: position only, the calibrated model leaves the tool's axis (the "
+                "flange z axis) %.4f deg off the nominal one (RMS over the joint limits); corrected, its predicted "
+                "error is %.4f deg: correcting is expected to leave the axis %s (--position-only / --full-pose "
+                "force either)\n",
+                r->position_only_used ? "not corrected" : "corrected", r->orient.uncorr_deg, r->orient.unc_deg,
+                r->position_only_used ? "no closer than not correcting" : "closer than not correcting");
+    } else {
+        fprintf(stderr, "rcal compensate: orientation %s (the model carries no uncertainty to weigh it by)\n",
+                r->position_only_used ? "not corrected" : "corrected");
+    }
+}
+
 /* Which parameters the corrections came from (issue 10). */
 static void print_sources(const rch_comp_result *r, const char *model)
 {
@@ -31,12 +52,16 @@ static void print_sources(const rch_comp_result *r, const char *model)
             24u - r->n_held, model,
             r->version1 ? " (a version-1 model: the held ones from the nominal model's identifiability)" : "",
             r->n_held ? r->held : "none");
+    char u95[64] = "n/a (the model carries no uncertainty)";
+    if (!isnan(r->max_pos95_mm))
+        snprintf(u95, sizeof u95, "%.4f mm", r->max_pos95_mm);
     fprintf(stderr,
             "rcal compensate: the held parameters' fitted values would have moved the flange by up to %.4f mm at "
             "these targets; mode %s (orientation %s by the data); largest 95 %% position uncertainty at a "
-            "compensated target %.4f mm; %lu targets left uncompensated for their uncertainty\n",
+            "compensated target %s; %lu targets left uncompensated for their uncertainty\n",
             r->max_held_mm, r->position_only_used ? "position only" : "position and orientation",
-            r->orientation_determined ? "determined" : "not determined", r->max_pos95_mm, r->n_uncertain);
+            r->orientation_determined ? "determined" : "not determined", u95, r->n_uncertain);
+    print_orientation(r);
 }
 
 /* Targets, iterations, largest correction and time (--summary). */
@@ -110,7 +135,13 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
     rch_jw_str(&w, "mode", r->position_only_used ? "position" : "pose");
     rch_jw_bool(&w, "orientation_determined", r->orientation_determined);
     rch_jw_num(&w, "max_uncertainty_mm", job->max_unc_mm);
-    rch_jw_num(&w, "largest_pos95_mm", r->max_pos95_mm);
+    rch_jw_num(&w, "largest_pos95_mm", r->max_pos95_mm); /* null: unknown (no uncertainty in the model) */
+    rch_jw_obj(&w, "orientation");
+    rch_jw_bool(&w, "corrected", !r->position_only_used);
+    rch_jw_str(&w, "chosen_by", r->mode_forced ? "option" : r->orient.known ? "uncertainty" : "model_file");
+    rch_jw_num(&w, "uncorrected_rms_deg", r->orient.known ? r->orient.uncorr_deg : NAN);
+    rch_jw_num(&w, "correction_error_rms_deg", r->orient.known ? r->orient.unc_deg : NAN);
+    rch_jw_end(&w);
     json_targets(&w, warnings);
     rch_jw_obj(&w, "params");
     rch_jw_uint(&w, "dh_used", 24u - r->n_held);
@@ -193,10 +224,12 @@ int rcal_cmd_compensate(int argc, char **argv)
          "per target (its input line) the predicted 95 % position uncertainty u95_mm of the compensated point, "
          "from the calibration's posterior covariance (prior-only directions included)",
          0, NULL},
-        {"--position-only", RCH_OPT_FLAG, &position_only, 0, 0, NULL, "match the flange position only", 0, NULL},
+        {"--position-only", RCH_OPT_FLAG, &position_only, 0, 0, NULL,
+         "match the position of the flange (or the --tool TCP) only, whatever the model's orientation", 0, NULL},
         {"--full-pose", RCH_OPT_FLAG, &full_pose, 0, 0, NULL,
-         "match position and orientation even when the model file says the data did not determine the "
-         "orientation (default: full pose only when it did)",
+         "match position and orientation (default: the orientation is corrected when the calibrated flange "
+         "orientation differs from nominal by more than the correction's predicted error, sqrt 2 x its RMS; "
+         "--summary says which and why)",
          0, NULL},
         {"--max-uncertainty-mm", RCH_OPT_DOUBLE, &max_unc_mm, 0.0, 1000.0, "MM",
          "leave a target uncompensated (with a warning) where the model's 95 % position uncertainty is larger "

@@ -737,13 +737,20 @@ def evaluate(model, data, refit_encoder=False, same_pose_deg=1e-6):
                       *v[13:17])
 
 
-Compensation = collections.namedtuple("Compensation", "q_deg status u95_mm")
+Compensation = collections.namedtuple("Compensation", "q_deg status u95_mm orientation")
 Compensation.__doc__ = """compensate(..., details=True): the corrected targets (deg, shaped like the
 input), a status per target (0 converged, 1 position matched with the
 orientation best effort, 2 not converged: the closest point found (on a path:
-the target plus the last good correction), 3 left uncompensated: uncertainty above the limit) and u95_mm,
+the target plus the last good correction), 3 left uncompensated: uncertainty above the limit), u95_mm,
 the predicted 95 % position uncertainty of the compensated point per target
-(what --uncertainty-out writes; NaN when the model has no uncertainty)."""
+(what --uncertainty-out writes; NaN when the model has no uncertainty: unknown,
+never 0), and orientation, what `rcal compensate --summary` says of the
+orientation: a dict with "corrected" (bool), "chosen_by" ("option",
+"uncertainty" or "model_file"), "uncorrected_rms_deg" (the calibrated-vs-nominal
+tilt of the tool's axis, the flange z axis, RMS over the joint limits) and
+"correction_error_rms_deg" (the correction's predicted error of that tilt;
+both NaN when the model has no covariance). The first three unpack as
+before: q, status, u95 = c[:3]."""
 
 
 _U95_POLICIES = {"skip": 0, "warn": 1, "refuse": 2}
@@ -767,8 +774,10 @@ def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=Non
     tool_mm:       the TCP in the flange frame, mm (--tool X,Y,Z; default the
                    flange centre)
     position_only: True --position-only, False --full-pose, None (default)
-                   as the model file says (position only unless the data
-                   determined the orientation)
+                   as rcal compensate chooses: the orientation is corrected
+                   when the calibrated-vs-nominal tilt of the tool's axis
+                   exceeds the correction's predicted error (details=True
+                   returns the figures)
     max_dev_deg:   largest correction per joint (--max-dev-deg; 0: 0.1 rad)
     max_uncertainty_mm: --max-uncertainty-mm (0: none for a model with a
                    posterior, 1 mm for one without)
@@ -816,7 +825,13 @@ def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=Non
     _flag_targets(codes, list(u95[:n]), max_uncertainty_mm, u95_policy, on_fail)
     if details:
         u = _rows(u95, n, 1, single, numpy)
-        return Compensation(corrected, codes[0] if single else codes, u)
+        mode = (ctypes.c_double * 4)()
+        _check(lib.rch_ffi_compensate_mode(cal._h, nom._h if nom is not None else None,
+                                           0 if position_only is None else (1 if position_only else 2),
+                                           float(max_dev_deg), tool, mode, err, _ERR_LEN), err)
+        orient = {"corrected": mode[0] == 0.0, "chosen_by": ("option", "uncertainty", "model_file")[int(mode[1])],
+                  "uncorrected_rms_deg": mode[2], "correction_error_rms_deg": mode[3]}
+        return Compensation(corrected, codes[0] if single else codes, u, orient)
     if return_status:
         return corrected, (codes[0] if single else codes)
     return corrected
@@ -831,11 +846,12 @@ def _flag_targets(codes, u95, max_unc_mm, u95_policy, on_fail):
             msgs.append("target %d: not compensated (the solver did not converge or hit a limit); returned the closest "
                         "point found (on a path: the target plus the last good correction)" % i)
         elif c == 3:
-            msgs.append("target %d: left uncompensated: the model's 95 %% position uncertainty here is %.4f mm, above "
-                        "the limit (the data did not determine the model at this pose)" % (i, u95[i]))
-        elif u95_policy == "warn" and max_unc_mm and math.isfinite(u95[i]) and u95[i] > max_unc_mm:
+            msgs.append("target %d: left uncompensated: the model's 95 %% position uncertainty here is above the "
+                        "limit (or unknown: a model without an uncertainty meets no limit)" % i)
+        elif u95_policy == "warn" and max_unc_mm and not u95[i] <= max_unc_mm:
             msgs.append("target %d: compensated, but the model's 95 %% position uncertainty at the compensated point "
-                        "is %.4f mm here, above %.4f mm" % (i, u95[i], max_unc_mm))
+                        "is %s here, above %.4f mm" % (i, "%.4f mm" % u95[i] if math.isfinite(u95[i]) else
+                                                       "unknown (the model carries no uncertainty)", max_unc_mm))
     if not msgs or on_fail == "ignore":
         return
     if on_fail == "raise" and any(c in (2, 3) for c in codes):

@@ -96,6 +96,7 @@ def _declare(lib):
         "rch_ffi_calib_json": (i, [vp, cp, sz, _c_size_p]),
         "rch_ffi_compensate": (i, [vp, vp, _c_double_p, _c_int_p, _c_double_p, _c_double_p, sz, i, d, d, i,
                                    _c_double_p, cp, sz]),
+        "rch_ffi_compensate_mode": (i, [vp, vp, i, d, _c_double_p, _c_double_p, cp, sz]),
     }
     for name, (res, args) in sigs.items():
         fn = getattr(lib, name)

@@ -93,3 +93,50 @@ def test_result_as_model(cal_file, tmp_path):
         rcal.compensate(42, rows)
     with pytest.raises(TypeError, match=r"compensate: nominal: .* not list"):
         rcal.compensate(r, rows, nominal=[1, 2])
+
+
+def test_orientation_mode_as_cli(cal_file, run_cli, tmp_path):
+    """details=True says what `rcal compensate --summary` says of the
+    orientation (issue 47): corrected or not, chosen by the model's
+    uncertainty, the tilt and its predicted error; the options force it."""
+    model = rcal.Model.load(cal_file)
+    rows = [[float(v) for v in r] for r in targets(model, 3, 4)]
+    src = tmp_path / "t.csv"
+    src.write_text("".join(",".join("%.4f" % v for v in r) + "\n" for r in rows))
+    p = run_cli("compensate", "--model", str(cal_file), "--in", str(src), "--out", str(tmp_path / "o.csv"),
+                "--summary")
+    m = re.search(r"orientation (corrected|not corrected): position only, the calibrated model leaves the tool's "
+                  r"axis \(the flange z axis\) ([0-9.]+) deg off .*?predicted error is ([0-9.]+) deg", p.stderr)
+    assert m, p.stderr
+    c = rcal.compensate(model, rows, details=True)
+    o = c.orientation
+    assert o["chosen_by"] == "uncertainty"
+    assert o["corrected"] == (m.group(1) == "corrected")
+    assert "%.4f" % o["uncorrected_rms_deg"] == m.group(2)
+    assert "%.4f" % o["correction_error_rms_deg"] == m.group(3)
+    assert o["corrected"] == (o["uncorrected_rms_deg"] > o["correction_error_rms_deg"])
+    q, status, u95 = c[:3]
+    assert len(q) == len(status) == len(u95) == 3
+    for forced in (True, False):
+        f = rcal.compensate(model, rows, position_only=forced, details=True).orientation
+        assert f["chosen_by"] == "option" and f["corrected"] == (not forced)
+
+
+def test_u95_unknown_without_uncertainty(tmp_path):
+    """A model without an uncertainty (rcal-model/1 with a nominal table):
+    u95 NaN (unknown), never 0; a limit the caller sets cannot be met
+    (status 3, the targets left as they were)."""
+    import json
+    import math
+    doc = json.load(open("data/irb120.json"))  # the tests run from the repository root (conftest)
+    doc["nominal"] = {"dh": json.loads(json.dumps(doc["dh"]))}
+    doc["dh"][1]["a_mm"] += 0.4
+    src = tmp_path / "v1.json"
+    src.write_text(json.dumps(doc))
+    q = [[10.0, 20.0, 30.0, 40.0, 50.0, 50.0], [-30.0, 40.0, 10.0, 20.0, -50.0, 90.0]]
+    c = rcal.compensate(str(src), q, details=True)
+    assert all(math.isnan(u) for u in c.u95_mm)
+    assert c.status == [0, 0] and [list(r) for r in c.q_deg] != q
+    assert c.orientation["chosen_by"] == "model_file" and math.isnan(c.orientation["uncorrected_rms_deg"])
+    s = rcal.compensate(str(src), q, details=True, max_uncertainty_mm=1.0, on_fail="ignore")
+    assert s.status == [3, 3] and [list(r) for r in s.q_deg] == q

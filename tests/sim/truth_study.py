@@ -97,6 +97,8 @@ def clipped(rng, scale, lim):
 # "wide" (issue 32: wider and heavier-tailed than rcal's prior, whose sd are
 # 0.5 mm, 0.1 deg, 1 deg): Student-t(3) 1 mm up to 3 mm, 0.2 deg up to 0.6 deg.
 ERRORS = "study"
+POOL = []  # per case (true errors, u95) of the targets, for the figures pooled over the robots
+MODE = "position-only"  # --mode: how compensate is asked to treat the orientation
 STATED_ATTACH = 0.0  # --stated-attach: the attachment told to rcal, measured to this sd (mm); 0: not told
 
 
@@ -185,10 +187,11 @@ def gauge_align(P, Q):
 ALIGN = "gauge"
 
 
-def align(P, Q):
+def align(P, Q, with_rot=False):
     """The landed points P against the meant Q: after the gauge (--align gauge, the base heading and height
     rcal holds) or after the best-fit rigid motion (--align rigid: one outlet cannot see a rotation of the
-    whole robot about it, so no length sees the cell frame)."""
+    whole robot about it, so no length sees the cell frame). with_rot: also the rotation applied (the
+    landed orientations are turned by it before they are compared)."""
     if ALIGN == "rigid":  # fitted on all points, then without those 10 x the median off (as gauge_align)
         keep = np.ones(len(P), dtype=bool)
         for _ in range(2):
@@ -196,8 +199,25 @@ def align(P, Q):
             A = P @ R.T + t
             d = np.linalg.norm(A - Q, axis=1)
             keep = d <= 10.0 * max(np.median(d), 1e-9)
+        return (A, R) if with_rot else A
+    A = gauge_align(P, Q)
+    if not with_rot:
         return A
-    return gauge_align(P, Q)
+    # the heading gauge_align applied, read back from the aligned points (it is a rotation about z)
+    Pc, Ac = P[:, :2] - P[:, :2].mean(0), A[:, :2] - A[:, :2].mean(0)
+    phi = np.arctan2(np.sum(Pc[:, 0] * Ac[:, 1] - Pc[:, 1] * Ac[:, 0]), np.sum(Pc[:, 0] * Ac[:, 0] + Pc[:, 1] * Ac[:, 1]))
+    return A, rot("z", phi)
+
+
+TOOL_AXIS = np.array([0.0, 0.0, 1.0])  # --tool-axis: the tool's axis in the flange frame (a spindle's, a wheel's)
+
+
+def axis_deg(Rs_landed, Rs_meant, R_align):
+    """Per target the angle (deg) between the tool's axis as landed (turned by the alignment) and as meant."""
+    a = np.einsum("ij,njk,k->ni", R_align, Rs_landed, TOOL_AXIS)
+    b = np.einsum("njk,k->nj", Rs_meant, TOOL_AXIS)
+    c = np.clip(np.sum(a * b, axis=1) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)), -1.0, 1.0)
+    return np.arccos(c) / DEG
 
 
 def pair_err(landed, meant, rng, n_pairs=20000):
@@ -314,7 +334,9 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     for p in (tout, uout):
         if os.path.exists(p):
             os.remove(p)
-    cmd = [rcal, "compensate", "--model", model, "--in", tin, "--out", tout, "--position-only"]
+    cmd = [rcal, "compensate", "--model", model, "--in", tin, "--out", tout, "--summary"]
+    if MODE != "auto":
+        cmd += ["--" + MODE]
     if not OLD:
         cmd += ["--uncertainty-out", uout]
     if any(tcp):
@@ -338,15 +360,33 @@ def one_case(rcal, k, rng, name, attach_mm, fixed_wrist, tcp, tmp, extra=(), bet
     e_c = np.linalg.norm(align(landed, meant) - meant, axis=1)
     e_u = np.linalg.norm(gauge_align(uncomp, meant) - meant, axis=1)
     e3 = np.linalg.norm(align(landed, meant) - meant, axis=1)
+    # the tool's axis: the true robot's orientation at the written joints against the nominal one the
+    # program meant, turned by the same alignment as the points (uncompensated: the targets themselves)
+    R_meant = np.array([nom.frames(q)[0] for q in T])
+    _, Ra_c = align(landed, meant, with_rot=True)
+    _, Ra_u = align(uncomp, meant, with_rot=True)
+    ax_c = axis_deg(np.array([truth.frames(q)[0] for q in C]), R_meant, Ra_c)
+    ax_u = axis_deg(np.array([truth.frames(q)[0] for q in T]), R_meant, Ra_u)
+    mode_used = ("mixed" if "mode mixed" in err else "full-pose" if "mode position and orientation" in err
+                 else "position-only" if "mode position only" in err else "?")
     res = {"case": k, "robot": name, "attach_mm": attach_mm, "outlets": outlets, "split": split,
            "err3d_rms": float(np.sqrt(np.mean(e3 ** 2))), "wrist": "fixed" if fixed_wrist else "random",
            "tcp": list(tcp), "noise_mm": sigma, "n": len(Q),
            "pair_med_comp": float(np.median(pe_c)), "pair_med_uncomp": float(np.median(pe_u)),
            "pair_p95_comp": float(np.percentile(pe_c, 95)), "pair_max_comp": float(pe_c.max()),
            "worse_share": float(np.mean(e_c > e_u)),
-           "err_med_comp": float(np.median(e_c)), "err_med_uncomp": float(np.median(e_u))}
+           "err_med_comp": float(np.median(e_c)), "err_med_uncomp": float(np.median(e_u)),
+           "err_p95_comp": float(np.percentile(e_c, 95)),
+           "axis_med_comp": float(np.median(ax_c)), "axis_med_uncomp": float(np.median(ax_u)),
+           "axis_p95_comp": float(np.percentile(ax_c, 95)), "mode": mode_used}
     if u95 is not None and len(u95) == len(e_c):
+        known = np.isfinite(u95)
+        res["u95_known"] = float(np.mean(known))
+        u95 = np.where(known, u95, np.inf)
         res["u95_cover"] = float(np.mean(e_c <= u95))
+        res["u95_over_p95"] = float(np.median(u95[known]) / max(np.percentile(e_c, 95), 1e-12)) if known.any() \
+            else float("nan")
+        POOL.append((e_c, u95))
         res["u95_ratio_p95"] = float(np.percentile(e_c / np.maximum(u95, 1e-12), 95))
         res["u95_med"] = float(np.median(u95))
     return res
@@ -377,12 +417,25 @@ def main():
                     help="check the goals (flange: centred <= 0.02 mm, off-centre <= 0.7 mm median; TCP <= 0.45 mm; "
                          "no case worse than uncompensated; targets made worse <= 1 %% median; u95 covers >= 90 %%); "
                          "exit 1 when one fails")
+    ap.add_argument("--mode", choices=["position-only", "auto", "full-pose"], default="position-only",
+                    help="compensate with --position-only (the default here), as rcal decides (auto: no option) or "
+                         "with --full-pose")
+    ap.add_argument("--tool-axis", default="0,0,1",
+                    help="the tool's axis in the flange frame whose angle after compensation is measured")
+    ap.add_argument("--axis-goal", type=float, default=0.0, metavar="DEG",
+                    help="with --check: the tool axis after compensation at most DEG (median over the robots of their "
+                         "median) and, on that median, not worse than uncompensated; 0: not checked")
+    ap.add_argument("--u95-ratio-goal", type=float, default=0.0, metavar="R",
+                    help="with --check: the median u95 at most R x the 95th percentile of the true errors, both pooled "
+                         "over every robot's targets, with a pooled coverage of at least 0.9; 0: not checked")
     ap.add_argument("--stated-attach", type=float, default=0.0, metavar="SD",
                     help="tell rcal where the cable is attached (--cable-point), measured to SD mm (sd; "
                          "--cable-point-sd SD), as a user with a drawing or a caliper would; 0: not told")
     a = ap.parse_args()
-    global ERRORS, ALIGN, STATED_ATTACH
+    global ERRORS, ALIGN, STATED_ATTACH, MODE, TOOL_AXIS
     ERRORS = a.errors
+    MODE = a.mode
+    TOOL_AXIS = np.array([float(v) for v in a.tool_axis.split(",")])
     STATED_ATTACH = a.stated_attach
     ALIGN = a.align
     rng = np.random.default_rng(a.seed)
@@ -423,6 +476,13 @@ def main():
             cov = [r["u95_cover"] for r in sel if "u95_cover" in r]
             print("%-10s 3-D error after compensation (%s aligned), RMS over targets: median over cases "
                   "%.4f mm" % (label, ALIGN, np.median([r["err3d_rms"] for r in sel])))
+            print("%-10s tool axis (%s in the flange frame) after compensation: median over cases of the median "
+                  "angle %.4f deg (uncompensated %.4f), cases worse %d; p95 %.4f deg; modes %s" % (
+                      label, ",".join("%g" % v for v in TOOL_AXIS), np.median([r["axis_med_comp"] for r in sel]),
+                      np.median([r["axis_med_uncomp"] for r in sel]),
+                      sum(r["axis_med_comp"] > r["axis_med_uncomp"] for r in sel),
+                      np.median([r["axis_p95_comp"] for r in sel]),
+                      {m: sum(r["mode"] == m for r in sel) for m in sorted(set(r["mode"] for r in sel))}))
             print("%-10s cases %2d  median of pairwise medians %.4f mm (uncompensated %.3f)  cases worse %d  "
                   "median share of targets worse %.4f  u95 coverage median %s" % (
                       label, len(sel), med, np.median([r["pair_med_uncomp"] for r in sel]), worse_cases, wshare,
@@ -435,6 +495,19 @@ def main():
                                    np.median([r["err_med_comp"] for r in sel])))
                 print("%-10s u95 coverage per robot: lowest %.3f, robots below 0.75: %d of %d" % (
                     label, min(cov), sum(c < 0.75 for c in cov), len(cov)))
+                ratio = [r["u95_over_p95"] for r in sel if "u95_over_p95" in r]
+                print("%-10s median u95 / 95th percentile of the true errors, per robot: median %.2f (lowest %.2f, "
+                      "highest %.2f); targets with an unknown u95 %.3f" % (
+                          label, np.nanmedian(ratio), np.nanmin(ratio), np.nanmax(ratio),
+                          1.0 - np.mean([r.get("u95_known", 1.0) for r in sel])))
+                if label == "all" and POOL:  # pooled over every robot's targets: the figure of a calibrated u95
+                    e = np.concatenate([a for a, _ in POOL])
+                    u = np.concatenate([b for _, b in POOL])
+                    fin = np.isfinite(u)
+                    print("%-10s pooled over all robots: median u95 %.4f mm / 95th percentile of the true errors "
+                          "%.4f mm = %.2f; coverage %.3f" % (label, np.median(u[fin]), np.percentile(e, 95),
+                                                              np.median(u[fin]) / np.percentile(e, 95),
+                                                              np.mean(e <= u)))
     if a.json:
         with open(a.json, "w") as f:
             json.dump(out, f, indent=1)
@@ -460,6 +533,17 @@ def main():
     cov = [r["u95_cover"] for r in ok if "u95_cover" in r]
     check(len(cov) == len(ok) and np.median(cov) >= 0.9, "u95_mm covers the truth at %.3f (median) >= 0.90 of targets"
           % (np.median(cov) if cov else 0))
+    if a.axis_goal > 0:
+        ax = np.median([r["axis_med_comp"] for r in ok])
+        axu = np.median([r["axis_med_uncomp"] for r in ok])
+        check(ax <= a.axis_goal and ax <= axu, "tool axis after compensation %.4f deg (median of medians) <= %.3f and "
+              "<= uncompensated %.4f" % (ax, a.axis_goal, axu))
+    if a.u95_ratio_goal > 0 and POOL:
+        e = np.concatenate([x for x, _ in POOL])
+        u = np.concatenate([y for _, y in POOL])
+        ratio = np.median(u[np.isfinite(u)]) / np.percentile(e, 95)
+        check(ratio <= a.u95_ratio_goal and np.mean(e <= u) >= 0.9, "u95 pooled: median / p95 of the true errors %.2f "
+              "<= %.2f, coverage %.3f >= 0.90" % (ratio, a.u95_ratio_goal, np.mean(e <= u)))
     print("%d passed, %d failed" % (len(passes), len(failures)))
     return 1 if failures else 0
 

@@ -32,11 +32,16 @@ double rch_comp_u95_written(double u95_mm, int status, double miss_mm)
     return u95_mm;
 }
 
-/* One line of --uncertainty-out (when asked for and the model has a posterior). */
+/* One line of --uncertainty-out (when asked for): "nan" where the u95 is
+ * unknown (a model without an uncertainty, a target left uncompensated). */
 static void u95_line(const rch_cpi_ctx *c, unsigned line, double u95_mm)
 {
-    if (c->gate && c->gate->u95_out && c->gate->unc && c->gate->unc->present)
-        fprintf(c->gate->u95_out, "%u,%.6f\n", line, u95_mm);
+    if (c->gate && c->gate->u95_out) {
+        if (isnan(u95_mm))
+            fprintf(c->gate->u95_out, "%u,nan\n", line);
+        else
+            fprintf(c->gate->u95_out, "%u,%.6f\n", line, u95_mm);
+    }
 }
 
 /* Compensate one target (degrees in, degrees out). 0 ok, 1 not converged
@@ -68,45 +73,60 @@ int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_de
             if (e > c->res->max_held_mm)
                 c->res->max_held_mm = e;
         }
-        if (c->gate->unc && c->gate->unc->present) {
-            double u95 = c->gate->unc->has_prior ? rch_model_unc_radius95_mm(c->gate->unc, m, qd)
-                                                 : rch_model_unc_pos95_mm(c->gate->unc, m, qd);
-            u95_at = u95;
-            /* A posterior (MAP) model: compensation never makes the expected
-             * error larger than the uncompensated target's (the posterior is
-             * never wider than the prior the nominal model stands for), so
-             * there is no limit unless the user sets one. A model without
-             * (least squares): 1 mm, its covariance leaves out what it held. */
-            double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm : c->gate->unc->has_prior ? INFINITY : 1.0;
-            if (!(u95 <= lim) && c->gate->u95_policy == RCH_COMP_U95_REFUSE) {
-                rch_diag_set(d, c->in_name, line, 0,
-                             "the model's 95 %% position uncertainty at the compensated point is %.4f mm here, above "
-                             "%.4f mm (--u95-policy refuse: nothing written)",
-                             u95, lim);
-                return -1;
-            }
-            if (!(u95 <= lim) && c->gate->u95_policy == RCH_COMP_U95_WARN) {
-                c->res->n_uncertain++;
-                if (c->warn)
-                    fprintf(c->warn,
-                            "%s:%u: warning: compensated, but the model's 95 %% position uncertainty at the "
-                            "compensated point is %.4f mm here, above %.4f mm\n",
-                            c->in_name, line, u95, lim);
-            } else if (!(u95 <= lim)) {
-                for (unsigned i = 0; i < RC_NJ; ++i)
-                    out_deg[i] = in_deg[i];
-                u95_line(c, line, rch_comp_u95_written(u95, 3, 0.0));
-                c->res->n_uncertain++;
-                if (c->warn)
-                    fprintf(c->warn,
-                            "%s:%u: warning: target left uncompensated: the model's 95 %% position uncertainty here "
-                            "is %.4f mm, above %.4f mm (the data did not determine the model at this pose)\n",
-                            c->in_name, line, u95, lim);
-                return 1;
-            }
-            if (u95 > c->res->max_pos95_mm)
-                c->res->max_pos95_mm = u95;
+        const rch_model_unc *unc = c->gate->unc && c->gate->unc->present ? c->gate->unc : NULL;
+        /* no covariance: the u95 is unknown (NaN, "n/a"), never 0 */
+        const double u95 = !unc ? NAN : unc->has_prior ? rch_model_unc_radius95_mm(unc, m, qd)
+                                                        : rch_model_unc_pos95_mm(unc, m, qd);
+        u95_at = u95;
+        /* A posterior (MAP) model: compensation never makes the expected
+         * error larger than the uncompensated target's (the posterior is
+         * never wider than the prior the nominal model stands for), so
+         * there is no limit unless the user sets one. A model without
+         * (least squares): 1 mm, its covariance leaves out what it held. A
+         * model without an uncertainty: no limit unless one is set, and
+         * then no target can be shown to be within it (the policy acts on
+         * every target). */
+        const double lim = c->gate->max_unc_mm > 0 ? c->gate->max_unc_mm
+                           : !unc || unc->has_prior ? INFINITY
+                                                    : 1.0;
+        /* beyond the limit: a known u95 above it (or not a number), an
+         * unknown one against a limit the user set */
+        const int beyond = unc ? !(u95 <= lim) : isfinite(lim);
+        char u95s[64];
+        if (isnan(u95))
+            snprintf(u95s, sizeof u95s, "unknown (the model carries no uncertainty)");
+        else
+            snprintf(u95s, sizeof u95s, "%.4f mm", u95);
+        if (beyond && c->gate->u95_policy == RCH_COMP_U95_REFUSE) {
+            rch_diag_set(d, c->in_name, line, 0,
+                         "the model's 95 %% position uncertainty at the compensated point is %s here, above %.4f mm "
+                         "(--u95-policy refuse: nothing written)",
+                         u95s, lim);
+            return -1;
         }
+        if (beyond && c->gate->u95_policy == RCH_COMP_U95_WARN) {
+            c->res->n_uncertain++;
+            if (c->warn)
+                fprintf(c->warn,
+                        "%s:%u: warning: compensated, but the model's 95 %% position uncertainty at the "
+                        "compensated point is %s here, above %.4f mm\n",
+                        c->in_name, line, u95s, lim);
+        } else if (beyond) {
+            for (unsigned i = 0; i < RC_NJ; ++i)
+                out_deg[i] = in_deg[i];
+            u95_line(c, line, rch_comp_u95_written(u95, 3, 0.0));
+            c->res->n_uncertain++;
+            if (c->warn)
+                fprintf(c->warn,
+                        "%s:%u: warning: target left uncompensated: the model's 95 %% position uncertainty here "
+                        "is %s, above %.4f mm (%s)\n",
+                        c->in_name, line, u95s, lim,
+                        unc ? "the data did not determine the model at this pose"
+                            : "--max-uncertainty-mm cannot be met by a model without one");
+            return 1;
+        }
+        if (u95 > c->res->max_pos95_mm)
+            c->res->max_pos95_mm = u95;
     }
     rc_comp_result res;
     const double t0 = now_ns();

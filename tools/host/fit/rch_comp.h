@@ -74,7 +74,7 @@ typedef struct rch_comp_job {
     const char *out_path;     /* result; NULL or "-": standard output */
     rch_comp_format format;
     int position_only;        /* match the flange position only (forced) */
-    int full_pose;            /* position and orientation (forced); neither: from the model file */
+    int full_pose;            /* position and orientation (forced); neither: rch_comp_orient_decide */
     double max_dev_deg;       /* largest correction per joint; 0: the default 0.1 rad */
     double max_unc_mm;        /* a target where the model's 95 % position uncertainty exceeds this is left
                                  uncompensated, with a warning; 0: 1 mm */
@@ -133,6 +133,42 @@ typedef struct rch_comp_gate {
  * command's --uncertainty-out and of the Python package. */
 double rch_comp_u95_written(double u95_mm, int status, double miss_mm);
 
+/* Whether compensation corrects the orientation when neither
+ * --position-only nor --full-pose forces it (issue 47): when doing so is
+ * expected to leave the tool's orientation closer to the program's than not
+ * doing it. The tool's axis is the flange z axis (a spindle's or a wheel's
+ * on the flange). Over RCH_COMP_ORIENT_POSES poses q uniform in the joint
+ * limits (fixed seed): delta, the tilt of that axis that position-only
+ * compensation leaves on the calibrated (determined) model, the angle
+ * between its z axis at the position-only solution q' and the nominal one at
+ * q (the calibrated-vs-nominal rotation at the target, turned by the
+ * correction's own joint moves); and tr C_r, the predicted variance of the
+ * tilt after correcting (rch_model_unc_rot_trace at q', the rotation
+ * perpendicular to the axis; determined part: parameters the data left to
+ * the prior sit at the drawing's value either way, and a roll about the
+ * axis does not move it). Corrected when the RMS of delta exceeds the RMS
+ * of the predicted error (uncorr_deg > unc_deg). A model without a
+ * covariance (rcal-model/1) is not decided (known 0): position only, as
+ * before. */
+#define RCH_COMP_ORIENT_POSES 256
+typedef struct rch_comp_orient {
+    int known;         /* the model carries a covariance: the figures are numbers */
+    int correct;       /* the decision: match the orientation too */
+    double uncorr_deg; /* RMS over the poses of the calibrated-vs-nominal flange rotation angle */
+    double unc_deg;    /* RMS over the poses of the predicted orientation error after correcting */
+} rch_comp_orient;
+/* det: the determined model, nominal: the model the targets were made with
+ * (both at the point compensated: rch_comp_point_model); cfg: the run's
+ * (its bound; NULL: defaults). unc NULL or without a covariance: known 0,
+ * correct 0. */
+void rch_comp_orient_decide(rch_comp_orient *o, const rch_model_unc *unc, const rc_model *det,
+                            const rc_model *nominal, const rc_comp_config *cfg);
+/* The mode a run uses: 1 position only. forced_position / forced_pose: the
+ * options; calibrated: the model file has a nominal table or an uncertainty
+ * (a bare model is compensated in full pose, as before). */
+int rch_comp_position_only(const rch_comp_orient *o, int forced_position, int forced_pose, int calibrated,
+                           int orientation_determined);
+
 typedef struct rch_comp_result {
     rch_comp_format format;       /* the form read (detected or forced) */
     unsigned long n;              /* targets compensated */
@@ -148,11 +184,15 @@ typedef struct rch_comp_result {
                                      parameters come from the nominal model's identifiability */
     int position_only_used;       /* the mode compensation ran in */
     int orientation_determined;   /* as the model file says */
+    int mode_forced;              /* --position-only or --full-pose chose the mode */
+    rch_comp_orient orient;       /* the figures the mode was chosen by (when not forced) */
+    int u95_unknown;              /* the model carries no uncertainty: every u95 is NaN ("n/a") */
     unsigned n_held;              /* DH parameters held nominal */
     char held[256];               /* their names */
     double max_held_mm;           /* largest flange move the held parameters' fitted values would have made */
     unsigned long n_uncertain;    /* targets left uncompensated: uncertainty above max_unc_mm */
-    double max_pos95_mm;          /* largest 95 % position uncertainty at a compensated target */
+    double max_pos95_mm;          /* largest 95 % position uncertainty at a compensated target; NaN when the
+                                     model carries none */
     unsigned long n_robtargets;   /* of n: RAPID robtargets corrected (through the nominal IK) */
 } rch_comp_result;
 

@@ -9,10 +9,12 @@
  * made; what is held is counted). */
 #include "rch_comp.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "rc_rand.h"
+#include "rc_sensor.h"
 
 void rch_model_rebuild(rc_model *out, const rc_model *m, int drop_nuisance, int drop_point, const double *tool_mm)
 {
@@ -96,4 +98,69 @@ unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, c
             ++n;
         }
     return n;
+}
+
+void rch_comp_orient_decide(rch_comp_orient *o, const rch_model_unc *unc, const rc_model *det,
+                            const rc_model *nominal, const rc_comp_config *cfg)
+{
+    memset(o, 0, sizeof *o);
+    if (!unc || !unc->present)
+        return;
+    rc_comp_config pc; /* the position-only mode of the run */
+    if (cfg)
+        pc = *cfg;
+    else
+        memset(&pc, 0, sizeof pc);
+    pc.flags |= RC_COMP_FLAG_POSITION_ONLY;
+    rc_rng g;
+    rc_rng_seed(&g, 20261205u);
+    double sd = 0.0, st = 0.0;
+    unsigned n = 0;
+    for (unsigned i = 0; i < RCH_COMP_ORIENT_POSES; ++i) {
+        double q[RC_NJ], p[3], Rc[9], Rn[9], D[9], w[3];
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            q[j] = det->q_min_rad[j] + (det->q_max_rad[j] - det->q_min_rad[j]) * rc_rng_u01(&g);
+        /* what position-only compensation leaves: the calibrated orientation at
+         * its joints q' (its correction turns the flange too) against the
+         * nominal one at the target */
+        rc_real qr[RC_NJ], qc[RC_NJ];
+        double qcd[RC_NJ];
+        rc_comp_result cr;
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            qr[j] = (rc_real)q[j];
+        (void)rc_comp_joint(qc, &cr, det, nominal, qr, NULL, &pc); /* not converged: its best point */
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            qcd[j] = (double)qc[j];
+        rc_fk(p, Rc, det, qcd);
+        rc_fk(p, Rn, nominal, q);
+        for (int r = 0; r < 3; ++r) /* D = Rc Rn^T: the uncorrected rotation, base frame */
+            for (int c = 0; c < 3; ++c)
+                D[r * 3 + c] = Rc[r * 3] * Rn[c * 3] + Rc[r * 3 + 1] * Rn[c * 3 + 1] + Rc[r * 3 + 2] * Rn[c * 3 + 2];
+        rc_rotvec_from_matrix(w, D);
+        const double z[3] = {Rc[2], Rc[5], Rc[8]}; /* the tool's axis: the flange z axis */
+        const double wz = w[0] * z[0] + w[1] * z[1] + w[2] * z[2];
+        const double a2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - wz * wz;
+        const double t = rch_model_unc_rot_trace(unc, det, qcd, 1, z);
+        if (!isfinite(a2) || !isfinite(t))
+            continue;
+        sd += a2 > 0.0 ? a2 : 0.0;
+        st += t;
+        ++n;
+    }
+    if (n == 0)
+        return;
+    o->known = 1;
+    o->uncorr_deg = sqrt(sd / n) * 180.0 / 3.14159265358979323846;
+    o->unc_deg = sqrt(st / n) * 180.0 / 3.14159265358979323846;
+    o->correct = sd > st;
+}
+
+int rch_comp_position_only(const rch_comp_orient *o, int forced_position, int forced_pose, int calibrated,
+                           int orientation_determined)
+{
+    if (forced_position || forced_pose)
+        return forced_position;
+    if (!calibrated)
+        return 0;
+    return o && o->known ? !o->correct : !orientation_determined;
 }

@@ -287,8 +287,10 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
         res->n_held = rch_comp_determined(&det, &unc, &res->version1, res->held, sizeof res->held, &robot,
                                           &robot.nominal);
     res->orientation_determined = unc.present && !res->version1 && unc.orientation_determined;
-    res->position_only_used = job->position_only || (!job->full_pose && !res->orientation_determined &&
-                                                     (robot.has_nominal || robot.unc.present));
+    res->mode_forced = job->position_only || job->full_pose;
+    res->u95_unknown = !(unc.present && !res->version1);
+    if (res->u95_unknown)
+        res->max_pos95_mm = NAN;
     /* the point compensation moves: the flange (or the given TCP) of both
      * models, never the cable attachment the calibration measured */
     static rc_model nom_pt, det_any;
@@ -299,6 +301,11 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     rc_comp_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.max_dev_rad = (rc_real)(job->max_dev_deg * DEG);
+    if (!res->mode_forced)
+        rch_comp_orient_decide(&res->orient, unc.present && !res->version1 ? &unc : NULL, &det, nom, &cfg);
+    res->position_only_used = rch_comp_position_only(&res->orient, job->position_only, job->full_pose,
+                                                     robot.has_nominal || robot.unc.present,
+                                                     res->orientation_determined);
     cfg.flags = res->position_only_used ? RC_COMP_FLAG_POSITION_ONLY : 0u;
     static rc_comp_stream s;
     rc_status st = rc_comp_stream_init(&s, &det, nom, &cfg);

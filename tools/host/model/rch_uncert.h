@@ -209,6 +209,18 @@ double rch_model_unc_radius95_mm(const rch_model_unc *u, const rc_model *m, cons
  * axis when theta6 is weak (cable lengths barely see the roll about it). */
 double rch_model_unc_tool95_mm(const rch_model_unc *u, const rc_model *det, const rc_model *fit,
                                const double q_rad[RC_NJ], const double tool_mm[3]);
+/* Trace (rad^2) of the covariance of the flange's small-rotation vector at
+ * q (with axis, 3, unit, base frame, not NULL: of its part perpendicular to
+ * axis, what tilts that axis) predicted by u over the DH parameters
+ * compensation moves (not held
+ * nominal, not fixed, with a finite standard error) and, with
+ * determined_only, not those the data left to the prior alone
+ * (RCH_PRIOR_CLASS_PRIOR_ONLY: their estimate sits at the drawing's value,
+ * so a correction does not move them and they weigh the same on both sides
+ * of rch_comp_orient_decide). m: the determined model (a tool offset does
+ * not change the rotation). NaN when u has no covariance. */
+double rch_model_unc_rot_trace(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ],
+                               int determined_only, const double *axis);
 /* The determined model: fit with its weak and not-identifiable DH
  * parameters at their nominal values. */
 void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_model_unc *u);

@@ -11,6 +11,7 @@
  * on the heap (NaN or -1 when it cannot be had), nothing kept. Errors: NaN
  * figures, or -1 from rch_uncert_map_compute. */
 #include "rch_uncert.h"
+#include "rch_prior.h"
 #include "rch_stats.h"
 
 #include <lapacke.h>
@@ -348,6 +349,39 @@ double rch_model_unc_tool95_mm(const rch_model_unc *u, const rc_model *det, cons
     cov_pack cp;
     pack_cov(&cp, buf, u->cov_dh, RC_N_DH, use, RC_N_DH);
     return sqrt(shift[0] * shift[0] + shift[1] * shift[1] + shift[2] * shift[2]) + ellipsoid95(Jp, &cp);
+}
+
+double rch_model_unc_rot_trace(const rch_model_unc *u, const rc_model *m, const double q_rad[RC_NJ],
+                               int determined_only, const double *axis)
+{
+    if (!u || !u->present)
+        return NAN;
+    uint8_t use[RC_N_DH];
+    unsigned n_used = 0;
+    for (unsigned k = 0; k < RC_N_DH; ++k) {
+        use[k] = k < u->n && u->cls[k] != RCH_PARAM_FIXED && !u->comp_nominal[k] && isfinite(u->se[k]) &&
+                 !(determined_only && u->has_prior && u->prior_cls[k] == RCH_PRIOR_CLASS_PRIOR_ONLY);
+        n_used += use[k];
+    }
+    if (n_used == 0)
+        return 0.0;
+    double Jr[3][RC_MAX_PARAMS], tr = 0.0;
+    rc_kin kin;
+    fk_sensitivity(NULL, Jr, use, RC_N_DH, m, sens_compile(&kin, m), q_rad);
+    for (unsigned a = 0; axis && a < RC_N_DH; ++a) { /* (I - axis axis^T) Jr: the tilt of the axis */
+        const double c = axis[0] * Jr[0][a] + axis[1] * Jr[1][a] + axis[2] * Jr[2][a];
+        for (int i = 0; i < 3; ++i)
+            Jr[i][a] -= c * axis[i];
+    }
+    for (int i = 0; i < 3; ++i)
+        for (unsigned a = 0; a < RC_N_DH; ++a) {
+            if (!use[a] || Jr[i][a] == 0.0)
+                continue;
+            for (unsigned b = 0; b < RC_N_DH; ++b)
+                if (use[b])
+                    tr += Jr[i][a] * u->cov_dh[a * RC_N_DH + b] * Jr[i][b];
+        }
+    return tr > 0.0 ? tr : 0.0;
 }
 
 void rch_model_unc_determined(rc_model *out, const rc_model *fit, const rc_model *nominal, const rch_model_unc *u)

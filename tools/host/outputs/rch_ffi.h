@@ -342,12 +342,13 @@ int rch_ffi_evaluate(double *out, const rch_ffi_model *m, const char *data_path,
  * the predicted 95 % position uncertainty of the compensated point (what
  * --uncertainty-out writes; NaN when the model carries no uncertainty);
  * q_deg: (n x 6) targets. The model is the determined part of cal
- * (rch_comp_determined). position_only: 0 as the model file says (position
- * only unless it says the orientation was determined), 1 position only
+ * (rch_comp_determined). position_only: 0 as rcal compensate chooses
+ * (rch_comp_orient_decide; rch_ffi_compensate_mode says), 1 position only
  * (--position-only), 2 position and orientation (--full-pose);
  * max_dev_deg: largest correction per joint, 0 for the default (0.1 rad);
  * max_unc_mm: --max-uncertainty-mm (0: none for a posterior model, 1 mm for
- * one without); u95_policy: what a target beyond it does (--u95-policy):
+ * one without; a model without an uncertainty meets no limit > 0: its u95
+ * is NaN and the policy acts); u95_policy: what a target beyond it does (--u95-policy):
  * 0 skip (left uncompensated, status 3), 1 warn (compensated anyway; the
  * caller sees u95_mm), 2 refuse (RCH_FFI_ERR_RANGE, "target i: ..."). A
  * target outside cal's joint limits stops the batch with RCH_FFI_ERR_RANGE
@@ -356,6 +357,17 @@ int rch_ffi_evaluate(double *out, const rch_ffi_model *m, const char *data_path,
 int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, double *out_deg, int *status,
                        double *u95_mm, const double *q_deg, size_t n, int position_only, double max_dev_deg,
                        double max_unc_mm, int u95_policy, const double *tool_mm, char *err, size_t err_len);
+
+/* How rch_ffi_compensate with these arguments (position_only, max_dev_deg,
+ * tool_mm: as there) treats the orientation, as
+ * `rcal compensate --summary` says it: out[0] 1 position only, 0 position
+ * and orientation; out[1] what chose it: 0 the option (position_only 1 or
+ * 2), 1 the model's uncertainty (rch_comp_orient_decide), 2 the model file
+ * (no covariance to weigh by); out[2] the calibrated-vs-nominal tilt of the
+ * tool's axis (the flange z axis), RMS over the joint limits, deg; out[3] the
+ * correction's predicted error of that tilt, RMS, deg (NaN: not known). */
+int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nominal, int position_only,
+                            double max_dev_deg, const double *tool_mm, double out[4], char *err, size_t err_len);
 
 /* ---- export and report (rcal export, rcal report) ---- */
 

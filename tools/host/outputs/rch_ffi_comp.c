@@ -61,12 +61,16 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
     if (calibrated)
         rch_comp_determined(&cs->det, &cs->unc, &version1, held, sizeof held, robot, &robot->nominal);
     const int orient = cs->unc.present && !version1 && cs->unc.orientation_determined;
-    const int pos_only = position_only == 1 || (position_only == 0 && !orient && calibrated);
     rch_comp_point_model(&cs->det, &cs->det, tool_mm);
     rch_comp_point_model(&cs->nom_pt, nominal ? &nominal->robot.model : &robot->nominal, tool_mm);
     rc_comp_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.max_dev_rad = (rc_real)(max_dev_deg * DEG);
+    rch_comp_orient od; /* the mode as rch_comp_run chooses it */
+    memset(&od, 0, sizeof od);
+    if (position_only == 0)
+        rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det, &cs->nom_pt, &cfg);
+    const int pos_only = rch_comp_position_only(&od, position_only == 1, position_only == 2, calibrated, orient);
     cfg.flags = pos_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
     const rc_status st0 = rc_comp_stream_init(&cs->s, &cs->det, &cs->nom_pt, &cfg);
     if (st0 != RC_OK) {
@@ -75,7 +79,7 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
                     rc_strerror(st0));
     }
     const rch_model_unc *gate = cs->unc.present && !version1 ? &cs->unc : NULL;
-    const double lim = max_unc_mm > 0 ? max_unc_mm : gate && gate->has_prior ? INFINITY : 1.0;
+    const double lim = max_unc_mm > 0 ? max_unc_mm : !gate || gate->has_prior ? INFINITY : 1.0;
     const rc_model *m = &cs->det;
     int rc = RCH_FFI_OK;
     for (size_t i = 0; i < n && rc == RCH_FFI_OK; ++i) {
@@ -97,14 +101,16 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
         const double u95 = !gate ? NAN
                            : gate->has_prior ? rch_model_unc_radius95_mm(gate, m, qd)
                                              : rch_model_unc_pos95_mm(gate, m, qd);
-        if (gate && !(u95 <= lim) && u95_policy == 2) {
+        /* no uncertainty: u95 NaN (unknown), beyond any limit the caller sets (as rch_comp.c) */
+        const int beyond = gate ? !(u95 <= lim) : isfinite(lim);
+        if (beyond && u95_policy == 2) {
             if (err && err_len > 0)
                 snprintf(err, err_len, "target %zu: the model's 95 %% position uncertainty at the compensated point is "
                          "%.4f mm here, above %.4f mm (u95_policy refuse: nothing returned)", i, u95, lim);
             rc = RCH_FFI_ERR_RANGE;
             break;
         }
-        if (gate && !(u95 <= lim) && u95_policy == 0) {
+        if (beyond && u95_policy == 0) {
             for (unsigned j = 0; j < RC_NJ; ++j)
                 out_deg[RC_NJ * i + j] = in[j]; /* left uncompensated: uncertainty above the limit */
             if (status)
@@ -125,4 +131,41 @@ int rch_ffi_compensate(const rch_ffi_model *cal, const rch_ffi_model *nominal, d
     }
     free(cs);
     return rc;
+}
+
+int rch_ffi_compensate_mode(const rch_ffi_model *cal, const rch_ffi_model *nominal, int position_only,
+                            double max_dev_deg, const double *tool_mm, double out[4], char *err, size_t err_len)
+{
+    if (!cal || !out)
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "compensate_mode: NULL argument");
+    if (position_only < 0 || position_only > 2 || !(max_dev_deg >= 0.0) || !isfinite(max_dev_deg))
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
+                    "compensate_mode: position_only must be 0, 1 or 2, max_dev_deg finite and >= 0");
+    comp_setup *cs = malloc(sizeof *cs);
+    if (!cs)
+        return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
+    const rch_robot *robot = &cal->robot;
+    int version1 = 0;
+    char held[256];
+    cs->det = robot->model;
+    memset(&cs->unc, 0, sizeof cs->unc);
+    const int calibrated = robot->has_nominal || robot->unc.present;
+    if (calibrated)
+        rch_comp_determined(&cs->det, &cs->unc, &version1, held, sizeof held, robot, &robot->nominal);
+    rch_comp_point_model(&cs->det, &cs->det, tool_mm);
+    rch_comp_point_model(&cs->nom_pt, nominal ? &nominal->robot.model : &robot->nominal, tool_mm);
+    rc_comp_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.max_dev_rad = (rc_real)(max_dev_deg * DEG);
+    rch_comp_orient od;
+    memset(&od, 0, sizeof od);
+    if (position_only == 0)
+        rch_comp_orient_decide(&od, cs->unc.present && !version1 ? &cs->unc : NULL, &cs->det, &cs->nom_pt, &cfg);
+    out[0] = rch_comp_position_only(&od, position_only == 1, position_only == 2, calibrated,
+                                    cs->unc.present && !version1 && cs->unc.orientation_determined);
+    out[1] = position_only ? 0.0 : od.known ? 1.0 : 2.0;
+    out[2] = od.known ? od.uncorr_deg : NAN;
+    out[3] = od.known ? od.unc_deg : NAN;
+    free(cs);
+    return RCH_FFI_OK;
 }
