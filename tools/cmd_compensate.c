@@ -38,7 +38,10 @@ static void print_orientation(const rch_comp_result *r)
                 "error is %.4f deg: correcting is expected to leave the axis %s (--position-only / --full-pose "
                 "force either)\n",
                 r->position_only_used ? "not corrected" : "corrected", r->orient.uncorr_deg, r->orient.unc_deg,
-                r->position_only_used ? "no closer than not correcting" : "closer than not correcting");
+                r->position_only_used ? (r->orient.tie ? "closer, but within 10 %: a tie, decided for the joints "
+                                                         "that move least"
+                                                       : "no closer than not correcting")
+                                      : "closer than not correcting");
     } else {
         fprintf(stderr, "rcal compensate: orientation %s (the model carries no uncertainty to weigh it by)\n",
                 r->position_only_used ? "not corrected" : "corrected");

@@ -107,8 +107,12 @@ static void test_decide_weighs_tilt_against_uncertainty(void **state)
 
     make_unc(&u, RC_P_ALPHA(5), 0.4 * DEG, RCH_PRIOR_CLASS_DETERMINED);
     rch_comp_orient_decide(&o, &u, &det, &nom.model, NULL);
-    assert_true(o.known && !o.correct);
+    assert_true(o.known && !o.correct && !o.tie);
     assert_true(fabs(o.unc_deg - 0.4) < 1e-6);
+    /* 0.3 against 0.29: closer by 3 %, within the margin: a tie, position only */
+    make_unc(&u, RC_P_ALPHA(5), 0.29 * DEG, RCH_PRIOR_CLASS_DETERMINED);
+    rch_comp_orient_decide(&o, &u, &det, &nom.model, NULL);
+    assert_true(o.known && !o.correct && o.tie);
     assert_int_equal(rch_comp_position_only(&o, 0, 0, 1, 1), 1); /* the file's flag no longer decides */
     /* the options still force either */
     assert_int_equal(rch_comp_position_only(&o, 0, 1, 1, 0), 0);

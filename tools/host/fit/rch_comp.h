@@ -151,8 +151,13 @@ double rch_comp_u95_written(double u95_mm, int status, double miss_mm);
  * covariance (rcal-model/1) is not decided (known 0): position only, as
  * before. */
 #define RCH_COMP_ORIENT_POSES 256
+/* Correcting the orientation must be expected to leave the tool's axis this
+ * factor closer than not correcting (RMS); within it the two are a tie, and
+ * the joints move least (position only). */
+#define RCH_COMP_ORIENT_TIE 1.1
 typedef struct rch_comp_orient {
     int known;         /* the model carries a covariance: the figures are numbers */
+    int tie;           /* correcting was expected closer, but within RCH_COMP_ORIENT_TIE: position only */
     int correct;       /* the decision: match the orientation too */
     double uncorr_deg; /* RMS over the poses of the calibrated-vs-nominal flange rotation angle */
     double unc_deg;    /* RMS over the poses of the predicted orientation error after correcting */

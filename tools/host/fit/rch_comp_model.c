@@ -152,7 +152,11 @@ void rch_comp_orient_decide(rch_comp_orient *o, const rch_model_unc *unc, const 
     o->known = 1;
     o->uncorr_deg = sqrt(sd / n) * 180.0 / 3.14159265358979323846;
     o->unc_deg = sqrt(st / n) * 180.0 / 3.14159265358979323846;
-    o->correct = sd > st;
+    /* a margin: within RCH_COMP_ORIENT_TIE of each other the two are a tie, decided for position only (the
+     * joints move least; a decision must not flip with the last digits of a fit: the real file's model had
+     * 0.7931 against 0.7754 deg and full pose moved the wrist by 5.7 deg) */
+    o->correct = sd > RCH_COMP_ORIENT_TIE * RCH_COMP_ORIENT_TIE * st;
+    o->tie = !o->correct && sd > st;
 }
 
 int rch_comp_position_only(const rch_comp_orient *o, int forced_position, int forced_pose, int calibrated,
