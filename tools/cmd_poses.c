@@ -210,14 +210,20 @@ static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, 
            res->n_distinct, res->n_candidates, res->n_outlets,
            res->n_outlets < 2 ? "" : pc->split ? ", each pose from one outlet (--split)" : ", every pose from each",
            res->n, res->n_ident);
+    char pts[400] = ""; /* on a plate: each point's run, with the points the follow check predicts from */
+    size_t pp = 0;
+    for (unsigned j = 0; j < pc->n_points && pp < sizeof pts; ++j)
+        pp += (size_t)snprintf(pts + pp, sizeof pts - pp, " --cable-point %g,%g,%g", pc->points_mm[j][0],
+                               pc->points_mm[j][1], pc->points_mm[j][2]);
     for (unsigned k = 0; k < res->n_outlets; ++k) {
         char opt[32] = "";
         if (res->n_outlets > 1)
             snprintf(opt, sizeof opt, " --outlet %u", k);
         printf("  outlet %u at (%.1f, %.1f, %.1f) mm: %zu rows; record them with: rcal acquire --poses %s%s "
-               "--encoder %g,%g,%g ...\n",
+               "--encoder %g,%g,%g%s%s ...\n",
                k, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2], res->rows_per_outlet[k], out_path,
-               opt, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2]);
+               opt, pc->outlet_mm[k][0], pc->outlet_mm[k][1], pc->outlet_mm[k][2], pc->n_points ? " --target P" : "",
+               pts);
     }
     printf("  predicted 3-D accuracy of the %s after calibration (95 %% position radius over %s random workspace "
            "poses, length noise %g mm):\n",

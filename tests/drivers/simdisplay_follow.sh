@@ -42,7 +42,9 @@ grep -q REFUSED err.txt || fail "frozen at outlet 1: no refusal: $(cat err.txt)"
 [ "$(rows frozen_o1.csv)" -eq 0 ] || fail "frozen at outlet 1: $(rows frozen_o1.csv) rows recorded"
 
 # a tool plate: the display follows each point; a frozen one is refused on point 1
-"$R" poses --count 4 --tool 50,0,150 $PTS --out plate.csv >/dev/null 2>&1 || fail "rcal poses --cable-point"
+"$R" poses --count 4 --tool 50,0,150 $PTS --out plate.csv >poses.txt 2>&1 || fail "rcal poses --cable-point"
+# the plan says how to record it: per point, with the points the follow check predicts from
+grep -q -- "--target P $PTS" poses.txt || fail "rcal poses on a plate: its 'record them with' lacks --target and the points"
 "$SD" --protocol ascii --truth "$TRUTH" --poses plate.csv --follow ann.txt --link tty.sim >/dev/null 2>sim.err \
   && fail "simdisplay on a plate plan without --cable-point: exit 0"
 grep -q -- "--cable-point X,Y,Z" sim.err && grep -q "plate.csv:2:" sim.err || fail "simdisplay's message: $(cat sim.err)"
