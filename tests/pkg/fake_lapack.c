@@ -4,9 +4,11 @@
  * system's alternatives) into a directory the tests put first on
  * LD_LIBRARY_PATH. Its ILAVER says 0.0.0 and its routines answer 42, so a
  * program that takes its LAPACK from the loader rather than from the
- * reference archives linked in (cmake/rcal_lapack.cmake) is caught. Every
- * routine rcal's LAPACKE calls is here (a missing one would end the process
- * with "symbol lookup error" instead of a failed assertion); FAKE_BLAS
+ * reference archives linked in (cmake/rcal_lapack.cmake) is caught: it
+ * runs these (a failed assertion) or, when a library it loads needs a
+ * routine the fake lacks (Debian's liblapacke.so.3 pulls libtmglib.so.3,
+ * which needs cgemv_), does not start ("symbol lookup error"); either way
+ * the test fails. The routines rcal's LAPACKE calls are here; FAKE_BLAS
  * builds the BLAS half. */
 #include <stddef.h>
 
