@@ -12,11 +12,19 @@ set(RCAL_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/rcal)
 install(EXPORT rcalTargets NAMESPACE rcal:: DESTINATION ${RCAL_INSTALL_CMAKEDIR} FILE rcalTargets.cmake)
 
 # A static rcal::host carries LAPACKE as a link-only dependency; the config
-# file finds it on the consumer's machine (no build-machine path installed).
+# file finds it on the consumer's machine (no build-machine path installed):
+# the reference LAPACK and BLAS archives by their own place when this build
+# pinned them (cmake/rcal_lapack.cmake), so that a consumer computes as rcal
+# does. A shared librcalhost.so has them inside.
 if(TARGET rcal_host AND NOT BUILD_SHARED_LIBS)
   set(RCAL_CONFIG_NEEDS_LAPACKE 1)
 else()
   set(RCAL_CONFIG_NEEDS_LAPACKE 0)
+endif()
+if(RCAL_LAPACK_PINNED)
+  set(RCAL_CONFIG_LAPACK_PINNED 1)
+else()
+  set(RCAL_CONFIG_LAPACK_PINNED 0)
 endif()
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/rcalConfig.cmake.in
   ${PROJECT_BINARY_DIR}/rcalConfig.cmake
@@ -37,7 +45,12 @@ install(FILES ${PROJECT_BINARY_DIR}/rcalConfig.cmake ${PROJECT_BINARY_DIR}/rcalC
 # pkg-config: relocatable (prefix from the .pc file's own place).
 file(RELATIVE_PATH RCAL_PC_TO_PREFIX /x/${CMAKE_INSTALL_LIBDIR}/pkgconfig /x)
 string(REGEX REPLACE "/$" "" RCAL_PC_TO_PREFIX "${RCAL_PC_TO_PREFIX}")
-if(TARGET rcal_host)
+if(TARGET rcal_host AND RCAL_LAPACK_PINNED)
+  # the reference archives by their place in the system (Debian's
+  # liblapack-dev, libblas-dev), never -llapack (an alternative)
+  set(RCAL_PC_LIBS "-lrcalhost -lrcalcore")
+  string(REPLACE ";" " " RCAL_PC_LIBS_PRIVATE "${RCAL_LAPACK_ARCHIVES};-l:libgfortran.so.5;-lm")
+elseif(TARGET rcal_host)
   set(RCAL_PC_LIBS "-lrcalhost -lrcalcore")
   set(RCAL_PC_LIBS_PRIVATE "-llapacke -lm")
 else()

@@ -8,7 +8,8 @@
 # so. The libraries (rcal::core, rcal::host) are unchanged; only the program.
 #
 # rcal_static_probe(<out>): sets <out> to the list of archives (after
-# LAPACKE: LAPACK, a BLAS and its run-time) that link a static program
+# LAPACKE: LAPACK, a BLAS and its run-time; the reference ones when
+# cmake/rcal_lapack.cmake pins them) that link a static program
 # calling the LAPACKE and libserialport functions rcal uses, or to "" when
 # none of the known layouts links.
 
@@ -26,6 +27,15 @@ function(rcal_static_probe out)
       set(RCAL_A_${n} "")
     endif()
   endforeach()
+  # Pinned (cmake/rcal_lapack.cmake): the reference archives by their own
+  # place, never the alternatives' liblapack.a/libblas.a.
+  if(RCAL_LAPACK_PINNED)
+    set(RCAL_A_lapacke ${RCAL_REF_LAPACKE_A})
+    set(RCAL_A_lapack ${RCAL_REF_LAPACK_A})
+    set(RCAL_A_blas ${RCAL_REF_BLAS_A})
+    set(RCAL_A_atlas "")
+    set(RCAL_A_openblas "")
+  endif()
   if(NOT RCAL_A_lapacke OR NOT RCAL_A_lapack OR NOT RCAL_A_gfortran)
     return()
   endif()

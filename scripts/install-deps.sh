@@ -2,7 +2,9 @@
 # SPDX-License-Identifier: MIT
 # Install what is missing (Debian packages only). Root or sudo required.
 set -euo pipefail
-PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev libcmocka-dev
+# liblapack-dev, libblas-dev: the reference LAPACK and BLAS archives rcal links by their own place
+# (cmake/rcal_lapack.cmake; never the alternatives ATLAS or OpenBLAS switch); gfortran: their run-time.
+PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev liblapack-dev libblas-dev gfortran libcmocka-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi clang libclang-rt-14-dev
       cppcheck clang-tidy valgrind binutils libgsl-dev
       python3 python3-pytest python3-numpy python3-venv python3-pip python3-setuptools python3-wheel liburdfdom-tools chromium fonts-dejavu-core)

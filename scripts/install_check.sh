@@ -11,7 +11,9 @@
 #     must print the same cable length;
 #  3. the same with -DBUILD_SHARED_LIBS=ON: SONAMEs checked with readelf, both
 #     consumers run against the shared libraries (and print the same length);
-#  4. the installed `rcal --version`, then the source and build trees are
+#  4. the installed `rcal --version` (its version, and the pinned reference
+#     BLAS/LAPACK linked in; no installed library or consumer needs a shared
+#     LAPACK or BLAS), then the source and build trees are
 #     deleted, the prefix is copied elsewhere and the copy's `rcal calibrate
 #     --data <copy>/share/rcal/sim_irb120.csv` must find its robot model under
 #     the copy's share/rcal (run from / with RCAL_DATA_DIR unset), and must
@@ -152,6 +154,20 @@ for kind in static shared; do
     [ -x "$WORK/$kind/bin/rcal" ] || continue
     v=$("$WORK/$kind/bin/rcal" --version | head -n 1)
     [ "$v" = "rcal $version" ] && ok "$kind: rcal --version: $v" || bad "$kind: rcal --version says '$v'"
+    # the pinned reference LAPACK and BLAS (cmake/rcal_lapack.cmake), linked in
+    la=$("$WORK/$kind/bin/rcal" --version | sed -n 's/^BLAS\/LAPACK: //p')
+    [[ $la == "reference LAPACK "*" and BLAS, linked in (pinned: "* ]] && ok "$kind: BLAS/LAPACK: $la" ||
+        bad "$kind: rcal --version says BLAS/LAPACK '$la', want the pinned reference, linked in"
+done
+# nothing installed or built against the package takes LAPACK or BLAS from the
+# loader (where an alternative would switch it): the shared host library and
+# both consumers have them inside
+for f in "$WORK/shared/lib/librcalhost.so" "$WORK/consumer-static/consumer" "$WORK/consumer-static/consumer_pc" \
+    "$WORK/consumer-shared/consumer" "$WORK/consumer-shared/consumer_pc"; do
+    [ -f "$f" ] || continue
+    needed=$(readelf -d "$f" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p' | grep -E '^lib(lapack|lapacke|blas|openblas|atlas)' || true)
+    [ -z "$needed" ] && ok "${f#"$WORK"/}: no shared LAPACK/BLAS needed (the reference archives linked in)" ||
+        bad "${f#"$WORK"/}: needs $needed from the loader"
 done
 # reference figures: the build tree's rcal on the source tree's data
 ref=""

@@ -10,6 +10,7 @@
 #include "rc_config.h"
 #include "rcal_cmds.h"
 #include "rch_file.h"
+#include "rch_lapack.h"
 #include "rch_paths.h"
 #include "rch_stdio.h"
 
@@ -45,7 +46,8 @@ static void usage(FILE *f)
 }
 
 /* Version of the program and of the core it runs with, the compile-time
- * limits and the robot model it would load by default. */
+ * limits, the robot model it would load by default and the BLAS/LAPACK it
+ * computes with. */
 static int version(void)
 {
     char robot[4096];
@@ -54,6 +56,10 @@ static int version(void)
     printf("core library %s\n", rc_version());
     printf("limits: RC_MAX_PARAMS %d, RC_MAX_EFFECTS %d\n", RC_MAX_PARAMS, RC_MAX_EFFECTS);
     printf("robot model: %s%s\n", robot, found ? "" : " (not found; set RCAL_DATA_DIR)");
+    rch_lapack_info la;
+    char line[3 * RCH_LAPACK_PATH];
+    rch_lapack_get(&la);
+    printf("BLAS/LAPACK: %s\n", rch_lapack_line(line, sizeof line, &la));
     return 0;
 }
 

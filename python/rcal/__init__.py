@@ -38,7 +38,7 @@ from ._check import _ints, _doubles, _real, _rows
 
 __all__ = ["RcalError", "RcalWarning", "Model", "Metrics", "Param", "Jump", "Result", "Diagnosis", "Evaluation", "Compensation",
            "calibrate", "diagnose", "evaluate", "compensate", "export", "report", "default_robot", "data_file",
-           "library_path"]
+           "library_path", "lapack"]
 
 try:  # optional
     import numpy as _np
@@ -140,6 +140,23 @@ def data_file(name):
     else the package's own copy (an installed package), else the
     repository's data/."""
     return os.path.join(_data_dir(), name)
+
+
+Lapack = collections.namedtuple("Lapack", "line linked_in version")
+Lapack.__doc__ = """The BLAS/LAPACK the library computes with: line as `rcal --version` prints
+it after "BLAS/LAPACK: ", linked_in True when LAPACK and BLAS are inside
+librcal_ffi.so (the build's pinned reference archives: no other BLAS/LAPACK
+on the machine or in the process changes a result), version LAPACK's
+ILAVER as a string ("3.11.0")."""
+
+
+def lapack():
+    """Which BLAS/LAPACK librcal_ffi.so computes with (a Lapack)."""
+    buf = ctypes.create_string_buffer(4096)
+    linked = ctypes.c_int()
+    ver = (ctypes.c_int * 3)()
+    _check(_lib.lib().rch_ffi_lapack(buf, len(buf), ctypes.byref(linked), ver))
+    return Lapack(buf.value.decode(), bool(linked.value), "%d.%d.%d" % tuple(ver))
 
 
 def default_robot():

@@ -60,6 +60,7 @@ def _declare(lib):
         "rch_ffi_fk": (i, [vp, i, _c_double_p, _c_double_p, _c_double_p, sz, cp, sz]),
         "rch_ffi_cable_length": (i, [vp, _c_double_p, _c_double_p, sz, cp, sz]),
         "rch_ffi_version": (cp, []),
+        "rch_ffi_lapack": (i, [cp, sz, _c_int_p, _c_int_p]),
         "rch_ffi_calibrate": (i, [pvp, ppc, sz, cp, cp, d, ul, u, cp, cp, u, cp, cp, ul, sz, cp, cp, cp, sz]),
         "rch_ffi_calibrate_arrays": (i, [pvp, _c_double_p, _c_double_p, _c_double_p, _c_int_p, _c_int_p, _c_int_p, sz,
                                          _c_double_p, sz, d, cp, cp, d, ul, u, cp, cp, u, cp, cp, ul, sz, cp, cp, cp,

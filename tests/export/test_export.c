@@ -395,11 +395,13 @@ static void test_names_from_nominal(void **state)
     assert_string_equal(n.flange_link, "tool0");
     assert_int_equal(n.n_dropped, 2); /* world_joint, sensor */
     /* the same with a UTF-8 byte-order mark */
-    char *bom = malloc(strlen(good_urdf) + 4);
+    /* sizes stated once (a strcpy to bom + 3 was -Werror=array-bounds in the ASan+UBSan build) */
+    size_t len = strlen(good_urdf), bom_len = 3 + len;
+    char *bom = malloc(bom_len + 1);
     assert_non_null(bom);
     memcpy(bom, "\xEF\xBB\xBF", 3);
-    strcpy(bom + 3, good_urdf);
-    assert_int_equal(rch_urdf_names_parse(&n, bom, strlen(bom), "bom.urdf", &d), 0);
+    memcpy(bom + 3, good_urdf, len + 1);
+    assert_int_equal(rch_urdf_names_parse(&n, bom, bom_len, "bom.urdf", &d), 0);
     assert_string_equal(n.joint[3], "j4");
     free(bom);
 }
@@ -419,11 +421,12 @@ static char *replace(const char *s, const char *from, const char *to)
 {
     const char *at = strstr(s, from);
     assert_non_null(at);
-    char *out = malloc(strlen(s) + strlen(to) + 1);
+    size_t head = (size_t)(at - s), n_to = strlen(to), n_tail = strlen(at + strlen(from));
+    char *out = malloc(head + n_to + n_tail + 1);
     assert_non_null(out);
-    memcpy(out, s, (size_t)(at - s));
-    strcpy(out + (at - s), to);
-    strcat(out, at + strlen(from));
+    memcpy(out, s, head);
+    memcpy(out + head, to, n_to);
+    memcpy(out + head + n_to, at + strlen(from), n_tail + 1);
     return out;
 }
 

@@ -65,6 +65,12 @@ int rch_ffi_abi(void);
 const char *rch_ffi_version(void);
 /* Short English name of a status; never NULL. */
 const char *rch_ffi_strerror(int status);
+/* The BLAS/LAPACK this library computes with (rch_lapack.h): one line into
+ * line (len bytes, truncated), *linked_in 1 when LAPACK and BLAS are inside
+ * this library (the build's pinned reference archives), version[3] LAPACK's
+ * ILAVER. Either pointer may be NULL. RCH_FFI_OK, RCH_FFI_ERR_ARG for
+ * line NULL with len > 0. */
+int rch_ffi_lapack(char *line, size_t len, int *linked_in, int *version);
 
 /* ---- models ---- */
 
