@@ -117,7 +117,7 @@ typedef struct rch_calib_judge {
     /* causes tried when beyond (rch_calib_judge.c): a relabelling of the joint columns or the plate's
      * points whose nominal fit explains the data far better than the file as read */
     int cause_found;
-    char cause[480];           /* what it is and the fix, or "" */
+    char cause[1024];           /* what it is and the fix, or "" */
     char tried[240];           /* the causes tried, in words */
 } rch_calib_judge;
 

@@ -236,7 +236,7 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
         rch_jw_bool(&w, "worse_than_nominal", j->worse_than_nominal);
         rch_jw_bool(&w, "usable", !j->beyond && !j->worse_than_nominal);
         if (j->beyond || j->worse_than_nominal) {
-            char why[1400];
+            char why[2048];
             rch_calib_judge_text(why, sizeof why, r);
             rch_jw_str(&w, "why", why);
         }

@@ -67,7 +67,7 @@ int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *
     }
     const rch_calib_judge *j = &r->judge;
     if (j->done && (j->beyond || j->worse_than_nominal) && !r->cfg.force) {
-        char why[1400];
+        char why[2048];
         rch_calib_judge_text(why, sizeof why, r);
         rch_diag_set(d, path, 0, 0, "not written: %s (--force writes it anyway)", why);
         return -1;

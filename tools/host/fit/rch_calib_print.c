@@ -586,7 +586,7 @@ static void print_summary(FILE *f, const rch_calib_result *r)
     hint_paths_of(&hp, r);
     fputs("\nsummary:\n", f);
     if (r->judge.done && (r->judge.beyond || r->judge.worse_than_nominal)) {
-        char why[1400];
+        char why[2048];
         rch_calib_judge_text(why, sizeof why, r);
         fprintf(f, "  NOT A MODEL TO USE: %s; %s\n", why,
                 r->cfg.force ? "written anyway (--force)" : "rcal calibrate --out refuses to write it (--force writes it)");
