@@ -73,6 +73,24 @@ static void json_places(rch_jw *w, const double (*p)[3], const unsigned *idx, un
     }
 }
 
+static void json_travel(rch_jw *w, const rch_poses_travel *t)
+{
+    rch_jw_obj(w, "joint_travel");
+    rch_jw_str(w, "metric", "sum over moves of max over joints |dq|, from home, per outlet and plate point");
+    rch_jw_num(w, "before_deg", t->before_deg);
+    rch_jw_num(w, "after_deg", t->after_deg);
+    rch_jw_num(w, "ratio", t->before_deg > 0 ? t->after_deg / t->before_deg : 1.0);
+    rch_jw_arr(w, "q_min_deg");
+    for (int j = 0; j < RC_NJ; ++j)
+        rch_jw_num(w, NULL, t->after_min_deg[j]);
+    rch_jw_end(w);
+    rch_jw_arr(w, "q_max_deg");
+    for (int j = 0; j < RC_NJ; ++j)
+        rch_jw_num(w, NULL, t->after_max_deg[j]);
+    rch_jw_end(w);
+    rch_jw_end(w);
+}
+
 /* What was planned and written, as one JSON object on stdout (rcal-poses/2). */
 static int report_json(const rch_poses_result *res, const rch_poses_config *pc, const rch_poses_choice *ch,
                        const double (*cand)[3], const char *out_path, const char *format, int argc, char **argv)
@@ -133,6 +151,7 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
     rch_jw_num(&w, "o1_random", res->o1_random);
     rch_jw_uint(&w, "rank_random", res->rank_random);
     rch_jw_num(&w, "o1_ratio", res->o1_random > 0 ? res->o1_plan / res->o1_random : NAN);
+    json_travel(&w, &res->travel);
     rch_jw_numf(&w, "len_min_mm", pc->len_min_mm, "%.6g");
     rch_jw_numf(&w, "len_max_mm", pc->len_max_mm, "%.6g");
     rch_jw_numf(&w, "margin_deg", pc->margin_deg, "%.6g");
@@ -195,7 +214,26 @@ static void print_point_gains(const rch_poses_result *res)
     }
 }
 
+/* The joint travel before and after ordering (rch_poses_order; issue 48). */
+static void print_plan_figures(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path);
+
+static void print_travel(const rch_poses_travel *t)
+{
+    printf("  joint travel: %.0f deg before ordering, %.0f deg after (%.2f; the sum of the largest joint move per "
+           "move, from home, per outlet and plate point)\n",
+           t->before_deg, t->after_deg, t->before_deg > 0 ? t->after_deg / t->before_deg : 1.0);
+    printf("    q4 in [%.0f, %.0f] deg, q6 in [%.0f, %.0f] deg (before: q4 [%.0f, %.0f], q6 [%.0f, %.0f])\n",
+           t->after_min_deg[3], t->after_max_deg[3], t->after_min_deg[5], t->after_max_deg[5], t->before_min_deg[3],
+           t->before_max_deg[3], t->before_min_deg[5], t->before_max_deg[5]);
+}
+
 static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
+{
+    print_plan_figures(res, pc, out_path);
+    print_travel(&res->travel);
+}
+
+static void print_plan_figures(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
 {
     if (pc->criterion == RCH_POSES_LENGTH) {
         printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
