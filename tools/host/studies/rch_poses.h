@@ -148,6 +148,9 @@ int rch_poses_order(rc_sample *rows, size_t n, const rc_model *m, double margin_
                     rch_diag *d);
 /* The joint travel of rows as rch_poses_order measures it (deg). */
 double rch_poses_travel_deg(const rc_sample *rows, size_t n, const rc_model *m, double margin_deg);
+/* tr for rows kept in their order (after = before). */
+void rch_poses_travel_of(rch_poses_travel *tr, const rc_sample *rows, size_t n, const rc_model *m,
+                         double margin_deg);
 
 /* Plan poses for model m (with its encoder position set). progress: a
  * stream for progress lines when the plan takes more than a few seconds

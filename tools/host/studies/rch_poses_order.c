@@ -337,6 +337,15 @@ static void span(double *lo, double *hi, const rc_sample *rows, size_t n)
     }
 }
 
+void rch_poses_travel_of(rch_poses_travel *tr, const rc_sample *rows, size_t n, const rc_model *m,
+                         double margin_deg)
+{
+    memset(tr, 0, sizeof *tr);
+    tr->before_deg = tr->after_deg = rch_poses_travel_deg(rows, n, m, margin_deg);
+    span(tr->before_min_deg, tr->before_max_deg, rows, n);
+    span(tr->after_min_deg, tr->after_max_deg, rows, n);
+}
+
 int rch_poses_order(rc_sample *rows, size_t n, const rc_model *m, double margin_deg, rch_poses_travel *tr,
                     rch_diag *d)
 {

@@ -35,7 +35,7 @@ static int order_rows(rch_poses_result *res, const rc_model *m, const rch_poses_
 {
     if (!c->keep_order)
         return rch_poses_order(res->poses, res->n, m, c->margin_deg, &res->travel, d);
-    res->travel.before_deg = res->travel.after_deg = rch_poses_travel_deg(res->poses, res->n, m, c->margin_deg);
+    rch_poses_travel_of(&res->travel, res->poses, res->n, m, c->margin_deg);
     return 0;
 }
 
