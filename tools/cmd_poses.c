@@ -440,7 +440,8 @@ static int parse(poses_args *a, int argc, char **argv)
          "choose the best K of the --candidate places", 0, NULL},
         {"--candidate", RCH_OPT_STRS, &a->cands, 0, 0, "X,Y,Z", "a candidate outlet place (repeatable)", 0, NULL},
         {"--order", RCH_OPT_CHOICE, &a->order, 0, 0, NULL,
-         "the rows' order: a tour per outlet from home that shortens the joint travel (q6 on its nearest branch), "
+         "the rows' order: a tour per outlet from home that shortens the joint travel (a joint over 360 deg on "
+         "the branch that shortens it), "
          "or the selection's",
          0, "travel|selection"},
         {"--format", RCH_OPT_CHOICE, &a->format, 0, 0, NULL, "what --out holds", 0, "csv|rapid"},
