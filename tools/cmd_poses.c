@@ -36,7 +36,10 @@ static const char details[] =
     "accuracy (every combination up to 64, else greedily); the plan is then made for them.\n"
     "Writes pose,q1..q6 (degrees, 0.01 deg steps) and, with several outlets, outlet (0..K-1); --format rapid\n"
     "writes an ABB RAPID module that moves through the same plan (the same options and seed give the same\n"
-    "plan). The design cost grows as N^2 (progress on stderr).";
+    "plan). The design cost grows as N^2 (progress on stderr). The rows are then ordered for joint travel\n"
+    "(--order travel): per outlet a tour from home (nearest neighbour, 2-opt), a joint with a range over 360 deg\n"
+    "on the branch (q +- 360, within the limits less --margin-deg) that shortens it; the travel before and after\n"
+    "is printed (the sum over moves of the largest joint move, deg).";
 
 static int parse_places(double (*out)[3], unsigned *n, const rch_opt_strs *v, const char *name)
 {
@@ -71,6 +74,24 @@ static void json_places(rch_jw *w, const double (*p)[3], const unsigned *idx, un
             rch_jw_numf(w, NULL, x[c], "%.6g");
         rch_jw_end(w);
     }
+}
+
+static void json_travel(rch_jw *w, const rch_poses_travel *t)
+{
+    rch_jw_obj(w, "joint_travel");
+    rch_jw_str(w, "metric", "sum over moves of max over joints |dq|, from home, per outlet and plate point");
+    rch_jw_numf(w, "before_deg", t->before_deg, "%.2f");
+    rch_jw_numf(w, "after_deg", t->after_deg, "%.2f");
+    rch_jw_num(w, "ratio", t->before_deg > 0 ? t->after_deg / t->before_deg : 1.0);
+    rch_jw_arr(w, "q_min_deg");
+    for (int j = 0; j < RC_NJ; ++j)
+        rch_jw_numf(w, NULL, t->after_min_deg[j], "%.2f");
+    rch_jw_end(w);
+    rch_jw_arr(w, "q_max_deg");
+    for (int j = 0; j < RC_NJ; ++j)
+        rch_jw_numf(w, NULL, t->after_max_deg[j], "%.2f");
+    rch_jw_end(w);
+    rch_jw_end(w);
 }
 
 /* What was planned and written, as one JSON object on stdout (rcal-poses/2). */
@@ -133,6 +154,7 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
     rch_jw_num(&w, "o1_random", res->o1_random);
     rch_jw_uint(&w, "rank_random", res->rank_random);
     rch_jw_num(&w, "o1_ratio", res->o1_random > 0 ? res->o1_plan / res->o1_random : NAN);
+    json_travel(&w, &res->travel);
     rch_jw_numf(&w, "len_min_mm", pc->len_min_mm, "%.6g");
     rch_jw_numf(&w, "len_max_mm", pc->len_max_mm, "%.6g");
     rch_jw_numf(&w, "margin_deg", pc->margin_deg, "%.6g");
@@ -195,7 +217,26 @@ static void print_point_gains(const rch_poses_result *res)
     }
 }
 
+/* The joint travel before and after ordering (rch_poses_order; issue 48). */
+static void print_plan_figures(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path);
+
+static void print_travel(const rch_poses_travel *t)
+{
+    printf("  joint travel: %.0f deg before ordering, %.0f deg after (%.2f; the sum of the largest joint move per "
+           "move, from home, per outlet and plate point)\n",
+           t->before_deg, t->after_deg, t->before_deg > 0 ? t->after_deg / t->before_deg : 1.0);
+    printf("    q4 in [%.0f, %.0f] deg, q6 in [%.0f, %.0f] deg (before: q4 [%.0f, %.0f], q6 [%.0f, %.0f])\n",
+           t->after_min_deg[3], t->after_max_deg[3], t->after_min_deg[5], t->after_max_deg[5], t->before_min_deg[3],
+           t->before_max_deg[3], t->before_min_deg[5], t->before_max_deg[5]);
+}
+
 static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
+{
+    print_plan_figures(res, pc, out_path);
+    print_travel(&res->travel);
+}
+
+static void print_plan_figures(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
 {
     if (pc->criterion == RCH_POSES_LENGTH) {
         printf("rcal poses: %zu poses from %zu candidates, %u identifiable directions (rc_ident) of %u parameters\n",
@@ -299,7 +340,7 @@ static int choose_places(rch_poses_choice *ch, rch_poses_config *pc, const rc_mo
 
 /* The options of rcal poses, and the planner's configuration made of them. */
 typedef struct poses_args {
-    const char *robot_path, *out_path, *criterion, *format;
+    const char *robot_path, *out_path, *criterion, *format, *order;
     unsigned long n, seed, n_cand, passes, choose;
     double max_minutes, settle_s;
     double enc[3], tool[3];
@@ -328,6 +369,7 @@ static int to_config(poses_args *a, int has_tool)
     pc->split = a->split;
     pc->criterion = strcmp(a->criterion, "length") == 0 ? RCH_POSES_LENGTH : RCH_POSES_POSITION;
     pc->has_tool = has_tool;
+    pc->keep_order = strcmp(a->order, "selection") == 0;
     memcpy(pc->tool_mm, a->tool, sizeof a->tool);
     if (a->cable_points.n) { /* the calibrate option's one parser */
         char perr[160];
@@ -360,6 +402,7 @@ static int parse(poses_args *a, int argc, char **argv)
     a->robot_path = RCAL_DEFAULT_ROBOT;
     a->criterion = "position";
     a->format = "csv";
+    a->order = "travel";
     a->seed = 1;
     a->passes = 4;
     a->max_minutes = 60.0;
@@ -396,6 +439,11 @@ static int parse(poses_args *a, int argc, char **argv)
         {"--choose-outlets", RCH_OPT_UINT, &a->choose, 1, RC_MAX_OUTLETS, "K",
          "choose the best K of the --candidate places", 0, NULL},
         {"--candidate", RCH_OPT_STRS, &a->cands, 0, 0, "X,Y,Z", "a candidate outlet place (repeatable)", 0, NULL},
+        {"--order", RCH_OPT_CHOICE, &a->order, 0, 0, NULL,
+         "the rows' order: a tour per outlet from home that shortens the joint travel (a joint over 360 deg on "
+         "the branch that shortens it), "
+         "or the selection's",
+         0, "travel|selection"},
         {"--format", RCH_OPT_CHOICE, &a->format, 0, 0, NULL, "what --out holds", 0, "csv|rapid"},
         {"--settle-s", RCH_OPT_DOUBLE, &a->settle_s, 0, 600, "S", "RAPID: WaitTime at each pose (settle and read)", 0,
          NULL},

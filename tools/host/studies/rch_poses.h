@@ -36,6 +36,8 @@
  * (columns scaled by their RMS), greedy + Fedorov exchange, reported by the
  * observability index O1 (rch_ident) beside N random poses.
  *
+ * The plan's rows are then ordered for joint travel (rch_poses_order).
+ *
  * Collisions of the cable with the arm are not modelled: review the plan
  * before running it. Cost of the position criterion: about candidates x K x
  * P^2 x N x (passes + 1) products (P ~ 26 + 3 K); 50 poses from 3 outlets
@@ -77,6 +79,7 @@ typedef struct rch_poses_config {
     const rch_prior_cfg *prior;    /* NULL: rch_prior_defaults */
     size_t n_work;                 /* workspace poses of the criterion, 0: 300 */
     size_t n_eval;                 /* workspace poses of the reported accuracy, 0: 1000 */
+    int keep_order;                /* 1: the rows in the selection's order (no rch_poses_order) */
 } rch_poses_config;
 
 typedef enum { RCH_POSES_POSITION = 0, RCH_POSES_LENGTH = 1 } rch_poses_criterion;
@@ -89,6 +92,14 @@ typedef struct rch_poses_accuracy {
     double median_mm, p95_mm;      /* over the n_eval workspace poses */
     double phi_mm2;                /* the criterion: mean trace of the position covariance over them */
 } rch_poses_accuracy;
+
+/* The plan's joint travel before and after rch_poses_order (issue 48). */
+typedef struct rch_poses_travel {
+    double before_deg, after_deg;     /* the sum over sessions of max_j |dq_j| per move, from home (deg) */
+    unsigned outlets_reordered;       /* outlets whose tour beat the input order (the others kept it) */
+    double before_min_deg[RC_NJ], before_max_deg[RC_NJ]; /* each joint's span over the rows */
+    double after_min_deg[RC_NJ], after_max_deg[RC_NJ];
+} rch_poses_travel;
 
 typedef struct rch_poses_result {
     rc_sample *poses;          /* (n) the plan, q at 0.01 deg steps; rch_poses_free */
@@ -107,6 +118,7 @@ typedef struct rch_poses_result {
                                   attachment it tries) + RCH_POSES_ROWS_SPARE */
     /* with a tool plate (c->n_points > 0, the position criterion): what each further point gains, the
      * plan's poses measured on points 0..j only (by_points[j - 1]), predicted at the same point */
+    rch_poses_travel travel;   /* the joint travel before and after ordering (rch_poses_order) */
     unsigned n_points;
     struct {
         size_t rows;
@@ -120,6 +132,25 @@ typedef struct rch_poses_result {
  * --table: 30 rows for 32 parameters, 3-D error 0.33-0.69 mm against a
  * predicted 0.05-0.07 mm; 60 rows and more as predicted). */
 #define RCH_POSES_ROWS_SPARE 10u
+
+/* The plan ordered for travel (issue 48; rch_poses_order.c): per outlet
+ * (the rows `rcal acquire --outlet N` runs; the same pose on each plate
+ * point stays one stop, its rows together) a tour from home (q = 0 within
+ * the limits less margin_deg) that shortens the joint travel, nearest
+ * neighbour then 2-opt; a joint with a range over 360 deg (less the margins)
+ * takes the branch q + 360 k (the same robot pose) that minimises the travel
+ * along the tour, within the limits less margin_deg. Travel: the sum over
+ * the sessions (outlet, target) of max over joints of |dq| per move, from
+ * home. Rows keep their columns' meaning (outlet, target, the pose); an
+ * outlet's order changes only when its travel falls. tr: the figures. 0, or
+ * -1 with d set (out of memory; rows unchanged). */
+int rch_poses_order(rc_sample *rows, size_t n, const rc_model *m, double margin_deg, rch_poses_travel *tr,
+                    rch_diag *d);
+/* The joint travel of rows as rch_poses_order measures it (deg). */
+double rch_poses_travel_deg(const rc_sample *rows, size_t n, const rc_model *m, double margin_deg);
+/* tr for rows kept in their order (after = before). */
+void rch_poses_travel_of(rch_poses_travel *tr, const rc_sample *rows, size_t n, const rc_model *m,
+                         double margin_deg);
 
 /* Plan poses for model m (with its encoder position set). progress: a
  * stream for progress lines when the plan takes more than a few seconds

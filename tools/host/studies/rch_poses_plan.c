@@ -30,8 +30,32 @@ static void point_gains(rch_poses_result *res, const rc_model *m, const rch_pose
     free(rows);
 }
 
+/* The selection ordered for travel (rch_poses_order), or measured only with keep_order. */
+static int order_rows(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, rch_diag *d)
+{
+    if (!c->keep_order)
+        return rch_poses_order(res->poses, res->n, m, c->margin_deg, &res->travel, d);
+    rch_poses_travel_of(&res->travel, res->poses, res->n, m, c->margin_deg);
+    return 0;
+}
+
+static int plan_rows(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, FILE *progress,
+                     rch_diag *d);
+
 int rch_poses_plan(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, FILE *progress,
                    rch_diag *d)
+{
+    if (plan_rows(res, m, c, progress, d) != 0)
+        return -1;
+    if (order_rows(res, m, c, d) != 0) {
+        rch_poses_free(res);
+        return -1;
+    }
+    return 0;
+}
+
+static int plan_rows(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, FILE *progress,
+                     rch_diag *d)
 {
     memset(res, 0, sizeof *res);
     if (c->criterion == RCH_POSES_LENGTH) {
