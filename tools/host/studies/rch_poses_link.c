@@ -50,7 +50,8 @@ int rch_poses_write_rapid_link(FILE *f, const rc_sample *rows, const unsigned ch
         fprintf(f, "        ENDTEST\n");
     }
     fprintf(f, "        RETURN -1;\n    ENDFUNC\n\n");
-    /* one line from the socket (one byte per SocketReceive: RAPID strings hold 80 characters, a longer line is cut and refused by rcal as UNKNOWN... rcal never sends one to a well-behaved program but a FAULT text) */
+    /* one line from the socket (one byte per SocketReceive: RAPID strings hold 80 characters; a longer
+     * line, a FAULT with its text, is cut and its pieces ignored) */
     fprintf(f, "    FUNC string rcal_line()\n"
                "        VAR string chunk;\n        VAR string line;\n        VAR num p;\n"
                "        WHILE TRUE DO\n"
