@@ -91,9 +91,33 @@ plans = {
 want = {0: ["LOST", "STALLED", "OFFSET"], 1: ["UNKNOWN", "DUPLICATE", "ORDER", "BUSY"], 2: []}
 wire = {0: ["STALLED", "OFFSET"], 1: ["UNKNOWN", "DUPLICATE", "ORDER"], 2: []}
 summaries, logs = {}, {}
+
+
+def rows_of(k):
+    return [int(x["pose"]) for x in read_csv("data.csv") if int(x["outlet"]) == k]
+
+
+# outlet 2 first: the cell stops at its 5th pose (BYE); rcal stops with what it recorded, the rerun resumes
+poses2 = by_outlet[2]
+acq = subprocess.Popen(acquire(2, wait_s="2"), stdout=subprocess.PIPE, stderr=open("quit.err", "w"), text=True)
+procs.append(acq)
+ctl = subprocess.Popen([sys.executable, os.path.join(HERE, "sim_controller.py"), "--port-from", "quit.err",
+                        "--poses", "plan.csv", "--outlet", "2", "--follow", "ann.txt", "--log", "quit.json",
+                        "--fault", "quit@%d" % poses2[4], "--max-seconds", "30"], stdout=subprocess.DEVNULL)
+procs.append(ctl)
+acq.communicate(timeout=45)
+ctl.wait(timeout=10)
+before = rows_of(2)
+if acq.returncode != 1 or "LOST: the controller said BYE" not in open("quit.err").read():
+    fail("the cell stopped: exit %d: %s" % (acq.returncode, open("quit.err").read()[-2000:]))
+if before != poses2[:4]:
+    fail("the cell stopped at pose %d: rows %s (want %s)" % (poses2[4], before, poses2[:4]))
+
 for k in (0, 1, 2):
     poses = by_outlet[k]
     flt = sum([["--fault", "%s@%d" % (kind, poses[1 + i])] for i, kind in enumerate(plans[k])], [])
+    if k == 2:  # resumed: the slow network from its first new pose
+        flt = ["--fault", "slow@%d" % poses[4]]
     err = open("acq%d.err" % k, "w")
     acq = subprocess.Popen(acquire(k), stdout=subprocess.PIPE, stderr=err, text=True)
     procs.append(acq)
@@ -130,6 +154,8 @@ for k in (0, 1, 2):
         fail("the second controller was not told FAULT BUSY")
     if k == 0 and logs[k]["connections"] < 2:
         fail("outlet 0: the controller did not reconnect")
+    if k == 2 and logs[k]["commands"][:2] != ["BACK %d" % poses[3], "NEXT %d" % poses[4]]:
+        fail("outlet 2 resumed with %s (want BACK %d, NEXT %d)" % (logs[k]["commands"][:2], poses[3], poses[4]))
 
 # 3. the file: every (pose, outlet) once, the controller's joints, the plan's beside
 rows = read_csv("data.csv")
@@ -148,7 +174,8 @@ for x in rows:
     qp = [float(x["q%d_plan" % j]) for j in range(1, 7)]
     if max(abs(a - b) for a, b in zip(qp, plan_q[pose])) > 1e-9:
         fail("pose %d: q_plan %s, plan %s" % (pose, qp, plan_q[pose]))
-    reports = [at["q"] for at in logs[k]["at"] if at["pose"] == pose]
+    ats = logs[k]["at"] + (json.load(open("quit.json"))["at"] if k == 2 else [])
+    reports = [at["q"] for at in ats if at["pose"] == pose]
     good = [rq for rq in reports if max(abs(a - b) for a, b in zip(rq, plan_q[pose])) <= TOL_DEG]
     if not any(max(abs(a - b) for a, b in zip(rq, q)) < 5e-7 for rq in good):
         fail("pose %d: recorded %s is none of the controller's accepted reports %s" % (pose, q, good))

@@ -14,6 +14,7 @@ precision, and injects faults at chosen poses:
   order@K        report another pose (not yet visited) before K
   second@K       a second controller connects while K is being moved to
   slow@K         from K on, every line leaves after --slow-ms (a slow network)
+  quit@K         say BYE when told to go to K and end (the cell stopped; rcal stops, a rerun resumes)
 
 Loopback only; bounded by --max-seconds. Writes a JSON summary (--log): every AT sent, the FAULT lines
 received by name, connections made.
@@ -133,7 +134,7 @@ def main():
 
     slow = [0.0]
     link = Link(port, slow)
-    log = {"at": [], "faults": {}, "connections": 0, "busy_seen": 0, "stop": None}
+    log = {"at": [], "faults": {}, "connections": 0, "busy_seen": 0, "stop": None, "commands": []}
     here = list(plan[min(plan)])  # the arm's joints
     done_faults = set()
 
@@ -220,6 +221,11 @@ def main():
             if f[0] in ("NEXT", "BACK", "AGAIN"):
                 k = int(f[1])
                 pending = (f[0], k)
+                log["commands"].append(line)
+                if once("quit", k):
+                    link.send("BYE")
+                    log["stop"] = "quit"
+                    break
                 if "slow" in faults.get(k, ()):
                     slow[0] = a.slow_ms / 1000.0
                 if once("stall", k):
