@@ -44,7 +44,13 @@ static const char details[] =
     "reopened; a disconnect is retried for --reconnect-s seconds; a pose that does not settle within\n"
     "--pose-timeout-s stops the run. Polled protocols ask at most every --poll-interval-ms: set it to the\n"
     "display's update period or more, so that N readings are N fresh measurements. Exit 0 done, 1 stopped\n"
-    "(rerun to resume), 2 usage.";
+    "(rerun to resume), 2 usage.\n"
+    "Controller link: with --controller tcp:[HOST:]PORT rcal listens (127.0.0.1 unless HOST is given) and the\n"
+    "robot program connects and speaks rcal-link/1 (docs/controller-link.md): rcal sends NEXT J / BACK J, the\n"
+    "controller answers AT J with its joints; a report off the plan by more than --controller-tol-deg, out of\n"
+    "order, duplicated or garbled, and a second controller, are named faults and nothing is recorded from them;\n"
+    "a lost link is waited for --controller-wait-s and resumes at the pose in force. The file then records the\n"
+    "controller's joints (6 decimals) and the plan's in q1_plan..q6_plan.";
 
 static int pick(const char *v, const char *choices)
 {
@@ -122,6 +128,17 @@ static int report_json(const rch_acq_result *r, const rch_acq_config *c, const c
     rch_jw_bool(&w, "follow_check", !c->no_follow_check);
     rch_jw_num(&w, "worst_follow_mm", r->n_new ? r->worst_follow_mm : NAN);
     rch_jw_uint(&w, "rechecks", r->verifies);
+    if (c->controller) {
+        rch_jw_obj(&w, "controller");
+        rch_jw_str(&w, "link", c->controller);
+        rch_jw_uint(&w, "port", r->link_port);
+        rch_jw_uint(&w, "connections", r->link_connects);
+        rch_jw_obj(&w, "faults");
+        for (int k = 0; k < RCH_LINK_NFAULTS; ++k)
+            rch_jw_uint(&w, rch_link_fault_name(k), r->link_faults[k]);
+        rch_jw_end(&w);
+        rch_jw_end(&w);
+    }
     rch_jw_uint(&w, "recheck_failures", r->verify_fails);
     rch_jw_arr(&w, "jumps");
     for (size_t k = 0; k < r->n_jumps && k < sizeof r->jumps / sizeof r->jumps[0]; ++k) {
@@ -135,6 +152,18 @@ static int report_json(const rch_acq_result *r, const rch_acq_config *c, const c
     return rch_jw_finish(&w);
 }
 
+/* --controller: the link's connections and its faults by name. */
+static void report_link(const rch_acq_result *r, const rch_acq_config *c, FILE *f)
+{
+    if (!c->controller)
+        return;
+    fprintf(f, "rcal acquire: controller link %s: %lu connection%s; faults:", c->controller, r->link_connects,
+            r->link_connects == 1 ? "" : "s");
+    for (int k = 0; k < RCH_LINK_NFAULTS; ++k)
+        fprintf(f, " %s %lu", rch_link_fault_name(k), r->link_faults[k]);
+    fprintf(f, "\n");
+}
+
 /* The one-line summary of a complete run. */
 static void report_text(const rch_acq_result *r, const rch_acq_config *c)
 {
@@ -144,6 +173,7 @@ static void report_text(const rch_acq_result *r, const rch_acq_config *c)
            r->n_before + r->n_new, r->n_new, c->out_path, r->readings, r->timeouts, r->bad_frames, r->shape_rejects,
            r->device, r->range, r->unstable, r->reconnects, r->follow_refusals, r->worst_follow_mm, r->trend_rejects,
            r->tau_ms / 1000.0, r->verifies);
+    report_link(r, c, stdout);
     for (size_t k = 0; k < r->n_jumps && k < sizeof r->jumps / sizeof r->jumps[0]; ++k)
         printf("rcal acquire: JUMP of %+.3f mm before pose %zu recorded past (--on-jump record): fit with calibrate "
                "--jumps\n", r->jumps[k].jump_mm, r->jumps[k].pose);
@@ -280,6 +310,17 @@ static int parse(acquire_args *a, int argc, char **argv)
         {"--announce", RCH_OPT_STR, &a->c.announce_path, 0, 0, "FILE", "pose for the robot side", 0, NULL},
         {"--confirm", RCH_OPT_FLAG, &a->c.confirm, 0, 0, NULL, "wait for Enter at each pose", 0, NULL},
         {"--joints", RCH_OPT_CHOICE, &a->joints, 0, 0, NULL, "source of q1..q6", 0, "plan"},
+        {"--controller", RCH_OPT_STR, &a->c.controller, 0, 0, "tcp:[HOST:]PORT",
+         "listen for the robot controller (docs/controller-link.md; HOST 127.0.0.1 unless given): its reports drive "
+         "the run and its joints are recorded, the plan's beside them", 0, NULL},
+        {"--controller-tol-deg", RCH_OPT_DOUBLE, &a->c.controller_tol_deg, 1e-6, 10, "DEG",
+         "a report farther from the plan than this per joint is the fault OFFSET (0.05)", 0, NULL},
+        {"--controller-wait-s", RCH_OPT_UINT, &a->c.controller_wait_s, 1, 86400, "S",
+         "a controller connects within this, first and after a loss (60)", 0, NULL},
+        {"--link-timeout-s", RCH_OPT_UINT, &a->c.link_timeout_s, 1, 3600, "S", "silence that loses the link (5)", 0,
+         NULL},
+        {"--move-timeout-s", RCH_OPT_UINT, &a->c.move_timeout_s, 1, 86400, "S",
+         "the controller reports the pose within this of NEXT/BACK, else STALLED (60)", 0, NULL},
         {"--quiet", RCH_OPT_FLAG, &a->c.quiet, 0, 0, NULL,
          "no per-pose lines (kept with --confirm) and fewer notes; the closing summary and every warning stay", 0, NULL},
         {"--json", RCH_OPT_FLAG, &a->json, 0, 0, NULL,
@@ -306,5 +347,7 @@ int rcal_cmd_acquire(int argc, char **argv)
         return report_json(&r, c, a.proto, rc, argc, argv) != 0 && rc == 0 ? 1 : rc;
     if (rc == 0 && r.n_new + r.n_before == r.n_poses && r.n_new)
         report_text(&r, c);
+    else
+        report_link(&r, c, stderr);
     return rc;
 }

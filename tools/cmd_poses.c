@@ -20,6 +20,7 @@
 #include "rch_jw.h"
 #include "rch_opt.h"
 #include "rch_poses.h"
+#include "rch_poses_link.h"
 #include "rch_robot.h"
 
 static const char summary[] = "plan a pose set for the best predicted 3-D accuracy (one or several outlets)";
@@ -285,10 +286,49 @@ static void print_plan_figures(const rch_poses_result *res, const rch_poses_conf
                pc->split ? " (or measure every pose from each outlet: leave out --split)" : "");
 }
 
-/* The plan into f: CSV (an outlet column with several outlets) or RAPID. 0 or -1. */
-static int write_out(FILE *f, const rch_poses_result *res, const rch_poses_config *pc, const char *format,
-                     double settle_s)
+/* --controller tcp:[HOST:]PORT of a link program: host (numeric, default 127.0.0.1) and port. 0 or -1. */
+static int link_addr(char host[64], unsigned *port, const char *spec)
 {
+    const char *p = spec && strncmp(spec, "tcp:", 4) == 0 ? spec + 4 : NULL, *c = p ? strrchr(p, ':') : NULL;
+    char *end;
+    unsigned long v;
+    if (!p)
+        return -1;
+    snprintf(host, 64, "127.0.0.1");
+    if (c) {
+        if (c == p || (size_t)(c - p) >= 64 || strspn(p, "0123456789.") != (size_t)(c - p))
+            return -1;
+        snprintf(host, 64, "%.*s", (int)(c - p), p);
+        p = c + 1;
+    }
+    v = strtoul(p, &end, 10);
+    if (*p < '0' || *p > '9' || *end || v < 1 || v > 65535)
+        return -1;
+    *port = (unsigned)v;
+    return 0;
+}
+
+/* The plan into f: CSV (an outlet column with several outlets), RAPID, or a link program. 0 or -1. */
+static int write_out(FILE *f, const rch_poses_result *res, const rch_poses_config *pc, const char *format,
+                     double settle_s, const char *link)
+{
+    if (strcmp(format, "rapid-link") == 0 || strcmp(format, "urscript-link") == 0) {
+        char host[64], comment[200];
+        unsigned port = 0;
+        unsigned char *lab = malloc(res->n ? res->n : 1);
+        if (!lab || link_addr(host, &port, link) != 0) {
+            free(lab);
+            return -1;
+        }
+        for (size_t i = 0; i < res->n; ++i)
+            lab[i] = res->poses[i].outlet;
+        snprintf(comment, sizeof comment, "rcal poses --count %zu --seed %llu: %u outlet(s)", res->n_distinct,
+                 pc->seed, res->n_outlets);
+        const int wr = format[0] == 'r' ? rch_poses_write_rapid_link(f, res->poses, lab, res->n, host, port, comment)
+                                        : rch_poses_write_urscript_link(f, res->poses, lab, res->n, host, port, comment);
+        free(lab);
+        return wr;
+    }
     if (strcmp(format, "rapid") != 0)
         return rch_data_write_plan_cols(f, res->poses, res->n, res->n_outlets > 1, pc->n_points > 0);
     unsigned char *lab = malloc(res->n ? res->n : 1);
@@ -343,6 +383,7 @@ typedef struct poses_args {
     const char *robot_path, *out_path, *criterion, *format, *order;
     unsigned long n, seed, n_cand, passes, choose;
     double max_minutes, settle_s;
+    const char *link; /* --controller of a link program */
     double enc[3], tool[3];
     rch_poses_config pc;
     rch_opt_strs outlets, cands, cable_points;
@@ -410,6 +451,7 @@ static int parse(poses_args *a, int argc, char **argv)
     a->enc[1] = -460.0;
     a->enc[2] = 10.0;
     a->settle_s = 5.0;
+    a->link = "tcp:127.0.0.1:5150";
     pc->len_min_mm = 250;
     pc->len_max_mm = 800;
     pc->margin_deg = 5;
@@ -444,7 +486,11 @@ static int parse(poses_args *a, int argc, char **argv)
          "the branch that shortens it), "
          "or the selection's",
          0, "travel|selection"},
-        {"--format", RCH_OPT_CHOICE, &a->format, 0, 0, NULL, "what --out holds", 0, "csv|rapid"},
+        {"--format", RCH_OPT_CHOICE, &a->format, 0, 0, NULL, "what --out holds (rapid-link, urscript-link: a program speaking docs/controller-link.md to rcal acquire "
+         "--controller)", 0, "csv|rapid|rapid-link|urscript-link"},
+        {"--controller", RCH_OPT_STR, &a->link, 0, 0, "tcp:[HOST:]PORT",
+         "where a link program connects (the PC running rcal acquire --controller; numeric HOST) [default "
+         "tcp:127.0.0.1:5150]", 0, NULL},
         {"--settle-s", RCH_OPT_DOUBLE, &a->settle_s, 0, 600, "S", "RAPID: WaitTime at each pose (settle and read)", 0,
          NULL},
         {"--len-min-mm", RCH_OPT_DOUBLE, &pc->len_min_mm, 0, 20000, "A", "shortest cable length", 0, NULL},
@@ -471,7 +517,14 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
     char dbuf[900];
     if (!a->json)
         print_plan(res, &a->pc, a->out_path);
-    if (write_out(out->f, res, &a->pc, a->format, a->settle_s) != 0) {
+    if ((strcmp(a->format, "rapid-link") == 0 || strcmp(a->format, "urscript-link") == 0) &&
+        link_addr((char[64]){0}, &(unsigned){0}, a->link) != 0) {
+        rch_out_abort(out);
+        fprintf(stderr, "rcal poses: --controller %s: expected tcp:[HOST:]PORT (HOST numeric, PORT 1..65535); nothing "
+                        "was written\n", a->link);
+        return 1;
+    }
+    if (write_out(out->f, res, &a->pc, a->format, a->settle_s, a->link) != 0) {
         const int err = rch_out_errno(out);
         rch_out_abort(out);
         fprintf(stderr, "rcal poses: %s: cannot write --out: %s; nothing was replaced\n", a->out_path, strerror(err));
@@ -483,7 +536,11 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
     }
     if (a->json)
         return report_json(res, &a->pc, ch, (const double(*)[3])a->cand, a->out_path, a->format, argc, argv) != 0;
-    printf("  written to %s%s\n", a->out_path, strcmp(a->format, "rapid") == 0 ? " (RAPID module)" : "");
+    printf("  written to %s%s\n", a->out_path, strcmp(a->format, "rapid") == 0            ? " (RAPID module)"
+                                                     : strcmp(a->format, "rapid-link") == 0 ? " (RAPID module, rcal-link/1)"
+                                                     : strcmp(a->format, "urscript-link") == 0
+                                                         ? " (URScript, rcal-link/1)"
+                                                         : "");
     return 0;
 }
 

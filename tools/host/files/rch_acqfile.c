@@ -120,9 +120,38 @@ static long good_prefix(const char *text, size_t len, const char *path, rch_diag
     return (long)good;
 }
 
+/* The plan's joints of a file with the columns q1_plan..q6_plan (the last six of each line, written by
+ * rch_acqfile_append_plan): *q_deg gets those of the data line `line` (1-based) of text. 0, or -1. */
+static int plan_cols_of(double q_deg[RC_NJ], const char *text, size_t len, unsigned line)
+{
+    size_t i = 0, end;
+    for (unsigned l = 1; l < line && i < len; ++i)
+        l += text[i] == '\n';
+    for (end = i; end < len && text[end] != '\n'; ++end)
+        ;
+    size_t p = end;
+    for (int j = RC_NJ - 1; j >= 0; --j) { /* back over six fields */
+        size_t e = p;
+        while (p > i && text[p - 1] != ',')
+            --p;
+        if (p == i)
+            return -1;
+        char buf[64];
+        size_t n = e - p < sizeof buf - 1 ? e - p : sizeof buf - 1;
+        memcpy(buf, text + p, n);
+        buf[n] = '\0';
+        char *stop;
+        q_deg[j] = strtod(buf, &stop);
+        if (stop == buf || (*stop != '\0' && *stop != '\r'))
+            return -1;
+        --p; /* the comma */
+    }
+    return 0;
+}
+
 static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state *st,
                       const double (*plan_deg)[RC_NJ], size_t n_poses, const char *path, int outlet_p1, int target_p1,
-                      rch_diag *d)
+                      const char *text, size_t len, rch_diag *d)
 {
     size_t last = f->n;
     for (size_t i = 0; i < f->n; ++i) {
@@ -132,8 +161,15 @@ static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state 
                          "another plan; choose another --out", pose, n_poses);
             return -1;
         }
+        double qp[RC_NJ];
+        if (text && plan_cols_of(qp, text, len, f->line[i]) != 0) {
+            rch_diag_set(d, path, f->line[i], 1, "the plan's joints q1_plan..q6_plan are missing or not numbers; "
+                         "choose another --out");
+            return -1;
+        }
         for (int j = 0; j < RC_NJ; ++j) {
-            const double q = f->s[i].q_rad[j] * DEG_PER_RAD;
+            /* a controller's joints (plan columns) differ from the plan by its tolerance: the plan columns decide */
+            const double q = text ? qp[j] : f->s[i].q_rad[j] * DEG_PER_RAD;
             if (fabs(q - plan_deg[pose][j]) > 1e-3) {
                 rch_diag_set(d, path, f->line[i], 1, "pose %lu has q%d = %.4f but the plan says %.4f: the file "
                              "belongs to another plan; choose another --out", pose, j + 1, q, plan_deg[pose][j]);
@@ -165,7 +201,8 @@ static int has_header(const char *text, size_t len, const char *h)
 }
 
 static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *path,
-                const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, rch_diag *d)
+                const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, int plan_cols,
+                rch_diag *d)
 {
     struct stat sb;
     char *text;
@@ -202,13 +239,23 @@ static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *
     good = good_prefix(text, len, path, d);
     if (good < 0)
         goto out;
-    static const char *const headers[4] = {RCH_ACQ_HEADER, RCH_ACQ_HEADER_OUTLET, RCH_ACQ_HEADER_TARGET,
-                                           RCH_ACQ_HEADER_OUTLET_TARGET};
-    int kind = -1; /* the file's header: bit 0 outlet, bit 1 target */
-    for (int k = 0; good > 0 && k < 4 && kind < 0; ++k)
+    static const char *const headers[8] = {
+        RCH_ACQ_HEADER, RCH_ACQ_HEADER_OUTLET, RCH_ACQ_HEADER_TARGET, RCH_ACQ_HEADER_OUTLET_TARGET,
+        RCH_ACQ_HEADER RCH_ACQ_PLAN_COLS, RCH_ACQ_HEADER_OUTLET RCH_ACQ_PLAN_COLS,
+        RCH_ACQ_HEADER_TARGET RCH_ACQ_PLAN_COLS, RCH_ACQ_HEADER_OUTLET_TARGET RCH_ACQ_PLAN_COLS};
+    int kind = -1; /* the file's header: bit 0 outlet, bit 1 target, bit 2 the plan's joints beside */
+    for (int k = 0; good > 0 && k < 8 && kind < 0; ++k)
         if (has_header(text, (size_t)good, headers[k]))
             kind = k;
-    const int want = (outlet_p1 ? 1 : 0) | (target_p1 ? 2 : 0);
+    const int want = (outlet_p1 ? 1 : 0) | (target_p1 ? 2 : 0) | (plan_cols ? 4 : 0);
+    if (good > 0 && kind >= 0 && (kind & 4) != (want & 4)) {
+        rch_diag_set(d, path, 1, 1, (kind & 4) ? "records a controller's joints with the plan's beside them "
+                                                 "(q1_plan..q6_plan): resume it with --controller (nothing was "
+                                                 "changed)"
+                                               : "records the plan's joints (no q1_plan..q6_plan): a run with "
+                                                 "--controller needs a file of its own (nothing was changed)");
+        goto out;
+    }
     if (good > 0 && kind < 0) {
         rch_diag_set(d, path, 1, 1, "exists but is not an acquisition file (header '%s' expected); choose "
                      "another --out (nothing was changed)", headers[want]);
@@ -237,7 +284,8 @@ static int scan(rch_acqfile_state *st, unsigned char *done, int fd, const char *
         rch_data f;
         if (rch_data_parse(&f, text, (size_t)good, path, RCH_DATA_POSE | RCH_DATA_ALLOW_EMPTY, d) != 0)
             goto out;
-        rc = check_plan(&f, done, st, plan_deg, n_poses, path, outlet_p1, target_p1, d);
+        rc = check_plan(&f, done, st, plan_deg, n_poses, path, outlet_p1, target_p1, plan_cols ? text : NULL,
+                        (size_t)good, d);
         rch_data_free(&f);
         if (rc != 0)
             goto out;
@@ -283,6 +331,14 @@ int rch_acqfile_open_outlet(rch_acqfile *a, rch_acqfile_state *st, unsigned char
 int rch_acqfile_open_at(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
                         const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, rch_diag *d)
 {
+    return rch_acqfile_open_plan(a, st, done, path, plan_deg, n_poses, outlet_p1, target_p1, 0, d);
+}
+
+int rch_acqfile_open_plan(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
+                          const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, int plan_cols,
+                          rch_diag *d)
+{
+    a->plan_cols = plan_cols != 0;
     memset(st, 0, sizeof *st);
     memset(done, 0, n_poses);
     a->fd = -1;
@@ -298,7 +354,8 @@ int rch_acqfile_open_at(rch_acqfile *a, rch_acqfile_state *st, unsigned char *do
         rch_diag_set(d, path, 0, 0, "cannot open for appending: %s", strerror(errno));
         return -1;
     }
-    if (lock_file(a->fd, path, d) != 0 || scan(st, done, a->fd, path, plan_deg, n_poses, a->outlet_p1, a->target_p1, d) != 0) {
+    if (lock_file(a->fd, path, d) != 0 || scan(st, done, a->fd, path, plan_deg, n_poses, a->outlet_p1, a->target_p1, a->plan_cols,
+                                                d) != 0) {
         close(a->fd);
         a->fd = -1;
         return -1;
@@ -309,16 +366,28 @@ int rch_acqfile_open_at(rch_acqfile *a, rch_acqfile_state *st, unsigned char *do
 int rch_acqfile_append(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], const rc_stable_result *r,
                        long long t_unix_ms, rch_diag *d)
 {
-    char line[512];
+    return rch_acqfile_append_plan(a, pose, q_deg, NULL, r, t_unix_ms, d);
+}
+
+int rch_acqfile_append_plan(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], const double plan_deg[RC_NJ],
+                            const rc_stable_result *r, long long t_unix_ms, rch_diag *d)
+{
+    char line[640];
     int n = snprintf(line, sizeof line, "%zu", pose);
-    for (int j = 0; j < RC_NJ; ++j)
-        n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f", q_deg[j]);
+    if (a->plan_cols && !plan_deg) {
+        rch_diag_set(d, a->path, 0, 0, "the plan's joints are missing for pose %zu", pose);
+        return -1;
+    }
+    for (int j = 0; j < RC_NJ; ++j) /* a controller's joints at its full precision (1e-6 deg); the plan's at 4 */
+        n += snprintf(line + n, sizeof line - (size_t)n, a->plan_cols ? ",%.6f" : ",%.4f", q_deg[j]);
     n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f,%.4f,%u,%lld", r->mean_mm, r->spread_mm, r->count,
                   t_unix_ms);
     if (a->outlet_p1)
         n += snprintf(line + n, sizeof line - (size_t)n, ",%d", a->outlet_p1 - 1);
     if (a->target_p1)
         n += snprintf(line + n, sizeof line - (size_t)n, ",%d", a->target_p1 - 1);
+    for (int j = 0; a->plan_cols && j < RC_NJ; ++j)
+        n += snprintf(line + n, sizeof line - (size_t)n, ",%.4f", plan_deg[j]);
     n += snprintf(line + n, sizeof line - (size_t)n, "\n");
     if (n <= 0 || (size_t)n >= sizeof line) {
         rch_diag_set(d, a->path, 0, 0, "sample line too long");

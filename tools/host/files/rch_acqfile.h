@@ -41,6 +41,10 @@
 #define RCH_ACQ_HEADER_OUTLET RCH_ACQ_HEADER ",outlet"
 #define RCH_ACQ_HEADER_TARGET RCH_ACQ_HEADER ",target"
 #define RCH_ACQ_HEADER_OUTLET_TARGET RCH_ACQ_HEADER ",outlet,target"
+/* A run driven by a controller (rcal acquire --controller, docs/controller-link.md) records the controller's
+ * joints in q1..q6 (%.6f deg) and the plan's beside them in these last columns; the plan check on resuming
+ * compares those. rch_data ignores them (unknown columns). */
+#define RCH_ACQ_PLAN_COLS ",q1_plan,q2_plan,q3_plan,q4_plan,q5_plan,q6_plan"
 #define RCH_ACQ_MAX_LINE 4096u                  /* longest line accepted when resuming */
 #define RCH_ACQ_MAX_BYTES (256u * 1024u * 1024u) /* largest file resumed (about 2.5 M samples) */
 
@@ -49,6 +53,7 @@ typedef struct rch_acqfile {
     char path[1024];
     int outlet_p1;       /* 0 no outlet column, k + 1 the outlet label k recorded (rch_acqfile_open_outlet) */
     int target_p1;       /* 0 no target column, p + 1 the cable point p of a tool plate recorded (rch_acqfile_open_at) */
+    int plan_cols;       /* 1: q1_plan..q6_plan columns (rch_acqfile_open_plan) */
 } rch_acqfile;
 
 /* What the file held when it was opened. */
@@ -80,9 +85,20 @@ int rch_acqfile_open_outlet(rch_acqfile *a, rch_acqfile_state *st, unsigned char
 int rch_acqfile_open_at(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
                         const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, rch_diag *d);
 
+/* rch_acqfile_open_at with plan_cols 1: the file has the last columns q1_plan..q6_plan (RCH_ACQ_PLAN_COLS),
+ * q1..q6 are a controller's joints; a file with them is resumed only this way and one without them never. */
+int rch_acqfile_open_plan(rch_acqfile *a, rch_acqfile_state *st, unsigned char *done, const char *path,
+                          const double (*plan_deg)[RC_NJ], size_t n_poses, int outlet_p1, int target_p1, int plan_cols,
+                          rch_diag *d);
+
 /* Append one sample line and fsync. 0, or -1 with d set. */
 int rch_acqfile_append(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], const rc_stable_result *r,
                        long long t_unix_ms, rch_diag *d);
+
+/* rch_acqfile_append with the plan's joints beside (a file opened with plan_cols; plan_deg may be NULL
+ * otherwise). */
+int rch_acqfile_append_plan(rch_acqfile *a, size_t pose, const double q_deg[RC_NJ], const double plan_deg[RC_NJ],
+                            const rc_stable_result *r, long long t_unix_ms, rch_diag *d);
 
 /* Close and unlock (safe on a closed file). 0, or -1 with d set (may be NULL). */
 int rch_acqfile_close(rch_acqfile *a, rch_diag *d);

@@ -34,6 +34,10 @@ void rch_acq_config_default(rch_acq_config *c)
     c->poll_interval_ms = 100;
     c->follow_tol_mm = 10.0;
     c->jump_mm = 3.0;
+    c->controller_tol_deg = 0.05;
+    c->controller_wait_s = 60;
+    c->link_timeout_s = 5;
+    c->move_timeout_s = 60;
 }
 
 int rch_acq_follows(double *miss_mm, double len_mm, double pred_mm, double ref_len_mm, double ref_pred_mm,
@@ -134,6 +138,8 @@ typedef struct acq {
     size_t jump_cleared;      /* pose + 1 whose suspected jump the check at ref_pose cleared; 0 none */
     int not_following;        /* the follow check refused a pose `retries` times: the run stops */
     int holding;              /* 1: the reference is a held sample, not yet written (run_poses) */
+    int linked;               /* --controller: the link drives the run */
+    rch_link link;
 } acq;
 
 #define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
@@ -590,6 +596,19 @@ static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
         WARN(a, "cannot write --announce %s: %s\n", c->announce_path, strerror(errno));
         return 1;
     }
+    if (a->linked) { /* the controller goes there and says where it stands */
+        double xyz[3];
+        int has_xyz;
+        rc_status st = rch_link_pose(&a->link, recheck ? "BACK" : "NEXT", i, a->plan_deg[i], q_deg, xyz, &has_xyz);
+        if (st != RC_OK) {
+            WARN(a, "pose %zu: the controller link failed (%s); stopped, nothing recorded from it (rerun to resume)\n",
+                 i, rc_strerror(st));
+            return 1;
+        }
+        rch_link_wait(&a->link, c->settle_ms + c->stable.timeout_ms + 5000ul);
+        a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
+        return 0;
+    }
     if (c->confirm && a->io->confirm(a->io->ctx, i) != 0) {
         WARN(a, "end of input; stopped (rerun to resume)\n");
         return 1;
@@ -666,11 +685,12 @@ static int append(acq *a, size_t i, const double q_deg[RC_NJ], const rc_stable_r
 {
     rch_diag dg;
     char buf[900];
-    if (rch_acqfile_append(&a->file, i, q_deg, r, t_ms, &dg) != 0) {
+    if (rch_acqfile_append_plan(&a->file, i, q_deg, a->plan_deg[i], r, t_ms, &dg) != 0) {
         WARN(a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
         return 1;
     }
     a->res->n_new++;
+    a->done[i] = 1; /* a controller's later report of it is a DUPLICATE */
     return 0;
 }
 
@@ -809,8 +829,12 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     if (check_paths(&a) != 0 || load_inputs(&a) != 0)
         goto out;
     res->n_poses = a.n_mine;
-    if (rch_acqfile_open_at(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n,
-                            a.outlet_p1, a.target_p1, &dg) != 0) {
+    if (c->controller && c->confirm) {
+        WARN(&a, "--controller and --confirm: the controller says when the robot is there; choose one\n");
+        goto out;
+    }
+    if (rch_acqfile_open_plan(&a.file, &fst, a.done, c->out_path, (const double(*)[RC_NJ])a.plan_deg, a.n,
+                              a.outlet_p1, a.target_p1, c->controller != NULL, &dg) != 0) {
         WARN(&a, "%s\n", rch_diag_str(&dg, buf, sizeof buf));
         goto out;
     }
@@ -849,7 +873,37 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     }
     port_open = 1;
     rcd_display_init(&a.d, a.port, &c->proto);
+    if (c->controller) {
+        rch_link_config lc;
+        memset(&lc, 0, sizeof lc);
+        lc.spec = c->controller;
+        lc.tol_deg = c->controller_tol_deg;
+        lc.wait_ms = c->controller_wait_s * 1000ul;
+        lc.link_timeout_ms = c->link_timeout_s * 1000ul;
+        lc.move_timeout_ms = c->move_timeout_s * 1000ul;
+        lc.hb_ms = 1000;
+        lc.retries = c->retries;
+        lc.n_poses = a.n;
+        lc.outlet = a.outlet_p1 - 1;
+        lc.point = a.target_p1 - 1;
+        if (rch_link_open(&a.link, &lc, err) != RC_OK)
+            goto out;
+        a.link.done = a.done;
+        a.linked = 1;
+        res->link_port = a.link.port;
+        if (out)
+            fflush(out);
+        if (err)
+            fflush(err);
+    }
     rc = run_poses(&a);
+    if (a.linked) {
+        rch_link_stop(&a.link, rc == 0 ? "done" : "stopped");
+        memcpy(res->link_faults, a.link.faults, sizeof res->link_faults);
+        res->link_connects = a.link.connects;
+        rch_link_close(&a.link);
+        a.linked = 0;
+    }
     res->tau_ms = rc_stable_tau_ms(&a.st);
     res->readings = a.d.stats.readings;
     res->bad_frames = a.d.stats.bad_frames;

@@ -64,6 +64,7 @@
 #include "rc_model.h"
 #include "rc_stable.h"
 #include "rcd_display.h"
+#include "rch_link.h"
 
 /* How the acquisition reaches the world. Pass NULL to rch_acquire_run for
  * the real one (backend "serialport" or "posix", nanosleep, wall clock,
@@ -138,6 +139,15 @@ typedef struct rch_acq_config {
                                    --cable-point */
     double points_mm[RC_MAX_TARGETS][3]; /* (n_points x 3) their drawing, flange frame */
     int confirm, quiet; /* quiet: no per-pose progress lines (kept with confirm), no notes */
+    /* The controller link (docs/controller-link.md): "tcp:[HOST:]PORT" or NULL. Given, the controller's
+     * reports drive the run (NEXT/BACK J instead of --announce/--confirm alone; settle_ms counts from its
+     * report), the file records its joints with the plan's beside (q1_plan..q6_plan) and --confirm is
+     * refused. */
+    const char *controller;
+    double controller_tol_deg;          /* a report farther from the plan than this per joint: OFFSET (0.05) */
+    unsigned long controller_wait_s;    /* a controller connects within this (60) */
+    unsigned long link_timeout_s;       /* silence that loses the link (5) */
+    unsigned long move_timeout_s;       /* a report after NEXT/BACK (60) */
 } rch_acq_config;
 
 /* Defaults as `rcal acquire` documents them (paths NULL, ASCII, posix off). */
@@ -159,6 +169,9 @@ typedef struct rch_acq_result {
     unsigned long verify_fails; /* of which the device read differently */
     size_t n_jumps;          /* confirmed jumps recorded past (on_jump_record) */
     struct { size_t pose; double jump_mm; } jumps[16]; /* the first 16 */
+    unsigned long link_faults[RCH_LINK_NFAULTS]; /* --controller: the faults named, per rch_link_fault */
+    unsigned long link_connects;                  /* controllers accepted (1 + reconnects) */
+    unsigned link_port;                           /* the port listened on */
 } rch_acq_result;
 
 /* Run the acquisition. Progress on out, problems on err (either may be

@@ -1,0 +1,131 @@
+/* SPDX-License-Identifier: MIT */
+/* test_poses_link.c - the link programs of `rcal poses --format rapid-link|urscript-link` (issue 48): the
+ * RAPID module read back by the project's RAPID reader (every jointtarget the plan's, to its 4 decimals), its
+ * blocks balanced and the socket and standstill instructions present; the URScript's blocks balanced and
+ * its calls those of the protocol. (tests/drivers/urscript_check.py checks URScript further from the CLI.) */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rch_poses_link.h"
+#include "rch_rapid.h"
+
+#define N 5
+
+static void plan(rc_sample rows[N], unsigned char lab[N])
+{
+    memset(rows, 0, sizeof(rc_sample) * N);
+    for (int i = 0; i < N; ++i) {
+        for (int j = 0; j < RC_NJ; ++j)
+            rows[i].q_rad[j] = 0.1 * (i + 1) - 0.07 * j + 0.000123 * i;
+        lab[i] = (unsigned char)(i % 2);
+    }
+}
+
+static char *write_to_text(int rapid, size_t *len)
+{
+    rc_sample rows[N];
+    unsigned char lab[N];
+    char *buf = NULL;
+    FILE *f = open_memstream(&buf, len);
+    assert_non_null(f);
+    plan(rows, lab);
+    assert_int_equal(rapid ? rch_poses_write_rapid_link(f, rows, lab, N, "192.168.125.5", 5150, "test")
+                           : rch_poses_write_urscript_link(f, rows, lab, N, "127.0.0.1", 5150, "test"), 0);
+    fclose(f);
+    return buf;
+}
+
+/* Occurrences of word at line starts (after indentation). */
+static int count_lead(const char *t, const char *word)
+{
+    int n = 0;
+    const size_t wl = strlen(word);
+    for (const char *p = t; p && *p; p = strchr(p, '\n'), p = p ? p + 1 : NULL) {
+        const char *q = p + strspn(p, " ");
+        n += strncmp(q, word, wl) == 0 && (q[wl] == ' ' || q[wl] == '\n' || q[wl] == '(' || q[wl] == ';');
+    }
+    return n;
+}
+
+static void test_rapid(void **state)
+{
+    size_t len;
+    char *t = write_to_text(1, &len);
+    rch_rapid_targets ts;
+    rch_diag d;
+    rc_sample rows[N];
+    unsigned char lab[N];
+    (void)state;
+    plan(rows, lab);
+    memset(&ts, 0, sizeof ts);
+    assert_int_equal(rch_rapid_scan(&ts, t, len, "link.mod", &d), 0);
+    assert_int_equal(ts.n, N);
+    for (size_t i = 0; i < ts.n; ++i) {
+        assert_int_equal(ts.t[i].kind, RCH_RAPID_JOINTTARGET);
+        assert_int_equal(ts.t[i].error[0], '\0');
+        for (int j = 0; j < RC_NJ; ++j)
+            assert_true(fabs(ts.t[i].val[j] - rows[i].q_rad[j] * 180.0 / 3.14159265358979323846) < 0.5e-4 + 1e-9);
+    }
+    rch_rapid_free(&ts);
+    assert_int_equal(count_lead(t, "PROC"), count_lead(t, "ENDPROC"));
+    assert_int_equal(count_lead(t, "FUNC"), count_lead(t, "ENDFUNC"));
+    assert_int_equal(count_lead(t, "TEST"), count_lead(t, "ENDTEST"));
+    assert_int_equal(count_lead(t, "WHILE"), count_lead(t, "ENDWHILE"));
+    assert_int_equal(count_lead(t, "TRAP"), count_lead(t, "ENDTRAP"));
+    int ifs = 0;
+    for (const char *p = t; (p = strstr(p, " THEN\n")) != NULL; ++p)
+        ++ifs;
+    assert_int_equal(ifs, count_lead(t, "ENDIF"));
+    static const char *const need[] = {"SocketCreate rcal_sock;", "SocketConnect rcal_sock, \"192.168.125.5\", 5150",
+                                       "SocketSend rcal_sock", "SocketReceive rcal_sock", "WaitRob \\ZeroSpeed;",
+                                       "CJointT()", "\"HELLO rcal-link/1 abb\\0A\"", "\"STOP\"", "\"NEXT \"",
+                                       "\"BACK \"", "\"AGAIN \"", "RETURN 1;", "ITimer 1, rcal_hb;"};
+    for (size_t k = 0; k < sizeof need / sizeof need[0]; ++k)
+        if (!strstr(t, need[k]))
+            fail_msg("the RAPID link module lacks %s", need[k]);
+    free(t);
+}
+
+static void test_urscript(void **state)
+{
+    size_t len;
+    char *t = write_to_text(0, &len);
+    (void)state;
+    /* blocks: def/while/if/thread open, end closes (elif/else continue an if) */
+    int open = 0;
+    for (const char *p = t; p && *p; p = strchr(p, '\n'), p = p ? p + 1 : NULL) {
+        const char *q = p + strspn(p, " ");
+        if (*q == '#')
+            continue;
+        if (!strncmp(q, "def ", 4) || !strncmp(q, "while ", 6) || !strncmp(q, "if ", 3) || !strncmp(q, "thread ", 7))
+            ++open;
+        if (!strncmp(q, "end\n", 4))
+            --open;
+        assert_true(open >= 0);
+    }
+    assert_int_equal(open, 0);
+    static const char *const need[] = {"socket_open(\"127.0.0.1\", 5150, \"rcal\")", "get_actual_joint_positions()",
+                                       "movej(rcal_plan[j]", "socket_send_line(\"HELLO rcal-link/1 ur\", \"rcal\")",
+                                       "socket_read_line(\"rcal\"", "rcal_outlet = [0, 1, 0, 1, 0]"};
+    for (size_t k = 0; k < sizeof need / sizeof need[0]; ++k)
+        if (!strstr(t, need[k]))
+            fail_msg("the URScript link program lacks %s", need[k]);
+    free(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rapid),
+        cmocka_unit_test(test_urscript),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
