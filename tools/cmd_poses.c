@@ -100,7 +100,7 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
     rch_jw_obj(&w, "dropped"); /* candidates dropped for the cable and the cell, by reason */
     rch_jw_uint(&w, "checked", res->n_checked);
     for (unsigned r = 1; r < RCH_CELL_N_REASONS; ++r)
-        rch_jw_uint(&w, rch_cell_reason_name((rch_cell_reason)r), res->dropped[r]);
+        rch_jw_uint(&w, rch_cell_reason_key((rch_cell_reason)r), res->dropped[r]);
     rch_jw_end(&w);
     rch_jw_uint(&w, "seed", pc->seed);
     rch_jw_uint(&w, "identifiable_directions", res->n_ident);

@@ -4,6 +4,7 @@
 #include "rch_cell.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 const char *rch_cell_reason_name(rch_cell_reason r)
@@ -17,6 +18,13 @@ const char *rch_cell_reason_name(rch_cell_reason r)
     case RCH_CELL_CABLE_FLOOR: return "cable near the floor";
     }
     return "?";
+}
+
+const char *rch_cell_reason_key(rch_cell_reason r)
+{
+    static const char *const k[RCH_CELL_N_REASONS] = {"safe", "below_floor", "link_in_box", "cable_link",
+                                                      "cable_box", "cable_floor"};
+    return (unsigned)r < RCH_CELL_N_REASONS ? k[r] : "?";
 }
 
 int rch_cell_any(const rch_cell *c)
@@ -238,4 +246,34 @@ void rch_cell_check(rch_cell_verdict *out, const rch_cell *c, const rc_model *m,
     if (check_arm(out, c, (const double(*)[12])fr, flange, att))
         return;
     check_cable(out, c, (const double(*)[12])fr, outlet_mm, att, clearance_mm);
+}
+
+int rch_cell_row_refused(char *why, size_t size, const rch_cell *c, const rc_model *m, const rc_sample *s,
+                         unsigned outlet)
+{
+    double att[3] = {0.0, 0.0, 0.0};
+    const double *out = &m->x[RC_P_ENC];
+    rch_cell_verdict v;
+    for (unsigned e = 0; e < m->n_effects; ++e) {
+        const rc_effect *ef = &m->effects[e];
+        if (ef->kind == RC_EFF_OUTLET && outlet > 0 && ef->joint == outlet)
+            out = &m->x[ef->first];
+        else if (ef->kind == RC_EFF_TOOL_OFFSET)
+            memcpy(att, &m->x[ef->first], sizeof att);
+    }
+    for (unsigned e = 0; e < m->n_effects; ++e) /* a plate's point before the tool point */
+        if (m->effects[e].kind == RC_EFF_CABLE_POINTS && 3u * s->target + 3u <= m->effects[e].count)
+            memcpy(att, &m->x[m->effects[e].first + 3u * s->target], sizeof att);
+    rch_cell_check(&v, c, m, s->q_rad, out, att, 0.0);
+    if (v.reason == RCH_CELL_SAFE)
+        return 0;
+    const char *what = v.reason == RCH_CELL_CABLE_FLOOR || (v.reason == RCH_CELL_BELOW_FLOOR && v.which < 0)
+                           ? "the floor"
+                           : v.reason == RCH_CELL_CABLE_BOX || v.reason == RCH_CELL_LINK_BOX ? "box" : "link";
+    const char *nm = v.which < 0 ? ""
+                     : (v.reason == RCH_CELL_CABLE_BOX || v.reason == RCH_CELL_LINK_BOX) ? c->box[v.which].name
+                                                                                          : c->link[v.which].name;
+    snprintf(why, size, "%s: %.2f mm %s %s%s%s%s", rch_cell_reason_name(v.reason), fabs(v.dist_mm),
+             v.dist_mm < 0.0 ? "inside" : "from", what, v.which < 0 ? "" : " (", nm, v.which < 0 ? "" : ")");
+    return 1;
 }

@@ -26,6 +26,8 @@
 #ifndef RCH_CELL_H
 #define RCH_CELL_H
 
+#include <stddef.h>
+
 #include "rc_model.h"
 
 #define RCH_CELL_MAX_LINKS 16u
@@ -65,6 +67,8 @@ typedef enum {
 
 /* "cable near a link" etc.; "safe" for RCH_CELL_SAFE. */
 const char *rch_cell_reason_name(rch_cell_reason r);
+/* Its JSON key: "below_floor", "link_in_box", "cable_link", "cable_box", "cable_floor" ("safe"). */
+const char *rch_cell_reason_key(rch_cell_reason r);
 
 /* The verdict on one pose: the first reason found (in the order of the enum
  * above after SAFE), which link or box (index, -1: none or the floor), and
@@ -96,6 +100,15 @@ double rch_cell_seg_box_mm(const double p0[3], const double p1[3], const rch_box
  * always safe. */
 void rch_cell_check(rch_cell_verdict *out, const rch_cell *c, const rc_model *m, const double q_rad[RC_NJ],
                     const double outlet_mm[3], const double attach_flange_mm[3], double clearance_mm);
+
+/* A plan row about to be run (rcal acquire): sample s measured from outlet
+ * (0: the model's encoder, k: its RC_EFF_OUTLET k) to its point (the
+ * model's RC_EFF_CABLE_POINTS point s->target, else its tool point, else
+ * the flange) with clearance 0: would the cable cross a link, a box or the
+ * floor, or the arm go below it? 0: no; 1: yes, why (size) says what and
+ * where ("the cable 3.2 mm inside link 4 (upper arm)"). */
+int rch_cell_row_refused(char *why, size_t size, const rch_cell *c, const rc_model *m, const rc_sample *s,
+                         unsigned outlet);
 
 /* 1: the cell has anything to check (links, a floor or boxes). */
 int rch_cell_any(const rch_cell *c);

@@ -138,6 +138,9 @@ typedef struct rch_acq_config {
                                    --cable-point */
     double points_mm[RC_MAX_TARGETS][3]; /* (n_points x 3) their drawing, flange frame */
     int confirm, quiet; /* quiet: no per-pose progress lines (kept with confirm), no notes */
+    int cell_check;     /* 1 (rcal acquire's default; 0 here): a plan row whose straight cable would cross a link,
+                           a box or the floor of the robot file, or put the arm below the floor, stops the run
+                           before the first move (rch_cell_row_refused) */
 } rch_acq_config;
 
 /* Defaults as `rcal acquire` documents them (paths NULL, ASCII, posix off). */
