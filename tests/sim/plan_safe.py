@@ -9,7 +9,10 @@ IRB1600-like robot files, then checks every planned row with its own
 implementation: its own DH chain (numpy), the capsules of the robot file,
 and the cable-capsule distance by dense sampling of both segments (no
 closed form shared with rcal), the floor by the cable's end points. Also
-checks that the planner did drop candidates (the check has teeth). Usage: plan_safe.py RCAL WORKDIR."""
+checks that the planner did drop candidates (the check has teeth), and
+that `rcal acquire` refuses a hand-made plan whose row puts the cable
+through the wrist before it opens the port (and runs it with
+--no-cell-check). Usage: plan_safe.py RCAL WORKDIR."""
 import csv
 import json
 import os
@@ -112,8 +115,25 @@ def poses(rfile, outlets, extra, tag):
     return (plan, js), None
 
 
+def acquire_refuses():
+    plan = os.path.join(WORK, "cross.csv")
+    with open(plan, "w") as f:  # pose 1: q1 = 90, the outlet behind the robot: the cable through the wrist
+        f.write("pose,q1,q2,q3,q4,q5,q6\n0,0,0,0,0,30,0\n1,90,-20,20,40,-50,10\n")
+    args = [RCAL, "acquire", "--port", os.path.join(WORK, "no_such_port"), "--protocol", "ascii", "--poses", plan,
+            "--out", os.path.join(WORK, "cross_data.csv"), "--robot", os.path.join(SRC, "data", "irb120.json"),
+            "--encoder", "250,-460,10"]
+    r = subprocess.run(args, capture_output=True, text=True)
+    refused = r.returncode != 0 and "cross.csv:3: pose 1 refused, cable near a link" in r.stderr
+    r2 = subprocess.run(args + ["--no-cell-check"], capture_output=True, text=True)
+    unchecked = "refused" not in r2.stderr and "no_such_port" in r2.stderr  # it went on to the port
+    print("acquire: crossing row refused: %s; with --no-cell-check it goes on to the port: %s" % (refused, unchecked))
+    return refused and unchecked
+
+
 def main():
     os.makedirs(WORK, exist_ok=True)
+    if not acquire_refuses():
+        return 1
     total_bad = total_rows = dropped = 0
     cases = [("irb120", [[250, -460, 10]], [], "readme1"),
              ("irb120", [[250, -460, 10], [-250, -460, 10], [450, 300, 10]], [], "readme3"),
