@@ -254,6 +254,7 @@ static int parse(acquire_args *a, int argc, char **argv)
     a->pose_s = 60;
     rch_acq_config_default(&a->c);
     a->c.robot_path = RCAL_DEFAULT_ROBOT;
+    int no_cell_check = 0;
     const rch_opt opts[] = {
         {"--port", RCH_OPT_STR, &a->c.port_path, 0, 0, "PATH", "serial device", RCH_OPT_REQUIRED, NULL},
         {"--protocol", RCH_OPT_CHOICE, &a->proto, 0, 0, NULL, "display protocol", RCH_OPT_REQUIRED, "ascii|ascii-poll|stx|modbus"},
@@ -307,6 +308,8 @@ static int parse(acquire_args *a, int argc, char **argv)
         {"--no-learn-tau", RCH_OPT_FLAG, &a->no_learn, 0, 0, NULL,
          "do not learn the display's time constant from the readings", 0, NULL},
         {"--no-follow-check", RCH_OPT_FLAG, &a->c.no_follow_check, 0, 0, NULL, "skip the follow check", 0, NULL},
+        {"--no-cell-check", RCH_OPT_FLAG, &no_cell_check, 0, 0, NULL,
+         "run plan rows whose cable would cross a link, a box or the floor of --robot (default: refused)", 0, NULL},
         {"--announce", RCH_OPT_STR, &a->c.announce_path, 0, 0, "FILE", "pose for the robot side", 0, NULL},
         {"--confirm", RCH_OPT_FLAG, &a->c.confirm, 0, 0, NULL, "wait for Enter at each pose", 0, NULL},
         {"--joints", RCH_OPT_CHOICE, &a->joints, 0, 0, NULL, "source of q1..q6", 0, "plan"},
@@ -329,6 +332,7 @@ static int parse(acquire_args *a, int argc, char **argv)
     const int st = rch_opt_cmd(&spec, "acquire", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (st >= 0)
         return st;
+    a->c.cell_check = !no_cell_check;
     return to_config(a, rch_opt_given(&spec, seen, "--outlet"), rch_opt_given(&spec, seen, "--target"),
                      rch_opt_given(&spec, seen, "--encoder"));
 }

@@ -118,6 +118,12 @@ static int report_json(const rch_poses_result *res, const rch_poses_config *pc, 
     if (pc->criterion != RCH_POSES_LENGTH)
         rch_jw_uint(&w, "rows_advised", res->rows_advised);
     rch_jw_uint(&w, "candidates", res->n_candidates);
+    rch_jw_numf(&w, "clearance_mm", pc->clearance_mm, "%.6g");
+    rch_jw_obj(&w, "dropped"); /* candidates dropped for the cable and the cell, by reason */
+    rch_jw_uint(&w, "checked", res->n_checked);
+    for (unsigned r = 1; r < RCH_CELL_N_REASONS; ++r)
+        rch_jw_uint(&w, rch_cell_reason_key((rch_cell_reason)r), res->dropped[r]);
+    rch_jw_end(&w);
     rch_jw_uint(&w, "seed", pc->seed);
     rch_jw_uint(&w, "identifiable_directions", res->n_ident);
     rch_jw_uint(&w, "params", res->n_params);
@@ -229,6 +235,23 @@ static void print_travel(const rch_poses_travel *t)
     printf("    q4 in [%.0f, %.0f] deg, q6 in [%.0f, %.0f] deg (before: q4 [%.0f, %.0f], q6 [%.0f, %.0f])\n",
            t->after_min_deg[3], t->after_max_deg[3], t->after_min_deg[5], t->after_max_deg[5], t->before_min_deg[3],
            t->before_max_deg[3], t->before_min_deg[5], t->before_max_deg[5]);
+}
+
+/* The candidates the cable and the cell dropped (issue 48): one line. */
+static void print_dropped(const rch_poses_result *res, const rch_poses_config *pc)
+{
+    char why[400];
+    size_t n = 0;
+    if (!rch_cell_any(pc->cell)) {
+        printf("  the cable and the cell: not checked (the robot file has no \"links\" or \"cell\")\n");
+        return;
+    }
+    for (unsigned r = 1; r < RCH_CELL_N_REASONS; ++r)
+        n += res->dropped[r];
+    rch_poses_dropped_str(why, sizeof why, res);
+    printf("  the cable and the cell (%u links, %s, %u boxes; clearance %g mm): dropped %zu of %zu candidates: %s\n",
+           pc->cell->n_links, pc->cell->has_floor ? "a floor" : "no floor", pc->cell->n_boxes, pc->clearance_mm, n,
+           res->n_checked, why);
 }
 
 static void print_plan(const rch_poses_result *res, const rch_poses_config *pc, const char *out_path)
@@ -456,6 +479,7 @@ static int parse(poses_args *a, int argc, char **argv)
     pc->len_max_mm = 800;
     pc->margin_deg = 5;
     pc->noise_mm = RCH_POSES_NOISE_MM;
+    pc->clearance_mm = RCH_CELL_CLEARANCE_MM;
     const rch_opt opts[] = {
         {"--count", RCH_OPT_UINT, &a->n, 1, RCH_POSES_MAX_COUNT, "N", "poses to plan", RCH_OPT_REQUIRED, NULL},
         {"--out", RCH_OPT_STR, &a->out_path, 0, 0, "FILE", "the plan (CSV, or RAPID with --format rapid)",
@@ -497,6 +521,9 @@ static int parse(poses_args *a, int argc, char **argv)
         {"--len-max-mm", RCH_OPT_DOUBLE, &pc->len_max_mm, 0, 20000, "B", "longest cable length", 0, NULL},
         {"--candidates", RCH_OPT_UINT, &a->n_cand, 0, RCH_POSES_MAX_CANDIDATES, "M", "0: max(2000, 40 N)", 0, NULL},
         {"--margin-deg", RCH_OPT_DOUBLE, &pc->margin_deg, 0, 360, "D", "kept from every joint limit", 0, NULL},
+        {"--clearance-mm", RCH_OPT_DOUBLE, &pc->clearance_mm, 0, 1000, "MM",
+         "the cable's least distance from a link, a box or the floor of the robot file's \"links\" and \"cell\"", 0,
+         NULL},
         {"--passes", RCH_OPT_UINT, &a->passes, 0, 100, "P", "exchange passes", 0, NULL},
         {"--max-minutes", RCH_OPT_DOUBLE, &a->max_minutes, 0.01, 1e7, "MIN",
          "refuse a plan estimated longer (the estimate is printed before the work when over 10 s)", 0, NULL},
@@ -515,8 +542,10 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
 {
     rch_diag dg;
     char dbuf[900];
-    if (!a->json)
+    if (!a->json) {
         print_plan(res, &a->pc, a->out_path);
+        print_dropped(res, &a->pc);
+    }
     if ((strcmp(a->format, "rapid-link") == 0 || strcmp(a->format, "urscript-link") == 0) &&
         link_addr((char[64]){0}, &(unsigned){0}, a->link) != 0) {
         rch_out_abort(out);
@@ -566,6 +595,7 @@ int rcal_cmd_poses(int argc, char **argv)
     if (!robot->has_encoder)
         memcpy(&robot->model.x[RC_P_ENC], a.enc, sizeof a.enc);
     pc->prior = &robot->prior;
+    pc->cell = &robot->cell;
     a.model = &robot->model;
     if (!a.n_places && !a.choose) { /* one outlet: the model's encoder */
         pc->n_outlets = 1;

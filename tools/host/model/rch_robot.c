@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "rc_linalg.h"
+#include "rch_cell_read.h"
 #include "rch_data.h"
 #include "rch_file.h"
 #include "rch_json.h"
@@ -712,7 +713,8 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
      * are informational: their contents are not checked) */
     static const char *const top_keys[] = {"format",  "name",        "dh",          "joint_limits_deg", "encoder_mm",
                                            "effects", "prior",       "nominal",     "calibration",      "uncertainty",
-                                           "fit",     "provenance",  "outlet_labels", "$schema",        NULL};
+                                           "fit",     "provenance",  "outlet_labels", "$schema",        "links",
+                                           "cell",    NULL};
     if (check_keys(root, top_keys, "the model file", name, d) != 0)
         goto done;
     const rch_json *fmt = rch_json_get(root, "format");
@@ -746,6 +748,8 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     if (read_calibration(out, rch_json_get(root, "calibration"), name, d) != 0)
         goto done;
     if (read_outlet_labels(out, rch_json_get(root, "outlet_labels"), name, d) != 0)
+        goto done;
+    if (rch_cell_read(&out->cell, rch_json_get(root, "links"), rch_json_get(root, "cell"), name, d) != 0)
         goto done;
     rc = 0;
 done:

@@ -25,6 +25,7 @@
 #include <stdio.h>
 
 #include "rc_model.h"
+#include "rch_cell.h"
 #include "rch_diag.h"
 #include "rch_jw.h"
 #include "rch_data.h"
@@ -50,6 +51,8 @@ typedef struct rch_robot {
     unsigned n_outlet_labels; /* "outlet_labels": the data files' label of outlet k (k = 0: encoder_mm, k the
                                  outlet effect numbered k); 0: absent (the labels are the numbers) */
     uint8_t outlet_label[RC_MAX_OUTLETS];
+    rch_cell cell;          /* "links" (the arm's capsules) and "cell" (floor, boxes): rch_cell.h; empty when
+                               absent */
 } rch_robot;
 
 /* Where a calibration came from (rcal-model/2 "provenance"). */

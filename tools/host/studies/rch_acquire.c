@@ -551,6 +551,13 @@ static int load_inputs(acq *a)
             /* back to the file's degrees, at its 4 decimals */
             a->plan_deg[i][j] = round(q * DEG_PER_RAD * 1e4) / 1e4;
         }
+        char why[200]; /* issue 48: a row whose cable would cross the arm or the cell is not run */
+        if (c->cell_check && !a->other[i] && rch_cell_row_refused(why, sizeof why, &robot->cell, &robot->model, &plan.s[i],
+                                                 a->pred_outlet)) {
+            WARN(a, "%s:%u: pose %zu refused, %s (the links and cell of %s); not moved there, nothing was "
+                    "recorded: re-plan with rcal poses\n", c->poses_path, plan.line[i], i, why, c->robot_path);
+            goto out;
+        }
     }
     if (predict_lengths(a, &robot->model, &plan) != 0)
         goto out;

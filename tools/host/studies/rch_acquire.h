@@ -148,6 +148,9 @@ typedef struct rch_acq_config {
     unsigned long controller_wait_s;    /* a controller connects within this (60) */
     unsigned long link_timeout_s;       /* silence that loses the link (5) */
     unsigned long move_timeout_s;       /* a report after NEXT/BACK (60) */
+    int cell_check;     /* 1 (rcal acquire's default; 0 here): a plan row whose straight cable would cross a link,
+                           a box or the floor of the robot file, or put the arm below the floor, stops the run
+                           before the first move (rch_cell_row_refused) */
 } rch_acq_config;
 
 /* Defaults as `rcal acquire` documents them (paths NULL, ASCII, posix off). */

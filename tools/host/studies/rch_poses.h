@@ -38,8 +38,12 @@
  *
  * The plan's rows are then ordered for joint travel (rch_poses_order).
  *
- * Collisions of the cable with the arm are not modelled: review the plan
- * before running it. Cost of the position criterion: about candidates x K x
+ * The cable and the cell (issue 48): with a cell (the robot file's "links"
+ * and "cell", rch_cell.h) a candidate whose straight cable, from any outlet
+ * it is measured from to any point it is hooked on, comes within
+ * clearance_mm of a link, a box or the floor, or whose flange or a link is
+ * below the floor, is dropped before the design (rch_poses_safe.c); the
+ * result counts them by reason. Cost of the position criterion: about candidates x K x
  * P^2 x N x (passes + 1) products (P ~ 26 + 3 K); 50 poses from 3 outlets
  * of 2000 candidates about 2 s on one core.
  * Host side (prefix rch_): heap; progress lines on a caller-given stream.
@@ -51,6 +55,7 @@
 #include <stdio.h>
 
 #include "rc_model.h"
+#include "rch_cell.h"
 #include "rch_diag.h"
 #include "rch_prior.h"
 
@@ -80,6 +85,8 @@ typedef struct rch_poses_config {
     size_t n_work;                 /* workspace poses of the criterion, 0: 300 */
     size_t n_eval;                 /* workspace poses of the reported accuracy, 0: 1000 */
     int keep_order;                /* 1: the rows in the selection's order (no rch_poses_order) */
+    const rch_cell *cell;          /* the arm's links and the cell (NULL or empty: every candidate safe) */
+    double clearance_mm;           /* the cable's least distance from a link, a box, the floor */
 } rch_poses_config;
 
 typedef enum { RCH_POSES_POSITION = 0, RCH_POSES_LENGTH = 1 } rch_poses_criterion;
@@ -125,7 +132,20 @@ typedef struct rch_poses_result {
         int ok;                   /* 0: the prediction failed (why: not kept) */
         rch_poses_accuracy acc;
     } by_points[RC_MAX_TARGETS];
+    /* candidates dropped for the cable and the cell (rch_cell_reason; [0] unused), of n_checked checked
+     * (a pose, or with split a pose from one outlet, inside the length range) */
+    size_t dropped[RCH_CELL_N_REASONS];
+    size_t n_checked;
 } rch_poses_result;
+
+/* Is pose q measured from outlet k (0..K-1 of c's outlets; the model's
+ * encoder when c has none) on every point the cable is hooked on (plate
+ * points, else the tool point, else the flange) safe for c's cell? 1, or 0
+ * with res->dropped[reason] counted; res->n_checked counted either way. */
+int rch_poses_safe(rch_poses_result *res, const rc_model *m, const rch_poses_config *c, const rc_sample *q,
+                   unsigned k);
+/* "12 cable near a link, 3 flange or link below the floor" (nothing: "none"). */
+void rch_poses_dropped_str(char *buf, size_t size, const rch_poses_result *res);
 /* `rcal calibrate` estimates the noise from its residuals (SSR / (n - p_eff)):
  * with about as many rows as parameters the estimate collapses, the prior
  * loses its weight and the fit follows the noise (measured, plan_study.py

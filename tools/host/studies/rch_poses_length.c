@@ -89,7 +89,8 @@ static void work_free(plan_work *w)
 }
 
 /* 1-2: candidates inside the limits and the length range, with their rows */
-static int draw_candidates(plan_work *w, const rc_model *m, const rch_poses_config *c, rch_diag *d)
+static int draw_candidates(plan_work *w, rch_poses_result *res, const rc_model *m, const rch_poses_config *c,
+                           rch_diag *d)
 {
     size_t got = 0, tries = 0;
     const double mg = c->margin_deg * PI_ / 180.0;
@@ -99,8 +100,11 @@ static int draw_candidates(plan_work *w, const rc_model *m, const rch_poses_conf
         rc_sample s;
         double len;
         if (++tries > 1000 * w->n_cand) {
-            rch_diag_set(d, "", 0, 0, "only %zu of %zu candidate poses have a cable length within [%g, %g] mm; "
-                         "check --encoder and the length range", got, w->n_cand, c->len_min_mm, c->len_max_mm);
+            char why[256];
+            rch_poses_dropped_str(why, sizeof why, res);
+            rch_diag_set(d, "", 0, 0, "only %zu of %zu candidate poses have a cable length within [%g, %g] mm and "
+                         "are safe for the cable and the cell (dropped: %s); check --encoder, the length range and "
+                         "--clearance-mm", got, w->n_cand, c->len_min_mm, c->len_max_mm, why);
             return -1;
         }
         memset(&s, 0, sizeof s);
@@ -113,6 +117,8 @@ static int draw_candidates(plan_work *w, const rc_model *m, const rch_poses_conf
             s.q_rad[j] = qr;
         }
         if (rc_meas(&len, w->G + got * w->P, m, &s) != RC_OK || !(len >= c->len_min_mm && len <= c->len_max_mm))
+            continue;
+        if (!rch_poses_safe(res, m, c, &s, 0))
             continue;
         w->cand[got++] = s;
     }
@@ -265,7 +271,7 @@ int rch_poses_plan_length(rch_poses_result *res, const rc_model *m, const rch_po
     }
     if (rch_poses_plan_cost(c, progress, w.n, w.n_cand, w.P < 20u ? w.P : 20u, 1, d) != 0)
         goto done;
-    if (draw_candidates(&w, m, c, d) != 0)
+    if (draw_candidates(&w, res, m, c, d) != 0)
         goto done;
     if (ident_subspace(&w, d) != 0)
         goto done;

@@ -158,10 +158,29 @@ static int pose_rows(double *rows, double *lo, double *hi, const pos_work *w, co
     return 0;
 }
 
+/* Which outlets pose s is safe from (safe, K; rch_poses_safe): every one
+ * (all poses from every outlet) or, with split, each reaching one; *reach
+ * the reaching outlets that are safe. 0: a candidate, -1: dropped. */
+static int pose_safety(uint8_t *safe, unsigned *reach, rch_poses_result *res, const pos_work *w,
+                       const rch_poses_config *c, const rc_sample *s, const double *llo, const double *lhi)
+{
+    *reach = 0;
+    for (unsigned k = 0; k < w->K; ++k) {
+        safe[k] = 0;
+        if (!(llo[k] >= c->len_min_mm && lhi[k] <= c->len_max_mm))
+            continue;
+        safe[k] = (uint8_t)rch_poses_safe(res, &w->m, c, s, k);
+        *reach += safe[k];
+        if (!safe[k] && !c->split)
+            return -1; /* measured from every outlet: one unsafe cable drops the pose */
+    }
+    return *reach ? 0 : -1;
+}
+
 /* 1-2: candidate poses inside the limits whose lengths are in range: every
  * outlet's (all poses from every outlet), or one candidate per reaching
  * outlet (split). */
-static int pos_candidates(pos_work *w, const rch_poses_config *c, rch_diag *d)
+static int pos_candidates(pos_work *w, rch_poses_result *res, const rch_poses_config *c, rch_diag *d)
 {
     const unsigned nf = w->nf, K = w->K;
     const double mg = c->margin_deg * PI_ / 180.0;
@@ -188,10 +207,13 @@ static int pos_candidates(pos_work *w, const rch_poses_config *c, rch_diag *d)
     while (got < w->n_pose) {
         rc_sample s;
         if (++tries > 1000 * w->n_pose) {
+            char why[256];
             free(rows);
+            rch_poses_dropped_str(why, sizeof why, res);
             rch_diag_set(d, "", 0, 0, "only %zu of %zu candidate poses have a cable length within [%g, %g] mm from "
-                         "%s; check --outlet/--encoder and the length range", got, w->n_pose, c->len_min_mm,
-                         c->len_max_mm, c->split ? "any outlet" : "every outlet");
+                         "%s and are safe for the cable and the cell (dropped: %s); check --outlet/--encoder, the "
+                         "length range and --clearance-mm", got, w->n_pose, c->len_min_mm, c->len_max_mm,
+                         c->split ? "any outlet" : "every outlet", why);
             return -1;
         }
         memset(&s, 0, sizeof s);
@@ -206,12 +228,15 @@ static int pos_candidates(pos_work *w, const rch_poses_config *c, rch_diag *d)
         if (pose_rows(rows, llo, lhi, w, &s) != 0)
             continue;
         unsigned reach = 0;
+        uint8_t safe[RC_MAX_OUTLETS];
         for (unsigned k = 0; k < K; ++k)
             reach += llo[k] >= c->len_min_mm && lhi[k] <= c->len_max_mm;
         if (c->split ? reach == 0 : reach < K)
             continue;
+        if (pose_safety(safe, &reach, res, w, c, &s, llo, lhi) != 0)
+            continue;
         for (unsigned k = 0; k < K; ++k) {
-            if (!(llo[k] >= c->len_min_mm && lhi[k] <= c->len_max_mm))
+            if (!(llo[k] >= c->len_min_mm && lhi[k] <= c->len_max_mm) || !safe[k])
                 continue;
             if (!c->split) {
                 memcpy(w->X + w->n_cand * w->rows_per * nf, rows, (size_t)K * P * nf * sizeof *rows);
@@ -556,7 +581,7 @@ int rch_poses_plan_position(rch_poses_result *res, const rc_model *m, const rch_
     w->n_pose = n_pose;
     if (rch_poses_plan_cost(c, progress, w->n, w->n_pose * w->K * w->P, w->nf, 0, d) != 0)
         goto done;
-    if (pos_candidates(w, c, d) != 0)
+    if (pos_candidates(w, res, c, d) != 0)
         goto done;
     if (w->n_cand < w->n) {
         rch_diag_set(d, "", 0, 0, "only %zu candidates for %zu poses: raise --candidates", w->n_cand, w->n);
