@@ -1,14 +1,14 @@
 MODULE rcal_plan
     ! rcal poses --count 8 --seed 4: 2 outlet(s), split
     ! 8 poses; at each: MoveAbsJ (fine), a message on the pendant, WaitTime <T> s while rcal acquire reads the cable length
-    CONST jointtarget rcal_p0:=[[-50.0100,69.7300,-41.0700,-123.4100,38.5700,-54.8500],[9E9,9E9,9E9,9E9,9E9,9E9]];
-    CONST jointtarget rcal_p1:=[[30.3200,90.4800,11.9400,23.9200,-7.0400,-4.1700],[9E9,9E9,9E9,9E9,9E9,9E9]];
-    CONST jointtarget rcal_p2:=[[-34.5500,78.6400,-94.4400,111.2500,100.5000,-18.6100],[9E9,9E9,9E9,9E9,9E9,9E9]];
-    CONST jointtarget rcal_p3:=[[-35.6300,59.4800,33.7300,151.4800,59.0100,-6.0200],[9E9,9E9,9E9,9E9,9E9,9E9]];
-    CONST jointtarget rcal_p4:=[[5.1800,-100.4500,-62.1000,-88.0400,50.3000,48.3500],[9E9,9E9,9E9,9E9,9E9,9E9]];
-    CONST jointtarget rcal_p5:=[[5.0100,-102.9000,-104.6700,18.5000,57.2500,-101.8000],[9E9,9E9,9E9,9E9,9E9,9E9]];
-    CONST jointtarget rcal_p6:=[[60.1600,-82.4600,-98.1000,80.7700,-20.7000,-260.4400],[9E9,9E9,9E9,9E9,9E9,9E9]];
-    CONST jointtarget rcal_p7:=[[-121.0200,86.6800,-73.5200,138.1600,17.4600,-119.7500],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p0:=[[107.2700,-64.8200,-29.4600,91.1300,-90.6400,-22.6100],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p1:=[[-10.5000,65.0000,49.0000,82.8200,-72.4000,-199.8100],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p2:=[[-66.4500,63.3400,-39.6600,-33.1000,-6.0200,-347.2600],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p3:=[[41.2700,64.4400,38.7600,-142.2600,-60.4000,-283.3200],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p4:=[[60.1600,-82.4600,-98.1000,80.7700,-20.7000,99.5600],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p5:=[[50.3200,-96.7200,-59.4400,119.6200,97.1800,-7.4900],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p6:=[[-121.0200,86.6800,-73.5200,138.1600,17.4600,-119.7500],[9E9,9E9,9E9,9E9,9E9,9E9]];
+    CONST jointtarget rcal_p7:=[[-146.0800,65.3000,-14.9000,30.0300,19.0000,-227.9400],[9E9,9E9,9E9,9E9,9E9,9E9]];
     CONST num rcal_settle_s:=5;
 
     PROC rcal_outlet0()
