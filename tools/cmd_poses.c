@@ -546,8 +546,10 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
         print_plan(res, &a->pc, a->out_path);
         print_dropped(res, &a->pc);
     }
+    char link_host[64] = "";
+    unsigned link_port = 0;
     if ((strcmp(a->format, "rapid-link") == 0 || strcmp(a->format, "urscript-link") == 0) &&
-        link_addr((char[64]){0}, &(unsigned){0}, a->link) != 0) {
+        link_addr(link_host, &link_port, a->link) != 0) {
         rch_out_abort(out);
         fprintf(stderr, "rcal poses: --controller %s: expected tcp:[HOST:]PORT (HOST numeric, PORT 1..65535); nothing "
                         "was written\n", a->link);
