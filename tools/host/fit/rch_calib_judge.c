@@ -39,7 +39,8 @@ static double decimal_step(const double *v, size_t n, double unit)
 {
     if (n == 0)
         return 0.0;
-    for (double step = 10.0; step > 0.9e-6; step /= 10.0) {
+    for (int e = 1; e >= -6; --e) { /* 10 ... 1e-6 */
+        const double step = pow(10.0, e);
         size_t k = 0;
         for (; k < n; ++k) {
             const double x = v[k] / unit / step;
@@ -67,10 +68,12 @@ static void joint_effect(double out[2], const rc_model *m, const rc_sample *s, s
             rc_sample a = s[i], b = s[i];
             a.q_rad[j] += h;
             b.q_rad[j] -= h;
-            double la, lb;
+            double la = 0.0, lb = 0.0;
             ok = rc_meas(&la, NULL, m, &a) == RC_OK && rc_meas(&lb, NULL, m, &b) == RC_OK;
-            const double g = (la - lb) / (2.0 * h);
-            v += g * g * step_rad * step_rad / 12.0;
+            if (ok) {
+                const double g = (la - lb) / (2.0 * h);
+                v += g * g * step_rad * step_rad / 12.0;
+            }
         }
         if (ok && isfinite(v)) {
             sum[tr] += v;

@@ -162,7 +162,7 @@ int rch_calib_sys_score(rch_calib_sys *out, const struct rch_calib_result *r, co
     Ah = calloc((size_t)nf + 1, sizeof *Ah);
     Ac = malloc(((size_t)nf * nf + 1) * sizeof *Ac);
     const unsigned k_off = r->n_outlets > 1 ? r->n_outlets : 1;
-    C = malloc((n * k_off + 1) * sizeof *C);
+    C = calloc(n * k_off + 1, sizeof *C);
     if (!A || !C || !Ah || !Ac) {
         snprintf(err, errlen, "out of memory");
         goto done;

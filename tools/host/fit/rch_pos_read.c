@@ -523,7 +523,7 @@ static int check_frame(const rc_model *m, const rc_sample *s, size_t n, double s
         /* the rigid fit's RMS with its degrees of freedom restored (the frame's 6, 3 per target): what the
          * rounding left is then about lim; joints exactly on round values (a plan of whole degrees)
          * leave the robot's own errors, whatever their size, so the window is two-sided */
-        const double k3 = (double)(n / 3 * 3), dof = k3 - 6.0 - 3.0 * targets_of(s, n);
+        const double k3 = (double)(n - n % 3), dof = k3 - 6.0 - 3.0 * targets_of(s, n);
         const double rpc = dof > 0.0 ? rp * sqrt(k3 / dof) : rp;
         if (eff > 0.0 && qstep >= RCH_POS_ROUNDING_MIN_DEG && rpc >= lim / RCH_POS_ROUNDING_RATIO &&
             rpc <= RCH_POS_ROUNDING_RATIO * lim) {
