@@ -121,7 +121,7 @@ static int read_floor(rch_cell *c, const rch_json *fl, const char *file, rch_dia
     const double len = sqrt(c->floor_normal[0] * c->floor_normal[0] + c->floor_normal[1] * c->floor_normal[1] +
                             c->floor_normal[2] * c->floor_normal[2]);
     if (!(len > 1e-9)) {
-        rch_diag_set(d, file, n->line, n->col, "\"floor\" \"normal\" must not be zero");
+        rch_diag_set(d, file, n ? n->line : 0, n ? n->col : 0, "\"floor\" \"normal\" must not be zero");
         return -1;
     }
     for (unsigned k = 0; k < 3; ++k)

@@ -50,7 +50,7 @@ int rch_link_parse(char host[64], unsigned *port, const char *spec)
             return -1;
         p = colon + 1;
     } else {
-        strcpy(host, "127.0.0.1");
+        memcpy(host, "127.0.0.1", sizeof "127.0.0.1");
     }
     if (*p < '0' || *p > '9')
         return -1;

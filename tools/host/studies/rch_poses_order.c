@@ -276,6 +276,16 @@ static int choose_branches(double (*out)[RC_NJ], const order_work *w, const size
 }
 
 /* One outlet's rows (idx, n of them, in file order) reordered into dst; *moved 1 when the order changed. */
+
+/* Whether two poses' joints are the same values (a pose on each plate point repeats them exactly). */
+static int same_q(const double *a, const double *b)
+{
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        if (a[j] != b[j]) /* NOLINT(clang-diagnostic-float-equal): the same row copied, not a computed value */
+            return 0;
+    return 1;
+}
+
 static int order_outlet(rc_sample *dst, const rc_sample *rows, const size_t *idx, size_t n, order_work *w,
                         const rc_model *m, double margin_rad, int *moved)
 {
@@ -288,7 +298,7 @@ static int order_outlet(rc_sample *dst, const rc_sample *rows, const size_t *idx
         goto out;
     w->U = 0; /* the stops: runs of rows with the same joints (the pose on each plate point) */
     for (size_t i = 0; i < n; ++i)
-        if (i == 0 || memcmp(rows[idx[i]].q_rad, rows[idx[i - 1]].q_rad, sizeof rows[0].q_rad) != 0) {
+        if (i == 0 || !same_q(rows[idx[i]].q_rad, rows[idx[i - 1]].q_rad)) {
             start[w->U] = i;
             memcpy(w->q[w->U++], rows[idx[i]].q_rad, sizeof w->q[0]);
         }
