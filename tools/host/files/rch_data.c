@@ -360,7 +360,7 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
             rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s%s",
                          col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
                          number_hint(&fields[c]),
-                         pc->implicit && out->n == 0 && isalpha((unsigned char)fields[c].p[0])
+                         pc->implicit && out->n == 0 && fields[c].len > 0 && isalpha((unsigned char)fields[c].p[0])
                              ? " (a first line is a header only when it names its columns: q1,q2,q3,q4,q5,q6)"
                              : "");
             return -1;
