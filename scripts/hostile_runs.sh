@@ -71,7 +71,7 @@ device_runs() {
     }
     dev ref dplan.csv -- &
     dev ref2 dplan2.csv -- &
-    dev off5 dplan.csv --disconnect-after 25 --reconnect-ms 300 --foreign-offset-mm 5 -- &
+    dev off5 dplan.csv --disconnect-at-pose 2 --reconnect-ms 300 --foreign-offset-mm 5 -- &
     dev jump5 dplan.csv --jump-at-pose 2 --jump-mm 5 -- &
     dev filt2 dplan2.csv --filter-tau-ms 2000 -- &
     dev filt5 dplan2.csv --filter-tau-ms 5000 -- &

@@ -64,6 +64,8 @@
  *                       with --reconnect-ms R open a new pty R ms later (its
  *                       path printed as a new stdout line, --link re-pointed),
  *                       else exit
+ *   --disconnect-at-pose P  the same when the robot reaches pose P (1 or
+ *                       more): a hang-up tied to the run, not to the clock
  *   --freeze-after N    after N frames the shown value never changes again
  *                       (HOLD pressed, firmware hung): `rcal acquire` must
  *                       refuse it (follow check)
@@ -148,6 +150,7 @@ typedef struct sim {
     double filter_tau_ms;       /* first-order filter of the shown value (0: none) */
     double filt_mm, filt_t_s;   /* its state */
     int have_filt;
+    unsigned long disconnect_at_pose; /* hang up (as --disconnect-after) when the robot reaches this pose (0: never) */
     unsigned long jump_at_pose; /* the display jumps by jump_mm when the robot reaches this pose (0: never) */
     double jump_mm;
     int jumped;
@@ -315,6 +318,10 @@ static void follow_pose(sim *s)
     s->cur_pose = idx;
     if (s->jump_at_pose && (unsigned long)idx == s->jump_at_pose)
         s->jumped = 1; /* the counter lost counts on the way: every later value is off */
+    if (s->disconnect_at_pose && (unsigned long)idx == s->disconnect_at_pose) {
+        s->disconnect_after = s->frames ? s->frames : 1; /* the next frame is cut in half */
+        s->disconnect_at_pose = 0;
+    }
     s->change_ms = t;
 }
 
@@ -639,6 +646,8 @@ static int parse_options(sim *s, sim_args *g, int argc, char **argv)
         {"--reconnect-ms", RCH_OPT_INT, &g->reconnect_ms, -1, SIM_MAX_MS, "R", "reopen after R ms (-1: exit)", 0, NULL},
         {"--foreign-offset-mm", RCH_OPT_DOUBLE, &s->foreign_offset_mm, -1e5, 1e5, "X", "another device after a reconnect", 0, NULL},
         {"--filter-tau-ms", RCH_OPT_DOUBLE, &s->filter_tau_ms, 0, 1e6, "T", "first-order display filter", 0, NULL},
+        {"--disconnect-at-pose", RCH_OPT_UINT, &s->disconnect_at_pose, 0, 4294967294.0, "P",
+         "hang up when the robot reaches P", 0, NULL},
         {"--jump-at-pose", RCH_OPT_UINT, &s->jump_at_pose, 0, 4294967294.0, "P", "jump when the robot reaches P", 0, NULL},
         {"--jump-mm", RCH_OPT_DOUBLE, &s->jump_mm, -1e5, 1e5, "J", "the jump (with --jump-at-pose)", 0, NULL},
         {"--freeze-after", RCH_OPT_UINT, &s->freeze_after, 0, 4294967294.0, "N", "frames, then the value freezes", 0, NULL},
