@@ -9,6 +9,8 @@
 # Child processes the tests start (rcal, rcal_simdisplay, ...) are traced too,
 # except system programs (python3, the compiler; see --trace-children-skip). A test fails on its own failure or on
 # any memcheck error or leak in it or its children. Disabled tests are skipped;
+# tests labelled `study` (many whole runs of paths the others take; they run
+# in the Release ctest only) are left out, as are
 # tests whose command is not an executable of the build tree (scripts:
 # python, cmake -E env, shell) are not run again here: memcheck cannot see
 # into them, and the Release and sanitizer ctest runs already ran them.
@@ -80,6 +82,8 @@ import json, sys
 for t in json.load(sys.stdin)["tests"]:
     props = {p["name"]: p["value"] for p in t.get("properties", [])}
     env = props.get("ENVIRONMENT", [])
+    if "study" in props.get("LABELS", []):
+        continue  # the studies: the Release run only (label study; scripts/test.sh)
     print("\x1e".join([t["name"], props.get("WORKING_DIRECTORY", "."), "\x1f".join(env),
                      "1" if props.get("DISABLED") else "0", "\x1f".join(t.get("command", []))]))
 ' >"$LOGDIR/tests.tsv" || { echo "valgrind: ctest --show-only failed"; exit 1; }
