@@ -107,6 +107,81 @@ static double quad_form(const double *s, const double *B, unsigned q)
     return t;
 }
 
+/* The score of each pose in the candidate's q identifiable directions (columns of Zq = Zc V_q), sg, and its
+ * leave-the-pose-out version for the CR3 variance, ug (both G x q, row-major). 0, or -1 out of memory. */
+static int pose_scores(double *sg, double *ug, const double *Zc, const double *M, const double *ev, unsigned p,
+                       unsigned q, size_t ld, const double *r, const double *r1, const ctx *c)
+{
+    const size_t n = c->n, G = c->n_poses;
+    double *Zq = malloc(((size_t)n * q) * sizeof *Zq);
+    size_t *first = malloc((G + 1 + n) * sizeof *first);
+    if (!Zq || !first) {
+        free(Zq);
+        free(first);
+        return -1;
+    }
+    size_t *rows = first + G + 1;
+    for (size_t i = 0; i < n; ++i)
+        for (unsigned a = 0; a < q; ++a) {
+            double z = 0.0;
+            for (unsigned b = 0; b < p; ++b)
+                z += Zc[(size_t)b * ld + i] * M[b * p + (p - 1 - a)];
+            Zq[i * q + a] = z;
+        }
+    /* the rows of each pose (counting sort) */
+    memset(first, 0, (G + 1) * sizeof *first);
+    for (size_t i = 0; i < n; ++i)
+        first[c->pose[i] + 1]++;
+    for (size_t g = 0; g < G; ++g)
+        first[g + 1] += first[g];
+    {
+        size_t *fill = malloc(G * sizeof *fill);
+        if (!fill) {
+            free(Zq);
+            free(first);
+            return -1;
+        }
+        memcpy(fill, first, G * sizeof *fill);
+        for (size_t i = 0; i < n; ++i)
+            rows[fill[c->pose[i]]++] = i;
+        free(fill);
+    }
+    memset(sg, 0, (size_t)G * q * sizeof *sg);
+    memset(ug, 0, (size_t)G * q * sizeof *ug);
+    for (size_t g = 0; g < G; ++g) {
+        const size_t m = first[g + 1] - first[g], *ri = &rows[first[g]];
+        double H[MAX_POSE_ROWS * MAX_POSE_ROWS], x[MAX_POSE_ROWS];
+        for (size_t u = 0; u < m; ++u)
+            for (unsigned a = 0; a < q; ++a)
+                sg[g * q + a] += Zq[ri[u] * q + a] * r[ri[u]];
+        if (m > MAX_POSE_ROWS) { /* no leverage correction for an outsize pose */
+            for (size_t u = 0; u < m; ++u)
+                for (unsigned a = 0; a < q; ++a)
+                    ug[g * q + a] += Zq[ri[u] * q + a] * r1[ri[u]];
+            continue;
+        }
+        /* (I - H_gg) x = r1_g: the pose's residuals as if it had been left out (CR3) */
+        for (size_t u = 0; u < m; ++u) {
+            x[u] = r1[ri[u]];
+            for (size_t v = 0; v < m; ++v) {
+                double h = 0.0;
+                for (unsigned a = 0; a < q; ++a)
+                    h += Zq[ri[u] * q + a] * Zq[ri[v] * q + a] / ev[p - 1 - a];
+                H[u * m + v] = (u == v ? 1.0 : 0.0) - h;
+            }
+        }
+        if (solve_small(H, x, m) != 0)
+            for (size_t u = 0; u < m; ++u)
+                x[u] = r1[ri[u]];
+        for (size_t u = 0; u < m; ++u)
+            for (unsigned a = 0; a < q; ++a)
+                ug[g * q + a] += Zq[ri[u] * q + a] * x[u];
+    }
+    free(Zq);
+    free(first);
+    return 0;
+}
+
 int rch_dg_score_test(double *f_stat, unsigned *dof, double *p_value, const rc_model *m0, const rc_model *m1,
                       unsigned nb, unsigned q_ident, unsigned k_fitted, const ctx *c)
 {
@@ -181,72 +256,8 @@ int rch_dg_score_test(double *f_stat, unsigned *dof, double *p_value, const rc_m
         ++q;
     if (q == 0 || G <= (size_t)q + 1)
         goto done;
-    double *Zq = malloc(((size_t)n * q) * sizeof *Zq);
-    size_t *first = malloc((G + 1 + n) * sizeof *first);
-    if (!Zq || !first) {
-        free(Zq);
-        free(first);
+    if (pose_scores(sg, ug, Zc, M, ev, p, q, ld, r, r1, c) != 0)
         goto done;
-    }
-    size_t *rows = first + G + 1;
-    for (size_t i = 0; i < n; ++i)
-        for (unsigned a = 0; a < q; ++a) {
-            double z = 0.0;
-            for (unsigned b = 0; b < p; ++b)
-                z += Zc[(size_t)b * ld + i] * M[b * p + (p - 1 - a)];
-            Zq[i * q + a] = z;
-        }
-    /* the rows of each pose (counting sort) */
-    memset(first, 0, (G + 1) * sizeof *first);
-    for (size_t i = 0; i < n; ++i)
-        first[c->pose[i] + 1]++;
-    for (size_t g = 0; g < G; ++g)
-        first[g + 1] += first[g];
-    {
-        size_t *fill = malloc(G * sizeof *fill);
-        if (!fill) {
-            free(Zq);
-            free(first);
-            goto done;
-        }
-        memcpy(fill, first, G * sizeof *fill);
-        for (size_t i = 0; i < n; ++i)
-            rows[fill[c->pose[i]]++] = i;
-        free(fill);
-    }
-    memset(sg, 0, (size_t)G * q * sizeof *sg);
-    memset(ug, 0, (size_t)G * q * sizeof *ug);
-    for (size_t g = 0; g < G; ++g) {
-        const size_t m = first[g + 1] - first[g], *ri = &rows[first[g]];
-        double H[MAX_POSE_ROWS * MAX_POSE_ROWS], x[MAX_POSE_ROWS];
-        for (size_t u = 0; u < m; ++u)
-            for (unsigned a = 0; a < q; ++a)
-                sg[g * q + a] += Zq[ri[u] * q + a] * r[ri[u]];
-        if (m > MAX_POSE_ROWS) { /* no leverage correction for an outsize pose */
-            for (size_t u = 0; u < m; ++u)
-                for (unsigned a = 0; a < q; ++a)
-                    ug[g * q + a] += Zq[ri[u] * q + a] * r1[ri[u]];
-            continue;
-        }
-        /* (I - H_gg) x = r1_g: the pose's residuals as if it had been left out (CR3) */
-        for (size_t u = 0; u < m; ++u) {
-            x[u] = r1[ri[u]];
-            for (size_t v = 0; v < m; ++v) {
-                double h = 0.0;
-                for (unsigned a = 0; a < q; ++a)
-                    h += Zq[ri[u] * q + a] * Zq[ri[v] * q + a] / ev[p - 1 - a];
-                H[u * m + v] = (u == v ? 1.0 : 0.0) - h;
-            }
-        }
-        if (solve_small(H, x, m) != 0)
-            for (size_t u = 0; u < m; ++u)
-                x[u] = r1[ri[u]];
-        for (size_t u = 0; u < m; ++u)
-            for (unsigned a = 0; a < q; ++a)
-                ug[g * q + a] += Zq[ri[u] * q + a] * x[u];
-    }
-    free(Zq);
-    free(first);
     double s[RC_MAX_PARAMS], B[RC_MAX_PARAMS * RC_MAX_PARAMS / 4 + 16];
     memset(s, 0, sizeof s);
     memset(B, 0, (size_t)q * q * sizeof *B);
