@@ -4,7 +4,9 @@
 #  1. copy the tree as git sees it (tracked and new files, no build
 #     directories) to a temporary place, configure, build and
 #     `cmake --install` it into a temporary prefix (static libraries);
-#  2. every installed header compiles on its own (C99, -pedantic);
+#  2. every installed header compiles on its own (C99, -pedantic), and only
+#     the public ones are installed (docs/install.md "Public headers");
+#     the manual pages and the bash completion are installed;
 #     build examples/consumer against the installed tree twice, with
 #     find_package(rcal CONFIG) and with a plain cc + pkg-config command line,
 #     run both: they load irb120.json through the installed host library and
@@ -103,7 +105,8 @@ t0=$(date +%s)
 if build_install static; then
     ok "static build and install ($(($(date +%s) - t0)) s): $(cd "$WORK/static" && ls lib/*.a | tr '\n' ' ')"
     for f in lib/cmake/rcal/rcalConfig.cmake lib/cmake/rcal/rcalConfigVersion.cmake lib/pkgconfig/rcal.pc \
-        include/rcal/rc_version.h include/rcal/rch_robot.h share/rcal/irb120.json share/doc/rcal/LICENSE; do
+        include/rcal/rc_version.h include/rcal/rch_robot.h share/rcal/irb120.json share/doc/rcal/LICENSE \
+        share/man/man1/rcal.1 share/man/man1/rcal-calibrate.1 share/bash-completion/completions/rcal; do
         [ -f "$WORK/static/$f" ] || bad "static: $f not installed"
     done
     # every installed header compiles on its own (C99, -pedantic, -Werror)
@@ -115,6 +118,10 @@ if build_install static; then
             bad "static: installed header $(basename "$h") does not compile on its own"
     done
     ok "static: $nh installed headers compile on their own"
+    host=$(sed -n 's/^public host headers: //p' "$WORK/src/docs/install.md" | tr -d '`,' | tr ' ' '\n' | grep . | sort)
+    want=$( (cd "$WORK/src/lib" && ls rc_*.h) | cat - <(echo rc_version.h) <(echo "$host") | sort -u)
+    [ "$(cd "$WORK/static/include/rcal" && ls)" = "$want" ] && ok "static: only the public headers are installed" ||
+        bad "static: the installed headers differ from docs/install.md's public set"
     static_out=$(consumer_both static --static "") && cat "$WORK/consumer-static.out" &&
         ok "static: the two consumers print the same length"
 else
@@ -154,6 +161,10 @@ for kind in static shared; do
     [ -x "$WORK/$kind/bin/rcal" ] || continue
     v=$("$WORK/$kind/bin/rcal" --version | head -n 1)
     [ "$v" = "rcal $version" ] && ok "$kind: rcal --version: $v" || bad "$kind: rcal --version says '$v'"
+    # the commit it was built from: "unknown" here (the fresh tree is a copy, not a git checkout)
+    c=$("$WORK/$kind/bin/rcal" --version | sed -n 's/^commit: //p')
+    [ "$c" = unknown ] && ok "$kind: rcal --version: commit: $c (built outside git)" ||
+        bad "$kind: rcal --version says commit '$c', want 'unknown' for a tree outside git"
     # the pinned reference LAPACK and BLAS (cmake/rcal_lapack.cmake), linked in
     la=$("$WORK/$kind/bin/rcal" --version | sed -n 's/^BLAS\/LAPACK: //p')
     [[ $la == "reference LAPACK "*" and BLAS, linked in (pinned: "* ]] && ok "$kind: BLAS/LAPACK: $la" ||

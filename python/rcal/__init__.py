@@ -25,6 +25,8 @@ arrays when the input was a numpy array (numpy is optional).
 Errors raise RcalError with the C library's message ("file:line:col: ...").
 """
 
+from __future__ import annotations
+
 import collections
 import ctypes
 import math
@@ -35,6 +37,16 @@ import warnings
 
 from . import _lib
 from ._check import _ints, _doubles, _real, _rows
+
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+# The types of the public signatures (annotations only: nothing is checked at
+# run time beyond what each function checks itself). ArrayLike: a list of
+# numbers, a list of lists or a numpy array; PathLike: a str or os.PathLike.
+PathLike = Union[str, "os.PathLike[str]"]
+Paths = Union[PathLike, Sequence[PathLike]]
+ArrayLike = Any
+Triple = Sequence[float]
 
 __all__ = ["RcalError", "RcalWarning", "Model", "Metrics", "Param", "Jump", "Result", "Diagnosis", "Evaluation", "Compensation",
            "calibrate", "diagnose", "evaluate", "compensate", "export", "report", "default_robot", "data_file",
@@ -56,7 +68,7 @@ def __getattr__(name):
     raise AttributeError("module 'rcal' has no attribute %r" % name)
 
 
-def library_path():
+def library_path() -> str:
     """Path of the librcal_ffi.so in use (RCAL_FFI_LIB, the package's own,
     or a build tree's)."""
     return _lib.lib().rcal_path
@@ -134,7 +146,7 @@ def _data_dir():
     return os.path.join(_lib.repo_root(), "data")
 
 
-def data_file(name):
+def data_file(name: str) -> str:
     """Path of a data file shipped with rcal ("irb120.json", "kr6.json",
     "sim_irb120.csv", "sim_irb120_truth.json"): in $RCAL_DATA_DIR when set,
     else the package's own copy (an installed package), else the
@@ -150,7 +162,7 @@ on the machine or in the process changes a result), version LAPACK's
 ILAVER as a string ("3.11.0")."""
 
 
-def lapack():
+def lapack() -> "Lapack":
     """Which BLAS/LAPACK librcal_ffi.so computes with (a Lapack)."""
     buf = ctypes.create_string_buffer(4096)
     linked = ctypes.c_int()
@@ -159,7 +171,7 @@ def lapack():
     return Lapack(buf.value.decode(), bool(linked.value), "%d.%d.%d" % tuple(ver))
 
 
-def default_robot():
+def default_robot() -> str:
     """Path of the nominal robot model `rcal` uses by default: irb120.json
     by data_file()."""
     return data_file("irb120.json")
@@ -184,7 +196,7 @@ class Model:
         self.path = None if path is None else os.fspath(path)  # the file it was loaded from, if any
 
     @classmethod
-    def load(cls, path):
+    def load(cls, path: PathLike) -> "Model":
         """Load a model file (rcal-model/1 JSON). Raises RcalError with the
         reader's "file:line:col: message" when it is missing or malformed."""
         lib = _lib.lib()
@@ -199,25 +211,25 @@ class Model:
             self._h = ctypes.c_void_p()
 
     @property
-    def name(self):
+    def name(self) -> str:
         """The model's name (the file's "name")."""
         buf = ctypes.create_string_buffer(256)
         _lib.lib().rch_ffi_model_name(self._h, buf, 256)
         return buf.value.decode(errors="replace")
 
     @property
-    def has_nominal(self):
+    def has_nominal(self) -> bool:
         """True for a calibrated model that carries its nominal table."""
         return bool(_lib.lib().rch_ffi_model_has_nominal(self._h))
 
     @property
-    def joint_limits_deg(self):
+    def joint_limits_deg(self) -> List[Tuple[float, float]]:
         """Joint limits: 6 pairs (min, max), degrees."""
         lo, hi = (ctypes.c_double * 6)(), (ctypes.c_double * 6)()
         _check(_lib.lib().rch_ffi_model_limits(self._h, lo, hi))
         return [(lo[j], hi[j]) for j in range(6)]
 
-    def params(self, nominal=False):
+    def params(self, nominal: bool = False) -> List[Tuple[str, str, float]]:
         """The parameters as a list of (name, unit, value): lengths in mm,
         angles in degrees ("a1", "d1", "alpha1", "theta1", ..., "ex", "ey",
         "ez", then the effects'). nominal=True: the 27 base parameters of the
@@ -233,7 +245,7 @@ class Model:
             out.append((name.value.decode(), _UNITS[u.value], v.value))
         return out
 
-    def fk(self, q_deg, nominal=False, rotation=False, determined=False):
+    def fk(self, q_deg: ArrayLike, nominal: bool = False, rotation: bool = False, determined: bool = False) -> Any:
         """Forward kinematics: the flange point (x, y, z) in mm, base frame, at
         joint angles q_deg (degrees); the cable's attachment point where the
         model has a tool_offset (a one-point cable calibration's, in the
@@ -254,7 +266,7 @@ class Model:
         p = _rows(pos, n, 3, single, numpy)
         return (p, _rows(rot, n, 9, single, numpy)) if rotation else p
 
-    def cable_length(self, q_deg):
+    def cable_length(self, q_deg: ArrayLike) -> Any:
         """Predicted cable length in mm at joint angles q_deg (degrees): the
         distance from the encoder outlet to the flange (tool) point plus the
         model's length-side effects. One pose gives a float, a batch a list
@@ -355,14 +367,14 @@ class Result:
         self.outlets = list(labels[:min(n.value, 64)])
 
     @property
-    def screened(self):
+    def screened(self) -> List[Dict[str, Any]]:
         """The rows left out of the fit as irreconcilable with the rest (the
         JSON's "screened" "rows_left_out": dicts with file, line, sensor,
         residual_mm, likely, fits_outlet), [] when none."""
         sc = self.json().get("screened") or {}
         return list(sc.get("rows_left_out") or [])
 
-    def figure(self, name):
+    def figure(self, name: str) -> Optional[float]:
         """A figure of the run by name (rch_ffi_calib_get in rch_ffi.h:
         "noise_mm", "effective_params", "prior", "groups", "jumps_fitted",
         "dequant_corrected", "validate_ad_mean_mm", ...), or None when
@@ -372,12 +384,12 @@ class Result:
             return None
         return v.value
 
-    def json_text(self):
+    def json_text(self) -> str:
         """The report exactly as `rcal calibrate --json` prints it (the same
         writer; time_ms is this run's)."""
         return _text(_lib.lib().rch_ffi_calib_json, self._h)
 
-    def json(self):
+    def json(self) -> Dict[str, Any]:
         """json_text() parsed: a dict."""
         import json
         return json.loads(self.json_text())
@@ -388,7 +400,7 @@ class Result:
             self._h = ctypes.c_void_p()
 
     @property
-    def model(self):
+    def model(self) -> "Model":
         """The identified model with the robot's nominal table (a new Model)."""
         lib = _lib.lib()
         h = ctypes.c_void_p()
@@ -396,20 +408,21 @@ class Result:
         _check(lib.rch_ffi_calib_model(ctypes.byref(h), self._h, err, _ERR_LEN), err)
         return Model(h.value)
 
-    def param(self, name):
+    def param(self, name: str) -> "Param":
         """The Param called name ("a2", "theta3", "ex", ...)."""
         for p in self.params:
             if p.name == name:
                 return p
         raise KeyError(name)
 
-    def write(self, path):
+    def write(self, path: PathLike) -> None:
         """Write the calibrated model file, as `rcal calibrate --out path`
         writes it (rcal-model/2 JSON, for `rcal compensate` and Model.load)."""
         err = ctypes.create_string_buffer(_ERR_LEN)
         _check(_lib.lib().rch_ffi_calib_write(self._h, _path(path), err, _ERR_LEN), err)
 
-    def report(self, directory, diagnosis=None, name="report", model=None, tolerance_mm=None):
+    def report(self, directory: PathLike, diagnosis: Optional["Diagnosis"] = None, name: str = "report",
+               model: Optional[PathLike] = None, tolerance_mm: Optional[float] = None) -> List[str]:
         """The HTML report: see rcal.report()."""
         return report(self, directory, diagnosis=diagnosis, name=name, model=model, tolerance_mm=tolerance_mm)
 
@@ -423,11 +436,19 @@ _CAL_FLAGS = {"tool_offset": 1, "jumps": 2, "dequantize": 4, "no_prior": 8, "hol
               "no_length_offset": 512, "no_drift": 1024, "force": 2048}
 
 
-def calibrate(data=None, q_deg=None, L_mm=None, xyz_mm=None, group=None, outlet=None, robot=None, method="lm",
-              test_fraction=0.1, seed=1, max_iter=0, fix=None, effects=None, jumps=False, dequantize=None,
-              prior=True, prior_stated=False, tool_offset=False, holdout_groups=False, jump_check=True, validate=None, truth=None,
-              cases=1, samples=0, plots=None, residuals=None, data_csv=None, positions=None, screen=True,
-              target=None, cable_points=None, cable_point_sd=None, length_offset=True, drift=True, force=False):
+def calibrate(data: Optional[Paths] = None, q_deg: ArrayLike = None, L_mm: ArrayLike = None,
+              xyz_mm: ArrayLike = None, group: ArrayLike = None, outlet: ArrayLike = None,
+              robot: Optional[PathLike] = None, method: str = "lm", test_fraction: float = 0.1, seed: int = 1,
+              max_iter: int = 0, fix: Optional[Union[str, Sequence[str]]] = None,
+              effects: Optional[Union[str, Sequence[str]]] = None, jumps: bool = False,
+              dequantize: Optional[bool] = None, prior: bool = True, prior_stated: bool = False,
+              tool_offset: bool = False, holdout_groups: bool = False, jump_check: bool = True,
+              validate: Optional[PathLike] = None, truth: Optional[PathLike] = None, cases: int = 1,
+              samples: int = 0, plots: Optional[PathLike] = None, residuals: Optional[PathLike] = None,
+              data_csv: Optional[Paths] = None, positions: Optional[Paths] = None, screen: bool = True,
+              target: ArrayLike = None, cable_points: Optional[Sequence[Triple]] = None,
+              cable_point_sd: Optional[float] = None, length_offset: bool = True, drift: bool = True,
+              force: bool = False) -> "Result":
     """Identify the DH errors and the encoder outlet from cable lengths, as
     `rcal calibrate` does (the same host function: identical figures).
     Each argument is the CLI option of the same meaning.
@@ -625,14 +646,14 @@ class Diagnosis:
         _check(lib.rch_ffi_diag_nuisance(self._h, nb, 256))
         self.nuisance = [x for x in nb.value.decode().split(",") if x]
 
-    def figure(self, name):
+    def figure(self, name: str) -> Optional[float]:
         """A figure by name (rch_ffi_diag_get), or None when unknown."""
         v = ctypes.c_double()
         if _lib.lib().rch_ffi_diag_get(self._h, name.encode(), ctypes.byref(v)) != 0:
             return None
         return v.value
 
-    def residuals(self):
+    def residuals(self) -> Any:
         """(before, after, floor): per sample as the diagnosis used them, the
         cross-validated held-out residual of the geometry, of the final model,
         and the noise-floor sigma, mm (numpy arrays when numpy is present)."""
@@ -641,15 +662,15 @@ class Diagnosis:
         _check(_lib.lib().rch_ffi_diag_residuals(self._h, *bufs))
         return tuple(_rows(b, n, 1, False, _np is not None) for b in bufs)
 
-    def json_text(self):
+    def json_text(self) -> str:
         """The report exactly as `rcal diagnose --json` prints it."""
         return _text(_lib.lib().rch_ffi_diag_json, self._h)
 
-    def json(self):
+    def json(self) -> Dict[str, Any]:
         import json
         return json.loads(self.json_text())
 
-    def write(self, path):
+    def write(self, path: PathLike) -> None:
         """The calibrated model with the effects found, what `rcal diagnose
         --out path` writes (never over the data or the robot file)."""
         err = ctypes.create_string_buffer(_ERR_LEN)
@@ -675,9 +696,11 @@ def _path_list(v, what):
     return "\n".join(paths).encode(), paths
 
 
-def diagnose(data=None, robot=None, seed=1, folds=5, steps=3, jumps=True, dequantize=False, q_step_deg=0.0,
-             len_step_mm=0.0, len_noise_mm=0.0, alpha=0.0, max_iter=0, positions=None, effects=None,
-             known_jumps=False):
+def diagnose(data: Optional[Paths] = None, robot: Optional[PathLike] = None, seed: int = 1, folds: int = 5,
+             steps: int = 3, jumps: bool = True, dequantize: bool = False, q_step_deg: float = 0.0,
+             len_step_mm: float = 0.0, len_noise_mm: float = 0.0, alpha: float = 0.0, max_iter: int = 0,
+             positions: Optional[Paths] = None, effects: Optional[Union[str, Sequence[str]]] = None,
+             known_jumps: bool = False) -> "Diagnosis":
     """Which missing physical effect explains the residuals, as `rcal
     diagnose` finds it (rch_diagnose_inputs): data (--data: one path or a
     list, one or several outlets), positions (--positions: tracker files,
@@ -739,7 +762,8 @@ def _model(model, what="model"):
                     "not %s" % (what, type(model).__name__))
 
 
-def evaluate(model, data, refit_encoder=False, same_pose_deg=1e-6):
+def evaluate(model: Union["Model", "Result", PathLike], data: PathLike, refit_encoder: bool = False,
+             same_pose_deg: float = 1e-6) -> "Evaluation":
     """A calibrated model (a Model, a Result of calibrate() or a model file)
     on data the fit never saw, as `rcal evaluate --model M --data D`
     (rch_evaluate: no refit of the robot; refit_encoder: --refit-encoder;
@@ -774,8 +798,11 @@ _U95_POLICIES = {"skip": 0, "warn": 1, "refuse": 2}
 _ON_FAIL = ("warn", "raise", "ignore")
 
 
-def compensate(model, targets_deg, nominal=None, tool_mm=None, position_only=None, max_dev_deg=0.0,
-               max_uncertainty_mm=0.0, return_status=False, details=False, u95_policy="skip", on_fail="warn"):
+def compensate(model: Union["Model", "Result", PathLike], targets_deg: ArrayLike,
+               nominal: Optional[Union["Model", PathLike]] = None, tool_mm: Optional[Triple] = None,
+               position_only: Optional[bool] = None, max_dev_deg: float = 0.0, max_uncertainty_mm: float = 0.0,
+               return_status: bool = False, details: bool = False, u95_policy: str = "skip",
+               on_fail: str = "warn") -> Any:
     """Correct joint targets made with the nominal model so that the
     calibrated robot reaches the nominal pose: q' with FK_cal(q') =
     FK_nom(q) for the tool point, target by target in order with one
@@ -880,7 +907,8 @@ def _flag_targets(codes, u95, max_unc_mm, u95_policy, on_fail):
 _FORMATS = {"urdf": 0, "dh-csv": 1}
 
 
-def export(model, out_path, format="urdf", nominal_urdf=None, drop_joint_effects=False):
+def export(model: Union["Model", "Result", PathLike], out_path: PathLike, format: str = "urdf",
+           nominal_urdf: Optional[PathLike] = None, drop_joint_effects: bool = False) -> Dict[str, int]:
     """The model as a URDF or its DH table as CSV, as `rcal export --model M
     --format F --out PATH` writes it (whole or not at all, never over an
     input). model: a model file, a Model loaded from one, or a Result (its
@@ -913,7 +941,8 @@ def export(model, out_path, format="urdf", nominal_urdf=None, drop_joint_effects
             shutil.rmtree(tmp, ignore_errors=True)
 
 
-def report(result, directory, diagnosis=None, name="report", model=None, tolerance_mm=None):
+def report(result: "Result", directory: PathLike, diagnosis: Optional["Diagnosis"] = None, name: str = "report",
+           model: Optional[PathLike] = None, tolerance_mm: Optional[float] = None) -> List[str]:
     """The HTML report of a calibration (and a diagnosis) into directory
     (created when missing), as `rcal calibrate --report` makes it:
     <name>.html with its plot data (<name>_*.csv), the calibration's JSON

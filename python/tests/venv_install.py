@@ -18,11 +18,16 @@ python_venv_install).
    diagnose, compensate equal to the CLI);
 4. the wheel of the same source installed into a virtual environment with
    nothing in it (no system site packages: no numpy, setuptools, wheel), and
-   session_check.py --demo-only there.
+   session_check.py --demo-only there;
+5. in both environments, `ldd` of the installed librcal_ffi.so names no
+   LAPACK, BLAS or Fortran run-time (liblapack*, libblas*, libatlas*,
+   libopenblas*, lapacke, libgfortran*, libquadmath*): the reference archives
+   are linked in, so the wheel runs where none is installed (issue 52).
 --demo-only (passed on to session_check.py) checks the demo data only. Exit 77 (ctest: skipped) with the reason when venv or pip
 is unavailable.
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -33,6 +38,32 @@ import time
 def skip(why):
     print("python_venv_install: SKIPPED: " + why)
     sys.exit(77)
+
+
+FOREIGN = re.compile(r"^(liblapack|libblas|libatlas|libopenblas|liblapacke|libgfortran|libquadmath|libcblas|libptcblas|"
+                     r"libf77blas)")
+
+
+def check_ldd(py, env, cwd, where):
+    """5. The installed extension needs no LAPACK, BLAS or Fortran library
+    from the loader. 0 when so (the libraries it needs printed), else 1."""
+    p = subprocess.run([py, "-c", "import rcal; print(rcal.library_path())"], cwd=cwd, env=env, capture_output=True,
+                       text=True)
+    lib = p.stdout.strip()
+    if p.returncode != 0 or not os.path.isfile(lib):
+        print("python_venv_install: FAILED: %s: rcal.library_path() %r (%s)" % (where, lib, p.stderr.strip()))
+        return 1
+    if shutil.which("ldd") is None:
+        print("python_venv_install: %s: no ldd on this machine; the library check is left out" % where)
+        return 0
+    p = subprocess.run(["ldd", lib], capture_output=True, text=True)
+    needed = [ln.split()[0] for ln in p.stdout.splitlines() if ln.strip()]
+    foreign = [n for n in needed if FOREIGN.match(os.path.basename(n))]
+    print("%s: ldd %s: %s" % (where, os.path.basename(lib), " ".join(needed)))
+    if p.returncode != 0 or foreign:
+        print("python_venv_install: FAILED: %s: the extension needs %s from the loader" % (where, foreign or p.stderr))
+        return 1
+    return 0
 
 
 def clean_wheel(py, src, tmp, env, rcal_bin, root):
@@ -65,6 +96,8 @@ def clean_wheel(py, src, tmp, env, rcal_bin, root):
         return 1
     print("clean environment (importable of numpy, wheel: %s): %s installed in %.1f s (wheel build included)" % (
         bare, wheels[0], t1 - t0))
+    if check_ldd(cpy, env, tmp, "clean environment (wheel)") != 0:
+        return 1
     p = subprocess.run([cpy, os.path.join(root, "python", "tests", "session_check.py"), rcal_bin, root,
                         os.path.join(tmp, "work_clean"), "--demo-only"], cwd=tmp, env=env, capture_output=True,
                        text=True)
@@ -116,6 +149,8 @@ def main(argv):
         print("installed: " + (p.stdout.strip() or p.stderr.strip()))
         if p.returncode != 0:
             print("python_venv_install: FAILED: the installed package does not use its own library and data")
+            return 1
+        if check_ldd(py, env, tmp, "venv (pip install ./python)") != 0:
             return 1
         p = subprocess.run([py, os.path.join(root, "python", "tests", "session_check.py"), rcal_bin, root,
                             os.path.join(tmp, "work")] + argv[3:], cwd=tmp, env=env, capture_output=True, text=True)

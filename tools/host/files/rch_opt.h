@@ -92,6 +92,16 @@ int rch_opt_fail(const rch_cmdspec *spec, const struct rch_diag *d);
  * defaults, help lines, details). */
 void rch_opt_usage(const rch_cmdspec *spec, FILE *f);
 
+/* The command's manual page, man(7) markup, from the same table (the
+ * hidden option --help-roff; the build writes rcal-CMD.1 with it,
+ * cmake/rcal_man.cmake). */
+void rch_opt_roff(const rch_cmdspec *spec, FILE *f);
+/* s escaped for man(7) text: \ as \e, - as \-, a leading . or ' guarded. */
+void rch_opt_roff_text(FILE *f, const char *s);
+/* The command's case in the bash completion function (the hidden option
+ * --help-bash): its options, an option's choices, files for a file's value. */
+void rch_opt_bash(const rch_cmdspec *spec, FILE *f);
+
 /* 1 when the option named `name` was given (seen from rch_opt_parse). */
 int rch_opt_given(const rch_cmdspec *spec, unsigned long long seen, const char *name);
 
