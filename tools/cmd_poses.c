@@ -518,8 +518,7 @@ static int parse(poses_args *a, int argc, char **argv)
         {"--format", RCH_OPT_CHOICE, &a->format, 0, 0, NULL, "what --out holds (rapid-link, urscript-link: a program speaking docs/controller-link.md to rcal acquire "
          "--controller)", 0, "csv|rapid|rapid-link|urscript-link"},
         {"--controller", RCH_OPT_STR, &a->link, 0, 0, "tcp:[HOST:]PORT",
-         "where a link program connects (the PC running rcal acquire --controller; numeric HOST) [default "
-         "tcp:127.0.0.1:5150]", 0, NULL},
+         "where a link program connects (the PC running rcal acquire --controller; numeric HOST)", 0, NULL},
         {"--settle-s", RCH_OPT_DOUBLE, &a->settle_s, 0, 600, "S", "RAPID: WaitTime at each pose (settle and read)", 0,
          NULL},
         {"--len-min-mm", RCH_OPT_DOUBLE, &pc->len_min_mm, 0, 20000, "A", "shortest cable length", 0, NULL},

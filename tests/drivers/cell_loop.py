@@ -13,7 +13,8 @@ the protocol answers one, received by the controller as a FAULT line; the record
 controller's accepted reports at its precision (5 decimals, the plan's beside them); rcal's own time per pose
 (docs/controller-link.md, "rcal's own time per pose": from the controller's AT to rcal's next command, less
 --settle-ms and the display's stability window) <= 20 ms at the median and the 95th percentile of every
-outlet's run (the largest is printed); the calibration's judge finds the model usable and its flange error
+outlet's run, and its CPU time per pose <= 20 ms at the largest (the largest wall time is printed: on a loaded
+machine a pose now and then waits for the scheduler or the disk's fsync); the calibration's judge finds the model usable and its flange error
 against the truth (calibrate --truth: rms over random poses) is within --max-flange-mm (default 0.05 mm).
 
 usage: cell_loop.py RCAL SIMDISPLAY SOURCE_DIR WORK_DIR [--poses N] [--keep]"""
@@ -65,7 +66,9 @@ t0 = time.monotonic()
 lap = {}
 
 # 1. the plan
-r = run([RCAL, "poses", "--count", str(N_POSES)] + sum([["--outlet", o] for o in OUTLETS], [])
+# (3000 candidates rather than the default 40 N: a quarter of the planning time; the plan's quality is judged by
+# tests/sim/plan_*.py, this run judges the loop)
+r = run([RCAL, "poses", "--count", str(N_POSES), "--candidates", "3000"] + sum([["--outlet", o] for o in OUTLETS], [])
         + ["--out", "plan.csv"], 600)
 if r.returncode != 0:
     fail("rcal poses: " + r.stderr)
@@ -137,6 +140,9 @@ if acq.returncode != 1 or "LOST: the controller said BYE" not in open("quit.err"
 if rows_of(2) != by_outlet[2][:Q]:
     fail("the cell stopped at pose %d: %d rows (want %d)" % (at(2, Q), len(rows_of(2)), Q))
 
+qtext = open("quit.err").read()
+if "LOST" not in qtext:
+    fail("the cell's BYE not named LOST: " + qtext[-2000:])
 summaries, logs, texts = {}, {}, {}
 for k in (0, 1, 2):
     t1 = time.monotonic()
@@ -156,6 +162,8 @@ for k in (0, 1, 2):
     if acq.returncode != 0:
         fail("outlet %d: rcal acquire exit %d: %s" % (k, acq.returncode, text[-3000:]))
     summaries[k] = json.loads(out)
+    with open("acq%d.json" % k, "w") as f:
+        f.write(out)
     logs[k] = json.load(open("ctl%d.json" % k))
     if ctl.returncode != 0 or logs[k]["stop"] != "done":
         fail("outlet %d: the controller did not end on STOP done: %s" % (k, open("ctl%d.json.err" % k).read()))
@@ -211,7 +219,8 @@ for k, t in timing.items():
           "%.2f ms, max %.2f ms; the controller's move median %.1f ms"
           % (k, t["settle_ms"], t["display_ms_median"], t["own_ms_median"], t["own_ms_p95"], t["own_ms_max"],
              t["poses"], t["cpu_ms_median"], t["cpu_ms_max"], t["move_ms_median"]))
-    if t["poses"] < summaries[k]["samples_written"] - 1 or t["own_ms_median"] > OWN_MS or t["own_ms_p95"] > OWN_MS:
+    if (t["poses"] < summaries[k]["samples_written"] - 1 or t["own_ms_median"] > OWN_MS or t["own_ms_p95"] > OWN_MS
+            or t["cpu_ms_max"] > OWN_MS):
         fail("outlet %d: rcal's own time per pose beyond %g ms (or too few poses timed): %s" % (k, OWN_MS, t))
 
 # 6. straight into a calibration, judged against the truth
@@ -236,5 +245,5 @@ print("calibration: %d rows, the judge: usable (ratio %.3g of factor %.3g); flan
 print("ok: %d poses x 3 outlets unattended, %d rows, 0 lost, 0 duplicated; faults named: %s; %s; %.1f s" % (
     N_POSES, len(rows), "; ".join("%d: %s" % (k, ", ".join("%s %d" % (n, c) for n, c in
                                                           summaries[k]["controller"]["faults"].items() if c))
-                                  for k in (0, 1, 2)) + "; 2: BYE, resumed",
+                                  for k in (0, 1, 2)) + "; 2: slow network (no fault: tolerated), BYE (LOST), resumed",
     ", ".join("%s %.1f s" % kv for kv in lap.items()), time.monotonic() - t0))
