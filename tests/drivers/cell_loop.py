@@ -128,13 +128,16 @@ faults = {
 want = {0: ["LOST", "STALLED", "OFFSET"], 1: ["UNKNOWN", "DUPLICATE", "ORDER", "BUSY"], 2: []}
 wire = {0: ["STALLED", "OFFSET"], 1: ["UNKNOWN", "DUPLICATE", "ORDER"], 2: []}
 
-# outlet 2 first: the cell stops at pose Q of its order (BYE); rcal stops with what it recorded
-acq = subprocess.Popen(acquire(2, wait_s="60"), stdout=subprocess.PIPE, stderr=open("quit.err", "w"), text=True)
+# outlet 2 first: the cell stops at pose Q of its order (BYE); rcal waits --controller-wait-s for it to come
+# back, then stops with what it recorded
+t1 = time.monotonic()
+acq = subprocess.Popen(acquire(2, wait_s="10"), stdout=subprocess.PIPE, stderr=open("quit.err", "w"), text=True)
 procs.append(acq)
 ctl = controller(2, "quit.json", "quit.err", ["quit@%d" % at(2, Q)])
 procs.append(ctl)
 acq.communicate(timeout=300)
 ctl.wait(timeout=30)
+lap["outlet 2 to BYE"] = time.monotonic() - t1
 if acq.returncode != 1 or "LOST: the controller said BYE" not in open("quit.err").read():
     fail("the cell stopped: exit %d: %s" % (acq.returncode, open("quit.err").read()[-2000:]))
 if rows_of(2) != by_outlet[2][:Q]:
