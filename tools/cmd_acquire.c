@@ -183,8 +183,8 @@ static void report_link(const rch_acq_result *r, const rch_acq_config *c, FILE *
     fprintf(f, "\n");
     if (r->timing.n)
         fprintf(f, "rcal acquire: rcal's own time per pose (AT to the next command, less --settle-ms %lu and the "
-                   "display's %.1f ms median): median %.2f ms, 95 %% %.2f ms, max %.2f ms over %zu poses; CPU %.2f ms "
-                   "median, %.2f ms max\n",
+                   "display's stability window, median %.1f ms): median %.2f ms, 95 %% %.2f ms, max %.2f ms over %zu "
+                   "poses; CPU %.2f ms median, %.2f ms max\n",
                 c->settle_ms, r->timing.display_ms_median, r->timing.own_ms_median, r->timing.own_ms_p95,
                 r->timing.own_ms_max, r->timing.n, r->timing.cpu_ms_median, r->timing.cpu_ms_max);
 }

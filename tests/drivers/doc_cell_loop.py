@@ -46,9 +46,10 @@ finally:
         os.killpg(p.pid, signal.SIGTERM)  # a display or controller left over
     except ProcessLookupError:
         pass
-print(out[-4000:])
 if p.returncode != 0:
+    print(out[-6000:])
     fail("the block ended with status %d" % p.returncode)
+print("\n".join(x for x in out.splitlines() if x.startswith("rcal acquire:") or "RMSE" in x or "written" in x))
 
 os.chdir(W)
 plan = list(csv.DictReader(open("plan.csv")))

@@ -2,7 +2,8 @@
 /* test_poses_link.c - the link programs of `rcal poses --format rapid-link|urscript-link` (issue 48): the
  * RAPID module read back by the project's RAPID reader (every jointtarget the plan's, to its 4 decimals), its
  * blocks balanced and the socket and standstill instructions present; the URScript's blocks balanced and
- * its calls those of the protocol. (tests/drivers/urscript_check.py checks URScript further from the CLI.) */
+ * its calls those of the protocol; each AT reporting the pose's outlet and plate point (-1 without), and every
+ * line's parentheses balanced. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
