@@ -8,7 +8,8 @@ garbage, a duplicate, an out-of-order report, a second controller, a slow networ
 mid-run with BYE, then the rerun resuming), then `rcal calibrate` on the file, judged against the truth
 (data/sim_irb120_truth.json).
 
-Asserts: 0 rows lost or duplicated; every fault named by rcal (its JSON summary and its stderr) and, where
+Asserts: 0 rows lost or duplicated; the file append-only through every run and fault (the file before a run is
+the prefix of the file after it, whole lines); every fault named by rcal (its JSON summary and its stderr) and, where
 the protocol answers one, received by the controller as a FAULT line; the recorded joints are the
 controller's accepted reports at its precision (5 decimals, the plan's beside them); rcal's own time per pose
 (docs/controller-link.md, "rcal's own time per pose": from the controller's AT to rcal's next command, less
@@ -149,6 +150,7 @@ if "LOST" not in qtext:
 summaries, logs, texts = {}, {}, {}
 for k in (0, 1, 2):
     t1 = time.monotonic()
+    before = open("data.csv", "rb").read()  # append-only through every fault: the file before is its prefix after
     err = open("acq%d.err" % k, "w")
     acq = subprocess.Popen(acquire(k), stdout=subprocess.PIPE, stderr=err, text=True)
     procs.append(acq)
@@ -162,6 +164,9 @@ for k in (0, 1, 2):
     err.close()
     lap["outlet %d" % k] = time.monotonic() - t1
     text = texts[k] = open("acq%d.err" % k).read()
+    after = open("data.csv", "rb").read()
+    if not after.startswith(before) or not after.endswith(b"\n"):
+        fail("outlet %d: data.csv is not the file before the run with rows appended" % k)
     if acq.returncode != 0:
         fail("outlet %d: rcal acquire exit %d: %s" % (k, acq.returncode, text[-3000:]))
     summaries[k] = json.loads(out)
@@ -246,7 +251,8 @@ print("calibration: %d rows, the judge: usable (ratio %.3g of factor %.3g); flan
                                                             fl["after_rms_mm"], fl["after_max_mm"],
                                                             fl["before_rms_mm"]))
 print("ok: %d poses x 3 outlets unattended, %d rows, 0 lost, 0 duplicated; faults named: %s; %s; %.1f s" % (
-    N_POSES, len(rows), "; ".join("%d: %s" % (k, ", ".join("%s %d" % (n, c) for n, c in
-                                                          summaries[k]["controller"]["faults"].items() if c))
-                                  for k in (0, 1, 2)) + "; 2: slow network (no fault: tolerated), BYE (LOST), resumed",
+    N_POSES, len(rows), "; ".join("outlet %d: %s" % (k, ", ".join("%s %d" % (n, c) for n, c in
+                                                                 summaries[k]["controller"]["faults"].items() if c)
+                                                       or "a slow network (no fault: tolerated)")
+                                  for k in (0, 1, 2)) + "; outlet 2 before: BYE (LOST), resumed",
     ", ".join("%s %.1f s" % kv for kv in lap.items()), time.monotonic() - t0))
