@@ -85,6 +85,24 @@ static int unescape(char *dst, size_t cap, const char *src)
     return 0;
 }
 
+/* rcal's own time per pose over the link (rch_acqtime.h): the "timing" object of the controller's. */
+static void json_timing(rch_jw *w, const rch_acqtime_stats *t, const rch_acq_config *c)
+{
+    rch_jw_obj(w, "timing");
+    rch_jw_uint(w, "poses", t->n);
+    rch_jw_uint(w, "settle_ms", c->settle_ms);
+    rch_jw_numf(w, "own_ms_median", t->own_ms_median, "%.3f");
+    rch_jw_numf(w, "own_ms_p95", t->own_ms_p95, "%.3f");
+    rch_jw_numf(w, "own_ms_max", t->own_ms_max, "%.3f");
+    rch_jw_numf(w, "display_ms_median", t->display_ms_median, "%.3f");
+    rch_jw_numf(w, "display_ms_max", t->display_ms_max, "%.3f");
+    rch_jw_numf(w, "move_ms_median", t->move_ms_median, "%.3f");
+    rch_jw_numf(w, "move_ms_max", t->move_ms_max, "%.3f");
+    rch_jw_numf(w, "cpu_ms_median", t->cpu_ms_median, "%.3f");
+    rch_jw_numf(w, "cpu_ms_max", t->cpu_ms_max, "%.3f");
+    rch_jw_end(w);
+}
+
 /* The run summary as one JSON object on stdout (rcal-acquire/1), also when
  * the run stopped (exit says how it ended). */
 static int report_json(const rch_acq_result *r, const rch_acq_config *c, const char *proto, int rc, int argc,
@@ -137,6 +155,7 @@ static int report_json(const rch_acq_result *r, const rch_acq_config *c, const c
         for (int k = 0; k < RCH_LINK_NFAULTS; ++k)
             rch_jw_uint(&w, rch_link_fault_name(k), r->link_faults[k]);
         rch_jw_end(&w);
+        json_timing(&w, &r->timing, c);
         rch_jw_end(&w);
     }
     rch_jw_uint(&w, "recheck_failures", r->verify_fails);
@@ -162,6 +181,12 @@ static void report_link(const rch_acq_result *r, const rch_acq_config *c, FILE *
     for (int k = 0; k < RCH_LINK_NFAULTS; ++k)
         fprintf(f, " %s %lu", rch_link_fault_name(k), r->link_faults[k]);
     fprintf(f, "\n");
+    if (r->timing.n)
+        fprintf(f, "rcal acquire: rcal's own time per pose (AT to the next command, less --settle-ms %lu and the "
+                   "display's stability window, median %.1f ms): median %.2f ms, 95 %% %.2f ms, max %.2f ms over %zu "
+                   "poses; CPU %.2f ms median, %.2f ms max\n",
+                c->settle_ms, r->timing.display_ms_median, r->timing.own_ms_median, r->timing.own_ms_p95,
+                r->timing.own_ms_max, r->timing.n, r->timing.cpu_ms_median, r->timing.cpu_ms_max);
 }
 
 /* The one-line summary of a complete run. */

@@ -338,17 +338,22 @@ static int write_out(FILE *f, const rch_poses_result *res, const rch_poses_confi
     if (strcmp(format, "rapid-link") == 0 || strcmp(format, "urscript-link") == 0) {
         char host[64], comment[200];
         unsigned port = 0;
-        unsigned char *lab = malloc(res->n ? res->n : 1);
+        unsigned char *lab = malloc(2 * (res->n ? res->n : 1)), *pts = lab ? lab + (res->n ? res->n : 1) : NULL;
         if (!lab || link_addr(host, &port, link) != 0) {
             free(lab);
             return -1;
         }
-        for (size_t i = 0; i < res->n; ++i)
+        for (size_t i = 0; i < res->n; ++i) {
             lab[i] = res->poses[i].outlet;
-        snprintf(comment, sizeof comment, "rcal poses --count %zu --seed %llu: %u outlet(s)", res->n_distinct,
-                 pc->seed, res->n_outlets);
-        const int wr = format[0] == 'r' ? rch_poses_write_rapid_link(f, res->poses, lab, res->n, host, port, comment)
-                                        : rch_poses_write_urscript_link(f, res->poses, lab, res->n, host, port, comment);
+            pts[i] = res->poses[i].target; /* the plan's target column: the plate point each AT reports */
+        }
+        if (pc->n_points == 0)
+            pts = NULL;
+        snprintf(comment, sizeof comment, "rcal poses --count %zu --seed %llu: %u outlet(s), %u plate point(s)",
+                 res->n_distinct, pc->seed, res->n_outlets, pc->n_points);
+        const int wr = format[0] == 'r'
+                           ? rch_poses_write_rapid_link(f, res->poses, lab, pts, res->n, host, port, comment)
+                           : rch_poses_write_urscript_link(f, res->poses, lab, pts, res->n, host, port, comment);
         free(lab);
         return wr;
     }
@@ -513,8 +518,7 @@ static int parse(poses_args *a, int argc, char **argv)
         {"--format", RCH_OPT_CHOICE, &a->format, 0, 0, NULL, "what --out holds (rapid-link, urscript-link: a program speaking docs/controller-link.md to rcal acquire "
          "--controller)", 0, "csv|rapid|rapid-link|urscript-link"},
         {"--controller", RCH_OPT_STR, &a->link, 0, 0, "tcp:[HOST:]PORT",
-         "where a link program connects (the PC running rcal acquire --controller; numeric HOST) [default "
-         "tcp:127.0.0.1:5150]", 0, NULL},
+         "where a link program connects (the PC running rcal acquire --controller; numeric HOST)", 0, NULL},
         {"--settle-s", RCH_OPT_DOUBLE, &a->settle_s, 0, 600, "S", "RAPID: WaitTime at each pose (settle and read)", 0,
          NULL},
         {"--len-min-mm", RCH_OPT_DOUBLE, &pc->len_min_mm, 0, 20000, "A", "shortest cable length", 0, NULL},

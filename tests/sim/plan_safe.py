@@ -5,7 +5,7 @@ clearance of a link, the floor or a box, no flange or link below the floor.
 
 Runs `rcal poses` on the README's plans (one outlet; three outlets every
 pose from each; --split) and on random outlets, for the IRB120 and the
-IRB1600-like robot files, then checks every planned row with its own
+IRB1600-like robot files (and one outlet of the KR 6-like file), then checks every planned row with its own
 implementation: its own DH chain (numpy), the capsules of the robot file,
 and the cable-capsule distance by dense sampling of both segments (no
 closed form shared with rcal), the floor by the cable's end points. Also
@@ -137,7 +137,8 @@ def main():
     total_bad = total_rows = dropped = 0
     cases = [("irb120", [[250, -460, 10]], [], "readme1"),
              ("irb120", [[250, -460, 10], [-250, -460, 10], [450, 300, 10]], [], "readme3"),
-             ("irb120", [[250, -460, 10], [-250, -460, 10]], ["--split"], "readme_split")]
+             ("irb120", [[250, -460, 10], [-250, -460, 10]], ["--split"], "readme_split"),
+             ("kr6", [[400, -600, 10]], [], "kr6")]  # data/kr6.json's capsules (issue 48)
     rng = np.random.default_rng(48)
     for i in range(6):  # random outlets around the robot, on the floor or raised
         name = "irb120" if i % 2 == 0 else "irb1600"

@@ -140,7 +140,15 @@ typedef struct acq {
     int holding;              /* 1: the reference is a held sample, not yet written (run_poses) */
     int linked;               /* --controller: the link drives the run */
     rch_link link;
+    rch_acqtime tm;           /* --controller: rcal's own time per pose (rch_acqtime.h) */
 } acq;
+
+/* A mark of rcal's time per pose (linked runs only). */
+static void tm_mark(acq *a, rch_acqtime_ev ev)
+{
+    if (a->linked)
+        rch_acqtime_mark(&a->tm, ev, rch_acqtime_clock_ms(), rch_acqtime_cpu_ms());
+}
 
 #define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
 #define WARN(a, ...) ((a)->err ? (void)fprintf((a)->err, "rcal acquire: " __VA_ARGS__) : (void)0)
@@ -251,6 +259,8 @@ static rc_status measure(rc_stable_result *out, acq *a, size_t pose)
         if (st == RC_OK) {
             fails = 0;
             st = rc_stable_push(s, out, r.len_mm, now_ms(a));
+            if (st == RC_OK)
+                tm_mark(a, RCH_ACQTIME_SAMPLE);
             if (st == RC_OK || st == RC_ERR_TIMEOUT)
                 break;
             if (st == RC_ERR_RANGE)
@@ -606,14 +616,18 @@ static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
     if (a->linked) { /* the controller goes there and says where it stands */
         double xyz[3];
         int has_xyz;
-        rc_status st = rch_link_pose(&a->link, recheck ? "BACK" : "NEXT", i, a->plan_deg[i], q_deg, xyz, &has_xyz);
+        rc_status st;
+        tm_mark(a, RCH_ACQTIME_CMD);
+        st = rch_link_pose(&a->link, recheck ? "BACK" : "NEXT", i, a->plan_deg[i], q_deg, xyz, &has_xyz);
         if (st != RC_OK) {
             WARN(a, "pose %zu: the controller link failed (%s); stopped, nothing recorded from it (rerun to resume)\n",
                  i, rc_strerror(st));
             return 1;
         }
+        tm_mark(a, RCH_ACQTIME_AT);
         rch_link_wait(&a->link, c->settle_ms + c->stable.timeout_ms + 5000ul);
         a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
+        tm_mark(a, RCH_ACQTIME_SETTLED);
         return 0;
     }
     if (c->confirm && a->io->confirm(a->io->ctx, i) != 0) {
@@ -783,6 +797,7 @@ static int run_poses(acq *a)
                 return 1;
             PROGRESS(a, "  L = %.4f mm (spread %.4f mm over %u readings)\n", r.mean_mm, r.spread_mm, r.count);
         }
+        tm_mark(a, RCH_ACQTIME_KEPT);
         a->has_ref = 1;
         a->ref_pose = i;
         a->ref_len_mm = r.mean_mm;
@@ -893,6 +908,10 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
         lc.n_poses = a.n;
         lc.outlet = a.outlet_p1 - 1;
         lc.point = a.target_p1 - 1;
+        if (rch_acqtime_init(&a.tm, a.n_mine, (double)c->settle_ms) != 0) {
+            WARN(&a, "out of memory\n");
+            goto out;
+        }
         if (rch_link_open(&a.link, &lc, err) != RC_OK)
             goto out;
         a.link.done = a.done;
@@ -905,7 +924,10 @@ int rch_acquire_run(rch_acq_result *res, const rch_acq_config *c, const rch_acq_
     }
     rc = run_poses(&a);
     if (a.linked) {
+        tm_mark(&a, RCH_ACQTIME_CMD); /* STOP: the last pose's own time ends here */
         rch_link_stop(&a.link, rc == 0 ? "done" : "stopped");
+        if (rch_acqtime_stats_of(&res->timing, &a.tm) != 0)
+            WARN(&a, "out of memory: no timing\n");
         memcpy(res->link_faults, a.link.faults, sizeof res->link_faults);
         res->link_connects = a.link.connects;
         rch_link_close(&a.link);
@@ -926,5 +948,6 @@ out:
     free(a.pred_mm);
     free(a.done);
     free(a.other);
+    rch_acqtime_free(&a.tm);
     return rc;
 }

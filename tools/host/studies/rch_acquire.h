@@ -64,6 +64,7 @@
 #include "rc_model.h"
 #include "rc_stable.h"
 #include "rcd_display.h"
+#include "rch_acqtime.h"
 #include "rch_link.h"
 
 /* How the acquisition reaches the world. Pass NULL to rch_acquire_run for
@@ -175,6 +176,7 @@ typedef struct rch_acq_result {
     unsigned long link_faults[RCH_LINK_NFAULTS]; /* --controller: the faults named, per rch_link_fault */
     unsigned long link_connects;                  /* controllers accepted (1 + reconnects) */
     unsigned link_port;                           /* the port listened on */
+    rch_acqtime_stats timing;                     /* --controller: rcal's own time per pose (rch_acqtime.h) */
 } rch_acq_result;
 
 /* Run the acquisition. Progress on out, problems on err (either may be

@@ -17,8 +17,31 @@ static int outlets_many(const unsigned char *lab, size_t n)
     return 0;
 }
 
-int rch_poses_write_rapid_link(FILE *f, const rc_sample *rows, const unsigned char *outlet_label, size_t n,
-                               const char *host, unsigned port, const char *comment)
+/* FUNC num NAME(num j): the label of plan pose j (lab NULL: -1 for every pose). */
+static void rapid_label_func(FILE *f, const char *name, const unsigned char *lab, size_t n)
+{
+    fprintf(f, "    FUNC num %s(num j)\n", name);
+    if (lab) {
+        fprintf(f, "        TEST j\n");
+        for (size_t i = 0; i < n; ++i)
+            fprintf(f, "        CASE %zu:\n            RETURN %u;\n", i, (unsigned)lab[i]);
+        fprintf(f, "        ENDTEST\n");
+    }
+    fprintf(f, "        RETURN -1;\n    ENDFUNC\n\n");
+}
+
+/* NAME = [l0, l1, ...]: the label of each plan pose (lab NULL: -1). */
+static void urscript_label_list(FILE *f, const char *name, const unsigned char *lab, size_t n)
+{
+    fprintf(f, "  %s = [", name);
+    for (size_t i = 0; i < n; ++i)
+        fprintf(f, "%s%d", i ? ", " : "", lab ? (int)lab[i] : -1);
+    fprintf(f, "]\n");
+}
+
+int rch_poses_write_rapid_link(FILE *f, const rc_sample *rows, const unsigned char *outlet_label,
+                               const unsigned char *point_label, size_t n, const char *host, unsigned port,
+                               const char *comment)
 {
     const int many = outlets_many(outlet_label, n);
     fprintf(f, "MODULE rcal_link\n");
@@ -42,14 +65,8 @@ int rch_poses_write_rapid_link(FILE *f, const rc_sample *rows, const unsigned ch
     for (size_t i = 0; i < n; ++i)
         fprintf(f, "        CASE %zu:\n            MoveAbsJ rcal_p%zu\\NoEOffs, v200, fine, tool0;\n", i, i);
     fprintf(f, "        ENDTEST\n        WaitRob \\ZeroSpeed;\n    ENDPROC\n\n");
-    fprintf(f, "    FUNC num rcal_outlet(num j)\n");
-    if (many) {
-        fprintf(f, "        TEST j\n");
-        for (size_t i = 0; i < n; ++i)
-            fprintf(f, "        CASE %zu:\n            RETURN %u;\n", i, (unsigned)outlet_label[i]);
-        fprintf(f, "        ENDTEST\n");
-    }
-    fprintf(f, "        RETURN -1;\n    ENDFUNC\n\n");
+    rapid_label_func(f, "rcal_outlet", many ? outlet_label : NULL, n);
+    rapid_label_func(f, "rcal_point", point_label, n);
     /* one line from the socket (one byte per SocketReceive: RAPID strings hold 80 characters; a longer
      * line, a FAULT with its text, is cut and its pieces ignored) */
     fprintf(f, "    FUNC string rcal_line()\n"
@@ -70,7 +87,7 @@ int rch_poses_write_rapid_link(FILE *f, const rc_sample *rows, const unsigned ch
     fprintf(f, "    PROC rcal_at(num j)\n        VAR jointtarget jt;\n"
                "        jt:=CJointT();\n"
                "        SocketSend rcal_sock \\Str:=\"AT \" + NumToStr(j, 0) + \" \" + NumToStr(rcal_outlet(j), 0) + "
-               "\" -1 \" + NumToStr(jt.robax.rax_1, 5) + \" \" + NumToStr(jt.robax.rax_2, 5) + \" \";\n"
+               "\" \" + NumToStr(rcal_point(j), 0) + \" \" + NumToStr(jt.robax.rax_1, 5) + \" \" + NumToStr(jt.robax.rax_2, 5) + \" \";\n"
                "        SocketSend rcal_sock \\Str:=NumToStr(jt.robax.rax_3, 5) + \" \" + NumToStr(jt.robax.rax_4, 5) "
                "+ \" \" + NumToStr(jt.robax.rax_5, 5) + \" \" + NumToStr(jt.robax.rax_6, 5) + \"\\0A\";\n"
                "    ENDPROC\n\n");
@@ -110,8 +127,9 @@ int rch_poses_write_rapid_link(FILE *f, const rc_sample *rows, const unsigned ch
     return ferror(f) ? -1 : 0;
 }
 
-int rch_poses_write_urscript_link(FILE *f, const rc_sample *rows, const unsigned char *outlet_label, size_t n,
-                                  const char *host, unsigned port, const char *comment)
+int rch_poses_write_urscript_link(FILE *f, const rc_sample *rows, const unsigned char *outlet_label,
+                                  const unsigned char *point_label, size_t n, const char *host, unsigned port,
+                                  const char *comment)
 {
     const int many = outlets_many(outlet_label, n);
     fprintf(f, "# %s\n", comment ? comment : "rcal poses");
@@ -126,10 +144,10 @@ int rch_poses_write_urscript_link(FILE *f, const rc_sample *rows, const unsigned
             fprintf(f, "%s%.7f", j ? ", " : "", rows[i].q_rad[j]);
         fprintf(f, "]");
     }
-    fprintf(f, "]\n  rcal_outlet = [");
-    for (size_t i = 0; i < n; ++i)
-        fprintf(f, "%s%d", i ? ", " : "", many ? (int)outlet_label[i] : -1);
-    fprintf(f, "]\n  rcal_n = %zu\n", n);
+    fprintf(f, "]\n");
+    urscript_label_list(f, "rcal_outlet", many ? outlet_label : NULL, n);
+    urscript_label_list(f, "rcal_point", point_label, n);
+    fprintf(f, "  rcal_n = %zu\n", n);
     fprintf(f, "  thread rcal_heartbeat():\n"
                "    while True:\n"
                "      sleep(1.0)\n"
@@ -139,7 +157,7 @@ int rch_poses_write_urscript_link(FILE *f, const rc_sample *rows, const unsigned
     fprintf(f, "  def rcal_at(j):\n"
                "    q = get_actual_joint_positions()\n"
                "    line = str_cat(\"AT \", str_cat(to_str(j), str_cat(\" \", str_cat(to_str(rcal_outlet[j]), "
-               "\" -1\"))))\n"
+               "str_cat(\" \", to_str(rcal_point[j]))))))\n"
                "    i = 0\n"
                "    while i < 6:\n"
                "      line = str_cat(line, str_cat(\" \", to_str(r2d(q[i]))))\n"
