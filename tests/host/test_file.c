@@ -196,6 +196,37 @@ static void test_read_file_limit(void **state)
     assert_int_equal(rch_read_file(&t, &n, "/nonexistent/x", 9, &d), -1);
 }
 
+/* A NUL byte in the first line is refused where it stands (binary data, a device, UTF-16) before the rest
+ * is read; one later (a power cut's) is left to the format's reader. */
+static void test_read_file_nul(void **state)
+{
+    (void)state;
+    char p[300];
+    static const char body[] = "q1,L\0x,3\n";
+    path_in(p, sizeof p, "nul.csv");
+    FILE *f = fopen(p, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(body, 1, sizeof body - 1, f), sizeof body - 1);
+    assert_int_equal(fclose(f), 0);
+    char *t = NULL;
+    size_t n = 7;
+    rch_diag d;
+    assert_int_equal(rch_read_file(&t, &n, p, 100, &d), -1);
+    assert_null(t);
+    assert_int_equal(n, 0);
+    assert_int_equal(d.line, 1);
+    assert_int_equal(d.col, 5);
+    assert_non_null(strstr(d.msg, "NUL byte"));
+    static const char later[] = "q1,L\n12,3\n\0\0";
+    f = fopen(p, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(later, 1, sizeof later - 1, f), sizeof later - 1);
+    assert_int_equal(fclose(f), 0);
+    assert_int_equal(rch_read_file(&t, &n, p, 100, &d), 0);
+    assert_int_equal(n, sizeof later - 1);
+    free(t);
+}
+
 /* Child: a page and its CSV as one bundle, the CSV larger than the file-size
  * limit: 0 when the bundle was committed, 1 when refused. */
 static int child_bundle(const char *page, const char *csv, long limit)
@@ -328,6 +359,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_read_file_limit, setup, teardown),
         cmocka_unit_test_setup_teardown(test_bundle_whole_or_nothing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_outputs_distinct, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_read_file_nul, setup, teardown),
         cmocka_unit_test_setup_teardown(test_link_mode_readonly, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -400,11 +400,11 @@ static void test_unbounded_work(void **state)
         refused(C, "acquire --out /dev/full", 1, NEED("not a regular file"), KEEP("plan.csv"),
                 ACQ " --poses plan.csv --out /dev/full");
     if (access("/dev/zero", R_OK) == 0) {
-        refused(C, "calibrate --data /dev/zero", 1, NEED("/dev/zero", "limit of"), NULL,
+        refused(C, "calibrate --data /dev/zero", 1, NEED("/dev/zero:1:1", "a NUL byte in the first line"), NULL,
                 R " calibrate --data /dev/zero");
         refused(C, "compensate --in /dev/zero", 1, NEED("/dev/zero:1:", "longer than 65536 bytes"),
                 &(files){{"model.json"}, {"z.out"}}, R " compensate --model model.json --in /dev/zero --out z.out");
-        refused(C, "rcal-rt --in /dev/zero", 1, NEED("/dev/zero", "limit of"), NULL,
+        refused(C, "rcal-rt --in /dev/zero", 1, NEED("/dev/zero:1:1", "a NUL byte"), NULL,
                 RT " --in /dev/zero --seconds 0.01");
         refused(C, "acquire --poses /dev/zero", 1, NEED("/dev/zero"), &(files){{"a.csv"}, {"z.csv"}},
                 ACQ " --poses /dev/zero --out z.csv");

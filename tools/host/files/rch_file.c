@@ -602,6 +602,7 @@ int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, 
         return -1;
     }
     size_t cap = max_bytes < 4096 ? max_bytes : 4096, n = 0;
+    int seen_nl = 0;
     char *buf = malloc(cap + 1);
     int oom = buf == NULL;
     while (!oom) {
@@ -625,6 +626,19 @@ int rch_read_file(char **text, size_t *len, const char *path, size_t max_bytes, 
             cap = ncap;
         }
         size_t got = fread(buf + n, 1, cap - n, f);
+        if (!seen_nl && got) { /* a NUL in the first line: binary data, a device or UTF-16, refused at once (a
+                                   NUL later, as a power cut leaves, is the format reader's to name) */
+            const char *nl = memchr(buf + n, '\n', got);
+            const char *nul = memchr(buf + n, '\0', nl ? (size_t)(nl - (buf + n)) : got);
+            if (nul) {
+                rch_diag_set(d, path, 1, (unsigned)(nul - buf) + 1u, "a NUL byte in the first line: not a text file "
+                             "(binary data, a device, or text in UTF-16: save it as UTF-8 or ASCII): refused");
+                free(buf);
+                fclose(f);
+                return -1;
+            }
+            seen_nl = nl != NULL;
+        }
         n += got;
         if (got == 0)
             break;
