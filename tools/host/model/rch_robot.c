@@ -714,7 +714,7 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     static const char *const top_keys[] = {"format",  "name",        "dh",          "joint_limits_deg", "encoder_mm",
                                            "effects", "prior",       "nominal",     "calibration",      "uncertainty",
                                            "fit",     "provenance",  "outlet_labels", "$schema",        "links",
-                                           "cell",    NULL};
+                                           "cell",    "controller", "source", NULL};
     if (check_keys(root, top_keys, "the model file", name, d) != 0)
         goto done;
     const rch_json *fmt = rch_json_get(root, "format");
@@ -750,6 +750,8 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     if (read_outlet_labels(out, rch_json_get(root, "outlet_labels"), name, d) != 0)
         goto done;
     if (rch_cell_read(&out->cell, rch_json_get(root, "links"), rch_json_get(root, "cell"), name, d) != 0)
+        goto done;
+    if (rch_ctrl_read(&out->ctrl, rch_json_get(root, "controller"), name, d) != 0)
         goto done;
     rc = 0;
 done:
@@ -946,6 +948,8 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
         write_dh(&w, "dh", nominal);
         rch_jw_end(&w);
     }
+    if (info && info->ctrl)
+        rch_ctrl_write(&w, info->ctrl);
     if (info && info->write) {
         rch_jw_obj(&w, "calibration");
         info->write(&w, info->ctx);
