@@ -4,6 +4,8 @@
  * solution classified into a branch. */
 #include "rch_ikg.h"
 
+#include "rch_ikg_int.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -12,6 +14,8 @@
 #endif
 
 #define IKG_MAX_IT 60          /* Newton steps of one start */
+#define IKG_GIVE_UP_IT 15      /* a start still this far off after so many steps is abandoned */
+#define IKG_GIVE_UP_MM 1.0
 #define IKG_W_ROT_MM 1000.0    /* a radian weighed as this many mm in the damped step */
 #define IKG_MAX_STEP_RAD 0.6   /* largest joint change of one step */
 #define IKG_SAME_RAD 1e-6      /* two solutions closer than this (each joint, modulo 2 pi) are one */
@@ -88,6 +92,7 @@ rch_ikg_status rch_ikg_init(rch_ikg *ik, const rc_model *m, const double *tool_m
         ik->q_max_rad[i] = m->q_max_rad[i];
     }
     ik->reach_mm = reach;
+    rch_ikg_seed_init(ik, m);
     ik->d4_mm = m->x[RC_P_D(3)];
     /* the zero position's sides (joint-side effects included) */
     rc_kin_data d;
@@ -112,7 +117,8 @@ static int branch_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad
 {
     double f[2];
     factors(f, d, ik->d4_mm);
-    return 4 * (f[0] * ik->ref_sign[0] < 0) + 2 * (f[1] * ik->ref_sign[1] < 0) + (q_rad[4] < 0);
+    return 4 * (f[0] * ik->ref_sign[0] < 0) + 2 * (f[1] * ik->ref_sign[1] < 0) +
+           (sin(q_rad[4] + ik->kin.link[4].theta_off_rad) < 0);
 }
 
 int rch_ikg_branch(const rch_ikg *ik, const double q_rad[RC_NJ])
@@ -221,7 +227,7 @@ static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *it
         *err_rad = sqrt(dot(&e[3], &e[3]));
         if (*err_mm <= RCH_IKG_TOL_MM && *err_rad <= RCH_IKG_TOL_RAD)
             return 1;
-        if (!isfinite(cost))
+        if (!isfinite(cost) || (it >= IKG_GIVE_UP_IT && *err_mm > IKG_GIVE_UP_MM))
             return 0;
         ++*iters;
         double dq[6];
@@ -338,6 +344,16 @@ static double dist(const double a[RC_NJ], const double b[RC_NJ])
     return s;
 }
 
+static double dist_turns(const double a[RC_NJ], const double b[RC_NJ])
+{
+    double s = 0.0;
+    for (int i = 0; i < RC_NJ; ++i) {
+        const double e = wrap_pi(a[i] - b[i]);
+        s += e * e;
+    }
+    return s;
+}
+
 static int target_of(target *t, const double pos_mm[3], const double rot[9])
 {
     for (int k = 0; k < 3; ++k) {
@@ -353,6 +369,29 @@ static int target_of(target *t, const double pos_mm[3], const double rot[9])
         }
     memcpy(t->Rt, rot, sizeof t->Rt);
     return 0;
+}
+
+/* The closed-form starts (rch_ikg_seeds) in the order they are tried:
+ * those of the branch first (by their branch on the real arm), nearest the
+ * seed first. Returns how many. */
+static int closed_starts(double cs[8][RC_NJ], int order[8], const rch_ikg *ik, const double pos_mm[3],
+                         const double rot[9], int branch, const double *seed_rad)
+{
+    const int ncs = rch_ikg_seeds(cs, ik, pos_mm, rot);
+    double key[8];
+    for (int k = 0; k < ncs; ++k) {
+        order[k] = k;
+        key[k] = seed_rad ? dist_turns(cs[k], seed_rad) : 0.0;
+        if (branch != RCH_IKG_ANY_BRANCH && rch_ikg_branch(ik, cs[k]) != branch)
+            key[k] += 1e6;
+    }
+    for (int i = 1; i < ncs; ++i) /* insertion sort: 8 at most */
+        for (int j = i; j > 0 && key[order[j]] < key[order[j - 1]]; --j) {
+            const int tmp = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = tmp;
+        }
+    return ncs;
 }
 
 rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_ikg *ik, const double pos_mm[3],
@@ -377,13 +416,25 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
             }
     double best[RC_NJ], best_d = HUGE_VAL;
     int found = 0, reached = 0, in_branch = 0;
-    for (unsigned k = seed_rad ? 0u : 1u; k <= IKG_N_START; ++k) {
+    /* the closed-form starts, those of the branch first (by their branch on
+     * the real arm) or nearest the seed first */
+    double cs[8][RC_NJ];
+    int order[8];
+    int ncs = -1; /* computed when the seed's own run did not do */
+    for (unsigned k = seed_rad ? 0u : 1u; ncs < 0 || k < 1u + (unsigned)ncs + IKG_N_START; ++k) {
         double q[RC_NJ], em, er;
         rc_kin_data d;
+        if (k >= 1 && ncs < 0)
+            ncs = closed_starts(cs, order, ik, pos_mm, rot, branch, seed_rad);
         if (k == 0)
             memcpy(q, seed_rad, sizeof q);
-        else
-            start_of(q, k - 1, ik, &t);
+        else if (k <= (unsigned)ncs)
+            memcpy(q, cs[order[k - 1]], sizeof q);
+        else {
+            if (found || in_branch)
+                break; /* the closed-form starts found it (or it outside the limits): no generic ones */
+            start_of(q, k - 1 - (unsigned)ncs, ik, &t);
+        }
         ++inf.starts;
         const int conv = newton(q, &em, &er, &inf.iterations, &d, ik, &t);
         if (!conv) {
@@ -430,16 +481,24 @@ int rch_ikg_all(double q_rad[RCH_IKG_MAX_SOL][RC_NJ], int branch[RCH_IKG_MAX_SOL
     if (target_of(&t, pos_mm, rot) != 0 || sqrt(dot(pos_mm, pos_mm)) > ik->reach_mm + 1e-6)
         return 0;
     int n = 0;
-    /* the starts, then each start with axis 4 and 6 turned half a turn */
-    for (unsigned k = 0; k < 2 * IKG_N_START && n < RCH_IKG_MAX_SOL; ++k) {
+    double cs[8][RC_NJ];
+    const int ncs = rch_ikg_seeds(cs, ik, pos_mm, rot);
+    /* the closed-form starts, the generic ones, then each generic one with
+     * axes 4 and 6 turned half a turn and axis 3 mirrored */
+    for (unsigned k = 0; k < (unsigned)ncs + 2 * IKG_N_START && n < RCH_IKG_MAX_SOL; ++k) {
         double q[RC_NJ], em, er;
         unsigned it = 0;
         rc_kin_data d;
-        start_of(q, k % IKG_N_START, ik, &t);
-        if (k >= IKG_N_START) {
-            q[3] += M_PI;
-            q[5] += M_PI;
-            q[2] = -q[2];
+        if (k < (unsigned)ncs)
+            memcpy(q, cs[k], sizeof q);
+        else {
+            const unsigned g = k - (unsigned)ncs;
+            start_of(q, g % IKG_N_START, ik, &t);
+            if (g >= IKG_N_START) {
+                q[3] += M_PI;
+                q[5] += M_PI;
+                q[2] = -q[2];
+            }
         }
         if (!newton(q, &em, &er, &it, &d, ik, &t))
             continue;

@@ -11,6 +11,12 @@
  * wrist, axes 2 and 3 parallel); rch_ik_solve falls back to this solver for
  * every other arm.
  *
+ * Starts: the caller's seed; then the eight closed-form solutions of the
+ * arm's idealised table when it is of a class with one (rch_ikg_seed.c:
+ * spherical wrist as rch_ik.h, or UR's offset wrist), each a few Newton
+ * steps from the real arm's solution of its branch; then a fixed set of
+ * generic starts (any other arm).
+ *
  * Branch: three bits, each the side of one singularity the configuration
  * is on, so that a branch changes only through that singularity:
  *   4 shoulder: s = ((P - o0) x z1) . z0, P = o5 the origin of DH frame 5
@@ -19,8 +25,8 @@
  *   2 elbow:    e = ((o2 - o1) x (E - o2)) . z1, E = o3 + d4 z3 (on axis 4
  *     where its common normal to axis 5 starts: the wrist centre of a
  *     spherical wrist, UR's elbow point): the arm stretched or folded;
- *   1 wrist:    q5 < 0 (the joint reading, not theta), axes 4 and 6 aligned
- *     at q5 + theta5 = 0 or pi;
+ *   1 wrist:    sin(q5 + theta5) < 0 (theta5 the row's offset; ABB's "axis 5
+ *     negative" where theta5 = 0), axes 4 and 6 aligned at sin = 0;
  * the shoulder and elbow bits set when the factor's sign differs from its
  * sign at q = 0 (taken positive where the zero position is itself singular,
  * as a UR's stretched arm). For the closed-form class this is ABB's cfx
@@ -67,7 +73,12 @@ typedef struct rch_ikg {
     double ref_sign[2];    /* shoulder, elbow factor signs at q = 0 (+1 where 0) */
     double d4_mm;          /* d of row 4 (the elbow point E) */
     double q_min_rad[RC_NJ], q_max_rad[RC_NJ];
+    int cls;               /* the closed form its starts come from: RCH_IKG_CLS_* (rch_ikg_seed.c) */
+    double ideal[RC_NJ][4]; /* the idealised table (a, d, alpha, theta) of the starts */
+    rc_model ideal_model;  /* the same as a model (the spherical class's rch_ik_all) */
 } rch_ikg;
+
+enum { RCH_IKG_CLS_NONE = 0, RCH_IKG_CLS_SPHERICAL = 1, RCH_IKG_CLS_OFFSET = 2 };
 
 /* Prepare ik for model m and the TCP tool_mm (3) in the flange frame (NULL:
  * the flange). RCH_IKG_ARG when m does not compile (rc_kin_compile). */
