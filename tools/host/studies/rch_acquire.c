@@ -140,6 +140,8 @@ typedef struct acq {
     int holding;              /* 1: the reference is a held sample, not yet written (run_poses) */
     int linked;               /* --controller: the link drives the run */
     rch_link link;
+    rch_ctrl ctrl;            /* the robot file's controller conventions: a joint source's values (the
+                                 controller's) are mapped to the model's before they are recorded */
 } acq;
 
 #define SAY(a, ...) ((a)->out ? (void)fprintf((a)->out, __VA_ARGS__) : (void)0)
@@ -506,6 +508,7 @@ static int load_inputs(acq *a)
         WARN(a, "%s\n", robot ? rch_diag_str(&dg, buf, sizeof buf) : "out of memory");
         goto out;
     }
+    a->ctrl = robot->ctrl;
     a->n = plan.n;
     a->plan_deg = calloc(plan.n, sizeof *a->plan_deg);
     a->pred_mm = calloc(plan.n, sizeof *a->pred_mm);
@@ -625,6 +628,13 @@ static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
     if (a->io->joints && a->io->joints(a->io->ctx, q_deg, a->plan_deg[i], i) != 0) {
         WARN(a, "pose %zu: the joint-angle source failed; stopped (rerun to resume)\n", i);
         return 1;
+    }
+    if (a->io->joints && !a->ctrl.identity_joints) { /* the controller's numbers, as it means them */
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            q_deg[j] /= DEG_PER_RAD;
+        rch_ctrl_to_model(q_deg, &a->ctrl, q_deg);
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            q_deg[j] *= DEG_PER_RAD;
     }
     return 0;
 }
