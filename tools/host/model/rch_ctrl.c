@@ -19,6 +19,53 @@ void rch_ctrl_identity(rch_ctrl *c)
     for (int i = 0; i < RC_NJ; ++i)
         c->sign[i] = 1.0;
     c->flange_R[0] = c->flange_R[4] = c->flange_R[8] = 1.0;
+    c->base_R[0] = c->base_R[4] = c->base_R[8] = 1.0;
+}
+
+void rch_ctrl_rpy_to_rot(double R[9], const double rpy[3])
+{
+    const double cr = cos(rpy[0]), sr = sin(rpy[0]), cp = cos(rpy[1]), sp = sin(rpy[1]), cy = cos(rpy[2]),
+                 sy = sin(rpy[2]);
+    const double T[9] = {cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,
+                         sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,
+                         -sp,     cp * sr,                cp * cr};
+    memcpy(R, T, sizeof T);
+}
+
+void rch_ctrl_rot_to_rpy(double rpy[3], const double R[9])
+{
+    const double sp = -R[6];
+    rpy[1] = atan2(sp, sqrt(R[7] * R[7] + R[8] * R[8]));
+    if (sqrt(R[7] * R[7] + R[8] * R[8]) > 1e-12) {
+        rpy[0] = atan2(R[7], R[8]);
+        rpy[2] = atan2(R[3], R[0]);
+    } else { /* pitch +-90 deg: roll folded into yaw */
+        rpy[0] = 0.0;
+        rpy[2] = atan2(-R[1], R[4]);
+    }
+}
+
+void rch_ctrl_fk(double pos_mm[3], double rot[9], const rch_ctrl *c, const rc_model *m, const double q_rad[RC_NJ])
+{
+    double p[3], R[9], p2[3], R2[9];
+    rc_fk(p, R, m, q_rad);
+    /* T F */
+    for (int i = 0; i < 3; ++i) {
+        p2[i] = p[i];
+        for (int j = 0; j < 3; ++j) {
+            p2[i] += R[3 * i + j] * c->flange_mm[j];
+            R2[3 * i + j] = R[3 * i] * c->flange_R[j] + R[3 * i + 1] * c->flange_R[3 + j] + R[3 * i + 2] * c->flange_R[6 + j];
+        }
+    }
+    /* B (T F) */
+    for (int i = 0; i < 3; ++i) {
+        pos_mm[i] = c->base_mm[i];
+        for (int j = 0; j < 3; ++j)
+            pos_mm[i] += c->base_R[3 * i + j] * p2[j];
+        if (rot)
+            for (int j = 0; j < 3; ++j)
+                rot[3 * i + j] = c->base_R[3 * i] * R2[j] + c->base_R[3 * i + 1] * R2[3 + j] + c->base_R[3 * i + 2] * R2[6 + j];
+    }
 }
 
 /* n numbers of arr into v; -1 with d set */
@@ -49,7 +96,7 @@ int rch_ctrl_read(rch_ctrl *c, const rch_json *m, const char *file, rch_diag *d)
         return -1;
     }
     static const char *const keys[] = {"joint_sign", "joint_zero_deg", "q3_coupling", "flange_rpy_deg",
-                                       "flange_xyz_mm", "note", NULL};
+                                       "flange_xyz_mm", "base_rpy_deg", "base_xyz_mm", "note", NULL};
     for (size_t k = 0; k < m->n; ++k) {
         unsigned j = 0;
         while (keys[j] && strcmp(keys[j], m->keys[k]) != 0)
@@ -57,7 +104,7 @@ int rch_ctrl_read(rch_ctrl *c, const rch_json *m, const char *file, rch_diag *d)
         if (!keys[j]) {
             rch_diag_set(d, file, m->items[k]->key_line, m->items[k]->key_col,
                          "unknown member \"%s\" in \"controller\" (known: joint_sign, joint_zero_deg, q3_coupling, "
-                         "flange_rpy_deg, flange_xyz_mm, note)", m->keys[k]);
+                         "flange_rpy_deg, flange_xyz_mm, base_rpy_deg, base_xyz_mm, note)", m->keys[k]);
             return -1;
         }
     }
@@ -106,13 +153,20 @@ int rch_ctrl_read(rch_ctrl *c, const rch_json *m, const char *file, rch_diag *d)
         return -1;
     memcpy(c->flange_rpy_deg, r, sizeof r);
     if (rpy || xyz) {
-        const double cr = cos(r[0] * DEG), sr = sin(r[0] * DEG), cp = cos(r[1] * DEG), sp = sin(r[1] * DEG),
-                     cy = cos(r[2] * DEG), sy = sin(r[2] * DEG);
-        const double R[9] = {cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,
-                             sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,
-                             -sp,     cp * sr,                cp * cr};
-        memcpy(c->flange_R, R, sizeof R);
+        const double rr[3] = {r[0] * DEG, r[1] * DEG, r[2] * DEG};
+        rch_ctrl_rpy_to_rot(c->flange_R, rr);
         c->has_flange = 1;
+    }
+    const rch_json *brpy = rch_json_get(m, "base_rpy_deg"), *bxyz = rch_json_get(m, "base_xyz_mm");
+    double b[3] = {0, 0, 0};
+    if ((brpy && nums(b, 3, brpy, "base_rpy_deg", file, d) != 0) ||
+        (bxyz && nums(c->base_mm, 3, bxyz, "base_xyz_mm", file, d) != 0))
+        return -1;
+    memcpy(c->base_rpy_deg, b, sizeof b);
+    if (brpy || bxyz) {
+        const double rr[3] = {b[0] * DEG, b[1] * DEG, b[2] * DEG};
+        rch_ctrl_rpy_to_rot(c->base_R, rr);
+        c->has_base = 1;
     }
     return 0;
 }
@@ -150,6 +204,10 @@ void rch_ctrl_write(rch_jw *w, const rch_ctrl *c)
     if (c->has_flange) {
         rch_jw_nums(w, "flange_rpy_deg", c->flange_rpy_deg, 3);
         rch_jw_nums(w, "flange_xyz_mm", c->flange_mm, 3);
+    }
+    if (c->has_base) {
+        rch_jw_nums(w, "base_rpy_deg", c->base_rpy_deg, 3);
+        rch_jw_nums(w, "base_xyz_mm", c->base_mm, 3);
     }
     rch_jw_end(w);
 }

@@ -7,8 +7,12 @@
  *     "q3_coupling":    k,                   model q3 += k q2 (default 0; Fanuc: -1)
  *     "flange_rpy_deg": [r, p, y],           the controller's flange frame in the last DH frame:
  *     "flange_xyz_mm":  [x, y, z]            F = Trans(xyz) Rz(y) Ry(p) Rx(r) (default identity)
+ *     "base_rpy_deg", "base_xyz_mm"          DH frame 0 in the controller's (a URDF root link's)
+ *                                            base frame, B likewise (default identity)
  *   }
- * so that, c being the controller's joint values (radians),
+ * so that the controller's flange pose is B T_dh(q) F, T_dh the model's
+ * forward kinematics (rch_ctrl_fk), and
+ * with c the controller's joint values (radians)
  *   q_i = s_i (c_i - z_i)          i = 1, 2, 4, 5, 6
  *   q_3 = s_3 (c_3 - z_3) + k q_2
  * (KUKA: A1, A4, A6 turn opposite to the model's right-handed axes, A2 and A3
@@ -36,7 +40,19 @@ typedef struct rch_ctrl {
     double flange_R[9];     /* row-major, in the last DH frame */
     double flange_mm[3];
     double flange_rpy_deg[3]; /* as read (written back by rch_ctrl_write) */
+    int has_base;           /* 1: base_R / base_mm are not the identity */
+    double base_R[9];       /* DH frame 0 in the controller's base frame */
+    double base_mm[3];
+    double base_rpy_deg[3];
 } rch_ctrl;
+
+/* The controller's flange pose at model joints q_rad: B T_dh(q) F. pos_mm
+ * (3), rot (3 x 3, may be NULL). */
+void rch_ctrl_fk(double pos_mm[3], double rot[9], const rch_ctrl *c, const rc_model *m, const double q_rad[RC_NJ]);
+
+/* Rotation (row-major) of URDF's fixed-axis roll, pitch, yaw (rad), and back. */
+void rch_ctrl_rpy_to_rot(double R[9], const double rpy_rad[3]);
+void rch_ctrl_rot_to_rpy(double rpy_rad[3], const double R[9]);
 
 /* The identity map. */
 void rch_ctrl_identity(rch_ctrl *c);

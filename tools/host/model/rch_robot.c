@@ -1,6 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 #include "rch_robot.h"
 
+#include <strings.h>
+
+#include "rch_urdf_robot.h"
+
 #include <ctype.h>
 #include <math.h>
 #include <stdio.h>
@@ -763,6 +767,14 @@ int rch_robot_load(rch_robot *out, const char *path, rch_diag *d)
 {
     char *text;
     size_t len;
+    const size_t pl = strlen(path);
+    if (pl > 5 && strcasecmp(path + pl - 5, ".urdf") == 0) { /* a URDF: rch_urdf_robot.h */
+        if (rch_read_file(&text, &len, path, (size_t)16 << 20, d) != 0)
+            return -1;
+        const int rc = rch_urdf_robot_parse(out, text, len, path, d);
+        free(text);
+        return rc;
+    }
     /* the one file reader: a directory, a read error (with its reason) or a file over 64 KiB is refused */
     if (rch_read_file(&text, &len, path, (size_t)1 << 16, d) != 0)
         return -1;
