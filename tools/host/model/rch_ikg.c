@@ -202,11 +202,11 @@ typedef struct {
 } target;
 
 /* The error at q: e (6: mm, rad), its weighted cost; J (36) when jac. */
-static double eval(double e[6], double J[36], rc_kin_data *d, const rch_ikg *ik, const target *t,
+static double eval(double e[6], double J[36], rc_kin_data *d, const rc_kin *kin, const target *t,
                    const double q[RC_NJ])
 {
     double p[3], R[9];
-    rc_kin_fk_jac(p, R, J, d, &ik->kin, q);
+    rc_kin_fk_jac(p, R, J, d, kin, q);
     for (int k = 0; k < 3; ++k)
         e[k] = t->pt[k] - p[k];
     rot_err(&e[3], t->Rt, R);
@@ -215,13 +215,13 @@ static double eval(double e[6], double J[36], rc_kin_data *d, const rch_ikg *ik,
 
 /* Newton (Levenberg-Marquardt where a step does not pay) from q; 1 when
  * converged (q the solution, d its chain), 0 not. */
-static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
-                  const rch_ikg *ik, const target *t)
+static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                      const rc_kin *kin, double reach_mm, const target *t)
 {
     double e[6], J[36], qa[RC_NJ], ea[6], Ja[36];
-    double cost = eval(e, J, d, ik, t, q);
+    double cost = eval(e, J, d, kin, t, q);
     double lambda = 0.0;
-    const double tiny = 1e-10 * (ik->reach_mm + 1.0);
+    const double tiny = 1e-10 * (reach_mm + 1.0);
     for (unsigned it = 0; it < IKG_MAX_IT; ++it) {
         *err_mm = sqrt(dot(e, e));
         *err_rad = sqrt(dot(&e[3], &e[3]));
@@ -269,7 +269,7 @@ static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *it
         const double sc = big > IKG_MAX_STEP_RAD ? IKG_MAX_STEP_RAD / big : 1.0;
         for (int i = 0; i < 6; ++i)
             qa[i] = q[i] + sc * dq[i];
-        const double ca = eval(ea, Ja, d, ik, t, qa);
+        const double ca = eval(ea, Ja, d, kin, t, qa);
         if (ca < cost) {
             memcpy(q, qa, sizeof qa);
             memcpy(e, ea, sizeof ea);
@@ -285,12 +285,47 @@ static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *it
             lambda = lambda > 0.0 ? lambda * 10.0 : 1e-4 * dmax * dmax;
             if (lambda > 1e12 * (dmax * dmax + 1.0))
                 return 0;
-            eval(e, J, d, ik, t, q); /* d back to q */
+            eval(e, J, d, kin, t, q); /* d back to q */
         }
     }
     *err_mm = sqrt(dot(e, e));
     *err_rad = sqrt(dot(&e[3], &e[3]));
     return *err_mm <= RCH_IKG_TOL_MM && *err_rad <= RCH_IKG_TOL_RAD;
+}
+
+static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                  const rch_ikg *ik, const target *t)
+{
+    return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t);
+}
+
+/* Continuation from the idealised arm's closed-form solution q (exact
+ * there): the DH rows moved from the idealised table to the real one in
+ * IKG_HOMOTOPY steps, Newton at each from the step before, so that the
+ * solution keeps the branch it had where a start of the real arm would slip
+ * into the neighbouring one (next to a singularity). 1 when converged (q, d
+ * at the real arm). */
+#define IKG_HOMOTOPY 8
+static int homotopy(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                    const rch_ikg *ik, const target *t)
+{
+    rc_kin k = ik->kin;
+    for (unsigned s = 1; s <= IKG_HOMOTOPY; ++s) {
+        const double f = (double)s / IKG_HOMOTOPY;
+        for (unsigned i = 0; i < RC_NJ; ++i) {
+            const rc_kin_link *r = &ik->kin.link[i];
+            const double ar = atan2(r->sin_alpha, r->cos_alpha), ai = ik->ideal[i][2];
+            const double al = ai + f * remainder(ar - ai, 2.0 * M_PI);
+            k.link[i].a_mm = ik->ideal[i][0] + f * (r->a_mm - ik->ideal[i][0]);
+            k.link[i].d_mm = ik->ideal[i][1] + f * (r->d_mm - ik->ideal[i][1]);
+            k.link[i].cos_alpha = cos(al);
+            k.link[i].sin_alpha = sin(al);
+            k.link[i].theta_off_rad = ik->ideal[i][3] + f * (r->theta_off_rad - ik->ideal[i][3]);
+        }
+        if (!newton_kin(q, err_mm, err_rad, iters, d, s == IKG_HOMOTOPY ? &ik->kin : &k, ik->reach_mm, t))
+            return 0;
+    }
+    return 1;
 }
 
 /* Starts: axis 1 towards the target (and away), the arm's two elbow sides
@@ -421,9 +456,13 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
     double cs[8][RC_NJ];
     int order[8];
     int ncs = -1; /* computed when the seed's own run did not do */
-    for (unsigned k = seed_rad ? 0u : 1u; ncs < 0 || k < 1u + (unsigned)ncs + IKG_N_START; ++k) {
+    double conv_q[8][RC_NJ]; /* solutions of another branch met on the way (for the wrist's reflections) */
+    unsigned n_conv = 0, n_refl = 0;
+    for (unsigned k = seed_rad ? 0u : 1u; ncs < 0 || k < 1u + 2u * (unsigned)ncs + IKG_N_START + 2u * n_refl;
+         ++k) {
         double q[RC_NJ], em, er;
         rc_kin_data d;
+        const unsigned k_refl = 1u + 2u * (unsigned)(ncs < 0 ? 0 : ncs); /* where the reflections start */
         if (k >= 1 && ncs < 0)
             ncs = closed_starts(cs, order, ik, pos_mm, rot, branch, seed_rad);
         if (k == 0)
@@ -433,10 +472,28 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         else {
             if (found || in_branch)
                 break; /* the closed-form starts found it (or it outside the limits): no generic ones */
-            start_of(q, k - 1 - (unsigned)ncs, ik, &t);
+            if (k <= 2u * (unsigned)ncs) { /* then each carried from the idealised arm */
+                memcpy(q, cs[order[k - 1 - (unsigned)ncs]], sizeof q);
+                if (k == 2u * (unsigned)ncs && branch != RCH_IKG_ANY_BRANCH)
+                    n_refl = n_conv; /* next: the other wrist side of each solution met */
+            } else if (k < k_refl + 2u * n_refl) {
+                /* a solution of the other wrist side reflected: q5 -> -q5 (an offset wrist's pair next to its
+                 * singularity), and with q4, q6 half a turn on (a spherical wrist's flip) */
+                const unsigned r = k - k_refl;
+                memcpy(q, conv_q[r / 2], sizeof q);
+                const double th5 = q[4] + ik->kin.link[4].theta_off_rad;
+                q[4] = -th5 - ik->kin.link[4].theta_off_rad;
+                if (r % 2) {
+                    q[3] += M_PI;
+                    q[5] += M_PI;
+                }
+            } else
+                start_of(q, k - k_refl - 2u * n_refl, ik, &t);
         }
         ++inf.starts;
-        const int conv = newton(q, &em, &er, &inf.iterations, &d, ik, &t);
+        const int conv = k > (unsigned)ncs && k <= 2u * (unsigned)ncs
+                             ? homotopy(q, &em, &er, &inf.iterations, &d, ik, &t)
+                             : newton(q, &em, &er, &inf.iterations, &d, ik, &t);
         if (!conv) {
             if (!reached && em < inf.err_mm) {
                 inf.err_mm = em;
@@ -446,8 +503,11 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         }
         reached = 1;
         const int b = branch_of(ik, &d, q);
-        if (branch != RCH_IKG_ANY_BRANCH && b != branch)
+        if (branch != RCH_IKG_ANY_BRANCH && b != branch) {
+            if ((b ^ branch) == 1 && n_conv < 8 && n_refl == 0)
+                memcpy(conv_q[n_conv++], q, sizeof q);
             continue;
+        }
         in_branch = 1;
         if (!place(q, ik, seed_rad))
             continue;
