@@ -454,7 +454,7 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
     /* the closed-form starts, those of the branch first (by their branch on
      * the real arm) or nearest the seed first */
     double cs[8][RC_NJ];
-    int order[8];
+    int order[8] = {0};
     int ncs = -1; /* computed when the seed's own run did not do */
     double conv_q[8][RC_NJ]; /* solutions of another branch met on the way (for the wrist's reflections) */
     unsigned n_conv = 0, n_refl = 0;
@@ -462,9 +462,9 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
          ++k) {
         double q[RC_NJ], em, er;
         rc_kin_data d;
-        const unsigned k_refl = 1u + 2u * (unsigned)(ncs < 0 ? 0 : ncs); /* where the reflections start */
         if (k >= 1 && ncs < 0)
             ncs = closed_starts(cs, order, ik, pos_mm, rot, branch, seed_rad);
+        const unsigned k_refl = 1u + 2u * (unsigned)(ncs < 0 ? 0 : ncs); /* where the reflections start */
         if (k == 0)
             memcpy(q, seed_rad, sizeof q);
         else if (k <= (unsigned)ncs)
