@@ -7,10 +7,10 @@ set -euo pipefail
 PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev liblapack-dev libblas-dev gfortran libcmocka-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi clang libclang-rt-14-dev
       cppcheck clang-tidy valgrind binutils libgsl-dev
-      python3 python3-pytest python3-numpy python3-venv python3-pip python3-setuptools python3-wheel liburdfdom-tools chromium fonts-dejavu-core
+      python3 python3-pytest python3-numpy python3-venv python3-pip python3-setuptools python3-wheel liburdfdom-tools libexpat1-dev chromium fonts-dejavu-core
       groff-base colcon python3-colcon-cmake python3-colcon-ros)
 # groff-base: renders the generated man pages (pkg_man_completion); colcon, python3-colcon-cmake,
-# python3-colcon-ros: read package.xml as colcon does (pkg_colcon_package).
+# python3-colcon-ros: read package.xml as colcon does (pkg_colcon_package). libexpat1-dev: URDF (rch_urdf*.c).
 # --list: print the package list (.ci/run installs it with apt-get itself)
 if [ "${1:-}" = "--list" ]; then
   echo "${PKGS[@]}"

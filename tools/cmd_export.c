@@ -90,6 +90,12 @@ int rcal_cmd_export(int argc, char **argv)
         fprintf(stderr, "rcal export: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
     }
+    if (nominal && res.overlay)
+        fprintf(stderr, "rcal export: %s with its joint origins calibrated (everything else kept)%s\n", nominal,
+                res.flange_moved ? "; no fixed joint after joint 6: the flange's change is not carried" : "");
+    else if (nominal && res.overlay_why[0])
+        fprintf(stderr, "rcal export: not an overlay of %s (%s): a URDF of DH frames with its names written\n",
+                nominal, res.overlay_why);
     if (res.n_effects_left)
         fprintf(stderr, "rcal export: %u model effect(s) not carried by the URDF (listed in its comments)\n",
                 res.n_effects_left);

@@ -129,7 +129,7 @@ static void test_model_round_trip(void **state)
     FILE *f = fmemopen(buf, sizeof buf, "w");
     assert_non_null(f);
     const char *path = "C:\\data\\\"q\".csv\t\x01";
-    const rch_robot_info info = {info_k, path, NULL, NULL, NULL, NULL, 0};
+    const rch_robot_info info = {info_k, path, NULL, NULL, NULL, NULL, 0, NULL};
     assert_int_equal(rch_robot_write(f, "cal \"x\" \\y", &m, &r.nominal, &info), 0);
     fclose(f);
     assert_int_equal(rch_robot_parse(&back, buf, strlen(buf), "rt.json", &dg), 0);

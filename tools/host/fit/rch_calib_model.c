@@ -44,7 +44,7 @@ int rch_calib_write_model(FILE *f, const rch_calib_result *r)
     if (!r->finite)
         return -1;
     const rch_robot_info info = {calib_info, r, r->have_unc ? &r->unc : NULL, r->have_unc ? &r->determined : NULL,
-                                 &r->prov, r->outlet_label, r->n_outlets};
+                                 &r->prov, r->outlet_label, r->n_outlets, &r->robot.ctrl};
     return rch_robot_write(f, r->robot.name, &r->model, &r->robot.nominal, &info);
 }
 

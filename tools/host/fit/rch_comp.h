@@ -47,6 +47,7 @@
 #include "rc_comp.h"
 #include "rch_diag.h"
 #include "rch_robot.h"
+#include "rch_ctrl.h"
 #include "rch_uncert.h"
 
 typedef enum rch_comp_format {
@@ -120,6 +121,9 @@ typedef struct rch_comp_gate {
     const rc_comp_config *cfg;
     rch_comp_u95_policy u95_policy; /* see rch_comp_job */
     int assume_degrees;        /* see rch_comp_job (0: joint targets that look like radians are refused) */
+    const rch_ctrl *ctrl;      /* the controller's joint conventions (the nominal file's, else the model
+                                  file's "controller"): a joint CSV's values are the controller's, mapped to
+                                  the model's and back; NULL: the identity */
 } rch_comp_gate;
 
 /* What u95_mm says of one target, by how its compensation ended (status: 0

@@ -132,9 +132,25 @@ int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno
     ++c->n_targets;
     if (beyond)
         rch_cpi_csv_release(c);
+    /* the controller's joints (a KUKA's A1, a Fanuc's J3 from the horizon) to the model's and back */
+    const rch_ctrl *ctl = c->gate && c->gate->ctrl && !c->gate->ctrl->identity_joints ? c->gate->ctrl : NULL;
+    if (ctl) {
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            qd[i] *= DEG;
+        rch_ctrl_to_model(qd, ctl, qd);
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            qd[i] /= DEG;
+    }
     const int r = rch_cpi_compensate(c, qo, qd, lineno, cols, d);
     if (r < 0)
         return r;
+    if (ctl) {
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            qo[i] *= DEG;
+        rch_ctrl_from_model(qo, ctl, qo);
+        for (unsigned i = 0; i < RC_NJ; ++i)
+            qo[i] /= DEG;
+    }
     for (int k = 0; k < nf; ++k) {
         int j = -1;
         for (int i = 0; i < RC_NJ; ++i)

@@ -348,7 +348,8 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     }
     const rch_comp_gate gate = {&fit_pt, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
                                 job->accept_robtargets, have_uo ? uo.f : NULL, nom_raw, job->tool_mm,
-                                &det_any, &robot.model, &cfg, job->u95_policy, job->assume_degrees};
+                                &det_any, &robot.model, &cfg, job->u95_policy, job->assume_degrees,
+                                job->nominal_path ? &nominal_robot.ctrl : &robot.ctrl};
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);

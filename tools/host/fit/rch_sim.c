@@ -236,7 +236,7 @@ static void sim_info(rch_jw *w, const void *ctx)
 
 int rch_sim_write_truth(FILE *f, const rch_sim_set *set)
 {
-    const rch_robot_info info = {sim_info, set, NULL, NULL, NULL, NULL, 0};
+    const rch_robot_info info = {sim_info, set, NULL, NULL, NULL, NULL, 0, NULL};
     return rch_robot_write(f, "simulated truth", &set->truth, &set->robot.nominal, &info);
 }
 

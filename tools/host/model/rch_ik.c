@@ -3,6 +3,8 @@
  * wrist, and ABB's confdata and tool0 (rch_ik.h). */
 #include "rch_ik.h"
 
+#include "rch_ikg.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -177,6 +179,14 @@ static int quadrant(double q_rad)
 
 void rch_ik_confdata(int cf[4], const rc_model *m, const double q[RC_NJ])
 {
+    if (rch_ik_supported(m, NULL, 0) != 0) { /* any other arm: the general IK's branch (rch_ikg.h) */
+        rch_ikg ik;
+        cf[0] = quadrant(q[0]);
+        cf[1] = quadrant(q[3]);
+        cf[2] = quadrant(q[5]);
+        cf[3] = rch_ikg_init(&ik, m, NULL) == RCH_IKG_OK ? rch_ikg_branch(&ik, q) : 0;
+        return;
+    }
     row r[RC_NJ];
     rows_of(r, m);
     double o1[3], o2[3], z1[3], w[3], R[9], h1[3], h2[3], hz[3], hw[3];
@@ -404,11 +414,52 @@ static void append_solutions(char *why, size_t why_len, const rc_model *m, const
         snprintf(why + at, why_len - at, " (write one of them as the robtarget's confdata)");
 }
 
+/* rch_ik_solve for an arm outside the closed form's class: the general IK
+ * (rch_ikg.h) of the branch cfx (its bits the same sides as ABB's), axes 1,
+ * 4 and 6 then turned into their quadrants. */
+static int solve_general(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3], const double quat[4],
+                         const int cf[4], const double *tool_mm, char *why, size_t why_len)
+{
+    rch_ikg ik;
+    if (rch_ikg_init(&ik, m, tool_mm) != RCH_IKG_OK) {
+        snprintf(why, why_len, "the nominal model does not compile for the inverse kinematics");
+        return -1;
+    }
+    for (unsigned i = 0; i < RC_NJ; ++i) { /* quadrants and limits below */
+        ik.q_min_rad[i] = -4.0 * M_PI;
+        ik.q_max_rad[i] = 4.0 * M_PI;
+    }
+    double Rt[9], Rz[9], R6[9];
+    rch_ik_quat_to_rot(Rt, quat);
+    rot_z(Rz, -RCH_IK_TOOL0_RZ_DEG * DEG);
+    mul3(R6, Rt, Rz);
+    double q[RC_NJ];
+    rch_ikg_info inf;
+    const rch_ikg_status st = rch_ikg_solve(q, &inf, &ik, pos_mm, R6, cf[3], NULL);
+    if (st != RCH_IKG_OK) {
+        snprintf(why, why_len, "general inverse kinematics, cfx = %d: %s", cf[3], rch_ikg_strerror(st));
+        return -1;
+    }
+    static const int axis[3] = {0, 3, 5};
+    for (int a = 0; a < 3; ++a)
+        if (to_quadrant(&q[axis[a]], cf[a]) != 0) {
+            snprintf(why, why_len, "the solution with cfx = %d has axis %d at %.4f deg, outside the quadrant "
+                     "cf%d = %d", cf[3], axis[a] + 1, q[axis[a]] / DEG, axis[a] + 1, cf[a]);
+            return -1;
+        }
+    for (int j = 0; j < RC_NJ; ++j)
+        if (q[j] < m->q_min_rad[j] - 1e-12 || q[j] > m->q_max_rad[j] + 1e-12) {
+            snprintf(why, why_len, "the solution with this confdata has axis %d = %.4f deg, outside its limits "
+                     "[%g, %g] deg", j + 1, q[j] / DEG, m->q_min_rad[j] / DEG, m->q_max_rad[j] / DEG);
+            return -1;
+        }
+    memcpy(q_rad, q, sizeof q);
+    return 0;
+}
+
 int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3], const double quat[4],
                  const int cf[4], const double *tool_mm, char *why, size_t why_len)
 {
-    if (rch_ik_supported(m, why, why_len) != 0)
-        return -1;
     const double qn = sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
     if (!(fabs(qn - 1.0) <= 1e-3)) {
         snprintf(why, why_len, "the quaternion's norm is %.6g, not 1", qn);
@@ -417,6 +468,10 @@ int rch_ik_solve(double q_rad[RC_NJ], const rc_model *m, const double pos_mm[3],
     if (cf[3] < 0 || cf[3] > 7) {
         snprintf(why, why_len, "cfx = %d: it must be 0..7", cf[3]);
         return -1;
+    }
+    if (rch_ik_supported(m, NULL, 0) != 0) {
+        const double qu[4] = {quat[0] / qn, quat[1] / qn, quat[2] / qn, quat[3] / qn};
+        return solve_general(q_rad, m, pos_mm, qu, cf, tool_mm, why, why_len);
     }
     /* where the wrist is singular only q4 + q6 (or q4 - q6) is fixed: q4 is
      * tried across its quadrant until q6 meets its own */

@@ -1,6 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 #include "rch_robot.h"
 
+#include <strings.h>
+
+#include "rch_urdf_robot.h"
+
 #include <ctype.h>
 #include <math.h>
 #include <stdio.h>
@@ -714,7 +718,7 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
     static const char *const top_keys[] = {"format",  "name",        "dh",          "joint_limits_deg", "encoder_mm",
                                            "effects", "prior",       "nominal",     "calibration",      "uncertainty",
                                            "fit",     "provenance",  "outlet_labels", "$schema",        "links",
-                                           "cell",    NULL};
+                                           "cell",    "controller", "source", NULL};
     if (check_keys(root, top_keys, "the model file", name, d) != 0)
         goto done;
     const rch_json *fmt = rch_json_get(root, "format");
@@ -751,6 +755,8 @@ int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *na
         goto done;
     if (rch_cell_read(&out->cell, rch_json_get(root, "links"), rch_json_get(root, "cell"), name, d) != 0)
         goto done;
+    if (rch_ctrl_read(&out->ctrl, rch_json_get(root, "controller"), name, d) != 0)
+        goto done;
     rc = 0;
 done:
     rch_json_free(root);
@@ -761,6 +767,14 @@ int rch_robot_load(rch_robot *out, const char *path, rch_diag *d)
 {
     char *text;
     size_t len;
+    const size_t pl = strlen(path);
+    if (pl > 5 && strcasecmp(path + pl - 5, ".urdf") == 0) { /* a URDF: rch_urdf_robot.h */
+        if (rch_read_file(&text, &len, path, (size_t)16 << 20, d) != 0)
+            return -1;
+        const int rc = rch_urdf_robot_parse(out, text, len, path, d);
+        free(text);
+        return rc;
+    }
     /* the one file reader: a directory, a read error (with its reason) or a file over 64 KiB is refused */
     if (rch_read_file(&text, &len, path, (size_t)1 << 16, d) != 0)
         return -1;
@@ -946,6 +960,8 @@ int rch_robot_write(FILE *f, const char *name, const rc_model *m, const rc_model
         write_dh(&w, "dh", nominal);
         rch_jw_end(&w);
     }
+    if (info && info->ctrl)
+        rch_ctrl_write(&w, info->ctrl);
     if (info && info->write) {
         rch_jw_obj(&w, "calibration");
         info->write(&w, info->ctx);

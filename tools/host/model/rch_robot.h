@@ -26,6 +26,7 @@
 
 #include "rc_model.h"
 #include "rch_cell.h"
+#include "rch_ctrl.h"
 #include "rch_diag.h"
 #include "rch_jw.h"
 #include "rch_data.h"
@@ -53,6 +54,8 @@ typedef struct rch_robot {
     uint8_t outlet_label[RC_MAX_OUTLETS];
     rch_cell cell;          /* "links" (the arm's capsules) and "cell" (floor, boxes): rch_cell.h; empty when
                                absent */
+    rch_ctrl ctrl;          /* "controller": the controller's joint signs, zeros, J2/J3 coupling and flange frame
+                               (rch_ctrl.h); the identity when absent */
 } rch_robot;
 
 /* Where a calibration came from (rcal-model/2 "provenance"). */
@@ -66,6 +69,9 @@ typedef struct rch_provenance {
     const char *tool;                       /* "rcal 0.1.0" */
 } rch_provenance;
 
+/* A model file; a path ending in ".urdf" (any case) is a URDF read by
+ * rch_urdf_robot_load (rch_urdf_in.h): a six-joint serial chain turned into
+ * the DH table. */
 int rch_robot_load(rch_robot *out, const char *path, rch_diag *d);
 int rch_robot_parse(rch_robot *out, const char *text, size_t len, const char *name, rch_diag *d);
 
@@ -81,6 +87,8 @@ typedef struct rch_robot_info {
     const uint8_t *outlet_label;   /* (n_outlets) the data's label of outlet k, written as "outlet_labels" when
                                       they are not simply 0, 1, ... (NULL: none) */
     unsigned n_outlets;
+    const rch_ctrl *ctrl;          /* the nominal file's "controller" member, written back when present (NULL:
+                                      none) */
 } rch_robot_info;
 
 /* Write a model file through rch_jw (every string escaped, non-finite numbers

@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_export.c - URDF and DH-CSV exports of a model (see rch_export.h). */
 #include "rch_export.h"
+
+#include "rch_urdf_robot.h"
 #include "rch_comp.h"
 
 #include <errno.h>
@@ -446,6 +448,44 @@ int rch_export_file(rch_export_result *res, FILE *f, rch_export_format format, c
                          rch_urdf_names_parse(names, text, len, nominal_urdf, d) != 0))
         goto done;
     const rch_export_cfg cfg = {format, nominal_urdf ? names : NULL, &se, model_path, drop_joint_effects};
+    if (nominal_urdf && format == RCH_EXPORT_URDF) {
+        /* the overlay, when the URDF is the model's nominal robot */
+        rch_export_result tmp;
+        FILE *null = fopen("/dev/null", "w");
+        if (!null || rch_export_write(&tmp, null, &cfg, r, d) != 0) { /* the effects' refusal */
+            if (null)
+                fclose(null);
+            goto done;
+        }
+        fclose(null);
+        char *buf = NULL;
+        size_t blen = 0;
+        FILE *mem = open_memstream(&buf, &blen);
+        rch_diag dd;
+        int moved = 0;
+        const int o = mem ? rch_urdf_overlay_write(mem, &moved, text, len, nominal_urdf, &r->nominal, &r->model, &dd)
+                          : -1;
+        if (mem)
+            fclose(mem);
+        if (o == 0) {
+            *res = tmp;
+            res->overlay = 1;
+            res->flange_moved = moved;
+            rc = fwrite(buf, 1, blen, f) == blen && fflush(f) == 0 ? 0 : -1;
+            if (rc != 0)
+                rch_diag_set(d, "", 0, 0, "write error: %s", strerror(errno));
+            free(buf);
+            goto done;
+        }
+        free(buf);
+        if (o != -2) {
+            *d = dd;
+            goto done;
+        }
+        rc = rch_export_write(res, f, &cfg, r, d);
+        snprintf(res->overlay_why, sizeof res->overlay_why, "%.250s", dd.msg);
+        goto done;
+    }
     rc = rch_export_write(res, f, &cfg, r, d);
 done:
     free(text);

@@ -88,6 +88,11 @@ typedef struct {
     unsigned n_effects_left;  /* model effects the URDF does not carry (length-side ones,
                                  and joint-side ones with drop_joint_effects) */
     int has_se;               /* CSV: a standard error was written */
+    int overlay;              /* URDF with --nominal-urdf: 1 the user's URDF was written with its joint
+                                 origins calibrated (rch_urdf_robot.h); 0 its names only (its chain is not
+                                 the model's nominal table: overlay_why says how) */
+    int flange_moved;         /* overlay: no fixed joint after joint 6 took the flange's change */
+    char overlay_why[256];
 } rch_export_result;
 
 /* Write robot r in cfg->format to f. URDF: refuses (-1) a model with
@@ -98,7 +103,9 @@ int rch_export_write(rch_export_result *res, FILE *f, const rch_export_cfg *cfg,
 
 /* The whole export of `rcal export`: load the model file (rch_robot_load, and
  * its standard errors), the nominal URDF when nominal_urdf is not NULL,
- * and write to f. */
+ * and write to f. A URDF with a nominal URDF whose chain is the model's
+ * nominal table is the overlay (rch_urdf_overlay_write: the user's file,
+ * only joint origins changed); else the generated URDF with its names. */
 int rch_export_file(rch_export_result *res, FILE *f, rch_export_format format, const char *model_path,
                     const char *nominal_urdf, int drop_joint_effects, rch_diag *d);
 

@@ -141,6 +141,8 @@ typedef struct acq {
     int linked;               /* --controller: the link drives the run */
     rch_link link;
     rch_acqtime tm;           /* --controller: rcal's own time per pose (rch_acqtime.h) */
+    rch_ctrl ctrl;            /* the robot file's controller conventions: a joint source's values (the
+                                 controller's) are mapped to the model's before they are recorded */
 } acq;
 
 /* A mark of rcal's time per pose (linked runs only). */
@@ -516,6 +518,7 @@ static int load_inputs(acq *a)
         WARN(a, "%s\n", robot ? rch_diag_str(&dg, buf, sizeof buf) : "out of memory");
         goto out;
     }
+    a->ctrl = robot->ctrl;
     a->n = plan.n;
     a->plan_deg = calloc(plan.n, sizeof *a->plan_deg);
     a->pred_mm = calloc(plan.n, sizeof *a->pred_mm);
@@ -639,6 +642,13 @@ static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
     if (a->io->joints && a->io->joints(a->io->ctx, q_deg, a->plan_deg[i], i) != 0) {
         WARN(a, "pose %zu: the joint-angle source failed; stopped (rerun to resume)\n", i);
         return 1;
+    }
+    if (a->io->joints && !a->ctrl.identity_joints) { /* the controller's numbers, as it means them */
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            q_deg[j] /= DEG_PER_RAD;
+        rch_ctrl_to_model(q_deg, &a->ctrl, q_deg);
+        for (unsigned j = 0; j < RC_NJ; ++j)
+            q_deg[j] *= DEG_PER_RAD;
     }
     return 0;
 }

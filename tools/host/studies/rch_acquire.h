@@ -80,7 +80,9 @@ typedef struct rch_acq_io {
     /* The joint-angle source: the q1..q6 (deg) recorded for pose `pose`.
      * NULL: the plan's own angles (the robot program visits the planned
      * poses). A controller stream (RAPID socket, EGM) plugs in here; it may
-     * block until the motion is finished. 0, or -1 to stop the run. */
+     * block until the motion is finished. 0, or -1 to stop the run. Its
+     * q_deg are the controller's numbers: mapped to the model's by the
+     * robot file's "controller" member (rch_ctrl.h; identity when absent). */
     int (*joints)(void *ctx, double q_deg[RC_NJ], const double plan_deg[RC_NJ], size_t pose);
     void *ctx;
 } rch_acq_io;
