@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* rch_ctrl.c - the controller's joint and flange conventions (rch_ctrl.h). */
 #include "rch_ctrl.h"
+#include "rch_json.h"
 
 #include "rch_jw.h"
 

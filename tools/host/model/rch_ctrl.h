@@ -27,8 +27,9 @@
 
 #include "rc_model.h"
 #include "rch_diag.h"
-#include "rch_json.h"
 #include "rch_jw.h"
+
+struct rch_json; /* rch_json.h (private): the parsed member rch_ctrl_read takes */
 
 typedef struct rch_ctrl {
     int present;            /* 1: the file has a "controller" member */
@@ -59,7 +60,7 @@ void rch_ctrl_identity(rch_ctrl *c);
 
 /* Read the "controller" member (NULL: the identity). 0, or -1 with d set
  * (file:line:col of the offending value). */
-int rch_ctrl_read(rch_ctrl *c, const rch_json *member, const char *file, rch_diag *d);
+int rch_ctrl_read(rch_ctrl *c, const struct rch_json *member, const char *file, rch_diag *d);
 
 /* Write c as the "controller" member (nothing when !c->present). */
 void rch_ctrl_write(rch_jw *w, const rch_ctrl *c);
