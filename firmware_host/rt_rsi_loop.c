@@ -38,6 +38,9 @@
 #define M_PI 3.14159265358979323846
 #endif
 #define DEG (M_PI / 180.0)
+/* a setpoint axis that moves more than this per cycle is not a robot's path
+ * (400 deg/s, the fastest axes of small robots, is 1.6 deg at 4 ms) */
+#define RT_RSI_MAX_SET_STEP_DEG 5.0
 
 void rt_rsi_usage(FILE *f)
 {
@@ -240,6 +243,8 @@ typedef struct rsi_state {
     double want[RT_RSI_NAX];   /* the last correction computed (held on a fault) */
     double max_step_seen;      /* largest change of ak_abs between answers in a session */
     long robot_delay;
+    double last_set[RT_RSI_NAX]; /* the last setpoint compensated */
+    int have_set;
     struct sockaddr_in ctrl;
     int have_ctrl;
 } rsi_state;
@@ -322,12 +327,20 @@ static void set_realtime(const rsi_opts *o, int *fifo_on)
 
 /* The correction wanted for this datagram's setpoint into s->want (held
  * on a fault). */
-static void compensate(rsi_state *s, rc_comp_stream *cs, const rsi_model *m, const rt_rsi_rob *r)
+static void compensate(rsi_state *s, rc_comp_stream *cs, const rsi_model *m, const rt_rsi_rob *r, double cycles)
 {
     if (!r->set_ok) {
         fault(s, F_BAD_TARGET, "ipoc %llu: %s; the correction held", r->ipoc, r->set_why);
         return;
     }
+    /* a setpoint no robot reaches in the time: not a path (the stream's warm start is kept for the path) */
+    for (int i = 0; s->have_set && i < RC_NJ; ++i)
+        if (fabs(r->set_deg[i] - s->last_set[i]) > RT_RSI_MAX_SET_STEP_DEG * cycles) {
+            fault(s, F_BAD_TARGET, "ipoc %llu: A%d jumped %.4f deg in %.0f cycle(s) (more than %g deg per cycle); "
+                  "the correction held", r->ipoc, i + 1, r->set_deg[i] - s->last_set[i], cycles,
+                  RT_RSI_MAX_SET_STEP_DEG);
+            return;
+        }
     double q[RC_NJ], qc[RC_NJ];
     for (int i = 0; i < RC_NJ; ++i) {
         q[i] = r->set_deg[i] * DEG;
@@ -338,6 +351,8 @@ static void compensate(rsi_state *s, rc_comp_stream *cs, const rsi_model *m, con
             return;
         }
     }
+    memcpy(s->last_set, r->set_deg, sizeof s->last_set);
+    s->have_set = 1;
     rc_comp_result res;
     const rc_status st = rc_comp_stream_step(cs, qc, &res, q);
     if (st != RC_OK) {
@@ -389,8 +404,11 @@ static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m
     snprintf(who, sizeof who, "%s:%u", inet_ntoa(from->sin_addr), (unsigned)ntohs(from->sin_port));
     s->datagrams++;
     const double now = mono_s();
-    const int known = s->have_ctrl && from->sin_addr.s_addr == s->ctrl.sin_addr.s_addr;
-    if ((io->have_only && from->sin_addr.s_addr != io->only.s_addr) || (!io->have_only && s->have_ctrl && !known)) {
+    /* the controller: its IP (the first sender's, or --rsi-controller) and, within a session, its port */
+    const int live = s->in_session && now - s->last_rx_s <= o->timeout_ms / 1e3;
+    const int ip_ok = io->have_only ? from->sin_addr.s_addr == io->only.s_addr
+                                    : !s->have_ctrl || from->sin_addr.s_addr == s->ctrl.sin_addr.s_addr;
+    if (!ip_ok || (live && from->sin_port != s->ctrl.sin_port)) {
         fault(s, F_FOREIGN, "a datagram from %s, not the controller: not read, not answered", who);
         return;
     }
@@ -412,6 +430,7 @@ static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m
         fault(s, F_REORDER, "ipoc %llu from %s after %llu: stale, not answered", r.ipoc, who, s->last_ipoc);
         return;
     }
+    double steps = 1.0;
     if (fresh) {
         if (s->in_session)
             fprintf(stderr, "rcal-rt: rsi: session %lu ended (%.0f ms of silence or an IPOC jump); a new one starts "
@@ -422,8 +441,11 @@ static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m
         s->in_session = 1;
         memset(s->ak_abs, 0, sizeof s->ak_abs);
         memset(s->want, 0, sizeof s->want);
+        s->have_set = 0;
+        /* a new program run: compensated from a cold start, as rcal compensate starts a file */
+        rc_comp_stream_init(cs, &m->det, &m->nom_pt, &m->cfg);
     } else {
-        const double steps = (double)(r.ipoc - s->last_ipoc) / o->cycle_ms;
+        steps = (double)(r.ipoc - s->last_ipoc) / o->cycle_ms;
         if (steps > 1.5)
             fault(s, F_DROP, "ipoc %llu after %llu: %.0f datagram(s) missing", r.ipoc, s->last_ipoc, steps - 1.0);
         else if (now - s->last_rx_s > 1.5 * o->cycle_ms / 1e3)
@@ -436,7 +458,7 @@ static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m
     s->ctrl.sin_port = from->sin_port; /* the controller's port of this datagram */
     s->last_ipoc = r.ipoc;
     s->last_rx_s = now;
-    compensate(s, cs, m, &r);
+    compensate(s, cs, m, &r, steps < 1.0 ? 1.0 : steps);
     double ak[RT_RSI_NAX];
     step_toward(s, ak, o, r.ipoc);
     char out[RT_RSI_MAX_REPLY];
