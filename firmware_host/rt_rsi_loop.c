@@ -41,6 +41,8 @@
 /* a setpoint axis that moves more than this per cycle is not a robot's path
  * (400 deg/s, the fastest axes of small robots, is 1.6 deg at 4 ms) */
 #define RT_RSI_MAX_SET_STEP_DEG 5.0
+#define RT_RSI_PENDING 8
+#define RT_RSI_LOG_LINE 320
 
 void rt_rsi_usage(FILE *f)
 {
@@ -247,6 +249,8 @@ typedef struct rsi_state {
     int have_set;
     struct sockaddr_in ctrl;
     int have_ctrl;
+    char pending[RT_RSI_PENDING][RT_RSI_LOG_LINE]; /* this datagram's log lines, written after its answer */
+    int n_pending;
 } rsi_state;
 
 static double mono_s(void)
@@ -256,18 +260,34 @@ static double mono_s(void)
     return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
 }
 
+#ifdef __GNUC__
 static void fault(rsi_state *s, int kind, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+#endif
 static void fault(rsi_state *s, int kind, const char *fmt, ...)
 {
     const unsigned long k = ++s->count[kind];
     if (k > 5 && k % 1000 != 0)
         return;
+    /* formatted now, written after the answer is sent (flush_log): stderr is not on the answer's path */
+    if (s->n_pending >= RT_RSI_PENDING)
+        return;
+    char *b = s->pending[s->n_pending++];
+    int w = snprintf(b, RT_RSI_LOG_LINE, "rcal-rt: rsi: %s #%lu: ", f_name[kind], k);
+    if (w < 0 || w >= RT_RSI_LOG_LINE)
+        w = 0;
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "rcal-rt: rsi: %s #%lu: ", f_name[kind], k);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "%s\n", k == 5 ? " (further ones: every 1000th)" : "");
+    vsnprintf(b + w, RT_RSI_LOG_LINE - (size_t)w, fmt, ap);
     va_end(ap);
+    if (k == 5)
+        snprintf(b + strlen(b), RT_RSI_LOG_LINE - strlen(b), " (further ones: every 1000th)");
+}
+
+static void flush_log(rsi_state *s)
+{
+    for (int i = 0; i < s->n_pending; ++i)
+        fprintf(stderr, "%s\n", s->pending[i]);
+    s->n_pending = 0;
 }
 
 static int open_socket(int *fd_out, const rsi_opts *o, const char *addr, long port)
@@ -397,7 +417,7 @@ typedef struct rsi_io {
 } rsi_io;
 
 /* One datagram: checked, compensated, answered. */
-static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_opts *o,
+static void one_dgram(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_opts *o,
                 const char *buf, size_t len, const struct sockaddr_in *from, const struct timespec *rx)
 {
     char who[64];
@@ -432,11 +452,12 @@ static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m
     }
     double steps = 1.0;
     if (fresh) {
-        if (s->in_session)
-            fprintf(stderr, "rcal-rt: rsi: session %lu ended (%.0f ms of silence or an IPOC jump); a new one starts "
-                    "at ipoc %llu from a zero correction\n", s->sessions, (now - s->last_rx_s) * 1e3, r.ipoc);
-        else
-            fprintf(stderr, "rcal-rt: rsi: session %lu: the controller %s, ipoc %llu\n", s->sessions + 1, who, r.ipoc);
+        if (s->n_pending < RT_RSI_PENDING)
+            snprintf(s->pending[s->n_pending++], RT_RSI_LOG_LINE,
+                     "rcal-rt: rsi: session %lu: the controller %s, ipoc %llu%s", s->sessions + 1, who, r.ipoc,
+                     s->in_session ? " (the last one ended: silence or an IPOC jump over --rsi-timeout-ms); from a "
+                                     "zero correction"
+                                   : "");
         s->sessions++;
         s->in_session = 1;
         memset(s->ak_abs, 0, sizeof s->ak_abs);
@@ -474,6 +495,13 @@ static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m
     if (r.delay > s->robot_delay && s->robot_delay >= 0)
         fault(s, F_ROBOT_LATE, "ipoc %llu: the robot counts %ld late answers (DEF_Delay)", r.ipoc, r.delay);
     s->robot_delay = r.delay;
+}
+
+static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_opts *o,
+                const char *buf, size_t len, const struct sockaddr_in *from, const struct timespec *rx)
+{
+    one_dgram(s, io, cs, m, o, buf, len, from, rx);
+    flush_log(s);
 }
 
 /* The model file replaced while running: counted and logged; the model
@@ -642,6 +670,7 @@ int rt_rsi_main(int argc, char **argv)
         /* after the answers: the model file, once a second */
         if (mono_s() - last_check > 1.0) {
             check_model(&s, &io, &o);
+            flush_log(&s);
             last_check = mono_s();
         }
     }
