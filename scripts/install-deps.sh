@@ -4,9 +4,10 @@
 set -euo pipefail
 # liblapack-dev, libblas-dev: the reference LAPACK and BLAS archives rcal links by their own place
 # (cmake/rcal_lapack.cmake; never the alternatives ATLAS or OpenBLAS switch); gfortran: their run-time.
+# libexpat1-dev: the XML of rcal-rt's KUKA RSI partner (firmware_host/rt_rsi.c; without it RSI is left out).
 PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev liblapack-dev libblas-dev gfortran libcmocka-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi clang libclang-rt-14-dev
-      cppcheck clang-tidy valgrind binutils libgsl-dev
+      cppcheck clang-tidy valgrind binutils libgsl-dev libexpat1-dev
       python3 python3-pytest python3-numpy python3-venv python3-pip python3-setuptools python3-wheel liburdfdom-tools chromium fonts-dejavu-core)
 # --list: print the package list (.ci/run installs it with apt-get itself)
 if [ "${1:-}" = "--list" ]; then
