@@ -156,7 +156,7 @@ static void set_fifo(int prio, const char *who)
         fprintf(stderr, "rsi_bench: note: %s: SCHED_FIFO refused (%s)\n", who, strerror(errno));
 }
 
-static void responder(int fd, int out_fd, int fifo, size_t cap)
+static void responder(int fd, int out_fd, int fifo, size_t cap, double period_us)
 {
     signal(SIGTERM, on_term);
     if (fifo) {
@@ -164,7 +164,7 @@ static void responder(int fd, int out_fd, int fifo, size_t cap)
         mlockall(MCL_CURRENT | MCL_FUTURE);
     }
     double *lat = malloc(cap * sizeof *lat);
-    size_t n = 0;
+    size_t n = 0, over = 0;
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
     while (!g_stop) {
@@ -198,15 +198,18 @@ static void responder(int fd, int out_fd, int fifo, size_t cap)
                                "A6=\"0.0\"/><IPOC>%llu</IPOC></Sen>", ipoc);
         sendto(fd, out, (size_t)m, 0, (struct sockaddr *)&from, sizeof from);
         const double tx = now_ns(CLOCK_REALTIME);
-        if (lat && n < cap)
-            lat[n++] = (tx - ((double)rx.tv_sec * 1e9 + (double)rx.tv_nsec)) / 1e3;
+        if (lat && n < cap) {
+            lat[n] = (tx - ((double)rx.tv_sec * 1e9 + (double)rx.tv_nsec)) / 1e3;
+            over += lat[n++] > period_us;
+        }
     }
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
     qsort(lat, n, sizeof *lat, cmp_d);
     char line[256];
     const double cpu = ((double)(c1.tv_sec - c0.tv_sec) * 1e9 + (double)(c1.tv_nsec - c0.tv_nsec)) / 1e3;
-    const int len = snprintf(line, sizeof line, "%zu %.1f %.1f %.1f %.2f\n", n, pct(lat, n, 50), pct(lat, n, 99.99),
-                             n ? lat[n - 1] : NAN, n ? cpu / (double)n : NAN);
+    const int len = snprintf(line, sizeof line, "%zu %.1f %.1f %.1f %.2f %zu %.1f\n", n, pct(lat, n, 50),
+                             pct(lat, n, 99.99), n ? lat[n - 1] : NAN, n ? cpu / (double)n : NAN, over,
+                             pct(lat, n, 99));
     if (write(out_fd, line, (size_t)len) != len)
         _exit(1);
     _exit(0);
@@ -222,8 +225,10 @@ typedef struct {
     const double (*ref)[NAX]; /* NULL: the trivial responder, AK not checked */
     int fifo;
     /* results */
-    double *rtt_us;
-    size_t answered, missed, late, wrong_ipoc, wrong_ak, compared;
+    double *rtt_us;     /* answers in time */
+    double *t_send;     /* per cycle: when its Rob was sent (late answers' round trip) */
+    double *rtt_all_us; /* every answer, in time or late */
+    size_t answered, n_all, missed, late, wrong_ipoc, wrong_ak, compared;
     double worst_ak;
 } ctrl;
 
@@ -257,6 +262,7 @@ static void *ctrl_run(void *arg)
             "<Delay D=\"0\"/><IPOC>%llu</IPOC></Rob>",
             q[0], q[1], q[2], q[3], q[4], q[5], q[0], q[1], q[2], q[3], q[4], q[5], ipoc);
         const double ts_send = now_ns(CLOCK_MONOTONIC);
+        c->t_send[k] = ts_send;
         send(c->fd, m, (size_t)len, 0);
         const double deadline = tk + c->period_ns;
         int got = 0;
@@ -275,16 +281,20 @@ static void *ctrl_run(void *arg)
             r[n] = '\0';
             const char *i = strstr(r, "<IPOC>");
             const unsigned long long e = i ? strtoull(i + 6, NULL, 10) : 0;
-            if (e < ipoc && e >= base) {
+            if (e < ipoc && e >= base && (e - base) % 4u == 0) {
                 ++c->late; /* an answer to an earlier cycle, after its deadline */
+                c->rtt_all_us[c->n_all++] = (t_rx - c->t_send[(e - base) / 4u]) / 1e3;
                 continue;
             }
             if (e != ipoc) {
                 ++c->wrong_ipoc;
                 continue;
             }
-            if (t_rx > deadline)
+            c->rtt_all_us[c->n_all++] = (t_rx - ts_send) / 1e3;
+            if (t_rx > deadline) {
+                ++c->late;
                 break;
+            }
             got = 1;
             c->rtt_us[c->answered++] = (t_rx - ts_send) / 1e3;
             if (c->ref && k >= HOLD) {
@@ -338,10 +348,28 @@ static int udp_bound(int *port)
 static void report(const char *name, ctrl *c)
 {
     qsort(c->rtt_us, c->answered, sizeof *c->rtt_us, cmp_d);
-    printf("  %-9s answered %zu of %zu, missed %zu (late answers %zu, wrong IPOC %zu); round trip median %.1f us, "
-           "p99.99 %.1f us, max %.1f us\n",
-           name, c->answered, c->n, c->missed, c->late, c->wrong_ipoc, pct(c->rtt_us, c->answered, 50),
-           pct(c->rtt_us, c->answered, 99.99), c->answered ? c->rtt_us[c->answered - 1] : NAN);
+    qsort(c->rtt_all_us, c->n_all, sizeof *c->rtt_all_us, cmp_d);
+    printf("  %-9s answered in time %zu of %zu, missed %zu (late answers %zu, wrong IPOC %zu); round trip of every "
+           "answer median %.1f us, p99 %.1f us, p99.99 %.1f us, max %.1f us\n",
+           name, c->answered, c->n, c->missed, c->late, c->wrong_ipoc, pct(c->rtt_all_us, c->n_all, 50),
+           pct(c->rtt_all_us, c->n_all, 99), pct(c->rtt_all_us, c->n_all, 99.99),
+           c->n_all ? c->rtt_all_us[c->n_all - 1] : NAN);
+}
+
+/* The machine's CPU time (user+nice+system, idle, steal) in ticks, /proc/stat. */
+static void cpu_ticks(double t[3])
+{
+    t[0] = t[1] = t[2] = 0;
+    FILE *f = fopen("/proc/stat", "r");
+    unsigned long long v[8] = {0};
+    if (f && fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
+                    &v[7]) == 8) {
+        t[0] = (double)(v[0] + v[1] + v[2] + v[5] + v[6]);
+        t[1] = (double)(v[3] + v[4]);
+        t[2] = (double)v[7];
+    }
+    if (f)
+        fclose(f);
 }
 
 static int parse(opts *o, int argc, char **argv)
@@ -406,7 +434,7 @@ int main(int argc, char **argv)
     const pid_t resp = fork();
     if (resp == 0) {
         close(pfd[0]);
-        responder(rfd, pfd[1], o.fifo, n + 16);
+        responder(rfd, pfd[1], o.fifo, n + 16, 1e6 / o.rate);
     }
     close(pfd[1]);
     close(rfd);
@@ -450,8 +478,14 @@ int main(int argc, char **argv)
     b.fd = udp_to(rport);
     a.rtt_us = malloc(n * sizeof(double));
     b.rtt_us = malloc(n * sizeof(double));
-    if (a.fd < 0 || b.fd < 0 || !a.rtt_us || !b.rtt_us)
+    a.t_send = malloc(n * sizeof(double));
+    b.t_send = malloc(n * sizeof(double));
+    a.rtt_all_us = malloc(n * sizeof(double));
+    b.rtt_all_us = malloc(n * sizeof(double));
+    if (a.fd < 0 || b.fd < 0 || !a.rtt_us || !b.rtt_us || !a.t_send || !b.t_send || !a.rtt_all_us || !b.rtt_all_us)
         return 1;
+    double ticks0[3], ticks1[3];
+    cpu_ticks(ticks0);
     a.period_ns = b.period_ns = 1e9 / o.rate;
     a.t0_ns = b.t0_ns = now_ns(CLOCK_MONOTONIC) + 20e6;
     b.offset_ns = a.period_ns / 2;
@@ -466,6 +500,7 @@ int main(int argc, char **argv)
     pthread_create(&tb, NULL, ctrl_run, &b);
     pthread_join(ta, NULL);
     pthread_join(tb, NULL);
+    cpu_ticks(ticks1);
     kill(rt, SIGTERM);
     kill(resp, SIGTERM);
     char rep[4096] = "";
@@ -480,16 +515,20 @@ int main(int argc, char **argv)
     int st = 0;
     waitpid(rt, &st, 0);
     waitpid(resp, NULL, 0);
-    size_t rcount = 0;
-    double rmed = NAN, rp4 = NAN, rmax = NAN, rcpu = NAN;
-    sscanf(rline, "%zu %lf %lf %lf %lf", &rcount, &rmed, &rp4, &rmax, &rcpu);
+    size_t rcount = 0, rover = 0;
+    double rmed = NAN, rp4 = NAN, rmax = NAN, rcpu = NAN, rp2 = NAN;
+    sscanf(rline, "%zu %lf %lf %lf %lf %zu %lf", &rcount, &rmed, &rp4, &rmax, &rcpu, &rover, &rp2);
     printf("rsi_bench: %zu cycles at %.0f Hz (%.0f s), %s; the responder half a period after rcal-rt\n", n, o.rate,
            o.seconds, o.fifo ? "--fifo asked (notes above say when refused)" : "normal scheduling (no --fifo)");
+    const double busy = ticks1[0] - ticks0[0], idle = ticks1[1] - ticks0[1], steal = ticks1[2] - ticks0[2];
+    printf("  the machine meanwhile (/proc/stat, all CPUs): %.1f %% busy, %.1f %% idle, %.1f %% stolen by the "
+           "hypervisor\n", 100 * busy / (busy + idle + steal + 1e-9), 100 * idle / (busy + idle + steal + 1e-9),
+           100 * steal / (busy + idle + steal + 1e-9));
     report("rcal-rt", &a);
     report("trivial", &b);
     printf("  rcal-rt's own report: %s", rep[0] ? rep : "(none)\n");
-    printf("  trivial responder receive-to-send: median %.1f us, p99.99 %.1f us, max %.1f us; CPU %.2f us per "
-           "answer (%zu answers)\n", rmed, rp4, rmax, rcpu, rcount);
+    printf("  trivial responder receive-to-send: median %.1f us, p99 %.1f us, p99.99 %.1f us, max %.1f us; %zu answers "
+           "over a cycle; CPU %.2f us per answer (%zu answers)\n", rmed, rp2, rp4, rmax, rover, rcpu, rcount);
     printf("  AK against rcal compensate (after the %d-cycle ramp): %zu compared, %zu differ by more than 1e-6 deg "
            "(worst %.3g deg)\n", HOLD, a.compared, a.wrong_ak, a.worst_ak);
     const int bad = a.wrong_ak || a.wrong_ipoc || b.wrong_ipoc || a.compared == 0 || !WIFEXITED(st) ||
@@ -498,5 +537,9 @@ int main(int argc, char **argv)
     free(ref);
     free(a.rtt_us);
     free(b.rtt_us);
+    free(a.t_send);
+    free(b.t_send);
+    free(a.rtt_all_us);
+    free(b.rtt_all_us);
     return bad ? 1 : 0;
 }

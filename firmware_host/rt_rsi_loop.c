@@ -238,6 +238,7 @@ static const char *const f_name[F_N] = {"foreign_sender", "malformed", "duplicat
 typedef struct rsi_state {
     unsigned long count[F_N];
     unsigned long datagrams, answered, sessions;
+    unsigned long over_cycle; /* answers sent more than a cycle after their datagram arrived */
     int in_session;
     unsigned long long last_ipoc;
     double last_rx_s;          /* monotonic seconds of the last controller datagram */
@@ -490,7 +491,9 @@ static void one_dgram(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_mo
     }
     struct timespec tx;
     clock_gettime(CLOCK_REALTIME, &tx);
-    rt_rsi_hist_add(&io->hist, ((double)(tx.tv_sec - rx->tv_sec) * 1e9 + (double)(tx.tv_nsec - rx->tv_nsec)) / 1e3);
+    const double took_us = ((double)(tx.tv_sec - rx->tv_sec) * 1e9 + (double)(tx.tv_nsec - rx->tv_nsec)) / 1e3;
+    rt_rsi_hist_add(&io->hist, took_us);
+    s->over_cycle += took_us > o->cycle_ms * 1e3;
     s->answered++;
     if (r.delay > s->robot_delay && s->robot_delay >= 0)
         fault(s, F_ROBOT_LATE, "ipoc %llu: the robot counts %ld late answers (DEF_Delay)", r.ipoc, r.delay);
@@ -534,9 +537,9 @@ static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, doub
         for (int k = 0; k < F_N; ++k)
             printf("%s\"%s\": %lu", k ? ", " : "", f_name[k], s->count[k]);
         printf("}, \"largest_step_deg\": %.10f, \"latency_us\": {\"median\": %.1f, \"p99\": %.1f, \"p99_99\": %.1f, "
-               "\"max\": %.1f, \"mean\": %.2f}, \"cpu_us_per_answer\": %.2f}\n",
+               "\"max\": %.1f, \"mean\": %.2f}, \"answers_over_a_cycle\": %lu, \"cpu_us_per_answer\": %.2f}\n",
                s->max_step_seen, rt_rsi_hist_pct(h, 50), rt_rsi_hist_pct(h, 99), rt_rsi_hist_pct(h, 99.99),
-               h->max_us, h->n ? h->sum_us / (double)h->n : 0.0, cpu_us);
+               h->max_us, h->n ? h->sum_us / (double)h->n : 0.0, s->over_cycle, cpu_us);
         return;
     }
     printf("rcal-rt rsi: %lu datagrams, %lu answered, %lu session(s), %s corrections, %s\n", s->datagrams,
@@ -548,8 +551,9 @@ static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, doub
     printf("  largest change of the correction between answers: %.10f deg (limit %.10f)\n", s->max_step_seen,
            o->max_step_deg);
     printf("  receive-to-send latency (kernel receive to sendto done): median %.1f us, p99 %.1f, p99.99 %.1f, max "
-           "%.1f; CPU %.2f us per answer\n",
-           rt_rsi_hist_pct(h, 50), rt_rsi_hist_pct(h, 99), rt_rsi_hist_pct(h, 99.99), h->max_us, cpu_us);
+           "%.1f; %lu answers over a cycle; CPU %.2f us per answer\n",
+           rt_rsi_hist_pct(h, 50), rt_rsi_hist_pct(h, 99), rt_rsi_hist_pct(h, 99.99), h->max_us, s->over_cycle,
+           cpu_us);
 }
 
 static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockaddr_in *from, struct timespec *rx)
