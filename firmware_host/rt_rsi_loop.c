@@ -14,7 +14,7 @@
 #include <errno.h>
 #include <math.h>
 #include <netinet/in.h>
-#include <poll.h>
+#include <sys/time.h>
 #include <sched.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -568,7 +568,7 @@ static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockadd
     mh.msg_iovlen = 1;
     mh.msg_control = ctl;
     mh.msg_controllen = sizeof ctl;
-    const ssize_t n = recvmsg(io->fd, &mh, MSG_DONTWAIT);
+    const ssize_t n = recvmsg(io->fd, &mh, 0); /* blocks up to SO_RCVTIMEO (100 ms): one call per datagram */
     if (n < 0)
         return -1;
     clock_gettime(CLOCK_REALTIME, rx);
@@ -653,29 +653,30 @@ int rt_rsi_main(int argc, char **argv)
     const double t_end = o.seconds > 0 ? mono_s() + o.seconds : INFINITY;
     double cpu0 = -1.0, last_check = mono_s();
     static char buf[RT_RSI_MAX_DGRAM + 1];
-    while (!g_stop && mono_s() < t_end) {
-        struct pollfd p = {io.fd, POLLIN, 0};
-        const int pr = poll(&p, 1, 100);
-        if (pr < 0 && errno != EINTR) {
-            fprintf(stderr, "rcal-rt: rsi: poll: %s\n", strerror(errno));
-            break;
-        }
+    const struct timeval rcv_to = {0, 100000}; /* the stop flag and --seconds looked at 10 times a second */
+    if (setsockopt(io.fd, SOL_SOCKET, SO_RCVTIMEO, &rcv_to, sizeof rcv_to) != 0)
+        fprintf(stderr, "rcal-rt: rsi: SO_RCVTIMEO: %s\n", strerror(errno));
+    for (double t = mono_s(); !g_stop && t < t_end;) {
         size_t len;
         struct sockaddr_in from;
         struct timespec rx;
-        while (pr > 0 && rx_one(&io, buf, sizeof buf - 1, &len, &from, &rx) == 0) {
+        if (rx_one(&io, buf, sizeof buf - 1, &len, &from, &rx) == 0) {
             if (cpu0 < 0) {
                 struct timespec c;
                 clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c);
                 cpu0 = (double)c.tv_sec + (double)c.tv_nsec * 1e-9;
             }
             one(&s, &io, &cs, &m, &o, buf, len, &from, &rx);
+        } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+            fprintf(stderr, "rcal-rt: rsi: receive: %s\n", strerror(errno));
+            break;
         }
-        /* after the answers: the model file, once a second */
-        if (mono_s() - last_check > 1.0) {
+        /* after the answer: the model file, once a second */
+        t = mono_s();
+        if (t - last_check > 1.0) {
             check_model(&s, &io, &o);
             flush_log(&s);
-            last_check = mono_s();
+            last_check = t;
         }
     }
     struct timespec c;

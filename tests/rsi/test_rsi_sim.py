@@ -322,6 +322,11 @@ def main():
         other.nothing("a second sender", 0.05)
         return ipoc
 
+    def robot_late(ctrl, ipoc, q):
+        ctrl.send(rob(q, ipoc + 4, delay=2))  # the robot counts two late answers (DEF_Delay)
+        ctrl.answer(ctrl.recv(2.0), ipoc + 4, "a Rob with Delay 2")
+        return ipoc + 4
+
     def late(ctrl, ipoc, q):
         time.sleep(0.03)
         return ipoc
@@ -341,7 +346,8 @@ def main():
         rest = compensate(rcal, src_model, targets[k0:], work, "rest")
         return ipoc + 4000, [None] * k0 + rest
 
-    faults = {100: drop, 140: reorder, 180: dup, 220: garbage, 260: bad_values, 300: foreign, 340: late,
+    faults = {100: drop, 140: reorder, 180: dup, 220: garbage, 260: bad_values, 300: foreign, 320: robot_late,
+              340: late,
               380: replace_model}
     run_path(c, targets, ref, 200000, faults=faults, label="faults")
     rep = p.stop()
@@ -355,6 +361,7 @@ def main():
     check(f.get("bad_target", 0) == 4, "bad setpoints counted (2 values, 1 beyond the limits, 1 jump)")
     check(f.get("foreign_sender", 0) == 3, "the second sender counted")
     check(f.get("late", 0) >= 1, "the late datagram counted")
+    check(f.get("robot_late", 0) == 1, "the robot's rising Delay count logged once")
     check(f.get("model_file_changed", 0) >= 1, "the replaced model file counted")
     check(rep.get("sessions") == 2, "the silence started a second session (%s)" % rep.get("sessions"))
     check(rep.get("largest_step_deg", 1) <= STEP + 1e-12, "the correction never jumped (%s)" %
