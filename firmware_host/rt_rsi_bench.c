@@ -415,6 +415,89 @@ static int parse(opts *o, int argc, char **argv)
     return 0;
 }
 
+/* rcal-rt on a free port (*port), its stdout and stderr on pipes; returns its
+ * pid once it says it listens, or -1. */
+static pid_t start_rt(int *port, FILE **fout, FILE **ferr, const opts *o)
+{
+    const int probe = udp_bound(port);
+    close(probe);
+    char port_s[16];
+    snprintf(port_s, sizeof port_s, "%d", *port);
+    int out[2], err[2];
+    if (pipe(out) != 0 || pipe(err) != 0)
+        return -1;
+    const pid_t rt = fork();
+    if (rt == 0) {
+        dup2(out[1], 1);
+        dup2(err[1], 2);
+        close(out[0]);
+        close(err[0]);
+        char a1[] = "--model", a2[] = "--rsi-port", a3[] = "--json", a4[] = "--fifo";
+        char *args[16] = {(char *)o->rt, a1, (char *)o->model, a2, port_s, a3, o->fifo ? a4 : NULL, NULL};
+        execv(o->rt, args);
+        _exit(127);
+    }
+    close(out[1]);
+    close(err[1]);
+    *fout = fdopen(out[0], "r");
+    *ferr = fdopen(err[0], "r");
+    char line[1024];
+    int ready = 0;
+    while (!ready && *ferr && fgets(line, sizeof line, *ferr)) {
+        fputs(line, stderr);
+        ready = strstr(line, "listening on") != NULL;
+    }
+    if (rt < 0 || !ready || !*fout) {
+        fprintf(stderr, "rsi_bench: rcal-rt did not start\n");
+        return -1;
+    }
+    return rt;
+}
+
+/* A controller's buffers and schedule; 0, or -1 out of memory. */
+static int ctrl_init(ctrl *c, int fd, size_t n, const opts *o, double t0_ns, double offset_ns)
+{
+    memset(c, 0, sizeof *c);
+    c->fd = fd;
+    c->n = n;
+    c->period_ns = 1e9 / o->rate;
+    c->t0_ns = t0_ns;
+    c->offset_ns = offset_ns;
+    c->fifo = o->fifo;
+    c->rtt_us = malloc(n * sizeof(double));
+    c->t_send = malloc(n * sizeof(double));
+    c->rtt_all_us = malloc(n * sizeof(double));
+    return fd >= 0 && c->rtt_us && c->t_send && c->rtt_all_us ? 0 : -1;
+}
+
+static void ctrl_free(ctrl *c)
+{
+    free(c->rtt_us);
+    free(c->t_send);
+    free(c->rtt_all_us);
+}
+
+static void summary(ctrl *a, ctrl *b, const opts *o, const double ticks0[3], const double ticks1[3], const char *rep,
+                    const char *rline)
+{
+    size_t rcount = 0, rover = 0;
+    double rmed = NAN, rp4 = NAN, rmax = NAN, rcpu = NAN, rp2 = NAN;
+    sscanf(rline, "%zu %lf %lf %lf %lf %zu %lf", &rcount, &rmed, &rp4, &rmax, &rcpu, &rover, &rp2);
+    printf("rsi_bench: %zu cycles at %.0f Hz (%.0f s), %s; the responder half a period after rcal-rt\n", a->n,
+           o->rate, o->seconds, o->fifo ? "--fifo asked (notes above say when refused)" : "normal scheduling (no --fifo)");
+    const double busy = ticks1[0] - ticks0[0], idle = ticks1[1] - ticks0[1], steal = ticks1[2] - ticks0[2];
+    const double all = busy + idle + steal + 1e-9;
+    printf("  the machine meanwhile (/proc/stat, all CPUs): %.1f %% busy, %.1f %% idle, %.1f %% stolen by the "
+           "hypervisor\n", 100 * busy / all, 100 * idle / all, 100 * steal / all);
+    report("rcal-rt", a);
+    report("trivial", b);
+    printf("  rcal-rt's own report: %s", rep[0] ? rep : "(none)\n");
+    printf("  trivial responder receive-to-send: median %.1f us, p99 %.1f us, p99.99 %.1f us, max %.1f us; %zu answers "
+           "over a cycle; CPU %.2f us per answer (%zu answers)\n", rmed, rp2, rp4, rmax, rover, rcpu, rcount);
+    printf("  AK against rcal compensate (after the %d-cycle ramp): %zu compared, %zu differ by more than 1e-6 deg "
+           "(worst %.3g deg)\n", HOLD, a->compared, a->wrong_ak, a->worst_ak);
+}
+
 int main(int argc, char **argv)
 {
     opts o;
@@ -424,7 +507,7 @@ int main(int argc, char **argv)
     double(*q)[NAX] = NULL, (*ref)[NAX] = NULL;
     if (make_reference(&q, &ref, n, &o) != 0)
         return 1;
-    /* the trivial responder */
+    /* the trivial responder: a forked process, its figures on a pipe */
     int rport = 0, pfd[2];
     const int rfd = udp_bound(&rport);
     if (rfd < 0 || pipe(pfd) != 0) {
@@ -438,63 +521,20 @@ int main(int argc, char **argv)
     }
     close(pfd[1]);
     close(rfd);
-    /* rcal-rt on a free port, its report on a pipe */
     int tport = 0;
-    const int probe = udp_bound(&tport);
-    close(probe);
-    char port_s[16];
-    snprintf(port_s, sizeof port_s, "%d", tport);
-    int out[2], err[2];
-    if (pipe(out) != 0 || pipe(err) != 0)
-        return 1;
-    const pid_t rt = fork();
-    if (rt == 0) {
-        dup2(out[1], 1);
-        dup2(err[1], 2);
-        close(out[0]);
-        close(err[0]);
-        char a1[] = "--model", a2[] = "--rsi-port", a3[] = "--json", a4[] = "--fifo";
-        char *args[16] = {(char *)o.rt, a1, (char *)o.model, a2, port_s, a3, o.fifo ? a4 : NULL, NULL};
-        execv(o.rt, args);
-        _exit(127);
-    }
-    close(out[1]);
-    close(err[1]);
-    FILE *ferr = fdopen(err[0], "r");
-    char line[1024];
-    int ready = 0;
-    while (!ready && fgets(line, sizeof line, ferr)) {
-        fputs(line, stderr);
-        ready = strstr(line, "listening on") != NULL;
-    }
-    if (!ready) {
-        fprintf(stderr, "rsi_bench: rcal-rt did not start\n");
-        return 1;
-    }
+    FILE *fout = NULL, *ferr = NULL;
+    const pid_t rt = start_rt(&tport, &fout, &ferr, &o);
     ctrl a, b;
-    memset(&a, 0, sizeof a);
-    memset(&b, 0, sizeof b);
-    a.fd = udp_to(tport);
-    b.fd = udp_to(rport);
-    a.rtt_us = malloc(n * sizeof(double));
-    b.rtt_us = malloc(n * sizeof(double));
-    a.t_send = malloc(n * sizeof(double));
-    b.t_send = malloc(n * sizeof(double));
-    a.rtt_all_us = malloc(n * sizeof(double));
-    b.rtt_all_us = malloc(n * sizeof(double));
-    if (a.fd < 0 || b.fd < 0 || !a.rtt_us || !b.rtt_us || !a.t_send || !b.t_send || !a.rtt_all_us || !b.rtt_all_us)
+    const double t0 = now_ns(CLOCK_MONOTONIC) + 20e6;
+    if (rt < 0 || ctrl_init(&a, udp_to(tport), n, &o, t0, 0.0) != 0 ||
+        ctrl_init(&b, udp_to(rport), n, &o, t0, 0.5e9 / o.rate) != 0)
         return 1;
-    double ticks0[3], ticks1[3];
-    cpu_ticks(ticks0);
-    a.period_ns = b.period_ns = 1e9 / o.rate;
-    a.t0_ns = b.t0_ns = now_ns(CLOCK_MONOTONIC) + 20e6;
-    b.offset_ns = a.period_ns / 2;
-    a.n = b.n = n;
     a.q = b.q = (const double(*)[NAX])q;
     a.ref = (const double(*)[NAX])ref;
-    a.fifo = b.fifo = o.fifo;
     if (o.fifo)
         mlockall(MCL_CURRENT | MCL_FUTURE);
+    double ticks0[3], ticks1[3];
+    cpu_ticks(ticks0);
     pthread_t ta, tb;
     pthread_create(&ta, NULL, ctrl_run, &a);
     pthread_create(&tb, NULL, ctrl_run, &b);
@@ -503,43 +543,22 @@ int main(int argc, char **argv)
     cpu_ticks(ticks1);
     kill(rt, SIGTERM);
     kill(resp, SIGTERM);
-    char rep[4096] = "";
-    FILE *fout = fdopen(out[0], "r");
+    char rep[4096] = "", line[1024], rline[256] = "";
     if (!fgets(rep, sizeof rep, fout))
         rep[0] = '\0';
     while (fgets(line, sizeof line, ferr))
         fputs(line, stderr);
-    char rline[256] = "";
     const ssize_t rn = read(pfd[0], rline, sizeof rline - 1);
     rline[rn > 0 ? rn : 0] = '\0';
     int st = 0;
     waitpid(rt, &st, 0);
     waitpid(resp, NULL, 0);
-    size_t rcount = 0, rover = 0;
-    double rmed = NAN, rp4 = NAN, rmax = NAN, rcpu = NAN, rp2 = NAN;
-    sscanf(rline, "%zu %lf %lf %lf %lf %zu %lf", &rcount, &rmed, &rp4, &rmax, &rcpu, &rover, &rp2);
-    printf("rsi_bench: %zu cycles at %.0f Hz (%.0f s), %s; the responder half a period after rcal-rt\n", n, o.rate,
-           o.seconds, o.fifo ? "--fifo asked (notes above say when refused)" : "normal scheduling (no --fifo)");
-    const double busy = ticks1[0] - ticks0[0], idle = ticks1[1] - ticks0[1], steal = ticks1[2] - ticks0[2];
-    printf("  the machine meanwhile (/proc/stat, all CPUs): %.1f %% busy, %.1f %% idle, %.1f %% stolen by the "
-           "hypervisor\n", 100 * busy / (busy + idle + steal + 1e-9), 100 * idle / (busy + idle + steal + 1e-9),
-           100 * steal / (busy + idle + steal + 1e-9));
-    report("rcal-rt", &a);
-    report("trivial", &b);
-    printf("  rcal-rt's own report: %s", rep[0] ? rep : "(none)\n");
-    printf("  trivial responder receive-to-send: median %.1f us, p99 %.1f us, p99.99 %.1f us, max %.1f us; %zu answers "
-           "over a cycle; CPU %.2f us per answer (%zu answers)\n", rmed, rp2, rp4, rmax, rover, rcpu, rcount);
-    printf("  AK against rcal compensate (after the %d-cycle ramp): %zu compared, %zu differ by more than 1e-6 deg "
-           "(worst %.3g deg)\n", HOLD, a.compared, a.wrong_ak, a.worst_ak);
+    summary(&a, &b, &o, ticks0, ticks1, rep, rline);
     const int bad = a.wrong_ak || a.wrong_ipoc || b.wrong_ipoc || a.compared == 0 || !WIFEXITED(st) ||
                     WEXITSTATUS(st) != 0;
     free(q);
     free(ref);
-    free(a.rtt_us);
-    free(b.rtt_us);
-    free(a.t_send);
-    free(b.t_send);
-    free(a.rtt_all_us);
-    free(b.rtt_all_us);
+    ctrl_free(&a);
+    ctrl_free(&b);
     return bad ? 1 : 0;
 }

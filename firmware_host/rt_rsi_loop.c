@@ -58,14 +58,6 @@ void rt_rsi_usage(FILE *f)
             "           --rsi-controller) answered; runs until --seconds or SIGINT/SIGTERM, then reports\n");
 }
 
-int rt_rsi_wanted(int argc, char **argv)
-{
-    for (int i = 1; i < argc; ++i)
-        if (strncmp(argv[i], "--rsi-", 6) == 0)
-            return 1;
-    return 0;
-}
-
 typedef struct rsi_opts {
     const char *model, *nominal, *config, *addr, *controller;
     long port;
@@ -581,6 +573,83 @@ static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockadd
     return 0;
 }
 
+/* --rsi-config, the port and --rsi-controller into io, net and o: -1 when
+ * read, else the exit status (1 a file refused, 2 a usage error). */
+static int setup(rsi_io *io, rt_rsi_net *net, rsi_opts *o)
+{
+    rt_rsi_names_default(&io->names);
+    if (o->config) {
+        char *text = NULL, msg[1024];
+        size_t len = 0;
+        rch_diag d;
+        if (rch_read_file(&text, &len, o->config, (size_t)1 << 20, &d) != 0) {
+            fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
+            return 1;
+        }
+        const rt_rsi_status st = rt_rsi_config_read(&io->names, net, msg, sizeof msg, text, len, o->config);
+        free(text);
+        if (st != RT_RSI_OK) {
+            fprintf(stderr, "rcal-rt: %s\n", st == RT_RSI_ERR_CONFIG ? msg : rt_rsi_strerror(st));
+            return 1;
+        }
+    }
+    if (o->port < 0)
+        o->port = net->port;
+    if (o->port < 0) {
+        fprintf(stderr, "rcal-rt: the RSI mode needs --rsi-port PORT (or a PORT in --rsi-config)\n");
+        return 2;
+    }
+    if (o->controller) {
+        if (inet_pton(AF_INET, o->controller, &io->only) != 1) {
+            fprintf(stderr, "rcal-rt: --rsi-controller '%s' is not an IPv4 address\n", o->controller);
+            return 2;
+        }
+        io->have_only = 1;
+    }
+    return -1;
+}
+
+/* The loop: one datagram, its answer, then the log and (once a second) the
+ * model file; until --seconds or a signal. Then the report. */
+static void serve(rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_opts *o, int fifo_on)
+{
+    static rsi_state s;
+    memset(&s, 0, sizeof s);
+    s.robot_delay = -1;
+    const double t_end = o->seconds > 0 ? mono_s() + o->seconds : INFINITY;
+    double cpu0 = -1.0, last_check = mono_s();
+    static char buf[RT_RSI_MAX_DGRAM + 1];
+    const struct timeval rcv_to = {0, 100000}; /* the stop flag and --seconds looked at 10 times a second */
+    if (setsockopt(io->fd, SOL_SOCKET, SO_RCVTIMEO, &rcv_to, sizeof rcv_to) != 0)
+        fprintf(stderr, "rcal-rt: rsi: SO_RCVTIMEO: %s\n", strerror(errno));
+    for (double t = mono_s(); !g_stop && t < t_end;) {
+        size_t len;
+        struct sockaddr_in from;
+        struct timespec rx;
+        if (rx_one(io, buf, sizeof buf - 1, &len, &from, &rx) == 0) {
+            if (cpu0 < 0) {
+                struct timespec c;
+                clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c);
+                cpu0 = (double)c.tv_sec + (double)c.tv_nsec * 1e-9;
+            }
+            one(&s, io, cs, m, o, buf, len, &from, &rx);
+        } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+            fprintf(stderr, "rcal-rt: rsi: receive: %s\n", strerror(errno));
+            break;
+        }
+        t = mono_s();
+        if (t - last_check > 1.0) {
+            check_model(&s, io, o);
+            flush_log(&s);
+            last_check = t;
+        }
+    }
+    struct timespec c;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c);
+    const double cpu_s = cpu0 < 0 ? 0.0 : (double)c.tv_sec + (double)c.tv_nsec * 1e-9 - cpu0;
+    report(&s, io, o, cpu_s, fifo_on);
+}
+
 int rt_rsi_main(int argc, char **argv)
 {
     rsi_opts o;
@@ -589,36 +658,9 @@ int rt_rsi_main(int argc, char **argv)
         return rc;
     static rsi_io io;
     memset(&io, 0, sizeof io);
-    rt_rsi_names_default(&io.names);
     rt_rsi_net net = {"", -1};
-    if (o.config) {
-        char *text = NULL, msg[1024];
-        size_t len = 0;
-        rch_diag d;
-        if (rch_read_file(&text, &len, o.config, (size_t)1 << 20, &d) != 0) {
-            fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
-            return 1;
-        }
-        const rt_rsi_status st = rt_rsi_config_read(&io.names, &net, msg, sizeof msg, text, len, o.config);
-        free(text);
-        if (st != RT_RSI_OK) {
-            fprintf(stderr, "rcal-rt: %s\n", st == RT_RSI_ERR_CONFIG ? msg : rt_rsi_strerror(st));
-            return 1;
-        }
-    }
-    if (o.port < 0)
-        o.port = net.port;
-    if (o.port < 0) {
-        fprintf(stderr, "rcal-rt: the RSI mode needs --rsi-port PORT (or a PORT in --rsi-config)\n");
-        return 2;
-    }
-    if (o.controller) {
-        if (inet_pton(AF_INET, o.controller, &io.only) != 1) {
-            fprintf(stderr, "rcal-rt: --rsi-controller '%s' is not an IPv4 address\n", o.controller);
-            return 2;
-        }
-        io.have_only = 1;
-    }
+    if ((rc = setup(&io, &net, &o)) >= 0)
+        return rc;
     static rsi_model m;
     if (model_load(&m, &o) != 0)
         return 1;
@@ -642,47 +684,12 @@ int rt_rsi_main(int argc, char **argv)
     }
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
+    sa.sa_handler = on_signal; /* no SA_RESTART: a signal ends the blocking read */
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     int fifo_on = 0;
     set_realtime(&o, &fifo_on);
-    static rsi_state s;
-    memset(&s, 0, sizeof s);
-    s.robot_delay = -1;
-    const double t_end = o.seconds > 0 ? mono_s() + o.seconds : INFINITY;
-    double cpu0 = -1.0, last_check = mono_s();
-    static char buf[RT_RSI_MAX_DGRAM + 1];
-    const struct timeval rcv_to = {0, 100000}; /* the stop flag and --seconds looked at 10 times a second */
-    if (setsockopt(io.fd, SOL_SOCKET, SO_RCVTIMEO, &rcv_to, sizeof rcv_to) != 0)
-        fprintf(stderr, "rcal-rt: rsi: SO_RCVTIMEO: %s\n", strerror(errno));
-    for (double t = mono_s(); !g_stop && t < t_end;) {
-        size_t len;
-        struct sockaddr_in from;
-        struct timespec rx;
-        if (rx_one(&io, buf, sizeof buf - 1, &len, &from, &rx) == 0) {
-            if (cpu0 < 0) {
-                struct timespec c;
-                clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c);
-                cpu0 = (double)c.tv_sec + (double)c.tv_nsec * 1e-9;
-            }
-            one(&s, &io, &cs, &m, &o, buf, len, &from, &rx);
-        } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
-            fprintf(stderr, "rcal-rt: rsi: receive: %s\n", strerror(errno));
-            break;
-        }
-        /* after the answer: the model file, once a second */
-        t = mono_s();
-        if (t - last_check > 1.0) {
-            check_model(&s, &io, &o);
-            flush_log(&s);
-            last_check = t;
-        }
-    }
-    struct timespec c;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c);
-    const double cpu_s = cpu0 < 0 ? 0.0 : (double)c.tv_sec + (double)c.tv_nsec * 1e-9 - cpu0;
-    report(&s, &io, &o, cpu_s, fifo_on);
+    serve(&io, &cs, &m, &o, fifo_on);
     close(io.fd);
     rt_rsi_dec_free(io.dec);
     rt_rsi_hist_free(&io.hist);

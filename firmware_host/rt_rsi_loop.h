@@ -6,10 +6,7 @@
 
 #include <stdio.h>
 
-/* 1 when the command line asks for RSI (an --rsi-* option). */
-int rt_rsi_wanted(int argc, char **argv);
-
-/* The whole RSI mode: its options, the model, the UDP loop until --seconds
+/* The whole RSI mode (rcal_rt.c calls it when an option starts with --rsi-): its options, the model, the UDP loop until --seconds
  * or SIGINT/SIGTERM, the report. Exit status: 0 after a clean stop, 1 for a
  * model, file or socket error, 2 for a usage error. */
 int rt_rsi_main(int argc, char **argv);
