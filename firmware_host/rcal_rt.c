@@ -38,6 +38,9 @@
 #include "rch_opt.h"
 #include "rch_robot.h"
 #include "rch_stdio.h"
+#ifdef RCAL_HAVE_EXPAT
+#include "rt_rsi_loop.h"
+#endif
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -72,6 +75,9 @@ static void usage(FILE *f)
             "           --cold solves every target from scratch (no warm start from the last correction)\n"
             "  --emit-c writes the C tables of a model for fw_example.c (fw_model_data.h)\n"
             "Without --model, the compiled-in firmware model tables are used.\n");
+#ifdef RCAL_HAVE_EXPAT
+    rt_rsi_usage(f);
+#endif
 }
 
 static double now_ns(void)
@@ -645,6 +651,15 @@ static void set_realtime(const rt_opts *o)
 static int run(int argc, char **argv)
 {
     rt_opts o;
+    for (int i = 1; i < argc; ++i) /* --rsi-*: the KUKA RSI partner (rt_rsi_loop.c, docs/rsi.md) */
+        if (strncmp(argv[i], "--rsi-", 6) == 0) {
+#ifdef RCAL_HAVE_EXPAT
+            return rt_rsi_main(argc, argv);
+#else
+            fprintf(stderr, "rcal-rt: %s: this rcal-rt was built without expat (libexpat1-dev): no RSI\n", argv[i]);
+            return 2;
+#endif
+        }
     int rc = parse_args(&o, argc, argv);
     if (rc >= 0)
         return rc;
