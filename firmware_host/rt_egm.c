@@ -118,10 +118,13 @@ size_t rt_egm_encode(uint8_t *buf, size_t cap, uint32_t seqno, uint32_t tm_ms, c
 
 /* ---- the guard ---- */
 
-void rt_egm_guard_init(rt_egm_guard *g, double step_deg)
+void rt_egm_guard_init(rt_egm_guard *g, double step_deg, const double q_min_deg[RT_EGM_NJ],
+                       const double q_max_deg[RT_EGM_NJ])
 {
     memset(g, 0, sizeof *g);
     g->step_deg = step_deg;
+    memcpy(g->q_min_deg, q_min_deg, sizeof g->q_min_deg);
+    memcpy(g->q_max_deg, q_max_deg, sizeof g->q_max_deg);
 }
 
 int rt_egm_guard_step(rt_egm_guard *g, double sent_deg[RT_EGM_NJ], const double target_deg[RT_EGM_NJ],
@@ -145,6 +148,7 @@ int rt_egm_guard_step(rt_egm_guard *g, double sent_deg[RT_EGM_NJ], const double 
     for (int i = 0; i < RT_EGM_NJ; ++i) {
         /* the compensation's own numbers when nothing was limited (bit for bit what rcal compensate writes) */
         sent_deg[i] = comp_deg && !limited ? comp_deg[i] : target_deg[i] + c[i];
+        sent_deg[i] = fmin(fmax(sent_deg[i], g->q_min_deg[i]), g->q_max_deg[i]);
         g->corr_deg[i] = c[i];
         g->sent_deg[i] = sent_deg[i];
     }

@@ -66,16 +66,19 @@ size_t rt_egm_encode(uint8_t *buf, size_t cap, uint32_t seqno, uint32_t tm_ms, c
  * the last one when it did not, and its change per cycle is limited to
  * step_deg per joint, so |sent_k - sent_k-1| <= |target_k - target_k-1| +
  * step_deg for every joint, whatever happens. The first correction is taken
- * as it is (there is no earlier reference). */
+ * as it is (there is no earlier reference). The reference is then kept
+ * within the joint limits (a clip never makes a change larger). */
 typedef struct rt_egm_guard {
     double step_deg;                 /* the stated limit of the correction's change per cycle */
+    double q_min_deg[RT_EGM_NJ], q_max_deg[RT_EGM_NJ]; /* the joint limits every reference is kept within */
     int have;
     double corr_deg[RT_EGM_NJ];      /* the correction of the last reference */
     double sent_deg[RT_EGM_NJ];      /* the last reference */
     unsigned long n_clamped;         /* references whose correction was limited */
 } rt_egm_guard;
 
-void rt_egm_guard_init(rt_egm_guard *g, double step_deg);
+void rt_egm_guard_init(rt_egm_guard *g, double step_deg, const double q_min_deg[RT_EGM_NJ],
+                       const double q_max_deg[RT_EGM_NJ]);
 /* The next reference into sent_deg for target_deg: comp_deg its compensation,
  * or NULL when the compensation failed (the last correction is kept).
  * Returns 1 when the correction was limited, else 0. */

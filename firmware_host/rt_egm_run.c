@@ -549,15 +549,18 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
     static rc_model lim;
     memset(&st, 0, sizeof st);
     st.o = o;
-    rt_egm_guard_init(&st.g, o->step_deg);
     w.ok = 0;
     w.cur = -1;
     rc_comp_config cfg = *cfg0;
     rc_comp_stream_init_kin(&s, cal, nom, &cfg);
+    double qmin[RT_EGM_NJ], qmax[RT_EGM_NJ];
     for (int i = 0; i < RC_NJ; ++i) {
         lim.q_min_rad[i] = (double)cal->q_min_rad[i];
         lim.q_max_rad[i] = (double)cal->q_max_rad[i];
+        qmin[i] = lim.q_min_rad[i] / DEG;
+        qmax[i] = lim.q_max_rad[i] / DEG;
     }
+    rt_egm_guard_init(&st.g, o->step_deg, qmin, qmax);
     if (o->in_path && src_open(&src, o->in_path, &lim) != 0)
         return 1;
     struct sockaddr_in ctl;
