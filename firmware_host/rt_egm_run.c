@@ -46,6 +46,8 @@
 #define EGM_LOG_EVERY 1000
 /* the model file looked at every this many replies (1 s at 250 Hz) */
 #define EGM_WATCH_EVERY 250
+/* this many older seqnos in a row from the controller: its numbering restarted (100 ms at 4 ms) */
+#define EGM_RESTART_RUN 25u
 /* a line of --in longer than this is refused */
 #define EGM_MAX_LINE 4096
 
@@ -253,6 +255,8 @@ typedef struct egm_state {
     rt_egm_guard g;
     double hist[EGM_HIST][RT_EGM_NJ];
     unsigned nhist, hpos;
+    unsigned back_run;           /* older seqnos in a row */
+    unsigned long restarts;      /* numbering restarts taken */
 } egm_state;
 
 /* 1 when this occurrence of fault k is to be logged */
@@ -470,15 +474,16 @@ static void summary(egm_state *st, const char *why_end, int ended_input, int rc)
     fprintf(stderr, "%s: faults:", o->label);
     for (int k = 0; k < F_NKIND; ++k)
         fprintf(stderr, " %s %lu", fault_name[k], st->n[k]);
-    fprintf(stderr, "; model reloads %lu\n", st->reloads);
+    fprintf(stderr, "; model reloads %lu, seqno restarts %lu\n", st->reloads, st->restarts);
     fprintf(stderr, "%s: receive-to-send median %.1f us, p99.99 %.1f us, max %.1f us; CPU per cycle median %.1f "
                     "us, mean %.1f us; exit status %d\n", o->label, pct(st->lat_us, st->ns, 50),
             pct(st->lat_us, st->ns, 99.99), st->ns ? st->lat_us[st->ns - 1] : NAN, pct(st->cpu_us, st->ns, 50),
             cpu_mean, rc);
     if (o->json) {
         printf("{\"label\": \"%s\", \"end\": \"%s\", \"datagrams\": %lu, \"replies\": %lu, \"targets\": %lu, "
-               "\"input_ended\": %d, \"rows_refused\": %lu, \"reloads\": %lu, \"faults\": {", o->label, why_end,
-               st->datagrams, st->replies, st->targets, ended_input, st->rows_refused, st->reloads);
+               "\"input_ended\": %d, \"rows_refused\": %lu, \"reloads\": %lu, \"restarts\": %lu, \"faults\": {",
+               o->label, why_end, st->datagrams, st->replies, st->targets, ended_input, st->rows_refused, st->reloads,
+               st->restarts);
         for (int k = 0; k < F_NKIND; ++k)
             printf("%s\"%s\": %lu", k ? ", " : "", fault_name[k], st->n[k]);
         printf("}, \"rx_tx_us\": {\"median\": %.3f, \"p99_99\": %.3f, \"max\": %.3f}, \"cpu_us\": {\"median\": "
@@ -507,8 +512,15 @@ static int check_datagram(egm_state *st, const rt_egm_robot *r, int *have_seq, u
             if (count_fault(st, F_REORDERED, 1))
                 fprintf(stderr, "rcal-rt: egm: seqno %u from %s after %u: out of order, not answered\n", r->seqno,
                         from, *last_seq);
-            return 0;
+            /* a controller that restarted its numbering (a new EGM session): EGM_RESTART_RUN older seqnos in a
+             * row are taken as the new numbering, not as reordering */
+            if (++st->back_run < EGM_RESTART_RUN)
+                return 0;
+            fprintf(stderr, "rcal-rt: egm: %u datagrams in a row from %s numbered before %u: its numbering restarted "
+                            "(at %u); answered again\n", st->back_run, from, *last_seq, r->seqno);
+            st->restarts++;
         }
+        st->back_run = 0;
         if (d > 1 && count_fault(st, F_DROPPED, (unsigned long)(d - 1)))
             fprintf(stderr, "rcal-rt: egm: seqno %u from %s after %u: %d datagrams lost\n", r->seqno, from,
                     *last_seq, d - 1);

@@ -447,6 +447,28 @@ def not_following():
     check(rc == 1, "not following: exit 1")
 
 
+def restart():
+    """the controller's numbering starts again (a new EGM session): taken after 25 older seqnos in a row"""
+    rows = path_rows(200, 3.0)
+    src = os.path.join(WORK, "restart.csv")
+    write_csv(src, rows)
+    p, port = start_rt(src, MODEL)
+    c = Controller(port, rows[0])
+    for _ in range(100):
+        c.cycle(jitter_ms=0.5)
+    n_before = len(c.replies)
+    c.seq = 0
+    for _ in range(60):
+        c.cycle(jitter_ms=0.5)
+    rc, summ, err = finish(p)
+    check(n_before == 100 and len(c.replies) == 100 + 60 - 24,
+          "restart: the first 24 of the new numbering not answered, then every one (%d, %d replies)"
+          % (n_before, len(c.replies)))
+    check(summ and summ["restarts"] == 1 and summ["faults"]["reordered"] == 25,
+          "restart: one restart taken, 25 counted as out of order (%s)" % (summ and summ["faults"]["reordered"]))
+    no_jump(c.replies, rows, "restart")
+
+
 def no_controller():
     src = os.path.join(WORK, "clean.csv")
     port = free_port()
@@ -460,6 +482,7 @@ clean()
 faults()
 stall()
 not_following()
+restart()
 no_controller()
 if FAILS:
     print("%d check(s) failed" % len(FAILS))
