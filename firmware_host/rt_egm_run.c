@@ -609,7 +609,7 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
     const char *why_end = "stopped by a signal";
     unsigned char buf[RT_EGM_MAX_DGRAM + 1];
     uint8_t out[256];
-    char from[64];
+    char from[64], ctl_s[64] = "";
     for (;;) {
         if (egm_stop)
             break;
@@ -629,30 +629,32 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
         const double t_rx = now_ns(), c_rx = cpu_ns();
         if (n < 0)
             continue;
-        addr_str(from, sizeof from, &peer);
+        /* the sender's address as text: only for a log line (the controller's is made once, at the lock) */
         /* only the controller: the address given, else the first valid sender (address and port) */
         const int from_ctl = locked ? addr_eq(&peer, &ctl)
                              : has_ctl ? peer.sin_addr.s_addr == ctl.sin_addr.s_addr : 1;
         if (!from_ctl) {
             if (count_fault(&st, F_FOREIGN, 1))
-                fprintf(stderr, "rcal-rt: egm: a datagram from %s, not the controller: not answered\n", from);
+                fprintf(stderr, "rcal-rt: egm: a datagram from %s, not the controller: not answered\n",
+                        addr_str(from, sizeof from, &peer));
             continue;
         }
         rt_egm_robot r;
         char why[256];
         if (rt_egm_decode(&r, why, sizeof why, &arena, buf, (size_t)n) != 0) {
             if (count_fault(&st, F_MALFORMED, 1))
-                fprintf(stderr, "rcal-rt: egm: from %s: %s: not answered\n", from, why);
+                fprintf(stderr, "rcal-rt: egm: from %s: %s: not answered\n", addr_str(from, sizeof from, &peer), why);
             continue;
         }
         if (!locked) {
             ctl = peer;
             locked = 1;
+            addr_str(ctl_s, sizeof ctl_s, &ctl);
             if (!o->quiet)
-                fprintf(stderr, "rcal-rt: egm: the controller is %s (only it is answered)\n", from);
+                fprintf(stderr, "rcal-rt: egm: the controller is %s (only it is answered)\n", ctl_s);
         }
         st.datagrams++;
-        if (!check_datagram(&st, &r, &have_seq, &last_seq, t_rx, &t_last, from))
+        if (!check_datagram(&st, &r, &have_seq, &last_seq, t_rx, &t_last, ctl_s))
             continue;
         /* the reference: the prepared one, else (the stream stalled) one more look, else the last again */
         if (!nx.ready)
@@ -674,7 +676,7 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
         const ssize_t sent = sendto(fd, out, len, 0, (struct sockaddr *)&ctl, sizeof ctl);
         const double t_tx = now_ns();
         if (sent != (ssize_t)len && count_fault(&st, F_SEND, 1))
-            fprintf(stderr, "rcal-rt: egm: sending to %s: %s\n", from, sent < 0 ? strerror(errno) : "short write");
+            fprintf(stderr, "rcal-rt: egm: sending to %s: %s\n", ctl_s, sent < 0 ? strerror(errno) : "short write");
         st.replies++;
         memcpy(st.hist[st.hpos], ref, sizeof ref);
         st.hpos = (st.hpos + 1) % EGM_HIST;
