@@ -288,6 +288,121 @@ static void read_json(side *s)
     close(s->rd);
 }
 
+typedef struct bench_check {
+    unsigned long wrong, checked; /* rcal-rt's replies off the expected joints by more than 1e-6 deg, and all */
+    double worst_deg;
+} bench_check;
+
+/* The replies of this cycle (seq) until both came or the deadline passed;
+ * rcal-rt's (side 0) checked against expect (cycles + 2 rows). */
+static void collect(side sd[2], uint32_t seq_now, double deadline, const double (*expect)[RT_EGM_NJ], size_t cycles,
+                    bench_check *chk)
+{
+    uint8_t in[RT_EGM_MAX_DGRAM];
+    while (!(sd[0].got && sd[1].got)) {
+        const double left_ms = (deadline - now_ns()) / 1e6;
+        if (left_ms <= 0)
+            break;
+        struct pollfd p[2] = {{sd[0].fd, POLLIN, 0}, {sd[1].fd, POLLIN, 0}};
+        if (poll(p, 2, (int)ceil(left_ms)) <= 0)
+            continue;
+        for (int j = 0; j < 2; ++j) {
+            if (!(p[j].revents & POLLIN))
+                continue;
+            const ssize_t r = recv(sd[j].fd, in, sizeof in, 0);
+            const double t = now_ns();
+            uint32_t seq;
+            double q[RT_EGM_NJ];
+            if (r <= 0 || unpack_sensor(&seq, q, in, (size_t)r) != 0)
+                continue;
+            sd[j].replies++;
+            if (seq == seq_now && !sd[j].got) {
+                sd[j].got = 1;
+                sd[j].rtt_us[sd[j].n_rtt++] = (t - sd[j].t_send) / 1e3;
+            }
+            if (j == 0 && seq >= 1 && seq <= cycles + 1) {
+                memcpy(sd[0].q, q, sizeof q); /* the robot follows */
+                double m = 0;
+                for (int i = 0; i < RT_EGM_NJ; ++i)
+                    m = fmax(m, fabs(q[i] - expect[seq - 1][i]));
+                chk->worst_deg = fmax(chk->worst_deg, m);
+                chk->wrong += m > 1e-6;
+                chk->checked++;
+            }
+        }
+    }
+}
+
+static void report(side sd[2], const bench_check *chk, double rate_hz, double seconds, size_t cycles, int fifo,
+                   int fifo_ok, double load0, double load1, int json)
+{
+    const char *names[2] = {"rcal-rt", "trivial"};
+    if (json) {
+        printf("{\"rate_hz\": %.1f, \"seconds\": %.1f, \"cycles\": %zu, \"sched_fifo\": %s, \"load_before\": %.2f, "
+               "\"load_after\": %.2f, \"checked\": %lu, \"wrong\": %lu, \"worst_deg\": %.3g",
+               rate_hz, seconds, cycles, fifo_ok ? "true" : "false", load0, load1, chk->checked, chk->wrong,
+               chk->worst_deg);
+        for (int j = 0; j < 2; ++j)
+            printf(", \"%s\": {\"missed\": %lu, \"rtt_us\": {\"median\": %.3f, \"p99_99\": %.3f, \"max\": %.3f}, "
+                   "\"responder\": %s}", names[j], sd[j].missed, pct(sd[j].rtt_us, sd[j].n_rtt, 50),
+                   pct(sd[j].rtt_us, sd[j].n_rtt, 99.99), sd[j].n_rtt ? sd[j].rtt_us[sd[j].n_rtt - 1] : 0.0,
+                   sd[j].json[0] ? sd[j].json : "null");
+        printf("}\n");
+    } else {
+        printf("rcal-rt --egm-bench: %zu cycles at %.0f Hz (%.0f s), loopback, %s; load average %.2f before, %.2f "
+               "after\n", cycles, rate_hz, seconds,
+               fifo_ok ? "SCHED_FIFO (controller 81, responders 80)"
+                       : fifo ? "SCHED_FIFO refused: normal scheduling" : "normal scheduling (no --fifo)",
+               load0, load1);
+        for (int j = 0; j < 2; ++j) {
+            printf("  %-8s missed cycles %lu; round trip median %.1f us, p99.99 %.1f us, max %.1f us\n", names[j],
+                   sd[j].missed, pct(sd[j].rtt_us, sd[j].n_rtt, 50), pct(sd[j].rtt_us, sd[j].n_rtt, 99.99),
+                   sd[j].n_rtt ? sd[j].rtt_us[sd[j].n_rtt - 1] : 0.0);
+            printf("           responder: %s\n", sd[j].json[0] ? sd[j].json : "(no summary)");
+        }
+        printf("  rcal-rt's replies: %lu checked against the path compensated here, %lu differ by more than 1e-6 "
+               "deg (largest %.3g deg)\n", chk->checked, chk->wrong, chk->worst_deg);
+    }
+}
+
+/* The two responders started, each on a free loopback port, and the controller's socket to each. 0 or -1. */
+static int start_sides(side sd[2], const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg, double rate_hz,
+                       size_t cycles, int fifo)
+{
+    unsigned port0 = 0;
+    /* two free ports: bound by the kernel, released, handed to the children */
+    for (int i = 0; i < 2; ++i) {
+        const int t = socket(AF_INET, SOCK_DGRAM, 0);
+        struct sockaddr_in a;
+        socklen_t al = sizeof a;
+        memset(&a, 0, sizeof a);
+        a.sin_family = AF_INET;
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        if (t < 0 || bind(t, (struct sockaddr *)&a, sizeof a) != 0 || getsockname(t, (struct sockaddr *)&a, &al) != 0) {
+            fprintf(stderr, "rcal-rt: --egm-bench: no loopback UDP port: %s\n", strerror(errno));
+            return -1;
+        }
+        sd[i].to = a;
+        port0 = ntohs(a.sin_port);
+        close(t);
+        sd[i].pid = spawn(&sd[i].rd, i, port0, cal, nom, cfg, rate_hz, cycles, fifo);
+        if (sd[i].pid < 0) {
+            fprintf(stderr, "rcal-rt: --egm-bench: fork: %s\n", strerror(errno));
+            return -1;
+        }
+        sd[i].fd = socket(AF_INET, SOCK_DGRAM, 0);
+        struct sockaddr_in me;
+        memset(&me, 0, sizeof me);
+        me.sin_family = AF_INET;
+        me.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        bind(sd[i].fd, (struct sockaddr *)&me, sizeof me);
+        synth_q(sd[i].q, 0, rate_hz);
+        for (int j = 0; j < RT_EGM_NJ; ++j)
+            sd[i].q[j] /= DEG;
+    }
+    return 0;
+}
+
 int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg, double rate_hz, double seconds,
                  int fifo, int json)
 {
@@ -320,36 +435,11 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
     }
     double la0[3] = {0, 0, 0}, la1[3] = {0, 0, 0};
     getloadavg(la0, 3);
-    unsigned port0 = 0;
-    /* two free ports: bound by the kernel, released, handed to the children */
-    for (int i = 0; i < 2; ++i) {
-        const int t = socket(AF_INET, SOCK_DGRAM, 0);
-        struct sockaddr_in a;
-        socklen_t al = sizeof a;
-        memset(&a, 0, sizeof a);
-        a.sin_family = AF_INET;
-        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        if (t < 0 || bind(t, (struct sockaddr *)&a, sizeof a) != 0 || getsockname(t, (struct sockaddr *)&a, &al) != 0) {
-            fprintf(stderr, "rcal-rt: --egm-bench: no loopback UDP port: %s\n", strerror(errno));
-            return 1;
-        }
-        sd[i].to = a;
-        port0 = ntohs(a.sin_port);
-        close(t);
-        sd[i].pid = spawn(&sd[i].rd, i, port0, cal, nom, cfg, rate_hz, cycles, fifo);
-        if (sd[i].pid < 0) {
-            fprintf(stderr, "rcal-rt: --egm-bench: fork: %s\n", strerror(errno));
-            return 1;
-        }
-        sd[i].fd = socket(AF_INET, SOCK_DGRAM, 0);
-        struct sockaddr_in me;
-        memset(&me, 0, sizeof me);
-        me.sin_family = AF_INET;
-        me.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        bind(sd[i].fd, (struct sockaddr *)&me, sizeof me);
-        synth_q(sd[i].q, 0, rate_hz);
-        for (int j = 0; j < RT_EGM_NJ; ++j)
-            sd[i].q[j] /= DEG;
+    if (start_sides(sd, cal, nom, cfg, rate_hz, cycles, fifo) != 0) {
+        free(expect);
+        free(sd[0].rtt_us);
+        free(sd[1].rtt_us);
+        return 1;
     }
     const int fifo_ok = fifo ? set_fifo(81) == 0 : 0;
     if (fifo && !fifo_ok)
@@ -357,12 +447,11 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
                 strerror(errno));
     struct timespec z = {0, 200000000L}; /* the responders bind */
     nanosleep(&z, NULL);
-    unsigned long wrong = 0, checked = 0;
-    double worst_deg = 0.0;
+    bench_check chk = {0, 0, 0.0};
     struct timespec next;
     clock_gettime(CLOCK_MONOTONIC, &next);
     const double t0 = now_ns();
-    uint8_t out[512], in[RT_EGM_MAX_DGRAM];
+    uint8_t out[512];
     for (size_t k = 0; k < cycles; ++k) {
         next.tv_nsec += period_ns;
         while (next.tv_nsec >= 1000000000L) {
@@ -379,38 +468,7 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
             x->t_send = now_ns();
             sendto(x->fd, out, len, 0, (struct sockaddr *)&x->to, sizeof x->to);
         }
-        while (!(sd[0].got && sd[1].got)) {
-            const double left_ms = (deadline - now_ns()) / 1e6;
-            if (left_ms <= 0)
-                break;
-            struct pollfd p[2] = {{sd[0].fd, POLLIN, 0}, {sd[1].fd, POLLIN, 0}};
-            if (poll(p, 2, (int)ceil(left_ms)) <= 0)
-                continue;
-            for (int j = 0; j < 2; ++j) {
-                if (!(p[j].revents & POLLIN))
-                    continue;
-                const ssize_t r = recv(sd[j].fd, in, sizeof in, 0);
-                const double t = now_ns();
-                uint32_t seq;
-                double q[RT_EGM_NJ];
-                if (r <= 0 || unpack_sensor(&seq, q, in, (size_t)r) != 0)
-                    continue;
-                sd[j].replies++;
-                if (seq == (uint32_t)k + 1 && !sd[j].got) {
-                    sd[j].got = 1;
-                    sd[j].rtt_us[sd[j].n_rtt++] = (t - sd[j].t_send) / 1e3;
-                }
-                if (j == 0 && seq >= 1 && seq <= cycles + 1) {
-                    memcpy(sd[0].q, q, sizeof q); /* the robot follows */
-                    double m = 0;
-                    for (int i = 0; i < RT_EGM_NJ; ++i)
-                        m = fmax(m, fabs(q[i] - expect[seq - 1][i]));
-                    worst_deg = fmax(worst_deg, m);
-                    wrong += m > 1e-6;
-                    checked++;
-                }
-            }
-        }
+        collect(sd, (uint32_t)k + 1, deadline, (const double(*)[RT_EGM_NJ])expect, cycles, &chk);
         for (int j = 0; j < 2; ++j)
             sd[j].missed += !sd[j].got;
     }
@@ -423,38 +481,13 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
         close(sd[j].fd);
         qsort(sd[j].rtt_us, sd[j].n_rtt, sizeof(double), cmp_double);
     }
-    const char *names[2] = {"rcal-rt", "trivial"};
-    if (json) {
-        printf("{\"rate_hz\": %.1f, \"seconds\": %.1f, \"cycles\": %zu, \"sched_fifo\": %s, \"load_before\": %.2f, "
-               "\"load_after\": %.2f, \"checked\": %lu, \"wrong\": %lu, \"worst_deg\": %.3g",
-               rate_hz, seconds, cycles, fifo_ok ? "true" : "false", la0[0], la1[0], checked, wrong, worst_deg);
-        for (int j = 0; j < 2; ++j)
-            printf(", \"%s\": {\"missed\": %lu, \"rtt_us\": {\"median\": %.3f, \"p99_99\": %.3f, \"max\": %.3f}, "
-                   "\"responder\": %s}", names[j], sd[j].missed, pct(sd[j].rtt_us, sd[j].n_rtt, 50),
-                   pct(sd[j].rtt_us, sd[j].n_rtt, 99.99), sd[j].n_rtt ? sd[j].rtt_us[sd[j].n_rtt - 1] : 0.0,
-                   sd[j].json[0] ? sd[j].json : "null");
-        printf("}\n");
-    } else {
-        printf("rcal-rt --egm-bench: %zu cycles at %.0f Hz (%.0f s), loopback, %s; load average %.2f before, %.2f "
-               "after\n", cycles, rate_hz, seconds,
-               fifo_ok ? "SCHED_FIFO (controller 81, responders 80)"
-                       : fifo ? "SCHED_FIFO refused: normal scheduling" : "normal scheduling (no --fifo)",
-               la0[0], la1[0]);
-        for (int j = 0; j < 2; ++j) {
-            printf("  %-8s missed cycles %lu; round trip median %.1f us, p99.99 %.1f us, max %.1f us\n", names[j],
-                   sd[j].missed, pct(sd[j].rtt_us, sd[j].n_rtt, 50), pct(sd[j].rtt_us, sd[j].n_rtt, 99.99),
-                   sd[j].n_rtt ? sd[j].rtt_us[sd[j].n_rtt - 1] : 0.0);
-            printf("           responder: %s\n", sd[j].json[0] ? sd[j].json : "(no summary)");
-        }
-        printf("  rcal-rt's replies: %lu checked against the path compensated here, %lu differ by more than 1e-6 "
-               "deg (largest %.3g deg)\n", checked, wrong, worst_deg);
-    }
+    report(sd, &chk, rate_hz, seconds, cycles, fifo, fifo_ok, la0[0], la1[0], json);
     free(expect);
     free(sd[0].rtt_us);
     free(sd[1].rtt_us);
-    if (wrong || checked == 0) {
+    if (chk.wrong || chk.checked == 0) {
         fprintf(stderr, "rcal-rt: --egm-bench: %lu of %lu replies differ from the compensation: exit status 1\n",
-                wrong, checked);
+                chk.wrong, chk.checked);
         return 1;
     }
     return 0;

@@ -551,42 +551,127 @@ static int check_datagram(egm_state *st, const rt_egm_robot *r, int *have_seq, u
     return 1;
 }
 
-int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg0)
+/* The loop's state (one run at a time: static storage in rt_egm_run). */
+typedef struct egm_loop {
+    egm_state st;
+    egm_watch w;
+    rc_comp_stream s;
+    rc_comp_config cfg;
+    rt_egm_arena arena;
+    egm_src src, *sp;        /* sp: &src with --in, else NULL (o->next) */
+    rc_model lim;            /* the joint limits the reader checks */
+    egm_next nx;
+    int fd, has_ctl, locked, have_seq, have_ref;
+    struct sockaddr_in ctl;
+    char ctl_s[64];
+    double t0, t_last;
+    uint32_t last_seq, own_seq;
+    double ref[RT_EGM_NJ];   /* the last reference sent */
+} egm_loop;
+
+/* A datagram from peer (n bytes in buf) checked: 1 to answer it (r decoded), 0 to drop it. */
+static int accept_datagram(egm_loop *L, rt_egm_robot *r, const unsigned char *buf, size_t n,
+                           const struct sockaddr_in *peer, double t_rx)
 {
-    static egm_state st;
-    static egm_watch w;
-    static rc_comp_stream s;
-    static rt_egm_arena arena;
-    static egm_src src;
-    static rc_model lim;
-    memset(&st, 0, sizeof st);
-    st.o = o;
-    w.ok = 0;
-    w.cur = -1;
-    rc_comp_config cfg = *cfg0;
-    rc_comp_stream_init_kin(&s, cal, nom, &cfg);
+    egm_state *st = &L->st;
+    char from[64], why[256];
+    /* only the controller: the address given, else the first valid sender (address and port); the sender's
+     * address made into text only for a log line (the controller's once, at the lock) */
+    const int from_ctl = L->locked ? addr_eq(peer, &L->ctl)
+                         : L->has_ctl ? peer->sin_addr.s_addr == L->ctl.sin_addr.s_addr : 1;
+    if (!from_ctl) {
+        if (count_fault(st, F_FOREIGN, 1))
+            fprintf(stderr, "rcal-rt: egm: a datagram from %s, not the controller: not answered\n",
+                    addr_str(from, sizeof from, peer));
+        return 0;
+    }
+    if (rt_egm_decode(r, why, sizeof why, &L->arena, buf, n) != 0) {
+        if (count_fault(st, F_MALFORMED, 1))
+            fprintf(stderr, "rcal-rt: egm: from %s: %s: not answered\n", addr_str(from, sizeof from, peer), why);
+        return 0;
+    }
+    if (!L->locked) {
+        L->ctl = *peer;
+        L->locked = 1;
+        addr_str(L->ctl_s, sizeof L->ctl_s, &L->ctl);
+        if (!st->o->quiet)
+            fprintf(stderr, "rcal-rt: egm: the controller is %s (only it is answered)\n", L->ctl_s);
+    }
+    st->datagrams++;
+    return check_datagram(st, r, &L->have_seq, &L->last_seq, t_rx, &L->t_last, L->ctl_s);
+}
+
+/* The answer to r: the reference sent, then (off the critical path) the next one prepared and the model
+ * file looked at; the cycle's times recorded. */
+static void answer(egm_loop *L, const rt_egm_robot *r, double t_rx, double c_rx)
+{
+    egm_state *st = &L->st;
+    uint8_t out[256];
+    /* the reference: the prepared one, else (the stream stalled) one more look, else the last again */
+    if (!L->nx.ready)
+        prepare(st, &L->nx, L->sp, &L->s);
+    if (L->nx.ready) {
+        memcpy(L->ref, L->nx.sent, sizeof L->ref);
+        L->have_ref = 1;
+        L->nx.ready = 0;
+    } else if (!L->nx.ended && count_fault(st, F_STALL, 1)) {
+        fprintf(stderr, "rcal-rt: egm: no target from %s for seqno %u: the last reference held\n",
+                L->sp ? L->sp->name : "the source", r->seqno);
+    }
+    if (!L->have_ref) { /* nothing to send yet: the robot holds where it is */
+        memcpy(L->ref, r->fb_deg, sizeof L->ref);
+        L->have_ref = 1;
+    }
+    const uint32_t tm = (uint32_t)((t_rx - L->t0) / 1e6);
+    const size_t len = rt_egm_encode(out, sizeof out, ++L->own_seq, tm, L->ref);
+    const ssize_t sent = sendto(L->fd, out, len, 0, (const struct sockaddr *)&L->ctl, sizeof L->ctl);
+    const double t_tx = now_ns();
+    if (sent != (ssize_t)len && count_fault(st, F_SEND, 1))
+        fprintf(stderr, "rcal-rt: egm: sending to %s: %s\n", L->ctl_s, sent < 0 ? strerror(errno) : "short write");
+    st->replies++;
+    memcpy(st->hist[st->hpos], L->ref, sizeof L->ref);
+    st->hpos = (st->hpos + 1) % EGM_HIST;
+    if (st->nhist < EGM_HIST)
+        st->nhist++;
+    if (st->replies % EGM_WATCH_EVERY == 0)
+        watch_model(st, &L->w, &L->s, &L->cfg);
+    prepare(st, &L->nx, L->sp, &L->s);
+    if (st->ns < EGM_MAX_SAMPLES) {
+        st->lat_us[st->ns] = (t_tx - t_rx) / 1e3;
+        st->cpu_us[st->ns] = (cpu_ns() - c_rx) / 1e3;
+        st->ns++;
+    }
+}
+
+/* Everything before the first datagram: the compensation, the guard, the
+ * input, the socket, the sample arrays, the signals. 0, or the exit status. */
+static int setup(egm_loop *L, const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg0)
+{
+    memset(L, 0, sizeof *L);
+    L->st.o = o;
+    L->w.cur = -1;
+    L->cfg = *cfg0;
+    rc_comp_stream_init_kin(&L->s, cal, nom, &L->cfg);
     double qmin[RT_EGM_NJ], qmax[RT_EGM_NJ];
     for (int i = 0; i < RC_NJ; ++i) {
-        lim.q_min_rad[i] = (double)cal->q_min_rad[i];
-        lim.q_max_rad[i] = (double)cal->q_max_rad[i];
-        qmin[i] = lim.q_min_rad[i] / DEG;
-        qmax[i] = lim.q_max_rad[i] / DEG;
+        L->lim.q_min_rad[i] = (double)cal->q_min_rad[i];
+        L->lim.q_max_rad[i] = (double)cal->q_max_rad[i];
+        qmin[i] = L->lim.q_min_rad[i] / DEG;
+        qmax[i] = L->lim.q_max_rad[i] / DEG;
     }
-    rt_egm_guard_init(&st.g, o->step_deg, qmin, qmax);
-    if (o->in_path && src_open(&src, o->in_path, &lim) != 0)
+    rt_egm_guard_init(&L->st.g, o->step_deg, qmin, qmax);
+    if (o->in_path && src_open(&L->src, o->in_path, &L->lim) != 0)
         return 1;
-    struct sockaddr_in ctl;
-    int has_ctl = 0, locked = 0;
-    const int fd = open_socket(o, &ctl, &has_ctl);
-    if (fd < 0)
+    L->sp = o->in_path ? &L->src : NULL;
+    if ((L->fd = open_socket(o, &L->ctl, &L->has_ctl)) < 0)
         return 2;
-    st.lat_us = malloc(EGM_MAX_SAMPLES * sizeof(double));
-    st.cpu_us = malloc(EGM_MAX_SAMPLES * sizeof(double));
-    if (!st.lat_us || !st.cpu_us) {
+    L->st.lat_us = malloc(EGM_MAX_SAMPLES * sizeof(double));
+    L->st.cpu_us = malloc(EGM_MAX_SAMPLES * sizeof(double));
+    if (!L->st.lat_us || !L->st.cpu_us) {
         fprintf(stderr, "rcal-rt: egm: out of memory\n");
-        free(st.lat_us);
-        free(st.cpu_us);
-        close(fd);
+        free(L->st.lat_us);
+        free(L->st.cpu_us);
+        close(L->fd);
         return 1;
     }
     egm_stop = 0;
@@ -595,111 +680,47 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-    watch_model(&st, &w, &s, &cfg); /* its first look: what is there now */
+    watch_model(&L->st, &L->w, &L->s, &L->cfg); /* its first look: what is there now */
+    prepare(&L->st, &L->nx, L->sp, &L->s);
+    L->t0 = L->t_last = now_ns();
+    return 0;
+}
 
-    egm_next nx;
-    memset(&nx, 0, sizeof nx);
-    egm_src *sp = o->in_path ? &src : NULL;
-    prepare(&st, &nx, sp, &s);
-    const double t0 = now_ns();
-    double t_last = t0;
-    uint32_t last_seq = 0, own_seq = 0;
-    int have_seq = 0, have_ref = 0;
-    double ref[RT_EGM_NJ] = {0};
+int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg0)
+{
+    static egm_loop L;
+    int rc = setup(&L, o, cal, nom, cfg0);
+    if (rc != 0)
+        return rc;
     const char *why_end = "stopped by a signal";
     unsigned char buf[RT_EGM_MAX_DGRAM + 1];
-    uint8_t out[256];
-    char from[64], ctl_s[64] = "";
-    for (;;) {
-        if (egm_stop)
-            break;
-        const double wait_ms = st.datagrams ? o->timeout_s * 1e3 - (now_ns() - t_last) / 1e6
-                                            : o->wait_s * 1e3 - (now_ns() - t0) / 1e6;
+    while (!egm_stop) {
+        const double wait_ms = L.st.datagrams ? o->timeout_s * 1e3 - (now_ns() - L.t_last) / 1e6
+                                              : o->wait_s * 1e3 - (now_ns() - L.t0) / 1e6;
         if (wait_ms <= 0) {
-            why_end = st.datagrams ? "the controller fell silent" : "no datagram from a controller";
+            why_end = L.st.datagrams ? "the controller fell silent" : "no datagram from a controller";
             break;
         }
-        struct pollfd pfd = {fd, POLLIN, 0};
-        const int pr = poll(&pfd, 1, (int)ceil(wait_ms));
-        if (pr <= 0)
+        struct pollfd pfd = {L.fd, POLLIN, 0};
+        if (poll(&pfd, 1, (int)ceil(wait_ms)) <= 0)
             continue; /* a timeout or a signal: looked at above */
         struct sockaddr_in peer;
         socklen_t pl = sizeof peer;
-        const ssize_t n = recvfrom(fd, buf, sizeof buf, MSG_TRUNC, (struct sockaddr *)&peer, &pl);
+        const ssize_t n = recvfrom(L.fd, buf, sizeof buf, MSG_TRUNC, (struct sockaddr *)&peer, &pl);
         const double t_rx = now_ns(), c_rx = cpu_ns();
-        if (n < 0)
-            continue;
-        /* the sender's address as text: only for a log line (the controller's is made once, at the lock) */
-        /* only the controller: the address given, else the first valid sender (address and port) */
-        const int from_ctl = locked ? addr_eq(&peer, &ctl)
-                             : has_ctl ? peer.sin_addr.s_addr == ctl.sin_addr.s_addr : 1;
-        if (!from_ctl) {
-            if (count_fault(&st, F_FOREIGN, 1))
-                fprintf(stderr, "rcal-rt: egm: a datagram from %s, not the controller: not answered\n",
-                        addr_str(from, sizeof from, &peer));
-            continue;
-        }
         rt_egm_robot r;
-        char why[256];
-        if (rt_egm_decode(&r, why, sizeof why, &arena, buf, (size_t)n) != 0) {
-            if (count_fault(&st, F_MALFORMED, 1))
-                fprintf(stderr, "rcal-rt: egm: from %s: %s: not answered\n", addr_str(from, sizeof from, &peer), why);
-            continue;
-        }
-        if (!locked) {
-            ctl = peer;
-            locked = 1;
-            addr_str(ctl_s, sizeof ctl_s, &ctl);
-            if (!o->quiet)
-                fprintf(stderr, "rcal-rt: egm: the controller is %s (only it is answered)\n", ctl_s);
-        }
-        st.datagrams++;
-        if (!check_datagram(&st, &r, &have_seq, &last_seq, t_rx, &t_last, ctl_s))
-            continue;
-        /* the reference: the prepared one, else (the stream stalled) one more look, else the last again */
-        if (!nx.ready)
-            prepare(&st, &nx, sp, &s);
-        if (nx.ready) {
-            memcpy(ref, nx.sent, sizeof ref);
-            have_ref = 1;
-            nx.ready = 0;
-        } else if (!nx.ended && count_fault(&st, F_STALL, 1)) {
-            fprintf(stderr, "rcal-rt: egm: no target from %s for seqno %u: the last reference held\n",
-                    sp ? sp->name : "the source", r.seqno);
-        }
-        if (!have_ref) { /* nothing to send yet: the robot holds where it is */
-            memcpy(ref, r.fb_deg, sizeof ref);
-            have_ref = 1;
-        }
-        const uint32_t tm = (uint32_t)((t_rx - t0) / 1e6);
-        const size_t len = rt_egm_encode(out, sizeof out, ++own_seq, tm, ref);
-        const ssize_t sent = sendto(fd, out, len, 0, (struct sockaddr *)&ctl, sizeof ctl);
-        const double t_tx = now_ns();
-        if (sent != (ssize_t)len && count_fault(&st, F_SEND, 1))
-            fprintf(stderr, "rcal-rt: egm: sending to %s: %s\n", ctl_s, sent < 0 ? strerror(errno) : "short write");
-        st.replies++;
-        memcpy(st.hist[st.hpos], ref, sizeof ref);
-        st.hpos = (st.hpos + 1) % EGM_HIST;
-        if (st.nhist < EGM_HIST)
-            st.nhist++;
-        /* off the critical path: the next reference, the model file */
-        if (st.replies % EGM_WATCH_EVERY == 0)
-            watch_model(&st, &w, &s, &cfg);
-        prepare(&st, &nx, sp, &s);
-        if (st.ns < EGM_MAX_SAMPLES) {
-            st.lat_us[st.ns] = (t_tx - t_rx) / 1e3;
-            st.cpu_us[st.ns] = (cpu_ns() - c_rx) / 1e3;
-            st.ns++;
-        }
+        if (n >= 0 && accept_datagram(&L, &r, buf, (size_t)n, &peer, t_rx))
+            answer(&L, &r, t_rx, c_rx);
     }
-    const int bad = st.rows_refused || st.n[F_NOCONV] || st.n[F_NOFOLLOW] || st.n[F_SEND] || !nx.ended ||
-                    !st.datagrams;
-    const int rc = bad ? 1 : 0;
-    summary(&st, why_end, nx.ended, rc);
-    free(st.lat_us);
-    free(st.cpu_us);
-    close(fd);
-    if (sp && sp->fd != 0)
-        close(sp->fd);
+    const egm_state *st = &L.st;
+    const int bad = st->rows_refused || st->n[F_NOCONV] || st->n[F_NOFOLLOW] || st->n[F_SEND] || !L.nx.ended ||
+                    !st->datagrams;
+    rc = bad ? 1 : 0;
+    summary(&L.st, why_end, L.nx.ended, rc);
+    free(L.st.lat_us);
+    free(L.st.cpu_us);
+    close(L.fd);
+    if (L.sp && L.sp->fd != 0)
+        close(L.sp->fd);
     return rc;
 }
