@@ -125,8 +125,12 @@ static int trivial(unsigned port, size_t max)
     sa.sa_handler = triv_signal;
     sigaction(SIGTERM, &sa, NULL);
     double *lat = malloc(max * sizeof *lat), *cpu = malloc(max * sizeof *cpu);
-    if (!lat || !cpu)
+    if (!lat || !cpu) {
+        free(lat);
+        free(cpu);
+        close(fd);
         return 1;
+    }
     size_t n = 0;
     uint32_t seq = 0;
     const double q[RT_EGM_NJ] = {0, 20, 30, 0, 40, 0};
@@ -388,6 +392,8 @@ static int start_sides(side sd[2], const rc_kin *cal, const rc_kin *nom, const r
         sd[i].pid = spawn(&sd[i].rd, i, port0, cal, nom, cfg, rate_hz, cycles, fifo);
         if (sd[i].pid < 0) {
             fprintf(stderr, "rcal-rt: --egm-bench: fork: %s\n", strerror(errno));
+            if (i == 1)
+                kill(sd[0].pid, SIGTERM);
             return -1;
         }
         sd[i].fd = socket(AF_INET, SOCK_DGRAM, 0);
@@ -395,7 +401,12 @@ static int start_sides(side sd[2], const rc_kin *cal, const rc_kin *nom, const r
         memset(&me, 0, sizeof me);
         me.sin_family = AF_INET;
         me.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        bind(sd[i].fd, (struct sockaddr *)&me, sizeof me);
+        if (sd[i].fd < 0 || bind(sd[i].fd, (struct sockaddr *)&me, sizeof me) != 0) {
+            fprintf(stderr, "rcal-rt: --egm-bench: the controller's socket: %s\n", strerror(errno));
+            for (int j = 0; j <= i; ++j) /* the responders started: stopped, not left behind */
+                kill(sd[j].pid, SIGTERM);
+            return -1;
+        }
         synth_q(sd[i].q, 0, rate_hz);
         for (int j = 0; j < RT_EGM_NJ; ++j)
             sd[i].q[j] /= DEG;

@@ -705,6 +705,7 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
         if (poll(&pfd, 1, (int)ceil(wait_ms)) <= 0)
             continue; /* a timeout or a signal: looked at above */
         struct sockaddr_in peer;
+        memset(&peer, 0, sizeof peer);
         socklen_t pl = sizeof peer;
         const ssize_t n = recvfrom(L.fd, buf, sizeof buf, MSG_TRUNC, (struct sockaddr *)&peer, &pl);
         const double t_rx = now_ns(), c_rx = cpu_ns();
