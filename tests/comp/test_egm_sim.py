@@ -449,6 +449,41 @@ def not_following():
     check(rc == 1, "not following: exit 1")
 
 
+def not_compensable():
+    """targets the solver cannot compensate: the model file replaced by one 10 deg off in theta2 (a correction
+    beyond the largest allowed, 0.1 rad): every target after it keeps the last good correction, counted"""
+    rows = path_rows(320, 4.0)
+    src = os.path.join(WORK, "nocomp.csv")
+    write_csv(src, rows)
+    model = os.path.join(WORK, "nocomp_model.json")
+    with open(MODEL) as fh:
+        text = fh.read()
+    with open(model, "w") as fh:
+        fh.write(text)
+    far = json.loads(text)
+    far["dh"][1]["theta_deg"] += 10.0
+    p, port = start_rt(src, model)
+    c = Controller(port, rows[0])
+    for k in range(330):
+        if k == 60:
+            with open(model + ".new", "w") as fh:
+                json.dump(far, fh)
+            os.replace(model + ".new", model)
+        c.cycle(jitter_ms=0.5)
+    c.drain(0.2)
+    rc, summ, err = finish(p)
+    f = summ["faults"] if summ else {}
+    check(summ and summ["reloads"] == 1 and f.get("not_compensated") == 320 - 250,
+          "not compensable: the 70 targets after the reload counted (%s)" % f.get("not_compensated"))
+    held = [max(abs((c.replies[k][3][i] - rows[k][i]) - (c.replies[249][3][i] - rows[249][i])) for i in range(6))
+            for k in range(250, min(320, len(c.replies)))]
+    check(len(held) == 70 and max(held) < 1e-9,
+          "not compensable: each reference is its target plus the last good correction (%.3g deg)"
+          % (max(held) if held else -1))
+    no_jump(c.replies, rows, "not compensable")
+    check("not compensated" in err and rc == 1, "not compensable: logged, exit 1")
+
+
 def restart():
     """the controller's numbering starts again (a new EGM session): taken after 25 older seqnos in a row"""
     rows = path_rows(200, 3.0)
@@ -486,6 +521,7 @@ clean()
 faults()
 stall()
 not_following()
+not_compensable()
 restart()
 no_controller()
 if FAILS:
