@@ -766,8 +766,8 @@ static int run(int argc, char **argv)
         set_realtime(&o);
         return run_egm(&o, cal, nom, &cfg);
 #else
-        fprintf(stderr, "rcal-rt: --egm-port and --egm-bench are not in this build (protobuf-c was not found "
-                        "when it was configured: Debian protobuf-c-compiler libprotobuf-c-dev)\n");
+        fprintf(stderr, "rcal-rt: --egm-port and --egm-bench are not in this build (configured with RCAL_EGM off, "
+                        "or protobuf-c was not found: Debian protobuf-c-compiler libprotobuf-c-dev)\n");
         return 2;
 #endif
     }
