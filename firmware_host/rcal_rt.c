@@ -632,10 +632,6 @@ static int check_args(const rt_opts *o)
     return 0;
 }
 
-/* The kinematics to compensate with: the compiled-in firmware tables, or
- * --model's determined model and its nominal (static storage). cfg's flags
- * set (o->position_only raised when the model's orientation is not
- * determined). 0, or 1 with the message. */
 /* The model files compiled into kc and kn (*pos_only raised when the
  * model's orientation is not determined). 0, or -1 with the message in err. */
 static int kin_from_files(rc_kin *kc, rc_kin *kn, int *pos_only, const char *model_path, const char *nominal_path,
@@ -667,6 +663,10 @@ static int kin_from_files(rc_kin *kc, rc_kin *kn, int *pos_only, const char *mod
     return 0;
 }
 
+/* The kinematics to compensate with: the compiled-in firmware tables, or
+ * --model's determined model and its nominal (static storage). cfg's flags
+ * set (o->position_only raised when the model's orientation is not
+ * determined). 0, or 1 with the message. */
 static int load_kin(const rc_kin **cal, const rc_kin **nom, rc_comp_config *cfg, rt_opts *o)
 {
     static rc_kin kin_cal, kin_nom;
