@@ -190,7 +190,8 @@ static int src_next(egm_src *s, double q_rad[RT_EGM_NJ])
 }
 
 /* A regular file is checked whole first the way rcal-rt --in checks it
- * (every field, the limits, the radians rule); a FIFO or a pipe row by row. */
+ * (every field, the limits, the radians rule); a FIFO, a pipe or standard
+ * input (whatever it is) row by row. */
 static int src_open(egm_src *s, const char *path, const rc_model *lim)
 {
     memset(s, 0, sizeof *s);
@@ -202,7 +203,7 @@ static int src_open(egm_src *s, const char *path, const rc_model *lim)
         return -1;
     }
     struct stat st;
-    if (fstat(s->fd, &st) == 0 && S_ISREG(st.st_mode)) {
+    if (s->fd != 0 && fstat(s->fd, &st) == 0 && S_ISREG(st.st_mode)) {
         char *text = NULL, msg[1024];
         size_t len = 0;
         rch_diag d;
@@ -468,17 +469,19 @@ static void summary(egm_state *st, const char *why_end, int ended_input, int rc)
     double cpu_mean = 0.0;
     for (size_t i = 0; i < st->ns; ++i)
         cpu_mean += st->cpu_us[i] / (double)st->ns;
-    fprintf(stderr, "%s: %s; %lu datagrams, %lu replies, %lu targets sent%s, %lu rows refused\n", o->label, why_end,
+    fprintf(stderr, "%s: %s; %lu datagrams, %lu replies, %lu targets taken%s, %lu rows refused\n", o->label, why_end,
             st->datagrams, st->replies, st->targets, ended_input ? " (the input ended)" : " (the input had not ended)",
             st->rows_refused);
     fprintf(stderr, "%s: faults:", o->label);
     for (int k = 0; k < F_NKIND; ++k)
         fprintf(stderr, " %s %lu", fault_name[k], st->n[k]);
     fprintf(stderr, "; model reloads %lu, seqno restarts %lu\n", st->reloads, st->restarts);
-    fprintf(stderr, "%s: receive-to-send median %.1f us, p99.99 %.1f us, max %.1f us; CPU per cycle median %.1f "
-                    "us, mean %.1f us; exit status %d\n", o->label, pct(st->lat_us, st->ns, 50),
-            pct(st->lat_us, st->ns, 99.99), st->ns ? st->lat_us[st->ns - 1] : NAN, pct(st->cpu_us, st->ns, 50),
-            cpu_mean, rc);
+    if (st->ns)
+        fprintf(stderr, "%s: receive-to-send median %.1f us, p99.99 %.1f us, max %.1f us; CPU per cycle median "
+                        "%.1f us, mean %.1f us; exit status %d\n", o->label, pct(st->lat_us, st->ns, 50),
+                pct(st->lat_us, st->ns, 99.99), st->lat_us[st->ns - 1], pct(st->cpu_us, st->ns, 50), cpu_mean, rc);
+    else
+        fprintf(stderr, "%s: no reply sent; exit status %d\n", o->label, rc);
     if (o->json) {
         printf("{\"label\": \"%s\", \"end\": \"%s\", \"datagrams\": %lu, \"replies\": %lu, \"targets\": %lu, "
                "\"input_ended\": %d, \"rows_refused\": %lu, \"reloads\": %lu, \"restarts\": %lu, \"faults\": {",
