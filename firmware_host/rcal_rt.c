@@ -5,6 +5,9 @@
  *   rcal-rt [--model MODEL.json] [--rate-hz 1000] [--seconds 10] [--in TARGETS.csv] [--fifo] [--cpu N]
  *   rcal-rt --bench [--targets N] [--repeat R] [--model MODEL.json]
  *   rcal-rt --emit-c MODEL.json [--position-only] > fw_model_data.h
+ *   rcal-rt [--model MODEL.json] --egm-port PORT --in FILE|FIFO [--egm-bind ADDR] [--egm-controller ADDR] ...
+ *   rcal-rt [--model MODEL.json] --egm-bench [--seconds S] [--rate-hz 250] [--fifo]
+ * (the EGM sensor of issue 49: rt_egm.h, docs/egm.md; built when protobuf-c is)
  *
  * Exit status: 0, 1 when a cycle failed (the compensation did not converge)
  * or missed its deadline (the counts on stderr), or an input was refused,
@@ -41,6 +44,9 @@
 #ifdef RCAL_HAVE_EXPAT
 #include "rt_rsi_loop.h"
 #endif
+#ifdef RCAL_HAVE_EGM
+#include "rt_egm.h"
+#endif
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -62,6 +68,9 @@ static void usage(FILE *f)
             "               [--in TARGETS.csv] [--position-only] [--fifo] [--cpu N] [--json]\n"
             "       rcal-rt --bench [--targets N] [--repeat R] [--cold] [--model MODEL.json] [--position-only]\n"
             "       rcal-rt --emit-c MODEL.json [--position-only]\n"
+            "       rcal-rt [--model M.json] --egm-port PORT --in FILE|FIFO|- [--egm-bind ADDR] [--egm-controller ADDR]\n"
+            "               [--egm-step-deg D] [--egm-follow-deg D] [--egm-timeout-s S] [--egm-wait-s S] [--json]\n"
+            "       rcal-rt [--model M.json] --egm-bench [--seconds S] [--rate-hz 250] [--fifo] [--json]\n"
             "  loop:    compensates one target per period (default 1000 Hz for 10 s) with\n"
             "           clock_nanosleep(TIMER_ABSTIME) and reports compute latency, wake-up\n"
             "           lateness and completion time (median, p99, p99.99, max) and deadline misses\n"
@@ -74,6 +83,11 @@ static void usage(FILE *f)
             "           reports latency per target and targets/s for each run and their medians;\n"
             "           --cold solves every target from scratch (no warm start from the last correction)\n"
             "  --emit-c writes the C tables of a model for fw_example.c (fw_model_data.h)\n"
+            "  --egm-port  an ABB EGM sensor in joint mode on UDP (default address 127.0.0.1): each EgmRobot of the\n"
+            "           controller answered with an EgmSensor whose planned joints are the next --in target\n"
+            "           compensated (degrees); faults counted, the reference never jumps (docs/egm.md)\n"
+            "  --egm-bench  rcal-rt's EGM loop and a trivial C responder answering a C controller at --rate-hz\n"
+            "           (250) for --seconds (10): latency, missed cycles, CPU per cycle\n"
             "Without --model, the compiled-in firmware model tables are used.\n");
 #ifdef RCAL_HAVE_EXPAT
     rt_rsi_usage(f);
@@ -473,6 +487,11 @@ typedef struct rt_opts {
     double rate_hz, seconds;
     unsigned long n_bench, repeat, cpu;
     int bench, cold, fifo, json, position_only, pin;
+    /* EGM (issue 49) */
+    unsigned long egm_port;
+    const char *egm_bind, *egm_controller;
+    double egm_step_deg, egm_follow_deg, egm_timeout_s, egm_wait_s;
+    int egm, egm_bench, rate_given;
 } rt_opts;
 
 /* The options into o: -1 when they were read, else the exit status (0 after
@@ -484,6 +503,10 @@ static int parse_args(rt_opts *o, int argc, char **argv)
     o->seconds = 10.0;
     o->n_bench = 200000;
     o->repeat = 5;
+    o->egm_step_deg = 0.01;
+    o->egm_follow_deg = 1.0;
+    o->egm_timeout_s = 1.0;
+    o->egm_wait_s = 60.0;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const int has = i + 1 < argc;
@@ -498,6 +521,7 @@ static int parse_args(rt_opts *o, int argc, char **argv)
         else if (strcmp(a, "--rate-hz") == 0 && has) {
             if (opt_double(a, argv[++i], &o->rate_hz) != 0)
                 return 2;
+            o->rate_given = 1;
         } else if (strcmp(a, "--seconds") == 0 && has) {
             if (opt_double(a, argv[++i], &o->seconds) != 0)
                 return 2;
@@ -511,7 +535,23 @@ static int parse_args(rt_opts *o, int argc, char **argv)
             if (opt_ulong(a, argv[++i], &o->cpu) != 0)
                 return 2;
             o->pin = 1;
-        } else if (strcmp(a, "--bench") == 0)
+        } else if (strcmp(a, "--egm-port") == 0 && has) {
+            if (opt_ulong(a, argv[++i], &o->egm_port) != 0)
+                return 2;
+            o->egm = 1;
+        } else if (strcmp(a, "--egm-bind") == 0 && has)
+            o->egm_bind = argv[++i];
+        else if (strcmp(a, "--egm-controller") == 0 && has)
+            o->egm_controller = argv[++i];
+        else if ((strcmp(a, "--egm-step-deg") == 0 || strcmp(a, "--egm-follow-deg") == 0 ||
+                  strcmp(a, "--egm-timeout-s") == 0 || strcmp(a, "--egm-wait-s") == 0) && has) {
+            double *v = a[6] == 's' ? &o->egm_step_deg : a[6] == 'f' ? &o->egm_follow_deg
+                        : a[6] == 't' ? &o->egm_timeout_s : &o->egm_wait_s;
+            if (opt_double(a, argv[++i], v) != 0)
+                return 2;
+        } else if (strcmp(a, "--egm-bench") == 0)
+            o->egm_bench = 1;
+        else if (strcmp(a, "--bench") == 0)
             o->bench = 1;
         else if (strcmp(a, "--cold") == 0)
             o->cold = 1;
@@ -527,7 +567,9 @@ static int parse_args(rt_opts *o, int argc, char **argv)
         } else {
             int takes_value = 0;
             static const char *const valued[] = {"--model",   "--nominal", "--in",     "--emit-c",
-                                                 "--rate-hz", "--seconds", "--targets", "--repeat", "--cpu"};
+                                                 "--rate-hz", "--seconds", "--targets", "--repeat", "--cpu",
+                                                 "--egm-port", "--egm-bind", "--egm-controller", "--egm-step-deg",
+                                                 "--egm-follow-deg", "--egm-timeout-s", "--egm-wait-s"};
             for (size_t k = 0; k < sizeof valued / sizeof valued[0]; ++k)
                 takes_value |= strcmp(a, valued[k]) == 0;
             if (takes_value)
@@ -575,9 +617,54 @@ static int check_args(const rt_opts *o)
         fprintf(stderr, "rcal-rt: --rate-hz times --seconds must be at least one cycle\n");
         return 2;
     }
+    if (o->egm && (o->egm_port == 0 || o->egm_port > 65535)) {
+        fprintf(stderr, "rcal-rt: --egm-port %lu is out of range (1 to 65535)\n", o->egm_port);
+        return 2;
+    }
+    if (o->egm && !o->in_path) {
+        fprintf(stderr, "rcal-rt: --egm-port needs --in FILE|FIFO|- (the path's joint targets, one per cycle)\n");
+        return 2;
+    }
+    if (!(o->egm_step_deg > 0.0 && o->egm_step_deg <= 10.0) || !(o->egm_follow_deg > 0.0) ||
+        !(o->egm_timeout_s > 0.0 && o->egm_timeout_s <= 3600.0) || !(o->egm_wait_s > 0.0 && o->egm_wait_s <= 86400.0)) {
+        fprintf(stderr, "rcal-rt: --egm-step-deg (0 to 10], --egm-follow-deg (> 0), --egm-timeout-s (0 to 3600], "
+                        "--egm-wait-s (0 to 86400]: a value is out of range\n");
+        return 2;
+    }
     if (o->pin && o->cpu >= (unsigned long)CPU_SETSIZE) {
         fprintf(stderr, "rcal-rt: --cpu must be 0..%d\n", CPU_SETSIZE - 1);
         return 2;
+    }
+    return 0;
+}
+
+/* The model files compiled into kc and kn (*pos_only raised when the
+ * model's orientation is not determined). 0, or -1 with the message in err. */
+static int kin_from_files(rc_kin *kc, rc_kin *kn, int *pos_only, const char *model_path, const char *nominal_path,
+                          char *err, size_t err_len)
+{
+    static rch_robot robot, nominal;
+    rch_diag d;
+    char msg[1024];
+    rch_comp_job job; /* the paths, for the check that --nominal is not the model itself */
+    memset(&job, 0, sizeof job);
+    job.model_path = model_path;
+    job.nominal_path = nominal_path;
+    if (rch_robot_load(&robot, model_path, &d) != 0 ||
+        (nominal_path && (rch_robot_load(&nominal, nominal_path, &d) != 0 ||
+                          rch_comp_same_model(&d, &job, &robot, &nominal) != 0))) {
+        snprintf(err, err_len, "%s", rch_diag_str(&d, msg, sizeof msg));
+        return -1;
+    }
+    static rc_model det;
+    if (determined(&det, &robot))
+        *pos_only = 1;
+    rc_status st = rc_kin_compile(kc, &det);
+    if (st == RC_OK)
+        st = rc_kin_compile(kn, nominal_path ? &nominal.model : &robot.nominal);
+    if (st != RC_OK) {
+        snprintf(err, err_len, "%s: the model cannot be compiled: %s", model_path, rc_strerror(st));
+        return -1;
     }
     return 0;
 }
@@ -588,32 +675,14 @@ static int check_args(const rt_opts *o)
  * determined). 0, or 1 with the message. */
 static int load_kin(const rc_kin **cal, const rc_kin **nom, rc_comp_config *cfg, rt_opts *o)
 {
-    static rch_robot robot, nominal;
     static rc_kin kin_cal, kin_nom;
     unsigned flags = FW_MODEL_COMP_FLAGS;
     *cal = &fw_kin_cal;
     *nom = &fw_kin_nom;
     if (o->model_path) {
-        rch_diag d;
-        char msg[1024];
-        rch_comp_job job; /* the paths, for the check that --nominal is not the model itself */
-        memset(&job, 0, sizeof job);
-        job.model_path = o->model_path;
-        job.nominal_path = o->nominal_path;
-        if (rch_robot_load(&robot, o->model_path, &d) != 0 ||
-            (o->nominal_path && (rch_robot_load(&nominal, o->nominal_path, &d) != 0 ||
-                                 rch_comp_same_model(&d, &job, &robot, &nominal) != 0))) {
-            fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
-            return 1;
-        }
-        static rc_model det;
-        if (determined(&det, &robot))
-            o->position_only = 1;
-        rc_status st = rc_kin_compile(&kin_cal, &det);
-        if (st == RC_OK)
-            st = rc_kin_compile(&kin_nom, o->nominal_path ? &nominal.model : &robot.nominal);
-        if (st != RC_OK) {
-            fprintf(stderr, "rcal-rt: %s: the model cannot be compiled: %s\n", o->model_path, rc_strerror(st));
+        char err[1200];
+        if (kin_from_files(&kin_cal, &kin_nom, &o->position_only, o->model_path, o->nominal_path, err, sizeof err)) {
+            fprintf(stderr, "rcal-rt: %s\n", err);
             return 1;
         }
         *cal = &kin_cal;
@@ -648,6 +717,42 @@ static void set_realtime(const rt_opts *o)
     }
 }
 
+#ifdef RCAL_HAVE_EGM
+/* --egm-port: the model file read again when it is replaced (rt_egm_reload_fn) */
+static int egm_reload(void *ctx, rc_kin *cal, rc_kin *nom, unsigned *flags, char *err, size_t err_len)
+{
+    const rt_opts *o = ctx;
+    int pos_only = o->position_only;
+    if (kin_from_files(cal, nom, &pos_only, o->model_path, o->nominal_path, err, err_len) != 0)
+        return -1;
+    *flags = pos_only ? (unsigned)RC_COMP_FLAG_POSITION_ONLY : 0u;
+    return 0;
+}
+
+static int run_egm(rt_opts *o, const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg)
+{
+    if (o->egm_bench)
+        return rt_egm_bench(cal, nom, cfg, o->rate_given ? o->rate_hz : 250.0, o->seconds, o->fifo, o->json);
+    rt_egm_opts e;
+    rt_egm_opts_default(&e);
+    e.port = (unsigned)o->egm_port;
+    if (o->egm_bind)
+        e.bind_addr = o->egm_bind;
+    e.controller = o->egm_controller;
+    e.in_path = o->in_path;
+    e.model_path = o->model_path;
+    e.reload = o->model_path ? egm_reload : NULL;
+    e.reload_ctx = o;
+    e.period_ms = o->rate_given ? 1e3 / o->rate_hz : 4.0;
+    e.step_deg = o->egm_step_deg;
+    e.follow_deg = o->egm_follow_deg;
+    e.timeout_s = o->egm_timeout_s;
+    e.wait_s = o->egm_wait_s;
+    e.json = o->json;
+    return rt_egm_run(&e, cal, nom, cfg);
+}
+#endif
+
 static int run(int argc, char **argv)
 {
     rt_opts o;
@@ -671,6 +776,16 @@ static int run(int argc, char **argv)
     rc_comp_config cfg;
     if (load_kin(&cal, &nom, &cfg, &o) != 0)
         return 1;
+    if (o.egm || o.egm_bench) {
+#ifdef RCAL_HAVE_EGM
+        set_realtime(&o);
+        return run_egm(&o, cal, nom, &cfg);
+#else
+        fprintf(stderr, "rcal-rt: --egm-port and --egm-bench are not in this build (configured with RCAL_EGM off, "
+                        "or protobuf-c was not found: Debian protobuf-c-compiler libprotobuf-c-dev)\n");
+        return 2;
+#endif
+    }
     targets t = {NULL, 0};
     if (o.in_path && load_targets(&t, o.in_path, cal) != 0)
         return 1;

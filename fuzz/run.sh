@@ -57,6 +57,7 @@ dict_for() {
 maxlen_for() {
     case "$1" in
     fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load | fuzz_json | fuzz_robot | fuzz_urdf | fuzz_rapid) echo 16384 ;;
+    fuzz_egm) echo 2048 ;;
     *) echo 1024 ;;
     esac
 }
