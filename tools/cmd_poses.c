@@ -332,8 +332,32 @@ static int link_addr(char host[64], unsigned *port, const char *spec)
 }
 
 /* The plan into f: CSV (an outlet column with several outlets), RAPID, or a link program. 0 or -1. */
+static int write_out_prog(FILE *f, const rch_poses_result *res, const rch_poses_config *pc, const char *format,
+                          double settle_s, const char *link);
+
+/* The plan as --format asks: the CSV in the model's joints (what `rcal acquire` reads), a robot program in
+ * the controller's (the robot file's "controller" member, rch_ctrl.h). 0, or -1. */
 static int write_out(FILE *f, const rch_poses_result *res, const rch_poses_config *pc, const char *format,
-                     double settle_s, const char *link)
+                     double settle_s, const char *link, const rch_ctrl *ctrl)
+{
+    if (strcmp(format, "csv") == 0 || ctrl->identity_joints)
+        return write_out_prog(f, res, pc, format, settle_s, link);
+    rch_poses_result r = *res;
+    rc_sample *p = malloc((res->n ? res->n : 1) * sizeof *p);
+    if (!p)
+        return -1;
+    for (size_t i = 0; i < res->n; ++i) {
+        p[i] = res->poses[i];
+        rch_ctrl_from_model(p[i].q_rad, ctrl, res->poses[i].q_rad);
+    }
+    r.poses = p;
+    const int wr = write_out_prog(f, &r, pc, format, settle_s, link);
+    free(p);
+    return wr;
+}
+
+static int write_out_prog(FILE *f, const rch_poses_result *res, const rch_poses_config *pc, const char *format,
+                          double settle_s, const char *link)
 {
     if (strcmp(format, "rapid-link") == 0 || strcmp(format, "urscript-link") == 0) {
         char host[64], comment[200];
@@ -419,6 +443,7 @@ typedef struct poses_args {
     double cand[RCH_OPT_MAX_STRS][3]; /* (n_c x 3) the --candidate places */
     unsigned n_places, n_c;
     const rc_model *model; /* the nominal robot (the predictions of fewer cable points) */
+    const rch_ctrl *ctrl;  /* the controller's joint conventions (robot file): what a robot program states */
 } poses_args;
 
 /* The parsed options into a->pc (has_tool: --tool given). -1, or 2 (reported). */
@@ -559,7 +584,7 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
                         "was written\n", a->link);
         return 1;
     }
-    if (write_out(out->f, res, &a->pc, a->format, a->settle_s, a->link) != 0) {
+    if (write_out(out->f, res, &a->pc, a->format, a->settle_s, a->link, a->ctrl) != 0) {
         const int err = rch_out_errno(out);
         rch_out_abort(out);
         fprintf(stderr, "rcal poses: %s: cannot write --out: %s; nothing was replaced\n", a->out_path, strerror(err));
@@ -603,6 +628,7 @@ int rcal_cmd_poses(int argc, char **argv)
     pc->prior = &robot->prior;
     pc->cell = &robot->cell;
     a.model = &robot->model;
+    a.ctrl = &robot->ctrl;
     if (!a.n_places && !a.choose) { /* one outlet: the model's encoder */
         pc->n_outlets = 1;
         memcpy(pc->outlet_mm[0], &robot->model.x[RC_P_ENC], sizeof pc->outlet_mm[0]);

@@ -602,6 +602,21 @@ static int check_paths(acq *a)
     return 0;
 }
 
+/* Joints in degrees between the controller's convention and the model's (the robot file's "controller"
+ * member, rch_ctrl.h): to_model 1 reads the controller's numbers, 0 writes the model's as the controller's. */
+static void ctrl_deg(double out_deg[RC_NJ], const rch_ctrl *c, const double in_deg[RC_NJ], int to_model)
+{
+    double in[RC_NJ], out[RC_NJ];
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        in[j] = in_deg[j] / DEG_PER_RAD;
+    if (to_model)
+        rch_ctrl_to_model(out, c, in);
+    else
+        rch_ctrl_from_model(out, c, in);
+    for (unsigned j = 0; j < RC_NJ; ++j)
+        out_deg[j] = out[j] * DEG_PER_RAD;
+}
+
 /* Show pose i to the robot side, wait for it. 0, or 1 with a message. */
 static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
 {
@@ -620,13 +635,20 @@ static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
         double xyz[3];
         int has_xyz;
         rc_status st;
+        double plan_ctrl[RC_NJ]; /* the plan as the controller states joints: what its report is checked against */
+        if (a->ctrl.identity_joints)
+            memcpy(plan_ctrl, a->plan_deg[i], sizeof plan_ctrl);
+        else
+            ctrl_deg(plan_ctrl, &a->ctrl, a->plan_deg[i], 0);
         tm_mark(a, RCH_ACQTIME_CMD);
-        st = rch_link_pose(&a->link, recheck ? "BACK" : "NEXT", i, a->plan_deg[i], q_deg, xyz, &has_xyz);
+        st = rch_link_pose(&a->link, recheck ? "BACK" : "NEXT", i, plan_ctrl, q_deg, xyz, &has_xyz);
         if (st != RC_OK) {
             WARN(a, "pose %zu: the controller link failed (%s); stopped, nothing recorded from it (rerun to resume)\n",
                  i, rc_strerror(st));
             return 1;
         }
+        if (!a->ctrl.identity_joints) /* the controller's joints, as it means them, recorded as the model's */
+            ctrl_deg(q_deg, &a->ctrl, q_deg, 1);
         tm_mark(a, RCH_ACQTIME_AT);
         rch_link_wait(&a->link, c->settle_ms + c->stable.timeout_ms + 5000ul);
         a->io->sleep_ms(a->io->ctx, a->port, c->settle_ms);
@@ -643,13 +665,8 @@ static int go_to(acq *a, size_t i, double q_deg[RC_NJ], int recheck)
         WARN(a, "pose %zu: the joint-angle source failed; stopped (rerun to resume)\n", i);
         return 1;
     }
-    if (a->io->joints && !a->ctrl.identity_joints) { /* the controller's numbers, as it means them */
-        for (unsigned j = 0; j < RC_NJ; ++j)
-            q_deg[j] /= DEG_PER_RAD;
-        rch_ctrl_to_model(q_deg, &a->ctrl, q_deg);
-        for (unsigned j = 0; j < RC_NJ; ++j)
-            q_deg[j] *= DEG_PER_RAD;
-    }
+    if (a->io->joints && !a->ctrl.identity_joints) /* the controller's numbers, as it means them */
+        ctrl_deg(q_deg, &a->ctrl, q_deg, 1);
     return 0;
 }
 
