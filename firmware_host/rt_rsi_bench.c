@@ -234,7 +234,7 @@ typedef struct {
 
 static double ak_of(const char *s, int i)
 {
-    char key[8];
+    char key[16]; /* " A1=\"" .. " A6=\"" (i is 0..5) */
     snprintf(key, sizeof key, " A%d=\"", i + 1);
     const char *p = strstr(s, key);
     return p ? strtod(p + strlen(key), NULL) : NAN;

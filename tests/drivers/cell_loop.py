@@ -35,8 +35,8 @@ TRUTH = os.path.join(SRC, "data", "sim_irb120_truth.json")
 OUTLETS = ["250,-460,10", "-250,-460,10", "0,-520,10"]
 TOL_DEG = 0.05
 OWN_MS = 20.0
-# fast: a display at 1 kHz with a 10 ms move transient, 20 ms settle, joints at 4000 deg/s
-SETTLE_MS, RATE_HZ, DISPLAY_SETTLE_MS, SPEED = 20, 1000, 10, 4000
+# fast: a display at 1 kHz with a 10 ms move transient, 50 ms settle, joints at 4000 deg/s
+SETTLE_MS, RATE_HZ, DISPLAY_SETTLE_MS, SPEED = 50, 1000, 10, 4000
 procs = []
 
 
