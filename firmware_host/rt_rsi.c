@@ -526,6 +526,11 @@ static int cfg_corr(cfg_ctx *c)
             if (!used[j] && strcmp(c->recv[j].tag, c->n->corr_tag) == 0 &&
                 (best < 0 || c->recv[j].indx < c->recv[best].indx))
                 best = j;
+        if (best < 0) { /* the group has six elements (chosen above): cannot happen, but never index by it */
+            snprintf(c->msg, c->msg_len, "%s:%lu: RECEIVE %s has fewer than six elements", c->path,
+                     c->recv[chosen].line, c->n->corr_tag);
+            return -1;
+        }
         used[best] = 1;
         set_name(c->n->corr_attr[a], c->recv[best].attr);
         for (int b = 0; b < a; ++b)

@@ -102,6 +102,8 @@ static int make_reference(double (**q)[NAX], double (**ref)[NAX], size_t n, cons
     FILE *f = fopen(tin, "w");
     if (!*q || !*ref || !f) {
         fprintf(stderr, "rsi_bench: %s: %s\n", tin, strerror(errno));
+        if (f)
+            fclose(f);
         return -1;
     }
     fprintf(f, "q1,q2,q3,q4,q5,q6\n");
@@ -122,11 +124,23 @@ static int make_reference(double (**q)[NAX], double (**ref)[NAX], size_t n, cons
     f = fopen(tout, "r");
     char line[512];
     size_t k = 0;
-    if (!f || !fgets(line, sizeof line, f))
+    if (!f || !fgets(line, sizeof line, f)) {
+        if (f)
+            fclose(f);
         return -1;
+    }
     while (k < n && fgets(line, sizeof line, f)) {
         double *r = (*ref)[k];
-        if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf", &r[0], &r[1], &r[2], &r[3], &r[4], &r[5]) != 6)
+        const char *p = line;
+        int j = 0;
+        for (; j < 6; ++j) { /* six numbers separated by commas, each checked (strtod) */
+            char *end;
+            r[j] = strtod(p, &end);
+            if (end == p || !isfinite(r[j]) || (j < 5 && *end != ','))
+                break;
+            p = end + 1;
+        }
+        if (j != 6)
             break;
         ++k;
     }
@@ -362,8 +376,20 @@ static void cpu_ticks(double t[3])
     t[0] = t[1] = t[2] = 0;
     FILE *f = fopen("/proc/stat", "r");
     unsigned long long v[8] = {0};
-    if (f && fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
-                    &v[7]) == 8) {
+    char line[512];
+    int got = 0;
+    if (f && fgets(line, sizeof line, f) && strncmp(line, "cpu ", 4) == 0) { /* each count checked (strtoull) */
+        const char *p = line + 4;
+        for (; got < 8; ++got) {
+            char *end;
+            errno = 0;
+            v[got] = strtoull(p, &end, 10);
+            if (end == p || errno != 0)
+                break;
+            p = end;
+        }
+    }
+    if (got == 8) {
         t[0] = (double)(v[0] + v[1] + v[2] + v[5] + v[6]);
         t[1] = (double)(v[3] + v[4]);
         t[2] = (double)v[7];
@@ -397,10 +423,15 @@ static int parse(opts *o, int argc, char **argv)
             o->model = v;
         else if (strcmp(a, "--work") == 0)
             o->work = v;
-        else if (strcmp(a, "--seconds") == 0)
-            o->seconds = atof(v);
-        else if (strcmp(a, "--rate-hz") == 0)
-            o->rate = atof(v);
+        else if (strcmp(a, "--seconds") == 0 || strcmp(a, "--rate-hz") == 0) {
+            char *end;
+            const double x = strtod(v, &end);
+            if (end == v || *end || !isfinite(x)) {
+                fprintf(stderr, "rsi_bench: %s %s: not a number\n", a, v);
+                return -1;
+            }
+            *(a[2] == 's' ? &o->seconds : &o->rate) = x;
+        }
         else {
             fprintf(stderr, "rsi_bench: unknown option %s\n", a);
             return -1;
@@ -482,7 +513,27 @@ static void summary(ctrl *a, ctrl *b, const opts *o, const double ticks0[3], con
 {
     size_t rcount = 0, rover = 0;
     double rmed = NAN, rp4 = NAN, rmax = NAN, rcpu = NAN, rp2 = NAN;
-    sscanf(rline, "%zu %lf %lf %lf %lf %zu %lf", &rcount, &rmed, &rp4, &rmax, &rcpu, &rover, &rp2);
+    { /* the responder's line: count median p99.99 max cpu over p99, each number checked */
+        double v[7];
+        const char *p = rline;
+        int k = 0;
+        for (; k < 7; ++k) {
+            char *end;
+            v[k] = strtod(p, &end);
+            if (end == p)
+                break;
+            p = end;
+        }
+        if (k == 7) {
+            rcount = (size_t)v[0];
+            rmed = v[1];
+            rp4 = v[2];
+            rmax = v[3];
+            rcpu = v[4];
+            rover = (size_t)v[5];
+            rp2 = v[6];
+        }
+    }
     printf("rsi_bench: %zu cycles at %.0f Hz (%.0f s), %s; the responder half a period after rcal-rt\n", a->n,
            o->rate, o->seconds, o->fifo ? "--fifo asked (notes above say when refused)" : "normal scheduling (no --fifo)");
     const double busy = ticks1[0] - ticks0[0], idle = ticks1[1] - ticks0[1], steal = ticks1[2] - ticks0[2];
@@ -505,13 +556,18 @@ int main(int argc, char **argv)
         return 2;
     const size_t n = (size_t)(o.seconds * o.rate + 0.5);
     double(*q)[NAX] = NULL, (*ref)[NAX] = NULL;
-    if (make_reference(&q, &ref, n, &o) != 0)
+    if (make_reference(&q, &ref, n, &o) != 0) {
+        free(q); /* make_reference leaves what it allocated to the caller */
+        free(ref);
         return 1;
+    }
     /* the trivial responder: a forked process, its figures on a pipe */
     int rport = 0, pfd[2];
     const int rfd = udp_bound(&rport);
     if (rfd < 0 || pipe(pfd) != 0) {
         fprintf(stderr, "rsi_bench: socket: %s\n", strerror(errno));
+        free(q);
+        free(ref);
         return 1;
     }
     const pid_t resp = fork();
@@ -526,9 +582,16 @@ int main(int argc, char **argv)
     const pid_t rt = start_rt(&tport, &fout, &ferr, &o);
     ctrl a, b;
     const double t0 = now_ns(CLOCK_MONOTONIC) + 20e6;
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
     if (rt < 0 || ctrl_init(&a, udp_to(tport), n, &o, t0, 0.0) != 0 ||
-        ctrl_init(&b, udp_to(rport), n, &o, t0, 0.5e9 / o.rate) != 0)
+        ctrl_init(&b, udp_to(rport), n, &o, t0, 0.5e9 / o.rate) != 0) {
+        ctrl_free(&a);
+        ctrl_free(&b);
+        free(q);
+        free(ref);
         return 1;
+    }
     a.q = b.q = (const double(*)[NAX])q;
     a.ref = (const double(*)[NAX])ref;
     if (o.fifo)

@@ -117,6 +117,10 @@ if [[ " $STEPS " == *" tidy "* ]]; then
         exit 1
     fi
     rm -f "$BUILD_DIR.cfg.log"
+    # generated sources the files include (egm.pb-c.h from firmware_host/egm.proto), when the build has them
+    if grep -qx 'rcal_egm_pb' <(cmake --build "$BUILD_DIR" --target help 2>/dev/null | sed 's/^\.\.\. //'); then
+        cmake --build "$BUILD_DIR" --target rcal_egm_pb >/dev/null 2>&1 || echo "static: note: rcal_egm_pb not built"
+    fi
     tidy_out=$(mktemp)
     files=$(python3 -c '
 import json, sys, re
