@@ -36,7 +36,11 @@
 #                      robust_issue23 (it closes stdout with >&- and checks the
 #                      exit status: memcheck's own descriptors change what a
 #                      closed stdout is; its sanitizer run is the check) run
-#                      under ASan+UBSan+LSan only.
+#                      under ASan+UBSan+LSan only. robust_hostile_cli (81 runs of
+#                      rcal on hostile inputs: 644 s under memcheck) and
+#                      methods_cli (55 runs: 253 s) take the CLI paths the
+#                      golden runs and the *_cli tests here take once; their
+#                      many runs are the sanitizer build's (CI time).
 #                      Set it to '' to run everything.
 #   VALGRIND_TIMEOUT   seconds per test (default 900)
 #   VALGRIND_CHILDREN  1: trace child processes (default), 0: only the test
@@ -48,11 +52,11 @@ set -u -o pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-$ROOT/build-valgrind}
-EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|pkg_limits_define_refused|pkg_limits_link_refused)\$}
+EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|robust_hostile_cli|methods_cli|pkg_limits_define_refused|pkg_limits_link_refused)\$}
 TMO=${VALGRIND_TIMEOUT:-900}
 CHILDREN=${VALGRIND_CHILDREN:-1}
 JOBS=${JOBS:-1}
-FIRST=${VALGRIND_FIRST-robust_hostile_cli methods_cli methods_recover diag_cli methods_paper comp_cli}
+FIRST=${VALGRIND_FIRST-methods_recover diag_cli methods_paper comp_cli}
 start=$(date +%s)
 
 command -v valgrind >/dev/null || { echo "valgrind: not installed (apt-get install valgrind)"; exit 1; }
