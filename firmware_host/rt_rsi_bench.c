@@ -224,6 +224,7 @@ static void responder(int fd, int out_fd, int fifo, size_t cap, double period_us
     const int len = snprintf(line, sizeof line, "%zu %.1f %.1f %.1f %.2f %zu %.1f\n", n, pct(lat, n, 50),
                              pct(lat, n, 99.99), n ? lat[n - 1] : NAN, n ? cpu / (double)n : NAN, over,
                              pct(lat, n, 99));
+    free(lat);
     if (write(out_fd, line, (size_t)len) != len)
         _exit(1);
     _exit(0);
@@ -573,6 +574,8 @@ int main(int argc, char **argv)
     const pid_t resp = fork();
     if (resp == 0) {
         close(pfd[0]);
+        free(q); /* the responder needs neither: freed in the forked copy too (memcheck traces it) */
+        free(ref);
         responder(rfd, pfd[1], o.fifo, n + 16, 1e6 / o.rate);
     }
     close(pfd[1]);
