@@ -38,7 +38,8 @@
 #                      closed stdout is; its sanitizer run is the check) run
 #                      under ASan+UBSan+LSan only. robust_hostile_cli (81 runs of
 #                      rcal on hostile inputs: 644 s under memcheck) and
-#                      methods_cli (55 runs: 253 s) take the CLI paths the
+#                      methods_cli (55 runs: 253 s) and diag_chain (diagnose
+#                      chains run to their end: 329 s) take the CLI paths the
 #                      golden runs and the *_cli tests here take once; their
 #                      many runs are the sanitizer build's (CI time).
 #                      Set it to '' to run everything.
@@ -52,7 +53,7 @@ set -u -o pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-$ROOT/build-valgrind}
-EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|robust_hostile_cli|methods_cli|pkg_limits_define_refused|pkg_limits_link_refused)\$}
+EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|robust_hostile_cli|methods_cli|diag_chain|pkg_limits_define_refused|pkg_limits_link_refused)\$}
 TMO=${VALGRIND_TIMEOUT:-900}
 CHILDREN=${VALGRIND_CHILDREN:-1}
 JOBS=${JOBS:-1}
