@@ -41,6 +41,7 @@
 #include "rch_opt.h"
 #include "rch_robot.h"
 #include "rch_stdio.h"
+#include "rt_sched.h"
 #ifdef RCAL_HAVE_EXPAT
 #include "rt_rsi_loop.h"
 #endif
@@ -696,27 +697,6 @@ static int load_kin(const rc_kin **cal, const rc_kin **nom, rc_comp_config *cfg,
     return 0;
 }
 
-/* --cpu and --fifo: each refusal a note, never fatal. */
-static void set_realtime(const rt_opts *o)
-{
-    if (o->pin) {
-        cpu_set_t set;
-        CPU_ZERO(&set);
-        CPU_SET((size_t)o->cpu, &set);
-        if (sched_setaffinity(0, sizeof set, &set) != 0)
-            fprintf(stderr, "rcal-rt: note: cannot pin to CPU %lu: %s\n", o->cpu, strerror(errno));
-    }
-    if (o->fifo) {
-        struct sched_param sp;
-        memset(&sp, 0, sizeof sp);
-        sp.sched_priority = 80;
-        if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
-            fprintf(stderr, "rcal-rt: note: SCHED_FIFO refused (%s); running as a normal process\n", strerror(errno));
-        if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-            fprintf(stderr, "rcal-rt: note: mlockall refused (%s)\n", strerror(errno));
-    }
-}
-
 #ifdef RCAL_HAVE_EGM
 /* --egm-port: the model file read again when it is replaced (rt_egm_reload_fn) */
 static int egm_reload(void *ctx, rc_kin *cal, rc_kin *nom, unsigned *flags, char *err, size_t err_len)
@@ -778,7 +758,7 @@ static int run(int argc, char **argv)
         return 1;
     if (o.egm || o.egm_bench) {
 #ifdef RCAL_HAVE_EGM
-        set_realtime(&o);
+        (void)rt_sched_realtime(o.pin, o.cpu, o.fifo);
         return run_egm(&o, cal, nom, &cfg);
 #else
         fprintf(stderr, "rcal-rt: --egm-port and --egm-bench are not in this build (configured with RCAL_EGM off, "
@@ -789,7 +769,7 @@ static int run(int argc, char **argv)
     targets t = {NULL, 0};
     if (o.in_path && load_targets(&t, o.in_path, cal) != 0)
         return 1;
-    set_realtime(&o);
+    (void)rt_sched_realtime(o.pin, o.cpu, o.fifo);
     rc = o.bench ? run_bench(cal, nom, &cfg, &t, o.n_bench, (unsigned)o.repeat, o.cold, o.json)
                  : run_loop(cal, nom, &cfg, &t, o.rate_hz, o.seconds, o.json);
     free(t.q);

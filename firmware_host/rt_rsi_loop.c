@@ -9,6 +9,7 @@
  * answer; every fault counted, the first of each kind and every 1000th
  * logged on stderr; only the controller's address answered. */
 #include "rt_rsi_loop.h"
+#include "rt_sched.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -313,29 +314,6 @@ static int open_socket(int *fd_out, const rsi_opts *o, const char *addr, long po
             (unsigned)ntohs(sa.sin_port), o->relative ? "relative" : "absolute", o->max_step_deg);
     *fd_out = fd;
     return 0;
-}
-
-static void set_realtime(const rsi_opts *o, int *fifo_on)
-{
-    *fifo_on = 0;
-    if (o->pin) {
-        cpu_set_t set;
-        CPU_ZERO(&set);
-        CPU_SET((size_t)o->cpu, &set);
-        if (sched_setaffinity(0, sizeof set, &set) != 0)
-            fprintf(stderr, "rcal-rt: note: cannot pin to CPU %lu: %s\n", o->cpu, strerror(errno));
-    }
-    if (o->fifo) {
-        struct sched_param sp;
-        memset(&sp, 0, sizeof sp);
-        sp.sched_priority = 80;
-        if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
-            fprintf(stderr, "rcal-rt: note: SCHED_FIFO refused (%s); running as a normal process\n", strerror(errno));
-        else
-            *fifo_on = 1;
-        if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-            fprintf(stderr, "rcal-rt: note: mlockall refused (%s)\n", strerror(errno));
-    }
 }
 
 /* The correction wanted for this datagram's setpoint into s->want (held
@@ -688,7 +666,7 @@ int rt_rsi_main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     int fifo_on = 0;
-    set_realtime(&o, &fifo_on);
+    fifo_on = rt_sched_realtime(o.pin, o.cpu, o.fifo);
     serve(&io, &cs, &m, &o, fifo_on);
     close(io.fd);
     rt_rsi_dec_free(io.dec);
