@@ -29,25 +29,13 @@
 
 #include "egm.pb-c.h"
 #include "rt_egm.h"
+#include "rt_sched.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 #define DEG (M_PI / 180.0)
 
-static double now_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
-}
-
-static double cpu_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
-}
 
 /* the bench's path: each joint a slow sine of its own (radians), k at rate_hz */
 typedef struct synth {
@@ -136,20 +124,20 @@ static int trivial(unsigned port, size_t max)
     const double q[RT_EGM_NJ] = {0, 20, 30, 0, 40, 0};
     unsigned char buf[RT_EGM_MAX_DGRAM + 1];
     uint8_t out[256];
-    const double t0 = now_ns();
+    const double t0 = rt_sched_now_ns();
     while (!triv_stop) {
         struct sockaddr_in peer;
         socklen_t pl = sizeof peer;
         const ssize_t r = recvfrom(fd, buf, sizeof buf, 0, (struct sockaddr *)&peer, &pl);
-        const double t_rx = now_ns(), c_rx = cpu_ns();
+        const double t_rx = rt_sched_now_ns(), c_rx = rt_sched_cpu_ns();
         if (r < 0)
             continue;
         const size_t len = rt_egm_encode(out, sizeof out, ++seq, (uint32_t)((t_rx - t0) / 1e6), q);
         sendto(fd, out, len, 0, (struct sockaddr *)&peer, pl);
-        const double t_tx = now_ns();
+        const double t_tx = rt_sched_now_ns();
         if (n < max) {
             lat[n] = (t_tx - t_rx) / 1e3;
-            cpu[n] = (cpu_ns() - c_rx) / 1e3;
+            cpu[n] = (rt_sched_cpu_ns() - c_rx) / 1e3;
             n++;
         }
     }
@@ -304,7 +292,7 @@ static void collect(side sd[2], uint32_t seq_now, double deadline, const double 
 {
     uint8_t in[RT_EGM_MAX_DGRAM];
     while (!(sd[0].got && sd[1].got)) {
-        const double left_ms = (deadline - now_ns()) / 1e6;
+        const double left_ms = (deadline - rt_sched_now_ns()) / 1e6;
         if (left_ms <= 0)
             break;
         struct pollfd p[2] = {{sd[0].fd, POLLIN, 0}, {sd[1].fd, POLLIN, 0}};
@@ -314,7 +302,7 @@ static void collect(side sd[2], uint32_t seq_now, double deadline, const double 
             if (!(p[j].revents & POLLIN))
                 continue;
             const ssize_t r = recv(sd[j].fd, in, sizeof in, 0);
-            const double t = now_ns();
+            const double t = rt_sched_now_ns();
             uint32_t seq;
             double q[RT_EGM_NJ];
             if (r <= 0 || unpack_sensor(&seq, q, in, (size_t)r) != 0)
@@ -461,7 +449,7 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
     bench_check chk = {0, 0, 0.0};
     struct timespec next;
     clock_gettime(CLOCK_MONOTONIC, &next);
-    const double t0 = now_ns();
+    const double t0 = rt_sched_now_ns();
     uint8_t out[512];
     for (size_t k = 0; k < cycles; ++k) {
         next.tv_nsec += period_ns;
@@ -474,9 +462,9 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
         const double deadline = (double)next.tv_sec * 1e9 + (double)next.tv_nsec + (double)period_ns;
         for (int j = 0; j < 2; ++j) {
             side *x = &sd[(k & 1u) ? 1 - j : j];
-            const size_t len = pack_robot(out, sizeof out, (uint32_t)k + 1, (uint32_t)((now_ns() - t0) / 1e6), x->q);
+            const size_t len = pack_robot(out, sizeof out, (uint32_t)k + 1, (uint32_t)((rt_sched_now_ns() - t0) / 1e6), x->q);
             x->got = 0;
-            x->t_send = now_ns();
+            x->t_send = rt_sched_now_ns();
             sendto(x->fd, out, len, 0, (struct sockaddr *)&x->to, sizeof x->to);
         }
         collect(sd, (uint32_t)k + 1, deadline, (const double(*)[RT_EGM_NJ])expect, cycles, &chk);

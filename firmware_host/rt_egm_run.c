@@ -32,6 +32,7 @@
 #include "rch_diag.h"
 #include "rch_file.h"
 #include "rt_egm.h"
+#include "rt_sched.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -58,19 +59,6 @@ static void on_signal(int sig)
     egm_stop = 1;
 }
 
-static double now_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
-}
-
-static double cpu_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
-}
 
 void rt_egm_opts_default(rt_egm_opts *o)
 {
@@ -628,7 +616,7 @@ static void answer(egm_loop *L, const rt_egm_robot *r, double t_rx, double c_rx)
     const uint32_t tm = (uint32_t)((t_rx - L->t0) / 1e6);
     const size_t len = rt_egm_encode(out, sizeof out, ++L->own_seq, tm, L->ref);
     const ssize_t sent = sendto(L->fd, out, len, 0, (const struct sockaddr *)&L->ctl, sizeof L->ctl);
-    const double t_tx = now_ns();
+    const double t_tx = rt_sched_now_ns();
     if (sent != (ssize_t)len && count_fault(st, F_SEND, 1))
         fprintf(stderr, "rcal-rt: egm: sending to %s: %s\n", L->ctl_s, sent < 0 ? strerror(errno) : "short write");
     st->replies++;
@@ -641,7 +629,7 @@ static void answer(egm_loop *L, const rt_egm_robot *r, double t_rx, double c_rx)
     prepare(st, &L->nx, L->sp, &L->s);
     if (st->ns < EGM_MAX_SAMPLES) {
         st->lat_us[st->ns] = (t_tx - t_rx) / 1e3;
-        st->cpu_us[st->ns] = (cpu_ns() - c_rx) / 1e3;
+        st->cpu_us[st->ns] = (rt_sched_cpu_ns() - c_rx) / 1e3;
         st->ns++;
     }
 }
@@ -685,7 +673,7 @@ static int setup(egm_loop *L, const rt_egm_opts *o, const rc_kin *cal, const rc_
     sigaction(SIGTERM, &sa, NULL);
     watch_model(&L->st, &L->w, &L->s, &L->cfg); /* its first look: what is there now */
     prepare(&L->st, &L->nx, L->sp, &L->s);
-    L->t0 = L->t_last = now_ns();
+    L->t0 = L->t_last = rt_sched_now_ns();
     return 0;
 }
 
@@ -698,8 +686,8 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
     const char *why_end = "stopped by a signal";
     unsigned char buf[RT_EGM_MAX_DGRAM + 1];
     while (!egm_stop) {
-        const double wait_ms = L.st.datagrams ? o->timeout_s * 1e3 - (now_ns() - L.t_last) / 1e6
-                                              : o->wait_s * 1e3 - (now_ns() - L.t0) / 1e6;
+        const double wait_ms = L.st.datagrams ? o->timeout_s * 1e3 - (rt_sched_now_ns() - L.t_last) / 1e6
+                                              : o->wait_s * 1e3 - (rt_sched_now_ns() - L.t0) / 1e6;
         if (wait_ms <= 0) {
             why_end = L.st.datagrams ? "the controller fell silent" : "no datagram from a controller";
             break;
@@ -711,7 +699,7 @@ int rt_egm_run(const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const
         memset(&peer, 0, sizeof peer);
         socklen_t pl = sizeof peer;
         const ssize_t n = recvfrom(L.fd, buf, sizeof buf, MSG_TRUNC, (struct sockaddr *)&peer, &pl);
-        const double t_rx = now_ns(), c_rx = cpu_ns();
+        const double t_rx = rt_sched_now_ns(), c_rx = rt_sched_cpu_ns();
         rt_egm_robot r;
         if (n >= 0 && accept_datagram(&L, &r, buf, (size_t)n, &peer, t_rx))
             answer(&L, &r, t_rx, c_rx);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <time.h>
 
 int rt_sched_realtime(int pin, unsigned long cpu, int fifo)
 {
@@ -30,4 +31,18 @@ int rt_sched_realtime(int pin, unsigned long cpu, int fifo)
             fprintf(stderr, "rcal-rt: note: mlockall refused (%s)\n", strerror(errno));
     }
     return fifo_on;
+}
+
+double rt_sched_now_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+}
+
+double rt_sched_cpu_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
 }
