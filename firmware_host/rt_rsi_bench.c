@@ -575,7 +575,9 @@ int main(int argc, char **argv)
     if (resp == 0) {
         close(pfd[0]);
         free(q); /* the responder needs neither: freed in the forked copy too (memcheck traces it) */
+        q = NULL;
         free(ref);
+        ref = NULL;
         responder(rfd, pfd[1], o.fifo, n + 16, 1e6 / o.rate);
     }
     close(pfd[1]);
