@@ -55,8 +55,6 @@
 #define DEG (M_PI / 180.0)
 /* --bench --targets limit: 56 bytes per target (its q and its latency) */
 #define RT_MAX_TARGETS 10000000UL
-/* --in: largest file (about 1.5 million targets of 40 bytes) */
-#define RT_MAX_BYTES ((size_t)64 << 20)
 /* --bench: targets times repeats (about 2 minutes at 1 us per target) */
 #define RT_MAX_BENCH_WORK 100000000.0
 /* the loop: cycles (24 bytes of timings each: 240 MB) */
@@ -156,59 +154,6 @@ static void synth_target(double q[RC_NJ], size_t k, double rate_hz)
     const double t = (double)k / rate_hz;
     for (int i = 0; i < RC_NJ; ++i)
         q[i] = c[i] + a[i] * sin(2.0 * M_PI * f[i] * t + i);
-}
-
-/* --in: the project's one CSV reader (rch_data, RCH_DATA_TARGETS: q1..q6 in
- * degrees per row, the header optional and recognised by its names; every
- * field refused with file:line:col unless it is a finite decimal number; a
- * joint beyond m's limits refused). A file that looks like radians (every
- * joint within +-pi and two of them moving: rch_data_q_look_rad) is refused.
- * 0, or -1 with the message. */
-static int load_targets(targets *t, const char *path, const rc_kin *m)
-{
-    static rc_model lim; /* the limits of the model compensating (the reader's check) */
-    char *text = NULL, msg[1024];
-    size_t len = 0;
-    rch_diag d;
-    rch_data data;
-    memset(&d, 0, sizeof d);
-    t->q = NULL;
-    t->n = 0;
-    for (int i = 0; i < RC_NJ; ++i) {
-        lim.q_min_rad[i] = (double)m->q_min_rad[i];
-        lim.q_max_rad[i] = (double)m->q_max_rad[i];
-    }
-    if (rch_read_file(&text, &len, path, RT_MAX_BYTES, &d) != 0) {
-        fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return -1;
-    }
-    const int rc = rch_data_parse_limited(&data, text, len, path, RCH_DATA_TARGETS | RCH_DATA_NO_LEN, &lim, &d);
-    free(text);
-    if (rc != 0) {
-        fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return -1;
-    }
-    double max_abs_deg[RC_NJ] = {0};
-    for (size_t k = 0; k < data.n; ++k)
-        for (int i = 0; i < RC_NJ; ++i)
-            max_abs_deg[i] = fmax(max_abs_deg[i], fabs(data.s[k].q_rad[i] / DEG));
-    char why[256];
-    if (rch_data_q_look_rad(why, sizeof why, max_abs_deg, data.n)) {
-        fprintf(stderr, "rcal-rt: %s: %s\n", path, why);
-        rch_data_free(&data);
-        return -1;
-    }
-    t->q = malloc(data.n * sizeof t->q[0]);
-    if (!t->q) {
-        fprintf(stderr, "rcal-rt: %s: out of memory for %zu targets\n", path, data.n);
-        rch_data_free(&data);
-        return -1;
-    }
-    for (size_t k = 0; k < data.n; ++k)
-        memcpy(t->q[k], data.s[k].q_rad, sizeof t->q[0]);
-    t->n = data.n;
-    rch_data_free(&data);
-    return 0;
 }
 
 static void get_target(double q[RC_NJ], const targets *t, size_t k, double rate_hz)
@@ -767,8 +712,13 @@ static int run(int argc, char **argv)
 #endif
     }
     targets t = {NULL, 0};
-    if (o.in_path && load_targets(&t, o.in_path, cal) != 0)
+    rch_diag d;
+    memset(&d, 0, sizeof d);
+    if (o.in_path && rch_comp_read_targets(&t.q, &t.n, o.in_path, cal, &d) != 0) {
+        char msg[1024];
+        fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return 1;
+    }
     (void)rt_sched_realtime(o.pin, o.cpu, o.fifo);
     rc = o.bench ? run_bench(cal, nom, &cfg, &t, o.n_bench, (unsigned)o.repeat, o.cold, o.json)
                  : run_loop(cal, nom, &cfg, &t, o.rate_hz, o.seconds, o.json);

@@ -1,14 +1,14 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # The host library's layers: tools/host/<layer>/, each using only the layers
-# before it (files <- model <- fit <- studies <- outputs). A file including a
+# before it (files <- model <- comp <- fit <- studies <- outputs). A file including a
 # header of a later layer is a circle in the making: this prints each such
 # include and exits 1; also any SVG markup written outside files/rch_svg.c
 # (the one SVG writer). Usage: scripts/layers.sh [SOURCE_DIR]
 set -eu
 root=${1:-$(dirname "$0")/..}
 host=$root/tools/host
-layers="files model fit studies outputs"
+layers="files model comp fit studies outputs"
 rank() { i=0; for l in $layers; do [ "$l" = "$1" ] && { echo $i; return; }; i=$((i + 1)); done; echo 99; }
 map=$(mktemp)
 trap 'rm -f "$map"' EXIT

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* cmd_compensate.c - rcal compensate: correct a robot program's joint targets
  * with a calibrated model. Options here; the work is rch_comp_run
- * (tools/host/fit/rch_comp.h: CSV and RAPID forms, safe output files). */
+ * (tools/host/comp/rch_comp.h: CSV and RAPID forms, safe output files). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -240,4 +240,12 @@ int rch_comp_same_model(rch_diag *d, const rch_comp_job *job, const rch_robot *m
  * file error (d set; no output file created or changed). */
 int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_diag *d);
 
+/* rcal-rt's --in file: q1..q6 in degrees per row (rch_data,
+ * RCH_DATA_TARGETS: the header optional and recognised by its names; every
+ * field refused with file:line:col unless a finite decimal number; a joint
+ * beyond m's limits refused); a file that looks like radians (every joint
+ * within +-pi and two of them moving: rch_data_q_look_rad) refused.
+ * q_rad: [n][6] rad, malloc'd (the caller frees). 0, or -1 with d set. */
+int rch_comp_read_targets(double (**q_rad)[RC_NJ], size_t *n, const char *path, const rc_kin *m, rch_diag *d);
+
 #endif
