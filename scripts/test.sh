@@ -8,7 +8,7 @@
 #     (fresh-tree install, static and shared, consumer built with find_package
 #     and with pkg-config: scripts/install_check.sh, about 30 s) and the SPDX
 #     licence line of every source file (scripts/spdx_check.sh), and the host
-#     library's layers (scripts/layers.sh).
+#     library's layers (scripts/layers.sh), the links between the Markdown pages (scripts/doc_links.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -34,7 +34,7 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 # 19 targets; FUZZ_SECONDS and FUZZ_JOBS set from outside win: longer runs are a release's, docs/release.md)
 export FUZZ_SECONDS=${FUZZ_SECONDS:-20} FUZZ_JOBS=${FUZZ_JOBS:-2}
 for extra in firmware_host/cross_build.sh scripts/static_analysis.sh fuzz/run.sh scripts/valgrind_tests.sh \
-  scripts/install_check.sh scripts/spdx_check.sh scripts/layers.sh; do
+  scripts/install_check.sh scripts/spdx_check.sh scripts/layers.sh scripts/doc_links.py; do
   if [ -x "$extra" ]; then
     echo "== $extra"
     "$extra" || status=1
