@@ -53,7 +53,8 @@
 typedef enum rch_comp_format {
     RCH_COMP_AUTO = 0, /* detect from the first line */
     RCH_COMP_CSV = 1,
-    RCH_COMP_RAPID = 2
+    RCH_COMP_RAPID = 2,
+    RCH_COMP_FANUC = 5  /* a Fanuc LS program (first line /PROG): rch_comp_fanuc.c, docs/comp-fanuc.md */
 } rch_comp_format;
 
 /* What a target whose u95 at the compensated point (the flange or the
@@ -88,6 +89,7 @@ typedef struct rch_comp_job {
     int assume_degrees;       /* joint targets are degrees even where they all look like radians; 0: such a
                                  program (rch_data_q_look_rad: every joint within +-pi, two of them moving by
                                  0.2 or more) is refused, nothing written (issue 47) */
+    const char *fanuc_frames_path; /* a Fanuc program's user and tool frames (rch_fanuc.h), or NULL */
 } rch_comp_job;
 
 /* The model whose point compensation moves: m without its cable attachment
@@ -124,6 +126,7 @@ typedef struct rch_comp_gate {
     const rch_ctrl *ctrl;      /* the controller's joint conventions (the nominal file's, else the model
                                   file's "controller"): a joint CSV's values are the controller's, mapped to
                                   the model's and back; NULL: the identity */
+    const char *fanuc_frames_path; /* see rch_comp_job */
 } rch_comp_gate;
 
 /* What u95_mm says of one target, by how its compensation ended (status: 0
