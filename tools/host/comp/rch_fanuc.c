@@ -320,7 +320,9 @@ static int option_ok(const char *w)
     static const char *const ok[] = {"FINE", "CD", "CR", "Wjnt", "Skip", "LBL", "TB", "TA", "DB", "PTH", "COORD",
                                      "RTCP", "EV", "Ind.EV", "max_speed", "sec", "msec", "mm", "cm", "min", "deg",
                                      "inch", "ipm", "BREAK", "R", "AR", "PSPD", "CNT", "ACC", "LPOS", "JPOS",
-                                     "Minimal_Rotation", "MROT", "Remote_TCP", "SR", "WJNT"};
+                                     "Minimal_Rotation", "MROT", "Remote_TCP", "SR", "WJNT",
+                                     /* what TB/TA/DB run at a point: calls and outputs, no motion */
+                                     "CALL", "DO", "RO", "AO", "GO", "ON", "OFF", "PULSE", "POINT_LOGIC"};
     for (size_t k = 0; k < sizeof ok / sizeof ok[0]; ++k)
         if (ieq(w, ok[k]))
             return 1;
