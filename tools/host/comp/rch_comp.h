@@ -22,6 +22,9 @@
  *    confdata with no solution, not a literal number, a wrong shape, a
  *    joint limit) is named with line, column and reason, and nothing is
  *    written.
+ *  - Fanuc LS (a first line /PROG): read whole, every position of /POS
+ *    corrected (rch_comp_fanuc.c, docs/comp-fanuc.md); the user and tool
+ *    frames from fanuc_frames_path. All or nothing as RAPID.
  * Blank lines and lines starting with '#' are copied. A malformed line or a
  * target outside the joint limits is an error with file:line:col. A target
  * that does not converge is written as the stream's fallback (the closest
@@ -205,7 +208,8 @@ typedef struct rch_comp_result {
     unsigned long n_uncertain;    /* targets left uncompensated: uncertainty above max_unc_mm */
     double max_pos95_mm;          /* largest 95 % position uncertainty at a compensated target; NaN when the
                                      model carries none */
-    unsigned long n_robtargets;   /* of n: RAPID robtargets corrected (through the nominal IK) */
+    unsigned long n_robtargets;   /* of n: RAPID robtargets, Fanuc Cartesian positions corrected (through the
+                                     nominal IK) */
 } rch_comp_result;
 
 /* Compensate lines of `in` (named in_name in messages) to `out` with the
