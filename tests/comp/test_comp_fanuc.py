@@ -331,6 +331,21 @@ def refusals(rcal, prog, frames_path, nominal_path, cal_path, tmp):
         assert re.search(re.escape(bad) + r":%d:\d+: " % ln, se), (new, ln, se)
         assert words in se, (new, words, se)
         n += 1
+    # --format fanuc, and a blank line before /PROG: copied, and the lines counted from the file's first
+    text = "\n" + src.replace("L P[3] 500mm/sec FINE ;", "L PR[3] 500mm/sec FINE ;", 1)
+    bad = os.path.join(tmp, "bad_blank.ls")
+    open(bad, "w").write(text)
+    rc, so, se = run(rcal, "--model", cal_path, "--nominal", nominal_path, "--in", bad, "--out",
+                     os.path.join(tmp, "nb.ls"), "--fanuc-frames", frames_path, "--format", "fanuc")
+    assert rc != 0 and re.search(re.escape(bad) + r":%d:10: " % (line_of("L P[3] 500mm/sec") + 1), se), se
+    good = os.path.join(tmp, "good_blank.ls")
+    open(good, "w").write("\n" + src)
+    rc, so, se = run(rcal, "--model", cal_path, "--nominal", nominal_path, "--in", good, "--out",
+                     os.path.join(tmp, "gb.ls"), "--fanuc-frames", frames_path, "--format", "fanuc", "--summary",
+                     "--json")
+    assert rc == 0 and json.loads(so)["input_format"] == "fanuc", (rc, so, se)
+    assert tokens_outside_numbers(open(os.path.join(tmp, "gb.ls")).read()) == tokens_outside_numbers("\n" + src)
+    n += 2
     # a UF 1 position without the frames file
     rc, so, se = run(rcal, "--model", cal_path, "--nominal", nominal_path, "--in", prog, "--out",
                      os.path.join(tmp, "nf.ls"), "--full-pose")
