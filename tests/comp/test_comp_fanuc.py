@@ -312,6 +312,7 @@ def refusals(rcal, prog, frames_path, nominal_path, cal_path, tmp):
         ("X =   547.561  mm", "X =  5547.561  mm", "P[2:\"approach\"]", "reach"),
         ("J6=   300.000 deg\n", "J6=   300.000 deg,\tE1=  10.000 mm\n", "E1=", "extended axes"),
         ("/END", "/FOO\n/END", "/FOO", "unknown section"),
+        ("'N U T, 0, 0, 1'", "'N U T, 0, 0, 2'", "P[3]{", "outside its limits"),
         ("  20:  J P[11] 100% FINE ;", "  20:  J P[11] 100% FINE", "J P[11] 100% FINE", "';'"),
     ]
     n = 0
