@@ -226,7 +226,7 @@ static int read_bracket(cur *c, tok *t)
 
 /* One /MN statement's tokens (from after a line's "n:" to its ';'; a line
  * starting with ':' continues it). Returns the count, 0 for a comment or
- * an empty statement, -1 (d set). *end_mn set when the next section starts. */
+ * an empty statement (*comment set for a comment), -1 (d set). */
 static int read_statement(cur *c, tok *tk, int *comment)
 {
     int n = 0;
