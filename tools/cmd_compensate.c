@@ -117,7 +117,8 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
                         char **argv)
 {
     const char *const files[] = {"model", job->model_path, "nominal", job->nominal_path, "in", job->in_path,
-                                 "out", job->out_path, "input_format", r->format == RCH_COMP_RAPID ? "rapid" : "csv",
+                                 "out", job->out_path, "input_format",
+                                 r->format == RCH_COMP_RAPID ? "rapid" : r->format == RCH_COMP_FANUC ? "fanuc" : "csv",
                                  NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
@@ -206,7 +207,7 @@ int rcal_cmd_compensate(int argc, char **argv)
     double max_dev_deg = 0.1 * 57.295779513082323; /* 0.1 rad, shown as the default */
     int position_only = 0, full_pose = 0, want_summary = 0, accept_rt = 0, json = 0, assume_deg = 0;
     double max_unc_mm = 0.0, tool[3] = {0.0, 0.0, 0.0};
-    const char *unc_out = NULL, *u95_policy = "skip";
+    const char *unc_out = NULL, *u95_policy = "skip", *fanuc_frames = NULL;
     rch_cmdspec spec;
     const rch_opt opts[] = {
         {"--model", RCH_OPT_STR, &model, 0, 0, "MODEL.json", "calibrated model (rcal-model/2 or /1, from rcal calibrate --out)",
@@ -246,7 +247,11 @@ int rcal_cmd_compensate(int argc, char **argv)
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
          "deprecated, no effect: RAPID robtargets are corrected (through the nominal inverse kinematics)", 0, NULL},
-        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
+        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid|fanuc"},
+        {"--fanuc-frames", RCH_OPT_STR, &fanuc_frames, 0, 0, "FRAMES.csv",
+         "a Fanuc program's user and tool frames, as the pendant shows them (lines uframe,n,x,y,z,w,p,r and "
+         "utool,n,x,y,z,w,p,r; mm, deg): a position in a UF or UT not given is refused (docs/comp-fanuc.md)",
+         0, NULL},
         {"--assume-degrees", RCH_OPT_FLAG, &assume_deg, 0, 0, NULL,
          "the joint targets are degrees even where they all look like radians (every joint within +-pi and two "
          "joints moving by 0.2 or more: refused without this option)",
@@ -271,7 +276,10 @@ int rcal_cmd_compensate(int argc, char **argv)
         .nominal_path = nominal,
         .in_path = in,
         .out_path = out,
-        .format = strcmp(format, "csv") == 0 ? RCH_COMP_CSV : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID : RCH_COMP_AUTO,
+        .format = strcmp(format, "csv") == 0     ? RCH_COMP_CSV
+                  : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID
+                  : strcmp(format, "fanuc") == 0 ? RCH_COMP_FANUC
+                                                 : RCH_COMP_AUTO,
         .position_only = position_only,
         .full_pose = full_pose,
         .max_unc_mm = max_unc_mm,
@@ -283,6 +291,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         .tool_mm = rch_opt_given(&spec, seen, "--tool") ? tool : NULL,
         .uncertainty_path = unc_out,
         .assume_degrees = assume_deg,
+        .fanuc_frames_path = fanuc_frames,
     };
     rch_comp_result r;
     memset(&r, 0, sizeof r);

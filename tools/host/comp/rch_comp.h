@@ -22,6 +22,9 @@
  *    confdata with no solution, not a literal number, a wrong shape, a
  *    joint limit) is named with line, column and reason, and nothing is
  *    written.
+ *  - Fanuc LS (a first line /PROG): read whole, every position of /POS
+ *    corrected (rch_comp_fanuc.c, docs/comp-fanuc.md); the user and tool
+ *    frames from fanuc_frames_path. All or nothing as RAPID.
  * Blank lines and lines starting with '#' are copied. A malformed line or a
  * target outside the joint limits is an error with file:line:col. A target
  * that does not converge is written as the stream's fallback (the closest
@@ -53,7 +56,8 @@
 typedef enum rch_comp_format {
     RCH_COMP_AUTO = 0, /* detect from the first line */
     RCH_COMP_CSV = 1,
-    RCH_COMP_RAPID = 2
+    RCH_COMP_RAPID = 2,
+    RCH_COMP_FANUC = 5  /* a Fanuc LS program (first line /PROG): rch_comp_fanuc.c, docs/comp-fanuc.md */
 } rch_comp_format;
 
 /* What a target whose u95 at the compensated point (the flange or the
@@ -88,6 +92,7 @@ typedef struct rch_comp_job {
     int assume_degrees;       /* joint targets are degrees even where they all look like radians; 0: such a
                                  program (rch_data_q_look_rad: every joint within +-pi, two of them moving by
                                  0.2 or more) is refused, nothing written (issue 47) */
+    const char *fanuc_frames_path; /* a Fanuc program's user and tool frames (rch_fanuc.h), or NULL */
 } rch_comp_job;
 
 /* The model whose point compensation moves: m without its cable attachment
@@ -124,6 +129,7 @@ typedef struct rch_comp_gate {
     const rch_ctrl *ctrl;      /* the controller's joint conventions (the nominal file's, else the model
                                   file's "controller"): a joint CSV's values are the controller's, mapped to
                                   the model's and back; NULL: the identity */
+    const char *fanuc_frames_path; /* see rch_comp_job */
 } rch_comp_gate;
 
 /* What u95_mm says of one target, by how its compensation ended (status: 0
@@ -202,7 +208,8 @@ typedef struct rch_comp_result {
     unsigned long n_uncertain;    /* targets left uncompensated: uncertainty above max_unc_mm */
     double max_pos95_mm;          /* largest 95 % position uncertainty at a compensated target; NaN when the
                                      model carries none */
-    unsigned long n_robtargets;   /* of n: RAPID robtargets corrected (through the nominal IK) */
+    unsigned long n_robtargets;   /* of n: RAPID robtargets, Fanuc Cartesian positions corrected (through the
+                                     nominal IK) */
 } rch_comp_result;
 
 /* Compensate lines of `in` (named in_name in messages) to `out` with the

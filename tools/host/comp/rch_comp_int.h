@@ -45,7 +45,7 @@ typedef struct {
     rch_comp_result *res;
     FILE *out, *warn;
     const char *in_name;
-    int format; /* 0 auto, 1 csv, 2 rapid */
+    int format; /* 0 auto, 1 csv, 2 rapid, 5 fanuc (rch_comp_format) */
     const char *eol; /* the line end of the line being read ("\n", "\r\n" or "\r"): a CSV line keeps it */
     double max_abs_deg[RC_NJ]; /* the largest |q| of each joint of the targets read (degrees as read) */
     unsigned long n_targets;   /* joint targets read (the radians check, rch_data_q_look_rad) */
@@ -104,6 +104,9 @@ int rch_cpi_csv_header(rch_cpi_ctx *c, const char *line, size_t n, unsigned line
  * everything after it, at most RCH_RAPID_MAX_BYTES, corrected all or
  * nothing. 0, 1 (some flagged), -1 (d set). */
 int rch_cpi_rapid(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d);
+
+/* rch_comp_fanuc.c: a Fanuc LS program, read whole as a RAPID module is. */
+int rch_cpi_fanuc(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d);
 
 /* rch_comp_frames.c: a robtarget's frames */
 /* The tool and work object the instruction that uses robtarget t names, as

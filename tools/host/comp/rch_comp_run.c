@@ -109,6 +109,10 @@ static int out_failed(const rch_cpi_ctx *c, unsigned lineno, rch_diag *d)
 static int decide_form(rch_cpi_ctx *c, const char *line, size_t bom, size_t tn, unsigned lineno, rch_diag *d)
 {
     const char *text = line + bom;
+    if (starts_with_ci(text, tn, "/PROG")) {
+        c->format = RCH_COMP_FANUC;
+        return 0;
+    }
     if (starts_with_ci(text, tn, "MODULE") || starts_with_ci(text, tn, "%%%") || starts_with_ci(text, tn, "!") ||
         find_ci(text, tn, "jointtarget") || find_ci(text, tn, "robtarget")) {
         c->format = 2;
@@ -205,6 +209,12 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
             }
             if (r > 0)
                 continue; /* a CSV header, copied */
+        }
+        if (c.format == RCH_COMP_FANUC) { /* a Fanuc LS program likewise (rch_comp_fanuc.c) */
+            rc = rch_cpi_fanuc(&c, line, (size_t)got, in, lineno, d);
+            if (rc >= 0 && out_failed(&c, lineno, d))
+                rc = -1;
+            break;
         }
         if (c.format == 2) { /* a module is read whole, its bytes as they are: all or nothing */
             rc = rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d);
@@ -349,7 +359,7 @@ int rch_comp_run(rch_comp_result *res, const rch_comp_job *job, FILE *warn, rch_
     const rch_comp_gate gate = {&fit_pt, unc.present && !res->version1 ? &unc : NULL, job->max_unc_mm,
                                 job->accept_robtargets, have_uo ? uo.f : NULL, nom_raw, job->tool_mm,
                                 &det_any, &robot.model, &cfg, job->u95_policy, job->assume_degrees,
-                                job->nominal_path ? &nominal_robot.ctrl : &robot.ctrl};
+                                job->nominal_path ? &nominal_robot.ctrl : &robot.ctrl, job->fanuc_frames_path};
     int rc = rch_comp_lines_gated(o.f, res, in, in_name, &s, &det, &gate, job->format, warn, d);
     if (in != stdin)
         fclose(in);
