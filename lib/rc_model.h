@@ -189,6 +189,10 @@ typedef enum rc_sensor_kind {
     RC_SENSOR_TRACKER_Z = 3
 } rc_sensor_kind;
 
+/* The unit of a sensor's measured value (rc_sample.sensor): "mm" for a
+ * length and a tracker coordinate; "?" for a kind the model does not know. */
+const char *rc_sensor_unit(unsigned sensor);
+
 /* One measurement: joint readings, cable length and its context. Zero-
  * initialise it (memset, calloc or = {0}) before filling the fields: a zero
  * sensor, target and outlet is a cable length from the first outlet, and a
