@@ -288,6 +288,47 @@ static void test_method_table(void **state)
     assert_string_equal(rc_method_name((rc_method)RC_METHOD_COUNT_), "unknown");
 }
 
+/* The effects' one list: every kind described under its own number, every
+ * name its kind's; a length with every length-side effect has the same value
+ * with and without its Jacobian (one function per effect does both). */
+static void test_effect_list(void **state)
+{
+    (void)state;
+    assert_int_equal(RC_EFF_LAST, RC_EFF_COUNT_ - 1);
+    assert_null(rc_effect_describe(RC_EFF_NONE));
+    assert_null(rc_effect_describe(RC_EFF_COUNT_));
+    for (unsigned k = 1; k <= RC_EFF_LAST; ++k) {
+        const rc_effect_desc *d = rc_effect_describe(k);
+        assert_non_null(d);
+        assert_int_equal(d->kind, k);
+        assert_int_equal(rc_effect_by_name(d->name), (int)k);
+        assert_string_equal(rc_effect_name((rc_effect_kind)k), d->name);
+    }
+    double dh[6][4];
+    const double enc[3] = {300.0, -400.0, 0.0};
+    rc_model m;
+    rct_irb120_dh(dh);
+    assert_int_equal(rc_model_init(&m, (const double(*)[4])dh, enc), RC_OK);
+    static const rc_effect_kind len_side[] = {RC_EFF_LENGTH_OFFSET, RC_EFF_LENGTH_SCALE, RC_EFF_CABLE_SAG,
+                                              RC_EFF_LENGTH_NONLIN, RC_EFF_LENGTH_PERIODIC, RC_EFF_TOOL_OFFSET};
+    for (unsigned k = 0; k < sizeof len_side / sizeof len_side[0]; ++k)
+        assert_int_equal(rc_model_add_effect(&m, len_side[k], 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TIME_DRIFT, 0, 2), RC_OK);
+    for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
+        m.x[k] = 1e-3 * (double)(k - RC_N_BASE + 1);
+    m.x[RC_N_BASE + 1 + 1 + 1 + 2 + 2] = 250.0; /* the drum's period */
+    rc_sample s;
+    memset(&s, 0, sizeof s);
+    s.q_rad[1] = 0.3;
+    s.q_rad[2] = -0.2;
+    s.t = 0.4;
+    double l1, l2, jac[RC_MAX_PARAMS];
+    assert_int_equal(rc_meas(&l1, NULL, &m, &s), RC_OK);
+    assert_int_equal(rc_meas(&l2, jac, &m, &s), RC_OK);
+    assert_true(l1 == l2);
+    assert_true(jac[RC_N_BASE] == 1.0); /* length_offset */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -295,6 +336,7 @@ int main(void)
         cmocka_unit_test(test_exact_fixed_and_methods),
         cmocka_unit_test(test_robot_blocks),
         cmocka_unit_test(test_method_table),
+        cmocka_unit_test(test_effect_list),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
