@@ -17,14 +17,10 @@ RC_STATIC_ASSERT(RC_EST_MAX_POP * RC_MAX_PARAMS < 4 * 1024 * 1024, est_pop_size)
 
 const char *rc_est_method_name(rc_est_method method)
 {
-    switch (method) {
-    case RC_EST_EKF: return "ekf";
-    case RC_EST_PF: return "pf";
-    case RC_EST_SCA: return "sca";
-    case RC_EST_QIBAS: return "qibas";
-    case RC_EST_SSLM: return "sslm";
-    }
-    return "unknown";
+#define RC_EST_NAME_(id, name) name,
+    static const char *const names[] = {RC_EST_METHODS(RC_EST_NAME_)};
+#undef RC_EST_NAME_
+    return (unsigned)method < sizeof names / sizeof names[0] ? names[method] : "unknown";
 }
 
 /* ---- identifiable subset ---------------------------------------------- */
@@ -780,6 +776,9 @@ rc_status rc_est_solve(rc_model *m, rc_est_result *res, rc_est_work *w, const rc
         model_at(&w->best, &c, w->ubest);
         *m = w->best;
         st = RC_OK;
+        break;
+    default: /* not a method (RC_EST_COUNT_ and beyond) */
+        st = RC_ERR_ARG;
         break;
     }
     if (st != RC_OK)

@@ -108,13 +108,12 @@
 #error "RC_EST_MAX_POP must be within 4..4096"
 #endif
 
-typedef enum rc_est_method {
-    RC_EST_EKF = 0,
-    RC_EST_PF = 1,
-    RC_EST_SCA = 2,
-    RC_EST_QIBAS = 3,
-    RC_EST_SSLM = 4
-} rc_est_method;
+/* The estimators: one line each (X(ID, name)), the enum and the names
+ * expanded from it. */
+#define RC_EST_METHODS(X) X(EKF, "ekf") X(PF, "pf") X(SCA, "sca") X(QIBAS, "qibas") X(SSLM, "sslm")
+#define RC_EST_ENUM_(id, name) RC_EST_##id,
+typedef enum rc_est_method { RC_EST_METHODS(RC_EST_ENUM_) RC_EST_COUNT_ } rc_est_method;
+#undef RC_EST_ENUM_
 
 /* All-zero means the defaults listed above. */
 typedef struct rc_est_config {

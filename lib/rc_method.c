@@ -1,29 +1,25 @@
 /* SPDX-License-Identifier: MIT */
-/* rc_method.c - the solver methods' and exits' names (rc_solve.h): the one
- * table a command line, a model file and a report read them from. */
+/* rc_method.c - the solver methods' and exits' names (rc_problem.h): the one
+ * table (RC_METHODS) a command line, a model file and a report read them
+ * from. */
 #include <stddef.h>
 #include <string.h>
 
-#include "rc_solve.h"
+#include "rc_problem.h"
 
-static const struct {
-    rc_method method;
-    const char *name;
-} method_names[] = {
-    {RC_METHOD_LM, "lm"},
-    {RC_METHOD_LTLM, "ltlm"},
-    {RC_METHOD_LM_PAPER, "lm-paper"},
-    {RC_METHOD_LTLM_PAPER, "ltlm-paper"},
-    {RC_METHOD_LM_PAPER_DEG, "lm-paper-deg"},
-    {RC_METHOD_LTLM_PAPER_DEG, "ltlm-paper-deg"},
-};
+#define RC_METHOD_DESC_(id, name, paper, ltlm, deg, text) {RC_METHOD_##id, name, paper, ltlm, deg, text},
+static const rc_method_desc method_table[] = {RC_METHODS(RC_METHOD_DESC_)};
+#undef RC_METHOD_DESC_
+
+const rc_method_desc *rc_method_describe(unsigned method)
+{
+    return method < sizeof method_table / sizeof method_table[0] ? &method_table[method] : NULL;
+}
 
 const char *rc_method_name(rc_method method)
 {
-    for (size_t i = 0; i < sizeof method_names / sizeof method_names[0]; ++i)
-        if (method_names[i].method == method)
-            return method_names[i].name;
-    return "unknown";
+    const rc_method_desc *d = rc_method_describe((unsigned)method);
+    return d != NULL ? d->name : "unknown";
 }
 
 rc_status rc_method_from_name(rc_method *out, const char *name)
@@ -31,9 +27,9 @@ rc_status rc_method_from_name(rc_method *out, const char *name)
     RC_ASSERT(out != NULL);
     if (name == NULL)
         return RC_ERR_ARG;
-    for (size_t i = 0; i < sizeof method_names / sizeof method_names[0]; ++i)
-        if (strcmp(method_names[i].name, name) == 0) {
-            *out = method_names[i].method;
+    for (size_t i = 0; i < sizeof method_table / sizeof method_table[0]; ++i)
+        if (strcmp(method_table[i].name, name) == 0) {
+            *out = method_table[i].method;
             return RC_OK;
         }
     return RC_ERR_ARG;

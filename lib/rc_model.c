@@ -122,35 +122,9 @@ rc_status rc_model_init(rc_model *m, const double dh[RC_NJ][4], const double enc
 }
 
 /* The table of effects, indexed by kind (rc_model.h, rc_effect_desc). */
-static const rc_effect_desc effect_table[] = {
-    {RC_EFF_NONE, "none", 0, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 0, "", 0.0, "", "", 0},
-    {RC_EFF_LENGTH_OFFSET, "length_offset", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 0, 0, 1, "mm", 1000.0, "", "", 0},
-    {RC_EFF_JOINT_COMPLIANCE, "joint_compliance", 1, RC_SIDE_JOINT, RC_EFF_ARG_JOINT, 2, 0, 1, "rad/m", 0.1, "",
-     "", 0},
-    {RC_EFF_JOINT_PERIODIC, "joint_periodic", 4, RC_SIDE_JOINT, RC_EFF_ARG_JOINT, 1, 0, 1, "rad", 0.2,
-     "s1|c1|s2|c2", "", 0},
-    {RC_EFF_TIME_DRIFT, "time_drift", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 1, 1, "mm", 1000.0, "", "d", 1},
-    {RC_EFF_GROUP_OFFSET, "group_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 1, 0, "mm", 1000.0, "", "g", 0},
-    {RC_EFF_LENGTH_SCALE, "length_scale", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "", 0.1, "", "", 0},
-    {RC_EFF_TOOL_OFFSET, "tool_offset", 3, RC_SIDE_POINT, RC_EFF_ARG_NONE, 0, 0, 1, "mm", 1000.0, "x|y|z", "", 0},
-    {RC_EFF_CABLE_SAG, "cable_sag", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "mm/m^3", 1000.0, "", "", 0},
-    {RC_EFF_LENGTH_NONLIN, "length_nonlinearity", 2, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "mm/m^2, mm/m^3",
-     1000.0, "n2|n3", "", 0},
-    {RC_EFF_LENGTH_PERIODIC, "length_periodic", 3, RC_SIDE_LENGTH, RC_EFF_ARG_PERIOD, 0, 0, 1, "mm", 1000.0,
-     "s|c|period", "", 0},
-    {RC_EFF_OUTLET, "outlet", 3, RC_SIDE_OUTLET, RC_EFF_ARG_OUTLET, 0, 0, 0, "mm", 1e5, "x|y|z", "", 0},
-    {RC_EFF_AXIS_TILT, "axis_tilt", 1, RC_SIDE_GEOMETRY, RC_EFF_ARG_JOINT, 1, 0, 1, "rad", 0.1, "", "", 0},
-    {RC_EFF_TRACKER_POSITION, "tracker_position", 3, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 0, 0, 0, "mm", 1e5, "x|y|z",
-     "", 0},
-    {RC_EFF_TRACKER_ROTATION, "tracker_rotation", 3, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 1, 0, 0, "rad", 7.0, "x|y|z",
-     "", 0},
-    {RC_EFF_TRACKER_TARGETS, "tracker_targets", 0, RC_SIDE_SENSOR, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z",
-     "", 0},
-    {RC_EFF_OUTLET_OFFSET, "outlet_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 0, 1, "mm", 1000.0, "", "o", 0},
-    {RC_EFF_OUTLET_SCALE, "outlet_scale", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 2, 0, 1, "", 0.001, "", "o", 0},
-    {RC_EFF_TRACKER_SCALE, "tracker_scale", 1, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 2, 0, 1, "", 3e-4, "", "", 0},
-    {RC_EFF_CABLE_POINTS, "cable_points", 0, RC_SIDE_POINT, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z", "", 0},
-};
+#define RC_EFF_DESC_(id, ...) {RC_EFF_##id, __VA_ARGS__},
+static const rc_effect_desc effect_table[] = {RC_EFFECTS(RC_EFF_DESC_)};
+#undef RC_EFF_DESC_
 RC_STATIC_ASSERT(sizeof effect_table / sizeof effect_table[0] == RC_EFF_LAST + 1, effect_table_covers_every_kind);
 
 const rc_effect_desc *rc_effect_describe(unsigned kind)
@@ -704,86 +678,205 @@ static rc_status sensor_chain(double *value, double *jac, const rc_model *m, con
     return st;
 }
 
-/* The length-side and outlet columns of a length's Jacobian jac (the
- * chain's and the point's are point_jac's): g (3) is dl/dp, dist the chord,
- * h2 its horizontal span squared, outlet_first the sample's outlet effect
- * (-1: e). */
-static void length_effects_jac(double *jac, const rc_model *m, const rc_sample *s, const chain *c, const double g[3],
-                               double dist, double h2, int outlet_first)
+/* A length's effects: what each kind's function reads (the sample, the
+ * chain, the chord) and what it adds to (the length's scale and additive
+ * terms, the gradient gd (3) of the chord-dependent terms with respect to
+ * the chord). Each kind has one function, called twice per length: with
+ * g == NULL it adds its value and, when J is not NULL, writes its columns
+ * that do not depend on dl/dp; with g (dl/dp, 3) it writes the columns that
+ * do (an outlet's, a tool point's). */
+typedef struct len_terms {
+    const rc_model *m;
+    const rc_sample *s;
+    const chain *c;
+    double u[3];          /* the chord's direction */
+    double dist, h2;      /* the chord (mm) and its horizontal span squared (mm^2) */
+    int outlet_first;     /* the sample's outlet effect's first parameter, -1: e */
+    const double *g;      /* NULL: the value pass; else dl/dp (3): the gradient pass */
+    double scale, add, gd[3];
+} len_terms;
+
+typedef void (*eff_fn)(len_terms *t, double *J, const rc_effect *ef, const double *x);
+
+/* Kinds with no part in a length's value (joint, geometry side: the chain's, point_jac). */
+static void eff_none(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)t, (void)J, (void)ef, (void)x;
+}
+#define eff_NONE eff_none
+#define eff_JOINT_COMPLIANCE eff_none
+#define eff_JOINT_PERIODIC eff_none
+#define eff_AXIS_TILT eff_none
+
+/* Another sensor's (the tracker's frame and targets): no part in a length. */
+static void eff_sensor(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)x;
+    if (t->g == NULL && J != NULL)
+        for (unsigned k = 0; k < ef->count; ++k)
+            J[k] = 0.0;
+}
+#define eff_TRACKER_POSITION eff_sensor
+#define eff_TRACKER_ROTATION eff_sensor
+#define eff_TRACKER_TARGETS eff_sensor
+#define eff_TRACKER_SCALE eff_sensor
+
+static void eff_LENGTH_OFFSET(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)ef;
+    if (t->g != NULL)
+        return;
+    t->add += x[0];
+    if (J != NULL)
+        J[0] = 1.0;
+}
+
+static void eff_LENGTH_SCALE(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)ef;
+    if (t->g != NULL)
+        return;
+    t->scale += x[0];
+    if (J != NULL)
+        J[0] = t->dist;
+}
+
+static void eff_OUTLET_OFFSET(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    if (t->g != NULL)
+        return;
+    if (t->s->outlet < ef->count)
+        t->add += x[t->s->outlet];
+    if (J != NULL)
+        for (unsigned k = 0; k < ef->count; ++k)
+            J[k] = k == t->s->outlet ? 1.0 : 0.0;
+}
+
+static void eff_OUTLET_SCALE(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    if (t->g != NULL)
+        return;
+    if (t->s->outlet < ef->count)
+        t->scale += x[t->s->outlet];
+    if (J != NULL)
+        for (unsigned k = 0; k < ef->count; ++k)
+            J[k] = k == t->s->outlet ? t->dist : 0.0;
+}
+
+static void eff_TIME_DRIFT(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    if (t->g != NULL)
+        return;
+    double tp = t->s->t;
+    for (unsigned k = 0; k < ef->count; ++k) {
+        t->add += x[k] * tp;
+        if (J != NULL)
+            J[k] = tp;
+        tp *= t->s->t;
+    }
+}
+
+static void eff_GROUP_OFFSET(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    if (t->g != NULL)
+        return;
+    if (t->s->group < ef->count)
+        t->add += x[t->s->group];
+    if (J != NULL)
+        for (unsigned k = 0; k < ef->count; ++k)
+            J[k] = (k == t->s->group) ? 1.0 : 0.0;
+}
+
+/* c h^2 L, h and L in m (1e-9 from mm^3) */
+static void eff_CABLE_SAG(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)ef;
+    if (t->g != NULL)
+        return;
+    const double k = x[0] * 1e-9, dist = t->dist, h2 = t->h2;
+    t->add += k * h2 * dist;
+    t->gd[0] += k * (2.0 * dist * t->u[0] * dist + h2 * t->u[0]);
+    t->gd[1] += k * (2.0 * dist * t->u[1] * dist + h2 * t->u[1]);
+    t->gd[2] += k * h2 * t->u[2];
+    if (J != NULL)
+        J[0] = 1e-9 * h2 * dist;
+}
+
+static void eff_LENGTH_NONLIN(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)ef;
+    if (t->g != NULL)
+        return;
+    const double v = t->dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
+    const double dv = (2.0 * x[0] * v + 3.0 * x[1] * v * v) * 1e-3; /* mm per mm of chord */
+    t->add += x[0] * v * v + x[1] * v * v * v;
+    for (int r = 0; r < 3; ++r)
+        t->gd[r] += dv * t->u[r];
+    if (J != NULL) {
+        J[0] = v * v;
+        J[1] = v * v * v;
+    }
+}
+
+static void eff_LENGTH_PERIODIC(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)ef;
+    if (t->g != NULL)
+        return;
+    if (J != NULL)
+        J[0] = J[1] = J[2] = 0.0;
+    if (!(fabs(x[2]) > 1e-9))
+        return;
+    const double w = 2.0 * M_PI / x[2], ph = w * t->dist, sp = sin(ph), cp = cos(ph);
+    const double dv = (x[0] * cp - x[1] * sp) * w; /* mm per mm of chord */
+    t->add += x[0] * sp + x[1] * cp;
+    for (int r = 0; r < 3; ++r)
+        t->gd[r] += dv * t->u[r];
+    if (J != NULL) {
+        J[0] = sp;
+        J[1] = cp;
+        J[2] = (x[0] * cp - x[1] * sp) * (-ph / x[2]); /* d ph / dP = -dist 2 pi / P^2 */
+    }
+}
+
+/* Where the length is measured from: -dl/dp for the sample's own outlet. */
+static void eff_OUTLET(len_terms *t, double *J, const rc_effect *ef, const double *x)
+{
+    (void)x;
+    if (t->g == NULL || J == NULL)
+        return;
+    for (unsigned k = 0; k < 3; ++k)
+        J[k] = (int)ef->first == t->outlet_first ? -t->g[k] : 0.0;
+}
+
+/* The measured point in the flange frame: dp/dt = R6 for the point the sample measures. */
+static void eff_point(len_terms *t, double *J, const rc_effect *ef, const double *x)
 {
     unsigned np;
-    for (int r = 0; r < 3; ++r)
-        jac[RC_P_ENC + r] = outlet_first < 0 ? -g[r] : 0.0;
-    for (unsigned i = 0; i < m->n_effects; ++i) {
-        const rc_effect *ef = &m->effects[i];
-        double *J = &jac[ef->first];
-        switch ((rc_effect_kind)ef->kind) {
-        case RC_EFF_OUTLET:
-            for (unsigned k = 0; k < 3; ++k)
-                J[k] = (int)ef->first == outlet_first ? -g[k] : 0.0;
-            break;
-        case RC_EFF_AXIS_TILT: /* the chain's (point_jac) */
-        case RC_EFF_JOINT_COMPLIANCE:
-        case RC_EFF_JOINT_PERIODIC: break;
-        case RC_EFF_TRACKER_POSITION: /* another sensor's: no part in a length */
-        case RC_EFF_TRACKER_ROTATION:
-        case RC_EFF_TRACKER_TARGETS:
-        case RC_EFF_TRACKER_SCALE:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = 0.0;
-            break;
-        case RC_EFF_OUTLET_OFFSET:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = k == s->outlet ? 1.0 : 0.0;
-            break;
-        case RC_EFF_OUTLET_SCALE:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = k == s->outlet ? dist : 0.0;
-            break;
-        case RC_EFF_LENGTH_OFFSET: J[0] = 1.0; break;
-        case RC_EFF_LENGTH_SCALE: J[0] = dist; break;
-        case RC_EFF_TIME_DRIFT: {
-            double tp = s->t;
-            for (unsigned k = 0; k < ef->count; ++k) {
-                J[k] = tp;
-                tp *= s->t;
-            }
-            break;
-        }
-        case RC_EFF_GROUP_OFFSET:
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = (k == s->group) ? 1.0 : 0.0;
-            break;
-        case RC_EFF_TOOL_OFFSET:   /* dp/dt = R6, for the point the sample measures */
-        case RC_EFF_CABLE_POINTS: {
-            const double *R = c->R[RC_NJ];
-            const int pi = points_index(m, &np), at = sample_point(s, tool_index(m), pi, np);
-            for (unsigned k = 0; k < ef->count; ++k)
-                J[k] = (int)(ef->first + k - k % 3u) == at ? g[0] * R[k % 3u] + g[1] * R[3 + k % 3u] +
-                                                                 g[2] * R[6 + k % 3u]
-                                                           : 0.0;
-            break;
-        }
-        case RC_EFF_CABLE_SAG: J[0] = 1e-9 * h2 * dist; break;
-        case RC_EFF_LENGTH_NONLIN: {
-            const double v = dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
-            J[0] = v * v;
-            J[1] = v * v * v;
-            break;
-        }
-        case RC_EFF_LENGTH_PERIODIC: {
-            const double *x = &m->x[ef->first];
-            J[0] = J[1] = J[2] = 0.0;
-            if (!(fabs(x[2]) > 1e-9))
-                break;
-            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
-            J[0] = sp;
-            J[1] = cp;
-            J[2] = (x[0] * cp - x[1] * sp) * (-ph / x[2]); /* d ph / dP = -dist 2 pi / P^2 */
-            break;
-        }
-        case RC_EFF_NONE: break;
-        }
+    (void)x;
+    if (t->g == NULL || J == NULL)
+        return;
+    const double *R = t->c->R[RC_NJ], *g = t->g;
+    const int pi = points_index(t->m, &np), at = sample_point(t->s, tool_index(t->m), pi, np);
+    for (unsigned k = 0; k < ef->count; ++k)
+        J[k] = (int)(ef->first + k - k % 3u) == at ? g[0] * R[k % 3u] + g[1] * R[3 + k % 3u] + g[2] * R[6 + k % 3u]
+                                                   : 0.0;
+}
+#define eff_TOOL_OFFSET eff_point
+#define eff_CABLE_POINTS eff_point
+
+#define RC_EFF_FN_(id, ...) eff_##id,
+static const eff_fn eff_fns[] = {RC_EFFECTS(RC_EFF_FN_)};
+#undef RC_EFF_FN_
+
+/* Every effect's function of t's pass (t->g NULL: values; else the
+ * gradient's columns) with jac (n_params) or NULL. */
+static void length_effects(len_terms *t, double *jac)
+{
+    for (unsigned i = 0; i < t->m->n_effects; ++i) {
+        const rc_effect *ef = &t->m->effects[i];
+        if (ef->kind < sizeof eff_fns / sizeof eff_fns[0])
+            eff_fns[ef->kind](t, jac != NULL ? &jac[ef->first] : NULL, ef, &t->m->x[ef->first]);
     }
 }
 
@@ -816,71 +909,31 @@ static rc_status meas_chain(double *len_mm, double *jac, const rc_model *m, cons
     /* Length-side effects: l = (1 + scale) * dist + additive terms; those
      * that depend on the chord d = p - e (sag, nonlinearity, periodic) add their
      * gradient with respect to d to gd (3), so that dl/dd = scale u + gd. */
-    double scale = 1.0, add = 0.0, gd[3] = {0.0, 0.0, 0.0};
-    const double h2 = u[0] * u[0] * dist * dist + u[1] * u[1] * dist * dist; /* horizontal span^2, mm^2 */
-    for (unsigned i = 0; i < m->n_effects; ++i) {
-        const rc_effect *ef = &m->effects[i];
-        const double *x = &m->x[ef->first];
-        switch ((rc_effect_kind)ef->kind) {
-        case RC_EFF_LENGTH_OFFSET: add += x[0]; break;
-        case RC_EFF_LENGTH_SCALE: scale += x[0]; break;
-        case RC_EFF_OUTLET_OFFSET:
-            if (s->outlet < ef->count)
-                add += x[s->outlet];
-            break;
-        case RC_EFF_OUTLET_SCALE:
-            if (s->outlet < ef->count)
-                scale += x[s->outlet];
-            break;
-        case RC_EFF_TIME_DRIFT: {
-            double tp = s->t;
-            for (unsigned k = 0; k < ef->count; ++k) {
-                add += x[k] * tp;
-                tp *= s->t;
-            }
-            break;
-        }
-        case RC_EFF_GROUP_OFFSET:
-            if (s->group < ef->count)
-                add += x[s->group];
-            break;
-        case RC_EFF_CABLE_SAG: { /* c h^2 L, h and L in m (1e-9 from mm^3) */
-            const double k = x[0] * 1e-9;
-            add += k * h2 * dist;
-            gd[0] += k * (2.0 * dist * u[0] * dist + h2 * u[0]);
-            gd[1] += k * (2.0 * dist * u[1] * dist + h2 * u[1]);
-            gd[2] += k * h2 * u[2];
-            break;
-        }
-        case RC_EFF_LENGTH_NONLIN: {
-            const double v = dist * 1e-3 - RC_LENGTH_NONLIN_CENTRE_M;
-            const double dv = (2.0 * x[0] * v + 3.0 * x[1] * v * v) * 1e-3; /* mm per mm of chord */
-            add += x[0] * v * v + x[1] * v * v * v;
-            for (int r = 0; r < 3; ++r)
-                gd[r] += dv * u[r];
-            break;
-        }
-        case RC_EFF_LENGTH_PERIODIC: {
-            if (!(fabs(x[2]) > 1e-9))
-                break;
-            const double w = 2.0 * M_PI / x[2], ph = w * dist, sp = sin(ph), cp = cos(ph);
-            const double dv = (x[0] * cp - x[1] * sp) * w; /* mm per mm of chord */
-            add += x[0] * sp + x[1] * cp;
-            for (int r = 0; r < 3; ++r)
-                gd[r] += dv * u[r];
-            break;
-        }
-        default: break;
-        }
-    }
-    *len_mm = scale * dist + add;
+    len_terms t;
+    t.m = m;
+    t.s = s;
+    t.c = c;
+    for (int r = 0; r < 3; ++r)
+        t.u[r] = u[r];
+    t.dist = dist;
+    t.h2 = u[0] * u[0] * dist * dist + u[1] * u[1] * dist * dist; /* horizontal span^2, mm^2 */
+    t.outlet_first = outlet_first;
+    t.g = NULL;
+    t.scale = 1.0;
+    t.add = 0.0;
+    t.gd[0] = t.gd[1] = t.gd[2] = 0.0;
+    length_effects(&t, jac);
+    *len_mm = t.scale * dist + t.add;
     if (jac == NULL)
         return RC_OK;
 
     double g[3]; /* dl/dp (3): the chord direction, scaled, plus the chord-dependent effects */
     for (int r = 0; r < 3; ++r)
-        g[r] = scale * u[r] + gd[r];
+        g[r] = t.scale * u[r] + t.gd[r];
     point_jac(jac, dl_dtheta, m, s, c, p, g);
-    length_effects_jac(jac, m, s, c, g, dist, h2, outlet_first);
+    for (int r = 0; r < 3; ++r)
+        jac[RC_P_ENC + r] = outlet_first < 0 ? -g[r] : 0.0;
+    t.g = g;
+    length_effects(&t, jac);
     return RC_OK;
 }

@@ -39,57 +39,88 @@
 #define RC_P_THETA(i) (4 * (i) + 3)
 #define RC_P_ENC RC_N_DH
 
-/* Model extensions. Joint-side effects change the joint angle seen by the
- * geometry; length-side effects add to the predicted cable length. */
-typedef enum rc_effect_kind {
-    RC_EFF_NONE = 0,
-    RC_EFF_LENGTH_OFFSET = 1,   /* l += b;                         1 param, mm */
-    RC_EFF_JOINT_COMPLIANCE = 2, /* theta_j += k * tau_j(q);       1 param, rad per m of lever */
-    RC_EFF_JOINT_PERIODIC = 3,  /* theta_j += s1 sin q + c1 cos q + s2 sin 2q + c2 cos 2q; 4 params, rad */
-    RC_EFF_TIME_DRIFT = 4,      /* l += d1 t + d2 t^2 (+ d3 t^3 + d4 t^4), t in [0,1] acquisition order;
-                                   count params (1..4; 0: 3), mm */
-    RC_EFF_GROUP_OFFSET = 5,    /* l += g_k for samples of group k; count params, mm */
-    RC_EFF_LENGTH_SCALE = 6,    /* l *= (1 + s) (encoder scale);   1 param, unitless */
-    RC_EFF_TOOL_OFFSET = 7,     /* measured point = flange + R6 (tx, ty, tz): where the cable
-                                   is attached, in the flange frame; 3 params, mm */
-    RC_EFF_CABLE_SAG = 8,       /* l += c h^2 L: the extra length of a light cable hanging
-                                   between outlet and attachment point; 1 param, mm per m^3 */
-    RC_EFF_LENGTH_NONLIN = 9,   /* l += n2 (lam - c)^2 + n3 (lam - c)^3, the length sensor's
-                                   deviation from linear; 2 params, mm per m^2 and mm per m^3 */
-    RC_EFF_LENGTH_PERIODIC = 10, /* l += s sin(2 pi L / P) + c cos(2 pi L / P), L the chord: the
-                                   length sensor's error once per drum turn (an eccentric drum);
-                                   3 params s, c (mm) and the period P (mm, the drum's
-                                   circumference; nonlinear, |P| < 1e-9 mm: no effect) */
-    RC_EFF_OUTLET = 11,         /* another place of the encoder: samples with rc_sample.outlet == k
-                                   (the effect's `joint` field, 1..RC_MAX_OUTLETS-1) are measured from
-                                   this outlet instead of e; 3 params (x, y, z) mm in the base frame */
-    RC_EFF_AXIS_TILT = 12,      /* Hayati's beta of DH row j (joint): frame j+1 turned about its own y
-                                   axis after Rx(alpha): T_j = Rz(theta) Tz(d) Tx(a) Rx(alpha) Ry(beta).
-                                   The tilt of a joint axis against a nominally parallel previous one,
-                                   which standard DH can only express with d of metres; 1 param, rad */
-    RC_EFF_TRACKER_POSITION = 13, /* a position sensor's frame (laser tracker): the translation T of
-                                   p_tracker = R p_base + T; 3 params (x, y, z) mm (lib/rc_sensor.h) */
-    RC_EFF_TRACKER_ROTATION = 14, /* its rotation R = exp([w]x), w the rotation vector; 3 params, rad */
-    RC_EFF_TRACKER_TARGETS = 15, /* the targets the tracker sees on the tool: a sample with rc_sample.target
-                                   == k sees flange + R6 (x_k, y_k, z_k); 3 params per target (count =
-                                   3 x targets, at most RC_MAX_TARGETS), mm in the flange frame */
-    RC_EFF_OUTLET_OFFSET = 16,  /* l += b_k for samples with rc_sample.outlet == k: each outlet's own zero
-                                   (a display re-zeroed at one outlet, a different cable hook); count
-                                   params, one per outlet (0: 1 + the largest RC_EFF_OUTLET number), mm */
-    RC_EFF_OUTLET_SCALE = 17,   /* l *= 1 + s_k for samples from outlet k (each encoder's own scale, or
-                                   one cable stretched differently); count params as OUTLET_OFFSET */
-    RC_EFF_TRACKER_SCALE = 18,  /* the tracker's length scale: p_tracker = (1 + s) (R p_base + T), e.g.
-                                   a wrong air temperature in its refractive index; 1 param, unitless */
-    RC_EFF_CABLE_POINTS = 19    /* the points of a tool plate the cable is hooked on in turn: a length
-                                   sample with rc_sample.target == k is measured to flange + R6 (x_k, y_k,
-                                   z_k) instead of the flange centre or RC_EFF_TOOL_OFFSET's point; 3
-                                   params per point (count = 3 x points, at most RC_MAX_TARGETS), mm in
-                                   the flange frame. Points apart on the plate make the flange's
-                                   orientation visible to the cable, as targets make it to a tracker */
-} rc_effect_kind;
+/* Model extensions, one list: RC_EFFECTS gives the kinds (the enum), their
+ * descriptions (rc_effect_describe) and, in rc_model.c, each length-side
+ * kind's one value-and-gradient function (eff_<KIND>). Joint-side effects
+ * change the joint angle seen by the geometry; length-side effects add to
+ * the predicted cable length. Adding a kind: one line here (at the end: the
+ * numbers are stable), its function in rc_model.c (length side) or its part
+ * of the chain (joint, point, geometry or sensor side).
+ * X(ID, name, count, side, arg, unit class, nuisance, user, unit text, limit,
+ *   suffixes, index prefix, index base) as in rc_effect_desc below. The kinds:
+ *  none:
+ *  length_offset:  l += b;                         1 param, mm
+ *  joint_compliance:  theta_j += k * tau_j(q);       1 param, rad per m of lever
+ *  joint_periodic:  theta_j += s1 sin q + c1 cos q + s2 sin 2q + c2 cos 2q; 4 params, rad
+ *  time_drift:  l += d1 t + d2 t^2 (+ d3 t^3 + d4 t^4), t in [0,1] acquisition order;
+ *      count params (1..4; 0: 3), mm
+ *  group_offset:  l += g_k for samples of group k; count params, mm
+ *  length_scale:  l *= (1 + s) (encoder scale);   1 param, unitless
+ *  tool_offset:  measured point = flange + R6 (tx, ty, tz): where the cable
+ *      is attached, in the flange frame; 3 params, mm
+ *  cable_sag:  l += c h^2 L: the extra length of a light cable hanging
+ *      between outlet and attachment point; 1 param, mm per m^3
+ *  length_nonlinearity:  l += n2 (lam - c)^2 + n3 (lam - c)^3, the length sensor's
+ *      deviation from linear; 2 params, mm per m^2 and mm per m^3
+ *  length_periodic:  l += s sin(2 pi L / P) + c cos(2 pi L / P), L the chord: the
+ *      length sensor's error once per drum turn (an eccentric drum);
+ *      3 params s, c (mm) and the period P (mm, the drum's
+ *      circumference; nonlinear, |P| < 1e-9 mm: no effect)
+ *  outlet:  another place of the encoder: samples with rc_sample.outlet == k
+ *      (the effect's `joint` field, 1..RC_MAX_OUTLETS-1) are measured from
+ *      this outlet instead of e; 3 params (x, y, z) mm in the base frame
+ *  axis_tilt:  Hayati's beta of DH row j (joint): frame j+1 turned about its own y
+ *      axis after Rx(alpha): T_j = Rz(theta) Tz(d) Tx(a) Rx(alpha) Ry(beta).
+ *      The tilt of a joint axis against a nominally parallel previous one,
+ *      which standard DH can only express with d of metres; 1 param, rad
+ *  tracker_position:  a position sensor's frame (laser tracker): the translation T of
+ *      p_tracker = R p_base + T; 3 params (x, y, z) mm (lib/rc_sensor.h)
+ *  tracker_rotation:  its rotation R = exp([w]x), w the rotation vector; 3 params, rad
+ *  tracker_targets:  the targets the tracker sees on the tool: a sample with rc_sample.target
+ *      == k sees flange + R6 (x_k, y_k, z_k); 3 params per target (count =
+ *      3 x targets, at most RC_MAX_TARGETS), mm in the flange frame
+ *  outlet_offset:  l += b_k for samples with rc_sample.outlet == k: each outlet's own zero
+ *      (a display re-zeroed at one outlet, a different cable hook); count
+ *      params, one per outlet (0: 1 + the largest RC_EFF_OUTLET number), mm
+ *  outlet_scale:  l *= 1 + s_k for samples from outlet k (each encoder's own scale, or
+ *      one cable stretched differently); count params as OUTLET_OFFSET
+ *  tracker_scale:  the tracker's length scale: p_tracker = (1 + s) (R p_base + T), e.g.
+ *      a wrong air temperature in its refractive index; 1 param, unitless
+ *  cable_points:  the points of a tool plate the cable is hooked on in turn: a length
+ *      sample with rc_sample.target == k is measured to flange + R6 (x_k, y_k,
+ *      z_k) instead of the flange centre or RC_EFF_TOOL_OFFSET's point; 3
+ *      params per point (count = 3 x points, at most RC_MAX_TARGETS), mm in
+ *      the flange frame. Points apart on the plate make the flange's
+ *      orientation visible to the cable, as targets make it to a tracker
+ */
+#define RC_EFFECTS(X) \
+    X(NONE, "none", 0, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 0, "", 0.0, "", "", 0) \
+    X(LENGTH_OFFSET, "length_offset", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 0, 0, 1, "mm", 1000.0, "", "", 0) \
+    X(JOINT_COMPLIANCE, "joint_compliance", 1, RC_SIDE_JOINT, RC_EFF_ARG_JOINT, 2, 0, 1, "rad/m", 0.1, "", "", 0) \
+    X(JOINT_PERIODIC, "joint_periodic", 4, RC_SIDE_JOINT, RC_EFF_ARG_JOINT, 1, 0, 1, "rad", 0.2, "s1|c1|s2|c2", "", 0) \
+    X(TIME_DRIFT, "time_drift", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 1, 1, "mm", 1000.0, "", "d", 1) \
+    X(GROUP_OFFSET, "group_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 1, 0, "mm", 1000.0, "", "g", 0) \
+    X(LENGTH_SCALE, "length_scale", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "", 0.1, "", "", 0) \
+    X(TOOL_OFFSET, "tool_offset", 3, RC_SIDE_POINT, RC_EFF_ARG_NONE, 0, 0, 1, "mm", 1000.0, "x|y|z", "", 0) \
+    X(CABLE_SAG, "cable_sag", 1, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "mm/m^3", 1000.0, "", "", 0) \
+    X(LENGTH_NONLIN, "length_nonlinearity", 2, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 1, "mm/m^2, mm/m^3", 1000.0, "n2|n3", "", 0) \
+    X(LENGTH_PERIODIC, "length_periodic", 3, RC_SIDE_LENGTH, RC_EFF_ARG_PERIOD, 0, 0, 1, "mm", 1000.0, "s|c|period", "", 0) \
+    X(OUTLET, "outlet", 3, RC_SIDE_OUTLET, RC_EFF_ARG_OUTLET, 0, 0, 0, "mm", 1e5, "x|y|z", "", 0) \
+    X(AXIS_TILT, "axis_tilt", 1, RC_SIDE_GEOMETRY, RC_EFF_ARG_JOINT, 1, 0, 1, "rad", 0.1, "", "", 0) \
+    X(TRACKER_POSITION, "tracker_position", 3, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 0, 0, 0, "mm", 1e5, "x|y|z", "", 0) \
+    X(TRACKER_ROTATION, "tracker_rotation", 3, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 1, 0, 0, "rad", 7.0, "x|y|z", "", 0) \
+    X(TRACKER_TARGETS, "tracker_targets", 0, RC_SIDE_SENSOR, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z", "", 0) \
+    X(OUTLET_OFFSET, "outlet_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 0, 1, "mm", 1000.0, "", "o", 0) \
+    X(OUTLET_SCALE, "outlet_scale", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 2, 0, 1, "", 0.001, "", "o", 0) \
+    X(TRACKER_SCALE, "tracker_scale", 1, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 2, 0, 1, "", 3e-4, "", "", 0) \
+    X(CABLE_POINTS, "cable_points", 0, RC_SIDE_POINT, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z", "", 0)
+
+#define RC_EFF_ENUM_(id, ...) RC_EFF_##id,
+typedef enum rc_effect_kind { RC_EFFECTS(RC_EFF_ENUM_) RC_EFF_COUNT_ } rc_effect_kind;
+#undef RC_EFF_ENUM_
 
 /* Last effect kind (for range checks of stored kinds). */
-#define RC_EFF_LAST RC_EFF_CABLE_POINTS
+#define RC_EFF_LAST (RC_EFF_COUNT_ - 1)
 
 /* Targets a position data set may use (rc_sample.target, RC_EFF_TRACKER_TARGETS). */
 #define RC_MAX_TARGETS 16
@@ -188,6 +219,10 @@ typedef enum rc_sensor_kind {
     RC_SENSOR_TRACKER_Y = 2,
     RC_SENSOR_TRACKER_Z = 3
 } rc_sensor_kind;
+
+/* The unit of a sensor's measured value (rc_sample.sensor): "mm" for a
+ * length and a tracker coordinate; "?" for a kind the model does not know. */
+const char *rc_sensor_unit(unsigned sensor);
 
 /* One measurement: joint readings, cable length and its context. Zero-
  * initialise it (memset, calloc or = {0}) before filling the fields: a zero

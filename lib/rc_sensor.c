@@ -154,3 +154,14 @@ rc_status rc_sensor_tracker(double *value, double pt[3], double g[3], double *ja
         jac[kf + j] = g[0] * R6[j] + g[1] * R6[3 + j] + g[2] * R6[6 + j];
     return RC_OK;
 }
+
+const char *rc_sensor_unit(unsigned sensor)
+{
+    switch (sensor) {
+    case RC_SENSOR_LENGTH:
+    case RC_SENSOR_TRACKER_X:
+    case RC_SENSOR_TRACKER_Y:
+    case RC_SENSOR_TRACKER_Z: return "mm";
+    default: return "?";
+    }
+}

@@ -53,26 +53,7 @@
 #include <stdint.h>
 
 #include "rc_model.h"
-
-typedef enum rc_method {
-    RC_METHOD_LM = 0,
-    RC_METHOD_LTLM = 1,
-    RC_METHOD_LM_PAPER = 2,
-    RC_METHOD_LTLM_PAPER = 3,
-    RC_METHOD_LM_PAPER_DEG = 4,
-    RC_METHOD_LTLM_PAPER_DEG = 5
-} rc_method;
-
-/* Points of one LTLM iteration, reported to rc_solve_config.on_ltlm. */
-typedef enum rc_ltlm_point {
-    RC_LTLM_X1 = 0,     /* x_{k+1,1}: one LM step from x_k */
-    RC_LTLM_X2 = 1,     /* x_{k+1,2}: the next LM step from x1 (cost not evaluated: -1) */
-    RC_LTLM_A = 2,      /* a = (x_k + x1)/2 (cost not evaluated: -1) */
-    RC_LTLM_B = 3,      /* b = (x1 + x2)/2 (cost not evaluated: -1) */
-    RC_LTLM_XL = 4,     /* xl(m) = x1 - (x1 - a) N_m */
-    RC_LTLM_XR = 5,     /* xr(m) = x1 + (x2 - b) N_m */
-    RC_LTLM_CHOSEN = 6  /* the best of {x1, xl, xr}: x_{k+1} */
-} rc_ltlm_point;
+#include "rc_problem.h"
 
 typedef struct rc_ltlm_event {
     unsigned iter;          /* 1-based iteration k+1 */
@@ -84,17 +65,6 @@ typedef struct rc_ltlm_event {
 } rc_ltlm_event;
 
 typedef void (*rc_ltlm_cb)(void *ctx, const rc_ltlm_event *ev);
-
-/* Why the solver stopped. */
-typedef enum rc_exit {
-    RC_EXIT_NONE = 0,
-    RC_EXIT_SMALL_STEP = 1,    /* scaled step below tol_step */
-    RC_EXIT_SMALL_COST = 2,    /* relative cost decrease below tol_cost */
-    RC_EXIT_SMALL_GRAD = 3,    /* no identifiable direction left whose step is significant */
-    RC_EXIT_MAX_ITER = 4,      /* iteration limit reached */
-    RC_EXIT_NO_DESCENT = 5,    /* damping grew to its limit without a better point */
-    RC_EXIT_NONFINITE = 6      /* a cost or step became NaN/inf (paper variants) */
-} rc_exit;
 
 /* Callback after each iteration: training RMS (mm) and the current model. */
 typedef void (*rc_iter_cb)(void *ctx, unsigned iter, double train_rms_mm, const rc_model *m);
@@ -146,51 +116,59 @@ typedef struct rc_solve_config {
     void *cb_ctx;            /* passed to on_iter and on_ltlm */
 } rc_solve_config;
 
-typedef struct rc_solve_result {
-    rc_exit exit;
-    unsigned iterations;
-    unsigned cost_evals;      /* passes over the training samples */
-    double rms_start_mm;      /* training RMS at the start */
-    double rms_final_mm;      /* training RMS at the end */
-    unsigned n_free;          /* parameters the solver was allowed to move */
-    unsigned rank;            /* identifiable directions among them (last iteration) */
-    double cond;              /* sqrt(largest / smallest kept eigenvalue), scaled */
-    unsigned ltlm_wins;       /* LTLM: iterations where a chaotic candidate beat x1 */
-} rc_solve_result;
-
-/* Workspace of rc_solve. The two matrices come last so that a workspace
- * sized by the parameter count (rc_solve_work_size, rc_solve_buf) is this
- * struct's prefix followed by the matrices at their real size. rc_solve
- * keeps its normal-equation row blocks (4 x n_params) and the samples' joint
- * sines and cosines (rc_qtrig_fill) in the unused tails of A and V (beyond
- * n_params^2 entries) when they fit there (the tables up to 1,396 samples for
- * 27 parameters); A and V hold nf x nf matrices (leading dimension nf) as
- * before. */
+/* Workspace of rc_solve: the solver's (rc_lsq_work), the model the data
+ * rows are evaluated on (the caller's effects, the point's x), then the two
+ * matrices last so that a workspace sized by the parameter count
+ * (rc_solve_work_size, rc_solve_buf) is this struct's prefix followed by the
+ * matrices at their real size. rc_solve keeps its normal-equation row blocks
+ * (4 x n_params) and the samples' joint sines and cosines (rc_qtrig_fill) in
+ * the unused tails of A and V (beyond n_params^2 entries) when they fit
+ * there (the tables up to 1,396 samples for 27 parameters); A and V hold
+ * nf x nf matrices (leading dimension nf). */
 typedef struct rc_solve_work {
-    double ev[RC_MAX_PARAMS];                 /* (nf) eigenvalues */
-    double g[RC_MAX_PARAMS];                  /* (nf) gradient J^T r */
-    double c[RC_MAX_PARAMS];                  /* (nf) V^T g */
-    double D[RC_MAX_PARAMS];                  /* (nf) column scaling */
-    double dx[RC_MAX_PARAMS];                 /* (nf) step */
-    double jrow[RC_MAX_PARAMS];               /* (n_params) one Jacobian row */
-    double lt_a[RC_MAX_PARAMS];               /* (nf) LTLM a on the free parameters */
-    double lt_b[RC_MAX_PARAMS];               /* (nf) LTLM b */
-    double lt_x2[RC_MAX_PARAMS];              /* (nf) LTLM x2 (first the scaled step x2 - x1) */
-    uint16_t idx[RC_MAX_PARAMS];              /* (nf) free parameter indices */
-    rc_model trial;
-    rc_model best;
-    rc_model cand;                            /* LTLM candidate */
+    rc_lsq_work lsq;
+    rc_model at;                              /* the model a pass evaluates */
     double A[RC_MAX_PARAMS * RC_MAX_PARAMS];  /* (nf x nf) normal matrix */
     double V[RC_MAX_PARAMS * RC_MAX_PARAMS];  /* (nf x nf) eigenvectors */
 } rc_solve_work;
 
-/* Name of a method ("lm", "ltlm", "lm-paper", "ltlm-paper", "lm-paper-deg",
- * "ltlm-paper-deg"); "unknown" otherwise. */
-const char *rc_method_name(rc_method method);
-/* The method named name (as rc_method_name spells it): RC_OK, or RC_ERR_ARG
- * for an unknown name (out untouched). */
-rc_status rc_method_from_name(rc_method *out, const char *name);
-const char *rc_exit_str(rc_exit e);
+/* The robot's problem (rc_problem.h): the model supplies the data blocks.
+ * Consecutive samples of one sensor form a block (cable lengths: dimension
+ * 1; a tracker position's three samples x, y, z: one item of dimension 3),
+ * in the samples' order, so the rows are the samples' in their order; a
+ * sample's rows are its weighted residual (prediction - rc_sample.value) and
+ * its weighted Jacobian row (rc_meas_prepared). The prior block is the
+ * configuration's prior; alpha6 is marked inert (it turns the flange about
+ * its own x after the last translation), the angles for the paper's -deg
+ * variants. RC_MODEL_MAX_BLOCKS runs at most; more (sensors interleaved)
+ * become one block of dimension 1, the same rows in the same order. */
+#define RC_MODEL_MAX_BLOCKS 8
+typedef struct rc_model_rows rc_model_rows;
+typedef struct rc_model_block {
+    const rc_model_rows *owner;
+    size_t s0;                 /* its first sample */
+} rc_model_block;
+struct rc_model_rows {
+    const rc_model *eval;      /* the model the rows are taken on */
+    rc_model *scratch;         /* NULL: the point is always eval->x; else a pass copies it here */
+    rc_meas_prep prep;
+    const rc_sample *samples;
+    const double *sin_q, *cos_q; /* (n x 6) each, rc_qtrig_fill; NULL: per sample */
+    rc_model_block blk[RC_MODEL_MAX_BLOCKS];
+    rc_block blocks[RC_MODEL_MAX_BLOCKS];
+    uint8_t inert[RC_MAX_PARAMS];
+    uint8_t unit[RC_MAX_PARAMS];
+};
+
+/* Fill p (and its storage r) with the problem of m on samples (n): m's
+ * effects, the point x of each pass copied into scratch (NULL: every pass is
+ * at m->x), the readings' sines sin_q, cos_q (or NULL), fixed parameters
+ * and the prior from cfg (NULL: none). max_dim 1: every sample a row of its
+ * own (a caller's Jacobian row holds n_params entries). */
+void rc_model_problem(rc_problem *p, rc_model_rows *r, const rc_model *m, rc_model *scratch, const rc_sample *samples,
+                      size_t n, const double *sin_q, const double *cos_q, const struct rc_solve_config *cfg,
+                      unsigned max_dim);
+
 
 /* The prior's part of the cost at m (mm^2, as rc_solve weighs it): 0
  * without a prior (cfg NULL, no prior_mean, prior_noise_mm <= 0). Only

@@ -118,7 +118,7 @@ static int parse(calib_args *a, int argc, char **argv)
         {"--method", RCH_OPT_CHOICE, &a->method, 0, 0, NULL,
          "lm (robust), ltlm (robust + chaotic candidates), lm-paper / ltlm-paper (the paper's update, angles in "
          "rad), lm-paper-deg / ltlm-paper-deg (the same with angles in degrees)",
-         0, "lm|ltlm|lm-paper|ltlm-paper|lm-paper-deg|ltlm-paper-deg"},
+         0, RC_METHOD_CHOICES},
         {"--test-fraction", RCH_OPT_DOUBLE, &cfg->test_fraction, 0, 0.999, "F",
          "share of samples held out for the before/after report", 0, NULL},
         {"--seed", RCH_OPT_UINT, &a->seed, 0, 0, "S", "split (and LTLM) seed", 0, NULL},

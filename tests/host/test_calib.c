@@ -119,8 +119,8 @@ static void ident_routes(const char *path)
     assert_true(train && w && V && work);
     double cost;
     for (unsigned i = 0; i < np; ++i)
-        w->idx[i] = (uint16_t)i;
-    assert_int_equal(rc_normal_eq(w->A, w->g, &cost, w->jrow, &r.model, w->idx, np, train, r.n_train), RC_OK);
+        w->lsq.idx[i] = (uint16_t)i;
+    assert_int_equal(rc_normal_eq(w->A, w->lsq.g, &cost, w->lsq.jrow, &r.model, w->lsq.idx, np, train, r.n_train), RC_OK);
     rc_ident id;
     assert_int_equal(rc_ident_normal(&id, V, work, w->A, np, r.n_train), RC_OK);
     const rc_ident *ref = &r.ident.core;

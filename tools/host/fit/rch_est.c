@@ -10,38 +10,37 @@
 #include <string.h>
 #include <time.h>
 
-static const char *const est_names[RCH_EST_ALL] = {"LM",       "EKF",          "PF",         "SCA",
-                                                   "QIBAS",    "SSLM",         "LTLM",       "LM-paper",
-                                                   "LM-paper-deg", "LTLM-paper", "LTLM-paper-deg"};
+/* One row of RCH_EST_METHODS. */
+typedef struct est_row {
+    const char *name;
+    int row, solve, est;
+} est_row;
+#define RCH_EST_ROW_(id, name, row, solve, est) {name, row, solve, est},
+static const est_row est_table[RCH_EST_ALL] = {RCH_EST_METHODS(RCH_EST_ROW_)};
+#undef RCH_EST_ROW_
 
 const char *rch_est_name(rch_est_id id)
 {
-    return (unsigned)id < RCH_EST_ALL ? est_names[id] : "unknown";
+    return (unsigned)id < RCH_EST_ALL ? est_table[id].name : "unknown";
 }
 
 int rch_est_paper_row(rch_est_id id)
 {
-    if ((unsigned)id < RCH_EST_COUNT)
-        return (int)id + 1;
-    return id == RCH_EST_LM_PAPER || id == RCH_EST_LM_PAPER_DEG ? 1 : 7;
+    return (unsigned)id < RCH_EST_ALL ? est_table[id].row : 7;
 }
 
 int rch_est_is_solve(rch_est_id id)
 {
-    return id == RCH_EST_LM || id == RCH_EST_LTLM || ((unsigned)id >= RCH_EST_COUNT && (unsigned)id < RCH_EST_ALL);
+    return (unsigned)id < RCH_EST_ALL && est_table[id].solve >= 0;
 }
 
 void rch_est_solve_config(rc_solve_config *cfg, rch_est_id id, uint64_t seed, const rch_est_opts *opts)
 {
-    static const rc_method mt[RCH_EST_ALL] = {RC_METHOD_LM,         RC_METHOD_LM,           RC_METHOD_LM,
-                                              RC_METHOD_LM,         RC_METHOD_LM,           RC_METHOD_LM,
-                                              RC_METHOD_LTLM,       RC_METHOD_LM_PAPER,     RC_METHOD_LM_PAPER_DEG,
-                                              RC_METHOD_LTLM_PAPER, RC_METHOD_LTLM_PAPER_DEG};
     static const rch_est_opts defaults;
     if (!opts)
         opts = &defaults;
     memset(cfg, 0, sizeof *cfg);
-    cfg->method = (unsigned)id < RCH_EST_ALL ? mt[id] : RC_METHOD_LM;
+    cfg->method = rch_est_is_solve(id) ? (rc_method)est_table[id].solve : RC_METHOD_LM;
     cfg->max_iter = opts->max_iter;
     cfg->seed = seed;
     cfg->fixed = opts->fixed;
@@ -66,7 +65,7 @@ int rch_est_parse(const char *name)
         return -1;
     for (int i = 0; i < RCH_EST_ALL; ++i) {
         char m[4] = {'m', (char)('1' + i), 0, 0};
-        if (ieq(name, est_names[i]) || (i < RCH_EST_COUNT && ieq(name, m)))
+        if (ieq(name, est_table[i].name) || (i < RCH_EST_COUNT && ieq(name, m)))
             return i;
     }
     return -1;
@@ -148,15 +147,12 @@ rc_status rch_est_run(rc_model *m, rch_est_out *out, rch_curve *curve, rch_est_w
         return st;
     }
     {
-        static const rc_est_method map[RCH_EST_COUNT] = {RC_EST_SSLM, RC_EST_EKF,   RC_EST_PF,
-                                                         RC_EST_SCA,  RC_EST_QIBAS, RC_EST_SSLM,
-                                                         RC_EST_SSLM};
         rc_est_config cfg;
         rc_est_result res;
-        if ((unsigned)id >= RCH_EST_COUNT)
+        if ((unsigned)id >= RCH_EST_ALL || est_table[id].est < 0)
             return RC_ERR_ARG;
         memset(&cfg, 0, sizeof cfg);
-        cfg.method = map[id];
+        cfg.method = (rc_est_method)est_table[id].est;
         cfg.max_iter = opts->max_iter;
         cfg.pop = opts->pop;
         cfg.bound_len_mm = opts->bound_len_mm;

@@ -25,24 +25,31 @@
 #include "rc_est.h"
 #include "rc_solve.h"
 
-typedef enum rch_est_id {
-    RCH_EST_LM = 0,
-    RCH_EST_EKF = 1,
-    RCH_EST_PF = 2,
-    RCH_EST_SCA = 3,
-    RCH_EST_QIBAS = 4,
-    RCH_EST_SSLM = 5,
-    RCH_EST_LTLM = 6,
-    RCH_EST_COUNT = 7,
-    /* The paper's own M1 and M7 (rc_solve's paper variants: Eq. 10 with
-     * mu = 5 and no acceptance; Algorithm I on it), angles in rad or in deg
-     * inside Eq. 10 (rcal compare --literal). */
-    RCH_EST_LM_PAPER = 7,
-    RCH_EST_LM_PAPER_DEG = 8,
-    RCH_EST_LTLM_PAPER = 9,
-    RCH_EST_LTLM_PAPER_DEG = 10,
-    RCH_EST_ALL = 11
-} rch_est_id;
+/* The methods of `rcal compare`: one line each, the enum, the names, the
+ * paper's row and the method that runs expanded from it.
+ * X(ID, name (the paper's), paper row 1..7, rc_solve's method or -1,
+ *   rc_est's method or -1). The first seven are the paper's M1..M7; then the
+ * paper's own M1 and M7 (rc_solve's paper variants: Eq. 10 with mu = 5 and
+ * no acceptance; Algorithm I on it), angles in rad or in deg inside Eq. 10
+ * (rcal compare --literal). */
+#define RCH_EST_METHODS(X)                                                                                        \
+    X(LM, "LM", 1, RC_METHOD_LM, -1)                                                                              \
+    X(EKF, "EKF", 2, -1, RC_EST_EKF)                                                                              \
+    X(PF, "PF", 3, -1, RC_EST_PF)                                                                                 \
+    X(SCA, "SCA", 4, -1, RC_EST_SCA)                                                                              \
+    X(QIBAS, "QIBAS", 5, -1, RC_EST_QIBAS)                                                                        \
+    X(SSLM, "SSLM", 6, -1, RC_EST_SSLM)                                                                           \
+    X(LTLM, "LTLM", 7, RC_METHOD_LTLM, -1)                                                                        \
+    X(LM_PAPER, "LM-paper", 1, RC_METHOD_LM_PAPER, -1)                                                            \
+    X(LM_PAPER_DEG, "LM-paper-deg", 1, RC_METHOD_LM_PAPER_DEG, -1)                                                \
+    X(LTLM_PAPER, "LTLM-paper", 7, RC_METHOD_LTLM_PAPER, -1)                                                      \
+    X(LTLM_PAPER_DEG, "LTLM-paper-deg", 7, RC_METHOD_LTLM_PAPER_DEG, -1)
+
+#define RCH_EST_ENUM_(id, name, row, solve, est) RCH_EST_##id,
+typedef enum rch_est_id { RCH_EST_METHODS(RCH_EST_ENUM_) RCH_EST_ALL } rch_est_id;
+#undef RCH_EST_ENUM_
+/* The paper's seven (M1..M7): the ids before the paper variants. */
+#define RCH_EST_COUNT RCH_EST_LM_PAPER
 
 /* "LM", "EKF", "PF", "SCA", "QIBAS", "SSLM", "LTLM" (the paper's names),
  * "LM-paper", "LM-paper-deg", "LTLM-paper", "LTLM-paper-deg". */

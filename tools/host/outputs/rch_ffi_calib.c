@@ -107,9 +107,11 @@ static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t 
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "calibrate: at most 16 data and 16 positions files");
     rch_calib_cfg cfg;
     rch_calib_cfg_init(&cfg);
-    if (rch_method_parse(&cfg.method, o->method ? o->method : "lm") != 0)
-        return fail(RCH_FFI_ERR_ARG, err, err_len,
-                    "unknown method '%s' (lm, ltlm, lm-paper, ltlm-paper, lm-paper-deg, ltlm-paper-deg)", o->method);
+    if (rch_method_parse(&cfg.method, o->method ? o->method : "lm") != 0) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "unknown method '%s' (%s)", o->method, RC_METHOD_LIST);
+        return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", msg);
+    }
     if (!(o->test_fraction >= 0.0 && o->test_fraction < 1.0))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s", "test_fraction must be in [0, 1)");
     if (o->cases > 1000 || o->max_iter > 100000)

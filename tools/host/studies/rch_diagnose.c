@@ -77,8 +77,8 @@ unsigned rch_dg_rank_at(const rc_model *m, unsigned np, const rc_sample *s, size
 {
     double cost;
     for (unsigned i = 0; i < np; ++i)
-        w->idx[i] = (uint16_t)i;
-    if (rc_normal_eq(w->A, w->g, &cost, w->jrow, m, w->idx, np, s, n) != RC_OK)
+        w->lsq.idx[i] = (uint16_t)i;
+    if (rc_normal_eq(w->A, w->lsq.g, &cost, w->lsq.jrow, m, w->lsq.idx, np, s, n) != RC_OK)
         return 0;
     double *work = malloc(rc_ident_work_size(np) * sizeof *work);
     rc_ident id;
