@@ -48,6 +48,7 @@ dict_for() {
     fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load) echo "$ROOT/fuzz/dict/csv.dict" ;;
     fuzz_json | fuzz_robot) echo "$ROOT/fuzz/dict/json.dict" ;;
     fuzz_rapid) echo "$ROOT/fuzz/dict/rapid.dict" ;;
+    fuzz_urscript) echo "$ROOT/fuzz/dict/urscript.dict" ;;
     fuzz_ascii | fuzz_stx | fuzz_display) echo "$ROOT/fuzz/dict/ascii.dict" ;;
     fuzz_urdf | fuzz_rsi) echo "$ROOT/fuzz/dict/xml.dict" ;;
     *) echo "" ;;

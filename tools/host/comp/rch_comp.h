@@ -53,7 +53,8 @@
 typedef enum rch_comp_format {
     RCH_COMP_AUTO = 0, /* detect from the first line */
     RCH_COMP_CSV = 1,
-    RCH_COMP_RAPID = 2
+    RCH_COMP_RAPID = 2,
+    RCH_COMP_URSCRIPT = 3 /* a Universal Robots program (.script; rch_urscript_comp.h) */
 } rch_comp_format;
 
 /* What a target whose u95 at the compensated point (the flange or the
