@@ -20,7 +20,10 @@ static const char details[] =
     "module: every jointtarget and robtarget literal (declarations, inline in instructions, assignments) is "
     "corrected, every other byte copied; a robtarget through the nominal IK with its confdata, written as the "
     "nominal pose of the corrected joints (tool0, or the --tool TCP; base frame). A RAPID target that cannot be "
-    "corrected is named with line, column and reason and nothing is written. A target that does not converge is written as the "
+    "corrected is named with line, column and reason and nothing is written. A Universal Robots URScript program "
+    "goes through the same way: the joint lists and p[...] poses of movej/movel/movep/movec, get_inverse_kin and "
+    "assignments, a pose through the nominal IK nearest the previous target's joints (or qnear) at set_tcp's TCP "
+    "(docs/comp-urscript.md). A target that does not converge is written as the "
     "closest point found within the bounds (the target plus the last good correction when it follows the previous "
     "target on a path), with a warning naming the cause and its position error; the exit status is then 1.";
 
