@@ -410,6 +410,66 @@ static void close_ik(scan *s, const frame *f)
     }
 }
 
+/* A name at 'at' (read to its end here): a pose p[...], a keyword argument's
+ * name =, or a name token. 0, or -1 (d set). */
+static int at_name(scan *s, cur at)
+{
+    frame *f = s->depth > 0 ? &s->f[s->depth - 1] : NULL;
+    const int ch = peekc(s, at.pos);
+    while (is_alpha(peekc(s, s->c.pos)) || is_digit(peekc(s, s->c.pos)))
+        adv(s, &s->c);
+    const size_t n = s->c.pos - at.pos;
+    if (n == 1 && ch == 'p' && peekc(s, s->c.pos) == '[') { /* p[ : a pose */
+        const int r = at_bracket(s, 1, at);
+        if (r < 0)
+            return -1;
+        if (r > 0)
+            return 0;
+        s->skip_bracket = s->ts->n > 0 && s->ts->t[s->ts->n - 1].off == at.pos;
+    }
+    /* a keyword argument: name = (not ==) at an argument's start */
+    if (f && f->kind == '(' && f->at_start) {
+        cur k = s->c;
+        skip_space(s, &k, 1);
+        if (peekc(s, k.pos) == '=' && peekc(s, k.pos + 1) != '=') {
+            snprintf(f->kw, sizeof f->kw, "%.*s", (int)(n < 23 ? n : 23), s->s + at.pos);
+            if (!strcmp(f->fn, "get_inverse_kin") && (f->arg == 1 || !strcmp(f->kw, "qnear")))
+                f->qnear_arg = !strcmp(f->kw, "qnear"); /* the second argument by another name: not qnear */
+            adv(s, &k);
+            s->c = k;
+            push_tok(s, T_EQ, k.pos - 1, 1);
+            return 0;
+        }
+    }
+    push_tok(s, T_NAME, at.pos, n);
+    if (f)
+        f->at_start = 0;
+    return 0;
+}
+
+/* A closing bracket ch at 'at': its frame closed (get_inverse_kin's seed
+ * tied to its pose). 0, or -1 (d set: no frame, or one of the other kind). */
+static int close_bracket(scan *s, int ch, cur at)
+{
+    frame *f = s->depth > 0 ? &s->f[s->depth - 1] : NULL;
+    if (!f || f->kind != (ch == ')' ? '(' : '[')) {
+        if (f)
+            rch_diag_set(s->d, s->file, at.line, at.col, "'%c' closes the '%c' of line %u, column %u", ch, f->kind,
+                         f->line, f->col);
+        else
+            rch_diag_set(s->d, s->file, at.line, at.col, "'%c' with no bracket open", ch);
+        return -1;
+    }
+    if (!strcmp(f->fn, "get_inverse_kin"))
+        close_ik(s, f);
+    --s->depth;
+    adv(s, &s->c);
+    push_tok(s, T_CLOSE, at.pos, 1);
+    if (s->depth > 0)
+        s->f[s->depth - 1].at_start = 0;
+    return 0;
+}
+
 int rch_urs_scan(rch_urs_targets *ts, const char *text, size_t len, const char *file, unsigned first_line, rch_diag *d)
 {
     static scan s; /* one scan at a time: the frames are too large for a small stack */
@@ -456,34 +516,8 @@ int rch_urs_scan(rch_urs_targets *ts, const char *text, size_t len, const char *
             adv(&s, &s.c);
             push_tok(&s, T_STR, at.pos, s.c.pos - at.pos);
         } else if (is_alpha(ch)) {
-            while (is_alpha(peekc(&s, s.c.pos)) || is_digit(peekc(&s, s.c.pos)))
-                adv(&s, &s.c);
-            const size_t n = s.c.pos - at.pos;
-            if (n == 1 && ch == 'p' && peekc(&s, s.c.pos) == '[') { /* p[ : a pose */
-                const int r = at_bracket(&s, 1, at);
-                if (r < 0)
-                    goto fail;
-                if (r > 0)
-                    continue;
-                s.skip_bracket = s.ts->n > 0 && s.ts->t[s.ts->n - 1].off == at.pos;
-            }
-            /* a keyword argument: name = (not ==) at an argument's start */
-            if (f && f->kind == '(' && f->at_start) {
-                cur k = s.c;
-                skip_space(&s, &k, 1);
-                if (peekc(&s, k.pos) == '=' && peekc(&s, k.pos + 1) != '=') {
-                    snprintf(f->kw, sizeof f->kw, "%.*s", (int)(n < 23 ? n : 23), text + at.pos);
-                    if (!strcmp(f->fn, "get_inverse_kin") && (f->arg == 1 || !strcmp(f->kw, "qnear")))
-                        f->qnear_arg = !strcmp(f->kw, "qnear"); /* the second argument by another name: not qnear */
-                    adv(&s, &k);
-                    s.c = k;
-                    push_tok(&s, T_EQ, k.pos - 1, 1);
-                    continue;
-                }
-            }
-            push_tok(&s, T_NAME, at.pos, n);
-            if (f)
-                f->at_start = 0;
+            if (at_name(&s, at) < 0)
+                goto fail;
         } else if (is_digit(ch) || (ch == '.' && is_digit(peekc(&s, s.c.pos + 1)))) {
             size_t e = number_end(&s, s.c.pos);
             if (e == 0) { /* 1.5x: read the run as one token */
@@ -525,21 +559,8 @@ int rch_urs_scan(rch_urs_targets *ts, const char *text, size_t len, const char *
             adv(&s, &s.c);
             push_tok(&s, T_OPEN, at.pos, 1);
         } else if (ch == ')' || ch == ']') {
-            if (!f || f->kind != (ch == ')' ? '(' : '[')) {
-                if (f)
-                    rch_diag_set(d, file, at.line, at.col, "'%c' closes the '%c' of line %u, column %u", ch, f->kind,
-                                 f->line, f->col);
-                else
-                    rch_diag_set(d, file, at.line, at.col, "'%c' with no bracket open", ch);
+            if (close_bracket(&s, ch, at) < 0)
                 goto fail;
-            }
-            if (!strcmp(f->fn, "get_inverse_kin"))
-                close_ik(&s, f);
-            --s.depth;
-            adv(&s, &s.c);
-            push_tok(&s, T_CLOSE, at.pos, 1);
-            if (s.depth > 0)
-                s.f[s.depth - 1].at_start = 0;
         } else if (ch == ',') {
             adv(&s, &s.c);
             push_tok(&s, T_COMMA, at.pos, 1);
