@@ -49,6 +49,7 @@ dict_for() {
     fuzz_json | fuzz_robot) echo "$ROOT/fuzz/dict/json.dict" ;;
     fuzz_rapid) echo "$ROOT/fuzz/dict/rapid.dict" ;;
     fuzz_fanuc) echo "$ROOT/fuzz/dict/fanuc.dict" ;;
+    fuzz_urscript) echo "$ROOT/fuzz/dict/urscript.dict" ;;
     fuzz_ascii | fuzz_stx | fuzz_display) echo "$ROOT/fuzz/dict/ascii.dict" ;;
     fuzz_urdf | fuzz_rsi) echo "$ROOT/fuzz/dict/xml.dict" ;;
     *) echo "" ;;

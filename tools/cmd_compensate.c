@@ -20,7 +20,10 @@ static const char details[] =
     "module: every jointtarget and robtarget literal (declarations, inline in instructions, assignments) is "
     "corrected, every other byte copied; a robtarget through the nominal IK with its confdata, written as the "
     "nominal pose of the corrected joints (tool0, or the --tool TCP; base frame). A RAPID target that cannot be "
-    "corrected is named with line, column and reason and nothing is written. A target that does not converge is written as the "
+    "corrected is named with line, column and reason and nothing is written. A Universal Robots URScript program "
+    "goes through the same way: the joint lists and p[...] poses of movej/movel/movep/movec, get_inverse_kin and "
+    "assignments, a pose through the nominal IK nearest the previous target's joints (or qnear) at set_tcp's TCP "
+    "(docs/comp-urscript.md). A target that does not converge is written as the "
     "closest point found within the bounds (the target plus the last good correction when it follows the previous "
     "target on a path), with a warning naming the cause and its position error; the exit status is then 1.";
 
@@ -118,7 +121,8 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
 {
     const char *const files[] = {"model", job->model_path, "nominal", job->nominal_path, "in", job->in_path,
                                  "out", job->out_path, "input_format",
-                                 r->format == RCH_COMP_RAPID ? "rapid" : r->format == RCH_COMP_FANUC ? "fanuc" : "csv",
+                                 r->format == RCH_COMP_RAPID ? "rapid" : r->format == RCH_COMP_FANUC ? "fanuc"
+                                 : r->format == RCH_COMP_URSCRIPT ? "urscript" : "csv",
                                  NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
@@ -247,7 +251,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
          "deprecated, no effect: RAPID robtargets are corrected (through the nominal inverse kinematics)", 0, NULL},
-        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid|fanuc"},
+        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid|urscript|fanuc"},
         {"--fanuc-frames", RCH_OPT_STR, &fanuc_frames, 0, 0, "FRAMES.csv",
          "a Fanuc program's user and tool frames, as the pendant shows them (lines uframe,n,x,y,z,w,p,r and "
          "utool,n,x,y,z,w,p,r; mm, deg): a position in a UF or UT not given is refused (docs/comp-fanuc.md)",
@@ -278,6 +282,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         .out_path = out,
         .format = strcmp(format, "csv") == 0     ? RCH_COMP_CSV
                   : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID
+                  : strcmp(format, "urscript") == 0 ? RCH_COMP_URSCRIPT
                   : strcmp(format, "fanuc") == 0 ? RCH_COMP_FANUC
                                                  : RCH_COMP_AUTO,
         .position_only = position_only,

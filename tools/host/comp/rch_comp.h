@@ -57,7 +57,8 @@ typedef enum rch_comp_format {
     RCH_COMP_AUTO = 0, /* detect from the first line */
     RCH_COMP_CSV = 1,
     RCH_COMP_RAPID = 2,
-    RCH_COMP_FANUC = 5  /* a Fanuc LS program (first line /PROG): rch_comp_fanuc.c, docs/comp-fanuc.md */
+    RCH_COMP_URSCRIPT = 3, /* a Universal Robots program (.script; rch_urscript_comp.h) */
+    RCH_COMP_FANUC = 5     /* a Fanuc LS program (first line /PROG): rch_comp_fanuc.c, docs/comp-fanuc.md */
 } rch_comp_format;
 
 /* What a target whose u95 at the compensated point (the flange or the

@@ -21,6 +21,7 @@
 #include "rch_data.h"
 #include "rch_file.h"
 #include "rch_stdio.h"
+#include "rch_urscript_comp.h"
 
 /* longest input line (a RAPID target line is a few hundred bytes): a longer
  * one, or a stream without line ends (/dev/zero), is refused, not buffered */
@@ -116,6 +117,10 @@ static int decide_form(rch_cpi_ctx *c, const char *line, size_t bom, size_t tn, 
     if (starts_with_ci(text, tn, "MODULE") || starts_with_ci(text, tn, "%%%") || starts_with_ci(text, tn, "!") ||
         find_ci(text, tn, "jointtarget") || find_ci(text, tn, "robtarget")) {
         c->format = 2;
+        return 0;
+    }
+    if (rch_cpi_urscript_detect(text, tn)) {
+        c->format = RCH_COMP_FORMAT_URSCRIPT;
         return 0;
     }
     size_t st[RCH_CPI_MAX_FIELDS], ln[RCH_CPI_MAX_FIELDS];
@@ -216,8 +221,10 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                 rc = -1;
             break;
         }
-        if (c.format == 2) { /* a module is read whole, its bytes as they are: all or nothing */
-            rc = rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d);
+        if (c.format == 2 || c.format == RCH_COMP_FORMAT_URSCRIPT) { /* read whole, its bytes as they are */
+            rc = c.format == 2 ? rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d)
+                               : rch_cpi_urscript(&c, line, (size_t)got, in, lineno, d);
+
             if (rc >= 0 && out_failed(&c, lineno, d))
                 rc = -1;
             break;

@@ -21,6 +21,11 @@
 #define M_PI 3.14159265358979323846
 #endif
 #define DEG (M_PI / 180.0)
+/* A pose up to this fraction beyond a boundary of the idealised arm (the shoulder's cylinder, the wrist's
+ * and the elbow's cosines past 1) still gets its starts, SEED_SPREAD rad (and more) apart on either side of
+ * the boundary: a calibrated arm reaches a little beyond its idealised twin there. */
+#define SEED_NEAR 0.02
+#define SEED_SPREAD 0.02
 
 static double ideal_angle(double a)
 {
@@ -111,18 +116,29 @@ static int offset_all(double out[8][RC_NJ], const double r[RC_NJ][4], const doub
     for (int k = 0; k < 3; ++k)
         o5[k] = p6[k] - r[5][1] * z6[k];
     const double rr = hypot(o5[0], o5[1]);
-    if (!(rr >= fabs(D) * (1.0 - 1e-9)) || rr == 0.0)
+    if (!(rr >= fabs(D) * (1.0 - SEED_NEAR)) || rr == 0.0)
         return 0; /* (at the shoulder singularity rr = |D|: one axis-1 angle, twice) */
-    const double phi = atan2(o5[1], o5[0]), as = asin(fmax(-1.0, fmin(1.0, D / (s1 * rr))));
+    /* Just inside the idealised arm's shoulder boundary (a calibrated arm's pose next to its own, issue 51):
+     * no solution of the idealised arm, two of the real one on either side of the double root, about
+     * sqrt(2 (|D| - rr) / |D|) away; the two starts are put there, not on the root (where Newton picks a
+     * side at random and the other branch had no start: NO_BRANCH) */
+    const double v = D / (s1 * rr);
+    const double phi = atan2(o5[1], o5[0]);
+    const double as = fabs(v) <= 1.0 + 1e-9 ? asin(fmax(-1.0, fmin(1.0, v)))
+                                     : copysign(M_PI / 2 - sqrt(2.0 * (fabs(D) - rr) / fabs(D)) - SEED_SPREAD, v);
     int n = 0;
     for (int i1 = 0; i1 < 2; ++i1) {
         const double th1 = i1 == 0 ? phi + as : phi + M_PI - as;
         const double z1[3] = {s1 * sin(th1), -s1 * cos(th1), 0.0};
         const double c5 = -(z6[0] * z1[0] + z6[1] * z1[1]) / (s4 * s5);
-        if (fabs(c5) > 1.0 + 1e-12)
+        if (fabs(c5) > 1.0 + SEED_NEAR)
             continue;
         for (int i5 = 0; i5 < 2; ++i5) {
-            const double th5 = (i5 ? -1.0 : 1.0) * acos(fmax(-1.0, fmin(1.0, c5)));
+            /* beyond the idealised wrist's singularity: the two starts apart, on either side of it */
+            const double a5 = fabs(c5) <= 1.0 + 1e-12 ? acos(fmax(-1.0, fmin(1.0, c5)))
+                              : c5 > 0           ? SEED_SPREAD
+                                                 : M_PI - SEED_SPREAD;
+            const double th5 = (i5 ? -1.0 : 1.0) * a5;
             /* theta6 from z1 in the flange frame */
             const double w[3] = {R6[0] * z1[0] + R6[3] * z1[1], R6[1] * z1[0] + R6[4] * z1[1],
                                  R6[2] * z1[0] + R6[5] * z1[1]};
@@ -139,10 +155,14 @@ static int offset_all(double out[8][RC_NJ], const double r[RC_NJ][4], const doub
             const double th234 = atan2(R[3], R[0]);
             const double a2 = r[1][0], a3 = r[2][0];
             const double c3 = (p[0] * p[0] + p[1] * p[1] - a2 * a2 - a3 * a3) / (2 * a2 * a3);
-            if (fabs(c3) > 1.0 + 1e-9)
+            if (fabs(c3) > 1.0 + SEED_NEAR)
                 continue;
             for (int i3 = 0; i3 < 2; ++i3) {
-                const double th3 = (i3 ? -1.0 : 1.0) * acos(fmax(-1.0, fmin(1.0, c3)));
+                /* the arm stretched or folded beyond the idealised arm's reach: the starts on either side */
+                const double a3c = fabs(c3) <= 1.0 + 1e-9 ? acos(fmax(-1.0, fmin(1.0, c3)))
+                                   : c3 > 0          ? SEED_SPREAD
+                                                     : M_PI - SEED_SPREAD;
+                const double th3 = (i3 ? -1.0 : 1.0) * a3c;
                 const double th2 = atan2(p[1], p[0]) - atan2(a3 * sin(th3), a2 + a3 * cos(th3));
                 const double th[RC_NJ] = {th1, th2, th3, th234 - th2 - th3, th5, th6};
                 for (int j = 0; j < RC_NJ; ++j)
