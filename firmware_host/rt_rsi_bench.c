@@ -12,7 +12,11 @@
  * a zero AK) on another, and runs two controller threads at the rate, the
  * responder's half a period after rcal-rt's. Each cycle a controller sends a
  * <Rob> with the next setpoint and waits for the answer until its next cycle:
- * no answer by then is a missed cycle. Reported: missed cycles, round trip
+ * no answer by then is a missed cycle, attributed to the responder when its
+ * answer did not arrive (kernel stamp) within a period of the controller's
+ * actual send, else to the machine (the controller thread itself sent or read
+ * late). Reported: missed cycles and their attribution, the controller's send
+ * lateness, round trip
  * (controller send to answer read) median/p99.99 for both, each responder's
  * own receive-to-send time (kernel receive stamp to sendto done) median/p99.99,
  * rcal-rt's CPU per answer, and the answers whose AK differs from compensate's
