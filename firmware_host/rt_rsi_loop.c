@@ -197,6 +197,8 @@ typedef struct rsi_state {
     unsigned long reloads;    /* replaced model files taken */
     /* the longest time of each stage (us): the measurement of where a late answer's time went */
     double max_decode_us, max_comp_us, max_send_us, max_after_us;
+    double max_wake_us;          /* the kernel's receive stamp to the read returning */
+    unsigned long wake_over_ms;  /* reads returning more than 1 ms after the kernel's receive */
     int in_session;
     unsigned long long last_ipoc;
     double last_rx_s;          /* monotonic seconds of the last controller datagram */
@@ -501,11 +503,11 @@ static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, doub
             printf("%s\"%s\": %lu", k ? ", " : "", f_name[k], s->count[k]);
         printf("}, \"largest_step_deg\": %.10f, \"latency_us\": {\"median\": %.1f, \"p99\": %.1f, \"p99_99\": %.1f, "
                "\"max\": %.1f, \"mean\": %.2f}, \"answers_over_a_cycle\": %lu, \"cpu_us_per_answer\": %.2f, "
-               "\"reloads\": %lu, \"stage_max_us\": {\"decode\": %.1f, \"compensate\": %.1f, \"send\": %.1f, "
-               "\"after\": %.1f}}\n",
+               "\"reloads\": %lu, \"stage_max_us\": {\"wake\": %.1f, \"decode\": %.1f, \"compensate\": %.1f, "
+               "\"send\": %.1f, \"after\": %.1f}, \"wakes_over_1ms\": %lu}\n",
                s->max_step_seen, rt_rsi_hist_pct(h, 50), rt_rsi_hist_pct(h, 99), rt_rsi_hist_pct(h, 99.99),
                h->max_us, h->n ? h->sum_us / (double)h->n : 0.0, s->over_cycle, cpu_us, s->reloads,
-               s->max_decode_us, s->max_comp_us, s->max_send_us, s->max_after_us);
+               s->max_wake_us, s->max_decode_us, s->max_comp_us, s->max_send_us, s->max_after_us, s->wake_over_ms);
         return;
     }
     printf("rcal-rt rsi: %lu datagrams, %lu answered, %lu session(s), %s corrections, %s\n", s->datagrams,
@@ -520,12 +522,14 @@ static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, doub
            "%.1f; %lu answers over a cycle; CPU %.2f us per answer\n",
            rt_rsi_hist_pct(h, 50), rt_rsi_hist_pct(h, 99), rt_rsi_hist_pct(h, 99.99), h->max_us, s->over_cycle,
            cpu_us);
-    printf("  model files taken while running: %lu; the longest stage: decode %.1f us, compensate %.1f us, send %.1f "
-           "us, after the answer (the model taken, the log) %.1f us\n", s->reloads, s->max_decode_us, s->max_comp_us,
+    printf("  model files taken while running: %lu; the longest stage: wake-up (kernel receive to the read) %.1f us "
+           "(%lu over 1 ms), decode %.1f us, compensate %.1f us, send %.1f us, after the answer (the model taken, the "
+           "log) %.1f us\n", s->reloads, s->max_wake_us, s->wake_over_ms, s->max_decode_us, s->max_comp_us,
            s->max_send_us, s->max_after_us);
 }
 
-static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockaddr_in *from, struct timespec *rx)
+static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockaddr_in *from, struct timespec *rx,
+                  double *wake_us)
 {
     struct iovec iov = {buf, cap};
     char ctl[256];
@@ -541,9 +545,12 @@ static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockadd
     if (n < 0)
         return -1;
     clock_gettime(CLOCK_REALTIME, rx);
+    const struct timespec read_at = *rx;
     for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); c; c = CMSG_NXTHDR(&mh, c))
         if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS)
             memcpy(rx, CMSG_DATA(c), sizeof *rx);
+    /* from the kernel's receive to the read returning: the thread's wake-up (the scheduler's, not the loop's) */
+    *wake_us = ((double)(read_at.tv_sec - rx->tv_sec) * 1e9 + (double)(read_at.tv_nsec - rx->tv_nsec)) / 1e3;
     *len = (size_t)n;
     if (mh.msg_flags & MSG_TRUNC)
         *len = cap + 1; /* over the limit: refused by the decoder */
@@ -603,7 +610,10 @@ static void serve(rsi_io *io, rsi_comp *c, const rsi_opts *o, int fifo_on)
         size_t len;
         struct sockaddr_in from;
         struct timespec rx;
-        if (rx_one(io, buf, sizeof buf - 1, &len, &from, &rx) == 0) {
+        double wake_us = 0.0;
+        if (rx_one(io, buf, sizeof buf - 1, &len, &from, &rx, &wake_us) == 0) {
+            s.max_wake_us = fmax(s.max_wake_us, wake_us);
+            s.wake_over_ms += wake_us > 1e3;
             if (cpu0 < 0) {
                 struct timespec ct;
                 clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ct);
