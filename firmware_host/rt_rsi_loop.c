@@ -56,10 +56,12 @@ void rt_rsi_usage(FILE *f)
             "               [--rsi-cycle-ms MS] [--rsi-timeout-ms MS] [--nominal ROBOT.json]\n"
             "               [--position-only|--full-pose] [--seconds S] [--fifo] [--cpu N] [--json]\n"
             "  RSI:     a KUKA RSI partner (correction mode, docs/rsi.md): each <Rob> datagram's setpoint axes\n"
-            "           (ASPos, degrees, read as the model's joints) compensated as rcal compensate does, answered\n"
+            "           (ASPos, degrees, the controller's axes: the model file's \"controller\" member maps them to the\n"
+            "           model's joints and back) compensated as rcal compensate does, answered\n"
             "           with <Sen><AK A1..A6/><IPOC/></Sen>, AK = compensated - setpoint; the correction changes by\n"
             "           at most --rsi-max-step-deg per answer (default 0.01); only the first sender (or\n"
-            "           --rsi-controller) answered; runs until --seconds or SIGINT/SIGTERM, then reports\n");
+            "           --rsi-controller) answered; a replaced model file is taken (the correction moving to it within\n"
+            "           the step limit); runs until --seconds or SIGINT/SIGTERM, then reports\n");
 }
 
 typedef struct rsi_opts {
