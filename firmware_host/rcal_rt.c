@@ -438,6 +438,7 @@ typedef struct rt_opts {
     const char *egm_bind, *egm_controller;
     double egm_step_deg, egm_follow_deg, egm_timeout_s, egm_wait_s;
     int egm, egm_bench, rate_given;
+    const rch_ctrl *ctrl; /* --model's controller joints (NULL: the identity, or no --model) */
 } rt_opts;
 
 /* The options into o: -1 when they were read, else the exit status (0 after
@@ -586,8 +587,8 @@ static int check_args(const rt_opts *o)
 
 /* The model files compiled into kc and kn (*pos_only raised when the
  * model's orientation is not determined). 0, or -1 with the message in err. */
-static int kin_from_files(rc_kin *kc, rc_kin *kn, int *pos_only, const char *model_path, const char *nominal_path,
-                          char *err, size_t err_len)
+static int kin_from_files(rc_kin *kc, rc_kin *kn, int *pos_only, rch_ctrl *ctrl, const char *model_path,
+                          const char *nominal_path, char *err, size_t err_len)
 {
     static rch_robot robot, nominal;
     rch_diag d;
@@ -602,6 +603,9 @@ static int kin_from_files(rc_kin *kc, rc_kin *kn, int *pos_only, const char *mod
         snprintf(err, err_len, "%s", rch_diag_str(&d, msg, sizeof msg));
         return -1;
     }
+    /* the controller's joints as rcal compensate reads them: the nominal file's member, else the model's */
+    if (ctrl)
+        *ctrl = nominal_path ? nominal.ctrl : robot.ctrl;
     static rc_model det;
     if (determined(&det, &robot))
         *pos_only = 1;
@@ -627,10 +631,13 @@ static int load_kin(const rc_kin **cal, const rc_kin **nom, rc_comp_config *cfg,
     *nom = &fw_kin_nom;
     if (o->model_path) {
         char err[1200];
-        if (kin_from_files(&kin_cal, &kin_nom, &o->position_only, o->model_path, o->nominal_path, err, sizeof err)) {
+        static rch_ctrl ctrl;
+        if (kin_from_files(&kin_cal, &kin_nom, &o->position_only, &ctrl, o->model_path, o->nominal_path, err,
+                           sizeof err)) {
             fprintf(stderr, "rcal-rt: %s\n", err);
             return 1;
         }
+        o->ctrl = ctrl.present && !ctrl.identity_joints ? &ctrl : NULL;
         *cal = &kin_cal;
         *nom = &kin_nom;
         flags = 0;
@@ -648,7 +655,7 @@ static int egm_reload(void *ctx, rc_kin *cal, rc_kin *nom, unsigned *flags, char
 {
     const rt_opts *o = ctx;
     int pos_only = o->position_only;
-    if (kin_from_files(cal, nom, &pos_only, o->model_path, o->nominal_path, err, err_len) != 0)
+    if (kin_from_files(cal, nom, &pos_only, NULL, o->model_path, o->nominal_path, err, err_len) != 0)
         return -1;
     *flags = pos_only ? (unsigned)RC_COMP_FLAG_POSITION_ONLY : 0u;
     return 0;
@@ -674,6 +681,10 @@ static int run_egm(rt_opts *o, const rc_kin *cal, const rc_kin *nom, const rc_co
     e.timeout_s = o->egm_timeout_s;
     e.wait_s = o->egm_wait_s;
     e.json = o->json;
+    e.ctrl = o->ctrl; /* kept as read at the start when the model file is replaced */
+    if (o->ctrl)
+        fprintf(stderr, "rcal-rt: egm: the controller's joints mapped to the model's and back (%s's \"controller\" "
+                        "member)\n", o->nominal_path ? o->nominal_path : o->model_path);
     return rt_egm_run(&e, cal, nom, cfg);
 }
 #endif

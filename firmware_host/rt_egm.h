@@ -17,6 +17,8 @@
 
 #include "rc_comp.h"
 
+struct rch_ctrl; /* rch_ctrl.h */
+
 #define RT_EGM_NJ 6
 /* largest datagram read; a longer one is malformed (EGM's are ~400 bytes) */
 #define RT_EGM_MAX_DGRAM 1400
@@ -115,6 +117,10 @@ typedef struct rt_egm_opts {
     int json;                        /* the summary also as one JSON line on stdout */
     int quiet;                       /* no per-fault log lines (the bench) */
     const char *label;               /* the summary's name ("rcal-rt egm") */
+    const struct rch_ctrl *ctrl;     /* the controller's joint convention (the model file's "controller"
+                                        member, rch_ctrl.h): --in targets and the robot's joints are the
+                                        controller's, compensated in the model's and answered in the
+                                        controller's; NULL: the identity */
 } rt_egm_opts;
 
 void rt_egm_opts_default(rt_egm_opts *o);

@@ -262,6 +262,11 @@ typedef struct side {
     double *rtt_us;
     size_t n_rtt;
     unsigned long missed, replies;
+    /* per cycle, for the attribution of a miss (attribute()): the send (CLOCK_REALTIME, as the kernel stamps),
+     * the reply's kernel arrival stamp (0: none came), the send's lateness behind the schedule (us), in time */
+    double *send_rt, *arr_rt, *send_late_us;
+    unsigned char *in_time;
+    unsigned long miss_resp, miss_ctrl, late_sends;
     int got;          /* this cycle's reply came */
     double t_send;
     double q[RT_EGM_NJ];
@@ -278,6 +283,45 @@ static void read_json(side *s)
     while (k > 0 && s->json[k - 1] == '\n')
         s->json[--k] = '\0';
     close(s->rd);
+}
+
+/* recv with the kernel's arrival stamp (CLOCK_REALTIME ns; the read's time when there is none) */
+static ssize_t recv_stamped(int fd, uint8_t *buf, size_t cap, double *arr_ns)
+{
+    struct iovec iov = {buf, cap};
+    char ctl[256];
+    struct msghdr mh;
+    memset(&mh, 0, sizeof mh);
+    mh.msg_iov = &iov;
+    mh.msg_iovlen = 1;
+    mh.msg_control = ctl;
+    mh.msg_controllen = sizeof ctl;
+    const ssize_t n = recvmsg(fd, &mh, 0);
+    struct timespec t;
+    clock_gettime(CLOCK_REALTIME, &t);
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); n > 0 && c; c = CMSG_NXTHDR(&mh, c))
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS)
+            memcpy(&t, CMSG_DATA(c), sizeof t);
+    *arr_ns = (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+    return n;
+}
+
+/* Each missed cycle (no reply read by the next cycle's scheduled start)
+ * attributed: the responder's when its reply did not arrive (kernel stamp)
+ * within a period of the controller's actual send, else the machine's (the
+ * controller itself sent late, or read late, the reply having come in
+ * time). late_sends: sends more than half a period behind the schedule. */
+static void attribute(side *x, size_t cycles, double period_ns)
+{
+    for (size_t k = 0; k < cycles; ++k) {
+        x->late_sends += x->send_late_us[k] > 0.5 * period_ns / 1e3;
+        if (x->in_time[k])
+            continue;
+        if (x->arr_rt[k] > 0 && x->arr_rt[k] - x->send_rt[k] <= period_ns)
+            x->miss_ctrl++;
+        else
+            x->miss_resp++;
+    }
 }
 
 typedef struct bench_check {
@@ -301,15 +345,19 @@ static void collect(side sd[2], uint32_t seq_now, double deadline, const double 
         for (int j = 0; j < 2; ++j) {
             if (!(p[j].revents & POLLIN))
                 continue;
-            const ssize_t r = recv(sd[j].fd, in, sizeof in, 0);
+            double arr;
+            const ssize_t r = recv_stamped(sd[j].fd, in, sizeof in, &arr);
             const double t = rt_sched_now_ns();
             uint32_t seq;
             double q[RT_EGM_NJ];
             if (r <= 0 || unpack_sensor(&seq, q, in, (size_t)r) != 0)
                 continue;
             sd[j].replies++;
+            if (seq >= 1 && seq <= cycles && sd[j].arr_rt[seq - 1] == 0.0)
+                sd[j].arr_rt[seq - 1] = arr;
             if (seq == seq_now && !sd[j].got) {
                 sd[j].got = 1;
+                sd[j].in_time[seq - 1] = 1;
                 sd[j].rtt_us[sd[j].n_rtt++] = (t - sd[j].t_send) / 1e3;
             }
             if (j == 0 && seq >= 1 && seq <= cycles + 1) {
@@ -335,8 +383,9 @@ static void report(side sd[2], const bench_check *chk, double rate_hz, double se
                rate_hz, seconds, cycles, fifo_ok ? "true" : "false", load0, load1, chk->checked, chk->wrong,
                chk->worst_deg);
         for (int j = 0; j < 2; ++j)
-            printf(", \"%s\": {\"missed\": %lu, \"rtt_us\": {\"median\": %.3f, \"p99_99\": %.3f, \"max\": %.3f}, "
-                   "\"responder\": %s}", names[j], sd[j].missed, pct(sd[j].rtt_us, sd[j].n_rtt, 50),
+            printf(", \"%s\": {\"missed\": %lu, \"missed_responder\": %lu, \"missed_machine\": %lu, "
+                   "\"late_sends\": %lu, \"rtt_us\": {\"median\": %.3f, \"p99_99\": %.3f, \"max\": %.3f}, "
+                   "\"responder\": %s}", names[j], sd[j].missed, sd[j].miss_resp, sd[j].miss_ctrl, sd[j].late_sends, pct(sd[j].rtt_us, sd[j].n_rtt, 50),
                    pct(sd[j].rtt_us, sd[j].n_rtt, 99.99), sd[j].n_rtt ? sd[j].rtt_us[sd[j].n_rtt - 1] : 0.0,
                    sd[j].json[0] ? sd[j].json : "null");
         printf("}\n");
@@ -350,6 +399,10 @@ static void report(side sd[2], const bench_check *chk, double rate_hz, double se
             printf("  %-8s missed cycles %lu; round trip median %.1f us, p99.99 %.1f us, max %.1f us\n", names[j],
                    sd[j].missed, pct(sd[j].rtt_us, sd[j].n_rtt, 50), pct(sd[j].rtt_us, sd[j].n_rtt, 99.99),
                    sd[j].n_rtt ? sd[j].rtt_us[sd[j].n_rtt - 1] : 0.0);
+            printf("           missed cycles attributed: %lu the responder's (its reply not in within a period of the "
+                   "actual send), %lu the machine's (the controller sent or read late; the reply came in time); "
+                   "sends over half a period behind schedule: %lu\n", sd[j].miss_resp, sd[j].miss_ctrl,
+                   sd[j].late_sends);
             printf("           responder: %s\n", sd[j].json[0] ? sd[j].json : "(no summary)");
         }
         printf("  rcal-rt's replies: %lu checked against the path compensated here, %lu differ by more than 1e-6 "
@@ -389,7 +442,9 @@ static int start_sides(side sd[2], const rc_kin *cal, const rc_kin *nom, const r
         memset(&me, 0, sizeof me);
         me.sin_family = AF_INET;
         me.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        if (sd[i].fd < 0 || bind(sd[i].fd, (struct sockaddr *)&me, sizeof me) != 0) {
+        const int on = 1;
+        if (sd[i].fd < 0 || setsockopt(sd[i].fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0 ||
+            bind(sd[i].fd, (struct sockaddr *)&me, sizeof me) != 0) {
             fprintf(stderr, "rcal-rt: --egm-bench: the controller's socket: %s\n", strerror(errno));
             for (int j = 0; j <= i; ++j) /* the responders started: stopped, not left behind */
                 kill(sd[j].pid, SIGTERM);
@@ -402,6 +457,17 @@ static int start_sides(side sd[2], const rc_kin *cal, const rc_kin *nom, const r
     return 0;
 }
 
+static void sides_free(side sd[2])
+{
+    for (int j = 0; j < 2; ++j) {
+        free(sd[j].rtt_us);
+        free(sd[j].send_rt);
+        free(sd[j].arr_rt);
+        free(sd[j].send_late_us);
+        free(sd[j].in_time);
+    }
+}
+
 int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg, double rate_hz, double seconds,
                  int fifo, int json)
 {
@@ -411,13 +477,19 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
     double (*expect)[RT_EGM_NJ] = malloc((cycles + 2) * sizeof *expect);
     side sd[2];
     memset(sd, 0, sizeof sd);
-    sd[0].rtt_us = malloc(cycles * sizeof(double));
-    sd[1].rtt_us = malloc(cycles * sizeof(double));
-    if (!expect || !sd[0].rtt_us || !sd[1].rtt_us) {
+    int mem_ok = 1;
+    for (int j = 0; j < 2; ++j) {
+        sd[j].rtt_us = malloc(cycles * sizeof(double));
+        sd[j].send_rt = calloc(cycles, sizeof(double));
+        sd[j].arr_rt = calloc(cycles, sizeof(double));
+        sd[j].send_late_us = calloc(cycles, sizeof(double));
+        sd[j].in_time = calloc(cycles, 1);
+        mem_ok &= sd[j].rtt_us && sd[j].send_rt && sd[j].arr_rt && sd[j].send_late_us && sd[j].in_time;
+    }
+    if (!expect || !mem_ok) {
         fprintf(stderr, "rcal-rt: --egm-bench: out of memory for %zu cycles\n", cycles);
         free(expect);
-        free(sd[0].rtt_us);
-        free(sd[1].rtt_us);
+        sides_free(sd);
         return 1;
     }
     static rc_comp_stream s;
@@ -436,8 +508,7 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
     getloadavg(la0, 3);
     if (start_sides(sd, cal, nom, cfg, rate_hz, cycles, fifo) != 0) {
         free(expect);
-        free(sd[0].rtt_us);
-        free(sd[1].rtt_us);
+        sides_free(sd);
         return 1;
     }
     const int fifo_ok = fifo ? set_fifo(81) == 0 : 0;
@@ -464,7 +535,11 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
             side *x = &sd[(k & 1u) ? 1 - j : j];
             const size_t len = pack_robot(out, sizeof out, (uint32_t)k + 1, (uint32_t)((rt_sched_now_ns() - t0) / 1e6), x->q);
             x->got = 0;
+            struct timespec rt;
+            clock_gettime(CLOCK_REALTIME, &rt);
+            x->send_rt[k] = (double)rt.tv_sec * 1e9 + (double)rt.tv_nsec;
             x->t_send = rt_sched_now_ns();
+            x->send_late_us[k] = (x->t_send - (deadline - (double)period_ns)) / 1e3;
             sendto(x->fd, out, len, 0, (struct sockaddr *)&x->to, sizeof x->to);
         }
         collect(sd, (uint32_t)k + 1, deadline, (const double(*)[RT_EGM_NJ])expect, cycles, &chk);
@@ -479,11 +554,11 @@ int rt_egm_bench(const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg
         waitpid(sd[j].pid, &stw, 0);
         close(sd[j].fd);
         qsort(sd[j].rtt_us, sd[j].n_rtt, sizeof(double), cmp_double);
+        attribute(&sd[j], cycles, (double)period_ns);
     }
     report(sd, &chk, rate_hz, seconds, cycles, fifo, fifo_ok, la0[0], la1[0], json);
     free(expect);
-    free(sd[0].rtt_us);
-    free(sd[1].rtt_us);
+    sides_free(sd);
     if (chk.wrong || chk.checked == 0) {
         fprintf(stderr, "rcal-rt: --egm-bench: %lu of %lu replies differ from the compensation: exit status 1\n",
                 chk.wrong, chk.checked);

@@ -28,6 +28,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rch_ctrl.h"
 #include "rch_data.h"
 #include "rch_diag.h"
 #include "rch_file.h"
@@ -246,6 +247,7 @@ typedef struct egm_state {
     unsigned nhist, hpos;
     unsigned back_run;           /* older seqnos in a row */
     unsigned long restarts;      /* numbering restarts taken */
+    rc_model lim_model;          /* the model's joint limits (a target mapped from the controller's checked) */
 } egm_state;
 
 /* 1 when this occurrence of fault k is to be logged */
@@ -395,15 +397,34 @@ static void prepare(egm_state *st, egm_next *nx, egm_src *src, rc_comp_stream *s
     if (r == 0)
         return;
     rc_real qr[RC_NJ], qc[RC_NJ];
-    double t_deg[RT_EGM_NJ], c_deg[RT_EGM_NJ];
+    double t_deg[RT_EGM_NJ], c_deg[RT_EGM_NJ], qm[RT_EGM_NJ];
+    /* the controller's joints (its signs, zeros, J2/J3 coupling) to the model's */
+    memcpy(qm, q, sizeof qm);
+    if (o->ctrl)
+        rch_ctrl_to_model(qm, o->ctrl, qm);
+    for (int i = 0; i < RT_EGM_NJ; ++i)
+        if (!(qm[i] >= st->lim_model.q_min_rad[i] && qm[i] <= st->lim_model.q_max_rad[i])) {
+            st->rows_refused++;
+            if (count_fault(st, F_BAD_ROW, 1))
+                fprintf(stderr, "rcal-rt: egm: target %lu refused, the reference held: joint %d = %.6f deg is "
+                                "%.6f deg of the model, outside its limits [%g, %g] deg\n", st->targets + 1, i + 1,
+                        q[i] / DEG, qm[i] / DEG, st->lim_model.q_min_rad[i] / DEG,
+                        st->lim_model.q_max_rad[i] / DEG);
+            return;
+        }
     for (int i = 0; i < RT_EGM_NJ; ++i) {
-        qr[i] = (rc_real)q[i];
+        qr[i] = (rc_real)qm[i];
         t_deg[i] = q[i] / DEG;
     }
     rc_comp_result res;
     const rc_status cs = rc_comp_stream_step(s, qc, &res, qr);
+    double cq[RT_EGM_NJ];
     for (int i = 0; i < RT_EGM_NJ; ++i)
-        c_deg[i] = (double)qc[i] / DEG;
+        cq[i] = (double)qc[i];
+    if (o->ctrl) /* back to the controller's joints */
+        rch_ctrl_from_model(cq, o->ctrl, cq);
+    for (int i = 0; i < RT_EGM_NJ; ++i)
+        c_deg[i] = cq[i] / DEG;
     if (cs != RC_OK && count_fault(st, F_NOCONV, 1))
         fprintf(stderr, "rcal-rt: egm: target %lu not compensated (%s): its reference keeps the last good "
                         "correction\n", st->targets + 1,
@@ -634,6 +655,31 @@ static void answer(egm_loop *L, const rt_egm_robot *r, double t_rx, double c_rx)
     }
 }
 
+/* The model's joint limits m as the controller's (out): its signs and
+ * zeros exactly, its J2/J3 coupling by the interval of c3 over the box (the
+ * reader and the guard check these; each target is checked again in the
+ * model's joints, exactly). */
+static void ctrl_limits(rc_model *out, const struct rch_ctrl *c, const rc_model *m)
+{
+    for (int i = 0; i < RC_NJ; ++i) {
+        out->q_min_rad[i] = m->q_min_rad[i];
+        out->q_max_rad[i] = m->q_max_rad[i];
+    }
+    if (!c)
+        return;
+    for (int i = 0; i < RC_NJ; ++i) {
+        double lo = m->q_min_rad[i], hi = m->q_max_rad[i];
+        if (i == 2 && c->q3_coupling != 0.0) { /* c3 = s3 (q3 - k q2) + z3 */
+            const double a = -c->q3_coupling * m->q_min_rad[1], b = -c->q3_coupling * m->q_max_rad[1];
+            lo += fmin(a, b);
+            hi += fmax(a, b);
+        }
+        const double x = c->sign[i] * lo + c->zero_rad[i], y = c->sign[i] * hi + c->zero_rad[i];
+        out->q_min_rad[i] = fmin(x, y);
+        out->q_max_rad[i] = fmax(x, y);
+    }
+}
+
 /* Everything before the first datagram: the compensation, the guard, the
  * input, the socket, the sample arrays, the signals. 0, or the exit status. */
 static int setup(egm_loop *L, const rt_egm_opts *o, const rc_kin *cal, const rc_kin *nom, const rc_comp_config *cfg0)
@@ -645,8 +691,11 @@ static int setup(egm_loop *L, const rt_egm_opts *o, const rc_kin *cal, const rc_
     rc_comp_stream_init_kin(&L->s, cal, nom, &L->cfg);
     double qmin[RT_EGM_NJ], qmax[RT_EGM_NJ];
     for (int i = 0; i < RC_NJ; ++i) {
-        L->lim.q_min_rad[i] = (double)cal->q_min_rad[i];
-        L->lim.q_max_rad[i] = (double)cal->q_max_rad[i];
+        L->st.lim_model.q_min_rad[i] = (double)cal->q_min_rad[i];
+        L->st.lim_model.q_max_rad[i] = (double)cal->q_max_rad[i];
+    }
+    ctrl_limits(&L->lim, o->ctrl, &L->st.lim_model);
+    for (int i = 0; i < RC_NJ; ++i) {
         qmin[i] = L->lim.q_min_rad[i] / DEG;
         qmax[i] = L->lim.q_max_rad[i] / DEG;
     }

@@ -12,7 +12,11 @@
  * a zero AK) on another, and runs two controller threads at the rate, the
  * responder's half a period after rcal-rt's. Each cycle a controller sends a
  * <Rob> with the next setpoint and waits for the answer until its next cycle:
- * no answer by then is a missed cycle. Reported: missed cycles, round trip
+ * no answer by then is a missed cycle, attributed to the responder when its
+ * answer did not arrive (kernel stamp) within a period of the controller's
+ * actual send, else to the machine (the controller thread itself sent or read
+ * late). Reported: missed cycles and their attribution, the controller's send
+ * lateness, round trip
  * (controller send to answer read) median/p99.99 for both, each responder's
  * own receive-to-send time (kernel receive stamp to sendto done) median/p99.99,
  * rcal-rt's CPU per answer, and the answers whose AK differs from compensate's
@@ -243,7 +247,12 @@ typedef struct {
     double *rtt_us;     /* answers in time */
     double *t_send;     /* per cycle: when its Rob was sent (late answers' round trip) */
     double *rtt_all_us; /* every answer, in time or late */
+    /* per cycle, for the attribution of a miss: the send (CLOCK_REALTIME, as the kernel stamps), the answer's
+     * kernel arrival stamp (0: none came), the send's lateness behind the schedule (us), answered in time */
+    double *send_rt, *arr_rt, *send_late_us;
+    unsigned char *in_time;
     size_t answered, n_all, missed, late, wrong_ipoc, wrong_ak, compared;
+    size_t miss_resp, miss_ctrl, late_sends; /* after the run: see attribute() */
     double worst_ak;
 } ctrl;
 
@@ -253,6 +262,46 @@ static double ak_of(const char *s, int i)
     snprintf(key, sizeof key, " A%d=\"", i + 1);
     const char *p = strstr(s, key);
     return p ? strtod(p + strlen(key), NULL) : NAN;
+}
+
+/* recv with the kernel's arrival stamp (CLOCK_REALTIME ns; the read's time when there is none) */
+static ssize_t recv_stamped(int fd, char *buf, size_t cap, double *arr_ns)
+{
+    struct iovec iov = {buf, cap};
+    char ctl[256];
+    struct msghdr mh;
+    memset(&mh, 0, sizeof mh);
+    mh.msg_iov = &iov;
+    mh.msg_iovlen = 1;
+    mh.msg_control = ctl;
+    mh.msg_controllen = sizeof ctl;
+    const ssize_t n = recvmsg(fd, &mh, MSG_DONTWAIT);
+    *arr_ns = now_ns(CLOCK_REALTIME);
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); n > 0 && c; c = CMSG_NXTHDR(&mh, c))
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+            struct timespec t;
+            memcpy(&t, CMSG_DATA(c), sizeof t);
+            *arr_ns = (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+        }
+    return n;
+}
+
+/* Each missed cycle (no answer read by the next cycle's scheduled start)
+ * attributed: the responder's when its answer did not arrive (kernel stamp)
+ * within a period of the controller's actual send, else the machine's (the
+ * controller itself sent late, or read late, its answer having come in
+ * time). late_sends: sends more than half a period behind the schedule. */
+static void attribute(ctrl *c)
+{
+    for (size_t k = 0; k < c->n; ++k) {
+        c->late_sends += c->send_late_us[k] > 0.5 * c->period_ns / 1e3;
+        if (c->in_time[k])
+            continue;
+        if (c->arr_rt[k] > 0 && c->arr_rt[k] - c->send_rt[k] <= c->period_ns)
+            ++c->miss_ctrl;
+        else
+            ++c->miss_resp;
+    }
 }
 
 static void *ctrl_run(void *arg)
@@ -276,8 +325,10 @@ static void *ctrl_run(void *arg)
             "<ASPos A1=\"%.6f\" A2=\"%.6f\" A3=\"%.6f\" A4=\"%.6f\" A5=\"%.6f\" A6=\"%.6f\"/>"
             "<Delay D=\"0\"/><IPOC>%llu</IPOC></Rob>",
             q[0], q[1], q[2], q[3], q[4], q[5], q[0], q[1], q[2], q[3], q[4], q[5], ipoc);
+        c->send_rt[k] = now_ns(CLOCK_REALTIME);
         const double ts_send = now_ns(CLOCK_MONOTONIC);
         c->t_send[k] = ts_send;
+        c->send_late_us[k] = (ts_send - tk) / 1e3;
         send(c->fd, m, (size_t)len, 0);
         const double deadline = tk + c->period_ns;
         int got = 0;
@@ -289,7 +340,8 @@ static void *ctrl_run(void *arg)
             if (poll(&p, 1, (int)ceil(left_ms)) <= 0)
                 continue;
             char r[1024];
-            const ssize_t n = recv(c->fd, r, sizeof r - 1, MSG_DONTWAIT);
+            double arr;
+            const ssize_t n = recv_stamped(c->fd, r, sizeof r - 1, &arr);
             if (n <= 0)
                 continue;
             const double t_rx = now_ns(CLOCK_MONOTONIC);
@@ -299,6 +351,7 @@ static void *ctrl_run(void *arg)
             if (e < ipoc && e >= base && (e - base) % 4u == 0) {
                 ++c->late; /* an answer to an earlier cycle, after its deadline */
                 c->rtt_all_us[c->n_all++] = (t_rx - c->t_send[(e - base) / 4u]) / 1e3;
+                c->arr_rt[(e - base) / 4u] = arr;
                 continue;
             }
             if (e != ipoc) {
@@ -306,11 +359,13 @@ static void *ctrl_run(void *arg)
                 continue;
             }
             c->rtt_all_us[c->n_all++] = (t_rx - ts_send) / 1e3;
+            c->arr_rt[k] = arr;
             if (t_rx > deadline) {
                 ++c->late;
                 break;
             }
             got = 1;
+            c->in_time[k] = 1;
             c->rtt_us[c->answered++] = (t_rx - ts_send) / 1e3;
             if (c->ref && k >= HOLD) {
                 ++c->compared;
@@ -339,7 +394,9 @@ static int udp_to(int port)
     sa.sin_family = AF_INET;
     sa.sin_port = htons((unsigned short)port);
     sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0)
+    const int on = 1;
+    if (fd < 0 || setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0 ||
+        connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0)
         return -1;
     return fd;
 }
@@ -362,6 +419,12 @@ static int udp_bound(int *port)
 
 static void report(const char *name, ctrl *c)
 {
+    attribute(c);
+    double *sl = malloc(c->n * sizeof *sl);
+    if (sl) {
+        memcpy(sl, c->send_late_us, c->n * sizeof *sl);
+        qsort(sl, c->n, sizeof *sl, cmp_d);
+    }
     qsort(c->rtt_us, c->answered, sizeof *c->rtt_us, cmp_d);
     qsort(c->rtt_all_us, c->n_all, sizeof *c->rtt_all_us, cmp_d);
     printf("  %-9s answered in time %zu of %zu, missed %zu (late answers %zu, wrong IPOC %zu); round trip of every "
@@ -369,6 +432,12 @@ static void report(const char *name, ctrl *c)
            name, c->answered, c->n, c->missed, c->late, c->wrong_ipoc, pct(c->rtt_all_us, c->n_all, 50),
            pct(c->rtt_all_us, c->n_all, 99), pct(c->rtt_all_us, c->n_all, 99.99),
            c->n_all ? c->rtt_all_us[c->n_all - 1] : NAN);
+    printf("  %-9s missed cycles attributed: %zu the responder's (its answer not in within a period of the actual "
+           "send), %zu the machine's (the simulated controller sent or read late; the answer came in time); the "
+           "controller's sends behind schedule: median %.1f us, p99.99 %.1f us, max %.1f us, %zu over half a period\n",
+           name, c->miss_resp, c->miss_ctrl, sl ? pct(sl, c->n, 50) : NAN, sl ? pct(sl, c->n, 99.99) : NAN,
+           sl && c->n ? sl[c->n - 1] : NAN, c->late_sends);
+    free(sl);
 }
 
 /* The machine's CPU time (user+nice+system, idle, steal) in ticks, /proc/stat. */
@@ -499,7 +568,14 @@ static int ctrl_init(ctrl *c, int fd, size_t n, const opts *o, double t0_ns, dou
     c->rtt_us = malloc(n * sizeof(double));
     c->t_send = malloc(n * sizeof(double));
     c->rtt_all_us = malloc(n * sizeof(double));
-    return fd >= 0 && c->rtt_us && c->t_send && c->rtt_all_us ? 0 : -1;
+    c->send_rt = calloc(n, sizeof(double));
+    c->arr_rt = calloc(n, sizeof(double));
+    c->send_late_us = calloc(n, sizeof(double));
+    c->in_time = calloc(n, 1);
+    return fd >= 0 && c->rtt_us && c->t_send && c->rtt_all_us && c->send_rt && c->arr_rt && c->send_late_us &&
+                   c->in_time
+               ? 0
+               : -1;
 }
 
 static void ctrl_free(ctrl *c)
@@ -507,6 +583,10 @@ static void ctrl_free(ctrl *c)
     free(c->rtt_us);
     free(c->t_send);
     free(c->rtt_all_us);
+    free(c->send_rt);
+    free(c->arr_rt);
+    free(c->send_late_us);
+    free(c->in_time);
 }
 
 static void summary(ctrl *a, ctrl *b, const opts *o, const double ticks0[3], const double ticks1[3], const char *rep,

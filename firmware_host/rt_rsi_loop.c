@@ -34,6 +34,7 @@
 #include "rch_opt.h"
 #include "rch_robot.h"
 #include "rt_rsi.h"
+#include "rt_rsi_model.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -44,6 +45,8 @@
 #define RT_RSI_MAX_SET_STEP_DEG 5.0
 #define RT_RSI_PENDING 8
 #define RT_RSI_LOG_LINE 320
+/* the model file looked at this often (by the watcher thread) */
+#define RT_RSI_WATCH_EVERY_S 0.25
 
 void rt_rsi_usage(FILE *f)
 {
@@ -53,10 +56,12 @@ void rt_rsi_usage(FILE *f)
             "               [--rsi-cycle-ms MS] [--rsi-timeout-ms MS] [--nominal ROBOT.json]\n"
             "               [--position-only|--full-pose] [--seconds S] [--fifo] [--cpu N] [--json]\n"
             "  RSI:     a KUKA RSI partner (correction mode, docs/rsi.md): each <Rob> datagram's setpoint axes\n"
-            "           (ASPos, degrees, read as the model's joints) compensated as rcal compensate does, answered\n"
+            "           (ASPos, degrees, the controller's axes: the model file's \"controller\" member maps them to the\n"
+            "           model's joints and back) compensated as rcal compensate does, answered\n"
             "           with <Sen><AK A1..A6/><IPOC/></Sen>, AK = compensated - setpoint; the correction changes by\n"
             "           at most --rsi-max-step-deg per answer (default 0.01); only the first sender (or\n"
-            "           --rsi-controller) answered; runs until --seconds or SIGINT/SIGTERM, then reports\n");
+            "           --rsi-controller) answered; a replaced model file is taken (the correction moving to it within\n"
+            "           the step limit); runs until --seconds or SIGINT/SIGTERM, then reports\n");
 }
 
 typedef struct rsi_opts {
@@ -163,55 +168,13 @@ static int parse(rsi_opts *o, int argc, char **argv)
     return -1;
 }
 
-/* ---- the model, set up as rch_comp_run sets it up ---- */
+/* ---- the model in use and the one a replaced file brought (rt_rsi_model.h) ---- */
 
-typedef struct rsi_model {
-    rc_model det, nom_pt;
-    rc_comp_config cfg;
-    int position_only;
-} rsi_model;
-
-static int model_load(rsi_model *m, const rsi_opts *o)
-{
-    static rch_robot robot, nominal;
-    static rch_model_unc unc;
-    rch_diag d;
-    char msg[1024];
-    memset(&d, 0, sizeof d);
-    rch_comp_job job;
-    memset(&job, 0, sizeof job);
-    job.model_path = o->model;
-    job.nominal_path = o->nominal;
-    if (rch_robot_load(&robot, o->model, &d) != 0 ||
-        (o->nominal && (rch_robot_load(&nominal, o->nominal, &d) != 0 ||
-                        rch_comp_same_model(&d, &job, &robot, &nominal) != 0))) {
-        fprintf(stderr, "rcal-rt: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return -1;
-    }
-    const rc_model *nom = o->nominal ? &nominal.model : &robot.nominal;
-    int version1 = 0;
-    char held[256] = "";
-    m->det = robot.model;
-    memset(&unc, 0, sizeof unc);
-    if (robot.has_nominal || robot.unc.present)
-        rch_comp_determined(&m->det, &unc, &version1, held, sizeof held, &robot, &robot.nominal);
-    const int orient_det = unc.present && !version1 && unc.orientation_determined;
-    rch_comp_point_model(&m->det, &m->det, NULL);
-    rch_comp_point_model(&m->nom_pt, nom, NULL);
-    memset(&m->cfg, 0, sizeof m->cfg);
-    rch_comp_orient or;
-    memset(&or, 0, sizeof or);
-    if (!o->position_only && !o->full_pose)
-        rch_comp_orient_decide(&or, unc.present && !version1 ? &unc : NULL, &m->det, &m->nom_pt, &m->cfg);
-    m->position_only = rch_comp_position_only(&or, o->position_only, o->full_pose,
-                                              robot.has_nominal || robot.unc.present, orient_det);
-    m->cfg.flags = m->position_only ? RC_COMP_FLAG_POSITION_ONLY : 0u;
-    if (!robot.has_nominal && !o->nominal)
-        fprintf(stderr, "rcal-rt: warning: %s has no \"nominal\" table; only its effects are corrected\n", o->model);
-    fprintf(stderr, "rcal-rt: rsi: compensating with %s (%s); held nominal: %s\n", o->model,
-            m->position_only ? "position only" : "position and orientation", held[0] ? held : "none");
-    return 0;
-}
+typedef struct rsi_comp {
+    rt_rsi_model mod[2];
+    rc_comp_stream cs[2];
+    int cur; /* mod[cur], cs[cur] in use */
+} rsi_comp;
 
 /* ---- the loop ---- */
 
@@ -223,15 +186,21 @@ static void on_signal(int sig)
 }
 
 enum { F_FOREIGN, F_MALFORMED, F_DUP, F_REORDER, F_DROP, F_LATE, F_BAD_TARGET, F_NOCONV, F_LIMITED, F_MODEL,
-       F_SEND, F_ROBOT_LATE, F_N };
+       F_SEND, F_ROBOT_LATE, F_RELOAD_REFUSED, F_N };
 static const char *const f_name[F_N] = {"foreign_sender", "malformed", "duplicate", "reordered",
                                         "dropped",        "late",      "bad_target", "not_converged",
-                                        "step_limited",   "model_file_changed", "send_failed", "robot_late"};
+                                        "step_limited",   "model_file_changed", "send_failed", "robot_late",
+                                        "model_reload_refused"};
 
 typedef struct rsi_state {
     unsigned long count[F_N];
     unsigned long datagrams, answered, sessions;
     unsigned long over_cycle; /* answers sent more than a cycle after their datagram arrived */
+    unsigned long reloads;    /* replaced model files taken */
+    /* the longest time of each stage (us): the measurement of where a late answer's time went */
+    double max_decode_us, max_comp_us, max_send_us, max_after_us;
+    double max_wake_us;          /* the kernel's receive stamp to the read returning */
+    unsigned long wake_over_ms;  /* reads returning more than 1 ms after the kernel's receive */
     int in_session;
     unsigned long long last_ipoc;
     double last_rx_s;          /* monotonic seconds of the last controller datagram */
@@ -317,9 +286,13 @@ static int open_socket(int *fd_out, const rsi_opts *o, const char *addr, long po
 }
 
 /* The correction wanted for this datagram's setpoint into s->want (held
- * on a fault). */
-static void compensate(rsi_state *s, rc_comp_stream *cs, const rsi_model *m, const rt_rsi_rob *r, double cycles)
+ * on a fault). The setpoint is the controller's (its axes as it means them:
+ * the model file's "controller" member maps them to the model's joints),
+ * compensated in the model's joints and mapped back: AK is in the
+ * controller's axes, as rcal compensate writes the controller's joints. */
+static void compensate(rsi_state *s, rsi_comp *c, const rt_rsi_rob *r, double cycles)
 {
+    const rt_rsi_model *m = &c->mod[c->cur];
     if (!r->set_ok) {
         fault(s, F_BAD_TARGET, "ipoc %llu: %s; the correction held", r->ipoc, r->set_why);
         return;
@@ -332,27 +305,27 @@ static void compensate(rsi_state *s, rc_comp_stream *cs, const rsi_model *m, con
                   RT_RSI_MAX_SET_STEP_DEG);
             return;
         }
-    double q[RC_NJ], qc[RC_NJ];
-    for (int i = 0; i < RC_NJ; ++i) {
-        q[i] = r->set_deg[i] * DEG;
+    double q[RC_NJ], qc[RC_NJ], cc[RC_NJ];
+    rt_rsi_model_to_model(q, m, r->set_deg);
+    for (int i = 0; i < RC_NJ; ++i)
         if (q[i] < m->det.q_min_rad[i] || q[i] > m->det.q_max_rad[i]) {
-            fault(s, F_BAD_TARGET, "ipoc %llu: A%d = %.6f deg is outside the joint limits [%g, %g] deg; the "
-                  "correction held", r->ipoc, i + 1, r->set_deg[i], m->det.q_min_rad[i] / DEG,
-                  m->det.q_max_rad[i] / DEG);
+            fault(s, F_BAD_TARGET, "ipoc %llu: A%d = %.6f deg is joint %d = %.6f deg of the model, outside its "
+                  "limits [%g, %g] deg; the correction held", r->ipoc, i + 1, r->set_deg[i], i + 1, q[i] / DEG,
+                  m->det.q_min_rad[i] / DEG, m->det.q_max_rad[i] / DEG);
             return;
         }
-    }
     memcpy(s->last_set, r->set_deg, sizeof s->last_set);
     s->have_set = 1;
     rc_comp_result res;
-    const rc_status st = rc_comp_stream_step(cs, qc, &res, q);
+    const rc_status st = rc_comp_stream_step(&c->cs[c->cur], qc, &res, q);
     if (st != RC_OK) {
         fault(s, F_NOCONV, "ipoc %llu: the compensation did not converge (%s, %.4f mm); the correction held",
               r->ipoc, st == RC_ERR_NOCONV ? rc_comp_exit_str(res.exit) : rc_strerror(st), (double)res.pos_err_mm);
         return;
     }
+    rt_rsi_model_to_ctrl(cc, m, qc);
     for (int i = 0; i < RC_NJ; ++i)
-        s->want[i] = qc[i] / DEG - r->set_deg[i];
+        s->want[i] = cc[i] - r->set_deg[i];
 }
 
 /* The correction to send: ak_abs moved toward want by at most max_step per
@@ -382,13 +355,13 @@ typedef struct rsi_io {
     rt_rsi_dec *dec;
     rt_rsi_names names;
     rt_rsi_hist hist;
-    struct stat model_st;
+    rt_rsi_watch watch;
     struct in_addr only; /* --rsi-controller */
     int have_only;
 } rsi_io;
 
 /* One datagram: checked, compensated, answered. */
-static void one_dgram(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_opts *o,
+static void one_dgram(rsi_state *s, rsi_io *io, rsi_comp *c, const rsi_opts *o,
                 const char *buf, size_t len, const struct sockaddr_in *from, const struct timespec *rx)
 {
     char who[64];
@@ -405,7 +378,9 @@ static void one_dgram(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_mo
     }
     rt_rsi_rob r;
     char why[192];
+    const double t_dec = mono_s();
     const rt_rsi_status st = rt_rsi_decode(&r, why, sizeof why, io->dec, buf, len);
+    s->max_decode_us = fmax(s->max_decode_us, (mono_s() - t_dec) * 1e6);
     if (st != RT_RSI_OK) {
         fault(s, F_MALFORMED, "from %s: %s: %s; not answered", who, rt_rsi_strerror(st), why);
         return;
@@ -435,7 +410,7 @@ static void one_dgram(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_mo
         memset(s->want, 0, sizeof s->want);
         s->have_set = 0;
         /* a new program run: compensated from a cold start, as rcal compensate starts a file */
-        rc_comp_stream_init(cs, &m->det, &m->nom_pt, &m->cfg);
+        rc_comp_stream_init(&c->cs[c->cur], &c->mod[c->cur].det, &c->mod[c->cur].nom_pt, &c->mod[c->cur].cfg);
     } else {
         steps = (double)(r.ipoc - s->last_ipoc) / o->cycle_ms;
         if (steps > 1.5)
@@ -450,15 +425,19 @@ static void one_dgram(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_mo
     s->ctrl.sin_port = from->sin_port; /* the controller's port of this datagram */
     s->last_ipoc = r.ipoc;
     s->last_rx_s = now;
-    compensate(s, cs, m, &r, steps < 1.0 ? 1.0 : steps);
+    const double t_comp = mono_s();
+    compensate(s, c, &r, steps < 1.0 ? 1.0 : steps);
     double ak[RT_RSI_NAX];
     step_toward(s, ak, o, r.ipoc);
+    const double t_send = mono_s();
+    s->max_comp_us = fmax(s->max_comp_us, (t_send - t_comp) * 1e6);
     char out[RT_RSI_MAX_REPLY];
     const size_t n = rt_rsi_encode(out, sizeof out, &io->names, ak, r.ipoc);
     if (n == 0 || sendto(io->fd, out, n, 0, (const struct sockaddr *)from, sizeof *from) != (ssize_t)n) {
         fault(s, F_SEND, "ipoc %llu to %s: %s", r.ipoc, who, n == 0 ? "the answer did not fit" : strerror(errno));
         return;
     }
+    s->max_send_us = fmax(s->max_send_us, (mono_s() - t_send) * 1e6);
     struct timespec tx;
     clock_gettime(CLOCK_REALTIME, &tx);
     const double took_us = ((double)(tx.tv_sec - rx->tv_sec) * 1e9 + (double)(tx.tv_nsec - rx->tv_nsec)) / 1e3;
@@ -470,30 +449,48 @@ static void one_dgram(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_mo
     s->robot_delay = r.delay;
 }
 
-static void one(rsi_state *s, rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_opts *o,
-                const char *buf, size_t len, const struct sockaddr_in *from, const struct timespec *rx)
+static void one(rsi_state *s, rsi_io *io, rsi_comp *c, const rsi_opts *o, const char *buf, size_t len,
+                const struct sockaddr_in *from, const struct timespec *rx)
 {
-    one_dgram(s, io, cs, m, o, buf, len, from, rx);
+    one_dgram(s, io, c, o, buf, len, from, rx);
     flush_log(s);
 }
 
-/* The model file replaced while running: counted and logged; the model
- * loaded at the start stays (a change of model mid-path would move the
- * path; restart rcal-rt between programs to use the new one). */
-static void check_model(rsi_state *s, rsi_io *io, const rsi_opts *o)
+/* The model file replaced while running (the watcher thread read it, off
+ * the answer path): the new model taken between two datagrams, its stream
+ * started cold (as rcal compensate starts), the correction moving to the
+ * new model's by at most --rsi-max-step-deg per answer (step_toward); a
+ * file that cannot be used is counted and the model in use kept. */
+static void take_model(rsi_state *s, rsi_io *io, rsi_comp *c, const rsi_opts *o)
 {
-    struct stat st;
-    const int gone = stat(o->model, &st) != 0;
-    if (gone || st.st_mtim.tv_sec != io->model_st.st_mtim.tv_sec ||
-        st.st_mtim.tv_nsec != io->model_st.st_mtim.tv_nsec || st.st_ino != io->model_st.st_ino ||
-        st.st_size != io->model_st.st_size) {
-        fault(s, F_MODEL, "%s %s while running: still compensating with the model read at the start (restart "
-              "rcal-rt to use another)", o->model, gone ? "was removed" : "changed");
-        if (!gone)
-            io->model_st = st;
-        else
-            memset(&io->model_st, 0, sizeof io->model_st);
+    static rt_rsi_model next;
+    char msg[700];
+    const int what = rt_rsi_watch_take(&io->watch, &next, msg, sizeof msg);
+    if (what == RT_RSI_WATCH_NONE)
+        return;
+    s->count[F_MODEL]++;
+    if (what == RT_RSI_WATCH_REMOVED) {
+        fault(s, F_RELOAD_REFUSED, "%s was removed (%s): the model in use kept", o->model, msg);
+        return;
     }
+    if (what == RT_RSI_WATCH_REFUSED) {
+        fault(s, F_RELOAD_REFUSED, "%s changed but cannot be used, the model in use kept: %s", o->model, msg);
+        return;
+    }
+    const int k = 1 - c->cur;
+    c->mod[k] = next;
+    if (rc_comp_stream_init(&c->cs[k], &c->mod[k].det, &c->mod[k].nom_pt, &c->mod[k].cfg) != RC_OK) {
+        fault(s, F_RELOAD_REFUSED, "%s changed but cannot be used for compensation: the model in use kept", o->model);
+        return;
+    }
+    /* a cold start, as rcal compensate starts a file: from here the answers are compensate's on the rest of the
+     * path with the new model (position only, a warm start from the old model's correction could settle on
+     * another of the joint solutions); step_toward moves the correction there */
+    c->cur = k;
+    s->reloads++;
+    if (s->n_pending < RT_RSI_PENDING)
+        snprintf(s->pending[s->n_pending++], RT_RSI_LOG_LINE, "rcal-rt: rsi: model_file_changed #%lu: %.180s; the "
+                 "correction moves to it at most %g deg per answer", s->count[F_MODEL], msg, o->max_step_deg);
 }
 
 static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, double cpu_s, int fifo_on)
@@ -507,9 +504,12 @@ static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, doub
         for (int k = 0; k < F_N; ++k)
             printf("%s\"%s\": %lu", k ? ", " : "", f_name[k], s->count[k]);
         printf("}, \"largest_step_deg\": %.10f, \"latency_us\": {\"median\": %.1f, \"p99\": %.1f, \"p99_99\": %.1f, "
-               "\"max\": %.1f, \"mean\": %.2f}, \"answers_over_a_cycle\": %lu, \"cpu_us_per_answer\": %.2f}\n",
+               "\"max\": %.1f, \"mean\": %.2f}, \"answers_over_a_cycle\": %lu, \"cpu_us_per_answer\": %.2f, "
+               "\"reloads\": %lu, \"stage_max_us\": {\"wake\": %.1f, \"decode\": %.1f, \"compensate\": %.1f, "
+               "\"send\": %.1f, \"after\": %.1f}, \"wakes_over_1ms\": %lu}\n",
                s->max_step_seen, rt_rsi_hist_pct(h, 50), rt_rsi_hist_pct(h, 99), rt_rsi_hist_pct(h, 99.99),
-               h->max_us, h->n ? h->sum_us / (double)h->n : 0.0, s->over_cycle, cpu_us);
+               h->max_us, h->n ? h->sum_us / (double)h->n : 0.0, s->over_cycle, cpu_us, s->reloads,
+               s->max_wake_us, s->max_decode_us, s->max_comp_us, s->max_send_us, s->max_after_us, s->wake_over_ms);
         return;
     }
     printf("rcal-rt rsi: %lu datagrams, %lu answered, %lu session(s), %s corrections, %s\n", s->datagrams,
@@ -524,9 +524,14 @@ static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, doub
            "%.1f; %lu answers over a cycle; CPU %.2f us per answer\n",
            rt_rsi_hist_pct(h, 50), rt_rsi_hist_pct(h, 99), rt_rsi_hist_pct(h, 99.99), h->max_us, s->over_cycle,
            cpu_us);
+    printf("  model files taken while running: %lu; the longest stage: wake-up (kernel receive to the read) %.1f us "
+           "(%lu over 1 ms), decode %.1f us, compensate %.1f us, send %.1f us, after the answer (the model taken, the "
+           "log) %.1f us\n", s->reloads, s->max_wake_us, s->wake_over_ms, s->max_decode_us, s->max_comp_us,
+           s->max_send_us, s->max_after_us);
 }
 
-static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockaddr_in *from, struct timespec *rx)
+static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockaddr_in *from, struct timespec *rx,
+                  double *wake_us)
 {
     struct iovec iov = {buf, cap};
     char ctl[256];
@@ -542,9 +547,12 @@ static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockadd
     if (n < 0)
         return -1;
     clock_gettime(CLOCK_REALTIME, rx);
+    const struct timespec read_at = *rx;
     for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); c; c = CMSG_NXTHDR(&mh, c))
         if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS)
             memcpy(rx, CMSG_DATA(c), sizeof *rx);
+    /* from the kernel's receive to the read returning: the thread's wake-up (the scheduler's, not the loop's) */
+    *wake_us = ((double)(read_at.tv_sec - rx->tv_sec) * 1e9 + (double)(read_at.tv_nsec - rx->tv_nsec)) / 1e3;
     *len = (size_t)n;
     if (mh.msg_flags & MSG_TRUNC)
         *len = cap + 1; /* over the limit: refused by the decoder */
@@ -589,13 +597,13 @@ static int setup(rsi_io *io, rt_rsi_net *net, rsi_opts *o)
 
 /* The loop: one datagram, its answer, then the log and (once a second) the
  * model file; until --seconds or a signal. Then the report. */
-static void serve(rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_opts *o, int fifo_on)
+static void serve(rsi_io *io, rsi_comp *c, const rsi_opts *o, int fifo_on)
 {
     static rsi_state s;
     memset(&s, 0, sizeof s);
     s.robot_delay = -1;
     const double t_end = o->seconds > 0 ? mono_s() + o->seconds : INFINITY;
-    double cpu0 = -1.0, last_check = mono_s();
+    double cpu0 = -1.0;
     static char buf[RT_RSI_MAX_DGRAM + 1];
     const struct timeval rcv_to = {0, 100000}; /* the stop flag and --seconds looked at 10 times a second */
     if (setsockopt(io->fd, SOL_SOCKET, SO_RCVTIMEO, &rcv_to, sizeof rcv_to) != 0)
@@ -604,27 +612,30 @@ static void serve(rsi_io *io, rc_comp_stream *cs, const rsi_model *m, const rsi_
         size_t len;
         struct sockaddr_in from;
         struct timespec rx;
-        if (rx_one(io, buf, sizeof buf - 1, &len, &from, &rx) == 0) {
+        double wake_us = 0.0;
+        if (rx_one(io, buf, sizeof buf - 1, &len, &from, &rx, &wake_us) == 0) {
+            s.max_wake_us = fmax(s.max_wake_us, wake_us);
+            s.wake_over_ms += wake_us > 1e3;
             if (cpu0 < 0) {
-                struct timespec c;
-                clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c);
-                cpu0 = (double)c.tv_sec + (double)c.tv_nsec * 1e-9;
+                struct timespec ct;
+                clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ct);
+                cpu0 = (double)ct.tv_sec + (double)ct.tv_nsec * 1e-9;
             }
-            one(&s, io, cs, m, o, buf, len, &from, &rx);
+            one(&s, io, c, o, buf, len, &from, &rx);
         } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
             fprintf(stderr, "rcal-rt: rsi: receive: %s\n", strerror(errno));
             break;
         }
+        /* after the answer: a model the watcher posted (a try, never a wait), its log line */
+        const double t_after = mono_s();
+        take_model(&s, io, c, o);
+        flush_log(&s);
         t = mono_s();
-        if (t - last_check > 1.0) {
-            check_model(&s, io, o);
-            flush_log(&s);
-            last_check = t;
-        }
+        s.max_after_us = fmax(s.max_after_us, (t - t_after) * 1e6);
     }
-    struct timespec c;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c);
-    const double cpu_s = cpu0 < 0 ? 0.0 : (double)c.tv_sec + (double)c.tv_nsec * 1e-9 - cpu0;
+    struct timespec ct;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ct);
+    const double cpu_s = cpu0 < 0 ? 0.0 : (double)ct.tv_sec + (double)ct.tv_nsec * 1e-9 - cpu0;
     report(&s, io, o, cpu_s, fifo_on);
 }
 
@@ -639,16 +650,21 @@ int rt_rsi_main(int argc, char **argv)
     rt_rsi_net net = {"", -1};
     if ((rc = setup(&io, &net, &o)) >= 0)
         return rc;
-    static rsi_model m;
-    if (model_load(&m, &o) != 0)
+    static rsi_comp comp;
+    memset(&comp, 0, sizeof comp);
+    const rt_rsi_model_src src = {o.model, o.nominal, o.position_only, o.full_pose};
+    struct stat st0;
+    const int have_st0 = stat(o.model, &st0) == 0; /* before the read: a replacement meanwhile is seen */
+    char note[1024], err[1200];
+    if (rt_rsi_model_load(&comp.mod[0], note, sizeof note, err, sizeof err, &src) != 0) {
+        fprintf(stderr, "rcal-rt: %s\n", err);
         return 1;
-    static rc_comp_stream cs;
-    if (rc_comp_stream_init(&cs, &m.det, &m.nom_pt, &m.cfg) != RC_OK) {
+    }
+    fprintf(stderr, "rcal-rt: rsi: %s\n", note);
+    if (rc_comp_stream_init(&comp.cs[0], &comp.mod[0].det, &comp.mod[0].nom_pt, &comp.mod[0].cfg) != RC_OK) {
         fprintf(stderr, "rcal-rt: %s: the model cannot be used for compensation\n", o.model);
         return 1;
     }
-    if (stat(o.model, &io.model_st) != 0)
-        memset(&io.model_st, 0, sizeof io.model_st);
     io.dec = rt_rsi_dec_new(&io.names);
     if (!io.dec || rt_rsi_hist_init(&io.hist) != 0) {
         fprintf(stderr, "rcal-rt: out of memory\n");
@@ -665,9 +681,10 @@ int rt_rsi_main(int argc, char **argv)
     sa.sa_handler = on_signal; /* no SA_RESTART: a signal ends the blocking read */
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-    int fifo_on = 0;
-    fifo_on = rt_sched_realtime(o.pin, o.cpu, o.fifo);
-    serve(&io, &cs, &m, &o, fifo_on);
+    rt_rsi_watch_start(&io.watch, &src, have_st0 ? &st0 : NULL, RT_RSI_WATCH_EVERY_S);
+    const int fifo_on = rt_sched_realtime(o.pin, o.cpu, o.fifo);
+    serve(&io, &comp, &o, fifo_on);
+    rt_rsi_watch_stop(&io.watch);
     close(io.fd);
     rt_rsi_dec_free(io.dec);
     rt_rsi_hist_free(&io.hist);

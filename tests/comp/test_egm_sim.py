@@ -508,6 +508,40 @@ def restart():
     no_jump(c.replies, rows, "restart")
 
 
+def controller_axes():
+    """a "controller" member (A1 the other way, A2/A3 reading -90/+90 at the model's zero): the targets and
+    the robot's joints are the controller's, the replies in its joints, equal to rcal compensate's (which maps
+    the same member) on the same rows"""
+    with open(MODEL) as fh:
+        m = json.load(fh)
+    sign, zero = [-1, 1, 1, 1, 1, 1], [0, -90, 90, 0, 0, 0]
+    m["controller"] = {"joint_sign": sign, "joint_zero_deg": zero}
+    model = os.path.join(WORK, "ctrl_model.json")
+    with open(model, "w") as fh:
+        json.dump(m, fh)
+    rows = [[round(sign[i] * q[i] + zero[i], 6) for i in range(6)] for q in path_rows(200, 0.3)]
+    want = compensate(model, rows, "ctrl")
+    plain = compensate(MODEL, path_rows(200, 0.3), "ctrl_plain")
+    check(max(abs(want[k][i] - (sign[i] * plain[k][i] + zero[i])) for k in range(200) for i in range(6)) <= 2e-6,
+          "controller axes: rcal compensate maps the member (its joints are the model's mapped)")
+    src = os.path.join(WORK, "ctrl.csv")
+    write_csv(src, rows)
+    p, port = start_rt(src, model)
+    c = Controller(port, rows[0])
+    for _ in range(210):
+        c.cycle()
+    c.drain(0.2)
+    rc, summ, err = finish(p)
+    n = min(200, len(c.replies))
+    worst = max(max_diff(c.replies[k][3], want[k]) for k in range(n)) if n else float("inf")
+    check(n == 200 and worst <= 1e-6, "controller axes: every reply equals rcal compensate's in the controller's "
+          "joints to 1e-6 deg (%d replies, largest %.3g)" % (n, worst))
+    f = summ["faults"] if summ else {}
+    check(rc == 0 and f.get("bad_row", 1) == 0 and f.get("not_following", 1) == 0,
+          "controller axes: exit 0, no row refused, the robot (in its joints) follows (%s) %s" % (f, err[-300:]))
+    check("controller's joints mapped" in err, "controller axes: the mapping said")
+
+
 def no_controller():
     src = os.path.join(WORK, "clean.csv")
     port = free_port()
@@ -523,6 +557,7 @@ stall()
 not_following()
 not_compensable()
 restart()
+controller_axes()
 no_controller()
 if FAILS:
     print("%d check(s) failed" % len(FAILS))

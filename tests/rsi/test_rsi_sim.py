@@ -331,24 +331,69 @@ def main():
         time.sleep(0.03)
         return ipoc
 
+    # another calibration of the same robot: its corrections differ from the first's
+    with open(src_model) as f:
+        mb = json.load(f)
+    for j, row in enumerate(mb["dh"]):
+        row["theta_deg"] = mb["nominal"]["dh"][j]["theta_deg"] + 2.0 * (row["theta_deg"] - mb["nominal"]["dh"][j]["theta_deg"])
+    model_b = os.path.join(work, "model_b.json")
+    with open(model_b, "w") as f:
+        json.dump(mb, f)
+    state = {"ref_b": None}
+
+    def hold(ctrl, ipoc, q, seconds, want, what):
+        """q sent each cycle for `seconds` (or until AK equals want): every answer's step checked; returns
+        (ipoc, the cycle AK first equalled want or None, answers)."""
+        t0 = time.time()
+        first = None
+        n = 0
+        while time.time() - t0 < seconds:
+            time.sleep(CYCLE)
+            ipoc += 4
+            ctrl.send(rob(q, ipoc))
+            ak = ctrl.answer(ctrl.recv(2.0), ipoc, what)
+            n += 1
+            if ak is not None and first is None and max(abs(ak[i] - want[i]) for i in range(6)) <= TOL:
+                first = n
+        return ipoc, first, n
+
     def replace_model(ctrl, ipoc, q):
-        with open(src_model) as f:
-            m = json.load(f)
-        m["dh"] = m["nominal"]["dh"]  # a model that corrects nothing
-        time.sleep(0.01)
-        with open(model + ".new", "w") as f:
-            json.dump(m, f)
+        # the model file replaced in a session: the answers move to the new model's, never by more than the step
+        k0 = targets.index(q)
+        state["ref_b"] = [None] * k0 + compensate(rcal, model_b, targets[k0:], work, "rest_b")
+        want_b = [state["ref_b"][k0][i] - q[i] for i in range(6)]
+        want_a = [ref[k0][i] - q[i] for i in range(6)]
+        check(max(abs(want_b[i] - want_a[i]) for i in range(6)) > 5 * STEP,
+              "the second model's correction differs from the first's (%s vs %s)" % (want_b, want_a))
+        shutil.copyfile(model_b, model + ".new")
         os.replace(model + ".new", model)
-        time.sleep(1.2)  # rcal-rt looks once a second; the silence also ends the session (300 ms)
+        ipoc, first, n = hold(ctrl, ipoc, q, 2.0, want_b, "the model file replaced")
+        check(first is not None, "after the model file was replaced the answers equal the new model's (%d sent)" % n)
+        return ipoc, state["ref_b"]
+
+    def broken_model(ctrl, ipoc, q):
+        # a file that is not a model: counted, the model in use kept (the answers stay the new model's)
+        with open(model + ".new", "w") as f:
+            f.write('{"format": "rcal-model/1", "dh": [')
+        os.replace(model + ".new", model)
+        k0 = targets.index(q)
+        want = [state["ref_b"][k0][i] - q[i] for i in range(6)]
+        ipoc, first, n = hold(ctrl, ipoc, q, 0.8, want, "a broken model file")
+        check(first == 1, "a broken model file: the answers stay the model in use's (first equal %s)" % first)
+        return ipoc
+
+    def silence(ctrl, ipoc, q):
+        time.sleep(0.4)  # over --rsi-timeout-ms: the session ends
         ctrl.new_session()
         # a new session is a new run of the program: compensate's reference starts there too
         k0 = targets.index(q)
-        rest = compensate(rcal, src_model, targets[k0:], work, "rest")
-        return ipoc + 4000, [None] * k0 + rest
+        shutil.copyfile(model_b, model + ".new")
+        os.replace(model + ".new", model)
+        time.sleep(0.6)  # the watcher takes the good file again
+        return ipoc + 4000, [None] * k0 + compensate(rcal, model_b, targets[k0:], work, "rest")
 
     faults = {100: drop, 140: reorder, 180: dup, 220: garbage, 260: bad_values, 300: foreign, 320: robot_late,
-              340: late,
-              380: replace_model}
+              340: late, 380: replace_model, 420: broken_model, 460: silence}
     run_path(c, targets, ref, 200000, faults=faults, label="faults")
     rep = p.stop()
     f = rep["faults"]
@@ -362,7 +407,9 @@ def main():
     check(f.get("foreign_sender", 0) == 3, "the second sender counted")
     check(f.get("late", 0) >= 1, "the late datagram counted")
     check(f.get("robot_late", 0) == 1, "the robot's rising Delay count logged once")
-    check(f.get("model_file_changed", 0) >= 1, "the replaced model file counted")
+    check(f.get("model_file_changed", 0) >= 3, "the replaced model files counted (%s)" % f.get("model_file_changed"))
+    check(f.get("model_reload_refused", 0) >= 1, "the broken model file counted")
+    check(rep.get("reloads", 0) >= 2, "the replaced model taken (%s)" % rep.get("reloads"))
     check(rep.get("sessions") == 2, "the silence started a second session (%s)" % rep.get("sessions"))
     check(rep.get("largest_step_deg", 1) <= STEP + 1e-12, "the correction never jumped (%s)" %
           rep.get("largest_step_deg"))
@@ -418,6 +465,20 @@ def main():
                            capture_output=True, text=True, timeout=30)
         check(r.returncode == 1 and what in r.stderr and (cfg + where) in r.stderr,
               "--rsi-config refused (%s), with its place: exit %d %s" % (what, r.returncode, r.stderr[-300:]))
+
+    # 5. the controller's axes (a "controller" member: A1 turns the other way, A2 and A3 read -90 and +90 at
+    # the model's zero): the setpoints are the controller's, AK in its axes, equal to rcal compensate's on the
+    # same (controller) joints
+    ctrl_model = os.path.join(root, "tests", "rsi", "data", "kr6_ctrl.json")
+    sign, zero = [-1, 1, 1, 1, 1, 1], [0, -90, 90, 0, 0, 0]
+    ctargets = [[round(sign[i] * q[i] + zero[i], 6) for i in range(6)] for q in targets[:250]]
+    cref = compensate(rcal, ctrl_model, ctargets, work, "ctrl")
+    p = RtProc(rt, ["--model", ctrl_model])
+    check(any("mapped to the model's" in e for e in p.err), "the controller member is said: %s" % p.err)
+    c = Ctrl(p.port)
+    run_path(c, ctargets, cref, 400000, label="controller axes")
+    rep = p.stop()
+    check(rep["faults"].get("bad_target", 1) == 0, "controller axes: no setpoint refused (%s)" % rep["faults"])
 
     if FAILS:
         print("%d failure(s)" % len(FAILS))
