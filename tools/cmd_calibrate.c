@@ -270,27 +270,6 @@ static int out_is_input(const calib_args *a)
 /* Every --data and --validate file against the robot's joint limits, before
  * the fit (rch_calib_run loads them again; its loader is not this file's):
  * 1 with the message (file:line:column) when a reading is beyond them. */
-static int data_in_limits(const calib_args *a)
-{
-    static rch_robot robot;
-    rch_diag d;
-    char msg[1024];
-    if (rch_robot_load(&robot, a->cfg.robot_path, &d) != 0)
-        return 0; /* rch_calib_run reports it */
-    for (size_t i = 0; i <= a->data.n; ++i) {
-        const char *path = i < a->data.n ? a->data.v[i] : a->cfg.validate_path;
-        rch_data data;
-        if (!path)
-            continue;
-        if (rch_data_load_limited(&data, path, 0, &robot.model, &d) != 0) {
-            fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
-            return 1;
-        }
-        rch_data_free(&data);
-    }
-    return 0;
-}
-
 int rcal_cmd_calibrate(int argc, char **argv)
 {
     calib_args a;
@@ -305,8 +284,6 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return ps;
     if (out_is_input(&a))
         return 2;
-    if (data_in_limits(&a))
-        return 1;
     rch_calib_result *r = malloc(sizeof *r); /* large: two models, the identifiability report */
     rch_diag d;
     char msg[1024];

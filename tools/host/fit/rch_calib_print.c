@@ -605,7 +605,7 @@ static void print_summary(FILE *f, const rch_calib_result *r)
               "finite)\n",
               f);
     const unsigned outside = r->have_unc ? outside_prior(r) : 0;
-    if (r->jumps_found && !r->cfg.jumps)
+    if (r->jumps_found && !r->cfg.jumps && !r->jumps_auto)
         fprintf(f, "  next: rcal calibrate --data %s --robot %s --jumps (the lengths jump and this fit does not model "
                    "them)\n",
                 hp.data, hp.robot);
@@ -669,7 +669,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     snprintf(all, sizeof all, steps == 1 ? "it is" : r->jumps_found == steps ? "they are" : "all %u are", steps);
     hint_paths hp;
     hint_paths_of(&hp, r);
-    if (r->jumps_found && !r->cfg.jumps)
+    if (r->jumps_found && !r->cfg.jumps && !r->jumps_auto)
         fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
                    "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --robot %s --jumps (it "
                    "fits the %u step%s found; rcal diagnose tells)\n\n",
