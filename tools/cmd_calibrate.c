@@ -10,6 +10,7 @@
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
+#include "rch_report.h"
 #include "rch_calib_effects.h"
 #include "rch_data.h"
 #include "rch_file.h"
@@ -306,7 +307,7 @@ int rcal_cmd_calibrate(int argc, char **argv)
             inputs[3 + i] = a.data.v[i];
         for (size_t i = 0; i < a.positions.n; ++i)
             inputs[3 + a.data.n + i] = a.positions.v[i];
-        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs,
+        if (rch_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs,
                                3 + a.data.n + a.positions.n, a.json) != 0)
             status = 1;
     }
