@@ -163,6 +163,10 @@ static int parse(calib_args *a, int argc, char **argv)
         {"--no-screen", RCH_OPT_FLAG, &cfg->no_screen, 0, 0, NULL,
          "fit every row: none left out as irreconcilable with the rest (by default a row beyond 8 robust standard "
          "deviations is named and left out, a file with more than 5 % of such rows refused)", 0, NULL},
+        {"--timing", RCH_OPT_FLAG, &cfg->timing, 0, 0, NULL,
+         "where the time went: each stage of the calibration's plan (read, start, map, jump_check, attachment, "
+         "prior_scale, uncertainty, screen, ...) with its wall and CPU time, on stderr (with --json: its "
+         "\"timing\" member)", 0, NULL},
         {"--no-jump-check", RCH_OPT_FLAG, &cfg->no_jump_check, 0, 0, NULL,
          "do not look for length jumps in the default run (a model fitted across jumps it found is not written: "
          "use --jumps)", 0, NULL},
@@ -295,6 +299,8 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return rc == -2 ? 2 : 1;
     }
     int status = r->after_ok ? 0 : 1;
+    if (a.cfg.timing)
+        rch_calib_timing_print(stderr, &r->timing, "rcal calibrate: ");
     if (r->screen.out) /* named on stderr too, whatever the output's form */
         rch_calib_print_screened(stderr, r, "rcal calibrate: ");
     if (a.json ? rch_calib_json(stdout, r, argc, argv) != 0 : (rch_calib_print(stdout, r), 0))

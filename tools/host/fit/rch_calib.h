@@ -36,6 +36,7 @@
 #include "rch_dequant.h"
 #include "rch_evaluate.h"
 #include "rch_jumps.h"
+#include "rch_jw.h"
 #include "rch_positions.h"
 #include "rch_prior_scale.h"
 #include "rch_stats.h"
@@ -263,6 +264,11 @@ void rch_calib_judge_floor_text(char *buf, size_t len, const rch_calib_result *r
 
 /* The text report (the paper's Table 7 form, identifiability, solver line). */
 void rch_calib_print(FILE *f, const rch_calib_result *r);
+/* The plan's timing record: one line per stage that ran (wall, CPU, runs)
+ * after prefix, then the total (--timing, on stderr); as a JSON member
+ * "timing" {wall_ms, cpu_ms, stages: [{stage, runs, wall_ms, cpu_ms}]}. */
+void rch_calib_timing_print(FILE *f, const rch_calib_timing *t, const char *prefix);
+void rch_calib_timing_json(rch_jw *w, const rch_calib_timing *t);
 /* The rows the fit left out (r->screen), one line each: "FILE:LINE: left
  * out: ... likely ...", each line after prefix. */
 void rch_calib_print_screened(FILE *f, const rch_calib_result *r, const char *prefix);

@@ -730,3 +730,13 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
                 r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
     print_summary(f, r);
 }
+
+void rch_calib_timing_print(FILE *f, const rch_calib_timing *t, const char *prefix)
+{
+    fprintf(f, "%stiming (each stage's own time; ms):      wall       cpu  runs\n", prefix);
+    for (unsigned k = 0; k < RCH_STAGE_N; ++k)
+        if (t->runs[k])
+            fprintf(f, "%s  %-34s %9.2f %9.2f %5u\n", prefix, rch_calib_stage_name(k), t->wall_ms[k], t->cpu_ms[k],
+                    t->runs[k]);
+    fprintf(f, "%s  %-34s %9.2f %9.2f\n", prefix, "total", t->total_wall_ms, t->total_cpu_ms);
+}
