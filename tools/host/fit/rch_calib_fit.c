@@ -2,8 +2,9 @@
 /* rch_calib_fit.c - one identification on a training set: the BC start,
  * the maximum a posteriori fit with the physical prior and its noise
  * estimate, the cable attachment decided by the evidence, the default run's
- * length-jump check, the --jumps nuisance fit, the before/after metrics
- * (rch_calib_int.h, rch_calib_fit_and_report).
+ * length-jump check, the --jumps nuisance fit, the before/after metrics,
+ * as a plan of stages (fit_plan, run by rch_calib_plan_run; the steering in
+ * rch_calib_fit_state, rch_calib_int.h; rch_calib_fit_run).
  *
  * Depends on: the core (rc_solve, rc_normal_eq, rc_prior_*), LAPACKE (the
  * effective number of parameters), rch_start, rch_calib_effects (--fix),
