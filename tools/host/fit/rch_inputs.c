@@ -23,12 +23,20 @@
 /* One cable file read once: parsed (joints within limits, the lengths'
  * scale checked as rch_data_load_limited does) and its digest (sha, 65)
  * taken from the same bytes. 0, or -1 with d set. */
-static int load_one(rch_data *out, const char *path, const rc_model *limits, char *sha, rch_diag *d)
+static int load_one(rch_data *out, const char *path, const char *text, size_t text_len, const rc_model *limits,
+                    char *sha, rch_diag *d)
 {
     char *buf = NULL;
     size_t len = 0;
     memset(out, 0, sizeof *out);
-    if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
+    if (text) { /* rows in memory (rch_calib_cfg.data_text): parsed as a file's, named path */
+        if (!(buf = malloc(text_len + 1))) {
+            rch_diag_set(d, path, 0, 0, "out of memory");
+            return -1;
+        }
+        memcpy(buf, text, text_len);
+        buf[len = text_len] = '\0';
+    } else if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
         return -1;
     rch_sha256 c;
     rch_sha256_init(&c);
@@ -60,7 +68,7 @@ static int load_all(rch_data *out, size_t *counts, char (*sha)[65], const rch_ca
     if (nf == 0)
         return 0; /* tracker positions only (append_positions) */
     if (nf == 1) {
-        int rc = load_one(out, rch_calib_cfg_file(cfg, 0), limits, sha[0], d);
+        int rc = load_one(out, rch_calib_cfg_file(cfg, 0), cfg->data_text, cfg->data_text_len, limits, sha[0], d);
         counts[0] = out->n;
         if (rc == 0 && rch_data_check_units(out, rch_calib_cfg_file(cfg, 0), d) != 0) {
             rch_data_free(out);
@@ -72,7 +80,7 @@ static int load_all(rch_data *out, size_t *counts, char (*sha)[65], const rch_ca
     size_t total = 0, k = 0;
     int all_xyz = 1, all_group = 1;
     for (size_t f = 0; f < nf; ++f) {
-        if (load_one(&part[f], rch_calib_cfg_file(cfg, f), limits, sha[f], d) != 0 ||
+        if (load_one(&part[f], rch_calib_cfg_file(cfg, f), NULL, 0, limits, sha[f], d) != 0 ||
             rch_data_check_units(&part[f], rch_calib_cfg_file(cfg, f), d) != 0) {
             if (part[f].s)
                 rch_data_free(&part[f]);
