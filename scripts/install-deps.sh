@@ -11,11 +11,12 @@ PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev liblapack-dev l
       cppcheck clang-tidy valgrind binutils libgsl-dev
       python3 python3-pytest python3-numpy python3-venv python3-pip python3-setuptools python3-wheel liburdfdom-tools libexpat1-dev chromium fonts-dejavu-core
       groff-base colcon python3-colcon-cmake python3-colcon-ros
-      protobuf-c-compiler libprotobuf-c-dev protobuf-compiler python3-protobuf)
+      protobuf-c-compiler libprotobuf-c-dev protobuf-compiler python3-protobuf strace)
 # groff-base: renders the generated man pages (pkg_man_completion); colcon, python3-colcon-cmake,
 # python3-colcon-ros: read package.xml as colcon does (pkg_colcon_package). libexpat1-dev: URDF (rch_urdf*.c)
 # and RSI's XML (firmware_host/rt_rsi.c). protobuf-c-compiler, libprotobuf-c-dev: EGM's messages
 # (firmware_host/egm.proto); protobuf-compiler, python3-protobuf: the simulated ABB controller (comp_egm_sim).
+# strace: a calibration opens each input once (tests/host/calib_read_once.sh, issue 50).
 # --list: print the package list (.ci/run installs it with apt-get itself)
 if [ "${1:-}" = "--list" ]; then
   echo "${PKGS[@]}"

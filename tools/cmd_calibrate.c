@@ -10,6 +10,7 @@
 #include "rcal_cmds.h"
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_calib.h"
+#include "rch_report.h"
 #include "rch_calib_effects.h"
 #include "rch_data.h"
 #include "rch_file.h"
@@ -162,6 +163,10 @@ static int parse(calib_args *a, int argc, char **argv)
         {"--no-screen", RCH_OPT_FLAG, &cfg->no_screen, 0, 0, NULL,
          "fit every row: none left out as irreconcilable with the rest (by default a row beyond 8 robust standard "
          "deviations is named and left out, a file with more than 5 % of such rows refused)", 0, NULL},
+        {"--timing", RCH_OPT_FLAG, &cfg->timing, 0, 0, NULL,
+         "where the time went: each stage of the calibration's plan (read, start, map, jump_check, attachment, "
+         "prior_scale, uncertainty, screen, ...) with its wall and CPU time, on stderr (with --json: its "
+         "\"timing\" member)", 0, NULL},
         {"--no-jump-check", RCH_OPT_FLAG, &cfg->no_jump_check, 0, 0, NULL,
          "do not look for length jumps in the default run (a model fitted across jumps it found is not written: "
          "use --jumps)", 0, NULL},
@@ -270,27 +275,6 @@ static int out_is_input(const calib_args *a)
 /* Every --data and --validate file against the robot's joint limits, before
  * the fit (rch_calib_run loads them again; its loader is not this file's):
  * 1 with the message (file:line:column) when a reading is beyond them. */
-static int data_in_limits(const calib_args *a)
-{
-    static rch_robot robot;
-    rch_diag d;
-    char msg[1024];
-    if (rch_robot_load(&robot, a->cfg.robot_path, &d) != 0)
-        return 0; /* rch_calib_run reports it */
-    for (size_t i = 0; i <= a->data.n; ++i) {
-        const char *path = i < a->data.n ? a->data.v[i] : a->cfg.validate_path;
-        rch_data data;
-        if (!path)
-            continue;
-        if (rch_data_load_limited(&data, path, 0, &robot.model, &d) != 0) {
-            fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
-            return 1;
-        }
-        rch_data_free(&data);
-    }
-    return 0;
-}
-
 int rcal_cmd_calibrate(int argc, char **argv)
 {
     calib_args a;
@@ -305,8 +289,6 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return ps;
     if (out_is_input(&a))
         return 2;
-    if (data_in_limits(&a))
-        return 1;
     rch_calib_result *r = malloc(sizeof *r); /* large: two models, the identifiability report */
     rch_diag d;
     char msg[1024];
@@ -317,6 +299,8 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return rc == -2 ? 2 : 1;
     }
     int status = r->after_ok ? 0 : 1;
+    if (a.cfg.timing)
+        rch_calib_timing_print(stderr, &r->timing, "rcal calibrate: ");
     if (r->screen.out) /* named on stderr too, whatever the output's form */
         rch_calib_print_screened(stderr, r, "rcal calibrate: ");
     if (a.json ? rch_calib_json(stdout, r, argc, argv) != 0 : (rch_calib_print(stdout, r), 0))
@@ -329,7 +313,7 @@ int rcal_cmd_calibrate(int argc, char **argv)
             inputs[3 + i] = a.data.v[i];
         for (size_t i = 0; i < a.positions.n; ++i)
             inputs[3 + a.data.n + i] = a.positions.v[i];
-        if (rcal_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs,
+        if (rch_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs,
                                3 + a.data.n + a.positions.n, a.json) != 0)
             status = 1;
     }

@@ -11,6 +11,7 @@
 #include "rch_paths.h" /* RCAL_DEFAULT_ROBOT */
 #include "rch_diagnose.h"
 #include "rch_calib.h"
+#include "rch_report.h"
 #include "rch_data.h"
 #include "rch_opt.h"
 #include "rch_resid.h"
@@ -83,7 +84,7 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
         return 1;
     }
     const char *const inputs[2] = {data_path, robot_path};
-    const int rc = rcal_report_inline(html, c, r, argc, argv, NULL, inputs, 2, quiet);
+    const int rc = rch_report_inline(html, c, r, argc, argv, NULL, inputs, 2, quiet);
     free(c);
     return rc;
 }

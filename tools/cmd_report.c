@@ -15,8 +15,6 @@
 #include "rch_save.h"
 #include "rch_text.h"
 
-#define RCAL_REPORT_MAX_INPUTS 64 /* input files a run may name (several --data, robot, validate) */
-
 static const char summary[] = "an HTML report of a calibration: one self-contained file to hand on";
 static const char details[] =
     "The page has its CSS inline and every plot as inline SVG: no script, no font, image or link that\n"
@@ -28,43 +26,18 @@ static const char details[] =
     "The data of every plot is written beside the page, named from it (x.html: x_metrics.csv, x_params.csv,\n"
     "...); the page and its CSVs are written whole or not at all. See docs/report.md.";
 
-/* path's name without a .html or .htm ending, followed by suffix. */
-static void beside(char *buf, size_t len, const char *path, const char *suffix)
-{
-    size_t n = strlen(path);
-    if (n > 5 && strcmp(path + n - 5, ".html") == 0)
-        n -= 5;
-    else if (n > 4 && strcmp(path + n - 4, ".htm") == 0)
-        n -= 4;
-    snprintf(buf, len, "%.*s%s", (int)n, path, suffix);
-}
-
-size_t rcal_report_bundle(char names[RCAL_REPORT_BUNDLE][RCAL_REPORT_NAME], const char *html)
-{
-    static const char *const csv[4] = {"metrics", "params", "accuracy", "candidates"};
-    size_t n = 0;
-    if (!html || strlen(html) >= 1024)
-        return 0;
-    beside(names[n++], RCAL_REPORT_NAME, html, ".calibration.json");
-    beside(names[n++], RCAL_REPORT_NAME, html, ".diagnosis.json");
-    for (size_t k = 0; k < 4; ++k)
-        if (rch_report_csv_path(names[n], RCAL_REPORT_NAME, html, csv[k]) == 0)
-            ++n;
-    return n;
-}
-
 int rcal_outputs_check(const char *cmd, const char *const *outs, const char *const *whats, size_t n,
                        const char *html, const char *const *inputs, size_t n_inputs)
 {
     enum { MAX_OUTS = 16 };
-    char bundle[RCAL_REPORT_BUNDLE][RCAL_REPORT_NAME], msg[1024];
-    const char *all[MAX_OUTS + RCAL_REPORT_BUNDLE], *all_what[MAX_OUTS + RCAL_REPORT_BUNDLE];
+    char bundle[RCH_REPORT_BUNDLE][RCH_REPORT_NAME], msg[1024];
+    const char *all[MAX_OUTS + RCH_REPORT_BUNDLE], *all_what[MAX_OUTS + RCH_REPORT_BUNDLE];
     size_t m = 0;
     for (size_t k = 0; k < n && m < MAX_OUTS; ++k) {
         all[m] = outs[k];
         all_what[m++] = whats[k];
     }
-    const size_t nb = rcal_report_bundle(bundle, html);
+    const size_t nb = rch_report_bundle(bundle, html);
     for (size_t k = 0; k < nb; ++k) {
         all[m] = bundle[k];
         all_what[m++] = "--report (a file beside the page)";
@@ -81,56 +54,6 @@ int rcal_outputs_check(const char *cmd, const char *const *outs, const char *con
                         all[k], inputs[i]);
                 return 1;
             }
-    return 0;
-}
-
-/* rch_save writers of the run's JSON; ctx is an rch_jw_cmd. */
-static int calib_json_cb(FILE *f, const void *ctx)
-{
-    const rch_jw_cmd *c = ctx;
-    return rch_calib_json(f, c->result, c->argc, c->argv);
-}
-
-static int diag_json_cb(FILE *f, const void *ctx)
-{
-    const rch_jw_cmd *c = ctx;
-    return rch_diagnose_json(f, c->result, c->argc, c->argv);
-}
-
-int rcal_report_inline(const char *html, const struct rch_calib_result *cal, const struct rch_diagnose_result *diag,
-                       int argc, char **argv, const char *model, const char *const *inputs, size_t n_inputs,
-                       int quiet)
-{
-    const rch_jw_cmd cal_ctx = {cal, argc, argv}, diag_ctx = {diag, argc, argv}; /* both made by this command line */
-    char cal_path[1100], diag_path[1100], msg[1024];
-    rch_diag d;
-    memset(&d, 0, sizeof d);
-    if (strlen(html) >= 1024 || strcmp(html, "-") == 0) {
-        fprintf(stderr, "rcal: --report %s: a file name (under 1024 bytes) is needed, the plot data go beside it\n",
-                html);
-        return 1;
-    }
-    beside(cal_path, sizeof cal_path, html, ".calibration.json");
-    beside(diag_path, sizeof diag_path, html, ".diagnosis.json");
-    const char *ins[RCAL_REPORT_MAX_INPUTS + 1];
-    size_t n_ins = 0;
-    ins[n_ins++] = model;
-    for (size_t i = 0; i < n_inputs && n_ins < RCAL_REPORT_MAX_INPUTS + 1; ++i)
-        ins[n_ins++] = inputs[i];
-    if (rch_save(cal_path, "--report (its calibration JSON)", ins, n_ins, calib_json_cb, &cal_ctx, &d) != 0 ||
-        (diag && rch_save(diag_path, "--report (its diagnosis JSON)", ins, n_ins, diag_json_cb, &diag_ctx, &d) != 0)) {
-        fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
-    rch_report_cfg cfg = {cal_path, diag ? diag_path : NULL, model, html, NULL, NULL, 0.0};
-    rch_report_result res;
-    if (rch_report_write(&res, &cfg, &d) != 0) {
-        fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
-        return 1;
-    }
-    if (!quiet)
-        fprintf(stderr, "rcal: report %s written (%u plots, %u warnings; its JSON: %s%s%s)\n", html, res.n_plots,
-                res.n_warnings, cal_path, diag ? ", " : "", diag ? diag_path : "");
     return 0;
 }
 
@@ -184,7 +107,7 @@ static int report_json(const rch_report_result *res, const rch_report_cfg *cfg, 
 
 int rcal_cmd_report(int argc, char **argv)
 {
-    rch_report_cfg cfg = {NULL, NULL, NULL, NULL, NULL, NULL, 0.0};
+    rch_report_cfg cfg = {NULL, NULL, NULL, NULL, NULL, NULL, 0.0, NULL, NULL, 0, 0};
     int json = 0;
     rch_cmdspec spec;
     const rch_opt opts[] = {

@@ -108,6 +108,15 @@ def test_arrays_give_the_file_result_bit_for_bit(py):
     assert_same_result(rcal.calibrate(q_deg=q, L_mm=L), py)
 
 
+def test_arrays_need_no_temporary_file(py, tmp_path, monkeypatch):
+    # issue 50: the arrays reach the calibration in memory: with TMPDIR a directory that does not exist (no
+    # temporary CSV can be made there) the result is still the file's, bit for bit
+    monkeypatch.setenv("TMPDIR", str(tmp_path / "absent"))
+    q, L = read_samples(DATA)
+    assert_same_result(rcal.calibrate(q_deg=q, L_mm=L), py)
+    assert not (tmp_path / "absent").exists()
+
+
 def test_numpy_arrays(py):
     np = pytest.importorskip("numpy")
     q, L = read_samples(DATA)

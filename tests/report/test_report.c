@@ -158,7 +158,7 @@ static int report_tol(rch_report_result *res, const char *cal, const char *diag,
     path_in(pd, sizeof pd, diag ? diag : "");
     path_in(po, sizeof po, out);
     const rch_report_cfg cfg = {pc, diag ? pd : NULL, NULL, po, "rcal report --out <x>", "2026-11-29T17:00:00Z",
-                                tol_mm};
+                                tol_mm, NULL, NULL, 0, 0};
     return rch_report_write(res, &cfg, d);
 }
 
@@ -483,7 +483,7 @@ static void test_refusals(void **state)
         assert_null(strstr(e->d_name, ".tmp"));
     closedir(dd);
     /* standard output cannot carry the CSVs beside it */
-    const rch_report_cfg cfg = {"x.json", NULL, NULL, "-", NULL, NULL, 0.0};
+    const rch_report_cfg cfg = {"x.json", NULL, NULL, "-", NULL, NULL, 0.0, NULL, NULL, 0, 0};
     assert_int_equal(rch_report_write(&res, &cfg, &d), -1);
     assert_non_null(strstr(rch_diag_str(&d, msg, sizeof msg), "needs a file"));
     /* a directory that does not exist: nothing written */

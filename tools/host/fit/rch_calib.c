@@ -24,6 +24,17 @@
 #include "rch_inputs.h"
 #include "rch_resid.h"
 
+/* The run's state (the plan of rch_calib_run): the request, the inputs read
+ * once, the solver's workspace, the rows held out (--residuals) and the
+ * timing record every stage books into. The result keeps the answers. */
+typedef struct calib_run {
+    const rch_calib_cfg *cfg;
+    rch_inputs *in;
+    rc_solve_work *w;
+    uint8_t *held;
+    rch_calib_timing timing;
+} calib_run;
+
 /* The split: random rows, or whole set-up groups drawn at random until the
  * held-out share is reached. idx (n): held-out indices first. */
 static size_t split(size_t *idx, const rc_sample *s, size_t n, double fraction, int by_group, unsigned long long seed)
@@ -80,7 +91,7 @@ static void position_figures(rch_calib_result *r, const rc_sample *train, const 
 
 /* One calibration on the rows sub (m) of data; held (m, or NULL) set to 1
  * for the held-out rows. */
-static int run_once(rch_calib_result *r, rc_solve_work *w, const rc_sample *s, size_t m, unsigned long long seed,
+static int run_once(calib_run *run, rch_calib_result *r, const rc_sample *s, size_t m, unsigned long long seed,
                     uint8_t *held, rch_diag *d)
 {
     size_t *idx = malloc((m ? m : 1) * sizeof *idx);
@@ -105,7 +116,7 @@ static int run_once(rch_calib_result *r, rc_solve_work *w, const rc_sample *s, s
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
-    rc = rch_calib_fit_and_report(r, w, train, test, d);
+    rc = rch_calib_fit_run(r, run->w, train, test, r->cfg.validate_path ? &run->in->validate : NULL, &run->timing, d);
     if (rc == 0 && r->n_pos_rows)
         position_figures(r, train, test);
 done:
@@ -155,7 +166,7 @@ double rch_calib_estimate_s(const rch_calib_cfg *cfg, size_t n_rows, double *bou
 
 /* The paper's protocol: `cases` random subsets of case_samples rows, each
  * split and calibrated; the held-out RMSE before and after over the cases. */
-static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data, rch_diag *d)
+static int run_cases(calib_run *run, rch_calib_result *r, const rch_data *data, rch_diag *d)
 {
     rch_calib_result *c = malloc(sizeof *c);
     size_t *idx = malloc((data->n ? data->n : 1) * sizeof *idx);
@@ -184,7 +195,7 @@ static int run_cases(rch_calib_result *r, rc_solve_work *w, const rch_data *data
             c->cfg.validate_path = NULL;
             c->cfg.plots_dir = NULL;
         }
-        int one = run_once(into, w, sub, m, r->cfg.seed * 1000003ull + k + 7, NULL, d);
+        int one = run_once(run, into, sub, m, r->cfg.seed * 1000003ull + k + 7, NULL, d);
         if (one != 0) {
             rc = one;
             goto done;
@@ -211,9 +222,9 @@ done:
 /* The per-sample residual CSV (cfg.residuals_path) of a single run: every
  * row with the identified model, set train or test by held (n); file_of (n)
  * the input file of each row. */
-static int save_residuals(const rch_calib_result *r, const rch_data *data, const unsigned *file_of,
-                          const uint8_t *held, rch_diag *d)
+static int save_residuals(const rch_calib_result *r, const rch_inputs *in, const uint8_t *held, rch_diag *d)
 {
+    const rch_data *data = &in->data;
     const char *inputs[RCH_CALIB_MAX_FILES + 3] = {r->cfg.robot_path, r->cfg.truth_path, r->cfg.validate_path};
     const size_t nf = rch_calib_cfg_n_files(&r->cfg);
     for (size_t f = 0; f < nf; ++f)
@@ -222,16 +233,11 @@ static int save_residuals(const rch_calib_result *r, const rch_data *data, const
     rch_resid_init(&t, inputs + 3, nf);
     int rc = 0;
     for (size_t i = 0; i < data->n && rc == 0; ++i)
-        rc = rch_resid_add_model(&t, &r->model, &data->s[i], &data->line[i], &file_of[i], 1,
+        rc = rch_resid_add_model(&t, &r->model, &data->s[i], &data->line[i], &in->file_of[i], 1,
                                  held[i] ? RCH_RESID_TEST : RCH_RESID_TRAIN, 0);
-    rch_data v;
-    if (rc == 0 && r->have_validate) {
-        rc = rch_data_load(&v, r->cfg.validate_path, 0, d);
-        if (rc == 0) {
-            rc = rch_resid_add_model(&t, &r->model, v.s, v.line, NULL, v.n, RCH_RESID_VALIDATE, 0);
-            rch_data_free(&v);
-        }
-    }
+    if (rc == 0 && r->have_validate) /* the validation rows as read (rch_inputs) */
+        rc = rch_resid_add_model(&t, &r->model, in->validate.s, in->validate.line, NULL, in->validate.n,
+                                 RCH_RESID_VALIDATE, 0);
     if (rc != 0 && !d->msg[0])
         rch_diag_set(d, "", 0, 0, "out of memory");
     if (rc == 0)
@@ -349,10 +355,10 @@ static int fit_effects(rch_calib_result *r, const rch_calib_cfg *cfg, size_t n_l
 /* The calibration again from the start on in's rows (the same inputs, split
  * seed and effects, the screen's and the systematic decision's findings
  * kept). 0, or as run_once. */
-static int refit_all(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, const rch_calib_cfg *cfg0,
-                     rch_diag *d)
+static int refit_all(calib_run *run, rch_calib_result *r, rch_diag *d)
 {
-    const rch_calib_cfg cfg = *cfg0; /* as asked (the run sets cfg.jumps when its check found jumps) */
+    const rch_inputs *in = run->in;
+    const rch_calib_cfg cfg = *run->cfg; /* as asked */
     /* the refit's plot replaces the fit's (the same command's) */
     for (const char *q = r->plot_paths, *e; *q && (e = strchr(q, '\n')) != NULL; q = e + 1) {
         char one[1200];
@@ -370,7 +376,7 @@ static int refit_all(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, cons
     take_inputs(r, in);
     int rc = fit_effects(r, &cfg, rch_pos_count_lengths(in->data.s, in->data.n), d);
     if (rc == 0)
-        rc = run_once(r, w, in->data.s, in->data.n, cfg.seed, NULL, d);
+        rc = run_once(run, r, in->data.s, in->data.n, cfg.seed, NULL, d);
     r->screen = keep;
     return rc;
 }
@@ -389,9 +395,11 @@ static int has_effect(const rc_model *m, rc_effect_kind kind)
  * penalty; the winners fitted by a refit, kept when its profile likelihood
  * gain n ln(noise0^2 / noise1^2) still beats the penalty (else the fit at
  * hand is restored and the refit said). 0, or -1 with d set. */
-static int systematic(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, const rch_calib_cfg *cfg0, rch_diag *d)
+static int stage_systematic(void *vrun, rch_calib_result *r, rch_diag *d)
 {
-    const rch_calib_cfg *cfg = cfg0;
+    calib_run *run = vrun;
+    const rch_inputs *in = run->in;
+    const rch_calib_cfg *cfg = run->cfg;
     if (!r->after_ok || !r->prior_on || cfg->cases > 1 || cfg->residuals_path ||
         (cfg->no_length_offset && cfg->no_drift) || rch_pos_count_lengths(in->data.s, in->data.n) < 40)
         return 0;
@@ -441,7 +449,7 @@ static int systematic(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, con
             r->sys.drift_fitted = 1;
             dr_ok = 0;
         }
-        const int rc = refit_all(r, w, in, cfg0, d);
+        const int rc = refit_all(run, r, d);
         const double occam = take_off ? old->sys.offset_occam : old->sys.drift_occam;
         const double gain = rc == 0 && r->after_ok && r->noise_mm > 0.0
                                 ? (double)r->n_train * log(old->noise_mm * old->noise_mm / (r->noise_mm * r->noise_mm))
@@ -468,10 +476,11 @@ static int systematic(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, con
  * are the fit's, not the model's) or a model that did not fit. 0, or -1 with
  * d set (refused: too many). */
 #define RCH_SCREEN_ROUNDS 4
-static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *in, const rch_calib_cfg *cfg0,
-                            rch_diag *d)
+static int stage_screen(void *vrun, rch_calib_result *r, rch_diag *d)
 {
-    if (!r->after_ok)
+    calib_run *run = vrun;
+    rch_inputs *in = run->in;
+    if (run->cfg->cases > 1 || run->cfg->no_screen || run->cfg->residuals_path || !r->after_ok)
         return 0;
     rch_data *data = &in->data;
     const size_t n = data->n;
@@ -504,7 +513,7 @@ static int screen_and_refit(rch_calib_result *r, rc_solve_work *w, rch_inputs *i
                 in->file_of[k++] = f0[i];
             }
         data->n = k;
-        rc = refit_all(r, w, in, cfg0, d);
+        rc = refit_all(run, r, d);
         if (rc != 0 || !r->after_ok)
             break;
     }
@@ -517,6 +526,87 @@ done:
     return rc;
 }
 
+/* read: every input, once (rch_inputs_load). */
+static int stage_read(void *vrun, rch_calib_result *r, rch_diag *d)
+{
+    calib_run *run = vrun;
+    if (rch_inputs_load(run->in, run->cfg, d) != 0) {
+        free(run->in);
+        run->in = NULL; /* nothing to free */
+        return -1;
+    }
+    take_inputs(r, run->in);
+    return 0;
+}
+
+/* setup: the cost checked (the cable files' rows), the workspace, the
+ * effects the fit carries. */
+static int stage_setup(void *vrun, rch_calib_result *r, rch_diag *d)
+{
+    calib_run *run = vrun;
+    const rch_calib_cfg *cfg = run->cfg;
+    const rch_data *data = &run->in->data;
+    size_t n_cable = 0;
+    for (size_t f = 0; f < run->in->n_files; ++f)
+        n_cable += run->in->counts[f];
+    if (check_cost(cfg, n_cable, d) != 0)
+        return -2;
+    run->w = malloc(sizeof *run->w);
+    run->held = cfg->residuals_path ? calloc(data->n ? data->n : 1, 1) : NULL;
+    if (!run->w || (cfg->residuals_path && !run->held)) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    return fit_effects(r, cfg, rch_pos_count_lengths(data->s, data->n), d);
+}
+
+/* split: the split and one fit (its own plan), or the paper's cases. */
+static int stage_split(void *vrun, rch_calib_result *r, rch_diag *d)
+{
+    calib_run *run = vrun;
+    const rch_data *data = &run->in->data;
+    if (run->cfg->cases > 1)
+        return run_cases(run, r, data, d);
+    return run_once(run, r, data->s, data->n, run->cfg->seed, run->held, d);
+}
+
+/* judge: the fit against what its sensor can produce. */
+static int stage_judge(void *vrun, rch_calib_result *r, rch_diag *d)
+{
+    calib_run *run = vrun;
+    (void)d;
+    if (run->cfg->cases <= 1)
+        rch_calib_judge_run(r, run->w, run->in->data.s, run->in->data.n);
+    return 0;
+}
+
+/* outputs: the residual CSV; the file lines of the jumps (one file). */
+static int stage_outputs(void *vrun, rch_calib_result *r, rch_diag *d)
+{
+    calib_run *run = vrun;
+    const rch_data *data = &run->in->data;
+    if (run->cfg->residuals_path && r->finite && save_residuals(r, run->in, run->held, d) != 0)
+        return -1;
+    if (r->have_jumps && r->prov.n_files == 1)
+        for (unsigned k = 0; k < r->jumps.n_jumps; ++k)
+            for (size_t i = 0; i < data->n; ++i)
+                if (data->s[i].t == r->jumps.at_t[k]) {
+                    r->jump_lines[k] = data->line[i];
+                    break;
+                }
+    return 0;
+}
+
+/* The run's plan, in order (the fit's own: rch_calib_fit.c). To add a
+ * stage: a function of (run, result) here, its id in rch_calib_stage_id
+ * (rch_calib.h) and its name in rch_calib_plan.c. */
+static const rch_calib_stage run_plan[] = {
+    {RCH_STAGE_READ, stage_read},           {RCH_STAGE_SETUP, stage_setup},
+    {RCH_STAGE_SPLIT, stage_split},         {RCH_STAGE_SYSTEMATIC, stage_systematic},
+    {RCH_STAGE_SCREEN, stage_screen},       {RCH_STAGE_JUDGE, stage_judge},
+    {RCH_STAGE_OUTPUTS, stage_outputs},
+};
+
 int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
 {
     memset(r, 0, sizeof *r);
@@ -526,63 +616,23 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
         rch_diag_set(d, "", 0, 0, "--residuals is for one calibration without --jumps (not with --cases or --jumps)");
         return -2;
     }
-    rch_inputs *in = malloc(sizeof *in);
-    if (!in) {
+    calib_run *run = calloc(1, sizeof *run);
+    if (run)
+        run->in = malloc(sizeof *run->in);
+    if (!run || !run->in) {
+        free(run);
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
-    if (rch_inputs_load(in, cfg, d) != 0) {
-        free(in);
-        return -1;
+    run->cfg = cfg;
+    const int rc = rch_calib_plan_run(run_plan, sizeof run_plan / sizeof run_plan[0], run, r, &run->timing, d);
+    r->timing = run->timing; /* (a refit's restore of the result kept its own) */
+    free(run->w);
+    free(run->held);
+    if (run->in) {
+        rch_inputs_free(run->in);
+        free(run->in);
     }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    r->read_ms = (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) / 1e6;
-    const rch_data *data = &in->data;
-    size_t n_cable = 0; /* the cost is the cable files' rows' */
-    for (size_t f = 0; f < in->n_files; ++f)
-        n_cable += in->counts[f];
-    int rc = -1;
-    rc_solve_work *w = NULL;
-    uint8_t *held = NULL;
-    take_inputs(r, in);
-    if (check_cost(cfg, n_cable, d) != 0) {
-        rc = -2;
-        goto done;
-    }
-    w = malloc(sizeof *w);
-    held = cfg->residuals_path ? calloc(data->n ? data->n : 1, 1) : NULL;
-    if (!w || (cfg->residuals_path && !held)) {
-        rch_diag_set(d, "", 0, 0, "out of memory");
-        goto done;
-    }
-    rc = fit_effects(r, cfg, rch_pos_count_lengths(data->s, data->n), d);
-    if (rc != 0)
-        goto done;
-    if (cfg->cases > 1)
-        rc = run_cases(r, w, data, d);
-    else
-        rc = run_once(r, w, data->s, data->n, cfg->seed, held, d);
-    if (rc == 0 && cfg->cases <= 1)
-        rc = systematic(r, w, in, cfg, d);
-    if (rc == 0 && cfg->cases <= 1 && !cfg->no_screen && !cfg->residuals_path)
-        rc = screen_and_refit(r, w, in, cfg, d);
-    if (rc == 0 && cfg->cases <= 1)
-        rch_calib_judge_run(r, w, in->data.s, in->data.n);
-    if (rc == 0 && cfg->residuals_path && r->finite && save_residuals(r, data, in->file_of, held, d) != 0)
-        rc = -1;
-    if (rc == 0 && r->have_jumps && r->prov.n_files == 1)
-        for (unsigned k = 0; k < r->jumps.n_jumps; ++k)
-            for (size_t i = 0; i < data->n; ++i)
-                if (data->s[i].t == r->jumps.at_t[k]) {
-                    r->jump_lines[k] = data->line[i];
-                    break;
-                }
-done:
-    free(w);
-    free(held);
-    rch_inputs_free(in);
-    free(in);
+    free(run);
     return rc;
 }

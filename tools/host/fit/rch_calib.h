@@ -36,6 +36,7 @@
 #include "rch_dequant.h"
 #include "rch_evaluate.h"
 #include "rch_jumps.h"
+#include "rch_jw.h"
 #include "rch_positions.h"
 #include "rch_prior_scale.h"
 #include "rch_stats.h"
@@ -121,6 +122,37 @@ typedef struct rch_calib_judge {
     char tried[240];           /* the causes tried, in words */
 } rch_calib_judge;
 
+/* The calibration's plan (rch_calib_plan.c, DESIGN.md "The calibration as
+ * a plan"): the stages, each booked in one timing record by the plan's
+ * runner (cf. Ceres' Solver::Summary). A stage's time is its own: a stage
+ * that runs others (a refit inside the screen) is booked without theirs. */
+typedef enum rch_calib_stage_id {
+    RCH_STAGE_READ,        /* every input read once (rch_inputs_load) */
+    RCH_STAGE_SETUP,       /* the cost checked, the effects the fit carries added */
+    RCH_STAGE_SPLIT,       /* the training / held-out split (or the cases) */
+    RCH_STAGE_START,       /* the BC start model, the prior and the parameters held */
+    RCH_STAGE_MAP,         /* the MAP fit with its noise loop (with --jumps: each pass a jump fit) */
+    RCH_STAGE_JUMP_CHECK,  /* the default run's length-jump check */
+    RCH_STAGE_ATTACHMENT,  /* the cable attachment decided by the evidence */
+    RCH_STAGE_PRIOR_SCALE, /* the prior's scale from the data, the refit under it */
+    RCH_STAGE_JUMPS,       /* the length jumps fitted as nuisance (--jumps, or found by the check) */
+    RCH_STAGE_METRICS,     /* the before/after figures */
+    RCH_STAGE_UNCERTAINTY, /* truth, identifiability, uncertainty, validation (rch_calib_finish) */
+    RCH_STAGE_SYSTEMATIC,  /* a length offset and a drift weighed (refits booked to their own stages) */
+    RCH_STAGE_SCREEN,      /* the irreconcilable rows left out (refits booked to their own stages) */
+    RCH_STAGE_JUDGE,       /* the fit against its sensor */
+    RCH_STAGE_OUTPUTS,     /* the residual CSV, the jumps' lines */
+    RCH_STAGE_N
+} rch_calib_stage_id;
+typedef struct rch_calib_timing {
+    double wall_ms[RCH_STAGE_N]; /* each stage's own wall time (CLOCK_MONOTONIC), summed over its runs */
+    double cpu_ms[RCH_STAGE_N];  /* its process CPU time (CLOCK_PROCESS_CPUTIME_ID) */
+    unsigned runs[RCH_STAGE_N];  /* how often it ran (refits and cases run the fit's stages again) */
+    double total_wall_ms, total_cpu_ms; /* the sums */
+} rch_calib_timing;
+/* "read", "setup", ... (the stage's name in --timing and the JSON), or "?". */
+const char *rch_calib_stage_name(unsigned id);
+
 enum { RCH_CALIB_SEEN_FLANGE = 0, RCH_CALIB_SEEN_ATTACHMENT = 1, RCH_CALIB_SEEN_TARGETS = 2 };
 
 typedef struct rch_calib_result {
@@ -130,12 +162,10 @@ typedef struct rch_calib_result {
     rc_model before;          /* BC model */
     rc_model model;           /* identified model */
     rc_solve_result solve;
-    double time_ms;           /* the identification alone */
-    /* Where the run's time went (ms; wall clock) and how much work it did:
-     * reading the files, the start model, the MAP fits (noise passes and the
-     * attachment test), the jump search (the check's and --jumps'), the
-     * figures and uncertainty (rch_calib_finish). Writing is the caller's. */
-    double read_ms, start_ms, fits_ms, jumps_ms, uncert_ms;
+    double time_ms;           /* the identification alone (the last fit's MAP to prior-scale stages) */
+    /* Where the run's time went, stage by stage (the plan's runner books it;
+     * writing is the caller's), and how much work it did. */
+    rch_calib_timing timing;
     rch_fit_counts counts;
     int finite;               /* every parameter of model is finite */
     int after_ok;             /* model is finite and gives finite lengths */
@@ -169,7 +199,6 @@ typedef struct rch_calib_result {
     int prior_scaled;                 /* the prior's scale was estimated from the data (rch_prior_scale) */
     rch_prior_scale prior_scale;      /* the factors, their uncertainty, the fallbacks */
     double noise_mm;          /* residual sd the prior was weighed against (estimated: SSR / (n - p_eff)) */
-    double noise_fit_mm;      /* the noise map_fit's last pass was fitted at (noise_mm: the next pass's) */
     double p_eff;             /* effective number of parameters the data determined (trace of the hat matrix) */
     unsigned noise_passes;    /* fits it took for the noise estimate to settle */
     unsigned n_outside_prior; /* DH parameters more than 3 prior sd from nominal (flagged) */
@@ -179,19 +208,7 @@ typedef struct rch_calib_result {
     double jump_check_max_mm; /* the largest of them */
     double jump_check_scale_mm; /* the robust sd of the residual with the steps (a step counts above 8 x it) */
     unsigned jump_check_steps; /* every change point the check's search found (jumps_found of them far above) */
-    int jumps_auto;           /* they were then fitted as nuisance (cfg.jumps set by the run) */
-    int have_jump_at, keep_jump_at; /* the change points of this training set are known (searched once) */
-    int attach_m0;                  /* refit at the change points found (the no-attachment model, the refit under
-                                       the prior's estimated scale) */
-    rc_model check_model;           /* the jump check's fit at its change points (geometry + offsets) */
-    int have_check_model;           /* check_model is set: the first nuisance fit starts from it */
-    unsigned map_passes0;           /* noise passes made before a resumed map_fit (added to noise_passes) */
-    int map_one_pass;               /* map_fit stops after its first noise pass (the jump check's early look) */
-    int map_warm;                   /* map_fit's first pass from the fit at hand (r->model, r->jumps.model) at its
-                                       noise r->noise_mm, not from the start model at its RMS */
-    unsigned n_jump_at;
-    double jump_rms_before_mm; /* training RMS of the geometry alone (the search's) */
-    size_t jump_at[RCH_JUMPS_MAX];    /* (n_jump_at) first training sample (in t order) after each jump */
+    int jumps_auto;           /* they were then fitted as nuisance (the run's decision; cfg.jumps as asked) */
     int attach_auto;          /* the cable attachment vector was the default's to decide (not --tool-offset) */
     int attach_centred;       /* decided: the cable is at the flange centre (no attachment vector) */
     int attach_bound;         /* attach_dchi2 is a lower bound (one centred fit proved the attachment needed) */
@@ -247,6 +264,11 @@ void rch_calib_judge_floor_text(char *buf, size_t len, const rch_calib_result *r
 
 /* The text report (the paper's Table 7 form, identifiability, solver line). */
 void rch_calib_print(FILE *f, const rch_calib_result *r);
+/* The plan's timing record: one line per stage that ran (wall, CPU, runs)
+ * after prefix, then the total (--timing, on stderr); as a JSON member
+ * "timing" {wall_ms, cpu_ms, stages: [{stage, runs, wall_ms, cpu_ms}]}. */
+void rch_calib_timing_print(FILE *f, const rch_calib_timing *t, const char *prefix);
+void rch_calib_timing_json(rch_jw *w, const rch_calib_timing *t);
 /* The rows the fit left out (r->screen), one line each: "FILE:LINE: left
  * out: ... likely ...", each line after prefix. */
 void rch_calib_print_screened(FILE *f, const rch_calib_result *r, const char *prefix);

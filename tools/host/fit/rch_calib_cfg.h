@@ -50,6 +50,10 @@ typedef struct rch_calib_cfg {
     int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
     double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
     int no_screen;          /* 1: every row fitted, none screened out (rch_calib_screen.c) */
+    int timing;             /* 1: the JSON carries the plan's timing record ("timing": each stage's time) */
+    const char *data_text;  /* the one data file's rows in memory (CSV, data_text_len bytes; the Python
+                               library's arrays): data_path only names them, nothing is read from disk */
+    size_t data_text_len;
     double max_minutes;     /* refuse a run estimated longer (rch_calib_estimate_s); 0: 60 */
     unsigned n_cable_points; /* points of a tool plate the cable is hooked on in turn (the data's target
                                 column names them; RC_EFF_CABLE_POINTS), 0: none */

@@ -183,19 +183,23 @@ static int uncertainty(rch_calib_result *r, const uint8_t *fixed, const rc_sampl
     return rc;
 }
 
-/* The model on data the fit never saw (no refit). */
-static int validate(rch_calib_result *r, rc_solve_work *w, rch_diag *d)
+/* The model on data the fit never saw (no refit): v, the validation file's
+ * rows as read (rch_inputs), their outlet labels mapped to the fit's. */
+static int validate(rch_calib_result *r, rc_solve_work *w, const rch_data *v, rch_diag *d)
 {
-    rch_data v;
     char err[256];
-    if (rch_data_load(&v, r->cfg.validate_path, 0, d) != 0)
-        return -1;
-    if (rch_data_outlets_as(r->outlet_label, r->n_outlets, v.s, v.n, v.line, r->cfg.validate_path, d) != 0) {
-        rch_data_free(&v); /* the validation file's labels are the calibration data's */
+    rc_sample *s = malloc((v->n ? v->n : 1) * sizeof *s);
+    if (!s) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
-    int rc = rch_evaluate(&r->validate, &r->model, v.s, v.n, NULL, w, err, sizeof err);
-    rch_data_free(&v);
+    memcpy(s, v->s, v->n * sizeof *s);
+    if (rch_data_outlets_as(r->outlet_label, r->n_outlets, s, v->n, v->line, r->cfg.validate_path, d) != 0) {
+        free(s); /* the validation file's labels are the calibration data's */
+        return -1;
+    }
+    int rc = rch_evaluate(&r->validate, &r->model, s, v->n, NULL, w, err, sizeof err);
+    free(s);
     if (rc != 0) {
         rch_diag_set(d, r->cfg.validate_path, 0, 0, "%s", err);
         return -1;
@@ -207,16 +211,16 @@ static int validate(rch_calib_result *r, rc_solve_work *w, rch_diag *d)
 /* After the fit: truth, identifiability, uncertainty, validation. fit:
  * the model fitted to train (r->model, or with the jumps' offsets). */
 int rch_calib_finish(rch_calib_result *r, const uint8_t *fixed, const rc_sample *train, const rc_model *fit,
-                  const uint16_t *setup, rch_diag *d)
+                     const uint16_t *setup, const rch_data *validate_rows, rch_diag *d)
 {
     if (r->cfg.truth_path && r->finite && truth_flange(r, d) != 0)
         return -1;
     r->have_ident = r->finite && rch_ident_compute(&r->ident, fit, train, r->n_train) == 0;
     if (r->finite && uncertainty(r, fixed, train, fit, setup, d) != 0)
         return -1;
-    if (r->cfg.validate_path && r->after_ok) {
+    if (r->cfg.validate_path && r->after_ok && validate_rows) {
         rc_solve_work *w = malloc(sizeof *w);
-        int rc = w ? validate(r, w, d) : -1;
+        int rc = w ? validate(r, w, validate_rows, d) : -1;
         free(w);
         if (rc != 0)
             return -1;

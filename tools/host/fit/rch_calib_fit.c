@@ -2,8 +2,9 @@
 /* rch_calib_fit.c - one identification on a training set: the BC start,
  * the maximum a posteriori fit with the physical prior and its noise
  * estimate, the cable attachment decided by the evidence, the default run's
- * length-jump check, the --jumps nuisance fit, the before/after metrics
- * (rch_calib_int.h, rch_calib_fit_and_report).
+ * length-jump check, the --jumps nuisance fit, the before/after metrics,
+ * as a plan of stages (fit_plan, run by rch_calib_plan_run; the steering in
+ * rch_calib_fit_state, rch_calib_int.h; rch_calib_fit_run).
  *
  * Depends on: the core (rc_solve, rc_normal_eq, rc_prior_*), LAPACKE (the
  * effective number of parameters), rch_start, rch_calib_effects (--fix),
@@ -17,7 +18,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <lapacke.h>
 
 #include "rch_calib_effects.h"
@@ -25,13 +25,6 @@
 #include "rch_prior.h"
 #include "rch_start.h"
 #include "rch_stats.h"
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
-}
 
 /* rc_solve, counted in r->counts (res may be NULL). */
 static rc_status solve_counted(rch_calib_result *r, rc_model *m, rc_solve_result *res, rc_solve_work *w,
@@ -104,27 +97,25 @@ static rc_sample *by_time(const rc_sample *s, size_t n)
  * (rch_jumps_find), every later fit of the same training set refits at them
  * (rch_jumps_refit): the noise passes, the attachment comparison and the
  * final fit move the change points' sizes, not where they are. */
-static int jumps_fit(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rch_jumps_config *jc,
+static int jumps_fit(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rch_jumps_config *jc,
                      const rc_sample *sorted, char *err, size_t errlen)
 {
-    if (r->have_jump_at) {
-        const int rc = rch_jumps_refit(&r->jumps, &r->before, fixed, sorted, r->n_train, r->jump_at, r->n_jump_at,
+    if (f->have_jump_at) {
+        const int rc = rch_jumps_refit(&r->jumps, &r->before, fixed, sorted, r->n_train, f->jump_at, f->n_jump_at,
                                        jc, w, err, errlen);
-        r->jumps.rms_before_mm = r->jump_rms_before_mm; /* the geometry alone, from the search */
+        r->jumps.rms_before_mm = f->jump_rms_before_mm; /* the geometry alone, from the search */
         return rc;
     }
-    const double t0 = now_ms();
     const int rc = rch_jumps_find(&r->jumps, &r->before, fixed, sorted, r->n_train, jc, w, err, errlen);
-    r->jumps_ms += now_ms() - t0;
     if (rc != 0)
         return -1;
     if (isfinite(r->jumps.rms_before_mm)) /* a search linearised at the fit at hand keeps the earlier one */
-        r->jump_rms_before_mm = r->jumps.rms_before_mm;
+        f->jump_rms_before_mm = r->jumps.rms_before_mm;
     else
-        r->jumps.rms_before_mm = r->jump_rms_before_mm;
-    r->n_jump_at = r->jumps.n_jumps;
-    memcpy(r->jump_at, r->jumps.at, r->jumps.n_jumps * sizeof r->jump_at[0]);
-    r->have_jump_at = 1;
+        r->jumps.rms_before_mm = f->jump_rms_before_mm;
+    f->n_jump_at = r->jumps.n_jumps;
+    memcpy(f->jump_at, r->jumps.at, r->jumps.n_jumps * sizeof f->jump_at[0]);
+    f->have_jump_at = 1;
     return 0;
 }
 
@@ -133,7 +124,7 @@ static int jumps_fit(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
  * (what predicts a new pose). Held-out samples are labelled with their
  * segment to evaluate; those between a jump and the training samples around
  * it cannot be placed (their segment is a guess) and are counted apart. */
-static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rc_solve_config *scfg,
+static int fit_jumps(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rc_solve_config *scfg,
                      const rc_sample *train, const rc_sample *eval_set, size_t n_eval, rch_diag *d)
 {
     rc_sample *tr = malloc(r->n_train * sizeof *tr), *ev = malloc(n_eval * sizeof *ev);
@@ -158,12 +149,12 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     memset(&jc, 0, sizeof jc);
     jc.solve = scfg;
     jc.counts = &r->counts;
-    rc_model *warm = r->have_jump_at ? malloc(sizeof *warm) : NULL;
+    rc_model *warm = f->have_jump_at ? malloc(sizeof *warm) : NULL;
     if (warm) { /* the last noise pass's fit at these change points: the final fit starts there */
         *warm = r->jumps.model;
         jc.warm = warm;
     }
-    const int jf = jumps_fit(r, w, fixed, &jc, tr, err, sizeof err);
+    const int jf = jumps_fit(f, r, w, fixed, &jc, tr, err, sizeof err);
     free(warm);
     if (jf != 0) {
         if (r->n_test)
@@ -198,13 +189,17 @@ static int fit_jumps(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed
     rc_eval(&r->train_before, &r->before, tr, r->n_train);
     if (!r->after_ok || rc_eval(&r->train_after, &r->jumps.model, tr, r->n_train) != RC_OK)
         memset(&r->train_after, 0, sizeof r->train_after);
-    uint8_t fxj[RC_MAX_PARAMS];
-    memcpy(fxj, fixed, sizeof fxj);
+    memcpy(f->fin_fixed, fixed, sizeof f->fin_fixed);
     if (r->jumps.n_jumps) /* the first segment's offset is the reference */
-        fxj[r->jumps.model.effects[r->jumps.model.n_effects - 1].first] = 1;
-    const double tu = now_ms();
-    rc = rch_calib_finish(r, fxj, tr, &r->jumps.model, setup, d);
-    r->uncert_ms += now_ms() - tu;
+        f->fin_fixed[r->jumps.model.effects[r->jumps.model.n_effects - 1].first] = 1;
+    /* the uncertainty stage's: the rows in time order, each in its segment, and their set-up groups */
+    f->fin_sorted = tr;
+    f->fin_train = tr;
+    f->fin_setup = setup;
+    f->fin_fit = &r->jumps.model;
+    tr = NULL;
+    setup = NULL;
+    rc = 0;
 done:
     free(tr);
     free(ev);
@@ -220,7 +215,7 @@ done:
  * excursions. With --jumps each pass is a jump search. r->model (and
  * r->jumps), r->noise_mm, r->p_eff, r->noise_passes are set; *chi2 is the
  * MAP objective in units of the noise variance (SSR / noise^2 + prior). */
-static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config *pcfg, const uint8_t *fixed,
+static rc_status map_fit(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_work *w, rc_solve_config *pcfg, const uint8_t *fixed,
                          const rc_sample *train, double *chi2)
 {
     rc_solve_config cfg = *pcfg;
@@ -233,23 +228,23 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
          * model, so a pass never inherits the previous one's excursions. */
         rc_metrics m0;
         double noise = rc_eval(&m0, &r->before, train, r->n_train) == RC_OK && m0.rmse_mm > 0.0 ? m0.rmse_mm : 1.0;
-        const int warm_first = r->map_warm && r->noise_mm > 0.0;
+        const int warm_first = f->map_warm && r->noise_mm > 0.0;
         if (warm_first)
             noise = r->noise_mm;
         rc_sample *sorted = NULL;
-        rc_model *warm = r->cfg.jumps ? malloc(sizeof *warm) : NULL;
-        if (r->cfg.jumps && warm)
+        rc_model *warm = f->jumps ? malloc(sizeof *warm) : NULL;
+        if (f->jumps && warm)
             sorted = by_time(train, r->n_train);
         for (unsigned pass = 0; pass < 6; ++pass) {
             cfg.prior_noise_mm = noise;
-            r->noise_fit_mm = noise;
+            f->noise_fit_mm = noise;
             const rc_model *fitm = &r->model;
             const rc_sample *fs = train;
             const uint8_t *fx = fixed;
             uint8_t fxj[RC_MAX_PARAMS];
             if (pass == 0 && !warm_first)
                 r->model = r->before; /* later passes start from the previous one's optimum */
-            if (r->cfg.jumps && sorted) {
+            if (f->jumps && sorted) {
                 rch_jumps_config jc;
                 char err[256];
                 memset(&jc, 0, sizeof jc);
@@ -261,21 +256,21 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
                  * refitted after, each refit from the previous pass's fit.
                  * Pass 0 only gives pass 1 its noise: when the default run's
                  * check found the points (jumps_auto), pass 0 refits there. */
-                if (!r->attach_m0 && (pass == 1 || (pass == 0 && !r->jumps_auto)))
-                    r->have_jump_at = 0;
-                if ((pass > 0 || warm_first) && r->have_jump_at) {
+                if (!f->attach_m0 && (pass == 1 || (pass == 0 && !r->jumps_auto)))
+                    f->have_jump_at = 0;
+                if ((pass > 0 || warm_first) && f->have_jump_at) {
                     *warm = r->jumps.model;
                     jc.warm = warm;
-                } else if (pass == 0 && r->have_jump_at && r->have_check_model) {
-                    jc.warm = &r->check_model; /* the check's fit at these points, at its noise */
-                } else if (pass > 0 && !r->have_jump_at) {
+                } else if (pass == 0 && f->have_jump_at && f->have_check_model) {
+                    jc.warm = &f->check_model; /* the check's fit at these points, at its noise */
+                } else if (pass > 0 && !f->have_jump_at) {
                     /* the search linearised at the last pass's fit (its geometry, its offsets dropped):
                      * no geometry-alone fit at this noise */
                     *warm = r->jumps.model;
                     jc.warm = warm;
                     jc.warm_role = RCH_WARM_LINEARISE;
                 }
-                if (jumps_fit(r, w, fixed, &jc, sorted, err, sizeof err) != 0)
+                if (jumps_fit(f, r, w, fixed, &jc, sorted, err, sizeof err) != 0)
                     break; /* fit_jumps reports it */
                 fitm = &r->jumps.model;
                 fs = sorted;
@@ -306,20 +301,20 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
             const double next = dof > 1.0 ? sqrt(ssr / dof) : noise;
             const int settled = fabs(next - noise) <= 0.02 * noise;
             noise = next > 1e-6 ? next : 1e-6;
-            if (settled || r->map_one_pass)
+            if (settled || f->map_one_pass)
                 break;
         }
         free(sorted);
         free(warm);
         r->noise_mm = cfg.prior_noise_mm = noise;
-        if (st == RC_OK && !r->cfg.jumps && !r->map_one_pass) { /* the last pass's optimum, at the settled noise */
+        if (st == RC_OK && !f->jumps && !f->map_one_pass) { /* the last pass's optimum, at the settled noise */
             rc_solve_config wc = cfg;
             rc_solve_config_warm(&wc);
             st = solve_counted(r, &r->model, &r->solve, w, &wc, train, r->n_train);
         }
     }
-    *chi2 = r->cfg.jumps ? chi2_loop : INFINITY;
-    if (st == RC_OK && !r->cfg.jumps) {
+    *chi2 = f->jumps ? chi2_loop : INFINITY;
+    if (st == RC_OK && !f->jumps) {
         const rc_model *fitm = &r->model;
         double c = 0.0;
         rc_solve_config pc = cfg;
@@ -347,7 +342,7 @@ static rc_status map_fit(rch_calib_result *r, rc_solve_work *w, rc_solve_config 
  * = F1, and *bound = F1 / nu1^2 (0); -1 when the test or the fit fails
  * (the loop decides). fm: the attachment model's fit (its jump offsets
  * with --jumps), the centred fit's start. */
-static int centred_bound(double *bound, rc_model *fit, rch_calib_result *r, rc_solve_work *w,
+static int centred_bound(rch_calib_fit_state *f, double *bound, rc_model *fit, rch_calib_result *r, rc_solve_work *w,
                          const rc_solve_config *c0, const uint8_t *fixed, const rc_sample *train, const rc_model *fm,
                          double nu1)
 {
@@ -360,7 +355,7 @@ static int centred_bound(double *bound, rc_model *fit, rch_calib_result *r, rc_s
     memcpy(fx, fixed, r->before.n_params);
     double ssr = 0.0;
     int ok = 0;
-    if (r->cfg.jumps) {
+    if (f->jumps) {
         rc_sample *sorted = by_time(train, r->n_train);
         rch_jumps *jj = malloc(sizeof *jj);
         if (sorted && jj) {
@@ -371,12 +366,12 @@ static int centred_bound(double *bound, rc_model *fit, rch_calib_result *r, rc_s
             jc.counts = &r->counts;
             jc.skip_se = 1; /* sizes only: the final fit gives their standard errors */
             jc.warm = &x;
-            ok = rch_jumps_refit(jj, &r->before, fixed, sorted, r->n_train, r->jump_at, r->n_jump_at, &jc, w, err,
+            ok = rch_jumps_refit(jj, &r->before, fixed, sorted, r->n_train, f->jump_at, f->n_jump_at, &jc, w, err,
                                  sizeof err) == 0;
             if (ok) {
                 x = jj->model;
                 ssr = jj->rms_after_mm * jj->rms_after_mm * (double)r->n_train;
-                if (r->n_jump_at)
+                if (f->n_jump_at)
                     fx[x.effects[x.n_effects - 1].first] = 1;
             }
         }
@@ -405,7 +400,7 @@ static int centred_bound(double *bound, rc_model *fit, rch_calib_result *r, rc_s
  * segment's offset held, as map_fit fitted it with --jumps), fitted under
  * the sd sd_fit (n_params; the stated r->prior_sd or another scale of it).
  * 0, or -1 when it cannot be estimated. */
-static int estimate_scale(rch_prior_scale *ps, rch_calib_result *r, const uint8_t *fixed, const rc_sample *train,
+static int estimate_scale(rch_calib_fit_state *f, rch_prior_scale *ps, rch_calib_result *r, const uint8_t *fixed, const rc_sample *train,
                           const double *sd_fit)
 {
     char err[160];
@@ -415,7 +410,7 @@ static int estimate_scale(rch_prior_scale *ps, rch_calib_result *r, const uint8_
     rc_sample *sorted = NULL;
     uint8_t fxj[RC_MAX_PARAMS];
     memcpy(fxj, fixed, sizeof fxj);
-    if (r->cfg.jumps) {
+    if (f->jumps) {
         if (!(sorted = malloc(r->n_train * sizeof *sorted)))
             return -1;
         memcpy(sorted, train, r->n_train * sizeof *sorted);
@@ -442,7 +437,7 @@ static int estimate_scale(rch_prior_scale *ps, rch_calib_result *r, const uint8_
  * 2 sum ln(prior sd / posterior sd) over its three components (the Laplace
  * evidence of the two models). Otherwise the model without it is used.
  * r->attach_* record the decision. */
-static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, uint8_t *fixed,
+static rc_status choose_attachment(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, uint8_t *fixed,
                                    const rc_sample *train, double chi2_1)
 {
     const rc_model m1 = r->model, before1 = r->before;
@@ -462,10 +457,10 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
         return RC_OK;
     rch_uncert u;
     char err[128];
-    const rc_model *fm = r->cfg.jumps ? &j1.model : &m1;
+    const rc_model *fm = f->jumps ? &j1.model : &m1;
     uint8_t fx[RC_MAX_PARAMS];
     memcpy(fx, fixed, sizeof fx);
-    if (r->cfg.jumps && j1.n_jumps)
+    if (f->jumps && j1.n_jumps)
         fx[j1.model.effects[j1.model.n_effects - 1].first] = 1;
     double occam = 0.0;
     r->counts.jac_passes++;
@@ -485,7 +480,7 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
      * centred model by at most what a refit would gain). */
     rch_prior_scale ps;
     const int scaled = !r->robot.prior.from_file && !r->cfg.prior_stated &&
-                       estimate_scale(&ps, r, fixed, train, r->prior_sd) == 0;
+                       estimate_scale(f, &ps, r, fixed, train, r->prior_sd) == 0;
     if (scaled) {
         double sd_a[RC_MAX_PARAMS];
         rch_prior_scale_apply_fit(sd_a, r->prior_sd, RC_MAX_PARAMS, &ps); /* (the jumps' offsets too) */
@@ -516,25 +511,25 @@ static rc_status choose_attachment(rch_calib_result *r, rc_solve_work *w, rc_sol
     double bound = 0.0;
     rc_model xc;
     xc.n_params = 0;
-    const int bd = centred_bound(&bound, &xc, r, w, &c0, fixed, train, fm, noise1);
+    const int bd = centred_bound(f, &bound, &xc, r, w, &c0, fixed, train, fm, noise1);
     if (bd == 0 && bound - chi2_1 > r->attach_occam) {
         /* the centred model's objective is at least `bound` at its own noise: the attachment is kept, and
          * the centred model's noise loop is not needed to say so */
         r->attach_dchi2 = bound - chi2_1;
         r->attach_bound = 1;
     } else {
-        r->attach_m0 = 1; /* at the attachment model's change points */
+        f->attach_m0 = 1; /* at the attachment model's change points */
         if (xc.n_params > 0) { /* the loop from the centred fit at nu1 and nu1: near its fixed point */
-            if (r->cfg.jumps)
+            if (f->jumps)
                 r->jumps.model = xc;
             else
                 r->model = xc;
             r->noise_mm = noise1;
-            r->map_warm = 1;
+            f->map_warm = 1;
         }
-        st = map_fit(r, w, &c0, fixed, train, &chi2_0);
-        r->attach_m0 = 0;
-        r->map_warm = 0;
+        st = map_fit(f, r, w, &c0, fixed, train, &chi2_0);
+        f->attach_m0 = 0;
+        f->map_warm = 0;
         /* both objectives in units of the attachment model's noise */
         const double chi2_0n = st == RC_OK ? chi2_0 * (r->noise_mm * r->noise_mm) / (noise1 * noise1) : INFINITY;
         r->attach_dchi2 = chi2_0n - chi2_1;
@@ -584,7 +579,7 @@ static double jump_scale(const rch_jumps *j, const rc_sample *tr, size_t n)
 /* The default run looks for length jumps as diagnose does: a model fitted
  * across a jump it does not know is wrong, so rch_calib_save_model refuses it
  * and names --jumps. r->jumps_found, r->jump_check_max_mm. */
-static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rc_solve_config *cfg,
+static void jump_check(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_work *w, const uint8_t *fixed, const rc_solve_config *cfg,
                        const rc_sample *train)
 {
     rc_sample *tr = by_time(train, r->n_train);
@@ -595,22 +590,20 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
         char err[128];
         memset(&jc, 0, sizeof jc);
         rc_solve_config c0 = *cfg;
-        c0.prior_noise_mm = r->noise_fit_mm; /* the noise that fit was made at (cfg's is the next pass's) */
+        c0.prior_noise_mm = f->noise_fit_mm; /* the noise that fit was made at (cfg's is the next pass's) */
         jc.solve = &c0;
         jc.counts = &r->counts;
         jc.skip_se = 1; /* sizes only: the final fit gives their standard errors */
         jc.warm = &keep_model; /* the MAP fit at hand is the search's geometry fit at this prior and noise */
         jc.warm_role = RCH_WARM_OPTIMUM;
-        const double t0 = now_ms();
         const int found = rch_jumps_find(j, &r->before, fixed, tr, r->n_train, &jc, w, err, sizeof err) == 0;
-        r->jumps_ms += now_ms() - t0;
         if (found) {
-            r->n_jump_at = j->n_jumps; /* every change point found: the nuisance fit starts from them */
-            r->check_model = j->model;
-            r->have_check_model = 1;
+            f->n_jump_at = j->n_jumps; /* every change point found: the nuisance fit starts from them */
+            f->check_model = j->model;
+            f->have_check_model = 1;
             r->jump_check_steps = j->n_jumps;
-            r->jump_rms_before_mm = j->rms_before_mm;
-            memcpy(r->jump_at, j->at, j->n_jumps * sizeof r->jump_at[0]);
+            f->jump_rms_before_mm = j->rms_before_mm;
+            memcpy(f->jump_at, j->at, j->n_jumps * sizeof f->jump_at[0]);
             /* A step can also describe an effect the geometry lacks (a joint
              * compliance leaves steps of a few times the residual, inside
              * set-ups too): a jump counts as a sensor event when it is far
@@ -642,14 +635,14 @@ static void jump_check(rch_calib_result *r, rc_solve_work *w, const uint8_t *fix
  * (r->prior_sd_fit: the joint zeros may narrow), the uncertainty's (never
  * below the stated sd) in r->prior_sd. A prior the robot file states is
  * kept as stated, and so with --prior-stated. */
-static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, const uint8_t *fixed,
+static rc_status scale_prior(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, const uint8_t *fixed,
                              const rc_sample *train)
 {
     if (r->robot.prior.from_file || r->cfg.prior_stated)
         return RC_OK;
     rch_prior_scale ps;
     const double *sd_at = cfg->prior_sd ? cfg->prior_sd : r->prior_sd;
-    if (estimate_scale(&ps, r, fixed, train, sd_at) != 0)
+    if (estimate_scale(f, &ps, r, fixed, train, sd_at) != 0)
         return RC_OK; /* the stated prior, as before */
     r->prior_scaled = 1;
     r->prior_scale = ps;
@@ -664,23 +657,151 @@ static rc_status scale_prior(rch_calib_result *r, rc_solve_work *w, rc_solve_con
     if (!changed)
         return RC_OK;
     double chi2 = 0.0;
-    r->attach_m0 = 1; /* at the change points already found: another prior moves the geometry, not the jumps */
-    r->map_warm = 1;  /* from the fit at hand and its noise: another prior moves both a little */
-    const rc_status st = map_fit(r, w, cfg, fixed, train, &chi2);
-    r->attach_m0 = 0;
-    r->map_warm = 0;
+    f->attach_m0 = 1; /* at the change points already found: another prior moves the geometry, not the jumps */
+    f->map_warm = 1;  /* from the fit at hand and its noise: another prior moves both a little */
+    const rc_status st = map_fit(f, r, w, cfg, fixed, train, &chi2);
+    f->attach_m0 = 0;
+    f->map_warm = 0;
     return st;
 }
 
-/* scale_prior with a prior, its time counted with the fits; -1 (d set) when the refit fails. */
-static int scale_prior_timed(rch_calib_result *r, rc_solve_work *w, rc_solve_config *cfg, const uint8_t *fixed,
-                             const rc_sample *train, rch_diag *d)
+
+/* The plan of one fit (rch_calib_fit_run): each stage a function of the
+ * fit's state f (the steering, rch_calib_fit_state) and the result r (the
+ * answers). */
+
+/* start: the BC model, the parameters held, the solver's request with the
+ * prior. A new training set's change points are searched (unless the jump
+ * check's are kept for the nuisance fit). */
+static int stage_start(void *run, rch_calib_result *r, rch_diag *d)
 {
+    rch_calib_fit_state *f = run;
+    if (!f->keep_jump_at) {
+        f->have_jump_at = 0; /* a new training set: its change points are searched */
+        f->have_check_model = 0;
+    }
+    if (rch_calib_start(&r->before, f->w, &r->robot, f->train, r->n_train, d) != 0)
+        return -1;
+    r->model = r->before;
+    uint8_t *fixed = f->fixed;
+    memset(fixed, 0, sizeof f->fixed);
+    if (r->cfg.fix && rch_calib_fix(fixed, &r->model, r->cfg.fix, d) != 0)
+        return -2;
+    rch_pos_fix_unseen(fixed, &r->model, f->train, r->n_train); /* what only an absent sensor sees */
+    rc_solve_config *cfg = &f->cfg;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->method = r->cfg.method;
+    cfg->fixed = fixed;
+    cfg->max_iter = r->cfg.max_iter;
+    cfg->seed = r->cfg.seed;
+    r->prior_on = !r->cfg.no_prior && (cfg->method == RC_METHOD_LM || cfg->method == RC_METHOD_LTLM);
+    if (r->prior_on) {
+        memset(r->prior_mean, 0, sizeof r->prior_mean);
+        memset(r->prior_sd, 0, sizeof r->prior_sd);
+        rch_prior_fill(r->prior_mean, r->prior_sd, &r->before, &r->robot.nominal, &r->robot.prior);
+        rch_prior_gauge(fixed);
+        cfg->prior_mean = r->prior_mean;
+        cfg->prior_sd = r->prior_sd;
+    }
+    memcpy(r->fixed, fixed, sizeof r->fixed);
+    f->st = RC_OK;
+    f->checked = 0;
+    f->eval_set = r->n_test ? f->test : f->train;
+    f->n_eval = r->n_test ? r->n_test : r->n_train;
+    return 0;
+}
+
+/* map (the jump check's look): the first noise pass alone, when the
+ * default run checks for length jumps (a cable's display; several outlets'
+ * rows interleave in acquisition order, where a step of the sequence is no
+ * display's event: their jumps only with --jumps, as rcal diagnose). It
+ * looks at the weakest prior of the loop: when it finds jumps the rest of
+ * the loop, fitted across them, would be thrown away; when it does not,
+ * the loop goes on from that pass (map_warm: the same passes as one loop). */
+static int stage_map_first(void *run, rch_calib_result *r, rch_diag *d)
+{
+    rch_calib_fit_state *f = run;
+    (void)d;
+    if (!(r->prior_on && !f->jumps && !r->cfg.no_jump_check && r->n_train >= 40 && !r->n_pos_rows &&
+          r->n_outlets <= 1))
+        return 0;
+    double chi2_e = 0.0;
+    f->map_one_pass = 1;
+    f->st = map_fit(f, r, f->w, &f->cfg, f->fixed, f->train, &chi2_e);
+    f->map_one_pass = 0;
+    f->checked = f->st == RC_OK;
+    f->passes0 = r->noise_passes;
+    return 0;
+}
+
+/* jump_check: length jumps at that first pass's fit; found (and no
+ * --residuals): the fit again from its start with them as nuisance, as
+ * --jumps does (the default run never hands on a geometry fitted across
+ * jumps), at the change points the check found. */
+static int stage_jump_check(void *run, rch_calib_result *r, rch_diag *d)
+{
+    rch_calib_fit_state *f = run;
+    (void)d;
+    if (!f->checked)
+        return 0;
+    jump_check(f, r, f->w, f->fixed, &f->cfg, f->train);
+    if (r->jumps_found && !r->cfg.residuals_path) {
+        f->jumps = 1;
+        r->jumps_auto = 1;
+        f->have_jump_at = 1; /* at the change points the check found */
+        f->keep_jump_at = 1;
+        return RCH_PLAN_AGAIN;
+    }
+    f->map_warm = 1;
+    f->map_passes0 = f->passes0;
+    return 0;
+}
+
+/* map: the maximum a posteriori fit with its noise loop (resumed after the
+ * check's pass), or plain least squares without the prior. */
+static int stage_map(void *run, rch_calib_result *r, rch_diag *d)
+{
+    rch_calib_fit_state *f = run;
+    (void)d;
+    if (!r->prior_on) {
+        f->st = solve_counted(r, &r->model, &r->solve, f->w, &f->cfg, f->train, r->n_train);
+        return 0;
+    }
+    f->chi2_1 = 0.0;
+    if (f->st == RC_OK)
+        f->st = map_fit(f, r, f->w, &f->cfg, f->fixed, f->train, &f->chi2_1);
+    f->map_warm = 0;
+    r->noise_passes += f->map_passes0;
+    f->map_passes0 = 0;
+    return 0;
+}
+
+/* attachment: the cable attachment decided by the evidence (the default's
+ * to decide); the identification's verdict. */
+static int stage_attachment(void *run, rch_calib_result *r, rch_diag *d)
+{
+    rch_calib_fit_state *f = run;
+    if (r->prior_on && f->st == RC_OK && r->attach_auto)
+        f->st = choose_attachment(f, r, f->w, &f->cfg, f->fixed, f->train, f->chi2_1);
+    if (f->st != RC_OK) {
+        rch_diag_set(d, "", 0, 0, "solver failed: %s", rc_strerror(f->st));
+        return -1;
+    }
+    r->finite = 1;
+    for (unsigned k = 0; k < r->model.n_params; ++k)
+        r->finite &= isfinite(r->model.x[k]) != 0;
+    rc_eval(&r->before_m, &r->before, f->eval_set, f->n_eval);
+    return 0;
+}
+
+/* prior_scale: the prior's scale from the data, the MAP fit again under it
+ * (after the jump check: once, on the final model). */
+static int stage_prior_scale(void *run, rch_calib_result *r, rch_diag *d)
+{
+    rch_calib_fit_state *f = run;
     if (!r->prior_on)
         return 0;
-    const double t0 = now_ms(), j0 = r->jumps_ms;
-    const rc_status st = scale_prior(r, w, cfg, fixed, train);
-    r->fits_ms += now_ms() - t0 - (r->jumps_ms - j0);
+    const rc_status st = scale_prior(f, r, f->w, &f->cfg, f->fixed, f->train);
     if (st != RC_OK) {
         rch_diag_set(d, "", 0, 0, "solver failed under the prior's estimated scale: %s", rc_strerror(st));
         return -1;
@@ -691,122 +812,82 @@ static int scale_prior_timed(rch_calib_result *r, rc_solve_work *w, rc_solve_con
     return 0;
 }
 
-/* Identification and the figures, once the split is made. */
-int rch_calib_fit_and_report(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
-                          rch_diag *d)
+/* jumps: with the jumps as nuisance, their final fit at the change points,
+ * the held-out rows placed in their segments. */
+static int stage_jumps(void *run, rch_calib_result *r, rch_diag *d)
 {
-    if (!r->keep_jump_at) {
-        r->have_jump_at = 0; /* a new training set: its change points are searched */
-        r->have_check_model = 0;
-    }
-    const double ts = now_ms();
-    if (rch_calib_start(&r->before, w, &r->robot, train, r->n_train, d) != 0)
-        return -1;
-    r->start_ms += now_ms() - ts;
-    r->model = r->before;
-    uint8_t fixed[RC_MAX_PARAMS];
-    memset(fixed, 0, sizeof fixed);
-    if (r->cfg.fix && rch_calib_fix(fixed, &r->model, r->cfg.fix, d) != 0)
-        return -2;
-    rch_pos_fix_unseen(fixed, &r->model, train, r->n_train); /* what only an absent sensor sees */
-    rc_solve_config cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.method = r->cfg.method;
-    cfg.fixed = fixed;
-    cfg.max_iter = r->cfg.max_iter;
-    cfg.seed = r->cfg.seed;
-    r->prior_on = !r->cfg.no_prior && (cfg.method == RC_METHOD_LM || cfg.method == RC_METHOD_LTLM);
-    if (r->prior_on) {
-        memset(r->prior_mean, 0, sizeof r->prior_mean);
-        memset(r->prior_sd, 0, sizeof r->prior_sd);
-        rch_prior_fill(r->prior_mean, r->prior_sd, &r->before, &r->robot.nominal, &r->robot.prior);
-        rch_prior_gauge(fixed);
-        cfg.prior_mean = r->prior_mean;
-        cfg.prior_sd = r->prior_sd;
-    }
-    memcpy(r->fixed, fixed, sizeof r->fixed);
-    const double t0 = now_ms(), jumps0 = r->jumps_ms;
-    rc_status st = RC_OK;
-    /* jumps: a cable's display; several outlets' rows interleave in acquisition order, where a step of the
-     * sequence is no display's event (their jumps only with --jumps, as rcal diagnose) */
-    const int check = r->prior_on && !r->cfg.jumps && !r->cfg.no_jump_check && r->n_train >= 40 &&
-                      !r->n_pos_rows && r->n_outlets <= 1;
-    if (check) {
-        /* The check looks at the first noise pass's fit (the weakest prior
-         * of the loop): when it finds jumps the rest of the loop, fitted
-         * across them, would be thrown away; when it does not, the loop
-         * goes on from that pass (map_warm: the same passes as one loop). */
-        double chi2_e = 0.0;
-        r->map_one_pass = 1;
-        st = map_fit(r, w, &cfg, fixed, train, &chi2_e);
-        r->map_one_pass = 0;
-        if (st == RC_OK) {
-            const unsigned passes = r->noise_passes;
-            jump_check(r, w, fixed, &cfg, train);
-            if (r->jumps_found && !r->cfg.residuals_path) {
-                /* fit them as nuisance, as --jumps does: the default run never
-                 * hands on a geometry fitted across jumps */
-                r->time_ms = now_ms() - t0;
-                r->fits_ms += r->time_ms - (r->jumps_ms - jumps0);
-                r->cfg.jumps = 1;
-                r->jumps_auto = 1;
-                r->have_jump_at = 1; /* at the change points the check found */
-                r->keep_jump_at = 1;
-                const int rc = rch_calib_fit_and_report(r, w, train, test, d);
-                r->keep_jump_at = 0;
-                return rc;
-            }
-            r->map_warm = 1;
-            r->map_passes0 = passes;
-        }
-    }
-    if (r->prior_on) {
-        double chi2_1 = 0.0;
-        if (st == RC_OK)
-            st = map_fit(r, w, &cfg, fixed, train, &chi2_1);
-        r->map_warm = 0;
-        r->noise_passes += r->map_passes0;
-        r->map_passes0 = 0;
-        if (st == RC_OK && r->attach_auto)
-            st = choose_attachment(r, w, &cfg, fixed, train, chi2_1);
-    } else {
-        st = solve_counted(r, &r->model, &r->solve, w, &cfg, train, r->n_train);
-    }
-    r->time_ms = now_ms() - t0;
-    r->fits_ms += r->time_ms - (r->jumps_ms - jumps0);
-    if (st != RC_OK) {
-        rch_diag_set(d, "", 0, 0, "solver failed: %s", rc_strerror(st));
-        return -1;
-    }
-    r->finite = 1;
-    for (unsigned k = 0; k < r->model.n_params; ++k)
-        r->finite &= isfinite(r->model.x[k]) != 0;
-    const rc_sample *eval_set = r->n_test ? test : train;
-    const size_t n_eval = r->n_test ? r->n_test : r->n_train;
-    rc_eval(&r->before_m, &r->before, eval_set, n_eval);
-    if (r->cfg.jumps) {
-        if (scale_prior_timed(r, w, &cfg, fixed, train, d) != 0)
-            return -1;
-        const double tj = now_ms(), u0 = r->uncert_ms, j0 = r->jumps_ms;
-        const int rc = fit_jumps(r, w, fixed, &cfg, train, eval_set, n_eval, d);
-        r->fits_ms += now_ms() - tj - (r->uncert_ms - u0) - (r->jumps_ms - j0); /* the refit at the points */
-        return rc;
-    }
-    if (scale_prior_timed(r, w, &cfg, fixed, train, d) != 0) /* after the jump check: once, on the final model */
-        return -1;
-    r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, eval_set, n_eval) == RC_OK;
+    rch_calib_fit_state *f = run;
+    if (!f->jumps)
+        return 0;
+    return fit_jumps(f, r, f->w, f->fixed, &f->cfg, f->train, f->eval_set, f->n_eval, d);
+}
+
+/* metrics: the before/after figures of the geometry fit (the jumps' are
+ * fit_jumps'). */
+static int stage_metrics(void *run, rch_calib_result *r, rch_diag *d)
+{
+    rch_calib_fit_state *f = run;
+    (void)d;
+    if (f->jumps)
+        return 0;
+    r->after_ok = r->finite && rc_eval(&r->after_m, &r->model, f->eval_set, f->n_eval) == RC_OK;
     int train_ok = r->after_ok;
-    if (eval_set == train) { /* nothing held out: the training figures are those */
+    if (f->eval_set == f->train) { /* nothing held out: the training figures are those */
         r->train_before = r->before_m;
         r->train_after = r->after_m;
     } else {
-        rc_eval(&r->train_before, &r->before, train, r->n_train);
-        train_ok = train_ok && rc_eval(&r->train_after, &r->model, train, r->n_train) == RC_OK;
+        rc_eval(&r->train_before, &r->before, f->train, r->n_train);
+        train_ok = train_ok && rc_eval(&r->train_after, &r->model, f->train, r->n_train) == RC_OK;
     }
     if (!train_ok)
         memset(&r->train_after, 0, sizeof r->train_after);
-    const double tu = now_ms();
-    const int rc = rch_calib_finish(r, fixed, train, &r->model, NULL, d);
-    r->uncert_ms += now_ms() - tu;
+    f->fin_train = f->train;
+    memcpy(f->fin_fixed, f->fixed, sizeof f->fin_fixed);
+    f->fin_fit = &r->model;
+    return 0;
+}
+
+/* uncertainty: truth, identifiability, uncertainty, validation. */
+static int stage_uncertainty(void *run, rch_calib_result *r, rch_diag *d)
+{
+    rch_calib_fit_state *f = run;
+    return rch_calib_finish(r, f->fin_fixed, f->fin_train, f->fin_fit, f->fin_setup, f->validate, d);
+}
+
+/* The fit's plan, in order. To add a stage: a function of (state, result)
+ * here, its id in rch_calib_stage_id and its name in rch_calib_plan.c. */
+static const rch_calib_stage fit_plan[] = {
+    {RCH_STAGE_START, stage_start},
+    {RCH_STAGE_MAP, stage_map_first},
+    {RCH_STAGE_JUMP_CHECK, stage_jump_check},
+    {RCH_STAGE_MAP, stage_map},
+    {RCH_STAGE_ATTACHMENT, stage_attachment},
+    {RCH_STAGE_PRIOR_SCALE, stage_prior_scale},
+    {RCH_STAGE_JUMPS, stage_jumps},
+    {RCH_STAGE_METRICS, stage_metrics},
+    {RCH_STAGE_UNCERTAINTY, stage_uncertainty},
+};
+
+int rch_calib_fit_run(rch_calib_result *r, rc_solve_work *w, const rc_sample *train, const rc_sample *test,
+                      const struct rch_data *validate, rch_calib_timing *t, rch_diag *d)
+{
+    rch_calib_fit_state *f = calloc(1, sizeof *f);
+    if (!f) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    f->w = w;
+    f->train = train;
+    f->test = test;
+    f->validate = validate;
+    f->jumps = r->cfg.jumps || r->jumps_auto; /* (a case copied from one whose check found jumps: as it) */
+    const rch_calib_timing t0 = *t;
+    const int rc = rch_calib_plan_run(fit_plan, sizeof fit_plan / sizeof fit_plan[0], f, r, t, d);
+    r->time_ms = 0.0; /* the identification alone: the MAP fits to the prior's scale and the jumps' refit */
+    for (unsigned id = RCH_STAGE_MAP; id <= RCH_STAGE_JUMPS; ++id)
+        r->time_ms += t->wall_ms[id] - t0.wall_ms[id];
+    free(f->fin_sorted);
+    free(f->fin_setup);
+    free(f);
     return rc;
 }

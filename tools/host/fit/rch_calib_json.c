@@ -327,6 +327,26 @@ static void json_extras(rch_jw *w, const rch_calib_result *r)
     }
 }
 
+void rch_calib_timing_json(rch_jw *w, const rch_calib_timing *t)
+{
+    rch_jw_obj(w, "timing");
+    rch_jw_numf(w, "wall_ms", t->total_wall_ms, "%.3f");
+    rch_jw_numf(w, "cpu_ms", t->total_cpu_ms, "%.3f");
+    rch_jw_arr(w, "stages");
+    for (unsigned k = 0; k < RCH_STAGE_N; ++k) {
+        if (!t->runs[k])
+            continue;
+        rch_jw_obj(w, NULL);
+        rch_jw_str(w, "stage", rch_calib_stage_name(k));
+        rch_jw_uint(w, "runs", t->runs[k]);
+        rch_jw_numf(w, "wall_ms", t->wall_ms[k], "%.3f");
+        rch_jw_numf(w, "cpu_ms", t->cpu_ms[k], "%.3f");
+        rch_jw_end(w);
+    }
+    rch_jw_end(w);
+    rch_jw_end(w);
+}
+
 int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
 {
     rch_jw w;
@@ -346,6 +366,8 @@ int rch_calib_json(FILE *f, const rch_calib_result *r, int argc, char **argv)
     rch_jw_uint(&w, "iterations", r->solve.iterations);
     rch_jw_uint(&w, "cost_evals", r->solve.cost_evals);
     rch_jw_numf(&w, "time_ms", r->time_ms, "%.3f");
+    if (r->cfg.timing)
+        rch_calib_timing_json(&w, &r->timing);
     json_params(&w, r);
     json_estimation(&w, r);
     if (r->n_pos_rows)

@@ -55,7 +55,7 @@ static int write_model_fn(FILE *f, const void *ctx)
 
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
 {
-    if (r->jumps_found && !r->cfg.jumps) {
+    if (r->jumps_found && !r->cfg.jumps && !r->jumps_auto) {
         char counts[200];
         rch_calib_jump_counts(counts, sizeof counts, r);
         rch_diag_set(d, path, 0, 0,

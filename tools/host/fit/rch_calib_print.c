@@ -605,7 +605,7 @@ static void print_summary(FILE *f, const rch_calib_result *r)
               "finite)\n",
               f);
     const unsigned outside = r->have_unc ? outside_prior(r) : 0;
-    if (r->jumps_found && !r->cfg.jumps)
+    if (r->jumps_found && !r->cfg.jumps && !r->jumps_auto)
         fprintf(f, "  next: rcal calibrate --data %s --robot %s --jumps (the lengths jump and this fit does not model "
                    "them)\n",
                 hp.data, hp.robot);
@@ -669,7 +669,7 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
     snprintf(all, sizeof all, steps == 1 ? "it is" : r->jumps_found == steps ? "they are" : "all %u are", steps);
     hint_paths hp;
     hint_paths_of(&hp, r);
-    if (r->jumps_found && !r->cfg.jumps)
+    if (r->jumps_found && !r->cfg.jumps && !r->jumps_auto)
         fprintf(f, "WARNING: the lengths jump in acquisition order: %s, and this fit does not model them: its "
                    "geometry is wrong and --out is refused.\n  next: rcal calibrate --data %s --robot %s --jumps (it "
                    "fits the %u step%s found; rcal diagnose tells)\n\n",
@@ -729,4 +729,14 @@ void rch_calib_print(FILE *f, const rch_calib_result *r)
         fprintf(f, "solver: %s, %u iterations, %u passes over the data, exit: %s, %.2f ms\n", method,
                 r->solve.iterations, r->solve.cost_evals, rc_exit_str(r->solve.exit), r->time_ms);
     print_summary(f, r);
+}
+
+void rch_calib_timing_print(FILE *f, const rch_calib_timing *t, const char *prefix)
+{
+    fprintf(f, "%stiming (each stage's own time; ms):      wall       cpu  runs\n", prefix);
+    for (unsigned k = 0; k < RCH_STAGE_N; ++k)
+        if (t->runs[k])
+            fprintf(f, "%s  %-34s %9.2f %9.2f %5u\n", prefix, rch_calib_stage_name(k), t->wall_ms[k], t->cpu_ms[k],
+                    t->runs[k]);
+    fprintf(f, "%s  %-34s %9.2f %9.2f\n", prefix, "total", t->total_wall_ms, t->total_cpu_ms);
 }

@@ -10,6 +10,7 @@
 #include <time.h>
 
 #include "rc_version.h"
+#include "rch_file.h"
 #include "rch_groups.h"
 #include "rch_positions.h"
 #include "rch_sha256.h"
@@ -19,12 +20,44 @@
 #endif
 #define DEG (M_PI / 180.0)
 
+/* One cable file read once: parsed (joints within limits, the lengths'
+ * scale checked as rch_data_load_limited does) and its digest (sha, 65)
+ * taken from the same bytes. 0, or -1 with d set. */
+static int load_one(rch_data *out, const char *path, const char *text, size_t text_len, const rc_model *limits,
+                    char *sha, rch_diag *d)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    memset(out, 0, sizeof *out);
+    if (text) { /* rows in memory (rch_calib_cfg.data_text): parsed as a file's, named path */
+        if (!(buf = malloc(text_len + 1))) {
+            rch_diag_set(d, path, 0, 0, "out of memory");
+            return -1;
+        }
+        memcpy(buf, text, text_len);
+        buf[len = text_len] = '\0';
+    } else if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
+        return -1;
+    rch_sha256 c;
+    rch_sha256_init(&c);
+    rch_sha256_update(&c, buf, len);
+    rch_sha256_final(&c, sha);
+    int rc = rch_data_parse_limited(out, buf, len, path, 0, limits, d);
+    free(buf);
+    if (rc == 0 && limits && rch_data_check_scale(out, path, limits, d) != 0) {
+        rch_data_free(out);
+        rc = -1;
+    }
+    return rc;
+}
+
 /* Load every data file and merge them in the order given: samples, x, y, z
  * (kept only when every file has them), source lines; t becomes the
  * acquisition order over all files; the group column is kept only when
  * every file has one (numbers offset per file). counts (files): samples
  * of each. */
-static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, const rc_model *limits, rch_diag *d)
+static int load_all(rch_data *out, size_t *counts, char (*sha)[65], const rch_calib_cfg *cfg, const rc_model *limits,
+                    rch_diag *d)
 {
     const size_t nf = rch_calib_cfg_n_files(cfg);
     memset(out, 0, sizeof *out);
@@ -35,7 +68,7 @@ static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, con
     if (nf == 0)
         return 0; /* tracker positions only (append_positions) */
     if (nf == 1) {
-        int rc = rch_data_load_limited(out, rch_calib_cfg_file(cfg, 0), 0, limits, d);
+        int rc = load_one(out, rch_calib_cfg_file(cfg, 0), cfg->data_text, cfg->data_text_len, limits, sha[0], d);
         counts[0] = out->n;
         if (rc == 0 && rch_data_check_units(out, rch_calib_cfg_file(cfg, 0), d) != 0) {
             rch_data_free(out);
@@ -47,7 +80,7 @@ static int load_all(rch_data *out, size_t *counts, const rch_calib_cfg *cfg, con
     size_t total = 0, k = 0;
     int all_xyz = 1, all_group = 1;
     for (size_t f = 0; f < nf; ++f) {
-        if (rch_data_load_limited(&part[f], rch_calib_cfg_file(cfg, f), 0, limits, d) != 0 ||
+        if (load_one(&part[f], rch_calib_cfg_file(cfg, f), NULL, 0, limits, sha[f], d) != 0 ||
             rch_data_check_units(&part[f], rch_calib_cfg_file(cfg, f), d) != 0) {
             if (part[f].s)
                 rch_data_free(&part[f]);
@@ -129,9 +162,7 @@ static void provenance(rch_inputs *in, const rch_calib_cfg *cfg)
     p->n_files = (unsigned)rch_calib_cfg_n_files(cfg);
     for (unsigned f = 0; f < p->n_files; ++f) {
         p->file[f] = rch_calib_cfg_file(cfg, f);
-        p->samples[f] = counts[f];
-        if (rch_sha256_file(p->sha256[f], p->file[f]) != 0)
-            snprintf(p->sha256[f], sizeof p->sha256[f], "unreadable");
+        p->samples[f] = counts[f]; /* (its digest: load_one, from the bytes read) */
     }
     time_t now = time(NULL);
     struct tm tmv;
@@ -196,8 +227,10 @@ static int append_positions(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *
             c += p.file[i] == f;
         pv->file[pv->n_files] = cfg->positions_paths[f];
         pv->samples[pv->n_files] = c;
-        if (rch_sha256_file(pv->sha256[pv->n_files], cfg->positions_paths[f]) != 0)
-            snprintf(pv->sha256[pv->n_files], sizeof pv->sha256[0], "unreadable");
+        if (f < RCH_POS_MAX_FILES) /* the digest of the bytes rch_pos_load read */
+            memcpy(pv->sha256[pv->n_files], p.sha256[f], sizeof pv->sha256[0]);
+        else
+            snprintf(pv->sha256[pv->n_files], sizeof pv->sha256[0], "unknown");
         pv->n_files++;
     }
     rch_pos_free(&p);
@@ -371,8 +404,14 @@ int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
     out->n_files = rch_calib_cfg_n_files(cfg);
     if (rch_robot_load(&out->robot, cfg->robot_path, d) != 0)
         return -1;
-    if (load_all(&out->data, out->counts, cfg, &out->robot.model, d) != 0) { /* joints within the robot's limits */
-        memset(&out->data, 0, sizeof out->data); /* the readers keep nothing when they fail */
+    if (load_all(&out->data, out->counts, out->prov.sha256, cfg, &out->robot.model, d) != 0) {
+        memset(&out->data, 0, sizeof out->data); /* (joints within the robot's limits) the readers keep nothing */
+        return -1;
+    }
+    /* the validation file, read here once (within the robot's limits); only a fitted model reads its rows */
+    if (cfg->validate_path && rch_data_load_limited(&out->validate, cfg->validate_path, 0, &out->robot.model, d) != 0) {
+        memset(&out->validate, 0, sizeof out->validate);
+        rch_data_free(&out->data);
         return -1;
     }
     groups(out, cfg);
@@ -400,6 +439,7 @@ fail:
 void rch_inputs_free(rch_inputs *in)
 {
     rch_data_free(&in->data);
+    rch_data_free(&in->validate);
     free(in->file_of);
     in->file_of = NULL;
 }

@@ -27,9 +27,13 @@
  *      by default when the file shows rounding (the joints on a display step
  *      of 0.01 deg or coarser, x, y, z the nominal FK of finer angles, at most
  *      5 % of rows refused; the decision and its reason in dequant.why).
+ *   8. the validation file (cfg->validate_path), within the robot's limits,
+ *      kept as read in validate: only a fitted model reads its rows.
+ * Each file is opened once (its digest taken from the bytes parsed); no
+ * later stage and no command opens an input again.
  * Not here: the pipeline's own checks (--residuals with --cases, the cost
  * estimate), the effects a fit adds to the model (attachment, axis tilts,
- * --effects) and the validation file, which only a fitted model reads.
+ * --effects).
  *
  * Depends on: rch_calib_cfg, rch_data, rch_robot, rch_positions,
  * rch_dequant, rch_groups, rch_sha256. Memory: data and file_of on the heap
@@ -71,6 +75,7 @@ typedef struct rch_inputs {
     int have_dequant;       /* the joints were dequantized (forced or automatic) */
     rch_dequant_result dequant;
     unsigned dequant_refused_lines[16]; /* first refused rows (file lines) */
+    rch_data validate;      /* cfg->validate_path's rows as read (labels as in the file), else empty */
 } rch_inputs;
 
 /* Read every input cfg names (robot_path, data_path / data_paths,

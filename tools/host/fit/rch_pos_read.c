@@ -36,6 +36,8 @@
 #include "rc_sensor.h"
 #include "rch_data.h"
 #include "rch_dequant.h"
+#include "rch_file.h"
+#include "rch_sha256.h"
 
 #define RAD2DEG (180.0 / 3.14159265358979323846)
 
@@ -661,6 +663,26 @@ static void finish(rch_pos *out, double next, double pose0, double *sig, size_t 
     free(sig);
 }
 
+/* One positions file read once: parsed (joints within limits) and its
+ * digest (out->sha256[f]) taken from the same bytes. 0, or -1 with d set. */
+static int read_hashed(rch_data *dt, rch_pos *out, const char *path, size_t f, const rc_model *limits, rch_diag *d)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    memset(dt, 0, sizeof *dt);
+    if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
+        return -1;
+    if (f < RCH_POS_MAX_FILES) {
+        rch_sha256 c;
+        rch_sha256_init(&c);
+        rch_sha256_update(&c, buf, len);
+        rch_sha256_final(&c, out->sha256[f]);
+    }
+    const int rc = rch_data_parse_limited(dt, buf, len, path, RCH_DATA_POSITIONS | RCH_DATA_NO_LEN, limits, d);
+    free(buf);
+    return rc;
+}
+
 int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0, const rc_model *limits,
                  rch_diag *d)
 {
@@ -669,7 +691,7 @@ int rch_pos_load(rch_pos *out, const char *const *paths, size_t k, double pose0,
     size_t nsig = 0;
     for (size_t f = 0; f < k; ++f) {
         rch_data dt;
-        if (rch_data_load_limited(&dt, paths[f], RCH_DATA_POSITIONS | RCH_DATA_NO_LEN, limits, d) != 0 ||
+        if (read_hashed(&dt, out, paths[f], f, limits, d) != 0 ||
             add_one(out, &dt, paths[f], (unsigned)f, &next, limits, &sig, &nsig, d) != 0) {
             rch_pos_free(out);
             free(sig);

@@ -28,6 +28,7 @@
 #include "rch_diag.h"
 #include "rch_jw.h"
 
+#define RCH_POS_MAX_FILES 16
 typedef struct rch_pos {
     rc_sample *s;       /* (n) three per position row: x, y, z (RC_SENSOR_TRACKER_*); t the pose's number */
     size_t n;
@@ -40,6 +41,8 @@ typedef struct rch_pos {
     double sigma_mm;    /* the median of the sigma_mm column (has_sigma): each row's weight is sigma_mm / its
                            own (rc_sample.weight), so the fit's noise is that of a row at the median */
     size_t dropped;     /* rows identical in every field to an earlier one: warned, dropped */
+    char sha256[RCH_POS_MAX_FILES][65]; /* rch_pos_load: each file's digest, of the bytes read (the first
+                                           RCH_POS_MAX_FILES files; a calibration reads each file once) */
 } rch_pos;
 
 /* Plausibility checks of rch_pos_load (tools/host/fit/rch_pos_read.c). */

@@ -37,6 +37,8 @@ typedef struct {
     const char *plots, *residuals;
     const char *const *positions; /* (n_positions) tracker positions files, or NULL */
     size_t n_positions;
+    const char *data_text; /* the one data "file"'s rows in memory (the arrays), or NULL */
+    size_t data_text_len;
     const double *cable_points_mm; /* (n_cable_points x 3) a tool plate's nominal points, flange frame, or NULL */
     size_t n_cable_points;
     double cable_point_sd_mm; /* their tolerance (0: the default) */
@@ -75,24 +77,8 @@ static int precheck(const rch_calib_cfg *cfg, char *err, size_t err_len)
     if (cfg->residuals_path && (cfg->cases > 1 || cfg->jumps))
         return fail(RCH_FFI_ERR_ARG, err, err_len, "%s",
                     "residuals is for one calibration without jumps (not with cases or jumps)");
-    rch_robot *robot = malloc(sizeof *robot);
-    if (!robot)
-        return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
-    rch_diag d;
-    int rc = RCH_FFI_OK;
-    if (rch_robot_load(robot, cfg->robot_path, &d) == 0) /* else rch_calib_run reports it */
-        for (size_t i = 0; i <= cfg->n_data_paths && rc == RCH_FFI_OK; ++i) {
-            const char *path = i < cfg->n_data_paths ? cfg->data_paths[i] : cfg->validate_path;
-            rch_data data;
-            if (!path)
-                continue;
-            if (rch_data_load_limited(&data, path, 0, &robot->model, &d) != 0)
-                rc = fail_diag(RCH_FFI_ERR_INPUT, err, err_len, &d);
-            else
-                rch_data_free(&data);
-        }
-    free(robot);
-    return rc;
+    return RCH_FFI_OK; /* the joints within the robot's limits, the data's and the validation's: rch_inputs_load,
+                          which reads each file once */
 }
 
 static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t n_data, const cal_opts *o,
@@ -137,6 +123,8 @@ static int calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t 
     cfg.data_path = n_data ? c->data_v[0] : NULL;
     cfg.data_paths = n_data ? c->data_v : NULL;
     cfg.n_data_paths = n_data;
+    cfg.data_text = o->data_text;
+    cfg.data_text_len = o->data_text_len;
     cfg.positions_paths = o->n_positions ? c->pos_v : NULL;
     cfg.n_positions_paths = o->n_positions;
     cfg.no_screen = (o->flags & RCH_FFI_CAL_NO_SCREEN) != 0;
@@ -214,7 +202,7 @@ int rch_ffi_calibrate(rch_ffi_calib **out, const char *const *data_paths, size_t
                       const char *residuals_path, char *err, size_t err_len)
 {
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0, NULL, 0, 0.0};
+                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0, NULL, 0, NULL, 0, 0.0};
     return calibrate(out, data_paths, n_data, &o, err, err_len);
 }
 
@@ -227,12 +215,15 @@ int rch_ffi_calibrate_inputs(rch_ffi_calib **out, const char *const *data_paths,
                              const char *residuals_path, char *err, size_t err_len)
 {
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path, positions_paths, n_positions, cable_points_mm, n_cable_points,
-                        cable_point_sd_mm};
+                        truth_path, cases, case_samples, plots_dir, residuals_path, positions_paths, n_positions, NULL, 0, cable_points_mm,
+                        n_cable_points, cable_point_sd_mm};
     return calibrate(out, data_paths, n_data, &o, err, err_len);
 }
 
-/* A message about the temporary CSV of the arrays names the arrays: "TMP:L:C: m"
+/* The name the arrays' rows go by inside (rch_calib_cfg.data_text). */
+#define RCH_FFI_ARRAYS_NAME "rcal-ffi-arrays"
+
+/* A message about the arrays' rows (named RCH_FFI_ARRAYS_NAME) names the arrays: "TMP:L:C: m"
  * becomes "arrays, sample L-2 (0-based): m" (the header is line 1), any other
  * mention of TMP "<arrays>". */
 static void name_arrays(char *err, size_t err_len, const char *tmp)
@@ -279,19 +270,13 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
                          "0..255, target (cable point) labels in 0..%d", i, RC_MAX_TARGETS - 1);
             return RCH_FFI_ERR_ARG;
         }
-    const char *dir = getenv("TMPDIR");
-    char tmp[PATH_LEN];
-    snprintf(tmp, sizeof tmp, "%s/rcal-ffi-XXXXXX", dir && dir[0] ? dir : "/tmp");
-    const int fd = mkstemp(tmp);
-    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-    if (!f) {
-        if (fd >= 0) {
-            close(fd);
-            unlink(tmp);
-        }
-        return fail(RCH_FFI_ERR_IO, err, err_len, "cannot create a temporary file %s", tmp);
-    }
-    rch_tmp_register(tmp);
+    /* the rows in memory, as a file's (the one CSV parser checks them): no temporary file */
+    const char *tmp = RCH_FFI_ARRAYS_NAME;
+    char *text = NULL;
+    size_t text_len = 0;
+    FILE *f = open_memstream(&text, &text_len);
+    if (!f)
+        return fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory");
     int bad = fprintf(f, "q1,q2,q3,q4,q5,q6,L%s%s%s%s\n", xyz_mm ? ",x,y,z" : "", group ? ",group" : "",
                       outlet ? ",outlet" : "", target ? ",target" : "") < 0;
     for (size_t i = 0; i < n && !bad; ++i) {
@@ -311,12 +296,11 @@ int rch_ffi_calibrate_arrays(rch_ffi_calib **out, const double *q_deg, const dou
     bad |= fclose(f) != 0;
     const char *paths[1] = {tmp};
     const cal_opts o = {robot_path, method, test_fraction, seed, max_iter, fix, effects, flags, validate_path,
-                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0, cable_points_mm, n_cable_points,
-                        cable_point_sd_mm};
-    int rc = bad ? fail(RCH_FFI_ERR_IO, err, err_len, "writing the temporary file %s failed", tmp)
+                        truth_path, cases, case_samples, plots_dir, residuals_path, NULL, 0, text, text_len,
+                        cable_points_mm, n_cable_points, cable_point_sd_mm};
+    int rc = bad ? fail(RCH_FFI_ERR_NOMEM, err, err_len, "%s", "out of memory (the arrays' rows)")
                  : calibrate(out, paths, 1, &o, err, err_len);
-    unlink(tmp);
-    rch_tmp_forget(tmp);
+    free(text);
     if (rc != RCH_FFI_OK)
         name_arrays(err, err_len, tmp);
     if (rc == RCH_FFI_OK) {

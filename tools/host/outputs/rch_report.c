@@ -20,9 +20,11 @@
 
 const char *rch_report_escape(char *buf, size_t len, const char *s) { return rch_xml_escape(buf, len, s, 0); }
 
-static rch_json *load_kind(const char *path, const char *opt, const char *need, const char *kind, rch_diag *d)
+/* path's document (text, len: its text in memory, path only its name; NULL: read from path). */
+static rch_json *load_kind(const char *path, const char *text, size_t len, const char *opt, const char *need,
+                           const char *kind, rch_diag *d)
 {
-    rch_json *j = rch_json_load(path, d);
+    rch_json *j = text ? rch_json_parse(text, len, path, d) : rch_json_load(path, d);
     if (j && (j->type != RCH_JOBJ || !rch_json_get(j, need))) {
         rch_diag_set(d, path, 0, 0, "%s: not %s (it has no member \"%s\")", opt, kind, need);
         rch_json_free(j);
@@ -55,14 +57,14 @@ static void job_free(job *j)
 
 static int job_load(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
 {
-    j->cal = load_kind(cfg->cal_path, "--calibration", "before", "the output of rcal calibrate --json", d);
+    j->cal = load_kind(cfg->cal_path, cfg->cal_text, cfg->cal_len, "--calibration", "before", "the output of rcal calibrate --json", d);
     if (!j->cal)
         return -1;
-    if (cfg->diag_path && !(j->diag = load_kind(cfg->diag_path, "--diagnosis", "candidates",
+    if (cfg->diag_path && !(j->diag = load_kind(cfg->diag_path, cfg->diag_text, cfg->diag_len, "--diagnosis", "candidates",
                                                 "the output of rcal diagnose --json", d)))
         return -1;
     if (cfg->model_path &&
-        !(j->model = load_kind(cfg->model_path, "--model", "dh", "a model file (rcal-model/1 or /2)", d)))
+        !(j->model = load_kind(cfg->model_path, NULL, 0, "--model", "dh", "a model file (rcal-model/1 or /2)", d)))
         return -1;
     r->cal = j->cal;
     r->diag = j->diag;

@@ -53,6 +53,10 @@ typedef struct {
     const char *date_utc;     /* "2026-11-29T17:00:00Z" shown as the report's date; NULL: now */
     double tolerance_mm;      /* > 0: the verdict is pass or fail against it (the largest 95 % position
                                  radius after compensation over the data's poses); 0: no verdict */
+    /* A run's own report (rch_report_inline): its JSON in memory, as written beside the page; given, it is
+     * read from here and cal_path / diag_path only name it (never opened again). */
+    const char *cal_text, *diag_text;
+    size_t cal_len, diag_len;
 } rch_report_cfg;
 
 typedef struct {
@@ -81,6 +85,28 @@ int rch_report_csv_path(char *buf, size_t cap, const char *page, const char *nam
 /* s HTML-escaped into buf (always NUL-terminated; truncated only between
  * whole characters or entities). Returns buf. */
 const char *rch_report_escape(char *buf, size_t len, const char *s);
+
+/* --report FILE.html of calibrate and diagnose (rch_report_inline.c): the
+ * page of `rcal report` from this run. cal (required) and diag (may be
+ * NULL) are the run's results; their JSON, as --json of this command line
+ * (argc, argv) prints it, is made in memory, kept beside the page as
+ * FILE.calibration.json and FILE.diagnosis.json (never over an input) and
+ * handed to rch_report_write as text (not read back). model: the model file
+ * written by the run, or NULL. inputs (n_inputs): the run's input files,
+ * which no output of the report may replace. quiet: no message on stderr.
+ * 0, or 1 with the message on stderr. */
+struct rch_calib_result;
+struct rch_diagnose_result;
+int rch_report_inline(const char *html, const struct rch_calib_result *cal, const struct rch_diagnose_result *diag,
+                      int argc, char **argv, const char *model, const char *const *inputs, size_t n_inputs,
+                      int quiet);
+
+/* Every file --report HTML writes besides the page (its JSON, the plot
+ * data), for the check that a command's outputs never name each other
+ * before the work: names[k] (k < RCH_REPORT_BUNDLE). Returns the count. */
+#define RCH_REPORT_BUNDLE 6
+#define RCH_REPORT_NAME 1100
+size_t rch_report_bundle(char names[RCH_REPORT_BUNDLE][RCH_REPORT_NAME], const char *html);
 
 
 #endif

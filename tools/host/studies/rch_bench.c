@@ -109,7 +109,11 @@ static int bench_calibrate(double *med, double *lo, double *hi, rch_bench_result
             free(ts);
             return -1;
         }
-        const double sp[RCH_BENCH_N_SPLIT] = {cr->read_ms, cr->start_ms, cr->fits_ms, cr->jumps_ms, cr->uncert_ms, tw};
+        const double *sw = cr->timing.wall_ms; /* the plan's stages (rch_calib_timing) in the bench's split */
+        const double fits = sw[RCH_STAGE_MAP] + sw[RCH_STAGE_ATTACHMENT] + sw[RCH_STAGE_PRIOR_SCALE] +
+                            sw[RCH_STAGE_JUMPS] + sw[RCH_STAGE_SYSTEMATIC] + sw[RCH_STAGE_SCREEN];
+        const double sp[RCH_BENCH_N_SPLIT] = {sw[RCH_STAGE_READ], sw[RCH_STAGE_START], fits,
+                                              sw[RCH_STAGE_JUMP_CHECK], sw[RCH_STAGE_UNCERTAINTY], tw};
         for (unsigned j = 0; j < RCH_BENCH_N_SPLIT; ++j)
             ts[j * cfg->runs + k] = sp[j];
         if (split) {
