@@ -117,7 +117,8 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
                         char **argv)
 {
     const char *const files[] = {"model", job->model_path, "nominal", job->nominal_path, "in", job->in_path,
-                                 "out", job->out_path, "input_format", r->format == RCH_COMP_RAPID ? "rapid" : "csv",
+                                 "out", job->out_path, "input_format",
+                                 r->format == RCH_COMP_RAPID ? "rapid" : r->format == RCH_COMP_KRL ? "krl" : "csv",
                                  NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
@@ -246,7 +247,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
          "deprecated, no effect: RAPID robtargets are corrected (through the nominal inverse kinematics)", 0, NULL},
-        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid"},
+        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid|krl"},
         {"--assume-degrees", RCH_OPT_FLAG, &assume_deg, 0, 0, NULL,
          "the joint targets are degrees even where they all look like radians (every joint within +-pi and two "
          "joints moving by 0.2 or more: refused without this option)",
@@ -271,7 +272,9 @@ int rcal_cmd_compensate(int argc, char **argv)
         .nominal_path = nominal,
         .in_path = in,
         .out_path = out,
-        .format = strcmp(format, "csv") == 0 ? RCH_COMP_CSV : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID : RCH_COMP_AUTO,
+        .format = strcmp(format, "csv") == 0 ? RCH_COMP_CSV : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID
+                  : strcmp(format, "krl") == 0                                  ? RCH_COMP_KRL
+                                                                                : RCH_COMP_AUTO,
         .position_only = position_only,
         .full_pose = full_pose,
         .max_unc_mm = max_unc_mm,

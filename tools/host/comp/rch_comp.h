@@ -53,7 +53,9 @@
 typedef enum rch_comp_format {
     RCH_COMP_AUTO = 0, /* detect from the first line */
     RCH_COMP_CSV = 1,
-    RCH_COMP_RAPID = 2
+    RCH_COMP_RAPID = 2,
+    RCH_COMP_KRL = 3 /* KUKA KRL .src/.dat (rch_krl.h): a first line &ACCESS, &REL, &PARAM, &COMMENT, DEF,
+                        DEFDAT, GLOBAL DEF or DECL */
 } rch_comp_format;
 
 /* What a target whose u95 at the compensated point (the flange or the

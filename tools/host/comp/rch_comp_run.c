@@ -109,6 +109,12 @@ static int out_failed(const rch_cpi_ctx *c, unsigned lineno, rch_diag *d)
 static int decide_form(rch_cpi_ctx *c, const char *line, size_t bom, size_t tn, unsigned lineno, rch_diag *d)
 {
     const char *text = line + bom;
+    if (starts_with_ci(text, tn, "&ACCESS") || starts_with_ci(text, tn, "&REL") || starts_with_ci(text, tn, "&PARAM") ||
+        starts_with_ci(text, tn, "&COMMENT") || starts_with_ci(text, tn, "DEF") ||
+        starts_with_ci(text, tn, "GLOBAL DEF") || starts_with_ci(text, tn, "DECL ")) {
+        c->format = 3; /* KUKA KRL */
+        return 0;
+    }
     if (starts_with_ci(text, tn, "MODULE") || starts_with_ci(text, tn, "%%%") || starts_with_ci(text, tn, "!") ||
         find_ci(text, tn, "jointtarget") || find_ci(text, tn, "robtarget")) {
         c->format = 2;
@@ -187,7 +193,7 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
             rc = -1;
             break;
         }
-        if (c.format != 2 && is_comment_or_blank(text, tn)) {
+        if (c.format != 2 && c.format != 3 && is_comment_or_blank(text, tn)) {
             fwrite(line, 1, n, c.out);
             fputs(c.eol, c.out);
             if (out_failed(&c, lineno, d)) {
@@ -206,8 +212,9 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
             if (r > 0)
                 continue; /* a CSV header, copied */
         }
-        if (c.format == 2) { /* a module is read whole, its bytes as they are: all or nothing */
-            rc = rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d);
+        if (c.format == 2 || c.format == 3) { /* a module is read whole, its bytes as they are: all or nothing */
+            rc = c.format == 2 ? rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d)
+                               : rch_cpi_krl(&c, line, (size_t)got, in, lineno, d);
             if (rc >= 0 && out_failed(&c, lineno, d))
                 rc = -1;
             break;
