@@ -96,8 +96,22 @@ static int krl_joints(rch_cpi_ctx *c, const krl_kin *k, double a_out[RC_NJ], con
     for (int i = 0; i < RC_NJ; ++i)
         a[i] = a_in[i] * DEG;
     rch_ctrl_to_model(q, k->ctl, a);
-    for (int i = 0; i < RC_NJ; ++i)
+    for (int i = 0; i < RC_NJ; ++i) {
         qd[i] = q[i] / DEG;
+        if (!(q[i] >= c->cal->q_min_rad[i] && q[i] <= c->cal->q_max_rad[i])) {
+            /* the limits as the controller reads them */
+            double lo[RC_NJ], hi[RC_NJ], ql[RC_NJ], qh[RC_NJ];
+            for (int j = 0; j < RC_NJ; ++j) {
+                ql[j] = c->cal->q_min_rad[j];
+                qh[j] = c->cal->q_max_rad[j];
+            }
+            rch_ctrl_from_model(lo, k->ctl, ql);
+            rch_ctrl_from_model(hi, k->ctl, qh);
+            snprintf(why, why_len, "A%d = %g deg is outside the joint limits [%g, %g] deg", i + 1, a_in[i],
+                     fmin(lo[i], hi[i]) / DEG, fmax(lo[i], hi[i]) / DEG);
+            return -1;
+        }
+    }
     rch_diag dd;
     const unsigned long before_unc = c->res->n_uncertain;
     const int r = rch_cpi_compensate(c, qo, qd, line, cols, &dd);

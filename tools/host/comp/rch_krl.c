@@ -74,7 +74,7 @@ const char *rch_krl_context_name(rch_krl_context c)
     case RCH_KRL_MOTION: return "motion";
     case RCH_KRL_CIRC_AUX: return "CIRC auxiliary point";
     }
-    return "target";
+    return "statement";
 }
 
 void rch_krl_free(rch_krl_targets *ts)
