@@ -22,6 +22,11 @@
  *    confdata with no solution, not a literal number, a wrong shape, a
  *    joint limit) is named with line, column and reason, and nothing is
  *    written.
+ *  - KUKA KRL (.src or .dat; a first line &ACCESS, &REL, &PARAM, &COMMENT,
+ *    DEF, DEFDAT, GLOBAL DEF or DECL): read whole (rch_krl.h), axis targets
+ *    corrected in the controller's joints, Cartesian ones through the
+ *    nominal IK on their Status/Turn branch in their $TOOL/$BASE; all or
+ *    nothing as RAPID (rch_comp_krl.c, docs/comp-krl.md).
  * Blank lines and lines starting with '#' are copied. A malformed line or a
  * target outside the joint limits is an error with file:line:col. A target
  * that does not converge is written as the stream's fallback (the closest
