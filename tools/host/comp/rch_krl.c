@@ -203,8 +203,10 @@ static decl *add_decl(scan *s, const char *name, int type)
 
 static rch_krl_target *new_target(scan *s, size_t i)
 {
-    if (s->pass != 2)
+    if (s->pass != 2 || s->ntk == 0)
         return NULL;
+    if (i >= s->ntk)
+        i = s->ntk - 1; /* a statement that ends too early: its last token */
     rch_krl_targets *o = s->out;
     if (o->n == o->cap) {
         const size_t nc = o->cap ? 2 * o->cap : 64;
