@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: MIT */
-/* rch_krl.c - the KRL reader (see rch_krl.h): lines tokenized (comments,
- * strings, numbers, names), statements recognised (declarations,
- * assignments, motions, frame changes), aggregates read into targets with
- * their frames. Two passes: the first collects the declarations, the FDATs
- * and TOOL_DATA/BASE_DATA; the second follows $TOOL/$BASE line by line.
+/* rch_krl.c - the KRL reader's tokens, aggregates and targets (see
+ * rch_krl.h): a line tokenized (comments, strings, numbers, names), an
+ * aggregate read into a target's slots and checked, its frames set; the
+ * declarations table and the frame state the statements (rch_krl_stmt.c)
+ * keep.
  * Memory: tokens and targets on the heap. Errors: a target's error, or -1
  * with d set (out of memory, a text too large). */
-#include "rch_krl.h"
+#include "rch_krl_int.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -15,45 +15,7 @@
 #include <string.h>
 #include <strings.h>
 
-enum { TK_ID = 'i', TK_NUM = 'n', TK_ENUM = 'e', TK_STR = 's' };
 
-typedef struct {
-    int kind;        /* TK_* or the punctuation character */
-    size_t off, len; /* in the text */
-} tok;
-
-#define MAX_NAMES_LEN 48
-#define MAX_DATA 65 /* TOOL_DATA[1..64], BASE_DATA[1..64] */
-
-typedef struct {
-    char name[MAX_NAMES_LEN];
-    int type; /* 1..4 rch_krl_type, 5 FRAME, 6 FDAT, 0 other */
-    int tool_no, base_no, ipo_tcp, fdat_ok;
-} decl;
-
-typedef struct {
-    int known;
-    rch_krl_frame f;
-    char from[64];
-    char why[200];
-} fstate;
-
-typedef struct {
-    const char *text;
-    size_t len;
-    tok *tk;
-    size_t ntk, cap;
-    decl *dl;
-    size_t ndl, capdl;
-    int have_tool[MAX_DATA], have_base[MAX_DATA];
-    rch_krl_frame tool_data[MAX_DATA], base_data[MAX_DATA];
-    fstate tool, base;
-    rch_krl_targets *out;
-    unsigned line;
-    size_t line_off; /* the line's first byte */
-    int pass;
-    int oom;
-} scan;
 
 const char *rch_krl_type_name(rch_krl_type t)
 {
@@ -84,31 +46,31 @@ void rch_krl_free(rch_krl_targets *ts)
     ts->n = ts->cap = 0;
 }
 
-static int tk_is(const scan *s, size_t i, const char *w)
+int rch_krli_tk_is(const rch_krli_scan *s, size_t i, const char *w)
 {
     return i < s->ntk && (s->tk[i].kind == TK_ID || s->tk[i].kind == TK_ENUM) && s->tk[i].len == strlen(w) &&
            strncasecmp(s->text + s->tk[i].off, w, s->tk[i].len) == 0;
 }
 
-static int tk_ch(const scan *s, size_t i, int ch)
+int rch_krli_tk_ch(const rch_krli_scan *s, size_t i, int ch)
 {
     return i < s->ntk && s->tk[i].kind == ch;
 }
 
-static void tk_name(char *buf, size_t n, const scan *s, size_t i)
+void rch_krli_tk_name(char *buf, size_t n, const rch_krli_scan *s, size_t i)
 {
     size_t k = s->tk[i].len < n - 1 ? s->tk[i].len : n - 1;
     memcpy(buf, s->text + s->tk[i].off, k);
     buf[k] = '\0';
 }
 
-static unsigned tk_col(const scan *s, size_t i)
+static unsigned tk_col(const rch_krli_scan *s, size_t i)
 {
     return (unsigned)(s->tk[i].off - s->line_off) + 1;
 }
 
 /* The tokens of text[a..b) (one line), up to a comment. 0, or -1 (memory). */
-static int tokenize(scan *s, size_t a, size_t b)
+int rch_krli_tokenize(rch_krli_scan *s, size_t a, size_t b)
 {
     s->ntk = 0;
     size_t i = a;
@@ -122,13 +84,13 @@ static int tokenize(scan *s, size_t a, size_t b)
         }
         if (s->ntk == s->cap) {
             const size_t nc = s->cap ? 2 * s->cap : 64;
-            tok *nt = realloc(s->tk, nc * sizeof *nt);
+            rch_krli_tok *nt = realloc(s->tk, nc * sizeof *nt);
             if (!nt)
                 return -1;
             s->tk = nt;
             s->cap = nc;
         }
-        tok *t = &s->tk[s->ntk++];
+        rch_krli_tok *t = &s->tk[s->ntk++];
         t->off = i;
         if (isalpha(ch) || ch == '_' || ch == '$' || ch == '#' || ch >= 0x80) {
             t->kind = ch == '#' ? TK_ENUM : TK_ID;
@@ -171,7 +133,7 @@ static int tokenize(scan *s, size_t a, size_t b)
     return 0;
 }
 
-static decl *find_decl(scan *s, const char *name)
+rch_krli_decl *rch_krli_find_decl(rch_krli_scan *s, const char *name)
 {
     for (size_t k = 0; k < s->ndl; ++k)
         if (strcasecmp(s->dl[k].name, name) == 0)
@@ -179,14 +141,14 @@ static decl *find_decl(scan *s, const char *name)
     return NULL;
 }
 
-static decl *add_decl(scan *s, const char *name, int type)
+rch_krli_decl *rch_krli_add_decl(rch_krli_scan *s, const char *name, int type)
 {
-    decl *d = find_decl(s, name);
+    rch_krli_decl *d = rch_krli_find_decl(s, name);
     if (d)
         return d;
     if (s->ndl == s->capdl) {
         const size_t nc = s->capdl ? 2 * s->capdl : 32;
-        decl *nd = realloc(s->dl, nc * sizeof *nd);
+        rch_krli_decl *nd = realloc(s->dl, nc * sizeof *nd);
         if (!nd) {
             s->oom = 1;
             return NULL;
@@ -201,7 +163,7 @@ static decl *add_decl(scan *s, const char *name, int type)
     return d;
 }
 
-static rch_krl_target *new_target(scan *s, size_t i)
+static rch_krl_target *new_target(rch_krli_scan *s, size_t i)
 {
     if (s->pass != 2 || s->ntk == 0)
         return NULL;
@@ -228,7 +190,7 @@ static rch_krl_target *new_target(scan *s, size_t i)
 }
 
 /* A statement rcal refuses, at token i. */
-static void refuse_at(scan *s, size_t i, const char *why)
+void rch_krli_refuse_at(rch_krli_scan *s, size_t i, const char *why)
 {
     rch_krl_target *t = new_target(s, i);
     if (t)
@@ -236,7 +198,7 @@ static void refuse_at(scan *s, size_t i, const char *why)
 }
 
 /* Index after the '}' matching the '{' at i, or s->ntk + 1 when unmatched. */
-static size_t agg_end(const scan *s, size_t i)
+size_t rch_krli_agg_end(const rch_krli_scan *s, size_t i)
 {
     int depth = 0;
     for (size_t k = i; k < s->ntk; ++k) {
@@ -250,7 +212,7 @@ static size_t agg_end(const scan *s, size_t i)
 
 /* The slot of component name n for axis (1) or Cartesian (0) aggregates,
  * or -1. *axis is set from the name when it is -1. */
-static int slot_of(const char *n, int *axis)
+int rch_krli_slot_of(const char *n, int *axis)
 {
     static const char *const cart[6] = {"X", "Y", "Z", "A", "B", "C"};
     for (int k = 0; k < 6; ++k)
@@ -275,15 +237,15 @@ static int slot_of(const char *n, int *axis)
 }
 
 /* Whether the aggregate at [i, e) has a component of a target. */
-static int agg_has_target_comp(const scan *s, size_t i, size_t e)
+int rch_krli_agg_has_target_comp(const rch_krli_scan *s, size_t i, size_t e)
 {
     for (size_t k = i + 1; k + 1 < e; ++k)
-        if (s->tk[k].kind == TK_ID && (tk_ch(s, k - 1, '{') || tk_ch(s, k - 1, ','))) {
+        if (s->tk[k].kind == TK_ID && (rch_krli_tk_ch(s, k - 1, '{') || rch_krli_tk_ch(s, k - 1, ','))) {
             char n[8];
             int ax = -1;
             if (s->tk[k].len < sizeof n) {
-                tk_name(n, sizeof n, s, k);
-                if (slot_of(n, &ax) >= 0)
+                rch_krli_tk_name(n, sizeof n, s, k);
+                if (rch_krli_slot_of(n, &ax) >= 0)
                     return 1;
             }
         }
@@ -293,7 +255,7 @@ static int agg_has_target_comp(const scan *s, size_t i, size_t e)
 /* The aggregate at [i, e) into t's slots: each component `NAME number`.
  * want_axis: 1 axis, 0 Cartesian, -1 from the names. Returns the kind read
  * (1 axis, 0 Cartesian) or -1 with t->error set. */
-static int read_agg(scan *s, rch_krl_target *t, size_t i, size_t e, int want_axis)
+static int read_agg(rch_krli_scan *s, rch_krl_target *t, size_t i, size_t e, int want_axis)
 {
     int axis = want_axis;
     if (e > s->ntk) {
@@ -312,8 +274,8 @@ static int read_agg(scan *s, rch_krl_target *t, size_t i, size_t e, int want_axi
             return -1;
         }
         char n[8];
-        tk_name(n, sizeof n, s, k);
-        const int sl = slot_of(n, &axis);
+        rch_krli_tk_name(n, sizeof n, s, k);
+        const int sl = rch_krli_slot_of(n, &axis);
         if (sl < 0) {
             snprintf(t->error, sizeof t->error, "column %u: component %s is not one of %s", tk_col(s, k), n,
                      axis == 1 ? "A1..A6, E1..E6" : "X, Y, Z, A, B, C, S, T, E1..E6");
@@ -326,9 +288,9 @@ static int read_agg(scan *s, rch_krl_target *t, size_t i, size_t e, int want_axi
         ++k;
         const size_t v0 = k;
         int neg = 0;
-        if (tk_ch(s, k, '-') || tk_ch(s, k, '+'))
+        if (rch_krli_tk_ch(s, k, '-') || rch_krli_tk_ch(s, k, '+'))
             neg = s->tk[k++].kind == '-';
-        if (!(k < e - 1 && s->tk[k].kind == TK_NUM && (tk_ch(s, k + 1, ',') || k + 1 == e - 1))) {
+        if (!(k < e - 1 && s->tk[k].kind == TK_NUM && (rch_krli_tk_ch(s, k + 1, ',') || k + 1 == e - 1))) {
             snprintf(t->error, sizeof t->error, "column %u: %s is not a literal decimal number", tk_col(s, v0), n);
             return -1;
         }
@@ -338,7 +300,7 @@ static int read_agg(scan *s, rch_krl_target *t, size_t i, size_t e, int want_axi
             snprintf(t->error, sizeof t->error, "column %u: %s: number too long", tk_col(s, v0), n);
             return -1;
         }
-        tk_name(buf, sizeof buf, s, k);
+        rch_krli_tk_name(buf, sizeof buf, s, k);
         char *endp;
         v = strtod(buf, &endp);
         if (*endp != '\0' || !isfinite(v) || fabs(v) > 1e9) {
@@ -363,7 +325,7 @@ static int read_agg(scan *s, rch_krl_target *t, size_t i, size_t e, int want_axi
 
 /* A frame literal {X,Y,Z,A,B,C} (all six, literal numbers) at [i, e). 0 or
  * -1 with why set. */
-static int read_frame(scan *s, rch_krl_frame *f, size_t i, size_t e, char *why, size_t why_len)
+int rch_krli_read_frame(rch_krli_scan *s, rch_krl_frame *f, size_t i, size_t e, char *why, size_t why_len)
 {
     rch_krl_target t;
     memset(&t, 0, sizeof t);
@@ -404,7 +366,7 @@ static void check_target(rch_krl_target *t)
 }
 
 /* Set t's frames from the current state (or an FDAT). */
-static void set_frames(scan *s, rch_krl_target *t, const decl *fdat)
+void rch_krli_set_frames(rch_krli_scan *s, rch_krl_target *t, const rch_krli_decl *fdat)
 {
     if (t->type < RCH_KRL_POS || t->error[0])
         return;
@@ -447,7 +409,8 @@ static void set_frames(scan *s, rch_krl_target *t, const decl *fdat)
 
 /* A target aggregate at [i, e) of the given context and (declared) type
  * (0: from its components). */
-static rch_krl_target *target_agg(scan *s, size_t i, size_t e, rch_krl_context ctx, int type, const char *name)
+rch_krl_target *rch_krli_target_agg(rch_krli_scan *s, size_t i, size_t e, rch_krl_context ctx, int type,
+                                    const char *name)
 {
     rch_krl_target *t = new_target(s, i);
     if (!t)
@@ -471,31 +434,31 @@ static rch_krl_target *target_agg(scan *s, size_t i, size_t e, rch_krl_context c
     return t;
 }
 
-static int type_code(const scan *s, size_t i)
+int rch_krli_type_code(const rch_krli_scan *s, size_t i)
 {
     static const char *const names[] = {"AXIS", "E6AXIS", "POS", "E6POS", "FRAME", "FDAT"};
     for (int k = 0; k < 6; ++k)
-        if (tk_is(s, i, names[k]))
+        if (rch_krli_tk_is(s, i, names[k]))
             return k + 1;
     return 0;
 }
 
 /* The FDAT's TOOL_NO, BASE_NO, IPO_FRAME from [i, e). */
-static void read_fdat(scan *s, decl *d, size_t i, size_t e)
+void rch_krli_read_fdat(rch_krli_scan *s, rch_krli_decl *d, size_t i, size_t e)
 {
     int got = 0;
     for (size_t k = i + 1; k + 1 < e && k + 1 < s->ntk; ++k) {
-        if ((tk_is(s, k, "TOOL_NO") || tk_is(s, k, "BASE_NO")) && s->tk[k + 1].kind == TK_NUM) {
+        if ((rch_krli_tk_is(s, k, "TOOL_NO") || rch_krli_tk_is(s, k, "BASE_NO")) && s->tk[k + 1].kind == TK_NUM) {
             char b[16];
-            tk_name(b, sizeof b, s, k + 1);
+            rch_krli_tk_name(b, sizeof b, s, k + 1);
             const int v = atoi(b);
-            if (tk_is(s, k, "TOOL_NO"))
+            if (rch_krli_tk_is(s, k, "TOOL_NO"))
                 d->tool_no = v;
             else
                 d->base_no = v;
-            got |= tk_is(s, k, "TOOL_NO") ? 1 : 2;
+            got |= rch_krli_tk_is(s, k, "TOOL_NO") ? 1 : 2;
         }
-        if (tk_is(s, k, "IPO_FRAME") && tk_is(s, k + 1, "#TCP"))
+        if (rch_krli_tk_is(s, k, "IPO_FRAME") && rch_krli_tk_is(s, k + 1, "#TCP"))
             d->ipo_tcp = 1;
     }
     d->fdat_ok = got == 3;
@@ -503,36 +466,36 @@ static void read_fdat(scan *s, decl *d, size_t i, size_t e)
 
 /* Refuse every aggregate with target components in [a, b) not read as a
  * target (an expression, a statement rcal does not read). */
-static void refuse_stray(scan *s, size_t a, size_t b, const char *what)
+void rch_krli_refuse_stray(rch_krli_scan *s, size_t a, size_t b, const char *what)
 {
     for (size_t k = a; k < b && k < s->ntk; ++k)
         if (s->tk[k].kind == '{') {
-            const size_t e = agg_end(s, k);
-            if (e <= s->ntk && agg_has_target_comp(s, k, e)) {
+            const size_t e = rch_krli_agg_end(s, k);
+            if (e <= s->ntk && rch_krli_agg_has_target_comp(s, k, e)) {
                 char why[160];
                 snprintf(why, sizeof why, "a target aggregate in %s: rcal cannot correct it", what);
-                refuse_at(s, k, why);
+                rch_krli_refuse_at(s, k, why);
             }
             k = e - 1;
         }
 }
 
 /* TOOL_DATA[n] / BASE_DATA[n] at i (4 tokens): n, or -1. */
-static int data_index(const scan *s, size_t i, int *is_tool)
+int rch_krli_data_index(const rch_krli_scan *s, size_t i, int *is_tool)
 {
-    if (!(tk_is(s, i, "TOOL_DATA") || tk_is(s, i, "BASE_DATA")) || !tk_ch(s, i + 1, '[') ||
-        !(i + 2 < s->ntk && s->tk[i + 2].kind == TK_NUM) || !tk_ch(s, i + 3, ']'))
+    if (!(rch_krli_tk_is(s, i, "TOOL_DATA") || rch_krli_tk_is(s, i, "BASE_DATA")) || !rch_krli_tk_ch(s, i + 1, '[') ||
+        !(i + 2 < s->ntk && s->tk[i + 2].kind == TK_NUM) || !rch_krli_tk_ch(s, i + 3, ']'))
         return -1;
     char b[16];
     if (s->tk[i + 2].len >= sizeof b)
         return -1;
-    tk_name(b, sizeof b, s, i + 2);
+    rch_krli_tk_name(b, sizeof b, s, i + 2);
     const int n = atoi(b);
-    *is_tool = tk_is(s, i, "TOOL_DATA");
+    *is_tool = rch_krli_tk_is(s, i, "TOOL_DATA");
     return n >= 1 && n < MAX_DATA ? n : -1;
 }
 
-static void set_state(fstate *f, int known, const rch_krl_frame *fr, const char *from, const char *why)
+void rch_krli_set_state(rch_krli_fstate *f, int known, const rch_krl_frame *fr, const char *from, const char *why)
 {
     f->known = known;
     memset(&f->f, 0, sizeof f->f);
@@ -542,458 +505,3 @@ static void set_state(fstate *f, int known, const rch_krl_frame *fr, const char 
     snprintf(f->why, sizeof f->why, "%.199s", why ? why : "");
 }
 
-/* $TOOL or $BASE = rhs at [i, ntk). */
-static void frame_assign(scan *s, int tool, size_t i)
-{
-    fstate *f = tool ? &s->tool : &s->base;
-    char from[64], why[200];
-    snprintf(from, sizeof from, "at line %u", s->line);
-    if (tk_ch(s, i, '{')) {
-        const size_t e = agg_end(s, i);
-        rch_krl_frame fr;
-        if (e == s->ntk && read_frame(s, &fr, i, e, why, sizeof why) == 0)
-            set_state(f, 1, &fr, from, NULL);
-        else {
-            char w2[260];
-            snprintf(w2, sizeof w2, "%s at line %u is not a literal frame", tool ? "$TOOL" : "$BASE", s->line);
-            set_state(f, 0, NULL, from, w2);
-        }
-        return;
-    }
-    int is_tool;
-    const int n = data_index(s, i, &is_tool);
-    if (n > 0 && i + 4 == s->ntk && is_tool == tool) {
-        if (tool ? s->have_tool[n] : s->have_base[n]) {
-            snprintf(from, sizeof from, "%s_DATA[%d] (line %u)", tool ? "TOOL" : "BASE", n, s->line);
-            set_state(f, 1, tool ? &s->tool_data[n] : &s->base_data[n], from, NULL);
-        } else {
-            snprintf(why, sizeof why, "%s_DATA[%d] (line %u) is not defined in this file (give the line from "
-                     "$config.dat, %s_DATA[%d]={X ..,A ..}, in the program)", tool ? "TOOL" : "BASE", n, s->line,
-                     tool ? "TOOL" : "BASE", n);
-            set_state(f, 0, NULL, from, why);
-        }
-        return;
-    }
-    if (tk_is(s, i, "$NULLFRAME") && i + 1 == s->ntk) {
-        set_state(f, 1, NULL, "$NULLFRAME", NULL);
-        return;
-    }
-    snprintf(why, sizeof why, "%s at line %u is set to an expression rcal does not evaluate", tool ? "$TOOL" : "$BASE",
-             s->line);
-    set_state(f, 0, NULL, from, why);
-    refuse_stray(s, i, s->ntk, "a frame expression");
-}
-
-static int is_motion(const scan *s, size_t i, int *circ)
-{
-    static const char *const m[] = {"PTP", "LIN", "CIRC", "SPTP", "SLIN", "SCIRC", "SPL", NULL};
-    for (int k = 0; m[k]; ++k)
-        if (tk_is(s, i, m[k])) {
-            *circ = k == 2 || k == 5;
-            return 1;
-        }
-    return 0;
-}
-
-/* A motion's target at [i, ..): an aggregate or a name. Returns the index
- * after it, or 0 after a refusal. */
-static size_t motion_target(scan *s, size_t i, rch_krl_context ctx, const char *instr, rch_krl_target **made)
-{
-    *made = NULL;
-    if (tk_ch(s, i, '{')) {
-        const size_t e = agg_end(s, i);
-        rch_krl_target *t = target_agg(s, i, e, ctx, 0, NULL);
-        if (t) {
-            snprintf(t->instr, sizeof t->instr, "%s", instr);
-            set_frames(s, t, NULL);
-            *made = t;
-        }
-        return e > s->ntk ? 0 : e;
-    }
-    if (i < s->ntk && s->tk[i].kind == TK_ID) {
-        size_t k = i + 1;
-        if (tk_ch(s, k, '[')) {
-            while (k < s->ntk && !tk_ch(s, k, ']'))
-                ++k;
-            ++k;
-        }
-        char n[MAX_NAMES_LEN];
-        tk_name(n, sizeof n, s, i);
-        const decl *d = find_decl(s, n);
-        if (d && d->type == 5) {
-            refuse_at(s, i, "a FRAME as a motion target carries no Status and Turn: declare it as POS or E6POS");
-            return 0;
-        }
-        if (k <= s->ntk && (k == s->ntk || tk_ch(s, k, ',') || s->tk[k].kind == TK_ID))
-            return k; /* the variable: corrected where it is declared */
-    }
-    refuse_at(s, i, "the motion's target is an expression (a geometric operator, a function, a component): rcal "
-                    "cannot correct it");
-    return 0;
-}
-
-static void motion(scan *s, int circ)
-{
-    char instr[8];
-    tk_name(instr, sizeof instr, s, 0);
-    rch_krl_target *aux = NULL, *end = NULL;
-    size_t k = motion_target(s, 1, circ ? RCH_KRL_CIRC_AUX : RCH_KRL_MOTION, instr, circ ? &aux : &end);
-    if (k == 0)
-        return;
-    if (circ) {
-        if (!tk_ch(s, k, ',')) {
-            refuse_at(s, k < s->ntk ? k : 0, "CIRC needs its auxiliary point and its end point");
-            return;
-        }
-        const size_t aux_idx = aux ? (size_t)(aux - s->out->t) : 0;
-        k = motion_target(s, k + 1, RCH_KRL_MOTION, instr, &end);
-        if (k == 0)
-            return;
-        aux = aux ? &s->out->t[aux_idx] : NULL; /* the array may have moved */
-        if (aux && !aux->error[0] && !((aux->mask >> RCH_KRL_S) & 1u)) {
-            /* no S and T on the auxiliary point: the end point's branch */
-            if (end && !end->error[0] && end->type >= RCH_KRL_POS) {
-                aux->val[RCH_KRL_S] = end->val[RCH_KRL_S];
-                aux->val[RCH_KRL_T] = end->val[RCH_KRL_T];
-            } else if (aux->type >= RCH_KRL_POS)
-                snprintf(aux->error, sizeof aux->error, "an auxiliary point without S and T takes its end point's, "
-                         "which is not a literal Cartesian target here");
-        }
-    }
-    while (k < s->ntk) {
-        if (tk_is(s, k, "C_DIS") || tk_is(s, k, "C_PTP") || tk_is(s, k, "C_VEL") || tk_is(s, k, "C_ORI") ||
-            tk_is(s, k, "C_SPL") || tk_ch(s, k, ',')) {
-            ++k;
-            continue;
-        }
-        if (tk_is(s, k, "CA")) {
-            k += 1 + (tk_ch(s, k + 1, '-') || tk_ch(s, k + 1, '+'));
-            if (k < s->ntk && s->tk[k].kind == TK_NUM) {
-                ++k;
-                continue;
-            }
-        }
-        if (tk_is(s, k, "WITH")) {
-            for (size_t j = k; j < s->ntk; ++j)
-                if (tk_is(s, j, "$TOOL") || tk_is(s, j, "$BASE") || tk_is(s, j, "$IPO_MODE")) {
-                    refuse_at(s, j, "WITH sets the motion's frames: not supported (set $TOOL/$BASE before it)");
-                    return;
-                }
-            refuse_stray(s, k, s->ntk, "a WITH list");
-            return;
-        }
-        refuse_at(s, k, "unexpected after the motion's target");
-        return;
-    }
-}
-
-/* [GLOBAL] DECL [GLOBAL] TYPE NAME[=value], ... at index i (the type). */
-static void declaration(scan *s, size_t i)
-{
-    const int tc = type_code(s, i);
-    size_t k = i + 1;
-    while (k < s->ntk) {
-        if (s->tk[k].kind != TK_ID)
-            return;
-        char n[MAX_NAMES_LEN];
-        tk_name(n, sizeof n, s, k);
-        decl *d = s->pass == 1 ? add_decl(s, n, tc) : find_decl(s, n);
-        size_t j = k + 1;
-        if (tk_ch(s, j, '[')) {
-            while (j < s->ntk && !tk_ch(s, j, ']'))
-                ++j;
-            ++j;
-        }
-        if (tk_ch(s, j, '=')) {
-            ++j;
-            size_t e = j;
-            if (tk_ch(s, j, '{'))
-                e = agg_end(s, j);
-            else
-                while (e < s->ntk && !tk_ch(s, e, ','))
-                    ++e;
-            if (e > s->ntk) {
-                if (tc >= 1 && tc <= 4)
-                    refuse_at(s, j, "the aggregate is not closed on its line ('}' missing)");
-                return;
-            }
-            if (tc == 6 && d && s->pass == 1 && tk_ch(s, j, '{'))
-                read_fdat(s, d, j, e);
-            if (tc >= 1 && tc <= 4) {
-                if (tk_ch(s, j, '{') && s->pass == 2) {
-                    rch_krl_target *t = target_agg(s, j, e, RCH_KRL_DECLARATION, tc, n);
-                    if (t) {
-                        /* a point of KUKA's inline forms: XPn with its FDAT FPn */
-                        const decl *f = NULL;
-                        if ((n[0] == 'X' || n[0] == 'x') && n[1]) {
-                            char fn[MAX_NAMES_LEN];
-                            snprintf(fn, sizeof fn, "F%s", n + 1);
-                            f = find_decl(s, fn);
-                            f = f && f->type == 6 ? f : NULL;
-                        }
-                        set_frames(s, t, f);
-                    }
-                } else if (!tk_ch(s, j, '{'))
-                    refuse_stray(s, j, e, "a declaration's value");
-            }
-            k = e;
-        } else
-            k = j;
-        if (!tk_ch(s, k, ','))
-            return;
-        ++k;
-    }
-}
-
-/* NAME[..][.member] = rhs at 0. */
-static void assignment(scan *s, size_t eq)
-{
-    char n[MAX_NAMES_LEN];
-    tk_name(n, sizeof n, s, 0);
-    if (tk_is(s, 0, "$TOOL") || tk_is(s, 0, "$BASE")) {
-        if (eq == 1 && s->pass == 2)
-            frame_assign(s, tk_is(s, 0, "$TOOL"), 2);
-        else if (eq != 1)
-            refuse_at(s, 0, "a component of $TOOL or $BASE changed: the frame is then not known to rcal");
-        return;
-    }
-    int is_tool;
-    const int di = data_index(s, 0, &is_tool);
-    if (di > 0 && eq == 4) {
-        if (s->pass == 1) {
-            char why[200];
-            rch_krl_frame fr;
-            const size_t e = agg_end(s, 5);
-            if (tk_ch(s, 5, '{') && e == s->ntk && read_frame(s, &fr, 5, e, why, sizeof why) == 0) {
-                if (is_tool) {
-                    s->tool_data[di] = fr;
-                    s->have_tool[di] = 1;
-                } else {
-                    s->base_data[di] = fr;
-                    s->have_base[di] = 1;
-                }
-            }
-        }
-        return;
-    }
-    if (s->pass != 2)
-        return;
-    if (tk_is(s, 0, "FDAT_ACT") && eq == 1) {
-        char fn[MAX_NAMES_LEN], why[200];
-        if (2 < s->ntk && s->tk[2].kind == TK_ID) {
-            tk_name(fn, sizeof fn, s, 2);
-            const decl *f = find_decl(s, fn);
-            if (f && f->type == 6 && f->fdat_ok && !f->ipo_tcp) {
-                const int tn = f->tool_no, bn = f->base_no;
-                char from[64];
-                snprintf(from, sizeof from, "FDAT %s (line %u)", fn, s->line);
-                if (tn == 0 || (tn < MAX_DATA && s->have_tool[tn]))
-                    set_state(&s->tool, 1, tn ? &s->tool_data[tn] : NULL, from, NULL);
-                else {
-                    snprintf(why, sizeof why, "FDAT %s names TOOL_DATA[%d], not defined in this file", fn, tn);
-                    set_state(&s->tool, 0, NULL, from, why);
-                }
-                if (bn == 0 || (bn < MAX_DATA && s->have_base[bn]))
-                    set_state(&s->base, 1, bn ? &s->base_data[bn] : NULL, from, NULL);
-                else {
-                    snprintf(why, sizeof why, "FDAT %s names BASE_DATA[%d], not defined in this file", fn, bn);
-                    set_state(&s->base, 0, NULL, from, why);
-                }
-                return;
-            }
-            snprintf(why, sizeof why, "FDAT_ACT=%s (line %u): its FDAT is not declared in this file (it is in the "
-                     ".dat) or has IPO_FRAME #TCP", fn, s->line);
-        } else
-            snprintf(why, sizeof why, "FDAT_ACT set to an expression at line %u", s->line);
-        set_state(&s->tool, 0, NULL, "FDAT_ACT", why);
-        set_state(&s->base, 0, NULL, "FDAT_ACT", why);
-        return;
-    }
-    const decl *d = find_decl(s, n);
-    if (eq == 1 && tk_ch(s, 2, '{') && agg_end(s, 2) == s->ntk) {
-        const size_t e = s->ntk;
-        if (d && d->type == 5)
-            return; /* a FRAME variable: a frame, not a target */
-        if (d && d->type >= 1 && d->type <= 4) {
-            rch_krl_target *t = target_agg(s, 2, e, RCH_KRL_ASSIGNMENT, d->type, n);
-            if (t)
-                set_frames(s, t, NULL);
-            return;
-        }
-        if (d && d->type != 0) {
-            refuse_stray(s, 2, e, "an assignment");
-            return;
-        }
-        if (!agg_has_target_comp(s, 2, e))
-            return; /* $VEL={CP 0.2}, ... */
-        rch_krl_target *t = target_agg(s, 2, e, RCH_KRL_ASSIGNMENT, 0, n);
-        if (t && !t->error[0] && t->type >= RCH_KRL_POS && !d &&
-            !((t->mask >> RCH_KRL_S) & 1u && (t->mask >> RCH_KRL_T) & 1u))
-            snprintf(t->error, sizeof t->error, "%s is not declared in this file and has no S and T: a FRAME or a "
-                     "POS, its type cannot be told", n);
-        if (t)
-            set_frames(s, t, NULL);
-        return;
-    }
-    /* a member of a target changed (XP1.X = 10) */
-    for (size_t k = 1; k + 1 < eq; ++k)
-        if (tk_ch(s, k, '.') && s->tk[k + 1].kind == TK_ID) {
-            char m[8];
-            int ax = -1;
-            if (s->tk[k + 1].len < sizeof m) {
-                tk_name(m, sizeof m, s, k + 1);
-                if (slot_of(m, &ax) >= 0 && (!d || (d->type >= 1 && d->type <= 4) || n[0] != '$')) {
-                    refuse_at(s, k + 1, "a target's component assigned: rcal cannot correct it");
-                    return;
-                }
-            }
-        }
-    refuse_stray(s, eq + 1, s->ntk, "an expression");
-}
-
-static void bas_call(scan *s)
-{
-    /* BAS ( #TOOL , n ) */
-    if (!tk_ch(s, 1, '('))
-        return;
-    if (tk_is(s, 2, "#INITMOV")) {
-        set_state(&s->tool, 1, NULL, "$NULLFRAME (BAS #INITMOV)", NULL);
-        set_state(&s->base, 1, NULL, "$NULLFRAME (BAS #INITMOV)", NULL);
-        return;
-    }
-    const int tool = tk_is(s, 2, "#TOOL"), base = tk_is(s, 2, "#BASE");
-    if (!tool && !base)
-        return;
-    fstate *f = tool ? &s->tool : &s->base;
-    char why[200], from[64];
-    if (tk_ch(s, 3, ',') && 4 < s->ntk && s->tk[4].kind == TK_NUM && tk_ch(s, 5, ')')) {
-        char b[16];
-        tk_name(b, sizeof b, s, 4);
-        const int n = atoi(b);
-        snprintf(from, sizeof from, "BAS(#%s,%d) at line %u", tool ? "TOOL" : "BASE", n, s->line);
-        if (n == 0) {
-            set_state(f, 1, NULL, from, NULL);
-            return;
-        }
-        if (n > 0 && n < MAX_DATA && (tool ? s->have_tool[n] : s->have_base[n])) {
-            set_state(f, 1, tool ? &s->tool_data[n] : &s->base_data[n], from, NULL);
-            return;
-        }
-        snprintf(why, sizeof why, "%s_DATA[%d] (BAS at line %u) is not defined in this file", tool ? "TOOL" : "BASE",
-                 n, s->line);
-    } else
-        snprintf(why, sizeof why, "BAS at line %u selects a frame rcal cannot tell", s->line);
-    set_state(f, 0, NULL, "BAS", why);
-}
-
-static void statement(scan *s)
-{
-    if (s->ntk == 0)
-        return;
-    size_t i = 0;
-    if (tk_is(s, i, "GLOBAL"))
-        ++i;
-    if (tk_is(s, i, "DECL")) {
-        ++i;
-        if (tk_is(s, i, "GLOBAL"))
-            ++i;
-        if (tk_is(s, i, "CONST"))
-            ++i;
-        declaration(s, i);
-        return;
-    }
-    if (type_code(s, i) && i + 1 < s->ntk && s->tk[i + 1].kind == TK_ID) {
-        declaration(s, i);
-        return;
-    }
-    int circ;
-    if (s->pass == 2 && is_motion(s, 0, &circ)) {
-        motion(s, circ);
-        return;
-    }
-    if (s->pass == 2 && s->tk[0].kind == TK_ID && s->tk[0].len > 4 &&
-        strncasecmp(s->text + s->tk[0].off + s->tk[0].len - 4, "_REL", 4) == 0) {
-        refuse_at(s, 0, "a relative motion: its end depends on where the robot is, rcal cannot correct it");
-        return;
-    }
-    if (tk_is(s, 0, "BAS")) {
-        if (s->pass == 2)
-            bas_call(s);
-        return;
-    }
-    /* an assignment: the first '=' at depth 0 after a name */
-    if (s->tk[0].kind == TK_ID) {
-        size_t k = 1;
-        int depth = 0;
-        for (; k < s->ntk; ++k) {
-            if (s->tk[k].kind == '[')
-                ++depth;
-            else if (s->tk[k].kind == ']')
-                --depth;
-            else if (depth == 0 && s->tk[k].kind == '=' && !tk_ch(s, k + 1, '=') && !tk_ch(s, k - 1, '<') &&
-                     !tk_ch(s, k - 1, '>'))
-                break;
-            else if (depth == 0 && !(s->tk[k].kind == '.' || s->tk[k].kind == TK_ID || s->tk[k].kind == TK_NUM ||
-                                     s->tk[k].kind == ','))
-                k = s->ntk;
-        }
-        if (k < s->ntk && s->tk[k].kind == '=') {
-            assignment(s, k);
-            return;
-        }
-    }
-    if (s->pass == 2)
-        refuse_stray(s, 0, s->ntk, "a statement rcal does not read");
-}
-
-static int run_pass(scan *s, int pass)
-{
-    s->pass = pass;
-    s->line = 0;
-    set_state(&s->tool, 1, NULL, "$NULLFRAME (default)", NULL);
-    set_state(&s->base, 1, NULL, "$NULLFRAME (default)", NULL);
-    size_t a = 0;
-    while (a < s->len) {
-        size_t b = a;
-        while (b < s->len && s->text[b] != '\n' && s->text[b] != '\r')
-            ++b;
-        ++s->line;
-        s->line_off = a;
-        if (tokenize(s, a, b) != 0)
-            return -1;
-        statement(s);
-        if (s->oom)
-            return -1;
-        a = b;
-        if (a < s->len && s->text[a] == '\r') {
-            ++a;
-            if (a < s->len && s->text[a] == '\n')
-                ++a;
-        } else if (a < s->len)
-            ++a;
-    }
-    return 0;
-}
-
-int rch_krl_scan(rch_krl_targets *out, const char *text, size_t len, const char *name, rch_diag *d)
-{
-    if (len > RCH_KRL_MAX_BYTES) {
-        rch_diag_set(d, name, 0, 0, "a KRL file of more than %u bytes is refused", RCH_KRL_MAX_BYTES);
-        return -1;
-    }
-    scan *s = calloc(1, sizeof *s);
-    if (!s) {
-        rch_diag_set(d, name, 0, 0, "out of memory");
-        return -1;
-    }
-    s->text = text;
-    s->len = len;
-    s->out = out;
-    int rc = run_pass(s, 1) == 0 && run_pass(s, 2) == 0 ? 0 : -1;
-    if (rc != 0)
-        rch_diag_set(d, name, s->line, 1, "out of memory");
-    free(s->tk);
-    free(s->dl);
-    free(s);
-    return rc;
-}
