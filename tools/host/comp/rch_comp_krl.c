@@ -70,14 +70,17 @@ static void invert(double pi[3], double Ri[9], const double p[3], const double R
 static void refuse(rch_cpi_ctx *c, unsigned long *n_bad, rch_diag *d, const rch_krl_target *t, unsigned base,
                    const char *why)
 {
-    char what[96];
-    snprintf(what, sizeof what, "%s%s%s", rch_krl_type_name(t->type), t->name[0] ? " " : "", t->name);
+    char what[128];
+    if (t->type == 0) /* a statement refused as a whole */
+        snprintf(what, sizeof what, "statement");
+    else
+        snprintf(what, sizeof what, "%s%s%s (%s)", rch_krl_type_name(t->type), t->name[0] ? " " : "", t->name,
+                 rch_krl_context_name(t->context));
     if (*n_bad == 0)
-        rch_diag_set(d, c->in_name, base + t->line, t->col, "%s (%s): %s", what, rch_krl_context_name(t->context),
-                     why);
+        rch_diag_set(d, c->in_name, base + t->line, t->col, "%s: %s", what, why);
     if (c->warn)
-        fprintf(c->warn, "%s:%u:%u: error: %s (%s) cannot be corrected: %s\n", c->in_name, base + t->line, t->col,
-                what, rch_krl_context_name(t->context), why);
+        fprintf(c->warn, "%s:%u:%u: error: %s cannot be corrected: %s\n", c->in_name, base + t->line, t->col, what,
+                why);
     ++*n_bad;
 }
 
