@@ -69,6 +69,19 @@ static unsigned tk_col(const rch_krli_scan *s, size_t i)
     return (unsigned)(s->tk[i].off - s->line_off) + 1;
 }
 
+/* Token i as a plain decimal integer (digits only, at most 9), or -1. */
+int rch_krli_tk_int(const rch_krli_scan *s, size_t i)
+{
+    if (i >= s->ntk || s->tk[i].kind != TK_NUM || s->tk[i].len > 9)
+        return -1;
+    char b[16];
+    rch_krli_tk_name(b, sizeof b, s, i);
+    for (const char *c = b; *c; ++c)
+        if (!isdigit((unsigned char)*c))
+            return -1;
+    return (int)strtol(b, NULL, 10);
+}
+
 /* The tokens of text[a..b) (one line), up to a comment. 0, or -1 (memory). */
 int rch_krli_tokenize(rch_krli_scan *s, size_t a, size_t b)
 {
@@ -449,9 +462,9 @@ void rch_krli_read_fdat(rch_krli_scan *s, rch_krli_decl *d, size_t i, size_t e)
     int got = 0;
     for (size_t k = i + 1; k + 1 < e && k + 1 < s->ntk; ++k) {
         if ((rch_krli_tk_is(s, k, "TOOL_NO") || rch_krli_tk_is(s, k, "BASE_NO")) && s->tk[k + 1].kind == TK_NUM) {
-            char b[16];
-            rch_krli_tk_name(b, sizeof b, s, k + 1);
-            const int v = atoi(b);
+            const int v = rch_krli_tk_int(s, k + 1);
+            if (v < 0)
+                continue; /* not a plain integer: the FDAT is not read (refused where it is used) */
             if (rch_krli_tk_is(s, k, "TOOL_NO"))
                 d->tool_no = v;
             else
@@ -486,11 +499,7 @@ int rch_krli_data_index(const rch_krli_scan *s, size_t i, int *is_tool)
     if (!(rch_krli_tk_is(s, i, "TOOL_DATA") || rch_krli_tk_is(s, i, "BASE_DATA")) || !rch_krli_tk_ch(s, i + 1, '[') ||
         !(i + 2 < s->ntk && s->tk[i + 2].kind == TK_NUM) || !rch_krli_tk_ch(s, i + 3, ']'))
         return -1;
-    char b[16];
-    if (s->tk[i + 2].len >= sizeof b)
-        return -1;
-    rch_krli_tk_name(b, sizeof b, s, i + 2);
-    const int n = atoi(b);
+    const int n = rch_krli_tk_int(s, i + 2);
     *is_tool = rch_krli_tk_is(s, i, "TOOL_DATA");
     return n >= 1 && n < MAX_DATA ? n : -1;
 }

@@ -55,6 +55,7 @@ typedef struct {
 int rch_krli_tk_is(const rch_krli_scan *s, size_t i, const char *w);
 int rch_krli_tk_ch(const rch_krli_scan *s, size_t i, int ch);
 void rch_krli_tk_name(char *buf, size_t n, const rch_krli_scan *s, size_t i);
+int rch_krli_tk_int(const rch_krli_scan *s, size_t i);
 int rch_krli_tokenize(rch_krli_scan *s, size_t a, size_t b);
 rch_krli_decl *rch_krli_find_decl(rch_krli_scan *s, const char *name);
 rch_krli_decl *rch_krli_add_decl(rch_krli_scan *s, const char *name, int type);

@@ -220,6 +220,40 @@ static void declaration(rch_krli_scan *s, size_t i)
     }
 }
 
+/* FDAT_ACT = FPn: the frames of that FDAT (declared in this file), else unknown. */
+static void fdat_act(rch_krli_scan *s)
+{
+    char fn[MAX_NAMES_LEN], why[200];
+    if (2 < s->ntk && s->tk[2].kind == TK_ID) {
+        rch_krli_tk_name(fn, sizeof fn, s, 2);
+        const rch_krli_decl *f = rch_krli_find_decl(s, fn);
+        if (f && f->type == 6 && f->fdat_ok && !f->ipo_tcp) {
+            const int tn = f->tool_no, bn = f->base_no;
+            char from[64];
+            snprintf(from, sizeof from, "FDAT %s (line %u)", fn, s->line);
+            if (tn == 0 || (tn < MAX_DATA && s->have_tool[tn]))
+                rch_krli_set_state(&s->tool, 1, tn ? &s->tool_data[tn] : NULL, from, NULL);
+            else {
+                snprintf(why, sizeof why, "FDAT %s names TOOL_DATA[%d], not defined in this file", fn, tn);
+                rch_krli_set_state(&s->tool, 0, NULL, from, why);
+            }
+            if (bn == 0 || (bn < MAX_DATA && s->have_base[bn]))
+                rch_krli_set_state(&s->base, 1, bn ? &s->base_data[bn] : NULL, from, NULL);
+            else {
+                snprintf(why, sizeof why, "FDAT %s names BASE_DATA[%d], not defined in this file", fn, bn);
+                rch_krli_set_state(&s->base, 0, NULL, from, why);
+            }
+            return;
+        }
+        snprintf(why, sizeof why, "FDAT_ACT=%s (line %u): its FDAT is not declared in this file (it is in the "
+                 ".dat) or has IPO_FRAME #TCP", fn, s->line);
+    } else
+        snprintf(why, sizeof why, "FDAT_ACT set to an expression at line %u", s->line);
+    rch_krli_set_state(&s->tool, 0, NULL, "FDAT_ACT", why);
+    rch_krli_set_state(&s->base, 0, NULL, "FDAT_ACT", why);
+    return;
+}
+
 /* NAME[..][.member] = rhs at 0. */
 static void assignment(rch_krli_scan *s, size_t eq)
 {
@@ -254,34 +288,7 @@ static void assignment(rch_krli_scan *s, size_t eq)
     if (s->pass != 2)
         return;
     if (rch_krli_tk_is(s, 0, "FDAT_ACT") && eq == 1) {
-        char fn[MAX_NAMES_LEN], why[200];
-        if (2 < s->ntk && s->tk[2].kind == TK_ID) {
-            rch_krli_tk_name(fn, sizeof fn, s, 2);
-            const rch_krli_decl *f = rch_krli_find_decl(s, fn);
-            if (f && f->type == 6 && f->fdat_ok && !f->ipo_tcp) {
-                const int tn = f->tool_no, bn = f->base_no;
-                char from[64];
-                snprintf(from, sizeof from, "FDAT %s (line %u)", fn, s->line);
-                if (tn == 0 || (tn < MAX_DATA && s->have_tool[tn]))
-                    rch_krli_set_state(&s->tool, 1, tn ? &s->tool_data[tn] : NULL, from, NULL);
-                else {
-                    snprintf(why, sizeof why, "FDAT %s names TOOL_DATA[%d], not defined in this file", fn, tn);
-                    rch_krli_set_state(&s->tool, 0, NULL, from, why);
-                }
-                if (bn == 0 || (bn < MAX_DATA && s->have_base[bn]))
-                    rch_krli_set_state(&s->base, 1, bn ? &s->base_data[bn] : NULL, from, NULL);
-                else {
-                    snprintf(why, sizeof why, "FDAT %s names BASE_DATA[%d], not defined in this file", fn, bn);
-                    rch_krli_set_state(&s->base, 0, NULL, from, why);
-                }
-                return;
-            }
-            snprintf(why, sizeof why, "FDAT_ACT=%s (line %u): its FDAT is not declared in this file (it is in the "
-                     ".dat) or has IPO_FRAME #TCP", fn, s->line);
-        } else
-            snprintf(why, sizeof why, "FDAT_ACT set to an expression at line %u", s->line);
-        rch_krli_set_state(&s->tool, 0, NULL, "FDAT_ACT", why);
-        rch_krli_set_state(&s->base, 0, NULL, "FDAT_ACT", why);
+        fdat_act(s);
         return;
     }
     const rch_krli_decl *d = rch_krli_find_decl(s, n);
@@ -342,9 +349,7 @@ static void bas_call(rch_krli_scan *s)
     rch_krli_fstate *f = tool ? &s->tool : &s->base;
     char why[200], from[64];
     if (rch_krli_tk_ch(s, 3, ',') && 4 < s->ntk && s->tk[4].kind == TK_NUM && rch_krli_tk_ch(s, 5, ')')) {
-        char b[16];
-        rch_krli_tk_name(b, sizeof b, s, 4);
-        const int n = atoi(b);
+        const int n = rch_krli_tk_int(s, 4);
         snprintf(from, sizeof from, "BAS(#%s,%d) at line %u", tool ? "TOOL" : "BASE", n, s->line);
         if (n == 0) {
             rch_krli_set_state(f, 1, NULL, from, NULL);
