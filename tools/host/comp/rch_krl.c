@@ -300,6 +300,12 @@ static int read_agg(rch_krli_scan *s, rch_krl_target *t, size_t i, size_t e, int
         }
         ++k;
         const size_t v0 = k;
+        if (k < e && s->tk[k].off == s->tk[k - 1].off + s->tk[k - 1].len) {
+            /* A1.5 reads as A1 0.5 here, but rewritten (A10.5000) it would not */
+            snprintf(t->error, sizeof t->error, "column %u: a blank is needed between %s and its value",
+                     tk_col(s, k), n);
+            return -1;
+        }
         int neg = 0;
         if (rch_krli_tk_ch(s, k, '-') || rch_krli_tk_ch(s, k, '+'))
             neg = s->tk[k++].kind == '-';
