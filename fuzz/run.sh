@@ -50,6 +50,7 @@ dict_for() {
     fuzz_rapid) echo "$ROOT/fuzz/dict/rapid.dict" ;;
     fuzz_fanuc) echo "$ROOT/fuzz/dict/fanuc.dict" ;;
     fuzz_urscript) echo "$ROOT/fuzz/dict/urscript.dict" ;;
+    fuzz_krl) echo "$ROOT/fuzz/dict/krl.dict" ;;
     fuzz_ascii | fuzz_stx | fuzz_display) echo "$ROOT/fuzz/dict/ascii.dict" ;;
     fuzz_urdf | fuzz_rsi) echo "$ROOT/fuzz/dict/xml.dict" ;;
     *) echo "" ;;
@@ -58,7 +59,7 @@ dict_for() {
 
 maxlen_for() {
     case "$1" in
-    fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load | fuzz_json | fuzz_robot | fuzz_urdf | fuzz_rapid | fuzz_fanuc) echo 16384 ;;
+    fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load | fuzz_json | fuzz_robot | fuzz_urdf | fuzz_rapid | fuzz_fanuc | fuzz_krl) echo 16384 ;;
     fuzz_egm) echo 2048 ;;
     *) echo 1024 ;;
     esac

@@ -122,7 +122,8 @@ static int summary_json(const rch_comp_result *r, const rch_comp_job *job, int r
     const char *const files[] = {"model", job->model_path, "nominal", job->nominal_path, "in", job->in_path,
                                  "out", job->out_path, "input_format",
                                  r->format == RCH_COMP_RAPID ? "rapid" : r->format == RCH_COMP_FANUC ? "fanuc"
-                                 : r->format == RCH_COMP_URSCRIPT ? "urscript" : "csv",
+                                 : r->format == RCH_COMP_URSCRIPT ? "urscript"
+                                 : r->format == RCH_COMP_KRL ? "krl" : "csv",
                                  NULL};
     rch_jw w;
     rch_jw_begin(&w, stdout, 0, "rcal-compensate/1", argc, argv);
@@ -251,7 +252,7 @@ int rcal_cmd_compensate(int argc, char **argv)
         {"--max-dev-deg", RCH_OPT_DOUBLE, &max_dev_deg, 0.001, 90.0, "D", "largest correction per joint", 0, NULL},
         {"--accept-robtargets", RCH_OPT_FLAG, &accept_rt, 0, 0, NULL,
          "deprecated, no effect: RAPID robtargets are corrected (through the nominal inverse kinematics)", 0, NULL},
-        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid|urscript|fanuc"},
+        {"--format", RCH_OPT_CHOICE, &format, 0, 0, NULL, "input form", 0, "auto|csv|rapid|urscript|fanuc|krl"},
         {"--fanuc-frames", RCH_OPT_STR, &fanuc_frames, 0, 0, "FRAMES.csv",
          "a Fanuc program's user and tool frames, as the pendant shows them (lines uframe,n,x,y,z,w,p,r and "
          "utool,n,x,y,z,w,p,r; mm, deg): a position in a UF or UT not given is refused (docs/comp-fanuc.md)",
@@ -284,6 +285,7 @@ int rcal_cmd_compensate(int argc, char **argv)
                   : strcmp(format, "rapid") == 0 ? RCH_COMP_RAPID
                   : strcmp(format, "urscript") == 0 ? RCH_COMP_URSCRIPT
                   : strcmp(format, "fanuc") == 0 ? RCH_COMP_FANUC
+                  : strcmp(format, "krl") == 0 ? RCH_COMP_KRL
                                                  : RCH_COMP_AUTO,
         .position_only = position_only,
         .full_pose = full_pose,

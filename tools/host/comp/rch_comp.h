@@ -25,6 +25,11 @@
  *  - Fanuc LS (a first line /PROG): read whole, every position of /POS
  *    corrected (rch_comp_fanuc.c, docs/comp-fanuc.md); the user and tool
  *    frames from fanuc_frames_path. All or nothing as RAPID.
+ *  - KUKA KRL (.src or .dat; a first line &ACCESS, &REL, &PARAM, &COMMENT,
+ *    DEF, DEFDAT, GLOBAL DEF or DECL): read whole (rch_krl.h), axis targets
+ *    corrected in the controller's joints, Cartesian ones through the
+ *    nominal IK on their Status/Turn branch in their $TOOL/$BASE; all or
+ *    nothing as RAPID (rch_comp_krl.c, docs/comp-krl.md).
  * Blank lines and lines starting with '#' are copied. A malformed line or a
  * target outside the joint limits is an error with file:line:col. A target
  * that does not converge is written as the stream's fallback (the closest
@@ -58,6 +63,8 @@ typedef enum rch_comp_format {
     RCH_COMP_CSV = 1,
     RCH_COMP_RAPID = 2,
     RCH_COMP_URSCRIPT = 3, /* a Universal Robots program (.script; rch_urscript_comp.h) */
+    RCH_COMP_KRL = 4,      /* KUKA KRL .src/.dat (rch_krl.h): a first line &ACCESS, &REL, &PARAM, &COMMENT, DEF
+                              (not ending in a colon: URScript's def), DEFDAT, GLOBAL DEF or DECL */
     RCH_COMP_FANUC = 5     /* a Fanuc LS program (first line /PROG): rch_comp_fanuc.c, docs/comp-fanuc.md */
 } rch_comp_format;
 

@@ -45,7 +45,7 @@ typedef struct {
     rch_comp_result *res;
     FILE *out, *warn;
     const char *in_name;
-    int format; /* 0 auto, 1 csv, 2 rapid, 5 fanuc (rch_comp_format) */
+    int format; /* rch_comp_format: 0 auto, 1 csv, 2 rapid, 3 urscript, 4 krl, 5 fanuc */
     const char *eol; /* the line end of the line being read ("\n", "\r\n" or "\r"): a CSV line keeps it */
     double max_abs_deg[RC_NJ]; /* the largest |q| of each joint of the targets read (degrees as read) */
     unsigned long n_targets;   /* joint targets read (the radians check, rch_data_q_look_rad) */
@@ -107,6 +107,16 @@ int rch_cpi_rapid(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsign
 
 /* rch_comp_fanuc.c: a Fanuc LS program, read whole as a RAPID module is. */
 int rch_cpi_fanuc(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d);
+
+/* Compensate at tcp (3, flange frame; has_tcp 0: the flange): the job's
+ * stream when it is the job's point, else one made for it (kept for the
+ * program). rch_comp_rapid.c. 0, or -1 with why set. */
+int rch_cpi_use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why, size_t why_len);
+
+/* rch_comp_krl.c: a KUKA KRL file (.src or .dat), read whole as a RAPID
+ * module is (the line already read and the rest of in), corrected all or
+ * nothing. 0, 1 (some flagged), -1 (d set). */
+int rch_cpi_krl(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d);
 
 /* rch_comp_frames.c: a robtarget's frames */
 /* The tool and work object the instruction that uses robtarget t names, as

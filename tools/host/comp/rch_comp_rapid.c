@@ -59,7 +59,7 @@ static void rapid_refuse(rch_cpi_ctx *c, unsigned long *n_bad, rch_diag *d, cons
 /* Compensate at tcp (3, flange frame): the job's stream when it is the
  * job's point, else one made for it (kept for the module). 0, or -1 with
  * why set. */
-static int use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why, size_t why_len)
+int rch_cpi_use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why, size_t why_len)
 {
     const double *jt = c->gate ? c->gate->tool_mm : NULL;
     c->stream = c->stream0;
@@ -159,7 +159,7 @@ static int rapid_robtarget(rch_cpi_ctx *c, double out[RCH_RAPID_NUMS], const rch
         rch_cpi_tool0_pose(px, qx, &fr, t);
         ik = rch_ik_solve(q, nom, px, qx, cf, NULL, why, why_len);
     }
-    if (ik != 0 || use_tcp(c, fr.tcp, fr.has_tcp, why, why_len) != 0)
+    if (ik != 0 || rch_cpi_use_tcp(c, fr.tcp, fr.has_tcp, why, why_len) != 0)
         return -1;
     unsigned cols[RC_NJ];
     for (unsigned i = 0; i < RC_NJ; ++i) {

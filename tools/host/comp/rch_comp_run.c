@@ -45,6 +45,18 @@ static int starts_with_ci(const char *s, size_t n, const char *w)
     return n >= k && strncasecmp(s, w, k) == 0;
 }
 
+/* The line's last character that is not blank (before a URScript comment
+ * '#') is a colon: URScript's "def main():", never KRL's "DEF main( )". */
+static int ends_with_colon(const char *s, size_t n)
+{
+    const char *hash = memchr(s, '#', n);
+    if (hash)
+        n = (size_t)(hash - s);
+    while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\r'))
+        --n;
+    return n > 0 && s[n - 1] == ':';
+}
+
 static const char *find_ci(const char *s, size_t n, const char *w)
 {
     size_t k = strlen(w);
@@ -110,6 +122,12 @@ static int out_failed(const rch_cpi_ctx *c, unsigned lineno, rch_diag *d)
 static int decide_form(rch_cpi_ctx *c, const char *line, size_t bom, size_t tn, unsigned lineno, rch_diag *d)
 {
     const char *text = line + bom;
+    if (starts_with_ci(text, tn, "&ACCESS") || starts_with_ci(text, tn, "&REL") || starts_with_ci(text, tn, "&PARAM") ||
+        starts_with_ci(text, tn, "&COMMENT") || (starts_with_ci(text, tn, "DEF") && !ends_with_colon(text, tn)) ||
+        starts_with_ci(text, tn, "GLOBAL DEF") || starts_with_ci(text, tn, "DECL ")) {
+        c->format = RCH_COMP_KRL;
+        return 0;
+    }
     if (starts_with_ci(text, tn, "/PROG")) {
         c->format = RCH_COMP_FANUC;
         return 0;
@@ -196,7 +214,7 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
             rc = -1;
             break;
         }
-        if (c.format != 2 && is_comment_or_blank(text, tn)) {
+        if (c.format != 2 && c.format != 3 && is_comment_or_blank(text, tn)) {
             fwrite(line, 1, n, c.out);
             fputs(c.eol, c.out);
             if (out_failed(&c, lineno, d)) {
@@ -221,9 +239,11 @@ int rch_comp_lines_gated(FILE *out, rch_comp_result *res, FILE *in, const char *
                 rc = -1;
             break;
         }
-        if (c.format == 2 || c.format == RCH_COMP_FORMAT_URSCRIPT) { /* read whole, its bytes as they are */
-            rc = c.format == 2 ? rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d)
-                               : rch_cpi_urscript(&c, line, (size_t)got, in, lineno, d);
+        if (c.format == 2 || c.format == RCH_COMP_FORMAT_URSCRIPT || c.format == RCH_COMP_KRL) {
+            /* read whole, its bytes as they are: all or nothing */
+            rc = c.format == 2                          ? rch_cpi_rapid(&c, line, (size_t)got, in, lineno, d)
+                 : c.format == RCH_COMP_FORMAT_URSCRIPT ? rch_cpi_urscript(&c, line, (size_t)got, in, lineno, d)
+                                                        : rch_cpi_krl(&c, line, (size_t)got, in, lineno, d);
 
             if (rc >= 0 && out_failed(&c, lineno, d))
                 rc = -1;
