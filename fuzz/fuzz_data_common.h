@@ -44,9 +44,9 @@ static void fuzz_data(const uint8_t *data, size_t size, unsigned flags)
         for (int j = 0; j < RC_NJ; ++j)
             FZ_CHECK(isfinite(s->q_rad[j]) && fabs(s->q_rad[j]) <= q_max);
         if (flags & RCH_DATA_NO_LEN)
-            FZ_CHECK(s->len_mm == 0.0 || (s->len_mm > 0.0 && s->len_mm <= 20000.0));
+            FZ_CHECK(s->value == 0.0 || (s->value > 0.0 && s->value <= 20000.0));
         else
-            FZ_CHECK(s->len_mm > 0.0 && s->len_mm <= 20000.0);
+            FZ_CHECK(s->value > 0.0 && s->value <= 20000.0);
         /* documented: t scaled to [0, 1] */
         FZ_CHECK(isfinite(s->t) && s->t >= 0.0 && s->t <= 1.0);
         /* a header takes line 1, except in a target list without one (RCH_DATA_TARGETS) */

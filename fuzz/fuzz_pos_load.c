@@ -37,7 +37,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     FZ_CHECK(p.n == 3 * p.rows && p.rows >= 1 && p.poses >= 1 && p.n_targets >= 1 && p.n_targets <= RC_MAX_TARGETS);
     for (size_t i = 0; i < p.n; ++i) {
-        FZ_CHECK(p.s[i].sensor == RC_SENSOR_TRACKER_X + i % 3 && isfinite(p.s[i].len_mm));
+        FZ_CHECK(p.s[i].sensor == RC_SENSOR_TRACKER_X + i % 3 && isfinite(p.s[i].value));
         FZ_CHECK(p.s[i].t >= 0.0 && p.s[i].t < (double)p.poses && p.s[i].target < p.n_targets);
         FZ_CHECK(p.line[i] >= 2 && p.file[i] == 0);
     }

@@ -46,7 +46,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* Exercise the model: zero pose and the joint-limit corners. */
     rc_sample s;
     memset(&s, 0, sizeof s);
-    s.len_mm = 500.0;
+    s.value = 500.0;
     double p[3], rot[9], jac[RC_MAX_PARAMS];
     for (int corner = 0; corner < 3; ++corner) {
         for (int j = 0; j < RC_NJ; ++j)

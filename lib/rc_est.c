@@ -474,7 +474,7 @@ static rc_status run_ekf(est_ctx *c, rc_model *m)
             double l, hph = 0.0;
             if (rc_meas(&l, w->jrow, x, &c->s[s]) != RC_OK)
                 continue; /* degenerate sample: no information */
-            const double innov = c->s[s].len_mm - l;
+            const double innov = c->s[s].value - l;
             for (unsigned j = 0; j < nf; ++j) {
                 h[j] = w->jrow[w->idx[j]];
                 w->P[(size_t)j * nf + j] += q * w->bound[j] * w->bound[j];
@@ -556,7 +556,7 @@ static rc_status run_iekf(est_ctx *c, rc_model *m)
                 h[j] = w->jrow[w->idx[j]];
                 pred += h[j] * (x->x[w->idx[j]] - xl[j]);
             }
-            const double innov = c->s[s].len_mm - pred;
+            const double innov = c->s[s].value - pred;
             double S;
             if (kalman_update(&S, &hph, w, x, nf, R, innov) != RC_OK)
                 return RC_ERR_NUMERIC;

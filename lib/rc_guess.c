@@ -35,7 +35,7 @@ rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample 
             p[r] -= c[r];
         /* -2 p.e' + k = L^2 - |p|^2 */
         const double row[4] = {-2.0 * p[0], -2.0 * p[1], -2.0 * p[2], 1.0};
-        const double rhs = samples[i].len_mm * samples[i].len_mm - (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        const double rhs = samples[i].value * samples[i].value - (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
         for (unsigned a = 0; a < 4; ++a) {
             b[a] += row[a] * rhs;
             for (unsigned k = 0; k < 4; ++k)
@@ -70,9 +70,9 @@ rc_status rc_encoder_guess(double enc_mm[3], const rc_model *m, const rc_sample 
         double p[3];
         rc_point_prepared(p, m, &mp, &samples[i], NULL, NULL);
         const double dx = p[0] - e[0], dy = p[1] - e[1], dz = p[2] - e[2];
-        const double d = sqrt(dx * dx + dy * dy + dz * dz) - samples[i].len_mm;
+        const double d = sqrt(dx * dx + dy * dy + dz * dz) - samples[i].value;
         res2 += d * d;
-        len2 += samples[i].len_mm * samples[i].len_mm;
+        len2 += samples[i].value * samples[i].value;
     }
     if (!(sqrt(res2) <= 0.15 * sqrt(len2) + sqrt((double)n)))
         return RC_ERR_RANGE;

@@ -230,7 +230,7 @@ const char *rc_sensor_unit(unsigned sensor);
  * sensor kind the model does not know makes rc_meas return RC_ERR_ARG. */
 typedef struct rc_sample {
     double q_rad[RC_NJ]; /* (6) joint readings */
-    double len_mm;       /* the measured value (mm): cable length, or the tracker coordinate */
+    double value;        /* the measured value (mm): cable length, or the tracker coordinate */
     double t;            /* acquisition order scaled to [0, 1] */
     uint16_t group;      /* set-up group (consecutive samples sharing a set-up) */
     uint8_t outlet;      /* the encoder outlet it was measured from: 0 = e, k = the RC_EFF_OUTLET effect

@@ -38,7 +38,7 @@ static rc_status sample_row(double *r, double *jac, const rc_model_rows *mr, siz
     if (st != RC_OK)
         return st;
     const double wt = rc_sample_weight(smp);
-    r[0] = (l - smp->len_mm) * wt;
+    r[0] = (l - smp->value) * wt;
     if (jac != NULL && wt != 1.0)
         for (unsigned k = 0; k < mr->eval->n_params; ++k)
             jac[k] *= wt;
@@ -216,7 +216,7 @@ rc_status rc_eval(rc_metrics *out, const rc_model *m, const rc_sample *samples, 
         rc_status st = rc_meas_prepared(&l, NULL, m, &p, &samples[i], NULL, NULL);
         if (st != RC_OK)
             return st;
-        const double e = l - samples[i].len_mm;
+        const double e = l - samples[i].value;
         const double d = e - mean;
         mean += d / (double)(i + 1);
         m2 += d * (e - mean);

@@ -193,7 +193,7 @@ static void test_identified_model_compensates(void **state)
         s[i].t = 0.0;
         s[i].group = 0;
         s[i].outlet = 0;
-        assert_int_equal(rc_meas(&s[i].len_mm, NULL, &truth, &s[i]), RC_OK);
+        assert_int_equal(rc_meas(&s[i].value, NULL, &truth, &s[i]), RC_OK);
     }
     cal = nom;
     memset(fixed, 0, sizeof fixed);

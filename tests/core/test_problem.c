@@ -234,7 +234,7 @@ static void test_robot_blocks(void **state)
         for (unsigned j = 0; j < RC_NJ; ++j)
             s[k].q_rad[j] = 0.5 * (rc_rng_u01(&g) - 0.5);
         s[k].sensor = k >= 2 && k < 8 ? (uint8_t)(RC_SENSOR_TRACKER_X + (k - 2) % 3) : RC_SENSOR_LENGTH;
-        s[k].len_mm = 500.0 + k;
+        s[k].value = 500.0 + k;
     }
     rc_problem p;
     rc_model_rows r;

@@ -93,7 +93,7 @@ static void draw(rc_sample *s, size_t n, const truth *t, double sd, rc_rng *g)
             s[i].q_rad[j] = (mid + (2.0 * rc_rng_u01(g) - 1.0) * (j == 5 ? 180.0 : half)) * PI / 180.0;
         }
         s[i].t = (double)i / (double)(n > 1 ? n - 1 : 1);
-        s[i].len_mm = own_len(t, s[i].q_rad) + sd * rc_rng_normal(g);
+        s[i].value = own_len(t, s[i].q_rad) + sd * rc_rng_normal(g);
     }
 }
 
@@ -152,7 +152,7 @@ static void test_own_fk_matches(void **state)
         double l;
         draw(&s, 1, &t, 0.0, &g);
         assert_int_equal(rc_meas(&l, NULL, &m, &s), RC_OK);
-        assert_true(fabs(l - s.len_mm) < 1e-9);
+        assert_true(fabs(l - s.value) < 1e-9);
     }
 }
 

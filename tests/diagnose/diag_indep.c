@@ -209,7 +209,7 @@ static void make(rc_sample *s, const rc_model *nom, eff e, rct_rng *g, double no
             extra[i] = drum_error_mm(l0[i], drum_mm, phase);
     const double rms = rms_centered(extra, N, center), k = e == E_SAG ? 1.0 : rms > 0 ? target / rms : 0.0;
     for (size_t i = 0; i < N; ++i)
-        s[i].len_mm = l0[i] + k * extra[i] + noise * rct_gauss(g);
+        s[i].value = l0[i] + k * extra[i] + noise * rct_gauss(g);
 }
 
 static int cmp_d(const void *a, const void *b)

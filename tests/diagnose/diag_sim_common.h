@@ -203,7 +203,7 @@ static inline int diag_simulate_band(rc_sample *s, size_t n, const rc_model *nom
     if (rch_sim_samples(s, NULL, n, &truth, &sc, &g) != 0)
         return -1;
     for (size_t i = 0; i < n; ++i)
-        s[i].len_mm = 0.001 * round((s[i].len_mm + *noise_mm * rc_rng_normal(&g)) / 0.001);
+        s[i].value = 0.001 * round((s[i].value + *noise_mm * rc_rng_normal(&g)) / 0.001);
     return 0;
 }
 

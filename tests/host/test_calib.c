@@ -68,7 +68,7 @@ static void test_run_demo(void **state)
     for (size_t i = 0; i < r.n_test; ++i) {
         double l;
         assert_int_equal(rc_meas(&l, NULL, &r.model, &data.s[idx[i]]), RC_OK);
-        rch_stats_add(&st, l - data.s[idx[i]].len_mm);
+        rch_stats_add(&st, l - data.s[idx[i]].value);
     }
     rc_metrics m;
     rch_stats_metrics(&m, &st);
@@ -285,7 +285,7 @@ static void test_random_poses(void **state)
             assert_true(q >= robot.model.q_min_rad[j] + margin && q <= robot.model.q_max_rad[j] - margin);
             lo[j] = q < lo[j] ? q : lo[j];
             hi[j] = q > hi[j] ? q : hi[j];
-            assert_true(s[i].len_mm == 0.0 && s[i].group == 0);
+            assert_true(s[i].value == 0.0 && s[i].group == 0);
         }
     for (unsigned j = 0; j < RC_NJ; ++j) { /* 2000 draws reach within 1 % of each end */
         const double span = robot.model.q_max_rad[j] - robot.model.q_min_rad[j] - 2 * margin;

@@ -75,7 +75,7 @@ static void one(tally *t, const rch_robot *nom, rct_rng *g, int grouped, rc_solv
         }
         double p[3];
         rct_flange(p, dh, s[i].q_rad);
-        s[i].len_mm = rct_dist(p, e) + noise * rct_gauss(g);
+        s[i].value = rct_dist(p, e) + noise * rct_gauss(g);
         s[i].t = (double)i / (N - 1);
         s[i].group = (uint16_t)(i / 20);
         s[i].outlet = 0;

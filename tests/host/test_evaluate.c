@@ -46,15 +46,15 @@ static void test_iso9283_and_refit(void **state)
         for (int r = 0; r < R; ++r) {
             rc_sample *x = &s[p * R + r];
             memcpy(x->q_rad, q, sizeof q);
-            x->len_mm = truth + bias + 0.01 * rct_gauss(&g);
+            x->value = truth + bias + 0.01 * rct_gauss(&g);
             x->t = 0;
             x->group = 0;
             x->outlet = 0;
-            mean += x->len_mm;
+            mean += x->value;
         }
         mean /= R;
         for (int r = 0; r < R; ++r)
-            ss += (s[p * R + r].len_mm - mean) * (s[p * R + r].len_mm - mean);
+            ss += (s[p * R + r].value - mean) * (s[p * R + r].value - mean);
         double ad = fabs(mean - truth), rd = 3.0 * sqrt(ss / (R - 1));
         ad_max = fmax(ad_max, ad);
         rd_max = fmax(rd_max, rd);

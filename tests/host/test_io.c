@@ -31,7 +31,7 @@ static void test_good(void **state)
     assert_int_equal(parse(&d, &dg, "1,2,3,10,20,30,40,50,60,509.19\r\n\n# comment\n1,2,3,0,0,0,0,0,0,300\n"), 0);
     assert_int_equal(d.n, 2);
     assert_true(fabs(d.s[0].q_rad[0] - 10.0 * 3.14159265358979 / 180.0) < 1e-9);
-    assert_true(fabs(d.s[0].len_mm - 509.19) < 1e-12);
+    assert_true(fabs(d.s[0].value - 509.19) < 1e-12);
     assert_int_equal(d.line[1], 5);
     assert_non_null(d.xyz);
     assert_true(d.s[0].t == 0.0 && d.s[1].t == 1.0);

@@ -66,10 +66,10 @@ static void make(rc_sample *s, size_t n, rct_rng *g, double noise, unsigned n_ju
         }
         double p[3];
         rct_flange(p, dh, s[i].q_rad);
-        s[i].len_mm = rct_dist(p, e) + noise * rct_gauss(g);
+        s[i].value = rct_dist(p, e) + noise * rct_gauss(g);
         for (unsigned k = 0; k < n_jumps; ++k)
             if (i >= at[k])
-                s[i].len_mm += size[k];
+                s[i].value += size[k];
         s[i].t = (double)i / (double)(n - 1);
         s[i].group = 0;
         s[i].outlet = 0;

@@ -64,7 +64,7 @@ static rc_sample *random_plan(size_t *n, const rc_model *m, size_t n_pose, unsig
                 memcpy(r[*n].q_rad, q[i], sizeof q[i]);
                 r[*n].outlet = (uint8_t)k;
                 r[*n].target = (uint8_t)t;
-                r[*n].len_mm = (double)*n; /* a tag: which input row this is */
+                r[*n].value = (double)*n; /* a tag: which input row this is */
                 ++*n;
             }
     free(q);
@@ -98,7 +98,7 @@ static void check_permutation(const rc_sample *in, const rc_sample *out, size_t 
     unsigned char *seen = calloc(n, 1);
     assert_non_null(seen);
     for (size_t i = 0; i < n; ++i) {
-        const size_t k = (size_t)out[i].len_mm;
+        const size_t k = (size_t)out[i].value;
         assert_true(k < n);
         assert_false(seen[k]);
         seen[k] = 1;
@@ -189,7 +189,7 @@ static void test_branch(void **st)
     for (int i = 0; i < 8; ++i) {
         r[i].q_rad[0] = (10.0 * i) * PI / 180.0;
         r[i].q_rad[5] = (i % 2 ? -350.0 : 350.0) * PI / 180.0;
-        r[i].len_mm = i;
+        r[i].value = i;
     }
     rc_sample in[8];
     memcpy(in, r, sizeof r);

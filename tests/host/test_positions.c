@@ -62,7 +62,7 @@ static rc_sample *make(size_t *n_out, const rc_model *m, unsigned nt, size_t pos
                 s[n].sensor = (uint8_t)(RC_SENSOR_TRACKER_X + c);
                 s[n].target = (uint8_t)k;
                 s[n].t = (double)p;
-                assert_int_equal(rc_meas(&s[n].len_mm, NULL, m, &s[n]), RC_OK);
+                assert_int_equal(rc_meas(&s[n].value, NULL, m, &s[n]), RC_OK);
                 ++n;
             }
     }
@@ -112,7 +112,7 @@ static void test_split_keeps_poses(void **state)
     rc_sample *s = calloc(total, sizeof *s); /* ten lengths first, then the positions */
     assert_non_null(s);
     for (size_t i = 0; i < nl; ++i)
-        s[i].len_mm = 500.0 + (double)i;
+        s[i].value = 500.0 + (double)i;
     memcpy(s + nl, pos, n * sizeof *s);
     assert_int_equal(rch_pos_count_lengths(s, total), nl);
     assert_int_equal(rch_pos_count_tracker(s, total), n);
@@ -149,10 +149,10 @@ static void test_errors_iso(void **state)
     memcpy(s, base, 3 * sizeof *s);     /* pose 0, +0.1 mm in x */
     memcpy(s + 3, base, 3 * sizeof *s); /* pose 0 again, -0.1 mm in x */
     memcpy(s + 6, base + 3, 3 * sizeof *s);
-    s[0].len_mm += 0.1;
-    s[3].len_mm -= 0.1;
-    s[6].len_mm += 0.3; /* pose 1: (0.3, 0.4, 0) off */
-    s[7].len_mm += 0.4;
+    s[0].value += 0.1;
+    s[3].value -= 0.1;
+    s[6].value += 0.3; /* pose 1: (0.3, 0.4, 0) off */
+    s[7].value += 0.4;
     rch_pos_err e;
     assert_int_equal(rch_pos_errors(&e, &m, s, 9), 0);
     assert_int_equal(e.points, 3);
@@ -247,7 +247,7 @@ static void test_load(void **state)
     assert_int_equal(p.n_targets, 2);
     assert_true(p.has_sigma && p.sigma_mm == 0.02);
     assert_true(p.s[3].t == 0.0 && p.s[6].t == 1.0 && p.s[4].target == 1 && p.s[5].sensor == RC_SENSOR_TRACKER_Z);
-    assert_true(p.s[4].len_mm == -200.0 && p.line[8] == 4);
+    assert_true(p.s[4].value == -200.0 && p.line[8] == 4);
     rch_pos_free(&p);
     f = fopen(path, "w");
     fputs("q1,q2,q3,q4,q5,q6,x,y,z\n0,10,-20,30,40,50,1000,-2x0,300\n", f);

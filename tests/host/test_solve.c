@@ -319,7 +319,7 @@ static void ident_cut_case(double s_target, unsigned *rank_solve, unsigned *rank
         s[i].outlet = 0;
         double l;
         assert_int_equal(rc_meas(&l, NULL, &m, &s[i]), RC_OK);
-        s[i].len_mm = l + 0.01 * rc_rng_normal(&g) + 0.3;
+        s[i].value = l + 0.01 * rc_rng_normal(&g) + 0.3;
     }
     uint8_t fixed[RC_MAX_PARAMS];
     memset(fixed, 1, sizeof fixed);
@@ -488,7 +488,7 @@ static void test_normal_eq_rows(void **state)
     for (size_t i = 0; i < N; ++i) {
         double l, J[RC_MAX_PARAMS];
         assert_int_equal(rc_meas_prepared(&l, J, &truth, &p, &s[i], NULL, NULL), RC_OK);
-        const double r = l - s[i].len_mm;
+        const double r = l - s[i].value;
         costr += r * r;
         for (unsigned a = 0; a < nf; ++a) {
             gr[a] += J[idx[a]] * r;

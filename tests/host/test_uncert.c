@@ -50,7 +50,7 @@ static void one_robot(tally *t, const rch_robot *nom, double noise_mm, size_t n,
         }
         double p[3];
         rct_flange(p, dh, s[i].q_rad);
-        s[i].len_mm = sqrt((p[0] - enc[0]) * (p[0] - enc[0]) + (p[1] - enc[1]) * (p[1] - enc[1]) +
+        s[i].value = sqrt((p[0] - enc[0]) * (p[0] - enc[0]) + (p[1] - enc[1]) * (p[1] - enc[1]) +
                            (p[2] - enc[2]) * (p[2] - enc[2])) +
                       noise_mm * gauss();
         s[i].group = grouped ? (uint16_t)(i / 10) : 0;

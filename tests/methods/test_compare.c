@@ -294,7 +294,7 @@ static void test_jumps_every_method(void **state)
     (void)state;
     memcpy(s, g_s, sizeof s);
     for (size_t i = NS / 2; i < NS; ++i)
-        s[i].len_mm += 4.0; /* t ascends with i */
+        s[i].value += 4.0; /* t ascends with i */
     rch_compare_defaults(&cfg);
     cfg.cases = 1;
     cfg.samples = NS;

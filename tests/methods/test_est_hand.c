@@ -53,9 +53,9 @@ static int setup(void **state)
         memset(&g_s[i], 0, sizeof g_s[i]);
         for (unsigned j = 0; j < RC_NJ; ++j)
             g_s[i].q_rad[j] = (rc_rng_u01(&g) - 0.5) * (j == 1 || j == 2 ? 1.6 : 3.0);
-        if (rc_meas(&g_s[i].len_mm, NULL, &truth, &g_s[i]) != RC_OK)
+        if (rc_meas(&g_s[i].value, NULL, &truth, &g_s[i]) != RC_OK)
             return -1;
-        g_s[i].len_mm += 0.02 * rc_rng_normal(&g);
+        g_s[i].value += 0.02 * rc_rng_normal(&g);
     }
     memset(g_fixed, 1, sizeof g_fixed);
     for (unsigned i = 0; i < NP; ++i)
@@ -291,7 +291,7 @@ static void test_ekf_hand(void **state)
             for (unsigned j = 0; j < NP; ++j)
                 m.x[g_idx[j]] = x[j];
             assert_int_equal(rc_meas(&l, jrow, &m, &g_s[s]), RC_OK);
-            const double innov = g_s[s].len_mm - l;
+            const double innov = g_s[s].value - l;
             for (unsigned j = 0; j < NP; ++j) {
                 hv[j] = jrow[g_idx[j]];
                 P[j][j] += q * g_bound[j] * g_bound[j];

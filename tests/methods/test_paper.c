@@ -57,7 +57,7 @@ static int setup(void **state)
         memset(&g_s[i], 0, sizeof g_s[i]);
         for (unsigned j = 0; j < RC_NJ; ++j)
             g_s[i].q_rad[j] = (rc_rng_u01(&g) - 0.5) * (j == 1 || j == 2 ? 1.6 : 3.0);
-        assert_int_equal(rc_meas(&g_s[i].len_mm, NULL, &truth, &g_s[i]), RC_OK);
+        assert_int_equal(rc_meas(&g_s[i].value, NULL, &truth, &g_s[i]), RC_OK);
     }
     return 0;
 }
@@ -90,7 +90,7 @@ static double hand_normal(double A[NP * NP], double gv[NP], const double u[NP], 
     for (unsigned s = 0; s < NS; ++s) {
         double l, j[NP];
         assert_int_equal(rc_meas(&l, jrow, &m, &g_s[s]), RC_OK);
-        const double r = l - g_s[s].len_mm;
+        const double r = l - g_s[s].value;
         cost += r * r;
         for (unsigned i = 0; i < NP; ++i)
             j[i] = jrow[g_idx[i]] * (i == 1 ? ang(deg) : 1.0);

@@ -50,7 +50,7 @@ static inline void rb_random(rc_sample *s, size_t n, const rc_model *t, unsigned
             s[i].q_rad[j] = span_deg[j] * RB_DEG * (2.0 * rc_rng_u01(&g) - 1.0);
         s[i].q_rad[1] = 0.3 * s[i].q_rad[1] + 10 * RB_DEG;
         s[i].t = n > 1 ? (double)i / (double)(n - 1) : 0.0;
-        (void)rc_meas(&s[i].len_mm, NULL, t, &s[i]);
+        (void)rc_meas(&s[i].value, NULL, t, &s[i]);
     }
 }
 

@@ -83,7 +83,7 @@ static void replay_csv(const char *text, size_t len, const char *name)
     for (unsigned flags = 0; flags <= RCH_DATA_NO_LEN; flags += RCH_DATA_NO_LEN) {
         if (rch_data_parse(&d, text, len, name, flags, &diag) == 0) {
             for (size_t i = 0; i < d.n; ++i)
-                assert_true(isfinite(d.s[i].t) && isfinite(d.s[i].len_mm));
+                assert_true(isfinite(d.s[i].t) && isfinite(d.s[i].value));
             rch_data_free(&d);
         } else {
             assert_true(diag.msg[0] != '\0');
@@ -210,11 +210,11 @@ static void test_csv_conventions(void **state)
     /* accepted: a byte-order mark, CR-only endings, quoted header names */
     assert_int_equal(parse_text(&d, &dg, bom, sizeof bom - 1, 0), 0);
     assert_int_equal(d.n, 1);
-    assert_true(fabs(d.s[0].len_mm - 500.0) < 1e-12);
+    assert_true(fabs(d.s[0].value - 500.0) < 1e-12);
     rch_data_free(&d);
     assert_int_equal(parse_text(&d, &dg, cr, sizeof cr - 1, 0), 0);
     assert_int_equal(d.n, 2);
-    assert_true(fabs(d.s[1].len_mm - 600.0) < 1e-12);
+    assert_true(fabs(d.s[1].value - 600.0) < 1e-12);
     assert_int_equal(d.line[1], 3);
     rch_data_free(&d);
     assert_int_equal(parse_text(&d, &dg, quoted, sizeof quoted - 1, 0), 0);

@@ -178,7 +178,7 @@ static size_t collinear(rc_sample *s, size_t n, const rc_model *t)
         double p[3];
         rc_fk(p, NULL, &nom, s[i].q_rad);
         assert_true(fabs(p[1]) < 1e-6 && fabs(p[2] - 500.0) < 1e-6);
-        (void)rc_meas(&s[i].len_mm, NULL, t, &s[i]);
+        (void)rc_meas(&s[i].value, NULL, t, &s[i]);
     }
     return n;
 }
@@ -201,7 +201,7 @@ static void test_constant_length(void **state)
     rb_truth(&t);
     rb_random(S, NS, &t, 4);
     for (size_t i = 0; i < NS; ++i)
-        S[i].len_mm = 500.0;
+        S[i].value = 500.0;
     all_methods("constant L column", S, NS, o);
 }
 
@@ -216,7 +216,7 @@ static void test_huge_and_tiny(void **state)
         char what[32];
         rb_random(S, NS, &t, 5);
         for (size_t i = 0; i < NS; ++i)
-            S[i].len_mm = L[k] * (1.0 + 1e-3 * (double)i);
+            S[i].value = L[k] * (1.0 + 1e-3 * (double)i);
         snprintf(what, sizeof what, "L ~ %g", L[k]);
         all_methods(what, S, NS, o);
     }
@@ -238,7 +238,7 @@ static void test_one_wild_outlier(void **state)
     for (size_t k = 0; k < sizeof jump / sizeof jump[0]; ++k) {
         char what[32];
         rb_random(S, NS, &t, 7);
-        S[NS / 2].len_mm += jump[k];
+        S[NS / 2].value += jump[k];
         snprintf(what, sizeof what, "outlier %+g mm", jump[k]);
         all_methods(what, S, NS, o);
     }
@@ -303,7 +303,7 @@ static void test_encoder_guess_degenerate(void **state)
     for (size_t i = 0; i < NS; ++i) {
         for (int j = 1; j < RC_NJ; ++j)
             S[i].q_rad[j] = S[0].q_rad[j];
-        (void)rc_meas(&S[i].len_mm, NULL, &t, &S[i]);
+        (void)rc_meas(&S[i].value, NULL, &t, &S[i]);
     }
     guess_checked("coplanar (q1 only)", S, NS, 1);
     /* the same degeneracies, not aligned with the base axes: the arm turned
@@ -316,7 +316,7 @@ static void test_encoder_guess_degenerate(void **state)
             memset(&S[i], 0, sizeof S[i]);
             assert_int_equal(rb_ik_xz(S[i].q_rad, &nom, 300.0 + 3.0 * (double)i, 400.0 + 4.0 * (double)i), 0);
             S[i].q_rad[0] = 45.0 * RB_DEG;
-            (void)rc_meas(&S[i].len_mm, NULL, &t, &S[i]);
+            (void)rc_meas(&S[i].value, NULL, &t, &S[i]);
         }
         guess_checked("collinear (oblique)", S, 40, 1);
         rc_rng g;
@@ -326,7 +326,7 @@ static void test_encoder_guess_degenerate(void **state)
             assert_int_equal(rb_ik_xz(S[i].q_rad, &nom, 300.0 + 150.0 * rc_rng_u01(&g),
                                       300.0 + 300.0 * rc_rng_u01(&g)), 0);
             S[i].q_rad[0] = 45.0 * RB_DEG;
-            (void)rc_meas(&S[i].len_mm, NULL, &t, &S[i]);
+            (void)rc_meas(&S[i].value, NULL, &t, &S[i]);
         }
         /* was RC_OK with an outlet 1.9 m off until the guard used the
          * smallest scatter eigenvalue (found by this suite) */
@@ -334,14 +334,14 @@ static void test_encoder_guess_degenerate(void **state)
     }
     rb_random(S, NS, &t, 12);
     for (size_t i = 0; i < NS; ++i)
-        S[i].len_mm = 500.0;
+        S[i].value = 500.0;
     guess_checked("constant L", S, NS, 0);
     rb_random(S, NS, &t, 13);
     for (size_t i = 0; i < NS; ++i)
-        S[i].len_mm = 1e150;
+        S[i].value = 1e150;
     guess_checked("L = 1e150", S, NS, 0);
     rb_random(S, NS, &t, 14);
-    S[5].len_mm = 1e9;
+    S[5].value = 1e9;
     guess_checked("one outlier 1e9", S, NS, 0);
 }
 

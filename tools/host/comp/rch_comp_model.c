@@ -67,7 +67,7 @@ unsigned rch_comp_determined(rc_model *det, rch_model_unc *unc, int *version1, c
         for (size_t i = 0; i < N; ++i) {
             for (unsigned j = 0; j < RC_NJ; ++j)
                 s[k].q_rad[j] = m.q_min_rad[j] + (m.q_max_rad[j] - m.q_min_rad[j]) * rc_rng_u01(&g);
-            if (rc_meas(&s[k].len_mm, NULL, &m, &s[k]) == RC_OK)
+            if (rc_meas(&s[k].value, NULL, &m, &s[k]) == RC_OK)
                 ++k;
         }
         rch_uncert u;

@@ -188,7 +188,7 @@ static int check_plan(const rch_data *f, unsigned char *done, rch_acqfile_state 
     if (last < f->n) { /* the last sample from this place */
         st->has_last = 1;
         st->last_pose = (size_t)f->pose[last];
-        st->last_len_mm = f->s[last].len_mm;
+        st->last_len_mm = f->s[last].value;
     }
     return 0;
 }

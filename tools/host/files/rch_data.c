@@ -372,7 +372,7 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
     memset(s, 0, sizeof *s);
     for (int j = 0; j < RC_NJ; ++j)
         s->q_rad[j] = v[C_Q1 + j] * (M_PI / 180.0);
-    s->len_mm = v[C_L];
+    s->value = v[C_L];
     s->t = v[C_T];
     s->group = (uint16_t)v[C_G];
     s->outlet = (uint8_t)v[C_O]; /* the file's label: rch_data_outlets numbers them 0.. */
@@ -570,13 +570,13 @@ int rch_data_check_scale(const rch_data *data, const char *name, const rc_model 
             continue;
         double p[3];
         rc_fk(p, NULL, m, data->s[i].q_rad);
-        a[k] = data->s[i].len_mm;
+        a[k] = data->s[i].value;
         b[k++] = sqrt((p[0] - e[0]) * (p[0] - e[0]) + (p[1] - e[1]) * (p[1] - e[1]) + (p[2] - e[2]) * (p[2] - e[2]));
     }
     int rc = 0;
     const char *fix = NULL, *unit = NULL;
     double sl = 0.0, sr = 0.0;
-    if (k >= RCH_DATA_SCALE_MIN_ROWS && data->s[0].len_mm > 0.0) {
+    if (k >= RCH_DATA_SCALE_MIN_ROWS && data->s[0].value > 0.0) {
         sl = mad(a, k);
         sr = mad(b, k);
         if (sr >= RCH_DATA_SCALE_MIN_SPREAD_MM)
@@ -679,7 +679,7 @@ int rch_data_write(FILE *f, const rc_sample *s, size_t n, const rc_model *nomina
         }
         for (int j = 0; j < RC_NJ; ++j)
             fprintf(f, "%.4f,", s[i].q_rad[j] * (180.0 / M_PI));
-        if (fprintf(f, "%.4f\n", s[i].len_mm) < 0)
+        if (fprintf(f, "%.4f\n", s[i].value) < 0)
             return -1;
     }
     return fflush(f) == 0 ? 0 : -1;
@@ -740,7 +740,7 @@ int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d)
     for (size_t i = 0; i < data->n; ++i) {
         for (unsigned j = 0; j < RC_NJ; ++j)
             qmax = fmax(qmax, fabs(data->s[i].q_rad[j]));
-        lmax = fmax(lmax, data->s[i].len_mm);
+        lmax = fmax(lmax, data->s[i].value);
     }
     /* the loader converted degrees to radians: a file written in radians
      * leaves every joint within 7 "degrees" (400 deg is 6.98 rad) */

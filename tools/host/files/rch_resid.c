@@ -103,9 +103,9 @@ int rch_resid_write(FILE *f, const rch_resid_table *t)
         put_num(f, "%.12g", r->s.t);
         for (unsigned j = 0; j < RC_NJ; ++j)
             put_num(f, "%.12g", r->s.q_rad[j] / DEG);
-        put_num(f, "%.17g", r->s.len_mm);
+        put_num(f, "%.17g", r->s.value);
         put_num(f, "%.17g", r->predicted_mm);
-        put_num(f, "%.17g", r->s.len_mm - r->predicted_mm);
+        put_num(f, "%.17g", r->s.value - r->predicted_mm);
         fprintf(f, ",%s", rch_resid_set_name(r->set));
         for (unsigned k = 0; k < t->n_steps; ++k)
             put_num(f, "%.17g", r->after_mm[k]);

@@ -179,7 +179,7 @@ static int fit_jumps(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_work 
         }
         double l;
         if (!amb && rc_meas(&l, NULL, &r->jumps.model, &ev[i]) == RC_OK)
-            rch_stats_add(&sa, l - ev[i].len_mm);
+            rch_stats_add(&sa, l - ev[i].value);
         r->n_ambiguous += (size_t)amb;
     }
     rch_stats_metrics(&r->after_unambiguous, &sa);
@@ -569,7 +569,7 @@ static double jump_scale(const rch_jumps *j, const rc_sample *tr, size_t n)
         c.group = (uint16_t)rch_jumps_segment(j, c.t);
         double l;
         if (rc_meas(&l, NULL, &j->model, &c) == RC_OK && isfinite(l))
-            v[m++] = (l - c.len_mm) * rc_sample_weight(&c);
+            v[m++] = (l - c.value) * rc_sample_weight(&c);
     }
     const double s = m > 10 ? rch_mad_sd(v, m) : j->rms_after_mm;
     free(v);

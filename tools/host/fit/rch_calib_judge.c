@@ -223,7 +223,7 @@ void rch_calib_judge_run(rch_calib_result *r, rc_solve_work *w, const rc_sample 
     size_t nl = 0, nq = 0;
     for (size_t i = 0; i < n; ++i) {
         if (s[i].sensor == RC_SENSOR_LENGTH)
-            v[nl++] = s[i].len_mm;
+            v[nl++] = s[i].value;
     }
     j->display_step_mm = cfg->display_step_mm > 0.0 ? cfg->display_step_mm : decimal_step(v, nl, 1.0);
     for (size_t i = 0; i < n; ++i)

@@ -33,7 +33,7 @@ static unsigned other_outlet(const rc_model *m, const rc_sample *s, double tol, 
         rc_sample c = *s;
         c.outlet = (uint8_t)k;
         double l;
-        if (rc_meas(&l, NULL, m, &c) == RC_OK && fabs(l - s->len_mm) < tol)
+        if (rc_meas(&l, NULL, m, &c) == RC_OK && fabs(l - s->value) < tol)
             return (unsigned)label[k] + 1u;
     }
     return 0;
@@ -60,7 +60,7 @@ int rch_calib_screen(rch_calib_result *r, uint8_t *drop, const rc_sample *s, siz
         rc_sample c = s[i];
         const unsigned seg = r->have_jumps ? rch_jumps_segment(&r->jumps, c.t) : 0u;
         c.group = (uint16_t)seg;
-        res[i] = rc_meas(&l, NULL, fm, &c) == RC_OK ? (l - s[i].len_mm) * rc_sample_weight(&s[i]) : NAN;
+        res[i] = rc_meas(&l, NULL, fm, &c) == RC_OK ? (l - s[i].value) * rc_sample_weight(&s[i]) : NAN;
         /* a row the fit did not see just before a jump's first training row may lie after the jump (the
          * change point is known only between training rows): the segment that explains it (a misread stays
          * far under both); only for the last few rows before it */
@@ -70,8 +70,8 @@ int rch_calib_screen(rch_calib_result *r, uint8_t *drop, const rc_sample *s, siz
                 between += s[k].t > c.t && s[k].t < r->jumps.at_t[seg];
             c.group = (uint16_t)(seg + 1);
             if (between <= 2 && rc_meas(&l, NULL, fm, &c) == RC_OK &&
-                fabs((l - s[i].len_mm) * rc_sample_weight(&s[i])) < fabs(res[i]))
-                res[i] = (l - s[i].len_mm) * rc_sample_weight(&s[i]);
+                fabs((l - s[i].value) * rc_sample_weight(&s[i])) < fabs(res[i]))
+                res[i] = (l - s[i].value) * rc_sample_weight(&s[i]);
         }
     }
     double scale[2] = {0.0, 0.0}; /* cable, tracker */

@@ -51,10 +51,10 @@ static int iso9283(rch_evaluate_result *out, const rc_model *m, const rc_sample 
         if (k >= 2) {
             double mean = 0.0, ss = 0.0, l;
             for (size_t i = a; i < b; ++i)
-                mean += c[i].len_mm;
+                mean += c[i].value;
             mean /= (double)k;
             for (size_t i = a; i < b; ++i)
-                ss += (c[i].len_mm - mean) * (c[i].len_mm - mean);
+                ss += (c[i].value - mean) * (c[i].value - mean);
             if (rc_meas(&l, NULL, m, &c[a]) != RC_OK) {
                 free(c);
                 return -1;

@@ -493,7 +493,7 @@ static int check_frame(const rc_model *m, const rc_sample *s, size_t n, double s
     memcpy(sm, s, n * sizeof *sm);
     for (size_t i = 0; i < n; ++i) /* z negated: a rotation of these is a reflection of the file's */
         if (sm[i].sensor == RC_SENSOR_TRACKER_Z)
-            sm[i].len_mm = -sm[i].len_mm;
+            sm[i].value = -sm[i].value;
     if (rigid_fit(&rp, &fit[0], m, s, n) != 0 || rigid_fit(&rm, &fit[1], m, sm, n) != 0)
         goto done;
     if (rp > RCH_POS_MIRROR_MIN_MM && rm < RCH_POS_MIRROR_RATIO * rp) {
@@ -562,7 +562,7 @@ static int check_model(const rc_model *m, const rc_sample *s, size_t n, double s
         for (size_t i = 0; i < k; ++i) {
             rc_fk(o[i], NULL, &flange, s[3 * i].q_rad);
             for (int c = 0; c < 3; ++c)
-                y[i][c] = s[3 * i + c].len_mm;
+                y[i][c] = s[3 * i + c].value;
         }
         rc = check_scale((const double(*)[3])o, (const double(*)[3])y, k, path, d);
     }
@@ -596,7 +596,7 @@ static int append_file(rch_pos *out, const rch_data *dt, const uint8_t *drop, co
             rc_sample *o = &out->s[out->n];
             *o = dt->s[i];
             o->sensor = (uint8_t)(RC_SENSOR_TRACKER_X + c);
-            o->len_mm = dt->xyz[i][c];
+            o->value = dt->xyz[i][c];
             o->t = base + key[i];
             o->outlet = 0;
             o->group = 0;

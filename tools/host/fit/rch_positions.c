@@ -167,7 +167,7 @@ int rch_pos_start(rc_model *m, const rc_sample *s, size_t n, int keep_frame)
         if (is_point(s, n, i) && s[i].target < nt) {
             rc_fk(o[k], R6[k], &flange, s[i].q_rad);
             for (int c = 0; c < 3; ++c)
-                y[k][c] = s[i + c].len_mm;
+                y[k][c] = s[i + c].value;
             tg[k++] = s[i].target;
         }
     double *t = &m->x[kf], R[9], T[3];
@@ -344,7 +344,7 @@ int rch_pos_errors(rch_pos_err *e, const rc_model *m, const rc_sample *s, size_t
         if (!is_point(s, n, i))
             continue;
         for (int c = 0; c < 3; ++c) {
-            p[k].meas[c] = s[i + c].len_mm;
+            p[k].meas[c] = s[i + c].value;
             if (rc_meas(&p[k].pred[c], NULL, m, &s[i + c]) != RC_OK) {
                 free(p);
                 return -1;

@@ -96,7 +96,7 @@ int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const
             if (rc_meas(&l, NULL, truth, &s) != RC_OK)
                 return -1;
             double noise = c->noise_mm > 0.0 ? c->noise_mm * rc_rng_normal(g) : 0.0;
-            s.len_mm = quant(l + noise, c->resolution_mm);
+            s.value = quant(l + noise, c->resolution_mm);
             memcpy(s.q_rad, out[i - 1].q_rad, sizeof s.q_rad);
             s.t = n > 1 ? (double)i / (double)(n - 1) : 0.0;
             if (true_q_rad)
@@ -141,7 +141,7 @@ int rch_sim_samples(rc_sample *out, double (*true_q_rad)[RC_NJ], size_t n, const
             if (l >= c->len_min_mm && l <= c->len_max_mm && p[2] > 50.0) {
                 found = 1;
                 double noise = c->noise_mm > 0.0 ? c->noise_mm * rc_rng_normal(g) : 0.0;
-                s.len_mm = quant(l + noise, c->resolution_mm);
+                s.value = quant(l + noise, c->resolution_mm);
             }
         }
         if (!found)

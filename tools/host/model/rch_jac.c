@@ -51,7 +51,7 @@ int rch_jac_eval(rch_jac *out, const rc_model *m, const uint16_t *idx, unsigned 
             return -2;
         }
         const double wt = rc_sample_weight(&s[i]); /* the fit's rows: weighed as the solver weighs them */
-        out->r[i] = (l - s[i].len_mm) * wt;
+        out->r[i] = (l - s[i].value) * wt;
         for (unsigned k = 0; k < nf; ++k) {
             const double v = jrow[out->idx[k]] * wt;
             out->J[i * nf + k] = v;

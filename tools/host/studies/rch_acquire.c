@@ -485,7 +485,7 @@ static int predict_lengths(acq *a, const rc_model *m, const rch_data *plan)
         a->pred_mm[i] = NAN;
         if (a->other[i])
             continue;
-        s.len_mm = 0.0;
+        s.value = 0.0;
         s.outlet = a->pred_outlet;
         if (rc_meas(&a->pred_mm[i], NULL, m, &s) != RC_OK || !isfinite(a->pred_mm[i])) {
             a->pred_mm[i] = NAN;

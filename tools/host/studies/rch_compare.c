@@ -132,7 +132,7 @@ static void sample_errors(double *err, const rc_model *m, const rc_sample *s, si
 {
     for (size_t k = 0; k < n; ++k) {
         double l;
-        err[k] = rc_meas(&l, NULL, m, &s[k]) == RC_OK ? l - s[k].len_mm : NAN;
+        err[k] = rc_meas(&l, NULL, m, &s[k]) == RC_OK ? l - s[k].value : NAN;
     }
 }
 

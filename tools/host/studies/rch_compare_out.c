@@ -368,7 +368,7 @@ int rch_compare_resid(rch_resid_table *t, const rch_compare_result *res, const r
         for (int r = 1; r < RCH_COMPARE_ROWS; ++r) {
             double l;
             if (col[r] >= 0 && res->ok_case1[r] && rc_meas(&l, NULL, &res->model_case1[r], &s[k]) == RC_OK)
-                row.after_mm[col[r]] = s[k].len_mm - l;
+                row.after_mm[col[r]] = s[k].value - l;
         }
         if (rch_resid_add(t, &row) != 0)
             return -1;

@@ -65,7 +65,7 @@ int rch_dg_cv_run(rc_model *models, double *res, ctx *c)
         double l;
         if (rc_meas(&l, NULL, &models[c->fold[i]], &c->s[i]) != RC_OK)
             return -1;
-        res[i] = l - c->s[i].len_mm;
+        res[i] = l - c->s[i].value;
     }
     return 0;
 }

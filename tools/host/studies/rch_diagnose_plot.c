@@ -54,7 +54,7 @@ static double test_x(const rch_diagnose_result *r, unsigned k, size_t i, const c
     }
     if (strcmp(name, "cable length") == 0) {
         *label = "cable length (mm)";
-        return s->len_mm;
+        return s->value;
     }
     if (strcmp(name, "cable direction") == 0) {
         double p[3], u[3], nu = 0.0;

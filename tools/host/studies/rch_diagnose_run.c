@@ -356,7 +356,7 @@ static void phase_steps(run_state *S)
     size_t nl = 0; /* the lengths' step (a tracker's coordinates have none) */
     for (size_t i = 0; i < n; ++i)
         if (out->s[i].sensor == RC_SENSOR_LENGTH)
-            S->tmp[nl++] = out->s[i].len_mm;
+            S->tmp[nl++] = out->s[i].value;
     out->len_step_mm = S->cfg.len_step_mm > 0.0   ? S->cfg.len_step_mm
                        : S->cfg.len_step_mm < 0.0 || nl == 0 ? 0.0
                                                              : rch_dequant_detect_step(S->tmp, nl);
@@ -453,7 +453,7 @@ static int phase_floor(run_state *S, rch_diag *d)
         nu = nu > 0.0 ? sqrt(nu) : 1.0;
         S->var[i][V_LEV2] = rc_gravity_lever_m((const double(*)[4])ref, 1, out->s[i].q_rad);
         S->var[i][V_LEV3] = rc_gravity_lever_m((const double(*)[4])ref, 2, out->s[i].q_rad);
-        S->var[i][V_LEN] = tracker ? nu : out->s[i].len_mm;
+        S->var[i][V_LEN] = tracker ? nu : out->s[i].value;
         S->var[i][V_UX] = u[0] / nu;
         S->var[i][V_UY] = u[1] / nu;
         S->var[i][V_UZ] = u[2] / nu;
@@ -592,7 +592,7 @@ static int sharp_step(const rc_model *geo, const rc_sample *s, size_t n, size_t 
             double l;
             if (rc_meas(&l, NULL, geo, &s[i]) != RC_OK)
                 return 0;
-            r[m] = l - s[i].len_mm;
+            r[m] = l - s[i].value;
             x[m++] = (double)i - (double)a;
             sum[side] += r[m - 1];
             sq[side] += r[m - 1] * r[m - 1];
@@ -640,10 +640,10 @@ static void given_jumps(run_state *S)
         j->se_mm[k] = cfg->given_jump_se_mm[k];
     }
     for (size_t i = 0; i < out->n; ++i)
-        out->s[i].len_mm -= cfg->given_offset_mm[rch_jumps_segment(j, out->s[i].t)];
+        out->s[i].value -= cfg->given_offset_mm[rch_jumps_segment(j, out->s[i].t)];
     for (unsigned f = 0; f < S->c.k; ++f)
         for (size_t i = 0; i < S->c.n_train[f]; ++i)
-            S->c.train[f][i].len_mm -= cfg->given_offset_mm[rch_jumps_segment(j, S->c.train[f][i].t)];
+            S->c.train[f][i].value -= cfg->given_offset_mm[rch_jumps_segment(j, S->c.train[f][i].t)];
 }
 
 /* 4b. Length jumps in acquisition order: rcal calibrate's (cfg.jumps_given,
@@ -721,10 +721,10 @@ static int phase_jumps(run_state *S, rch_diag *d)
         out->jumps_implausible += fabs(out->jumps.size_mm[k]) > out->jump_max_mm;
     const rc_effect *e = &out->jumps.model.effects[out->jumps.model.n_effects - 1];
     for (size_t i = 0; i < n; ++i)
-        out->s[i].len_mm -= out->jumps.model.x[e->first + rch_jumps_segment(&out->jumps, out->s[i].t)];
+        out->s[i].value -= out->jumps.model.x[e->first + rch_jumps_segment(&out->jumps, out->s[i].t)];
     for (unsigned f = 0; f < S->c.k; ++f) /* the folds' training copies too */
         for (size_t i = 0; i < S->c.n_train[f]; ++i)
-            S->c.train[f][i].len_mm -=
+            S->c.train[f][i].value -=
                 out->jumps.model.x[e->first + rch_jumps_segment(&out->jumps, S->c.train[f][i].t)];
     out->geo = out->jumps.geometry;
     for (unsigned f = 0; f < S->c.k; ++f)

@@ -205,10 +205,10 @@ int rch_dg_score_test(double *f_stat, unsigned *dof, double *p_value, const rc_m
         double l;
         if (rc_meas(&l, jac, m0, &c->s[i]) != RC_OK)
             goto done;
-        r[i] = l - c->s[i].len_mm;
+        r[i] = l - c->s[i].value;
         r1[i] = r[i];
         if (m1 && rc_meas(&l, NULL, m1, &c->s[i]) == RC_OK)
-            r1[i] = l - c->s[i].len_mm;
+            r1[i] = l - c->s[i].value;
         for (unsigned k = 0; k < nf; ++k)
             J[(size_t)k * ld + i] = jac[col[k]];
     }

@@ -170,8 +170,8 @@ static int periodic_start(rc_model *m, const rc_model *base, const rc_sample *s,
         double l;
         if (rc_meas(&l, NULL, base, &s[i]) != RC_OK)
             continue;
-        len[cnt] = s[i].len_mm;
-        e[cnt] = s[i].len_mm - l;
+        len[cnt] = s[i].value;
+        e[cnt] = s[i].value - l;
         lmin = len[cnt] < lmin ? len[cnt] : lmin;
         lmax = len[cnt] > lmax ? len[cnt] : lmax;
         ml += len[cnt];
@@ -263,8 +263,8 @@ static int cand_identify(run_state *S, unsigned ci, unsigned count, rch_diagnose
     if (cd->kind == RC_EFF_LENGTH_PERIODIC) { /* a drum turn: 10 mm .. the lengths' range, at most 500 mm */
         double lmin = 1e300, lmax = -1e300;
         for (size_t i = 0; i < out->n; ++i) {
-            lmin = out->s[i].len_mm < lmin ? out->s[i].len_mm : lmin;
-            lmax = out->s[i].len_mm > lmax ? out->s[i].len_mm : lmax;
+            lmin = out->s[i].value < lmin ? out->s[i].value : lmin;
+            lmax = out->s[i].value > lmax ? out->s[i].value : lmax;
         }
         const double per = fabs(full->x[full->effects[full->n_effects - 1].first + 2]);
         const double hi = lmax - lmin < PERIOD_MAX_MM ? lmax - lmin : PERIOD_MAX_MM;
