@@ -22,17 +22,6 @@
 #include "rch_ikg.h"
 
 typedef struct {
-    size_t off, len;
-    char rep[40];
-} edit;
-
-static int edit_cmp(const void *a, const void *b)
-{
-    const size_t x = ((const edit *)a)->off, y = ((const edit *)b)->off;
-    return x < y ? -1 : x > y;
-}
-
-typedef struct {
     double R[9], p[3];
 } pose;
 
@@ -112,51 +101,6 @@ static void fanuc_config(char cfg[3], int turn[3], const fstate *fs, const doubl
     static const int ax[3] = {0, 3, 5};
     for (int k = 0; k < 3; ++k)
         turn[k] = (int)ceil((j[ax[k]] / DEG - 180.0) / 360.0 - 1e-12);
-}
-
-/* Compensate at tcp (3, DH flange frame): as the RAPID path's use_tcp. */
-static int use_tcp(rch_cpi_ctx *c, const double tcp[3], char *why, size_t why_len)
-{
-    const double *jt = c->gate ? c->gate->tool_mm : NULL;
-    const int has_tcp = tcp[0] != 0.0 || tcp[1] != 0.0 || tcp[2] != 0.0;
-    c->stream = c->stream0;
-    c->cal = c->cal0;
-    c->fit = c->fit0;
-    if ((!has_tcp && !jt) || (jt && tcp[0] == jt[0] && tcp[1] == jt[1] && tcp[2] == jt[2]))
-        return 0;
-    for (size_t k = 0; k < c->ntcps; ++k)
-        if (c->tcps[k]->tcp[0] == tcp[0] && c->tcps[k]->tcp[1] == tcp[1] && c->tcps[k]->tcp[2] == tcp[2]) {
-            c->stream = &c->tcps[k]->s;
-            c->cal = &c->tcps[k]->det;
-            c->fit = &c->tcps[k]->fit;
-            return 0;
-        }
-    const rch_comp_gate *g = c->gate;
-    if (!g || !g->det_any || !g->cfg || !g->nominal || c->ntcps == RCH_CPI_MAX_TCPS) {
-        snprintf(why, why_len, "its tool's TCP [%g,%g,%g] (flange frame) is not the point this compensation was set "
-                 "up for%s", tcp[0], tcp[1], tcp[2], c->ntcps == RCH_CPI_MAX_TCPS ? " (more than 16 TCPs)" : "");
-        return -1;
-    }
-    rch_cpi_tcp_stream *ts = calloc(1, sizeof *ts);
-    if (!ts) {
-        snprintf(why, why_len, "out of memory");
-        return -1;
-    }
-    memcpy(ts->tcp, tcp, sizeof ts->tcp);
-    rch_comp_point_model(&ts->det, g->det_any, tcp);
-    rch_comp_point_model(&ts->nom, g->nominal, tcp);
-    rch_comp_point_model(&ts->fit, g->fit_any ? g->fit_any : g->det_any, tcp);
-    const rc_status st = rc_comp_stream_init(&ts->s, &ts->det, &ts->nom, g->cfg);
-    if (st != RC_OK) {
-        snprintf(why, why_len, "the model cannot be used for compensation at its tool's TCP: %s", rc_strerror(st));
-        free(ts);
-        return -1;
-    }
-    c->tcps[c->ntcps++] = ts;
-    c->stream = &ts->s;
-    c->cal = &ts->det;
-    c->fit = g->fit_any ? &ts->fit : NULL;
-    return 0;
 }
 
 /* The frames of position q: UF (in the world) and UT (in the faceplate).
@@ -251,7 +195,7 @@ static int fanuc_pos(rch_cpi_ctx *c, const fstate *fs, double out[RCH_FANUC_NUMS
                 return -1;
             }
     }
-    if (use_tcp(c, fut.p, why, why_len) != 0)
+    if (rch_cpi_use_tcp(c, fut.p, fut.p[0] != 0.0 || fut.p[1] != 0.0 || fut.p[2] != 0.0, why, why_len) != 0)
         return -1;
     unsigned cols[RC_NJ];
     for (int k = 0; k < RC_NJ; ++k) {
@@ -375,17 +319,9 @@ static int do_fanuc_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
         rch_fanuc_free(&prog);
         return -1;
     }
-    edit *ed = NULL;
-    size_t ne = 0;
+    rch_cpi_edits ed = {NULL, 0, 0};
     unsigned long n_bad = 0;
     int rc = 0;
-    ed = malloc(prog.n * RCH_FANUC_NUMS * sizeof *ed);
-    if (!ed) {
-        rch_diag_set(d, c->in_name, 0, 0, "out of memory");
-        free(fs.ik);
-        rch_fanuc_free(&prog);
-        return -1;
-    }
     for (size_t i = 0; i < prog.n; ++i) {
         const rch_fanuc_pos *q = &prog.p[i];
         char why[512];
@@ -402,32 +338,22 @@ static int do_fanuc_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
         if (r > 0)
             rc = 1;
         for (unsigned k = 0; k < q->n; ++k) {
-            edit *x = &ed[ne++];
-            x->off = q->num_off[k];
-            x->len = q->num_len[k];
             const char *fmt = k >= 6 ? "%.0f" : (!q->joint && k < 3) ? "%.4f" : "%.6f";
-            snprintf(x->rep, sizeof x->rep, fmt, out[k] == 0.0 ? 0.0 : out[k]);
+            if (rch_cpi_edit_add(&ed, q->num_off[k], q->num_len[k], fmt, out[k] == 0.0 ? 0.0 : out[k]) != 0) {
+                rch_diag_set(d, c->in_name, 0, 0, "out of memory");
+                rch_cpi_edits_free(&ed);
+                free(fs.ik);
+                rch_fanuc_free(&prog);
+                return -1;
+            }
         }
     }
     if (n_bad > 0) {
-        if (c->warn)
-            rch_diag_set(d, c->in_name, 0, 0, "%lu position%s cannot be corrected (each named above with its line, "
-                         "column and reason); nothing written", n_bad, n_bad == 1 ? "" : "s");
-        else
-            strncat(d->msg, " (nothing written)", sizeof d->msg - strlen(d->msg) - 1);
+        rch_cpi_refused(c, d, n_bad, "position");
         rc = -1;
-    } else {
-        /* in the text's order (a record's CONFIG turns come before its X) */
-        qsort(ed, ne, sizeof *ed, edit_cmp);
-        size_t at = 0;
-        for (size_t k = 0; k < ne; ++k) {
-            fwrite(text + at, 1, ed[k].off - at, c->out);
-            fputs(ed[k].rep, c->out);
-            at = ed[k].off + ed[k].len;
-        }
-        fwrite(text + at, 1, len - at, c->out);
-    }
-    free(ed);
+    } else /* in the text's order there (a record's CONFIG turns come before its X) */
+        rch_cpi_edits_write(c, text, len, &ed);
+    rch_cpi_edits_free(&ed);
     free(fs.ik);
     rch_fanuc_free(&prog);
     return rc;
@@ -435,36 +361,5 @@ static int do_fanuc_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
 
 int rch_cpi_fanuc(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d)
 {
-    size_t cap = got + 65536, n = got;
-    char *buf = malloc(cap);
-    if (!buf) {
-        rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-        return -1;
-    }
-    memcpy(buf, line, got);
-    for (;;) {
-        if (n == cap) {
-            if (cap > RCH_FANUC_MAX_BYTES) {
-                free(buf);
-                rch_diag_set(d, c->in_name, 0, 0, "a Fanuc LS program of more than %u bytes is refused",
-                             RCH_FANUC_MAX_BYTES);
-                return -1;
-            }
-            char *nb = realloc(buf, 2 * cap);
-            if (!nb) {
-                free(buf);
-                rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-                return -1;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-        const size_t k = fread(buf + n, 1, cap - n, in);
-        n += k;
-        if (k == 0)
-            break;
-    }
-    const int rc = do_fanuc_text(c, buf, n, lineno - 1, d);
-    free(buf);
-    return rc;
+    return rch_cpi_whole(c, line, got, in, lineno, RCH_FANUC_MAX_BYTES, "a Fanuc LS program", do_fanuc_text, d);
 }

@@ -99,6 +99,31 @@ int rch_cpi_csv_line(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno
 /* A header line: q1..q6 (or j1..j6) found, the line copied. 0 or -1. */
 int rch_cpi_csv_header(rch_cpi_ctx *c, const char *line, size_t n, unsigned lineno, rch_diag *d);
 
+/* Programs read whole (rch_comp_whole.c). One replacement of the text:
+ * text[off..off+len) -> rep; the edits of one program. */
+typedef struct rch_cpi_edit {
+    size_t off, len;
+    char rep[40];
+} rch_cpi_edit;
+typedef struct rch_cpi_edits {
+    rch_cpi_edit *ed; /* (n) malloc'd */
+    size_t n, cap;
+} rch_cpi_edits;
+/* What a format does with the whole text (line0: the line before its first). */
+typedef int (*rch_cpi_text_fn)(rch_cpi_ctx *c, const char *text, size_t len, unsigned line0, rch_diag *d);
+/* The line already read (got bytes) and the rest of in, at most max_bytes
+ * (what: "a RAPID module", ...), handed to fn. fn's return, or -1 (d set). */
+int rch_cpi_whole(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, size_t max_bytes,
+                  const char *what, rch_cpi_text_fn fn, rch_diag *d);
+/* One more edit: v printed with fmt. 0, or -1 (out of memory). */
+int rch_cpi_edit_add(rch_cpi_edits *e, size_t off, size_t len, const char *fmt, double v);
+void rch_cpi_edits_free(rch_cpi_edits *e);
+/* text to c->out with the edits applied (sorted here by offset); every other byte as it was. */
+void rch_cpi_edits_write(rch_cpi_ctx *c, const char *text, size_t len, rch_cpi_edits *e);
+/* n_bad targets (noun: "target", "position") refused, nothing written: said
+ * once in d (with c->warn each was named above; else d holds the first). */
+void rch_cpi_refused(rch_cpi_ctx *c, rch_diag *d, unsigned long n_bad, const char *noun);
+
 /* rch_comp_rapid.c: a RAPID module */
 /* The rest of a RAPID input: the line already read (raw, got bytes) and
  * everything after it, at most RCH_RAPID_MAX_BYTES, corrected all or

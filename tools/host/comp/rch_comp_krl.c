@@ -18,28 +18,6 @@
 #include "rch_comp_int.h"
 #include "rch_krl.h"
 
-typedef struct {
-    size_t off, len;
-    char rep[40];
-} edit;
-
-static int add_edit(edit **e, size_t *n, size_t *cap, size_t off, size_t len, const char *fmt, double v)
-{
-    if (*n == *cap) {
-        const size_t nc = *cap ? 2 * *cap : 64;
-        edit *ne = realloc(*e, nc * sizeof *ne);
-        if (!ne)
-            return -1;
-        *e = ne;
-        *cap = nc;
-    }
-    edit *x = &(*e)[(*n)++];
-    x->off = off;
-    x->len = len;
-    snprintf(x->rep, sizeof x->rep, fmt, v);
-    return 0;
-}
-
 /* (p, R) = (p1, R1) (p2, R2) */
 static void compose(double p[3], double R[9], const double p1[3], const double R1[9], const double p2[3],
                     const double R2[9])
@@ -196,8 +174,7 @@ static int do_krl_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned ba
     static rch_ctrl ident;
     rch_ctrl_identity(&ident);
     krl_kin k = {c->gate ? c->gate->nominal : NULL, c->gate && c->gate->ctrl ? c->gate->ctrl : &ident, NULL};
-    edit *ed = NULL;
-    size_t ne = 0, cap = 0;
+    rch_cpi_edits ed = {NULL, 0, 0};
     unsigned long n_bad = 0;
     int rc = 0, oom = 0;
     for (size_t i = 0; i < ts.n && !oom; ++i) {
@@ -239,78 +216,25 @@ static int do_krl_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned ba
             if (!((t->mask >> s) & 1u))
                 continue; /* an auxiliary point's S and T, left out, stay out */
             const char *fmt = !cart ? "%.6f" : s < 3 ? "%.4f" : s < 6 ? "%.6f" : "%.0f";
-            if (add_edit(&ed, &ne, &cap, t->num_off[s], t->num_len[s], fmt, out[s]) != 0)
+            if (rch_cpi_edit_add(&ed, t->num_off[s], t->num_len[s], fmt, out[s]) != 0)
                 oom = 1;
         }
     }
     if (oom) {
         rch_diag_set(d, c->in_name, 0, 0, "out of memory");
         rc = -1;
-    } else if (n_bad > 0 && c->warn) {
-        rch_diag_set(d, c->in_name, 0, 0, "%lu target%s cannot be corrected (each named above with its line, column "
-                     "and reason); nothing written", n_bad, n_bad == 1 ? "" : "s");
-        rc = -1;
     } else if (n_bad > 0) {
-        char more[80];
-        if (n_bad > 1)
-            snprintf(more, sizeof more, " (and %lu more targets; nothing written)", n_bad - 1);
-        else
-            snprintf(more, sizeof more, " (nothing written)");
-        strncat(d->msg, more, sizeof d->msg - strlen(d->msg) - 1);
+        rch_cpi_refused(c, d, n_bad, "target");
         rc = -1;
-    } else {
-        /* the edits are in the text's order: one per slot, slots in the order of the aggregate's components */
-        size_t at = 0;
-        for (size_t a = 1; a < ne; ++a) /* insertion sort by offset (components may be written in any order) */
-            for (size_t b = a; b > 0 && ed[b - 1].off > ed[b].off; --b) {
-                const edit x = ed[b];
-                ed[b] = ed[b - 1];
-                ed[b - 1] = x;
-            }
-        for (size_t e = 0; e < ne; ++e) {
-            fwrite(text + at, 1, ed[e].off - at, c->out);
-            fputs(ed[e].rep, c->out);
-            at = ed[e].off + ed[e].len;
-        }
-        fwrite(text + at, 1, len - at, c->out);
-    }
+    } else /* sorted by offset there: components may be written in any order */
+        rch_cpi_edits_write(c, text, len, &ed);
     free(k.ik);
-    free(ed);
+    rch_cpi_edits_free(&ed);
     rch_krl_free(&ts);
     return rc;
 }
 
 int rch_cpi_krl(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d)
 {
-    size_t cap = got + 65536, n = got;
-    char *buf = malloc(cap);
-    if (!buf) {
-        rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-        return -1;
-    }
-    memcpy(buf, line, got);
-    for (;;) {
-        if (n == cap) {
-            if (cap > RCH_KRL_MAX_BYTES) {
-                free(buf);
-                rch_diag_set(d, c->in_name, 0, 0, "a KRL file of more than %u bytes is refused", RCH_KRL_MAX_BYTES);
-                return -1;
-            }
-            char *nb = realloc(buf, 2 * cap);
-            if (!nb) {
-                free(buf);
-                rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-                return -1;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-        const size_t k = fread(buf + n, 1, cap - n, in);
-        n += k;
-        if (k == 0)
-            break;
-    }
-    const int rc = do_krl_text(c, buf, n, lineno - 1, d);
-    free(buf);
-    return rc;
+    return rch_cpi_whole(c, line, got, in, lineno, RCH_KRL_MAX_BYTES, "a KRL file", do_krl_text, d);
 }

@@ -18,29 +18,6 @@
 #include "rch_data.h"
 #include "rch_ik.h"
 
-/* One replacement of the rewritten module: text[off..off+len) -> rep. */
-typedef struct {
-    size_t off, len;
-    char rep[40];
-} edit;
-
-static int add_edit(edit **e, size_t *n, size_t *cap, size_t off, size_t len, const char *fmt, double v)
-{
-    if (*n == *cap) {
-        const size_t nc = *cap ? 2 * *cap : 64;
-        edit *ne = realloc(*e, nc * sizeof *ne);
-        if (!ne)
-            return -1;
-        *e = ne;
-        *cap = nc;
-    }
-    edit *x = &(*e)[(*n)++];
-    x->off = off;
-    x->len = len;
-    snprintf(x->rep, sizeof x->rep, fmt, v);
-    return 0;
-}
-
 /* A target rcal cannot correct: named with its line, column and reason. */
 static void rapid_refuse(rch_cpi_ctx *c, unsigned long *n_bad, rch_diag *d, const rch_rapid_target *t, unsigned base,
                          const char *why)
@@ -72,14 +49,14 @@ int rch_cpi_use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why,
         if (c->tcps[k]->tcp[0] == tcp[0] && c->tcps[k]->tcp[1] == tcp[1] && c->tcps[k]->tcp[2] == tcp[2]) {
             c->stream = &c->tcps[k]->s;
             c->cal = &c->tcps[k]->det;
-            c->fit = &c->tcps[k]->fit;
+            c->fit = c->gate->fit_any ? &c->tcps[k]->fit : NULL;
             return 0;
         }
     const rch_comp_gate *g = c->gate;
     if (!g || !g->det_any || !g->cfg || !g->nominal || c->ntcps == RCH_CPI_MAX_TCPS) {
         snprintf(why, why_len, "its tool's TCP [%g,%g,%g] (flange frame) is not the point this compensation was set "
                  "up for%s", tcp[0], tcp[1], tcp[2],
-                 c->ntcps == RCH_CPI_MAX_TCPS ? " (more than 16 TCPs in one module)" : "");
+                 c->ntcps == RCH_CPI_MAX_TCPS ? " (more than 16 TCPs in one program)" : "");
         return -1;
     }
     rch_cpi_tcp_stream *ts = calloc(1, sizeof *ts);
@@ -246,8 +223,7 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
         rch_rapid_free(&ts);
         return -1;
     }
-    edit *ed = NULL;
-    size_t ne = 0, cap = 0;
+    rch_cpi_edits ed = {NULL, 0, 0};
     unsigned long n_bad = 0;
     int rc = 0;
     for (size_t i = 0; i < ts.n; ++i) {
@@ -284,37 +260,20 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
             rc = 1;
         for (unsigned k = 0; k < t->n; ++k) {
             const char *fmt = t->kind == RCH_RAPID_JOINTTARGET ? "%.4f" : k < 3 ? "%.4f" : k < 7 ? "%.7f" : "%.0f";
-            if (add_edit(&ed, &ne, &cap, t->num_off[k], t->num_len[k], fmt, out[k]) != 0) {
+            if (rch_cpi_edit_add(&ed, t->num_off[k], t->num_len[k], fmt, out[k]) != 0) {
                 rch_diag_set(d, c->in_name, 0, 0, "out of memory");
-                free(ed);
+                rch_cpi_edits_free(&ed);
                 rch_rapid_free(&ts);
                 return -1;
             }
         }
     }
-    if (n_bad > 0 && c->warn) {
-        /* each target is named above; the error says how many, once */
-        rch_diag_set(d, c->in_name, 0, 0, "%lu target%s cannot be corrected (each named above with its line, column "
-                     "and reason); nothing written", n_bad, n_bad == 1 ? "" : "s");
+    if (n_bad > 0) {
+        rch_cpi_refused(c, d, n_bad, "target");
         rc = -1;
-    } else if (n_bad > 0) {
-        if (n_bad > 1) {
-            char more[80];
-            snprintf(more, sizeof more, " (and %lu more targets; nothing written)", n_bad - 1);
-            strncat(d->msg, more, sizeof d->msg - strlen(d->msg) - 1);
-        } else
-            strncat(d->msg, " (nothing written)", sizeof d->msg - strlen(d->msg) - 1);
-        rc = -1;
-    } else {
-        size_t at = 0;
-        for (size_t k = 0; k < ne; ++k) {
-            fwrite(text + at, 1, ed[k].off - at, c->out);
-            fputs(ed[k].rep, c->out);
-            at = ed[k].off + ed[k].len;
-        }
-        fwrite(text + at, 1, len - at, c->out); /* the input's bytes: its BOM and line ends as they were */
-    }
-    free(ed);
+    } else
+        rch_cpi_edits_write(c, text, len, &ed);
+    rch_cpi_edits_free(&ed);
     rch_rapid_free(&ts);
     return rc;
 }
@@ -323,36 +282,5 @@ static int do_rapid_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned 
  * everything after it, at most RCH_RAPID_MAX_BYTES. */
 int rch_cpi_rapid(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d)
 {
-    size_t cap = got + 65536, n = got;
-    char *buf = malloc(cap);
-    if (!buf) {
-        rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-        return -1;
-    }
-    memcpy(buf, line, got);
-    for (;;) {
-        if (n == cap) {
-            if (cap > RCH_RAPID_MAX_BYTES) {
-                free(buf);
-                rch_diag_set(d, c->in_name, 0, 0, "a RAPID module of more than %u bytes is refused",
-                             RCH_RAPID_MAX_BYTES);
-                return -1;
-            }
-            char *nb = realloc(buf, 2 * cap);
-            if (!nb) {
-                free(buf);
-                rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-                return -1;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-        const size_t k = fread(buf + n, 1, cap - n, in);
-        n += k;
-        if (k == 0)
-            break;
-    }
-    const int rc = do_rapid_text(c, buf, n, lineno - 1, d);
-    free(buf);
-    return rc;
+    return rch_cpi_whole(c, line, got, in, lineno, RCH_RAPID_MAX_BYTES, "a RAPID module", do_rapid_text, d);
 }

@@ -22,11 +22,6 @@
 /* two solutions nearer than this are the same (rad, each joint) */
 #define SAME_RAD 1e-6
 
-typedef struct {
-    size_t off, len;
-    char rep[40];
-} edit;
-
 typedef struct { /* a rigid pose: p (mm), R row-major */
     double p[3], R[9];
 } pose;
@@ -41,8 +36,7 @@ typedef struct {
     int have_cur;
     double cur[RC_NJ];       /* where the original program's robot stands (model rad) */
     double cur_c[RC_NJ];     /* where the compensated program's robot stands */
-    edit *ed;
-    size_t ne, cap;
+    rch_cpi_edits ed;
     unsigned long n_bad;
     unsigned base;
     unsigned err_line, err_col; /* where a refusal points when not at the literal (a joint's value) */
@@ -109,23 +103,6 @@ static void to_urs(double v[6], const pose *a, const double old[3])
     }
 }
 
-static int add_edit(urs *u, size_t off, size_t len, const char *fmt, double v)
-{
-    if (u->ne == u->cap) {
-        const size_t nc = u->cap ? 2 * u->cap : 64;
-        edit *ne = realloc(u->ed, nc * sizeof *ne);
-        if (!ne)
-            return -1;
-        u->ed = ne;
-        u->cap = nc;
-    }
-    edit *x = &u->ed[u->ne++];
-    x->off = off;
-    x->len = len;
-    snprintf(x->rep, sizeof x->rep, fmt, v == 0.0 ? 0.0 : v); /* never "-0.000" */
-    return 0;
-}
-
 static void refuse(urs *u, const rch_urs_target *t, const char *why)
 {
     rch_cpi_ctx *c = u->c;
@@ -140,53 +117,6 @@ static void refuse(urs *u, const rch_urs_target *t, const char *why)
         fprintf(c->warn, "%s:%u:%u: error: %s (%s) cannot be corrected: %s\n", c->in_name, line, col,
                 what, where, why);
     ++u->n_bad;
-}
-
-/* Compensate at tcp (3, DH flange frame): the job's stream when it is the
- * job's point, else one made for it (kept for the program; as RAPID's). 0,
- * or -1 with why set. */
-static int use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why, size_t why_len)
-{
-    const double *jt = c->gate ? c->gate->tool_mm : NULL;
-    c->stream = c->stream0;
-    c->cal = c->cal0;
-    c->fit = c->fit0;
-    if ((!has_tcp && !jt) || (has_tcp && jt && tcp[0] == jt[0] && tcp[1] == jt[1] && tcp[2] == jt[2]) ||
-        (!jt && tcp[0] == 0.0 && tcp[1] == 0.0 && tcp[2] == 0.0))
-        return 0;
-    for (size_t k = 0; k < c->ntcps; ++k)
-        if (c->tcps[k]->tcp[0] == tcp[0] && c->tcps[k]->tcp[1] == tcp[1] && c->tcps[k]->tcp[2] == tcp[2]) {
-            c->stream = &c->tcps[k]->s;
-            c->cal = &c->tcps[k]->det;
-            c->fit = c->gate->fit_any ? &c->tcps[k]->fit : NULL;
-            return 0;
-        }
-    const rch_comp_gate *g = c->gate;
-    if (!g || !g->det_any || !g->cfg || !g->nominal || c->ntcps == RCH_CPI_MAX_TCPS) {
-        snprintf(why, why_len, "its TCP [%g,%g,%g] mm (flange frame) is not the point this compensation was set up "
-                 "for%s", tcp[0], tcp[1], tcp[2], c->ntcps == RCH_CPI_MAX_TCPS ? " (more than 16 TCPs)" : "");
-        return -1;
-    }
-    rch_cpi_tcp_stream *ts = calloc(1, sizeof *ts);
-    if (!ts) {
-        snprintf(why, why_len, "out of memory");
-        return -1;
-    }
-    memcpy(ts->tcp, tcp, sizeof ts->tcp);
-    rch_comp_point_model(&ts->det, g->det_any, tcp);
-    rch_comp_point_model(&ts->nom, g->nominal, tcp);
-    rch_comp_point_model(&ts->fit, g->fit_any ? g->fit_any : g->det_any, tcp);
-    const rc_status st = rc_comp_stream_init(&ts->s, &ts->det, &ts->nom, g->cfg);
-    if (st != RC_OK) {
-        snprintf(why, why_len, "the model cannot be used for compensation at its TCP: %s", rc_strerror(st));
-        free(ts);
-        return -1;
-    }
-    c->tcps[c->ntcps++] = ts;
-    c->stream = &ts->s;
-    c->cal = &ts->det;
-    c->fit = g->fit_any ? &ts->fit : NULL;
-    return 0;
 }
 
 /* The nominal solution of the DH flange pose T nearest seed (model rad),
@@ -268,7 +198,7 @@ static int correct(urs *u, double qo[RC_NJ], const double q[RC_NJ], const rch_ur
     double tp[3];
     tcp_dh(tp, u);
     const int has = u->has_tcp || (c->gate && c->gate->tool_mm);
-    if (use_tcp(c, tp, has, why, wl) != 0)
+    if (rch_cpi_use_tcp(c, tp, has, why, wl) != 0)
         return -1;
     double qd[RC_NJ], od[RC_NJ];
     unsigned cols[RC_NJ];
@@ -454,69 +384,27 @@ static int do_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned base, 
         if (t->kind == RCH_URS_POSE)
             c->res->n_robtargets++;
         for (unsigned k = 0; k < RCH_URS_NUMS; ++k)
-            if (add_edit(&u, t->num_off[k], t->num_len[k], t->kind == RCH_URS_POSE && k < 3 ? "%.8f" : "%.9f",
-                         out[k]) != 0) {
+            if (rch_cpi_edit_add(&u.ed, t->num_off[k], t->num_len[k], t->kind == RCH_URS_POSE && k < 3 ? "%.8f" : "%.9f",
+                                 out[k] == 0.0 ? 0.0 : out[k]) != 0) { /* never "-0.000" */
                 rch_diag_set(d, c->in_name, 0, 0, "out of memory");
-                free(u.ed);
+                rch_cpi_edits_free(&u.ed);
                 rch_urs_free(&ts);
                 return -1;
             }
     }
     if (u.n_bad > 0) {
-        if (c->warn)
-            rch_diag_set(d, c->in_name, 0, 0, "%lu target%s cannot be corrected (each named above with its line, "
-                         "column and reason); nothing written", u.n_bad, u.n_bad == 1 ? "" : "s");
-        else
-            strncat(d->msg, " (nothing written)", sizeof d->msg - strlen(d->msg) - 1);
+        rch_cpi_refused(c, d, u.n_bad, "target");
         rc = -1;
-    } else {
-        size_t at = 0;
-        for (size_t k = 0; k < u.ne; ++k) {
-            fwrite(text + at, 1, u.ed[k].off - at, c->out);
-            fputs(u.ed[k].rep, c->out);
-            at = u.ed[k].off + u.ed[k].len;
-        }
-        fwrite(text + at, 1, len - at, c->out);
-    }
-    free(u.ed);
+    } else
+        rch_cpi_edits_write(c, text, len, &u.ed);
+    rch_cpi_edits_free(&u.ed);
     rch_urs_free(&ts);
     return rc;
 }
 
 int rch_cpi_urscript(rch_cpi_ctx *c, const char *line, size_t got, FILE *in, unsigned lineno, rch_diag *d)
 {
-    size_t cap = got + 65536, n = got;
-    char *buf = malloc(cap);
-    if (!buf) {
-        rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-        return -1;
-    }
-    memcpy(buf, line, got);
-    for (;;) {
-        if (n == cap) {
-            if (cap > RCH_URS_MAX_BYTES) {
-                free(buf);
-                rch_diag_set(d, c->in_name, 0, 0, "a URScript program of more than %u bytes is refused",
-                             RCH_URS_MAX_BYTES);
-                return -1;
-            }
-            char *nb = realloc(buf, 2 * cap);
-            if (!nb) {
-                free(buf);
-                rch_diag_set(d, c->in_name, lineno, 1, "out of memory");
-                return -1;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-        const size_t k = fread(buf + n, 1, cap - n, in);
-        n += k;
-        if (k == 0)
-            break;
-    }
-    const int rc = do_text(c, buf, n, lineno - 1, d);
-    free(buf);
-    return rc;
+    return rch_cpi_whole(c, line, got, in, lineno, RCH_URS_MAX_BYTES, "a URScript program", do_text, d);
 }
 
 static int word_at(const char *s, size_t n, const char *w)
