@@ -71,9 +71,12 @@ static int is_position(const rc_sample *s, size_t k, size_t n)
     if (k + 3 > n || s[k].sensor != RC_SENSOR_TRACKER_X || s[k + 1].sensor != RC_SENSOR_TRACKER_Y ||
         s[k + 2].sensor != RC_SENSOR_TRACKER_Z)
         return 0;
-    return s[k + 1].target == s[k].target && s[k + 2].target == s[k].target &&
-           memcmp(s[k + 1].q_rad, s[k].q_rad, sizeof s[k].q_rad) == 0 &&
-           memcmp(s[k + 2].q_rad, s[k].q_rad, sizeof s[k].q_rad) == 0;
+    if (s[k + 1].target != s[k].target || s[k + 2].target != s[k].target)
+        return 0;
+    for (int j = 0; j < RC_NJ; ++j)
+        if (s[k + 1].q_rad[j] != s[k].q_rad[j] || s[k + 2].q_rad[j] != s[k].q_rad[j])
+            return 0;
+    return 1;
 }
 
 /* The blocks of samples (n): runs of one sensor in order; 0 when there would

@@ -49,7 +49,7 @@ int rch_cpi_use_tcp(rch_cpi_ctx *c, const double tcp[3], int has_tcp, char *why,
         if (c->tcps[k]->tcp[0] == tcp[0] && c->tcps[k]->tcp[1] == tcp[1] && c->tcps[k]->tcp[2] == tcp[2]) {
             c->stream = &c->tcps[k]->s;
             c->cal = &c->tcps[k]->det;
-            c->fit = c->gate->fit_any ? &c->tcps[k]->fit : NULL;
+            c->fit = c->gate && c->gate->fit_any ? &c->tcps[k]->fit : NULL;
             return 0;
         }
     const rch_comp_gate *g = c->gate;

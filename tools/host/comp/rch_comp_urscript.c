@@ -316,30 +316,34 @@ static int do_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned base, 
         rch_urs_free(&ts);
         return -1;
     }
-    static urs u; /* the IK's tables are large */
-    memset(&u, 0, sizeof u);
-    u.c = c;
-    u.base = 0; /* the reader counts the file's lines */
+    urs *up = calloc(1, sizeof *up); /* the IK's tables are large */
+    if (!up) {
+        rch_diag_set(d, c->in_name, 0, 0, "out of memory");
+        rch_urs_free(&ts);
+        return -1;
+    }
+    up->c = c;
+    up->base = 0; /* the reader counts the file's lines */
     (void)base;
-    u.d = d;
+    up->d = d;
     rch_ctrl idc;
     rch_ctrl_identity(&idc);
-    u.ctrl = c->gate && c->gate->ctrl ? c->gate->ctrl : &idc;
-    ident(&u.tcp);
-    ident(&u.B);
-    ident(&u.F);
-    if (u.ctrl->has_base) {
-        memcpy(u.B.R, u.ctrl->base_R, sizeof u.B.R);
-        memcpy(u.B.p, u.ctrl->base_mm, sizeof u.B.p);
+    up->ctrl = c->gate && c->gate->ctrl ? c->gate->ctrl : &idc;
+    ident(&up->tcp);
+    ident(&up->B);
+    ident(&up->F);
+    if (up->ctrl->has_base) {
+        memcpy(up->B.R, up->ctrl->base_R, sizeof up->B.R);
+        memcpy(up->B.p, up->ctrl->base_mm, sizeof up->B.p);
     }
-    if (u.ctrl->has_flange) {
-        memcpy(u.F.R, u.ctrl->flange_R, sizeof u.F.R);
-        memcpy(u.F.p, u.ctrl->flange_mm, sizeof u.F.p);
+    if (up->ctrl->has_flange) {
+        memcpy(up->F.R, up->ctrl->flange_R, sizeof up->F.R);
+        memcpy(up->F.p, up->ctrl->flange_mm, sizeof up->F.p);
     }
     if (c->gate && c->gate->tool_mm) /* --tool: a point in the DH flange frame, before any set_tcp */
         for (int i = 0; i < 3; ++i) /* F^-1 tool */
-            u.tcp.p[i] = u.F.R[i] * (c->gate->tool_mm[0] - u.F.p[0]) + u.F.R[3 + i] * (c->gate->tool_mm[1] - u.F.p[1]) +
-                         u.F.R[6 + i] * (c->gate->tool_mm[2] - u.F.p[2]);
+            up->tcp.p[i] = up->F.R[i] * (c->gate->tool_mm[0] - up->F.p[0]) + up->F.R[3 + i] * (c->gate->tool_mm[1] - up->F.p[1]) +
+                         up->F.R[6 + i] * (c->gate->tool_mm[2] - up->F.p[2]);
     const rc_model *nom = c->gate ? c->gate->nominal : NULL;
     size_t n_targets = 0;
     for (size_t i = 0; i < ts.n; ++i)
@@ -349,11 +353,13 @@ static int do_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned base, 
         rch_diag_set(d, c->in_name, 0, 0, "no joint list or pose target in this program (movej, movel, movep, movec, "
                      "get_inverse_kin, assignments): nothing to correct; nothing written");
         rch_urs_free(&ts);
+        free(up);
         return -1;
     }
-    if (!nom || rch_ikg_init(&u.ik, nom, NULL) != RCH_IKG_OK) {
+    if (!nom || rch_ikg_init(&up->ik, nom, NULL) != RCH_IKG_OK) {
         rch_diag_set(d, c->in_name, 0, 0, "no nominal model to invert the pose targets with; nothing written");
         rch_urs_free(&ts);
+        free(up);
         return -1;
     }
     for (size_t i = 0; i < ts.n; ++i) {
@@ -361,20 +367,20 @@ static int do_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned base, 
         char why[512];
         double out[6];
         if (t->error[0]) {
-            refuse(&u, t, t->error);
+            refuse(up, t, t->error);
             continue;
         }
         if (t->role == RCH_URS_QNEAR)
             continue; /* a seed, kept */
         if (t->role == RCH_URS_TCP) {
-            from_urs(&u.tcp, t->val);
-            u.has_tcp = t->val[0] != 0 || t->val[1] != 0 || t->val[2] != 0;
+            from_urs(&up->tcp, t->val);
+            up->has_tcp = t->val[0] != 0 || t->val[1] != 0 || t->val[2] != 0;
             continue;
         }
-        const int r = t->kind == RCH_URS_JOINTS ? do_joints(&u, out, t, why, sizeof why)
-                                                : do_pose(&u, out, t, &ts, why, sizeof why);
+        const int r = t->kind == RCH_URS_JOINTS ? do_joints(up, out, t, why, sizeof why)
+                                                : do_pose(up, out, t, &ts, why, sizeof why);
         if (r < 0) {
-            refuse(&u, t, why);
+            refuse(up, t, why);
             continue;
         }
         if (r > 0)
@@ -384,21 +390,23 @@ static int do_text(rch_cpi_ctx *c, const char *text, size_t len, unsigned base, 
         if (t->kind == RCH_URS_POSE)
             c->res->n_robtargets++;
         for (unsigned k = 0; k < RCH_URS_NUMS; ++k)
-            if (rch_cpi_edit_add(&u.ed, t->num_off[k], t->num_len[k], t->kind == RCH_URS_POSE && k < 3 ? "%.8f" : "%.9f",
+            if (rch_cpi_edit_add(&up->ed, t->num_off[k], t->num_len[k], t->kind == RCH_URS_POSE && k < 3 ? "%.8f" : "%.9f",
                                  out[k] == 0.0 ? 0.0 : out[k]) != 0) { /* never "-0.000" */
                 rch_diag_set(d, c->in_name, 0, 0, "out of memory");
-                rch_cpi_edits_free(&u.ed);
+                rch_cpi_edits_free(&up->ed);
                 rch_urs_free(&ts);
+                free(up);
                 return -1;
             }
     }
-    if (u.n_bad > 0) {
-        rch_cpi_refused(c, d, u.n_bad, "target");
+    if (up->n_bad > 0) {
+        rch_cpi_refused(c, d, up->n_bad, "target");
         rc = -1;
     } else
-        rch_cpi_edits_write(c, text, len, &u.ed);
-    rch_cpi_edits_free(&u.ed);
+        rch_cpi_edits_write(c, text, len, &up->ed);
+    rch_cpi_edits_free(&up->ed);
     rch_urs_free(&ts);
+    free(up);
     return rc;
 }
 

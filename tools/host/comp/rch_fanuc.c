@@ -525,14 +525,14 @@ static int config(cur *c, rch_fanuc_pos *q)
     static const char *const letters[3] = {"NF", "UD", "TB"};
     for (int k = 0; k < 3; ++k) {
         skip_blanks(c);
-        const char ch = c->i < c->n ? (char)toupper((unsigned char)c->t[c->i]) : '\0';
-        if (ch == '\0' || !strchr(letters[k], ch)) {
+        const int ch = c->i < c->n ? toupper((unsigned char)c->t[c->i]) : 0;
+        if (ch == 0 || !strchr(letters[k], ch)) {
             char m[160];
             snprintf(m, sizeof m, "CONFIG letter %d must be %c or %c (%s)", k + 1, letters[k][0], letters[k][1],
                      k == 0 ? "no flip / flip" : k == 1 ? "up / down" : "front (top) / back");
             return err(c, c->line, c->col, m);
         }
-        q->cfg[k] = ch;
+        q->cfg[k] = (char)ch;
         adv(c);
     }
     for (int k = 0; k < 3; ++k) {
