@@ -31,7 +31,7 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
   ctest --test-dir build-asan --output-on-failure -j"$JOBS" -LE '^study$' || status=1
 
 # fuzz/run.sh: every target 20 s from its committed corpus, two at a time (the two cores of the CI machine;
-# 19 targets; FUZZ_SECONDS and FUZZ_JOBS set from outside win: longer runs are a release's, docs/release.md)
+# 20 targets; FUZZ_SECONDS and FUZZ_JOBS set from outside win: longer runs are a release's, docs/release.md)
 export FUZZ_SECONDS=${FUZZ_SECONDS:-20} FUZZ_JOBS=${FUZZ_JOBS:-2}
 for extra in firmware_host/cross_build.sh scripts/static_analysis.sh fuzz/run.sh scripts/valgrind_tests.sh \
   scripts/install_check.sh scripts/spdx_check.sh scripts/layers.sh scripts/doc_links.py; do
