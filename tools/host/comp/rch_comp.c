@@ -12,6 +12,7 @@
 #include "rch_comp.h"
 
 #include <math.h>
+#include <string.h>
 #include <time.h>
 
 #include "rch_comp_int.h"
@@ -170,4 +171,21 @@ int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_de
                                     : "the closest point found within the bounds",
                 (double)res.pos_err_mm);
     return 1;
+}
+
+int rch_cpi_compensate_at(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_deg[RC_NJ], unsigned line,
+                          const unsigned cols[RC_NJ], char *why, size_t why_len)
+{
+    rch_diag dd;
+    memset(&dd, 0, sizeof dd);
+    const unsigned long before = c->res->n_uncertain;
+    const int r = rch_cpi_compensate(c, out_deg, in_deg, line, cols, &dd);
+    c->stream = c->stream0;
+    c->cal = c->cal0;
+    c->fit = c->fit0;
+    if (r < 0) {
+        snprintf(why, why_len, "%.300s", dd.msg);
+        return -1;
+    }
+    return c->res->n_uncertain != before ? 2 : r;
 }

@@ -202,18 +202,9 @@ static int fanuc_pos(rch_cpi_ctx *c, const fstate *fs, double out[RCH_FANUC_NUMS
         qd[k] = qm[k] / DEG;
         cols[k] = q->num_col[q->joint ? k : 0];
     }
-    rch_diag dd;
-    const unsigned long before_unc = c->res->n_uncertain;
-    const int r = rch_cpi_compensate(c, qo, qd, base + q->line, cols, &dd);
-    c->stream = c->stream0;
-    c->cal = c->cal0;
-    c->fit = c->fit0;
-    if (r < 0) {
-        snprintf(why, why_len, "%.300s", dd.msg);
-        return -1;
-    }
-    if (c->res->n_uncertain != before_unc)
-        return 2;
+    const int r = rch_cpi_compensate_at(c, qo, qd, base + q->line, cols, why, why_len);
+    if (r < 0 || r == 2)
+        return r;
     double qr[RC_NJ];
     for (int k = 0; k < RC_NJ; ++k)
         qr[k] = qo[k] * DEG;

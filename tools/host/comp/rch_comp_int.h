@@ -80,6 +80,12 @@ typedef struct {
  * for diagnostics. */
 int rch_cpi_compensate(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_deg[RC_NJ], unsigned line,
                        const unsigned cols[RC_NJ], rch_diag *d);
+/* One target of a program read whole, on the stream rch_cpi_use_tcp chose:
+ * rch_cpi_compensate, then the job's own stream set back. 0 or 1 as
+ * rch_cpi_compensate, 2 left uncompensated for its uncertainty (copied as it
+ * was), -1 with why set. */
+int rch_cpi_compensate_at(rch_cpi_ctx *c, double out_deg[RC_NJ], const double in_deg[RC_NJ], unsigned line,
+                          const unsigned cols[RC_NJ], char *why, size_t why_len);
 
 /* rch_comp_csv.c: CSV lines */
 /* Split a line at commas. start[k]/len[k]: field k (trimmed); returns the

@@ -93,15 +93,11 @@ static int krl_joints(rch_cpi_ctx *c, const krl_kin *k, double a_out[RC_NJ], con
             return -1;
         }
     }
-    rch_diag dd;
-    const unsigned long before_unc = c->res->n_uncertain;
-    const int r = rch_cpi_compensate(c, qo, qd, line, cols, &dd);
-    if (r < 0) {
-        snprintf(why, why_len, "%.300s (the model's joint)", dd.msg);
-        return -1;
-    }
-    if (c->res->n_uncertain != before_unc)
-        return 2;
+    const int r = rch_cpi_compensate_at(c, qo, qd, line, cols, why, why_len);
+    if (r < 0)
+        strncat(why, " (the model's joint)", why_len - strlen(why) - 1);
+    if (r < 0 || r == 2)
+        return r;
     for (int i = 0; i < RC_NJ; ++i)
         q[i] = qo[i] * DEG;
     rch_ctrl_from_model(a, k->ctl, q);
@@ -138,10 +134,7 @@ static int krl_cart(rch_cpi_ctx *c, const krl_kin *k, double out[RCH_KRL_NSLOT],
     unsigned cols[RC_NJ];
     for (int i = 0; i < RC_NJ; ++i)
         cols[i] = t->col;
-    const int r = krl_joints(c, k, ao, a, base + t->line, cols, why, why_len);
-    c->stream = c->stream0;
-    c->cal = c->cal0;
-    c->fit = c->fit0;
+    const int r = krl_joints(c, k, ao, a, base + t->line, cols, why, why_len); /* the job's stream set back */
     if (r < 0 || r == 2)
         return r;
     c->res->n_robtargets++;

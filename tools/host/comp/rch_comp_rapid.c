@@ -143,18 +143,9 @@ static int rapid_robtarget(rch_cpi_ctx *c, double out[RCH_RAPID_NUMS], const rch
         qd[i] = q[i] / DEG;
         cols[i] = t->col;
     }
-    rch_diag dd;
-    const unsigned long before_unc = c->res->n_uncertain;
-    const int r = rch_cpi_compensate(c, qo, qd, base + t->line, cols, &dd);
-    c->stream = c->stream0;
-    c->cal = c->cal0;
-    c->fit = c->fit0;
-    if (r < 0) {
-        snprintf(why, why_len, "%.300s", dd.msg);
-        return -1;
-    }
-    if (c->res->n_uncertain != before_unc)
-        return 2; /* left uncompensated: copied as it was */
+    const int r = rch_cpi_compensate_at(c, qo, qd, base + t->line, cols, why, why_len);
+    if (r < 0 || r == 2)
+        return r; /* 2: left uncompensated, copied as it was */
     c->res->n_robtargets++;
     double qr[RC_NJ], pos[3], quat[4];
     int cfo[4];

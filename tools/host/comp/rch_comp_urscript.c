@@ -206,15 +206,8 @@ static int correct(urs *u, double qo[RC_NJ], const double q[RC_NJ], const rch_ur
         qd[i] = q[i] / DEG;
         cols[i] = t->num_col[i];
     }
-    rch_diag dd;
-    memset(&dd, 0, sizeof dd);
-    const unsigned long before = c->res->n_uncertain;
-    const int r = rch_cpi_compensate(c, od, qd, t->line, cols, &dd);
-    c->stream = c->stream0;
-    c->cal = c->cal0;
-    c->fit = c->fit0;
+    const int r = rch_cpi_compensate_at(c, od, qd, t->line, cols, why, wl);
     if (r < 0) {
-        snprintf(why, wl, "%.300s", dd.msg);
         for (int i = 0; i < RC_NJ && t->kind == RCH_URS_JOINTS; ++i)
             if (!(q[i] >= c->cal->q_min_rad[i] && q[i] <= c->cal->q_max_rad[i])) { /* named at that number */
                 u->err_line = t->num_line[i];
@@ -225,7 +218,7 @@ static int correct(urs *u, double qo[RC_NJ], const double q[RC_NJ], const rch_ur
     }
     for (int i = 0; i < RC_NJ; ++i)
         qo[i] = od[i] * DEG;
-    return c->res->n_uncertain != before ? 2 : r;
+    return r;
 }
 
 /* A joint list: its values are the controller's (rad). */
