@@ -288,21 +288,9 @@ static void read_json(side *s)
 /* recv with the kernel's arrival stamp (CLOCK_REALTIME ns; the read's time when there is none) */
 static ssize_t recv_stamped(int fd, uint8_t *buf, size_t cap, double *arr_ns)
 {
-    struct iovec iov = {buf, cap};
-    char ctl[256];
-    struct msghdr mh;
-    memset(&mh, 0, sizeof mh);
-    mh.msg_iov = &iov;
-    mh.msg_iovlen = 1;
-    mh.msg_control = ctl;
-    mh.msg_controllen = sizeof ctl;
-    const ssize_t n = recvmsg(fd, &mh, 0);
     struct timespec t;
-    clock_gettime(CLOCK_REALTIME, &t);
-    for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); n > 0 && c; c = CMSG_NXTHDR(&mh, c))
-        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS)
-            memcpy(&t, CMSG_DATA(c), sizeof t);
-    *arr_ns = (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+    const ssize_t n = rt_sched_recv_stamped(fd, buf, cap, 0, NULL, &t, NULL, NULL);
+    *arr_ns = rt_sched_ts_ns(&t);
     return n;
 }
 

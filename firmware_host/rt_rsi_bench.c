@@ -42,6 +42,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rt_sched.h"
+
 #define NAX 6
 #define HOLD 100 /* cycles at the start setpoint: the correction ramps in */
 
@@ -189,25 +191,12 @@ static void responder(int fd, int out_fd, int fifo, size_t cap, double period_us
         struct pollfd p = {fd, POLLIN, 0};
         if (poll(&p, 1, 100) <= 0)
             continue;
-        char buf[8192], ctl[256], out[512];
+        char buf[8192], out[512];
         struct sockaddr_in from;
-        struct iovec iov = {buf, sizeof buf - 1};
-        struct msghdr mh;
-        memset(&mh, 0, sizeof mh);
-        mh.msg_name = &from;
-        mh.msg_namelen = sizeof from;
-        mh.msg_iov = &iov;
-        mh.msg_iovlen = 1;
-        mh.msg_control = ctl;
-        mh.msg_controllen = sizeof ctl;
-        const ssize_t r = recvmsg(fd, &mh, MSG_DONTWAIT);
+        struct timespec rx;
+        const ssize_t r = rt_sched_recv_stamped(fd, buf, sizeof buf - 1, MSG_DONTWAIT, &from, &rx, NULL, NULL);
         if (r <= 0)
             continue;
-        struct timespec rx;
-        clock_gettime(CLOCK_REALTIME, &rx);
-        for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); c; c = CMSG_NXTHDR(&mh, c))
-            if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS)
-                memcpy(&rx, CMSG_DATA(c), sizeof rx);
         buf[r] = '\0';
         const char *i = strstr(buf, "<IPOC>");
         const unsigned long long ipoc = i ? strtoull(i + 6, NULL, 10) : 0;
@@ -267,22 +256,9 @@ static double ak_of(const char *s, int i)
 /* recv with the kernel's arrival stamp (CLOCK_REALTIME ns; the read's time when there is none) */
 static ssize_t recv_stamped(int fd, char *buf, size_t cap, double *arr_ns)
 {
-    struct iovec iov = {buf, cap};
-    char ctl[256];
-    struct msghdr mh;
-    memset(&mh, 0, sizeof mh);
-    mh.msg_iov = &iov;
-    mh.msg_iovlen = 1;
-    mh.msg_control = ctl;
-    mh.msg_controllen = sizeof ctl;
-    const ssize_t n = recvmsg(fd, &mh, MSG_DONTWAIT);
-    *arr_ns = now_ns(CLOCK_REALTIME);
-    for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); n > 0 && c; c = CMSG_NXTHDR(&mh, c))
-        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
-            struct timespec t;
-            memcpy(&t, CMSG_DATA(c), sizeof t);
-            *arr_ns = (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
-        }
+    struct timespec t;
+    const ssize_t n = rt_sched_recv_stamped(fd, buf, cap, MSG_DONTWAIT, NULL, &t, NULL, NULL);
+    *arr_ns = rt_sched_ts_ns(&t);
     return n;
 }
 

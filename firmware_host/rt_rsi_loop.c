@@ -533,29 +533,15 @@ static void report(const rsi_state *s, const rsi_io *io, const rsi_opts *o, doub
 static int rx_one(rsi_io *io, char *buf, size_t cap, size_t *len, struct sockaddr_in *from, struct timespec *rx,
                   double *wake_us)
 {
-    struct iovec iov = {buf, cap};
-    char ctl[256];
-    struct msghdr mh;
-    memset(&mh, 0, sizeof mh);
-    mh.msg_name = from;
-    mh.msg_namelen = sizeof *from;
-    mh.msg_iov = &iov;
-    mh.msg_iovlen = 1;
-    mh.msg_control = ctl;
-    mh.msg_controllen = sizeof ctl;
-    const ssize_t n = recvmsg(io->fd, &mh, 0); /* blocks up to SO_RCVTIMEO (100 ms): one call per datagram */
+    struct timespec read_at;
+    int trunc;
+    /* blocks up to SO_RCVTIMEO (100 ms): one call per datagram */
+    const ssize_t n = rt_sched_recv_stamped(io->fd, buf, cap, 0, from, rx, &read_at, &trunc);
     if (n < 0)
         return -1;
-    clock_gettime(CLOCK_REALTIME, rx);
-    const struct timespec read_at = *rx;
-    for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); c; c = CMSG_NXTHDR(&mh, c))
-        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS)
-            memcpy(rx, CMSG_DATA(c), sizeof *rx);
     /* from the kernel's receive to the read returning: the thread's wake-up (the scheduler's, not the loop's) */
-    *wake_us = ((double)(read_at.tv_sec - rx->tv_sec) * 1e9 + (double)(read_at.tv_nsec - rx->tv_nsec)) / 1e3;
-    *len = (size_t)n;
-    if (mh.msg_flags & MSG_TRUNC)
-        *len = cap + 1; /* over the limit: refused by the decoder */
+    *wake_us = (rt_sched_ts_ns(&read_at) - rt_sched_ts_ns(rx)) / 1e3;
+    *len = trunc ? cap + 1 : (size_t)n; /* over the limit: refused by the decoder */
     return 0;
 }
 

@@ -6,7 +6,9 @@
 #include <sched.h>
 #include <stdio.h>
 #include <string.h>
+#include <netinet/in.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
 #include <time.h>
 
 int rt_sched_realtime(int pin, unsigned long cpu, int fifo)
@@ -45,4 +47,36 @@ double rt_sched_cpu_ns(void)
     struct timespec t;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     return (double)t.tv_sec * 1e9 + (double)t.tv_nsec;
+}
+
+double rt_sched_ts_ns(const struct timespec *t)
+{
+    return (double)t->tv_sec * 1e9 + (double)t->tv_nsec;
+}
+
+ssize_t rt_sched_recv_stamped(int fd, void *buf, size_t cap, int flags, struct sockaddr_in *from, struct timespec *rx,
+                              struct timespec *read_at, int *trunc)
+{
+    struct iovec iov = {buf, cap};
+    char ctl[256];
+    struct msghdr mh;
+    memset(&mh, 0, sizeof mh);
+    if (from) {
+        mh.msg_name = from;
+        mh.msg_namelen = sizeof *from;
+    }
+    mh.msg_iov = &iov;
+    mh.msg_iovlen = 1;
+    mh.msg_control = ctl;
+    mh.msg_controllen = sizeof ctl;
+    const ssize_t n = recvmsg(fd, &mh, flags);
+    clock_gettime(CLOCK_REALTIME, rx);
+    if (read_at)
+        *read_at = *rx;
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(&mh); n > 0 && c; c = CMSG_NXTHDR(&mh, c))
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS)
+            memcpy(rx, CMSG_DATA(c), sizeof *rx);
+    if (trunc)
+        *trunc = n >= 0 && (mh.msg_flags & MSG_TRUNC) != 0;
+    return n;
 }
