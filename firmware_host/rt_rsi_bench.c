@@ -206,12 +206,13 @@ static void responder(int fd, int out_fd, int fifo, size_t cap, double period_us
         sendto(fd, out, (size_t)m, 0, (struct sockaddr *)&from, sizeof from);
         const double tx = now_ns(CLOCK_REALTIME);
         if (lat && n < cap) {
-            lat[n] = (tx - ((double)rx.tv_sec * 1e9 + (double)rx.tv_nsec)) / 1e3;
+            lat[n] = (tx - rt_sched_ts_ns(&rx)) / 1e3;
             over += lat[n++] > period_us;
         }
     }
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
-    qsort(lat, n, sizeof *lat, cmp_d);
+    if (lat)
+        qsort(lat, n, sizeof *lat, cmp_d);
     char line[256];
     const double cpu = ((double)(c1.tv_sec - c0.tv_sec) * 1e9 + (double)(c1.tv_nsec - c0.tv_nsec)) / 1e3;
     const int len = snprintf(line, sizeof line, "%zu %.1f %.1f %.1f %.2f %zu %.1f\n", n, pct(lat, n, 50),
