@@ -210,19 +210,31 @@ typedef struct rc_model {
     double q_max_rad[RC_NJ];
 } rc_model;
 
-/* What a sample measured (rc_sample.sensor): one scalar residual row each.
- * A tracker position is three samples, its x, y and z components in the
- * tracker's frame (lib/rc_sensor.h). */
-typedef enum rc_sensor_kind {
-    RC_SENSOR_LENGTH = 0,    /* cable length from an outlet (the default of a zeroed sample) */
-    RC_SENSOR_TRACKER_X = 1, /* x of a target in the tracker frame (mm) */
-    RC_SENSOR_TRACKER_Y = 2,
-    RC_SENSOR_TRACKER_Z = 3
-} rc_sensor_kind;
+/* What a sample measured (rc_sample.sensor): one scalar residual row each,
+ * in one list. RC_SENSORS gives the kinds (the enum), their units
+ * (rc_sensor_unit) and each one's hook (lib/rc_sensor.h: its value, the
+ * point it sees and d value / d point, its own parameters' derivatives; the
+ * chain's part is rc_model.c's, the same for every sensor). A cable length
+ * is the chain's own (no hook). A tracker position is three samples, its x,
+ * y and z components in the tracker's frame. Adding a sensor: one line here
+ * (at the end: the numbers are stable), its hook in a file of its own, its
+ * effects in RC_EFFECTS (side RC_SIDE_SENSOR).
+ * X(ID, name, unit, hook) */
+#define RC_SENSORS(X)                                                   \
+    X(LENGTH, "length", "mm", rc_sensor_none)                          \
+    X(TRACKER_X, "tracker_x", "mm", rc_sensor_tracker)                 \
+    X(TRACKER_Y, "tracker_y", "mm", rc_sensor_tracker)                 \
+    X(TRACKER_Z, "tracker_z", "mm", rc_sensor_tracker)
+
+#define RC_SENSOR_ENUM_(id, name, unit, hook) RC_SENSOR_##id,
+typedef enum rc_sensor_kind { RC_SENSORS(RC_SENSOR_ENUM_) RC_SENSOR_COUNT_ } rc_sensor_kind;
+#undef RC_SENSOR_ENUM_
 
 /* The unit of a sensor's measured value (rc_sample.sensor): "mm" for a
  * length and a tracker coordinate; "?" for a kind the model does not know. */
 const char *rc_sensor_unit(unsigned sensor);
+/* The name of a sensor kind ("length", ...), "unknown" for another number. */
+const char *rc_sensor_name(unsigned sensor);
 
 /* One measurement: joint readings, cable length and its context. Zero-
  * initialise it (memset, calloc or = {0}) before filling the fields: a zero
