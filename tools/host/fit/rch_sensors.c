@@ -6,7 +6,9 @@
 #include <string.h>
 
 /* The table: one line per sensor (its descriptor is defined in its own file). */
+extern const rch_sensor_desc rch_sensor_touch; /* rch_sensor_touch.c: points touched on plates */
 static const rch_sensor_desc *const sensors[] = {
+    &rch_sensor_touch,
     NULL /* the end */
 };
 
