@@ -178,8 +178,13 @@ rc_status rc_model_add_effect(rc_model *m, rc_effect_kind kind, unsigned joint, 
     } else if (joint >= RC_NJ) {
         return RC_ERR_ARG;
     }
-    if ((kind == RC_EFF_TRACKER_TARGETS || kind == RC_EFF_CABLE_POINTS) && (n % 3 != 0 || n > 3 * RC_MAX_TARGETS))
-        return RC_ERR_ARG; /* three per target, per point */
+    if (ds->count == 0 && ds->suffixes[0] != '\0') { /* a group of named parameters per item (target, point) */
+        unsigned per = 1;
+        for (const char *c = ds->suffixes; *c; ++c)
+            per += *c == '|';
+        if (n % per != 0 || n > per * RC_MAX_TARGETS)
+            return RC_ERR_ARG; /* three per target, per point */
+    }
     if (ds->side == RC_SIDE_SENSOR || kind == RC_EFF_CABLE_POINTS)
         for (unsigned i = 0; i < m->n_effects; ++i)
             if (m->effects[i].kind == (uint8_t)kind)
@@ -668,11 +673,12 @@ static void point_jac(double *jac, double dl_dtheta[RC_NJ], const rc_model *m, c
     }
 }
 
-/* A tracker sample (rc_sensor.h): its component and Jacobian row. */
+/* A sample of a sensor with a hook (RC_SENSORS, rc_sensor.h): its value
+ * and Jacobian row, the chain's part along the hook's gradient. */
 static rc_status sensor_chain(double *value, double *jac, const rc_model *m, const rc_sample *s, const chain *c)
 {
     double pt[3], g[3], dl_dtheta[RC_NJ];
-    const rc_status st = rc_sensor_tracker(value, pt, g, jac, m, s, c->o[RC_NJ], c->R[RC_NJ]);
+    const rc_status st = rc_sensor_hook(s->sensor)(value, pt, g, jac, m, s, c->o[RC_NJ], c->R[RC_NJ]);
     if (st == RC_OK && jac != NULL)
         point_jac(jac, dl_dtheta, m, s, c, pt, g);
     return st;
@@ -704,9 +710,6 @@ static void eff_none(len_terms *t, double *J, const rc_effect *ef, const double 
     (void)t, (void)J, (void)ef, (void)x;
 }
 #define eff_NONE eff_none
-#define eff_JOINT_COMPLIANCE eff_none
-#define eff_JOINT_PERIODIC eff_none
-#define eff_AXIS_TILT eff_none
 
 /* Another sensor's (the tracker's frame and targets): no part in a length. */
 static void eff_sensor(len_terms *t, double *J, const rc_effect *ef, const double *x)
@@ -716,10 +719,6 @@ static void eff_sensor(len_terms *t, double *J, const rc_effect *ef, const doubl
         for (unsigned k = 0; k < ef->count; ++k)
             J[k] = 0.0;
 }
-#define eff_TRACKER_POSITION eff_sensor
-#define eff_TRACKER_ROTATION eff_sensor
-#define eff_TRACKER_TARGETS eff_sensor
-#define eff_TRACKER_SCALE eff_sensor
 
 static void eff_LENGTH_OFFSET(len_terms *t, double *J, const rc_effect *ef, const double *x)
 {
@@ -865,7 +864,17 @@ static void eff_point(len_terms *t, double *J, const rc_effect *ef, const double
 #define eff_TOOL_OFFSET eff_point
 #define eff_CABLE_POINTS eff_point
 
-#define RC_EFF_FN_(id, ...) eff_##id,
+/* An effect's function by its side: a length-, point- or outlet-side kind has
+ * its own (eff_<KIND>); a joint- or geometry-side kind has no part in a
+ * length's own terms (the chain's, point_jac); a sensor-side kind's columns
+ * of a length are zero (rc_sensor.h). */
+#define EFF_BY_SIDE_RC_SIDE_LENGTH(id) eff_##id
+#define EFF_BY_SIDE_RC_SIDE_POINT(id) eff_##id
+#define EFF_BY_SIDE_RC_SIDE_OUTLET(id) eff_##id
+#define EFF_BY_SIDE_RC_SIDE_JOINT(id) eff_none
+#define EFF_BY_SIDE_RC_SIDE_GEOMETRY(id) eff_none
+#define EFF_BY_SIDE_RC_SIDE_SENSOR(id) eff_sensor
+#define RC_EFF_FN_(id, name, count, side, ...) EFF_BY_SIDE_##side(id),
 static const eff_fn eff_fns[] = {RC_EFFECTS(RC_EFF_FN_)};
 #undef RC_EFF_FN_
 

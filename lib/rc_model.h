@@ -92,6 +92,13 @@
  *      params per point (count = 3 x points, at most RC_MAX_TARGETS), mm in
  *      the flange frame. Points apart on the plate make the flange's
  *      orientation visible to the cable, as targets make it to a tracker
+ *  touch_tip:  the touch probe's point (or a hard tool tip) in the flange frame: a
+ *      plane sample (RC_SENSOR_PLANE) sees flange + R6 (x, y, z); 3 params, mm
+ *  plane_normals:  plate k's unit normal n_k = rc_plane_normal(theta_k, phi_k); 2
+ *      params per plate (count = 2 x plates), rad
+ *  plane_offsets:  plate k's distance d_k from the base origin along n_k; a plane
+ *      sample of plate k predicts n_k . p - d_k (measured: 0); 1 param per
+ *      plate, mm
  */
 #define RC_EFFECTS(X) \
     X(NONE, "none", 0, RC_SIDE_LENGTH, RC_EFF_ARG_NONE, 2, 0, 0, "", 0.0, "", "", 0) \
@@ -113,7 +120,10 @@
     X(OUTLET_OFFSET, "outlet_offset", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 0, 0, 1, "mm", 1000.0, "", "o", 0) \
     X(OUTLET_SCALE, "outlet_scale", 0, RC_SIDE_LENGTH, RC_EFF_ARG_COUNT, 2, 0, 1, "", 0.001, "", "o", 0) \
     X(TRACKER_SCALE, "tracker_scale", 1, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 2, 0, 1, "", 3e-4, "", "", 0) \
-    X(CABLE_POINTS, "cable_points", 0, RC_SIDE_POINT, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z", "", 0)
+    X(CABLE_POINTS, "cable_points", 0, RC_SIDE_POINT, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e4, "x|y|z", "", 0) \
+    X(TOUCH_TIP, "touch_tip", 3, RC_SIDE_SENSOR, RC_EFF_ARG_NONE, 0, 0, 0, "mm", 1e4, "x|y|z", "", 0) \
+    X(PLANE_NORMALS, "plane_normals", 0, RC_SIDE_SENSOR, RC_EFF_ARG_COUNT, 1, 0, 0, "rad", 7.0, "theta|phi", "p", 0) \
+    X(PLANE_OFFSETS, "plane_offsets", 0, RC_SIDE_SENSOR, RC_EFF_ARG_COUNT, 0, 0, 0, "mm", 1e5, "", "p", 0)
 
 #define RC_EFF_ENUM_(id, ...) RC_EFF_##id,
 typedef enum rc_effect_kind { RC_EFFECTS(RC_EFF_ENUM_) RC_EFF_COUNT_ } rc_effect_kind;
@@ -210,19 +220,43 @@ typedef struct rc_model {
     double q_max_rad[RC_NJ];
 } rc_model;
 
-/* What a sample measured (rc_sample.sensor): one scalar residual row each.
- * A tracker position is three samples, its x, y and z components in the
- * tracker's frame (lib/rc_sensor.h). */
-typedef enum rc_sensor_kind {
-    RC_SENSOR_LENGTH = 0,    /* cable length from an outlet (the default of a zeroed sample) */
-    RC_SENSOR_TRACKER_X = 1, /* x of a target in the tracker frame (mm) */
-    RC_SENSOR_TRACKER_Y = 2,
-    RC_SENSOR_TRACKER_Z = 3
-} rc_sensor_kind;
+/* What a sample measured (rc_sample.sensor): one scalar residual row each,
+ * in one list. RC_SENSORS gives the kinds (the enum), their units
+ * (rc_sensor_unit) and each one's hook (lib/rc_sensor.h: its value, the
+ * point it sees and d value / d point, its own parameters' derivatives; the
+ * chain's part is rc_model.c's, the same for every sensor). A cable length
+ * is the chain's own (no hook). A tracker position is three samples, its x,
+ * y and z components in the tracker's frame. Adding a sensor: one line here
+ * (at the end: the numbers are stable), its hook in a file of its own, its
+ * effects in RC_EFFECTS (side RC_SIDE_SENSOR).
+ * X(ID, name, unit, hook) */
+#define RC_SENSORS(X)                                                   \
+    X(LENGTH, "length", "mm", rc_sensor_none)                          \
+    X(TRACKER_X, "tracker_x", "mm", rc_sensor_tracker)                 \
+    X(TRACKER_Y, "tracker_y", "mm", rc_sensor_tracker)                 \
+    X(TRACKER_Z, "tracker_z", "mm", rc_sensor_tracker)                 \
+    X(PLANE, "plane", "mm", rc_sensor_plane)
+
+#define RC_SENSOR_ENUM_(id, name, unit, hook) RC_SENSOR_##id,
+typedef enum rc_sensor_kind { RC_SENSORS(RC_SENSOR_ENUM_) RC_SENSOR_COUNT_ } rc_sensor_kind;
+#undef RC_SENSOR_ENUM_
 
 /* The unit of a sensor's measured value (rc_sample.sensor): "mm" for a
  * length and a tracker coordinate; "?" for a kind the model does not know. */
 const char *rc_sensor_unit(unsigned sensor);
+/* The name of a sensor kind ("length", ...), "unknown" for another number. */
+const char *rc_sensor_name(unsigned sensor);
+
+/* A plate's unit normal n (3) from its angles (RC_EFF_PLANE_NORMALS):
+ * n = cos(theta) P + sin(theta) (cos(phi) E1 + sin(phi) E2), P = (1, 2, 3) /
+ * sqrt(14), E1 = (-2, 1, 0) / sqrt(5), E2 = P x E1: polar angles about a pole
+ * no horizontal, vertical or 45-degree plate faces (P is 37 deg from z, 58
+ * from y, 74 from x), so phi is well determined for the plates of a cell.
+ * dn_dtheta, dn_dphi (3 each) or NULL: the derivatives. */
+void rc_plane_normal(double n[3], double dn_dtheta[3], double dn_dphi[3], double theta, double phi);
+/* The angles of the unit normal n (3), turned to the pole's side (n . P >= 0,
+ * theta in [0, pi/2]): *flip 1 when n was turned (the plane's d changes sign). */
+void rc_plane_angles(double *theta, double *phi, int *flip, const double n[3]);
 
 /* One measurement: joint readings, cable length and its context. Zero-
  * initialise it (memset, calloc or = {0}) before filling the fields: a zero

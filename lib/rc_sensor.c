@@ -155,13 +155,29 @@ rc_status rc_sensor_tracker(double *value, double pt[3], double g[3], double *ja
     return RC_OK;
 }
 
-const char *rc_sensor_unit(unsigned sensor)
+rc_status rc_sensor_none(double *value, double pt[3], double g[3], double *jac, const rc_model *m,
+                         const rc_sample *s, const double o6[3], const double R6[9])
 {
-    switch (sensor) {
-    case RC_SENSOR_LENGTH:
-    case RC_SENSOR_TRACKER_X:
-    case RC_SENSOR_TRACKER_Y:
-    case RC_SENSOR_TRACKER_Z: return "mm";
-    default: return "?";
-    }
+    (void)value, (void)pt, (void)g, (void)jac, (void)m, (void)s, (void)o6, (void)R6;
+    return RC_ERR_ARG;
+}
+
+/* The list RC_SENSORS as tables, indexed by kind. */
+#define RC_SENSOR_UNIT_(id, name, unit, hook) unit,
+static const char *const sensor_units[] = {RC_SENSORS(RC_SENSOR_UNIT_)};
+#undef RC_SENSOR_UNIT_
+#define RC_SENSOR_NAME_(id, name, unit, hook) name,
+static const char *const sensor_names[] = {RC_SENSORS(RC_SENSOR_NAME_)};
+#undef RC_SENSOR_NAME_
+#define RC_SENSOR_HOOK_(id, name, unit, hook) hook,
+static const rc_sensor_hook_fn sensor_hooks[] = {RC_SENSORS(RC_SENSOR_HOOK_)};
+#undef RC_SENSOR_HOOK_
+
+const char *rc_sensor_unit(unsigned sensor) { return sensor < RC_SENSOR_COUNT_ ? sensor_units[sensor] : "?"; }
+
+const char *rc_sensor_name(unsigned sensor) { return sensor < RC_SENSOR_COUNT_ ? sensor_names[sensor] : "unknown"; }
+
+rc_sensor_hook_fn rc_sensor_hook(unsigned sensor)
+{
+    return sensor < RC_SENSOR_COUNT_ ? sensor_hooks[sensor] : rc_sensor_none;
 }

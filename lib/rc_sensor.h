@@ -32,12 +32,29 @@ void rc_rotvec_jl(double J[9], const double w[3]);
 /* Rotation vector w (3, |w| <= pi) of the rotation R (3 x 3). */
 void rc_rotvec_from_matrix(double w[3], const double R[9]);
 
-/* The hook of rc_meas for a tracker sample s: the flange pose o6 (3), R6
- * (3 x 3). value: the component; pt (3): the target in the base frame; g
- * (3): d value / d pt. jac (m->n_params) or NULL: every entry zeroed, then
- * the tracker frame's and the target's filled (the chain's are the
- * caller's). RC_ERR_ARG: a target the model lacks, or not a tracker sample. */
-rc_status rc_sensor_tracker(double *value, double pt[3], double g[3], double *jac, const rc_model *m,
-                            const rc_sample *s, const double o6[3], const double R6[9]);
+/* A sensor's hook (RC_SENSORS): for sample s of its kind, at the flange
+ * pose o6 (3), R6 (3 x 3): value, its prediction in the sensor's unit;
+ * pt (3), the point on the tool it sees, in the base frame; g (3),
+ * d value / d pt, the gradient the chain's part of the Jacobian row is
+ * taken along (rc_model.c, the same for every sensor). jac (m->n_params)
+ * or NULL: every entry zeroed, then the sensor's own parameters' filled.
+ * RC_ERR_ARG: a sample of another kind or one the model cannot predict (a
+ * target, a plane it lacks). */
+typedef rc_status (*rc_sensor_hook_fn)(double *value, double pt[3], double g[3], double *jac, const rc_model *m,
+                                       const rc_sample *s, const double o6[3], const double R6[9]);
+
+/* Every hook RC_SENSORS names, declared from the list. */
+#define RC_SENSOR_HOOK_DECL_(id, name, unit, hook)                                                                 \
+    rc_status hook(double *value, double pt[3], double g[3], double *jac, const rc_model *m, const rc_sample *s, \
+                   const double o6[3], const double R6[9]);
+RC_SENSORS(RC_SENSOR_HOOK_DECL_)
+#undef RC_SENSOR_HOOK_DECL_
+
+/* The hook of sensor kind sensor (rc_sample.sensor); rc_sensor_none for a
+ * cable length (the chain's own) and for a number that is no kind. */
+rc_sensor_hook_fn rc_sensor_hook(unsigned sensor);
+
+/* rc_sensor_tracker: a tracker sample's component (see the top);
+ * rc_sensor_none: RC_ERR_ARG always (a length is not a hook's). */
 
 #endif /* RC_SENSOR_H */

@@ -124,6 +124,7 @@ typedef struct parse_ctx {
     const rc_model *lim; /* joint limits of the robot, or NULL */
     size_t n_header;     /* fields of the header line */
     int implicit;        /* RCH_DATA_TARGETS without a header: the columns are q1..q6 by position */
+    const char *nm[C_N]; /* the columns' names: col_names, a sensor file's label (and value) its own */
 } parse_ctx;
 
 /* 1 when field f (quotes removed) is a column name the reader knows. */
@@ -162,10 +163,10 @@ static int parse_header(parse_ctx *pc, field *fields, size_t nf, const char *lin
             fields[i].len -= 2;
         }
         for (int k = 0; k < C_N; ++k) {
-            if (fields[i].len == strlen(col_names[k]) && strncasecmp(fields[i].p, col_names[k], fields[i].len) == 0) {
+            if (fields[i].len == strlen(pc->nm[k]) && strncasecmp(fields[i].p, pc->nm[k], fields[i].len) == 0) {
                 if (pc->col_of[k] >= 0) {
                     rch_diag_set(pc->d, pc->name, pc->line_no, fields[i].col, "column '%s' appears twice in the header",
-                                 col_names[k]);
+                                 pc->nm[k]);
                     return -1;
                 }
                 pc->col_of[k] = (int)i;
@@ -191,10 +192,19 @@ static int parse_header(parse_ctx *pc, field *fields, size_t nf, const char *lin
                              col_names[k], header_hint(line, ll));
                 return -1;
             }
+    if ((flags & RCH_DATA_SENSOR) && pc->col_of[C_TG] < 0) {
+        rch_diag_set(pc->d, pc->name, pc->line_no, 1, "header has no '%s' column%s", pc->nm[C_TG],
+                     header_hint(line, ll));
+        return -1;
+    }
+    if ((flags & RCH_DATA_SENSOR) && pc->nm[C_L] == col_names[C_L])
+        pc->col_of[C_L] = -1; /* a sensor without a measured value: an L column is not its */
+    if (flags & RCH_DATA_SENSOR)
+        pc->col_of[C_X] = pc->col_of[C_Y] = pc->col_of[C_Z] = pc->col_of[C_O] = -1;
     if ((pc->col_of[C_X] >= 0) != (pc->col_of[C_Y] >= 0) || (pc->col_of[C_X] >= 0) != (pc->col_of[C_Z] >= 0))
         pc->col_of[C_X] = pc->col_of[C_Y] = pc->col_of[C_Z] = -1; /* use x,y,z only as a triple */
-    if (!(flags & RCH_DATA_POSITIONS))
-        pc->col_of[C_SG] = -1; /* a positions file's column only (a cable file's target: the tool point the
+    if (!(flags & (RCH_DATA_POSITIONS | RCH_DATA_SENSOR)))
+        pc->col_of[C_SG] = -1; /* a positions or sensor file's column only (a cable file's target: the tool point the
                                   cable is on, RC_EFF_CABLE_POINTS) */
     return 0;
 }
@@ -227,7 +237,7 @@ static int grow(rch_data *out, parse_ctx *pc)
             out->sigma_mm = sg;
         s = sg ? s : NULL;
     }
-    if (s && ln && pc->col_of[C_P] >= 0 && (pc->flags & (RCH_DATA_POSE | RCH_DATA_POSITIONS))) {
+    if (s && ln && pc->col_of[C_P] >= 0 && (pc->flags & (RCH_DATA_POSE | RCH_DATA_POSITIONS | RCH_DATA_SENSOR))) {
         unsigned long *pz = realloc(out->pose, nc * sizeof *pz);
         if (pz)
             out->pose = pz;
@@ -259,7 +269,7 @@ static int out_of_limits(const rc_model *m, int j, double v)
 /* Range of one field's value v of column k: 0, or -1 with d set. */
 static int check_value(const parse_ctx *pc, int k, double v, const field *f)
 {
-    const char *nm = col_names[k];
+    const char *nm = pc->nm[k];
     const unsigned ln = pc->line_no, col = f->col;
     if (!isfinite(v))
         rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %s is not finite (no sensor reads it: fix or remove the row)",
@@ -287,10 +297,10 @@ static int check_value(const parse_ctx *pc, int k, double v, const field *f)
     else if (k == C_G && (v < 0.0 || v > 65535.0 || v != floor(v)))
         rch_diag_set(pc->d, pc->name, ln, col, "field 'group': %g is not an integer in 0..65535", v);
     else if (k == C_TG && (v < 0.0 || v >= RC_MAX_TARGETS || v != floor(v)))
-        rch_diag_set(pc->d, pc->name, ln, col, "field 'target': %g is not a target number (an integer 0..%d)", v,
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g is not a %s number (an integer 0..%d)", nm, v, nm,
                      RC_MAX_TARGETS - 1);
     else if (k == C_SG && !(v > 0.0 && v <= 100.0))
-        rch_diag_set(pc->d, pc->name, ln, col, "field 'sigma_mm': %g is not a tracker's standard deviation (0 < sigma "
+        rch_diag_set(pc->d, pc->name, ln, col, "field 'sigma_mm': %g is not a sensor's standard deviation (0 < sigma "
                      "<= 100 mm)", v);
     else if (k == C_O && (v < 0.0 || v > 255.0 || v != floor(v)))
         rch_diag_set(pc->d, pc->name, ln, col,
@@ -333,7 +343,7 @@ static int check_field_count(const parse_ctx *pc, const field *fields, size_t nf
         rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)ll + 1,
                      "%s%s%sthe row has %zu fields, the header %zu: a field is missing and the columns after it are "
                      "shifted (an empty field is still written: 1,,3); fix or remove the row",
-                     k_lost >= 0 ? "missing field '" : "", k_lost >= 0 ? col_names[k_lost] : "",
+                     k_lost >= 0 ? "missing field '" : "", k_lost >= 0 ? pc->nm[k_lost] : "",
                      k_lost >= 0 ? "': " : "", nf, nh);
         return -1;
     }
@@ -348,17 +358,17 @@ static int parse_row(rch_data *out, parse_ctx *pc, const field *fields, size_t n
     if (check_field_count(pc, fields, nf, ll) != 0 || grow(out, pc) != 0)
         return -1;
     for (int k = 0; k < C_N; ++k) {
-        if (pc->col_of[k] < 0 || (k == C_P && !(pc->flags & (RCH_DATA_POSE | RCH_DATA_POSITIONS))))
+        if (pc->col_of[k] < 0 || (k == C_P && !(pc->flags & (RCH_DATA_POSE | RCH_DATA_POSITIONS | RCH_DATA_SENSOR))))
             continue;
         const size_t c = (size_t)pc->col_of[k];
         if (c >= nf) {
             rch_diag_set(pc->d, pc->name, pc->line_no, (unsigned)ll + 1,
-                         "missing field '%s' (column %zu; the line has %zu fields)", col_names[k], c + 1, nf);
+                         "missing field '%s' (column %zu; the line has %zu fields)", pc->nm[k], c + 1, nf);
             return -1;
         }
         if (parse_number(&v[k], &fields[c]) != 0) {
             rch_diag_set(pc->d, pc->name, pc->line_no, fields[c].col, "field '%s': '%.*s' is not a number%s%s",
-                         col_names[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
+                         pc->nm[k], (int)(fields[c].len > 40 ? 40 : fields[c].len), fields[c].p,
                          number_hint(&fields[c]),
                          pc->implicit && out->n == 0 && fields[c].len > 0 && isalpha((unsigned char)fields[c].p[0])
                              ? " (a first line is a header only when it names its columns: q1,q2,q3,q4,q5,q6)"
@@ -423,7 +433,7 @@ static int nul_check(const parse_ctx *pc, const char *line, size_t ll, const cha
 }
 
 static int parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
-                 const rc_model *lim, rch_diag *d)
+                 const rc_model *lim, const char *label, const char *value, rch_diag *d)
 {
     field fields[256];
     size_t pos = 0;
@@ -435,8 +445,18 @@ static int parse(rch_data *out, const char *text, size_t len, const char *name, 
     pc.flags = flags;
     pc.d = d;
     pc.lim = lim;
-    for (int k = 0; k < C_N; ++k)
+    for (int k = 0; k < C_N; ++k) {
         pc.col_of[k] = -1;
+        pc.nm[k] = col_names[k];
+    }
+    if (flags & RCH_DATA_SENSOR) {
+        pc.nm[C_TG] = label;
+        if (value)
+            pc.nm[C_L] = value;
+        else
+            flags |= RCH_DATA_NO_LEN;
+        pc.flags = flags;
+    }
     if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
         pos = 3; /* UTF-8 byte-order mark (spreadsheet export) */
     while (pos < len) {
@@ -499,13 +519,50 @@ fail:
 int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
                    rch_diag *d)
 {
-    return parse(out, text, len, name, flags, NULL, d);
+    return parse(out, text, len, name, flags, NULL, NULL, NULL, d);
 }
 
 int rch_data_parse_limited(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
                            const rc_model *limits, rch_diag *d)
 {
-    return parse(out, text, len, name, flags, limits, d);
+    return parse(out, text, len, name, flags, limits, NULL, NULL, d);
+}
+
+int rch_data_parse_sensor(rch_data *out, const char *text, size_t len, const char *name, const char *label,
+                          const char *value, const rc_model *limits, rch_diag *d)
+{
+    return parse(out, text, len, name, RCH_DATA_SENSOR, limits, label, value, d);
+}
+
+int rch_data_header_has(const char *text, size_t len, const char *column)
+{
+    field fields[256];
+    size_t pos = len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0 ? 3u : 0u;
+    while (pos < len) { /* the first line that is neither blank nor a comment */
+        size_t e = pos, blank = 0;
+        while (e < len && text[e] != '\n' && text[e] != '\r')
+            ++e;
+        const char *line = text + pos;
+        const size_t ll = e - pos;
+        pos = e + 1;
+        while (blank < ll && isspace((unsigned char)line[blank]))
+            ++blank;
+        if (blank == ll || line[blank] == '#')
+            continue;
+        const size_t nf = split_line(fields, 256, line, ll);
+        for (size_t i = 0; i < nf && i < 256; ++i) {
+            const char *p = fields[i].p;
+            size_t n = fields[i].len;
+            if (n >= 2 && p[0] == '"' && p[n - 1] == '"') {
+                ++p;
+                n -= 2;
+            }
+            if (n == strlen(column) && strncasecmp(p, column, n) == 0)
+                return 1;
+        }
+        return 0;
+    }
+    return 0;
 }
 
 /* ---- scale of lengths and positions against the robot (issue 33) ---- */
@@ -632,7 +689,7 @@ int rch_data_load_limited(rch_data *out, const char *path, unsigned flags, const
     memset(out, 0, sizeof *out);
     if (rch_read_file(&buf, &len, path, RCH_DATA_MAX_BYTES, d) != 0)
         return -1;
-    int rc = parse(out, buf, len, path, flags, limits, d);
+    int rc = parse(out, buf, len, path, flags, limits, NULL, NULL, d);
     free(buf);
     if (rc == 0 && limits && !(flags & (RCH_DATA_NO_LEN | RCH_DATA_POSITIONS)) &&
         rch_data_check_scale(out, path, limits, d) != 0) {
@@ -735,12 +792,16 @@ void rch_split(size_t *idx, size_t n, unsigned long long seed)
 int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d)
 {
     double qmax = 0.0, lmax = 0.0;
+    size_t n_len = 0; /* lengths among the rows (another sensor's file has none: RCH_DATA_SENSOR) */
     if (data->n < 5)
         return 0;
     for (size_t i = 0; i < data->n; ++i) {
         for (unsigned j = 0; j < RC_NJ; ++j)
             qmax = fmax(qmax, fabs(data->s[i].q_rad[j]));
-        lmax = fmax(lmax, data->s[i].value);
+        if (data->s[i].sensor == RC_SENSOR_LENGTH) {
+            lmax = fmax(lmax, data->s[i].value);
+            ++n_len;
+        }
     }
     /* the loader converted degrees to radians: a file written in radians
      * leaves every joint within 7 "degrees" (400 deg is 6.98 rad) */
@@ -750,7 +811,7 @@ int rch_data_check_units(const rch_data *data, const char *name, rch_diag *d)
                      "(multiply by 180/pi)");
         return -1;
     }
-    if (lmax < 20.0) {
+    if (n_len > 0 && lmax < 20.0) {
         rch_diag_set(d, name, 0, 0,
                      "every cable length is below 20: the L column looks like metres, rcal reads millimetres "
                      "(multiply by 1000)");

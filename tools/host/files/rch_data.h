@@ -34,6 +34,9 @@ enum {
                                   optional target (0..RC_MAX_TARGETS-1, rc_sample.target), pose (pose[]),
                                   sigma_mm (sigma_mm[]); docs/positions.md. Rows stay rows: rch_pos_load
                                   (tools/host/fit/rch_positions.h) makes the three samples of each */
+    RCH_DATA_SENSOR = 32u,     /* another sensor's file (rch_data_parse_sensor): its label column (required,
+                                  0..RC_MAX_TARGETS-1, rc_sample.target) and value column (or none: value 0)
+                                  named by the caller; pose, sigma_mm optional; L, x, y, z, outlet not read */
     RCH_DATA_TARGETS = 16u     /* joint targets (rcal-rt --in): the header is optional. The first line is a
                                   header when one of its fields names a column (q1, L, pose, ... any case),
                                   never because a field fails to parse; otherwise it is the first row of a
@@ -109,6 +112,15 @@ int rch_data_parse(rch_data *out, const char *text, size_t len, const char *name
 /* The same with joint limits (as rch_data_load_limited; limits may be NULL). */
 int rch_data_parse_limited(rch_data *out, const char *text, size_t len, const char *name, unsigned flags,
                            const rc_model *limits, rch_diag *d);
+/* A sensor's file (RCH_DATA_SENSOR, tools/host/fit/rch_sensors.h): label the
+ * name of its label column ("plane"), value of its measured value's (NULL:
+ * the sensor has none, value 0); joints within limits' (NULL: unchecked).
+ * rc_sample.sensor is left 0: the caller sets its kind. 0, or -1 with d set. */
+int rch_data_parse_sensor(rch_data *out, const char *text, size_t len, const char *name, const char *label,
+                          const char *value, const rc_model *limits, rch_diag *d);
+/* 1 when the header line of text (len; the first line neither blank nor a
+ * '#' comment) has a column named column (any case, quotes removed). */
+int rch_data_header_has(const char *text, size_t len, const char *column);
 void rch_data_free(rch_data *data);
 
 /* Units: joint angles that all stay within +-7 (degrees, as read) look

@@ -11,6 +11,7 @@
  * rch_prior, rch_jumps, rch_uncert, rch_comp, rch_positions. Memory: scratch
  * freed before returning. Errors: 0, -1 with d set, -2 on a bad --fix name.
  */
+#include "rch_sensors.h"
 #include "rch_calib_int.h"
 
 #include "rch_calib.h"
@@ -723,6 +724,7 @@ static int stage_map_first(void *run, rch_calib_result *r, rch_diag *d)
     rch_calib_fit_state *f = run;
     (void)d;
     if (!(r->prior_on && !f->jumps && !r->cfg.no_jump_check && r->n_train >= 40 && !r->n_pos_rows &&
+          rch_sensors_count(f->train, r->n_train) == 0 &&
           r->n_outlets <= 1))
         return 0;
     double chi2_e = 0.0;

@@ -13,6 +13,7 @@
 #include "rch_file.h"
 #include "rch_groups.h"
 #include "rch_positions.h"
+#include "rch_sensors.h"
 #include "rch_sha256.h"
 
 #ifndef M_PI
@@ -42,9 +43,11 @@ static int load_one(rch_data *out, const char *path, const char *text, size_t te
     rch_sha256_init(&c);
     rch_sha256_update(&c, buf, len);
     rch_sha256_final(&c, sha);
-    int rc = rch_data_parse_limited(out, buf, len, path, 0, limits, d);
+    const rch_sensor_desc *sd = rch_sensor_for_file(buf, len); /* another sensor's file, by its header */
+    int rc = sd ? rch_sensor_parse(out, sd, buf, len, path, limits, d)
+                : rch_data_parse_limited(out, buf, len, path, 0, limits, d);
     free(buf);
-    if (rc == 0 && limits && rch_data_check_scale(out, path, limits, d) != 0) {
+    if (rc == 0 && !sd && limits && rch_data_check_scale(out, path, limits, d) != 0) {
         rch_data_free(out);
         rc = -1;
     }
@@ -425,6 +428,7 @@ int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
         for (size_t k = 0; k < out->counts[f] && i < out->data.n; ++k)
             out->file_of[i++] = (unsigned)f;
     if (outlets(out, d) != 0 || cable_points(out, cfg, d) != 0 ||
+        rch_sensors_add_effects(&out->robot.model, out->data.s, out->data.n, d) != 0 ||
         (cfg->n_positions_paths && append_positions(out, cfg, d) != 0))
         goto fail;
     out->n_read = out->data.n;

@@ -222,7 +222,7 @@ void rch_pos_fix_unseen(uint8_t *fixed, const rc_model *m, const rc_sample *s, s
     const size_t nl = rch_pos_count_lengths(s, n);
     uint8_t seen_t[RC_MAX_TARGETS] = {0};
     for (size_t i = 0; i < n; ++i)
-        if (s[i].sensor != RC_SENSOR_LENGTH && s[i].target < RC_MAX_TARGETS)
+        if (s[i].sensor >= RC_SENSOR_TRACKER_X && s[i].sensor <= RC_SENSOR_TRACKER_Z && s[i].target < RC_MAX_TARGETS)
             seen_t[s[i].target] = 1;
     if (nl == 0)
         fixed[RC_P_ENC] = fixed[RC_P_ENC + 1] = fixed[RC_P_ENC + 2] = 1;

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "rch_positions.h"
+#include "rch_sensors.h"
 
 /* The first guess of outlet k's position (k = 0: e) from its samples. */
 static int guess_outlet(double e[3], const rc_model *m, unsigned k, const rc_sample *s, size_t n, rch_diag *d)
@@ -52,6 +53,8 @@ int rch_calib_bc(rc_model *start, rc_solve_work *w, const rc_model *nominal, int
         rch_diag_set(d, "", 0, 0, "cannot place the tracker: the positions do not spread in three directions");
         return -1;
     }
+    if (rch_sensors_start(start, s, n, d) != 0) /* the other sensors' closed forms (rch_sensors.h) */
+        return -1;
     if (!has_encoder && (n_len > 0 || n == 0)) { /* no lengths at all: e is held (rch_pos_fix_unseen) */
         double e[3];
         if (guess_outlet(e, start, 0, s, n, d) != 0)
