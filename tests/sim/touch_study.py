@@ -446,7 +446,8 @@ def ref_fit(name, planes_idx, Q, n_planes):
         return np.concatenate([r / 0.01, (th[:22] - x0[free]) / sd])
 
     th = np.concatenate([x0[free], tip, np.array([[0.0, 0.0, d] for _, d in pl]).ravel()])
-    for it in range(30):
+    last = np.inf
+    for it in range(40):
         r = resid(th)
         J = np.zeros((len(r), len(th)))
         for i in range(len(th)):
@@ -454,11 +455,13 @@ def ref_fit(name, planes_idx, Q, n_planes):
             tp = th.copy()
             tp[i] += h
             J[:, i] = (resid(tp) - r) / h
-        lam = 1e-9 * np.trace(J.T @ J) / len(th)
+        lam = 1e-14 * np.trace(J.T @ J) / len(th)  # the prior makes it full rank; damping would stall it
         step = np.linalg.solve(J.T @ J + lam * np.eye(len(th)), -J.T @ r)
         th = th + step
-        if np.max(np.abs(step[:22])) < 1e-9:
+        cost = r @ r
+        if it > 2 and abs(last - cost) < 1e-9 * cost:
             break
+        last = cost
     return unpack(th)[0]
 
 
