@@ -26,6 +26,7 @@ compensated by this script's own least squares (DH rows, probe, planes, with a p
 judged the same way: what the data allow, apart from rcal. Exit 77 without numpy.
 """
 import argparse
+import json
 import os
 import re
 import sys
@@ -343,6 +344,16 @@ def self_check(a):
                   "trigger noise and the display rounding, inside its extent and the %g deg cone, joints within "
                   "limits, wrist not singular (%d rows not)" % (k, name, which, len(c["plates"]), len(c["rows"]),
                                                                 CONE_DEG, bad))
+    # the judge's reading of the fitted probe from a model (an effect naming a probe; nothing: an error, not 0)
+    fake = os.path.join(tmp, "model_probe.json")
+    for doc, want in (({"effects": [{"kind": "tracker_targets", "params": [9, 9, 9]},
+                                    {"kind": "touch_probe", "params": [1.5, -2.0, 150.25]}]}, [1.5, -2.0, 150.25]),
+                      ({"effects": [{"kind": "length_offset", "params": [0.1]}]}, None)):
+        with open(fake, "w") as f:
+            json.dump(doc, f)
+        got, _ = model_probe(fake)
+        check((got is None and want is None) or (got is not None and want is not None and np.allclose(got, want)),
+              "the fitted probe read from a model: %s (wanted %s)" % (None if got is None else got.tolist(), want))
     print("largest distance of a written row's true point from its plate: %.4f mm (noisy rows; the noise "
           "itself included), %.4f mm (noise-free rows: the display rounding alone); unrounded joints: %.2e mm "
           "off the drawn noise; rounding's share of its first-order bound at most %.2f; probe axis at most "
@@ -379,12 +390,14 @@ def scale_free_pairs(landed, meant, rng):
     return np.abs(s * dl - dm), s
 
 
-def judge(k, case, T, C, tcp):
+def judge(k, case, T, C, tool, tool_true):
+    """truth_study's figures of the compensated joints C of the targets T: the program meant the nominal robot's
+    point `tool` (flange frame); the TRUE robot carries the tool at tool_true."""
     name, truth = case["name"], case["truth"]
     nom = ts.nominal_robot(name)
-    meant = np.array([nom.point(q, tcp) for q in T])
-    landed = np.array([truth.point(q, tcp) for q in C])
-    uncomp = np.array([truth.point(q, tcp) for q in T])
+    meant = np.array([nom.point(q, tool) for q in T])
+    landed = np.array([truth.point(q, tool_true) for q in C])
+    uncomp = np.array([truth.point(q, tool_true) for q in T])
     pe_c = ts.pair_err(landed, meant, np.random.default_rng(k))
     pe_u = ts.pair_err(uncomp, meant, np.random.default_rng(k))
     ts.ALIGN = "rigid"
@@ -449,10 +462,11 @@ def ref_fit(name, planes_idx, Q, n_planes):
     for sigma in (0.01, None, None):  # the rows weighed by 0.01 mm, then twice by the residuals' robust sd
         if sigma is None:
             rd = resid(th, 1.0)[:len(Q)]
-            sigma = max(1.4826 * np.median(np.abs(rd - np.median(rd))), 1e-4)
+            sigma = max(1.4826 * np.median(np.abs(rd - np.median(rd))), 0.002)  # below: the fit ill-conditioned
         w = sigma
         th = gauss_newton(lambda t: resid(t, w), th)
-    return unpack(th)[0]
+    rob, tip, _ = unpack(th)
+    return rob, tip
 
 
 def gauss_newton(resid, th):
@@ -516,14 +530,16 @@ def one_case(a, k, name, tmp):
             f.write("dh%d a %+.4f d %+.4f alpha %+.5f theta %+.5f (mm, deg, true - nominal)\n"
                     % (j + 1, ra - a0, rd - d0, ral / DEG - al0, rth / DEG - th0))
     res = {"case": k, "robot": name, "planes": len(case["plates"]), "rows": len(rows),
-           "noise_mm": case["noise_sd"], "probe": case["tip"].tolist()}
-    tcp = [0.0, 0.0, 0.0]
-    T = judge_targets(case["rng"], name, tcp)
+           "noise_mm": case["noise_sd"], "probe_true_mm": case["tip"].tolist()}
+    flange = np.zeros(3)
+    T = judge_targets(case["rng"], name, flange)
     if a.reference:
         planes_idx, Q = read_touches(data)
-        model = ref_fit(name, planes_idx, Q, len(case["plates"]))
-        C = ref_compensate(model, ts.nominal_robot(name), T, tcp)
-        res.update(judge(k, case, T, C, tcp))
+        model, tip = ref_fit(name, planes_idx, Q, len(case["plates"]))
+        res["probe_fit_mm"] = tip.tolist()
+        for at, tool, tool_true in (("flange", flange, flange), ("probe", tip, case["tip"])):
+            C = ref_compensate(model, ts.nominal_robot(name), T, tool)
+            res[at] = judge(k, case, T, C, tool, tool_true)
         return res
     model = os.path.join(cdir, "model.json")
     if os.path.exists(model):
@@ -542,18 +558,44 @@ def one_case(a, k, name, tmp):
         f.write("q1,q2,q3,q4,q5,q6\n")
         for q in T:
             f.write(",".join("%.6f" % (v / DEG) for v in q) + "\n")
-    cmd = [a.rcal, "compensate", "--model", model, "--in", tin, "--out", tout, "--summary", "--position-only",
-           "--uncertainty-out", uout]
-    rc, out, err = ts.run(cmd)
-    if not os.path.exists(tout):
-        res["error"] = "compensate rc %d: %s" % (rc, err.strip()[:400])
+    tip, where = model_probe(model)
+    if tip is None:
+        res["error"] = "the model %s names no fitted probe (%s)" % (model, where)
         return res
-    C = np.loadtxt(tout, delimiter=",", skiprows=1, usecols=range(6), ndmin=2) * DEG
-    if len(C) != len(T):
-        res["error"] = "compensate wrote %d of %d targets" % (len(C), len(T))
-        return res
-    res.update(judge(k, case, T, C, tcp))
+    res["probe_fit_mm"] = tip.tolist()
+    for at, tool, tool_true in (("flange", flange, flange), ("probe", tip, case["tip"])):
+        for f in (tout, uout):
+            if os.path.exists(f):
+                os.remove(f)
+        cmd = [a.rcal, "compensate", "--model", model, "--in", tin, "--out", tout, "--summary", "--position-only",
+               "--uncertainty-out", uout]
+        if at == "probe":
+            cmd += ["--tool", ",".join("%.6f" % v for v in tool)]
+        rc, out, err = ts.run(cmd)
+        if not os.path.exists(tout):
+            res["error"] = "compensate (at the %s) rc %d: %s" % (at, rc, err.strip()[:400])
+            return res
+        C = np.loadtxt(tout, delimiter=",", skiprows=1, usecols=range(6), ndmin=2) * DEG
+        if len(C) != len(T):
+            res["error"] = "compensate (at the %s) wrote %d of %d targets" % (at, len(C), len(T))
+            return res
+        res[at] = judge(k, case, T, C, tool, tool_true)
     return res
+
+
+def model_probe(path):
+    """The fitted probe tip (flange frame, mm) in an rcal model: an effect whose kind names a probe or a touch,
+    with 3 params, or a top-level key naming a probe with 3 numbers. (None, what was looked for) if none."""
+    with open(path) as f:
+        doc = json.load(f)
+    for e in doc.get("effects", []):
+        kind = str(e.get("kind", ""))
+        if re.search("probe|touch", kind, re.I) and len(e.get("params", [])) == 3:
+            return np.array(e["params"], float), kind
+    for key, v in doc.items():
+        if re.search("probe", key, re.I) and isinstance(v, list) and len(v) == 3:
+            return np.array(v, float), key
+    return None, "looked for an effect whose kind holds 'probe' or 'touch' with 3 params, or a key 'probe...'"
 
 
 def main():
@@ -576,6 +618,10 @@ def main():
     ap.add_argument("--judge", choices=["pairs", "scale-free"], default="pairs",
                     help="with --check: the compensated pairwise median as truth_study.py judges it (pairs), or after "
                          "the landed points' best-fit scale (scale-free: planes alone measure no length)")
+    ap.add_argument("--at", choices=["probe", "flange"], default="probe",
+                    help="with --check: judge the probe's tip (compensated with the model's fitted probe as the tool; "
+                         "the point the touches see) or the flange (the judge of truth_study.py's default --tcp 0,0,0; "
+                         "its split from the probe is not seen by touches). Both are printed")
     a = ap.parse_args()
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
     if a.planes < 0 or a.planes > 16:
@@ -595,21 +641,26 @@ def main():
         if "error" in r:
             print("%s ERROR %s" % (head, r["error"]), flush=True)
             continue
-        print("%s pair median %.4f mm (uncompensated %.4f) ratio %.3f p95 %.4f; rigid-aligned 3-D median %.4f "
-              "(uncompensated %.4f); scale-free pair median %.4f, scale %+.0f ppm" % (
-                  head, r["pair_med_comp"], r["pair_med_uncomp"], r["pair_med_comp"] / r["pair_med_uncomp"],
-                  r["pair_p95_comp"], r["err_med_comp"], r["err_med_uncomp"], r["pair_med_scale_free"],
-                  r["scale_ppm"]), flush=True)
+        dtip = np.array(r["probe_fit_mm"]) - r["probe_true_mm"]
+        print("%s probe fitted - true %s mm" % (head, np.round(dtip, 3).tolist()))
+        for at in ("probe", "flange"):
+            j = r[at]
+            print("    at the %-6s pair median %.4f mm (uncompensated %.4f) ratio %.3f, p95 %.4f; rigid-aligned 3-D "
+                  "median %.4f (uncompensated %.4f); after the best-fit scale %.4f, scale %+.0f ppm" % (
+                      at, j["pair_med_comp"], j["pair_med_uncomp"], j["pair_med_comp"] / j["pair_med_uncomp"],
+                      j["pair_p95_comp"], j["err_med_comp"], j["err_med_uncomp"], j["pair_med_scale_free"],
+                      j["scale_ppm"]), flush=True)
     ok = [r for r in out if "error" not in r]
-    if ok:
-        print("cases %d (%s%s): median of pairwise medians %.4f mm (uncompensated %.4f), worst ratio %.3f, "
-              "cases worse %d; scale-free %.4f mm" % (
-                  len(ok), "reference fit" if a.reference else "rcal",
-                  ", one plate" if a.one_plate else "", np.median([r["pair_med_comp"] for r in ok]),
-                  np.median([r["pair_med_uncomp"] for r in ok]),
-                  max(r["pair_med_comp"] / r["pair_med_uncomp"] for r in ok),
-                  sum(r["pair_med_comp"] > r["pair_med_uncomp"] for r in ok),
-                  np.median([r["pair_med_scale_free"] for r in ok])))
+    for at in ("probe", "flange") if ok else ():
+        sel = [r[at] for r in ok]
+        print("at the %-6s cases %d (%s%s): median of pairwise medians %.4f mm (uncompensated %.4f), ratio median "
+              "%.3f worst %.3f, cases worse %d; after the best-fit scale %.4f mm" % (
+                  at, len(sel), "reference fit" if a.reference else "rcal", ", one plate" if a.one_plate else "",
+                  np.median([j["pair_med_comp"] for j in sel]), np.median([j["pair_med_uncomp"] for j in sel]),
+                  np.median([j["pair_med_comp"] / j["pair_med_uncomp"] for j in sel]),
+                  max(j["pair_med_comp"] / j["pair_med_uncomp"] for j in sel),
+                  sum(j["pair_med_comp"] > j["pair_med_uncomp"] for j in sel),
+                  np.median([j["pair_med_scale_free"] for j in sel])))
     print("errors: %d; files in %s" % (len(out) - len(ok), tmp))
     if not a.check:
         return 0
@@ -629,13 +680,14 @@ def main():
               % (len(ok), len(out)))
         key = "pair_med_scale_free" if a.judge == "scale-free" else "pair_med_comp"
         for r in ok:
-            check(r[key] <= a.ratio * r["pair_med_uncomp"],
-                  "case %d: compensated pair median%s %.4f mm <= %.2f x uncompensated %.4f" % (
-                      r["case"], " after the best-fit scale" if a.judge == "scale-free" else "", r[key], a.ratio,
-                      r["pair_med_uncomp"]))
+            j = r[a.at]
+            check(j[key] <= a.ratio * j["pair_med_uncomp"],
+                  "case %d: at the %s, compensated pair median%s %.4f mm <= %.2f x uncompensated %.4f" % (
+                      r["case"], a.at, " after the best-fit scale" if a.judge == "scale-free" else "", j[key],
+                      a.ratio, j["pair_med_uncomp"]))
         if ok:
-            worse = [r["case"] for r in ok if r["pair_med_comp"] > r["pair_med_uncomp"]]
-            check(not worse, "no case worse than uncompensated (worse: %s)" % worse)
+            worse = [r["case"] for r in ok if r[a.at]["pair_med_comp"] > r[a.at]["pair_med_uncomp"]]
+            check(not worse, "at the %s, no case worse than uncompensated (worse: %s)" % (a.at, worse))
     print("%d passed, %d failed" % (len(passes), len(failures)))
     return 1 if failures else 0
 
