@@ -269,8 +269,17 @@ def read_touches(path):
     return d[:, 1].astype(int), d[:, 2:8] * DEG
 
 
-def make_case(seed, k, name, n_planes, one_plate, n_per=None, noise_free=False):
-    """One case's truth and rows, from its own generator [seed, k] (the same for every run)."""
+def gauge_plate(pl0, rng, height):
+    """A 60 mm square face parallel to plate 0, height mm above it along its normal (gauge blocks under a
+    small plate, or a block's face): a length the planes can be told."""
+    c = pl0["c"] + height * pl0["n"] + rng.uniform(-0.2, 0.2) * pl0["side"] * pl0["u"]
+    return {"c": c, "n": pl0["n"], "u": pl0["u"], "v": pl0["v"], "side": 60.0, "kind": "gauge",
+            "d": float(pl0["n"] @ c), "of": 0, "height": height}
+
+
+def make_case(seed, k, name, n_planes, one_plate, n_per=None, noise_free=False, gauge=0.0):
+    """One case's truth and rows, from its own generator [seed, k] (the same for every run); gauge > 0: one more
+    plane, parallel to plane 0 at that height (mm) above it."""
     rng = np.random.default_rng([seed, k])
     lim = ts.ROBOTS[name]["lim"]
     truth = ts.true_robot(rng, name)
@@ -278,6 +287,8 @@ def make_case(seed, k, name, n_planes, one_plate, n_per=None, noise_free=False):
     if n_planes <= 0:
         n_planes = int(rng.integers(3, 5))
     plates = draw_plates(rng, name, n_planes, one_plate)
+    if gauge > 0:
+        plates.append(gauge_plate(plates[0], np.random.default_rng([seed, k, 3]), gauge))
     noise_sd = rng.uniform(0.003, 0.02)
     if n_per is None:
         n_per = int(rng.integers(60, 121))
@@ -304,12 +315,12 @@ def self_check(a):
     worst_raw, worst_round, worst_ratio, worst_free, worst_cone = 0.0, 0.0, 0.0, 0.0, 0.0
     for k in range(a.cases):
         name = names[k % len(names)]
-        case = make_case(a.seed, k, name, a.planes, a.one_plate)
-        free = make_case(a.seed, k, name, a.planes, a.one_plate, noise_free=True)
+        case = make_case(a.seed, k, name, a.planes, a.one_plate, gauge=a.gauge)
+        free = make_case(a.seed, k, name, a.planes, a.one_plate, noise_free=True, gauge=a.gauge)
         rob, tip = case["truth"], case["tip"]
         paths = [os.path.join(tmp, "self%d_%s.csv" % (k, s)) for s in ("a", "b", "free")]
         write_touches(paths[0], case["rows"])
-        write_touches(paths[1], make_case(a.seed, k, name, a.planes, a.one_plate)["rows"])
+        write_touches(paths[1], make_case(a.seed, k, name, a.planes, a.one_plate, gauge=a.gauge)["rows"])
         write_touches(paths[2], free["rows"])
         check(open(paths[0]).read() == open(paths[1]).read(), "case %d: the same seed writes the same file" % k)
         lim = ts.ROBOTS[name]["lim"]
@@ -415,14 +426,17 @@ def judge(k, case, T, C, tool, tool_true):
 PRIOR = (0.5, 0.5, 0.1 * DEG, 1.0 * DEG)  # a, d (mm), alpha, theta (rad): rcal's prior sd
 
 
-def ref_fit(name, planes_idx, Q, n_planes):
+def ref_fit(name, planes_idx, Q, n_planes, ties=None):
     """DH rows (theta1, d1 held: the base is not seen), the probe and the planes (n . x = d, n unit) from the
-    rows by Gauss-Newton with a prior of rcal's size on the DH rows; returns the fitted Robot."""
+    rows by Gauss-Newton with a prior of rcal's size on the DH rows; returns the fitted Robot and probe.
+    ties {j: (j0, h)}: plane j is told parallel to plane j0, h mm above it (its own parameters then unused)."""
+    ties = ties or {}
     nom = ts.nominal_robot(name)
     x0 = np.array([v for r in nom.rows for v in r])  # a, d, alpha, off per link
     free = [i for i in range(24) if i not in (1, 3)]  # d1, theta1 held
     R0, p0 = fk_batch(nom, Q)
-    # start: the probe 150 mm along z, each plane through its rows' centroid, normal from their spread
+    # start: the probe 150 mm along z, each plane through its rows' centroid, normal from their spread, turned
+    # against the probe's axis (out of the touched face: a tie's height counts along it)
     tip = np.array([0.0, 0.0, 150.0])
     X = p0 + np.einsum("nij,j->ni", R0, tip)
     pl = []
@@ -430,6 +444,8 @@ def ref_fit(name, planes_idx, Q, n_planes):
         P = X[planes_idx == j]
         c = P.mean(0)
         n = np.linalg.svd(P - c)[2][2]
+        if np.mean(R0[planes_idx == j][:, :, 2] @ n) > 0:
+            n = -n
         pl.append((n, float(n @ c)))
 
     def unpack(th):
@@ -455,8 +471,12 @@ def ref_fit(name, planes_idx, Q, n_planes):
         R, p = fk_batch(rob, Q)
         x = p + np.einsum("nij,j->ni", R, t)
         N = normals(P)
-        r = np.einsum("ni,ni->n", N[planes_idx], x) - P[planes_idx, 2]
-        return np.concatenate([r / w, (th[:22] - x0[free]) / sd])
+        D = P[:, 2].copy()
+        for j, (j0, h) in ties.items():
+            N[j], D[j] = N[j0], D[j0] + h
+        r = np.einsum("ni,ni->n", N[planes_idx], x) - D[planes_idx]
+        unused = np.concatenate([P[j] for j in ties]) if ties else np.zeros(0)
+        return np.concatenate([r / w, (th[:22] - x0[free]) / sd, unused])
 
     th = np.concatenate([x0[free], tip, np.array([[0.0, 0.0, d] for _, d in pl]).ravel()])
     for sigma in (0.01, None, None):  # the rows weighed by 0.01 mm, then twice by the residuals' robust sd
@@ -511,7 +531,7 @@ UNSEEN = re.compile(r"determin|unseen|not seen|identif|observ|rank|degenera", re
 
 
 def one_case(a, k, name, tmp):
-    case = make_case(a.seed, k, name, a.planes, a.one_plate)
+    case = make_case(a.seed, k, name, a.planes, a.one_plate, gauge=a.gauge)
     rows = case["rows"]
     cdir = os.path.join(tmp, "case%02d" % k)
     os.makedirs(cdir, exist_ok=True)
@@ -535,7 +555,8 @@ def one_case(a, k, name, tmp):
     T = judge_targets(case["rng"], name, flange)
     if a.reference:
         planes_idx, Q = read_touches(data)
-        model, tip = ref_fit(name, planes_idx, Q, len(case["plates"]))
+        ties = {j: (pl["of"], pl["height"]) for j, pl in enumerate(case["plates"]) if pl["kind"] == "gauge"}
+        model, tip = ref_fit(name, planes_idx, Q, len(case["plates"]), ties)
         res["probe_fit_mm"] = tip.tolist()
         for at, tool, tool_true in (("flange", flange, flange), ("probe", tip, case["tip"])):
             C = ref_compensate(model, ts.nominal_robot(name), T, tool)
@@ -618,6 +639,11 @@ def main():
     ap.add_argument("--judge", choices=["pairs", "scale-free"], default="pairs",
                     help="with --check: the compensated pairwise median as truth_study.py judges it (pairs), or after "
                          "the landed points' best-fit scale (scale-free: planes alone measure no length)")
+    ap.add_argument("--scale-ppm", type=float, default=3000.0,
+                    help="with --judge scale-free: the landed points' best-fit scale within +-PPM of 1")
+    ap.add_argument("--gauge", type=float, default=0.0, metavar="MM",
+                    help="one more plane, a 60 mm face parallel to plane 0, MM above it; --reference is told that "
+                         "length (rcal has no way to be told yet: to it an ordinary plane)")
     ap.add_argument("--at", choices=["probe", "flange"], default="probe",
                     help="with --check: judge the probe's tip (compensated with the model's fitted probe as the tool; "
                          "the point the touches see) or the flange (the judge of truth_study.py's default --tcp 0,0,0; "
@@ -685,8 +711,11 @@ def main():
                   "case %d: at the %s, compensated pair median%s %.4f mm <= %.2f x uncompensated %.4f" % (
                       r["case"], a.at, " after the best-fit scale" if a.judge == "scale-free" else "", j[key],
                       a.ratio, j["pair_med_uncomp"]))
+            if a.judge == "scale-free":  # the scale the planes leave to the prior: bounded, not judged
+                check(abs(j["scale_ppm"]) <= a.scale_ppm, "case %d: at the %s, the landed points' scale %+.0f ppm "
+                      "within +-%g ppm" % (r["case"], a.at, j["scale_ppm"], a.scale_ppm))
         if ok:
-            worse = [r["case"] for r in ok if r[a.at]["pair_med_comp"] > r[a.at]["pair_med_uncomp"]]
+            worse = [r["case"] for r in ok if r[a.at][key] > r[a.at]["pair_med_uncomp"]]
             check(not worse, "at the %s, no case worse than uncompensated (worse: %s)" % (a.at, worse))
     print("%d passed, %d failed" % (len(passes), len(failures)))
     return 1 if failures else 0
