@@ -403,17 +403,19 @@ def scale_free_pairs(landed, meant, rng):
 
 def judge(k, case, T, C, tool, tool_true):
     """truth_study's figures of the compensated joints C of the targets T: the program meant the nominal robot's
-    point `tool` (flange frame); the TRUE robot carries the tool at tool_true."""
+    point `tool` (flange frame, as the model knows the tool); the TRUE robot carries it at tool_true. The
+    uncompensated figure is the robot's own: the targets meant with the true tool (not with the fitted one)."""
     name, truth = case["name"], case["truth"]
     nom = ts.nominal_robot(name)
     meant = np.array([nom.point(q, tool) for q in T])
+    meant_u = np.array([nom.point(q, tool_true) for q in T])
     landed = np.array([truth.point(q, tool_true) for q in C])
     uncomp = np.array([truth.point(q, tool_true) for q in T])
     pe_c = ts.pair_err(landed, meant, np.random.default_rng(k))
-    pe_u = ts.pair_err(uncomp, meant, np.random.default_rng(k))
+    pe_u = ts.pair_err(uncomp, meant_u, np.random.default_rng(k))
     ts.ALIGN = "rigid"
     e_c = np.linalg.norm(ts.align(landed, meant) - meant, axis=1)
-    e_u = np.linalg.norm(ts.align(uncomp, meant) - meant, axis=1)
+    e_u = np.linalg.norm(ts.align(uncomp, meant_u) - meant_u, axis=1)
     sf, s = scale_free_pairs(landed, meant, np.random.default_rng(k))
     return {"pair_med_comp": float(np.median(pe_c)), "pair_med_uncomp": float(np.median(pe_u)),
             "pair_p95_comp": float(np.percentile(pe_c, 95)), "err_med_comp": float(np.median(e_c)),
