@@ -11,12 +11,15 @@ within 40 deg of the plate's inward normal and turned at random about it (joints
 singular), moved along the normal by a trigger noise (Gaussian, sd drawn 0.003-0.02 mm per case, about 2 %
 of the rows heavy-tailed; never told to rcal), the joints rounded to 0.001 deg as a controller displays
 them. The touch file (`pose,plane,q1..q6`) is calibrated with `rcal calibrate --data` (nothing about the
-probe or the plates told), 500 targets are compensated (`rcal compensate --position-only`) and driven on
-the TRUE robot, and judged as truth_study.py judges: the median of the pairwise distance errors, compensated
-against uncompensated (a rigid motion of the whole cell is invisible to planes and to that figure).
+probe or the plates told), 500 targets are compensated (`rcal compensate --position-only`, at the probe's
+tip with the model's fitted probe as `--tool`, and at the flange) and driven on the TRUE robot, and judged as
+truth_study.py judges: the median of the pairwise distance errors, compensated against uncompensated (a
+rigid motion of the whole cell is invisible to planes and to that figure); also after the landed points'
+best-fit scale (touches measure no length: the robot's scale is the prior's; docs/touches.md).
 
     python3 touch_study.py RCAL [--seed S] [--cases N] [--robot irb120|irb1600] [--one-plate]
                            [--planes N] [--check] [--dir D] [--self-check] [--reference]
+                           [--at probe|flange] [--judge pairs|scale-free] [--ratio R] [--gauge MM]
 
 --planes 1: one plate, one placement (directions of the robot left unseen): rcal must exit 0 or refuse
 naming what the data cannot determine. --self-check: the generator against its own kinematics (every
