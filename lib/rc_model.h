@@ -254,9 +254,11 @@ const char *rc_sensor_name(unsigned sensor);
  * from y, 74 from x), so phi is well determined for the plates of a cell.
  * dn_dtheta, dn_dphi (3 each) or NULL: the derivatives. */
 void rc_plane_normal(double n[3], double dn_dtheta[3], double dn_dphi[3], double theta, double phi);
-/* The angles of the unit normal n (3), turned to the pole's side (n . P >= 0,
- * theta in [0, pi/2]): *flip 1 when n was turned (the plane's d changes sign). */
-void rc_plane_angles(double *theta, double *phi, int *flip, const double n[3]);
+/* The angles of the unit normal n (3): theta in [0, pi], phi in (-pi, pi]
+ * (singular at n = +-P only). A plate's normal points out of its face, to
+ * the side the probe comes from (tools/host/fit/rch_sensor_touch.c), so a
+ * gauge block's top is at +height. */
+void rc_plane_angles(double *theta, double *phi, const double n[3]);
 
 /* One measurement: joint readings, cable length and its context. Zero-
  * initialise it (memset, calloc or = {0}) before filling the fields: a zero

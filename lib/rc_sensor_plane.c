@@ -36,16 +36,13 @@ void rc_plane_normal(double n[3], double dn_dtheta[3], double dn_dphi[3], double
     }
 }
 
-void rc_plane_angles(double *theta, double *phi, int *flip, const double n[3])
+void rc_plane_angles(double *theta, double *phi, const double n[3])
 {
-    double c = n[0] * pole[0] + n[1] * pole[1] + n[2] * pole[2];
-    const double sg = c < 0.0 ? -1.0 : 1.0;
-    const double a = sg * (n[0] * e1[0] + n[1] * e1[1] + n[2] * e1[2]);
-    const double b = sg * (n[0] * e2[0] + n[1] * e2[1] + n[2] * e2[2]);
-    c *= sg;
+    const double c = n[0] * pole[0] + n[1] * pole[1] + n[2] * pole[2];
+    const double a = n[0] * e1[0] + n[1] * e1[1] + n[2] * e1[2];
+    const double b = n[0] * e2[0] + n[1] * e2[1] + n[2] * e2[2];
     *theta = atan2(sqrt(a * a + b * b), c);
     *phi = atan2(b, a);
-    *flip = sg < 0.0;
 }
 
 rc_status rc_sensor_plane(double *value, double pt[3], double g[3], double *jac, const rc_model *m,

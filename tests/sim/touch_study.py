@@ -259,12 +259,19 @@ def touches(rng, rob, lim, tip, plates, n_per, noise_sd, bank):
     return rows
 
 
-def write_touches(path, rows):
-    """The touch file: pose, plane, q1..q6 (deg, as displayed: 0.001 deg). No measured value, no sigma."""
+def write_touches(path, rows, plates=None):
+    """The touch file: pose, plane, q1..q6 (deg, as displayed: 0.001 deg), no sigma. With a gauge plate among
+    plates (--gauge): a height_mm column, the gauge's rows written as touches of the plate it stands on at its
+    height (what docs/touches.md asks of a gauge block); the rows of the other plates at height 0."""
+    gauged = plates is not None and any(pl["kind"] == "gauge" for pl in plates)
     with open(path, "w") as f:
-        f.write("pose,plane,q1,q2,q3,q4,q5,q6\n")
+        f.write("pose,plane,q1,q2,q3,q4,q5,q6" + (",height_mm" if gauged else "") + "\n")
         for i, (q, j, _) in enumerate(rows):
-            f.write("%d,%d,%s\n" % (i, j, ",".join("%.3f" % v for v in np.round(q / DEG, 3))))
+            label, h = j, 0.0
+            if gauged and plates[j]["kind"] == "gauge":
+                label, h = plates[j]["of"], plates[j]["height"]
+            f.write("%d,%d,%s%s\n" % (i, label, ",".join("%.3f" % v for v in np.round(q / DEG, 3)),
+                                       (",%.3f" % h) if gauged else ""))
 
 
 def read_touches(path):
@@ -543,7 +550,7 @@ def one_case(a, k, name, tmp):
     robot = os.path.join(cdir, "robot.json")
     ts.write_robot(robot, name)
     data = os.path.join(cdir, "touches.csv")
-    write_touches(data, rows)
+    write_touches(data, rows, None if a.reference else case["plates"])
     with open(os.path.join(cdir, "truth.txt"), "w") as f:
         f.write("probe %s (flange frame, mm)\nnoise_sd %.4f mm\n" % (case["tip"].tolist(), case["noise_sd"]))
         for j, pl in enumerate(case["plates"]):

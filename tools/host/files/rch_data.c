@@ -276,7 +276,10 @@ static int check_value(const parse_ctx *pc, int k, double v, const field *f)
                      nm, isnan(v) ? "NaN" : "infinity");
     else if (k < C_L && fabs(v) > 720.0)
         rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g degrees is outside -720..720", nm, v);
-    else if (k == C_L && !(v >= RCH_DATA_MIN_LEN_MM && v <= 20000.0))
+    else if (k == C_L && (pc->flags & RCH_DATA_SENSOR) && fabs(v) > 1e4)
+        rch_diag_set(pc->d, pc->name, ln, col, "field '%s': %g mm is not a reading of this sensor (|value| <= 10000 mm)",
+                     nm, v);
+    else if (k == C_L && !(pc->flags & RCH_DATA_SENSOR) && !(v >= RCH_DATA_MIN_LEN_MM && v <= 20000.0))
         rch_diag_set(pc->d, pc->name, ln, col,
                      "field 'L': %g mm is not a cable length a draw-wire encoder reads (%g <= L <= 20000 mm): %s",
                      v, RCH_DATA_MIN_LEN_MM,
@@ -452,9 +455,8 @@ static int parse(rch_data *out, const char *text, size_t len, const char *name, 
     if (flags & RCH_DATA_SENSOR) {
         pc.nm[C_TG] = label;
         if (value)
-            pc.nm[C_L] = value;
-        else
-            flags |= RCH_DATA_NO_LEN;
+            pc.nm[C_L] = value; /* optional: 0 where the file has none */
+        flags |= RCH_DATA_NO_LEN;
         pc.flags = flags;
     }
     if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)

@@ -35,8 +35,8 @@ enum {
                                   sigma_mm (sigma_mm[]); docs/positions.md. Rows stay rows: rch_pos_load
                                   (tools/host/fit/rch_positions.h) makes the three samples of each */
     RCH_DATA_SENSOR = 32u,     /* another sensor's file (rch_data_parse_sensor): its label column (required,
-                                  0..RC_MAX_TARGETS-1, rc_sample.target) and value column (or none: value 0)
-                                  named by the caller; pose, sigma_mm optional; L, x, y, z, outlet not read */
+                                  0..RC_MAX_TARGETS-1, rc_sample.target) and value column (optional: value 0
+                                  without it; |value| <= 1e4) named by the caller; pose, sigma_mm optional; L, x, y, z, outlet not read */
     RCH_DATA_TARGETS = 16u     /* joint targets (rcal-rt --in): the header is optional. The first line is a
                                   header when one of its fields names a column (q1, L, pose, ... any case),
                                   never because a field fails to parse; otherwise it is the first row of a

@@ -3,8 +3,12 @@
  * (docs/touches.md; the sensor's prediction: lib/rc_sensor_plane.c).
  *
  * A touch file: q1..q6 (degrees) and plane (the plate or plate placement,
- * 0..RC_MAX_TARGETS-1) per row, optional pose and sigma_mm: the probe's
- * point lay on that plate's surface when the joints were read. The probe
+ * 0..RC_MAX_TARGETS-1) per row, optional pose, sigma_mm and height_mm: the
+ * probe's point lay on that plate's surface (height_mm above it along its
+ * normal: the top of a gauge block of that height standing on the plate)
+ * when the joints were read. Planes alone see no length (every length of
+ * the robot, the probe and the plates scaled alike fits as well): a gauge
+ * block's height is the length that fixes the robot's size. The probe
  * tip (RC_EFF_TOUCH_TIP) and every plate (RC_EFF_PLANE_NORMALS, _OFFSETS)
  * are fitted with the robot; their start is closed form at the model's
  * geometry (touch_start): with the tip held, each plate is the plane through
@@ -70,9 +74,12 @@ static int fit_planes(double (*n)[3], double *dist, unsigned *bad, const rc_mode
 {
     for (unsigned k = 0; k < np; ++k) {
         double c[3] = {0, 0, 0}, S[9] = {0}, V[9], ev[3], p[3];
-        size_t cnt = 0;
+        size_t cnt = 0, on = 0; /* touches of plate k, those on its face (height 0) */
         for (size_t i = 0; i < ns; ++i)
-            if (s[i].sensor == RC_SENSOR_PLANE && s[i].target == k) {
+            on += s[i].sensor == RC_SENSOR_PLANE && s[i].target == k && s[i].value == 0.0;
+        const int face = on >= 3; /* the plane through the face's touches (a gauge block's top is parallel) */
+        for (size_t i = 0; i < ns; ++i)
+            if (s[i].sensor == RC_SENSOR_PLANE && s[i].target == k && (!face || s[i].value == 0.0)) {
                 touch_point(p, m, &s[i], t);
                 for (int r = 0; r < 3; ++r)
                     c[r] += p[r];
@@ -85,7 +92,7 @@ static int fit_planes(double (*n)[3], double *dist, unsigned *bad, const rc_mode
         for (int r = 0; r < 3; ++r)
             c[r] /= (double)cnt;
         for (size_t i = 0; i < ns; ++i)
-            if (s[i].sensor == RC_SENSOR_PLANE && s[i].target == k) {
+            if (s[i].sensor == RC_SENSOR_PLANE && s[i].target == k && (!face || s[i].value == 0.0)) {
                 touch_point(p, m, &s[i], t);
                 for (int r = 0; r < 3; ++r)
                     for (int q = 0; q < 3; ++q)
@@ -95,8 +102,16 @@ static int fit_planes(double (*n)[3], double *dist, unsigned *bad, const rc_mode
             *bad = k;
             return -1;
         }
+        double side = 0.0; /* the flange's side of the plate: where the probe comes from */
+        for (size_t i = 0; i < ns; ++i)
+            if (s[i].sensor == RC_SENSOR_PLANE && s[i].target == k) {
+                double o[3], R[9];
+                flange(o, R, m, s[i].q_rad);
+                for (int r = 0; r < 3; ++r)
+                    side += V[3 * r + 2] * (o[r] - c[r]);
+            }
         for (int r = 0; r < 3; ++r)
-            n[k][r] = V[3 * r + 2]; /* the smallest eigenvalue's vector */
+            n[k][r] = side < 0.0 ? -V[3 * r + 2] : V[3 * r + 2]; /* the smallest eigenvalue's vector, out of the face */
         dist[k] = n[k][0] * c[0] + n[k][1] * c[1] + n[k][2] * c[2];
     }
     return 0;
@@ -170,13 +185,12 @@ static int touch_start(rc_model *m, const rc_sample *s, size_t ns, rch_diag *d)
     }
     memcpy(&m->x[tf], t, sizeof t);
     for (unsigned k = 0; k < np; ++k) {
-        int flip;
-        rc_plane_angles(&m->x[nf + 2 * k], &m->x[nf + 2 * k + 1], &flip, n[k]);
-        m->x[df + k] = flip ? -dist[k] : dist[k];
+        rc_plane_angles(&m->x[nf + 2 * k], &m->x[nf + 2 * k + 1], n[k]);
+        m->x[df + k] = dist[k];
     }
     return 0;
 }
 
 const rch_sensor_desc rch_sensor_touch = {
-    RC_SENSOR_PLANE, "touch", "plane", "planes", NULL, "docs/touches.md", touch_add_effects, touch_start,
+    RC_SENSOR_PLANE, "touch", "plane", "planes", "height_mm", "docs/touches.md", touch_add_effects, touch_start,
 };

@@ -30,7 +30,7 @@ typedef struct rch_sensor_desc {
     const char *name;   /* "touch": messages and the report */
     const char *label;  /* the column that names its file and labels its rows ("plane": rc_sample.target) */
     const char *labels; /* what a label numbers, plural ("planes") */
-    const char *value;  /* its measured value's column, NULL: none (a row is the measurement; value 0) */
+    const char *value;  /* its measured value's column (optional in a file: 0 without it), NULL: none */
     const char *doc;    /* its docs page ("docs/touches.md") */
     /* Add its effects to m for labels 0 .. n_labels - 1 (none when present). 0, or -1 (capacity). */
     int (*add_effects)(rc_model *m, unsigned n_labels);
