@@ -324,6 +324,91 @@ static void test_tracker_jacobian(void **state)
     assert_int_equal(rc_meas(&v, NULL, &m, &s), RC_ERR_ARG);
 }
 
+/* A touch on a plate (RC_SENSOR_PLANE, lib/rc_sensor_plane.c): every
+ * derivative by central differences (the chain's, the tip's, the plates'),
+ * the value against n . (o6 + R6 t) - d written here with the pole and its
+ * basis written out, and the angles' round trip over the sphere. */
+static void test_plane_jacobian(void **state)
+{
+    (void)state;
+    rc_rng g;
+    rc_rng_seed(&g, 41);
+    rc_model m = nominal();
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_JOINT_PERIODIC, 2, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_AXIS_TILT, 1, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_TOUCH_TIP, 0, 0), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_PLANE_NORMALS, 0, 4), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_PLANE_OFFSETS, 0, 2), RC_OK);
+    assert_int_equal(rc_model_add_effect(&m, RC_EFF_PLANE_NORMALS, 0, 3), RC_ERR_ARG); /* one set; pairs */
+    for (unsigned k = RC_N_BASE; k < m.n_params; ++k)
+        m.x[k] = 1e-3 * rc_rng_normal(&g);
+    const unsigned tip = m.n_params - 9, nrm = m.n_params - 6, off = m.n_params - 2;
+    m.x[tip] = 20.0, m.x[tip + 1] = -15.0, m.x[tip + 2] = 150.0;
+    m.x[nrm] = 0.7, m.x[nrm + 1] = -2.0, m.x[nrm + 2] = 2.2, m.x[nrm + 3] = 1.1;
+    m.x[off] = 300.0, m.x[off + 1] = -120.0;
+    char name[64];
+    assert_string_equal(rc_param_name(name, sizeof name, &m, nrm + 3), "plane_normals.p1.phi");
+    assert_string_equal(rc_param_name(name, sizeof name, &m, off + 1), "plane_offsets.p1");
+    assert_string_equal(rc_sensor_unit(RC_SENSOR_PLANE), "mm");
+    assert_string_equal(rc_sensor_name(RC_SENSOR_PLANE), "plane");
+    const double P[3] = {1 / sqrt(14.0), 2 / sqrt(14.0), 3 / sqrt(14.0)}, E1[3] = {-2 / sqrt(5.0), 1 / sqrt(5.0), 0};
+    const double E2[3] = {P[1] * E1[2] - P[2] * E1[1], P[2] * E1[0] - P[0] * E1[2], P[0] * E1[1] - P[1] * E1[0]};
+    rc_model flat = m; /* no joint-side effect, no tilt: rc_fk is the chain the test writes against */
+    flat.x[RC_N_BASE] = flat.x[RC_N_BASE + 1] = flat.x[RC_N_BASE + 2] = flat.x[RC_N_BASE + 3] = 0.0;
+    flat.x[RC_N_BASE + 4] = 0.0;
+    for (int trial = 0; trial < 40; ++trial) {
+        rc_sample s;
+        random_pose(&s, &g);
+        s.sensor = RC_SENSOR_PLANE;
+        s.target = (uint8_t)(trial % 2);
+        s.value = trial % 3 == 0 ? 50.0 : 0.0; /* a gauge block: the value is what the prediction is held to */
+        double v, jac[RC_MAX_PARAMS];
+        assert_int_equal(rc_meas(&v, jac, &m, &s), RC_OK);
+        for (unsigned k = 0; k < m.n_params; ++k) {
+            const double h = rc_param_unit(&m, k) == 0 ? 1e-4 : 1e-7;
+            rc_model mp = m, mm = m;
+            mp.x[k] += h;
+            mm.x[k] -= h;
+            double lp, lm;
+            assert_int_equal(rc_meas(&lp, NULL, &mp, &s), RC_OK);
+            assert_int_equal(rc_meas(&lm, NULL, &mm, &s), RC_OK);
+            const double fd = (lp - lm) / (2.0 * h);
+            if (fabs(fd - jac[k]) > 1e-5 * (1.0 + fabs(fd))) {
+                print_error("param %s: analytic %.9g, finite difference %.9g\n", rc_param_name(name, 64, &m, k),
+                            jac[k], fd);
+                fail();
+            }
+        }
+        double o6[3], R6[9], n[3];
+        const double th = flat.x[nrm + 2 * s.target], ph = flat.x[nrm + 2 * s.target + 1];
+        rc_fk(o6, R6, &flat, s.q_rad);
+        for (int r = 0; r < 3; ++r)
+            n[r] = cos(th) * P[r] + sin(th) * (cos(ph) * E1[r] + sin(ph) * E2[r]);
+        double want = -flat.x[off + s.target];
+        for (int r = 0; r < 3; ++r)
+            want += n[r] * (o6[r] + R6[3 * r] * flat.x[tip] + R6[3 * r + 1] * flat.x[tip + 1] +
+                            R6[3 * r + 2] * flat.x[tip + 2]);
+        assert_int_equal(rc_meas(&v, NULL, &flat, &s), RC_OK);
+        assert_true(fabs(v - want) < 1e-9 * (1.0 + fabs(want)));
+    }
+    for (int trial = 0; trial < 200; ++trial) { /* angles of a normal give it back */
+        double n[3] = {rc_rng_normal(&g), rc_rng_normal(&g), rc_rng_normal(&g)}, th, ph, back[3];
+        const double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int r = 0; r < 3; ++r)
+            n[r] /= len;
+        rc_plane_angles(&th, &ph, n);
+        rc_plane_normal(back, NULL, NULL, th, ph);
+        for (int r = 0; r < 3; ++r)
+            assert_true(fabs(back[r] - n[r]) < 1e-12);
+    }
+    rc_sample s;
+    random_pose(&s, &g);
+    s.sensor = RC_SENSOR_PLANE;
+    s.target = 2; /* a plate the model lacks */
+    double v;
+    assert_int_equal(rc_meas(&v, NULL, &m, &s), RC_ERR_ARG);
+}
+
 static void test_effect_capacity(void **state)
 {
     (void)state;
@@ -578,6 +663,7 @@ int main(void)
         cmocka_unit_test(test_fk_zero_pose),        cmocka_unit_test(test_lt_map),              cmocka_unit_test(test_wrap_angles),
         cmocka_unit_test(test_prepared_base),       cmocka_unit_test(test_prepared_effects),
         cmocka_unit_test(test_wrap_leaves_huge_angles), cmocka_unit_test(test_dh_sensitivity), cmocka_unit_test(test_tracker_jacobian), cmocka_unit_test(test_sensor_scales),
+        cmocka_unit_test(test_plane_jacobian),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
