@@ -8,6 +8,7 @@
  * rch_cost, rch_resid, rch_positions, rch_data. Memory: the inputs and the
  * scratch freed before returning. Errors: see rch_calib_run.
  */
+#include "rch_sensors.h"
 #include "rch_calib.h"
 #include "rch_file.h"
 #include "rch_calib_int.h"
@@ -287,6 +288,15 @@ static void take_inputs(rch_calib_result *r, const rch_inputs *in)
     r->n_groups = in->n_groups;
     r->groups_from_file = in->groups_from_file;
     r->prov = in->prov;
+    r->n_lengths = rch_pos_count_lengths(in->data.s, in->data.n);
+    for (size_t i = 0; i < in->data.n && !r->other_sensor; ++i) {
+        const rch_sensor_desc *sd = rch_sensor_of_kind(in->data.s[i].sensor);
+        if (sd) {
+            r->other_sensor = sd->kind;
+            if (sd->caveat)
+                sd->caveat(r->sensor_note, sizeof r->sensor_note, in->data.s, in->data.n);
+        }
+    }
     r->n_pos_rows = in->n_pos_rows;
     r->n_pos_poses = in->n_pos_poses;
     r->n_targets = in->n_targets;

@@ -232,6 +232,9 @@ typedef struct rch_calib_result {
     int have_validate;
     rch_evaluate_result validate; /* on cfg.validate_path */
     char plot_paths[2400];    /* files written into plots_dir, "\n"-separated */
+    size_t n_lengths;         /* cable lengths among the samples read */
+    unsigned other_sensor;    /* the rc_sensor_kind of a sensor of the table (rch_sensors.h) among them, 0: none */
+    char sensor_note[400];    /* that sensor's caveat on the data (rch_sensor_desc.caveat), "" */
     /* with cfg.positions_paths: */
     size_t n_pos_rows;        /* position rows read (three samples each) */
     size_t n_pos_poses;

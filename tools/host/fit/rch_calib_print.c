@@ -8,6 +8,7 @@
  * Depends on: rch_calib.h, rch_prior, rch_uncert, rch_positions, rch_text.
  * Memory: none on the heap. Errors: none (write errors are the stream's).
  */
+#include "rch_sensors.h"
 #include "rch_calib.h"
 #include "rch_calib_int.h"
 
@@ -40,8 +41,10 @@ static void print_model(FILE *f, const rch_calib_result *r)
         fprintf(f, "  %5u %10.4f %10.4f %12.5f %12.5f | %9.4f %10.4f %12.5f %12.5f\n", j + 1, x[0], x[1],
                 x[2] / DEG, x[3] / DEG, x[0] - x0[0], x[1] - x0[1], (x[2] - x0[2]) / DEG, (x[3] - x0[3]) / DEG);
     }
-    if (r->n_pos_rows && r->n_data == 3 * r->n_pos_rows)
-        fprintf(f, "  encoder e: no cable lengths (tracker positions only), held\n\n");
+    const rch_sensor_desc *sd = rch_sensor_of_kind(r->other_sensor);
+    if (r->n_lengths == 0)
+        fprintf(f, "  encoder e: no cable lengths (%s only), held\n\n",
+                r->n_pos_rows ? "tracker positions" : sd ? sd->words : "other sensors");
     else
         fprintf(f, "  encoder e = (%.4f, %.4f, %.4f) mm  (before calibration: %.4f, %.4f, %.4f)\n\n", m->x[RC_P_ENC],
                 m->x[RC_P_ENC + 1], m->x[RC_P_ENC + 2], bc->x[RC_P_ENC], bc->x[RC_P_ENC + 1], bc->x[RC_P_ENC + 2]);
@@ -285,7 +288,7 @@ static void diagnose_hint(char *buf, size_t len, const rch_calib_result *r)
 /* Cable lengths only to one attachment point (no tracker, no cable points). */
 static int one_point_cable(const rch_calib_result *r)
 {
-    return r->n_pos_rows == 0 && rch_pos_effect_at(&r->model, RC_EFF_CABLE_POINTS, NULL) < 0;
+    return r->n_pos_rows == 0 && r->other_sensor == 0 && rch_pos_effect_at(&r->model, RC_EFF_CABLE_POINTS, NULL) < 0;
 }
 
 /* Tracker positions and no cable lengths. */
@@ -378,14 +381,19 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                 r->noise_passes == 1 ? "" : "s", r->p_eff);
     if (u->has_prior && r->prior_scaled)
         print_prior_scale(f, r);
+    const rch_sensor_desc *sd = rch_sensor_of_kind(r->other_sensor);
     if (u->has_prior && r->n_pos_rows)
         fprintf(f, "  theta1 and d1 held (gauge): the tracker's frame absorbs the robot's heading and height, as "
                    "an outlet does for lengths; a cell sets its base frame anyway\n");
+    else if (u->has_prior && r->n_lengths == 0 && sd)
+        fprintf(f, "  theta1 and d1 held (gauge): %s; a cell sets its base frame anyway\n", sd->gauge);
     else if (u->has_prior)
         fprintf(f, "  theta1 and d1 held (gauge): lengths from outlets whose places are estimated cannot see the "
                    "robot's heading and height against them; a cell sets its base frame anyway\n");
-    if (!tracker_only(r))
+    if (r->n_lengths > 0)
         print_outlets(f, m);
+    if (r->sensor_note[0])
+        fprintf(f, "  %s: %s\n", sd ? sd->words : "data", r->sensor_note);
     if (r->attach_auto)
         fprintf(f, "  cable attachment: %s (an attachment vector improves the fit by %s%.1f against its Occam "
                    "penalty %.1f)\n",
@@ -446,6 +454,11 @@ static void print_uncertainty(FILE *f, const rch_calib_result *r)
                    "most of the geometry to the prior; measure poses that move every joint, with the targets "
                    "spread on the tool\n",
                 r->after_m.rmse_mm, r->seen_median_mm);
+    else if (accuracy_needs_poses(r) && r->n_lengths == 0 && rch_sensor_of_kind(r->other_sensor))
+        fprintf(f, "  next: the %s are fitted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave most of "
+                   "the geometry to the prior; %s\n",
+                rch_sensor_of_kind(r->other_sensor)->words, r->after_m.rmse_mm, r->seen_median_mm,
+                rch_sensor_of_kind(r->other_sensor)->advice);
     else if (accuracy_needs_poses(r))
         fprintf(f, "  next: the lengths are predicted to %.3f mm but the 3-D accuracy only to %.3f mm: the poses leave "
                    "most of the geometry to the prior; plan poses that move every joint, from more than one outlet: "
@@ -619,6 +632,11 @@ static void print_summary(FILE *f, const rch_calib_result *r)
                    "accuracy at the targets is %.0f x the position RMSE: the poses leave most of the geometry to "
                    "the prior)\n",
                 r->seen_median_mm / r->after_m.rmse_mm);
+    else if (accuracy_needs_poses(r) && r->n_lengths == 0 && rch_sensor_of_kind(r->other_sensor))
+        fprintf(f, "  next: %s (the 3-D accuracy is %.0f x the RMSE of the %s: the poses leave most of the geometry "
+                   "to the prior)\n",
+                rch_sensor_of_kind(r->other_sensor)->advice, r->seen_median_mm / r->after_m.rmse_mm,
+                rch_sensor_of_kind(r->other_sensor)->words);
     else if (accuracy_needs_poses(r))
         fprintf(f, "  next: rcal poses --robot %s --count 60 --outlet X,Y,Z --outlet X2,Y2,Z2 --out plan.csv (the "
                    "3-D accuracy is %.0f x the length RMSE: the poses leave most of the geometry to the prior)\n",

@@ -19,6 +19,7 @@
 #include "rch_sensors.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "rc_linalg.h"
@@ -191,6 +192,23 @@ static int touch_start(rc_model *m, const rc_sample *s, size_t ns, rch_diag *d)
     return 0;
 }
 
+/* No cable length and no gauge height: nothing in the data is a length. */
+static void touch_caveat(char *note, size_t note_len, const rc_sample *s, size_t n)
+{
+    note[0] = '\0';
+    for (size_t i = 0; i < n; ++i)
+        if (s[i].sensor == RC_SENSOR_LENGTH || (s[i].sensor == RC_SENSOR_PLANE && s[i].value != 0.0))
+            return;
+    snprintf(note, note_len,
+             "no length in the data (no gauge block's height_mm, no cable length): planes see only directions, "
+             "every length of the robot, the probe and the plates scaled alike fits as well, so the robot's size "
+             "is the prior's; touch the top of a gauge block of known height standing on a plate "
+             "(docs/touches.md)");
+}
+
 const rch_sensor_desc rch_sensor_touch = {
     RC_SENSOR_PLANE, "touch", "plane", "planes", "height_mm", "docs/touches.md", touch_add_effects, touch_start,
+    touch_caveat, "plate touches",
+    "the plates' places absorb the robot's heading and height, as an outlet does for lengths",
+    "touch plates facing three directions, at poses that move every joint and turn the probe (docs/touches.md)",
 };

@@ -37,6 +37,12 @@ typedef struct rch_sensor_desc {
     /* Closed-form start of its effects at m's geometry from its samples among s (n): what the fit
      * starts from. 0, or -1 with d set (the rows cannot place them). */
     int (*start)(rc_model *m, const rc_sample *s, size_t n, rch_diag *d);
+    /* What the data s (n, every sensor's) leave unseen that the report must say (one sentence into note,
+     * note_len), or "" (NULL: nothing to say). */
+    void (*caveat)(char *note, size_t note_len, const rc_sample *s, size_t n);
+    const char *words;  /* its data in words, for the report ("plate touches") */
+    const char *gauge;  /* why theta1 and d1 are held with its data alone ("the plates' places absorb ...") */
+    const char *advice; /* the next step when its poses leave the geometry to the prior */
 } rch_sensor_desc;
 
 /* The sensor whose file text (len) is, by its header's label column; NULL:

@@ -4,6 +4,7 @@
  * floor, the folds, the cross-validated geometry, the length jumps, the
  * search (rch_diagnose_search.c), the verdict and the per-sensor figures.
  * See rch_diagnose.h. */
+#include "rch_sensors.h"
 #include "rch_diagnose_int.h"
 #include "rch_text.h"
 #include "rch_dequant.h"
@@ -324,7 +325,13 @@ static int phase_sensors(run_state *S)
     }
     for (unsigned j = 0; j < out->n_sensors; ++j) {
         rch_diagnose_sensor *z = &out->sensors[j];
-        if (z->tracker) {
+        const rch_sensor_desc *sd = NULL; /* another sensor of the table (rch_sensors.h): a row a sample */
+        for (size_t i = 0; z->tracker && i < n && !sd; ++i)
+            if (S->cls[i] == j)
+                sd = rch_sensor_of_kind(out->s[i].sensor);
+        if (sd) {
+            snprintf(z->name, sizeof z->name, "%s", sd->name);
+        } else if (z->tracker) {
             z->rows /= 3;
             snprintf(z->name, sizeof z->name, "tracker");
         } else if (out->n_sensors - (out->n_tracker > 0) > 1) {

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_sensors.h"
 #include "rch_diagnose_int.h"
 #include "rch_stats.h"
 
@@ -278,22 +279,34 @@ unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_s
             g = ss[i].group + 1u > g ? ss[i].group + 1u : g;
         const unsigned k0 = k;
         k += rch_dg_structure_tests(out + k, rs, ss, m, (const double(*)[V_N])vs, g, a_each * (double)per);
+        /* another sensor of the table (rch_sensors.h): its name; it has no distance or direction from a place */
+        const rch_sensor_desc *sd = tracker ? rch_sensor_of_kind(ss[0].sensor) : NULL;
         for (unsigned j = k0; j < k; ++j) { /* names say the sensor; the cable's "length" is the tracker's distance */
             char nm[40];
             const char *base = out[j].name;
+            if (sd && (strcmp(base, "cable length") == 0 || strcmp(base, "cable direction") == 0)) {
+                memmove(&out[j], &out[j + 1], (k - j - 1) * sizeof out[0]);
+                --k;
+                --j;
+                continue;
+            }
             if (tracker && strcmp(base, "cable length") == 0)
                 base = "distance from the tracker";
             else if (tracker && strcmp(base, "cable direction") == 0)
                 base = "direction from the tracker";
-            snprintf(nm, sizeof nm, "%s: %.30s", tracker ? "tracker" : "cable", base);
+            snprintf(nm, sizeof nm, "%s: %.30s", sd ? sd->name : tracker ? "tracker" : "cable", base);
             memcpy(out[j].name, nm, sizeof nm);
         }
         if (!tracker && outlets > 1)
             k += anova_by(&out[k], "cable: outlet (ANOVA)", rs, ss, m, key_outlet, a_each);
-        if (tracker) {
+        if (tracker && !sd) {
             k += anova_by(&out[k], "tracker: coordinate x, y, z (ANOVA)", rs, ss, m, key_coordinate, a_each);
             if (targets > 1)
                 k += anova_by(&out[k], "tracker: target (ANOVA)", rs, ss, m, key_target, a_each);
+        } else if (sd && targets > 1) { /* its label: a plate's own offset the model lacks, one plate misread */
+            char nm[40];
+            snprintf(nm, sizeof nm, "%s: %s (ANOVA)", sd->name, sd->label);
+            k += anova_by(&out[k], nm, rs, ss, m, key_target, a_each);
         }
     }
 done:
