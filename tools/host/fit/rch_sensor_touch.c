@@ -68,20 +68,32 @@ static void touch_point(double p[3], const rc_model *m, const rc_sample *s, cons
         p[r] = o[r] + R[3 * r] * t[0] + R[3 * r + 1] * t[1] + R[3 * r + 2] * t[2];
 }
 
-/* Each plate k < np through its points at the tip t: n (np x 3), dist (np).
- * 0, or -1 with *bad the plate whose points do not span a plane. */
+/* The point of sample s on its plate's face: the probe's at the tip t less
+ * its height along the plate's normal n (have_n: n known, else not moved). */
+static void face_point(double p[3], const rc_model *m, const rc_sample *s, const double t[3], const double n[3],
+                       int have_n)
+{
+    touch_point(p, m, s, t);
+    for (int r = 0; have_n && r < 3; ++r)
+        p[r] -= s->value * n[r];
+}
+
+/* Each plate k < np through its points at the tip t: n (np x 3), dist (np);
+ * have_n: n holds the last round's normals (the heights taken off along
+ * them), else only touches at height 0 when a plate has 3. 0, or -1 with
+ * *bad the plate whose points do not span a plane. */
 static int fit_planes(double (*n)[3], double *dist, unsigned *bad, const rc_model *m, const rc_sample *s, size_t ns,
-                      unsigned np, const double t[3])
+                      unsigned np, const double t[3], int have_n)
 {
     for (unsigned k = 0; k < np; ++k) {
         double c[3] = {0, 0, 0}, S[9] = {0}, V[9], ev[3], p[3];
         size_t cnt = 0, on = 0; /* touches of plate k, those on its face (height 0) */
         for (size_t i = 0; i < ns; ++i)
             on += s[i].sensor == RC_SENSOR_PLANE && s[i].target == k && s[i].value == 0.0;
-        const int face = on >= 3; /* the plane through the face's touches (a gauge block's top is parallel) */
+        const int face = !have_n && on >= 3; /* the first round: the face's touches alone */
         for (size_t i = 0; i < ns; ++i)
             if (s[i].sensor == RC_SENSOR_PLANE && s[i].target == k && (!face || s[i].value == 0.0)) {
-                touch_point(p, m, &s[i], t);
+                face_point(p, m, &s[i], t, n[k], have_n);
                 for (int r = 0; r < 3; ++r)
                     c[r] += p[r];
                 ++cnt;
@@ -94,7 +106,7 @@ static int fit_planes(double (*n)[3], double *dist, unsigned *bad, const rc_mode
             c[r] /= (double)cnt;
         for (size_t i = 0; i < ns; ++i)
             if (s[i].sensor == RC_SENSOR_PLANE && s[i].target == k && (!face || s[i].value == 0.0)) {
-                touch_point(p, m, &s[i], t);
+                face_point(p, m, &s[i], t, n[k], have_n);
                 for (int r = 0; r < 3; ++r)
                     for (int q = 0; q < 3; ++q)
                         S[3 * r + q] += (p[r] - c[r]) * (p[q] - c[q]);
@@ -172,7 +184,7 @@ static int touch_start(rc_model *m, const rc_sample *s, size_t ns, rch_diag *d)
     memcpy(t, &m->x[tf], sizeof t);
     for (unsigned r = 0; r < TOUCH_START_ROUNDS; ++r) {
         const double t0[3] = {t[0], t[1], t[2]};
-        if (fit_planes(n, dist, &bad, m, s, ns, np, t) != 0) {
+        if (fit_planes(n, dist, &bad, m, s, ns, np, t, r > 0) != 0) {
             rch_diag_set(d, "", 0, 0,
                          "cannot place plane %u: its touches do not spread over a plate (at least 3, %.0f mm apart "
                          "in two directions; docs/touches.md)",
