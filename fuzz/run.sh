@@ -45,7 +45,7 @@ fi
 
 dict_for() {
     case "$1" in
-    fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load) echo "$ROOT/fuzz/dict/csv.dict" ;;
+    fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load | fuzz_touch) echo "$ROOT/fuzz/dict/csv.dict" ;;
     fuzz_json | fuzz_robot) echo "$ROOT/fuzz/dict/json.dict" ;;
     fuzz_rapid) echo "$ROOT/fuzz/dict/rapid.dict" ;;
     fuzz_fanuc) echo "$ROOT/fuzz/dict/fanuc.dict" ;;
@@ -59,7 +59,7 @@ dict_for() {
 
 maxlen_for() {
     case "$1" in
-    fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load | fuzz_json | fuzz_robot | fuzz_urdf | fuzz_rapid | fuzz_fanuc | fuzz_krl) echo 16384 ;;
+    fuzz_csv | fuzz_plan | fuzz_targets | fuzz_positions | fuzz_pos_load | fuzz_touch | fuzz_json | fuzz_robot | fuzz_urdf | fuzz_rapid | fuzz_fanuc | fuzz_krl) echo 16384 ;;
     fuzz_egm) echo 2048 ;;
     *) echo 1024 ;;
     esac
