@@ -40,6 +40,29 @@ static void random_pose(rc_sample *s, rc_rng *g)
     s->outlet = 0;
 }
 
+/* d value / d x_k of sample s: central differences against rc_meas's analytic gradient. */
+static void check_sample_jacobian(const rc_model *m, const rc_sample *s)
+{
+    double l, jac[RC_MAX_PARAMS];
+    assert_int_equal(rc_meas(&l, jac, m, s), RC_OK);
+    for (unsigned k = 0; k < m->n_params; ++k) {
+        const double h = rc_param_unit(m, k) == 0 ? 1e-4 : 1e-7;
+        rc_model mp = *m, mm = *m;
+        mp.x[k] += h;
+        mm.x[k] -= h;
+        double lp, lm;
+        assert_int_equal(rc_meas(&lp, NULL, &mp, s), RC_OK);
+        assert_int_equal(rc_meas(&lm, NULL, &mm, s), RC_OK);
+        const double fd = (lp - lm) / (2.0 * h);
+        if (fabs(fd - jac[k]) > 1e-5 * (1.0 + fabs(fd))) {
+            char name[64];
+            print_error("param %s: analytic %.9g, finite difference %.9g\n", rc_param_name(name, 64, m, k), jac[k],
+                        fd);
+            fail();
+        }
+    }
+}
+
 /* d l / d x_k: central differences against rc_meas's analytic gradient, for
  * the base model and a model with every effect kind. */
 static void check_param_jacobian_points(rc_model *m, rc_rng *g, int tracker, int points)
@@ -54,24 +77,7 @@ static void check_param_jacobian_points(rc_model *m, rc_rng *g, int tracker, int
         } else if (points) { /* a length to cable point trial % points */
             s.target = (uint8_t)(trial % points);
         }
-        double l, jac[RC_MAX_PARAMS];
-        assert_int_equal(rc_meas(&l, jac, m, &s), RC_OK);
-        for (unsigned k = 0; k < m->n_params; ++k) {
-            const double h = rc_param_unit(m, k) == 0 ? 1e-4 : 1e-7;
-            rc_model mp = *m, mm = *m;
-            mp.x[k] += h;
-            mm.x[k] -= h;
-            double lp, lm;
-            assert_int_equal(rc_meas(&lp, NULL, &mp, &s), RC_OK);
-            assert_int_equal(rc_meas(&lm, NULL, &mm, &s), RC_OK);
-            const double fd = (lp - lm) / (2.0 * h);
-            if (fabs(fd - jac[k]) > 1e-5 * (1.0 + fabs(fd))) {
-                char name[64];
-                print_error("param %s: analytic %.9g, finite difference %.9g\n", rc_param_name(name, 64, m, k),
-                            jac[k], fd);
-                fail();
-            }
-        }
+        check_sample_jacobian(m, &s);
     }
 }
 
@@ -362,23 +368,8 @@ static void test_plane_jacobian(void **state)
         s.sensor = RC_SENSOR_PLANE;
         s.target = (uint8_t)(trial % 2);
         s.value = trial % 3 == 0 ? 50.0 : 0.0; /* a gauge block: the value is what the prediction is held to */
-        double v, jac[RC_MAX_PARAMS];
-        assert_int_equal(rc_meas(&v, jac, &m, &s), RC_OK);
-        for (unsigned k = 0; k < m.n_params; ++k) {
-            const double h = rc_param_unit(&m, k) == 0 ? 1e-4 : 1e-7;
-            rc_model mp = m, mm = m;
-            mp.x[k] += h;
-            mm.x[k] -= h;
-            double lp, lm;
-            assert_int_equal(rc_meas(&lp, NULL, &mp, &s), RC_OK);
-            assert_int_equal(rc_meas(&lm, NULL, &mm, &s), RC_OK);
-            const double fd = (lp - lm) / (2.0 * h);
-            if (fabs(fd - jac[k]) > 1e-5 * (1.0 + fabs(fd))) {
-                print_error("param %s: analytic %.9g, finite difference %.9g\n", rc_param_name(name, 64, &m, k),
-                            jac[k], fd);
-                fail();
-            }
-        }
+        double v;
+        check_sample_jacobian(&m, &s);
         double o6[3], R6[9], n[3];
         const double th = flat.x[nrm + 2 * s.target], ph = flat.x[nrm + 2 * s.target + 1];
         rc_fk(o6, R6, &flat, s.q_rad);
