@@ -121,6 +121,29 @@ static int branch_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad
            (sin(q_rad[4] + ik->kin.link[4].theta_off_rad) < 0);
 }
 
+static int boundary_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad[RC_NJ])
+{
+    double f[2];
+    factors(f, d, ik->d4_mm);
+    double u[3], w[3];
+    const double z3[3] = {d->R[3][2], d->R[3][5], d->R[3][8]};
+    for (int k = 0; k < 3; ++k) {
+        u[k] = d->o[2][k] - d->o[1][k];
+        w[k] = d->o[3][k] + ik->d4_mm * z3[k] - d->o[2][k];
+    }
+    const double uw = sqrt(dot(u, u) * dot(w, w));
+    return 4 * (fabs(f[0]) <= RCH_IKG_BOUNDARY * ik->reach_mm) + 2 * (fabs(f[1]) <= RCH_IKG_BOUNDARY * uw) +
+           (fabs(sin(q_rad[4] + ik->kin.link[4].theta_off_rad)) <= RCH_IKG_BOUNDARY);
+}
+
+int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ])
+{
+    rc_kin_data d;
+    double p[3];
+    rc_kin_fk(p, NULL, &d, &ik->kin, q_rad);
+    return boundary_of(ik, &d, q_rad);
+}
+
 int rch_ikg_branch(const rch_ikg *ik, const double q_rad[RC_NJ])
 {
     rc_kin_data d;

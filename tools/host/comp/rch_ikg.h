@@ -90,6 +90,14 @@ void rch_ikg_fk(double pos_mm[3], double rot[9], const rch_ikg *ik, const double
 /* The branch (0..7, bits above) of the configuration q_rad (6). */
 int rch_ikg_branch(const rch_ikg *ik, const double q_rad[RC_NJ]);
 
+/* The bits (4, 2, 1 as the branch's) of the singularities q_rad (6) lies on:
+ * its factor within RCH_IKG_BOUNDARY of 0 (shoulder: the distance of P from
+ * its plane over the reach; elbow: the sine of the angle at o2 between o1
+ * and E; wrist: sin(q5 + theta5)). Such a configuration is on both sides of
+ * that boundary: it answers a solve of either label (rch_ikg_solve). */
+#define RCH_IKG_BOUNDARY 1e-7
+int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ]);
+
 /* What one solve did (may be NULL). */
 typedef struct {
     unsigned starts;      /* Newton runs */
