@@ -238,14 +238,31 @@ static double eval(double e[6], double J[36], rc_kin_data *d, const rc_kin *kin,
 
 /* Newton (Levenberg-Marquardt where a step does not pay) from q; 1 when
  * converged (q the solution, d its chain), 0 not. */
+
+/* How one Newton run goes: the branch it keeps to (-1: none; rch_ikg_solve's
+ * starts of the asked branch), the joint it holds (-1: none; the scan along a
+ * self-motion), its steps. */
+/* A run that stops converging (no step pays, or out of steps): a solution when within RCH_IKG_ACCEPT_*
+ * (next to a singularity the Jacobian's conditioning, not the method, bounds the last digits). */
+static int stalled_ok(double err_mm, double err_rad)
+{
+    return err_mm <= RCH_IKG_ACCEPT_MM && err_rad <= RCH_IKG_ACCEPT_RAD;
+}
+
+typedef struct {
+    const rch_ikg *ik;
+    int keep, fix;
+    unsigned max_it;
+} newton_opt;
+
 static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
-                      const rc_kin *kin, double reach_mm, const target *t)
+                      const rc_kin *kin, double reach_mm, const target *t, const newton_opt *o)
 {
     double e[6], J[36], qa[RC_NJ], ea[6], Ja[36];
     double cost = eval(e, J, d, kin, t, q);
     double lambda = 0.0;
     const double tiny = 1e-10 * (reach_mm + 1.0);
-    for (unsigned it = 0; it < IKG_MAX_IT; ++it) {
+    for (unsigned it = 0; it < o->max_it; ++it) {
         *err_mm = sqrt(dot(e, e));
         *err_rad = sqrt(dot(&e[3], &e[3]));
         if (*err_mm <= RCH_IKG_TOL_MM && *err_rad <= RCH_IKG_TOL_RAD)
@@ -255,7 +272,7 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
         ++*iters;
         double dq[6];
         int ok = -1;
-        if (lambda == 0.0) {
+        if (lambda == 0.0 && o->fix < 0) {
             double A[36], b[6];
             memcpy(A, J, sizeof A);
             memcpy(b, e, sizeof b);
@@ -282,8 +299,14 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
                 lambda = 1e-6 * dmax;
             for (int i = 0; i < 6; ++i)
                 A[7 * i] += lambda;
+            if (o->fix >= 0) { /* the held joint's row and column: dq = 0 there */
+                for (int i = 0; i < 6; ++i)
+                    A[6 * i + o->fix] = A[6 * o->fix + i] = 0.0;
+                A[7 * o->fix] = 1.0;
+                b[o->fix] = 0.0;
+            }
             if (rc_kin_chol6(A, b) != RC_OK)
-                return 0;
+                return stalled_ok(*err_mm, *err_rad);
             memcpy(dq, b, sizeof dq);
         }
         double big = 0.0;
@@ -293,7 +316,7 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
         for (int i = 0; i < 6; ++i)
             qa[i] = q[i] + sc * dq[i];
         const double ca = eval(ea, Ja, d, kin, t, qa);
-        if (ca < cost) {
+        if (ca < cost && (o->keep < 0 || branch_of(o->ik, d, qa) == o->keep)) {
             memcpy(q, qa, sizeof qa);
             memcpy(e, ea, sizeof ea);
             memcpy(J, Ja, sizeof Ja);
@@ -307,19 +330,29 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
                 dmax = fmax(dmax, fabs(J[7 * i]));
             lambda = lambda > 0.0 ? lambda * 10.0 : 1e-4 * dmax * dmax;
             if (lambda > 1e12 * (dmax * dmax + 1.0))
-                return 0;
+                return stalled_ok(*err_mm, *err_rad);
             eval(e, J, d, kin, t, q); /* d back to q */
         }
     }
     *err_mm = sqrt(dot(e, e));
     *err_rad = sqrt(dot(&e[3], &e[3]));
-    return *err_mm <= RCH_IKG_TOL_MM && *err_rad <= RCH_IKG_TOL_RAD;
+    return stalled_ok(*err_mm, *err_rad);
 }
 
 static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
                   const rch_ikg *ik, const target *t)
 {
-    return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t);
+    const newton_opt o = {ik, -1, -1, IKG_MAX_IT};
+    return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o);
+}
+
+/* Newton kept inside branch `keep` (a step that leaves it is refused as one that does not pay), from q of
+ * that branch. */
+static int newton_in(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                     const rch_ikg *ik, const target *t, int keep)
+{
+    const newton_opt o = {ik, keep, -1, IKG_MAX_IT};
+    return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o);
 }
 
 /* Continuation from the idealised arm's closed-form solution q (exact
@@ -333,6 +366,7 @@ static int homotopy(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *
                     const rch_ikg *ik, const target *t)
 {
     rc_kin k = ik->kin;
+    const newton_opt o = {ik, -1, -1, IKG_MAX_IT};
     for (unsigned s = 1; s <= IKG_HOMOTOPY; ++s) {
         const double f = (double)s / IKG_HOMOTOPY;
         for (unsigned i = 0; i < RC_NJ; ++i) {
@@ -345,10 +379,131 @@ static int homotopy(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *
             k.link[i].sin_alpha = sin(al);
             k.link[i].theta_off_rad = ik->ideal[i][3] + f * (r->theta_off_rad - ik->ideal[i][3]);
         }
-        if (!newton_kin(q, err_mm, err_rad, iters, d, s == IKG_HOMOTOPY ? &ik->kin : &k, ik->reach_mm, t))
+        if (!newton_kin(q, err_mm, err_rad, iters, d, s == IKG_HOMOTOPY ? &ik->kin : &k, ik->reach_mm, t, &o))
             return 0;
     }
     return 1;
+}
+
+/* The scan along a self-motion. Next to the wrist's singularity (a UR's axes 2, 3, 4 and 6 parallel, a
+ * spherical wrist's 4 and 6 aligned) or the shoulder's (the wrist point on axis 1), the solutions of a
+ * calibrated arm lie on a curve along which the pose hardly changes (the idealised arm's self-motion): a
+ * start's joints along it are ill-determined (a closed-form start of the right branch may be a radian off),
+ * the Jacobian is ill-conditioned there, and Newton from the start slides to another solution on the curve,
+ * of another branch, or stalls in the flat valley. Here joint j is held at IKG_SCAN + 1 values over a turn
+ * from q0 and the other five fitted (damped steps, each from the value before: the curve followed; with j
+ * held the five are well conditioned). At each the residual left is along the one direction the five
+ * columns of the Jacobian do not span: its component along their generalized cross product (continuous
+ * along the curve) is a signed function g of the held value, zero at each solution. Each sign change is
+ * bracketed and its root found (regula falsi, Illinois), then polished by Newton on all six; the roots are
+ * taken until one is of `branch`. 1 then (q, d, errors). */
+#define IKG_SCAN 48
+#define IKG_SCAN_IT 6
+#define IKG_ROOT_IT 40
+
+/* The determinant of a 5 x 5 matrix (row-major, destroyed; partial pivoting). */
+static double det5(double M[25])
+{
+    double det = 1.0;
+    for (int c = 0; c < 5; ++c) {
+        int p = c;
+        for (int r = c + 1; r < 5; ++r)
+            if (fabs(M[5 * r + c]) > fabs(M[5 * p + c]))
+                p = r;
+        if (M[5 * p + c] == 0.0)
+            return 0.0;
+        if (p != c) {
+            for (int k = 0; k < 5; ++k) {
+                const double tmp = M[5 * c + k];
+                M[5 * c + k] = M[5 * p + k];
+                M[5 * p + k] = tmp;
+            }
+            det = -det;
+        }
+        det *= M[6 * c];
+        for (int r = c + 1; r < 5; ++r) {
+            const double f = M[5 * r + c] / M[6 * c];
+            for (int k = c; k < 5; ++k)
+                M[5 * r + k] -= f * M[5 * c + k];
+        }
+    }
+    return det;
+}
+
+/* q[j] = s, the other five fitted from q; returns g (above). */
+static double fit_held(double q[RC_NJ], unsigned *iters, rc_kin_data *d, const rch_ikg *ik, const target *t,
+                       int j, double s, unsigned it)
+{
+    const newton_opt hold = {ik, -1, j, it};
+    double em, er, e[6], J[36];
+    q[j] = s;
+    newton_kin(q, &em, &er, iters, d, &ik->kin, ik->reach_mm, t, &hold);
+    eval(e, J, d, &ik->kin, t, q);
+    double n[6], nn = 0.0, g = 0.0;
+    for (int i = 0; i < 6; ++i) { /* n_i = (-1)^i det(the weighted columns but j, row i left out) */
+        double M[25];
+        int r = 0;
+        for (int row = 0; row < 6; ++row) {
+            if (row == i)
+                continue;
+            const double w = row < 3 ? 1.0 : IKG_W_ROT_MM;
+            int c = 0;
+            for (int col = 0; col < 6; ++col)
+                if (col != j)
+                    M[5 * r + c++] = w * J[6 * row + col];
+            ++r;
+        }
+        n[i] = (i & 1 ? -1.0 : 1.0) * det5(M);
+        nn += n[i] * n[i];
+        g += n[i] * e[i] * (i < 3 ? 1.0 : IKG_W_ROT_MM);
+    }
+    return nn > 0.0 && isfinite(g) ? g / sqrt(nn) : 0.0;
+}
+
+static int scan(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                const rch_ikg *ik, const target *t, const double q0[RC_NJ], int j, int branch)
+{
+    double qs[IKG_SCAN + 1][RC_NJ], g[IKG_SCAN + 1], x[RC_NJ];
+    const double h = 2.0 * M_PI / IKG_SCAN;
+    memcpy(x, q0, sizeof x);
+    for (int k = 0; k <= IKG_SCAN; ++k) {
+        g[k] = fit_held(x, iters, d, ik, t, j, q0[j] + h * k, IKG_SCAN_IT);
+        memcpy(qs[k], x, sizeof x);
+    }
+    for (int k = 0; k < IKG_SCAN; ++k) {
+        if (!((g[k] <= 0.0 && g[k + 1] > 0.0) || (g[k] >= 0.0 && g[k + 1] < 0.0)))
+            continue;
+        /* regula falsi (Illinois) on [a, b] */
+        double a = q0[j] + h * k, b = a + h, ga = g[k], gb = g[k + 1];
+        int side = 0;
+        memcpy(x, qs[k], sizeof x);
+        for (int it = 0; it < IKG_ROOT_IT && ga != 0.0 && b - a > 1e-13; ++it) {
+            const double c = (a * gb - b * ga) / (gb - ga);
+            const double gc = fit_held(x, iters, d, ik, t, j, c, IKG_SCAN_IT);
+            if ((gc > 0.0) == (gb > 0.0)) {
+                b = c;
+                gb = gc;
+                if (side == -1)
+                    ga *= 0.5;
+                side = -1;
+            } else {
+                a = c;
+                ga = gc;
+                if (side == 1)
+                    gb *= 0.5;
+                side = 1;
+            }
+            if (gc == 0.0)
+                break;
+        }
+        const newton_opt o = {ik, rch_ikg_branch(ik, x) == branch ? branch : -1, -1, IKG_MAX_IT};
+        if (newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o) &&
+            branch_of(ik, d, x) == branch) {
+            memcpy(q, x, sizeof x);
+            return 1;
+        }
+    }
+    return 0;
 }
 
 /* Starts: axis 1 towards the target (and away), the arm's two elbow sides
@@ -514,9 +669,12 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
                 start_of(q, k - k_refl - 2u * n_refl, ik, &t);
         }
         ++inf.starts;
+        const int keep = branch != RCH_IKG_ANY_BRANCH && k <= (unsigned)ncs && rch_ikg_branch(ik, q) == branch
+                             ? branch
+                             : -1;
         const int conv = k > (unsigned)ncs && k <= 2u * (unsigned)ncs
                              ? homotopy(q, &em, &er, &inf.iterations, &d, ik, &t)
-                             : newton(q, &em, &er, &inf.iterations, &d, ik, &t);
+                             : newton_in(q, &em, &er, &inf.iterations, &d, ik, &t, keep);
         if (!conv) {
             if (!reached && em < inf.err_mm) {
                 inf.err_mm = em;
@@ -525,7 +683,9 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
             continue;
         }
         reached = 1;
-        const int b = branch_of(ik, &d, q);
+        int b = branch_of(ik, &d, q);
+        if (branch != RCH_IKG_ANY_BRANCH && b != branch && ((b ^ branch) & ~boundary_of(ik, &d, q)) == 0)
+            b = branch; /* on the boundary of the bits that differ: on both sides (rch_ikg.h) */
         if (branch != RCH_IKG_ANY_BRANCH && b != branch) {
             if ((b ^ branch) == 1 && n_conv < 8 && n_refl == 0)
                 memcpy(conv_q[n_conv++], q, sizeof q);
@@ -547,6 +707,24 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         if (!seed_rad || k == 0)
             break;
     }
+    /* none of the branch: the scans along the self-motions (q6: the wrist's, q1: the shoulder's) from each
+     * closed-form start, those of the branch first */
+    for (int i = 0; branch != RCH_IKG_ANY_BRANCH && !in_branch && i < ncs; ++i)
+        for (int j = 5; j >= 0 && !in_branch; j -= 5) {
+            double q[RC_NJ], em, er;
+            rc_kin_data d;
+            ++inf.starts;
+            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, cs[order[i]], j, branch))
+                continue;
+            reached = in_branch = 1;
+            if (!place(q, ik, seed_rad))
+                continue;
+            memcpy(best, q, sizeof best);
+            inf.err_mm = em;
+            inf.err_rad = er;
+            inf.branch = branch;
+            found = 1;
+        }
     if (found)
         memcpy(q_rad, best, sizeof best);
     else

@@ -36,7 +36,8 @@
  *
  * Accuracy: a solution's forward kinematics meets the target within
  * RCH_IKG_TOL_MM and RCH_IKG_TOL_RAD (Newton's last step is quadratic: far
- * below in practice). Joint values: each axis taken in the turn nearest the
+ * below in practice), or, where Newton stalls next to a singularity, within
+ * RCH_IKG_ACCEPT_MM and RCH_IKG_ACCEPT_RAD. Joint values: each axis taken in the turn nearest the
  * seed (no seed: in (-180, 180] deg) and moved by whole turns into the
  * model's limits when a turn fits.
  *
@@ -51,6 +52,10 @@
 
 #define RCH_IKG_TOL_MM 1e-8
 #define RCH_IKG_TOL_RAD 1e-10
+/* A Newton run that stops converging (next to a singularity, where the Jacobian's conditioning bounds the
+ * last digits) is a solution within these: 1000 times below what a compensated program needs. */
+#define RCH_IKG_ACCEPT_MM 1e-6
+#define RCH_IKG_ACCEPT_RAD 1e-9
 #define RCH_IKG_MAX_SOL 16 /* distinct solutions rch_ikg_all reports */
 #define RCH_IKG_ANY_BRANCH (-1)
 
