@@ -346,14 +346,6 @@ static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *it
     return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o);
 }
 
-/* Newton kept inside branch `keep` (a step that leaves it is refused as one that does not pay), from q of
- * that branch. */
-static int newton_in(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
-                     const rch_ikg *ik, const target *t, int keep)
-{
-    const newton_opt o = {ik, keep, -1, IKG_MAX_IT};
-    return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o);
-}
 
 /* Continuation from the idealised arm's closed-form solution q (exact
  * there): the DH rows moved from the idealised table to the real one in
@@ -669,12 +661,9 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
                 start_of(q, k - k_refl - 2u * n_refl, ik, &t);
         }
         ++inf.starts;
-        const int keep = branch != RCH_IKG_ANY_BRANCH && k <= (unsigned)ncs && rch_ikg_branch(ik, q) == branch
-                             ? branch
-                             : -1;
         const int conv = k > (unsigned)ncs && k <= 2u * (unsigned)ncs
                              ? homotopy(q, &em, &er, &inf.iterations, &d, ik, &t)
-                             : newton_in(q, &em, &er, &inf.iterations, &d, ik, &t, keep);
+                             : newton(q, &em, &er, &inf.iterations, &d, ik, &t);
         if (!conv) {
             if (!reached && em < inf.err_mm) {
                 inf.err_mm = em;

@@ -155,8 +155,9 @@ static int offset_all(double out[8][RC_NJ], const double r[RC_NJ][4], const doub
             const double th234 = atan2(R[3], R[0]);
             const double a2 = r[1][0], a3 = r[2][0];
             const double c3 = (p[0] * p[0] + p[1] * p[1] - a2 * a2 - a3 * a3) / (2 * a2 * a3);
-            if (fabs(c3) > 1.0 + SEED_NEAR)
-                continue;
+            /* (past the idealised elbow's reach, however far: next to the wrist's singularity theta6, and so
+             * the elbow's target, is ill-determined on the idealised arm; the scan along the wrist's
+             * self-motion, rch_ikg.c, starts from here) */
             for (int i3 = 0; i3 < 2; ++i3) {
                 /* the arm stretched or folded beyond the idealised arm's reach: the starts on either side */
                 const double a3c = fabs(c3) <= 1.0 + 1e-9 ? acos(fmax(-1.0, fmin(1.0, c3)))
