@@ -452,50 +452,76 @@ static double fit_held(double q[RC_NJ], unsigned *iters, rc_kin_data *d, const r
     return nn > 0.0 && isfinite(g) ? g / sqrt(nn) : 0.0;
 }
 
+/* The root of g in [a, b] (signs differ there) from x at a (regula falsi, Illinois), then Newton on all
+ * six kept to the branch where it is in it; 1 when a solution of `branch` (q, d, errors). */
+static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                     const rch_ikg *ik, const target *t, int j, int branch, const double x0[RC_NJ], double a,
+                     double b, double ga, double gb)
+{
+    double x[RC_NJ];
+    memcpy(x, x0, sizeof x);
+    int side = 0;
+    for (int it = 0; it < IKG_ROOT_IT && ga != 0.0 && b - a > 1e-13; ++it) {
+        const double c = (a * gb - b * ga) / (gb - ga);
+        const double gc = fit_held(x, iters, d, ik, t, j, c, IKG_SCAN_IT);
+        if (gc == 0.0)
+            break;
+        if ((gc > 0.0) == (gb > 0.0)) {
+            b = c;
+            gb = gc;
+            if (side == -1)
+                ga *= 0.5;
+            side = -1;
+        } else {
+            a = c;
+            ga = gc;
+            if (side == 1)
+                gb *= 0.5;
+            side = 1;
+        }
+    }
+    const newton_opt o = {ik, rch_ikg_branch(ik, x) == branch ? branch : -1, -1, IKG_MAX_IT};
+    if (newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o) && branch_of(ik, d, x) == branch) {
+        memcpy(q, x, sizeof x);
+        return 1;
+    }
+    return 0;
+}
+
+/* g at n + 1 held values s0 + k h from x0; each sign change to held_root; where |g| has a local minimum
+ * without one (two roots in a step: a pair next to a fold or the boundary), the two steps around it again,
+ * IKG_SUB times finer, depth more times. */
+#define IKG_SUB 16
+static int scan_range(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                      const rch_ikg *ik, const target *t, int j, int branch, const double x0[RC_NJ], double s0,
+                      double h, int n, int depth)
+{
+    double qs[IKG_SCAN + 1][RC_NJ], g[IKG_SCAN + 1], x[RC_NJ];
+    memcpy(x, x0, sizeof x);
+    for (int k = 0; k <= n; ++k) {
+        g[k] = fit_held(x, iters, d, ik, t, j, s0 + h * k, IKG_SCAN_IT);
+        memcpy(qs[k], x, sizeof x);
+    }
+    for (int k = 0; k < n; ++k)
+        if (((g[k] <= 0.0 && g[k + 1] > 0.0) || (g[k] >= 0.0 && g[k + 1] < 0.0)) &&
+            held_root(q, err_mm, err_rad, iters, d, ik, t, j, branch, qs[k], s0 + h * k, s0 + h * (k + 1), g[k],
+                      g[k + 1]))
+            return 1;
+    if (depth > 0)
+        for (int k = 1; k < n; ++k)
+            if (fabs(g[k]) <= fabs(g[k - 1]) && fabs(g[k]) <= fabs(g[k + 1]) && (g[k - 1] > 0.0) == (g[k] > 0.0) &&
+                (g[k + 1] > 0.0) == (g[k] > 0.0) &&
+                scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, qs[k - 1], s0 + h * (k - 1),
+                           2.0 * h / IKG_SUB, IKG_SUB, depth - 1))
+                return 1;
+    return 0;
+}
+
 static int scan(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
                 const rch_ikg *ik, const target *t, const double q0[RC_NJ], int j, int branch)
 {
-    double qs[IKG_SCAN + 1][RC_NJ], g[IKG_SCAN + 1], x[RC_NJ];
-    const double h = 2.0 * M_PI / IKG_SCAN;
-    memcpy(x, q0, sizeof x);
-    for (int k = 0; k <= IKG_SCAN; ++k) {
-        g[k] = fit_held(x, iters, d, ik, t, j, q0[j] + h * k, IKG_SCAN_IT);
-        memcpy(qs[k], x, sizeof x);
-    }
-    for (int k = 0; k < IKG_SCAN; ++k) {
-        if (!((g[k] <= 0.0 && g[k + 1] > 0.0) || (g[k] >= 0.0 && g[k + 1] < 0.0)))
-            continue;
-        /* regula falsi (Illinois) on [a, b] */
-        double a = q0[j] + h * k, b = a + h, ga = g[k], gb = g[k + 1];
-        int side = 0;
-        memcpy(x, qs[k], sizeof x);
-        for (int it = 0; it < IKG_ROOT_IT && ga != 0.0 && b - a > 1e-13; ++it) {
-            const double c = (a * gb - b * ga) / (gb - ga);
-            const double gc = fit_held(x, iters, d, ik, t, j, c, IKG_SCAN_IT);
-            if ((gc > 0.0) == (gb > 0.0)) {
-                b = c;
-                gb = gc;
-                if (side == -1)
-                    ga *= 0.5;
-                side = -1;
-            } else {
-                a = c;
-                ga = gc;
-                if (side == 1)
-                    gb *= 0.5;
-                side = 1;
-            }
-            if (gc == 0.0)
-                break;
-        }
-        const newton_opt o = {ik, rch_ikg_branch(ik, x) == branch ? branch : -1, -1, IKG_MAX_IT};
-        if (newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o) &&
-            branch_of(ik, d, x) == branch) {
-            memcpy(q, x, sizeof x);
-            return 1;
-        }
-    }
-    return 0;
+    return scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, q0, q0[j], 2.0 * M_PI / IKG_SCAN, IKG_SCAN,
+                      2);
 }
 
 /* Starts: axis 1 towards the target (and away), the arm's two elbow sides
