@@ -69,7 +69,7 @@ int main(int argc, char **argv)
         return 1;
     printf("ik_bench: %s%s, %d random poses, rch_ikg_solve\n", r.name, pert ? ", DH perturbed" : "", n);
     for (int m = 0; m < 3; ++m) {
-        int fails = 0;
+        int fails = 0, by_status[5] = {0, 0, 0, 0, 0};
         unsigned long starts = 0;
         lcg = 777;
         for (int k = 0; k < n; ++k) {
@@ -86,11 +86,16 @@ int main(int argc, char **argv)
                                                     m == 1 ? NULL : seed);
             t[k] = now_us() - t0;
             fails += st != RCH_IKG_OK;
+            ++by_status[st <= RCH_IKG_LIMITS ? st : 1];
             starts += inf.starts;
         }
         qsort(t, (size_t)n, sizeof *t, cmp);
-        printf("  %-30s median %7.2f us  p90 %7.2f us  max %8.1f us  starts/target %.2f  failed %d\n", mode[m],
+        printf("  %-30s median %7.2f us  p90 %7.2f us  max %8.1f us  starts/target %.2f  failed %d", mode[m],
                t[n / 2], t[(n * 9) / 10], t[n - 1], (double)starts / n, fails);
+        if (fails)
+            printf(" (unreachable %d, no branch %d, limits %d)", by_status[RCH_IKG_UNREACHABLE],
+                   by_status[RCH_IKG_NO_BRANCH], by_status[RCH_IKG_LIMITS]);
+        printf("\n");
     }
     }
     free(t);

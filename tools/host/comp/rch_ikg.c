@@ -740,6 +740,28 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
             inf.branch = branch;
             found = 1;
         }
+    /* any branch, and none found (or every one outside the limits): each branch asked in turn (its scans find
+     * the solutions next to a singularity the starts slid past), the one nearest the seed */
+    for (int b = 0; branch == RCH_IKG_ANY_BRANCH && !found && b < 8; ++b) {
+        double q[RC_NJ];
+        rch_ikg_info ib;
+        const rch_ikg_status sb = rch_ikg_solve(q, &ib, ik, pos_mm, rot, b, seed_rad);
+        inf.starts += ib.starts;
+        inf.iterations += ib.iterations;
+        reached |= sb != RCH_IKG_UNREACHABLE;
+        in_branch |= sb == RCH_IKG_OK || sb == RCH_IKG_LIMITS;
+        if (sb != RCH_IKG_OK)
+            continue;
+        const double dd = seed_rad ? dist(q, seed_rad) : 0.0;
+        if (dd < best_d) {
+            best_d = dd;
+            memcpy(best, q, sizeof best);
+            inf.err_mm = ib.err_mm;
+            inf.err_rad = ib.err_rad;
+            inf.branch = ib.branch;
+        }
+        found = 1;
+    }
     if (found)
         memcpy(q_rad, best, sizeof best);
     else
