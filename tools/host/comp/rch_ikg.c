@@ -121,7 +121,7 @@ static int branch_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad
            (sin(q_rad[4] + ik->kin.link[4].theta_off_rad) < 0);
 }
 
-static int boundary_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad[RC_NJ])
+static int boundary_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad[RC_NJ], double tol)
 {
     double f[2];
     factors(f, d, ik->d4_mm);
@@ -132,16 +132,16 @@ static int boundary_of(const rch_ikg *ik, const rc_kin_data *d, const double q_r
         w[k] = d->o[3][k] + ik->d4_mm * z3[k] - d->o[2][k];
     }
     const double uw = sqrt(dot(u, u) * dot(w, w));
-    return 4 * (fabs(f[0]) <= RCH_IKG_BOUNDARY * ik->reach_mm) + 2 * (fabs(f[1]) <= RCH_IKG_BOUNDARY * uw) +
-           (fabs(sin(q_rad[4] + ik->kin.link[4].theta_off_rad)) <= RCH_IKG_BOUNDARY);
+    return 4 * (fabs(f[0]) <= tol * ik->reach_mm) + 2 * (fabs(f[1]) <= tol * uw) +
+           (fabs(sin(q_rad[4] + ik->kin.link[4].theta_off_rad)) <= tol);
 }
 
-int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ])
+int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ], double tol)
 {
     rc_kin_data d;
     double p[3];
     rc_kin_fk(p, NULL, &d, &ik->kin, q_rad);
-    return boundary_of(ik, &d, q_rad);
+    return boundary_of(ik, &d, q_rad, tol);
 }
 
 int rch_ikg_branch(const rch_ikg *ik, const double q_rad[RC_NJ])
@@ -452,11 +452,31 @@ static double fit_held(double q[RC_NJ], unsigned *iters, rc_kin_data *d, const r
     return nn > 0.0 && isfinite(g) ? g / sqrt(nn) : 0.0;
 }
 
+/* A solution of the branch next to the asked one across a boundary it lies within RCH_IKG_NEAR_BOUNDARY
+ * of (rch_ikg.h: returned when the asked branch has none found). */
+typedef struct {
+    int have, branch;
+    double q[RC_NJ], err_mm, err_rad;
+} near_sol;
+
+static void near_offer(near_sol *ns, const rch_ikg *ik, const rc_kin_data *d, const double q[RC_NJ], int b,
+                       int branch, double em, double er)
+{
+    if (ns == NULL || ns->have || branch == RCH_IKG_ANY_BRANCH || b == branch ||
+        ((b ^ branch) & ~boundary_of(ik, d, q, RCH_IKG_NEAR_BOUNDARY)) != 0)
+        return;
+    ns->have = 1;
+    ns->branch = b;
+    memcpy(ns->q, q, sizeof ns->q);
+    ns->err_mm = em;
+    ns->err_rad = er;
+}
+
 /* The root of g in [a, b] (signs differ there) from x at a (regula falsi, Illinois), then Newton on all
  * six kept to the branch where it is in it; 1 when a solution of `branch` (q, d, errors). */
 static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
-                     const rch_ikg *ik, const target *t, int j, int branch, const double x0[RC_NJ], double a,
-                     double b, double ga, double gb)
+                     const rch_ikg *ik, const target *t, int j, int branch, near_sol *ns, const double x0[RC_NJ],
+                     double a, double b, double ga, double gb)
 {
     double x[RC_NJ];
     memcpy(x, x0, sizeof x);
@@ -481,10 +501,14 @@ static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned 
         }
     }
     const newton_opt o = {ik, rch_ikg_branch(ik, x) == branch ? branch : -1, -1, IKG_MAX_IT};
-    if (newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o) && branch_of(ik, d, x) == branch) {
+    if (!newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o))
+        return 0;
+    const int bx = branch_of(ik, d, x);
+    if (bx == branch || ((bx ^ branch) & ~boundary_of(ik, d, x, RCH_IKG_BOUNDARY)) == 0) {
         memcpy(q, x, sizeof x);
         return 1;
     }
+    near_offer(ns, ik, d, x, bx, branch, *err_mm, *err_rad);
     return 0;
 }
 
@@ -492,9 +516,11 @@ static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned 
  * without one (two roots in a step: a pair next to a fold or the boundary), the two steps around it again,
  * IKG_SUB times finer, depth more times. */
 #define IKG_SUB 16
+#define IKG_SUB_MIN 2   /* minima refined per level */
+#define IKG_SUB_DEPTH 5 /* levels: a step of 2 pi / 48 / 8^5 (4e-6 rad) at the finest */
 static int scan_range(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
-                      const rch_ikg *ik, const target *t, int j, int branch, const double x0[RC_NJ], double s0,
-                      double h, int n, int depth)
+                      const rch_ikg *ik, const target *t, int j, int branch, near_sol *ns, const double x0[RC_NJ],
+                      double s0, double h, int n, int depth)
 {
     double qs[IKG_SCAN + 1][RC_NJ], g[IKG_SCAN + 1], x[RC_NJ];
     memcpy(x, x0, sizeof x);
@@ -504,24 +530,43 @@ static int scan_range(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
     }
     for (int k = 0; k < n; ++k)
         if (((g[k] <= 0.0 && g[k + 1] > 0.0) || (g[k] >= 0.0 && g[k + 1] < 0.0)) &&
-            held_root(q, err_mm, err_rad, iters, d, ik, t, j, branch, qs[k], s0 + h * k, s0 + h * (k + 1), g[k],
+            held_root(q, err_mm, err_rad, iters, d, ik, t, j, branch, ns, qs[k], s0 + h * k, s0 + h * (k + 1), g[k],
                       g[k + 1]))
             return 1;
-    if (depth > 0)
-        for (int k = 1; k < n; ++k)
-            if (fabs(g[k]) <= fabs(g[k - 1]) && fabs(g[k]) <= fabs(g[k + 1]) && (g[k - 1] > 0.0) == (g[k] > 0.0) &&
-                (g[k + 1] > 0.0) == (g[k] > 0.0) &&
-                scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, qs[k - 1], s0 + h * (k - 1),
-                           2.0 * h / IKG_SUB, IKG_SUB, depth - 1))
-                return 1;
+    if (depth == 0)
+        return 0;
+    /* the IKG_SUB_MIN smallest such minima, smallest first */
+    int mins[IKG_SUB_MIN], nm = 0;
+    for (int k = 1; k < n; ++k) {
+        if (!(fabs(g[k]) <= fabs(g[k - 1]) && fabs(g[k]) <= fabs(g[k + 1]) && (g[k - 1] > 0.0) == (g[k] > 0.0) &&
+              (g[k + 1] > 0.0) == (g[k] > 0.0)))
+            continue;
+        if (nm < IKG_SUB_MIN)
+            mins[nm++] = k;
+        else if (fabs(g[k]) < fabs(g[mins[nm - 1]]))
+            mins[nm - 1] = k;
+        else
+            continue;
+        for (int i = nm - 1; i > 0 && fabs(g[mins[i]]) < fabs(g[mins[i - 1]]); --i) {
+            const int tmp = mins[i];
+            mins[i] = mins[i - 1];
+            mins[i - 1] = tmp;
+        }
+    }
+    for (int i = 0; i < nm; ++i) {
+        const int k = mins[i];
+        if (scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, ns, qs[k - 1], s0 + h * (k - 1),
+                       2.0 * h / IKG_SUB, IKG_SUB, depth - 1))
+            return 1;
+    }
     return 0;
 }
 
 static int scan(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
-                const rch_ikg *ik, const target *t, const double q0[RC_NJ], int j, int branch)
+                const rch_ikg *ik, const target *t, const double q0[RC_NJ], int j, int branch, near_sol *ns)
 {
-    return scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, q0, q0[j], 2.0 * M_PI / IKG_SCAN, IKG_SCAN,
-                      2);
+    return scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, ns, q0, q0[j], 2.0 * M_PI / IKG_SCAN, IKG_SCAN,
+                      IKG_SUB_DEPTH);
 }
 
 /* Starts: axis 1 towards the target (and away), the arm's two elbow sides
@@ -653,6 +698,7 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
     int order[8] = {0};
     int ncs = -1; /* computed when the seed's own run did not do */
     double conv_q[8][RC_NJ]; /* solutions of another branch met on the way (for the wrist's reflections) */
+    near_sol ns = {0, -1, {0}, 0.0, 0.0};
     unsigned n_conv = 0, n_refl = 0;
     for (unsigned k = seed_rad ? 0u : 1u; ncs < 0 || k < 1u + 2u * (unsigned)ncs + IKG_N_START + 2u * n_refl;
          ++k) {
@@ -699,9 +745,10 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         }
         reached = 1;
         int b = branch_of(ik, &d, q);
-        if (branch != RCH_IKG_ANY_BRANCH && b != branch && ((b ^ branch) & ~boundary_of(ik, &d, q)) == 0)
+        if (branch != RCH_IKG_ANY_BRANCH && b != branch && ((b ^ branch) & ~boundary_of(ik, &d, q, RCH_IKG_BOUNDARY)) == 0)
             b = branch; /* on the boundary of the bits that differ: on both sides (rch_ikg.h) */
         if (branch != RCH_IKG_ANY_BRANCH && b != branch) {
+            near_offer(&ns, ik, &d, q, b, branch, em, er);
             if ((b ^ branch) == 1 && n_conv < 8 && n_refl == 0)
                 memcpy(conv_q[n_conv++], q, sizeof q);
             continue;
@@ -729,7 +776,7 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
             double q[RC_NJ], em, er;
             rc_kin_data d;
             ++inf.starts;
-            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, cs[order[i]], j, branch))
+            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, cs[order[i]], j, branch, &ns))
                 continue;
             reached = in_branch = 1;
             if (!place(q, ik, seed_rad))
@@ -740,6 +787,18 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
             inf.branch = branch;
             found = 1;
         }
+    /* none of the branch found, but one of the branch across a boundary it lies next to (rch_ikg.h) */
+    if (!found && ns.have) {
+        double q[RC_NJ];
+        memcpy(q, ns.q, sizeof q);
+        if (place(q, ik, seed_rad)) {
+            memcpy(best, q, sizeof best);
+            inf.err_mm = ns.err_mm;
+            inf.err_rad = ns.err_rad;
+            inf.branch = ns.branch;
+            found = 1;
+        }
+    }
     /* any branch, and none found (or every one outside the limits): each branch asked in turn (its scans find
      * the solutions next to a singularity the starts slid past), the one nearest the seed */
     for (int b = 0; branch == RCH_IKG_ANY_BRANCH && !found && b < 8; ++b) {

@@ -96,12 +96,21 @@ void rch_ikg_fk(double pos_mm[3], double rot[9], const rch_ikg *ik, const double
 int rch_ikg_branch(const rch_ikg *ik, const double q_rad[RC_NJ]);
 
 /* The bits (4, 2, 1 as the branch's) of the singularities q_rad (6) lies on:
- * its factor within RCH_IKG_BOUNDARY of 0 (shoulder: the distance of P from
- * its plane over the reach; elbow: the sine of the angle at o2 between o1
- * and E; wrist: sin(q5 + theta5)). Such a configuration is on both sides of
- * that boundary: it answers a solve of either label (rch_ikg_solve). */
+ * its factor within tol of 0 (shoulder: the distance of P from its plane
+ * over the reach; elbow: the sine of the angle at o2 between o1 and E;
+ * wrist: sin(q5 + theta5)). Within RCH_IKG_BOUNDARY a configuration is on
+ * both sides of that boundary: it answers a solve of either label
+ * (rch_ikg_solve). */
 #define RCH_IKG_BOUNDARY 1e-7
-int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ]);
+int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ], double tol);
+
+/* At a singularity the labels of its two sides meet: a pose made by joints
+ * on (or within rounding of) a boundary may have its solution on the other
+ * side, a hair away. When no solution of the asked branch is found,
+ * rch_ikg_solve returns one of a branch differing only in bits whose boundary
+ * it lies within RCH_IKG_NEAR_BOUNDARY of (the same measures; 1e-3: sin q5
+ * within 0.06 deg of 0), with info->branch saying which. */
+#define RCH_IKG_NEAR_BOUNDARY 1e-3
 
 /* What one solve did (may be NULL). */
 typedef struct {
