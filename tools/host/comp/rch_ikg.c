@@ -769,10 +769,12 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         if (!seed_rad || k == 0)
             break;
     }
-    /* none of the branch: the scans along the self-motions (q6: the wrist's, q1: the shoulder's) from each
-     * closed-form start, those of the branch first */
-    for (int i = 0; branch != RCH_IKG_ANY_BRANCH && !in_branch && i < ncs; ++i)
-        for (int j = 5; j >= 0 && !in_branch; j -= 5) {
+    /* none of the branch: the scans along the self-motions (q6 held: the wrist's, q1: the shoulder's) and
+     * across the elbow's fold (q3 held: the pair of solutions either side of it) from each closed-form
+     * start, those of the branch first */
+    static const int held[3] = {5, 0, 2};
+    for (int jj = 0; branch != RCH_IKG_ANY_BRANCH && !in_branch && jj < 3; ++jj)
+        for (int i = 0, j = held[jj]; !in_branch && i < ncs; ++i) {
             double q[RC_NJ], em, er;
             rc_kin_data d;
             ++inf.starts;
