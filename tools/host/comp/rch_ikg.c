@@ -516,6 +516,7 @@ static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned 
  * without one (two roots in a step: a pair next to a fold or the boundary), the two steps around it again,
  * IKG_SUB times finer, depth more times. */
 #define IKG_SUB 16
+#define IKG_MET 4 /* solutions of other branches a solve keeps as the scans' starts */
 #define IKG_SUB_MIN 2   /* minima refined per level */
 #define IKG_SUB_DEPTH 5 /* levels: a step of 2 pi / 48 / 8^5 (4e-6 rad) at the finest */
 static int scan_range(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
@@ -700,6 +701,8 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
     double conv_q[8][RC_NJ]; /* solutions of another branch met on the way (for the wrist's reflections) */
     near_sol ns = {0, -1, {0}, 0.0, 0.0};
     unsigned n_conv = 0, n_refl = 0;
+    double met[IKG_MET][RC_NJ]; /* solutions of other branches met (the scans start from them too) */
+    int n_met = 0;
     for (unsigned k = seed_rad ? 0u : 1u; ncs < 0 || k < 1u + 2u * (unsigned)ncs + IKG_N_START + 2u * n_refl;
          ++k) {
         double q[RC_NJ], em, er;
@@ -749,6 +752,8 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
             b = branch; /* on the boundary of the bits that differ: on both sides (rch_ikg.h) */
         if (branch != RCH_IKG_ANY_BRANCH && b != branch) {
             near_offer(&ns, ik, &d, q, b, branch, em, er);
+            if (n_met < IKG_MET)
+                memcpy(met[n_met++], q, sizeof q);
             if ((b ^ branch) == 1 && n_conv < 8 && n_refl == 0)
                 memcpy(conv_q[n_conv++], q, sizeof q);
             continue;
@@ -774,11 +779,12 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
      * start, those of the branch first */
     static const int held[3] = {5, 0, 2};
     for (int jj = 0; branch != RCH_IKG_ANY_BRANCH && !in_branch && jj < 3; ++jj)
-        for (int i = 0, j = held[jj]; !in_branch && i < ncs; ++i) {
+        for (int i = 0, j = held[jj]; !in_branch && i < ncs + n_met; ++i) {
             double q[RC_NJ], em, er;
             rc_kin_data d;
             ++inf.starts;
-            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, cs[order[i]], j, branch, &ns))
+            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, i < ncs ? cs[order[i]] : met[i - ncs], j, branch,
+                      &ns))
                 continue;
             reached = in_branch = 1;
             if (!place(q, ik, seed_rad))
