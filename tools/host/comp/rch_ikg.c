@@ -500,7 +500,7 @@ static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned 
             side = 1;
         }
     }
-    const newton_opt o = {ik, rch_ikg_branch(ik, x) == branch ? branch : -1, -1, IKG_MAX_IT};
+    const newton_opt o = {ik, rch_ikg_branch(ik, x) == branch ? branch : -1, -1, 4 * IKG_MAX_IT};
     if (!newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o))
         return 0;
     const int bx = branch_of(ik, d, x);
