@@ -516,6 +516,7 @@ static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned 
  * without one (two roots in a step: a pair next to a fold or the boundary), the two steps around it again,
  * IKG_SUB times finer, depth more times. */
 #define IKG_SUB 16
+#define IKG_SCAN_NEAR 0.1 /* a scan starts where a factor is within this of its boundary (rch_ikg_on_boundary) */
 #define IKG_MET 4 /* solutions of other branches a solve keeps as the scans' starts */
 #define IKG_SUB_MIN 2   /* minima refined per level */
 #define IKG_SUB_DEPTH 5 /* levels: a step of 2 pi / 48 / 8^5 (4e-6 rad) at the finest */
@@ -782,9 +783,12 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         for (int i = 0, j = held[jj]; !in_branch && i < ncs + n_met; ++i) {
             double q[RC_NJ], em, er;
             rc_kin_data d;
+            const double *x0 = i < ncs ? cs[order[i]] : met[i - ncs];
+            rc_kin_fk(q, NULL, &d, &ik->kin, x0);
+            if (!boundary_of(ik, &d, x0, IKG_SCAN_NEAR))
+                continue; /* far from every singularity: the starts found what there is */
             ++inf.starts;
-            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, i < ncs ? cs[order[i]] : met[i - ncs], j, branch,
-                      &ns))
+            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, x0, j, branch, &ns))
                 continue;
             reached = in_branch = 1;
             if (!place(q, ik, seed_rad))

@@ -14,8 +14,16 @@
  * Starts: the caller's seed; then the eight closed-form solutions of the
  * arm's idealised table when it is of a class with one (rch_ikg_seed.c:
  * spherical wrist as rch_ik.h, or UR's offset wrist), each a few Newton
- * steps from the real arm's solution of its branch; then a fixed set of
- * generic starts (any other arm).
+ * steps from the real arm's solution of its branch (a target just past the
+ * idealised arm's reach still gets them); then a fixed set of generic starts
+ * (any other arm). When none of these gives the asked branch (next to a
+ * singularity, where a calibrated arm's solutions lie along an almost free
+ * curve or in a close pair across a fold): scans with one joint held (q6:
+ * the wrist's self-motion, q1: the shoulder's, q3: across the elbow's fold)
+ * from each closed-form start and each solution met, the other five fitted
+ * and the solutions located as the roots of the residual's signed component
+ * (rch_ikg.c, scan). The fast path is unchanged: the scans cost only where
+ * they are needed (milliseconds, next to a singularity).
  *
  * Branch: three bits, each the side of one singularity the configuration
  * is on, so that a branch changes only through that singularity:
