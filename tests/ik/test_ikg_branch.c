@@ -33,22 +33,24 @@
 static int n_per_set = 300; /* per set; --study N */
 static int verbose;
 
-static unsigned long long lcg = 20261205;
-static double urand(double lo, double hi)
+static unsigned long long lcg = 20261205, lcg_arm = 51;
+static double urand_of(unsigned long long *state, double lo, double hi)
 {
-    lcg = lcg * 6364136223846793005ULL + 1442695040888963407ULL;
-    return lo + (hi - lo) * (double)(lcg >> 11) / 9007199254740992.0;
+    *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return lo + (hi - lo) * (double)(*state >> 11) / 9007199254740992.0;
 }
+static double urand(double lo, double hi) { return urand_of(&lcg, lo, hi); }
 
 /* The arms: nominal, and perturbed as a calibration perturbs them (every a, d
- * by up to amp_mm, alpha, theta by up to amp_deg). */
+ * by up to amp_mm, alpha, theta by up to amp_deg), drawn from their own
+ * sequence: the same arms in the ctest and the study. */
 static void perturb(rc_model *m, double amp_mm, double amp_deg)
 {
     for (int i = 0; i < 6; ++i) {
-        m->x[RC_P_A(i)] += urand(-amp_mm, amp_mm);
-        m->x[RC_P_D(i)] += urand(-amp_mm, amp_mm);
-        m->x[RC_P_ALPHA(i)] += urand(-amp_deg, amp_deg) * DEG;
-        m->x[RC_P_THETA(i)] += urand(-amp_deg, amp_deg) * DEG;
+        m->x[RC_P_A(i)] += urand_of(&lcg_arm, -amp_mm, amp_mm);
+        m->x[RC_P_D(i)] += urand_of(&lcg_arm, -amp_mm, amp_mm);
+        m->x[RC_P_ALPHA(i)] += urand_of(&lcg_arm, -amp_deg, amp_deg) * DEG;
+        m->x[RC_P_THETA(i)] += urand_of(&lcg_arm, -amp_deg, amp_deg) * DEG;
     }
 }
 

@@ -775,11 +775,13 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         if (!seed_rad || k == 0)
             break;
     }
-    /* none of the branch: the scans along the self-motions (q6 held: the wrist's, q1: the shoulder's) and
-     * across the elbow's fold (q3 held: the pair of solutions either side of it) from each closed-form
-     * start, those of the branch first */
-    static const int held[3] = {5, 0, 2};
-    for (int jj = 0; branch != RCH_IKG_ANY_BRANCH && !in_branch && jj < 3; ++jj)
+    /* none of the branch: the scans along the self-motions (q6 held: the wrist's, q1: the shoulder's),
+     * across the elbow's fold (q3 held: the pair of solutions either side of it), then along the wrist's
+     * self-motion by q2 and q4 (a UR's axes 2, 3, 4 and 6 parallel: any of them follows the curve, and q2
+     * or q4 held where the elbow is folded or stretched as well, the five then not singular) from each
+     * closed-form start and each solution met, those of the branch first */
+    static const int held[5] = {5, 0, 2, 1, 3};
+    for (int jj = 0; branch != RCH_IKG_ANY_BRANCH && !in_branch && jj < 5; ++jj)
         for (int i = 0, j = held[jj]; !in_branch && i < ncs + n_met; ++i) {
             double q[RC_NJ], em, er;
             rc_kin_data d;
