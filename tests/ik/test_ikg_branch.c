@@ -11,6 +11,7 @@
  *
  *   test_ikg_branch            the ctest (fixed seed, counts printed)
  *   test_ikg_branch --study N  N configurations per set (the study)
+ *   test_ikg_branch --seed S   other configurations and perturbed arms
  *   IKG_VERBOSE=1              every failure listed */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -139,8 +140,9 @@ static void check(counts *c, const rch_ikg *ik, const double q[6], const char *w
             if (em > RCH_IKG_ACCEPT_MM || er > 3 * RCH_IKG_ACCEPT_RAD) {
                 ++c->inexact;
                 bad = "inexact";
-            } else if (bs != b && !(exact && (rch_ikg_on_boundary(ik, qs, RCH_IKG_NEAR_BOUNDARY) & (bs ^ b)) == (bs ^ b) &&
-                                    (rch_ikg_on_boundary(ik, q, RCH_IKG_BOUNDARY) & (bs ^ b)) == (bs ^ b))) {
+            } else if (bs != b &&
+                       !(exact && (rch_ikg_on_boundary(ik, qs, RCH_IKG_NEAR_BOUNDARY) & (bs ^ b)) == (bs ^ b) &&
+                         (rch_ikg_on_boundary(ik, q, RCH_IKG_BOUNDARY) & (bs ^ b)) == (bs ^ b))) {
                 ++c->wrong;
                 bad = "wrong branch";
             } else
@@ -299,6 +301,8 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; ++i)
         if (strcmp(argv[i], "--study") == 0 && i + 1 < argc)
             n_per_set = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) /* other poses and other perturbed arms */
+            lcg_arm = lcg = strtoull(argv[++i], NULL, 10);
     verbose = getenv("IKG_VERBOSE") ? atoi(getenv("IKG_VERBOSE")) : 0;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ur5e),

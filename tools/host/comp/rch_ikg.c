@@ -242,6 +242,13 @@ static double eval(double e[6], double J[36], rc_kin_data *d, const rc_kin *kin,
 /* How one Newton run goes: the branch it keeps to (-1: none; rch_ikg_solve's
  * starts of the asked branch), the joint it holds (-1: none; the scan along a
  * self-motion), its steps. */
+/* Met to the goal (RCH_IKG_TOL_*): only such a solution lying on a boundary answers either label (a run
+ * stalled next to a singularity may stop on the boundary between two solutions, solving neither side). */
+static int converged(double err_mm, double err_rad)
+{
+    return err_mm <= RCH_IKG_TOL_MM && err_rad <= RCH_IKG_TOL_RAD;
+}
+
 /* A run that stops converging (no step pays, or out of steps): a solution when within RCH_IKG_ACCEPT_*
  * (next to a singularity the Jacobian's conditioning, not the method, bounds the last digits). */
 static int stalled_ok(double err_mm, double err_rad)
@@ -504,7 +511,8 @@ static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned 
     if (!newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o))
         return 0;
     const int bx = branch_of(ik, d, x);
-    if (bx == branch || ((bx ^ branch) & ~boundary_of(ik, d, x, RCH_IKG_BOUNDARY)) == 0) {
+    if (bx == branch ||
+        (converged(*err_mm, *err_rad) && ((bx ^ branch) & ~boundary_of(ik, d, x, RCH_IKG_BOUNDARY)) == 0)) {
         memcpy(q, x, sizeof x);
         return 1;
     }
@@ -749,7 +757,8 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         }
         reached = 1;
         int b = branch_of(ik, &d, q);
-        if (branch != RCH_IKG_ANY_BRANCH && b != branch && ((b ^ branch) & ~boundary_of(ik, &d, q, RCH_IKG_BOUNDARY)) == 0)
+        if (branch != RCH_IKG_ANY_BRANCH && b != branch && converged(em, er) &&
+            ((b ^ branch) & ~boundary_of(ik, &d, q, RCH_IKG_BOUNDARY)) == 0)
             b = branch; /* on the boundary of the bits that differ: on both sides (rch_ikg.h) */
         if (branch != RCH_IKG_ANY_BRANCH && b != branch) {
             near_offer(&ns, ik, &d, q, b, branch, em, er);
