@@ -179,8 +179,8 @@ static void random_q(double q[6], const rch_ikg *ik)
 /* One arm: random configurations; each bit's boundary approached by 1e-3 ..
  * 1 deg (log-uniform, either side); two bits at once; the boundary itself.
  * Counts the failures: fails[0] every set but two singularities at once,
- * fails[1] that set, fails[2] its solves. */
-static void sweep(int fails[3], const char *name, const rc_model *m)
+ * fails[1] that set, fails[2] its solves, fails[3] all solves. */
+static void sweep(int fails[4], const char *name, const rc_model *m)
 {
     rch_ikg ik;
     assert_int_equal(rch_ikg_init(&ik, m, NULL), RCH_IKG_OK);
@@ -231,6 +231,7 @@ static void sweep(int fails[3], const char *name, const rc_model *m)
         fails[set == 4] += f;
         if (set == 4)
             fails[2] += c.n;
+        fails[3] += c.n;
     }
 }
 
@@ -245,14 +246,14 @@ static int setup(void **state)
     return 0;
 }
 
-/* The arms of the sweep: each nominal, then two perturbed draws. Every
- * solve right, but next to two singularities at once (the IRB120's arm
- * stretched straight up: the wrist point on axis 1 at full reach; a UR's
- * elbow folded, q3 at pi, with the shoulder or the wrist) where at most 1 in
- * 50 is left open (measured: up to 1 in 60; docs/comp.md). */
+/* The arms of the sweep: each nominal, then two perturbed draws. The ctest
+ * (its fixed seed): every solve right. The study (--study N, other poses):
+ * at most 1 in 10000 wrong or refused (docs/comp.md: what is left open). */
+static int study;
+
 static void sweep_arm(const char *name, const rc_model *nominal)
 {
-    int fails[3] = {0, 0, 0};
+    int fails[4] = {0, 0, 0, 0};
     char label[64];
     sweep(fails, name, nominal);
     for (int k = 0; k < 2; ++k) {
@@ -261,10 +262,15 @@ static void sweep_arm(const char *name, const rc_model *nominal)
         snprintf(label, sizeof label, "%s perturbed %d", name, k + 1);
         sweep(fails, label, &m);
     }
-    printf("%s: %d failed of the single-singularity, random and boundary sets; %d of %d next to two at once\n",
-           name, fails[0], fails[1], fails[2]);
-    assert_int_equal(fails[0], 0);
-    assert_true(50 * fails[1] <= fails[2]);
+    printf("%s: %d failed of %d solves (random, next to one singularity, on a boundary); %d of %d next to two "
+           "at once\n",
+           name, fails[0], fails[3] - fails[2], fails[1], fails[2]);
+    if (study)
+        assert_true(10000 * (fails[0] + fails[1]) <= fails[3]);
+    else {
+        assert_int_equal(fails[0], 0);
+        assert_int_equal(fails[1], 0);
+    }
 }
 
 static void test_ur5e(void **state)
@@ -299,8 +305,10 @@ static void test_irb120(void **state)
 int main(int argc, char **argv)
 {
     for (int i = 1; i < argc; ++i)
-        if (strcmp(argv[i], "--study") == 0 && i + 1 < argc)
+        if (strcmp(argv[i], "--study") == 0 && i + 1 < argc) {
             n_per_set = atoi(argv[++i]);
+            study = 1;
+        }
         else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) /* other poses and other perturbed arms */
             lcg_arm = lcg = strtoull(argv[++i], NULL, 10);
     verbose = getenv("IKG_VERBOSE") ? atoi(getenv("IKG_VERBOSE")) : 0;
