@@ -236,12 +236,6 @@ static double eval(double e[6], double J[36], rc_kin_data *d, const rc_kin *kin,
     return dot(e, e) + IKG_W_ROT_MM * IKG_W_ROT_MM * dot(&e[3], &e[3]);
 }
 
-/* Newton (Levenberg-Marquardt where a step does not pay) from q; 1 when
- * converged (q the solution, d its chain), 0 not. */
-
-/* How one Newton run goes: the branch it keeps to (-1: none; rch_ikg_solve's
- * starts of the asked branch), the joint it holds (-1: none; the scan along a
- * self-motion), its steps. */
 /* Met to the goal (RCH_IKG_TOL_*): only such a solution lying on a boundary answers either label (a run
  * stalled next to a singularity may stop on the boundary between two solutions, solving neither side). */
 static int converged(double err_mm, double err_rad)
@@ -256,12 +250,16 @@ static int stalled_ok(double err_mm, double err_rad)
     return err_mm <= RCH_IKG_ACCEPT_MM && err_rad <= RCH_IKG_ACCEPT_RAD;
 }
 
+/* How one Newton run goes: the branch it keeps to (-1: none; the scan's polish), the joint it holds (-1:
+ * none; the scan along a self-motion), its steps. */
 typedef struct {
     const rch_ikg *ik;
     int keep, fix;
     unsigned max_it;
 } newton_opt;
 
+/* Newton (Levenberg-Marquardt where a step does not pay) from q; 1 when
+ * converged (q the solution, d its chain), 0 not. */
 static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
                       const rc_kin *kin, double reach_mm, const target *t, const newton_opt *o)
 {
