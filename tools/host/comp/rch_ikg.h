@@ -134,7 +134,9 @@ typedef struct {
  * any (RCH_IKG_ANY_BRANCH), the one nearest seed_rad (6, may be NULL: the
  * first found). With a seed, Newton starts there first: a seed close to a
  * solution (a program's previous target, URScript's qnear) costs one run.
- * RCH_IKG_OK, or the reason with q_rad unchanged. */
+ * RCH_IKG_OK, or the reason with q_rad unchanged. info->branch is the
+ * returned solution's branch: the asked one, or at a singularity the label
+ * across it (RCH_IKG_BOUNDARY, RCH_IKG_NEAR_BOUNDARY above). */
 rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_ikg *ik, const double pos_mm[3],
                              const double rot[9], int branch, const double *seed_rad);
 
