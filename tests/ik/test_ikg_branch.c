@@ -4,7 +4,8 @@
  * branch is solved in that branch (rch_ikg.h), on the nominal and perturbed
  * (calibrated-like) UR5e, UR10e and IRB120, on random configurations and on
  * configurations 1e-3 .. 1 deg from each singularity (the wrist's q5 = 0 / pi,
- * the elbow stretched or folded, the wrist point on the axis of joint 1) and
+ * the elbow stretched or folded, the wrist point in the plane through axis 1
+ * parallel to axis 2: on axis 1 for a spherical wrist) and
  * two at once; at the singularity itself (the joints' factor 0 within
  * rounding) the definition of rch_ikg.h: a solution of the asked branch, or
  * of the one across that boundary and within RCH_IKG_NEAR_BOUNDARY of it.
