@@ -141,9 +141,10 @@ static void check(counts *c, const rch_ikg *ik, const double q[6], const char *w
             if (em > RCH_IKG_ACCEPT_MM || er > 3 * RCH_IKG_ACCEPT_RAD) {
                 ++c->inexact;
                 bad = "inexact";
-            } else if (bs != b &&
+            } else if (bs != b && (rch_ikg_on_boundary(ik, qs, RCH_IKG_BOUNDARY) & (bs ^ b)) != (bs ^ b) &&
                        !(exact && (rch_ikg_on_boundary(ik, qs, RCH_IKG_NEAR_BOUNDARY) & (bs ^ b)) == (bs ^ b) &&
                          (rch_ikg_on_boundary(ik, q, RCH_IKG_BOUNDARY) & (bs ^ b)) == (bs ^ b))) {
+                /* (a solution on the boundary of the bits that differ is on both sides: right, rch_ikg.h) */
                 ++c->wrong;
                 bad = "wrong branch";
             } else
