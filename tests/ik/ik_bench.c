@@ -6,8 +6,9 @@
  * by up to 0.05 rad: a program's previous target, URScript's qnear), by the
  * target's branch with no seed (a KRL Status, a Fanuc CONFIG, ABB's cfx),
  * and by the target's branch with the seed. Prints the median, 90th
- * percentile and worst microseconds per target of each and how many solves
- * failed (none should); then the same on the table perturbed as a
+ * percentile and worst microseconds per target of each, the median of the
+ * targets of each branch, and how many solves failed (none should; by
+ * status); then the same on the table perturbed as a
  * calibration perturbs it (every a, d by up to 0.5 mm, every alpha, theta
  * by up to 0.05 deg: the closed form's starts are then a few Newton steps
  * off). One core, wall clock (CLOCK_MONOTONIC). */
@@ -54,7 +55,10 @@ int main(int argc, char **argv)
         return 1;
     }
     static rch_ikg ik;
-    double *t = malloc(sizeof(double) * (size_t)n);
+    double *t = malloc(sizeof(double) * (size_t)n), *tb = malloc(sizeof(double) * (size_t)n);
+    int *br = malloc(sizeof(int) * (size_t)n);
+    if (!t || !tb || !br)
+        return 1;
     static const char *const mode[3] = {"seeded (seed within 0.05 rad)", "branch, no seed", "branch and seed"};
     for (int pert = 0; pert < 2; ++pert) {
     rc_model m0 = r.nominal;
@@ -69,7 +73,7 @@ int main(int argc, char **argv)
         return 1;
     printf("ik_bench: %s%s, %d random poses, rch_ikg_solve\n", r.name, pert ? ", DH perturbed" : "", n);
     for (int m = 0; m < 3; ++m) {
-        int fails = 0;
+        int fails = 0, by_status[5] = {0, 0, 0, 0, 0};
         unsigned long starts = 0;
         lcg = 777;
         for (int k = 0; k < n; ++k) {
@@ -85,14 +89,36 @@ int main(int argc, char **argv)
             const rch_ikg_status st = rch_ikg_solve(qs, &inf, &ik, p, R, m == 0 ? RCH_IKG_ANY_BRANCH : b,
                                                     m == 1 ? NULL : seed);
             t[k] = now_us() - t0;
+            br[k] = b;
             fails += st != RCH_IKG_OK;
+            ++by_status[st <= RCH_IKG_LIMITS ? st : 1];
             starts += inf.starts;
         }
+        /* the median of each branch's targets */
+        double med_b[8];
+        int n_b[8];
+        for (int b = 0; b < 8; ++b) {
+            n_b[b] = 0;
+            for (int k = 0; k < n; ++k)
+                if (br[k] == b)
+                    tb[n_b[b]++] = t[k];
+            qsort(tb, (size_t)n_b[b], sizeof *tb, cmp);
+            med_b[b] = n_b[b] ? tb[n_b[b] / 2] : 0.0;
+        }
         qsort(t, (size_t)n, sizeof *t, cmp);
-        printf("  %-30s median %7.2f us  p90 %7.2f us  max %8.1f us  starts/target %.2f  failed %d\n", mode[m],
+        printf("  %-30s median %7.2f us  p90 %7.2f us  max %8.1f us  starts/target %.2f  failed %d", mode[m],
                t[n / 2], t[(n * 9) / 10], t[n - 1], (double)starts / n, fails);
+        if (fails)
+            printf(" (unreachable %d, no branch %d, limits %d)", by_status[RCH_IKG_UNREACHABLE],
+                   by_status[RCH_IKG_NO_BRANCH], by_status[RCH_IKG_LIMITS]);
+        printf("\n    median by the target's branch (us):");
+        for (int b = 0; b < 8; ++b)
+            printf(" %d: %.2f", b, med_b[b]);
+        printf("\n");
     }
     }
     free(t);
+    free(tb);
+    free(br);
     return 0;
 }

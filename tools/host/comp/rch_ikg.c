@@ -121,6 +121,29 @@ static int branch_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad
            (sin(q_rad[4] + ik->kin.link[4].theta_off_rad) < 0);
 }
 
+static int boundary_of(const rch_ikg *ik, const rc_kin_data *d, const double q_rad[RC_NJ], double tol)
+{
+    double f[2];
+    factors(f, d, ik->d4_mm);
+    double u[3], w[3];
+    const double z3[3] = {d->R[3][2], d->R[3][5], d->R[3][8]};
+    for (int k = 0; k < 3; ++k) {
+        u[k] = d->o[2][k] - d->o[1][k];
+        w[k] = d->o[3][k] + ik->d4_mm * z3[k] - d->o[2][k];
+    }
+    const double uw = sqrt(dot(u, u) * dot(w, w));
+    return 4 * (fabs(f[0]) <= tol * ik->reach_mm) + 2 * (fabs(f[1]) <= tol * uw) +
+           (fabs(sin(q_rad[4] + ik->kin.link[4].theta_off_rad)) <= tol);
+}
+
+int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ], double tol)
+{
+    rc_kin_data d;
+    double p[3];
+    rc_kin_fk(p, NULL, &d, &ik->kin, q_rad);
+    return boundary_of(ik, &d, q_rad, tol);
+}
+
 int rch_ikg_branch(const rch_ikg *ik, const double q_rad[RC_NJ])
 {
     rc_kin_data d;
@@ -213,16 +236,38 @@ static double eval(double e[6], double J[36], rc_kin_data *d, const rc_kin *kin,
     return dot(e, e) + IKG_W_ROT_MM * IKG_W_ROT_MM * dot(&e[3], &e[3]);
 }
 
+/* Met to the goal (RCH_IKG_TOL_*): only such a solution lying on a boundary answers either label (a run
+ * stalled next to a singularity may stop on the boundary between two solutions, solving neither side). */
+static int converged(double err_mm, double err_rad)
+{
+    return err_mm <= RCH_IKG_TOL_MM && err_rad <= RCH_IKG_TOL_RAD;
+}
+
+/* A run that stops converging (no step pays, or out of steps): a solution when within RCH_IKG_ACCEPT_*
+ * (next to a singularity the Jacobian's conditioning, not the method, bounds the last digits). */
+static int stalled_ok(double err_mm, double err_rad)
+{
+    return err_mm <= RCH_IKG_ACCEPT_MM && err_rad <= RCH_IKG_ACCEPT_RAD;
+}
+
+/* How one Newton run goes: the branch it keeps to (-1: none; the scan's polish), the joint it holds (-1:
+ * none; the scan along a self-motion), its steps. */
+typedef struct {
+    const rch_ikg *ik;
+    int keep, fix;
+    unsigned max_it;
+} newton_opt;
+
 /* Newton (Levenberg-Marquardt where a step does not pay) from q; 1 when
  * converged (q the solution, d its chain), 0 not. */
 static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
-                      const rc_kin *kin, double reach_mm, const target *t)
+                      const rc_kin *kin, double reach_mm, const target *t, const newton_opt *o)
 {
     double e[6], J[36], qa[RC_NJ], ea[6], Ja[36];
     double cost = eval(e, J, d, kin, t, q);
     double lambda = 0.0;
     const double tiny = 1e-10 * (reach_mm + 1.0);
-    for (unsigned it = 0; it < IKG_MAX_IT; ++it) {
+    for (unsigned it = 0; it < o->max_it; ++it) {
         *err_mm = sqrt(dot(e, e));
         *err_rad = sqrt(dot(&e[3], &e[3]));
         if (*err_mm <= RCH_IKG_TOL_MM && *err_rad <= RCH_IKG_TOL_RAD)
@@ -232,7 +277,7 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
         ++*iters;
         double dq[6];
         int ok = -1;
-        if (lambda == 0.0) {
+        if (lambda == 0.0 && o->fix < 0) {
             double A[36], b[6];
             memcpy(A, J, sizeof A);
             memcpy(b, e, sizeof b);
@@ -259,8 +304,14 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
                 lambda = 1e-6 * dmax;
             for (int i = 0; i < 6; ++i)
                 A[7 * i] += lambda;
+            if (o->fix >= 0) { /* the held joint's row and column: dq = 0 there */
+                for (int i = 0; i < 6; ++i)
+                    A[6 * i + o->fix] = A[6 * o->fix + i] = 0.0;
+                A[7 * o->fix] = 1.0;
+                b[o->fix] = 0.0;
+            }
             if (rc_kin_chol6(A, b) != RC_OK)
-                return 0;
+                return stalled_ok(*err_mm, *err_rad);
             memcpy(dq, b, sizeof dq);
         }
         double big = 0.0;
@@ -270,7 +321,7 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
         for (int i = 0; i < 6; ++i)
             qa[i] = q[i] + sc * dq[i];
         const double ca = eval(ea, Ja, d, kin, t, qa);
-        if (ca < cost) {
+        if (ca < cost && (o->keep < 0 || branch_of(o->ik, d, qa) == o->keep)) {
             memcpy(q, qa, sizeof qa);
             memcpy(e, ea, sizeof ea);
             memcpy(J, Ja, sizeof Ja);
@@ -284,20 +335,22 @@ static int newton_kin(double q[RC_NJ], double *err_mm, double *err_rad, unsigned
                 dmax = fmax(dmax, fabs(J[7 * i]));
             lambda = lambda > 0.0 ? lambda * 10.0 : 1e-4 * dmax * dmax;
             if (lambda > 1e12 * (dmax * dmax + 1.0))
-                return 0;
+                return stalled_ok(*err_mm, *err_rad);
             eval(e, J, d, kin, t, q); /* d back to q */
         }
     }
     *err_mm = sqrt(dot(e, e));
     *err_rad = sqrt(dot(&e[3], &e[3]));
-    return *err_mm <= RCH_IKG_TOL_MM && *err_rad <= RCH_IKG_TOL_RAD;
+    return stalled_ok(*err_mm, *err_rad);
 }
 
 static int newton(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
                   const rch_ikg *ik, const target *t)
 {
-    return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t);
+    const newton_opt o = {ik, -1, -1, IKG_MAX_IT};
+    return newton_kin(q, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o);
 }
+
 
 /* Continuation from the idealised arm's closed-form solution q (exact
  * there): the DH rows moved from the idealised table to the real one in
@@ -310,6 +363,7 @@ static int homotopy(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *
                     const rch_ikg *ik, const target *t)
 {
     rc_kin k = ik->kin;
+    const newton_opt o = {ik, -1, -1, IKG_MAX_IT};
     for (unsigned s = 1; s <= IKG_HOMOTOPY; ++s) {
         const double f = (double)s / IKG_HOMOTOPY;
         for (unsigned i = 0; i < RC_NJ; ++i) {
@@ -322,10 +376,205 @@ static int homotopy(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *
             k.link[i].sin_alpha = sin(al);
             k.link[i].theta_off_rad = ik->ideal[i][3] + f * (r->theta_off_rad - ik->ideal[i][3]);
         }
-        if (!newton_kin(q, err_mm, err_rad, iters, d, s == IKG_HOMOTOPY ? &ik->kin : &k, ik->reach_mm, t))
+        if (!newton_kin(q, err_mm, err_rad, iters, d, s == IKG_HOMOTOPY ? &ik->kin : &k, ik->reach_mm, t, &o))
             return 0;
     }
     return 1;
+}
+
+/* The scan along a self-motion. Next to the wrist's singularity (a UR's axes 2, 3, 4 and 6 parallel, a
+ * spherical wrist's 4 and 6 aligned) or the shoulder's (the wrist point on axis 1), the solutions of a
+ * calibrated arm lie on a curve along which the pose hardly changes (the idealised arm's self-motion): a
+ * start's joints along it are ill-determined (a closed-form start of the right branch may be a radian off),
+ * the Jacobian is ill-conditioned there, and Newton from the start slides to another solution on the curve,
+ * of another branch, or stalls in the flat valley. Here joint j is held at IKG_SCAN + 1 values over a turn
+ * from q0 and the other five fitted (damped steps, each from the value before: the curve followed; with j
+ * held the five are well conditioned). At each the residual left is along the one direction the five
+ * columns of the Jacobian do not span: its component along their generalized cross product (continuous
+ * along the curve) is a signed function g of the held value, zero at each solution. Each sign change is
+ * bracketed and its root found (regula falsi, Illinois), then polished by Newton on all six; the roots are
+ * taken until one is of `branch`. 1 then (q, d, errors). */
+#define IKG_SCAN 48
+#define IKG_SCAN_IT 6
+#define IKG_ROOT_IT 40
+
+/* The determinant of a 5 x 5 matrix (row-major, destroyed; partial pivoting). */
+static double det5(double M[25])
+{
+    double det = 1.0;
+    for (int c = 0; c < 5; ++c) {
+        int p = c;
+        for (int r = c + 1; r < 5; ++r)
+            if (fabs(M[5 * r + c]) > fabs(M[5 * p + c]))
+                p = r;
+        if (M[5 * p + c] == 0.0)
+            return 0.0;
+        if (p != c) {
+            for (int k = 0; k < 5; ++k) {
+                const double tmp = M[5 * c + k];
+                M[5 * c + k] = M[5 * p + k];
+                M[5 * p + k] = tmp;
+            }
+            det = -det;
+        }
+        det *= M[6 * c];
+        for (int r = c + 1; r < 5; ++r) {
+            const double f = M[5 * r + c] / M[6 * c];
+            for (int k = c; k < 5; ++k)
+                M[5 * r + k] -= f * M[5 * c + k];
+        }
+    }
+    return det;
+}
+
+/* q[j] = s, the other five fitted from q; returns g (above). */
+static double fit_held(double q[RC_NJ], unsigned *iters, rc_kin_data *d, const rch_ikg *ik, const target *t,
+                       int j, double s, unsigned it)
+{
+    const newton_opt hold = {ik, -1, j, it};
+    double em, er, e[6], J[36];
+    q[j] = s;
+    newton_kin(q, &em, &er, iters, d, &ik->kin, ik->reach_mm, t, &hold);
+    eval(e, J, d, &ik->kin, t, q);
+    double n[6], nn = 0.0, g = 0.0;
+    for (int i = 0; i < 6; ++i) { /* n_i = (-1)^i det(the weighted columns but j, row i left out) */
+        double M[25];
+        int r = 0;
+        for (int row = 0; row < 6; ++row) {
+            if (row == i)
+                continue;
+            const double w = row < 3 ? 1.0 : IKG_W_ROT_MM;
+            int c = 0;
+            for (int col = 0; col < 6; ++col)
+                if (col != j)
+                    M[5 * r + c++] = w * J[6 * row + col];
+            ++r;
+        }
+        n[i] = (i & 1 ? -1.0 : 1.0) * det5(M);
+        nn += n[i] * n[i];
+        g += n[i] * e[i] * (i < 3 ? 1.0 : IKG_W_ROT_MM);
+    }
+    return nn > 0.0 && isfinite(g) ? g / sqrt(nn) : 0.0;
+}
+
+/* A solution of the branch next to the asked one across a boundary it lies within RCH_IKG_NEAR_BOUNDARY
+ * of (rch_ikg.h: returned when the asked branch has none found). */
+typedef struct {
+    int have, branch;
+    double q[RC_NJ], err_mm, err_rad;
+} near_sol;
+
+static void near_offer(near_sol *ns, const rch_ikg *ik, const rc_kin_data *d, const double q[RC_NJ], int b,
+                       int branch, double em, double er)
+{
+    if (ns == NULL || ns->have || branch == RCH_IKG_ANY_BRANCH || b == branch ||
+        ((b ^ branch) & ~boundary_of(ik, d, q, RCH_IKG_NEAR_BOUNDARY)) != 0)
+        return;
+    ns->have = 1;
+    ns->branch = b;
+    memcpy(ns->q, q, sizeof ns->q);
+    ns->err_mm = em;
+    ns->err_rad = er;
+}
+
+/* The root of g in [a, b] (signs differ there) from x at a (regula falsi, Illinois), then Newton on all
+ * six kept to the branch where it is in it; 1 when a solution of `branch` (q, d, errors). */
+static int held_root(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                     const rch_ikg *ik, const target *t, int j, int branch, near_sol *ns, const double x0[RC_NJ],
+                     double a, double b, double ga, double gb)
+{
+    double x[RC_NJ];
+    memcpy(x, x0, sizeof x);
+    int side = 0;
+    for (int it = 0; it < IKG_ROOT_IT && ga != 0.0 && b - a > 1e-13; ++it) {
+        const double c = (a * gb - b * ga) / (gb - ga);
+        const double gc = fit_held(x, iters, d, ik, t, j, c, IKG_SCAN_IT);
+        if (gc == 0.0)
+            break;
+        if ((gc > 0.0) == (gb > 0.0)) {
+            b = c;
+            gb = gc;
+            if (side == -1)
+                ga *= 0.5;
+            side = -1;
+        } else {
+            a = c;
+            ga = gc;
+            if (side == 1)
+                gb *= 0.5;
+            side = 1;
+        }
+    }
+    const newton_opt o = {ik, rch_ikg_branch(ik, x) == branch ? branch : -1, -1, 4 * IKG_MAX_IT};
+    if (!newton_kin(x, err_mm, err_rad, iters, d, &ik->kin, ik->reach_mm, t, &o))
+        return 0;
+    const int bx = branch_of(ik, d, x);
+    if (bx == branch ||
+        (converged(*err_mm, *err_rad) && ((bx ^ branch) & ~boundary_of(ik, d, x, RCH_IKG_BOUNDARY)) == 0)) {
+        memcpy(q, x, sizeof x);
+        return 1;
+    }
+    near_offer(ns, ik, d, x, bx, branch, *err_mm, *err_rad);
+    return 0;
+}
+
+/* g at n + 1 held values s0 + k h from x0; each sign change to held_root; where |g| has a local minimum
+ * without one (two roots in a step: a pair next to a fold or the boundary), the two steps around it again,
+ * IKG_SUB times finer, depth more times. */
+#define IKG_SUB 16
+#define IKG_SCAN_NEAR 0.1 /* a scan starts where a factor is within this of its boundary (rch_ikg_on_boundary) */
+#define IKG_MET 4 /* solutions of other branches a solve keeps as the scans' starts */
+#define IKG_SUB_MIN 2   /* minima refined per level */
+#define IKG_SUB_DEPTH 5 /* levels: a step of 2 pi / 48 / 8^5 (4e-6 rad) at the finest */
+static int scan_range(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                      const rch_ikg *ik, const target *t, int j, int branch, near_sol *ns, const double x0[RC_NJ],
+                      double s0, double h, int n, int depth)
+{
+    double qs[IKG_SCAN + 1][RC_NJ], g[IKG_SCAN + 1], x[RC_NJ];
+    memcpy(x, x0, sizeof x);
+    for (int k = 0; k <= n; ++k) {
+        g[k] = fit_held(x, iters, d, ik, t, j, s0 + h * k, IKG_SCAN_IT);
+        memcpy(qs[k], x, sizeof x);
+    }
+    for (int k = 0; k < n; ++k)
+        if (((g[k] <= 0.0 && g[k + 1] > 0.0) || (g[k] >= 0.0 && g[k + 1] < 0.0)) &&
+            held_root(q, err_mm, err_rad, iters, d, ik, t, j, branch, ns, qs[k], s0 + h * k, s0 + h * (k + 1), g[k],
+                      g[k + 1]))
+            return 1;
+    if (depth == 0)
+        return 0;
+    /* the IKG_SUB_MIN smallest such minima, smallest first */
+    int mins[IKG_SUB_MIN], nm = 0;
+    for (int k = 1; k < n; ++k) {
+        if (!(fabs(g[k]) <= fabs(g[k - 1]) && fabs(g[k]) <= fabs(g[k + 1]) && (g[k - 1] > 0.0) == (g[k] > 0.0) &&
+              (g[k + 1] > 0.0) == (g[k] > 0.0)))
+            continue;
+        if (nm < IKG_SUB_MIN)
+            mins[nm++] = k;
+        else if (fabs(g[k]) < fabs(g[mins[nm - 1]]))
+            mins[nm - 1] = k;
+        else
+            continue;
+        for (int i = nm - 1; i > 0 && fabs(g[mins[i]]) < fabs(g[mins[i - 1]]); --i) {
+            const int tmp = mins[i];
+            mins[i] = mins[i - 1];
+            mins[i - 1] = tmp;
+        }
+    }
+    for (int i = 0; i < nm; ++i) {
+        const int k = mins[i];
+        if (scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, ns, qs[k - 1], s0 + h * (k - 1),
+                       2.0 * h / IKG_SUB, IKG_SUB, depth - 1))
+            return 1;
+    }
+    return 0;
+}
+
+static int scan(double q[RC_NJ], double *err_mm, double *err_rad, unsigned *iters, rc_kin_data *d,
+                const rch_ikg *ik, const target *t, const double q0[RC_NJ], int j, int branch, near_sol *ns)
+{
+    return scan_range(q, err_mm, err_rad, iters, d, ik, t, j, branch, ns, q0, q0[j], 2.0 * M_PI / IKG_SCAN, IKG_SCAN,
+                      IKG_SUB_DEPTH);
 }
 
 /* Starts: axis 1 towards the target (and away), the arm's two elbow sides
@@ -457,7 +706,10 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
     int order[8] = {0};
     int ncs = -1; /* computed when the seed's own run did not do */
     double conv_q[8][RC_NJ]; /* solutions of another branch met on the way (for the wrist's reflections) */
+    near_sol ns = {0, -1, {0}, 0.0, 0.0};
     unsigned n_conv = 0, n_refl = 0;
+    double met[IKG_MET][RC_NJ]; /* solutions of other branches met (the scans start from them too) */
+    int n_met = 0;
     for (unsigned k = seed_rad ? 0u : 1u; ncs < 0 || k < 1u + 2u * (unsigned)ncs + IKG_N_START + 2u * n_refl;
          ++k) {
         double q[RC_NJ], em, er;
@@ -502,8 +754,14 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
             continue;
         }
         reached = 1;
-        const int b = branch_of(ik, &d, q);
+        int b = branch_of(ik, &d, q);
+        if (branch != RCH_IKG_ANY_BRANCH && b != branch && converged(em, er) &&
+            ((b ^ branch) & ~boundary_of(ik, &d, q, RCH_IKG_BOUNDARY)) == 0)
+            b = branch; /* on the boundary of the bits that differ: on both sides (rch_ikg.h) */
         if (branch != RCH_IKG_ANY_BRANCH && b != branch) {
+            near_offer(&ns, ik, &d, q, b, branch, em, er);
+            if (n_met < IKG_MET)
+                memcpy(met[n_met++], q, sizeof q);
             if ((b ^ branch) == 1 && n_conv < 8 && n_refl == 0)
                 memcpy(conv_q[n_conv++], q, sizeof q);
             continue;
@@ -523,6 +781,66 @@ rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_
         /* no seed: the first will do; a seed's own run: the nearest */
         if (!seed_rad || k == 0)
             break;
+    }
+    /* none of the branch: the scans along the self-motions (q6 held: the wrist's, q1: the shoulder's),
+     * across the elbow's fold (q3 held: the pair of solutions either side of it), then along the wrist's
+     * self-motion by q2 and q4 (a UR's axes 2, 3, 4 and 6 parallel: any of them follows the curve, and q2
+     * or q4 held where the elbow is folded or stretched as well, the five then not singular) from each
+     * closed-form start and each solution met, those of the branch first */
+    static const int held[5] = {5, 0, 2, 1, 3};
+    for (int jj = 0; branch != RCH_IKG_ANY_BRANCH && !in_branch && jj < 5; ++jj)
+        for (int i = 0, j = held[jj]; !in_branch && i < ncs + n_met; ++i) {
+            double q[RC_NJ], em, er;
+            rc_kin_data d;
+            const double *x0 = i < ncs ? cs[order[i]] : met[i - ncs];
+            rc_kin_fk(q, NULL, &d, &ik->kin, x0);
+            if (!boundary_of(ik, &d, x0, IKG_SCAN_NEAR))
+                continue; /* far from every singularity: the starts found what there is */
+            ++inf.starts;
+            if (!scan(q, &em, &er, &inf.iterations, &d, ik, &t, x0, j, branch, &ns))
+                continue;
+            reached = in_branch = 1;
+            if (!place(q, ik, seed_rad))
+                continue;
+            memcpy(best, q, sizeof best);
+            inf.err_mm = em;
+            inf.err_rad = er;
+            inf.branch = branch;
+            found = 1;
+        }
+    /* none of the branch found, but one of the branch across a boundary it lies next to (rch_ikg.h) */
+    if (!found && ns.have) {
+        double q[RC_NJ];
+        memcpy(q, ns.q, sizeof q);
+        if (place(q, ik, seed_rad)) {
+            memcpy(best, q, sizeof best);
+            inf.err_mm = ns.err_mm;
+            inf.err_rad = ns.err_rad;
+            inf.branch = ns.branch;
+            found = 1;
+        }
+    }
+    /* any branch, and none found (or every one outside the limits): each branch asked in turn (its scans find
+     * the solutions next to a singularity the starts slid past), the one nearest the seed */
+    for (int b = 0; branch == RCH_IKG_ANY_BRANCH && !found && b < 8; ++b) {
+        double q[RC_NJ];
+        rch_ikg_info ib;
+        const rch_ikg_status sb = rch_ikg_solve(q, &ib, ik, pos_mm, rot, b, seed_rad);
+        inf.starts += ib.starts;
+        inf.iterations += ib.iterations;
+        reached |= sb != RCH_IKG_UNREACHABLE;
+        in_branch |= sb == RCH_IKG_OK || sb == RCH_IKG_LIMITS;
+        if (sb != RCH_IKG_OK)
+            continue;
+        const double dd = seed_rad ? dist(q, seed_rad) : 0.0;
+        if (dd < best_d) {
+            best_d = dd;
+            memcpy(best, q, sizeof best);
+            inf.err_mm = ib.err_mm;
+            inf.err_rad = ib.err_rad;
+            inf.branch = ib.branch;
+        }
+        found = 1;
     }
     if (found)
         memcpy(q_rad, best, sizeof best);

@@ -14,8 +14,16 @@
  * Starts: the caller's seed; then the eight closed-form solutions of the
  * arm's idealised table when it is of a class with one (rch_ikg_seed.c:
  * spherical wrist as rch_ik.h, or UR's offset wrist), each a few Newton
- * steps from the real arm's solution of its branch; then a fixed set of
- * generic starts (any other arm).
+ * steps from the real arm's solution of its branch (a target just past the
+ * idealised arm's reach still gets them); then a fixed set of generic starts
+ * (any other arm). When none of these gives the asked branch (next to a
+ * singularity, where a calibrated arm's solutions lie along an almost free
+ * curve or in a close pair across a fold): scans with one joint held (q6:
+ * the wrist's self-motion, q1: the shoulder's, q3: across the elbow's fold)
+ * from each closed-form start and each solution met, the other five fitted
+ * and the solutions located as the roots of the residual's signed component
+ * (rch_ikg.c, scan). The fast path is unchanged: the scans cost only where
+ * they are needed (milliseconds, next to a singularity).
  *
  * Branch: three bits, each the side of one singularity the configuration
  * is on, so that a branch changes only through that singularity:
@@ -36,7 +44,8 @@
  *
  * Accuracy: a solution's forward kinematics meets the target within
  * RCH_IKG_TOL_MM and RCH_IKG_TOL_RAD (Newton's last step is quadratic: far
- * below in practice). Joint values: each axis taken in the turn nearest the
+ * below in practice), or, where Newton stalls next to a singularity, within
+ * RCH_IKG_ACCEPT_MM and RCH_IKG_ACCEPT_RAD. Joint values: each axis taken in the turn nearest the
  * seed (no seed: in (-180, 180] deg) and moved by whole turns into the
  * model's limits when a turn fits.
  *
@@ -51,6 +60,10 @@
 
 #define RCH_IKG_TOL_MM 1e-8
 #define RCH_IKG_TOL_RAD 1e-10
+/* A Newton run that stops converging (next to a singularity, where the Jacobian's conditioning bounds the
+ * last digits) is a solution within these: 1000 times below what a compensated program needs. */
+#define RCH_IKG_ACCEPT_MM 1e-6
+#define RCH_IKG_ACCEPT_RAD 1e-9
 #define RCH_IKG_MAX_SOL 16 /* distinct solutions rch_ikg_all reports */
 #define RCH_IKG_ANY_BRANCH (-1)
 
@@ -90,6 +103,23 @@ void rch_ikg_fk(double pos_mm[3], double rot[9], const rch_ikg *ik, const double
 /* The branch (0..7, bits above) of the configuration q_rad (6). */
 int rch_ikg_branch(const rch_ikg *ik, const double q_rad[RC_NJ]);
 
+/* The bits (4, 2, 1 as the branch's) of the singularities q_rad (6) lies on:
+ * its factor within tol of 0 (shoulder: the distance of P from its plane
+ * over the reach; elbow: the sine of the angle at o2 between o1 and E;
+ * wrist: sin(q5 + theta5)). Within RCH_IKG_BOUNDARY a configuration is on
+ * both sides of that boundary: it answers a solve of either label
+ * (rch_ikg_solve). */
+#define RCH_IKG_BOUNDARY 1e-7
+int rch_ikg_on_boundary(const rch_ikg *ik, const double q_rad[RC_NJ], double tol);
+
+/* At a singularity the labels of its two sides meet: a pose made by joints
+ * on (or within rounding of) a boundary may have its solution on the other
+ * side, a hair away. When no solution of the asked branch is found,
+ * rch_ikg_solve returns one of a branch differing only in bits whose boundary
+ * it lies within RCH_IKG_NEAR_BOUNDARY of (the same measures; 1e-3: sin q5
+ * within 0.06 deg of 0), with info->branch saying which. */
+#define RCH_IKG_NEAR_BOUNDARY 1e-3
+
 /* What one solve did (may be NULL). */
 typedef struct {
     unsigned starts;      /* Newton runs */
@@ -104,7 +134,9 @@ typedef struct {
  * any (RCH_IKG_ANY_BRANCH), the one nearest seed_rad (6, may be NULL: the
  * first found). With a seed, Newton starts there first: a seed close to a
  * solution (a program's previous target, URScript's qnear) costs one run.
- * RCH_IKG_OK, or the reason with q_rad unchanged. */
+ * RCH_IKG_OK, or the reason with q_rad unchanged. info->branch is the
+ * returned solution's branch: the asked one, or at a singularity the label
+ * across it (RCH_IKG_BOUNDARY, RCH_IKG_NEAR_BOUNDARY above). */
 rch_ikg_status rch_ikg_solve(double q_rad[RC_NJ], rch_ikg_info *info, const rch_ikg *ik, const double pos_mm[3],
                              const double rot[9], int branch, const double *seed_rad);
 

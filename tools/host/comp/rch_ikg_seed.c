@@ -155,8 +155,9 @@ static int offset_all(double out[8][RC_NJ], const double r[RC_NJ][4], const doub
             const double th234 = atan2(R[3], R[0]);
             const double a2 = r[1][0], a3 = r[2][0];
             const double c3 = (p[0] * p[0] + p[1] * p[1] - a2 * a2 - a3 * a3) / (2 * a2 * a3);
-            if (fabs(c3) > 1.0 + SEED_NEAR)
-                continue;
+            /* (past the idealised elbow's reach, however far: next to the wrist's singularity theta6, and so
+             * the elbow's target, is ill-determined on the idealised arm; the scan along the wrist's
+             * self-motion, rch_ikg.c, starts from here) */
             for (int i3 = 0; i3 < 2; ++i3) {
                 /* the arm stretched or folded beyond the idealised arm's reach: the starts on either side */
                 const double a3c = fabs(c3) <= 1.0 + 1e-9 ? acos(fmax(-1.0, fmin(1.0, c3)))
@@ -194,5 +195,25 @@ int rch_ikg_seeds(double out[8][RC_NJ], const rch_ikg *ik, const double pt[3], c
         R0[3 * i + 2] = Rt[3 * i + 2];
     }
     rch_ik_rot_to_quat(quat, R0);
-    return rch_ik_all(out, &ik->ideal_model, p6, quat, NULL);
+    int n = rch_ik_all(out, &ik->ideal_model, p6, quat, NULL);
+    /* Just beyond the idealised arm's elbow reach (stretched, or folded past its inner bound) where the
+     * calibrated arm still reaches (issue 51): no closed-form solution, so no start, and the generic starts
+     * found some branches and not others. The target is moved towards (then away from) the shoulder by
+     * SEED_SHIFT_MM[k] until the idealised arm has solutions: each a few steps from the real arm's. */
+    static const double shift_mm[] = {1.0, -1.0, 4.0, -4.0, 12.0, -12.0};
+    const double sh[3] = {0.0, 0.0, ik->ideal[0][1]}; /* on axis 1 at the shoulder's height */
+    for (unsigned k = 0; n == 0 && k < sizeof shift_mm / sizeof shift_mm[0]; ++k) {
+        double v[3], len = 0.0, p[3];
+        for (int i = 0; i < 3; ++i) {
+            v[i] = sh[i] - p6[i];
+            len += v[i] * v[i];
+        }
+        len = sqrt(len);
+        if (!(len > 2.0 * fabs(shift_mm[k])))
+            break;
+        for (int i = 0; i < 3; ++i)
+            p[i] = p6[i] + shift_mm[k] * v[i] / len;
+        n = rch_ik_all(out, &ik->ideal_model, p, quat, NULL);
+    }
+    return n;
 }
