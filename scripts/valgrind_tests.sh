@@ -42,6 +42,10 @@
 #                      chains run to their end: 329 s) take the CLI paths the
 #                      golden runs and the *_cli tests here take once; their
 #                      many runs are the sanitizer build's (CI time).
+#                      ik_general and ik_branch (tens of thousands of IK
+#                      solves near singularities, 10 s each in Release): the
+#                      sanitizer build's; comp_urscript, comp_krl_conv run
+#                      the IK under memcheck.
 #                      Set it to '' to run everything.
 #   VALGRIND_TIMEOUT   seconds per test (default 900)
 #   VALGRIND_CHILDREN  1: trace child processes (default), 0: only the test
@@ -53,7 +57,7 @@ set -u -o pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-$ROOT/build-valgrind}
-EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|robust_hostile_cli|methods_cli|diag_chain|pkg_limits_define_refused|pkg_limits_link_refused)\$}
+EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|robust_hostile_cli|methods_cli|diag_chain|pkg_limits_define_refused|pkg_limits_link_refused|ik_general|ik_branch)\$}
 TMO=${VALGRIND_TIMEOUT:-900}
 CHILDREN=${VALGRIND_CHILDREN:-1}
 JOBS=${JOBS:-1}
