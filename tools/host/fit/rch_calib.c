@@ -8,7 +8,6 @@
  * rch_cost, rch_resid, rch_positions, rch_data. Memory: the inputs and the
  * scratch freed before returning. Errors: see rch_calib_run.
  */
-#include "rch_sensors.h"
 #include "rch_calib.h"
 #include "rch_file.h"
 #include "rch_calib_int.h"
@@ -24,6 +23,7 @@
 #include "rch_data.h"
 #include "rch_inputs.h"
 #include "rch_resid.h"
+#include "rch_sensors.h"
 
 /* The run's state (the plan of rch_calib_run): the request, the inputs read
  * once, the solver's workspace, the rows held out (--residuals) and the

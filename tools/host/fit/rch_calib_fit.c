@@ -11,7 +11,6 @@
  * rch_prior, rch_jumps, rch_uncert, rch_comp, rch_positions. Memory: scratch
  * freed before returning. Errors: 0, -1 with d set, -2 on a bad --fix name.
  */
-#include "rch_sensors.h"
 #include "rch_calib_int.h"
 
 #include "rch_calib.h"
@@ -26,6 +25,7 @@
 #include "rch_prior.h"
 #include "rch_start.h"
 #include "rch_stats.h"
+#include "rch_sensors.h"
 
 /* rc_solve, counted in r->counts (res may be NULL). */
 static rc_status solve_counted(rch_calib_result *r, rc_model *m, rc_solve_result *res, rc_solve_work *w,

@@ -8,7 +8,6 @@
  * Depends on: rch_calib.h, rch_prior, rch_uncert, rch_positions, rch_text.
  * Memory: none on the heap. Errors: none (write errors are the stream's).
  */
-#include "rch_sensors.h"
 #include "rch_calib.h"
 #include "rch_calib_int.h"
 
@@ -19,6 +18,7 @@
 #include "rch_prior.h"
 #include "rch_seen.h"
 #include "rch_text.h"
+#include "rch_sensors.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846

@@ -24,25 +24,18 @@
 
 #include "rc_linalg.h"
 #include "rc_sensor.h"
+#include "rch_positions.h"
 
 #define TOUCH_START_ROUNDS 200
 #define TOUCH_MIN_SPREAD_MM 1.0 /* a plate's touches must spread this far in two directions (RMS) */
 
 extern const rch_sensor_desc rch_sensor_touch;
 
-static int effect_at(const rc_model *m, unsigned kind)
-{
-    for (unsigned i = 0; i < m->n_effects; ++i)
-        if (m->effects[i].kind == kind)
-            return (int)m->effects[i].first;
-    return -1;
-}
-
 static int touch_add_effects(rc_model *m, unsigned n_planes)
 {
-    if (effect_at(m, RC_EFF_TOUCH_TIP) < 0 && rc_model_add_effect(m, RC_EFF_TOUCH_TIP, 0, 0) != RC_OK)
+    if (rch_pos_effect_at(m, RC_EFF_TOUCH_TIP, NULL) < 0 && rc_model_add_effect(m, RC_EFF_TOUCH_TIP, 0, 0) != RC_OK)
         return -1;
-    if (effect_at(m, RC_EFF_PLANE_NORMALS) < 0 &&
+    if (rch_pos_effect_at(m, RC_EFF_PLANE_NORMALS, NULL) < 0 &&
         (rc_model_add_effect(m, RC_EFF_PLANE_NORMALS, 0, 2u * n_planes) != RC_OK ||
          rc_model_add_effect(m, RC_EFF_PLANE_OFFSETS, 0, n_planes) != RC_OK))
         return -1;
@@ -52,7 +45,7 @@ static int touch_add_effects(rc_model *m, unsigned n_planes)
 /* The flange of m at q: o (3), R (3 x 3); rc_fk's point less a tool offset. */
 static void flange(double o[3], double R[9], const rc_model *m, const double q[RC_NJ])
 {
-    const int ti = effect_at(m, RC_EFF_TOOL_OFFSET);
+    const int ti = rch_pos_effect_at(m, RC_EFF_TOOL_OFFSET, NULL);
     rc_fk(o, R, m, q);
     if (ti >= 0)
         for (int r = 0; r < 3; ++r)
@@ -172,14 +165,11 @@ static int fit_tip(double t[3], double *dist, const rc_model *m, const rc_sample
 
 static int touch_start(rc_model *m, const rc_sample *s, size_t ns, rch_diag *d)
 {
-    const int tf = effect_at(m, RC_EFF_TOUCH_TIP), nf = effect_at(m, RC_EFF_PLANE_NORMALS),
-              df = effect_at(m, RC_EFF_PLANE_OFFSETS);
+    unsigned np = 0, bad = 0;
+    const int tf = rch_pos_effect_at(m, RC_EFF_TOUCH_TIP, NULL), nf = rch_pos_effect_at(m, RC_EFF_PLANE_NORMALS, NULL),
+              df = rch_pos_effect_at(m, RC_EFF_PLANE_OFFSETS, &np);
     if (tf < 0 || nf < 0 || df < 0)
         return 0;
-    unsigned np = 0, bad = 0;
-    for (unsigned i = 0; i < m->n_effects; ++i)
-        if (m->effects[i].kind == RC_EFF_PLANE_OFFSETS)
-            np = m->effects[i].count;
     double t[3], n[RC_MAX_TARGETS][3], dist[RC_MAX_TARGETS];
     memcpy(t, &m->x[tf], sizeof t);
     for (unsigned r = 0; r < TOUCH_START_ROUNDS; ++r) {

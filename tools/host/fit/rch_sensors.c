@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rch_stats.h"
+
 /* The table: one line per sensor (its descriptor is defined in its own file). */
 extern const rch_sensor_desc rch_sensor_touch; /* rch_sensor_touch.c: points touched on plates */
 static const rch_sensor_desc *const sensors[] = {
@@ -28,12 +30,6 @@ const rch_sensor_desc *rch_sensor_of_kind(unsigned kind)
     return NULL;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 int rch_sensor_parse(rch_data *out, const rch_sensor_desc *sd, const char *text, size_t len, const char *name,
                      const rc_model *limits, rch_diag *d)
 {
@@ -48,9 +44,9 @@ int rch_sensor_parse(rch_data *out, const rch_sensor_desc *sd, const char *text,
             rch_diag_set(d, name, 0, 0, "out of memory");
             return -1;
         }
+        double med, mx;
         memcpy(v, out->sigma_mm, out->n * sizeof *v);
-        qsort(v, out->n, sizeof *v, cmp_double);
-        const double med = out->n % 2 ? v[out->n / 2] : 0.5 * (v[out->n / 2 - 1] + v[out->n / 2]);
+        rch_median_max(&med, &mx, v, out->n);
         free(v);
         for (size_t i = 0; i < out->n; ++i)
             out->s[i].weight = med / out->sigma_mm[i];

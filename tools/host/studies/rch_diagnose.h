@@ -122,7 +122,8 @@ typedef struct rch_diagnose_cfg {
  * outlet (lengths, mm) or the tracker (positions: 3-D errors, mm). */
 typedef struct rch_diagnose_sensor {
     char name[40];         /* "cable", "cable outlet 2" (the file's label), "tracker" */
-    int tracker;           /* 1: positions (three coordinates a row) */
+    int tracker;           /* 1: not a cable: the tracker's positions (three coordinates a row) or another sensor */
+    char kind[16];         /* "cable", "tracker", or the sensor's name (rch_sensors.h: "touch") */
     unsigned label;        /* the outlet's label in the file (cable) */
     size_t rows;           /* lengths, or position rows (three samples each) */
     double before_mm;      /* held-out RMS, geometry only (3-D for the tracker) */

@@ -78,7 +78,7 @@ static void print_summary(FILE *f, const rch_diagnose_result *r)
             "floor");
     for (unsigned k = 0; k < r->n_sensors; ++k) {
         char name[64];
-        snprintf(name, sizeof name, "%s%s", r->sensors[k].name, r->sensors[k].tracker && strcmp(r->sensors[k].name, "tracker") == 0 ? " (3-D)" : "");
+        snprintf(name, sizeof name, "%s%s", r->sensors[k].name, strcmp(r->sensors[k].kind, "tracker") == 0 ? " (3-D)" : "");
         fprintf(f, "  %-34s %8zu %10.4f %10.4f %10.4f\n", name, r->sensors[k].rows, r->sensors[k].before_mm,
                 r->sensors[k].after_mm, r->sensors[k].floor_mm);
     }
@@ -305,7 +305,7 @@ int rch_diagnose_json(FILE *f, const rch_diagnose_result *r, int argc, char **ar
         const rch_diagnose_sensor *z = &r->sensors[k];
         rch_jw_obj(&w, NULL);
         rch_jw_str(&w, "name", z->name);
-        rch_jw_str(&w, "kind", z->tracker ? "tracker" : "cable");
+        rch_jw_str(&w, "kind", z->kind);
         if (z->tracker)
             rch_jw_null(&w, "outlet");
         else

@@ -4,7 +4,6 @@
  * floor, the folds, the cross-validated geometry, the length jumps, the
  * search (rch_diagnose_search.c), the verdict and the per-sensor figures.
  * See rch_diagnose.h. */
-#include "rch_sensors.h"
 #include "rch_diagnose_int.h"
 #include "rch_text.h"
 #include "rch_dequant.h"
@@ -27,6 +26,7 @@
 #include "rch_resid.h"
 #include "rch_robot.h"
 #include "rch_stats.h"
+#include "rch_sensors.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -329,6 +329,7 @@ static int phase_sensors(run_state *S)
         for (size_t i = 0; z->tracker && i < n && !sd; ++i)
             if (S->cls[i] == j)
                 sd = rch_sensor_of_kind(out->s[i].sensor);
+        snprintf(z->kind, sizeof z->kind, "%s", sd ? sd->name : z->tracker ? "tracker" : "cable");
         if (sd) {
             snprintf(z->name, sizeof z->name, "%s", sd->name);
         } else if (z->tracker) {

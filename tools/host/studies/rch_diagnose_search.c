@@ -78,8 +78,11 @@ static int cand_relevant(const run_state *S, const cdef *cd)
 {
     const rch_diagnose_result *out = S->out;
     const unsigned outlets = out->n_sensors - (out->n_tracker > 0);
+    int tracker = 0; /* a tracker's rows (n_tracker counts every sensor other than the cable) */
+    for (unsigned j = 0; j < out->n_sensors; ++j)
+        tracker |= strcmp(out->sensors[j].kind, "tracker") == 0;
     return cd->on == ON_ANY || (cd->on == ON_CABLE && out->n_cable > 0) || (cd->on == ON_OUTLETS && outlets > 1) ||
-           (cd->on == ON_TRACKER && out->n_tracker > 0);
+           (cd->on == ON_TRACKER && tracker);
 }
 #define N_ALL_CANDS (sizeof all_cands / sizeof all_cands[0])
 RC_STATIC_ASSERT(sizeof all_cands / sizeof all_cands[0] <= RCH_DIAGNOSE_MAX_CAND, candidates_fit_the_step);

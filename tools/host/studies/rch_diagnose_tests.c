@@ -6,9 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rch_sensors.h"
 #include "rch_diagnose_int.h"
 #include "rch_stats.h"
+#include "rch_sensors.h"
 
 /* ------------------------------------------------------- structure tests */
 
@@ -281,22 +281,22 @@ unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_s
         k += rch_dg_structure_tests(out + k, rs, ss, m, (const double(*)[V_N])vs, g, a_each * (double)per);
         /* another sensor of the table (rch_sensors.h): its name; it has no distance or direction from a place */
         const rch_sensor_desc *sd = tracker ? rch_sensor_of_kind(ss[0].sensor) : NULL;
+        unsigned kept = k0;
         for (unsigned j = k0; j < k; ++j) { /* names say the sensor; the cable's "length" is the tracker's distance */
             char nm[40];
             const char *base = out[j].name;
-            if (sd && (strcmp(base, "cable length") == 0 || strcmp(base, "cable direction") == 0)) {
-                memmove(&out[j], &out[j + 1], (k - j - 1) * sizeof out[0]);
-                --k;
-                --j;
-                continue;
-            }
+            const int place = strcmp(base, "cable length") == 0 || strcmp(base, "cable direction") == 0;
+            if (sd && place)
+                continue; /* dropped */
             if (tracker && strcmp(base, "cable length") == 0)
                 base = "distance from the tracker";
             else if (tracker && strcmp(base, "cable direction") == 0)
                 base = "direction from the tracker";
             snprintf(nm, sizeof nm, "%s: %.30s", sd ? sd->name : tracker ? "tracker" : "cable", base);
-            memcpy(out[j].name, nm, sizeof nm);
+            out[kept] = out[j];
+            memcpy(out[kept++].name, nm, sizeof nm);
         }
+        k = kept;
         if (!tracker && outlets > 1)
             k += anova_by(&out[k], "cable: outlet (ANOVA)", rs, ss, m, key_outlet, a_each);
         if (tracker && !sd) {
