@@ -63,7 +63,8 @@ typedef struct rch_screen_row {
     unsigned line, file;   /* the data file's line; file: the input's index (cable files, then positions) */
     double residual_mm;    /* |model - measured| (a tracker row: its largest coordinate) under the first fit */
     double scale_mm;       /* its sensor's robust scale */
-    int tracker;           /* a position row (else a length) */
+    int tracker;           /* a position row, or another sensor's (else a length) */
+    uint8_t sensor;        /* its rc_sensor_kind (the first sample's of the row) */
     unsigned label_fits;   /* 1 + the outlet label whose place explains the length (a wrong label), 0: none */
     int block;             /* one of three or more out rows in a row (a different session) */
 } rch_screen_row;

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "rch_jw.h"
+#include "rch_sensors.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -251,7 +252,8 @@ static void json_screened(rch_jw *w, const rch_calib_result *r)
             rch_jw_obj(w, NULL);
             rch_jw_str(w, "file", q->file < r->prov.n_files ? r->prov.file[q->file] : "");
             rch_jw_uint(w, "line", q->line);
-            rch_jw_str(w, "sensor", q->tracker ? "tracker" : "cable");
+            const rch_sensor_desc *sd = rch_sensor_of_kind(q->sensor);
+            rch_jw_str(w, "sensor", sd ? sd->name : q->tracker ? "tracker" : "cable");
             rch_jw_numf(w, "residual_mm", q->residual_mm, "%.6g");
             rch_jw_str(w, "likely", rch_screen_kind(q));
             if (q->label_fits)

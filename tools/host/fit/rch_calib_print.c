@@ -652,8 +652,9 @@ void rch_calib_print_screened(FILE *f, const rch_calib_result *r, const char *pr
         char why[64] = "";
         if (w->label_fits)
             snprintf(why, sizeof why, " (its length fits outlet %u)", w->label_fits - 1u);
+        const rch_sensor_desc *sd = rch_sensor_of_kind(w->sensor);
         fprintf(f, "%s%s:%u: left out: %s %.4g mm off (%.0f x its sensor's robust scale %.3g mm): likely %s%s\n", prefix,
-                file, w->line, w->tracker ? "position" : "length", w->residual_mm,
+                file, w->line, sd ? sd->name : w->tracker ? "position" : "length", w->residual_mm,
                 w->scale_mm > 0.0 ? w->residual_mm / w->scale_mm : 0.0, w->scale_mm, rch_screen_kind(w), why);
     }
     if (z->out > z->n_named)

@@ -104,6 +104,7 @@ int rch_calib_screen(rch_calib_result *r, uint8_t *drop, const rc_sample *s, siz
                 w->residual_mm = worst;
                 w->scale_mm = scale[tr];
                 w->tracker = tr;
+                w->sensor = s[i].sensor;
                 w->label_fits = tr ? 0 : other_outlet(fm, &s[i], 3.0 * scale[tr] + RCH_SCREEN_FLOOR_MM,
                                                        r->outlet_label, r->n_outlets);
             }
