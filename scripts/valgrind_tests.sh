@@ -42,7 +42,10 @@
 #                      chains run to their end: 329 s) take the CLI paths the
 #                      golden runs and the *_cli tests here take once; their
 #                      many runs are the sanitizer build's (CI time).
-#                      ik_general and ik_branch (tens of thousands of IK
+#                      robust_inputs_cli (rcal on every malformed input
+#                      file: 83 s under memcheck; the same parsers are fuzzed
+#                      under ASan+UBSan and read under memcheck by the *_cli
+#                      tests). ik_general and ik_branch (tens of thousands of IK
 #                      solves near singularities, 10 s each in Release): the
 #                      sanitizer build's; comp_urscript, comp_krl_conv run
 #                      the IK under memcheck.
@@ -57,7 +60,7 @@ set -u -o pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD_DIR=${BUILD_DIR:-$ROOT/build-valgrind}
-EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|robust_hostile_cli|methods_cli|diag_chain|pkg_limits_define_refused|pkg_limits_link_refused|ik_general|ik_branch)\$}
+EXCLUDE=${VALGRIND_EXCLUDE-^(diag_sim|diag_indep|diag_sensors|drv_e2e|robust_issue23|robust_hostile_cli|robust_inputs_cli|methods_cli|diag_chain|pkg_limits_define_refused|pkg_limits_link_refused|ik_general|ik_branch)\$}
 TMO=${VALGRIND_TIMEOUT:-900}
 CHILDREN=${VALGRIND_CHILDREN:-1}
 JOBS=${JOBS:-1}
