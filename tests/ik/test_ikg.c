@@ -22,6 +22,15 @@
 
 static rch_robot ur, abb;
 
+/* random poses per tool of test_ur_every_branch: under AddressSanitizer a quarter (the sanitizer pass watches
+ * the code paths, the Release ctest keeps the breadth; a branch proved absent runs the scans, 10 x slower
+ * instrumented) */
+#if defined(__SANITIZE_ADDRESS__)
+#define N_EVERY 50
+#else
+#define N_EVERY 200
+#endif
+
 static int setup(void **state)
 {
     (void)state;
@@ -76,7 +85,7 @@ static void test_ur_every_branch(void **state)
         rch_ikg ik;
         assert_int_equal(rch_ikg_init(&ik, &ur.nominal, with_tool ? tool : NULL), RCH_IKG_OK);
         int full = 0;
-        for (int n = 0; n < 200; ++n) {
+        for (int n = 0; n < N_EVERY; ++n) {
             double q[6], p[3], R[9];
             random_q(q, &ur.nominal);
             rch_ikg_fk(p, R, &ik, q);
@@ -115,7 +124,7 @@ static void test_ur_every_branch(void **state)
                 assert_true(fabs(wrapd(qs[i] - q[i])) < 1e-7);
         }
         /* most random poses of a UR-type arm have 8 (the rest 4 or 2) */
-        assert_true(full >= 120);
+        assert_true(full >= N_EVERY * 6 / 10);
     }
 }
 
