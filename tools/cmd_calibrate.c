@@ -27,7 +27,8 @@ static int write_model(const rch_calib_result *r, const char *out_path, int quie
         fprintf(stderr, "rcal calibrate: not writing %s: the model is not finite\n", out_path);
         return 0;
     }
-    if (text ? rch_calib_save_model_text(r, out_path, text, len, &d) != 0 : rch_calib_save_model(r, out_path, &d) != 0) {
+    const int rc = text ? rch_calib_save_model_text(r, out_path, text, len, &d) : rch_calib_save_model(r, out_path, &d);
+    if (rc != 0) {
         fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return -1;
     }

@@ -74,8 +74,9 @@ static void from_model(aim_fig *a, const rep *r, const dfile *df, size_t n_df)
     memset(&dg, 0, sizeof dg);
     /* a run's own model text: parsed as rch_robot_load parses the file (which refuses one over 64 KiB) */
     const char *mt = r->mem ? r->mem->model_text : NULL;
+    const size_t ml = mt ? r->mem->model_len : 0;
     if (!robot || !r->cfg->model_path ||
-        (mt ? r->mem->model_len > ((size_t)1 << 16) || rch_robot_parse(robot, mt, r->mem->model_len, r->cfg->model_path, &dg) != 0
+        (mt ? ml > ((size_t)1 << 16) || rch_robot_parse(robot, mt, ml, r->cfg->model_path, &dg) != 0
             : rch_robot_load(robot, r->cfg->model_path, &dg) != 0)) {
         free(robot);
         return;
