@@ -92,6 +92,11 @@ written report_touch "rmodel3.json r3.calibration.json r3.html"
 # without --out: no model, the page still from memory
 check report_nomodel "robot.json data.csv" --robot robot.json --data data.csv --report r4.html
 written report_nomodel "r4.calibration.json r4.html"
+# the model on stdout (--out -): the page takes its text from memory (it used to try to open a file "-")
+check report_stdout "robot.json data.csv" --robot robot.json --data data.csv --out - --report r5.html
+written report_stdout "r5.calibration.json r5.html"
+grep -q 'rcal-model/2' out_report_stdout && grep -q '<th>model file</th>' r5.html ||
+    { echo "FAIL report_stdout: the model not on stdout or not on the page"; fail=1; }
 # one drawing path: `rcal report` from the files the run wrote draws the page the run drew from memory (but
 # for the report's own command line and date); the poses of the uncompensated figure are the data's, the
 # tracker file's among them (600 cable rows and 60 position rows)
