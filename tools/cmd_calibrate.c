@@ -17,8 +17,9 @@
 #include "rch_opt.h"
 #include "rch_robot.h"
 
-/* Write the calibrated model to out_path (never over an input), after the fit. */
-static int write_model(const rch_calib_result *r, const char *out_path, int quiet)
+/* Write the calibrated model to out_path (never over an input), after the fit; text (may be NULL): its
+ * text kept for --report (heap, *len bytes; NULL when not written). */
+static int write_model(const rch_calib_result *r, const char *out_path, int quiet, char **text, size_t *len)
 {
     rch_diag d;
     char msg[1024];
@@ -26,7 +27,8 @@ static int write_model(const rch_calib_result *r, const char *out_path, int quie
         fprintf(stderr, "rcal calibrate: not writing %s: the model is not finite\n", out_path);
         return 0;
     }
-    if (rch_calib_save_model(r, out_path, &d) != 0) {
+    const int rc = text ? rch_calib_save_model_text(r, out_path, text, len, &d) : rch_calib_save_model(r, out_path, &d);
+    if (rc != 0) {
         fprintf(stderr, "rcal calibrate: %s\n", rch_diag_str(&d, msg, sizeof msg));
         return -1;
     }
@@ -289,23 +291,28 @@ int rcal_cmd_calibrate(int argc, char **argv)
         return ps;
     if (out_is_input(&a))
         return 2;
+    a.cfg.keep_poses = a.report_path != NULL; /* the report's poses from the run's reading, not the files again */
     rch_calib_result *r = malloc(sizeof *r); /* large: two models, the identifiability report */
     rch_diag d;
     char msg[1024];
     const int rc = r ? rch_calib_run(r, &a.cfg, &d) : -1;
     if (rc != 0) {
         fprintf(stderr, "rcal calibrate: %s\n", r ? rch_diag_str(&d, msg, sizeof msg) : "out of memory");
+        if (r)
+            rch_calib_result_free(r);
         free(r);
         return rc == -2 ? 2 : 1;
     }
     int status = r->after_ok ? 0 : 1;
+    char *model_text = NULL; /* the model file's text as written, for --report (never read back) */
+    size_t model_len = 0;
     if (a.cfg.timing)
         rch_calib_timing_print(stderr, &r->timing, "rcal calibrate: ");
     if (r->screen.out) /* named on stderr too, whatever the output's form */
         rch_calib_print_screened(stderr, r, "rcal calibrate: ");
     if (a.json ? rch_calib_json(stdout, r, argc, argv) != 0 : (rch_calib_print(stdout, r), 0))
         status = 1;
-    else if (a.out_path && write_model(r, a.out_path, a.json) != 0)
+    else if (a.out_path && write_model(r, a.out_path, a.json, a.report_path ? &model_text : NULL, &model_len) != 0)
         status = 1;
     else if (a.report_path && r->finite) {
         const char *inputs[2 * RCH_OPT_MAX_STRS + 3] = {a.cfg.robot_path, a.cfg.truth_path, a.cfg.validate_path};
@@ -313,14 +320,16 @@ int rcal_cmd_calibrate(int argc, char **argv)
             inputs[3 + i] = a.data.v[i];
         for (size_t i = 0; i < a.positions.n; ++i)
             inputs[3 + a.data.n + i] = a.positions.v[i];
-        if (rch_report_inline(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, inputs,
-                               3 + a.data.n + a.positions.n, a.json) != 0)
+        if (rch_report_inline_model(a.report_path, r, NULL, argc, argv, r->finite ? a.out_path : NULL, model_text,
+                                    model_len, inputs, 3 + a.data.n + a.positions.n, a.json) != 0)
             status = 1;
     }
     if (a.cfg.residuals_path && !r->finite)
         fprintf(stderr, "rcal calibrate: not writing %s: the model is not finite\n", a.cfg.residuals_path);
     else if (!a.json && status == 0 && a.cfg.residuals_path)
         printf("per-sample residuals written to %s\n", a.cfg.residuals_path);
+    free(model_text);
+    rch_calib_result_free(r);
     free(r);
     return status;
 }

@@ -546,6 +546,9 @@ static int stage_read(void *vrun, rch_calib_result *r, rch_diag *d)
         return -1;
     }
     take_inputs(r, run->in);
+    r->read_q = run->in->read_q; /* the result's own from here (rch_calib_result_free) */
+    memcpy(r->read_n, run->in->read_n, sizeof r->read_n);
+    run->in->read_q = NULL;
     return 0;
 }
 
@@ -645,4 +648,10 @@ int rch_calib_run(rch_calib_result *r, const rch_calib_cfg *cfg, rch_diag *d)
     }
     free(run);
     return rc;
+}
+
+void rch_calib_result_free(rch_calib_result *r)
+{
+    free(r->read_q);
+    r->read_q = NULL;
 }

@@ -218,6 +218,9 @@ typedef struct rch_calib_result {
     unsigned n_groups;        /* set-up groups of the data (file column, else from the wrist) */
     int groups_from_file;
     rch_provenance prov;      /* data file, samples, sha256, date, tool */
+    double (*read_q)[RC_NJ];  /* with cfg.keep_poses: each data file's poses as read (rch_inputs.read_q; heap:
+                                 rch_calib_result_free), else NULL */
+    size_t read_n[RCH_PROV_MAX_FILES]; /* (prov.n_files) poses of each in read_q */
     int have_dequant;
     rch_dequant_result dequant;   /* with cfg.dequantize */
     unsigned dequant_refused_lines[16]; /* first refused rows (file lines) */
@@ -286,5 +289,10 @@ int rch_calib_write_model(FILE *f, const rch_calib_result *r);
 /* rch_calib_write_model into path, whole or not at all (rch_save), never over
  * one of the inputs (--data, --robot, --truth). 0, or -1 with d set. */
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d);
+/* The same, the text written also handed back (*text: heap, the caller frees; *len bytes) for a reader in this
+ * process (--report), which then never opens the file written. 0, or -1 with d set (*text NULL). */
+int rch_calib_save_model_text(const rch_calib_result *r, const char *path, char **text, size_t *len, rch_diag *d);
+/* What the result holds on the heap (read_q, with cfg.keep_poses); the result itself is the caller's. */
+void rch_calib_result_free(rch_calib_result *r);
 
 #endif

@@ -50,6 +50,8 @@ typedef struct rch_calib_cfg {
     int have_tracker_start; /* tracker_start is the tracker frame's start (else closed form) */
     double tracker_start[6]; /* T (mm) and the rotation vector (rad) of the base in the tracker's frame */
     int no_screen;          /* 1: every row fitted, none screened out (rch_calib_screen.c) */
+    int keep_poses;         /* 1: the result keeps each data file's poses as read (rch_calib_result.read_q, for
+                               --report's figures; freed by rch_calib_result_free) */
     int timing;             /* 1: the JSON carries the plan's timing record ("timing": each stage's time) */
     const char *data_text;  /* the one data file's rows in memory (CSV, data_text_len bytes; the Python
                                library's arrays): data_path only names them, nothing is read from disk */

@@ -11,6 +11,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "rch_jw.h"
 #include "rch_save.h"
@@ -53,8 +54,26 @@ static int write_model_fn(FILE *f, const void *ctx)
     return rch_calib_write_model(f, ctx);
 }
 
+/* rch_save's writer of a text in memory. */
+typedef struct {
+    const char *text;
+    size_t len;
+} mem_text;
+static int write_text_fn(FILE *f, const void *ctx)
+{
+    const mem_text *t = ctx;
+    return fwrite(t->text, 1, t->len, f) == t->len ? 0 : -1;
+}
+
 int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *d)
 {
+    return rch_calib_save_model_text(r, path, NULL, NULL, d);
+}
+
+int rch_calib_save_model_text(const rch_calib_result *r, const char *path, char **text, size_t *len, rch_diag *d)
+{
+    if (text)
+        *text = NULL;
     if (r->jumps_found && !r->cfg.jumps && !r->jumps_auto) {
         char counts[200];
         rch_calib_jump_counts(counts, sizeof counts, r);
@@ -96,5 +115,24 @@ int rch_calib_save_model(const rch_calib_result *r, const char *path, rch_diag *
         inputs[n++] = rch_calib_cfg_file(&r->cfg, f);
     for (size_t f = 0; f < r->cfg.n_positions_paths && f < RCH_CALIB_MAX_FILES; ++f)
         inputs[n++] = r->cfg.positions_paths[f];
-    return rch_save(path, "--out", inputs, n, write_model_fn, r, d);
+    if (!text)
+        return rch_save(path, "--out", inputs, n, write_model_fn, r, d);
+    /* the text made once in memory, written from there: the reader in this process takes the same bytes */
+    char *buf = NULL;
+    size_t blen = 0;
+    FILE *m = open_memstream(&buf, &blen);
+    const int wr = m ? rch_calib_write_model(m, r) : -1;
+    if (!m || fclose(m) != 0 || wr != 0) {
+        free(buf);
+        rch_diag_set(d, path, 0, 0, "--out: the model could not be made in memory (out of memory, or not finite)");
+        return -1;
+    }
+    const mem_text t = {buf, blen};
+    if (rch_save(path, "--out", inputs, n, write_text_fn, &t, d) != 0) {
+        free(buf);
+        return -1;
+    }
+    *text = buf;
+    *len = blen;
+    return 0;
 }

@@ -174,6 +174,25 @@ static void provenance(rch_inputs *in, const rch_calib_cfg *cfg)
     p->tool = "rcal " RC_VERSION_STRING;
 }
 
+/* With cfg->keep_poses: the joints of n rows (stride: samples a row) of
+ * provenance file f appended to in->read_q. 0, or -1 with d set. */
+static int keep_poses(rch_inputs *in, unsigned f, const rc_sample *s, size_t n, size_t stride, rch_diag *d)
+{
+    size_t have = 0;
+    for (unsigned g = 0; g < f; ++g)
+        have += in->read_n[g];
+    double(*q)[RC_NJ] = realloc(in->read_q, (have + n + 1) * sizeof *q);
+    if (!q) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        return -1;
+    }
+    in->read_q = q;
+    for (size_t i = 0; i < n; ++i)
+        memcpy(q[have + i], s[i * stride].q_rad, sizeof *q);
+    in->read_n[f] = n;
+    return 0;
+}
+
 /* The tracker positions files (cfg.positions_paths) appended to data: three
  * samples a row (rch_positions.h), one set-up group a file, the tracker
  * frame and targets added to the model. 0, or -1 with d set. */
@@ -234,6 +253,15 @@ static int append_positions(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *
             memcpy(pv->sha256[pv->n_files], p.sha256[f], sizeof pv->sha256[0]);
         else
             snprintf(pv->sha256[pv->n_files], sizeof pv->sha256[0], "unknown");
+        if (cfg->keep_poses) { /* the file's rows: three samples each, in file order */
+            size_t first = 0;
+            while (first < p.n && p.file[first] != f)
+                ++first;
+            if (keep_poses(in, pv->n_files, p.s + first, c / 3, 3, d) != 0) {
+                rch_pos_free(&p);
+                return -1;
+            }
+        }
         pv->n_files++;
     }
     rch_pos_free(&p);
@@ -411,6 +439,13 @@ int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
         memset(&out->data, 0, sizeof out->data); /* (joints within the robot's limits) the readers keep nothing */
         return -1;
     }
+    /* the cable files' rows as parsed (a sensor file's none: its rows are no pose of the report's figures) */
+    for (size_t f = 0, i = 0; cfg->keep_poses && f < out->n_files && f < RCH_PROV_MAX_FILES; i += out->counts[f++])
+        if (keep_poses(out, (unsigned)f, out->data.s + i,
+                       out->counts[f] && out->data.s[i].sensor == RC_SENSOR_LENGTH ? out->counts[f] : 0, 1, d) != 0) {
+            rch_inputs_free(out);
+            return -1;
+        }
     /* the validation file, read here once (within the robot's limits); only a fitted model reads its rows */
     if (cfg->validate_path && rch_data_load_limited(&out->validate, cfg->validate_path, 0, &out->robot.model, d) != 0) {
         memset(&out->validate, 0, sizeof out->validate);
@@ -446,4 +481,6 @@ void rch_inputs_free(rch_inputs *in)
     rch_data_free(&in->validate);
     free(in->file_of);
     in->file_of = NULL;
+    free(in->read_q);
+    in->read_q = NULL;
 }

@@ -75,6 +75,9 @@ typedef struct rch_inputs {
     int have_dequant;       /* the joints were dequantized (forced or automatic) */
     rch_dequant_result dequant;
     unsigned dequant_refused_lines[16]; /* first refused rows (file lines) */
+    double (*read_q)[RC_NJ]; /* with cfg->keep_poses: every data file's rows' joints as parsed (rad, one a row,
+                                before any is dequantized or dropped), the files in provenance order; else NULL */
+    size_t read_n[RCH_PROV_MAX_FILES]; /* (prov.n_files) rows of each in read_q (0: a sensor file, no pose read) */
     rch_data validate;      /* cfg->validate_path's rows as read (labels as in the file), else empty */
 } rch_inputs;
 

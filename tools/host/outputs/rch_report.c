@@ -63,8 +63,9 @@ static int job_load(job *j, rep *r, const rch_report_cfg *cfg, rch_diag *d)
     if (cfg->diag_path && !(j->diag = load_kind(cfg->diag_path, cfg->diag_text, cfg->diag_len, "--diagnosis", "candidates",
                                                 "the output of rcal diagnose --json", d)))
         return -1;
-    if (cfg->model_path &&
-        !(j->model = load_kind(cfg->model_path, NULL, 0, "--model", "dh", "a model file (rcal-model/1 or /2)", d)))
+    const char *mt = r->mem ? r->mem->model_text : NULL;
+    if (cfg->model_path && !(j->model = load_kind(cfg->model_path, mt, mt ? r->mem->model_len : 0, "--model", "dh",
+                                                  "a model file (rcal-model/1 or /2)", d)))
         return -1;
     r->cal = j->cal;
     r->diag = j->diag;
@@ -155,6 +156,11 @@ static void job_write(job *j, rep *r, const char *date)
 
 int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag *d)
 {
+    return rch_report_write_mem(res, cfg, NULL, d);
+}
+
+int rch_report_write_mem(rch_report_result *res, const rch_report_cfg *cfg, const rch_report_mem *mem, rch_diag *d)
+{
     memset(res, 0, sizeof *res);
     if (!cfg || !cfg->cal_path || !cfg->out_path) {
         rch_diag_set(d, "", 0, 0, "report: --calibration and --out are required");
@@ -182,6 +188,7 @@ int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag
         return -1;
     }
     r->cfg = cfg;
+    r->mem = mem;
     r->res = res;
     if (job_load(&j, r, cfg, d) != 0 || job_open(&j, r, cfg, d) != 0)
         goto done;

@@ -77,6 +77,31 @@ typedef struct {
  * what its option says, an output that names an input, a write failure). */
 int rch_report_write(rch_report_result *res, const rch_report_cfg *cfg, rch_diag *d);
 
+/* One data file of a run in this process, as the run read it: its digest
+ * and its rows' joints (rad, one pose a row; NULL with n 0: a file whose
+ * rows are no poses, a sensor's). */
+typedef struct {
+    const char *file;         /* as the run's provenance names it */
+    const char *sha256;       /* hex digest of the bytes the run read */
+    const double (*q_rad)[6]; /* (n) */
+    size_t n;
+} rch_report_data;
+
+/* What a run in this process hands its own report (rch_report_inline), so
+ * that the report opens none of its inputs: the model file's text as the
+ * run wrote it (cfg->model_path only names it) and the data files
+ * (data[k] is the k-th data file of the calibration's provenance). The
+ * page drawn is the one rch_report_write draws from the files. */
+typedef struct {
+    const char *model_text; /* or NULL: cfg->model_path read (when given) */
+    size_t model_len;
+    const rch_report_data *data; /* (n_data) or NULL: each data file hashed and read as it is now */
+    size_t n_data;
+} rch_report_mem;
+
+/* rch_report_write with the inputs in memory (mem may be NULL: the same as rch_report_write). */
+int rch_report_write_mem(rch_report_result *res, const rch_report_cfg *cfg, const rch_report_mem *mem, rch_diag *d);
+
 /* The plot-data file `name` of page: the page's path without .html/.htm,
  * then "_<name>.csv" (x.html, "params" -> x_params.csv). 0, or -1 when it
  * does not fit in cap. */
@@ -100,6 +125,13 @@ struct rch_diagnose_result;
 int rch_report_inline(const char *html, const struct rch_calib_result *cal, const struct rch_diagnose_result *diag,
                       int argc, char **argv, const char *model, const char *const *inputs, size_t n_inputs,
                       int quiet);
+/* The same with the model file's text as the run wrote it (model_text, model_len; NULL: model is read):
+ * calibrate --report, which then opens none of its inputs or outputs again (the data files as the run
+ * read them: cal->read_q with cfg.keep_poses). */
+int rch_report_inline_model(const char *html, const struct rch_calib_result *cal,
+                            const struct rch_diagnose_result *diag, int argc, char **argv, const char *model,
+                            const char *model_text, size_t model_len, const char *const *inputs, size_t n_inputs,
+                            int quiet);
 
 /* Every file --report HTML writes besides the page (its JSON, the plot
  * data), for the check that a command's outputs never name each other

@@ -43,8 +43,11 @@ static size_t data_poses(double (**q)[RC_NJ], const dfile *df, size_t n_df)
         rch_data d;
         rch_diag dg;
         memset(&dg, 0, sizeof dg);
-        if (rch_data_load(&d, df[i].file, 0, &dg) != 0 &&
-            rch_data_load(&d, df[i].file, RCH_DATA_POSITIONS, &dg) != 0)
+        memset(&d, 0, sizeof d);
+        if (df[i].mem) { /* the run's own reading: its rows' joints */
+            d.n = df[i].mem->n;
+        } else if (rch_data_load(&d, df[i].file, 0, &dg) != 0 &&
+                   rch_data_load(&d, df[i].file, RCH_DATA_POSITIONS | RCH_DATA_NO_LEN, &dg) != 0)
             continue;
         for (size_t k = 0; k < d.n && n < AIM_MAX_POSES; ++k) {
             if (n == cap) {
@@ -55,9 +58,10 @@ static size_t data_poses(double (**q)[RC_NJ], const dfile *df, size_t n_df)
                 *q = t;
                 cap = nc;
             }
-            memcpy((*q)[n++], d.s[k].q_rad, sizeof **q);
+            memcpy((*q)[n++], df[i].mem ? df[i].mem->q_rad[k] : d.s[k].q_rad, sizeof **q);
         }
-        rch_data_free(&d);
+        if (!df[i].mem)
+            rch_data_free(&d);
     }
     return n;
 }
@@ -68,7 +72,12 @@ static void from_model(aim_fig *a, const rep *r, const dfile *df, size_t n_df)
     rch_robot *robot = calloc(1, sizeof *robot);
     rch_diag dg;
     memset(&dg, 0, sizeof dg);
-    if (!robot || !r->cfg->model_path || rch_robot_load(robot, r->cfg->model_path, &dg) != 0) {
+    /* a run's own model text: parsed as rch_robot_load parses the file (which refuses one over 64 KiB) */
+    const char *mt = r->mem ? r->mem->model_text : NULL;
+    const size_t ml = mt ? r->mem->model_len : 0;
+    if (!robot || !r->cfg->model_path ||
+        (mt ? ml > ((size_t)1 << 16) || rch_robot_parse(robot, mt, ml, r->cfg->model_path, &dg) != 0
+            : rch_robot_load(robot, r->cfg->model_path, &dg) != 0)) {
         free(robot);
         return;
     }

@@ -361,7 +361,8 @@ void rch_rep_sec_warnings(rep *r)
     r->res->n_warnings = r->n_warn;
 }
 
-static void input_row(rep *r, const char *what, const char *path, const rch_json *j)
+/* text (len): the input in memory (a run's own, never read back), else NULL: hashed from path. */
+static void input_row(rep *r, const char *what, const char *path, const rch_json *j, const char *text, size_t len)
 {
     char hex[65];
     if (!path)
@@ -372,7 +373,14 @@ static void input_row(rep *r, const char *what, const char *path, const rch_json
     fputs("</span>, format ", r->f);
     rch_rep_put_str(r, jstr(j, "format"));
     fputs(", SHA-256 <span class=\"mono\">", r->f);
-    fputs(rch_sha256_file(hex, path) == 0 ? hex : "?", r->f);
+    if (text) {
+        rch_sha256 c;
+        rch_sha256_init(&c);
+        rch_sha256_update(&c, text, len);
+        rch_sha256_final(&c, hex);
+        fputs(hex, r->f);
+    } else
+        fputs(rch_sha256_file(hex, path) == 0 ? hex : "?", r->f);
     fputs("</span>", r->f);
     rch_rep_kv_end(r);
 }
@@ -405,9 +413,11 @@ void rch_rep_sec_provenance(rep *r, const dfile *df, size_t n_df, const char *da
     }
     if (r->prov)
         fprintf(f, "<tr><th></th><td class=\"note\">provenance %s</td></tr>\n", r->prov_from);
-    input_row(r, "calibration", r->cfg->cal_path, r->cal);
-    input_row(r, "diagnosis", r->cfg->diag_path, r->diag);
-    input_row(r, "model file", r->cfg->model_path, r->model);
+    const rch_report_cfg *cfg = r->cfg;
+    input_row(r, "calibration", cfg->cal_path, r->cal, cfg->cal_text, cfg->cal_len);
+    input_row(r, "diagnosis", cfg->diag_path, r->diag, cfg->diag_text, cfg->diag_len);
+    input_row(r, "model file", cfg->model_path, r->model, r->mem ? r->mem->model_text : NULL,
+              r->mem ? r->mem->model_len : 0);
     rch_rep_kv(r, "this report");
     fputs("<span class=\"mono\">", f);
     rch_rep_put_esc(f, r->cfg->command_line ? r->cfg->command_line : "rcal report");

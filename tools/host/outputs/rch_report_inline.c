@@ -4,6 +4,11 @@
  * rch_report_inline): the run's JSON made in memory, kept beside the page
  * and handed to rch_report_write as text, not written and read back.
  *
+ * The model file the run wrote (its text kept by rch_calib_save_model_text)
+ * and the data files as the run read them (their digests and poses:
+ * rch_calib_result.read_q) go to the page in memory too (rch_report_mem):
+ * with them no input and no output of the run is opened again.
+ *
  * Depends on: rch_calib (its JSON), rch_diagnose (its JSON), rch_save,
  * rch_report. Memory: the JSON texts freed before returning. Errors: 1 with
  * the message on stderr.
@@ -79,6 +84,33 @@ int rch_report_inline(const char *html, const struct rch_calib_result *cal, cons
                       int argc, char **argv, const char *model, const char *const *inputs, size_t n_inputs,
                       int quiet)
 {
+    return rch_report_inline_model(html, cal, diag, argc, argv, model, NULL, 0, inputs, n_inputs, quiet);
+}
+
+/* The run's data files as it read them (cal->read_q, cfg.keep_poses) into data (one per provenance file);
+ * the count, 0 when the run kept none (the report then reads the files). */
+static size_t run_data(rch_report_data data[RCH_PROV_MAX_FILES], const rch_calib_result *cal)
+{
+    if (!cal->read_q)
+        return 0;
+    size_t at = 0;
+    const unsigned n = cal->prov.n_files < RCH_PROV_MAX_FILES ? cal->prov.n_files : RCH_PROV_MAX_FILES;
+    for (unsigned f = 0; f < n; ++f) {
+        const char *sha = cal->prov.sha256[f];
+        data[f].file = cal->prov.file[f];
+        data[f].sha256 = strlen(sha) == 64 ? sha : NULL; /* "unknown": the file read as it is now */
+        data[f].q_rad = (const double(*)[6])(cal->read_q + at);
+        data[f].n = cal->read_n[f];
+        at += cal->read_n[f];
+    }
+    return n;
+}
+
+int rch_report_inline_model(const char *html, const struct rch_calib_result *cal,
+                            const struct rch_diagnose_result *diag, int argc, char **argv, const char *model,
+                            const char *model_text, size_t model_len, const char *const *inputs, size_t n_inputs,
+                            int quiet)
+{
     char cal_path[1100], diag_path[1100], msg[1024];
     rch_diag d;
     memset(&d, 0, sizeof d);
@@ -103,11 +135,13 @@ int rch_report_inline(const char *html, const struct rch_calib_result *cal, cons
     }
     const mem_text cal_t = {ct, cl}, diag_t = {dt, dl};
     rch_report_cfg cfg = {cal_path, diag ? diag_path : NULL, model, html, NULL, NULL, 0.0, ct, dt, cl, dl};
+    rch_report_data data[RCH_PROV_MAX_FILES];
+    const rch_report_mem mem = {model_text, model_len, data, run_data(data, cal)};
     rch_report_result res;
     int rc = 0;
     if (rch_save(cal_path, "--report (its calibration JSON)", ins, n_ins, text_cb, &cal_t, &d) != 0 ||
         (diag && rch_save(diag_path, "--report (its diagnosis JSON)", ins, n_ins, text_cb, &diag_t, &d) != 0) ||
-        rch_report_write(&res, &cfg, &d) != 0) {
+        rch_report_write_mem(&res, &cfg, &mem, &d) != 0) {
         fprintf(stderr, "rcal: --report: %s\n", rch_diag_str(&d, msg, sizeof msg));
         rc = 1;
     }

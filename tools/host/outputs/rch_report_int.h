@@ -77,6 +77,7 @@ typedef struct {
     const rch_json *prov; /* provenance block: likewise */
     const char *unc_from, *prov_from;
     const rch_report_cfg *cfg;
+    const rch_report_mem *mem; /* the inputs a run in this process hands over, or NULL (read from the files) */
     rch_report_result *res;
     char warn[RCH_REPORT_MAX_WARN][640];
     unsigned n_warn;
@@ -148,6 +149,7 @@ typedef struct {
     double samples;
     char sha_now[65];           /* "" when the file cannot be read from here */
     char why[96];               /* why not (a FIFO, a device, too large, ...) */
+    const rch_report_data *mem; /* the run's own reading of it (rch_report_mem), or NULL: the file as it is now */
 } dfile;
 
 /* The calibration's parameters (n rows, heap; NULL with *n 0 when none). */

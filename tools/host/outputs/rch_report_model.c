@@ -209,10 +209,17 @@ size_t rch_rep_data_files(const rep *r, dfile out[MAX_DFILES])
         out[0].samples = jnum(r->cal, "n_train") + jnum(r->cal, "n_test");
         n = 1;
     }
+    /* a run in this process: the digest of the bytes it read (data[i] is the provenance's i-th file) */
+    for (size_t i = 0; r->mem && r->mem->data && i < n; ++i)
+        if (i < r->mem->n_data && r->mem->data[i].file && strcmp(r->mem->data[i].file, out[i].file) == 0 &&
+            r->mem->data[i].sha256)
+            out[i].mem = &r->mem->data[i];
     /* names found in the file, not given by the user: a regular file below
      * the size limit only (never a FIFO or /dev/zero, which never end) */
     for (size_t i = 0; i < n; ++i)
-        if (rch_sha256_file_unasked(out[i].sha_now, out[i].file, RCH_UNASKED_MAX_BYTES, out[i].why,
+        if (out[i].mem)
+            snprintf(out[i].sha_now, sizeof out[i].sha_now, "%s", out[i].mem->sha256);
+        else if (rch_sha256_file_unasked(out[i].sha_now, out[i].file, RCH_UNASKED_MAX_BYTES, out[i].why,
                                     sizeof out[i].why) != 0)
             out[i].sha_now[0] = '\0';
     return n;
