@@ -551,25 +551,41 @@ UNSEEN = re.compile(r"determin|unseen|not seen|identif|observ|rank|degenera", re
 
 
 def plan_args(case, rng, gauge):
-    """What a user tells `rcal poses` of the cell: each TRUE plate's centre moved by up to 3 mm per axis, its normal
-    turned by up to 2 deg, its usable diameter 10 mm inside its side; the probe's drawing off by up to 2 mm; the
-    gauge block's place on plate 0 off by up to 3 mm. The planner never sees the truth itself."""
+    """What a user tells `rcal poses` of the cell, taught with the robot: the probe's drawing off by up to 2 mm;
+    for each plate the touches already drawn on it (this script's own, on the TRUE robot) seen through the
+    NOMINAL robot and that probe: the plane through those points (the normal on the side the TRUE one faces, as
+    a user knows it), its point the taught touch nearest the face's centre, its usable diameter 20 mm inside the
+    side; the gauge block's place the same way from the touches of its top, less its height. The truth's own
+    numbers never reach the planner."""
+    nom = ts.nominal_robot(case["name"])
+    tip = case["tip"] + rng.uniform(-2, 2, 3)
+    taught = {}
+    for q, j, _ in case["rows"]:
+        taught.setdefault(j, []).append(nom.point(q, tip))
+    told = {}
+    for j, pl in enumerate(case["plates"]):
+        P = np.array(taught[j])
+        m = P.mean(axis=0)
+        n = np.linalg.svd(P - m)[2][2]
+        n = n if n @ pl["n"] > 0 else -n
+        # the touch the user made nearest the face's middle (where it landed on the TRUE face)
+        k = int(np.argmin([np.linalg.norm(case["truth"].point(q, case["tip"]) - pl["c"])
+                           for q, jj, _ in case["rows"] if jj == j]))
+        c = P[k] - ((P[k] - m) @ n) * n
+        told[j] = (c, n)
     args = []
-    for pl in case["plates"]:
+    for j, pl in enumerate(case["plates"]):
         if pl["kind"] == "gauge":
             continue
-        c = pl["c"] + rng.uniform(-3, 3, 3)
-        u, v = pl["u"], pl["v"]
-        ang, az = rng.uniform(0, 2) * DEG, rng.uniform(0, 2 * np.pi)
-        n = np.cos(ang) * pl["n"] + np.sin(ang) * (np.cos(az) * u + np.sin(az) * v)
-        args += ["--plate", ",".join("%.3f" % x for x in list(c) + list(n) + [pl["side"] - 10.0])]
-    tip = case["tip"] + rng.uniform(-2, 2, 3)
+        c, n = told[j]
+        args += ["--plate", ",".join("%.3f" % x for x in list(c) + list(n) + [pl["side"] - 20.0])]
     args += ["--tool", ",".join("%.3f" % x for x in tip)]
-    for pl in case["plates"]:
+    for j, pl in enumerate(case["plates"]):
         if pl["kind"] == "gauge":
-            at = pl["c"] - gauge * pl["n"] + rng.uniform(-3, 3, 3)
-            args += ["--gauge-mm", "%g" % gauge, "--gauge-plate", "0", "--gauge-at",
-                     ",".join("%.3f" % x for x in at), "--gauge-size-mm", "%g" % (pl["side"] - 10.0)]
+            c, n = told[j]
+            at = c - gauge * told[pl["of"]][1]
+            args += ["--gauge-mm", "%g" % gauge, "--gauge-plate", "%d" % pl["of"], "--gauge-at",
+                     ",".join("%.3f" % x for x in at), "--gauge-size-mm", "%g" % (pl["side"] - 20.0)]
     return args
 
 
@@ -617,7 +633,7 @@ def one_case(a, k, name, tmp, planned=False):
         plan = os.path.join(cdir, "plan.csv")
         n_total = len(rows)
         cmd = [a.rcal, "poses", "--robot", robot, "--count", str(n_total), "--out", plan, "--seed", str(k + 1)]
-        cmd += plan_args(case, np.random.default_rng([a.seed, k, 5]), a.gauge)
+        cmd += plan_args(case, np.random.default_rng([a.seed, k, 5]), a.gauge) + a.plan_args.split()
         rc, out, err = ts.run(cmd)
         if rc != 0:
             return {"case": k, "robot": name, "planes": len(case["plates"]), "rows": 0, "noise_mm": case["noise_sd"],
@@ -770,6 +786,8 @@ def main():
                     help="per case N random touches (spread evenly over the plates) against N planned by `rcal poses "
                          "--plate ...` from the cell's approximate placements, touched on the TRUE robot; with --check "
                          "the planned runs' median compensated pair median must be the lower")
+    ap.add_argument("--plan-args", default="", metavar="'OPTS'",
+                    help="with --compare-plan: further options of rcal poses (e.g. '--cone-deg 40')")
     a = ap.parse_args()
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
     if a.planes < 0 or a.planes > 16:
