@@ -262,6 +262,11 @@ static void print_plan(const rch_poses_touch_result *res, const touch_args *a, i
     printf("    random, same count: median %.4f mm, 95th percentile %.4f mm (fewest on a plate: %zu)\n",
            res->random.median_mm, res->random.p95_mm, res->random_per_plate_min);
     printf("  joint travel: %.0f deg before ordering, %.0f deg after\n", res->travel.before_deg, res->travel.after_deg);
+    if (res->n < res->nf + RCH_POSES_ROWS_SPARE)
+        printf("  WARNING: %zu touches for about %u parameters calibrate fits: it estimates the noise from the "
+               "residuals and needs at least %u, else the fit follows the noise (measured: 60 touches on 3 plates "
+               "and a gauge no better than random ones, 100 better; docs/touches.md); next: raise --count\n",
+               res->n, res->nf, res->nf + RCH_POSES_ROWS_SPARE);
     printf("  record them: drive each row's joints, approach along the plate's normal until the probe triggers, and "
            "write the triggered joints in the row (docs/touches.md)\n");
 }
