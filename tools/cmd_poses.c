@@ -609,12 +609,13 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
     return 0;
 }
 
-/* The touch sensor's plan (cmd_poses_touch.c): --plate given, or --sensor touch. */
+/* The touch sensor's plan (cmd_poses_touch.c): --plate given, or --sensor touch (either spelling). */
 static int wants_touch(int argc, char **argv)
 {
     for (int i = 1; i < argc; ++i)
-        if (strcmp(argv[i], "--plate") == 0 || (strcmp(argv[i], "--sensor") == 0 && i + 1 < argc &&
-                                                strcmp(argv[i + 1], "touch") == 0))
+        if (strcmp(argv[i], "--plate") == 0 || strncmp(argv[i], "--plate=", 8) == 0 ||
+            strcmp(argv[i], "--sensor=touch") == 0 ||
+            (strcmp(argv[i], "--sensor") == 0 && i + 1 < argc && strcmp(argv[i + 1], "touch") == 0))
             return 1;
     return 0;
 }

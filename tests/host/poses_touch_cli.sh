@@ -36,6 +36,8 @@ refused "--gauge-plate 4: only 3 --plate given" --plate $P0 --plate $P1 --plate 
 refused "give its --gauge-mm" --plate $P0 --plate $P1 --plate $P2 --gauge-plate 1
 refused "--sensor cable takes no --plate" --sensor cable --plate $P0
 refused "(plate 1): size 15 mm" --plate $P0 --plate 465,0,375,-1,0,0,15 --plate $P2
+refused "--plate is required" --sensor=touch
+refused "(plate 0): the normal" --plate=1,2,3,0,0,0
 # a good plan: the skeleton, read back by calibrate's touch reader (rows valid: joints within limits, plates)
 "$rcal" poses --robot "$robot" --count 30 --candidates 800 --out "$work/plan.csv" --tool 10,-5,150 --plate $P0 \
     --plate $P1 --plate $P2 --gauge-mm 50 --gauge-at 375,30,60 --json > "$work/plan.json" 2> "$work/err" || {
