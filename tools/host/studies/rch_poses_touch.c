@@ -310,7 +310,8 @@ static int touch_candidates(touch_work *w, rch_poses_touch_result *res, const rc
     const double cmin = cos(c->cone_deg * DEG_);
     size_t per_group[RCH_TOUCH_MAX_PLATES + 1] = {0};
     w->n_cand = 0;
-    while (w->n_cand < want && res->n_tried < 50 * want) {
+    size_t draws = 0; /* a plate whose disc the block covers draws nothing: bounded here */
+    while (w->n_cand < want && res->n_tried < 50 * want && ++draws < 200 * want) {
         unsigned gr = rc_rng_below(&g, w->np);
         if (c->gauge_mm > 0.0 && rc_rng_u01(&g) < c->gauge_share)
             gr = w->np;
