@@ -40,7 +40,8 @@ static const char details[] =
     "plan). The design cost grows as N^2 (progress on stderr). The rows are then ordered for joint travel\n"
     "(--order travel): per outlet a tour from home (nearest neighbour, 2-opt), a joint with a range over 360 deg\n"
     "on the branch (q +- 360, within the limits less --margin-deg) that shortens it; the travel before and after\n"
-    "is printed (the sum over moves of the largest joint move, deg).";
+    "is printed (the sum over moves of the largest joint move, deg).\n"
+    "--plate X,Y,Z,NX,NY,NZ[,SIZE] or --sensor touch: plan a touch run instead (rcal poses --sensor touch --help).";
 
 static int parse_places(double (*out)[3], unsigned *n, const rch_opt_strs *v, const char *name)
 {
@@ -436,6 +437,7 @@ typedef struct poses_args {
     unsigned long n, seed, n_cand, passes, choose;
     double max_minutes, settle_s;
     const char *link; /* --controller of a link program */
+    const char *sensor; /* --sensor: cable here (touch: cmd_poses_touch.c) */
     double enc[3], tool[3];
     rch_poses_config pc;
     rch_opt_strs outlets, cands, cable_points;
@@ -505,6 +507,7 @@ static int parse(poses_args *a, int argc, char **argv)
     a->enc[2] = 10.0;
     a->settle_s = 5.0;
     a->link = "tcp:127.0.0.1:5150";
+    a->sensor = "cable";
     pc->len_min_mm = 250;
     pc->len_max_mm = 800;
     pc->margin_deg = 5;
@@ -558,6 +561,8 @@ static int parse(poses_args *a, int argc, char **argv)
          "refuse a plan estimated longer (the estimate is printed before the work when over 10 s)", 0, NULL},
         {"--json", RCH_OPT_FLAG, &a->json, 0, 0, NULL, "what was planned and written, as one JSON object on stdout", 0,
          NULL},
+        {"--sensor", RCH_OPT_CHOICE, &a->sensor, 0, 0, NULL, "the sensor planned for (touch: plate touches, --plate)",
+         0, "cable|touch"},
     };
     const int st = rch_opt_cmd(&spec, "poses", summary, details, opts, RCH_OPT_COUNT(opts), argc, argv, &seen);
     if (st >= 0)
@@ -604,9 +609,22 @@ static int finish(rch_out *out, const rch_poses_result *res, const poses_args *a
     return 0;
 }
 
+/* The touch sensor's plan (cmd_poses_touch.c): --plate given, or --sensor touch (either spelling). */
+static int wants_touch(int argc, char **argv)
+{
+    for (int i = 1; i < argc; ++i)
+        if (strcmp(argv[i], "--plate") == 0 || strncmp(argv[i], "--plate=", 8) == 0 ||
+            strcmp(argv[i], "--sensor=touch") == 0 ||
+            (strcmp(argv[i], "--sensor") == 0 && i + 1 < argc && strcmp(argv[i + 1], "touch") == 0))
+            return 1;
+    return 0;
+}
+
 int rcal_cmd_poses(int argc, char **argv)
 {
     poses_args a;
+    if (wants_touch(argc, argv))
+        return rcal_cmd_poses_touch(argc, argv);
     rch_poses_config *pc = &a.pc;
     rch_poses_result res;
     rch_poses_choice *ch = NULL;

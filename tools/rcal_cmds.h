@@ -16,6 +16,7 @@ int rcal_cmd_compare(int argc, char **argv);    /* issue 3 */
 int rcal_cmd_chaos(int argc, char **argv);      /* issue 3 */
 int rcal_cmd_acquire(int argc, char **argv);    /* issue 4 */
 int rcal_cmd_poses(int argc, char **argv);      /* issue 4 */
+int rcal_cmd_poses_touch(int argc, char **argv); /* issue 50: rcal poses --plate (cmd_poses_touch.c) */
 int rcal_cmd_compensate(int argc, char **argv); /* issue 5 */
 int rcal_cmd_grind(int argc, char **argv);      /* issue 5 */
 int rcal_cmd_diagnose(int argc, char **argv);   /* issue 6 */

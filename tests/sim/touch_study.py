@@ -20,13 +20,19 @@ best-fit scale (touches measure no length: the robot's scale is the prior's; doc
     python3 touch_study.py RCAL [--seed S] [--cases N] [--robot irb120|irb1600] [--one-plate]
                            [--planes N] [--check] [--dir D] [--self-check] [--reference]
                            [--at probe|flange] [--judge pairs|scale-free] [--ratio R] [--gauge MM]
+                           [--compare-plan N]
 
 --planes 1: one plate, one placement (directions of the robot left unseen): rcal must exit 0 or refuse
 naming what the data cannot determine. --self-check: the generator against its own kinematics (every
 written row's true point on its plate to the trigger noise and the display rounding; the noise-free rows
 reproduce; the same seed writes the same file); rcal is not run. --reference: the same data fitted and
 compensated by this script's own least squares (DH rows, probe, planes, with a prior of rcal's size),
-judged the same way: what the data allow, apart from rcal. Exit 77 without numpy.
+judged the same way: what the data allow, apart from rcal. --compare-plan N: per case N touches drawn as above
+(spread evenly over the plates) against N planned by `rcal poses --plate ...` on the NOMINAL robot from the
+cell's approximate placements (the true plates' centres off by up to 3 mm, normals by up to 2 deg, the probe
+by 2 mm); each planned row touched on the TRUE robot at the point nearest the planned one along the true
+plate's normal (this script's Newton, the flange's orientation kept; a row off the true face is not touched):
+the generator decides what the true robot touches. Exit 77 without numpy.
 """
 import argparse
 import json
@@ -287,7 +293,7 @@ def gauge_plate(pl0, rng, height):
             "d": float(pl0["n"] @ c), "of": 0, "height": height}
 
 
-def make_case(seed, k, name, n_planes, one_plate, n_per=None, noise_free=False, gauge=0.0):
+def make_case(seed, k, name, n_planes, one_plate, n_per=None, noise_free=False, gauge=0.0, n_total=0):
     """One case's truth and rows, from its own generator [seed, k] (the same for every run); gauge > 0: one more
     plane, parallel to plane 0 at that height (mm) above it."""
     rng = np.random.default_rng([seed, k])
@@ -302,6 +308,8 @@ def make_case(seed, k, name, n_planes, one_plate, n_per=None, noise_free=False, 
     noise_sd = rng.uniform(0.003, 0.02)
     if n_per is None:
         n_per = int(rng.integers(60, 121))
+    if n_total > 0:  # --compare-plan: this many touches in all, spread evenly over the plates (the gauge's face one)
+        n_per = max(3, n_total // len(plates))
     bank = Bank(np.random.default_rng([seed, k, 1]), truth, lim, tip)
     rows = touches(np.random.default_rng([seed, k, 2]), truth, lim, tip, plates, n_per,
                    0.0 if noise_free else noise_sd, bank)
@@ -542,13 +550,96 @@ def ref_compensate(model, nom, T, tcp):
 UNSEEN = re.compile(r"determin|unseen|not seen|identif|observ|rank|degenera", re.I)
 
 
-def one_case(a, k, name, tmp):
-    case = make_case(a.seed, k, name, a.planes, a.one_plate, gauge=a.gauge)
+def plan_args(case, rng, gauge):
+    """What a user tells `rcal poses` of the cell, taught with the robot: the probe's drawing off by up to 2 mm;
+    for each plate the touches already drawn on it (this script's own, on the TRUE robot) seen through the
+    NOMINAL robot and that probe: the plane through those points (the normal on the side the TRUE one faces, as
+    a user knows it), its point the taught touch nearest the face's centre, its usable diameter 20 mm inside the
+    side; the gauge block's place the same way from the touches of its top, less its height. The truth's own
+    numbers never reach the planner."""
+    nom = ts.nominal_robot(case["name"])
+    tip = case["tip"] + rng.uniform(-2, 2, 3)
+    taught = {}
+    for q, j, _ in case["rows"]:
+        taught.setdefault(j, []).append(nom.point(q, tip))
+    told = {}
+    for j, pl in enumerate(case["plates"]):
+        P = np.array(taught[j])
+        m = P.mean(axis=0)
+        n = np.linalg.svd(P - m)[2][2]
+        n = n if n @ pl["n"] > 0 else -n
+        # the touch the user made nearest the face's middle (where it landed on the TRUE face)
+        k = int(np.argmin([np.linalg.norm(case["truth"].point(q, case["tip"]) - pl["c"])
+                           for q, jj, _ in case["rows"] if jj == j]))
+        c = P[k] - ((P[k] - m) @ n) * n
+        told[j] = (c, n)
+    args = []
+    for j, pl in enumerate(case["plates"]):
+        if pl["kind"] == "gauge":
+            continue
+        c, n = told[j]
+        args += ["--plate", ",".join("%.3f" % x for x in list(c) + list(n) + [pl["side"] - 20.0])]
+    args += ["--tool", ",".join("%.3f" % x for x in tip)]
+    for j, pl in enumerate(case["plates"]):
+        if pl["kind"] == "gauge":
+            c, n = told[j]
+            at = c - gauge * told[pl["of"]][1]
+            args += ["--gauge-mm", "%g" % gauge, "--gauge-plate", "%d" % pl["of"], "--gauge-at",
+                     ",".join("%.3f" % x for x in at), "--gauge-size-mm", "%g" % (pl["side"] - 20.0)]
+    return args
+
+
+def touch_plan(case, path, rng):
+    """The planned rows (pose,plane,q1..q6[,height_mm], degrees) touched on the TRUE robot: at each row's joints
+    the TRUE probe point is moved along the TRUE plate's normal onto its face (the gauge's top for a row with a
+    height), the flange's orientation kept, and the joints solved by this script's Newton from the planned ones;
+    the trigger noise as for a drawn touch. A row whose point falls off the true face, or whose joints leave the
+    limits, is not touched (counted). Returns (rows, missed)."""
+    rob, tip, lim = case["truth"], case["tip"], ts.ROBOTS[case["name"]]["lim"]
+    d = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    gi = [j for j, pl in enumerate(case["plates"]) if pl["kind"] == "gauge"]
+    rows, missed = [], 0
+    for r in d:
+        q0 = r[2:8] * DEG
+        j = gi[0] if (len(r) > 8 and r[8] > 0 and gi) else int(r[1])
+        pl = case["plates"][j]
+        x, R, _ = tip_jacobian(rob, q0, tip)
+        x = x - (pl["n"] @ x - pl["d"]) * pl["n"]
+        h = pl["side"] / 2.0
+        if abs(pl["u"] @ (x - pl["c"])) > h or abs(pl["v"] @ (x - pl["c"])) > h:
+            missed += 1
+            continue
+        eps = rng.normal(0.0, case["noise_sd"])
+        if rng.random() < 0.02:
+            eps = float(np.clip(ts.heavy(rng, 8.0 * case["noise_sd"]), -0.25, 0.25))
+        q = ik_pose(rob, q0, tip, x + eps * pl["n"], R)
+        q = within(q, lim) if q is not None else None
+        if q is None:
+            missed += 1
+            continue
+        rows.append((q, j, eps))
+    return rows, missed
+
+
+def one_case(a, k, name, tmp, planned=False):
+    case = make_case(a.seed, k, name, a.planes, a.one_plate, gauge=a.gauge, n_total=a.compare_plan)
     rows = case["rows"]
-    cdir = os.path.join(tmp, "case%02d" % k)
+    cdir = os.path.join(tmp, "case%02d%s" % (k, "_plan" if planned else ""))
     os.makedirs(cdir, exist_ok=True)
     robot = os.path.join(cdir, "robot.json")
     ts.write_robot(robot, name)
+    missed = 0
+    if planned:  # rcal poses plans the touches on the nominal robot from the approximate cell
+        plan = os.path.join(cdir, "plan.csv")
+        n_total = len(rows)
+        cmd = [a.rcal, "poses", "--robot", robot, "--count", str(n_total), "--out", plan, "--seed", str(k + 1)]
+        cmd += plan_args(case, np.random.default_rng([a.seed, k, 5]), a.gauge) + a.plan_args.split()
+        rc, out, err = ts.run(cmd)
+        if rc != 0:
+            return {"case": k, "robot": name, "planes": len(case["plates"]), "rows": 0, "noise_mm": case["noise_sd"],
+                    "error": "rcal poses rc %d: %s" % (rc, err.strip()[:400])}
+        rows, missed = touch_plan(case, plan, np.random.default_rng([a.seed, k, 6]))
+        case["rows"] = rows
     data = os.path.join(cdir, "touches.csv")
     write_touches(data, rows, None if a.reference else case["plates"])
     with open(os.path.join(cdir, "truth.txt"), "w") as f:
@@ -562,7 +653,7 @@ def one_case(a, k, name, tmp):
             f.write("dh%d a %+.4f d %+.4f alpha %+.5f theta %+.5f (mm, deg, true - nominal)\n"
                     % (j + 1, ra - a0, rd - d0, ral / DEG - al0, rth / DEG - th0))
     res = {"case": k, "robot": name, "planes": len(case["plates"]), "rows": len(rows),
-           "noise_mm": case["noise_sd"], "probe_true_mm": case["tip"].tolist()}
+           "noise_mm": case["noise_sd"], "probe_true_mm": case["tip"].tolist(), "missed": missed}
     flange = np.zeros(3)
     T = judge_targets(case["rng"], name, flange)
     if a.reference:
@@ -631,6 +722,37 @@ def model_probe(path):
     return None, "looked for an effect whose kind holds 'probe' or 'touch' with 3 params, or a key 'probe...'"
 
 
+def compare_plan(a, name, tmp):
+    """--compare-plan N: the same cases touched at N random places and at N planned ones; judged at a.at."""
+    med = {False: [], True: []}
+    errors = 0
+    for k in range(a.cases):
+        for planned in (False, True):
+            r = one_case(a, k, name, tmp, planned)
+            label = "planned" if planned else "random "
+            if "error" in r:
+                errors += 1
+                print("case %2d %s ERROR %s" % (k, label, r["error"]), flush=True)
+                continue
+            j = r[a.at]
+            med[planned].append(j["pair_med_comp"])
+            print("case %2d %s rows %3d (missed %d) at the %s pair median %.4f mm (uncompensated %.4f), after the "
+                  "best-fit scale %.4f, scale %+.0f ppm" % (k, label, r["rows"], r["missed"], a.at, j["pair_med_comp"],
+                                                            j["pair_med_uncomp"], j["pair_med_scale_free"],
+                                                            j["scale_ppm"]), flush=True)
+    mr = float(np.median(med[False])) if med[False] else float("nan")
+    mp = float(np.median(med[True])) if med[True] else float("nan")
+    print("%d cases, %d touches each: median compensated pair median at the %s: planned %.4f mm, random %.4f mm "
+          "(ratio %.2f); errors %d; files in %s" % (a.cases, a.compare_plan, a.at, mp, mr, mp / mr, errors, tmp))
+    if not a.check:
+        return 0
+    from rct_check import check, failures, passes
+    check(errors == 0, "every case planned, calibrated and compensated both ways (errors: %d)" % errors)
+    check(mp < mr, "planned touches' median compensated pair median %.4f mm below random touches' %.4f mm" % (mp, mr))
+    print("%d passed, %d failed" % (len(passes), len(failures)))
+    return 1 if failures else 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("rcal", nargs="?", help="the rcal tool (not needed with --self-check or --reference)")
@@ -660,6 +782,12 @@ def main():
                     help="with --check: judge the probe's tip (compensated with the model's fitted probe as the tool; "
                          "the point the touches see) or the flange (the judge of truth_study.py's default --tcp 0,0,0; "
                          "its split from the probe is not seen by touches). Both are printed")
+    ap.add_argument("--compare-plan", type=int, default=0, metavar="N",
+                    help="per case N random touches (spread evenly over the plates) against N planned by `rcal poses "
+                         "--plate ...` from the cell's approximate placements, touched on the TRUE robot; with --check "
+                         "the planned runs' median compensated pair median must be the lower")
+    ap.add_argument("--plan-args", default="", metavar="'OPTS'",
+                    help="with --compare-plan: further options of rcal poses (e.g. '--cone-deg 40')")
     a = ap.parse_args()
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
     if a.planes < 0 or a.planes > 16:
@@ -671,6 +799,8 @@ def main():
     name = a.robot or "irb120"
     tmp = a.dir or tempfile.mkdtemp(prefix="rcal_touch_")
     os.makedirs(tmp, exist_ok=True)
+    if a.compare_plan:
+        return compare_plan(a, name, tmp)
     out = []
     for k in range(a.cases):
         r = one_case(a, k, name, tmp)

@@ -22,6 +22,8 @@ int rch_poses_plan_cost(const rch_poses_config *c, FILE *progress, size_t n, siz
 /* The checks both criteria share (count, candidates, length range, margin
  * inside every joint's limits); *n_cand the candidates to draw. 0 or -1. */
 int rch_poses_check_config(const rc_model *m, const rch_poses_config *c, size_t *n_cand, rch_diag *d);
+/* C = M^-1 (M symmetric positive definite, nf x nf; LAPACK's Cholesky). 0 or -1. */
+int rch_poses_spd_inverse(double *C, const double *M, unsigned nf);
 /* A += w x x^T, A (r x r) row-major, x (r). */
 void rch_poses_add_outer(double *A, const double *x, double w, unsigned r);
 /* A progress line "rcal poses: WHAT k+1/n" at every tenth of n (n >= 10; f NULL: none). */

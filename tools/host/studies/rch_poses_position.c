@@ -255,7 +255,7 @@ static int pos_candidates(pos_work *w, rch_poses_result *res, const rch_poses_co
 }
 
 /* C = M^-1 (M symmetric positive definite, nf x nf; either storage). 0 or -1. */
-static int spd_inverse(double *C, const double *M, unsigned nf)
+int rch_poses_spd_inverse(double *C, const double *M, unsigned nf)
 {
     memcpy(C, M, (size_t)nf * nf * sizeof *C);
     if (LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)nf, C, (lapack_int)nf) != 0 ||
@@ -271,7 +271,7 @@ static int spd_inverse(double *C, const double *M, unsigned nf)
 static int pos_refresh(pos_work *w)
 {
     const unsigned nf = w->nf;
-    if (spd_inverse(w->C, w->M, nf) != 0)
+    if (rch_poses_spd_inverse(w->C, w->M, nf) != 0)
         return -1;
     for (unsigned i = 0; i < nf; ++i) /* T = Q C */
         for (unsigned j = 0; j < nf; ++j) {
@@ -411,7 +411,7 @@ static int pos_accuracy(rch_poses_accuracy *acc, const pos_work *w, const double
     double *C = malloc(((size_t)nf * nf + 1) * sizeof *C), *r = malloc((n_eval ? n_eval : 1) * sizeof *r);
     int rc = -1;
     memset(acc, 0, sizeof *acc);
-    if (!C || !r || spd_inverse(C, M, nf) != 0)
+    if (!C || !r || rch_poses_spd_inverse(C, M, nf) != 0)
         goto out;
     rc_rng g;
     rc_rng_seed(&g, seed);
