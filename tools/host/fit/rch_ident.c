@@ -3,6 +3,8 @@
 
 #include "rc_ident.h"
 #include "rch_jac.h"
+#include "rch_positions.h"
+#include "rch_sensors.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -10,34 +12,79 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int param_index(const rc_model *m, const char *name)
+/* The problem analysed: the parameters of m the data's sensors see (idx,
+ * nf: what only an absent sensor sees, rch_pos_fix_unseen, is not part of
+ * it) and the data in words ("cable lengths", "plate touches and tracker
+ * positions") for the explanations. */
+typedef struct prob {
+    const rc_model *m;
+    uint16_t idx[RC_MAX_PARAMS];
+    unsigned nf;
+    char words[160];
+} prob;
+
+/* Column of the parameter called name; -1 when none is (or it is not in the problem). */
+static int param_index(const prob *p, const char *name)
 {
     char buf[64];
-    for (unsigned k = 0; k < m->n_params; ++k)
-        if (strcmp(rc_param_name(buf, sizeof buf, m, k), name) == 0)
+    for (unsigned k = 0; k < p->nf; ++k)
+        if (strcmp(rc_param_name(buf, sizeof buf, p->m, p->idx[k]), name) == 0)
             return (int)k;
     return -1;
 }
 
-/* Component of v (n_params) on the parameter called name; 0 when none is. */
-static double comp(const double *v, const rc_model *m, const char *name)
+/* Component of v (nf) on the parameter called name; 0 when none is. */
+static double comp(const double *v, const prob *p, const char *name)
 {
-    const int k = param_index(m, name);
+    const int k = param_index(p, name);
     return k >= 0 ? v[k] : 0.0;
 }
 
-/* SVD of the column-scaled identification Jacobian of m over the samples (n):
- * sv (np) descending (zero beyond n), vt (np x np) row k = direction k;
- * Js (n x np, row-major), when not NULL, gets the scaled Jacobian. */
-static int scaled_svd(double *sv, double *vt, double *Js, const rc_model *m, const rc_sample *s, size_t n)
+/* Append w to the words of p (" and " between). */
+static void add_words(prob *p, const char *w)
 {
-    const unsigned np = m->n_params;
+    const size_t len = strlen(p->words);
+    snprintf(p->words + len, sizeof p->words - len, "%s%s", len ? " and " : "", w);
+}
+
+/* p from m and the samples s (n). */
+static void make_prob(prob *p, const rc_model *m, const rc_sample *s, size_t n)
+{
+    uint8_t fixed[RC_MAX_PARAMS] = {0};
+    memset(p, 0, sizeof *p);
+    p->m = m;
+    rch_pos_fix_unseen(fixed, m, s, n);
+    for (unsigned k = 0; k < m->n_params; ++k)
+        if (!fixed[k])
+            p->idx[p->nf++] = (uint16_t)k;
+    /* the data in words: lengths, the tracker's, then the table's sensors, by their descriptors */
+    uint8_t kinds[RC_SENSOR_COUNT_] = {0};
+    for (size_t i = 0; i < n; ++i)
+        if (s[i].sensor < RC_SENSOR_COUNT_)
+            kinds[s[i].sensor] = 1;
+    if (kinds[RC_SENSOR_LENGTH])
+        add_words(p, "cable lengths");
+    if (kinds[RC_SENSOR_TRACKER_X] || kinds[RC_SENSOR_TRACKER_Y] || kinds[RC_SENSOR_TRACKER_Z])
+        add_words(p, "tracker positions");
+    for (unsigned k = 0; k < RC_SENSOR_COUNT_; ++k) {
+        const rch_sensor_desc *sd = rch_sensor_of_kind(k);
+        if (kinds[k] && sd)
+            add_words(p, sd->words);
+    }
+}
+
+/* SVD of the column-scaled identification Jacobian of p over the samples (n):
+ * sv (np = p->nf) descending (zero beyond n), vt (np x np) row k = direction k;
+ * Js (n x np, row-major), when not NULL, gets the scaled Jacobian. */
+static int scaled_svd(double *sv, double *vt, double *Js, const prob *p, const rc_sample *s, size_t n)
+{
+    const unsigned np = p->nf;
     rch_jac jac;
     char err[160];
     double *J, *sup = malloc(np * sizeof *sup);
     int rc = -1;
     memset(&jac, 0, sizeof jac);
-    if (!sup || rch_jac_eval(&jac, m, NULL, np, s, n, err, sizeof err) != 0) /* the Jacobian at the solution */
+    if (!sup || rch_jac_eval(&jac, p->m, p->idx, np, s, n, err, sizeof err) != 0) /* the Jacobian at the solution */
         goto done;
     J = jac.J;
     rc_ident_scale(sup, jac.norm2, np, 1); /* the one column-scaling rule */
@@ -59,7 +106,8 @@ done:
 }
 
 /* The known causes of unseen directions, in one table: each a set of
- * parameters and why lengths cannot separate them. A direction of the SVD
+ * parameters and why the data cannot separate them ("{data}": the data's
+ * sensors in words). A direction of the SVD
  * gets the first reason it lies on (dir_share of its squared length: where
  * several null directions share one singular value the SVD mixes them, and
  * a mix gets no reason rather than a wrong one); the sets with is_set are
@@ -72,7 +120,7 @@ static const struct {
 } known_sets[] = {
     {{"alpha6"}, RCH_IDENT_WHY_SHARE, 1,
      "alpha6 turns the flange about its own x axis after the last translation: it never moves the flange point, so "
-     "cable lengths cannot see it"},
+     "{data} cannot see it"},
     {{"theta6"}, RCH_IDENT_WHY_SHARE, 1,
      "theta6 only moves the measured point through a6 (zero nominally): the tool orientation about axis 6 is "
      "invisible to a point measurement"},
@@ -86,8 +134,8 @@ static const struct {
      "a6 and the cable attachment's x both move the measured point along the flange's x axis: only their sum is "
      "seen"},
     {{"alpha6", "theta6"}, RCH_IDENT_WHY_SHARE, 1,
-     "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 is zero: cable "
-     "lengths cannot see them"},
+     "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 is zero: "
+     "{data} cannot see them"},
     {{"theta1", "ex", "ey"}, RCH_IDENT_WHY_SHARE, 1,
      "turning the whole robot about its base axis is the same as turning the encoder around it: lengths do not fix "
      "the base heading"},
@@ -103,17 +151,38 @@ static const struct {
 };
 #define N_KNOWN (sizeof known_sets / sizeof known_sets[0])
 
-static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
+/* The reason of known set k into out (len): its words, "{data}" replaced by the data's (pr->words). */
+static void why_of(char *out, size_t len, unsigned k, const prob *pr)
+{
+    const char *w = known_sets[k].why, *at = strstr(w, "{data}");
+    if (at)
+        snprintf(out, len, "%.*s%s%s", (int)(at - w), w, pr->words, at + 6);
+    else
+        snprintf(out, len, "%s", w);
+}
+
+/* Are all the parameters of known set k in the problem? */
+static int set_present(unsigned k, const prob *pr)
+{
+    for (unsigned a = 0; a < 5 && known_sets[k].params[a]; ++a)
+        if (param_index(pr, known_sets[k].params[a]) < 0)
+            return 0;
+    return 1;
+}
+
+static void explain(rch_ident_dir *d, const double *v, const prob *pr)
 {
     d->why[0] = '\0';
     for (unsigned p = 0; p < N_KNOWN; ++p) {
+        if (!set_present(p, pr)) /* a set naming a parameter the data's sensors do not have says nothing here */
+            continue;
         double s2 = 0.0; /* the squared length of v on the set's parameters */
         for (unsigned k = 0; k < 5 && known_sets[p].params[k]; ++k) {
-            const double c = comp(v, m, known_sets[p].params[k]);
+            const double c = comp(v, pr, known_sets[p].params[k]);
             s2 += c * c;
         }
         if (s2 >= known_sets[p].dir_share) {
-            snprintf(d->why, sizeof d->why, "%s", known_sets[p].why);
+            why_of(d->why, sizeof d->why, p, pr);
             return;
         }
     }
@@ -124,9 +193,9 @@ static void explain(rch_ident_dir *d, const double *v, const rc_model *m)
  * order), the sign chosen so that the first is positive (a singular
  * vector's sign is arbitrary: the same direction prints the same), then
  * the plain-words reason. */
-static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
+static void describe(rch_ident_dir *d, const double *v, const prob *pr)
 {
-    const unsigned np = m->n_params;
+    const unsigned np = pr->nf;
     size_t pos = 0;
     unsigned order[RC_MAX_PARAMS];
     for (unsigned i = 0; i < np; ++i)
@@ -147,19 +216,19 @@ static void describe(rch_ident_dir *d, const double *v, const rc_model *m)
         if (fabs(v[order[i]]) < 0.1)
             break;
         int w = snprintf(d->combo + pos, sizeof d->combo - pos, "%s%+.2f %s", i ? " " : "", sign * v[order[i]],
-                         rc_param_name(name, sizeof name, m, order[i]));
+                         rc_param_name(name, sizeof name, pr->m, pr->idx[order[i]]));
         if (w < 0 || (size_t)w >= sizeof d->combo - pos)
             break;
         pos += (size_t)w;
     }
-    explain(d, v, m);
+    explain(d, v, pr);
 }
 
 /* out->combos from the scaled Jacobian Js (n x np) and its largest singular
  * value s_max. */
-static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max, const rc_model *m)
+static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max, const prob *pr)
 {
-    const unsigned np = m->n_params;
+    const unsigned np = pr->nf;
     unsigned found[N_KNOWN];
     unsigned n_found = 0;
     double *A = malloc(n * 5 * sizeof *A);
@@ -171,7 +240,7 @@ static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max
         int idx[5];
         unsigned k = 0, all = 1;
         for (; k < 5 && known_sets[p].params[k]; ++k)
-            all &= (idx[k] = param_index(m, known_sets[p].params[k])) >= 0;
+            all &= (idx[k] = param_index(pr, known_sets[p].params[k])) >= 0;
         if (!all || out->n_combos >= RCH_IDENT_MAX_COMBOS)
             continue;
         int holds = 0; /* a smaller set found already inside this one */
@@ -204,7 +273,7 @@ static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max
                                     known_sets[p].params[b]);
         c->weak = rel >= RC_IDENT_NULL_REL;
         c->sv_rel = rel;
-        snprintf(c->why, sizeof c->why, "%s", known_sets[p].why);
+        why_of(c->why, sizeof c->why, p, pr);
         found[n_found++] = p;
     }
 done:
@@ -213,17 +282,25 @@ done:
 
 int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, size_t n)
 {
-    const unsigned np = m->n_params;
     memset(out, 0, sizeof *out);
-    out->n_params = np;
-    if (n == 0 || np == 0 || np > RC_MAX_PARAMS)
+    if (n == 0 || m->n_params == 0 || m->n_params > RC_MAX_PARAMS)
         return -1;
+    prob *pr = malloc(sizeof *pr);
+    if (!pr)
+        return -1;
+    make_prob(pr, m, s, n);
+    const unsigned np = pr->nf;
+    out->n_params = np;
+    if (np == 0) {
+        free(pr);
+        return -1;
+    }
     double *sv = malloc(np * sizeof *sv), *vt = malloc((size_t)np * np * sizeof *vt);
     double *V = malloc((size_t)np * np * sizeof *V), *Js = malloc(n * np * sizeof *Js);
     int rc = -1;
-    if (!sv || !vt || !V || !Js || scaled_svd(sv, vt, Js, m, s, n) != 0)
+    if (!sv || !vt || !V || !Js || scaled_svd(sv, vt, Js, pr, s, n) != 0)
         goto done;
-    find_combos(out, Js, n, sv[0], m);
+    find_combos(out, Js, n, sv[0], pr);
     for (unsigned k = 0; k < np; ++k) /* V: direction k in column k */
         for (unsigned i = 0; i < np; ++i)
             V[(size_t)i * np + k] = vt[(size_t)k * np + i];
@@ -243,7 +320,7 @@ int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, siz
         rch_ident_dir *d = &out->dirs[out->n_dirs++];
         d->sv_rel = out->sv_rel[k];
         d->weak = id->dir_class[k] == RC_IDENT_WEAK;
-        describe(d, &vt[(size_t)k * np], m);
+        describe(d, &vt[(size_t)k * np], pr);
     }
     rc = 0;
 done:
@@ -251,5 +328,6 @@ done:
     free(vt);
     free(V);
     free(Js);
+    free(pr);
     return rc;
 }
