@@ -4,7 +4,8 @@
  * outlet e is no part of the problem (no ex, ey, ez in a direction or a
  * known set, n_params without them) and no explanation speaks of the cable
  * (its lengths, the encoder); the explanations speak of the data's sensor
- * (the tracker's alpha6 "tracker positions cannot see it"); with cable
+ * (the tracker's alpha6 "tracker positions cannot see it", the touch
+ * probe's tip as the cable attachment: "d6 touch_tip.z"); with cable
  * lengths the table keeps e and its words. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -121,6 +122,13 @@ static void test_touch_only(void **state)
     assert_true(id->n_params > np0 - 3);            /* the tip and the plates are in */
     assert_true(id->n_dirs > 0);
     assert_no_cable(id);
+    int tip_set = 0; /* the probe tip's sets in the sensor's words, as the cable attachment's */
+    for (unsigned k = 0; k < id->n_combos; ++k)
+        if (strcmp(id->combos[k].params, "d6 touch_tip.z") == 0) {
+            tip_set = 1;
+            assert_non_null(strstr(id->combos[k].why, "the touch tip's z"));
+        }
+    assert_true(tip_set);
     free(id);
     free(s);
 }

@@ -16,11 +16,32 @@
  * nf: what only an absent sensor sees, rch_pos_fix_unseen, is not part of
  * it) and the data in words ("cable lengths", "plate touches and tracker
  * positions") for the explanations. */
+#define MAX_TIPS (1 + RC_SENSOR_COUNT_) /* the cable attachment, each table sensor's tip */
+#define MAX_SET_PARAMS 5
+
+/* A point of the data's sensors on the flange: its parameters' name ("tool_offset") and its words. */
+typedef struct tip {
+    char name[32];
+    char words[48];
+} tip;
+
+/* A known set as used here: its parameters named ("{tip}" resolved), its reason. */
+typedef struct inst {
+    unsigned set;
+    unsigned n;
+    char params[MAX_SET_PARAMS][48];
+    char why[256];
+} inst;
+
 typedef struct prob {
     const rc_model *m;
     uint16_t idx[RC_MAX_PARAMS];
     unsigned nf;
     char words[160];
+    unsigned n_tips;
+    tip tips[MAX_TIPS];
+    unsigned n_inst;
+    inst insts[32 * MAX_TIPS];
 } prob;
 
 /* Column of the parameter called name; -1 when none is (or it is not in the problem). */
@@ -66,10 +87,19 @@ static void make_prob(prob *p, const rc_model *m, const rc_sample *s, size_t n)
         add_words(p, "cable lengths");
     if (kinds[RC_SENSOR_TRACKER_X] || kinds[RC_SENSOR_TRACKER_Y] || kinds[RC_SENSOR_TRACKER_Z])
         add_words(p, "tracker positions");
+    if (kinds[RC_SENSOR_LENGTH]) { /* the points on the flange: the cable's attachment, each table sensor's tip */
+        snprintf(p->tips[p->n_tips].name, sizeof p->tips[0].name, "%s", rc_effect_name(RC_EFF_TOOL_OFFSET));
+        snprintf(p->tips[p->n_tips++].words, sizeof p->tips[0].words, "the cable attachment");
+    }
     for (unsigned k = 0; k < RC_SENSOR_COUNT_; ++k) {
         const rch_sensor_desc *sd = rch_sensor_of_kind(k);
         if (kinds[k] && sd)
             add_words(p, sd->words);
+        if (kinds[k] && sd && sd->tip_effect >= 0 && p->n_tips < MAX_TIPS) {
+            snprintf(p->tips[p->n_tips].name, sizeof p->tips[0].name, "%s",
+                     rc_effect_name((rc_effect_kind)sd->tip_effect));
+            snprintf(p->tips[p->n_tips++].words, sizeof p->tips[0].words, "the %s tip", sd->name);
+        }
     }
 }
 
@@ -128,10 +158,10 @@ static const struct {
      "moving the robot base up is the same as moving the encoder down: only their difference is measured"},
     {{"d2", "d3"}, RCH_IDENT_WHY_SHARE, 1,
      "joints 2 and 3 are parallel: d2 and d3 shift the arm along the same axis, only their sum counts"},
-    {{"d6", "tool_offset.z"}, RCH_IDENT_WHY_SHARE, 1,
-     "d6 and the cable attachment's z both move the measured point along the flange axis: only their sum is seen"},
-    {{"a6", "tool_offset.x"}, RCH_IDENT_WHY_SHARE, 1,
-     "a6 and the cable attachment's x both move the measured point along the flange's x axis: only their sum is "
+    {{"d6", "{tip}.z"}, RCH_IDENT_WHY_SHARE, 1,
+     "d6 and {tip}'s z both move the measured point along the flange axis: only their sum is seen"},
+    {{"a6", "{tip}.x"}, RCH_IDENT_WHY_SHARE, 1,
+     "a6 and {tip}'s x both move the measured point along the flange's x axis: only their sum is "
      "seen"},
     {{"alpha6", "theta6"}, RCH_IDENT_WHY_SHARE, 1,
      "alpha6 and theta6 turn the flange about its own axes without moving the flange point while a6 is zero: "
@@ -139,10 +169,10 @@ static const struct {
     {{"theta1", "ex", "ey"}, RCH_IDENT_WHY_SHARE, 1,
      "turning the whole robot about its base axis is the same as turning the encoder around it: lengths do not fix "
      "the base heading"},
-    {{"alpha6", "tool_offset.y", "tool_offset.z"}, RCH_IDENT_WHY_SHARE, 1,
-     "turning the flange about its x axis moves the cable attachment as a change of its y and z does"},
-    {{"theta6", "tool_offset.x", "tool_offset.y"}, RCH_IDENT_WHY_SHARE, 1,
-     "turning the flange about its axis moves the cable attachment as a change of its x and y does"},
+    {{"alpha6", "{tip}.y", "{tip}.z"}, RCH_IDENT_WHY_SHARE, 1,
+     "turning the flange about its x axis moves {tip} as a change of its y and z does"},
+    {{"theta6", "{tip}.x", "{tip}.y"}, RCH_IDENT_WHY_SHARE, 1,
+     "turning the flange about its axis moves {tip} as a change of its x and y does"},
     /* these trade against many parameters at once: named when they lead a direction */
     {{"length_scale"}, 0.5, 0,
      "an encoder scale error looks like a uniformly larger robot: separate them with one reference length (a gauge "
@@ -151,38 +181,67 @@ static const struct {
 };
 #define N_KNOWN (sizeof known_sets / sizeof known_sets[0])
 
-/* The reason of known set k into out (len): its words, "{data}" replaced by the data's (pr->words). */
-static void why_of(char *out, size_t len, unsigned k, const prob *pr)
+/* Replace each "{tok}" of text by val into out (len). */
+static void subst(char *out, size_t len, const char *text, const char *tok, const char *val)
 {
-    const char *w = known_sets[k].why, *at = strstr(w, "{data}");
-    if (at)
-        snprintf(out, len, "%.*s%s%s", (int)(at - w), w, pr->words, at + 6);
-    else
-        snprintf(out, len, "%s", w);
+    size_t pos = 0;
+    const size_t tl = strlen(tok);
+    out[0] = '\0';
+    for (const char *at; (at = strstr(text, tok)) != NULL && pos < len; text = at + tl)
+        pos += (size_t)snprintf(out + pos, len - pos, "%.*s%s", (int)(at - text), text, val);
+    if (pos < len)
+        snprintf(out + pos, len - pos, "%s", text);
 }
 
-/* Are all the parameters of known set k in the problem? */
-static int set_present(unsigned k, const prob *pr)
+/* Does known set k name a point on the flange ("{tip}")? */
+static int names_tip(unsigned k)
 {
-    for (unsigned a = 0; a < 5 && known_sets[k].params[a]; ++a)
-        if (param_index(pr, known_sets[k].params[a]) < 0)
-            return 0;
-    return 1;
+    for (unsigned a = 0; a < MAX_SET_PARAMS && known_sets[k].params[a]; ++a)
+        if (strncmp(known_sets[k].params[a], "{tip}", 5) == 0)
+            return 1;
+    return 0;
+}
+
+/* pr->insts: the known sets in table order, a set naming "{tip}" once per point of the data's sensors, each
+ * kept only when all its parameters are in the problem (a set naming what the data's sensors do not have says
+ * nothing here); the reasons in the data's words ("{data}", "{tip}"). */
+static void make_insts(prob *pr)
+{
+    for (unsigned k = 0; k < N_KNOWN; ++k) {
+        const unsigned reps = names_tip(k) ? pr->n_tips : 1u;
+        for (unsigned t = 0; t < reps && pr->n_inst < sizeof pr->insts / sizeof pr->insts[0]; ++t) {
+            inst *in = &pr->insts[pr->n_inst];
+            int all = 1;
+            in->set = k;
+            in->n = 0;
+            for (unsigned a = 0; a < MAX_SET_PARAMS && known_sets[k].params[a]; ++a) {
+                subst(in->params[a], sizeof in->params[a], known_sets[k].params[a], "{tip}",
+                      pr->n_tips ? pr->tips[t].name : "");
+                all &= param_index(pr, in->params[a]) >= 0;
+                ++in->n;
+            }
+            if (!all)
+                continue;
+            char w[256];
+            subst(w, sizeof w, known_sets[k].why, "{data}", pr->words);
+            subst(in->why, sizeof in->why, w, "{tip}", pr->n_tips ? pr->tips[t].words : "");
+            ++pr->n_inst;
+        }
+    }
 }
 
 static void explain(rch_ident_dir *d, const double *v, const prob *pr)
 {
     d->why[0] = '\0';
-    for (unsigned p = 0; p < N_KNOWN; ++p) {
-        if (!set_present(p, pr)) /* a set naming a parameter the data's sensors do not have says nothing here */
-            continue;
+    for (unsigned p = 0; p < pr->n_inst; ++p) {
+        const inst *in = &pr->insts[p];
         double s2 = 0.0; /* the squared length of v on the set's parameters */
-        for (unsigned k = 0; k < 5 && known_sets[p].params[k]; ++k) {
-            const double c = comp(v, pr, known_sets[p].params[k]);
+        for (unsigned k = 0; k < in->n; ++k) {
+            const double c = comp(v, pr, in->params[k]);
             s2 += c * c;
         }
-        if (s2 >= known_sets[p].dir_share) {
-            why_of(d->why, sizeof d->why, p, pr);
+        if (s2 >= known_sets[in->set].dir_share) {
+            snprintf(d->why, sizeof d->why, "%s", in->why);
             return;
         }
     }
@@ -229,37 +288,36 @@ static void describe(rch_ident_dir *d, const double *v, const prob *pr)
 static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max, const prob *pr)
 {
     const unsigned np = pr->nf;
-    unsigned found[N_KNOWN];
+    unsigned found[sizeof pr->insts / sizeof pr->insts[0]];
     unsigned n_found = 0;
-    double *A = malloc(n * 5 * sizeof *A);
-    if (!A || s_max <= 0.0 || n < 5)
+    double *A = malloc(n * MAX_SET_PARAMS * sizeof *A);
+    if (!A || s_max <= 0.0 || n < MAX_SET_PARAMS)
         goto done;
-    for (unsigned p = 0; p < N_KNOWN; ++p) {
-        if (!known_sets[p].is_set)
+    for (unsigned p = 0; p < pr->n_inst; ++p) {
+        const inst *in = &pr->insts[p];
+        if (!known_sets[in->set].is_set || out->n_combos >= RCH_IDENT_MAX_COMBOS)
             continue;
-        int idx[5];
-        unsigned k = 0, all = 1;
-        for (; k < 5 && known_sets[p].params[k]; ++k)
-            all &= (idx[k] = param_index(pr, known_sets[p].params[k])) >= 0;
-        if (!all || out->n_combos >= RCH_IDENT_MAX_COMBOS)
-            continue;
+        int idx[MAX_SET_PARAMS];
+        const unsigned k = in->n;
+        for (unsigned b = 0; b < k; ++b)
+            idx[b] = param_index(pr, in->params[b]); /* every one in the problem (make_insts) */
         int holds = 0; /* a smaller set found already inside this one */
         for (unsigned f = 0; f < n_found && !holds; ++f) {
-            unsigned in = 1;
-            for (unsigned a = 0; a < 5 && known_sets[found[f]].params[a]; ++a) {
+            unsigned inside = 1;
+            for (unsigned a = 0; a < pr->insts[found[f]].n; ++a) {
                 unsigned hit = 0;
                 for (unsigned b = 0; b < k; ++b)
-                    hit |= strcmp(known_sets[found[f]].params[a], known_sets[p].params[b]) == 0;
-                in &= hit;
+                    hit |= strcmp(pr->insts[found[f]].params[a], in->params[b]) == 0;
+                inside &= hit;
             }
-            holds = (int)in;
+            holds = (int)inside;
         }
         if (holds)
             continue;
         for (size_t i = 0; i < n; ++i)
             for (unsigned b = 0; b < k; ++b)
                 A[i * k + b] = Js[i * np + (unsigned)idx[b]];
-        double sv[5], super[5];
+        double sv[MAX_SET_PARAMS], super[MAX_SET_PARAMS];
         if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'N', (lapack_int)n, (lapack_int)k, A, (lapack_int)k, sv, NULL, 1,
                            NULL, 1, super) != 0)
             continue;
@@ -269,11 +327,10 @@ static void find_combos(rch_ident *out, const double *Js, size_t n, double s_max
         rch_ident_combo *c = &out->combos[out->n_combos++];
         size_t pos = 0;
         for (unsigned b = 0; b < k; ++b)
-            pos += (size_t)snprintf(c->params + pos, sizeof c->params - pos, "%s%s", b ? " " : "",
-                                    known_sets[p].params[b]);
+            pos += (size_t)snprintf(c->params + pos, sizeof c->params - pos, "%s%s", b ? " " : "", in->params[b]);
         c->weak = rel >= RC_IDENT_NULL_REL;
         c->sv_rel = rel;
-        why_of(c->why, sizeof c->why, p, pr);
+        snprintf(c->why, sizeof c->why, "%s", in->why);
         found[n_found++] = p;
     }
 done:
@@ -289,6 +346,7 @@ int rch_ident_compute(rch_ident *out, const rc_model *m, const rc_sample *s, siz
     if (!pr)
         return -1;
     make_prob(pr, m, s, n);
+    make_insts(pr);
     const unsigned np = pr->nf;
     out->n_params = np;
     if (np == 0) {
