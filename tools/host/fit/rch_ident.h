@@ -1,5 +1,14 @@
 /* SPDX-License-Identifier: MIT */
-/* rch_ident.h - identifiability of the model parameters from cable lengths.
+/* rch_ident.h - identifiability of the model parameters from the data
+ * (cable lengths, tracker positions, a table sensor's rows: rch_sensors.h).
+ *
+ * The problem analysed is the parameters the data's sensors see: what only
+ * an absent sensor sees (rch_pos_fix_unseen: without lengths the encoder e,
+ * the outlets and the attachment; without a sensor's rows its effects) is
+ * held by the fit and is no part of the table (n_params counts the rest).
+ * The explanations speak of the data the samples hold ("tracker positions
+ * cannot see it"; a table sensor by its descriptor's words) and a known set
+ * is used only when all its parameters are in the problem.
  *
  * The identification Jacobian J (n samples x n_params, each column scaled to
  * unit norm so that mm and rad compare) is decomposed by SVD (LAPACKE
@@ -46,7 +55,7 @@ typedef struct rch_ident_combo {
 } rch_ident_combo;
 
 typedef struct rch_ident {
-    unsigned n_params;
+    unsigned n_params;            /* parameters analysed (those of the problem) */
     double sv_rel[RC_MAX_PARAMS]; /* (n_params) descending */
     unsigned rank;                /* sv_rel >= RC_IDENT_NULL_REL */
     unsigned n_weak;              /* RC_IDENT_NULL_REL <= sv_rel < RC_IDENT_WEAK_REL */

@@ -213,4 +213,5 @@ const rch_sensor_desc rch_sensor_touch = {
     touch_caveat, "plate touches",
     "the plates' places absorb the robot's heading and height, as an outlet does for lengths",
     "touch plates facing three directions, at poses that move every joint and turn the probe (docs/touches.md)",
+    RC_EFF_TOUCH_TIP,
 };

@@ -43,6 +43,8 @@ typedef struct rch_sensor_desc {
     const char *words;  /* its data in words, for the report ("plate touches") */
     const char *gauge;  /* why theta1 and d1 are held with its data alone ("the plates' places absorb ...") */
     const char *advice; /* the next step when its poses leave the geometry to the prior */
+    int tip_effect;     /* its point on the flange: an rc_effect_kind of three parameters x, y, z ("the <name> tip" in
+                           the identifiability's reasons, as the cable attachment's tool_offset), -1: none */
 } rch_sensor_desc;
 
 /* The sensor whose file text (len) is, by its header's label column; NULL:

@@ -72,7 +72,8 @@
 #define RCH_DIAGNOSE_MAX_CAND 24
 #define RCH_DIAGNOSE_MAX_STEPS 4
 #define RCH_DIAGNOSE_MAX_TESTS 40
-#define RCH_DIAGNOSE_MAX_SENSORS 17 /* the tracker and up to RC_MAX_OUTLETS cable outlets */
+#define RCH_DIAGNOSE_MAX_SENSORS (RC_MAX_OUTLETS + RC_SENSOR_COUNT_) /* up to RC_MAX_OUTLETS cable outlets, the
+                                                                   tracker, each other sensor kind */
 #define RCH_DIAGNOSE_MAX_FILES 16
 #define RCH_DIAGNOSE_MAX_FOLDS 20
 #define RCH_DIAGNOSE_MAX_NOTES 8

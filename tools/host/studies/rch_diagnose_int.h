@@ -82,9 +82,16 @@ unsigned rch_dg_groups_usable(unsigned n_groups, size_t n);
 unsigned rch_dg_structure_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
                                 const double (*var)[V_N], unsigned n_groups, double alpha);
 
+/* The class of sample s's sensor: its kind (rc_sensor_kind), the tracker's
+ * three coordinates one class (RC_SENSOR_TRACKER_X). A diagnosis keeps each
+ * class apart: its rows, its figures (a class per cable outlet there), its
+ * structure tests. */
+unsigned rch_dg_sensor_class(const rc_sample *s);
+
 /* The structure tests of each sensor in the data (rch_dg_structure_tests on
- * the cable rows and on the tracker rows apart, with an ANOVA over the
- * outlets, the coordinates and the targets; Bonferroni over all of them).
+ * each class's rows apart (rch_dg_sensor_class: the cable's, the tracker's,
+ * each other sensor's), with an ANOVA over the outlets, the coordinates and
+ * the targets or the sensor's labels; Bonferroni over all of them).
  * One outlet's lengths alone: rch_dg_structure_tests itself. */
 unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
                              const double (*var)[V_N], unsigned n_groups, double alpha);

@@ -306,12 +306,14 @@ static int phase_sensors(run_state *S)
     S->c.n_poses = out->n_poses = next;
     free(k);
     free(first);
-    int slot[RC_MAX_OUTLETS + 1];
-    for (unsigned j = 0; j <= RC_MAX_OUTLETS; ++j)
+    /* a class per cable outlet, one for the tracker (its three coordinates), one per other sensor kind */
+    int slot[RC_MAX_OUTLETS + RC_SENSOR_COUNT_];
+    for (unsigned j = 0; j < RC_MAX_OUTLETS + RC_SENSOR_COUNT_; ++j)
         slot[j] = -1;
     for (size_t i = 0; i < n; ++i) {
         const int tr = out->s[i].sensor != RC_SENSOR_LENGTH;
-        const unsigned key = tr ? RC_MAX_OUTLETS : out->s[i].outlet % RC_MAX_OUTLETS;
+        const unsigned key = tr ? RC_MAX_OUTLETS + rch_dg_sensor_class(&out->s[i]) % RC_SENSOR_COUNT_
+                                : out->s[i].outlet % RC_MAX_OUTLETS;
         if (slot[key] < 0 && out->n_sensors < RCH_DIAGNOSE_MAX_SENSORS) {
             rch_diagnose_sensor *z = &out->sensors[out->n_sensors];
             z->tracker = tr;
@@ -323,6 +325,9 @@ static int phase_sensors(run_state *S)
         out->n_tracker += (size_t)tr;
         out->n_cable += (size_t)!tr;
     }
+    unsigned outlets = 0; /* the cable's classes */
+    for (unsigned j = 0; j < out->n_sensors; ++j)
+        outlets += !out->sensors[j].tracker;
     for (unsigned j = 0; j < out->n_sensors; ++j) {
         rch_diagnose_sensor *z = &out->sensors[j];
         const rch_sensor_desc *sd = NULL; /* another sensor of the table (rch_sensors.h): a row a sample */
@@ -335,7 +340,7 @@ static int phase_sensors(run_state *S)
         } else if (z->tracker) {
             z->rows /= 3;
             snprintf(z->name, sizeof z->name, "tracker");
-        } else if (out->n_sensors - (out->n_tracker > 0) > 1) {
+        } else if (outlets > 1) {
             snprintf(z->name, sizeof z->name, "cable outlet %u", z->label);
         } else {
             snprintf(z->name, sizeof z->name, "cable");

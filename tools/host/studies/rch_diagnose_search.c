@@ -77,10 +77,12 @@ static const cdef all_cands[] = {
 static int cand_relevant(const run_state *S, const cdef *cd)
 {
     const rch_diagnose_result *out = S->out;
-    const unsigned outlets = out->n_sensors - (out->n_tracker > 0);
-    int tracker = 0; /* a tracker's rows (n_tracker counts every sensor other than the cable) */
-    for (unsigned j = 0; j < out->n_sensors; ++j)
+    unsigned outlets = 0; /* the cable's classes (one per outlet) */
+    int tracker = 0;      /* a tracker's rows (n_tracker counts every sensor other than the cable) */
+    for (unsigned j = 0; j < out->n_sensors; ++j) {
+        outlets += !out->sensors[j].tracker;
         tracker |= strcmp(out->sensors[j].kind, "tracker") == 0;
+    }
     return cd->on == ON_ANY || (cd->on == ON_CABLE && out->n_cable > 0) || (cd->on == ON_OUTLETS && outlets > 1) ||
            (cd->on == ON_TRACKER && tracker);
 }

@@ -236,21 +236,25 @@ static unsigned anova_by(rch_diagnose_test *t, const char *name, const double *r
     return 1;
 }
 
+unsigned rch_dg_sensor_class(const rc_sample *s)
+{
+    return s->sensor >= RC_SENSOR_TRACKER_X && s->sensor <= RC_SENSOR_TRACKER_Z ? (unsigned)RC_SENSOR_TRACKER_X
+                                                                                : s->sensor;
+}
+
 unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_sample *s, size_t n,
                              const double (*var)[V_N], unsigned n_groups, double alpha)
 {
-    size_t nc = 0, nt = 0;
-    unsigned outlets = 0, targets = 0;
+    size_t nk[RC_SENSOR_COUNT_] = {0};     /* rows of each class */
+    unsigned labels[RC_SENSOR_COUNT_] = {0}; /* the outlets (cable), the targets, another sensor's labels */
     for (size_t i = 0; i < n; ++i) {
-        const int tr = s[i].sensor != RC_SENSOR_LENGTH;
-        nt += (size_t)tr;
-        nc += (size_t)!tr;
-        if (!tr && s[i].outlet + 1u > outlets)
-            outlets = s[i].outlet + 1u;
-        if (tr && s[i].target + 1u > targets)
-            targets = s[i].target + 1u;
+        const unsigned c = rch_dg_sensor_class(&s[i]) % RC_SENSOR_COUNT_;
+        const unsigned l = c == RC_SENSOR_LENGTH ? s[i].outlet : s[i].target;
+        ++nk[c];
+        if (l + 1u > labels[c])
+            labels[c] = l + 1u;
     }
-    if (nt == 0 && outlets <= 1) /* one outlet's lengths: the tests as they always were */
+    if (nk[RC_SENSOR_LENGTH] == n && labels[RC_SENSOR_LENGTH] <= 1) /* one outlet's lengths: as they always were */
         return rch_dg_structure_tests(out, r, s, n, var, n_groups, alpha);
     double *rs = malloc((n ? n : 1) * sizeof *rs);
     rc_sample *ss = malloc((n ? n : 1) * sizeof *ss);
@@ -258,29 +262,35 @@ unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_s
     unsigned k = 0;
     if (!rs || !ss || !vs)
         goto done;
-    /* Bonferroni over every test of both sensors: each subset's own count
-     * of structure tests (12 or 13) and the ANOVAs */
+    /* Bonferroni over every test of every class: each one's own count of structure tests (12 or 13; another
+     * sensor of the table (rch_sensors.h) without the two against a place) and its ANOVAs */
     const unsigned per = 12u + rch_dg_groups_usable(n_groups, n);
-    const unsigned total = (nc ? per + (outlets > 1) : 0u) + (nt ? per + 1u + (targets > 1) : 0u);
+    unsigned total = 0;
+    for (unsigned c = 0; c < RC_SENSOR_COUNT_; ++c)
+        if (nk[c] > 0)
+            total += c == RC_SENSOR_LENGTH      ? per + (labels[c] > 1)
+                     : c == RC_SENSOR_TRACKER_X ? per + 1u + (labels[c] > 1)
+                                                : per - 2u + (labels[c] > 1);
     const double a_each = alpha / (double)total;
-    for (int tracker = 0; tracker < 2; ++tracker) {
+    for (unsigned cls = 0; cls < RC_SENSOR_COUNT_; ++cls) {
+        if (nk[cls] == 0)
+            continue;
+        const int tracker = cls != RC_SENSOR_LENGTH; /* not the cable: no outlet, a target or a label */
         size_t m = 0;
         for (size_t i = 0; i < n; ++i)
-            if ((s[i].sensor != RC_SENSOR_LENGTH) == tracker) {
+            if (rch_dg_sensor_class(&s[i]) == cls) {
                 rs[m] = r[i];
                 ss[m] = s[i];
                 memcpy(vs[m], var[i], sizeof vs[m]);
                 ++m;
             }
-        if (m == 0)
-            continue;
         unsigned g = 0; /* the subset's groups, renumbered densely */
         for (size_t i = 0; i < m; ++i)
             g = ss[i].group + 1u > g ? ss[i].group + 1u : g;
         const unsigned k0 = k;
         k += rch_dg_structure_tests(out + k, rs, ss, m, (const double(*)[V_N])vs, g, a_each * (double)per);
         /* another sensor of the table (rch_sensors.h): its name; it has no distance or direction from a place */
-        const rch_sensor_desc *sd = tracker ? rch_sensor_of_kind(ss[0].sensor) : NULL;
+        const rch_sensor_desc *sd = tracker ? rch_sensor_of_kind(cls) : NULL;
         unsigned kept = k0;
         for (unsigned j = k0; j < k; ++j) { /* names say the sensor; the cable's "length" is the tracker's distance */
             char nm[40];
@@ -297,13 +307,13 @@ unsigned rch_dg_sensor_tests(rch_diagnose_test *out, const double *r, const rc_s
             memcpy(out[kept++].name, nm, sizeof nm);
         }
         k = kept;
-        if (!tracker && outlets > 1)
+        if (!tracker && labels[cls] > 1)
             k += anova_by(&out[k], "cable: outlet (ANOVA)", rs, ss, m, key_outlet, a_each);
         if (tracker && !sd) {
             k += anova_by(&out[k], "tracker: coordinate x, y, z (ANOVA)", rs, ss, m, key_coordinate, a_each);
-            if (targets > 1)
+            if (labels[cls] > 1)
                 k += anova_by(&out[k], "tracker: target (ANOVA)", rs, ss, m, key_target, a_each);
-        } else if (sd && targets > 1) { /* its label: a plate's own offset the model lacks, one plate misread */
+        } else if (sd && labels[cls] > 1) { /* its label: a plate's own offset the model lacks, one plate misread */
             char nm[40];
             snprintf(nm, sizeof nm, "%s: %s (ANOVA)", sd->name, sd->label);
             k += anova_by(&out[k], nm, rs, ss, m, key_target, a_each);
