@@ -24,6 +24,22 @@ int rch_poses_plan_cost(const rch_poses_config *c, FILE *progress, size_t n, siz
 int rch_poses_check_config(const rc_model *m, const rch_poses_config *c, size_t *n_cand, rch_diag *d);
 /* C = M^-1 (M symmetric positive definite, nf x nf; LAPACK's Cholesky). 0 or -1. */
 int rch_poses_spd_inverse(double *C, const double *M, unsigned nf);
+/* The point a plan is judged at (the flange, a tool or a probe) and its free parameters: the workspace's
+ * information and the predicted accuracy of both criteria and of the touch plan. */
+typedef struct rch_poses_point {
+    const rc_model *m;  /* the joint limits of the workspace poses */
+    const rc_model *mp; /* the point's model (rch_uncert_point_sens) */
+    unsigned nf;        /* free parameters */
+    const int *col;     /* (nf) the column of rch_uncert_point_sens of each, -1: it does not move the point */
+    const double *sc;   /* (nf) their scale (prior sd) */
+} rch_poses_point;
+/* Q = mean over n workspace poses (uniform in the joint limits, seed) of Jps^T Jps, Jps the point's
+ * sensitivity to the scaled free parameters; Q (nf x nf). */
+void rch_poses_workspace_q(double *Q, const rch_poses_point *pt, size_t n, unsigned long long seed);
+/* The predicted accuracy of a design of information M (nf x nf): the 95 % radius at n_eval workspace poses
+ * (their own seed). 0 or -1 (M not positive definite, out of memory). */
+int rch_poses_point_accuracy(rch_poses_accuracy *acc, const rch_poses_point *pt, const double *M, size_t n_eval,
+                             unsigned long long seed);
 /* A += w x x^T, A (r x r) row-major, x (r). */
 void rch_poses_add_outer(double *A, const double *x, double w, unsigned r);
 /* A progress line "rcal poses: WHAT k+1/n" at every tenth of n (n >= 10; f NULL: none). */

@@ -380,34 +380,44 @@ static void prior_info(double *M, unsigned nf)
         M[(size_t)k * nf + k] = 1.0;
 }
 
-/* Q = mean over n workspace poses (uniform in the joint limits, seed) of
- * Jps^T Jps, Jps the point's sensitivity to the scaled free parameters. */
-static void workspace_q(double *Q, const pos_work *w, size_t n, unsigned long long seed)
+/* J = the point's sensitivity to the scaled free parameters at q: J[i][a] = Jp[i][col[a]] sc[a] (0 where
+ * col[a] < 0). */
+static void point_sens(double J[3][RC_MAX_PARAMS], const rch_poses_point *pt, const double q[RC_NJ])
 {
-    const unsigned nf = w->nf;
+    double Jp[3][RC_MAX_PARAMS];
+    rch_uncert_point_sens(Jp, pt->mp, q);
+    for (int i = 0; i < 3; ++i)
+        for (unsigned a = 0; a < pt->nf; ++a)
+            J[i][a] = pt->col[a] >= 0 ? Jp[i][pt->col[a]] * pt->sc[a] : 0.0;
+}
+
+/* joints uniform in the limits of m */
+static void workspace_pose(double q[RC_NJ], const rc_model *m, rc_rng *g)
+{
+    for (int j = 0; j < RC_NJ; ++j)
+        q[j] = m->q_min_rad[j] + (m->q_max_rad[j] - m->q_min_rad[j]) * rc_rng_u01(g);
+}
+
+void rch_poses_workspace_q(double *Q, const rch_poses_point *pt, size_t n, unsigned long long seed)
+{
+    const unsigned nf = pt->nf;
     rc_rng g;
     rc_rng_seed(&g, seed);
     memset(Q, 0, (size_t)nf * nf * sizeof *Q);
     for (size_t t = 0; t < n; ++t) {
-        double q[RC_NJ], Jp[3][RC_MAX_PARAMS], J[3][RC_MAX_PARAMS];
-        for (int j = 0; j < RC_NJ; ++j)
-            q[j] = w->m.q_min_rad[j] + (w->m.q_max_rad[j] - w->m.q_min_rad[j]) * rc_rng_u01(&g);
-        rch_uncert_point_sens(Jp, &w->mp, q);
-        for (int i = 0; i < 3; ++i)
-            for (unsigned a = 0; a < nf; ++a)
-                J[i][a] = Jp[i][w->fi[a]] * w->sc[a];
+        double q[RC_NJ], J[3][RC_MAX_PARAMS];
+        workspace_pose(q, pt->m, &g);
+        point_sens(J, pt, q);
         for (unsigned a = 0; a < nf; ++a)
             for (unsigned b = 0; b < nf; ++b)
                 Q[(size_t)a * nf + b] += (J[0][a] * J[0][b] + J[1][a] * J[1][b] + J[2][a] * J[2][b]) / (double)n;
     }
 }
 
-/* The predicted accuracy of the design whose information is M: the 95 %
- * radius at n_eval workspace poses (their own seed). */
-static int pos_accuracy(rch_poses_accuracy *acc, const pos_work *w, const double *M, size_t n_eval,
-                        unsigned long long seed)
+int rch_poses_point_accuracy(rch_poses_accuracy *acc, const rch_poses_point *pt, const double *M, size_t n_eval,
+                             unsigned long long seed)
 {
-    const unsigned nf = w->nf;
+    const unsigned nf = pt->nf;
     double *C = malloc(((size_t)nf * nf + 1) * sizeof *C), *r = malloc((n_eval ? n_eval : 1) * sizeof *r);
     int rc = -1;
     memset(acc, 0, sizeof *acc);
@@ -417,13 +427,9 @@ static int pos_accuracy(rch_poses_accuracy *acc, const pos_work *w, const double
     rc_rng_seed(&g, seed);
     double phi = 0.0;
     for (size_t t = 0; t < n_eval; ++t) {
-        double q[RC_NJ], Jp[3][RC_MAX_PARAMS], J[3][RC_MAX_PARAMS], P[9];
-        for (int j = 0; j < RC_NJ; ++j)
-            q[j] = w->m.q_min_rad[j] + (w->m.q_max_rad[j] - w->m.q_min_rad[j]) * rc_rng_u01(&g);
-        rch_uncert_point_sens(Jp, &w->mp, q);
-        for (int i = 0; i < 3; ++i)
-            for (unsigned a = 0; a < nf; ++a)
-                J[i][a] = Jp[i][w->fi[a]] * w->sc[a];
+        double q[RC_NJ], J[3][RC_MAX_PARAMS], P[9];
+        workspace_pose(q, pt->m, &g);
+        point_sens(J, pt, q);
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) {
                 double s = 0.0;
@@ -448,6 +454,15 @@ out:
     free(C);
     free(r);
     return rc;
+}
+
+/* the point's description of w's design */
+static rch_poses_point pos_point(const pos_work *w, int *col)
+{
+    for (unsigned a = 0; a < w->nf; ++a)
+        col[a] = (int)w->fi[a];
+    const rch_poses_point pt = {&w->m, &w->mp, w->nf, col, w->sc};
+    return pt;
 }
 
 #define SEED_WORK 0x5851F42D4C957F2Dull
@@ -591,7 +606,9 @@ int rch_poses_plan_position(rch_poses_result *res, const rc_model *m, const rch_
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto done;
     }
-    workspace_q(w->Q, w, c->n_work ? c->n_work : 300, c->seed ^ SEED_WORK);
+    int col[RC_MAX_PARAMS];
+    const rch_poses_point pt = pos_point(w, col);
+    rch_poses_workspace_q(w->Q, &pt, c->n_work ? c->n_work : 300, c->seed ^ SEED_WORK);
     if (pos_design(w, c, progress) != 0) {
         rch_diag_set(d, "", 0, 0, "the design's information matrix is not positive definite (numeric failure)");
         goto done;
@@ -618,10 +635,10 @@ int rch_poses_plan_position(rch_poses_result *res, const rc_model *m, const rch_
     }
     const size_t n_eval = c->n_eval ? c->n_eval : 1000;
     design_info(w->M, w, w->design, w->n);
-    if (pos_accuracy(&res->plan, w, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
+    if (rch_poses_point_accuracy(&res->plan, &pt, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
         goto numeric;
     design_info(w->M, w, w->rnd, w->n);
-    if (pos_accuracy(&res->random, w, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
+    if (rch_poses_point_accuracy(&res->random, &pt, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
         goto numeric;
     if (pos_rows_out(res, w) != 0) {
         rch_diag_set(d, "", 0, 0, "out of memory");
@@ -701,7 +718,9 @@ int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_pose
         }
         rch_poses_add_outer(M, X + ((size_t)rows[i].outlet * w->P + rows[i].target) * w->nf, 1.0, w->nf);
     }
-    if (pos_accuracy(acc, w, M, c->n_eval ? c->n_eval : 1000, c->seed ^ SEED_EVAL) != 0) {
+    int col[RC_MAX_PARAMS];
+    const rch_poses_point pt = pos_point(w, col);
+    if (rch_poses_point_accuracy(acc, &pt, M, c->n_eval ? c->n_eval : 1000, c->seed ^ SEED_EVAL) != 0) {
         rch_diag_set(d, "", 0, 0, "the predicted accuracy could not be computed (numeric failure)");
         goto out;
     }

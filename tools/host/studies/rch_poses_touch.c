@@ -380,82 +380,18 @@ static int touch_candidates(touch_work *w, rch_poses_touch_result *res, const rc
     return 0;
 }
 
-/* Q = mean over workspace poses of Jps^T Jps at the probe (the touch_tip columns the tool offset's). */
-static void touch_q(double *Q, const touch_work *w, size_t n, unsigned long long seed)
+/* The probe's point of w's design: the touch_tip columns are the point model's tool offset's, the plates'
+ * move no point. */
+static rch_poses_point touch_point(const touch_work *w, int *col)
 {
-    const unsigned nf = w->nf;
-    rc_rng g;
-    rc_rng_seed(&g, seed);
-    memset(Q, 0, (size_t)nf * nf * sizeof *Q);
-    for (size_t t = 0; t < n; ++t) {
-        double q[RC_NJ], Jp[3][RC_MAX_PARAMS], J[3][RC_MAX_PARAMS];
-        for (int j = 0; j < RC_NJ; ++j)
-            q[j] = w->m.q_min_rad[j] + (w->m.q_max_rad[j] - w->m.q_min_rad[j]) * rc_rng_u01(&g);
-        rch_uncert_point_sens(Jp, &w->mp, q);
-        for (int i = 0; i < 3; ++i)
-            for (unsigned a = 0; a < nf; ++a) {
-                const int k = (int)w->fi[a];
-                double v = 0.0;
-                if (k >= w->tip_first && k < w->tip_first + 3)
-                    v = Jp[i][w->tool_first + (k - w->tip_first)];
-                else if (k < w->plane_first)
-                    v = Jp[i][k];
-                J[i][a] = v * w->sc[a];
-            }
-        for (unsigned a = 0; a < nf; ++a)
-            for (unsigned b = 0; b < nf; ++b)
-                Q[(size_t)a * nf + b] += (J[0][a] * J[0][b] + J[1][a] * J[1][b] + J[2][a] * J[2][b]) / (double)n;
+    for (unsigned a = 0; a < w->nf; ++a) {
+        const int k = (int)w->fi[a];
+        col[a] = k >= w->tip_first && k < w->tip_first + 3 ? w->tool_first + (k - w->tip_first)
+                 : k < w->plane_first                      ? k
+                                                           : -1;
     }
-}
-
-/* The predicted accuracy of information M: the 95 % radius at the probe over n_eval workspace poses. */
-static int touch_accuracy(rch_poses_accuracy *acc, const touch_work *w, const double *M, size_t n_eval,
-                          unsigned long long seed)
-{
-    const unsigned nf = w->nf;
-    double *C = malloc(((size_t)nf * nf + 1) * sizeof *C), *r = malloc((n_eval ? n_eval : 1) * sizeof *r);
-    int rc = -1;
-    memset(acc, 0, sizeof *acc);
-    if (!C || !r || rch_poses_spd_inverse(C, M, nf) != 0)
-        goto out;
-    rc_rng g;
-    rc_rng_seed(&g, seed);
-    double phi = 0.0;
-    for (size_t t = 0; t < n_eval; ++t) {
-        double q[RC_NJ], Jp[3][RC_MAX_PARAMS], J[3][RC_MAX_PARAMS], P[9];
-        for (int j = 0; j < RC_NJ; ++j)
-            q[j] = w->m.q_min_rad[j] + (w->m.q_max_rad[j] - w->m.q_min_rad[j]) * rc_rng_u01(&g);
-        rch_uncert_point_sens(Jp, &w->mp, q);
-        for (int i = 0; i < 3; ++i)
-            for (unsigned a = 0; a < nf; ++a) {
-                const int k = (int)w->fi[a];
-                const double v = k >= w->tip_first && k < w->tip_first + 3 ? Jp[i][w->tool_first + (k - w->tip_first)]
-                                 : k < w->plane_first                      ? Jp[i][k]
-                                                                           : 0.0;
-                J[i][a] = v * w->sc[a];
-            }
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) {
-                double s = 0.0;
-                for (unsigned a = 0; a < nf; ++a) {
-                    double ta = 0.0;
-                    for (unsigned b = 0; b < nf; ++b)
-                        ta += C[(size_t)a * nf + b] * J[j][b];
-                    s += J[i][a] * ta;
-                }
-                P[i * 3 + j] = s;
-            }
-        phi += P[0] + P[4] + P[8];
-        r[t] = rch_uncert_radius95(P);
-    }
-    acc->phi_mm2 = n_eval ? phi / (double)n_eval : NAN;
-    acc->median_mm = rch_quantile(r, n_eval, 0.5);
-    acc->p95_mm = rch_quantile(r, n_eval, 0.95);
-    rc = 0;
-out:
-    free(C);
-    free(r);
-    return rc;
+    const rch_poses_point pt = {&w->m, &w->mp, w->nf, col, w->sc};
+    return pt;
 }
 
 /* C = M^-1, B = C Q C. 0 or -1. */
@@ -743,7 +679,9 @@ static int touch_run(rch_poses_touch_result *res, touch_work *w, const rc_model 
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
-    touch_q(w->Q, w, c->n_work ? c->n_work : 300, c->seed ^ SEED_WORK);
+    int col[RC_MAX_PARAMS];
+    const rch_poses_point pt = touch_point(w, col);
+    rch_poses_workspace_q(w->Q, &pt, c->n_work ? c->n_work : 300, c->seed ^ SEED_WORK);
     if (touch_design(w, c, progress) != 0) {
         rch_diag_set(d, "", 0, 0, "the design's information matrix is not positive definite (numeric failure)");
         return -1;
@@ -767,10 +705,10 @@ static int touch_run(rch_poses_touch_result *res, touch_work *w, const rc_model 
         res->random_per_plate_min = rpp[k] < res->random_per_plate_min ? rpp[k] : res->random_per_plate_min;
     const size_t n_eval = c->n_eval ? c->n_eval : 1000;
     touch_info(w->M, w, w->design, w->n);
-    if (touch_accuracy(&res->plan, w, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
+    if (rch_poses_point_accuracy(&res->plan, &pt, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
         goto numeric;
     touch_info(w->M, w, w->rnd, w->n);
-    if (touch_accuracy(&res->random, w, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
+    if (rch_poses_point_accuracy(&res->random, &pt, w->M, n_eval, c->seed ^ SEED_EVAL) != 0)
         goto numeric;
     for (size_t t = 0; t < w->n; ++t)
         res->rows[t] = w->cand[w->design[t]];
