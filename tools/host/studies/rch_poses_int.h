@@ -40,6 +40,11 @@ void rch_poses_workspace_q(double *Q, const rch_poses_point *pt, size_t n, unsig
  * (their own seed). 0 or -1 (M not positive definite, out of memory). */
 int rch_poses_point_accuracy(rch_poses_accuracy *acc, const rch_poses_point *pt, const double *M, size_t n_eval,
                              unsigned long long seed);
+/* The prior's information in scaled coordinates: M (nf x nf) = the identity. */
+void rch_poses_prior_info(double *M, unsigned nf);
+/* The I-optimal criterion's state: C = M^-1, B = C Q C (T scratch; all nf x nf). 0 or -1 (M not positive
+ * definite). */
+int rch_poses_refresh(double *C, double *B, double *T, const double *M, const double *Q, unsigned nf);
 /* A += w x x^T, A (r x r) row-major, x (r). */
 void rch_poses_add_outer(double *A, const double *x, double w, unsigned r);
 /* A progress line "rcal poses: WHAT k+1/n" at every tenth of n (n >= 10; f NULL: none). */

@@ -267,27 +267,30 @@ int rch_poses_spd_inverse(double *C, const double *M, unsigned nf)
     return 0;
 }
 
-/* C = M^-1 and B = C Q C. 0 or -1. */
-static int pos_refresh(pos_work *w)
+int rch_poses_refresh(double *C, double *B, double *T, const double *M, const double *Q, unsigned nf)
 {
-    const unsigned nf = w->nf;
-    if (rch_poses_spd_inverse(w->C, w->M, nf) != 0)
+    if (rch_poses_spd_inverse(C, M, nf) != 0)
         return -1;
     for (unsigned i = 0; i < nf; ++i) /* T = Q C */
         for (unsigned j = 0; j < nf; ++j) {
             double s = 0.0;
             for (unsigned k = 0; k < nf; ++k)
-                s += w->Q[(size_t)i * nf + k] * w->C[(size_t)k * nf + j];
-            w->T[(size_t)i * nf + j] = s;
+                s += Q[(size_t)i * nf + k] * C[(size_t)k * nf + j];
+            T[(size_t)i * nf + j] = s;
         }
     for (unsigned i = 0; i < nf; ++i) /* B = C T */
         for (unsigned j = 0; j < nf; ++j) {
             double s = 0.0;
             for (unsigned k = 0; k < nf; ++k)
-                s += w->C[(size_t)i * nf + k] * w->T[(size_t)k * nf + j];
-            w->B[(size_t)i * nf + j] = s;
+                s += C[(size_t)i * nf + k] * T[(size_t)k * nf + j];
+            B[(size_t)i * nf + j] = s;
         }
     return 0;
+}
+
+static int pos_refresh(pos_work *w)
+{
+    return rch_poses_refresh(w->C, w->B, w->T, w->M, w->Q, w->nf);
 }
 
 static void add_rows(double *M, const double *X, unsigned r, unsigned nf, double sign)
@@ -372,8 +375,7 @@ static void pos_take(pos_work *w, size_t t, size_t i, int take)
         w->design[t] = i;
 }
 
-/* The prior in scaled coordinates: the identity. */
-static void prior_info(double *M, unsigned nf)
+void rch_poses_prior_info(double *M, unsigned nf)
 {
     memset(M, 0, (size_t)nf * nf * sizeof *M);
     for (unsigned k = 0; k < nf; ++k)
@@ -493,7 +495,7 @@ static int pos_alloc(pos_work *w)
  * candidate that lowers phi most, while one does). 0 or -1 (numeric). */
 static int pos_design(pos_work *w, const rch_poses_config *c, FILE *progress)
 {
-    prior_info(w->M, w->nf);
+    rch_poses_prior_info(w->M, w->nf);
     for (size_t t = 0; t < w->n; ++t) {
         double bg;
         if (pos_refresh(w) != 0)
@@ -532,7 +534,7 @@ static int pos_design(pos_work *w, const rch_poses_config *c, FILE *progress)
 /* The information of the design idx (n candidates) into M. */
 static void design_info(double *M, const pos_work *w, const size_t *idx, size_t n)
 {
-    prior_info(M, w->nf);
+    rch_poses_prior_info(M, w->nf);
     for (size_t t = 0; t < n; ++t)
         add_rows(M, w->X + idx[t] * w->rows_per * w->nf, w->rows_per, w->nf, 1.0);
 }
@@ -702,7 +704,7 @@ int rch_poses_predict(rch_poses_accuracy *acc, const rc_model *m, const rch_pose
         rch_diag_set(d, "", 0, 0, "out of memory");
         goto out;
     }
-    prior_info(M, w->nf);
+    rch_poses_prior_info(M, w->nf);
     for (size_t i = 0; i < n; ++i) {
         if (rows[i].outlet >= w->K) {
             rch_diag_set(d, "", 0, 0, "row %zu: outlet %u, but %u outlet(s) given", i, rows[i].outlet, w->K);

@@ -394,27 +394,9 @@ static rch_poses_point touch_point(const touch_work *w, int *col)
     return pt;
 }
 
-/* C = M^-1, B = C Q C. 0 or -1. */
 static int touch_refresh(touch_work *w)
 {
-    const unsigned nf = w->nf;
-    if (rch_poses_spd_inverse(w->C, w->M, nf) != 0)
-        return -1;
-    for (unsigned i = 0; i < nf; ++i)
-        for (unsigned j = 0; j < nf; ++j) {
-            double s = 0.0;
-            for (unsigned k = 0; k < nf; ++k)
-                s += w->Q[(size_t)i * nf + k] * w->C[(size_t)k * nf + j];
-            w->T[(size_t)i * nf + j] = s;
-        }
-    for (unsigned i = 0; i < nf; ++i)
-        for (unsigned j = 0; j < nf; ++j) {
-            double s = 0.0;
-            for (unsigned k = 0; k < nf; ++k)
-                s += w->C[(size_t)i * nf + k] * w->T[(size_t)k * nf + j];
-            w->B[(size_t)i * nf + j] = s;
-        }
-    return 0;
+    return rch_poses_refresh(w->C, w->B, w->T, w->M, w->Q, w->nf);
 }
 
 /* How much one row x lowers phi = trace(Q M^-1): x^T B x / (1 + x^T C x). */
@@ -501,17 +483,10 @@ static void touch_take(touch_work *w, size_t t, size_t i, int take)
         w->design[t] = i;
 }
 
-static void touch_prior(double *M, unsigned nf)
-{
-    memset(M, 0, (size_t)nf * nf * sizeof *M);
-    for (unsigned k = 0; k < nf; ++k)
-        M[(size_t)k * nf + k] = 1.0;
-}
-
 /* Greedy with the quotas, then exchange passes that keep them. 0 or -1 (numeric). */
 static int touch_design(touch_work *w, const rch_poses_touch_config *c, FILE *progress)
 {
-    touch_prior(w->M, w->nf);
+    rch_poses_prior_info(w->M, w->nf);
     for (size_t t = 0; t < w->n; ++t) {
         if (touch_refresh(w) != 0)
             return -1;
@@ -547,7 +522,7 @@ static int touch_design(touch_work *w, const rch_poses_touch_config *c, FILE *pr
 
 static void touch_info(double *M, const touch_work *w, const size_t *idx, size_t n)
 {
-    touch_prior(M, w->nf);
+    rch_poses_prior_info(M, w->nf);
     for (size_t t = 0; t < n; ++t)
         rch_poses_add_outer(M, w->X + idx[t] * w->nf, 1.0, w->nf);
 }
