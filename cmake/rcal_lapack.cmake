@@ -100,7 +100,7 @@ if(RCAL_PIN_REFERENCE_LAPACK)
   set(RCAL_LAPACK_SHARED_TAIL ${_gfortran_so} m)
   set(RCAL_LAPACK_BUILT "${RCAL_REF_LAPACK_A}, ${RCAL_REF_BLAS_A}")
   # The pinned LAPACK's version (ILAVER), for the test that the program runs
-  # with it (tests/pkg: pkg_lapack_pinned).
+  # with it (tests/system/pkg: pkg_lapack_pinned).
   if(NOT CMAKE_CROSSCOMPILING)
     set(_src ${CMAKE_BINARY_DIR}/rcal_lapack_version.c)
     file(WRITE ${_src} "/* written by cmake/rcal_lapack.cmake */

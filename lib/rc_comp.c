@@ -457,7 +457,7 @@ rc_status rc_comp_stream_step(rc_comp_stream *s, rc_real q_out_rad[RC_NJ], rc_co
          * iterate) in res. A jump keeps the solver's closest point inside
          * the bounds: the last correction belongs to another pose and may
          * land further off than the target itself (measured: 76 mm off
-         * where the target was 16 mm, tests/sim/truth_study.py --errors
+         * where the target was 16 mm, tests/system/sim/truth_study.py --errors
          * wide); the closest point is never worse than the target. */
         res->held_last = 1;
         rc_comp_work *w = &s->work;

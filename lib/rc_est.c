@@ -57,7 +57,7 @@ rc_status rc_est_subset(uint8_t *fixed_out, unsigned *n_kept, rc_est_work *w, co
      * rc_ident calls not identifiable: a dropped parameter is always a
      * null one. The converse is looser: the residual is not divided by
      * s_max^2 (>= 1), so a pair down to about half the bound in s_rel is
-     * still kept (tests/core/test_solve.c, test_solve_cut_is_rc_ident). */
+     * still kept (tests/lib/test_solve.c, test_solve_cut_is_rc_ident). */
     rc_ident_scale(w->D, w->P, nf, (size_t)nf + 1);
     for (unsigned i = 0; i < nf; ++i)
         for (unsigned k = 0; k < nf; ++k) {

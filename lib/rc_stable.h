@@ -15,7 +15,7 @@
  * low-pass of time constant tau) creeps towards the true length; n readings
  * may agree within tol_mm while it is still far off (a step of 100 mm through a
  * 2 s filter, read at 20 Hz, passes the spread test 0.52 mm short, through a
- * 5 s one 1.48 mm: tests/core/test_stable.c; with the trend test 0.03 mm). A full
+ * 5 s one 1.48 mm: tests/lib/test_stable.c; with the trend test 0.03 mm). A full
  * window is accepted only when the change still to come, extrapolated from
  * the window's least-squares slope, is within tol_mm:
  *     |slope| * (tau + w/2) <= tol_mm      (w: the window's duration)

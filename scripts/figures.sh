@@ -66,12 +66,12 @@ command -v arm-none-eabi-gcc >/dev/null && run cross_build sh firmware_host/cros
 run poses $R poses --count 30 --seed 1 --out $O/poses30.csv
 run serial_bench build/tools/simdisplay/rcal_serial_bench
 # issue 3: every method on a simulated robot; issue 4: end-to-end acquisition
-run methods_recover build/tests/methods/methods_recover
+run methods_recover build/tests/tools/host/fit/methods_recover
 run drv_e2e ctest --test-dir build -R drv_e2e -V
 # issue 6: detection rates of hidden effects (20 seeds each)
 for spec in "0.01 1" "0.1 1" "0.1 3"; do
   set -- $spec
-  build/tests/diagnose/diag_rates 20 300 3 $1 $2 > docs/diagnose/rates_q$1_x$2.txt 2>&1 || echo "   (diag_rates exit $?)"
+  build/tests/tools/host/studies/diag_rates 20 300 3 $1 $2 > docs/diagnose/rates_q$1_x$2.txt 2>&1 || echo "   (diag_rates exit $?)"
 done
 # issue 7: stack use of the core's public functions
 run stack env TOP=10 bash scripts/stack_usage.sh

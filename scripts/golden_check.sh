@@ -4,10 +4,10 @@
 # recorded ones (issue 35: a refactoring changes no output byte).
 #
 # Runs a fixed list of `rcal` commands (and `rcal-rt --emit-c`) on the shipped
-# data (data/, tests/comp/data/every_form.mod, files made with `rcal simulate`
+# data (data/, tests/tools/host/comp/data/every_form.mod, files made with `rcal simulate`
 # at fixed seeds) in a temporary directory, each run in a directory of its own,
 # and compares, run by run, its stdout, its stderr (when not empty), its exit
-# status and every file it wrote with tests/golden/<run>/ (the same names;
+# status and every file it wrote with tests/system/golden/<run>/ (the same names;
 # stdout, stderr, status; a written file under its own name, plots/... kept).
 # Before the comparison every output goes through the masks below (the only
 # figures that may change from one run to the next); after them the
@@ -48,9 +48,9 @@
 # repository) form a second group, skipped with a message when it is absent.
 #
 # Usage: scripts/golden_check.sh BUILD_DIR [--record]
-#   --record   rewrite tests/golden/ from this build (after a change that
+#   --record   rewrite tests/system/golden/ from this build (after a change that
 #              alters outputs on purpose; review the diff before committing).
-#   GOLDEN_DIR=DIR  compare with (or record into) DIR instead of tests/golden.
+#   GOLDEN_DIR=DIR  compare with (or record into) DIR instead of tests/system/golden.
 #   RCAL_REAL_DATA=FILE  the real file (default ../shared/data/robotcali.csv).
 #   KEEP=1     keep the temporary directory.
 # Exit: 0 every run identical (or within 1e-9), 1 a difference, a missing or
@@ -65,7 +65,7 @@ record=0
 R="$build/tools/rcal"
 RT="$build/firmware_host/rcal-rt"
 [ -x "$R" ] || { echo "golden_check: $R not built: skipped"; exit 77; }
-gold=${GOLDEN_DIR:-$src/tests/golden}
+gold=${GOLDEN_DIR:-$src/tests/system/golden}
 real_src=${RCAL_REAL_DATA:-$src/../shared/data/robotcali.csv}
 work=$(mktemp -d /tmp/rcal_golden_XXXXXX)
 cleanup() { if [ "${KEEP:-0}" = 1 ]; then echo "work directory kept: $work"; else rm -rf "$work"; fi; }
@@ -129,7 +129,7 @@ run() {
 
 # ---- inputs ----
 cp "$src"/data/* "$work/in/"
-cp "$src/tests/comp/data/every_form.mod" "$work/in/"
+cp "$src/tests/tools/host/comp/data/every_form.mod" "$work/in/"
 printf 'q1,q2,q3,q4,q5,q6\n10,20,30,40,50,50\n-30,10,5,0,60,-90\n45,-20,40,120,-45,180\n0,0,0,0,30,0\n' \
     > "$work/in/targets.csv"
 

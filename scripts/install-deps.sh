@@ -3,7 +3,7 @@
 # Install what is missing (Debian packages only). Root or sudo required.
 set -euo pipefail
 # protobuf-c-compiler, libprotobuf-c-dev: rcal-rt's EGM messages (firmware_host/egm.proto, issue 49);
-# protobuf-compiler, python3-protobuf: the simulated EGM controller of the tests (tests/comp/test_egm_sim.py).
+# protobuf-compiler, python3-protobuf: the simulated EGM controller of the tests (tests/firmware_host/test_egm_sim.py).
 # liblapack-dev, libblas-dev: the reference LAPACK and BLAS archives rcal links by their own place
 # (cmake/rcal_lapack.cmake; never the alternatives ATLAS or OpenBLAS switch); gfortran: their run-time.
 PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev liblapack-dev libblas-dev gfortran libcmocka-dev
@@ -16,7 +16,7 @@ PKGS=(cmake make gcc pkg-config libserialport-dev liblapacke-dev liblapack-dev l
 # python3-colcon-ros: read package.xml as colcon does (pkg_colcon_package). libexpat1-dev: URDF (rch_urdf*.c)
 # and RSI's XML (firmware_host/rt_rsi.c). protobuf-c-compiler, libprotobuf-c-dev: EGM's messages
 # (firmware_host/egm.proto); protobuf-compiler, python3-protobuf: the simulated ABB controller (comp_egm_sim).
-# strace: a calibration opens each input once (tests/host/calib_read_once.sh, issue 50).
+# strace: a calibration opens each input once (tests/tools/host/fit/calib_read_once.sh, issue 50).
 # --list: print the package list (.ci/run installs it with apt-get itself)
 if [ "${1:-}" = "--list" ]; then
   echo "${PKGS[@]}"

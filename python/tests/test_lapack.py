@@ -2,7 +2,7 @@
 """librcal_ffi.so computes with the reference LAPACK and BLAS the build
 pinned (cmake/rcal_lapack.cmake), linked into the library: rcal.lapack()
 says so, in this process and in one whose LD_LIBRARY_PATH puts another
-liblapack.so.3/libblas.so.3 first (tests/pkg/fake_lapack.c: ILAVER 0.0.0;
+liblapack.so.3/libblas.so.3 first (tests/system/pkg/fake_lapack.c: ILAVER 0.0.0;
 the library computes only with what is linked in, so the same figures
 follow). The CLI's --version line is the same."""
 import os

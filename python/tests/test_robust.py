@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Issue 33, item 5: Python gives the CLI's validation and the CLI's
 failures. Each test is a gap found by comparing what `rcal` refuses
-(tests/robust/*) with what the package accepted: shapes, dtypes and
+(tests/system/robust/*) with what the package accepted: shapes, dtypes and
 non-finite values; labels; tracker positions through the same plausibility
 checks and screening as `rcal calibrate --positions` (the same messages);
 failed compensation targets flagged per target."""

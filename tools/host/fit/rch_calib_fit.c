@@ -475,7 +475,7 @@ static rc_status choose_attachment(rch_calib_fit_state *f, rch_calib_result *r, 
      * sd a d6 3 mm off the drawing costs (3 / 0.5)^2 = 36 of prior the
      * attachment's z takes over at no cost, and a centred cable would be
      * read as off-centre, the flange centre left to the prior (measured:
-     * tests/sim/truth_study.py --errors wide, a centred robot with d6 -3 mm
+     * tests/system/sim/truth_study.py --errors wide, a centred robot with d6 -3 mm
      * compensated 2.4 mm off). The attachment fit's objective is taken at
      * the scaled prior without a refit (a bound from above: it leans to the
      * centred model by at most what a refit would gain). */
@@ -611,7 +611,7 @@ static void jump_check(rch_calib_fit_state *f, rch_calib_result *r, rc_solve_wor
              * above what is left, 8 x the RMS residual with the jumps (measured:
              * the real IRB120 file's two largest are 10.6 and 14.5 x, a third
              * 3.7 x; the step a missing joint compliance leaves, 4.4 x in
-             * tests/diagnose/test_diag_roundtrip.c). */
+             * tests/tools/host/studies/test_diag_roundtrip.c). */
             /* ... on a robust scale of that residual (1.4826 MAD): one misread lifts the RMS and would hide
              * a jump (a 10 mm misread in 600 rows lifted it 0.01 -> 0.4 mm) */
             const double scale = jump_scale(j, tr, r->n_train);

@@ -32,7 +32,7 @@
  * tenths of a millimetre) is then drawn toward the drawing as far as the
  * determined zeros are, instead of wandering a degree on noise and turning
  * a tool point 50 mm off the axis by 0.9 mm; its uncertainty keeps the
- * stated sd (factor). Measured (tests/sim/truth_study.py, 32 robots, TCP
+ * stated sd (factor). Measured (tests/system/sim/truth_study.py, 32 robots, TCP
  * 50, 0, 150): TCP median 0.31 -> 0.22 mm, the most targets a robot made
  * worse 34 % -> 5 %; narrowing the uncertainty too, or the lengths and
  * twists, lost coverage (robots below 75 %: 1 -> 5 of 32 under wide errors).
@@ -43,7 +43,7 @@
  * RCH_PRIOR_SCALE_TAIL_DOF (3), so the prior enters the posterior's 95 %
  * figures widened by t_{min(gamma_t, 3), 0.975} / 1.96
  * (rch_prior_scale_predictive: 1.62; 1.42 at gamma 4); the fit itself uses
- * the estimated sd. Decision (measured, tests/sim/truth_study.py --errors
+ * the estimated sd. Decision (measured, tests/system/sim/truth_study.py --errors
  * wide, builds Student-t(3) about the drawing): a sample variance from 5-10
  * values of a heavy-tailed spread falls short of the true one on many
  * robots, and t_gamma alone left 5 of 16 off-centre robots below 75 %

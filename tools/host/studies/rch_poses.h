@@ -225,7 +225,7 @@ int rch_poses_write_rapid(FILE *f, const rc_sample *rows, const unsigned char *o
  * poses x candidates x r^2 per phase, r the identifiable rank. first_s: the
  * greedy design and one pass; all_s: every --passes pass (exchange stops
  * early when no swap helps, so all_s is the most it takes). Measured against
- * real runs in tests/sim/plan_study.py's neighbourhood: within a factor of 2. */
+ * real runs in tests/system/sim/plan_study.py's neighbourhood: within a factor of 2. */
 void rch_poses_estimate(double *first_s, double *all_s, size_t n, size_t n_cand, unsigned nf, unsigned long passes,
                         int length_criterion);
 
