@@ -440,12 +440,15 @@ int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
         return -1;
     }
     /* the cable files' rows as parsed (a sensor file's none: its rows are no pose of the report's figures) */
-    for (size_t f = 0, i = 0; cfg->keep_poses && f < out->n_files && f < RCH_PROV_MAX_FILES; i += out->counts[f++])
-        if (keep_poses(out, (unsigned)f, out->data.s + i,
-                       out->counts[f] && out->data.s[i].sensor == RC_SENSOR_LENGTH ? out->counts[f] : 0, 1, d) != 0) {
+    for (size_t f = 0, i = 0; cfg->keep_poses && f < out->n_files && f < RCH_PROV_MAX_FILES; i += out->counts[f++]) {
+        const size_t n = out->counts[f];
+        /* NOLINTNEXTLINE(clang-analyzer-core.UndefinedBinaryOperatorResult): load_all filled s[0, data.n) */
+        const int cable = n > 0 && i < out->data.n && out->data.s[i].sensor == RC_SENSOR_LENGTH;
+        if (keep_poses(out, (unsigned)f, out->data.s + i, cable ? n : 0, 1, d) != 0) {
             rch_inputs_free(out);
             return -1;
         }
+    }
     /* the validation file, read here once (within the robot's limits); only a fitted model reads its rows */
     if (cfg->validate_path && rch_data_load_limited(&out->validate, cfg->validate_path, 0, &out->robot.model, d) != 0) {
         memset(&out->validate, 0, sizeof out->validate);

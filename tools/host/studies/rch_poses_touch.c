@@ -556,7 +556,9 @@ static void touch_spread(rch_poses_touch_result *res, const touch_work *w)
             res->spread_mm[k] = 0.0;
             continue;
         }
-        const double cu = suu / n - su * su / n / n, cv = svv / n - sv * sv / n / n, cuv = suv / n - su * sv / n / n;
+        const double dn = (double)n;
+        const double cu = suu / dn - su * su / dn / dn, cv = svv / dn - sv * sv / dn / dn,
+                     cuv = suv / dn - su * sv / dn / dn;
         const double tr = 0.5 * (cu + cv), det = cu * cv - cuv * cuv, disc = sqrt(fmax(tr * tr - det, 0.0));
         res->spread_mm[k] = sqrt(fmax(tr - disc, 0.0));
     }
@@ -640,7 +642,7 @@ static int touch_run(rch_poses_touch_result *res, touch_work *w, const rc_model 
     if (rch_poses_plan_cost(&cost, progress, w->n, want, w->nf, 0, d) != 0 ||
         touch_candidates(w, res, m, c, want, progress, d) != 0)
         return -1;
-    const size_t mm = (size_t)w->nf * w->nf;
+    const size_t mm = (size_t)w->nf * w->nf + 1; /* + 1: never malloc(0) */
     w->Q = malloc(mm * sizeof *w->Q);
     w->M = malloc(mm * sizeof *w->M);
     w->C = malloc(mm * sizeof *w->C);
