@@ -197,7 +197,7 @@ static int parse(diag_args *a, int argc, char **argv)
         fprintf(stderr, "rcal diagnose: give --data FILE (cable lengths) or --positions FILE (tracker), or both\n");
         return 2;
     }
-    if (!(a->data.n == 1 && a->positions.n == 0) && (a->resid || a->report_path)) { /* they read it again */
+    if (!(a->data.n == 1 && a->positions.n == 0) && (a->resid || a->report_path)) { /* one file: its lines, calibrate --report's one data file */
         fprintf(stderr, "rcal diagnose: --residuals and --report take one --data file (no --positions) for now; "
                         "the diagnosis itself takes them all\n");
         return 2;
