@@ -30,37 +30,30 @@ static const char details[] =
     "'unexplained'. Up to N effects are added one after the other.\n"
     "Steps are detected from the data unless given (a negative value: no quantization).";
 
-/* --residuals: the data lines from the file again (the diagnosis keeps the
+/* --residuals: the data lines as the diagnosis read them (it keeps the
  * samples in file order, less rows --dequantize-joints refused). */
 static int save_residuals(const rch_diagnose_result *r, const char *data_path, const char *robot_path,
                           const char *path)
 {
-    rch_data data;
     rch_diag d;
     char msg[1024];
     const char *inputs[2] = {data_path, robot_path};
-    if (rch_data_load(&data, data_path, 0, &d) != 0) {
-        fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
+    if (r->n_read != r->n || !r->line) {
+        fprintf(stderr, "rcal diagnose: --residuals: %zu of %zu rows were refused (--dequantize-joints); their lines "
+                        "cannot be named: not written\n", r->n_read - r->n, r->n_read);
         return 1;
     }
     int rc = 0;
-    if (data.n != r->n) {
-        fprintf(stderr, "rcal diagnose: --residuals: %zu of %zu rows were refused (--dequantize-joints); their lines "
-                        "cannot be named: not written\n", data.n - r->n, data.n);
+    rch_resid_table t;
+    rch_resid_init(&t, inputs, 1);
+    if (rch_diagnose_resid(&t, r, r->line) != 0) {
+        fprintf(stderr, "rcal diagnose: out of memory\n");
         rc = 1;
-    } else {
-        rch_resid_table t;
-        rch_resid_init(&t, inputs, 1);
-        if (rch_diagnose_resid(&t, r, data.line) != 0) {
-            fprintf(stderr, "rcal diagnose: out of memory\n");
-            rc = 1;
-        } else if (rch_resid_save(path, inputs, 2, &t, &d) != 0) {
-            fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
-            rc = 1;
-        }
-        rch_resid_free(&t);
+    } else if (rch_resid_save(path, inputs, 2, &t, &d) != 0) {
+        fprintf(stderr, "rcal diagnose: %s\n", rch_diag_str(&d, msg, sizeof msg));
+        rc = 1;
     }
-    rch_data_free(&data);
+    rch_resid_free(&t);
     return rc;
 }
 
@@ -75,16 +68,21 @@ static int diagnose_report(const rch_diagnose_result *r, const char *data_path, 
     cc.robot_path = robot_path;
     cc.seed = seed;
     cc.dequantize = dequantize;
+    cc.inputs = r->raw; /* the files as the diagnosis read them: not read again */
+    cc.keep_poses = 1;  /* the page's poses from memory */
     rch_calib_result *c = malloc(sizeof *c);
     rch_diag d;
     char msg[1024];
     if (!c || rch_calib_run(c, &cc, &d) != 0) {
+        if (c)
+            rch_calib_result_free(c);
         fprintf(stderr, "rcal diagnose: --report: the calibration: %s\n", c ? rch_diag_str(&d, msg, sizeof msg) : "out of memory");
         free(c);
         return 1;
     }
     const char *const inputs[2] = {data_path, robot_path};
     const int rc = rch_report_inline(html, c, r, argc, argv, NULL, inputs, 2, quiet);
+    rch_calib_result_free(c);
     free(c);
     return rc;
 }
@@ -199,7 +197,7 @@ static int parse(diag_args *a, int argc, char **argv)
         fprintf(stderr, "rcal diagnose: give --data FILE (cable lengths) or --positions FILE (tracker), or both\n");
         return 2;
     }
-    if (!(a->data.n == 1 && a->positions.n == 0) && (a->resid || a->report_path)) { /* they read it again */
+    if (!(a->data.n == 1 && a->positions.n == 0) && (a->resid || a->report_path)) { /* one file: its lines, calibrate --report's one data file */
         fprintf(stderr, "rcal diagnose: --residuals and --report take one --data file (no --positions) for now; "
                         "the diagnosis itself takes them all\n");
         return 2;

@@ -380,9 +380,14 @@ static int refit_all(calib_run *run, rch_calib_result *r, rch_diag *d)
     }
     const rch_calib_screen_result keep = r->screen;
     const rch_calib_sys sys = r->sys;
+    double(*read_q)[RC_NJ] = r->read_q; /* the poses as read (cfg.keep_poses): the run's, kept */
+    size_t read_n[RCH_PROV_MAX_FILES];
+    memcpy(read_n, r->read_n, sizeof read_n);
     memset(r, 0, sizeof *r);
     r->cfg = cfg;
     r->sys = sys;
+    r->read_q = read_q;
+    memcpy(r->read_n, read_n, sizeof read_n);
     take_inputs(r, in);
     int rc = fit_effects(r, &cfg, rch_pos_count_lengths(in->data.s, in->data.n), d);
     if (rc == 0)

@@ -14,6 +14,7 @@
 #include "rc_solve.h"
 
 #define RCH_CALIB_MAX_FILES 16
+struct rch_inputs; /* rch_inputs.h */
 typedef struct rch_calib_cfg {
     const char *data_path;  /* measurements CSV (required; the first of data_paths when several) */
     const char *const *data_paths; /* (n_data_paths) several files merged, NULL: data_path alone */
@@ -68,6 +69,9 @@ typedef struct rch_calib_cfg {
     double display_step_mm; /* the lengths' display step; 0: from the data's digits */
     double joint_step_deg;  /* the joints' display step; < 0: from the data's digits; 0 given: none */
     int joint_step_given;
+    const struct rch_inputs *inputs; /* the inputs read already (rch_inputs_load with no_dequantize and keep_poses,
+                                        of the files this cfg names): copied, dequantized as this cfg says, never
+                                        read again (rch_inputs_copy); NULL: read them */
 } rch_calib_cfg;
 
 /* The defaults of `rcal calibrate`: everything zero or NULL but method LM,

@@ -429,8 +429,69 @@ static int cable_points(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *d)
     return 0;
 }
 
+/* a copy of n elements of size each of src into *dst (NULL stays NULL). 0, or -1 out of memory. */
+static int dup_array(void *dst, const void *src, size_t n, size_t size)
+{
+    void **out = dst;
+    *out = NULL;
+    if (!src)
+        return 0;
+    if (!(*out = malloc((n ? n : 1) * size)))
+        return -1;
+    memcpy(*out, src, n * size);
+    return 0;
+}
+
+static int dup_data(rch_data *out, const rch_data *src)
+{
+    *out = *src;
+    out->s = NULL;
+    out->xyz = NULL;
+    out->line = NULL;
+    out->pose = NULL;
+    out->sigma_mm = NULL;
+    return dup_array(&out->s, src->s, src->n, sizeof *src->s) | dup_array(&out->xyz, src->xyz, src->n, sizeof *src->xyz) |
+           dup_array(&out->line, src->line, src->n, sizeof *src->line) |
+           dup_array(&out->pose, src->pose, src->n, sizeof *src->pose) |
+           dup_array(&out->sigma_mm, src->sigma_mm, src->n, sizeof *src->sigma_mm);
+}
+
+int rch_inputs_copy(rch_inputs *out, const rch_inputs *raw, const rch_calib_cfg *cfg, rch_diag *d)
+{
+    if (cfg->n_positions_paths && (cfg->cases > 1 || cfg->residuals_path || cfg->dequantize || cfg->jumps)) {
+        memset(out, 0, sizeof *out); /* append_positions' refusal */
+        rch_diag_set(d, "", 0, 0,
+                     "--positions is not yet combined with --cases, --residuals, --dequantize-joints or --jumps");
+        return -1;
+    }
+    *out = *raw;
+    out->file_of = NULL;
+    out->read_q = NULL;
+    memset(&out->data, 0, sizeof out->data);
+    memset(&out->validate, 0, sizeof out->validate);
+    size_t n_q = 0;
+    for (unsigned f = 0; f < RCH_PROV_MAX_FILES; ++f)
+        n_q += raw->read_n[f];
+    if (!cfg->keep_poses)
+        memset(out->read_n, 0, sizeof out->read_n);
+    if ((dup_data(&out->data, &raw->data) | dup_data(&out->validate, &raw->validate) |
+         dup_array(&out->file_of, raw->file_of, raw->data.n, sizeof *raw->file_of) |
+         (cfg->keep_poses ? dup_array(&out->read_q, raw->read_q, n_q, sizeof *raw->read_q) : 0)) != 0) {
+        rch_diag_set(d, "", 0, 0, "out of memory");
+        rch_inputs_free(out);
+        return -1;
+    }
+    if (!cfg->no_dequantize && dequantize(out, cfg, d) != 0) {
+        rch_inputs_free(out);
+        return -1;
+    }
+    return 0;
+}
+
 int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d)
 {
+    if (cfg->inputs)
+        return rch_inputs_copy(out, cfg->inputs, cfg, d);
     memset(out, 0, sizeof *out);
     out->n_files = rch_calib_cfg_n_files(cfg);
     if (rch_robot_load(&out->robot, cfg->robot_path, d) != 0)

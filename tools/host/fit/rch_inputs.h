@@ -85,6 +85,12 @@ typedef struct rch_inputs {
  * positions_paths; dequantize, have_tracker_start; cases, residuals_path
  * and jumps only to refuse them with positions). 0, or -1 with d set. */
 int rch_inputs_load(rch_inputs *out, const rch_calib_cfg *cfg, rch_diag *d);
+/* The inputs raw (read by rch_inputs_load with no_dequantize and keep_poses
+ * from the files cfg names) as rch_inputs_load would read them for cfg:
+ * copied, then dequantized as cfg says (step 7), read_q kept only with
+ * cfg->keep_poses. No file is opened. rch_inputs_load does this when
+ * cfg->inputs is set. 0, or -1 with d set (*out holds nothing to free). */
+int rch_inputs_copy(rch_inputs *out, const rch_inputs *raw, const rch_calib_cfg *cfg, rch_diag *d);
 /* Free data and file_of; in may be zeroed or freed already. */
 void rch_inputs_free(rch_inputs *in);
 

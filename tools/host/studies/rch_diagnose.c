@@ -11,6 +11,7 @@
 
 #include "rc_ident.h"
 #include "rch_diagnose_int.h"
+#include "rch_inputs.h"
 
 int rch_dg_fit(rc_model *m, rc_solve_result *res, ctx *c, const uint8_t *fixed, const rc_sample *s,
                size_t n)
@@ -103,6 +104,11 @@ void rch_diagnose_free(rch_diagnose_result *r)
     free(r->line);
     free(r->file);
     r->line = r->file = NULL;
+    if (r->raw) {
+        rch_inputs_free(r->raw);
+        free(r->raw);
+        r->raw = NULL;
+    }
     r->s = NULL;
     r->res_before_mm = r->res_after_mm = r->floor_mm = NULL;
 }

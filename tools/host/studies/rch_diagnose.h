@@ -68,6 +68,7 @@
 #include "rch_diag.h"
 #include "rch_jumps.h"
 #include "rch_resid.h"
+struct rch_inputs; /* rch_inputs.h: the inputs as read */
 
 #define RCH_DIAGNOSE_MAX_CAND 24
 #define RCH_DIAGNOSE_MAX_STEPS 4
@@ -212,6 +213,10 @@ typedef struct rch_diagnose_result {
     uint8_t outlet_label[RC_MAX_OUTLETS]; /* the files' label of outlet k (k = 0: the robot's encoder) */
     unsigned *line;            /* (n) each sample's line in its file (rch_diagnose_inputs), or NULL */
     unsigned *file;            /* (n) its file: data files first, then positions files, or NULL */
+    struct rch_inputs *raw;    /* the inputs as read, once (rch_diagnose_inputs: rch_inputs_load, joints as read,
+                                  poses kept), for every later stage (the jumps' calibration, the next step's
+                                  model, --report's calibration and page): no file is read again; or NULL */
+    size_t n_read;             /* samples read, before --dequantize-joints refused any (rch_inputs.n_read) */
     unsigned n_groups;
     unsigned n_flicker;        /* samples whose wrist reading moved by one display step within a group */
     unsigned folds;

@@ -4,8 +4,10 @@
  * positions, both), read by calibrate's one reader (rch_inputs_load), made
  * into one start model with the sensors' frames and the effects already
  * known; then the workflow (rch_diagnose_run). See rch_diagnose.h.
+ * Each file is opened once: the inputs read (raw) are kept in the result for
+ * every later stage (rch_calib_cfg.inputs).
  * Depends on: rch_inputs, rch_calib_effects. Memory: the result's line and
- * file arrays (rch_diagnose_free). Errors: -1 with d set. */
+ * file arrays and the inputs read (rch_diagnose_free). Errors: -1 with d set. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -107,14 +109,29 @@ int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, con
         rch_diag_set(d, "", 0, 0, "%s", perr);
         return -1;
     }
-    cc.dequantize = cfg->dequantize;
-    cc.no_dequantize = !cfg->dequantize; /* diagnose dequantizes only when told (calibrate's hint tells it) */
-    rch_inputs *data = calloc(1, sizeof *data);
-    if (!data) {
+    /* every file read once, the joints as read and the poses kept (raw): the diagnosis, the jumps' calibration,
+     * the next step's model and --report's calibration each take their copy of it (rch_calib_cfg.inputs) */
+    rch_inputs *raw = calloc(1, sizeof *raw), *data = calloc(1, sizeof *data);
+    if (!raw || !data) {
+        free(raw);
+        free(data);
         rch_diag_set(d, "", 0, 0, "out of memory");
         return -1;
     }
+    cc.no_dequantize = 1;
+    cc.keep_poses = 1;
+    if (rch_inputs_load(raw, &cc, d) != 0) {
+        free(raw);
+        free(data);
+        return -1;
+    }
+    cc.inputs = raw;
+    cc.keep_poses = 0;
+    cc.dequantize = cfg->dequantize;
+    cc.no_dequantize = !cfg->dequantize; /* diagnose dequantizes only when told (calibrate's hint tells it) */
     if (rch_inputs_load(data, &cc, d) != 0) {
+        rch_inputs_free(raw);
+        free(raw);
         free(data);
         return -1;
     }
@@ -163,6 +180,8 @@ int rch_diagnose_inputs(rch_diagnose_result *out, const rch_diagnose_in *in, con
                 out->jump_line[k] = data->data.line[i];
                 break;
             }
+    out->raw = raw;
+    out->n_read = data->n_read;
     rch_inputs_free(data);
     free(data);
     return rc;

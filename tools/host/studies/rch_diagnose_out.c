@@ -505,6 +505,7 @@ int rch_diagnose_save_model(const rch_diagnose_result *r, const char *data_path,
     cfg.effects = list[0] ? list : NULL;
     cfg.jumps = next_jumps(r);
     cfg.dequantize = r->dequant_corrected > 0;
+    cfg.inputs = r->raw; /* the files as the diagnosis read them, not read again */
     const int rc = rch_calib_run(&cr, &cfg, d);
     if (rc != 0)
         return -1;
