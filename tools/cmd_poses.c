@@ -625,6 +625,18 @@ int rcal_cmd_poses(int argc, char **argv)
     poses_args a;
     if (wants_touch(argc, argv))
         return rcal_cmd_poses_touch(argc, argv);
+    if (argc == 2 && strcmp(argv[1], "--help-bash") == 0) { /* the completion: the touch table once a plate is typed */
+        printf("            if [[ \" ${COMP_WORDS[*]} \" == *\" --plate\"* || \" ${COMP_WORDS[*]} \" == *\" --sensor touch \"* ||\n"
+               "                  \" ${COMP_WORDS[*]} \" == *\" --sensor=touch \"* ]]; then\n");
+        fflush(stdout);
+        if (rcal_cmd_poses_touch(argc, argv) != 0)
+            return 1;
+        printf("            else\n");
+        fflush(stdout);
+        const int st = parse(&a, argc, argv);
+        printf("            fi\n");
+        return st;
+    }
     rch_poses_config *pc = &a.pc;
     rch_poses_result res;
     rch_poses_choice *ch = NULL;
