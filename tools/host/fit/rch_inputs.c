@@ -236,6 +236,12 @@ static int append_positions(rch_inputs *in, const rch_calib_cfg *cfg, rch_diag *
     data->n += p.n;
     free(data->xyz); /* the length files' x, y, z (only --dequantize-joints reads them) */
     data->xyz = NULL;
+    /* a sensor file's own pose and sigma columns (read into its samples when parsed) are not the appended
+     * rows': every array left holds data->n entries (rch_inputs_copy copies n of each) */
+    free(data->pose);
+    data->pose = NULL;
+    free(data->sigma_mm);
+    data->sigma_mm = NULL;
     in->n_groups += (unsigned)cfg->n_positions_paths;
     in->n_pos_rows = p.rows;
     in->n_pos_poses = p.poses;
